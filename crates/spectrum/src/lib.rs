@@ -15,4 +15,5 @@ pub use error::SpectrumFileError;
 pub use table::{DenseSpectrum, Tabulated};
 pub mod embedded_files;
 pub mod names;
+pub mod rgb_space;
 pub use data::Observer;
