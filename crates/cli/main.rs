@@ -1,1 +1,38 @@
-fn main() {}
+//! The `prism` command: spectral rendering, colorimetry and tone reproduction.
+
+mod color;
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+#[derive(Parser)]
+#[command(
+    name = "prism",
+    version,
+    about = "Prism: a spectral, predictive renderer with a tone-reproduction toolkit"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Colorimetry of a spectrum: XYZ, xy, CCT/Duv, CIELAB and sRGB, as colour-science computes them.
+    Color(color::ColorArgs),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Color(args) => color::run(&args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(message) => {
+            eprintln!("error: {message}");
+            ExitCode::FAILURE
+        }
+    }
+}

@@ -1,0 +1,296 @@
+//! `prism color`: colorimetry of one spectrum, scriptable (`--json`) and checked against
+//! colour-science (tests/fixtures/color_cli.json).
+
+use std::path::Path;
+
+use clap::{Args, ValueEnum};
+use glam::DVec3;
+use prism_spectrum::adaptation::{adaptation_matrix, AdaptationMethod};
+use prism_spectrum::cct::uv_to_cct_duv;
+use prism_spectrum::colorimetry::{
+    emission_to_xyz, reflectance_to_xyz, xyz_to_lab, xyz_to_uv_1960, xyz_to_xy,
+};
+use prism_spectrum::data::{
+    canonical_illuminant_name, colorchecker_patch, colorchecker_patch_index,
+    colorchecker_patch_names, embedded_file, embedded_stems,
+};
+use prism_spectrum::names::did_you_mean;
+use prism_spectrum::rgb_space::RgbColorSpace;
+use prism_spectrum::spectrum_file::read_single_spectrum;
+use prism_spectrum::{DenseSpectrum, Observer, Tabulated};
+use serde_json::{json, Value};
+
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum ObserverArg {
+    /// CIE 1931 2° standard observer.
+    Cie1931,
+    /// CIE 1964 10° standard observer.
+    Cie1964,
+}
+
+impl From<ObserverArg> for Observer {
+    fn from(arg: ObserverArg) -> Self {
+        match arg {
+            ObserverArg::Cie1931 => Observer::Cie1931,
+            ObserverArg::Cie1964 => Observer::Cie1964,
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum AdaptArg {
+    Bradford,
+    Cat16,
+    Cat02,
+    VonKries,
+    None,
+}
+
+impl From<AdaptArg> for AdaptationMethod {
+    fn from(arg: AdaptArg) -> Self {
+        match arg {
+            AdaptArg::Bradford => AdaptationMethod::Bradford,
+            AdaptArg::Cat16 => AdaptationMethod::Cat16,
+            AdaptArg::Cat02 => AdaptationMethod::Cat02,
+            AdaptArg::VonKries => AdaptationMethod::VonKries,
+            AdaptArg::None => AdaptationMethod::None,
+        }
+    }
+}
+
+#[derive(Args, Debug)]
+pub struct ColorArgs {
+    /// Spectrum: a CSV file (`wavelength_nm,value`), a file stem under spectra/ (e.g. D65, F11,
+    /// LED-B3) or a ColorChecker patch (e.g. `colorchecker:dark skin`).
+    #[arg(long, value_name = "FILE.csv|NAME")]
+    pub spectrum: String,
+    /// Treat the spectrum as a reflectance under this illuminant (CIE name or CSV file);
+    /// XYZ is then normalised so a perfect reflector has Y = 100. Without it the spectrum is
+    /// spectral radiance in W·m⁻²·sr⁻¹·nm⁻¹ and Y is luminance in cd/m².
+    #[arg(long, value_name = "NAME|FILE.csv")]
+    pub illuminant: Option<String>,
+    /// Colour-matching functions for XYZ, xy and Lab (CCT and sRGB always use CIE 1931).
+    #[arg(long, value_enum, default_value = "cie1931")]
+    pub observer: ObserverArg,
+    /// Chromatic adaptation from the illuminant's white to D65 for sRGB (reflectances only).
+    #[arg(long, value_enum, default_value = "bradford")]
+    pub adapt: AdaptArg,
+    /// Print one JSON object instead of a table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// What a spectrum argument stands for, for validation.
+#[derive(Clone, Copy, PartialEq)]
+enum Role {
+    Reflectance,
+    Emission,
+    Illuminant,
+}
+
+impl Role {
+    fn must_be_non_negative(self) -> Option<&'static str> {
+        match self {
+            Role::Reflectance => None,
+            Role::Emission => Some("emission (spectral radiance)"),
+            Role::Illuminant => Some("an illuminant's spectral power"),
+        }
+    }
+}
+
+const COLORCHECKER_PREFIX: &str = "colorchecker:";
+
+fn looks_like_path(text: &str) -> bool {
+    text.contains('/') || text.contains('\\') || text.contains('.')
+}
+
+/// Resolves `FILE.csv|NAME|colorchecker:PATCH` to a table and a label for the report.
+fn resolve_spectrum(spec: &str, role: Role, flag: &str) -> Result<(Tabulated, String), String> {
+    let lower = spec.to_lowercase();
+    if let Some(patch) = lower.strip_prefix(COLORCHECKER_PREFIX) {
+        let index = colorchecker_patch_index(patch).map_err(|e| format!("{flag} {spec}: {e}"))?;
+        let name = &colorchecker_patch_names()[index];
+        return Ok((colorchecker_patch(index), format!("colorchecker:{name}")));
+    }
+    let path = Path::new(spec);
+    if path.is_file() {
+        let (table, columns) = read_single_spectrum(path).map_err(|e| e.to_string())?;
+        if let Some(what) = role.must_be_non_negative() {
+            columns
+                .require_non_negative(0, path, what)
+                .map_err(|e| e.to_string())?;
+        }
+        return Ok((table, spec.to_string()));
+    }
+    let named = canonical_illuminant_name(spec)
+        .or_else(|| embedded_stems().find(|s| s.eq_ignore_ascii_case(spec)));
+    if let Some(stem) = named {
+        let columns = embedded_file(stem).expect("stem comes from the embedded list");
+        if columns.columns.len() != 1 {
+            return Err(format!(
+                "{flag} {spec}: spectra/{stem}.csv holds {} columns ({}); name a single spectrum",
+                columns.columns.len(),
+                columns.names.join(", ")
+            ));
+        }
+        return Ok((columns.table(0), stem.to_string()));
+    }
+    if path.exists() {
+        return Err(format!("{flag} {spec}: not a regular file"));
+    }
+    if looks_like_path(spec) && !spec.contains(':') {
+        return Err(format!(
+            "{flag} {spec}: cannot read the file: no such file (expected a CSV of `wavelength_nm,value` lines)"
+        ));
+    }
+    let mut candidates: Vec<String> = embedded_stems().map(str::to_string).collect();
+    candidates.extend(
+        colorchecker_patch_names()
+            .iter()
+            .map(|p| format!("{COLORCHECKER_PREFIX}{p}")),
+    );
+    Err(format!(
+        "{flag} {spec}: unknown spectrum: not a file, not a name under spectra/ and not `colorchecker:<patch>`{}",
+        did_you_mean(spec, candidates.iter().map(String::as_str))
+    ))
+}
+
+/// Everything `prism color` reports; `None` where a quantity is undefined.
+struct ColorReport {
+    spectrum: String,
+    illuminant: Option<String>,
+    observer: Observer,
+    xyz: DVec3,
+    xy: Option<[f64; 2]>,
+    cct_k: Option<f64>,
+    duv: Option<f64>,
+    lab: Option<DVec3>,
+    linear_srgb: DVec3,
+    srgb: DVec3,
+}
+
+fn chromaticity(xyz: DVec3) -> Option<[f64; 2]> {
+    let sum = xyz.x + xyz.y + xyz.z;
+    (sum > 0.0).then(|| xyz_to_xy(xyz))
+}
+
+fn compute(args: &ColorArgs) -> Result<ColorReport, String> {
+    let observer = Observer::from(args.observer);
+    let srgb = RgbColorSpace::srgb();
+    let (report_xyz, xyz_1931, lab, linear_srgb, illuminant_label, spectrum_label);
+    match &args.illuminant {
+        Some(illuminant_spec) => {
+            let (spectrum, label) =
+                resolve_spectrum(&args.spectrum, Role::Reflectance, "--spectrum")?;
+            let (illuminant, illum_label) =
+                resolve_spectrum(illuminant_spec, Role::Illuminant, "--illuminant")?;
+            let reflectance = spectrum.to_dense();
+            let illuminant = illuminant.to_dense();
+            let perfect = DenseSpectrum::constant(1.0);
+            let white = reflectance_to_xyz(&perfect, &illuminant, observer).ok_or_else(|| {
+                format!("--illuminant {illuminant_spec}: the illuminant has no power in 360–830 nm")
+            })?;
+            report_xyz = reflectance_to_xyz(&reflectance, &illuminant, observer).unwrap();
+            lab = Some(xyz_to_lab(report_xyz, white));
+            xyz_1931 = reflectance_to_xyz(&reflectance, &illuminant, Observer::Cie1931).unwrap();
+            let white_1931 =
+                reflectance_to_xyz(&perfect, &illuminant, Observer::Cie1931).unwrap() / 100.0;
+            let adapt = adaptation_matrix(args.adapt.into(), white_1931, srgb.white_xyz());
+            linear_srgb = srgb.xyz_to_rgb * (adapt * (xyz_1931 / 100.0));
+            illuminant_label = Some(illum_label);
+            spectrum_label = label;
+        }
+        None => {
+            let (spectrum, label) = resolve_spectrum(&args.spectrum, Role::Emission, "--spectrum")?;
+            let radiance = spectrum.to_dense();
+            report_xyz = emission_to_xyz(&radiance, observer);
+            xyz_1931 = emission_to_xyz(&radiance, Observer::Cie1931);
+            lab = None;
+            linear_srgb = srgb.xyz_to_rgb * xyz_1931;
+            illuminant_label = None;
+            spectrum_label = label;
+        }
+    }
+    let (cct_k, duv) = match chromaticity(xyz_1931) {
+        Some(_) => {
+            let (t, d) = uv_to_cct_duv(xyz_to_uv_1960(xyz_1931));
+            (Some(t), Some(d))
+        }
+        None => (None, None),
+    };
+    let encoded = linear_srgb.to_array().map(|v| srgb.transfer.encode(v));
+    Ok(ColorReport {
+        spectrum: spectrum_label,
+        illuminant: illuminant_label,
+        observer,
+        xyz: report_xyz,
+        xy: chromaticity(report_xyz),
+        cct_k,
+        duv,
+        lab,
+        linear_srgb,
+        srgb: DVec3::from_array(encoded),
+    })
+}
+
+fn to_json(r: &ColorReport) -> Value {
+    let vec3 = |v: DVec3| json!([v.x, v.y, v.z]);
+    json!({
+        "spectrum": r.spectrum,
+        "illuminant": r.illuminant,
+        "observer": r.observer.name(),
+        "XYZ": vec3(r.xyz),
+        "xy": r.xy,
+        "CCT_K": r.cct_k,
+        "Duv": r.duv,
+        "Lab": r.lab.map(vec3),
+        "linear_sRGB": vec3(r.linear_srgb),
+        "sRGB": vec3(r.srgb),
+    })
+}
+
+fn print_table(r: &ColorReport) {
+    let row = |name: &str, v: DVec3| println!("{name:<13}{:>14.6}{:>14.6}{:>14.6}", v.x, v.y, v.z);
+    match &r.illuminant {
+        Some(illum) => {
+            println!("{:<13}{} (reflectance)", "spectrum", r.spectrum);
+            println!("{:<13}{illum}", "illuminant");
+        }
+        None => println!(
+            "{:<13}{} (spectral radiance, W·m⁻²·sr⁻¹·nm⁻¹)",
+            "spectrum", r.spectrum
+        ),
+    }
+    println!("{:<13}{}", "observer", r.observer.name());
+    row(
+        if r.illuminant.is_some() {
+            "XYZ (Y=100)"
+        } else {
+            "XYZ (cd/m²)"
+        },
+        r.xyz,
+    );
+    match r.xy {
+        Some([x, y]) => println!("{:<13}{x:>14.6}{y:>14.6}", "xy"),
+        None => println!("{:<13}{:>14}", "xy", "undefined"),
+    }
+    match (r.cct_k, r.duv) {
+        (Some(t), Some(d)) => println!("{:<13}{t:>12.1} K   Duv {d:+.5}  (CIE 1931)", "CCT"),
+        _ => println!("{:<13}{:>14}", "CCT", "undefined"),
+    }
+    if let Some(lab) = r.lab {
+        row("L*a*b*", lab);
+    }
+    row("linear sRGB", r.linear_srgb);
+    row("sRGB", r.srgb);
+}
+
+pub fn run(args: &ColorArgs) -> Result<(), String> {
+    let report = compute(args)?;
+    if args.json {
+        println!("{}", to_json(&report));
+    } else {
+        print_table(&report);
+    }
+    Ok(())
+}

@@ -1,0 +1,256 @@
+//! End-to-end checks of `prism color` against colour-science (tests/fixtures/color_cli.json,
+//! made by tools/export_color_cli_fixture.py) and of its error messages.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use serde_json::Value;
+
+fn prism(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_prism"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .args(args)
+        .output()
+        .expect("prism runs")
+}
+
+fn fixture(name: &str) -> Value {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/fixtures")
+        .join(name);
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+fn floats(v: &Value) -> Vec<f64> {
+    v.as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect()
+}
+
+fn assert_close(what: &str, ours: &[f64], expected: &[f64], tol: impl Fn(f64) -> f64) {
+    assert_eq!(ours.len(), expected.len(), "{what}");
+    for (o, e) in ours.iter().zip(expected) {
+        assert!(
+            (o - e).abs() <= tol(*e),
+            "{what}: ours {ours:?}, colour-science {expected:?}"
+        );
+    }
+}
+
+#[test]
+fn color_json_matches_colour_science() {
+    let fixture = fixture("color_cli.json");
+    let cases = fixture["cases"].as_array().unwrap();
+    assert!(cases.len() >= 10);
+    for case in cases {
+        let mut args: Vec<&str> = vec!["color", "--json"];
+        args.extend(
+            case["args"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|a| a.as_str().unwrap()),
+        );
+        let out = prism(&args);
+        assert!(
+            out.status.success(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let ours: Value = serde_json::from_slice(&out.stdout).unwrap();
+        let want = &case["expected"];
+        let what = |key: &str| format!("{args:?} {key}");
+        // Issue contract: XYZ to 1e-6 relative; CCT to 0.5 K.
+        assert_close(
+            &what("XYZ"),
+            &floats(&ours["XYZ"]),
+            &floats(&want["XYZ"]),
+            |e| 1e-6 * e.abs(),
+        );
+        assert_close(
+            &what("xy"),
+            &floats(&ours["xy"]),
+            &floats(&want["xy"]),
+            |_| 1e-8,
+        );
+        assert_close(
+            &what("CCT_K"),
+            &[ours["CCT_K"].as_f64().unwrap()],
+            &[want["CCT_K"].as_f64().unwrap()],
+            |_| 0.5,
+        );
+        assert_close(
+            &what("Duv"),
+            &[ours["Duv"].as_f64().unwrap()],
+            &[want["Duv"].as_f64().unwrap()],
+            |_| 1e-5,
+        );
+        if want["Lab"].is_null() {
+            assert!(ours["Lab"].is_null(), "{}", what("Lab"));
+        } else {
+            assert_close(
+                &what("Lab"),
+                &floats(&ours["Lab"]),
+                &floats(&want["Lab"]),
+                |_| 1e-6,
+            );
+        }
+        // sRGB values of emission are absolute (hundreds of cd/m²): relative tolerance.
+        let rgb_tol = |e: f64| 1e-7 * e.abs().max(1.0);
+        assert_close(
+            &what("linear_sRGB"),
+            &floats(&ours["linear_sRGB"]),
+            &floats(&want["linear_sRGB"]),
+            rgb_tol,
+        );
+        assert_close(
+            &what("sRGB"),
+            &floats(&ours["sRGB"]),
+            &floats(&want["sRGB"]),
+            rgb_tol,
+        );
+    }
+}
+
+#[test]
+fn color_without_json_prints_a_table() {
+    let out = prism(&[
+        "color",
+        "--spectrum",
+        "colorchecker:dark skin",
+        "--illuminant",
+        "D65",
+    ]);
+    assert!(out.status.success());
+    let text = String::from_utf8(out.stdout).unwrap();
+    for label in ["XYZ (Y=100)", "xy", "CCT", "L*a*b*", "sRGB"] {
+        assert!(text.contains(label), "{text}");
+    }
+}
+
+struct TempFile(PathBuf);
+
+impl TempFile {
+    fn new(name: &str, text: &str) -> Self {
+        let dir = std::env::temp_dir().join(format!("prism-color-test-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join(name);
+        std::fs::write(&path, text).unwrap();
+        Self(path)
+    }
+    fn arg(&self) -> &str {
+        self.0.to_str().unwrap()
+    }
+}
+
+impl Drop for TempFile {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_file(&self.0);
+    }
+}
+
+fn expect_error(args: &[&str], needles: &[&str]) {
+    let out = prism(args);
+    assert!(!out.status.success(), "{args:?} should fail");
+    let err = String::from_utf8_lossy(&out.stderr);
+    for needle in needles {
+        assert!(err.contains(needle), "{args:?}: `{needle}` not in: {err}");
+    }
+}
+
+#[test]
+fn bad_input_names_the_file_the_line_and_what_was_expected() {
+    expect_error(
+        &["color", "--spectrum", "no/such/file.csv"],
+        &["no/such/file.csv", "no such file"],
+    );
+    let malformed = TempFile::new("malformed.csv", "400,0.5\n410;0.6\n");
+    expect_error(
+        &["color", "--spectrum", malformed.arg()],
+        &[&format!("{}:2:", malformed.arg()), "expected"],
+    );
+    let decreasing = TempFile::new("decreasing.csv", "# test\n500,1\n490,1\n");
+    expect_error(
+        &["color", "--spectrum", decreasing.arg()],
+        &[&format!("{}:3:", decreasing.arg()), "increase strictly"],
+    );
+    let nan = TempFile::new("nan.csv", "400,1\n410,nan\n");
+    expect_error(
+        &["color", "--spectrum", nan.arg()],
+        &[&format!("{}:2:", nan.arg()), "finite"],
+    );
+    let negative = TempFile::new("negative.csv", "wavelength_nm,value\n400,1\n410,-0.5\n");
+    expect_error(
+        &["color", "--spectrum", negative.arg()],
+        &[&format!("{}:3:", negative.arg()), "non-negative"],
+    );
+    // A negative reflectance is data, not an error (colour-science accepts it too) …
+    let out = prism(&[
+        "color",
+        "--spectrum",
+        negative.arg(),
+        "--illuminant",
+        "D65",
+        "--json",
+    ]);
+    assert!(out.status.success());
+    // … but a negative illuminant is.
+    expect_error(
+        &[
+            "color",
+            "--spectrum",
+            "colorchecker:red",
+            "--illuminant",
+            negative.arg(),
+        ],
+        &[&format!("{}:3:", negative.arg()), "non-negative"],
+    );
+}
+
+#[test]
+fn unknown_names_suggest_the_closest_known_ones() {
+    expect_error(
+        &["color", "--spectrum", "D66"],
+        &["D66", "did you mean", "`D65`"],
+    );
+    expect_error(
+        &[
+            "color",
+            "--spectrum",
+            "colorchecker:dark skn",
+            "--illuminant",
+            "D65",
+        ],
+        &["dark skn", "`dark skin`"],
+    );
+    expect_error(
+        &[
+            "color",
+            "--spectrum",
+            "colorchecker:red",
+            "--illuminant",
+            "LED-B9",
+        ],
+        &["LED-B9", "did you mean"],
+    );
+    expect_error(
+        &["color", "--spectrum", "D65", "--observer", "cie1965"],
+        &["cie1965", "cie1964"],
+    );
+    expect_error(
+        &["color", "--spectrum", "cie1931-2deg"],
+        &["spectra/cie1931-2deg.csv", "3 columns"],
+    );
+}
+
+#[test]
+fn names_and_aliases_resolve_to_the_same_spectrum() {
+    let a = prism(&["color", "--spectrum", "F2", "--json"]);
+    let b = prism(&["color", "--spectrum", "fl2", "--json"]);
+    assert!(a.status.success() && b.status.success());
+    let a: Value = serde_json::from_slice(&a.stdout).unwrap();
+    let b: Value = serde_json::from_slice(&b.stdout).unwrap();
+    assert_eq!(a["XYZ"], b["XYZ"]);
+}
