@@ -254,3 +254,20 @@ fn names_and_aliases_resolve_to_the_same_spectrum() {
     let b: Value = serde_json::from_slice(&b.stdout).unwrap();
     assert_eq!(a["XYZ"], b["XYZ"]);
 }
+
+#[test]
+fn blackbody_spectra_have_their_own_temperature_as_cct() {
+    for temperature_k in [1500.0, 2856.0, 6500.0, 20000.0] {
+        let spec = format!("blackbody:{temperature_k}");
+        let out = prism(&["color", "--spectrum", &spec, "--json"]);
+        assert!(out.status.success());
+        let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+        let cct = v["CCT_K"].as_f64().unwrap();
+        assert!((cct - temperature_k).abs() < 0.5, "{spec}: CCT {cct}");
+        assert!(v["Duv"].as_f64().unwrap().abs() < 1e-5);
+    }
+    expect_error(
+        &["color", "--spectrum", "blackbody:hot"],
+        &["blackbody:<temperature in K>"],
+    );
+}

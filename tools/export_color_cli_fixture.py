@@ -36,7 +36,7 @@ CALLS = {
     "XYZ (reflectance)": 'colour.sd_to_XYZ(R, cmfs, I, method="Integration")',
     "XYZ (emission)": 'colour.sd_to_XYZ(L, cmfs, None, k=683.002, method="Integration")',
     "xy": "colour.XYZ_to_xy(XYZ)",
-    "CCT_K, Duv": "colour.temperature.uv_to_CCT_Ohno2013(colour.xy_to_UCS_uv(colour.XYZ_to_xy(XYZ_cie1931)))",
+    "CCT_K, Duv": "colour.temperature.uv_to_CCT_Ohno2013(colour.xy_to_UCS_uv(colour.XYZ_to_xy(XYZ_cie1931)), colour.MSDS_CMFS['CIE 1931 2 Degree Standard Observer'].copy().align(SpectralShape(360, 830, 1)))",
     "Lab": "colour.XYZ_to_Lab(XYZ / 100, colour.XYZ_to_xy(XYZ_white))",
     "linear_sRGB (reflectance)": "normalised_primary_matrix(sRGB)^-1 @ matrix_chromatic_adaptation_VonKries("
     "XYZ_white_cie1931 / 100, xy_to_XYZ(sRGB.whitepoint), transform) @ XYZ_cie1931 / 100",
@@ -64,8 +64,10 @@ def srgb_matrices():
 
 
 def cct(xyz_1931):
+    # colour-science's default locus stops at 780 nm; Prism's (and CIE 15's) spans 360-830 nm.
+    cmfs = colour.MSDS_CMFS[OBSERVERS["cie1931"]].copy().align(SHAPE)
     uv = colour.xy_to_UCS_uv(colour.XYZ_to_xy(xyz_1931))
-    t, duv = uv_to_CCT_Ohno2013(uv)
+    t, duv = uv_to_CCT_Ohno2013(uv, cmfs)
     return float(t), float(duv)
 
 

@@ -6,9 +6,9 @@ use std::path::Path;
 use clap::{Args, ValueEnum};
 use glam::DVec3;
 use prism_spectrum::adaptation::{adaptation_matrix, AdaptationMethod};
-use prism_spectrum::cct::uv_to_cct_duv;
+use prism_spectrum::cct::{blackbody_dense, xyz_to_cct_ohno2013};
 use prism_spectrum::colorimetry::{
-    emission_to_xyz, reflectance_to_xyz, xyz_to_lab, xyz_to_uv_1960, xyz_to_xy,
+    emission_to_xyz_cd_per_m2, illuminant_white_xyz, reflectance_to_xyz, xyz_to_lab, xyz_to_xy,
 };
 use prism_spectrum::data::{
     canonical_illuminant_name, colorchecker_patch, colorchecker_patch_index,
@@ -61,7 +61,8 @@ impl From<AdaptArg> for AdaptationMethod {
 #[derive(Args, Debug)]
 pub struct ColorArgs {
     /// Spectrum: a CSV file (`wavelength_nm,value`), a file stem under spectra/ (e.g. D65, F11,
-    /// LED-B3) or a ColorChecker patch (e.g. `colorchecker:dark skin`).
+    /// LED-B3), a ColorChecker patch (e.g. `colorchecker:dark skin`) or a blackbody's absolute
+    /// spectral radiance (e.g. `blackbody:5000` in K).
     #[arg(long, value_name = "FILE.csv|NAME")]
     pub spectrum: String,
     /// Treat the spectrum as a reflectance under this illuminant (CIE name or CSV file);
@@ -99,6 +100,7 @@ impl Role {
 }
 
 const COLORCHECKER_PREFIX: &str = "colorchecker:";
+const BLACKBODY_PREFIX: &str = "blackbody:";
 
 fn looks_like_path(text: &str) -> bool {
     text.contains('/') || text.contains('\\') || text.contains('.')
@@ -111,6 +113,25 @@ fn resolve_spectrum(spec: &str, role: Role, flag: &str) -> Result<(Tabulated, St
         let index = colorchecker_patch_index(patch).map_err(|e| format!("{flag} {spec}: {e}"))?;
         let name = &colorchecker_patch_names()[index];
         return Ok((colorchecker_patch(index), format!("colorchecker:{name}")));
+    }
+    if let Some(temperature) = lower.strip_prefix(BLACKBODY_PREFIX) {
+        let temperature_k = temperature
+            .trim()
+            .trim_end_matches('k')
+            .trim()
+            .parse::<f64>()
+            .ok()
+            .filter(|t| t.is_finite() && *t > 0.0)
+            .ok_or_else(|| {
+                format!("{flag} {spec}: expected `blackbody:<temperature in K>` with a positive temperature, e.g. `blackbody:5000`")
+            })?;
+        let dense = blackbody_dense(temperature_k);
+        let wavelengths: Vec<f64> = (0..dense.values().len())
+            .map(DenseSpectrum::wavelength_nm)
+            .collect();
+        let table = Tabulated::new(wavelengths, dense.values().to_vec())
+            .expect("the 1 nm grid is increasing");
+        return Ok((table, format!("blackbody:{temperature_k}K")));
     }
     let path = Path::new(spec);
     if path.is_file() {
@@ -170,8 +191,7 @@ struct ColorReport {
 }
 
 fn chromaticity(xyz: DVec3) -> Option<[f64; 2]> {
-    let sum = xyz.x + xyz.y + xyz.z;
-    (sum > 0.0).then(|| xyz_to_xy(xyz))
+    xyz_to_xy(xyz).map(|xy| xy.to_array())
 }
 
 fn compute(args: &ColorArgs) -> Result<ColorReport, String> {
@@ -186,15 +206,16 @@ fn compute(args: &ColorArgs) -> Result<ColorReport, String> {
                 resolve_spectrum(illuminant_spec, Role::Illuminant, "--illuminant")?;
             let reflectance = spectrum.to_dense();
             let illuminant = illuminant.to_dense();
-            let perfect = DenseSpectrum::constant(1.0);
-            let white = reflectance_to_xyz(&perfect, &illuminant, observer).ok_or_else(|| {
-                format!("--illuminant {illuminant_spec}: the illuminant has no power in 360–830 nm")
-            })?;
-            report_xyz = reflectance_to_xyz(&reflectance, &illuminant, observer).unwrap();
+            let white = illuminant_white_xyz(&illuminant, observer);
+            if !(white.y > 0.0) {
+                return Err(format!(
+                    "--illuminant {illuminant_spec}: expected an illuminant with power in 360–830 nm, found none"
+                ));
+            }
+            report_xyz = reflectance_to_xyz(&reflectance, &illuminant, observer);
             lab = Some(xyz_to_lab(report_xyz, white));
-            xyz_1931 = reflectance_to_xyz(&reflectance, &illuminant, Observer::Cie1931).unwrap();
-            let white_1931 =
-                reflectance_to_xyz(&perfect, &illuminant, Observer::Cie1931).unwrap() / 100.0;
+            xyz_1931 = reflectance_to_xyz(&reflectance, &illuminant, Observer::Cie1931);
+            let white_1931 = illuminant_white_xyz(&illuminant, Observer::Cie1931) / 100.0;
             let adapt = adaptation_matrix(args.adapt.into(), white_1931, srgb.white_xyz());
             linear_srgb = srgb.xyz_to_rgb * (adapt * (xyz_1931 / 100.0));
             illuminant_label = Some(illum_label);
@@ -203,21 +224,16 @@ fn compute(args: &ColorArgs) -> Result<ColorReport, String> {
         None => {
             let (spectrum, label) = resolve_spectrum(&args.spectrum, Role::Emission, "--spectrum")?;
             let radiance = spectrum.to_dense();
-            report_xyz = emission_to_xyz(&radiance, observer);
-            xyz_1931 = emission_to_xyz(&radiance, Observer::Cie1931);
+            report_xyz = emission_to_xyz_cd_per_m2(&radiance, observer);
+            xyz_1931 = emission_to_xyz_cd_per_m2(&radiance, Observer::Cie1931);
             lab = None;
             linear_srgb = srgb.xyz_to_rgb * xyz_1931;
             illuminant_label = None;
             spectrum_label = label;
         }
     }
-    let (cct_k, duv) = match chromaticity(xyz_1931) {
-        Some(_) => {
-            let (t, d) = uv_to_cct_duv(xyz_to_uv_1960(xyz_1931));
-            (Some(t), Some(d))
-        }
-        None => (None, None),
-    };
+    let cct = xyz_to_cct_ohno2013(xyz_1931);
+    let (cct_k, duv) = (cct.map(|c| c.cct_k), cct.map(|c| c.duv));
     let encoded = linear_srgb.to_array().map(|v| srgb.transfer.encode(v));
     Ok(ColorReport {
         spectrum: spectrum_label,

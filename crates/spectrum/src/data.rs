@@ -182,6 +182,13 @@ pub fn colorchecker_patch_index(name: &str) -> Result<usize, String> {
     if prefixed.len() == 1 {
         return Ok(prefixed[0]);
     }
+    if prefixed.len() > 1 {
+        let matches: Vec<&str> = prefixed.iter().map(|&i| names[i].as_str()).collect();
+        return Err(format!(
+            "ColorChecker patch `{name}` is ambiguous: it starts {}; give more of the name",
+            matches.join(", ")
+        ));
+    }
     Err(format!(
         "unknown ColorChecker patch `{name}`{}; patches are: {}",
         did_you_mean(name, names.iter().map(String::as_str)),
