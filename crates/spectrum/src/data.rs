@@ -102,13 +102,23 @@ pub fn cmfs(observer: Observer) -> &'static Cmfs {
 /// CIE 1924 photopic luminous efficiency V(λ).
 pub fn photopic_efficiency() -> &'static DenseSpectrum {
     static V: OnceLock<DenseSpectrum> = OnceLock::new();
-    V.get_or_init(|| embedded_file("cie1924-photopic").unwrap().table(0).to_dense())
+    V.get_or_init(|| {
+        embedded_file("cie1924-photopic")
+            .unwrap()
+            .table(0)
+            .to_dense()
+    })
 }
 
 /// CIE 1951 scotopic luminous efficiency V'(λ).
 pub fn scotopic_efficiency() -> &'static DenseSpectrum {
     static V: OnceLock<DenseSpectrum> = OnceLock::new();
-    V.get_or_init(|| embedded_file("cie1951-scotopic").unwrap().table(0).to_dense())
+    V.get_or_init(|| {
+        embedded_file("cie1951-scotopic")
+            .unwrap()
+            .table(0)
+            .to_dense()
+    })
 }
 
 /// Canonical CIE name of an illuminant: case-insensitive, `FL2` accepted for `F2`,
@@ -192,7 +202,10 @@ mod tests {
     fn every_embedded_file_parses_with_a_provenance_header() {
         for (stem, text) in EMBEDDED_SPECTRA {
             assert!(text.starts_with("# "), "{stem} lacks a provenance header");
-            assert!(text.contains("colour-science"), "{stem} does not name its exporter");
+            assert!(
+                text.contains("colour-science"),
+                "{stem} does not name its exporter"
+            );
             assert!(embedded_file(stem).is_some());
         }
     }

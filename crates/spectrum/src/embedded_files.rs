@@ -31,9 +31,24 @@ pub const EMBEDDED_SPECTRA: &[(&str, &str)] = &[
     ("LED-RGB1", include_str!("../../../spectra/LED-RGB1.csv")),
     ("LED-V1", include_str!("../../../spectra/LED-V1.csv")),
     ("LED-V2", include_str!("../../../spectra/LED-V2.csv")),
-    ("cie1924-photopic", include_str!("../../../spectra/cie1924-photopic.csv")),
-    ("cie1931-2deg", include_str!("../../../spectra/cie1931-2deg.csv")),
-    ("cie1951-scotopic", include_str!("../../../spectra/cie1951-scotopic.csv")),
-    ("cie1964-10deg", include_str!("../../../spectra/cie1964-10deg.csv")),
-    ("colorchecker", include_str!("../../../spectra/colorchecker.csv")),
+    (
+        "cie1924-photopic",
+        include_str!("../../../spectra/cie1924-photopic.csv"),
+    ),
+    (
+        "cie1931-2deg",
+        include_str!("../../../spectra/cie1931-2deg.csv"),
+    ),
+    (
+        "cie1951-scotopic",
+        include_str!("../../../spectra/cie1951-scotopic.csv"),
+    ),
+    (
+        "cie1964-10deg",
+        include_str!("../../../spectra/cie1964-10deg.csv"),
+    ),
+    (
+        "colorchecker",
+        include_str!("../../../spectra/colorchecker.csv"),
+    ),
 ];

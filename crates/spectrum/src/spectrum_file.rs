@@ -105,13 +105,20 @@ pub fn parse_spectral_text(text: &str, path: &Path) -> Result<SpectralColumns, S
             if fields.len() != n {
                 return Err(err(
                     line_no,
-                    format!("expected {n} fields like the lines before, found {}", fields.len()),
+                    format!(
+                        "expected {n} fields like the lines before, found {}",
+                        fields.len()
+                    ),
                 ));
             }
         }
         let mut numbers = Vec::with_capacity(fields.len());
         for (col, field) in fields.iter().enumerate() {
-            let what = if col == 0 { "wavelength in nm" } else { "value" };
+            let what = if col == 0 {
+                "wavelength in nm"
+            } else {
+                "value"
+            };
             match parse_number(field) {
                 Some(v) if v.is_finite() => numbers.push(v),
                 Some(_) => {
@@ -161,7 +168,13 @@ pub fn parse_spectral_text(text: &str, path: &Path) -> Result<SpectralColumns, S
     }
     let names = names.unwrap_or_else(|| {
         (0..columns.len())
-            .map(|i| if i == 0 { "value".to_string() } else { format!("value{}", i + 1) })
+            .map(|i| {
+                if i == 0 {
+                    "value".to_string()
+                } else {
+                    format!("value{}", i + 1)
+                }
+            })
             .collect()
     });
     Ok(SpectralColumns {
@@ -180,7 +193,9 @@ pub fn read_spectral_file(path: &Path) -> Result<SpectralColumns, SpectrumFileEr
 }
 
 /// Reads a file with exactly one value column (`wavelength_nm,value`).
-pub fn read_single_spectrum(path: &Path) -> Result<(Tabulated, SpectralColumns), SpectrumFileError> {
+pub fn read_single_spectrum(
+    path: &Path,
+) -> Result<(Tabulated, SpectralColumns), SpectrumFileError> {
     let cols = read_spectral_file(path)?;
     if cols.columns.len() != 1 {
         return Err(SpectrumFileError::new(
@@ -205,7 +220,8 @@ mod tests {
 
     #[test]
     fn accepts_commas_tabs_spaces_comments_and_a_header() {
-        let c = parse("# made by hand\nwavelength_nm,value\n400,1\n410\t2\n420   3 # note\n\n").unwrap();
+        let c = parse("# made by hand\nwavelength_nm,value\n400,1\n410\t2\n420   3 # note\n\n")
+            .unwrap();
         assert_eq!(c.wavelengths_nm, vec![400.0, 410.0, 420.0]);
         assert_eq!(c.columns, vec![vec![1.0, 2.0, 3.0]]);
         assert_eq!(c.lines, vec![3, 4, 5]);
@@ -216,11 +232,23 @@ mod tests {
     fn errors_name_the_line_and_what_was_expected() {
         let e = parse("400,1\n399,2\n").unwrap_err();
         assert_eq!(e.line, Some(2));
-        assert!(e.to_string().contains("s.csv:2: wavelengths must increase strictly"), "{e}");
+        assert!(
+            e.to_string()
+                .contains("s.csv:2: wavelengths must increase strictly"),
+            "{e}"
+        );
         let e = parse("400,1\n410,abc\n").unwrap_err();
-        assert!(e.to_string().contains("s.csv:2: expected a number (value), found `abc`"), "{e}");
+        assert!(
+            e.to_string()
+                .contains("s.csv:2: expected a number (value), found `abc`"),
+            "{e}"
+        );
         let e = parse("400,1\n410,NaN\n").unwrap_err();
-        assert!(e.to_string().contains("s.csv:2: expected a finite value, found `NaN`"), "{e}");
+        assert!(
+            e.to_string()
+                .contains("s.csv:2: expected a finite value, found `NaN`"),
+            "{e}"
+        );
         let e = parse("400,1\n410,1,2\n").unwrap_err();
         assert!(e.to_string().contains("s.csv:2: expected 2 fields"), "{e}");
         let e = parse("# nothing\n").unwrap_err();
@@ -230,7 +258,13 @@ mod tests {
     #[test]
     fn negative_values_are_reported_when_forbidden() {
         let c = parse("400,1\n410,-2\n").unwrap();
-        let e = c.require_non_negative(0, Path::new("s.csv"), "emission").unwrap_err();
-        assert!(e.to_string().starts_with("s.csv:2: emission must be non-negative"), "{e}");
+        let e = c
+            .require_non_negative(0, Path::new("s.csv"), "emission")
+            .unwrap_err();
+        assert!(
+            e.to_string()
+                .starts_with("s.csv:2: emission must be non-negative"),
+            "{e}"
+        );
     }
 }

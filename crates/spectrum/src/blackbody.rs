@@ -1,0 +1,170 @@
+//! Blackbody emission by Planck's law, in spectral radiance per nanometre:
+//!
+//! ```text
+//!     B(λ, T) = 2hc² / λ⁵ · 1 / (exp(hc / (λ k_B T)) − 1)      [W·m⁻²·sr⁻¹·m⁻¹]
+//! ```
+//!
+//! With λ in nm, λ⁵ gains a factor 10⁻⁴⁵ and the per-metre density is turned into a per-nm
+//! one by a factor 10⁻⁹, so B = c₁ / λ_nm⁵ / expm1(c₂ / (λ_nm T)) with c₁ = 2hc²·10³⁶ and
+//! c₂ = hc/k_B·10⁹ nm·K (pbrt-v4 §4.4.1 `Blackbody`, which works in metres).
+//! Normalised emission divides by the value at Wien's peak λ_max = b / T.
+
+use crate::constants::{BOLTZMANN_J_PER_K, PLANCK_J_S, SPEED_OF_LIGHT_M_PER_S};
+use crate::sampled_spectrum::{SampledSpectrum, N_SPECTRUM_SAMPLES};
+
+/// Wien's displacement constant b in m·K (CODATA 2018).
+pub const WIEN_DISPLACEMENT_M_K: f64 = 2.897_771_955e-3;
+
+/// First radiation constant for spectral radiance per nm with λ in nm:
+/// 2hc² · 10⁻⁹ (per nm) / 10⁻⁴⁵ (λ⁵ in nm⁵), in W·m⁻²·sr⁻¹·nm⁻¹·nm⁵.
+pub const PLANCK_C1_RADIANCE_NM: f64 =
+    2.0 * PLANCK_J_S * SPEED_OF_LIGHT_M_PER_S * SPEED_OF_LIGHT_M_PER_S * 1e36;
+/// Second radiation constant hc/k_B in nm·K.
+pub const PLANCK_C2_NM_K: f64 = PLANCK_J_S * SPEED_OF_LIGHT_M_PER_S / BOLTZMANN_J_PER_K * 1e9;
+
+/// Spectral radiance of a blackbody at `temperature_k` and `wavelength_nm`, in
+/// W·m⁻²·sr⁻¹·nm⁻¹. Zero for non-positive or non-finite temperatures and wavelengths.
+pub fn blackbody_radiance(wavelength_nm: f64, temperature_k: f64) -> f64 {
+    if !(wavelength_nm > 0.0 && temperature_k > 0.0 && temperature_k.is_finite()) {
+        return 0.0;
+    }
+    let l2 = wavelength_nm * wavelength_nm;
+    let l5 = l2 * l2 * wavelength_nm;
+    // expm1 keeps precision in the Rayleigh–Jeans regime (small exponent);
+    // a huge exponent gives ∞ and hence 0.
+    PLANCK_C1_RADIANCE_NM / (l5 * (PLANCK_C2_NM_K / (wavelength_nm * temperature_k)).exp_m1())
+}
+
+/// `blackbody_radiance` in f32 (the renderer's precision).
+#[inline]
+pub fn blackbody_radiance_f32(wavelength_nm: f32, temperature_k: f32) -> f32 {
+    if !(wavelength_nm > 0.0 && temperature_k > 0.0 && temperature_k.is_finite()) {
+        return 0.0;
+    }
+    let l2 = wavelength_nm * wavelength_nm;
+    let l5 = l2 * l2 * wavelength_nm;
+    let exponent = PLANCK_C2_NM_K as f32 / (wavelength_nm * temperature_k);
+    PLANCK_C1_RADIANCE_NM as f32 / (l5 * exponent.exp_m1())
+}
+
+/// `blackbody_radiance` at four wavelengths (one `SampledWavelengths`), times `scale`.
+#[inline]
+pub fn blackbody_radiance_4(
+    wavelengths_nm: [f32; N_SPECTRUM_SAMPLES],
+    temperature_k: f32,
+    scale: f32,
+) -> SampledSpectrum {
+    if !(temperature_k.is_finite() && temperature_k > 0.0) {
+        return SampledSpectrum::zero();
+    }
+    let c1 = PLANCK_C1_RADIANCE_NM as f32 * scale;
+    let c2_over_t = PLANCK_C2_NM_K as f32 / temperature_k;
+    SampledSpectrum::new(wavelengths_nm.map(|wl| {
+        let l2 = wl * wl;
+        let l5 = l2 * l2 * wl;
+        let value = c1 / (l5 * (c2_over_t / wl).exp_m1());
+        // Non-positive wavelengths give negative/NaN values: clamp them to zero.
+        if wl > 0.0 {
+            value
+        } else {
+            0.0
+        }
+    }))
+}
+
+/// Wavelength of maximal spectral radiance per nm, λ_max = b / T (Wien), in nm.
+pub fn wien_peak_wavelength_nm(temperature_k: f64) -> f64 {
+    WIEN_DISPLACEMENT_M_K / temperature_k * 1e9
+}
+
+/// B(λ_max, T): the largest spectral radiance per nm of a blackbody at `temperature_k`.
+pub fn blackbody_peak_radiance(temperature_k: f64) -> f64 {
+    blackbody_radiance(wien_peak_wavelength_nm(temperature_k), temperature_k)
+}
+
+/// B(λ, T) / B(λ_max, T): 1 at Wien's peak; zero for invalid temperatures.
+pub fn blackbody_normalized(wavelength_nm: f64, temperature_k: f64) -> f64 {
+    let peak = blackbody_peak_radiance(temperature_k);
+    if peak > 0.0 && peak.is_finite() {
+        blackbody_radiance(wavelength_nm, temperature_k) / peak
+    } else {
+        0.0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Planck's law written out in SI units, independently of the nm-scaled constants.
+    fn planck_si_per_nm(wavelength_nm: f64, temperature_k: f64) -> f64 {
+        let (h, c, k) = (6.626_070_15e-34, 299_792_458.0, 1.380_649e-23);
+        let lambda_m = wavelength_nm * 1e-9;
+        let per_m = 2.0 * h * c * c
+            / lambda_m.powi(5)
+            / ((h * c / (lambda_m * k * temperature_k)).exp() - 1.0);
+        per_m * 1e-9
+    }
+
+    #[test]
+    fn radiance_at_500_nm_and_5000_k_matches_the_closed_form() {
+        let expected = planck_si_per_nm(500.0, 5000.0);
+        // ≈ 1.2108e4 W·m⁻²·sr⁻¹·nm⁻¹ (hand check: c₁/λ⁵ = 3.811e6, exp(5.7551) − 1 = 314.8).
+        assert!((expected - 1.2107e4).abs() < 5.0, "{expected}");
+        let got = blackbody_radiance(500.0, 5000.0);
+        assert!((got / expected - 1.0).abs() < 1e-12, "{got} vs {expected}");
+        let got32 = blackbody_radiance_f32(500.0, 5000.0) as f64;
+        assert!((got32 / expected - 1.0).abs() < 1e-5);
+    }
+
+    #[test]
+    fn peak_is_at_wiens_wavelength() {
+        for temperature_k in [1000.0, 3000.0, 5000.0, 6500.0, 10_000.0] {
+            let peak_nm = wien_peak_wavelength_nm(temperature_k);
+            let b = |wl: f64| blackbody_radiance(wl, temperature_k);
+            // The peak is a maximum: the neighbours ±0.01 % are lower, and the numerical
+            // derivative vanishes there to the precision of Wien's constant.
+            let h = peak_nm * 1e-4;
+            assert!(b(peak_nm) > b(peak_nm - h) && b(peak_nm) > b(peak_nm + h));
+            let slope = (b(peak_nm + h) - b(peak_nm - h)) / (2.0 * h);
+            let curvature_scale = b(peak_nm) / peak_nm;
+            assert!(
+                slope.abs() < 1e-6 * curvature_scale,
+                "{temperature_k} K: {slope}"
+            );
+            assert!((blackbody_normalized(peak_nm, temperature_k) - 1.0).abs() < 1e-15);
+            assert!(blackbody_normalized(peak_nm * 1.3, temperature_k) < 1.0);
+        }
+        assert!((wien_peak_wavelength_nm(5000.0) - 579.554_391).abs() < 1e-5);
+    }
+
+    #[test]
+    fn four_lane_version_agrees_with_f64() {
+        let wavelengths_nm = [360.0f32, 555.5, 700.25, 830.0];
+        for temperature_k in [800.0f32, 2856.0, 6504.0, 25_000.0] {
+            let got = blackbody_radiance_4(wavelengths_nm, temperature_k, 2.0);
+            for (lane, &wl) in wavelengths_nm.iter().enumerate() {
+                let expected = 2.0 * blackbody_radiance(wl as f64, temperature_k as f64);
+                assert!(
+                    (got[lane] as f64 / expected - 1.0).abs() < 2e-5,
+                    "{wl} nm, {temperature_k} K: {} vs {expected}",
+                    got[lane]
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn invalid_inputs_give_zero() {
+        assert_eq!(blackbody_radiance(500.0, 0.0), 0.0);
+        assert_eq!(blackbody_radiance(500.0, -10.0), 0.0);
+        assert_eq!(blackbody_radiance(500.0, f64::NAN), 0.0);
+        assert_eq!(blackbody_radiance(500.0, f64::INFINITY), 0.0);
+        assert_eq!(blackbody_radiance(-1.0, 5000.0), 0.0);
+        assert_eq!(blackbody_radiance(360.0, 10.0), 0.0); // exp overflows → 0, not NaN
+        assert_eq!(blackbody_radiance_f32(500.0, -1.0), 0.0);
+        assert!(blackbody_radiance_4([360.0; 4], 0.0, 1.0).is_black());
+        assert!(blackbody_radiance_4([-5.0, 0.0, 500.0, 600.0], 10.0, 1.0).is_black());
+        assert_eq!(blackbody_normalized(500.0, 0.0), 0.0);
+    }
+}
