@@ -81,6 +81,41 @@ pub fn sample_visible_wavelength(u: f32) -> f32 {
     wavelength_nm.clamp(LAMBDA_MIN_NM, LAMBDA_MAX_NM)
 }
 
+/// ln x for positive normal x without library calls (Cephes `logf`: exponent from the bits,
+/// mantissa folded into [√½, √2), degree-8 polynomial), about 1 ulp; lanes vectorise.
+#[inline(always)]
+fn ln_positive(x: f32) -> f32 {
+    let bits = x.to_bits();
+    let exponent = ((bits >> 23) & 0xff) as i32 - 126;
+    // Mantissa in [0.5, 1).
+    let mantissa = f32::from_bits((bits & 0x807f_ffff) | 0x3f00_0000);
+    let below = mantissa < std::f32::consts::FRAC_1_SQRT_2;
+    let e = (exponent - below as i32) as f32;
+    let m = if below {
+        mantissa + mantissa - 1.0
+    } else {
+        mantissa - 1.0
+    };
+    let z = m * m;
+    let mut y = ((((((((7.037_683_6e-2 * m - 1.151_461e-1) * m + 1.167_699_9e-1) * m
+        - 1.242_014_1e-1)
+        * m
+        + 1.424_932_3e-1)
+        * m
+        - 1.666_805_8e-1)
+        * m
+        + 2.000_071_4e-1)
+        * m
+        - 2.499_999_4e-1)
+        * m
+        + 3.333_333e-1)
+        * m
+        * z;
+    y += -2.121_944_4e-4 * e;
+    y += -0.5 * z;
+    m + y + 0.693_359_4 * e
+}
+
 /// Four wavelengths (nm) with the density (nm⁻¹) each was sampled with.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SampledWavelengths {
@@ -107,11 +142,27 @@ impl SampledWavelengths {
 
     /// Hero wavelength from `u` ∈ [0, 1) by the visible-wavelength importance density, plus
     /// three rotated copies (u + i/4 mod 1), each with its pdf.
+    ///
+    /// Per lane t = t₀ + u (t₁ − t₀) = tanh(k(λ − c)), so λ = c + ln((1 + t)/(1 − t)) / 2k
+    /// and p(λ) = A / cosh² = A (1 − t)(1 + t): no hyperbolic functions, and the loop over
+    /// the lanes vectorises (the logarithm is `ln_positive` below).
     #[inline]
     pub fn sample_visible(u: f32) -> Self {
-        let lambda_nm = rotated_variates(u).map(sample_visible_wavelength);
-        let pdf = SampledSpectrum::new(lambda_nm.map(visible_wavelength_pdf));
-        Self { lambda_nm, pdf }
+        let variates = rotated_variates(u);
+        let mut lambda_nm = [0.0f32; N_SPECTRUM_SAMPLES];
+        let mut pdf = [0.0f32; N_SPECTRUM_SAMPLES];
+        for lane in 0..N_SPECTRUM_SAMPLES {
+            let t = TANH_AT_MIN as f32 + variates[lane] * (TANH_AT_MAX - TANH_AT_MIN) as f32;
+            let (one_plus, one_minus) = (1.0 + t, 1.0 - t);
+            let wl = VISIBLE_DENSITY_CENTER_NM as f32
+                + ln_positive(one_plus / one_minus) * (0.5 / VISIBLE_DENSITY_FALLOFF_PER_NM) as f32;
+            lambda_nm[lane] = wl.clamp(LAMBDA_MIN_NM, LAMBDA_MAX_NM);
+            pdf[lane] = VISIBLE_DENSITY_NORMALISATION_PER_NM as f32 * (one_plus * one_minus);
+        }
+        Self {
+            lambda_nm,
+            pdf: SampledSpectrum::new(pdf),
+        }
     }
 
     /// Hero wavelength uniform over 360–830 nm plus three rotated copies; pdf 1/470 nm⁻¹.
@@ -311,8 +362,28 @@ mod tests {
                 // Near the wrap point u + i/4 ≈ 1 the CDF can read 0 or 1.
                 let diff = (cdf - expected).abs();
                 assert!(diff.min(1.0 - diff) < 1e-5);
-                assert_eq!(s.pdf()[lane], visible_wavelength_pdf(s.lambda()[lane]));
+                let pdf = visible_wavelength_pdf(s.lambda()[lane]);
+                assert!((s.pdf()[lane] / pdf - 1.0).abs() < 1e-5);
+                let scalar = sample_visible_wavelength(expected);
+                assert!(
+                    (s.lambda()[lane] - scalar).abs() < 1e-3,
+                    "{} vs {scalar}",
+                    s.lambda()[lane]
+                );
             }
+        }
+    }
+
+    #[test]
+    fn fast_ln_matches_std() {
+        let mut x = 1e-3f32;
+        while x < 1e3 {
+            let expected = (x as f64).ln();
+            assert!(
+                (ln_positive(x) as f64 - expected).abs() < 2e-7 * expected.abs().max(1.0),
+                "ln {x}"
+            );
+            x *= 1.001;
         }
     }
 

@@ -310,8 +310,9 @@ impl PiecewiseLinear {
             let inv_step = self.inv_step_per_nm;
             SampledSpectrum::new(lambda_nm.map(|wl| {
                 let x = (wl - first) * inv_step;
-                // `as usize` saturates: negative and NaN give 0, handled by `inside`.
-                let i = (x as usize).min(n - 2);
+                // Clamp, then a native f32 → i32 conversion (NaN gives 0); lanes outside the
+                // table are zeroed below.
+                let i = (x.clamp(0.0, (n - 2) as f32) as i32 as usize).min(n - 2);
                 let t = x - i as f32;
                 let v = values[i] + t * (values[i + 1] - values[i]);
                 if wl >= first && wl <= last {
@@ -321,16 +322,32 @@ impl PiecewiseLinear {
                 }
             }))
         } else {
+            // Branch-free binary search, the four lanes in lockstep: `segment[lane]` ends as
+            // the last index i ≤ n − 2 with wavelengths[i] ≤ λ (0 for λ below the table).
             let wavelengths = &*self.wavelengths_nm;
-            SampledSpectrum::new(lambda_nm.map(|wl| {
-                if !(wl >= first && wl <= last) {
-                    return 0.0;
+            let mut segment = [0usize; N_SPECTRUM_SAMPLES];
+            let mut len = n - 1;
+            while len > 1 {
+                let half = len / 2;
+                for (base, &wl) in segment.iter_mut().zip(lambda_nm.iter()) {
+                    let probe = *base + half;
+                    *base = if wavelengths[probe] <= wl {
+                        probe
+                    } else {
+                        *base
+                    };
                 }
-                let i = wavelengths.partition_point(|&w| w <= wl).clamp(1, n - 1);
-                let (w0, w1) = (wavelengths[i - 1], wavelengths[i]);
+                len -= half;
+            }
+            let mut out = [0.0f32; N_SPECTRUM_SAMPLES];
+            for lane in 0..N_SPECTRUM_SAMPLES {
+                let (i, wl) = (segment[lane], lambda_nm[lane]);
+                let (w0, w1) = (wavelengths[i], wavelengths[i + 1]);
                 let t = (wl - w0) / (w1 - w0);
-                values[i - 1] + t * (values[i] - values[i - 1])
-            }))
+                let v = values[i] + t * (values[i + 1] - values[i]);
+                out[lane] = if wl >= first && wl <= last { v } else { 0.0 };
+            }
+            SampledSpectrum::new(out)
         }
     }
 
@@ -393,7 +410,10 @@ impl DenseTable {
         let values = &*self.values;
         SampledSpectrum::new(lambda_nm.map(|wl| {
             let x = wl - LAMBDA_MIN_NM;
-            let i = (x as usize).min(DENSE_SAMPLE_COUNT - 2);
+            // Clamp, then a native f32 → i32 conversion (NaN gives 0); lanes outside
+            // 360–830 nm are zeroed below.
+            let last_segment = DENSE_SAMPLE_COUNT - 2;
+            let i = (x.clamp(0.0, last_segment as f32) as i32 as usize).min(last_segment);
             let t = x - i as f32;
             let v = values[i] + t * (values[i + 1] - values[i]);
             if x >= 0.0 && x <= (DENSE_SAMPLE_COUNT - 1) as f32 {
