@@ -210,7 +210,16 @@ pub struct PiecewiseLinear {
     last_nm: f32,
     /// 1 / spacing in nm⁻¹ when the wavelengths are uniformly spaced, else 0.
     inv_step_per_nm: f32,
+    /// Non-uniform tables: `guide[c]` is the segment holding the start of cell c of
+    /// `GUIDE_CELLS_PER_SEGMENT·(n − 1)` equal cells over [first, last] (empty when uniform).
+    /// Evaluation binary-searches only the few segments between neighbouring guide entries.
+    guide: Arc<[u32]>,
+    /// Cells per nm of the guide.
+    guide_cells_per_nm: f32,
 }
+
+/// Guide cells per table segment: enough that a cell rarely spans more than one node.
+const GUIDE_CELLS_PER_SEGMENT: usize = 2;
 
 /// Relative tolerance (in units of the spacing) under which a table counts as uniform.
 const UNIFORM_SPACING_TOLERANCE: f64 = 1e-6;
@@ -262,7 +271,14 @@ impl PiecewiseLinear {
         } else {
             0.0
         };
+        let (guide, guide_cells_per_nm) = if inv_step_per_nm == 0.0 && n >= 2 {
+            build_guide(&wl32)
+        } else {
+            (Vec::new(), 0.0)
+        };
         Ok(Self {
+            guide: guide.into(),
+            guide_cells_per_nm,
             first_nm: wl32[0],
             last_nm: wl32[n - 1],
             wavelengths_nm: wl32.into(),
@@ -322,22 +338,24 @@ impl PiecewiseLinear {
                 }
             }))
         } else {
-            // Branch-free binary search, the four lanes in lockstep: `segment[lane]` ends as
-            // the last index i ≤ n − 2 with wavelengths[i] ≤ λ (0 for λ below the table).
+            // The guide cell of λ narrows the search to the segments between the guide
+            // entries one cell either side (a margin for rounding), usually one or two.
             let wavelengths = &*self.wavelengths_nm;
+            let guide = &*self.guide;
+            let last_cell = guide.len() - 1;
             let mut segment = [0usize; N_SPECTRUM_SAMPLES];
-            let mut len = n - 1;
-            while len > 1 {
-                let half = len / 2;
-                for (base, &wl) in segment.iter_mut().zip(lambda_nm.iter()) {
-                    let probe = *base + half;
-                    *base = if wavelengths[probe] <= wl {
-                        probe
-                    } else {
-                        *base
-                    };
-                }
-                len -= half;
+            for (i, &wl) in segment.iter_mut().zip(lambda_nm.iter()) {
+                let cell = (((wl - first) * self.guide_cells_per_nm).clamp(0.0, last_cell as f32)
+                    as i32 as usize)
+                    .min(last_cell);
+                let lo = guide[cell.saturating_sub(1)] as usize;
+                let hi = guide[(cell + 2).min(last_cell)] as usize;
+                // Count the nodes in (lo, hi] at or below λ (branch-free, usually 1–3 nodes).
+                *i = lo
+                    + wavelengths[lo + 1..=hi]
+                        .iter()
+                        .map(|&w| (w <= wl) as usize)
+                        .sum::<usize>();
             }
             let mut out = [0.0f32; N_SPECTRUM_SAMPLES];
             for lane in 0..N_SPECTRUM_SAMPLES {
@@ -376,6 +394,24 @@ impl PiecewiseLinear {
         let (v0, v1) = (values[i - 1] as f64, values[i] as f64);
         v0 + t * (v1 - v0)
     }
+}
+
+/// Guide table of a non-uniform piecewise-linear table: for each of
+/// `GUIDE_CELLS_PER_SEGMENT·(n − 1)` equal cells over [first, last] (plus one entry for
+/// λ = last), the last segment i ≤ n − 2 whose start wavelength is ≤ the cell's start.
+fn build_guide(wavelengths_nm: &[f32]) -> (Vec<u32>, f32) {
+    let n = wavelengths_nm.len();
+    let cells = GUIDE_CELLS_PER_SEGMENT * (n - 1);
+    let (first, last) = (wavelengths_nm[0] as f64, wavelengths_nm[n - 1] as f64);
+    let cell_nm = (last - first) / cells as f64;
+    let guide = (0..=cells)
+        .map(|c| {
+            let start = first + c as f64 * cell_nm;
+            let i = wavelengths_nm.partition_point(|&w| w as f64 <= start);
+            i.saturating_sub(1).min(n - 2) as u32
+        })
+        .collect();
+    (guide, (1.0 / cell_nm) as f32)
 }
 
 /// A spectrum on the 1 nm grid 360, 361, …, 830 nm in f32.
@@ -511,6 +547,41 @@ mod tests {
                         lambda[lane]
                     );
                 }
+            }
+        }
+    }
+
+    #[test]
+    fn clustered_non_uniform_tables_evaluate_exactly() {
+        // Nodes crowded at both ends and sparse in the middle stress the guide table.
+        let mut wavelengths_nm: Vec<f64> = (0..40).map(|i| 380.0 + 0.05 * i as f64).collect();
+        wavelengths_nm.extend([450.0, 455.5, 600.0]);
+        wavelengths_nm.extend((0..40).map(|i| 700.0 + 0.01 * i as f64));
+        wavelengths_nm.push(780.0);
+        let values: Vec<f64> = (0..wavelengths_nm.len())
+            .map(|i| ((i * 7919) % 13) as f64)
+            .collect();
+        let s = Spectrum::piecewise_linear(&wavelengths_nm, &values).unwrap();
+        let table = Tabulated::new(wavelengths_nm.clone(), values).unwrap();
+        let mut probes: Vec<f32> = wavelengths_nm.iter().map(|&w| w as f32).collect();
+        probes.extend((0..20_000).map(|i| 375.0 + 0.021 * i as f32));
+        while !probes.len().is_multiple_of(4) {
+            probes.push(600.0);
+        }
+        for chunk in probes.chunks(4) {
+            let lambda: [f32; 4] = chunk.try_into().unwrap();
+            let got = s.eval(&wavelengths(lambda));
+            for lane in 0..4 {
+                // Against the f64 evaluation of the same f32 nodes (segment search by
+                // plain binary search); the f64 `Tabulated` agrees to f32 node rounding.
+                let expected = s.eval_nm(lambda[lane] as f64);
+                assert!((expected - table.eval(lambda[lane] as f64)).abs() < 0.1);
+                assert!(
+                    (got[lane] as f64 - expected).abs() < 1e-5,
+                    "{} nm: {} vs {expected}",
+                    lambda[lane],
+                    got[lane]
+                );
             }
         }
     }
