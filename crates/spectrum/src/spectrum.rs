@@ -59,7 +59,8 @@ impl Spectrum {
     }
 
     /// A piecewise-linear spectrum (zero outside the table). Uniformly spaced tables are
-    /// detected and evaluated by direct indexing, others by binary search.
+    /// detected and evaluated by direct indexing, others through a guide table (2 cells per
+    /// segment) and a short scan; `eval_nm` binary-searches.
     pub fn piecewise_linear(
         wavelengths_nm: &[f64],
         values: &[f64],
@@ -212,7 +213,7 @@ pub struct PiecewiseLinear {
     inv_step_per_nm: f32,
     /// Non-uniform tables: `guide[c]` is the segment holding the start of cell c of
     /// `GUIDE_CELLS_PER_SEGMENT·(n − 1)` equal cells over [first, last] (empty when uniform).
-    /// Evaluation binary-searches only the few segments between neighbouring guide entries.
+    /// Evaluation scans only the few nodes between neighbouring guide entries.
     guide: Arc<[u32]>,
     /// Cells per nm of the guide.
     guide_cells_per_nm: f32,
