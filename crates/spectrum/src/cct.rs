@@ -16,15 +16,10 @@ use std::sync::OnceLock;
 
 use glam::{DVec2, DVec3};
 
+use crate::blackbody::blackbody_radiance;
 use crate::colorimetry::{tristimulus_sums, xyz_to_uv_1960};
 use crate::data::Observer;
 use crate::table::DenseSpectrum;
-
-/// First radiation constant c₁ = 2πhc² in W·m² as colour-science 0.4.7 `CONSTANT_C1`.
-pub const PLANCK_C1_W_M2: f64 = 3.741771e-16;
-/// Second radiation constant c₂ = hc/k in m·K as colour-science 0.4.7 `CONSTANT_C2`
-/// (CIE 15:2018 §3.1, ITS-90).
-pub const PLANCK_C2_M_K: f64 = 1.4388e-2;
 
 /// Lowest temperature of the Planckian table in K.
 pub const CCT_MIN_K: f64 = 1000.0;
@@ -43,28 +38,9 @@ pub struct CctDuv {
     pub duv: f64,
 }
 
-/// Spectral radiance of a blackbody in W·m⁻²·sr⁻¹·nm⁻¹ (Planck's law in vacuum,
-/// L = c₁ / (π λ⁵ (exp(c₂ / λT) − 1)), CIE 15:2018 eq. 3.1 with colour-science's c₁, c₂).
-/// Zero for non-positive or non-finite wavelength or temperature.
-pub fn blackbody_radiance_w_per_m2_sr_nm(wavelength_nm: f64, temperature_k: f64) -> f64 {
-    let valid = wavelength_nm > 0.0
-        && temperature_k > 0.0
-        && wavelength_nm.is_finite()
-        && temperature_k.is_finite();
-    if !valid {
-        return 0.0;
-    }
-    let wavelength_m = wavelength_nm * 1e-9;
-    let per_m = PLANCK_C1_W_M2
-        / std::f64::consts::PI
-        / wavelength_m.powi(5)
-        / (PLANCK_C2_M_K / (wavelength_m * temperature_k)).exp_m1();
-    per_m * 1e-9
-}
-
 /// A blackbody's spectral radiance on the 1 nm grid, W·m⁻²·sr⁻¹·nm⁻¹.
 pub fn blackbody_dense(temperature_k: f64) -> DenseSpectrum {
-    DenseSpectrum::from_fn(|wl| blackbody_radiance_w_per_m2_sr_nm(wl, temperature_k))
+    DenseSpectrum::from_fn(|wl| blackbody_radiance(wl, temperature_k))
 }
 
 /// CIE 1960 (u, v) of a blackbody at `temperature_k` with the CIE 1931 observer
@@ -251,13 +227,5 @@ mod tests {
         assert!(uv_to_cct_ohno2013(DVec2::new(f64::NAN, 0.3)).is_none());
         assert!(cct_to_uv_ohno2013(-5.0, 0.0).is_none());
         assert!(xyz_to_cct_ohno2013(DVec3::ZERO).is_none());
-        assert_eq!(blackbody_radiance_w_per_m2_sr_nm(500.0, 0.0), 0.0);
-    }
-
-    #[test]
-    fn blackbody_radiance_matches_colour_science_docstring() {
-        // planck_law(500e-9, 5500) = 20472701909806.5 W·m⁻²·sr⁻¹·m⁻¹.
-        let l = blackbody_radiance_w_per_m2_sr_nm(500.0, 5500.0);
-        assert!((l / 1e-9 / 20_472_701_909_806.5 - 1.0).abs() < 1e-12, "{l}");
     }
 }

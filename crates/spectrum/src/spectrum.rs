@@ -1,0 +1,688 @@
+//! `Spectrum`: every kind of spectral distribution a scene can name, as one enum evaluated
+//! with `match` (pbrt-v4 §4.5 `Spectrum`, without the tagged pointer). Evaluation at a
+//! `SampledWavelengths` is allocation-free; tables live behind `Arc` so cloning a spectrum
+//! is cheap.
+
+use std::fmt;
+use std::sync::Arc;
+
+use crate::blackbody::{blackbody_peak_radiance, blackbody_radiance, blackbody_radiance_4};
+use crate::constants::{DENSE_SAMPLE_COUNT, LAMBDA_MIN_NM};
+use crate::data;
+use crate::sampled_spectrum::{SampledSpectrum, N_SPECTRUM_SAMPLES};
+use crate::sampled_wavelengths::SampledWavelengths;
+use crate::table::{DenseSpectrum, Tabulated};
+
+/// Why spectral data could not become a `Spectrum`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct InvalidSpectrum {
+    pub message: String,
+}
+
+impl InvalidSpectrum {
+    fn new(message: impl Into<String>) -> Self {
+        Self {
+            message: message.into(),
+        }
+    }
+}
+
+impl fmt::Display for InvalidSpectrum {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.message)
+    }
+}
+
+impl std::error::Error for InvalidSpectrum {}
+
+/// A spectral distribution (radiance, reflectance, index of refraction, …) over wavelength.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Spectrum {
+    /// The same value at every wavelength.
+    Constant(f32),
+    /// A table at arbitrary increasing wavelengths, linear between them, zero outside.
+    PiecewiseLinear(PiecewiseLinear),
+    /// The 1 nm grid over 360–830 nm, linear between samples, zero outside. Named CIE
+    /// illuminants are stored this way.
+    Dense(DenseTable),
+    /// `scale` · B(λ, T), Planck's law in W·m⁻²·sr⁻¹·nm⁻¹ (see `blackbody.rs`).
+    /// `Spectrum::blackbody_normalized` sets `scale = 1 / B(λ_max, T)`.
+    Blackbody { temperature_k: f32, scale: f32 },
+    // RGB-upsampled spectra (Jakob & Hanika 2019) go here: `RgbAlbedo`, `RgbUnbounded`,
+    // `RgbIlluminant`, with an arm each in `eval`, `eval_nm` and `scaled`.
+}
+
+impl Spectrum {
+    /// A constant spectrum.
+    pub const fn constant(value: f32) -> Self {
+        Spectrum::Constant(value)
+    }
+
+    /// A piecewise-linear spectrum (zero outside the table). Uniformly spaced tables are
+    /// detected and evaluated by direct indexing, others through a guide table (2 cells per
+    /// segment) and a short scan; `eval_nm` binary-searches.
+    pub fn piecewise_linear(
+        wavelengths_nm: &[f64],
+        values: &[f64],
+    ) -> Result<Self, InvalidSpectrum> {
+        PiecewiseLinear::new(wavelengths_nm, values).map(Spectrum::PiecewiseLinear)
+    }
+
+    /// A piecewise-linear spectrum holding the table's samples as they are.
+    pub fn from_tabulated(table: &Tabulated) -> Result<Self, InvalidSpectrum> {
+        Self::piecewise_linear(table.wavelengths_nm(), table.values())
+    }
+
+    /// The table resampled onto the 1 nm grid 360–830 nm (exact for tables whose
+    /// wavelengths are whole nanometres).
+    pub fn dense_from_tabulated(table: &Tabulated) -> Result<Self, InvalidSpectrum> {
+        Self::from_dense(&table.to_dense())
+    }
+
+    /// A dense 1 nm spectrum.
+    pub fn from_dense(dense: &DenseSpectrum) -> Result<Self, InvalidSpectrum> {
+        DenseTable::new(dense).map(Spectrum::Dense)
+    }
+
+    /// A CIE illuminant by name (`D65`, `A`, `F11`, `LED-B1`, …; see
+    /// `data::canonical_illuminant_name`), as its relative spectral power distribution as
+    /// published (e.g. D65 = 100 at 560 nm), on the 1 nm grid.
+    pub fn cie_illuminant(name: &str) -> Result<Self, InvalidSpectrum> {
+        let table = data::illuminant(name).ok_or_else(|| {
+            InvalidSpectrum::new(format!(
+                "unknown CIE illuminant '{name}'{}",
+                data::illuminant_suggestion(name)
+            ))
+        })?;
+        Self::dense_from_tabulated(&table)
+    }
+
+    /// Absolute blackbody spectral radiance B(λ, T) in W·m⁻²·sr⁻¹·nm⁻¹.
+    pub fn blackbody(temperature_k: f32) -> Result<Self, InvalidSpectrum> {
+        check_temperature(temperature_k)?;
+        Ok(Spectrum::Blackbody {
+            temperature_k,
+            scale: 1.0,
+        })
+    }
+
+    /// Blackbody normalised to 1 at its peak: B(λ, T) / B(λ_max, T), λ_max = b / T (Wien).
+    pub fn blackbody_normalized(temperature_k: f32) -> Result<Self, InvalidSpectrum> {
+        check_temperature(temperature_k)?;
+        let peak = blackbody_peak_radiance(temperature_k as f64);
+        let scale = (1.0 / peak) as f32;
+        if !(scale.is_finite() && scale > 0.0) {
+            return Err(InvalidSpectrum::new(format!(
+                "blackbody temperature {temperature_k} K is outside the range whose peak radiance f32 can represent"
+            )));
+        }
+        Ok(Spectrum::Blackbody {
+            temperature_k,
+            scale,
+        })
+    }
+
+    /// This spectrum multiplied by `factor` (tables are copied once, here, not per evaluation).
+    pub fn scaled(self, factor: f32) -> Self {
+        match self {
+            Spectrum::Constant(v) => Spectrum::Constant(v * factor),
+            Spectrum::PiecewiseLinear(p) => Spectrum::PiecewiseLinear(p.scaled(factor)),
+            Spectrum::Dense(d) => Spectrum::Dense(d.scaled(factor)),
+            Spectrum::Blackbody {
+                temperature_k,
+                scale,
+            } => Spectrum::Blackbody {
+                temperature_k,
+                scale: scale * factor,
+            },
+        }
+    }
+
+    /// Values at the four sampled wavelengths.
+    #[inline]
+    pub fn eval(&self, wavelengths: &SampledWavelengths) -> SampledSpectrum {
+        let lambda_nm = wavelengths.lambda();
+        match self {
+            Spectrum::Constant(v) => SampledSpectrum::splat(*v),
+            Spectrum::PiecewiseLinear(p) => p.eval4(lambda_nm),
+            Spectrum::Dense(d) => d.eval4(lambda_nm),
+            Spectrum::Blackbody {
+                temperature_k,
+                scale,
+            } => blackbody_radiance_4(lambda_nm, *temperature_k, *scale),
+        }
+    }
+
+    /// Value at one wavelength in f64 (reference integrals, tests, colorimetry).
+    pub fn eval_nm(&self, wavelength_nm: f64) -> f64 {
+        match self {
+            Spectrum::Constant(v) => *v as f64,
+            Spectrum::PiecewiseLinear(p) => p.eval_nm(wavelength_nm),
+            Spectrum::Dense(d) => d.eval_nm(wavelength_nm),
+            Spectrum::Blackbody {
+                temperature_k,
+                scale,
+            } => *scale as f64 * blackbody_radiance(wavelength_nm, *temperature_k as f64),
+        }
+    }
+
+    /// Samples the spectrum at every whole nanometre in 360..=830.
+    pub fn to_dense(&self) -> DenseSpectrum {
+        DenseSpectrum::from_fn(|wl| self.eval_nm(wl))
+    }
+}
+
+fn check_temperature(temperature_k: f32) -> Result<(), InvalidSpectrum> {
+    if temperature_k.is_finite() && temperature_k > 0.0 {
+        Ok(())
+    } else {
+        Err(InvalidSpectrum::new(format!(
+            "blackbody temperature must be a finite number of kelvin above 0, got {temperature_k}"
+        )))
+    }
+}
+
+/// Converts table values to f32, rejecting NaN, ±∞ and values f32 cannot hold.
+fn finite_f32_values(values: &[f64]) -> Result<Vec<f32>, InvalidSpectrum> {
+    values
+        .iter()
+        .enumerate()
+        .map(|(i, &v)| {
+            let v32 = v as f32;
+            if v32.is_finite() {
+                Ok(v32)
+            } else {
+                Err(InvalidSpectrum::new(format!(
+                    "spectrum value {} (sample {}) is not a finite f32 number",
+                    v,
+                    i + 1
+                )))
+            }
+        })
+        .collect()
+}
+
+/// Piecewise-linear table at increasing wavelengths; zero outside [first, last].
+#[derive(Clone, Debug, PartialEq)]
+pub struct PiecewiseLinear {
+    wavelengths_nm: Arc<[f32]>,
+    values: Arc<[f32]>,
+    first_nm: f32,
+    last_nm: f32,
+    /// 1 / spacing in nm⁻¹ when the wavelengths are uniformly spaced, else 0.
+    inv_step_per_nm: f32,
+    /// Non-uniform tables: `guide[c]` is the segment holding the start of cell c of
+    /// `GUIDE_CELLS_PER_SEGMENT·(n − 1)` equal cells over [first, last] (empty when uniform).
+    /// Evaluation scans only the few nodes between neighbouring guide entries.
+    guide: Arc<[u32]>,
+    /// Cells per nm of the guide.
+    guide_cells_per_nm: f32,
+}
+
+/// Guide cells per table segment: enough that a cell rarely spans more than one node.
+const GUIDE_CELLS_PER_SEGMENT: usize = 2;
+
+/// Relative tolerance (in units of the spacing) under which a table counts as uniform.
+const UNIFORM_SPACING_TOLERANCE: f64 = 1e-6;
+
+impl PiecewiseLinear {
+    /// Validates and stores the table: same non-zero length, finite strictly increasing
+    /// wavelengths (also after rounding to f32), finite values.
+    pub fn new(wavelengths_nm: &[f64], values: &[f64]) -> Result<Self, InvalidSpectrum> {
+        if wavelengths_nm.is_empty() {
+            return Err(InvalidSpectrum::new("spectrum table is empty"));
+        }
+        if wavelengths_nm.len() != values.len() {
+            return Err(InvalidSpectrum::new(format!(
+                "spectrum table has {} wavelengths but {} values",
+                wavelengths_nm.len(),
+                values.len()
+            )));
+        }
+        let wl32: Vec<f32> = wavelengths_nm.iter().map(|&w| w as f32).collect();
+        if let Some(i) = wl32.iter().position(|w| !w.is_finite()) {
+            return Err(InvalidSpectrum::new(format!(
+                "wavelength {} nm (sample {}) is not finite",
+                wavelengths_nm[i],
+                i + 1
+            )));
+        }
+        if let Some(i) = wl32.windows(2).position(|w| w[0] >= w[1]) {
+            return Err(InvalidSpectrum::new(format!(
+                "wavelengths must increase strictly: sample {} ({} nm) is not above sample {} ({} nm)",
+                i + 2,
+                wavelengths_nm[i + 1],
+                i + 1,
+                wavelengths_nm[i]
+            )));
+        }
+        let values32 = finite_f32_values(values)?;
+        let n = wavelengths_nm.len();
+        let first = wavelengths_nm[0];
+        let inv_step_per_nm = if n >= 2 {
+            let step = (wavelengths_nm[n - 1] - first) / (n - 1) as f64;
+            let uniform = wavelengths_nm.iter().enumerate().all(|(i, &w)| {
+                (w - (first + i as f64 * step)).abs() <= UNIFORM_SPACING_TOLERANCE * step
+            });
+            if uniform {
+                (1.0 / step) as f32
+            } else {
+                0.0
+            }
+        } else {
+            0.0
+        };
+        let (guide, guide_cells_per_nm) = if inv_step_per_nm == 0.0 && n >= 2 {
+            build_guide(&wl32)
+        } else {
+            (Vec::new(), 0.0)
+        };
+        Ok(Self {
+            guide: guide.into(),
+            guide_cells_per_nm,
+            first_nm: wl32[0],
+            last_nm: wl32[n - 1],
+            wavelengths_nm: wl32.into(),
+            values: values32.into(),
+            inv_step_per_nm,
+        })
+    }
+
+    /// True when evaluation indexes directly (uniform spacing).
+    pub fn is_uniform(&self) -> bool {
+        self.inv_step_per_nm > 0.0
+    }
+
+    pub fn wavelengths_nm(&self) -> &[f32] {
+        &self.wavelengths_nm
+    }
+
+    pub fn values(&self) -> &[f32] {
+        &self.values
+    }
+
+    fn scaled(&self, factor: f32) -> Self {
+        Self {
+            values: self.values.iter().map(|v| v * factor).collect(),
+            ..self.clone()
+        }
+    }
+
+    #[inline]
+    fn eval4(&self, lambda_nm: [f32; N_SPECTRUM_SAMPLES]) -> SampledSpectrum {
+        let values = &*self.values;
+        let n = values.len();
+        if n < 2 {
+            // A single sample: defined only at its own wavelength (as `Tabulated`).
+            return SampledSpectrum::new(lambda_nm.map(|wl| {
+                if wl == self.first_nm {
+                    values[0]
+                } else {
+                    0.0
+                }
+            }));
+        }
+        let (first, last) = (self.first_nm, self.last_nm);
+        if self.is_uniform() {
+            let inv_step = self.inv_step_per_nm;
+            SampledSpectrum::new(lambda_nm.map(|wl| {
+                let x = (wl - first) * inv_step;
+                // Clamp, then a native f32 → i32 conversion (NaN gives 0); lanes outside the
+                // table are zeroed below.
+                let i = (x.clamp(0.0, (n - 2) as f32) as i32 as usize).min(n - 2);
+                let t = x - i as f32;
+                let v = values[i] + t * (values[i + 1] - values[i]);
+                if wl >= first && wl <= last {
+                    v
+                } else {
+                    0.0
+                }
+            }))
+        } else {
+            // The guide cell of λ narrows the search to the segments between the guide
+            // entries one cell either side (a margin for rounding), usually one or two.
+            let wavelengths = &*self.wavelengths_nm;
+            let guide = &*self.guide;
+            let last_cell = guide.len() - 1;
+            let mut segment = [0usize; N_SPECTRUM_SAMPLES];
+            for (i, &wl) in segment.iter_mut().zip(lambda_nm.iter()) {
+                let cell = (((wl - first) * self.guide_cells_per_nm).clamp(0.0, last_cell as f32)
+                    as i32 as usize)
+                    .min(last_cell);
+                let lo = guide[cell.saturating_sub(1)] as usize;
+                let hi = guide[(cell + 2).min(last_cell)] as usize;
+                // Count the nodes in (lo, hi] at or below λ (branch-free, usually 1–3 nodes).
+                *i = lo
+                    + wavelengths[lo + 1..=hi]
+                        .iter()
+                        .map(|&w| (w <= wl) as usize)
+                        .sum::<usize>();
+            }
+            let mut out = [0.0f32; N_SPECTRUM_SAMPLES];
+            for lane in 0..N_SPECTRUM_SAMPLES {
+                let (i, wl) = (segment[lane], lambda_nm[lane]);
+                let (w0, w1) = (wavelengths[i], wavelengths[i + 1]);
+                let t = (wl - w0) / (w1 - w0);
+                let v = values[i] + t * (values[i + 1] - values[i]);
+                out[lane] = if wl >= first && wl <= last { v } else { 0.0 };
+            }
+            SampledSpectrum::new(out)
+        }
+    }
+
+    fn eval_nm(&self, wavelength_nm: f64) -> f64 {
+        let values = &*self.values;
+        let n = values.len();
+        let (first, last) = (self.first_nm as f64, self.last_nm as f64);
+        if !(wavelength_nm >= first && wavelength_nm <= last) {
+            return 0.0;
+        }
+        if n < 2 {
+            return values[0] as f64;
+        }
+        let (i, t) = if self.is_uniform() {
+            let x = (wavelength_nm - first) * self.inv_step_per_nm as f64;
+            let i = (x as usize).min(n - 2);
+            (i + 1, x - i as f64)
+        } else {
+            let w = &*self.wavelengths_nm;
+            let i = w
+                .partition_point(|&x| x as f64 <= wavelength_nm)
+                .clamp(1, n - 1);
+            let (w0, w1) = (w[i - 1] as f64, w[i] as f64);
+            (i, (wavelength_nm - w0) / (w1 - w0))
+        };
+        let (v0, v1) = (values[i - 1] as f64, values[i] as f64);
+        v0 + t * (v1 - v0)
+    }
+}
+
+/// Guide table of a non-uniform piecewise-linear table: for each of
+/// `GUIDE_CELLS_PER_SEGMENT·(n − 1)` equal cells over [first, last] (plus one entry for
+/// λ = last), the last segment i ≤ n − 2 whose start wavelength is ≤ the cell's start.
+fn build_guide(wavelengths_nm: &[f32]) -> (Vec<u32>, f32) {
+    let n = wavelengths_nm.len();
+    let cells = GUIDE_CELLS_PER_SEGMENT * (n - 1);
+    let (first, last) = (wavelengths_nm[0] as f64, wavelengths_nm[n - 1] as f64);
+    let cell_nm = (last - first) / cells as f64;
+    let guide = (0..=cells)
+        .map(|c| {
+            let start = first + c as f64 * cell_nm;
+            let i = wavelengths_nm.partition_point(|&w| w as f64 <= start);
+            i.saturating_sub(1).min(n - 2) as u32
+        })
+        .collect();
+    (guide, (1.0 / cell_nm) as f32)
+}
+
+/// A spectrum on the 1 nm grid 360, 361, …, 830 nm in f32.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DenseTable {
+    values: Arc<[f32; DENSE_SAMPLE_COUNT]>,
+}
+
+impl DenseTable {
+    pub fn new(dense: &DenseSpectrum) -> Result<Self, InvalidSpectrum> {
+        let converted = finite_f32_values(dense.values())?;
+        let mut values = [0.0f32; DENSE_SAMPLE_COUNT];
+        values.copy_from_slice(&converted);
+        Ok(Self {
+            values: Arc::new(values),
+        })
+    }
+
+    /// Values at 360, 361, …, 830 nm.
+    pub fn values(&self) -> &[f32; DENSE_SAMPLE_COUNT] {
+        &self.values
+    }
+
+    fn scaled(&self, factor: f32) -> Self {
+        Self {
+            values: Arc::new(self.values.map(|v| v * factor)),
+        }
+    }
+
+    #[inline]
+    fn eval4(&self, lambda_nm: [f32; N_SPECTRUM_SAMPLES]) -> SampledSpectrum {
+        let values = &*self.values;
+        SampledSpectrum::new(lambda_nm.map(|wl| {
+            let x = wl - LAMBDA_MIN_NM;
+            // Clamp, then a native f32 → i32 conversion (NaN gives 0); lanes outside
+            // 360–830 nm are zeroed below.
+            let last_segment = DENSE_SAMPLE_COUNT - 2;
+            let i = (x.clamp(0.0, last_segment as f32) as i32 as usize).min(last_segment);
+            let t = x - i as f32;
+            let v = values[i] + t * (values[i + 1] - values[i]);
+            if x >= 0.0 && x <= (DENSE_SAMPLE_COUNT - 1) as f32 {
+                v
+            } else {
+                0.0
+            }
+        }))
+    }
+
+    fn eval_nm(&self, wavelength_nm: f64) -> f64 {
+        let x = wavelength_nm - LAMBDA_MIN_NM as f64;
+        if !(x >= 0.0 && x <= (DENSE_SAMPLE_COUNT - 1) as f64) {
+            return 0.0;
+        }
+        let i = (x as usize).min(DENSE_SAMPLE_COUNT - 2);
+        let t = x - i as f64;
+        let (v0, v1) = (self.values[i] as f64, self.values[i + 1] as f64);
+        v0 + t * (v1 - v0)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn wavelengths(lambda_nm: [f32; 4]) -> SampledWavelengths {
+        SampledWavelengths::new(lambda_nm, SampledSpectrum::splat(1.0))
+    }
+
+    fn all_kinds() -> Vec<(&'static str, Spectrum)> {
+        let uniform = Spectrum::piecewise_linear(
+            &[400.0, 450.0, 500.0, 550.0, 600.0, 650.0, 700.0],
+            &[0.1, 0.5, 0.2, 0.9, 0.4, 0.3, 0.8],
+        )
+        .unwrap();
+        let non_uniform = Spectrum::piecewise_linear(
+            &[380.0, 381.5, 420.0, 555.25, 700.0, 780.0],
+            &[1.0, 2.0, 0.5, 3.0, 0.25, 4.0],
+        )
+        .unwrap();
+        vec![
+            ("constant", Spectrum::constant(0.7)),
+            ("uniform", uniform),
+            ("non-uniform", non_uniform),
+            (
+                "dense",
+                Spectrum::from_dense(&data::cmfs(data::Observer::Cie1931).y_bar).unwrap(),
+            ),
+            ("blackbody", Spectrum::blackbody(3000.0).unwrap()),
+            (
+                "blackbody normalised",
+                Spectrum::blackbody_normalized(6500.0).unwrap(),
+            ),
+            ("F11", Spectrum::cie_illuminant("F11").unwrap()),
+            ("D65", Spectrum::cie_illuminant("d65").unwrap()),
+        ]
+    }
+
+    #[test]
+    fn eval_agrees_with_eval_nm_for_every_kind() {
+        let mut lanes = Vec::new();
+        // Nodes, in-between points, the range ends and points outside every table.
+        for i in 0..=1880 {
+            lanes.push(355.0 + i as f32 * 0.25);
+        }
+        lanes.extend([
+            359.9,
+            360.0,
+            379.99,
+            380.0,
+            780.0,
+            780.01,
+            830.0,
+            830.1,
+            -5.0,
+            f32::NAN,
+        ]);
+        while lanes.len() % 4 != 0 {
+            lanes.push(500.0);
+        }
+        for (name, spectrum) in all_kinds() {
+            let scale = (0..=470)
+                .map(|i| spectrum.eval_nm(360.0 + i as f64).abs())
+                .fold(0.0, f64::max);
+            for chunk in lanes.chunks(4) {
+                let lambda: [f32; 4] = chunk.try_into().unwrap();
+                let got = spectrum.eval(&wavelengths(lambda));
+                for lane in 0..4 {
+                    let expected = spectrum.eval_nm(lambda[lane] as f64);
+                    let got_lane = got[lane] as f64;
+                    assert!(
+                        (got_lane - expected).abs() <= 2e-6 * scale + 1e-5 * expected.abs(),
+                        "{name} at {} nm: eval {got_lane}, eval_nm {expected}",
+                        lambda[lane]
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn clustered_non_uniform_tables_evaluate_exactly() {
+        // Nodes crowded at both ends and sparse in the middle stress the guide table.
+        let mut wavelengths_nm: Vec<f64> = (0..40).map(|i| 380.0 + 0.05 * i as f64).collect();
+        wavelengths_nm.extend([450.0, 455.5, 600.0]);
+        wavelengths_nm.extend((0..40).map(|i| 700.0 + 0.01 * i as f64));
+        wavelengths_nm.push(780.0);
+        let values: Vec<f64> = (0..wavelengths_nm.len())
+            .map(|i| ((i * 7919) % 13) as f64)
+            .collect();
+        let s = Spectrum::piecewise_linear(&wavelengths_nm, &values).unwrap();
+        let table = Tabulated::new(wavelengths_nm.clone(), values).unwrap();
+        let mut probes: Vec<f32> = wavelengths_nm.iter().map(|&w| w as f32).collect();
+        probes.extend((0..20_000).map(|i| 375.0 + 0.021 * i as f32));
+        while !probes.len().is_multiple_of(4) {
+            probes.push(600.0);
+        }
+        for chunk in probes.chunks(4) {
+            let lambda: [f32; 4] = chunk.try_into().unwrap();
+            let got = s.eval(&wavelengths(lambda));
+            for lane in 0..4 {
+                // Against the f64 evaluation of the same f32 nodes (segment search by
+                // plain binary search); the f64 `Tabulated` agrees to f32 node rounding.
+                let expected = s.eval_nm(lambda[lane] as f64);
+                assert!((expected - table.eval(lambda[lane] as f64)).abs() < 0.1);
+                assert!(
+                    (got[lane] as f64 - expected).abs() < 1e-5,
+                    "{} nm: {} vs {expected}",
+                    lambda[lane],
+                    got[lane]
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn tables_match_their_source_and_vanish_outside() {
+        let table = Tabulated::new(vec![400.0, 500.0, 700.0], vec![1.0, 3.0, 1.0]).unwrap();
+        let s = Spectrum::from_tabulated(&table).unwrap();
+        let Spectrum::PiecewiseLinear(p) = &s else {
+            panic!("expected a piecewise-linear spectrum")
+        };
+        assert!(!p.is_uniform());
+        for wl in [399.9, 400.0, 450.0, 600.0, 700.0, 700.1] {
+            assert!((s.eval_nm(wl) - table.eval(wl)).abs() < 1e-6);
+        }
+        let uniform = Spectrum::piecewise_linear(&[400.0, 500.0, 600.0], &[1.0, 3.0, 1.0]).unwrap();
+        let Spectrum::PiecewiseLinear(p) = &uniform else {
+            panic!("expected a piecewise-linear spectrum")
+        };
+        assert!(p.is_uniform());
+        let got = uniform.eval(&wavelengths([399.0, 450.0, 600.0, 601.0]));
+        assert_eq!(got.values, [0.0, 2.0, 1.0, 0.0]);
+        let single = Spectrum::piecewise_linear(&[500.0], &[2.0]).unwrap();
+        assert_eq!(
+            single.eval(&wavelengths([500.0, 501.0, 0.0, 499.0])).values,
+            [2.0, 0.0, 0.0, 0.0]
+        );
+        assert_eq!(single.eval_nm(500.0), 2.0);
+    }
+
+    #[test]
+    fn named_illuminants_are_dense_copies_of_the_cie_tables() {
+        let f11 = Spectrum::cie_illuminant("FL11").unwrap();
+        assert!(matches!(f11, Spectrum::Dense(_)));
+        let table = data::illuminant("F11").unwrap();
+        for i in 0..=470 {
+            let wl = 360.0 + i as f64;
+            assert!((f11.eval_nm(wl) - table.eval(wl)).abs() < 1e-4 * table.eval(wl).max(1.0));
+        }
+        let err = Spectrum::cie_illuminant("D56").unwrap_err();
+        assert!(
+            err.message.contains("unknown CIE illuminant 'D56'"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn blackbody_kinds_follow_plancks_law() {
+        let abs = Spectrum::blackbody(5000.0).unwrap();
+        assert!((abs.eval_nm(500.0) / blackbody_radiance(500.0, 5000.0) - 1.0).abs() < 1e-12);
+        let norm = Spectrum::blackbody_normalized(5000.0).unwrap();
+        let peak_nm = crate::blackbody::wien_peak_wavelength_nm(5000.0);
+        assert!((norm.eval_nm(peak_nm) - 1.0).abs() < 1e-6);
+        assert!(Spectrum::blackbody(0.0).is_err());
+        assert!(Spectrum::blackbody(-300.0).is_err());
+        assert!(Spectrum::blackbody_normalized(f32::NAN).is_err());
+    }
+
+    #[test]
+    fn scaling_multiplies_every_kind() {
+        for (name, spectrum) in all_kinds() {
+            let scaled = spectrum.clone().scaled(2.5);
+            for wl in [365.0, 412.3, 555.0, 701.7, 829.0] {
+                let (a, b) = (spectrum.eval_nm(wl), scaled.eval_nm(wl));
+                assert!(
+                    (b - 2.5 * a).abs() <= 1e-6 * b.abs().max(1e-30),
+                    "{name} at {wl}: {a} {b}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn invalid_tables_are_rejected_with_messages() {
+        let e = Spectrum::piecewise_linear(&[], &[]).unwrap_err();
+        assert!(e.message.contains("empty"));
+        let e = Spectrum::piecewise_linear(&[400.0, 500.0], &[1.0]).unwrap_err();
+        assert!(e.message.contains("2 wavelengths but 1 values"));
+        let e = Spectrum::piecewise_linear(&[400.0, 400.0], &[1.0, 2.0]).unwrap_err();
+        assert!(e.message.contains("increase strictly"), "{e}");
+        let e = Spectrum::piecewise_linear(&[400.0, 400.000_000_01], &[1.0, 2.0]).unwrap_err();
+        assert!(e.message.contains("increase strictly"), "{e}");
+        let e = Spectrum::piecewise_linear(&[400.0, f64::NAN], &[1.0, 2.0]).unwrap_err();
+        assert!(e.message.contains("not finite"), "{e}");
+        let e = Spectrum::piecewise_linear(&[400.0, 500.0], &[1.0, f64::NAN]).unwrap_err();
+        assert!(e.message.contains("sample 2"), "{e}");
+        let e = Spectrum::piecewise_linear(&[400.0, 500.0], &[1e300, 1.0]).unwrap_err();
+        assert!(e.message.contains("finite f32"), "{e}");
+    }
+
+    #[test]
+    fn to_dense_samples_whole_nanometres() {
+        let s = Spectrum::piecewise_linear(&[380.0, 780.0], &[0.0, 400.0]).unwrap();
+        let d = s.to_dense();
+        assert_eq!(d.values()[20], 0.0);
+        assert!((d.values()[21] - 1.0).abs() < 1e-4);
+        assert_eq!(d.values()[421], 0.0);
+        assert_eq!(
+            Spectrum::constant(3.0).to_dense(),
+            DenseSpectrum::constant(3.0)
+        );
+    }
+}

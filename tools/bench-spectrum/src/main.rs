@@ -1,0 +1,150 @@
+//! `cargo run --release -p bench-spectrum`: nanoseconds per 4-wavelength `Spectrum::eval`
+//! for every spectrum kind, per hero-wavelength sample, and per spectrum → XYZ of a 1 nm
+//! table. Prints one JSON object (median of several runs) for tools/ to chart.
+
+use std::hint::black_box;
+use std::time::Instant;
+
+use prism_spectrum::data::{cmfs, Observer};
+use prism_spectrum::{DenseSpectrum, SampledSpectrum, SampledWavelengths, Spectrum};
+
+const RUNS: usize = 9;
+const EVALS_PER_RUN: usize = 2_000_000;
+const WAVELENGTH_SETS: usize = 4096;
+
+/// Median and minimum of `RUNS` timings of `per_run` calls of `body(i)`, in ns per call
+/// (the minimum is the steadier figure on a loaded machine).
+fn median_ns(per_run: usize, mut body: impl FnMut(usize)) -> (f64, f64) {
+    let mut timings: Vec<f64> = (0..RUNS)
+        .map(|_| {
+            let start = Instant::now();
+            for i in 0..per_run {
+                body(i);
+            }
+            start.elapsed().as_secs_f64() * 1e9 / per_run as f64
+        })
+        .collect();
+    timings.sort_by(|a, b| a.total_cmp(b));
+    (timings[RUNS / 2], timings[0])
+}
+
+/// SplitMix64 for the wavelength variates.
+fn splitmix(state: &mut u64) -> f32 {
+    *state = state.wrapping_add(0x9e37_79b9_7f4a_7c15);
+    let mut z = *state;
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    ((z ^ (z >> 31)) >> 40) as f32 * (1.0 / (1u64 << 24) as f32)
+}
+
+fn bench_eval(spectrum: &Spectrum, wavelengths: &[SampledWavelengths]) -> (f64, f64) {
+    let mut acc = SampledSpectrum::zero();
+    let ns = median_ns(EVALS_PER_RUN, |i| {
+        // Wavelengths vary every call; black_box keeps the spectrum from being hoisted.
+        let w = &wavelengths[i % WAVELENGTH_SETS];
+        acc += black_box(spectrum).eval(black_box(w));
+    });
+    black_box(acc);
+    ns
+}
+
+/// Σ over the 471 grid samples of S(λ)·(x̄, ȳ, z̄)(λ)·1 nm (colorimetry.rs has the real one).
+fn dense_to_xyz(spectrum: &DenseSpectrum, observer: &prism_spectrum::data::Cmfs) -> [f64; 3] {
+    let s = spectrum.values();
+    let (x, y, z) = (
+        observer.x_bar.values(),
+        observer.y_bar.values(),
+        observer.z_bar.values(),
+    );
+    let mut xyz = [0.0; 3];
+    for i in 0..s.len() {
+        xyz[0] += s[i] * x[i];
+        xyz[1] += s[i] * y[i];
+        xyz[2] += s[i] * z[i];
+    }
+    xyz
+}
+
+fn main() {
+    let mut state = 0x00be_ac40;
+    let wavelengths: Vec<SampledWavelengths> = (0..WAVELENGTH_SETS)
+        .map(|_| SampledWavelengths::sample_visible(splitmix(&mut state)))
+        .collect();
+
+    let uniform_table: Vec<f64> = (0..=94).map(|i| 360.0 + 5.0 * i as f64).collect();
+    let uniform_values: Vec<f64> = uniform_table
+        .iter()
+        .map(|wl| (wl / 50.0).sin().abs())
+        .collect();
+    // 95 samples, irregular spacing (as measured reflectances often are).
+    let irregular_table: Vec<f64> = (0..95)
+        .map(|i| 360.0 + 470.0 * (i as f64 / 94.0).powf(1.3))
+        .collect();
+    let irregular_values: Vec<f64> = irregular_table
+        .iter()
+        .map(|wl| (wl / 40.0).cos().abs())
+        .collect();
+
+    let kinds: Vec<(&str, Spectrum)> = vec![
+        ("constant", Spectrum::constant(0.5)),
+        (
+            "piecewise_linear_uniform",
+            Spectrum::piecewise_linear(&uniform_table, &uniform_values).unwrap(),
+        ),
+        (
+            "piecewise_linear_non_uniform",
+            Spectrum::piecewise_linear(&irregular_table, &irregular_values).unwrap(),
+        ),
+        (
+            "dense",
+            Spectrum::from_dense(&cmfs(Observer::Cie1931).y_bar).unwrap(),
+        ),
+        ("blackbody", Spectrum::blackbody_normalized(6500.0).unwrap()),
+        (
+            "named_illuminant_d65",
+            Spectrum::cie_illuminant("D65").unwrap(),
+        ),
+        // RGB-upsampled kinds (rgb_albedo, rgb_unbounded, rgb_illuminant) are added here
+        // with their variants.
+    ];
+
+    let (mut medians, mut minima) = (Vec::new(), Vec::new());
+    for (name, spectrum) in &kinds {
+        let (median, min) = bench_eval(spectrum, &wavelengths);
+        medians.push(format!("\"{name}\": {median:.2}"));
+        minima.push(format!("\"{name}\": {min:.2}"));
+    }
+
+    let mut u_state = 7u64;
+    let mut sink = 0.0f32;
+    let sample_ns = median_ns(EVALS_PER_RUN, |_| {
+        let w = SampledWavelengths::sample_visible(black_box(splitmix(&mut u_state)));
+        sink += w.pdf()[0];
+    });
+    let rng_ns = median_ns(EVALS_PER_RUN, |_| {
+        sink += black_box(splitmix(&mut u_state));
+    });
+    black_box(sink);
+
+    let observer = cmfs(Observer::Cie1931);
+    let d65 = Spectrum::cie_illuminant("D65").unwrap().to_dense();
+    let mut xyz_sink = 0.0;
+    let xyz_ns = median_ns(200_000, |_| {
+        xyz_sink += dense_to_xyz(black_box(&d65), observer)[1];
+    });
+    black_box(xyz_sink);
+
+    println!(
+        "{{\"benchmark\": \"prism-spectrum\", \"unit\": \"ns\", \"runs\": {RUNS}, \"statistic\": \"median\", \
+\"eval_4_wavelengths_ns\": {{{}}}, \
+\"eval_4_wavelengths_min_ns\": {{{}}}, \
+\"sample_visible_wavelengths_ns\": {:.2}, \
+\"spectrum_to_xyz_1nm_ns\": {:.1}, \
+\"spectrum_to_xyz_1nm_min_ns\": {:.1}}}",
+        medians.join(", "),
+        minima.join(", "),
+        (sample_ns.0 - rng_ns.0).max(0.0),
+        xyz_ns.0,
+        xyz_ns.1
+    );
+}
