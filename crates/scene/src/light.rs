@@ -36,6 +36,8 @@ pub enum Strength {
     Scale(f64),
 }
 
+// Scenes hold few lights; boxing the environment's transform would only add noise.
+#[allow(clippy::large_enum_variant)]
 #[derive(Debug, Clone, PartialEq)]
 pub enum LightKind {
     Point {

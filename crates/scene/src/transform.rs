@@ -129,7 +129,7 @@ fn parse_step(v: &V) -> Result<Transform> {
                     .numbers::<3>()
                     .map_err(|_| arg.type_err("a number or an array of 3 numbers"))?,
             };
-            if s.iter().any(|c| *c == 0.0) {
+            if s.contains(&0.0) {
                 return Err(arg.err(format!("expected non-zero scale factors, found {s:?}")));
             }
             Ok(Transform::from_matrix(DMat4::from_scale(s.into())).ok_or_else(singular)?)
