@@ -294,7 +294,7 @@ mod tests {
             items[1].pos,
             Position {
                 line: 2,
-                column: 11
+                column: 12
             }
         );
         let Value::Object(inner) = &items[1].value else {

@@ -5,9 +5,8 @@
 use std::path::PathBuf;
 
 use glam::DVec3;
-use prism_spectrum::names::did_you_mean;
 
-use crate::reader::{quoted_list, Obj, Result, V};
+use crate::reader::{quoted_list, suggest, Obj, Result, V};
 use crate::shape::Shape;
 use crate::spectrum_ref::{parse_spectrum, NamedSpectra, SpectrumRef, SpectrumUse};
 use crate::transform::{parse_transform, Transform};
@@ -212,7 +211,7 @@ pub(crate) fn parse_light(v: &V, spectra: &NamedSpectra, shapes: &[Shape]) -> Re
                     };
                     shape_v.err(format!(
                         "unknown shape `{wanted}` ({known}){}",
-                        did_you_mean(wanted, names.iter().copied())
+                        suggest(wanted, names.iter().copied())
                     ))
                 })?;
             let two_sided = o.bool_or("two_sided", false)?;

@@ -2,9 +2,7 @@
 //! dielectric, two-sided wrapper and opacity mask. Materials are named in the `materials`
 //! section and referenced by name.
 
-use prism_spectrum::names::did_you_mean;
-
-use crate::reader::{quoted_list, Obj, Result, V};
+use crate::reader::{quoted_list, suggest, Obj, Result, V};
 use crate::spectrum_ref::{parse_spectrum, NamedSpectra, SpectrumRef, SpectrumUse};
 
 #[derive(Debug, Clone, PartialEq)]
@@ -124,7 +122,7 @@ pub(crate) fn material_index(v: &V, names: &[&str]) -> Result<usize> {
         };
         v.err(format!(
             "unknown material `{wanted}` ({known}){}",
-            did_you_mean(wanted, names.iter().copied())
+            suggest(wanted, names.iter().copied())
         ))
     })
 }
@@ -239,7 +237,7 @@ fn parse_ior(v: &V) -> Result<Ior> {
         return Ok(Ior::Constant(v.positive()?));
     }
     let o = v.object(&["sellmeier", "cauchy"]).map_err(|e| {
-        if v.object(&[]).is_err() {
+        if !v.is_object() {
             v.type_err("a number, {\"sellmeier\": …} or {\"cauchy\": …}")
         } else {
             e

@@ -36,6 +36,33 @@ pub(crate) fn quoted_list(names: &[&str]) -> String {
         .join(", ")
 }
 
+/// " (did you mean …?)": the closest names by edit distance, or else names that the typo
+/// starts with or is contained in (`equisolid_angle` → `equisolid`).
+pub(crate) fn suggest<'n>(
+    wanted: &str,
+    names: impl IntoIterator<Item = &'n str> + Clone,
+) -> String {
+    let close = did_you_mean(wanted, names.clone());
+    if !close.is_empty() || wanted.is_empty() {
+        return close;
+    }
+    let lower = wanted.to_lowercase();
+    let related: Vec<String> = names
+        .into_iter()
+        .filter(|n| {
+            let n = n.to_lowercase();
+            lower.starts_with(&n) || n.contains(&lower)
+        })
+        .take(3)
+        .map(|n| format!("`{n}`"))
+        .collect();
+    if related.is_empty() {
+        String::new()
+    } else {
+        format!(" (did you mean {}?)", related.join(", "))
+    }
+}
+
 /// A value in the tree, with its path.
 #[derive(Clone)]
 pub(crate) struct V<'a> {
@@ -57,6 +84,22 @@ impl<'a> V<'a> {
             other => other.kind().to_string(),
         };
         self.err(format!("expected {expected}, found {found}"))
+    }
+
+    /// A member of this value if it is an object (no field check).
+    pub fn member(&self, key: &str) -> Option<V<'a>> {
+        match &self.node.value {
+            Value::Object(members) => members.iter().find(|m| m.key == key).map(|m| V {
+                node: &m.value,
+                path: self.path.key(key),
+                cx: self.cx,
+            }),
+            _ => None,
+        }
+    }
+
+    pub fn is_object(&self) -> bool {
+        matches!(self.node.value, Value::Object(_))
     }
 
     pub fn f64(&self) -> Result<f64> {
@@ -158,7 +201,7 @@ impl<'a> V<'a> {
             self.err(format!(
                 "unknown {what} `{s}`, expected one of {}{}",
                 quoted_list(names),
-                did_you_mean(s, names.iter().copied())
+                suggest(s, names.iter().copied())
             ))
         })
     }
@@ -291,7 +334,7 @@ impl<'a> Obj<'a> {
                         "unknown field `{}`, expected one of {}{}",
                         m.key,
                         quoted_list(allowed),
-                        did_you_mean(&m.key, allowed.iter().copied())
+                        suggest(&m.key, allowed.iter().copied())
                     ),
                 ));
             }

@@ -132,8 +132,7 @@ fn parse_root(v: &V) -> Result<SceneDescription> {
             let shape = parse_shape(&item, &shape_cx, &mut meshes)?;
             if let Some(name) = &shape.name {
                 if shapes.iter().any(|s| s.name.as_ref() == Some(name)) {
-                    let at = item.object(&[]).ok().and_then(|s| s.get("name"));
-                    return Err(at.unwrap_or(item).err(format!(
+                    return Err(item.member("name").unwrap_or(item).err(format!(
                         "shape name `{name}` is used twice; names must be unique"
                     )));
                 }

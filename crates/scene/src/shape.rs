@@ -3,10 +3,8 @@
 
 use std::path::PathBuf;
 
-use prism_spectrum::names::did_you_mean;
-
 use crate::material::material_index;
-use crate::reader::{quoted_list, Result, V};
+use crate::reader::{quoted_list, suggest, Result, V};
 use crate::transform::{parse_transform, Transform};
 
 /// A mesh file to load once and share between the shapes that use it.
@@ -126,7 +124,7 @@ fn named_index(v: &V, what: &str, section: &str, names: &[&str]) -> Result<usize
         };
         v.err(format!(
             "unknown {what} `{wanted}` ({known}){}",
-            did_you_mean(wanted, names.iter().copied())
+            suggest(wanted, names.iter().copied())
         ))
     })
 }

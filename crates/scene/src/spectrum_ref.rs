@@ -5,11 +5,10 @@
 use std::path::PathBuf;
 
 use prism_spectrum::data::{canonical_illuminant_name, illuminant, ILLUMINANT_NAMES};
-use prism_spectrum::names::did_you_mean;
 use prism_spectrum::spectrum_file::read_spectral_file;
 use prism_spectrum::Tabulated;
 
-use crate::reader::{quoted_list, Result, V};
+use crate::reader::{quoted_list, suggest, Result, V};
 
 /// A spectrum as the scene gives it; files are already loaded.
 #[derive(Debug, Clone, PartialEq)]
@@ -95,18 +94,12 @@ pub(crate) fn parse_spectrum(
         return Err(v.err(format!(
             "unknown spectrum `{s}`: expected a name from `spectra` ({named_list}), \
              a CIE illuminant or a .csv file{}",
-            did_you_mean(s, candidates)
+            suggest(s, candidates)
         )));
     }
     let o = v
         .object(&["blackbody_k", "rgb", "file", "column"])
-        .map_err(|e| {
-            if v.object(&[]).is_err() {
-                v.type_err(FORMS)
-            } else {
-                e
-            }
-        })?;
+        .map_err(|e| if !v.is_object() { v.type_err(FORMS) } else { e })?;
     match o.at_most_one(&["blackbody_k", "rgb", "file"])? {
         Some(("blackbody_k", t)) => Ok(SpectrumRef::Blackbody {
             temperature_k: t.positive()?,
@@ -146,7 +139,7 @@ fn load_file(v: &V, file: &V, column: Option<&V>, usage: SpectrumUse) -> Result<
                     "no column `{name}` in {}, expected one of {}{}",
                     path.display(),
                     quoted_list(&names),
-                    did_you_mean(name, names.iter().copied())
+                    suggest(name, names.iter().copied())
                 ))
             })?
         }

@@ -94,7 +94,7 @@ pub(crate) fn parse_transform(v: &V) -> Result<Transform> {
 
 fn parse_step(v: &V) -> Result<Transform> {
     let o = v.object(&STEPS).map_err(|e| {
-        if v.object(&[]).is_err() && v.array().is_err() {
+        if !v.is_object() && v.array().is_err() {
             v.type_err("a transform step such as {\"translate\": [x, y, z]} or a list of steps")
         } else {
             e

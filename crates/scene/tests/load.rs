@@ -33,7 +33,10 @@ fn minimal_scene_loads_with_defaults() {
             sigma_px: 0.5
         }
     );
-    assert!(matches!(s.integrator, Integrator::Path { max_depth: 8, .. }));
+    assert!(matches!(
+        s.integrator,
+        Integrator::Path { max_depth: 8, .. }
+    ));
     assert_eq!(s.shapes.len(), 1);
     assert_eq!(s.shapes[0].kind, ShapeKind::Sphere { radius_m: 1.0 });
     assert_eq!(s.shapes[0].material, None);
@@ -105,8 +108,14 @@ const ALL_FIELDS: &str = r#"{
 
 fn all_fields_dir() -> Dir {
     let dir = Dir::new("all-fields");
-    dir.write("spectra/paint.csv", "wavelength_nm,value\n400,0.7\n700,0.8\n");
-    dir.write("spectra/two.csv", "wavelength_nm,bark,leaf\n400,0.1,0.05\n700,0.3,0.5\n");
+    dir.write(
+        "spectra/paint.csv",
+        "wavelength_nm,value\n400,0.7\n700,0.8\n",
+    );
+    dir.write(
+        "spectra/two.csv",
+        "wavelength_nm,bark,leaf\n400,0.1,0.05\n700,0.3,0.5\n",
+    );
     dir.write("meshes/bunny.ply", "ply\n");
     dir.write("meshes/teapot.obj", "v 0 0 0\n");
     dir.write("sky.exr", "");
@@ -215,7 +224,16 @@ fn every_field_kind_comes_through() {
     let m: Vec<&str> = s.materials.iter().map(|m| m.name.as_str()).collect();
     assert_eq!(
         m,
-        ["white", "gold", "custom_metal", "glass", "flint", "water", "sheet", "leafy"]
+        [
+            "white",
+            "gold",
+            "custom_metal",
+            "glass",
+            "flint",
+            "water",
+            "sheet",
+            "leafy"
+        ]
     );
     assert_eq!(
         s.materials[0].kind,
@@ -294,7 +312,10 @@ fn every_field_kind_comes_through() {
         DVec3::new(1.0, 2.0, 3.0)
     );
     assert_eq!(s.shapes[3].name.as_deref(), Some("lamp"));
-    assert_eq!(s.shapes[3].kind, ShapeKind::Rectangle { size_m: [2.0, 1.0] });
+    assert_eq!(
+        s.shapes[3].kind,
+        ShapeKind::Rectangle { size_m: [2.0, 1.0] }
+    );
     assert_eq!(s.shapes[4].kind, ShapeKind::Disk { radius_m: 0.25 });
     assert_eq!(
         s.shapes[5].kind,
@@ -311,7 +332,10 @@ fn every_field_kind_comes_through() {
     assert_eq!(*mesh, 0);
     assert_eq!(transforms.len(), 2);
     assert_eq!(transforms[0].transform_point(DVec3::ZERO), DVec3::X);
-    assert_eq!(transforms[1].transform_point(DVec3::ONE), DVec3::new(1.0, 2.0, 1.0));
+    assert_eq!(
+        transforms[1].transform_point(DVec3::ONE),
+        DVec3::new(1.0, 2.0, 1.0)
+    );
 
     // Lights.
     assert_eq!(s.lights.len(), 6);
@@ -392,7 +416,9 @@ fn camera_kinds_and_their_parameters() {
         aperture_radius_m,
         f_number,
         ..
-    } = kind(r#"{"type": "thin_lens", "fov_deg": 90, "aperture_radius_m": 0.01, "focus_distance_m": 2}"#)
+    } = kind(
+        r#"{"type": "thin_lens", "fov_deg": 90, "aperture_radius_m": 0.01, "focus_distance_m": 2}"#,
+    )
     else {
         panic!()
     };
