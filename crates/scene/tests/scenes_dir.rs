@@ -70,3 +70,27 @@ fn the_camera_gallery_is_one_room_seen_by_every_camera_model() {
         .collect();
     assert_eq!(kinds, names);
 }
+
+/// No panics on user input: every truncation of a real scene, and every single-character
+/// replacement with a troublesome character, gives a value or an error.
+#[test]
+fn truncated_and_corrupted_scenes_never_panic() {
+    let path = scenes_dir().join("cameras/thin-lens.json");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let chars: Vec<char> = text.chars().collect();
+    for end in 0..chars.len() {
+        let prefix: String = chars[..end].iter().collect();
+        if prefix.trim_end() == text.trim_end() {
+            continue;
+        }
+        assert!(prism_scene::parse_scene_str(&prefix, &path).is_err());
+    }
+    for i in (0..chars.len()).step_by(3) {
+        for c in ['"', '-', '0', '}', ']', 'x'] {
+            let mut corrupted = chars.clone();
+            corrupted[i] = c;
+            let corrupted: String = corrupted.into_iter().collect();
+            let _ = prism_scene::parse_scene_str(&corrupted, &path);
+        }
+    }
+}
