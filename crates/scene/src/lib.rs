@@ -1,0 +1,30 @@
+//! prism-scene: the JSON scene format. `load_scene` reads a file, checks every field and
+//! value, resolves and loads assets, and returns a `SceneDescription` of plain data for
+//! render. Errors name the file, line:column, the JSON path and what was expected; the
+//! format is documented in docs/scene-format.md.
+
+pub mod camera;
+pub mod error;
+pub mod film;
+pub mod integrator;
+mod json;
+pub mod light;
+pub mod material;
+pub mod medium;
+mod reader;
+pub mod scene;
+pub mod shape;
+pub mod spectrum_ref;
+pub mod transform;
+
+pub use camera::{Camera, CameraKind, FisheyeFit, FisheyeProjection, FovAxis};
+pub use error::{JsonPath, PathSegment, Position, SceneError};
+pub use film::{Aov, Film, PixelFilter};
+pub use integrator::{Integrator, MisHeuristic, SamplerKind};
+pub use light::{Light, LightKind, Strength};
+pub use material::{ConductorOptics, Ior, Material, MaterialKind, Microfacet, Roughness};
+pub use medium::{Medium, MediumKind};
+pub use scene::{load_scene, parse_scene_str, SceneDescription};
+pub use shape::{MeshAsset, MeshFormat, Shape, ShapeKind};
+pub use spectrum_ref::SpectrumRef;
+pub use transform::Transform;

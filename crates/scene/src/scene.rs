@@ -1,0 +1,170 @@
+//! The whole scene: the top-level object and the order its sections are resolved in
+//! (spectra → media → materials → meshes → shapes → lights; camera, film, integrator).
+
+use std::path::{Path, PathBuf};
+
+use crate::camera::{parse_camera, Camera};
+use crate::error::{JsonPath, SceneError};
+use crate::film::{parse_film, Film};
+use crate::integrator::{parse_integrator, Integrator};
+use crate::json::{self, Position};
+use crate::light::{parse_light, Light};
+use crate::material::{parse_materials, Material};
+use crate::medium::{parse_media, Medium};
+use crate::reader::{Ctx, Result, V};
+use crate::shape::{parse_meshes, parse_shape, MeshAsset, Shape, ShapeContext};
+use crate::spectrum_ref::{parse_spectrum, SpectrumRef, SpectrumUse};
+
+/// Everything render needs to build a scene, as plain data: angles in radians, lengths in
+/// metres, asset paths resolved, spectra loaded, references turned into indices.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SceneDescription {
+    /// The scene file this came from.
+    pub file: PathBuf,
+    pub camera: Camera,
+    pub film: Film,
+    pub integrator: Integrator,
+    /// The `spectra` section, in file order (references to them are already inlined).
+    pub spectra: Vec<(String, SpectrumRef)>,
+    pub materials: Vec<Material>,
+    /// Mesh files, each loaded once: the `meshes` section, then files named on shapes.
+    pub meshes: Vec<MeshAsset>,
+    pub shapes: Vec<Shape>,
+    pub lights: Vec<Light>,
+    pub media: Vec<Medium>,
+}
+
+pub const TOP_LEVEL_FIELDS: [&str; 10] = [
+    "camera",
+    "film",
+    "integrator",
+    "spectra",
+    "materials",
+    "meshes",
+    "shapes",
+    "lights",
+    "media",
+    "$schema",
+];
+
+/// Reads and parses a scene file; assets resolve relative to its folder.
+pub fn load_scene(path: impl AsRef<Path>) -> std::result::Result<SceneDescription, SceneError> {
+    let path = path.as_ref();
+    let text = std::fs::read_to_string(path).map_err(|e| SceneError {
+        file: path.to_path_buf(),
+        position: None,
+        path: JsonPath::default(),
+        message: format!("cannot read the scene file: {e}"),
+    })?;
+    parse_scene_str(&text, path)
+}
+
+/// Parses scene text as if it were the file `path` (used for messages and to resolve assets).
+pub fn parse_scene_str(
+    text: &str,
+    path: impl AsRef<Path>,
+) -> std::result::Result<SceneDescription, SceneError> {
+    let path = path.as_ref();
+    let cx = Ctx {
+        file: path.to_path_buf(),
+        base_dir: path.parent().map(Path::to_path_buf).unwrap_or_default(),
+    };
+    // serde_json's syntax errors are the reference: exact, and with line:column.
+    if let Err(e) = serde_json::from_str::<serde_json::Value>(text) {
+        let position = Position {
+            line: e.line(),
+            column: e.column(),
+        };
+        let full = e.to_string();
+        let suffix = format!(" at line {} column {}", e.line(), e.column());
+        let message = full.strip_suffix(&suffix).unwrap_or(&full).to_string();
+        return Err(cx.error(
+            position,
+            &JsonPath::default(),
+            format!("invalid JSON: {message}"),
+        ));
+    }
+    let root = json::parse(text).map_err(|e| {
+        cx.error(
+            e.pos,
+            &JsonPath::default(),
+            format!("invalid JSON: {}", e.message),
+        )
+    })?;
+    let v = V {
+        node: &root,
+        path: JsonPath::default(),
+        cx: &cx,
+    };
+    parse_root(&v)
+}
+
+fn parse_root(v: &V) -> Result<SceneDescription> {
+    let o = v.object(&TOP_LEVEL_FIELDS)?;
+
+    let mut spectra: Vec<(String, SpectrumRef)> = Vec::new();
+    if let Some(section) = o.get("spectra") {
+        for (name, entry) in section.map()? {
+            // Entries may use the ones above them.
+            let s = parse_spectrum(&entry, &spectra, SpectrumUse::NonNegative)?;
+            spectra.push((name.to_string(), s));
+        }
+    }
+    let media = o
+        .get("media")
+        .map_or(Ok(Vec::new()), |m| parse_media(&m, &spectra))?;
+    let materials = o
+        .get("materials")
+        .map_or(Ok(Vec::new()), |m| parse_materials(&m, &spectra))?;
+    let mut meshes = o
+        .get("meshes")
+        .map_or(Ok(Vec::new()), |m| parse_meshes(&m))?;
+
+    let material_names: Vec<&str> = materials.iter().map(|m| m.name.as_str()).collect();
+    let medium_names: Vec<&str> = media.iter().map(|m| m.name.as_str()).collect();
+    let shape_cx = ShapeContext {
+        materials: &material_names,
+        media: &medium_names,
+    };
+    let mut shapes: Vec<Shape> = Vec::new();
+    if let Some(list) = o.get("shapes") {
+        for item in list.array()? {
+            let shape = parse_shape(&item, &shape_cx, &mut meshes)?;
+            if let Some(name) = &shape.name {
+                if shapes.iter().any(|s| s.name.as_ref() == Some(name)) {
+                    return Err(item.member("name").unwrap_or(item).err(format!(
+                        "shape name `{name}` is used twice; names must be unique"
+                    )));
+                }
+            }
+            shapes.push(shape);
+        }
+    }
+    let mut lights = Vec::new();
+    if let Some(list) = o.get("lights") {
+        for item in list.array()? {
+            lights.push(parse_light(&item, &spectra, &shapes)?);
+        }
+    }
+    let camera = o
+        .get("camera")
+        .map_or(Ok(Camera::default()), |c| parse_camera(&c))?;
+    let film = o
+        .get("film")
+        .map_or(Ok(Film::default()), |f| parse_film(&f, &v.cx.base_dir))?;
+    let integrator = o
+        .get("integrator")
+        .map_or(Ok(Integrator::default()), |i| parse_integrator(&i))?;
+    Ok(SceneDescription {
+        file: v.cx.file.clone(),
+        camera,
+        film,
+        integrator,
+        spectra,
+        materials,
+        meshes,
+        shapes,
+        lights,
+        media,
+    })
+}

@@ -1,0 +1,96 @@
+//! Every .json under the workspace's scenes/ is a complete scene that loads.
+
+use std::path::{Path, PathBuf};
+
+use prism_scene::{load_scene, CameraKind};
+
+fn json_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.is_dir() {
+            json_files(&path, out);
+        } else if path.extension().is_some_and(|e| e == "json") {
+            out.push(path);
+        }
+    }
+}
+
+fn scenes_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes")
+}
+
+#[test]
+fn every_scene_under_scenes_loads() {
+    let mut files = Vec::new();
+    json_files(&scenes_dir(), &mut files);
+    assert!(files.len() >= 9, "{files:?}");
+    for file in &files {
+        if let Err(e) = load_scene(file) {
+            panic!("{e}");
+        }
+    }
+}
+
+#[test]
+fn the_camera_gallery_is_one_room_seen_by_every_camera_model() {
+    let names = [
+        "pinhole",
+        "thin-lens",
+        "fisheye-equidistant",
+        "fisheye-equisolid",
+        "fisheye-orthographic",
+        "fisheye-stereographic",
+        "orthographic",
+        "spherical",
+    ];
+    let scenes: Vec<_> = names
+        .iter()
+        .map(|n| load_scene(scenes_dir().join(format!("cameras/{n}.json"))).unwrap())
+        .collect();
+    for s in &scenes[1..] {
+        assert_eq!(s.shapes, scenes[0].shapes);
+        assert_eq!(s.materials, scenes[0].materials);
+        assert_eq!(s.lights, scenes[0].lights);
+        assert_eq!(s.integrator, scenes[0].integrator);
+    }
+    let kinds: Vec<&str> = scenes
+        .iter()
+        .map(|s| match s.camera.kind {
+            CameraKind::Pinhole { .. } => "pinhole",
+            CameraKind::ThinLens { .. } => "thin-lens",
+            CameraKind::Fisheye { projection, .. } => match projection {
+                prism_scene::FisheyeProjection::Equidistant => "fisheye-equidistant",
+                prism_scene::FisheyeProjection::Equisolid => "fisheye-equisolid",
+                prism_scene::FisheyeProjection::Orthographic => "fisheye-orthographic",
+                prism_scene::FisheyeProjection::Stereographic => "fisheye-stereographic",
+            },
+            CameraKind::Orthographic { .. } => "orthographic",
+            CameraKind::Spherical => "spherical",
+        })
+        .collect();
+    assert_eq!(kinds, names);
+}
+
+/// No panics on user input: every truncation of a real scene, and every single-character
+/// replacement with a troublesome character, gives a value or an error.
+#[test]
+fn truncated_and_corrupted_scenes_never_panic() {
+    let path = scenes_dir().join("cameras/thin-lens.json");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let chars: Vec<char> = text.chars().collect();
+    for end in 0..chars.len() {
+        let prefix: String = chars[..end].iter().collect();
+        if prefix.trim_end() == text.trim_end() {
+            continue;
+        }
+        assert!(prism_scene::parse_scene_str(&prefix, &path).is_err());
+    }
+    for i in (0..chars.len()).step_by(3) {
+        for c in ['"', '-', '0', '}', ']', 'x'] {
+            let mut corrupted = chars.clone();
+            corrupted[i] = c;
+            let corrupted: String = corrupted.into_iter().collect();
+            let _ = prism_scene::parse_scene_str(&corrupted, &path);
+        }
+    }
+}
