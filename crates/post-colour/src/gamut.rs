@@ -24,7 +24,7 @@
 use std::fmt;
 use std::str::FromStr;
 
-use glam::{DMat3, DVec3};
+use glam::{DMat3, DVec2, DVec3};
 use prism_spectrum::names::did_you_mean;
 use prism_spectrum::rgb_space::RgbColorSpace;
 use prism_spectrum::AdaptationMethod;
@@ -329,6 +329,8 @@ trait OpponentSpace: Sync {
     fn l_white(&self) -> f64;
     /// Chroma resolution at which bisection stops.
     fn chroma_tolerance(&self) -> f64;
+    /// (a, b) of the target space's grey at lightness `l` (the centre chroma shrinks to).
+    fn neutral_ab(&self, l: f64) -> DVec2;
 }
 
 impl OpponentSpace for CielabConverter {
@@ -345,6 +347,10 @@ impl OpponentSpace for CielabConverter {
     }
     fn chroma_tolerance(&self) -> f64 {
         CIELAB_CHROMA_TOLERANCE
+    }
+    fn neutral_ab(&self, _l: f64) -> DVec2 {
+        // CIELAB is relative to the target white: its greys are exactly a* = b* = 0.
+        DVec2::ZERO
     }
 }
 
@@ -363,24 +369,34 @@ impl OpponentSpace for OklabConverter {
     fn chroma_tolerance(&self) -> f64 {
         OKLAB_CHROMA_TOLERANCE
     }
+    fn neutral_ab(&self, l: f64) -> DVec2 {
+        DVec2::new(self.neutral_ab_per_l[0], self.neutral_ab_per_l[1]) * l
+    }
 }
 
-/// The largest s in [0, 1] (to the space's chroma tolerance) with (L, s·a, s·b) inside the
-/// unit cube, by bisection; s = 0 (the neutral of lightness L, inside for L in
-/// [0, L_white]) is taken as inside. Returns 1 when `lab` itself is inside.
+/// (L, a, b) with its chroma about the space's neutral axis scaled by `s`.
+#[inline]
+fn scale_chroma<S: OpponentSpace>(space: &S, lab: DVec3, s: f64) -> DVec3 {
+    let n = space.neutral_ab(lab.x);
+    DVec3::new(lab.x, n.x + (lab.y - n.x) * s, n.y + (lab.z - n.y) * s)
+}
+
+/// The largest s in [0, 1] (to the space's chroma tolerance) with the chroma of `lab`
+/// scaled by s inside the unit cube, by bisection; s = 0 (the grey of lightness L, inside
+/// for L in [0, L_white]) is taken as inside. Returns 1 when `lab` itself is inside.
 fn chroma_scale_to_boundary<S: OpponentSpace>(space: &S, lab: DVec3) -> f64 {
     if is_inside_f64(space.lab_to_rgb(lab)) {
         return 1.0;
     }
-    let chroma = lab.y.hypot(lab.z);
+    let n = space.neutral_ab(lab.x);
+    let chroma = (lab.y - n.x).hypot(lab.z - n.y);
     let (mut lo, mut hi) = (0.0_f64, 1.0_f64);
     for _ in 0..MAX_BISECTION_STEPS {
         if (hi - lo) * chroma <= space.chroma_tolerance() {
             break;
         }
         let mid = 0.5 * (lo + hi);
-        let candidate = DVec3::new(lab.x, lab.y * mid, lab.z * mid);
-        if is_inside_f64(space.lab_to_rgb(candidate)) {
+        if is_inside_f64(space.lab_to_rgb(scale_chroma(space, lab, mid))) {
             lo = mid;
         } else {
             hi = mid;
@@ -419,7 +435,7 @@ fn local_chunk<S: OpponentSpace>(
         let rgb = DVec3::new(f64::from(t[0]), f64::from(t[1]), f64::from(t[2]));
         let lab = clip_lightness(space.rgb_to_lab(rgb), space.l_white());
         let s = chroma_scale_to_boundary(space, lab);
-        let mapped = space.lab_to_rgb(DVec3::new(lab.x, lab.y * s, lab.z * s));
+        let mapped = space.lab_to_rgb(scale_chroma(space, lab, s));
         *p = clip_to_unit_cube(to_pixel(mapped));
     }
     outside
@@ -474,14 +490,14 @@ fn global_chroma(
             }
             let rgb = DVec3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2]));
             let value = clip_lightness(lab.rgb_to_lab(rgb), l_white);
-            let scaled = DVec3::new(value.x, value.y * k, value.z * k);
+            let scaled = scale_chroma(lab, value, k);
             // Lightness-clipped pixels may still need a local step to reach the boundary.
             let s = if inside {
                 1.0
             } else {
                 chroma_scale_to_boundary(lab, scaled)
             };
-            let mapped = lab.lab_to_rgb(DVec3::new(scaled.x, scaled.y * s, scaled.z * s));
+            let mapped = lab.lab_to_rgb(scale_chroma(lab, scaled, s));
             *p = clip_to_unit_cube(to_pixel(mapped));
         }
     });

@@ -31,6 +31,10 @@ pub struct OklabConverter {
     m2_inverse: DMat3,
     /// Oklab L of the space's white, RGB (1, 1, 1) (1 to about 1e-6 for D65).
     pub l_white: f64,
+    /// (a, b) / L of the space's white: the published matrices put D65 at
+    /// (a, b) ≈ (−2·10⁻⁵, −1.2·10⁻⁴), not exactly on a = b = 0, and the greys of the space
+    /// lie on the line (L, L·a_w/L_w, L·b_w/L_w).
+    pub neutral_ab_per_l: [f64; 2],
 }
 
 impl OklabConverter {
@@ -44,8 +48,11 @@ impl OklabConverter {
             m2,
             m2_inverse: m2.inverse(),
             l_white: 1.0,
+            neutral_ab_per_l: [0.0, 0.0],
         };
-        c.l_white = c.rgb_to_oklab(DVec3::ONE).x;
+        let white = c.rgb_to_oklab(DVec3::ONE);
+        c.l_white = white.x;
+        c.neutral_ab_per_l = [white.y / white.x, white.z / white.x];
         c
     }
 
@@ -100,5 +107,9 @@ mod tests {
         let rgb = DVec3::new(1.2, -0.1, 0.4);
         assert!(c.oklab_to_rgb(c.rgb_to_oklab(rgb)).abs_diff_eq(rgb, 1e-12));
         assert!((c.l_white - 1.0).abs() < 1e-5);
+        // Greys of the space lie on the neutral line.
+        let grey = c.rgb_to_oklab(DVec3::splat(0.2));
+        let [na, nb] = c.neutral_ab_per_l;
+        assert!((grey.y - na * grey.x).abs() < 1e-12 && (grey.z - nb * grey.x).abs() < 1e-12);
     }
 }
