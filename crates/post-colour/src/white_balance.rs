@@ -52,9 +52,10 @@ pub const WHITE_BALANCE_SYNTAX: &str = "none, grey-world (or gray-world), white-
      cct:<kelvin 1000–25000>";
 
 /// How the scene white is found.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Default)]
 pub enum WhiteBalance {
-    /// No white balance (pixels untouched).
+    /// No white balance (pixels untouched; the CLI default).
+    #[default]
     None,
     /// Mean colour of the image is grey.
     GreyWorld,
@@ -66,12 +67,6 @@ pub enum WhiteBalance {
     Illuminant(String),
     /// White at a colour temperature in K (Planckian below 4000 K, daylight from 4000 K).
     Cct(f64),
-}
-
-impl Default for WhiteBalance {
-    fn default() -> Self {
-        Self::None
-    }
 }
 
 fn invalid(given: &str, message: String) -> PostColourError {

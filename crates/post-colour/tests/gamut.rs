@@ -215,7 +215,7 @@ fn local_lch_moves_to_the_boundary_not_inside_it() {
         GamutTarget::Srgb,
         GamutMethod::LocalLch,
     );
-    let touches = p[0].iter().any(|&c| c < 1e-3 || c > 1.0 - 1e-3);
+    let touches = p[0].iter().any(|&c| !(1e-3..=1.0 - 1e-3).contains(&c));
     assert!(touches, "{:?}", p[0]);
 }
 
