@@ -23,8 +23,13 @@ fn main() {
     let threads = rayon::current_num_threads();
     let mut p = pixels.clone();
     let start = Instant::now();
-    apply_white_balance(&mut p, &rec2020, &WhiteBalance::GreyWorld, AdaptationMethod::Bradford)
-        .unwrap();
+    apply_white_balance(
+        &mut p,
+        &rec2020,
+        &WhiteBalance::GreyWorld,
+        AdaptationMethod::Bradford,
+    )
+    .unwrap();
     print_line("wb:grey-world", start.elapsed().as_secs_f64(), 0.0, threads);
     for method in GamutMethod::names() {
         let method = GamutMethod::parse(method).unwrap();
@@ -32,7 +37,12 @@ fn main() {
         let start = Instant::now();
         let report = map_gamut(&mut p, &rec2020, GamutTarget::Srgb, method);
         let seconds = start.elapsed().as_secs_f64();
-        print_line(&format!("gamut:{method}"), seconds, report.fraction_outside, threads);
+        print_line(
+            &format!("gamut:{method}"),
+            seconds,
+            report.fraction_outside,
+            threads,
+        );
     }
 }
 

@@ -18,8 +18,8 @@
 //!   that illuminant, CIE 1931 2° observer (CIE 15:2018 §7).
 //! - `cct:T` (T in kelvin, 1000–25000, optional `K`): below 4000 K the Planckian locus
 //!   (prism-spectrum's Planck integration, c₂ = 1.4388 × 10⁻² m·K); from 4000 K the CIE
-//!   daylight locus, as the CIE D-series illuminants are defined (CIE 15:2018 §4.1,
-//!   eqs. 4.7–4.9 of the 2004 edition's §3.1). So `cct:2856` ≈ illuminant A and
+//!   daylight locus, as the CIE D-series illuminants are defined (CIE 15:2004 §3.1,
+//!   eqs. 3.3–3.4; CIE 15:2018 §4.1). So `cct:2856` ≈ illuminant A and
 //!   `cct:6504` ≈ D65.
 
 use std::fmt;
