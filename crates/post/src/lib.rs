@@ -9,3 +9,6 @@ pub mod io;
 
 pub use error::{PostError, Result};
 pub use image::{AovLayer, Image};
+pub mod tonemap;
+
+pub use tonemap::{ToneOperator, ToneParams, ToneReport, ToneResult};
