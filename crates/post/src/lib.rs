@@ -9,6 +9,7 @@ pub mod io;
 
 pub use error::{PostError, Result};
 pub use image::{AovLayer, Image};
+pub mod metrics;
 pub mod tonemap;
 
 pub use tonemap::{ToneOperator, ToneParams, ToneReport, ToneResult};
