@@ -10,6 +10,9 @@ pub mod io;
 pub use error::{PostError, Result};
 pub use image::{AovLayer, Image};
 pub mod metrics;
+pub mod pipeline;
 pub mod tonemap;
 
+pub use metrics::{compare, Comparison};
+pub use pipeline::{compare_files, tonemap_file, TonemapFileReport, TonemapOptions};
 pub use tonemap::{ToneOperator, ToneParams, ToneReport, ToneResult};

@@ -125,3 +125,69 @@ fn absolute_operators_need_a_scale_and_accept_either_source() {
         assert_eq!(with_param.pixels(), with_header.pixels(), "{}", op.name());
     }
 }
+
+#[test]
+fn tonemap_file_writes_png_and_exr_and_compare_files_reads_them_back() {
+    use prism_post::{compare_files, io, tonemap_file, TonemapOptions};
+    let dir = std::env::temp_dir().join(format!("prism-post-pipeline-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let input = dir.join("in.exr");
+    let pixels = (0..64 * 48)
+        .map(|i| {
+            let v = 10f32.powf(-2.0 + 4.0 * (i % 64) as f32 / 63.0);
+            [v, 0.8 * v, 0.6 * v]
+        })
+        .collect();
+    io::write_image(
+        &input,
+        &Image::new(64, 48, pixels, RgbColorSpace::srgb()).unwrap(),
+    )
+    .unwrap();
+    let options = TonemapOptions {
+        operator: ToneOperator::Reinhard02,
+        params: ToneParams::default(),
+        target: RgbColorSpace::srgb(),
+    };
+    let exr_out = dir.join("out.exr");
+    let png_out = dir.join("out.png");
+    let report = tonemap_file(&input, &exr_out, &options).unwrap();
+    assert_eq!((report.width, report.height), (64, 48));
+    assert!(serde_json::to_string(&report)
+        .unwrap()
+        .contains("\"operator\":\"reinhard02\""));
+    tonemap_file(&input, &png_out, &options).unwrap();
+    let exr = io::read_image(&exr_out).unwrap();
+    assert!(exr
+        .pixels()
+        .iter()
+        .flatten()
+        .all(|c| (0.0..=1.0).contains(c)));
+    // The 16-bit PNG holds the same display values to within one code step (decoded).
+    let c = compare_files(&png_out, &exr_out).unwrap();
+    assert!(c.rmse < 1e-4, "{c:?}");
+    let json = serde_json::to_value(&c).unwrap();
+    for key in [
+        "mse",
+        "rmse",
+        "relmse",
+        "psnr_db",
+        "ssim",
+        "delta_e2000_mean",
+        "delta_e2000_p95",
+    ] {
+        assert!(json.get(key).is_some(), "{key}");
+    }
+    assert!(json["per_channel"]["mse"].is_array());
+    // Mismatched sizes name both files.
+    let small = dir.join("small.exr");
+    io::write_image(
+        &small,
+        &Image::filled(2, 2, [1.0; 3], RgbColorSpace::srgb()).unwrap(),
+    )
+    .unwrap();
+    let err = compare_files(&small, &exr_out).unwrap_err().to_string();
+    assert!(
+        err.contains("small.exr") && err.contains("out.exr"),
+        "{err}"
+    );
+}
