@@ -1,0 +1,66 @@
+//! The one error type of prism-post: every failure names the file (when there is one) and
+//! what was expected.
+
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+/// Errors from image I/O, tone operators and metrics.
+#[derive(Debug)]
+pub enum PostError {
+    /// The operating system refused to open, read, write or rename a file.
+    Io {
+        path: PathBuf,
+        action: &'static str,
+        source: std::io::Error,
+    },
+    /// A file was opened but its content is not what was expected.
+    Format { path: PathBuf, message: String },
+    /// An argument (operator parameter, image size, option) is not usable.
+    Invalid(String),
+}
+
+impl PostError {
+    pub fn format(path: &Path, message: impl Into<String>) -> Self {
+        PostError::Format {
+            path: path.to_path_buf(),
+            message: message.into(),
+        }
+    }
+
+    pub fn io(path: &Path, action: &'static str, source: std::io::Error) -> Self {
+        PostError::Io {
+            path: path.to_path_buf(),
+            action,
+            source,
+        }
+    }
+
+    pub fn invalid(message: impl Into<String>) -> Self {
+        PostError::Invalid(message.into())
+    }
+}
+
+impl fmt::Display for PostError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            PostError::Io {
+                path,
+                action,
+                source,
+            } => write!(f, "{}: cannot {action}: {source}", path.display()),
+            PostError::Format { path, message } => write!(f, "{}: {message}", path.display()),
+            PostError::Invalid(message) => f.write_str(message),
+        }
+    }
+}
+
+impl std::error::Error for PostError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            PostError::Io { source, .. } => Some(source),
+            _ => None,
+        }
+    }
+}
+
+pub type Result<T, E = PostError> = std::result::Result<T, E>;

@@ -1,0 +1,410 @@
+//! OpenEXR read/write with the `exr` crate: linear RGB in unprefixed `R`, `G`, `B`
+//! channels, extra layers as prefixed channels (`depth.Z`, `normal.X`, …) in the same
+//! part, the colour space in the standard `chromaticities` attribute and the absolute scale
+//! in the custom attribute `prism:cd_m2_per_unit` (DESIGN.md, "Units and conventions").
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use ::exr::meta::attribute::{AttributeValue, Chromaticities, Text};
+use ::exr::prelude::{
+    f16, AnyChannel, AnyChannels, Encoding, FlatSamples, LayerAttributes, ReadChannels, ReadLayers,
+    SmallVec, Vec2, WritableImage,
+};
+use prism_spectrum::rgb_space::RgbColorSpace;
+use rayon::prelude::*;
+
+use super::{color_space_from_chromaticities, spectral_exr, write_atomically};
+use crate::error::{PostError, Result};
+use crate::image::Image;
+
+/// Header attribute holding cd/m² per unit of relative luminance Y.
+pub const CD_M2_PER_UNIT_ATTRIBUTE: &str = "prism:cd_m2_per_unit";
+
+/// Sample type of written channels.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ExrSampleType {
+    /// 16-bit half float (values above 65504 become infinite; exr rounds to nearest).
+    F16,
+    /// 32-bit float.
+    F32,
+}
+
+/// Compression of written channels (all lossless).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ExrCompression {
+    None,
+    Rle,
+    Zip,
+    Piz,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ExrWriteOptions {
+    pub sample_type: ExrSampleType,
+    pub compression: ExrCompression,
+}
+
+impl Default for ExrWriteOptions {
+    fn default() -> Self {
+        Self {
+            sample_type: ExrSampleType::F32,
+            compression: ExrCompression::Zip,
+        }
+    }
+}
+
+/// All channels of every part, as (full name, samples), with the common size.
+pub(crate) struct ExrChannels {
+    pub width: usize,
+    pub height: usize,
+    pub channels: Vec<(String, FlatSamples)>,
+    pub chromaticities: Option<Chromaticities>,
+    pub attributes: BTreeMap<String, AttributeValue>,
+}
+
+fn exr_error(path: &Path, action: &'static str, e: ::exr::error::Error) -> PostError {
+    match e {
+        ::exr::error::Error::Io(io) => PostError::io(path, action, io),
+        other => PostError::format(path, format!("not a readable OpenEXR file: {other}")),
+    }
+}
+
+/// Reads every channel of every part of an EXR file (largest resolution level, flat data).
+pub(crate) fn read_exr_channels(path: &Path) -> Result<ExrChannels> {
+    let image = ::exr::prelude::read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .all_channels()
+        .all_layers()
+        .all_attributes()
+        .from_file(path)
+        .map_err(|e| exr_error(path, "read", e))?;
+    let first = image
+        .layer_data
+        .first()
+        .ok_or_else(|| PostError::format(path, "the file holds no image part"))?;
+    let (width, height) = (first.size.0, first.size.1);
+    let mut channels = Vec::new();
+    let mut attributes = BTreeMap::new();
+    for layer in image.layer_data {
+        if (layer.size.0, layer.size.1) != (width, height) {
+            return Err(PostError::format(
+                path,
+                format!(
+                    "parts differ in size ({}×{} and {}×{}): expected every part the same size",
+                    width, height, layer.size.0, layer.size.1
+                ),
+            ));
+        }
+        let prefix = layer
+            .attributes
+            .layer_name
+            .as_ref()
+            .map(|n| n.to_string())
+            .filter(|n| !n.is_empty());
+        for (name, value) in layer.attributes.other {
+            attributes.entry(name.to_string()).or_insert(value);
+        }
+        if let Some(software) = layer.attributes.software_name {
+            attributes
+                .entry("software".to_string())
+                .or_insert(AttributeValue::Text(software));
+        }
+        for channel in layer.channel_data.list {
+            let name = channel.name.to_string();
+            let full = match &prefix {
+                Some(p) if !name.starts_with(&format!("{p}.")) => format!("{p}.{name}"),
+                _ => name,
+            };
+            channels.push((full, channel.sample_data));
+        }
+    }
+    Ok(ExrChannels {
+        width,
+        height,
+        channels,
+        chromaticities: image.attributes.chromaticities,
+        attributes,
+    })
+}
+
+fn to_f32(samples: &FlatSamples) -> Vec<f32> {
+    match samples {
+        FlatSamples::F32(v) => v.clone(),
+        FlatSamples::F16(v) => v.par_iter().map(|h| h.to_f32()).collect(),
+        FlatSamples::U32(v) => v.iter().map(|&u| u as f32).collect(),
+    }
+}
+
+pub(crate) fn sample_at(samples: &FlatSamples, i: usize) -> f32 {
+    match samples {
+        FlatSamples::F32(v) => v[i],
+        FlatSamples::F16(v) => v[i].to_f32(),
+        FlatSamples::U32(v) => v[i] as f32,
+    }
+}
+
+/// Reads an EXR image: `R`, `G`, `B` (or a lone `Y` as grey) become the pixels, other
+/// channels become layers split at their last `.`; a spectral EXR without RGB channels is
+/// reduced to XYZ with the CIE 1931 observer, then to linear sRGB.
+pub fn read_exr(path: &Path) -> Result<Image> {
+    let data = read_exr_channels(path)?;
+    let find = |n: &str| data.channels.iter().position(|(name, _)| name == n);
+    let rgb = match (find("R"), find("G"), find("B"), find("Y")) {
+        (Some(r), Some(g), Some(b), _) => Some([r, g, b]),
+        (None, None, None, Some(y)) => Some([y, y, y]),
+        _ => None,
+    };
+    let Some(rgb) = rgb else {
+        if data
+            .channels
+            .iter()
+            .any(|(n, _)| spectral_exr::parse_spectral_channel(n).is_some())
+        {
+            let spectral = spectral_exr::spectral_from_channels(path, &data)?;
+            return spectral
+                .to_rgb_image(prism_spectrum::Observer::Cie1931, &RgbColorSpace::srgb());
+        }
+        let names: Vec<&str> = data.channels.iter().map(|(n, _)| n.as_str()).collect();
+        return Err(PostError::format(
+            path,
+            format!(
+                "expected channels R, G, B (or Y, or spectral S0.<λ>nm), found: {}",
+                names.join(", ")
+            ),
+        ));
+    };
+    let (r, g, b) = (
+        &data.channels[rgb[0]].1,
+        &data.channels[rgb[1]].1,
+        &data.channels[rgb[2]].1,
+    );
+    let n = data.width * data.height;
+    let mut pixels = vec![[0.0f32; 3]; n];
+    pixels
+        .par_chunks_mut(4096)
+        .enumerate()
+        .for_each(|(chunk_index, chunk)| {
+            let base = chunk_index * 4096;
+            for (k, p) in chunk.iter_mut().enumerate() {
+                let i = base + k;
+                *p = [sample_at(r, i), sample_at(g, i), sample_at(b, i)];
+            }
+        });
+    let space = match &data.chromaticities {
+        Some(c) => color_space_from_chromaticities(
+            [
+                [c.red.0 as f64, c.red.1 as f64],
+                [c.green.0 as f64, c.green.1 as f64],
+                [c.blue.0 as f64, c.blue.1 as f64],
+            ],
+            [c.white.0 as f64, c.white.1 as f64],
+        ),
+        // OpenEXR's default chromaticities are those of ITU-R BT.709 (= sRGB).
+        None => RgbColorSpace::srgb(),
+    };
+    let mut image = Image::new(data.width, data.height, pixels, space)
+        .map_err(|e| PostError::format(path, e.to_string()))?;
+
+    // Extra layers, grouped by the prefix before the last '.', in file order.
+    let mut groups: Vec<(String, Vec<(String, usize)>)> = Vec::new();
+    for (index, (name, _)) in data.channels.iter().enumerate() {
+        if rgb.contains(&index) || spectral_exr::parse_spectral_channel(name).is_some() {
+            continue;
+        }
+        let (layer, channel) = match name.rfind('.') {
+            Some(dot) => (&name[..dot], &name[dot + 1..]),
+            None => ("", name.as_str()),
+        };
+        let (layer, channel) = (layer.replace('.', "_"), channel.to_string());
+        match groups.iter_mut().find(|(l, _)| *l == layer) {
+            Some((_, list)) => list.push((channel, index)),
+            None => groups.push((layer, vec![(channel, index)])),
+        }
+    }
+    for (layer, list) in groups {
+        let planes: Vec<Vec<f32>> = list
+            .iter()
+            .map(|(_, i)| to_f32(&data.channels[*i].1))
+            .collect();
+        let k = planes.len();
+        let mut samples = vec![0.0f32; n * k];
+        for (c, plane) in planes.iter().enumerate() {
+            for (i, v) in plane.iter().enumerate() {
+                samples[i * k + c] = *v;
+            }
+        }
+        let names: Vec<&str> = list.iter().map(|(c, _)| c.as_str()).collect();
+        image
+            .set_layer(&layer, &names, samples)
+            .map_err(|e| PostError::format(path, e.to_string()))?;
+    }
+
+    for (name, value) in &data.attributes {
+        match (name.as_str(), value) {
+            (CD_M2_PER_UNIT_ATTRIBUTE, AttributeValue::F32(v)) => {
+                image.cd_m2_per_unit = Some(*v as f64)
+            }
+            (CD_M2_PER_UNIT_ATTRIBUTE, AttributeValue::F64(v)) => image.cd_m2_per_unit = Some(*v),
+            (CD_M2_PER_UNIT_ATTRIBUTE, _) => {
+                return Err(PostError::format(
+                    path,
+                    format!("attribute {CD_M2_PER_UNIT_ATTRIBUTE} must be a float or double"),
+                ))
+            }
+            (_, AttributeValue::Text(t)) => {
+                image.metadata.insert(name.clone(), t.to_string());
+            }
+            _ => {}
+        }
+    }
+    if let Some(scale) = image.cd_m2_per_unit {
+        if !(scale.is_finite() && scale > 0.0) {
+            return Err(PostError::format(
+                path,
+                format!("{CD_M2_PER_UNIT_ATTRIBUTE} = {scale}: expected a positive finite number"),
+            ));
+        }
+    }
+    Ok(image)
+}
+
+/// `chromaticities` attribute of a colour space.
+pub(crate) fn chromaticities_of(space: &RgbColorSpace) -> Chromaticities {
+    let v = |xy: [f64; 2]| Vec2(xy[0] as f32, xy[1] as f32);
+    Chromaticities {
+        red: v(space.primaries_xy[0]),
+        green: v(space.primaries_xy[1]),
+        blue: v(space.primaries_xy[2]),
+        white: v(space.white_xy),
+    }
+}
+
+pub(crate) fn flat_samples(values: Vec<f32>, sample_type: ExrSampleType) -> FlatSamples {
+    match sample_type {
+        ExrSampleType::F32 => FlatSamples::F32(values),
+        ExrSampleType::F16 => {
+            FlatSamples::F16(values.par_iter().map(|&v| f16::from_f32(v)).collect())
+        }
+    }
+}
+
+pub(crate) fn encoding(options: &ExrWriteOptions) -> Encoding {
+    use ::exr::compression::Compression;
+    let compression = match options.compression {
+        ExrCompression::None => Compression::Uncompressed,
+        ExrCompression::Rle => Compression::RLE,
+        ExrCompression::Zip => Compression::ZIP16,
+        ExrCompression::Piz => Compression::PIZ,
+    };
+    Encoding {
+        compression,
+        ..Encoding::default()
+    }
+}
+
+pub(crate) fn text(path: &Path, s: &str) -> Result<Text> {
+    Text::new_or_none(s).ok_or_else(|| {
+        PostError::format(
+            path,
+            format!("cannot store '{s}' in an EXR header: expected non-empty Latin-1 text"),
+        )
+    })
+}
+
+/// Writes channels in one part, plus header attributes, through a temporary file.
+pub(crate) fn write_exr_channels(
+    path: &Path,
+    width: usize,
+    height: usize,
+    channels: Vec<(String, FlatSamples)>,
+    chromaticities: Option<Chromaticities>,
+    attributes: Vec<(String, AttributeValue)>,
+    options: &ExrWriteOptions,
+) -> Result<()> {
+    let mut list: SmallVec<[AnyChannel<FlatSamples>; 4]> = SmallVec::new();
+    for (name, samples) in channels {
+        list.push(AnyChannel::new(text(path, &name)?, samples));
+    }
+    let mut layer_attributes = LayerAttributes::default();
+    for (name, value) in attributes {
+        layer_attributes.other.insert(text(path, &name)?, value);
+    }
+    let layer = ::exr::prelude::Layer::new(
+        (width, height),
+        layer_attributes,
+        encoding(options),
+        AnyChannels::sort(list),
+    );
+    let mut image = ::exr::prelude::Image::from_layer(layer);
+    image.attributes.chromaticities = chromaticities;
+    write_atomically(path, |tmp| {
+        image
+            .write()
+            .to_file(tmp)
+            .map_err(|e| exr_error(path, "write", e))
+    })
+}
+
+/// Writes `image` as one EXR part: `R`, `G`, `B`, then every layer's channels prefixed
+/// with its name, `chromaticities` from the colour space, `prism:cd_m2_per_unit` (double)
+/// when the image has an absolute scale, and the metadata as text attributes.
+pub fn write_exr(path: &Path, image: &Image, options: &ExrWriteOptions) -> Result<()> {
+    let n = image.width() * image.height();
+    let mut planes = [vec![0.0f32; n], vec![0.0f32; n], vec![0.0f32; n]];
+    {
+        let [r, g, b] = &mut planes;
+        r.par_iter_mut()
+            .zip(g.par_iter_mut())
+            .zip(b.par_iter_mut())
+            .zip(image.pixels().par_iter())
+            .for_each(|(((r, g), b), p)| {
+                *r = p[0];
+                *g = p[1];
+                *b = p[2];
+            });
+    }
+    let mut channels = Vec::new();
+    for (name, plane) in ["R", "G", "B"].into_iter().zip(planes) {
+        channels.push((name.to_string(), flat_samples(plane, options.sample_type)));
+    }
+    for layer in image.layers() {
+        let k = layer.channels.len();
+        for (c, channel) in layer.channels.iter().enumerate() {
+            let plane: Vec<f32> = (0..n).map(|i| layer.samples[i * k + c]).collect();
+            let name = if layer.name.is_empty() {
+                channel.clone()
+            } else {
+                format!("{}.{}", layer.name, channel)
+            };
+            channels.push((name, flat_samples(plane, options.sample_type)));
+        }
+    }
+    let mut attributes = Vec::new();
+    if let Some(scale) = image.cd_m2_per_unit {
+        attributes.push((
+            CD_M2_PER_UNIT_ATTRIBUTE.to_string(),
+            AttributeValue::F64(scale),
+        ));
+    }
+    for (key, value) in &image.metadata {
+        // Spectral-layout markers describe spectral channels this RGB file does not have.
+        if key == spectral_exr::VERSION_ATTRIBUTE
+            || key == spectral_exr::EMISSIVE_UNITS_ATTRIBUTE
+            || key == "software"
+        {
+            continue;
+        }
+        attributes.push((key.clone(), AttributeValue::Text(text(path, value)?)));
+    }
+    write_exr_channels(
+        path,
+        image.width(),
+        image.height(),
+        channels,
+        Some(chromaticities_of(&image.color_space)),
+        attributes,
+        options,
+    )
+}

@@ -1,0 +1,145 @@
+//! Image files: OpenEXR (RGB + AOV layers, spectral layout), Radiance RGBE and PNG.
+//! Every write goes to a temporary file in the destination's directory that is renamed
+//! over the destination only once complete, so a failed write never leaves half a file.
+
+pub mod exr;
+pub mod png;
+pub mod rgbe;
+pub mod spectral_exr;
+
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+use prism_spectrum::rgb_space::RgbColorSpace;
+
+use crate::error::{PostError, Result};
+use crate::image::Image;
+
+/// File formats, chosen from the file extension.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ImageFormat {
+    Exr,
+    Hdr,
+    Png,
+}
+
+impl ImageFormat {
+    /// `.exr`, `.hdr`/`.pic`/`.rgbe`, `.png` (case-insensitive).
+    pub fn from_path(path: &Path) -> Result<Self> {
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(|e| e.to_ascii_lowercase());
+        match ext.as_deref() {
+            Some("exr") => Ok(ImageFormat::Exr),
+            Some("hdr") | Some("pic") | Some("rgbe") => Ok(ImageFormat::Hdr),
+            Some("png") => Ok(ImageFormat::Png),
+            _ => Err(PostError::format(
+                path,
+                "unknown image extension: expected .exr, .hdr (Radiance RGBE) or .png",
+            )),
+        }
+    }
+}
+
+/// Reads an EXR, Radiance HDR or PNG image, chosen by extension. A spectral EXR (Fichet et
+/// al. 2021 layout) without RGB channels is reduced to XYZ with the CIE 1931 observer and
+/// expressed in linear sRGB.
+pub fn read_image(path: &Path) -> Result<Image> {
+    match ImageFormat::from_path(path)? {
+        ImageFormat::Exr => exr::read_exr(path),
+        ImageFormat::Hdr => rgbe::read_hdr(path),
+        ImageFormat::Png => png::read_png(path),
+    }
+}
+
+/// Writes `image` in the format named by the extension of `path`, with default options
+/// (EXR: float, ZIP; PNG: 16-bit).
+pub fn write_image(path: &Path, image: &Image) -> Result<()> {
+    match ImageFormat::from_path(path)? {
+        ImageFormat::Exr => exr::write_exr(path, image, &exr::ExrWriteOptions::default()),
+        ImageFormat::Hdr => rgbe::write_hdr(path, image),
+        ImageFormat::Png => png::write_png(path, image, png::PngBitDepth::Sixteen),
+    }
+}
+
+/// The temporary sibling a write goes to before it is renamed over `path`.
+fn temp_sibling(path: &Path) -> PathBuf {
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    path.with_file_name(format!(".{name}.{}.tmp", std::process::id()))
+}
+
+/// Runs `write` on a temporary path beside `path`, then renames it to `path`; on failure
+/// the temporary file is removed and the destination is left as it was.
+pub(crate) fn write_atomically(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
+    let tmp = temp_sibling(path);
+    let result = write(&tmp).and_then(|()| {
+        std::fs::rename(&tmp, path).map_err(|e| PostError::io(path, "rename the finished file", e))
+    });
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result
+}
+
+/// [`write_atomically`] through a buffered writer; errors name `path`, not the temp file.
+pub(crate) fn write_stream_atomically(
+    path: &Path,
+    write: impl FnOnce(&mut BufWriter<File>) -> std::io::Result<()>,
+) -> Result<()> {
+    write_atomically(path, |tmp| {
+        let file = File::create(tmp).map_err(|e| PostError::io(path, "create", e))?;
+        let mut out = BufWriter::new(file);
+        write(&mut out)
+            .and_then(|()| out.flush())
+            .map_err(|e| PostError::io(path, "write", e))
+    })
+}
+
+/// The built-in colour space whose primaries and white match `primaries_xy`/`white_xy`
+/// within 5e-4 (the precision files usually print), else a linear space built from them.
+pub fn color_space_from_chromaticities(
+    primaries_xy: [[f64; 2]; 3],
+    white_xy: [f64; 2],
+) -> RgbColorSpace {
+    const TOLERANCE: f64 = 5e-4;
+    let close =
+        |a: &[f64; 2], b: &[f64; 2]| (a[0] - b[0]).abs().max((a[1] - b[1]).abs()) < TOLERANCE;
+    RgbColorSpace::all()
+        .into_iter()
+        .find(|s| {
+            close(&s.white_xy, &white_xy)
+                && s.primaries_xy
+                    .iter()
+                    .zip(primaries_xy.iter())
+                    .all(|(a, b)| close(a, b))
+        })
+        .unwrap_or_else(|| {
+            RgbColorSpace::from_primaries(
+                "file chromaticities",
+                primaries_xy,
+                white_xy,
+                "D65",
+                prism_spectrum::rgb_space::TransferFunction::Linear,
+            )
+        })
+}
+
+/// Converts linear RGB pixels from one colour space to another through XYZ (no chromatic
+/// adaptation: white balance is a separate, explicit step).
+pub fn convert_pixels(pixels: &mut [[f32; 3]], from: &RgbColorSpace, to: &RgbColorSpace) {
+    use rayon::prelude::*;
+    if from.primaries_xy == to.primaries_xy && from.white_xy == to.white_xy {
+        return;
+    }
+    let m = (to.xyz_to_rgb * from.rgb_to_xyz).as_mat3();
+    pixels.par_chunks_mut(4096).for_each(|chunk| {
+        for p in chunk {
+            *p = (m * glam::Vec3::from(*p)).to_array();
+        }
+    });
+}

@@ -1,0 +1,160 @@
+//! PNG read/write (8 or 16 bits per channel) with the `png` crate. Written pixels are
+//! clipped to [0, 1] and encoded with the transfer function of the image's colour space
+//! (IEC 61966-2-1 sRGB curve for sRGB and Display P3, BT.2020 OETF for Rec.2020); the file
+//! carries an `sRGB` chunk for sRGB, else a `cHRM` chunk with the primaries and white.
+//! Reading inverts this: the colour space is found from `cHRM` (sRGB without one).
+
+use std::fs::File;
+use std::io::BufReader;
+use std::path::Path;
+
+use png::{BitDepth, ColorType, Decoder, Encoder, SourceChromaticities, Transformations};
+use prism_spectrum::rgb_space::RgbColorSpace;
+use rayon::prelude::*;
+
+use super::{color_space_from_chromaticities, write_stream_atomically};
+use crate::error::{PostError, Result};
+use crate::image::Image;
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PngBitDepth {
+    Eight,
+    Sixteen,
+}
+
+fn quantise(linear: f32, encode: &impl Fn(f64) -> f64, max_code: f64) -> u16 {
+    let v = if linear.is_finite() {
+        (linear as f64).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (encode(v).clamp(0.0, 1.0) * max_code).round() as u16
+}
+
+/// Writes `image` as an RGB PNG of the given depth (see the module notes on encoding).
+pub fn write_png(path: &Path, image: &Image, depth: PngBitDepth) -> Result<()> {
+    let (w, h) = (image.width(), image.height());
+    if w > u32::MAX as usize || h > u32::MAX as usize {
+        return Err(PostError::invalid(format!(
+            "{}: {w}×{h} is too large for PNG",
+            path.display()
+        )));
+    }
+    let transfer = image.color_space.transfer;
+    let encode = move |v: f64| transfer.encode(v);
+    let bytes: Vec<u8> = match depth {
+        PngBitDepth::Eight => image
+            .pixels()
+            .par_iter()
+            .flat_map_iter(|p| p.map(|c| quantise(c, &encode, 255.0) as u8))
+            .collect(),
+        PngBitDepth::Sixteen => image
+            .pixels()
+            .par_iter()
+            .flat_map_iter(|p| {
+                let [r, g, b] = p.map(|c| quantise(c, &encode, 65535.0).to_be_bytes());
+                [r[0], r[1], g[0], g[1], b[0], b[1]]
+            })
+            .collect(),
+    };
+    let space = &image.color_space;
+    write_stream_atomically(path, |out| {
+        let mut encoder = Encoder::new(out, w as u32, h as u32);
+        encoder.set_color(ColorType::Rgb);
+        encoder.set_depth(match depth {
+            PngBitDepth::Eight => BitDepth::Eight,
+            PngBitDepth::Sixteen => BitDepth::Sixteen,
+        });
+        if *space == RgbColorSpace::srgb() {
+            encoder.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
+        } else {
+            let xy = |v: [f64; 2]| (v[0] as f32, v[1] as f32);
+            encoder.set_source_chromaticities(SourceChromaticities::new(
+                xy(space.white_xy),
+                xy(space.primaries_xy[0]),
+                xy(space.primaries_xy[1]),
+                xy(space.primaries_xy[2]),
+            ));
+        }
+        let mut writer = encoder.write_header().map_err(std::io::Error::other)?;
+        writer
+            .write_image_data(&bytes)
+            .map_err(std::io::Error::other)?;
+        writer.finish().map_err(std::io::Error::other)
+    })
+}
+
+/// Reads an 8- or 16-bit PNG (grey, grey+alpha, RGB, RGBA or palette) to linear RGB; an
+/// alpha channel becomes the unprefixed layer channel `A`.
+pub fn read_png(path: &Path) -> Result<Image> {
+    let file = File::open(path).map_err(|e| PostError::io(path, "open", e))?;
+    let mut decoder = Decoder::new(BufReader::new(file));
+    decoder.set_transformations(Transformations::EXPAND);
+    let mut reader = decoder
+        .read_info()
+        .map_err(|e| PostError::format(path, format!("not a readable PNG file: {e}")))?;
+    let mut buffer = vec![0u8; reader.output_buffer_size()];
+    let info = reader
+        .next_frame(&mut buffer)
+        .map_err(|e| PostError::format(path, format!("PNG image data is unreadable: {e}")))?;
+    let (w, h) = (info.width as usize, info.height as usize);
+    let channels = match info.color_type {
+        ColorType::Grayscale => 1,
+        ColorType::GrayscaleAlpha => 2,
+        ColorType::Rgb => 3,
+        ColorType::Rgba => 4,
+        ColorType::Indexed => {
+            return Err(PostError::format(
+                path,
+                "palette PNG was not expanded to RGB",
+            ))
+        }
+    };
+    let sixteen = info.bit_depth == BitDepth::Sixteen;
+    let chrm = reader
+        .info()
+        .chrm_chunk
+        .or(reader.info().source_chromaticities);
+    let space = match chrm {
+        Some(c) if reader.info().srgb.is_none() => {
+            let xy = |v: (png::ScaledFloat, png::ScaledFloat)| {
+                [v.0.into_value() as f64, v.1.into_value() as f64]
+            };
+            color_space_from_chromaticities([xy(c.red), xy(c.green), xy(c.blue)], xy(c.white))
+        }
+        _ => RgbColorSpace::srgb(),
+    };
+    let max_code = if sixteen { 65535usize } else { 255 };
+    let lut: Vec<f32> = (0..=max_code)
+        .map(|code| space.transfer.decode(code as f64 / max_code as f64) as f32)
+        .collect();
+    let bytes_per_sample = if sixteen { 2 } else { 1 };
+    let stride = channels * bytes_per_sample;
+    let sample = |px: &[u8], c: usize| -> usize {
+        if sixteen {
+            u16::from_be_bytes([px[2 * c], px[2 * c + 1]]) as usize
+        } else {
+            px[c] as usize
+        }
+    };
+    let data = &buffer[..w * h * stride];
+    let pixels: Vec<[f32; 3]> = data
+        .par_chunks(stride)
+        .map(|px| {
+            if channels >= 3 {
+                [lut[sample(px, 0)], lut[sample(px, 1)], lut[sample(px, 2)]]
+            } else {
+                [lut[sample(px, 0)]; 3]
+            }
+        })
+        .collect();
+    let mut image = Image::new(w, h, pixels, space)?;
+    if channels == 2 || channels == 4 {
+        let alpha: Vec<f32> = data
+            .chunks(stride)
+            .map(|px| sample(px, channels - 1) as f32 / max_code as f32)
+            .collect();
+        image.set_layer("", &["A"], alpha)?;
+    }
+    Ok(image)
+}

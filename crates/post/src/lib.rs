@@ -1,0 +1,18 @@
+//! prism-post: the image type, EXR (RGB, AOV layers, spectral layout of Fichet et al. 2021),
+//! Radiance RGBE and PNG I/O, tone operators and image metrics.
+//!
+//! Data flow (DESIGN.md): white balance → gamut mapping → tone operator → display encoding.
+
+pub mod error;
+pub mod image;
+pub mod io;
+
+pub use error::{PostError, Result};
+pub use image::{AovLayer, Image};
+pub mod metrics;
+pub mod pipeline;
+pub mod tonemap;
+
+pub use metrics::{compare, Comparison};
+pub use pipeline::{compare_files, tonemap_file, TonemapFileReport, TonemapOptions};
+pub use tonemap::{ToneOperator, ToneParams, ToneReport, ToneResult};

@@ -1,0 +1,117 @@
+//! AgX (Troy Sobotka, 2022; Blender 4.0's default view transform) in the minimal form of
+//! Benjamin Wrensch (2023, "Minimal AgX implementation"): inset matrix, log2 encoding
+//! between −12.47393 and +4.026069 EV around 0.18, a 6th-order polynomial fit of the AgX
+//! base contrast sigmoid, the inverse inset, and a 2.2 power back to linear display light:
+//! x = (clamp(log2(M_in · rgb), ev_min, ev_max) − ev_min) / (ev_max − ev_min),
+//! s(x) = 15.5x⁶ − 40.14x⁵ + 31.96x⁴ − 6.868x³ + 0.4298x² + 0.1191x − 0.00232,
+//! rgb_out = max(M_out · s, 0)^2.2. Works in linear sRGB (Rec.709); other spaces are
+//! converted there and back.
+
+use glam::{Mat3, Vec3};
+
+use super::aces::srgb_matrices;
+use super::pixels::map_pixels;
+use super::{Context, OperatorInfo, Output};
+
+pub(crate) static INFO: OperatorInfo = OperatorInfo {
+    name: "agx",
+    reference: "AgX (Sobotka 2022), minimal polynomial fit of Wrensch 2023",
+    absolute: false,
+    params: &[],
+};
+
+const EV_MIN: f32 = -12.47393;
+const EV_MAX: f32 = 4.026069;
+
+/// Inset matrix, column-major as printed in the GLSL source.
+#[allow(clippy::excessive_precision)] // the published digits, kept verbatim
+const INSET: [f32; 9] = [
+    0.842479062253094,
+    0.0423282422610123,
+    0.0423756549057051,
+    0.0784335999999992,
+    0.878468636469772,
+    0.0784336,
+    0.0792237451477643,
+    0.0791661274605434,
+    0.879142973793104,
+];
+/// Outset (inverse inset), column-major.
+#[allow(clippy::excessive_precision)] // the published digits, kept verbatim
+const OUTSET: [f32; 9] = [
+    1.19687900512017,
+    -0.0528968517574562,
+    -0.0529716355144438,
+    -0.0980208811401368,
+    1.15190312990417,
+    -0.0980434501171241,
+    -0.0990297440797205,
+    -0.0989611768448433,
+    1.15107367264116,
+];
+
+/// The polynomial fit of the AgX default contrast curve on [0, 1].
+pub fn contrast(x: f32) -> f32 {
+    let x2 = x * x;
+    let x4 = x2 * x2;
+    15.5 * x4 * x2 - 40.14 * x4 * x + 31.96 * x4 - 6.868 * x2 * x + 0.4298 * x2 + 0.1191 * x
+        - 0.00232
+}
+
+/// Log2 encoding of one channel onto [0, 1].
+pub fn log_encode(v: f32) -> f32 {
+    (v.log2().clamp(EV_MIN, EV_MAX) - EV_MIN) / (EV_MAX - EV_MIN)
+}
+
+pub(crate) fn apply(ctx: &Context) -> Output {
+    let (to_srgb, from_srgb) = srgb_matrices(&ctx.image.color_space);
+    let inset = Mat3::from_cols_array(&INSET) * to_srgb;
+    let outset = Mat3::from_cols_array(&OUTSET);
+    Output {
+        mapped: map_pixels(ctx.image, ctx.exposure, |c| {
+            let v = inset * Vec3::from(c);
+            let s = Vec3::new(
+                contrast(log_encode(v.x)),
+                contrast(log_encode(v.y)),
+                contrast(log_encode(v.z)),
+            );
+            let d = (outset * s).max(Vec3::ZERO);
+            let linear = Vec3::new(d.x.powf(2.2), d.y.powf(2.2), d.z.powf(2.2));
+            (from_srgb * linear).to_array()
+        }),
+        values: vec![],
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::test_support::*;
+    use super::super::{ToneOperator, ToneParams};
+    use super::*;
+
+    #[test]
+    fn outset_inverts_inset_and_mid_grey_lands_mid_display() {
+        let product = Mat3::from_cols_array(&OUTSET) * Mat3::from_cols_array(&INSET);
+        // The printed matrices are inverse to ~1e-7 (f32 of 15 printed digits).
+        assert!(product.abs_diff_eq(Mat3::IDENTITY, 1e-5));
+        // 0.18 is 2.474 EV below 1: x = 10.0/16.5; s(x) ≈ 0.4967 (hand evaluation).
+        assert!((contrast(log_encode(0.18)) - 0.4967).abs() < 1e-3);
+        let img = small_image();
+        let out = ToneOperator::Agx
+            .apply(&img, &ToneParams::default())
+            .unwrap()
+            .image;
+        // A grey stays (nearly) grey: inset rows sum to 1 within 1e-4.
+        let g = out.pixels()[2];
+        assert!(
+            (g[0] - g[1]).abs() < 1e-3 && (g[1] - g[2]).abs() < 1e-3,
+            "{g:?}"
+        );
+        let v = 4.0f32 * 1.0001;
+        let want = contrast(log_encode(v)).powf(2.2);
+        assert!((g[1] - want).abs() < 2e-3, "{g:?} vs {want}");
+        // Where red saturates first, the outset's negative off-diagonal terms lower the
+        // output by < 1e-4 relative (measured 7e-5): a property of the published transform.
+        assert_monotone_within(ToneOperator::Agx, &ToneParams::default(), None, 1e-4);
+    }
+}

@@ -1,0 +1,91 @@
+//! Drago, Myszkowski, Annen & Chiba 2003, "Adaptive Logarithmic Mapping For Displaying High
+//! Contrast Scenes", Eurographics, eq. 4:
+//! L_d = (L_dmax · 0.01 / log10(L_wmax + 1)) · ln(L_w + 1) / ln(2 + 8 (L_w / L_wmax)^(ln b / ln 0.5)),
+//! with world luminances divided by the log-average L_wa first (§3.2; as in pfstmo), bias
+//! b = 0.85 and L_dmax = 100 cd/m² (so the prefactor is 1/log10(L_wmax + 1) and the
+//! brightest pixel maps to 1).
+
+use super::pixels::{luminance_stats, map_luminance};
+use super::{Context, OperatorInfo, Output, ParamSpec};
+
+pub(crate) static INFO: OperatorInfo = OperatorInfo {
+    name: "drago03",
+    reference: "Drago, Myszkowski, Annen, Chiba 2003, Adaptive Logarithmic Mapping For \
+                Displaying High Contrast Scenes, Eurographics (eq. 4)",
+    absolute: false,
+    params: &[
+        ParamSpec {
+            name: "bias",
+            default: Some(0.85),
+            min: 0.5,
+            max: 1.0,
+            doc: "bias b of the adaptive log base (0.7–0.9 recommended)",
+        },
+        ParamSpec {
+            name: "display_max",
+            default: Some(100.0),
+            min: 1.0,
+            max: 1e5,
+            doc: "L_dmax, maximum display luminance in cd/m² (100 maps L_wmax to 1)",
+        },
+    ],
+};
+
+pub(crate) fn apply(ctx: &Context) -> Output {
+    let stats = luminance_stats(ctx.image, ctx.exposure, ctx.weights);
+    let bias = ctx.value("bias");
+    let display_max = ctx.value("display_max");
+    let l_wmax = stats.max / stats.log_average;
+    let exponent = (bias.ln() / 0.5f64.ln()) as f32;
+    let prefactor = if l_wmax > 0.0 {
+        (display_max * 0.01 / (l_wmax + 1.0).log10()) as f32
+    } else {
+        0.0
+    };
+    let inv_avg = (1.0 / stats.log_average) as f32;
+    let inv_max = if l_wmax > 0.0 {
+        (1.0 / l_wmax) as f32
+    } else {
+        0.0
+    };
+    let mapped = map_luminance(ctx.image, ctx.exposure, ctx.weights, |l| {
+        let lw = l * inv_avg;
+        prefactor * lw.ln_1p() / (2.0 + 8.0 * (lw * inv_max).powf(exponent)).ln()
+    });
+    Output {
+        mapped,
+        values: vec![
+            ("log_average", stats.log_average),
+            ("max_scaled_luminance", l_wmax),
+            ("bias", bias),
+        ],
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::test_support::*;
+    use super::super::{ToneOperator, ToneParams};
+
+    #[test]
+    fn matches_equation_4() {
+        let img = small_image();
+        let out = ToneOperator::Drago03
+            .apply(&img, &ToneParams::default())
+            .unwrap()
+            .image;
+        let lw: Vec<f64> = img.pixels().iter().map(|p| luminance(&img, *p)).collect();
+        let l_wa = (lw.iter().map(|l| (1e-6 + l).ln()).sum::<f64>() / 4.0).exp();
+        let scaled: Vec<f64> = lw.iter().map(|l| l / l_wa).collect();
+        let l_max = scaled.iter().cloned().fold(0.0, f64::max);
+        let b = 0.85f64;
+        for (i, p) in out.pixels().iter().enumerate() {
+            let l = scaled[i];
+            let ld = (1.0 / (l_max + 1.0).log10()) * (l + 1.0).ln()
+                / (2.0 + 8.0 * (l / l_max).powf(b.ln() / 0.5f64.ln())).ln();
+            assert_close(luminance(&out, *p), ld, "L_d");
+        }
+        assert_close(luminance(&out, out.pixels()[3]), 1.0, "brightest → 1");
+        assert_monotone(ToneOperator::Drago03, &ToneParams::default(), None);
+    }
+}

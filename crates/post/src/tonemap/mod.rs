@@ -1,0 +1,301 @@
+//! Tone operators: each a documented function of relative or absolute luminance, in its own
+//! file with its reference and equations. [`ToneOperator::apply`] maps a linear HDR image to
+//! linear display values (nominally [0, 1]; clipping and gamut mapping come after), never
+//! outputs NaN, ±∞ or negative values, and reports how many input pixels were non-finite or
+//! negative ([`ToneReport`]).
+
+mod aces;
+mod agx;
+mod drago03;
+mod exponential;
+mod ferwerda96;
+mod linear;
+mod logarithmic;
+mod mean_value;
+pub mod pixels;
+mod reinhard02;
+mod schlick94;
+mod tumblin_rushmeier;
+mod ward94;
+
+use std::collections::BTreeMap;
+
+use serde::Serialize;
+
+use crate::error::{PostError, Result};
+use crate::image::Image;
+use pixels::Mapped;
+
+/// One operator parameter: name, default (`None`: computed from the image) and meaning.
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct ParamSpec {
+    pub name: &'static str,
+    pub default: Option<f64>,
+    /// Inclusive lower and upper bounds of accepted values.
+    pub min: f64,
+    pub max: f64,
+    pub doc: &'static str,
+}
+
+/// What `prism tonemap --list` prints for one operator.
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct OperatorInfo {
+    pub name: &'static str,
+    pub reference: &'static str,
+    /// Needs absolute luminance (cd/m²).
+    pub absolute: bool,
+    pub params: &'static [ParamSpec],
+}
+
+/// The tone operators implemented so far.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ToneOperator {
+    Linear,
+    MeanValue,
+    Ward94,
+    Exponential,
+    Logarithmic,
+    Drago03,
+    Schlick94,
+    TumblinRushmeier,
+    Reinhard02,
+    Ferwerda96,
+    Aces,
+    Agx,
+}
+
+/// Settings shared by every operator, plus per-operator parameter overrides.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ToneParams {
+    /// Exposure in stops applied before the operator (input × 2^EV).
+    pub exposure_ev: f64,
+    /// cd/m² per unit of relative luminance; overrides the image's `cd_m2_per_unit`.
+    pub luminance_scale_cd_m2: Option<f64>,
+    /// Operator parameters by name (`--param key=value`), checked against the operator's
+    /// [`ParamSpec`]s.
+    pub values: BTreeMap<String, f64>,
+}
+
+impl Default for ToneParams {
+    fn default() -> Self {
+        Self {
+            exposure_ev: 0.0,
+            luminance_scale_cd_m2: None,
+            values: BTreeMap::new(),
+        }
+    }
+}
+
+/// What an operator met and derived; serialisable for `--json` reports.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ToneReport {
+    pub operator: &'static str,
+    /// Input pixels with a NaN or infinite component (mapped as black).
+    pub non_finite_pixels: u64,
+    /// Input pixels with a negative component (that component clamped to 0).
+    pub negative_pixels: u64,
+    /// Resolved parameters and image statistics the mapping used (L_avg, L_white, …).
+    pub values: BTreeMap<String, f64>,
+}
+
+#[derive(Debug, Clone)]
+pub struct ToneResult {
+    pub image: Image,
+    pub report: ToneReport,
+}
+
+/// Everything an operator's `apply` needs: the image, exposure factor, luminance weights,
+/// and resolved parameters.
+pub(crate) struct Context<'a> {
+    pub image: &'a Image,
+    pub params: &'a ToneParams,
+    pub info: &'static OperatorInfo,
+    /// 2^EV.
+    pub exposure: f32,
+    /// Y = w · RGB in the image's colour space.
+    pub weights: [f32; 3],
+}
+
+impl Context<'_> {
+    /// The parameter's value: the override if given, else its default (`None` when the
+    /// default is computed from the image).
+    pub fn param(&self, name: &str) -> Option<f64> {
+        self.params.values.get(name).copied().or_else(|| {
+            self.info
+                .params
+                .iter()
+                .find(|p| p.name == name)
+                .and_then(|p| p.default)
+        })
+    }
+
+    /// A parameter with a fixed default.
+    pub fn value(&self, name: &str) -> f64 {
+        self.param(name)
+            .expect("parameters read with value() have a default in their ParamSpec")
+    }
+
+    /// cd/m² per unit: `--luminance-scale`, else the image's `prism:cd_m2_per_unit`.
+    pub fn absolute_scale(&self) -> Result<f64> {
+        self.params
+            .luminance_scale_cd_m2
+            .or(self.image.cd_m2_per_unit)
+            .ok_or_else(|| {
+                PostError::invalid(format!(
+                    "operator {} needs absolute luminance: the image has no \
+                     prism:cd_m2_per_unit header; give --luminance-scale (cd/m² per unit)",
+                    self.info.name
+                ))
+            })
+    }
+}
+
+/// An operator's output before it is wrapped into a [`ToneResult`].
+pub(crate) struct Output {
+    pub mapped: Mapped,
+    pub values: Vec<(&'static str, f64)>,
+}
+
+impl ToneOperator {
+    pub const ALL: [ToneOperator; 12] = [
+        ToneOperator::Linear,
+        ToneOperator::MeanValue,
+        ToneOperator::Ward94,
+        ToneOperator::Exponential,
+        ToneOperator::Logarithmic,
+        ToneOperator::Drago03,
+        ToneOperator::Schlick94,
+        ToneOperator::TumblinRushmeier,
+        ToneOperator::Reinhard02,
+        ToneOperator::Ferwerda96,
+        ToneOperator::Aces,
+        ToneOperator::Agx,
+    ];
+
+    pub fn info(self) -> &'static OperatorInfo {
+        match self {
+            ToneOperator::Linear => &linear::INFO,
+            ToneOperator::MeanValue => &mean_value::INFO,
+            ToneOperator::Ward94 => &ward94::INFO,
+            ToneOperator::Exponential => &exponential::INFO,
+            ToneOperator::Logarithmic => &logarithmic::INFO,
+            ToneOperator::Drago03 => &drago03::INFO,
+            ToneOperator::Schlick94 => &schlick94::INFO,
+            ToneOperator::TumblinRushmeier => &tumblin_rushmeier::INFO,
+            ToneOperator::Reinhard02 => &reinhard02::INFO,
+            ToneOperator::Ferwerda96 => &ferwerda96::INFO,
+            ToneOperator::Aces => &aces::INFO,
+            ToneOperator::Agx => &agx::INFO,
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        self.info().name
+    }
+
+    /// Every operator's name, reference and parameters (for `--list`).
+    pub fn catalogue() -> Vec<&'static OperatorInfo> {
+        Self::ALL.iter().map(|op| op.info()).collect()
+    }
+
+    /// Looks an operator up by its CLI name (`reinhard02`, `tumblin-rushmeier`, …).
+    pub fn from_name(name: &str) -> Result<Self> {
+        Self::ALL
+            .into_iter()
+            .find(|op| op.name().eq_ignore_ascii_case(name))
+            .ok_or_else(|| {
+                PostError::invalid(format!(
+                    "unknown tone operator '{name}'{}; expected one of: {}",
+                    prism_spectrum::names::did_you_mean(name, Self::ALL.iter().map(|o| o.name())),
+                    Self::ALL.map(|o| o.name()).join(", ")
+                ))
+            })
+    }
+
+    /// Checks that every parameter in `params` exists for this operator and lies within
+    /// its bounds, and that the exposure and luminance scale are usable.
+    pub fn validate(self, params: &ToneParams) -> Result<()> {
+        let info = self.info();
+        if !params.exposure_ev.is_finite() {
+            return Err(PostError::invalid(format!(
+                "exposure {} EV: expected a finite number of stops",
+                params.exposure_ev
+            )));
+        }
+        if let Some(s) = params.luminance_scale_cd_m2 {
+            if !(s.is_finite() && s > 0.0) {
+                return Err(PostError::invalid(format!(
+                    "luminance scale {s} cd/m² per unit: expected a positive number"
+                )));
+            }
+        }
+        for (name, value) in &params.values {
+            let Some(spec) = info.params.iter().find(|p| p.name == name) else {
+                let known: Vec<&str> = info.params.iter().map(|p| p.name).collect();
+                return Err(PostError::invalid(format!(
+                    "operator {} has no parameter '{name}'{}; its parameters: {}",
+                    info.name,
+                    prism_spectrum::names::did_you_mean(name, known.iter().copied()),
+                    if known.is_empty() {
+                        "none".to_string()
+                    } else {
+                        known.join(", ")
+                    }
+                )));
+            };
+            if !(value.is_finite() && *value >= spec.min && *value <= spec.max) {
+                return Err(PostError::invalid(format!(
+                    "{} {name} = {value}: expected a number in [{}, {}] ({})",
+                    info.name, spec.min, spec.max, spec.doc
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    /// Tone-maps `image` to linear display values in its own colour space.
+    pub fn apply(self, image: &Image, params: &ToneParams) -> Result<ToneResult> {
+        self.validate(params)?;
+        let ctx = Context {
+            image,
+            params,
+            info: self.info(),
+            exposure: 2f64.powf(params.exposure_ev) as f32,
+            weights: image.luminance_weights(),
+        };
+        let output = match self {
+            ToneOperator::Linear => linear::apply(&ctx),
+            ToneOperator::MeanValue => mean_value::apply(&ctx),
+            ToneOperator::Ward94 => ward94::apply(&ctx)?,
+            ToneOperator::Exponential => exponential::apply(&ctx),
+            ToneOperator::Logarithmic => logarithmic::apply(&ctx),
+            ToneOperator::Drago03 => drago03::apply(&ctx),
+            ToneOperator::Schlick94 => schlick94::apply(&ctx),
+            ToneOperator::TumblinRushmeier => tumblin_rushmeier::apply(&ctx)?,
+            ToneOperator::Reinhard02 => reinhard02::apply(&ctx),
+            ToneOperator::Ferwerda96 => ferwerda96::apply(&ctx)?,
+            ToneOperator::Aces => aces::apply(&ctx),
+            ToneOperator::Agx => agx::apply(&ctx),
+        };
+        let mut out = image.with_pixels(output.mapped.pixels)?;
+        out.cd_m2_per_unit = None;
+        out.metadata
+            .insert("prism:tone_operator".into(), self.name().into());
+        Ok(ToneResult {
+            image: out,
+            report: ToneReport {
+                operator: self.name(),
+                non_finite_pixels: output.mapped.non_finite_pixels,
+                negative_pixels: output.mapped.negative_pixels,
+                values: output
+                    .values
+                    .into_iter()
+                    .map(|(k, v)| (k.to_string(), v))
+                    .collect(),
+            },
+        })
+    }
+}
+
+#[cfg(test)]
+pub(crate) mod test_support;

@@ -1,0 +1,78 @@
+//! Small hand-made images and checks shared by the operators' tests.
+
+use prism_spectrum::rgb_space::RgbColorSpace;
+
+use super::{ToneOperator, ToneParams};
+use crate::image::Image;
+
+/// A 4×1 sRGB image of greys and colours with known luminances.
+pub fn small_image() -> Image {
+    Image::new(
+        4,
+        1,
+        vec![
+            [0.05, 0.05, 0.05],
+            [1.0, 0.5, 0.25],
+            [4.0, 4.0, 4.0],
+            [20.0, 30.0, 10.0],
+        ],
+        RgbColorSpace::srgb(),
+    )
+    .unwrap()
+}
+
+pub fn luminance(image: &Image, p: [f32; 3]) -> f64 {
+    let w = image.luminance_weights();
+    (0..3).map(|c| w[c] as f64 * p[c] as f64).sum()
+}
+
+/// f32 evaluation of a formula vs the f64 reference: a few ulps of the result and of the
+/// log-average (a sum of n ln terms): 1e-5 relative is ~100 ulps of f32.
+pub const F32_RELATIVE: f64 = 1e-5;
+
+pub fn assert_close(got: f64, want: f64, what: &str) {
+    assert!(
+        (got - want).abs() <= F32_RELATIVE * want.abs().max(1e-6),
+        "{what}: got {got}, want {want}"
+    );
+}
+
+/// Output luminance is non-decreasing over an increasing grey and coloured ramp spanning
+/// 1e-4 … 1e5 (relative), for the operator's defaults.
+pub fn assert_monotone(op: ToneOperator, params: &ToneParams, cd_m2_per_unit: Option<f64>) {
+    assert_monotone_within(op, params, cd_m2_per_unit, 0.0);
+}
+
+/// As [`assert_monotone`], allowing a relative drop of `tint_drop` on the coloured ramp
+/// (per-channel curves followed by a mixing matrix, as AgX's outset, can lower luminance
+/// slightly where one channel saturates before the others). Greys stay strictly checked.
+pub fn assert_monotone_within(
+    op: ToneOperator,
+    params: &ToneParams,
+    cd_m2_per_unit: Option<f64>,
+    tint_drop: f64,
+) {
+    for (tint, drop) in [([1.0f32, 1.0, 1.0], 0.0), ([1.0, 0.4, 0.1], tint_drop)] {
+        let n = 400;
+        let pixels = (0..n)
+            .map(|i| {
+                let v = 10f32.powf(-4.0 + 9.0 * i as f32 / (n - 1) as f32);
+                tint.map(|t| t * v)
+            })
+            .collect();
+        let mut img = Image::new(n, 1, pixels, RgbColorSpace::srgb()).unwrap();
+        img.cd_m2_per_unit = cd_m2_per_unit;
+        let out = op.apply(&img, params).unwrap().image;
+        let lum: Vec<f64> = out.pixels().iter().map(|p| luminance(&out, *p)).collect();
+        for (i, pair) in lum.windows(2).enumerate() {
+            assert!(
+                // 1e-6: f32 rounding of equal outputs (a saturated curve).
+                pair[1] >= pair[0] * (1.0 - 1e-6 - drop),
+                "{}: luminance decreases at {i}: {} → {}",
+                op.name(),
+                pair[0],
+                pair[1]
+            );
+        }
+    }
+}
