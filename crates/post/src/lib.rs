@@ -3,6 +3,7 @@
 //!
 //! Data flow (DESIGN.md): white balance → gamut mapping → tone operator → display encoding.
 
+pub mod colour;
 pub mod error;
 pub mod image;
 pub mod io;

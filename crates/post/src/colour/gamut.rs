@@ -18,7 +18,7 @@
 //!   pixel (a, b ← k·a, k·b at constant L*, h), with k the largest that brings every
 //!   outside pixel inside. Chroma ratios, hence the ordering of chroma, are preserved.
 //! - [`GamutMethod::AcesRgc`]: ACES Reference Gamut Compression 1.0 in ACEScg
-//!   ([`crate::aces_rgc`]) applied to every pixel as the reference does, then converted
+//!   ([`crate::colour::aces_rgc`]) applied to every pixel as the reference does, then converted
 //!   to the target and clipped (the RGC only compresses into AP1).
 
 use std::fmt;
@@ -30,11 +30,11 @@ use prism_spectrum::rgb_space::RgbColorSpace;
 use prism_spectrum::AdaptationMethod;
 use rayon::prelude::*;
 
-use crate::aces_rgc::{aces_rgc_acescg, AcesRgcParameters};
-use crate::cielab_lch::{CielabConverter, CIELAB_L_WHITE};
-use crate::error::PostColourError;
-use crate::oklab::OklabConverter;
-use crate::rgb_matrix::{mul, rgb_to_rgb_matrix, same_colorimetry, to_pixel, CHUNK_PIXELS};
+use crate::colour::aces_rgc::{aces_rgc_acescg, AcesRgcParameters};
+use crate::colour::cielab_lch::{CielabConverter, CIELAB_L_WHITE};
+use crate::colour::error::PostColourError;
+use crate::colour::oklab::OklabConverter;
+use crate::colour::rgb_matrix::{mul, rgb_to_rgb_matrix, same_colorimetry, to_pixel, CHUNK_PIXELS};
 
 /// Bisection stops when the chroma interval is below this, in CIELAB C*ab units
 /// (far below a just-noticeable difference, ΔE*ab ≈ 1).

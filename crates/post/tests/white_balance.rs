@@ -2,8 +2,8 @@
 //! D65 (|a*|, |b*| < 0.5), for every applicable method and adaptation transform.
 
 use glam::DVec3;
-use prism_post_colour::white_balance::{cct_white_xyz, daylight_locus_xy};
-use prism_post_colour::{apply_white_balance, PostColourError, WhiteBalance};
+use prism_post::colour::white_balance::{cct_white_xyz, daylight_locus_xy};
+use prism_post::colour::{apply_white_balance, PostColourError, WhiteBalance};
 use prism_spectrum::colorimetry::{reflectance_to_xyz, xyz_to_lab, xyz_to_xy};
 use prism_spectrum::data::{colorchecker_patch, illuminant};
 use prism_spectrum::rgb_space::RgbColorSpace;

@@ -4,7 +4,7 @@
 
 use std::time::Instant;
 
-use prism_post_colour::{apply_white_balance, map_gamut, GamutMethod, GamutTarget, WhiteBalance};
+use prism_post::colour::{apply_white_balance, map_gamut, GamutMethod, GamutTarget, WhiteBalance};
 use prism_spectrum::rgb_space::RgbColorSpace;
 use prism_spectrum::AdaptationMethod;
 

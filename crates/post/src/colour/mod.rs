@@ -1,6 +1,6 @@
-//! prism-post-colour: white balance and gamut mapping on slices of linear RGB pixels
+//! White balance and gamut mapping on slices of linear RGB pixels
 //! (`&mut [[f32; 3]]` in a given [`RgbColorSpace`](prism_spectrum::rgb_space::RgbColorSpace)),
-//! so that it plugs into any image type. To be folded into prism-post.
+//! so that it plugs into any image type.
 //!
 //! Pipeline position (DESIGN.md): white balance ──► gamut mapping ──► tone operator.
 //! See docs/gamut-and-white-balance.md for the methods, parameters, references and CLI syntax.

@@ -36,8 +36,8 @@ use prism_spectrum::rgb_space::{xy_to_xyz_unit_y, RgbColorSpace};
 use prism_spectrum::{adaptation_matrix, AdaptationMethod, Observer};
 use rayon::prelude::*;
 
-use crate::error::PostColourError;
-use crate::rgb_matrix::{apply_rgb_matrix, CHUNK_PIXELS};
+use crate::colour::error::PostColourError;
+use crate::colour::rgb_matrix::{apply_rgb_matrix, CHUNK_PIXELS};
 
 /// Lowest colour temperature accepted by `cct:` in K (the Planckian table's start).
 pub const WB_CCT_MIN_K: f64 = 1000.0;
