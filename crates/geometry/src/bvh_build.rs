@@ -77,3 +77,34 @@ pub fn build_bvh(boxes: &[Aabb], quality: BuildQuality) -> Option<CwBvh> {
         &mut Duration::default(),
     ))
 }
+
+/// Largest reciprocal used for a zero (or sub-1e-18) direction component in the slab test.
+const MAX_INV_DIRECTION: f32 = 1.0e18;
+
+/// The obvhs ray for a traversal. obvhs' own `Ray::new` clamps `1/d` to `±1/ε` (≈8·10⁶) for
+/// tiny components and takes the sign of `-0.0` as negative while its node test takes the
+/// traversal side from `d < 0`: a ray travelling exactly along a box face then "drifts" out of
+/// the slab after `t ≈ 8·10⁶ × margin`, and one with a `-0.0` component is culled outright.
+/// Here a zero component gets `±10¹⁸` with the sign the node test expects, which keeps the
+/// drift below any scene scale and the products finite (no `0·∞`/`∞−∞` NaNs).
+#[inline]
+pub fn bvh_ray(origin: Vec3A, direction: Vec3A, t_min: f32, t_max: f32) -> obvhs::ray::Ray {
+    let inv = |d: f32| {
+        if d.abs() < 1.0 / MAX_INV_DIRECTION {
+            if d < 0.0 {
+                -MAX_INV_DIRECTION
+            } else {
+                MAX_INV_DIRECTION
+            }
+        } else {
+            1.0 / d
+        }
+    };
+    obvhs::ray::Ray {
+        origin,
+        direction,
+        inv_direction: Vec3A::new(inv(direction.x), inv(direction.y), inv(direction.z)),
+        tmin: t_min,
+        tmax: t_max,
+    }
+}

@@ -13,9 +13,9 @@
 use glam::Vec3A;
 use obvhs::aabb::Aabb;
 use obvhs::cwbvh::CwBvh;
-use obvhs::ray::{Ray as BvhRay, RayHit};
+use obvhs::ray::RayHit;
 
-use crate::bvh_build::{build_bvh, padded_aabb, BuildQuality};
+use crate::bvh_build::{build_bvh, bvh_ray, padded_aabb, BuildQuality};
 use crate::disk::Disk;
 use crate::interaction::SurfaceInteraction;
 use crate::mesh::{TriangleMesh, NO_MATERIAL};
@@ -261,8 +261,8 @@ impl Geometry {
 }
 
 #[inline]
-fn to_bvh_ray(ray: &Ray) -> BvhRay {
-    BvhRay::new(ray.origin, ray.direction, ray.t_min, ray.t_max)
+fn to_bvh_ray(ray: &Ray) -> obvhs::ray::Ray {
+    bvh_ray(ray.origin, ray.direction, ray.t_min, ray.t_max)
 }
 
 #[inline]

@@ -7,9 +7,9 @@
 use glam::Vec3A;
 use obvhs::aabb::Aabb;
 use obvhs::cwbvh::CwBvh;
-use obvhs::ray::{Ray as BvhRay, RayHit};
+use obvhs::ray::RayHit;
 
-use crate::bvh_build::{build_bvh, padded_aabb, BuildQuality};
+use crate::bvh_build::{build_bvh, bvh_ray, padded_aabb, BuildQuality};
 use crate::mesh::TriangleMesh;
 use crate::triangle::WatertightRay;
 
@@ -86,7 +86,7 @@ impl MeshBvh {
         let mut best: Option<MeshHit> = None;
         let mut hit = RayHit::none();
         bvh.ray_traverse(
-            BvhRay::new(origin, direction, t_min, t_max),
+            bvh_ray(origin, direction, t_min, t_max),
             &mut hit,
             |r, id| {
                 let [a, b, c] = self.leaf_triangles[id];
@@ -115,7 +115,7 @@ impl MeshBvh {
             return false;
         };
         let wt = WatertightRay::new(origin, direction, t_min);
-        !bvh.ray_traverse_miss(BvhRay::new(origin, direction, t_min, t_max), |r, id| {
+        !bvh.ray_traverse_miss(bvh_ray(origin, direction, t_min, t_max), |r, id| {
             let [a, b, c] = self.leaf_triangles[id];
             wt.intersect(a, b, c, r.tmax).map_or(f32::INFINITY, |h| h.t)
         })
