@@ -87,6 +87,14 @@ impl FilterSampler {
         (x, self.pdf[i])
     }
 
+    /// The film point (px) of a camera sample of `pixel`: its centre plus an offset drawn
+    /// from the filter with `u`, and the sample's weight f/p.
+    #[inline]
+    pub fn sample_film_point(&self, pixel: glam::UVec2, u: Vec2) -> (Vec2, f32) {
+        let s = self.sample(u);
+        (pixel.as_vec2() + Vec2::splat(0.5) + s.offset_px, s.weight)
+    }
+
     /// A film offset for `u` ∈ [0, 1)² and its weight f/p.
     #[inline]
     pub fn sample(&self, u: Vec2) -> FilterSample {

@@ -17,6 +17,8 @@ pub use filter_sampler::{FilterSample, FilterSampler};
 pub use image::{AovPlane, FilmImage};
 pub use tile::{FilmTile, SurfaceAov, TileBounds};
 
+use std::sync::Arc;
+
 use glam::{DVec3, UVec2, Vec2};
 use prism_spectrum::rgb_space::RgbColorSpace;
 use rayon::prelude::*;
@@ -56,7 +58,7 @@ impl AovSelection {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Film {
     resolution: UVec2,
-    filter_sampler: FilterSampler,
+    filter_sampler: Arc<FilterSampler>,
     aov_selection: AovSelection,
     pixels: Vec<PixelAccum>,
     aovs: Vec<AovAccum>,
@@ -80,7 +82,7 @@ impl Film {
         let n = resolution.x as usize * resolution.y as usize;
         Ok(Self {
             resolution,
-            filter_sampler: FilterSampler::new(filter),
+            filter_sampler: Arc::new(FilterSampler::new(filter)),
             aov_selection,
             pixels: vec![PixelAccum::default(); n],
             aovs: if aov_selection.any() {
@@ -113,10 +115,10 @@ impl Film {
 
     /// The film point (px) of a camera sample of `pixel` with filter variate `u`, and its
     /// weight: pixel centre + an offset drawn from the filter.
+    /// (`FilmTile::sample_film_point` does the same inside a tile.)
     #[inline]
     pub fn sample_film_point(&self, pixel: UVec2, u: Vec2) -> (Vec2, f32) {
-        let s = self.filter_sampler.sample(u);
-        (pixel.as_vec2() + Vec2::splat(0.5) + s.offset_px, s.weight)
+        self.filter_sampler.sample_film_point(pixel, u)
     }
 
     /// The film cut into tiles of `tile_size_px` (≥ 1; clamped) square, row-major.
@@ -144,7 +146,11 @@ impl Film {
                 .min(self.resolution)
                 .max(bounds.min.min(self.resolution)),
         };
-        FilmTile::new(b, self.aov_selection.any())
+        FilmTile::new(
+            b,
+            self.aov_selection.any(),
+            Arc::clone(&self.filter_sampler),
+        )
     }
 
     /// Adds a tile's sums into the film. Merging tiles in any fixed order gives the same
@@ -161,7 +167,8 @@ impl Film {
         }
     }
 
-    /// Renders every tile with `render_tile` on the current rayon pool and merges the tiles
+    /// Renders every tile with `render_tile` on the current rayon pool (a
+    /// `ThreadPool::install` around the call picks the pool) and merges the tiles
     /// in row-major order. `render_tile` must seed its samples per pixel (e.g. with
     /// `PixelSampler`), never per thread; then the film is bit-identical for any number of
     /// threads.

@@ -3,9 +3,12 @@
 //! `filter_sampler`), tiles are disjoint and a pixel's sums depend only on its own samples
 //! in the order they were added — never on threads.
 
-use glam::{DVec3, UVec2, Vec3A};
+use std::sync::Arc;
+
+use glam::{DVec3, UVec2, Vec2, Vec3A};
 use prism_spectrum::{SampledSpectrum, SampledWavelengths};
 
+use super::filter_sampler::FilterSampler;
 use super::xyz::xyz_of_sample;
 
 /// A half-open pixel rectangle [min, max).
@@ -92,10 +95,15 @@ pub struct FilmTile {
     pub(crate) pixels: Vec<PixelAccum>,
     /// Empty when the film records no surface AOVs.
     pub(crate) aovs: Vec<AovAccum>,
+    filter_sampler: Arc<FilterSampler>,
 }
 
 impl FilmTile {
-    pub(crate) fn new(bounds: TileBounds, with_aovs: bool) -> Self {
+    pub(crate) fn new(
+        bounds: TileBounds,
+        with_aovs: bool,
+        filter_sampler: Arc<FilterSampler>,
+    ) -> Self {
         let n = bounds.pixel_count();
         Self {
             bounds,
@@ -105,7 +113,15 @@ impl FilmTile {
             } else {
                 Vec::new()
             },
+            filter_sampler,
         }
+    }
+
+    /// The film point (px) of a camera sample of `pixel` with filter variate `u`, and the
+    /// weight to pass to `add_sample` (see `FilterSampler`).
+    #[inline]
+    pub fn sample_film_point(&self, pixel: UVec2, u: Vec2) -> (Vec2, f32) {
+        self.filter_sampler.sample_film_point(pixel, u)
     }
 
     pub fn bounds(&self) -> TileBounds {
