@@ -60,6 +60,9 @@ fn flat_unit_radiance_gives_y_one_within_the_standard_error() {
         assert_eq!(image.cd_m2_per_unit, cd_m2_per_unit());
         assert!((image.cd_m2_per_unit - 683.002 * 106.857).abs() < 1.0);
         assert!((cie_y_integral_nm() - 106.857).abs() < 0.01);
+        for (l, y) in image.luminance_cd_m2().iter().zip(&image.y) {
+            assert!((f64::from(*l) - f64::from(*y) * 683.002 * cie_y_integral_nm()).abs() < 1e-2);
+        }
         let spp = image.aov("spp.Y").unwrap();
         assert!(spp.values.iter().all(|&v| v == 16.0));
     }

@@ -34,6 +34,14 @@ impl FilmImage {
         self.aovs.iter().find(|p| p.name == name)
     }
 
+    /// The luminance plane in cd/m² (Y · `cd_m2_per_unit`), e.g. for a `luminance.Y` layer.
+    pub fn luminance_cd_m2(&self) -> Vec<f32> {
+        self.y
+            .iter()
+            .map(|&y| (f64::from(y) * self.cd_m2_per_unit) as f32)
+            .collect()
+    }
+
     /// Row-major index of pixel (x, y).
     pub fn index(&self, x: u32, y: u32) -> usize {
         y as usize * self.width as usize + x as usize
