@@ -1,0 +1,110 @@
+//! BVH construction with obvhs (PLOC build, Meister & Bittner 2018, "Parallel locally-ordered
+//! clustering for bounding volume hierarchy construction", + reinsertion optimisation,
+//! Meister & Bittner 2017; converted to an 8-wide compressed BVH, Ylitie et al. 2017,
+//! "Efficient incoherent ray traversal on GPUs through compressed wide BVHs").
+
+use glam::Vec3A;
+use obvhs::aabb::Aabb;
+use obvhs::cwbvh::builder::build_cwbvh;
+use obvhs::cwbvh::CwBvh;
+use obvhs::BvhBuildParams;
+use std::time::Duration;
+
+/// Quality/speed trade-off of the build: the obvhs presets. obvhs' `pre_split` (spatial
+/// splits of large triangles) applies only to its triangle-specific builder, which we do not
+/// use because we build over padded boxes (see [`padded_aabb`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum BuildQuality {
+    Fastest,
+    VeryFast,
+    /// Default: measured in tools/bench-bvh (docs/geometry.md) as the best build/trace trade.
+    #[default]
+    Fast,
+    Medium,
+    Slow,
+    VerySlow,
+}
+
+impl BuildQuality {
+    pub const ALL: [BuildQuality; 6] = [
+        BuildQuality::Fastest,
+        BuildQuality::VeryFast,
+        BuildQuality::Fast,
+        BuildQuality::Medium,
+        BuildQuality::Slow,
+        BuildQuality::VerySlow,
+    ];
+
+    pub fn params(self) -> BvhBuildParams {
+        match self {
+            BuildQuality::Fastest => BvhBuildParams::fastest_build(),
+            BuildQuality::VeryFast => BvhBuildParams::very_fast_build(),
+            BuildQuality::Fast => BvhBuildParams::fast_build(),
+            BuildQuality::Medium => BvhBuildParams::medium_build(),
+            BuildQuality::Slow => BvhBuildParams::slow_build(),
+            BuildQuality::VerySlow => BvhBuildParams::very_slow_build(),
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            BuildQuality::Fastest => "fastest",
+            BuildQuality::VeryFast => "very_fast",
+            BuildQuality::Fast => "fast",
+            BuildQuality::Medium => "medium",
+            BuildQuality::Slow => "slow",
+            BuildQuality::VerySlow => "very_slow",
+        }
+    }
+}
+
+/// A box enlarged by a few ulps of its coordinates, so that the compressed child boxes and the
+/// slab test can never cull a ray that grazes a primitive lying exactly on a box face — part
+/// of keeping the watertight triangle test watertight through the BVH.
+pub fn padded_aabb(min: Vec3A, max: Vec3A) -> Aabb {
+    let pad = (min.abs().max(max.abs()) * (8.0 * f32::EPSILON)) + Vec3A::splat(f32::MIN_POSITIVE);
+    Aabb::new(min - pad, max + pad)
+}
+
+/// Build a CWBVH over boxes; `None` for an empty list.
+pub fn build_bvh(boxes: &[Aabb], quality: BuildQuality) -> Option<CwBvh> {
+    if boxes.is_empty() {
+        return None;
+    }
+    Some(build_cwbvh(
+        boxes,
+        quality.params(),
+        &mut Duration::default(),
+    ))
+}
+
+/// Largest reciprocal used for a zero (or sub-1e-18) direction component in the slab test.
+const MAX_INV_DIRECTION: f32 = 1.0e18;
+
+/// The obvhs ray for a traversal. obvhs' own `Ray::new` clamps `1/d` to `±1/ε` (≈8·10⁶) for
+/// tiny components and takes the sign of `-0.0` as negative while its node test takes the
+/// traversal side from `d < 0`: a ray travelling exactly along a box face then "drifts" out of
+/// the slab after `t ≈ 8·10⁶ × margin`, and one with a `-0.0` component is culled outright.
+/// Here a zero component gets `±10¹⁸` with the sign the node test expects, which keeps the
+/// drift below any scene scale and the products finite (no `0·∞`/`∞−∞` NaNs).
+#[inline]
+pub fn bvh_ray(origin: Vec3A, direction: Vec3A, t_min: f32, t_max: f32) -> obvhs::ray::Ray {
+    let inv = |d: f32| {
+        if d.abs() < 1.0 / MAX_INV_DIRECTION {
+            if d < 0.0 {
+                -MAX_INV_DIRECTION
+            } else {
+                MAX_INV_DIRECTION
+            }
+        } else {
+            1.0 / d
+        }
+    };
+    obvhs::ray::Ray {
+        origin,
+        direction,
+        inv_direction: Vec3A::new(inv(direction.x), inv(direction.y), inv(direction.z)),
+        tmin: t_min,
+        tmax: t_max,
+    }
+}

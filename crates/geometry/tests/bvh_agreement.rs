@@ -1,0 +1,245 @@
+//! The BVH's closest-hit and occlusion queries agree with brute force over every triangle, and
+//! closed meshes never leak rays aimed exactly at their shared edges and vertices
+//! (Woop, Benthin & Wald 2013).
+
+use glam::Vec3A;
+use prism_geometry::{
+    BuildQuality, Geometry, GeometryBuilder, Ray, Shape, Transform, TriangleMesh, WatertightRay,
+};
+use rand::{Rng, SeedableRng};
+use rand_pcg::Pcg64;
+
+fn single(mesh: &TriangleMesh, quality: BuildQuality) -> Geometry {
+    let mut b = GeometryBuilder::new();
+    let id = b.add_mesh(mesh.clone());
+    b.add_instance(Shape::Mesh(id), Transform::IDENTITY, None)
+        .unwrap();
+    b.build(quality)
+}
+
+/// Closest t over all triangles with the same watertight test.
+fn brute_force(mesh: &TriangleMesh, ray: &Ray) -> Option<(f32, usize)> {
+    let wt = WatertightRay::new(ray.origin, ray.direction, ray.t_min);
+    let mut best: Option<(f32, usize)> = None;
+    for i in 0..mesh.triangle_count() {
+        let [a, b, c] = mesh.triangle(i);
+        let t_max = best.map_or(ray.t_max, |(t, _)| t);
+        if let Some(h) = wt.intersect(a, b, c, t_max) {
+            best = Some((h.t, i));
+        }
+    }
+    best
+}
+
+fn random_unit(rng: &mut Pcg64) -> Vec3A {
+    loop {
+        let v = Vec3A::new(
+            rng.gen_range(-1.0..1.0),
+            rng.gen_range(-1.0..1.0),
+            rng.gen_range(-1.0..1.0),
+        );
+        let l2 = v.length_squared();
+        if l2 > 1e-4 && l2 <= 1.0 {
+            return v / l2.sqrt();
+        }
+    }
+}
+
+fn triangle_soup(n: usize, rng: &mut Pcg64) -> TriangleMesh {
+    let mut positions = Vec::new();
+    let mut indices = Vec::new();
+    for i in 0..n {
+        let c = Vec3A::new(
+            rng.gen_range(-1.5..1.5),
+            rng.gen_range(-1.5..1.5),
+            rng.gen_range(-1.5..1.5),
+        );
+        let size = rng.gen_range(0.02..0.4);
+        for _ in 0..3 {
+            positions.push(c + random_unit(rng) * size);
+        }
+        let k = 3 * i as u32;
+        indices.push([k, k + 1, k + 2]);
+    }
+    TriangleMesh::new(positions, indices)
+}
+
+fn test_meshes() -> Vec<(&'static str, TriangleMesh)> {
+    let mut rng = Pcg64::seed_from_u64(7);
+    vec![
+        ("icosphere", TriangleMesh::icosphere(1.0, 3)),
+        ("uv_sphere", TriangleMesh::uv_sphere(1.2, 16, 32)),
+        ("cube", TriangleMesh::cuboid(Vec3A::new(1.0, 0.6, 0.8))),
+        ("soup", triangle_soup(600, &mut rng)),
+    ]
+}
+
+#[test]
+fn closest_and_any_hit_agree_with_brute_force_on_random_rays() {
+    let mut rng = Pcg64::seed_from_u64(2024);
+    let mut total = 0;
+    for (name, mesh) in test_meshes() {
+        for quality in [BuildQuality::Fastest, BuildQuality::Fast] {
+            let geometry = single(&mesh, quality);
+            for i in 0..13_000 {
+                let origin = Vec3A::new(
+                    rng.gen_range(-2.5..2.5),
+                    rng.gen_range(-2.5..2.5),
+                    rng.gen_range(-2.5..2.5),
+                );
+                let dir = random_unit(&mut rng) * rng.gen_range(0.5..2.0);
+                // A third of the rays are segments (shadow-ray style), the rest unbounded.
+                let t_max = if i % 3 == 0 {
+                    rng.gen_range(0.1..3.0)
+                } else {
+                    f32::INFINITY
+                };
+                let ray = Ray::new(origin, dir, 1e-4, t_max);
+                let expected = brute_force(&mesh, &ray);
+                let got = geometry.intersect(&ray);
+                match (expected, got) {
+                    (None, None) => {}
+                    (Some((t, tri)), Some(h)) => {
+                        assert_eq!(h.t, t, "{name}: closest t differs for {ray:?}");
+                        if h.primitive_id as usize != tri {
+                            // Only a tie (shared edge/vertex) may pick another triangle.
+                            let [a, b, c] = mesh.triangle(h.primitive_id as usize);
+                            let wt = WatertightRay::new(ray.origin, ray.direction, ray.t_min);
+                            assert_eq!(
+                                wt.intersect(a, b, c, ray.t_max).map(|x| x.t),
+                                Some(t),
+                                "{name}"
+                            );
+                        }
+                    }
+                    (e, g) => panic!("{name}: brute force {e:?} vs BVH {g:?} for {ray:?}"),
+                }
+                assert_eq!(
+                    geometry.occluded(&ray),
+                    expected.is_some(),
+                    "{name}: occlusion for {ray:?}"
+                );
+                total += 1;
+            }
+        }
+    }
+    assert!(total >= 100_000);
+}
+
+/// Points on edges and vertices of the mesh, the targets of the leak test.
+fn edge_and_vertex_targets(mesh: &TriangleMesh) -> Vec<Vec3A> {
+    let mut targets: Vec<Vec3A> = mesh.positions.clone();
+    for tri in &mesh.indices {
+        for k in 0..3 {
+            let (a, b) = (
+                mesh.positions[tri[k] as usize],
+                mesh.positions[tri[(k + 1) % 3] as usize],
+            );
+            targets.push(0.5 * (a + b));
+            targets.push(a + 0.25 * (b - a));
+        }
+    }
+    targets
+}
+
+#[test]
+fn rays_at_shared_edges_and_vertices_never_leak_out_of_closed_meshes() {
+    let mut rng = Pcg64::seed_from_u64(99);
+    let mut rays = 0;
+    for mesh in [
+        TriangleMesh::icosphere(1.0, 2),
+        TriangleMesh::cuboid(Vec3A::new(1.0, 0.5, 2.0)),
+        TriangleMesh::uv_sphere(1.0, 12, 24),
+    ] {
+        let geometry = single(&mesh, BuildQuality::Fast);
+        let targets = edge_and_vertex_targets(&mesh);
+        let mut origins = vec![Vec3A::ZERO];
+        origins.extend((0..12).map(|_| random_unit(&mut rng) * rng.gen_range(0.0..0.45)));
+        for &o in &origins {
+            for &target in &targets {
+                let ray = Ray::new(o, target - o, 0.0, f32::INFINITY);
+                let hit = geometry.intersect(&ray);
+                assert!(
+                    hit.is_some(),
+                    "leak from inside: {ray:?} aimed at {target:?}"
+                );
+                assert!(geometry.occluded(&ray), "occlusion leak: {ray:?}");
+                // Every exit point is at (or within rounding of) the target's distance.
+                assert!(
+                    (hit.unwrap().t - 1.0).abs() < 1e-3,
+                    "{ray:?} t = {}",
+                    hit.unwrap().t
+                );
+                // From outside, aimed at the same point: the near side must be hit.
+                let outside = target + (target - o).normalize() * 3.0;
+                let back = Ray::new(outside, target - outside, 0.0, f32::INFINITY);
+                assert!(
+                    geometry.intersect(&back).is_some(),
+                    "leak from outside: {back:?}"
+                );
+                rays += 2;
+            }
+        }
+    }
+    assert!(rays > 50_000, "{rays}");
+}
+
+#[test]
+fn scene_of_many_instances_agrees_with_brute_force_in_world_space() {
+    let mut rng = Pcg64::seed_from_u64(5);
+    let sphere = TriangleMesh::icosphere(0.5, 2);
+    let cube = TriangleMesh::cuboid(Vec3A::splat(0.4));
+    let mut b = GeometryBuilder::new();
+    let ids = [b.add_mesh(sphere.clone()), b.add_mesh(cube.clone())];
+    let mut placed = Vec::new();
+    for k in 0..20 {
+        let t = Transform::translate(Vec3A::new(
+            rng.gen_range(-3.0..3.0),
+            rng.gen_range(-3.0..3.0),
+            rng.gen_range(-3.0..3.0),
+        ))
+        .compose(&Transform::rotate(random_unit(&mut rng), rng.gen_range(0.0..6.0)).unwrap())
+        .compose(
+            &Transform::scale(Vec3A::new(
+                rng.gen_range(0.5..1.5),
+                rng.gen_range(0.5..1.5),
+                1.0,
+            ))
+            .unwrap(),
+        );
+        let m = ids[k % 2];
+        b.add_instance(Shape::Mesh(m), t, None).unwrap();
+        placed.push((if k % 2 == 0 { &sphere } else { &cube }, t));
+    }
+    let geometry = b.build(BuildQuality::Medium);
+    for _ in 0..5_000 {
+        let ray = Ray::new(
+            Vec3A::new(rng.gen_range(-5.0..5.0), rng.gen_range(-5.0..5.0), 6.0),
+            random_unit(&mut rng),
+            1e-4,
+            f32::INFINITY,
+        );
+        let mut expected: Option<(f32, usize)> = None;
+        for (k, (mesh, t)) in placed.iter().enumerate() {
+            let local = t.inverse_ray(&ray);
+            if let Some((tt, _)) = brute_force(mesh, &local) {
+                if expected.is_none_or(|(best, _)| tt < best) {
+                    expected = Some((tt, k));
+                }
+            }
+        }
+        let got = geometry.intersect(&ray);
+        assert_eq!(got.map(|h| h.t), expected.map(|e| e.0), "{ray:?}");
+        if let (Some(h), Some((_, k))) = (got, expected) {
+            assert_eq!(h.instance_id as usize, k);
+            let si = geometry.interaction(&ray, &h);
+            assert!(
+                (si.p - ray.at(h.t)).length() < 1e-4,
+                "{:?} vs {:?}",
+                si.p,
+                ray.at(h.t)
+            );
+        }
+        assert_eq!(geometry.occluded(&ray), expected.is_some());
+    }
+}

@@ -1,0 +1,49 @@
+//! The film's finished output: what prism-post writes to EXR (DESIGN.md "Units and
+//! conventions": unprefixed R, G, B linear Rec.709; header `prism:cd_m2_per_unit`; AOV
+//! layers with prefixed channel names).
+
+/// One AOV channel, row-major, `width × height` values.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AovPlane {
+    /// EXR channel name: `spp.Y`, `depth.Z`, `normal.X`/`.Y`/`.Z`, `albedo.R`/`.G`/`.B`.
+    pub name: String,
+    pub values: Vec<f32>,
+}
+
+/// A finished film. All planes are row-major, top row first.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FilmImage {
+    pub width: u32,
+    pub height: u32,
+    /// CIE 1931 XYZ, normalised so that a flat spectral radiance of 1 gives Y = 1.
+    pub xyz: Vec<[f32; 3]>,
+    /// Linear Rec.709 (sRGB primaries, D65) RGB from `xyz`
+    /// (`RgbColorSpace::srgb().xyz_to_rgb`), not clamped.
+    pub rgb: Vec<[f32; 3]>,
+    /// The Y plane of `xyz`.
+    pub y: Vec<f32>,
+    /// Multiply Y by this for luminance in cd/m²: 683.002 · ∫ȳ dλ.
+    pub cd_m2_per_unit: f64,
+    /// AOV channels: always `spp.Y` (samples per pixel), then the enabled surface AOVs.
+    pub aovs: Vec<AovPlane>,
+}
+
+impl FilmImage {
+    /// The AOV channel called `name`.
+    pub fn aov(&self, name: &str) -> Option<&AovPlane> {
+        self.aovs.iter().find(|p| p.name == name)
+    }
+
+    /// The luminance plane in cd/m² (Y · `cd_m2_per_unit`), e.g. for a `luminance.Y` layer.
+    pub fn luminance_cd_m2(&self) -> Vec<f32> {
+        self.y
+            .iter()
+            .map(|&y| (f64::from(y) * self.cd_m2_per_unit) as f32)
+            .collect()
+    }
+
+    /// Row-major index of pixel (x, y).
+    pub fn index(&self, x: u32, y: u32) -> usize {
+        y as usize * self.width as usize + x as usize
+    }
+}

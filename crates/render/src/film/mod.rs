@@ -1,0 +1,281 @@
+//! Film: per-pixel XYZ accumulation in f64 with filter weights and sample counts, optional
+//! surface AOVs, tile-parallel rendering with deterministic merging, and the finished image
+//! (pbrt-v4 §5.4 "Film and imaging", `RGBFilm` / `GBufferFilm`, with XYZ in place of RGB).
+//!
+//! Pixels may receive different sample counts (a `SamplePlan` decides); each pixel's value
+//! is Σ wᵢ XYZᵢ / Σ wᵢ with wᵢ = f/p from filter importance sampling, and `spp.Y` records
+//! its count.
+
+pub mod filter;
+mod filter_sampler;
+mod image;
+mod tile;
+pub mod xyz;
+
+pub use filter::Filter;
+pub use filter_sampler::{FilterSample, FilterSampler};
+pub use image::{AovPlane, FilmImage};
+pub use tile::{FilmTile, SurfaceAov, TileBounds};
+
+use std::sync::Arc;
+
+use glam::{DVec3, UVec2, Vec2};
+use prism_spectrum::rgb_space::RgbColorSpace;
+use rayon::prelude::*;
+
+use crate::error::InvalidParameter;
+use tile::{AovAccum, PixelAccum};
+
+/// Which surface AOVs the film records (`spp.Y` is always recorded).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct AovSelection {
+    /// `depth.Z`: mean distance to the first hit over the samples that hit (m; +∞ if none).
+    pub depth: bool,
+    /// `normal.X/Y/Z`: mean first-hit shading normal over all samples (misses count 0).
+    pub normal: bool,
+    /// `albedo.R/G/B`: mean first-hit albedo over all samples (misses count 0).
+    pub albedo: bool,
+}
+
+impl AovSelection {
+    pub const NONE: AovSelection = AovSelection {
+        depth: false,
+        normal: false,
+        albedo: false,
+    };
+    pub const ALL: AovSelection = AovSelection {
+        depth: true,
+        normal: true,
+        albedo: true,
+    };
+
+    pub fn any(&self) -> bool {
+        self.depth || self.normal || self.albedo
+    }
+}
+
+/// The film: accumulators for every pixel.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Film {
+    resolution: UVec2,
+    filter_sampler: Arc<FilterSampler>,
+    aov_selection: AovSelection,
+    pixels: Vec<PixelAccum>,
+    aovs: Vec<AovAccum>,
+}
+
+impl Film {
+    /// An empty film of `resolution` (≥ 1 × 1) reconstructing with `filter`.
+    pub fn new(
+        resolution: UVec2,
+        filter: Filter,
+        aov_selection: AovSelection,
+    ) -> Result<Self, InvalidParameter> {
+        if resolution.x == 0 || resolution.y == 0 {
+            return Err(InvalidParameter::new(
+                "film",
+                "resolution",
+                format!("{}×{}", resolution.x, resolution.y),
+                "width and height ≥ 1 pixel",
+            ));
+        }
+        let n = resolution.x as usize * resolution.y as usize;
+        Ok(Self {
+            resolution,
+            filter_sampler: Arc::new(FilterSampler::new(filter)),
+            aov_selection,
+            pixels: vec![PixelAccum::default(); n],
+            aovs: if aov_selection.any() {
+                vec![AovAccum::default(); n]
+            } else {
+                Vec::new()
+            },
+        })
+    }
+
+    pub fn resolution(&self) -> UVec2 {
+        self.resolution
+    }
+
+    pub fn filter(&self) -> &Filter {
+        self.filter_sampler.filter()
+    }
+
+    pub fn aov_selection(&self) -> AovSelection {
+        self.aov_selection
+    }
+
+    /// The whole film as one rectangle.
+    pub fn bounds(&self) -> TileBounds {
+        TileBounds {
+            min: UVec2::ZERO,
+            max: self.resolution,
+        }
+    }
+
+    /// The film point (px) of a camera sample of `pixel` with filter variate `u`, and its
+    /// weight: pixel centre + an offset drawn from the filter.
+    /// (`FilmTile::sample_film_point` does the same inside a tile.)
+    #[inline]
+    pub fn sample_film_point(&self, pixel: UVec2, u: Vec2) -> (Vec2, f32) {
+        self.filter_sampler.sample_film_point(pixel, u)
+    }
+
+    /// The film cut into tiles of `tile_size_px` (≥ 1; clamped) square, row-major.
+    pub fn tiles(&self, tile_size_px: u32) -> Vec<TileBounds> {
+        let t = tile_size_px.max(1);
+        let mut out = Vec::new();
+        for y0 in (0..self.resolution.y).step_by(t as usize) {
+            for x0 in (0..self.resolution.x).step_by(t as usize) {
+                let min = UVec2::new(x0, y0);
+                out.push(TileBounds {
+                    min,
+                    max: (min + UVec2::splat(t)).min(self.resolution),
+                });
+            }
+        }
+        out
+    }
+
+    /// An empty tile over `bounds` (clipped to the film).
+    pub fn new_tile(&self, bounds: TileBounds) -> FilmTile {
+        let b = TileBounds {
+            min: bounds.min.min(self.resolution),
+            max: bounds
+                .max
+                .min(self.resolution)
+                .max(bounds.min.min(self.resolution)),
+        };
+        FilmTile::new(
+            b,
+            self.aov_selection.any(),
+            Arc::clone(&self.filter_sampler),
+        )
+    }
+
+    /// Adds a tile's sums into the film. Merging tiles in any fixed order gives the same
+    /// result; tiles of one pass never overlap, so within a pass the order does not matter
+    /// at all.
+    pub fn merge_tile(&mut self, tile: &FilmTile) {
+        let b = tile.bounds();
+        for (k, pixel) in b.pixels().enumerate() {
+            let i = pixel.y as usize * self.resolution.x as usize + pixel.x as usize;
+            self.pixels[i].merge(&tile.pixels[k]);
+            if let (Some(dst), Some(src)) = (self.aovs.get_mut(i), tile.aovs.get(k)) {
+                dst.merge(src);
+            }
+        }
+    }
+
+    /// Renders every tile with `render_tile` on the current rayon pool (a
+    /// `ThreadPool::install` around the call picks the pool) and merges the tiles
+    /// in row-major order. `render_tile` must seed its samples per pixel (e.g. with
+    /// `PixelSampler`), never per thread; then the film is bit-identical for any number of
+    /// threads.
+    pub fn render_tiles<F>(&mut self, tile_size_px: u32, render_tile: F)
+    where
+        F: Fn(&mut FilmTile) + Sync + Send,
+    {
+        let tiles: Vec<FilmTile> = self
+            .tiles(tile_size_px)
+            .into_par_iter()
+            .map(|bounds| {
+                let mut tile = self.new_tile(bounds);
+                render_tile(&mut tile);
+                tile
+            })
+            .collect();
+        for tile in &tiles {
+            self.merge_tile(tile);
+        }
+    }
+
+    /// Normalises the sums into the finished image.
+    pub fn finish(&self) -> FilmImage {
+        let xyz_to_rgb = RgbColorSpace::srgb().xyz_to_rgb;
+        let n = self.pixels.len();
+        let mut xyz = Vec::with_capacity(n);
+        let mut rgb = Vec::with_capacity(n);
+        let mut y = Vec::with_capacity(n);
+        let mut spp = Vec::with_capacity(n);
+        for p in &self.pixels {
+            let v = if p.weight_sum != 0.0 {
+                p.xyz_sum / p.weight_sum
+            } else {
+                DVec3::ZERO
+            };
+            let c = xyz_to_rgb * v;
+            xyz.push(v.as_vec3().to_array());
+            rgb.push(c.as_vec3().to_array());
+            y.push(v.y as f32);
+            spp.push(p.sample_count as f32);
+        }
+        let mut aovs = vec![AovPlane {
+            name: "spp.Y".into(),
+            values: spp,
+        }];
+        let sel = self.aov_selection;
+        if sel.any() {
+            let counts = self.pixels.iter().map(|p| p.sample_count);
+            let per_sample = |sum: DVec3, count: u32| {
+                if count > 0 {
+                    sum / f64::from(count)
+                } else {
+                    DVec3::ZERO
+                }
+            };
+            if sel.depth {
+                let values = self
+                    .aovs
+                    .iter()
+                    .map(|a| {
+                        if a.hit_count > 0 {
+                            (a.depth_sum / f64::from(a.hit_count)) as f32
+                        } else {
+                            f32::INFINITY
+                        }
+                    })
+                    .collect();
+                aovs.push(AovPlane {
+                    name: "depth.Z".into(),
+                    values,
+                });
+            }
+            let planes = |field: fn(&AovAccum) -> DVec3, names: [&str; 3]| {
+                let means: Vec<DVec3> = self
+                    .aovs
+                    .iter()
+                    .zip(counts.clone())
+                    .map(|(a, c)| per_sample(field(a), c))
+                    .collect();
+                (0..3)
+                    .map(|k| AovPlane {
+                        name: names[k].into(),
+                        values: means.iter().map(|m| m[k] as f32).collect(),
+                    })
+                    .collect::<Vec<_>>()
+            };
+            if sel.normal {
+                aovs.extend(planes(
+                    |a| a.normal_sum,
+                    ["normal.X", "normal.Y", "normal.Z"],
+                ));
+            }
+            if sel.albedo {
+                aovs.extend(planes(
+                    |a| a.albedo_sum,
+                    ["albedo.R", "albedo.G", "albedo.B"],
+                ));
+            }
+        }
+        FilmImage {
+            width: self.resolution.x,
+            height: self.resolution.y,
+            xyz,
+            rgb,
+            y,
+            cd_m2_per_unit: xyz::cd_m2_per_unit(),
+            aovs,
+        }
+    }
+}

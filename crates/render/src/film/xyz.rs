@@ -1,0 +1,94 @@
+//! Spectral samples → CIE 1931 XYZ in the output normalisation of DESIGN.md: XYZ =
+//! ∫ L(λ) (x̄, ȳ, z̄)(λ) dλ / ∫ ȳ dλ, so a flat spectral radiance of 1 gives Y = 1 (the
+//! pbrt-v4 `SampledSpectrum::ToXYZ` / Mitsuba 3 convention), and Y · `cd_m2_per_unit()` is
+//! the luminance in cd/m² (683.002 lm/W · ∫ L ȳ dλ).
+
+use std::sync::OnceLock;
+
+use glam::DVec3;
+use prism_spectrum::data::{cmfs, Cmfs};
+use prism_spectrum::{
+    Observer, SampledSpectrum, SampledWavelengths, K_M_PHOTOPIC_LM_PER_W, N_SPECTRUM_SAMPLES,
+};
+
+fn cie1931() -> &'static Cmfs {
+    cmfs(Observer::Cie1931)
+}
+
+/// ∫ ȳ(λ) dλ over 360–830 nm of the CIE 1931 2° observer on its 1 nm table (Σ ȳ · 1 nm),
+/// ≈ 106.857 nm.
+pub fn cie_y_integral_nm() -> f64 {
+    static Y: OnceLock<f64> = OnceLock::new();
+    *Y.get_or_init(|| cie1931().y_bar.values().iter().sum())
+}
+
+/// Luminance in cd/m² of an output value Y = 1: 683.002 lm/W · ∫ ȳ dλ.
+pub fn cd_m2_per_unit() -> f64 {
+    K_M_PHOTOPIC_LM_PER_W * cie_y_integral_nm()
+}
+
+/// The XYZ estimate of one sample with hero-wavelength sampling:
+/// (1/4) Σᵢ L(λᵢ) (x̄, ȳ, z̄)(λᵢ) / p(λᵢ) / ∫ ȳ dλ, with the CMFs linearly interpolated on
+/// their 1 nm table. Lanes with pdf 0 (terminated secondaries) contribute nothing.
+pub fn xyz_of_sample(radiance: SampledSpectrum, wavelengths: &SampledWavelengths) -> DVec3 {
+    let c = cie1931();
+    let pdf = wavelengths.pdf();
+    let mut xyz = DVec3::ZERO;
+    for lane in 0..N_SPECTRUM_SAMPLES {
+        let p = f64::from(pdf[lane]);
+        let l = f64::from(radiance[lane]);
+        if p <= 0.0 || l == 0.0 {
+            continue;
+        }
+        let wl = f64::from(wavelengths.wavelength_nm(lane));
+        let bar = DVec3::new(c.x_bar.eval(wl), c.y_bar.eval(wl), c.z_bar.eval(wl));
+        xyz += bar * (l / p);
+    }
+    xyz / (N_SPECTRUM_SAMPLES as f64 * cie_y_integral_nm())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn y_integral_matches_the_cie_table() {
+        let y = cie_y_integral_nm();
+        assert!((y - 106.857).abs() < 0.01, "{y}");
+        assert!((cd_m2_per_unit() - 683.002 * y).abs() < 1e-9);
+    }
+
+    #[test]
+    fn flat_radiance_integrates_to_y_one_with_stratified_wavelengths() {
+        for sample in [
+            SampledWavelengths::sample_visible as fn(f32) -> SampledWavelengths,
+            SampledWavelengths::sample_uniform,
+        ] {
+            let n = 20_000;
+            let mut sum = DVec3::ZERO;
+            for i in 0..n {
+                let u = (i as f32 + 0.5) / n as f32;
+                sum += xyz_of_sample(SampledSpectrum::one(), &sample(u));
+            }
+            let xyz = sum / n as f64;
+            assert!((xyz.y - 1.0).abs() < 2e-3, "{xyz}");
+            // Equal-energy white: X ≈ Y ≈ Z (the CMFs have equal integrals).
+            assert!(
+                (xyz.x - 1.0).abs() < 5e-3 && (xyz.z - 1.0).abs() < 5e-3,
+                "{xyz}"
+            );
+        }
+    }
+
+    #[test]
+    fn terminated_secondaries_keep_the_estimate_unbiased() {
+        let n = 20_000;
+        let mut sum = 0.0;
+        for i in 0..n {
+            let mut w = SampledWavelengths::sample_visible((i as f32 + 0.5) / n as f32);
+            w.terminate_secondary();
+            sum += xyz_of_sample(SampledSpectrum::one(), &w).y;
+        }
+        assert!((sum / n as f64 - 1.0).abs() < 2e-3);
+    }
+}

@@ -1,0 +1,26 @@
+//! prism-render: cameras, samplers and film (this slice); BSDFs, lights, media and
+//! integrators follow.
+//!
+//! Conventions (DESIGN.md "Units and conventions"): metres, radians, right-handed with Y up.
+//! Camera space looks down −Z with +X right and +Y up (`prism_geometry::Transform::look_at`).
+//! Film coordinates are in pixels, continuous: (0, 0) is the top-left corner of the top-left
+//! pixel, x grows right and y grows down, pixel (i, j) covers [i, i+1) × [j, j+1) and its
+//! centre is (i + ½, j + ½) (pbrt-v4 §5.4 "Film and imaging", discrete vs continuous pixel
+//! coordinates, §8.1.4).
+
+pub mod camera;
+pub mod error;
+pub mod film;
+pub mod sampler;
+pub mod sampling;
+
+pub use camera::{
+    ApertureSpec, Camera, CameraFrame, FisheyeCamera, FisheyeCoverage, FisheyeProjection,
+    FocalSpec, OrthographicCamera, PinholeCamera, SphericalCamera, ThinLensCamera,
+};
+pub use error::InvalidParameter;
+pub use film::{
+    AovPlane, AovSelection, Film, FilmImage, FilmTile, Filter, FilterSample, FilterSampler,
+    SurfaceAov, TileBounds,
+};
+pub use sampler::{PixelSampler, SampleStream};
