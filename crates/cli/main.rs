@@ -1,6 +1,7 @@
 //! The `prism` command: spectral rendering, colorimetry and tone reproduction.
 
 mod color;
+mod compare;
 
 use std::process::ExitCode;
 
@@ -21,12 +22,15 @@ struct Cli {
 enum Command {
     /// Colorimetry of a spectrum: XYZ, xy, CCT/Duv, CIELAB and sRGB, as colour-science computes them.
     Color(color::ColorArgs),
+    /// Error metrics of an image against a reference: MSE, RMSE, relMSE, PSNR, SSIM, ΔE2000.
+    Compare(compare::CompareArgs),
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Color(args) => color::run(&args),
+        Command::Compare(args) => compare::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
