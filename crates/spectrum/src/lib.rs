@@ -17,3 +17,8 @@ pub mod embedded_files;
 pub mod names;
 pub mod rgb_space;
 pub use data::Observer;
+pub mod rgb_upsample;
+pub use rgb_upsample::{
+    RgbAlbedoSpectrum, RgbGamut, RgbIlluminantSpectrum, RgbToSpectrumTable, RgbUnboundedSpectrum,
+    RgbUpsampleError, SigmoidPolynomial,
+};
