@@ -17,6 +17,7 @@ pub mod embedded_files;
 pub mod names;
 pub mod rgb_space;
 pub use data::Observer;
+<<<<<<< HEAD
 pub mod adaptation;
 pub mod cct;
 pub mod colorimetry;
@@ -32,3 +33,10 @@ pub use reradiation::{ReradiationError, ReradiationMatrix, WavelengthGrid};
 pub use sampled_spectrum::{SampledSpectrum, N_SPECTRUM_SAMPLES};
 pub use sampled_wavelengths::SampledWavelengths;
 pub use spectrum::{DenseTable, InvalidSpectrum, PiecewiseLinear, Spectrum};
+=======
+pub mod rgb_upsample;
+pub use rgb_upsample::{
+    RgbAlbedoSpectrum, RgbGamut, RgbIlluminantSpectrum, RgbToSpectrumTable, RgbUnboundedSpectrum,
+    RgbUpsampleError, SigmoidPolynomial,
+};
+>>>>>>> wt-c

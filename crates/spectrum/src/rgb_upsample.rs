@@ -1,0 +1,681 @@
+//! RGB → spectrum upsampling after Jakob & Hanika 2019, "A Low-Dimensional Function Space for
+//! Efficient Spectral Upsampling" (Computer Graphics Forum 38(2)), as pbrt-v4 uses it
+//! (pbrt-v4 book §4.6.6 "RGB Spectra": `RGBToSpectrumTable`, `RGBAlbedoSpectrum`,
+//! `RGBUnboundedSpectrum`, `RGBIlluminantSpectrum`).
+//!
+//! A reflectance is the sigmoid of a quadratic polynomial in wavelength,
+//! s(λ) = S(c0 λ² + c1 λ + c2) with S(x) = 1/2 + x / (2 √(1 + x²)) (paper §3, eqs. 2–3).
+//! The coefficients for each RGB are precomputed on a grid (paper §4, pbrt-v4's
+//! rgb2spec_opt) by `tools/rgb2spec` and embedded from `crates/spectrum/data/`; at run time
+//! they are interpolated trilinearly (paper §5). See docs/rgb-upsampling.md.
+//!
+//! Table layout (pbrt-v4): `[max component 0..3][z 0..res][y 0..res][x 0..res][c0, c1, c2]`,
+//! little-endian f32, where z = the largest RGB component (nodes `z_nodes`, a
+//! smoothstep-of-smoothstep spacing that is dense near 0 and 1) and x, y = the next two
+//! components (in cyclic order) divided by z, on a uniform grid over [0, 1]. Coefficients
+//! take λ in nm directly: no rescaling at evaluation.
+
+use std::fmt;
+use std::sync::OnceLock;
+
+use crate::constants::{DENSE_SAMPLE_COUNT, LAMBDA_MAX_NM, LAMBDA_MIN_NM};
+use crate::data::{cmfs, illuminant, Observer};
+use crate::rgb_space::RgbColorSpace;
+
+/// First bytes of a coefficient table file.
+pub const TABLE_MAGIC: &[u8; 13] = b"PRISMRGB2SPEC";
+/// Version of the table file format this code reads and writes.
+pub const TABLE_FORMAT_VERSION: u32 = 1;
+
+/// Largest |x| the sigmoid is evaluated at: keeps x² finite in f32 (S(±1e18) is exactly
+/// 1 or 0 in f32, as S(±∞) is), so infinite or huge polynomials never give NaN.
+const SIGMOID_ARG_LIMIT: f32 = 1.0e18;
+/// c2 standing in for ±∞ in the flat spectra 0 and 1 (S(±1e18) is exactly 1 or 0 in f32
+/// and f64).
+const FLAT_C2_LIMIT: f32 = SIGMOID_ARG_LIMIT;
+
+/// The RGB spaces Prism ships coefficient tables for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum RgbGamut {
+    /// sRGB / Rec.709 primaries, D65 white.
+    Srgb,
+    /// ITU-R BT.2020 primaries, D65 white.
+    Rec2020,
+    /// ACEScg (AP1) primaries, D60 white.
+    AcesCg,
+}
+
+impl RgbGamut {
+    pub const ALL: [RgbGamut; 3] = [RgbGamut::Srgb, RgbGamut::Rec2020, RgbGamut::AcesCg];
+
+    /// Short name used on the command line and in table file names (`srgb`, `rec2020`, `acescg`).
+    pub fn name(self) -> &'static str {
+        match self {
+            RgbGamut::Srgb => "srgb",
+            RgbGamut::Rec2020 => "rec2020",
+            RgbGamut::AcesCg => "acescg",
+        }
+    }
+
+    /// Parses `srgb`, `rec2020` or `acescg` (case-insensitive, `-`, `_`, `.` ignored).
+    pub fn from_name(name: &str) -> Result<Self, RgbUpsampleError> {
+        let key: String = name
+            .chars()
+            .filter(|c| c.is_ascii_alphanumeric())
+            .collect::<String>()
+            .to_ascii_lowercase();
+        match key.as_str() {
+            "srgb" | "rec709" => Ok(RgbGamut::Srgb),
+            "rec2020" | "bt2020" => Ok(RgbGamut::Rec2020),
+            "acescg" | "ap1" => Ok(RgbGamut::AcesCg),
+            _ => Err(RgbUpsampleError::new(format!(
+                "unknown RGB gamut `{name}`: expected srgb, rec2020 or acescg"
+            ))),
+        }
+    }
+
+    /// The colour space (primaries, white, matrices).
+    pub fn color_space(self) -> RgbColorSpace {
+        match self {
+            RgbGamut::Srgb => RgbColorSpace::srgb(),
+            RgbGamut::Rec2020 => RgbColorSpace::rec2020(),
+            RgbGamut::AcesCg => RgbColorSpace::acescg(),
+        }
+    }
+
+    /// The embedded coefficient table of this gamut, parsed on first use.
+    pub fn table(self) -> &'static RgbToSpectrumTable {
+        static SRGB: OnceLock<RgbToSpectrumTable> = OnceLock::new();
+        static REC2020: OnceLock<RgbToSpectrumTable> = OnceLock::new();
+        static ACESCG: OnceLock<RgbToSpectrumTable> = OnceLock::new();
+        let (cell, bytes): (_, &[u8]) = match self {
+            RgbGamut::Srgb => (&SRGB, include_bytes!("../data/rgb2spec_srgb.bin")),
+            RgbGamut::Rec2020 => (&REC2020, include_bytes!("../data/rgb2spec_rec2020.bin")),
+            RgbGamut::AcesCg => (&ACESCG, include_bytes!("../data/rgb2spec_acescg.bin")),
+        };
+        cell.get_or_init(|| {
+            // Embedded at build time and checked by the tests: failing here is a build bug.
+            RgbToSpectrumTable::from_bytes(bytes)
+                .unwrap_or_else(|e| panic!("embedded {} table is malformed: {e}", self.name()))
+        })
+    }
+
+    /// The space's white illuminant (D65, or D60 for ACEScg) on the 1 nm grid 360–830 nm,
+    /// scaled so that Σ I(λ) ȳ(λ) Δλ = Σ ȳ(λ) Δλ (CIE 1931, Δλ = 1 nm): with the
+    /// DESIGN.md convention Y = ∫L ȳ dλ / ∫ȳ dλ it has luminance Y = 1, as pbrt-v4's
+    /// normalised standard illuminants do.
+    pub fn white_illuminant(self) -> &'static [f32; DENSE_SAMPLE_COUNT] {
+        static SRGB: OnceLock<[f32; DENSE_SAMPLE_COUNT]> = OnceLock::new();
+        static REC2020: OnceLock<[f32; DENSE_SAMPLE_COUNT]> = OnceLock::new();
+        static ACESCG: OnceLock<[f32; DENSE_SAMPLE_COUNT]> = OnceLock::new();
+        let cell = match self {
+            RgbGamut::Srgb => &SRGB,
+            RgbGamut::Rec2020 => &REC2020,
+            RgbGamut::AcesCg => &ACESCG,
+        };
+        cell.get_or_init(|| {
+            let dense = white_illuminant_dense(&self.color_space());
+            let mut out = [0.0f32; DENSE_SAMPLE_COUNT];
+            for (o, v) in out.iter_mut().zip(dense.iter()) {
+                *o = *v as f32;
+            }
+            out
+        })
+    }
+}
+
+/// The space's white illuminant on the 1 nm grid, normalised to Σ I ȳ = Σ ȳ (f64).
+pub fn white_illuminant_dense(space: &RgbColorSpace) -> Vec<f64> {
+    let y_bar = &cmfs(Observer::Cie1931).y_bar;
+    // The colour spaces name only D65/D60, both embedded.
+    let spd = illuminant(space.white_illuminant)
+        .expect("white illuminants of the built-in spaces are embedded")
+        .to_dense();
+    let scale = y_bar.values().iter().sum::<f64>() / spd.inner_product(y_bar);
+    spd.values().iter().map(|v| v * scale).collect()
+}
+
+/// Why an RGB could not be upsampled or a table could not be read.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct RgbUpsampleError {
+    pub message: String,
+}
+
+impl RgbUpsampleError {
+    pub fn new(message: impl Into<String>) -> Self {
+        Self {
+            message: message.into(),
+        }
+    }
+}
+
+impl fmt::Display for RgbUpsampleError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.message)
+    }
+}
+
+impl std::error::Error for RgbUpsampleError {}
+
+/// S(x) = 1/2 + x / (2 √(1 + x²)) (Jakob & Hanika 2019, eq. 3), f32.
+#[inline(always)]
+fn sigmoid_f32(x: f32) -> f32 {
+    let x = x.clamp(-SIGMOID_ARG_LIMIT, SIGMOID_ARG_LIMIT);
+    0.5 + 0.5 * x / (1.0 + x * x).sqrt()
+}
+
+/// S(x) in f64 (same clamp, so f32 and f64 paths agree at the extremes).
+#[inline(always)]
+fn sigmoid_f64(x: f64) -> f64 {
+    let x = x.clamp(-SIGMOID_ARG_LIMIT as f64, SIGMOID_ARG_LIMIT as f64);
+    0.5 + 0.5 * x / (1.0 + x * x).sqrt()
+}
+
+/// s(λ) = S(c0 λ² + c1 λ + c2), λ in nm (Jakob & Hanika 2019, eq. 2; pbrt-v4
+/// `RGBSigmoidPolynomial`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SigmoidPolynomial {
+    /// Coefficient of λ² (per nm²).
+    pub c0: f32,
+    /// Coefficient of λ (per nm).
+    pub c1: f32,
+    /// Constant term.
+    pub c2: f32,
+}
+
+impl SigmoidPolynomial {
+    pub fn new(c0: f32, c1: f32, c2: f32) -> Self {
+        Self { c0, c1, c2 }
+    }
+
+    /// The flat spectrum `value` ∈ [0, 1]: c0 = c1 = 0, S(c2) = value (pbrt-v4's special
+    /// case for grey RGB; 0 and 1 use c2 = ∓1e18, whose sigmoid is exactly 0 and 1 in f32).
+    pub fn constant(value: f32) -> Self {
+        let v = value.clamp(0.0, 1.0);
+        let c2 = (v - 0.5) / (v * (1.0 - v)).sqrt();
+        // NaN cannot occur: v ∈ [0, 1]; ±∞ at v = 0, 1 is clamped.
+        Self::new(0.0, 0.0, c2.clamp(-FLAT_C2_LIMIT, FLAT_C2_LIMIT))
+    }
+
+    /// s(λ) at one wavelength in nm (Horner form, branch-free).
+    #[inline]
+    pub fn eval(&self, wavelength_nm: f32) -> f32 {
+        sigmoid_f32((self.c0 * wavelength_nm + self.c1) * wavelength_nm + self.c2)
+    }
+
+    /// s(λ) at four wavelengths in nm (the hero wavelength and its three rotations).
+    #[inline]
+    pub fn eval4(&self, wavelengths_nm: [f32; 4]) -> [f32; 4] {
+        wavelengths_nm.map(|l| self.eval(l))
+    }
+
+    /// s(λ) in f64 arithmetic from the f32 coefficients.
+    #[inline]
+    pub fn eval_f64(&self, wavelength_nm: f64) -> f64 {
+        let (c0, c1, c2) = (self.c0 as f64, self.c1 as f64, self.c2 as f64);
+        sigmoid_f64((c0 * wavelength_nm + c1) * wavelength_nm + c2)
+    }
+
+    /// The largest value over 360–830 nm: at an end, or at the parabola's vertex when it
+    /// lies inside (S is monotonic; pbrt-v4 `RGBSigmoidPolynomial::MaxValue`).
+    pub fn max_value(&self) -> f32 {
+        let mut result = self.eval(LAMBDA_MIN_NM).max(self.eval(LAMBDA_MAX_NM));
+        let vertex_nm = -self.c1 / (2.0 * self.c0);
+        if (LAMBDA_MIN_NM..=LAMBDA_MAX_NM).contains(&vertex_nm) {
+            result = result.max(self.eval(vertex_nm));
+        }
+        result
+    }
+}
+
+/// The smoothstep-of-smoothstep spacing of the z (largest component) nodes:
+/// z_k = smoothstep(smoothstep(k / (res − 1))), smoothstep(x) = x² (3 − 2x) (pbrt-v4
+/// rgb2spec_opt).
+pub fn z_nodes(resolution: usize) -> Vec<f32> {
+    let smoothstep = |x: f64| x * x * (3.0 - 2.0 * x);
+    (0..resolution)
+        .map(|k| smoothstep(smoothstep(k as f64 / (resolution - 1) as f64)) as f32)
+        .collect()
+}
+
+/// Sigmoid-polynomial coefficients on a grid over RGB ∈ [0, 1]³ (pbrt-v4
+/// `RGBToSpectrumTable`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct RgbToSpectrumTable {
+    resolution: usize,
+    gamut_name: String,
+    z_nodes: Vec<f32>,
+    /// `[3][res][res][res][3]` flattened: [max component][z][y][x][c0, c1, c2].
+    coefficients: Vec<f32>,
+}
+
+impl RgbToSpectrumTable {
+    /// Builds a table; checks the sizes, that the z nodes increase from 0 to 1 and that
+    /// every number is finite.
+    pub fn new(
+        resolution: usize,
+        gamut_name: &str,
+        z_nodes: Vec<f32>,
+        coefficients: Vec<f32>,
+    ) -> Result<Self, RgbUpsampleError> {
+        if !(2..=1024).contains(&resolution) {
+            return Err(RgbUpsampleError::new(format!(
+                "table resolution {resolution} is out of range: expected 2 to 1024"
+            )));
+        }
+        if z_nodes.len() != resolution {
+            return Err(RgbUpsampleError::new(format!(
+                "{} z nodes for resolution {resolution}",
+                z_nodes.len()
+            )));
+        }
+        if z_nodes[0] != 0.0
+            || z_nodes[resolution - 1] != 1.0
+            || !z_nodes.windows(2).all(|w| w[0] < w[1])
+        {
+            return Err(RgbUpsampleError::new(
+                "z nodes must increase strictly from 0 to 1",
+            ));
+        }
+        let expected = 3 * resolution * resolution * resolution * 3;
+        if coefficients.len() != expected {
+            return Err(RgbUpsampleError::new(format!(
+                "{} coefficients, expected 3 × {resolution}³ × 3 = {expected}",
+                coefficients.len()
+            )));
+        }
+        if let Some(i) = coefficients.iter().position(|c| !c.is_finite()) {
+            return Err(RgbUpsampleError::new(format!(
+                "coefficient {i} is not finite"
+            )));
+        }
+        Ok(Self {
+            resolution,
+            gamut_name: gamut_name.to_string(),
+            z_nodes,
+            coefficients,
+        })
+    }
+
+    pub fn resolution(&self) -> usize {
+        self.resolution
+    }
+
+    pub fn gamut_name(&self) -> &str {
+        &self.gamut_name
+    }
+
+    pub fn z_nodes(&self) -> &[f32] {
+        &self.z_nodes
+    }
+
+    /// All coefficients, `[3][res][res][res][3]` flattened.
+    pub fn raw_coefficients(&self) -> &[f32] {
+        &self.coefficients
+    }
+
+    /// The coefficients stored at one node.
+    pub fn node(&self, max_component: usize, zi: usize, yi: usize, xi: usize) -> [f32; 3] {
+        let r = self.resolution;
+        let o = 3 * (((max_component * r + zi) * r + yi) * r + xi);
+        [
+            self.coefficients[o],
+            self.coefficients[o + 1],
+            self.coefficients[o + 2],
+        ]
+    }
+
+    /// Serialises to the file format: magic "PRISMRGB2SPEC", u32 version, u32 resolution,
+    /// u32 name length + UTF-8 gamut name, `res` f32 z nodes, then the coefficients
+    /// (all little-endian).
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let mut out = Vec::with_capacity(
+            TABLE_MAGIC.len() + 12 + self.gamut_name.len() + 4 * self.coefficients.len(),
+        );
+        out.extend_from_slice(TABLE_MAGIC);
+        out.extend_from_slice(&TABLE_FORMAT_VERSION.to_le_bytes());
+        out.extend_from_slice(&(self.resolution as u32).to_le_bytes());
+        out.extend_from_slice(&(self.gamut_name.len() as u32).to_le_bytes());
+        out.extend_from_slice(self.gamut_name.as_bytes());
+        for v in self.z_nodes.iter().chain(self.coefficients.iter()) {
+            out.extend_from_slice(&v.to_le_bytes());
+        }
+        out
+    }
+
+    /// Parses the format written by [`RgbToSpectrumTable::to_bytes`].
+    pub fn from_bytes(bytes: &[u8]) -> Result<Self, RgbUpsampleError> {
+        let mut rest = bytes
+            .strip_prefix(TABLE_MAGIC.as_slice())
+            .ok_or_else(|| RgbUpsampleError::new("not an RGB→spectrum table (bad magic)"))?;
+        let mut read_u32 = |what: &str| -> Result<u32, RgbUpsampleError> {
+            let (head, tail) = rest.split_at_checked(4).ok_or_else(|| {
+                RgbUpsampleError::new(format!("table truncated before the {what}"))
+            })?;
+            rest = tail;
+            Ok(u32::from_le_bytes([head[0], head[1], head[2], head[3]]))
+        };
+        let version = read_u32("version")?;
+        if version != TABLE_FORMAT_VERSION {
+            return Err(RgbUpsampleError::new(format!(
+                "table format version {version}, this build reads {TABLE_FORMAT_VERSION}"
+            )));
+        }
+        let resolution = read_u32("resolution")? as usize;
+        let name_len = read_u32("gamut name length")? as usize;
+        let (name, floats) = rest
+            .split_at_checked(name_len)
+            .ok_or_else(|| RgbUpsampleError::new("table truncated in the gamut name"))?;
+        let gamut_name = std::str::from_utf8(name)
+            .map_err(|_| RgbUpsampleError::new("gamut name is not UTF-8"))?;
+        if floats.len() % 4 != 0 {
+            return Err(RgbUpsampleError::new(
+                "table body is not a whole number of f32",
+            ));
+        }
+        let values: Vec<f32> = floats
+            .chunks_exact(4)
+            .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+            .collect();
+        if values.len() < resolution {
+            return Err(RgbUpsampleError::new("table truncated in the z nodes"));
+        }
+        let (z, coefficients) = values.split_at(resolution);
+        Self::new(resolution, gamut_name, z.to_vec(), coefficients.to_vec())
+    }
+
+    /// The sigmoid polynomial for a linear RGB in [0, 1]³ (components outside are clamped;
+    /// NaN counts as 0): trilinear interpolation of the coefficients of the 8 surrounding
+    /// nodes (pbrt-v4 `RGBToSpectrumTable::operator()`); grey gives a flat spectrum.
+    pub fn coefficients(&self, rgb: [f32; 3]) -> SigmoidPolynomial {
+        // `max` turns NaN into 0, then clamp to [0, 1].
+        let rgb = rgb.map(|c| c.max(0.0).clamp(0.0, 1.0));
+        if rgb[0] == rgb[1] && rgb[1] == rgb[2] {
+            return SigmoidPolynomial::constant(rgb[0]);
+        }
+        // Which component is largest; the other two, in cyclic order, over it.
+        let max_c = if rgb[0] > rgb[1] {
+            if rgb[0] > rgb[2] {
+                0
+            } else {
+                2
+            }
+        } else if rgb[1] > rgb[2] {
+            1
+        } else {
+            2
+        };
+        let res = self.resolution;
+        let last = (res - 1) as f32;
+        let z = rgb[max_c]; // > 0: not grey, so the max exceeds some component ≥ 0
+        let x = rgb[(max_c + 1) % 3] * last / z;
+        let y = rgb[(max_c + 2) % 3] * last / z;
+        let xi = (x as usize).min(res - 2);
+        let yi = (y as usize).min(res - 2);
+        // Largest zi with z_nodes[zi] < z, within [0, res − 2] (pbrt-v4 FindInterval).
+        let zi = self
+            .z_nodes
+            .partition_point(|&n| n < z)
+            .saturating_sub(1)
+            .min(res - 2);
+        let dx = x - xi as f32;
+        let dy = y - yi as f32;
+        let dz = (z - self.z_nodes[zi]) / (self.z_nodes[zi + 1] - self.z_nodes[zi]);
+        let lerp = |t: f32, a: f32, b: f32| a + t * (b - a);
+        let mut c = [0.0f32; 3];
+        for (i, ci) in c.iter_mut().enumerate() {
+            let at = |dzi: usize, dyi: usize, dxi: usize| {
+                self.coefficients
+                    [3 * (((max_c * res + zi + dzi) * res + yi + dyi) * res + xi + dxi) + i]
+            };
+            *ci = lerp(
+                dz,
+                lerp(
+                    dy,
+                    lerp(dx, at(0, 0, 0), at(0, 0, 1)),
+                    lerp(dx, at(0, 1, 0), at(0, 1, 1)),
+                ),
+                lerp(
+                    dy,
+                    lerp(dx, at(1, 0, 0), at(1, 0, 1)),
+                    lerp(dx, at(1, 1, 0), at(1, 1, 1)),
+                ),
+            );
+        }
+        SigmoidPolynomial::new(c[0], c[1], c[2])
+    }
+}
+
+/// Checks that every component is finite (and ≥ `min`, ≤ `max`).
+fn validate_rgb(kind: &str, rgb: [f32; 3], min: f32, max: f32) -> Result<(), RgbUpsampleError> {
+    if let Some(c) = rgb
+        .iter()
+        .find(|c| !(c.is_finite() && **c >= min && **c <= max))
+    {
+        let range = if max.is_finite() {
+            format!("[{min}, {max}]")
+        } else {
+            format!("≥ {min}")
+        };
+        return Err(RgbUpsampleError::new(format!(
+            "{kind} RGB ({}, {}, {}) has component {c}: each must be finite and {range}",
+            rgb[0], rgb[1], rgb[2]
+        )));
+    }
+    Ok(())
+}
+
+/// Linear interpolation of a 1 nm grid table (index 0 = 360 nm) at `wavelength_nm`, zero
+/// outside 360–830 nm.
+#[inline]
+fn dense_lookup(table: &[f32; DENSE_SAMPLE_COUNT], wavelength_nm: f32) -> f32 {
+    let x = wavelength_nm - LAMBDA_MIN_NM;
+    if !(x >= 0.0 && x <= (DENSE_SAMPLE_COUNT - 1) as f32) {
+        return 0.0;
+    }
+    let i = (x as usize).min(DENSE_SAMPLE_COUNT - 2);
+    let t = x - i as f32;
+    table[i] + t * (table[i + 1] - table[i])
+}
+
+/// A reflectance (or transmittance) from an RGB in [0, 1]³: values in [0, 1]
+/// (pbrt-v4 `RGBAlbedoSpectrum`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RgbAlbedoSpectrum {
+    pub polynomial: SigmoidPolynomial,
+}
+
+impl RgbAlbedoSpectrum {
+    /// `rgb` is linear in `gamut`; each component must be finite and in [0, 1].
+    pub fn new(gamut: RgbGamut, rgb: [f32; 3]) -> Result<Self, RgbUpsampleError> {
+        validate_rgb("albedo", rgb, 0.0, 1.0)?;
+        Ok(Self {
+            polynomial: gamut.table().coefficients(rgb),
+        })
+    }
+
+    #[inline]
+    pub fn eval4(&self, wavelengths_nm: [f32; 4]) -> [f32; 4] {
+        self.polynomial.eval4(wavelengths_nm)
+    }
+
+    pub fn eval_nm(&self, wavelength_nm: f64) -> f64 {
+        self.polynomial.eval_f64(wavelength_nm)
+    }
+
+    pub fn max_value(&self) -> f32 {
+        self.polynomial.max_value()
+    }
+}
+
+/// An unbounded spectrum (e.g. a scattering coefficient) from a non-negative RGB:
+/// scale · s(λ) with scale = 2 · max component and s fitted to rgb / scale, whose largest
+/// component is 1/2 (pbrt-v4 `RGBUnboundedSpectrum`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RgbUnboundedSpectrum {
+    pub scale: f32,
+    pub polynomial: SigmoidPolynomial,
+}
+
+impl RgbUnboundedSpectrum {
+    /// `rgb` is linear in `gamut`; each component must be finite and ≥ 0.
+    pub fn new(gamut: RgbGamut, rgb: [f32; 3]) -> Result<Self, RgbUpsampleError> {
+        validate_rgb("unbounded", rgb, 0.0, f32::INFINITY)?;
+        let (scale, polynomial) = scaled_polynomial(gamut, rgb);
+        Ok(Self { scale, polynomial })
+    }
+
+    #[inline]
+    pub fn eval4(&self, wavelengths_nm: [f32; 4]) -> [f32; 4] {
+        self.polynomial
+            .eval4(wavelengths_nm)
+            .map(|v| v * self.scale)
+    }
+
+    pub fn eval_nm(&self, wavelength_nm: f64) -> f64 {
+        self.scale as f64 * self.polynomial.eval_f64(wavelength_nm)
+    }
+
+    pub fn max_value(&self) -> f32 {
+        self.scale * self.polynomial.max_value()
+    }
+}
+
+/// scale = 2 · max(rgb) and the polynomial of rgb / scale (pbrt-v4); black → (0, flat 0).
+fn scaled_polynomial(gamut: RgbGamut, rgb: [f32; 3]) -> (f32, SigmoidPolynomial) {
+    let scale = 2.0 * rgb[0].max(rgb[1]).max(rgb[2]);
+    let normalised = if scale > 0.0 {
+        rgb.map(|c| c / scale)
+    } else {
+        [0.0; 3]
+    };
+    (scale, gamut.table().coefficients(normalised))
+}
+
+/// An emission spectrum from a non-negative RGB: the unbounded spectrum times the space's
+/// white illuminant (normalised to luminance Y = 1, see [`RgbGamut::white_illuminant`]), so
+/// RGB (1, 1, 1) emits the white illuminant itself (pbrt-v4 `RGBIlluminantSpectrum`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RgbIlluminantSpectrum {
+    pub scale: f32,
+    pub polynomial: SigmoidPolynomial,
+    illuminant: &'static [f32; DENSE_SAMPLE_COUNT],
+}
+
+impl RgbIlluminantSpectrum {
+    /// `rgb` is linear in `gamut`; each component must be finite and ≥ 0.
+    pub fn new(gamut: RgbGamut, rgb: [f32; 3]) -> Result<Self, RgbUpsampleError> {
+        validate_rgb("illuminant", rgb, 0.0, f32::INFINITY)?;
+        let (scale, polynomial) = scaled_polynomial(gamut, rgb);
+        Ok(Self {
+            scale,
+            polynomial,
+            illuminant: gamut.white_illuminant(),
+        })
+    }
+
+    /// The white illuminant on the 1 nm grid (360–830 nm).
+    pub fn illuminant(&self) -> &'static [f32; DENSE_SAMPLE_COUNT] {
+        self.illuminant
+    }
+
+    #[inline]
+    pub fn eval4(&self, wavelengths_nm: [f32; 4]) -> [f32; 4] {
+        let s = self.polynomial.eval4(wavelengths_nm);
+        std::array::from_fn(|i| {
+            self.scale * s[i] * dense_lookup(self.illuminant, wavelengths_nm[i])
+        })
+    }
+
+    pub fn eval_nm(&self, wavelength_nm: f64) -> f64 {
+        let x = wavelength_nm - LAMBDA_MIN_NM as f64;
+        let illum = if x >= 0.0 && x <= (DENSE_SAMPLE_COUNT - 1) as f64 {
+            let i = (x as usize).min(DENSE_SAMPLE_COUNT - 2);
+            let t = x - i as f64;
+            let (a, b) = (self.illuminant[i] as f64, self.illuminant[i + 1] as f64);
+            a + t * (b - a)
+        } else {
+            0.0
+        };
+        self.scale as f64 * self.polynomial.eval_f64(wavelength_nm) * illum
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sigmoid_handles_extremes_without_nan() {
+        assert_eq!(sigmoid_f32(f32::INFINITY), 1.0);
+        assert_eq!(sigmoid_f32(f32::NEG_INFINITY), 0.0);
+        assert_eq!(sigmoid_f32(0.0), 0.5);
+        assert_eq!(SigmoidPolynomial::constant(1.0).eval(500.0), 1.0);
+        assert_eq!(SigmoidPolynomial::constant(0.0).eval(500.0), 0.0);
+        assert!((SigmoidPolynomial::constant(0.25).eval(700.0) - 0.25).abs() < 1e-6);
+    }
+
+    #[test]
+    fn max_value_finds_an_interior_peak() {
+        // Peak of a downward parabola at 550 nm: x(550) = 2.
+        let c0 = -1e-4f32;
+        let p = SigmoidPolynomial::new(c0, -2.0 * c0 * 550.0, 2.0 + c0 * 550.0 * 550.0);
+        assert!((p.max_value() - sigmoid_f32(2.0)).abs() < 1e-4);
+        assert!(p.max_value() > p.eval(360.0) && p.max_value() > p.eval(830.0));
+    }
+
+    #[test]
+    fn z_nodes_run_from_0_to_1_densest_at_the_ends() {
+        let z = z_nodes(32);
+        assert_eq!((z[0], z[31]), (0.0, 1.0));
+        assert!(z[1] - z[0] < z[16] - z[15]);
+    }
+
+    #[test]
+    fn tables_round_trip_through_bytes_and_reject_damage() {
+        let res = 2;
+        let coeffs: Vec<f32> = (0..3 * 8 * 3).map(|i| i as f32).collect();
+        let t = RgbToSpectrumTable::new(res, "test", z_nodes(res), coeffs).unwrap();
+        let bytes = t.to_bytes();
+        assert_eq!(RgbToSpectrumTable::from_bytes(&bytes).unwrap(), t);
+        assert!(RgbToSpectrumTable::from_bytes(&bytes[..bytes.len() - 4]).is_err());
+        assert!(RgbToSpectrumTable::from_bytes(&bytes[..20]).is_err());
+        assert!(RgbToSpectrumTable::from_bytes(b"NOTATABLE").is_err());
+        assert_eq!(t.node(1, 0, 1, 0), [30.0, 31.0, 32.0]);
+    }
+
+    #[test]
+    fn embedded_tables_parse_and_name_their_gamut() {
+        for gamut in RgbGamut::ALL {
+            let t = gamut.table();
+            assert_eq!(t.gamut_name(), gamut.name());
+            assert_eq!(t.z_nodes(), z_nodes(t.resolution()).as_slice());
+        }
+    }
+
+    #[test]
+    fn constructors_reject_bad_input_with_a_message() {
+        let e = RgbAlbedoSpectrum::new(RgbGamut::Srgb, [0.5, 1.5, 0.0]).unwrap_err();
+        assert!(
+            e.message.contains("1.5") && e.message.contains("[0, 1]"),
+            "{e}"
+        );
+        assert!(RgbAlbedoSpectrum::new(RgbGamut::Srgb, [f32::NAN, 0.0, 0.0]).is_err());
+        assert!(RgbUnboundedSpectrum::new(RgbGamut::Srgb, [-0.1, 0.0, 0.0]).is_err());
+        assert!(RgbIlluminantSpectrum::new(RgbGamut::Srgb, [f32::INFINITY, 0.0, 0.0]).is_err());
+        assert!(RgbUnboundedSpectrum::new(RgbGamut::Srgb, [7.0, 0.0, 0.0]).is_ok());
+        assert!(RgbGamut::from_name("ACEScg").is_ok());
+        assert!(RgbGamut::from_name("p3")
+            .unwrap_err()
+            .message
+            .contains("srgb"));
+    }
+
+    #[test]
+    fn black_unbounded_and_illuminant_spectra_are_zero() {
+        let u = RgbUnboundedSpectrum::new(RgbGamut::Srgb, [0.0; 3]).unwrap();
+        assert_eq!(u.eval4([400.0, 500.0, 600.0, 700.0]), [0.0; 4]);
+        let i = RgbIlluminantSpectrum::new(RgbGamut::AcesCg, [0.0; 3]).unwrap();
+        assert_eq!(i.eval_nm(555.0), 0.0);
+    }
+}
