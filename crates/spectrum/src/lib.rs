@@ -4,39 +4,36 @@
 //!
 //! Units: wavelengths in nm, spectral radiance in W·m⁻²·sr⁻¹·nm⁻¹, luminance in cd/m².
 
-pub mod constants;
-pub mod data;
-pub mod error;
-pub mod spectrum_file;
-pub mod table;
-
-pub use constants::*;
-pub use error::SpectrumFileError;
-pub use table::{DenseSpectrum, Tabulated};
-pub mod embedded_files;
-pub mod names;
-pub mod rgb_space;
-pub use data::Observer;
-<<<<<<< HEAD
 pub mod adaptation;
+pub mod blackbody;
 pub mod cct;
 pub mod colorimetry;
+pub mod constants;
+pub mod data;
+pub mod embedded_files;
+pub mod error;
+pub mod names;
 pub mod photometry;
-pub use adaptation::{adaptation_matrix, AdaptationMethod};
-pub use cct::{cct_to_uv_ohno2013, uv_to_cct_ohno2013, xyz_to_cct_ohno2013, CctDuv};
-pub mod blackbody;
 pub mod reradiation;
+pub mod rgb_space;
+pub mod rgb_upsample;
 pub mod sampled_spectrum;
 pub mod sampled_wavelengths;
 pub mod spectrum;
+pub mod spectrum_file;
+pub mod table;
+
+pub use adaptation::{adaptation_matrix, AdaptationMethod};
+pub use cct::{cct_to_uv_ohno2013, uv_to_cct_ohno2013, xyz_to_cct_ohno2013, CctDuv};
+pub use constants::*;
+pub use data::Observer;
+pub use error::SpectrumFileError;
 pub use reradiation::{ReradiationError, ReradiationMatrix, WavelengthGrid};
-pub use sampled_spectrum::{SampledSpectrum, N_SPECTRUM_SAMPLES};
-pub use sampled_wavelengths::SampledWavelengths;
-pub use spectrum::{DenseTable, InvalidSpectrum, PiecewiseLinear, Spectrum};
-=======
-pub mod rgb_upsample;
 pub use rgb_upsample::{
     RgbAlbedoSpectrum, RgbGamut, RgbIlluminantSpectrum, RgbToSpectrumTable, RgbUnboundedSpectrum,
     RgbUpsampleError, SigmoidPolynomial,
 };
->>>>>>> wt-c
+pub use sampled_spectrum::{SampledSpectrum, N_SPECTRUM_SAMPLES};
+pub use sampled_wavelengths::SampledWavelengths;
+pub use spectrum::{DenseTable, InvalidSpectrum, PiecewiseLinear, Spectrum};
+pub use table::{DenseSpectrum, Tabulated};
