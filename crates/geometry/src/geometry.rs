@@ -147,6 +147,11 @@ impl Geometry {
         &self.instances
     }
 
+    /// Number of distinct meshes stored (instances share them).
+    pub fn mesh_count(&self) -> usize {
+        self.meshes.len()
+    }
+
     pub fn mesh(&self, id: MeshId) -> &TriangleMesh {
         &self.meshes[id.0 as usize].mesh
     }
