@@ -94,6 +94,13 @@ fn sort_rays(rays: &mut [Ray]) {
     rays.par_sort_unstable_by_key(key);
 }
 
+thread_local! {
+    /// One long-lived pool per thread count, so that CPU accounting sees the same threads
+    /// before and after each measurement.
+    static POOLS: [std::sync::Arc<rayon::ThreadPool>; 2] =
+        [std::sync::Arc::new(pool(1)), std::sync::Arc::new(pool(2))];
+}
+
 fn pool(threads: usize) -> rayon::ThreadPool {
     rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
@@ -101,34 +108,104 @@ fn pool(threads: usize) -> rayon::ThreadPool {
         .expect("thread pool")
 }
 
-/// Rays per second and hit fraction of `f` over `rays` on `threads` threads (best of 3).
-fn trace(rays: &[Ray], threads: usize, f: &(dyn Fn(&Ray) -> bool + Sync)) -> (f64, f64) {
-    let p = pool(threads);
-    let mut best = f64::INFINITY;
+/// CPU time (ns) used so far by each thread of this process, from
+/// `/proc/self/task/*/schedstat` (ns resolution); `None` off Linux.
+fn thread_cpu_ns() -> Option<std::collections::HashMap<String, u64>> {
+    let mut out = std::collections::HashMap::new();
+    for entry in std::fs::read_dir("/proc/self/task").ok()? {
+        let entry = entry.ok()?;
+        let text = std::fs::read_to_string(entry.path().join("schedstat")).ok()?;
+        let ns = text.split_whitespace().next()?.parse::<u64>().ok()?;
+        out.insert(entry.file_name().to_string_lossy().into_owned(), ns);
+    }
+    Some(out)
+}
+
+/// CPU seconds spent between two snapshots by threads alive at both.
+fn cpu_s_between(
+    a: &std::collections::HashMap<String, u64>,
+    b: &std::collections::HashMap<String, u64>,
+) -> f64 {
+    a.iter()
+        .filter_map(|(tid, &t0)| b.get(tid).map(|&t1| t1.saturating_sub(t0)))
+        .sum::<u64>() as f64
+        * 1e-9
+}
+
+/// Throughput of one measurement: wall-clock rays/s, rays per CPU-second (robust to other
+/// processes sharing the cores) and hit fraction.
+struct Throughput {
+    rays_per_s: f64,
+    rays_per_cpu_s: Option<f64>,
+    hit_fraction: f64,
+}
+
+impl Throughput {
+    fn json(&self) -> Value {
+        json!({
+            "mrays_s": mrays(self.rays_per_s),
+            "mrays_per_cpu_s": self.rays_per_cpu_s.map(mrays),
+        })
+    }
+
+    fn show(&self) -> String {
+        format!(
+            "{:.2} Mrays/s ({:.2} per CPU-s)",
+            self.rays_per_s / 1e6,
+            self.rays_per_cpu_s.unwrap_or(f64::NAN) / 1e6
+        )
+    }
+}
+
+/// Best of 3 runs of `f` over `rays` on `threads` threads.
+fn trace(rays: &[Ray], threads: usize, f: &(dyn Fn(&Ray) -> bool + Sync)) -> Throughput {
+    let p = &POOLS.with(|p| p[threads - 1].clone());
+    let mut best = (f64::INFINITY, None);
     let mut hits = 0usize;
     for _ in 0..3 {
+        let cpu0 = thread_cpu_ns();
         let start = Instant::now();
         hits = p.install(|| {
             rays.par_chunks(CHUNK)
                 .map(|c| c.iter().filter(|r| f(r)).count())
                 .sum()
         });
-        best = best.min(start.elapsed().as_secs_f64());
+        let wall = start.elapsed().as_secs_f64();
+        let cpu = cpu0
+            .zip(thread_cpu_ns())
+            .map(|(a, b)| cpu_s_between(&a, &b));
+        if wall < best.0 {
+            best = (wall, cpu);
+        }
     }
-    (rays.len() as f64 / best, hits as f64 / rays.len() as f64)
+    let n = rays.len() as f64;
+    Throughput {
+        rays_per_s: n / best.0,
+        rays_per_cpu_s: best.1.map(|c| n / c),
+        hit_fraction: hits as f64 / n,
+    }
 }
 
+/// Build on a 2-thread pool (the target machine has 2 cores); the time covers box
+/// computation, the obvhs build and the leaf-order triangle copy.
 fn build(mesh: &TriangleMesh, quality: BuildQuality) -> (Geometry, f64) {
-    let start = Instant::now();
     let mut b = GeometryBuilder::new();
     let id = b.add_mesh(mesh.clone());
     b.add_instance(Shape::Mesh(id), Transform::IDENTITY, None)
-        .unwrap();
-    let clone_s = start.elapsed().as_secs_f64();
+        .expect("mesh was added");
     let start = Instant::now();
-    let g = b.build(quality);
-    let _ = clone_s;
+    let g = pool(2).install(|| b.build(quality));
     (g, start.elapsed().as_secs_f64())
+}
+
+/// 1-minute load average, to judge whether other processes shared the cores during the run.
+fn load_average() -> Option<f64> {
+    std::fs::read_to_string("/proc/loadavg")
+        .ok()?
+        .split_whitespace()
+        .next()?
+        .parse()
+        .ok()
 }
 
 fn mrays(x: f64) -> Value {
@@ -136,6 +213,7 @@ fn mrays(x: f64) -> Value {
 }
 
 fn main() {
+    let load_at_start = load_average();
     let mesh = bench_mesh();
     let primary = primary_rays();
     let random = random_rays(1);
@@ -148,19 +226,19 @@ fn main() {
     let mut default_geometry = None;
     for q in BuildQuality::ALL {
         let (g, build_s) = build(&mesh, q);
-        let (closest, _) = trace(&random, 1, &|r| g.intersect(r).is_some());
-        let (closest2, _) = trace(&random, 2, &|r| g.intersect(r).is_some());
+        let t1 = trace(&random, 1, &|r| g.intersect(r).is_some());
+        let t2 = trace(&random, 2, &|r| g.intersect(r).is_some());
         eprintln!(
-            "{}: build {build_s:.3} s, incoherent closest {:.2} / {:.2} Mrays/s (1/2 threads)",
+            "{}: build {build_s:.3} s, incoherent closest 1t {} 2t {}",
             q.name(),
-            closest / 1e6,
-            closest2 / 1e6
+            t1.show(),
+            t2.show()
         );
         presets.push(json!({
             "preset": q.name(),
             "build_s": (build_s * 1000.0).round() / 1000.0,
-            "incoherent_closest_mrays_s_1t": mrays(closest),
-            "incoherent_closest_mrays_s_2t": mrays(closest2),
+            "incoherent_closest_1t": t1.json(),
+            "incoherent_closest_2t": t2.json(),
         }));
         if q == BuildQuality::default() {
             default_geometry = Some(g);
@@ -175,21 +253,26 @@ fn main() {
         ("incoherent_sorted", &sorted),
     ] {
         for threads in [1, 2] {
-            let (closest, hit_fraction) = trace(rays, threads, &|r| g.intersect(r).is_some());
-            let (any, _) = trace(rays, threads, &|r| g.occluded(r));
-            eprintln!("{name} {threads}t: closest {:.2}, any {:.2} Mrays/s, hit fraction {hit_fraction:.3}", closest / 1e6, any / 1e6);
+            let closest = trace(rays, threads, &|r| g.intersect(r).is_some());
+            let any = trace(rays, threads, &|r| g.occluded(r));
+            eprintln!(
+                "{name} {threads}t: closest {}, any hit {}, hit fraction {:.3}",
+                closest.show(),
+                any.show(),
+                closest.hit_fraction
+            );
             traversal.push(json!({
                 "rays": name,
                 "threads": threads,
-                "closest_mrays_s": mrays(closest),
-                "any_hit_mrays_s": mrays(any),
-                "hit_fraction": (hit_fraction * 1000.0).round() / 1000.0,
+                "closest": closest.json(),
+                "any_hit": any.json(),
+                "hit_fraction": (closest.hit_fraction * 1000.0).round() / 1000.0,
             }));
         }
     }
 
-    // Reference: obvhs alone, its own (non-watertight, Möller–Trumbore) triangle test over its
-    // triangle builder, same preset and rays, single- and two-threaded.
+    // Reference: obvhs alone — its triangle builder and its own (non-watertight,
+    // Möller–Trumbore) triangle test, same preset and rays.
     let tris: Vec<Triangle> = (0..mesh.triangle_count())
         .map(|i| {
             let [v0, v1, v2] = mesh.triangle(i);
@@ -197,11 +280,13 @@ fn main() {
         })
         .collect();
     let start = Instant::now();
-    let cw = build_cwbvh_from_tris(
-        &tris,
-        BuildQuality::default().params(),
-        &mut Default::default(),
-    );
+    let cw = pool(2).install(|| {
+        build_cwbvh_from_tris(
+            &tris,
+            BuildQuality::default().params(),
+            &mut Default::default(),
+        )
+    });
     let ob_build_s = start.elapsed().as_secs_f64();
     let leaf: Vec<Triangle> = cw
         .primitive_indices
@@ -216,26 +301,30 @@ fn main() {
             |ray, id| leaf[id].intersect(ray),
         )
     };
-    let (ob1, _) = trace(&random, 1, &ob);
-    let (ob2, _) = trace(&random, 2, &ob);
+    let ob1 = trace(&random, 1, &ob);
+    let ob2 = trace(&random, 2, &ob);
     eprintln!(
-        "obvhs reference: build {ob_build_s:.3} s, incoherent closest {:.2} / {:.2}",
-        ob1 / 1e6,
-        ob2 / 1e6
+        "obvhs reference: build {ob_build_s:.3} s, incoherent closest 1t {} 2t {}",
+        ob1.show(),
+        ob2.show()
     );
 
     let out = json!({
+        "command": "cargo run --release -p bench-bvh",
+        "load_average_1min_at_start": load_at_start,
+        "load_average_1min_at_end": load_average(),
         "mesh": { "triangles": mesh.triangle_count(), "kind": "displaced uv sphere, 501 x 1000" },
         "ray_count": RAY_COUNT,
         "threads_available": std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1),
+        "units": "mrays_s: million rays per wall-clock second; mrays_per_cpu_s: million rays per CPU-second of this process (all threads)",
         "default_preset": BuildQuality::default().name(),
         "presets": presets,
         "traversal_default_preset": traversal,
         "incoherent_sort_s": (sort_s * 1000.0).round() / 1000.0,
         "obvhs_reference": {
             "build_s": (ob_build_s * 1000.0).round() / 1000.0,
-            "incoherent_closest_mrays_s_1t": mrays(ob1),
-            "incoherent_closest_mrays_s_2t": mrays(ob2),
+            "incoherent_closest_1t": ob1.json(),
+            "incoherent_closest_2t": ob2.json(),
         },
     });
     println!("{}", serde_json::to_string_pretty(&out).expect("json"));
