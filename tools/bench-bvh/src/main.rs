@@ -91,7 +91,11 @@ fn sort_rays(rays: &mut [Ray]) {
         };
         (oct << 30) | spread(q.x as u64) | (spread(q.y as u64) << 1) | (spread(q.z as u64) << 2)
     };
-    rays.par_sort_unstable_by_key(key);
+    let mut keyed: Vec<(u64, Ray)> = rays.par_iter().map(|r| (key(r), *r)).collect();
+    keyed.par_sort_unstable_by_key(|(k, _)| *k);
+    for (dst, (_, r)) in rays.iter_mut().zip(keyed) {
+        *dst = r;
+    }
 }
 
 thread_local! {
@@ -188,14 +192,20 @@ fn trace(rays: &[Ray], threads: usize, f: &(dyn Fn(&Ray) -> bool + Sync)) -> Thr
 
 /// Build on a 2-thread pool (the target machine has 2 cores); the time covers box
 /// computation, the obvhs build and the leaf-order triangle copy.
-fn build(mesh: &TriangleMesh, quality: BuildQuality) -> (Geometry, f64) {
+fn build(mesh: &TriangleMesh, quality: BuildQuality) -> (Geometry, f64, Option<f64>) {
     let mut b = GeometryBuilder::new();
     let id = b.add_mesh(mesh.clone());
     b.add_instance(Shape::Mesh(id), Transform::IDENTITY, None)
         .expect("mesh was added");
+    let p = POOLS.with(|p| p[1].clone());
+    let cpu0 = thread_cpu_ns();
     let start = Instant::now();
-    let g = pool(2).install(|| b.build(quality));
-    (g, start.elapsed().as_secs_f64())
+    let g = p.install(|| b.build(quality));
+    let wall = start.elapsed().as_secs_f64();
+    let cpu = cpu0
+        .zip(thread_cpu_ns())
+        .map(|(a, b)| cpu_s_between(&a, &b));
+    (g, wall, cpu)
 }
 
 /// 1-minute load average, to judge whether other processes shared the cores during the run.
@@ -225,18 +235,20 @@ fn main() {
     let mut presets = Vec::new();
     let mut default_geometry = None;
     for q in BuildQuality::ALL {
-        let (g, build_s) = build(&mesh, q);
+        let (g, build_s, build_cpu_s) = build(&mesh, q);
         let t1 = trace(&random, 1, &|r| g.intersect(r).is_some());
         let t2 = trace(&random, 2, &|r| g.intersect(r).is_some());
         eprintln!(
-            "{}: build {build_s:.3} s, incoherent closest 1t {} 2t {}",
+            "{}: build {build_s:.3} s ({:.3} CPU-s), incoherent closest 1t {} 2t {}",
             q.name(),
+            build_cpu_s.unwrap_or(f64::NAN),
             t1.show(),
             t2.show()
         );
         presets.push(json!({
             "preset": q.name(),
             "build_s": (build_s * 1000.0).round() / 1000.0,
+            "build_cpu_s": build_cpu_s.map(|c| (c * 1000.0).round() / 1000.0),
             "incoherent_closest_1t": t1.json(),
             "incoherent_closest_2t": t2.json(),
         }));
