@@ -49,7 +49,7 @@ impl Curvature {
             .try_normalize()
             .map(|d| (d - n * n.dot(d)).normalize_or_zero())
             .unwrap_or(Vec3A::ZERO);
-        if !(det > 0.0) || !det.is_finite() {
+        if det.is_nan() || det <= 0.0 || det.is_infinite() {
             return Self {
                 k1: 0.0,
                 k2: 0.0,

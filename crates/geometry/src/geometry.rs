@@ -147,6 +147,11 @@ impl Geometry {
         &self.instances
     }
 
+    /// Number of distinct meshes stored (instances share them).
+    pub fn mesh_count(&self) -> usize {
+        self.meshes.len()
+    }
+
     pub fn mesh(&self, id: MeshId) -> &TriangleMesh {
         &self.meshes[id.0 as usize].mesh
     }
@@ -154,47 +159,47 @@ impl Geometry {
     /// Closest hit of `ray` in `(t_min, t_max)`.
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
         let top = self.top.as_ref()?;
+        if self.instances.len() == 1 {
+            // One instance: its box test would only repeat the bottom level's root test.
+            return self.intersect_instance(0, ray, ray.t_max);
+        }
         let mut best: Option<Hit> = None;
         let mut hit = RayHit::none();
         top.ray_traverse(to_bvh_ray(ray), &mut hit, |r, leaf| {
-            let instance_id = top.primitive_indices[leaf];
-            let inst = &self.instances[instance_id as usize];
-            let (o, d) = object_ray(inst, ray);
-            match inst.shape {
-                Shape::Mesh(MeshId(m)) => {
-                    match self.meshes[m as usize].intersect(o, d, ray.t_min, r.tmax) {
-                        Some(h) => {
-                            best = Some(Hit {
-                                t: h.t,
-                                instance_id,
-                                primitive_id: h.triangle,
-                                b1: h.b1,
-                                b2: h.b2,
-                            });
-                            h.t
-                        }
-                        None => f32::INFINITY,
-                    }
+            match self.intersect_instance(top.primitive_indices[leaf], ray, r.tmax) {
+                Some(h) => {
+                    best = Some(h);
+                    h.t
                 }
-                _ => {
-                    let local = Ray::new(o, d, ray.t_min, r.tmax);
-                    match analytic_intersect(&inst.shape, &local) {
-                        Some(t) => {
-                            best = Some(Hit {
-                                t,
-                                instance_id,
-                                primitive_id: 0,
-                                b1: 0.0,
-                                b2: 0.0,
-                            });
-                            t
-                        }
-                        None => f32::INFINITY,
-                    }
-                }
+                None => f32::INFINITY,
             }
         });
         best
+    }
+
+    /// Closest hit on one instance with `t` in `(ray.t_min, t_max)`.
+    #[inline]
+    fn intersect_instance(&self, instance_id: u32, ray: &Ray, t_max: f32) -> Option<Hit> {
+        let inst = &self.instances[instance_id as usize];
+        let (o, d) = object_ray(inst, ray);
+        match inst.shape {
+            Shape::Mesh(MeshId(m)) => self.meshes[m as usize]
+                .intersect(o, d, ray.t_min, t_max)
+                .map(|h| Hit {
+                    t: h.t,
+                    instance_id,
+                    primitive_id: h.triangle,
+                    b1: h.b1,
+                    b2: h.b2,
+                }),
+            _ => analytic_intersect(&inst.shape, &Ray::new(o, d, ray.t_min, t_max)).map(|t| Hit {
+                t,
+                instance_id,
+                primitive_id: 0,
+                b1: 0.0,
+                b2: 0.0,
+            }),
+        }
     }
 
     /// Whether anything blocks `ray` in `(t_min, t_max)` — the shadow-ray query; it stops at
@@ -203,23 +208,26 @@ impl Geometry {
         let Some(top) = self.top.as_ref() else {
             return false;
         };
+        if self.instances.len() == 1 {
+            return self.occludes(0, ray);
+        }
         !top.ray_traverse_miss(to_bvh_ray(ray), |_, leaf| {
-            let inst = &self.instances[top.primitive_indices[leaf] as usize];
-            let (o, d) = object_ray(inst, ray);
-            let blocked = match inst.shape {
-                Shape::Mesh(MeshId(m)) => {
-                    self.meshes[m as usize].occluded(o, d, ray.t_min, ray.t_max)
-                }
-                _ => {
-                    analytic_intersect(&inst.shape, &Ray::new(o, d, ray.t_min, ray.t_max)).is_some()
-                }
-            };
-            if blocked {
+            if self.occludes(top.primitive_indices[leaf], ray) {
                 ray.t_min
             } else {
                 f32::INFINITY
             }
         })
+    }
+
+    #[inline]
+    fn occludes(&self, instance_id: u32, ray: &Ray) -> bool {
+        let inst = &self.instances[instance_id as usize];
+        let (o, d) = object_ray(inst, ray);
+        match inst.shape {
+            Shape::Mesh(MeshId(m)) => self.meshes[m as usize].occluded(o, d, ray.t_min, ray.t_max),
+            _ => analytic_intersect(&inst.shape, &Ray::new(o, d, ray.t_min, ray.t_max)).is_some(),
+        }
     }
 
     /// Full world-space record of `hit` (found for `ray`).

@@ -196,9 +196,13 @@ fn scan_for_error(text: &str) -> Option<(Option<usize>, String)> {
                     ));
                 }
                 for corner in &rest {
-                    for (k, (part, count, what)) in corner
+                    for (k, (part, count, (what, whats))) in corner
                         .split('/')
-                        .zip([(nv, "vertex"), (nvt, "texture coordinate"), (nvn, "normal")])
+                        .zip([
+                            (nv, ("vertex", "vertices")),
+                            (nvt, ("texture coordinate", "texture coordinates")),
+                            (nvn, ("normal", "normals")),
+                        ])
                         .map(|(p, (c, w))| (p, c, w))
                         .enumerate()
                     {
@@ -216,7 +220,7 @@ fn scan_for_error(text: &str) -> Option<(Option<usize>, String)> {
                             return Some((
                                 line_no,
                                 format!(
-                                    "face: {what} index {idx} is out of range; {count} {what}s are defined before this line (OBJ indices start at 1, negative ones count back)"
+                                    "face: {what} index {idx} is out of range; {count} {whats} are defined before this line (OBJ indices start at 1, negative ones count back)"
                                 ),
                             ));
                         }

@@ -9,17 +9,21 @@
 //! edge function 0 count as inside). When an edge function is exactly 0 it is recomputed in
 //! f64, as the paper and pbrt-v4 do, to resolve the sign.
 
-use glam::Vec3A;
+use glam::{Mat3A, Vec3A, Vec3Swizzles};
 
-/// Per-ray constants of the watertight test (paper §3, "precomputation").
+/// Per-ray constants of the watertight test (paper §3, "precomputation"). The permutation and
+/// shear are folded into three row vectors, so that the sheared coordinates of a vertex `a`
+/// (relative to the origin) are `a·shear_x = a[kx] + Sx·a[kz]`, `a·shear_y = a[ky] + Sy·a[kz]`
+/// and `a·pick_z = a[kz]`. Each row has one zero entry whose product is an exact zero, so the
+/// sums round exactly like the paper's scalar code, and the same vertex always yields the same
+/// bits — which is what watertightness rests on. Three vertices are transformed at once with a
+/// 3×3 matrix product (SIMD) instead of branchy per-component indexing.
 #[derive(Clone, Copy, Debug)]
 pub struct WatertightRay {
     pub origin: Vec3A,
-    kx: usize,
-    ky: usize,
-    kz: usize,
-    sx: f32,
-    sy: f32,
+    shear_x: Vec3A,
+    shear_y: Vec3A,
+    pick_z: Vec3A,
     sz: f32,
     pub t_min: f32,
 }
@@ -52,13 +56,13 @@ impl WatertightRay {
         let kx = if kz == 2 { 0 } else { kz + 1 };
         let ky = if kx == 2 { 0 } else { kx + 1 };
         let dz = direction[kz];
+        let unit = |k: usize| Vec3A::AXES[k];
+        let (sx, sy) = (-direction[kx] / dz, -direction[ky] / dz);
         Self {
             origin,
-            kx,
-            ky,
-            kz,
-            sx: -direction[kx] / dz,
-            sy: -direction[ky] / dz,
+            shear_x: unit(kx) + sx * unit(kz),
+            shear_y: unit(ky) + sy * unit(kz),
+            pick_z: unit(kz),
             sz: 1.0 / dz,
             t_min,
         }
@@ -67,39 +71,29 @@ impl WatertightRay {
     /// Intersect the triangle `p0 p1 p2` within `(t_min, t_max)`; two-sided.
     #[inline(always)]
     pub fn intersect(&self, p0: Vec3A, p1: Vec3A, p2: Vec3A, t_max: f32) -> Option<TriangleHit> {
-        let a = p0 - self.origin;
-        let b = p1 - self.origin;
-        let c = p2 - self.origin;
-        let (az, bz, cz) = (a[self.kz], b[self.kz], c[self.kz]);
-        let ax = a[self.kx] + self.sx * az;
-        let ay = a[self.ky] + self.sy * az;
-        let bx = b[self.kx] + self.sx * bz;
-        let by = b[self.ky] + self.sy * bz;
-        let cx = c[self.kx] + self.sx * cz;
-        let cy = c[self.ky] + self.sy * cz;
+        // Rows of the vertices relative to the origin; columns (x of a, b, c), … after transpose.
+        let m = Mat3A::from_cols(p0 - self.origin, p1 - self.origin, p2 - self.origin).transpose();
+        let xs = m * self.shear_x; // (ax, bx, cx)
+        let ys = m * self.shear_y; // (ay, by, cy)
+        let zs = m * self.pick_z; // (az, bz, cz)
 
-        // Edge functions (paper eq. 4), plain products for exact antisymmetry.
-        let mut u = cx * by - cy * bx;
-        let mut v = ax * cy - ay * cx;
-        let mut w = bx * ay - by * ax;
-        if u == 0.0 || v == 0.0 || w == 0.0 {
+        // Edge functions (paper eq. 4) — u = cx·by − cy·bx, v = ax·cy − ay·cx,
+        // w = bx·ay − by·ax — with plain products for exact antisymmetry between neighbours.
+        let mut uvw = xs.zxy() * ys.yzx() - ys.zxy() * xs.yzx();
+        if uvw.cmpeq(Vec3A::ZERO).any() {
             // Paper §3.1: fall back to double precision on exact zeros.
-            let (axd, ayd, bxd, byd, cxd, cyd) = (
-                ax as f64, ay as f64, bx as f64, by as f64, cx as f64, cy as f64,
-            );
-            u = (cxd * byd - cyd * bxd) as f32;
-            v = (axd * cyd - ayd * cxd) as f32;
-            w = (bxd * ayd - byd * axd) as f32;
+            let (x, y) = (xs.as_dvec3(), ys.as_dvec3());
+            uvw = (x.zxy() * y.yzx() - y.zxy() * x.yzx()).as_vec3a();
         }
-        if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
+        if uvw.cmplt(Vec3A::ZERO).any() && uvw.cmpgt(Vec3A::ZERO).any() {
             return None;
         }
-        let det = u + v + w;
+        let det = uvw.element_sum();
         if det == 0.0 {
             return None;
         }
         // Scaled hit distance (paper eq. 6) compared against the interval without dividing.
-        let t_scaled = (u * az + v * bz + w * cz) * self.sz;
+        let t_scaled = uvw.dot(zs) * self.sz;
         if det > 0.0 {
             if t_scaled <= self.t_min * det || t_scaled >= t_max * det {
                 return None;
@@ -113,11 +107,12 @@ impl WatertightRay {
         if !(t > self.t_min && t < t_max) {
             return None;
         }
+        let b = uvw * inv_det;
         Some(TriangleHit {
             t,
-            b0: u * inv_det,
-            b1: v * inv_det,
-            b2: w * inv_det,
+            b0: b.x,
+            b1: b.y,
+            b2: b.z,
         })
     }
 }
