@@ -1,6 +1,7 @@
 //! The `prism` command: spectral rendering, colorimetry and tone reproduction.
 
 mod color;
+mod render;
 
 use std::process::ExitCode;
 
@@ -21,12 +22,15 @@ struct Cli {
 enum Command {
     /// Colorimetry of a spectrum: XYZ, xy, CCT/Duv, CIELAB and sRGB, as colour-science computes them.
     Color(color::ColorArgs),
+    /// Render a scene file to an EXR or PNG image (docs/rendering.md).
+    Render(render::RenderArgs),
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Color(args) => color::run(&args),
+        Command::Render(args) => render::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
