@@ -98,6 +98,9 @@ fn check_output(path: &Path) -> Result<(), String> {
     }
 }
 
+/// One EXR layer being assembled: name, channel names, one plane per channel.
+type LayerPlanes<'a> = (String, Vec<String>, Vec<&'a [f32]>);
+
 /// The film as a prism-post image with every layer.
 fn to_image(film: &FilmImage) -> Result<Image, String> {
     let (w, h) = (film.width as usize, film.height as usize);
@@ -108,7 +111,7 @@ fn to_image(film: &FilmImage) -> Result<Image, String> {
         .set_layer("luminance", &["Y"], film.luminance_cd_m2())
         .map_err(|e| e.to_string())?;
     // AOV planes come as `layer.channel`; group them by layer, channels interleaved.
-    let mut layers: Vec<(String, Vec<String>, Vec<&[f32]>)> = Vec::new();
+    let mut layers: Vec<LayerPlanes> = Vec::new();
     for plane in &film.aovs {
         let (layer, channel) = plane.name.split_once('.').unwrap_or(("", &plane.name));
         match layers.iter_mut().find(|(l, _, _)| l == layer) {

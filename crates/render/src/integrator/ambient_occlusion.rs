@@ -32,7 +32,8 @@ pub struct AmbientOcclusion {
 impl AmbientOcclusion {
     /// `max_distance_m` > 0 (may be +∞), `samples` ≥ 1.
     pub fn new(max_distance_m: f32, samples: u32) -> Result<Self, String> {
-        if !(max_distance_m > 0.0) {
+        // NaN fails this test too.
+        if max_distance_m.is_nan() || max_distance_m <= 0.0 {
             return Err(format!(
                 "ambient occlusion: `max_distance_m` = {max_distance_m} must be > 0"
             ));
