@@ -106,3 +106,46 @@ fn unimplemented_integrator_and_bad_mesh_name_the_file_and_place() {
     assert!(err.contains("s.json: shapes[1]"), "{err}");
     assert!(err.contains("bad.obj:3"), "{err}");
 }
+
+#[test]
+fn mesh_instances_are_placed_by_their_own_then_the_shape_transform() {
+    // A 0.8 m square (two triangles in z = 0, normal +z) instanced at x = −1 and x = +1,
+    // the shape transform lifting both to y = 0.5, seen along −z by an orthographic camera
+    // 3 m away with 1 m pixels: the outer pixels hit a copy at depth 3 m, the middle one
+    // (|x| < 0.5) misses.
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("quad.obj"),
+        "v -0.4 -0.4 0\nv 0.4 -0.4 0\nv 0.4 0.4 0\nv -0.4 0.4 0\nf 1 2 3\nf 1 3 4\n",
+    )
+    .unwrap();
+    let scene_path = dir.path().join("s.json");
+    std::fs::write(
+        &scene_path,
+        r#"{"integrator": "depth",
+            "camera": {"type": "orthographic", "width_m": 3,
+                       "transform": {"look_at": {"eye": [0, 0.5, 3], "target": [0, 0.5, 0]}}},
+            "film": {"resolution": [3, 1], "filter": "box"},
+            "meshes": {"quad": "quad.obj"},
+            "shapes": [{"type": "instances", "mesh": "quad",
+                        "instances": [{"translate": [-1, 0, 0]}, {"translate": [1, 0, 0]}],
+                        "transform": {"translate": [0, 0.5, 0]}}]}"#,
+    )
+    .unwrap();
+    let description = prism_scene::load_scene(&scene_path).unwrap();
+    let scene = RenderScene::build(&description, None).unwrap();
+    let (image, _) = render(
+        &scene,
+        &RenderSettings {
+            spp: 4,
+            seed: 0,
+            tile_size_px: 16,
+        },
+        &|_| {},
+    );
+    let depth = &image.aov("depth.Z").unwrap().values;
+    assert!((depth[0] - 3.0).abs() < 1e-5, "{depth:?}");
+    assert!(depth[1].is_infinite(), "{depth:?}");
+    assert!((depth[2] - 3.0).abs() < 1e-5, "{depth:?}");
+    assert_eq!(scene.geometry.mesh_count(), 1);
+}
