@@ -2,6 +2,7 @@
 
 mod color;
 mod compare;
+mod render;
 
 use std::process::ExitCode;
 
@@ -24,6 +25,8 @@ enum Command {
     Color(color::ColorArgs),
     /// Error metrics of an image against a reference: MSE, RMSE, relMSE, PSNR, SSIM, ΔE2000.
     Compare(compare::CompareArgs),
+    /// Render a scene file to an EXR or PNG image (docs/rendering.md).
+    Render(render::RenderArgs),
 }
 
 fn main() -> ExitCode {
@@ -31,6 +34,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Color(args) => color::run(&args),
         Command::Compare(args) => compare::run(&args),
+        Command::Render(args) => render::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

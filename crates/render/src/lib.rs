@@ -1,5 +1,5 @@
-//! prism-render: cameras, samplers and film (this slice); BSDFs, lights, media and
-//! integrators follow.
+//! prism-render: cameras, samplers, film, scene building (description → geometry, camera,
+//! film) and the diagnostic integrators; BSDFs, lights, media and the path tracer follow.
 //!
 //! Conventions (DESIGN.md "Units and conventions"): metres, radians, right-handed with Y up.
 //! Camera space looks down −Z with +X right and +Y up (`prism_geometry::Transform::look_at`).
@@ -11,8 +11,10 @@
 pub mod camera;
 pub mod error;
 pub mod film;
+pub mod integrator;
 pub mod sampler;
 pub mod sampling;
+pub mod scene_build;
 
 pub use camera::{
     ApertureSpec, Camera, CameraFrame, FisheyeCamera, FisheyeCoverage, FisheyeProjection,
@@ -23,4 +25,6 @@ pub use film::{
     AovPlane, AovSelection, Film, FilmImage, FilmTile, Filter, FilterSample, FilterSampler,
     SurfaceAov, TileBounds,
 };
+pub use integrator::{render, total_samples, Integrator, RenderSettings, RenderStats};
 pub use sampler::{PixelSampler, SampleStream};
+pub use scene_build::{RenderScene, SceneBuildError};

@@ -23,9 +23,36 @@ pub fn sample_uniform_disk_concentric(u: Vec2) -> Vec2 {
     r * Vec2::new(theta.cos(), theta.sin())
 }
 
+/// Cosine-weighted direction on the hemisphere about +Z (Malley's method: a uniform disk
+/// point lifted onto the hemisphere; pbrt-v4 §A.5.3 `SampleCosineHemisphere`). Density
+/// cos θ / π per steradian.
+#[inline]
+pub fn sample_cosine_hemisphere(u: Vec2) -> glam::Vec3A {
+    let d = sample_uniform_disk_concentric(u);
+    let z = (1.0 - d.length_squared()).max(0.0).sqrt();
+    glam::Vec3A::new(d.x, d.y, z)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn cosine_hemisphere_is_unit_upward_and_has_mean_cos_two_thirds() {
+        // E[cos θ] under p = cos θ/π is ∫cos²θ/π dω = 2/3.
+        let n = 256;
+        let mut sum = 0.0f64;
+        for i in 0..n {
+            for j in 0..n {
+                let u = (Vec2::new(i as f32, j as f32) + 0.5) / n as f32;
+                let d = sample_cosine_hemisphere(u);
+                assert!((d.length() - 1.0).abs() < 1e-5 && d.z >= 0.0);
+                sum += f64::from(d.z);
+            }
+        }
+        let mean = sum / f64::from(n * n);
+        assert!((mean - 2.0 / 3.0).abs() < 1e-3, "{mean}");
+    }
 
     #[test]
     fn concentric_disk_stays_in_disk_and_reaches_its_edge() {

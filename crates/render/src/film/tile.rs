@@ -150,15 +150,35 @@ impl FilmTile {
         filter_weight: f32,
         aov: Option<&SurfaceAov>,
     ) -> bool {
-        let Some(i) = self.index(pixel) else {
+        if !self.bounds.contains(pixel) {
             debug_assert!(false, "pixel {pixel} outside tile {:?}", self.bounds);
             return false;
-        };
+        }
         let xyz = if radiance.has_non_finite() {
             DVec3::ZERO
         } else {
             xyz_of_sample(radiance, wavelengths)
         };
+        self.add_sample_xyz(pixel, xyz, filter_weight, aov)
+    }
+
+    /// Adds one camera sample whose colour is already CIE 1931 XYZ in the output
+    /// normalisation (`xyz::xyz_of_sample`): the diagnostic integrators, whose outputs are
+    /// known exactly (a flat spectrum, or an RGB value) and need no wavelength sampling.
+    /// A non-finite XYZ is dropped like non-finite radiance in `add_sample`.
+    #[inline]
+    pub fn add_sample_xyz(
+        &mut self,
+        pixel: UVec2,
+        xyz: DVec3,
+        filter_weight: f32,
+        aov: Option<&SurfaceAov>,
+    ) -> bool {
+        let Some(i) = self.index(pixel) else {
+            debug_assert!(false, "pixel {pixel} outside tile {:?}", self.bounds);
+            return false;
+        };
+        let xyz = if xyz.is_finite() { xyz } else { DVec3::ZERO };
         let w = if filter_weight.is_finite() {
             f64::from(filter_weight)
         } else {

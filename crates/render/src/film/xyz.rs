@@ -27,6 +27,31 @@ pub fn cd_m2_per_unit() -> f64 {
     K_M_PHOTOPIC_LM_PER_W * cie_y_integral_nm()
 }
 
+/// XYZ of a flat spectral radiance of 1 in the output normalisation:
+/// (∫x̄ / ∫ȳ, 1, ∫z̄ / ∫ȳ) over the 1 nm CIE 1931 table (equal-energy white E; X and Z
+/// are ≈ 1 because the three CMFs have nearly equal integrals). Y is exactly 1, so a
+/// diagnostic output written as a flat spectrum of value v has Y = v exactly.
+pub fn flat_spectrum_xyz() -> DVec3 {
+    static E: OnceLock<DVec3> = OnceLock::new();
+    *E.get_or_init(|| {
+        let c = cie1931();
+        let y = cie_y_integral_nm();
+        DVec3::new(
+            c.x_bar.values().iter().sum::<f64>() / y,
+            1.0,
+            c.z_bar.values().iter().sum::<f64>() / y,
+        )
+    })
+}
+
+/// XYZ of a linear Rec.709 (sRGB primaries, D65) colour: `RgbColorSpace::srgb().rgb_to_xyz`,
+/// the inverse of the matrix `Film::finish` applies, so the RGB comes back out of the film.
+pub fn rec709_to_xyz(rgb: [f32; 3]) -> DVec3 {
+    static M: OnceLock<glam::DMat3> = OnceLock::new();
+    let m = M.get_or_init(|| prism_spectrum::rgb_space::RgbColorSpace::srgb().rgb_to_xyz);
+    *m * DVec3::from(rgb.map(f64::from))
+}
+
 /// The XYZ estimate of one sample with hero-wavelength sampling:
 /// (1/4) Σᵢ L(λᵢ) (x̄, ȳ, z̄)(λᵢ) / p(λᵢ) / ∫ ȳ dλ, with the CMFs linearly interpolated on
 /// their 1 nm table. Lanes with pdf 0 (terminated secondaries) contribute nothing.

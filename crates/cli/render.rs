@@ -1,0 +1,250 @@
+//! `prism render SCENE.json`: load a scene (prism-scene), build it (prism-render), render it
+//! tile by tile on a rayon pool and write the image (prism-post) atomically.
+//!
+//! Output: `-o`, else the scene's `film.output` (relative to the scene file), else
+//! `<scene stem>.exr` in the current directory. EXR: unprefixed R, G, B linear Rec.709,
+//! header `prism:cd_m2_per_unit`, layers `luminance.Y` (cd/m²), `depth.Z` (m),
+//! `normal.X/Y/Z`, `albedo.R/G/B` and `spp.Y`. PNG: the RGB sRGB-encoded (16 bit). See
+//! docs/rendering.md.
+
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use clap::Args;
+use glam::UVec2;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use prism_post::io::{write_image, ImageFormat};
+use prism_post::Image;
+use prism_render::integrator::DEFAULT_TILE_SIZE_PX;
+use prism_render::{render, total_samples, FilmImage, RenderScene, RenderSettings, RenderStats};
+use prism_spectrum::rgb_space::RgbColorSpace;
+use serde_json::json;
+
+#[derive(Args, Debug)]
+pub struct RenderArgs {
+    /// The scene file (JSON, docs/scene-format.md).
+    pub scene: PathBuf,
+    /// Output image (.exr or .png; .hdr also works). Default: the scene's `film.output`,
+    /// else `<scene stem>.exr` in the current directory.
+    #[arg(short = 'o', long = "output")]
+    pub output: Option<PathBuf>,
+    /// Samples per pixel (default: the scene's `film.spp`).
+    #[arg(long)]
+    pub spp: Option<u32>,
+    /// Worker threads (default: one per core).
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// Sampler seed (default: the scene's `film.seed`).
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// Film resolution override, WIDTHxHEIGHT (e.g. 64x48), for previews and tests.
+    #[arg(long, value_parser = parse_resolution)]
+    pub resolution: Option<UVec2>,
+    /// Write render statistics as JSON to this file.
+    #[arg(long = "stats-json")]
+    pub stats_json: Option<PathBuf>,
+}
+
+fn parse_resolution(s: &str) -> Result<UVec2, String> {
+    let parse = |t: &str| t.trim().parse::<u32>().ok().filter(|&v| v >= 1);
+    match s.split_once(['x', 'X']) {
+        Some((w, h)) => match (parse(w), parse(h)) {
+            (Some(w), Some(h)) => Ok(UVec2::new(w, h)),
+            _ => Err(format!(
+                "`{s}`: expected WIDTHxHEIGHT with both ≥ 1, e.g. 64x48"
+            )),
+        },
+        None => Err(format!("`{s}`: expected WIDTHxHEIGHT, e.g. 64x48")),
+    }
+}
+
+/// Where the image goes (see the module docs).
+fn output_path(args: &RenderArgs, scene_output: Option<&Path>) -> PathBuf {
+    if let Some(o) = &args.output {
+        return o.clone();
+    }
+    if let Some(o) = scene_output {
+        return o.to_path_buf();
+    }
+    let stem = args
+        .scene
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "render".into());
+    PathBuf::from(format!("{stem}.exr"))
+}
+
+/// Fails early (before rendering) when the output cannot be written: unknown extension,
+/// missing folder or a folder that is not one.
+fn check_output(path: &Path) -> Result<(), String> {
+    ImageFormat::from_path(path).map_err(|e| format!("output {}: {e}", path.display()))?;
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    match std::fs::metadata(dir) {
+        Ok(m) if m.is_dir() => Ok(()),
+        Ok(_) => Err(format!(
+            "output {}: {} is not a directory",
+            path.display(),
+            dir.display()
+        )),
+        Err(e) => Err(format!(
+            "output {}: cannot use the directory {}: {e}",
+            path.display(),
+            dir.display()
+        )),
+    }
+}
+
+/// One EXR layer being assembled: name, channel names, one plane per channel.
+type LayerPlanes<'a> = (String, Vec<String>, Vec<&'a [f32]>);
+
+/// The film as a prism-post image with every layer.
+fn to_image(film: &FilmImage) -> Result<Image, String> {
+    let (w, h) = (film.width as usize, film.height as usize);
+    let mut image =
+        Image::new(w, h, film.rgb.clone(), RgbColorSpace::srgb()).map_err(|e| e.to_string())?;
+    image.cd_m2_per_unit = Some(film.cd_m2_per_unit);
+    image
+        .set_layer("luminance", &["Y"], film.luminance_cd_m2())
+        .map_err(|e| e.to_string())?;
+    // AOV planes come as `layer.channel`; group them by layer, channels interleaved.
+    let mut layers: Vec<LayerPlanes> = Vec::new();
+    for plane in &film.aovs {
+        let (layer, channel) = plane.name.split_once('.').unwrap_or(("", &plane.name));
+        match layers.iter_mut().find(|(l, _, _)| l == layer) {
+            Some((_, channels, planes)) => {
+                channels.push(channel.to_string());
+                planes.push(&plane.values);
+            }
+            None => layers.push((
+                layer.to_string(),
+                vec![channel.to_string()],
+                vec![&plane.values],
+            )),
+        }
+    }
+    for (layer, channels, planes) in layers {
+        let n = w * h;
+        let mut samples = Vec::with_capacity(n * planes.len());
+        for i in 0..n {
+            samples.extend(planes.iter().map(|p| p[i]));
+        }
+        let names: Vec<&str> = channels.iter().map(String::as_str).collect();
+        image
+            .set_layer(&layer, &names, samples)
+            .map_err(|e| e.to_string())?;
+    }
+    Ok(image)
+}
+
+/// Peak resident set size (VmHWM in /proc/self/status), bytes; `None` off Linux.
+fn peak_memory_bytes() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024)
+}
+
+fn progress_bar(total: u64) -> ProgressBar {
+    if !std::io::stderr().is_terminal() {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr());
+    let style = ProgressStyle::with_template(
+        "{elapsed_precise} [{bar:40}] {percent:>3}% {per_sec} samples, ETA {eta}",
+    )
+    .unwrap_or_else(|_| ProgressStyle::default_bar())
+    .progress_chars("=> ");
+    bar.set_style(style);
+    bar.enable_steady_tick(Duration::from_millis(200));
+    bar
+}
+
+pub fn run(args: &RenderArgs) -> Result<(), String> {
+    let description = prism_scene::load_scene(&args.scene).map_err(|e| e.to_string())?;
+    let output = output_path(args, description.film.output.as_deref());
+    check_output(&output)?;
+    let scene = RenderScene::build(&description, args.resolution).map_err(|e| e.to_string())?;
+    let settings = RenderSettings {
+        spp: args.spp.unwrap_or(scene.spp),
+        seed: args.seed.unwrap_or(scene.seed),
+        tile_size_px: DEFAULT_TILE_SIZE_PX,
+    };
+    if settings.spp == 0 {
+        return Err("--spp must be at least 1".into());
+    }
+    let mut pool = rayon::ThreadPoolBuilder::new();
+    if let Some(n) = args.threads {
+        if n == 0 {
+            return Err("--threads must be at least 1".into());
+        }
+        pool = pool.num_threads(n);
+    }
+    let pool = pool
+        .build()
+        .map_err(|e| format!("cannot start the thread pool: {e}"))?;
+    let threads = pool.current_num_threads();
+
+    let bar = progress_bar(total_samples(scene.resolution, settings.spp));
+    let start = Instant::now();
+    let (film, stats) = pool.install(|| render(&scene, &settings, &|n| bar.inc(n)));
+    let wall_time_s = start.elapsed().as_secs_f64();
+    bar.finish_and_clear();
+
+    let image = to_image(&film)?;
+    write_image(&output, &image).map_err(|e| e.to_string())?;
+    if let Some(path) = &args.stats_json {
+        write_stats(path, &scene, &settings, threads, wall_time_s, &stats)?;
+    }
+    eprintln!(
+        "wrote {} ({}×{}, {} spp, {:.2} s, {:.3} M rays/s)",
+        output.display(),
+        scene.resolution.x,
+        scene.resolution.y,
+        settings.spp,
+        wall_time_s,
+        stats.rays_traced as f64 / wall_time_s.max(1e-9) / 1e6
+    );
+    Ok(())
+}
+
+fn write_stats(
+    path: &Path,
+    scene: &RenderScene,
+    settings: &RenderSettings,
+    threads: usize,
+    wall_time_s: f64,
+    stats: &RenderStats,
+) -> Result<(), String> {
+    let value = json!({
+        "wall_time_s": wall_time_s,
+        "rays_traced": stats.rays_traced,
+        "rays_per_second": stats.rays_traced as f64 / wall_time_s.max(1e-9),
+        "samples": stats.samples,
+        "peak_memory_bytes": peak_memory_bytes(),
+        "resolution": [scene.resolution.x, scene.resolution.y],
+        "spp": settings.spp,
+        "threads": threads,
+        "integrator": scene.integrator.name(),
+        "non_finite_samples": stats.non_finite_samples,
+    });
+    let text = serde_json::to_string_pretty(&value).map_err(|e| e.to_string())? + "\n";
+    // Atomic like the image: a temporary sibling renamed over the destination.
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let tmp = path.with_file_name(format!(".{name}.{}.tmp", std::process::id()));
+    let result = std::fs::write(&tmp, text).and_then(|()| std::fs::rename(&tmp, path));
+    if let Err(e) = result {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(format!(
+            "cannot write the statistics {}: {e}",
+            path.display()
+        ));
+    }
+    Ok(())
+}

@@ -1,0 +1,97 @@
+//! A `SceneDescription` (prism-scene) turned into what the integrators need: geometry with
+//! its BVH, the camera, the film and the albedo of every material.
+
+mod albedo;
+mod camera;
+mod error;
+mod filter;
+mod geometry;
+mod transform;
+
+pub use albedo::{material_albedo, reflectance_rgb, DEFAULT_ALBEDO};
+pub use camera::{build_camera, horizontal_fov_rad};
+pub use error::SceneBuildError;
+pub use filter::build_filter;
+pub use geometry::build_geometry;
+
+use std::path::PathBuf;
+
+use glam::UVec2;
+use prism_geometry::{Geometry, NO_MATERIAL};
+use prism_scene::SceneDescription;
+
+use crate::camera::Camera;
+use crate::film::{AovSelection, Film};
+use crate::integrator::Integrator;
+
+/// Everything a render needs, built from a scene description.
+pub struct RenderScene {
+    /// The scene file it came from (for messages).
+    pub file: PathBuf,
+    pub geometry: Geometry,
+    pub camera: Camera,
+    pub integrator: Integrator,
+    /// Film resolution in pixels.
+    pub resolution: UVec2,
+    pub filter: crate::Filter,
+    /// Samples per pixel and seed from the scene (`prism render` may override them).
+    pub spp: u32,
+    pub seed: u64,
+    /// Albedo (linear Rec.709) per scene material, then one for the default material.
+    pub albedo_rgb: Vec<[f32; 3]>,
+}
+
+impl RenderScene {
+    /// Builds the runtime scene. `resolution` overrides the scene's film resolution
+    /// (tests and previews).
+    pub fn build(
+        scene: &SceneDescription,
+        resolution: Option<UVec2>,
+    ) -> Result<Self, SceneBuildError> {
+        let file = scene.file.clone();
+        let resolution = resolution.unwrap_or(UVec2::new(
+            scene.film.resolution[0],
+            scene.film.resolution[1],
+        ));
+        let integrator = Integrator::from_description(&scene.integrator)
+            .map_err(|message| SceneBuildError::new(&file, "integrator", message))?;
+        let camera = build_camera(&file, &scene.camera, resolution)?;
+        let filter = build_filter(&scene.film.filter)
+            .map_err(|e| SceneBuildError::new(&file, "film.filter", e.to_string()))?;
+        let mut albedo_rgb: Vec<[f32; 3]> = (0..scene.materials.len())
+            .map(|i| material_albedo(&scene.materials, i))
+            .collect();
+        albedo_rgb.push(DEFAULT_ALBEDO);
+        let geometry = build_geometry(scene)?;
+        Ok(Self {
+            file,
+            geometry,
+            camera,
+            integrator,
+            resolution,
+            filter,
+            spp: scene.film.spp,
+            seed: scene.film.seed,
+            albedo_rgb,
+        })
+    }
+
+    /// An empty film for this scene recording every surface AOV.
+    pub fn new_film(&self) -> Film {
+        // The resolution was checked when the camera frame was built.
+        Film::new(self.resolution, self.filter, AovSelection::ALL)
+            .expect("resolution checked by CameraFrame::new")
+    }
+
+    /// Albedo of a hit's `material_id`.
+    #[inline]
+    pub fn albedo(&self, material_id: u32) -> [f32; 3] {
+        if material_id == NO_MATERIAL {
+            return DEFAULT_ALBEDO;
+        }
+        self.albedo_rgb
+            .get(material_id as usize)
+            .copied()
+            .unwrap_or(DEFAULT_ALBEDO)
+    }
+}

@@ -1,0 +1,279 @@
+//! End-to-end checks of `prism render`: every example scene renders, determinism across
+//! thread counts, output formats and layers, statistics, and error messages.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use prism_post::io::exr::read_exr;
+use serde_json::Value;
+
+fn prism(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_prism"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .args(args)
+        .output()
+        .expect("prism runs")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+fn scene_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.is_dir() {
+            scene_files(&path, out);
+        } else if path.extension().is_some_and(|e| e == "json") {
+            out.push(path);
+        }
+    }
+}
+
+#[test]
+fn every_example_scene_renders_at_a_tiny_resolution() {
+    let mut files = Vec::new();
+    scene_files(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes"),
+        &mut files,
+    );
+    assert!(files.len() >= 9, "{files:?}");
+    let dir = tempfile::tempdir().unwrap();
+    for (i, f) in files.iter().enumerate() {
+        let out = dir.path().join(format!("{i}.exr"));
+        let o = prism(&[
+            "render",
+            s(f),
+            "-o",
+            s(&out),
+            "--resolution",
+            "16x12",
+            "--spp",
+            "1",
+        ]);
+        assert!(o.status.success(), "{}: {}", f.display(), stderr(&o));
+        assert!(out.is_file());
+    }
+}
+
+#[test]
+fn same_seed_gives_bit_identical_exr_pixels_for_one_and_two_threads() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut images = Vec::new();
+    for threads in ["1", "2"] {
+        let out = dir.path().join(format!("t{threads}.exr"));
+        let o = prism(&[
+            "render",
+            "scenes/cameras/thin-lens.json",
+            "-o",
+            s(&out),
+            "--resolution",
+            "40x30",
+            "--spp",
+            "3",
+            "--seed",
+            "11",
+            "--threads",
+            threads,
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        images.push(read_exr(&out).unwrap());
+    }
+    let bits = |im: &prism_post::Image| -> Vec<u32> {
+        let mut v: Vec<u32> = im.pixels().iter().flatten().map(|x| x.to_bits()).collect();
+        for l in im.layers() {
+            v.extend(l.samples.iter().map(|x| x.to_bits()));
+        }
+        v
+    };
+    assert_eq!(bits(&images[0]), bits(&images[1]));
+}
+
+#[test]
+fn exr_has_rgb_the_aov_and_luminance_layers_and_the_absolute_scale() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("x.exr");
+    let o = prism(&[
+        "render",
+        "scenes/cameras/pinhole.json",
+        "-o",
+        s(&out),
+        "--resolution",
+        "32x24",
+        "--spp",
+        "2",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let image = read_exr(&out).unwrap();
+    // 683.002 lm/W · ∫ȳ dλ (CIE 1931, 1 nm, 360–830 nm: 106.857 nm) ≈ 72983.
+    let scale = image.cd_m2_per_unit.expect("prism:cd_m2_per_unit");
+    assert!((scale - 72983.0).abs() < 2.0, "{scale}");
+    for (layer, channels) in [
+        ("depth", vec!["Z"]),
+        ("normal", vec!["X", "Y", "Z"]),
+        ("albedo", vec!["R", "G", "B"]),
+        ("spp", vec!["Y"]),
+        ("luminance", vec!["Y"]),
+    ] {
+        let l = image
+            .layer(layer)
+            .unwrap_or_else(|| panic!("layer {layer}"));
+        // EXR stores channels sorted by name; compare as sets.
+        let mut got = l.channels.clone();
+        got.sort();
+        let mut want: Vec<String> = channels.iter().map(|c| c.to_string()).collect();
+        want.sort();
+        assert_eq!(got, want, "{layer}");
+    }
+    // luminance.Y = Y · scale; AO output is a flat spectrum, so Y ∈ [0, 1].
+    let lum = &image.layer("luminance").unwrap().samples;
+    assert!(lum
+        .iter()
+        .all(|&v| (0.0..=scale as f32 * 1.0001).contains(&v)));
+    assert!(lum.iter().any(|&v| v > 0.1 * scale as f32));
+    assert!(image
+        .layer("spp")
+        .unwrap()
+        .samples
+        .iter()
+        .all(|&v| v == 2.0));
+}
+
+#[test]
+fn png_output_is_a_png() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("x.png");
+    let o = prism(&[
+        "render",
+        "scenes/minimal.json",
+        "-o",
+        s(&out),
+        "--resolution",
+        "20x10",
+        "--spp",
+        "1",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let bytes = std::fs::read(&out).unwrap();
+    assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n");
+}
+
+#[test]
+fn stats_json_has_every_key_with_sane_values() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("x.exr");
+    let stats = dir.path().join("stats.json");
+    let o = prism(&[
+        "render",
+        "scenes/cameras/orthographic.json",
+        "-o",
+        s(&out),
+        "--resolution",
+        "24x16",
+        "--spp",
+        "2",
+        "--threads",
+        "2",
+        "--stats-json",
+        s(&stats),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: Value = serde_json::from_str(&std::fs::read_to_string(&stats).unwrap()).unwrap();
+    for key in [
+        "wall_time_s",
+        "rays_traced",
+        "rays_per_second",
+        "samples",
+        "peak_memory_bytes",
+        "resolution",
+        "spp",
+        "threads",
+        "integrator",
+        "non_finite_samples",
+    ] {
+        assert!(v.get(key).is_some(), "missing {key}: {v}");
+    }
+    assert!(v["wall_time_s"].as_f64().unwrap() > 0.0);
+    assert_eq!(v["samples"], 24 * 16 * 2);
+    // AO with 1 occlusion ray: one camera ray per sample plus one per hit.
+    let rays = v["rays_traced"].as_u64().unwrap();
+    assert!((24 * 16 * 2..=24 * 16 * 2 * 2).contains(&rays), "{rays}");
+    assert!(v["rays_per_second"].as_f64().unwrap() > 0.0);
+    if cfg!(target_os = "linux") {
+        assert!(v["peak_memory_bytes"].as_u64().unwrap() > 1_000_000);
+    }
+    assert_eq!(v["resolution"], serde_json::json!([24, 16]));
+    assert_eq!(v["spp"], 2);
+    assert_eq!(v["threads"], 2);
+    assert_eq!(v["integrator"], "ambient_occlusion");
+    assert_eq!(v["non_finite_samples"], 0);
+}
+
+#[test]
+fn a_bad_scene_is_reported_with_file_line_and_column() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("bad.json");
+    std::fs::write(&scene, "{\n  \"integrator\": \"normal\",\n  \"shapes\": [{\"type\": \"sphere\", \"radius\": 1}]\n}\n").unwrap();
+    let o = prism(&["render", s(&scene), "-o", s(&dir.path().join("x.exr"))]);
+    assert!(!o.status.success());
+    let e = stderr(&o);
+    assert!(e.contains("bad.json:3:"), "{e}");
+    assert!(e.contains("radius_m"), "{e}");
+    assert!(!dir.path().join("x.exr").exists());
+}
+
+#[test]
+fn unwritable_output_or_unknown_extension_fails_cleanly_without_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let not_a_dir = dir.path().join("file.txt");
+    std::fs::write(&not_a_dir, "x").unwrap();
+    for out in [
+        not_a_dir.join("x.exr"),
+        dir.path().join("missing/x.exr"),
+        dir.path().join("x.tiff"),
+    ] {
+        let o = prism(&[
+            "render",
+            "scenes/minimal.json",
+            "-o",
+            s(&out),
+            "--resolution",
+            "8x8",
+        ]);
+        assert!(!o.status.success(), "{}", out.display());
+        let e = stderr(&o);
+        assert!(e.contains(s(&out)), "{e}");
+        assert!(!out.exists());
+    }
+    let tiff = stderr(&prism(&[
+        "render",
+        "scenes/minimal.json",
+        "-o",
+        s(&dir.path().join("x.tiff")),
+    ]));
+    assert!(tiff.contains(".exr") && tiff.contains(".png"), "{tiff}");
+    // Nothing but the file we made: no temporaries left behind.
+    let names: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(names, vec![std::ffi::OsString::from("file.txt")]);
+}
+
+#[test]
+fn unimplemented_path_integrator_is_a_clear_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("p.json");
+    std::fs::write(&scene, r#"{"shapes": [{"type": "sphere"}]}"#).unwrap();
+    let o = prism(&["render", s(&scene), "-o", s(&dir.path().join("x.exr"))]);
+    assert!(!o.status.success());
+    assert!(
+        stderr(&o).contains("p.json: integrator: the `path` integrator"),
+        "{}",
+        stderr(&o)
+    );
+}
