@@ -207,7 +207,7 @@ fn compute(args: &ColorArgs) -> Result<ColorReport, String> {
             let reflectance = spectrum.to_dense();
             let illuminant = illuminant.to_dense();
             let white = illuminant_white_xyz(&illuminant, observer);
-            if !(white.y > 0.0) {
+            if white.y.is_nan() || white.y <= 0.0 {
                 return Err(format!(
                     "--illuminant {illuminant_spec}: expected an illuminant with power in 360–830 nm, found none"
                 ));

@@ -108,8 +108,8 @@ fn wall_scene(x: f64, h: f64, length: f64) -> String {
 fn ambient_occlusion_beside_a_wall_matches_the_view_factor() {
     let length = 2000.0;
     let spp = 16_384;
-    for (x, h) in [(0.25, 1.0), (1.0, 1.0), (0.5, 0.3), (0.5, 1000.0)] {
-        let closed_form_occluded = 0.5 * (1.0 - x / (x * x + h * h as f64).sqrt());
+    for (x, h) in [(0.25f64, 1.0f64), (1.0, 1.0), (0.5, 0.3), (0.5, 1000.0)] {
+        let closed_form_occluded = 0.5 * (1.0 - x / (x * x + h * h).sqrt());
         let quadrature = occluded_fraction_quadrature(x, h, length);
         assert!(
             (quadrature - closed_form_occluded).abs() < 2e-3,
