@@ -43,8 +43,8 @@ impl FisheyeProjection {
     }
 }
 
-/// Circular: the whole image circle fits in the shorter film side. Cropped: the field of
-/// view spans the film width and the circle is cut by the frame.
+/// Circular: the whole image circle fits in the shorter film side. Cropped: the image circle
+/// passes through the film corners (the field of view spans the diagonal; the film is filled).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum FisheyeFit {
     Circular,
