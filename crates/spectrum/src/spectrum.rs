@@ -9,6 +9,9 @@ use std::sync::Arc;
 use crate::blackbody::{blackbody_peak_radiance, blackbody_radiance, blackbody_radiance_4};
 use crate::constants::{DENSE_SAMPLE_COUNT, LAMBDA_MIN_NM};
 use crate::data;
+use crate::rgb_upsample::{
+    RgbAlbedoSpectrum, RgbGamut, RgbIlluminantSpectrum, RgbUnboundedSpectrum, RgbUpsampleError,
+};
 use crate::sampled_spectrum::{SampledSpectrum, N_SPECTRUM_SAMPLES};
 use crate::sampled_wavelengths::SampledWavelengths;
 use crate::table::{DenseSpectrum, Tabulated};
@@ -48,8 +51,14 @@ pub enum Spectrum {
     /// `scale` · B(λ, T), Planck's law in W·m⁻²·sr⁻¹·nm⁻¹ (see `blackbody.rs`).
     /// `Spectrum::blackbody_normalized` sets `scale = 1 / B(λ_max, T)`.
     Blackbody { temperature_k: f32, scale: f32 },
-    // RGB-upsampled spectra (Jakob & Hanika 2019) go here: `RgbAlbedo`, `RgbUnbounded`,
-    // `RgbIlluminant`, with an arm each in `eval`, `eval_nm` and `scaled`.
+    /// A reflectance in [0, 1] upsampled from RGB (Jakob & Hanika 2019 sigmoid polynomial).
+    RgbAlbedo(RgbAlbedoSpectrum),
+    /// scale · sigmoid polynomial, from a non-negative RGB (pbrt-v4 `RGBUnboundedSpectrum`);
+    /// also what a scaled `RgbAlbedo` becomes.
+    RgbUnbounded(RgbUnboundedSpectrum),
+    /// The unbounded spectrum times the gamut's white illuminant (pbrt-v4
+    /// `RGBIlluminantSpectrum`), for emission.
+    RgbIlluminant(RgbIlluminantSpectrum),
 }
 
 impl Spectrum {
@@ -59,8 +68,9 @@ impl Spectrum {
     }
 
     /// A piecewise-linear spectrum (zero outside the table). Uniformly spaced tables are
-    /// detected and evaluated by direct indexing, others through a guide table (2 cells per
-    /// segment) and a short scan; `eval_nm` binary-searches.
+    /// detected and evaluated by direct indexing, others through a per-1-nm segment index
+    /// (one lookup, plus a forward step per node inside the cell); `eval_nm`
+    /// binary-searches.
     pub fn piecewise_linear(
         wavelengths_nm: &[f64],
         values: &[f64],
@@ -122,6 +132,23 @@ impl Spectrum {
         })
     }
 
+    /// A reflectance from a linear RGB in `gamut`, each component in [0, 1]; values stay in
+    /// [0, 1]. Uses the refined coefficients (`RgbAlbedoSpectrum::new`).
+    pub fn rgb_albedo(gamut: RgbGamut, rgb: [f32; 3]) -> Result<Self, RgbUpsampleError> {
+        RgbAlbedoSpectrum::new(gamut, rgb).map(Spectrum::RgbAlbedo)
+    }
+
+    /// An unbounded spectrum (scattering coefficients, …) from a linear RGB ≥ 0 in `gamut`.
+    pub fn rgb_unbounded(gamut: RgbGamut, rgb: [f32; 3]) -> Result<Self, RgbUpsampleError> {
+        RgbUnboundedSpectrum::new(gamut, rgb).map(Spectrum::RgbUnbounded)
+    }
+
+    /// An emission spectrum from a linear RGB ≥ 0 in `gamut`: RGB (1, 1, 1) is the gamut's
+    /// white illuminant at luminance Y = 1.
+    pub fn rgb_illuminant(gamut: RgbGamut, rgb: [f32; 3]) -> Result<Self, RgbUpsampleError> {
+        RgbIlluminantSpectrum::new(gamut, rgb).map(Spectrum::RgbIlluminant)
+    }
+
     /// This spectrum multiplied by `factor` (tables are copied once, here, not per evaluation).
     pub fn scaled(self, factor: f32) -> Self {
         match self {
@@ -135,6 +162,16 @@ impl Spectrum {
                 temperature_k,
                 scale: scale * factor,
             },
+            // A scaled reflectance is no longer bounded by 1: same polynomial, with a scale.
+            Spectrum::RgbAlbedo(a) => Spectrum::RgbUnbounded(RgbUnboundedSpectrum {
+                scale: factor,
+                polynomial: a.polynomial,
+            }),
+            Spectrum::RgbUnbounded(u) => Spectrum::RgbUnbounded(RgbUnboundedSpectrum {
+                scale: u.scale * factor,
+                ..u
+            }),
+            Spectrum::RgbIlluminant(i) => Spectrum::RgbIlluminant(i.scaled(factor)),
         }
     }
 
@@ -150,6 +187,9 @@ impl Spectrum {
                 temperature_k,
                 scale,
             } => blackbody_radiance_4(lambda_nm, *temperature_k, *scale),
+            Spectrum::RgbAlbedo(a) => SampledSpectrum::new(a.eval4(lambda_nm)),
+            Spectrum::RgbUnbounded(u) => SampledSpectrum::new(u.eval4(lambda_nm)),
+            Spectrum::RgbIlluminant(i) => SampledSpectrum::new(i.eval4(lambda_nm)),
         }
     }
 
@@ -163,6 +203,9 @@ impl Spectrum {
                 temperature_k,
                 scale,
             } => *scale as f64 * blackbody_radiance(wavelength_nm, *temperature_k as f64),
+            Spectrum::RgbAlbedo(a) => a.eval_nm(wavelength_nm),
+            Spectrum::RgbUnbounded(u) => u.eval_nm(wavelength_nm),
+            Spectrum::RgbIlluminant(i) => i.eval_nm(wavelength_nm),
         }
     }
 
@@ -211,16 +254,21 @@ pub struct PiecewiseLinear {
     last_nm: f32,
     /// 1 / spacing in nm⁻¹ when the wavelengths are uniformly spaced, else 0.
     inv_step_per_nm: f32,
-    /// Non-uniform tables: `guide[c]` is the segment holding the start of cell c of
-    /// `GUIDE_CELLS_PER_SEGMENT·(n − 1)` equal cells over [first, last] (empty when uniform).
-    /// Evaluation scans only the few nodes between neighbouring guide entries.
-    guide: Arc<[u32]>,
-    /// Cells per nm of the guide.
-    guide_cells_per_nm: f32,
+    /// Non-uniform tables: `segment_at_cell[c]` is a segment i ≤ n − 2 with
+    /// w[i] ≤ every wavelength that maps to cell c of the `cell_nm`-wide cells over
+    /// [first, last] (empty when uniform). Lookup = this entry + a forward step over the
+    /// nodes inside the cell (none for tables spaced ≥ 1 nm, apart from the rare node
+    /// within rounding distance of a cell start).
+    segment_at_cell: Arc<[u32]>,
+    /// Cells per nm (1 for tables up to 65,536 nm wide).
+    cells_per_nm: f32,
 }
 
-/// Guide cells per table segment: enough that a cell rarely spans more than one node.
-const GUIDE_CELLS_PER_SEGMENT: usize = 2;
+/// Width of the segment-index cells of non-uniform tables, in nm (widened for tables
+/// wider than `MAX_SEGMENT_CELLS` nm).
+const SEGMENT_CELL_NM: f64 = 1.0;
+/// Most cells of a segment-index table.
+const MAX_SEGMENT_CELLS: usize = 1 << 16;
 
 /// Relative tolerance (in units of the spacing) under which a table counts as uniform.
 const UNIFORM_SPACING_TOLERANCE: f64 = 1e-6;
@@ -272,14 +320,14 @@ impl PiecewiseLinear {
         } else {
             0.0
         };
-        let (guide, guide_cells_per_nm) = if inv_step_per_nm == 0.0 && n >= 2 {
-            build_guide(&wl32)
+        let (segment_at_cell, cells_per_nm) = if inv_step_per_nm == 0.0 && n >= 2 {
+            build_segment_index(&wl32)
         } else {
             (Vec::new(), 0.0)
         };
         Ok(Self {
-            guide: guide.into(),
-            guide_cells_per_nm,
+            segment_at_cell: segment_at_cell.into(),
+            cells_per_nm,
             first_nm: wl32[0],
             last_nm: wl32[n - 1],
             wavelengths_nm: wl32.into(),
@@ -339,28 +387,11 @@ impl PiecewiseLinear {
                 }
             }))
         } else {
-            // The guide cell of λ narrows the search to the segments between the guide
-            // entries one cell either side (a margin for rounding), usually one or two.
             let wavelengths = &*self.wavelengths_nm;
-            let guide = &*self.guide;
-            let last_cell = guide.len() - 1;
-            let mut segment = [0usize; N_SPECTRUM_SAMPLES];
-            for (i, &wl) in segment.iter_mut().zip(lambda_nm.iter()) {
-                let cell = (((wl - first) * self.guide_cells_per_nm).clamp(0.0, last_cell as f32)
-                    as i32 as usize)
-                    .min(last_cell);
-                let lo = guide[cell.saturating_sub(1)] as usize;
-                let hi = guide[(cell + 2).min(last_cell)] as usize;
-                // Count the nodes in (lo, hi] at or below λ (branch-free, usually 1–3 nodes).
-                *i = lo
-                    + wavelengths[lo + 1..=hi]
-                        .iter()
-                        .map(|&w| (w <= wl) as usize)
-                        .sum::<usize>();
-            }
             let mut out = [0.0f32; N_SPECTRUM_SAMPLES];
             for lane in 0..N_SPECTRUM_SAMPLES {
-                let (i, wl) = (segment[lane], lambda_nm[lane]);
+                let wl = lambda_nm[lane];
+                let i = self.segment_of(wl);
                 let (w0, w1) = (wavelengths[i], wavelengths[i + 1]);
                 let t = (wl - w0) / (w1 - w0);
                 let v = values[i] + t * (values[i + 1] - values[i]);
@@ -368,6 +399,25 @@ impl PiecewiseLinear {
             }
             SampledSpectrum::new(out)
         }
+    }
+
+    /// Non-uniform tables with n ≥ 2: the segment i ∈ [0, n − 2] holding `wl` — the last
+    /// i ≤ n − 2 with w[i] ≤ wl, or 0 below the table (and for NaN). One cell lookup plus
+    /// a forward step per node inside the cell.
+    #[inline(always)]
+    fn segment_of(&self, wl: f32) -> usize {
+        let wavelengths = &*self.wavelengths_nm;
+        let cells = &*self.segment_at_cell;
+        let last_cell = cells.len() - 1;
+        let last_segment = wavelengths.len() - 2;
+        // Clamp, then a native f32 → i32 conversion (NaN gives 0).
+        let x = (wl - self.first_nm) * self.cells_per_nm;
+        let cell = (x.clamp(0.0, last_cell as f32) as i32 as usize).min(last_cell);
+        let mut i = cells[cell] as usize;
+        while i < last_segment && wavelengths[i + 1] <= wl {
+            i += 1;
+        }
+        i
     }
 
     fn eval_nm(&self, wavelength_nm: f64) -> f64 {
@@ -397,22 +447,31 @@ impl PiecewiseLinear {
     }
 }
 
-/// Guide table of a non-uniform piecewise-linear table: for each of
-/// `GUIDE_CELLS_PER_SEGMENT·(n − 1)` equal cells over [first, last] (plus one entry for
-/// λ = last), the last segment i ≤ n − 2 whose start wavelength is ≤ the cell's start.
-fn build_guide(wavelengths_nm: &[f32]) -> (Vec<u32>, f32) {
+/// Segment-index table of a non-uniform piecewise-linear table (n ≥ 2): cells of
+/// `SEGMENT_CELL_NM` (or wider, at most `MAX_SEGMENT_CELLS` cells) over [first, last]; entry
+/// c is the last segment i ≤ n − 2 with w[i] ≤ (start of cell c) − margin, where the margin
+/// exceeds the f32 rounding of the cell computation in `segment_of`, so the entry never
+/// lies beyond the segment of any wavelength mapped to the cell. Returns the entries and
+/// cells per nm.
+fn build_segment_index(wavelengths_nm: &[f32]) -> (Vec<u32>, f32) {
     let n = wavelengths_nm.len();
-    let cells = GUIDE_CELLS_PER_SEGMENT * (n - 1);
     let (first, last) = (wavelengths_nm[0] as f64, wavelengths_nm[n - 1] as f64);
-    let cell_nm = (last - first) / cells as f64;
-    let guide = (0..=cells)
+    let range = last - first;
+    let cell_nm = SEGMENT_CELL_NM.max(range / (MAX_SEGMENT_CELLS - 1) as f64);
+    let cells = (range / cell_nm).ceil() as usize + 1;
+    let cells_per_nm = (1.0 / cell_nm) as f32;
+    // f32 error of (wl − first)·cells_per_nm, in nm: the subtraction (a few ulp of the
+    // largest wavelength) and the relative error of the product (a few f32 ε of x).
+    let scale = first.abs().max(last.abs());
+    let margin_nm = 8.0 * f32::EPSILON as f64 * (scale + cells as f64 * cell_nm);
+    let entries = (0..cells)
         .map(|c| {
-            let start = first + c as f64 * cell_nm;
+            let start = first + c as f64 * cell_nm - margin_nm;
             let i = wavelengths_nm.partition_point(|&w| w as f64 <= start);
             i.saturating_sub(1).min(n - 2) as u32
         })
         .collect();
-    (guide, (1.0 / cell_nm) as f32)
+    (entries, cells_per_nm)
 }
 
 /// A spectrum on the 1 nm grid 360, 361, …, 830 nm in f32.
@@ -507,6 +566,22 @@ mod tests {
             ),
             ("F11", Spectrum::cie_illuminant("F11").unwrap()),
             ("D65", Spectrum::cie_illuminant("d65").unwrap()),
+            (
+                "rgb albedo",
+                Spectrum::rgb_albedo(RgbGamut::Srgb, [0.8, 0.3, 0.1]).unwrap(),
+            ),
+            (
+                "rgb albedo rec2020 saturated",
+                Spectrum::rgb_albedo(RgbGamut::Rec2020, [0.1, 0.9, 0.05]).unwrap(),
+            ),
+            (
+                "rgb unbounded",
+                Spectrum::rgb_unbounded(RgbGamut::AcesCg, [3.0, 0.5, 1.25]).unwrap(),
+            ),
+            (
+                "rgb illuminant",
+                Spectrum::rgb_illuminant(RgbGamut::Srgb, [2.0, 1.0, 0.25]).unwrap(),
+            ),
         ]
     }
 
@@ -542,8 +617,20 @@ mod tests {
                 for lane in 0..4 {
                     let expected = spectrum.eval_nm(lambda[lane] as f64);
                     let got_lane = got[lane] as f64;
+                    // The sigmoid kinds are defined at every wavelength: NaN in, NaN out.
+                    if expected.is_nan() && got_lane.is_nan() {
+                        continue;
+                    }
+                    // Saturated sigmoid polynomials have terms ~1e3 for an argument ~1, so
+                    // the f32 argument carries ~1e-4 of rounding (f64 `eval_nm` does not).
+                    let sigmoid_slack = if name.starts_with("rgb") {
+                        1e-4 * scale
+                    } else {
+                        0.0
+                    };
                     assert!(
-                        (got_lane - expected).abs() <= 2e-6 * scale + 1e-5 * expected.abs(),
+                        (got_lane - expected).abs()
+                            <= 2e-6 * scale + 1e-5 * expected.abs() + sigmoid_slack,
                         "{name} at {} nm: eval {got_lane}, eval_nm {expected}",
                         lambda[lane]
                     );
@@ -554,7 +641,7 @@ mod tests {
 
     #[test]
     fn clustered_non_uniform_tables_evaluate_exactly() {
-        // Nodes crowded at both ends and sparse in the middle stress the guide table.
+        // Nodes crowded at both ends and sparse in the middle stress the segment index.
         let mut wavelengths_nm: Vec<f64> = (0..40).map(|i| 380.0 + 0.05 * i as f64).collect();
         wavelengths_nm.extend([450.0, 455.5, 600.0]);
         wavelengths_nm.extend((0..40).map(|i| 700.0 + 0.01 * i as f64));
@@ -583,6 +670,108 @@ mod tests {
                     lambda[lane],
                     got[lane]
                 );
+            }
+        }
+    }
+
+    /// SplitMix64, uniform f64 in [0, 1).
+    fn next_unit(state: &mut u64) -> f64 {
+        *state = state.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = *state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        ((z ^ (z >> 31)) >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
+    }
+
+    #[test]
+    fn segment_index_matches_binary_search_exactly_on_random_tables() {
+        let mut state = 0x5e9_0001u64;
+        for table_no in 0..200 {
+            // Random increasing wavelengths: gaps from 0.001 nm to 40 nm, some tables wide
+            // (IOR data reach far into the infrared), some starting at negative or odd values.
+            let n = 2 + (next_unit(&mut state) * 120.0) as usize;
+            let mut w = 200.0 + next_unit(&mut state) * 400.0;
+            let wide = table_no % 5 == 0;
+            let mut wavelengths_nm = Vec::with_capacity(n);
+            for _ in 0..n {
+                wavelengths_nm.push(w);
+                let u = next_unit(&mut state);
+                w += if u < 0.2 {
+                    0.001 + u * 0.01
+                } else if wide {
+                    u * 400.0
+                } else {
+                    u * 40.0
+                };
+            }
+            let values: Vec<f64> = (0..n).map(|_| next_unit(&mut state) * 10.0 - 2.0).collect();
+            let Ok(Spectrum::PiecewiseLinear(p)) =
+                Spectrum::piecewise_linear(&wavelengths_nm, &values)
+            else {
+                continue; // rounding to f32 merged two nodes
+            };
+            if p.is_uniform() {
+                continue;
+            }
+            let w32 = p.wavelengths_nm().to_vec();
+            let (first, last) = (w32[0], w32[n - 1]);
+            let mut probes: Vec<f32> = w32.clone();
+            // Nodes, their f32 neighbours, random points, and points outside.
+            for &x in &w32 {
+                probes.push(f32::from_bits(x.to_bits() - 1));
+                probes.push(f32::from_bits(x.to_bits() + 1));
+            }
+            for _ in 0..4000 {
+                let u = next_unit(&mut state);
+                probes.push((first as f64 - 5.0 + u * (last - first + 10.0) as f64) as f32);
+            }
+            probes.extend([f32::NAN, -1e30, 1e30, first - 1.0, last + 1.0]);
+            while !probes.len().is_multiple_of(4) {
+                probes.push(first);
+            }
+            let tabulated = Tabulated::new(wavelengths_nm.clone(), values.clone()).unwrap();
+            let spectrum = Spectrum::PiecewiseLinear(p.clone());
+            for chunk in probes.chunks(4) {
+                let lambda: [f32; 4] = chunk.try_into().unwrap();
+                let got = spectrum.eval(&wavelengths(lambda));
+                for lane in 0..4 {
+                    let wl = lambda[lane];
+                    // Reference: binary search over the f32 nodes, same f32 arithmetic.
+                    let i = w32.partition_point(|&x| x <= wl).clamp(1, n - 1) - 1;
+                    if wl >= first && wl <= last {
+                        assert_eq!(p.segment_of(wl), i, "table {table_no} at {wl} nm");
+                    }
+                    let (w0, w1) = (w32[i], w32[i + 1]);
+                    let t = (wl - w0) / (w1 - w0);
+                    let vals = p.values();
+                    let v = vals[i] + t * (vals[i + 1] - vals[i]);
+                    let expected = if wl >= first && wl <= last { v } else { 0.0 };
+                    assert_eq!(
+                        got[lane].to_bits(),
+                        expected.to_bits(),
+                        "table {table_no} at {wl} nm: {} vs {expected}",
+                        got[lane]
+                    );
+                    // And the f64 table agrees up to f32 rounding.
+                    // (inside both the f32 and the f64 node ranges).
+                    let inside_f64 =
+                        wl as f64 >= wavelengths_nm[0] && wl as f64 <= wavelengths_nm[n - 1];
+                    if wl >= first && wl <= last && inside_f64 {
+                        let reference = tabulated.eval(wl as f64);
+                        // Nodes rounded to f32 move by ≤ ½ ulp: the value by slope × that.
+                        // (the f64 table may put λ in a neighbouring segment).
+                        let slope = (i.saturating_sub(1)..(i + 2).min(n - 1))
+                            .map(|k| ((vals[k + 1] - vals[k]) / (w32[k + 1] - w32[k])).abs())
+                            .fold(0.0f32, f32::max) as f64;
+                        let tol = slope * 2.0 * f32::EPSILON as f64 * wl.abs() as f64
+                            + 1e-5 * (1.0 + reference.abs());
+                        assert!(
+                            (got[lane] as f64 - reference).abs() <= tol,
+                            "table {table_no} at {wl} nm: {} vs Tabulated {reference}",
+                            got[lane]
+                        );
+                    }
+                }
             }
         }
     }

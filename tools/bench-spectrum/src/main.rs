@@ -6,7 +6,9 @@ use std::hint::black_box;
 use std::time::Instant;
 
 use prism_spectrum::data::{cmfs, Observer};
-use prism_spectrum::{DenseSpectrum, SampledSpectrum, SampledWavelengths, Spectrum};
+use prism_spectrum::{
+    DenseSpectrum, RgbAlbedoSpectrum, RgbGamut, SampledSpectrum, SampledWavelengths, Spectrum,
+};
 
 const RUNS: usize = 9;
 const EVALS_PER_RUN: usize = 2_000_000;
@@ -104,8 +106,18 @@ fn main() {
             "named_illuminant_d65",
             Spectrum::cie_illuminant("D65").unwrap(),
         ),
-        // RGB-upsampled kinds (rgb_albedo, rgb_unbounded, rgb_illuminant) are added here
-        // with their variants.
+        (
+            "rgb_albedo",
+            Spectrum::rgb_albedo(RgbGamut::Srgb, [0.8, 0.3, 0.1]).unwrap(),
+        ),
+        (
+            "rgb_unbounded",
+            Spectrum::rgb_unbounded(RgbGamut::Rec2020, [2.0, 0.5, 0.25]).unwrap(),
+        ),
+        (
+            "rgb_illuminant",
+            Spectrum::rgb_illuminant(RgbGamut::AcesCg, [4.0, 2.0, 1.0]).unwrap(),
+        ),
     ];
 
     let (mut medians, mut minima) = (Vec::new(), Vec::new());
@@ -134,17 +146,49 @@ fn main() {
     });
     black_box(xyz_sink);
 
+    // RGB → coefficients: the pure table lookup (textures) and the refined path
+    // (`RgbAlbedoSpectrum::new`, constant colours), over saturated Rec.2020 colours.
+    let colours: Vec<[f32; 3]> = (0..256)
+        .map(|_| {
+            let mut c = [
+                splitmix(&mut u_state),
+                splitmix(&mut u_state),
+                splitmix(&mut u_state),
+            ];
+            c[(u_state % 3) as usize] *= 0.1;
+            c
+        })
+        .collect();
+    let mut poly_sink = 0.0f32;
+    let lookup_ns = median_ns(200_000, |i| {
+        let s = RgbAlbedoSpectrum::from_table(RgbGamut::Rec2020, black_box(colours[i % 256]));
+        poly_sink += s.unwrap().polynomial.c2;
+    });
+    let refined_ns = median_ns(2_000, |i| {
+        let s = RgbAlbedoSpectrum::new(RgbGamut::Rec2020, black_box(colours[i % 256]));
+        poly_sink += s.unwrap().polynomial.c2;
+    });
+    black_box(poly_sink);
+
     println!(
         "{{\"benchmark\": \"prism-spectrum\", \"unit\": \"ns\", \"runs\": {RUNS}, \"statistic\": \"median\", \
 \"eval_4_wavelengths_ns\": {{{}}}, \
 \"eval_4_wavelengths_min_ns\": {{{}}}, \
 \"sample_visible_wavelengths_ns\": {:.2}, \
 \"spectrum_to_xyz_1nm_ns\": {:.1}, \
-\"spectrum_to_xyz_1nm_min_ns\": {:.1}}}",
+\"spectrum_to_xyz_1nm_min_ns\": {:.1}, \
+\"rgb_albedo_from_table_ns\": {:.1}, \
+\"rgb_albedo_from_table_min_ns\": {:.1}, \
+\"rgb_albedo_refined_ns\": {:.0}, \
+\"rgb_albedo_refined_min_ns\": {:.0}}}",
         medians.join(", "),
         minima.join(", "),
         (sample_ns.0 - rng_ns.0).max(0.0),
         xyz_ns.0,
-        xyz_ns.1
+        xyz_ns.1,
+        lookup_ns.0,
+        lookup_ns.1,
+        refined_ns.0,
+        refined_ns.1
     );
 }
