@@ -538,6 +538,8 @@ impl RgbToSpectrumTable {
 
 /// Most Newton steps of [`RgbToSpectrumTable::coefficients_refined`].
 pub const REFINE_MAX_ITERATIONS: usize = 8;
+/// Most step halvings per Newton step.
+const REFINE_MAX_HALVINGS: usize = 12;
 /// Refinement stops once every RGB component is this close (f32 evaluation noise is
 /// ~1e-7).
 const REFINE_TOLERANCE: f64 = 2e-6;
@@ -665,7 +667,7 @@ pub fn refine_polynomial(
         // Backtracking: halve the step until the residual drops.
         let mut alpha = 1.0;
         let mut accepted = false;
-        for _ in 0..12 {
+        for _ in 0..REFINE_MAX_HALVINGS {
             let trial: [f64; 3] = std::array::from_fn(|k| c[k] + alpha * step[k]);
             if trial.iter().all(|v| v.abs() <= REFINE_COEFFICIENT_LIMIT) {
                 let p_trial = from_normalised(trial);
@@ -679,6 +681,8 @@ pub fn refine_polynomial(
             }
             alpha *= 0.5;
         }
+        // No stall test: colours near the solid's boundary converge through many small
+        // steps from a poor lookup (a 1 % stall test left 8 reachable grid points > 1e-3).
         if !accepted {
             break;
         }
@@ -710,12 +714,16 @@ fn validate_rgb(kind: &str, rgb: [f32; 3], min: f32, max: f32) -> Result<(), Rgb
 #[inline]
 fn dense_lookup(table: &[f32; DENSE_SAMPLE_COUNT], wavelength_nm: f32) -> f32 {
     let x = wavelength_nm - LAMBDA_MIN_NM;
-    if !(x >= 0.0 && x <= (DENSE_SAMPLE_COUNT - 1) as f32) {
-        return 0.0;
-    }
-    let i = (x as usize).min(DENSE_SAMPLE_COUNT - 2);
+    // Branch-free: clamp, native f32 → i32 (NaN gives 0), select zero outside.
+    let last_segment = DENSE_SAMPLE_COUNT - 2;
+    let i = (x.clamp(0.0, last_segment as f32) as i32 as usize).min(last_segment);
     let t = x - i as f32;
-    table[i] + t * (table[i + 1] - table[i])
+    let v = table[i] + t * (table[i + 1] - table[i]);
+    if x >= 0.0 && x <= (DENSE_SAMPLE_COUNT - 1) as f32 {
+        v
+    } else {
+        0.0
+    }
 }
 
 /// A reflectance (or transmittance) from an RGB in [0, 1]³: values in [0, 1]

@@ -260,6 +260,9 @@ pub struct PiecewiseLinear {
     /// nodes inside the cell (none for tables spaced ≥ 1 nm, apart from the rare node
     /// within rounding distance of a cell start).
     segment_at_cell: Arc<[u32]>,
+    /// Non-uniform tables: per segment [w0, w1, v0, slope] (one 16-byte load per lane;
+    /// v = v0 + (λ − w0)·slope, slope rounded once from f64). Empty when uniform.
+    segments: Arc<[[f32; 4]]>,
     /// Cells per nm (1 for tables up to 65,536 nm wide).
     cells_per_nm: f32,
 }
@@ -325,7 +328,13 @@ impl PiecewiseLinear {
         } else {
             (Vec::new(), 0.0)
         };
+        let segments = if segment_at_cell.is_empty() {
+            Vec::new()
+        } else {
+            build_segments(&wl32, &values32)
+        };
         Ok(Self {
+            segments: segments.into(),
             segment_at_cell: segment_at_cell.into(),
             cells_per_nm,
             first_nm: wl32[0],
@@ -350,8 +359,15 @@ impl PiecewiseLinear {
     }
 
     fn scaled(&self, factor: f32) -> Self {
+        let values: Vec<f32> = self.values.iter().map(|v| v * factor).collect();
+        let segments = if self.segments.is_empty() {
+            Vec::new()
+        } else {
+            build_segments(&self.wavelengths_nm, &values)
+        };
         Self {
-            values: self.values.iter().map(|v| v * factor).collect(),
+            values: values.into(),
+            segments: segments.into(),
             ..self.clone()
         }
     }
@@ -387,18 +403,21 @@ impl PiecewiseLinear {
                 }
             }))
         } else {
-            let wavelengths = &*self.wavelengths_nm;
             let mut out = [0.0f32; N_SPECTRUM_SAMPLES];
             for lane in 0..N_SPECTRUM_SAMPLES {
                 let wl = lambda_nm[lane];
-                let i = self.segment_of(wl);
-                let (w0, w1) = (wavelengths[i], wavelengths[i + 1]);
-                let t = (wl - w0) / (w1 - w0);
-                let v = values[i] + t * (values[i + 1] - values[i]);
+                let [w0, _, v0, slope] = self.segment_data(wl);
+                let v = v0 + (wl - w0) * slope;
                 out[lane] = if wl >= first && wl <= last { v } else { 0.0 };
             }
             SampledSpectrum::new(out)
         }
+    }
+
+    /// `segments[segment_of(wl)]`: [w0, w1, v0, slope] of the segment holding `wl`.
+    #[inline(always)]
+    fn segment_data(&self, wl: f32) -> [f32; 4] {
+        self.segments[self.segment_of(wl)]
     }
 
     /// Non-uniform tables with n ≥ 2: the segment i ∈ [0, n − 2] holding `wl` — the last
@@ -406,15 +425,20 @@ impl PiecewiseLinear {
     /// a forward step per node inside the cell.
     #[inline(always)]
     fn segment_of(&self, wl: f32) -> usize {
-        let wavelengths = &*self.wavelengths_nm;
+        let segments = &*self.segments;
         let cells = &*self.segment_at_cell;
         let last_cell = cells.len() - 1;
-        let last_segment = wavelengths.len() - 2;
+        let last_segment = segments.len() - 1;
         // Clamp, then a native f32 → i32 conversion (NaN gives 0).
         let x = (wl - self.first_nm) * self.cells_per_nm;
         let cell = (x.clamp(0.0, last_cell as f32) as i32 as usize).min(last_cell);
-        let mut i = cells[cell] as usize;
-        while i < last_segment && wavelengths[i + 1] <= wl {
+        let mut i = (cells[cell] as usize).min(last_segment);
+        // Tables spaced ≥ 1 nm hold at most one node per cell: one branch-free step (a node
+        // inside the cell is common, ~spacing⁻¹ per lane, so a branch would mispredict).
+        // w1 of segment i is w[i + 1].
+        i += (i < last_segment && segments[i][1] <= wl) as usize;
+        // More nodes per cell only in sub-nm clusters.
+        while i < last_segment && segments[i][1] <= wl {
             i += 1;
         }
         i
@@ -445,6 +469,18 @@ impl PiecewiseLinear {
         let (v0, v1) = (values[i - 1] as f64, values[i] as f64);
         v0 + t * (v1 - v0)
     }
+}
+
+/// [w0, w1, v0, slope] of every segment (n ≥ 2), slope = (v1 − v0)/(w1 − w0) in f64.
+fn build_segments(wavelengths_nm: &[f32], values: &[f32]) -> Vec<[f32; 4]> {
+    wavelengths_nm
+        .windows(2)
+        .zip(values.windows(2))
+        .map(|(w, v)| {
+            let slope = (v[1] as f64 - v[0] as f64) / (w[1] as f64 - w[0] as f64);
+            [w[0], w[1], v[0], slope as f32]
+        })
+        .collect()
 }
 
 /// Segment-index table of a non-uniform piecewise-linear table (n ≥ 2): cells of
@@ -740,11 +776,13 @@ mod tests {
                     let i = w32.partition_point(|&x| x <= wl).clamp(1, n - 1) - 1;
                     if wl >= first && wl <= last {
                         assert_eq!(p.segment_of(wl), i, "table {table_no} at {wl} nm");
+                        assert_eq!(p.segment_data(wl), p.segments[i]);
                     }
                     let (w0, w1) = (w32[i], w32[i + 1]);
-                    let t = (wl - w0) / (w1 - w0);
                     let vals = p.values();
-                    let v = vals[i] + t * (vals[i + 1] - vals[i]);
+                    let [sw0, sw1, v0, slope] = p.segments[i];
+                    assert_eq!((sw0, sw1, v0), (w0, w1, vals[i]));
+                    let v = v0 + (wl - w0) * slope;
                     let expected = if wl >= first && wl <= last { v } else { 0.0 };
                     assert_eq!(
                         got[lane].to_bits(),

@@ -444,3 +444,91 @@ fn illuminant_spectra_emit_their_rgb_with_white_at_unit_luminance() {
         }
     }
 }
+
+/// Diagnosis of the pure-table failures (run with `--ignored --nocapture`): for every
+/// LP-reachable grid point whose table round trip exceeds 1e-3, the 8 nodes of its
+/// interpolation cell — how many are themselves off (node RGB error > 1e-4, i.e. colours
+/// the sigmoid family cannot reach: the fit stopped at the coefficient bound), and the
+/// largest normalised coefficient among them.
+#[test]
+#[ignore]
+fn diagnose_wide_gamut_table_failures() {
+    use prism_spectrum::rgb_upsample::{refine_polynomial, SigmoidPolynomial};
+    for gamut in [RgbGamut::Rec2020, RgbGamut::AcesCg] {
+        let weights = reflectance_to_rgb(gamut);
+        let table = gamut.table();
+        let res = table.resolution();
+        let z_nodes = table.z_nodes();
+        let classes = classes(gamut);
+        let node_rgb_error = |rgb: [f64; 3], p: SigmoidPolynomial| {
+            let out = project(&weights, &sample_dense(|wl| p.eval4(wl)));
+            max_abs_diff(out, rgb)
+        };
+        let (mut failing, mut with_bad_node, mut with_huge) = (0, 0, 0);
+        let mut bad_nodes_hist = [0usize; 9];
+        for (n, rgb) in grid().into_iter().enumerate() {
+            if classes[n] >= MARGINS.len() || rgb[0] == rgb[1] && rgb[1] == rgb[2] {
+                continue;
+            }
+            let s = RgbAlbedoSpectrum::from_table(gamut, rgb).unwrap();
+            let out = project(&weights, &sample_dense(|wl| s.eval4(wl)));
+            if max_abs_diff(out, rgb.map(|c| c as f64)) <= ROUND_TRIP_TOLERANCE {
+                continue;
+            }
+            failing += 1;
+            // The cell, as `RgbToSpectrumTable::coefficients` finds it.
+            let l = if rgb[0] > rgb[1] {
+                if rgb[0] > rgb[2] {
+                    0
+                } else {
+                    2
+                }
+            } else if rgb[1] > rgb[2] {
+                1
+            } else {
+                2
+            };
+            let z = rgb[l];
+            let last = (res - 1) as f32;
+            let xi = ((rgb[(l + 1) % 3] * last / z) as usize).min(res - 2);
+            let yi = ((rgb[(l + 2) % 3] * last / z) as usize).min(res - 2);
+            let zi = z_nodes
+                .partition_point(|&v| v < z)
+                .saturating_sub(1)
+                .min(res - 2);
+            let (mut bad, mut max_coeff) = (0, 0.0f64);
+            for d in 0..8 {
+                let (k, j, i) = (zi + (d >> 2), yi + ((d >> 1) & 1), xi + (d & 1));
+                let zk = z_nodes[k] as f64;
+                let mut node_rgb = [0.0; 3];
+                node_rgb[l] = zk;
+                node_rgb[(l + 1) % 3] = i as f64 / last as f64 * zk;
+                node_rgb[(l + 2) % 3] = j as f64 / last as f64 * zk;
+                let c = table.node(l, k, j, i);
+                let p = SigmoidPolynomial::new(c[0], c[1], c[2]);
+                // Normalised |A| (t = (λ − 360)/470).
+                max_coeff = max_coeff.max((c[0] as f64 * 470.0 * 470.0).abs());
+                if k > 0 && node_rgb_error(node_rgb, p) > 1e-4 {
+                    // Confirm with the refinement: still off → the sigmoid cannot reach it.
+                    let (_, e) = refine_polynomial(gamut.reflectance_rgb_weights(), p, node_rgb);
+                    if e > 1e-4 {
+                        bad += 1;
+                    }
+                }
+            }
+            bad_nodes_hist[bad] += 1;
+            if bad > 0 {
+                with_bad_node += 1;
+            }
+            if max_coeff > 1e3 {
+                with_huge += 1;
+            }
+        }
+        println!(
+            "{}: {failing} reachable points over 1e-3; {with_bad_node} have ≥ 1 unreachable \
+             node in their cell (histogram of bad nodes 0..8: {bad_nodes_hist:?}); \
+             {with_huge} have a node with |A| > 1e3",
+            gamut.name()
+        );
+    }
+}

@@ -11,7 +11,9 @@ use prism_spectrum::{
 };
 
 const RUNS: usize = 9;
-const EVALS_PER_RUN: usize = 2_000_000;
+/// Interleaved rounds over all kinds for the eval timings.
+const ROUNDS: usize = 15;
+const EVALS_PER_RUN: usize = 1_000_000;
 const WAVELENGTH_SETS: usize = 4096;
 
 /// Median and minimum of `RUNS` timings of `per_run` calls of `body(i)`, in ns per call
@@ -39,13 +41,16 @@ fn splitmix(state: &mut u64) -> f32 {
     ((z ^ (z >> 31)) >> 40) as f32 * (1.0 / (1u64 << 24) as f32)
 }
 
-fn bench_eval(spectrum: &Spectrum, wavelengths: &[SampledWavelengths]) -> (f64, f64) {
+/// ns per `eval` over one run of `EVALS_PER_RUN` calls.
+fn bench_eval(spectrum: &Spectrum, wavelengths: &[SampledWavelengths]) -> f64 {
     let mut acc = SampledSpectrum::zero();
-    let ns = median_ns(EVALS_PER_RUN, |i| {
+    let start = Instant::now();
+    for i in 0..EVALS_PER_RUN {
         // Wavelengths vary every call; black_box keeps the spectrum from being hoisted.
         let w = &wavelengths[i % WAVELENGTH_SETS];
         acc += black_box(spectrum).eval(black_box(w));
-    });
+    }
+    let ns = start.elapsed().as_secs_f64() * 1e9 / EVALS_PER_RUN as f64;
     black_box(acc);
     ns
 }
@@ -120,11 +125,26 @@ fn main() {
         ),
     ];
 
-    let (mut medians, mut minima) = (Vec::new(), Vec::new());
-    for (name, spectrum) in &kinds {
-        let (median, min) = bench_eval(spectrum, &wavelengths);
+    // Rounds interleave the kinds, so load from other processes spreads over all of them
+    // and ratios between kinds measured in the same run stay meaningful.
+    let mut timings: Vec<Vec<f64>> = vec![Vec::new(); kinds.len()];
+    for _ in 0..ROUNDS {
+        for (t, (_, spectrum)) in timings.iter_mut().zip(&kinds) {
+            t.push(bench_eval(spectrum, &wavelengths));
+        }
+    }
+    let (mut medians, mut minima, mut ratios) = (Vec::new(), Vec::new(), Vec::new());
+    let dense_min = kinds
+        .iter()
+        .position(|(name, _)| *name == "dense")
+        .map(|k| timings[k].iter().copied().fold(f64::INFINITY, f64::min))
+        .unwrap();
+    for ((name, _), t) in kinds.iter().zip(&mut timings) {
+        t.sort_by(|a, b| a.total_cmp(b));
+        let (median, min) = (t[t.len() / 2], t[0]);
         medians.push(format!("\"{name}\": {median:.2}"));
         minima.push(format!("\"{name}\": {min:.2}"));
+        ratios.push(format!("\"{name}\": {:.2}", min / dense_min));
     }
 
     let mut u_state = 7u64;
@@ -171,9 +191,10 @@ fn main() {
     black_box(poly_sink);
 
     println!(
-        "{{\"benchmark\": \"prism-spectrum\", \"unit\": \"ns\", \"runs\": {RUNS}, \"statistic\": \"median\", \
+        "{{\"benchmark\": \"prism-spectrum\", \"unit\": \"ns\", \"runs\": {RUNS}, \"eval_rounds\": {ROUNDS}, \"statistic\": \"median\", \
 \"eval_4_wavelengths_ns\": {{{}}}, \
 \"eval_4_wavelengths_min_ns\": {{{}}}, \
+\"eval_4_wavelengths_min_over_dense_min\": {{{}}}, \
 \"sample_visible_wavelengths_ns\": {:.2}, \
 \"spectrum_to_xyz_1nm_ns\": {:.1}, \
 \"spectrum_to_xyz_1nm_min_ns\": {:.1}, \
@@ -183,6 +204,7 @@ fn main() {
 \"rgb_albedo_refined_min_ns\": {:.0}}}",
         medians.join(", "),
         minima.join(", "),
+        ratios.join(", "),
         (sample_ns.0 - rng_ns.0).max(0.0),
         xyz_ns.0,
         xyz_ns.1,
