@@ -714,10 +714,10 @@ fn validate_rgb(kind: &str, rgb: [f32; 3], min: f32, max: f32) -> Result<(), Rgb
 #[inline]
 fn dense_lookup(table: &[f32; DENSE_SAMPLE_COUNT], wavelength_nm: f32) -> f32 {
     let x = wavelength_nm - LAMBDA_MIN_NM;
-    // Branch-free: clamp, native f32 → i32 (NaN gives 0), select zero outside.
+    // Branch-free: clamped index (NaN gives 0), select zero outside.
     let last_segment = DENSE_SAMPLE_COUNT - 2;
-    let i = (x.clamp(0.0, last_segment as f32) as i32 as usize).min(last_segment);
-    let t = x - i as f32;
+    let (i, i_f32) = crate::spectrum::floor_index_and_value(x, last_segment);
+    let t = x - i_f32;
     let v = table[i] + t * (table[i + 1] - table[i]);
     if x >= 0.0 && x <= (DENSE_SAMPLE_COUNT - 1) as f32 {
         v

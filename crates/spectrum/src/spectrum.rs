@@ -225,6 +225,31 @@ fn check_temperature(temperature_k: f32) -> Result<(), InvalidSpectrum> {
     }
 }
 
+/// Most samples of a piecewise-linear table (keeps every index exact in f32, see
+/// `floor_index`).
+pub const MAX_TABLE_SAMPLES: usize = 1 << 24;
+
+/// ⌊x⌋ clamped to [0, max] (NaN → 0), for table indices. The clamp makes the float → int
+/// conversion's own range and NaN checks (Rust's saturating `as`) redundant, so this uses
+/// the bare truncation: 2–3× fewer instructions per lane.
+#[inline(always)]
+pub(crate) fn floor_index(x: f32, max: usize) -> usize {
+    floor_index_and_value(x, max).0
+}
+
+/// `floor_index` and the same index as f32 (converted from i32: one instruction, where
+/// `usize as f32` branches on the sign bit).
+#[inline(always)]
+pub(crate) fn floor_index_and_value(x: f32, max: usize) -> (usize, f32) {
+    let m = max.min(MAX_TABLE_SAMPLES) as u32 as f32;
+    // `x > 0.0` is false for NaN.
+    let x = if x > 0.0 { x } else { 0.0 };
+    let x = if x < m { x } else { m };
+    // SAFETY: x is finite and in [0, 2²⁴], so truncating it to i32 is defined.
+    let k = unsafe { x.to_int_unchecked::<i32>() };
+    (k as usize, k as f32)
+}
+
 /// Converts table values to f32, rejecting NaN, ±∞ and values f32 cannot hold.
 fn finite_f32_values(values: &[f64]) -> Result<Vec<f32>, InvalidSpectrum> {
     values
@@ -259,12 +284,18 @@ pub struct PiecewiseLinear {
     /// [first, last] (empty when uniform). Lookup = this entry + a forward step over the
     /// nodes inside the cell (none for tables spaced ≥ 1 nm, apart from the rare node
     /// within rounding distance of a cell start).
-    segment_at_cell: Arc<[u32]>,
+    segment_at_cell: Arc<[CellEntry]>,
     /// Non-uniform tables: per segment [w0, w1, v0, slope] (one 16-byte load per lane;
     /// v = v0 + (λ − w0)·slope, slope rounded once from f64). Empty when uniform.
     segments: Arc<[[f32; 4]]>,
+    /// Uniform tables: per segment [v0, v1 − v0] (one 8-byte load per lane, the same
+    /// arithmetic as values[i] + t·(values[i + 1] − values[i])). Empty otherwise.
+    uniform_pairs: Arc<[[f32; 2]]>,
     /// Cells per nm (1 for tables up to 65,536 nm wide).
     cells_per_nm: f32,
+    /// Every cell holds at most one segment start beyond its entry (cells are narrower
+    /// than the closest node spacing), so lookup is one entry + one branch-free step.
+    single_step: bool,
 }
 
 /// Width of the segment-index cells of non-uniform tables, in nm (widened for tables
@@ -288,6 +319,12 @@ impl PiecewiseLinear {
                 "spectrum table has {} wavelengths but {} values",
                 wavelengths_nm.len(),
                 values.len()
+            )));
+        }
+        if wavelengths_nm.len() > MAX_TABLE_SAMPLES {
+            return Err(InvalidSpectrum::new(format!(
+                "spectrum table has {} samples, more than the {MAX_TABLE_SAMPLES} supported",
+                wavelengths_nm.len()
             )));
         }
         let wl32: Vec<f32> = wavelengths_nm.iter().map(|&w| w as f32).collect();
@@ -323,20 +360,27 @@ impl PiecewiseLinear {
         } else {
             0.0
         };
-        let (segment_at_cell, cells_per_nm) = if inv_step_per_nm == 0.0 && n >= 2 {
+        let (segment_at_cell, cells_per_nm, single_step) = if inv_step_per_nm == 0.0 && n >= 2 {
             build_segment_index(&wl32)
         } else {
-            (Vec::new(), 0.0)
+            (Vec::new(), 0.0, false)
         };
         let segments = if segment_at_cell.is_empty() {
             Vec::new()
         } else {
             build_segments(&wl32, &values32)
         };
+        let uniform_pairs = if inv_step_per_nm > 0.0 {
+            build_uniform_pairs(&values32)
+        } else {
+            Vec::new()
+        };
         Ok(Self {
+            uniform_pairs: uniform_pairs.into(),
             segments: segments.into(),
             segment_at_cell: segment_at_cell.into(),
             cells_per_nm,
+            single_step,
             first_nm: wl32[0],
             last_nm: wl32[n - 1],
             wavelengths_nm: wl32.into(),
@@ -365,9 +409,15 @@ impl PiecewiseLinear {
         } else {
             build_segments(&self.wavelengths_nm, &values)
         };
+        let uniform_pairs = if self.uniform_pairs.is_empty() {
+            Vec::new()
+        } else {
+            build_uniform_pairs(&values)
+        };
         Self {
             values: values.into(),
             segments: segments.into(),
+            uniform_pairs: uniform_pairs.into(),
             ..self.clone()
         }
     }
@@ -391,11 +441,11 @@ impl PiecewiseLinear {
             let inv_step = self.inv_step_per_nm;
             SampledSpectrum::new(lambda_nm.map(|wl| {
                 let x = (wl - first) * inv_step;
-                // Clamp, then a native f32 → i32 conversion (NaN gives 0); lanes outside the
-                // table are zeroed below.
-                let i = (x.clamp(0.0, (n - 2) as f32) as i32 as usize).min(n - 2);
-                let t = x - i as f32;
-                let v = values[i] + t * (values[i + 1] - values[i]);
+                // Clamped index (NaN gives 0); lanes outside the table are zeroed below.
+                let (i, i_f32) = floor_index_and_value(x, n - 2);
+                let t = x - i_f32;
+                let [v0, dv] = self.uniform_pairs[i];
+                let v = v0 + t * dv;
                 if wl >= first && wl <= last {
                     v
                 } else {
@@ -404,14 +454,35 @@ impl PiecewiseLinear {
             }))
         } else {
             let mut out = [0.0f32; N_SPECTRUM_SAMPLES];
-            for lane in 0..N_SPECTRUM_SAMPLES {
-                let wl = lambda_nm[lane];
-                let [w0, _, v0, slope] = self.segment_data(wl);
-                let v = v0 + (wl - w0) * slope;
-                out[lane] = if wl >= first && wl <= last { v } else { 0.0 };
+            // A per-table constant: the branch is always predicted.
+            if self.single_step {
+                for lane in 0..N_SPECTRUM_SAMPLES {
+                    let wl = lambda_nm[lane];
+                    let [w0, _, v0, slope] = self.segments[self.segment_single_step(wl)];
+                    let v = v0 + (wl - w0) * slope;
+                    out[lane] = if wl >= first && wl <= last { v } else { 0.0 };
+                }
+            } else {
+                for lane in 0..N_SPECTRUM_SAMPLES {
+                    let wl = lambda_nm[lane];
+                    let [w0, _, v0, slope] = self.segment_data(wl);
+                    let v = v0 + (wl - w0) * slope;
+                    out[lane] = if wl >= first && wl <= last { v } else { 0.0 };
+                }
             }
             SampledSpectrum::new(out)
         }
+    }
+
+    /// `segment_of` for tables whose cells hold at most one node (`single_step`): the
+    /// entry plus one branch-free step, no loop.
+    #[inline(always)]
+    fn segment_single_step(&self, wl: f32) -> usize {
+        let cells = &*self.segment_at_cell;
+        let x = (wl - self.first_nm) * self.cells_per_nm;
+        let entry = cells[floor_index(x, cells.len() - 1)];
+        // next_nm is +∞ for the last segment, so this never steps past it.
+        entry.segment as usize + (entry.next_nm <= wl) as usize
     }
 
     /// `segments[segment_of(wl)]`: [w0, w1, v0, slope] of the segment holding `wl`.
@@ -429,15 +500,16 @@ impl PiecewiseLinear {
         let cells = &*self.segment_at_cell;
         let last_cell = cells.len() - 1;
         let last_segment = segments.len() - 1;
-        // Clamp, then a native f32 → i32 conversion (NaN gives 0).
+        // Clamped cell index (NaN gives 0).
         let x = (wl - self.first_nm) * self.cells_per_nm;
-        let cell = (x.clamp(0.0, last_cell as f32) as i32 as usize).min(last_cell);
-        let mut i = (cells[cell] as usize).min(last_segment);
-        // Tables spaced ≥ 1 nm hold at most one node per cell: one branch-free step (a node
-        // inside the cell is common, ~spacing⁻¹ per lane, so a branch would mispredict).
-        // w1 of segment i is w[i + 1].
-        i += (i < last_segment && segments[i][1] <= wl) as usize;
-        // More nodes per cell only in sub-nm clusters.
+        let cell = floor_index(x, last_cell);
+        let entry = cells[cell];
+        // Tables spaced ≥ 1 nm hold at most one node per cell: one branch-free step against
+        // the node cached in the entry (a node inside the cell is common, ~spacing⁻¹ per
+        // lane, so a branch would mispredict, and reading it from `segments` would add a
+        // dependent load).
+        let mut i = (entry.segment as usize + (entry.next_nm <= wl) as usize).min(last_segment);
+        // More nodes per cell only in sub-nm clusters (w1 of segment i is w[i + 1]).
         while i < last_segment && segments[i][1] <= wl {
             i += 1;
         }
@@ -471,6 +543,11 @@ impl PiecewiseLinear {
     }
 }
 
+/// [v0, v1 − v0] of every segment of a uniform table (n ≥ 2).
+fn build_uniform_pairs(values: &[f32]) -> Vec<[f32; 2]> {
+    values.windows(2).map(|v| [v[0], v[1] - v[0]]).collect()
+}
+
 /// [w0, w1, v0, slope] of every segment (n ≥ 2), slope = (v1 − v0)/(w1 − w0) in f64.
 fn build_segments(wavelengths_nm: &[f32], values: &[f32]) -> Vec<[f32; 4]> {
     wavelengths_nm
@@ -489,11 +566,23 @@ fn build_segments(wavelengths_nm: &[f32], values: &[f32]) -> Vec<[f32; 4]> {
 /// exceeds the f32 rounding of the cell computation in `segment_of`, so the entry never
 /// lies beyond the segment of any wavelength mapped to the cell. Returns the entries and
 /// cells per nm.
-fn build_segment_index(wavelengths_nm: &[f32]) -> (Vec<u32>, f32) {
+fn build_segment_index(wavelengths_nm: &[f32]) -> (Vec<CellEntry>, f32, bool) {
     let n = wavelengths_nm.len();
     let (first, last) = (wavelengths_nm[0] as f64, wavelengths_nm[n - 1] as f64);
     let range = last - first;
-    let cell_nm = SEGMENT_CELL_NM.max(range / (MAX_SEGMENT_CELLS - 1) as f64);
+    // Cells of 1 nm, narrower (down to half the closest spacing) where nodes are closer,
+    // within a budget of cells, so that most tables need one step at most.
+    let min_spacing = wavelengths_nm
+        .windows(2)
+        .map(|w| w[1] as f64 - w[0] as f64)
+        .fold(f64::INFINITY, f64::min);
+    let cell_budget = (4 * n)
+        .max(range.ceil() as usize + 1)
+        .min(MAX_SEGMENT_CELLS);
+    let cell_nm = SEGMENT_CELL_NM
+        .min(0.5 * min_spacing)
+        .max(range / (cell_budget - 1) as f64)
+        .max(range / (MAX_SEGMENT_CELLS - 1) as f64);
     let cells = (range / cell_nm).ceil() as usize + 1;
     let cells_per_nm = (1.0 / cell_nm) as f32;
     // f32 error of (wl − first)·cells_per_nm, in nm: the subtraction (a few ulp of the
@@ -503,11 +592,40 @@ fn build_segment_index(wavelengths_nm: &[f32]) -> (Vec<u32>, f32) {
     let entries = (0..cells)
         .map(|c| {
             let start = first + c as f64 * cell_nm - margin_nm;
-            let i = wavelengths_nm.partition_point(|&w| w as f64 <= start);
-            i.saturating_sub(1).min(n - 2) as u32
+            let i = wavelengths_nm
+                .partition_point(|&w| w as f64 <= start)
+                .saturating_sub(1)
+                .min(n - 2);
+            CellEntry {
+                segment: i as u32,
+                // The last segment never steps on (λ = last stays in it).
+                next_nm: if i + 1 < n - 1 {
+                    wavelengths_nm[i + 1]
+                } else {
+                    f32::INFINITY
+                },
+            }
         })
         .collect();
-    (entries, cells_per_nm)
+    // One step suffices iff no cell sees two segment starts (nodes 1..n − 2) in
+    // (start − margin, end + margin].
+    let single_step = (0..cells).all(|c| {
+        let start = first + c as f64 * cell_nm - margin_nm;
+        let end = first + (c + 1) as f64 * cell_nm + margin_nm;
+        let starts = &wavelengths_nm[1..n - 1];
+        let lo = starts.partition_point(|&w| w as f64 <= start);
+        let hi = starts.partition_point(|&w| w as f64 <= end);
+        hi - lo <= 1
+    });
+    (entries, cells_per_nm, single_step)
+}
+
+/// One cell of the segment index: a segment whose start lies at or below every wavelength
+/// of the cell, and the wavelength where the next segment starts (+∞ for the last).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct CellEntry {
+    segment: u32,
+    next_nm: f32,
 }
 
 /// A spectrum on the 1 nm grid 360, 361, …, 830 nm in f32.
@@ -542,11 +660,10 @@ impl DenseTable {
         let values = &*self.values;
         SampledSpectrum::new(lambda_nm.map(|wl| {
             let x = wl - LAMBDA_MIN_NM;
-            // Clamp, then a native f32 → i32 conversion (NaN gives 0); lanes outside
-            // 360–830 nm are zeroed below.
+            // Clamped index (NaN gives 0); lanes outside 360–830 nm are zeroed below.
             let last_segment = DENSE_SAMPLE_COUNT - 2;
-            let i = (x.clamp(0.0, last_segment as f32) as i32 as usize).min(last_segment);
-            let t = x - i as f32;
+            let (i, i_f32) = floor_index_and_value(x, last_segment);
+            let t = x - i_f32;
             let v = values[i] + t * (values[i + 1] - values[i]);
             if x >= 0.0 && x <= (DENSE_SAMPLE_COUNT - 1) as f32 {
                 v
@@ -722,6 +839,7 @@ mod tests {
     #[test]
     fn segment_index_matches_binary_search_exactly_on_random_tables() {
         let mut state = 0x5e9_0001u64;
+        let mut modes_seen = [0usize; 2];
         for table_no in 0..200 {
             // Random increasing wavelengths: gaps from 0.001 nm to 40 nm, some tables wide
             // (IOR data reach far into the infrared), some starting at negative or odd values.
@@ -732,12 +850,13 @@ mod tests {
             for _ in 0..n {
                 wavelengths_nm.push(w);
                 let u = next_unit(&mut state);
-                w += if u < 0.2 {
+                // Odd tables: no sub-nm gaps (the single-step lookup); even: clusters.
+                w += if u < 0.2 && table_no % 2 == 0 {
                     0.001 + u * 0.01
                 } else if wide {
-                    u * 400.0
+                    1.0 + u * 400.0
                 } else {
-                    u * 40.0
+                    0.7 + u * 40.0
                 };
             }
             let values: Vec<f64> = (0..n).map(|_| next_unit(&mut state) * 10.0 - 2.0).collect();
@@ -749,6 +868,7 @@ mod tests {
             if p.is_uniform() {
                 continue;
             }
+            modes_seen[p.single_step as usize] += 1;
             let w32 = p.wavelengths_nm().to_vec();
             let (first, last) = (w32[0], w32[n - 1]);
             let mut probes: Vec<f32> = w32.clone();
@@ -777,6 +897,9 @@ mod tests {
                     if wl >= first && wl <= last {
                         assert_eq!(p.segment_of(wl), i, "table {table_no} at {wl} nm");
                         assert_eq!(p.segment_data(wl), p.segments[i]);
+                        if p.single_step {
+                            assert_eq!(p.segment_single_step(wl), i, "table {table_no} at {wl}");
+                        }
                     }
                     let (w0, w1) = (w32[i], w32[i + 1]);
                     let vals = p.values();
@@ -812,6 +935,8 @@ mod tests {
                 }
             }
         }
+        // Both lookups were exercised.
+        assert!(modes_seen[0] > 20 && modes_seen[1] > 20, "{modes_seen:?}");
     }
 
     #[test]

@@ -41,6 +41,13 @@ fn splitmix(state: &mut u64) -> f32 {
     ((z ^ (z >> 31)) >> 40) as f32 * (1.0 / (1u64 << 24) as f32)
 }
 
+/// `Spectrum::eval` as one out-of-line call per evaluation, as a renderer's BSDF or light
+/// code calls it (and one symbol to disassemble).
+#[inline(never)]
+fn eval_not_inlined(spectrum: &Spectrum, wavelengths: &SampledWavelengths) -> SampledSpectrum {
+    spectrum.eval(wavelengths)
+}
+
 /// ns per `eval` over one run of `EVALS_PER_RUN` calls.
 fn bench_eval(spectrum: &Spectrum, wavelengths: &[SampledWavelengths]) -> f64 {
     let mut acc = SampledSpectrum::zero();
@@ -48,7 +55,7 @@ fn bench_eval(spectrum: &Spectrum, wavelengths: &[SampledWavelengths]) -> f64 {
     for i in 0..EVALS_PER_RUN {
         // Wavelengths vary every call; black_box keeps the spectrum from being hoisted.
         let w = &wavelengths[i % WAVELENGTH_SETS];
-        acc += black_box(spectrum).eval(black_box(w));
+        acc += eval_not_inlined(black_box(spectrum), black_box(w));
     }
     let ns = start.elapsed().as_secs_f64() * 1e9 / EVALS_PER_RUN as f64;
     black_box(acc);
@@ -124,6 +131,24 @@ fn main() {
             Spectrum::rgb_illuminant(RgbGamut::AcesCg, [4.0, 2.0, 1.0]).unwrap(),
         ),
     ];
+
+    // `BENCH_SPECTRUM_ONLY=<kind>`: time that kind alone (e.g. under `perf stat`, whose
+    // per-task cycle counts do not see other processes' load) and stop.
+    if let Ok(only) = std::env::var("BENCH_SPECTRUM_ONLY") {
+        let (_, spectrum) = kinds
+            .iter()
+            .find(|(name, _)| *name == only)
+            .unwrap_or_else(|| panic!("no kind {only}"));
+        let ns: Vec<f64> = (0..ROUNDS)
+            .map(|_| bench_eval(spectrum, &wavelengths))
+            .collect();
+        let min = ns.iter().copied().fold(f64::INFINITY, f64::min);
+        println!(
+            "{{\"kind\": \"{only}\", \"evals\": {}, \"min_ns\": {min:.2}}}",
+            ROUNDS * EVALS_PER_RUN
+        );
+        return;
+    }
 
     // Rounds interleave the kinds, so load from other processes spreads over all of them
     // and ratios between kinds measured in the same run stay meaningful.
