@@ -537,7 +537,7 @@ impl RgbToSpectrumTable {
 }
 
 /// Most Newton steps of [`RgbToSpectrumTable::coefficients_refined`].
-pub const REFINE_MAX_ITERATIONS: usize = 8;
+pub const REFINE_MAX_ITERATIONS: usize = 24;
 /// Most step halvings per Newton step.
 const REFINE_MAX_HALVINGS: usize = 12;
 /// Refinement stops once every RGB component is this close (f32 evaluation noise is
@@ -571,40 +571,81 @@ fn from_normalised(c: [f64; 3]) -> SigmoidPolynomial {
     )
 }
 
+/// Samples on the 1 nm grid, padded to whole groups of four.
+const PADDED_SAMPLES: usize = DENSE_SAMPLE_COUNT.div_ceil(4) * 4;
+
+/// s(λ) and S'(x(λ)) at every whole nm 360–830, in f32 groups of four (so the square roots
+/// and divisions vectorise). s is computed exactly as `SigmoidPolynomial::eval` does, so
+/// the residual is that of what the renderer evaluates.
+struct SigmoidSamples {
+    value: [f32; PADDED_SAMPLES],
+    slope: [f32; PADDED_SAMPLES],
+}
+
+impl SigmoidSamples {
+    fn new(p: &SigmoidPolynomial) -> Self {
+        let [a, b, c] = p.centred;
+        let mut out = Self {
+            value: [0.0; PADDED_SAMPLES],
+            slope: [0.0; PADDED_SAMPLES],
+        };
+        for (i, (v, d)) in out.value.iter_mut().zip(out.slope.iter_mut()).enumerate() {
+            let u = LAMBDA_MIN_NM + i as f32 - EVAL_CENTRE_NM;
+            let x = ((a * u + b) * u + c).clamp(-SIGMOID_ARG_LIMIT, SIGMOID_ARG_LIMIT);
+            let q = (1.0 + x * x).sqrt();
+            *v = 0.5 + 0.5 * x / q;
+            // S'(x) = 1 / (2 (1 + x²)^{3/2}).
+            *d = 0.5 / (q * q * q);
+        }
+        out
+    }
+
+    /// Linear RGB of the samples minus `target`.
+    fn residual(&self, weights: &[[f64; 3]; DENSE_SAMPLE_COUNT], target: [f64; 3]) -> [f64; 3] {
+        let mut rgb = [0.0; 3];
+        for (w, &v) in weights.iter().zip(&self.value) {
+            for k in 0..3 {
+                rgb[k] += w[k] * v as f64;
+            }
+        }
+        std::array::from_fn(|k| rgb[k] - target[k])
+    }
+
+    /// d(RGB)/d(A, B, C), (A, B, C) the normalised coefficients (row = RGB component):
+    /// Σ w S'(x) (t², t, 1), t = (λ − 360)/470.
+    fn jacobian(&self, weights: &[[f64; 3]; DENSE_SAMPLE_COUNT]) -> [[f64; 3]; 3] {
+        let mut jac = [[0.0; 3]; 3];
+        for (i, (w, &ds)) in weights.iter().zip(&self.slope).enumerate() {
+            let t = i as f64 / NORMALISED_RANGE_NM;
+            let ds = ds as f64;
+            let d = [ds * t * t, ds * t, ds];
+            for k in 0..3 {
+                for p in 0..3 {
+                    jac[k][p] += w[k] * d[p];
+                }
+            }
+        }
+        jac
+    }
+}
+
 /// Linear RGB of the reflectance `p` as the renderer evaluates it (f32 `eval` at every
 /// whole nm) minus `target`.
+#[cfg(test)]
 fn rgb_residual(
     weights: &[[f64; 3]; DENSE_SAMPLE_COUNT],
     p: &SigmoidPolynomial,
     target: [f64; 3],
 ) -> [f64; 3] {
-    let mut rgb = [0.0; 3];
-    for (i, w) in weights.iter().enumerate() {
-        let v = p.eval(LAMBDA_MIN_NM + i as f32) as f64;
-        for k in 0..3 {
-            rgb[k] += w[k] * v;
-        }
-    }
-    std::array::from_fn(|k| rgb[k] - target[k])
+    SigmoidSamples::new(p).residual(weights, target)
 }
 
-/// d(RGB)/d(A, B, C) at the normalised coefficients `c` (row = RGB component).
-fn rgb_jacobian(weights: &[[f64; 3]; DENSE_SAMPLE_COUNT], c: [f64; 3]) -> [[f64; 3]; 3] {
-    let mut jac = [[0.0; 3]; 3];
-    for (i, w) in weights.iter().enumerate() {
-        let t = i as f64 / NORMALISED_RANGE_NM;
-        let x = (c[0] * t + c[1]) * t + c[2];
-        let inv = 1.0 / (1.0 + x * x).sqrt();
-        // S'(x) = 1 / (2 (1 + x²)^{3/2}); ∂x/∂(A, B, C) = (t², t, 1).
-        let ds = 0.5 * inv * inv * inv;
-        let d = [ds * t * t, ds * t, ds];
-        for k in 0..3 {
-            for p in 0..3 {
-                jac[k][p] += w[k] * d[p];
-            }
-        }
-    }
-    jac
+fn transpose3(m: [[f64; 3]; 3]) -> [[f64; 3]; 3] {
+    std::array::from_fn(|r| std::array::from_fn(|c| m[c][r]))
+}
+
+fn mat_mul3(a: [[f64; 3]; 3], b: [[f64; 3]; 3]) -> [[f64; 3]; 3] {
+    std::array::from_fn(|r| std::array::from_fn(|c| (0..3).map(|k| a[r][k] * b[k][c]).sum()))
 }
 
 fn norm2(v: [f64; 3]) -> f64 {
@@ -655,31 +696,64 @@ pub fn refine_polynomial(
 ) -> (SigmoidPolynomial, f64) {
     let mut p = start;
     let mut c = to_normalised(&p);
-    let mut r = rgb_residual(weights, &p, target);
+    let mut samples = SigmoidSamples::new(&p);
+    let mut r = samples.residual(weights, target);
     let mut cost = norm2(r);
     for _ in 0..REFINE_MAX_ITERATIONS {
         if max_abs(r) <= REFINE_TOLERANCE {
             break;
         }
-        let Some(step) = solve3(rgb_jacobian(weights, c), r.map(|v| -v)) else {
-            break;
-        };
-        // Backtracking: halve the step until the residual drops.
-        let mut alpha = 1.0;
+        let jac = samples.jacobian(weights);
+        let r0 = r;
         let mut accepted = false;
-        for _ in 0..REFINE_MAX_HALVINGS {
+        let mut try_step = |step: [f64; 3], alpha: f64| {
             let trial: [f64; 3] = std::array::from_fn(|k| c[k] + alpha * step[k]);
-            if trial.iter().all(|v| v.abs() <= REFINE_COEFFICIENT_LIMIT) {
-                let p_trial = from_normalised(trial);
-                let r_trial = rgb_residual(weights, &p_trial, target);
-                let cost_trial = norm2(r_trial);
-                if cost_trial < cost {
-                    (c, p, r, cost) = (trial, p_trial, r_trial, cost_trial);
+            if !trial.iter().all(|v| v.abs() <= REFINE_COEFFICIENT_LIMIT) {
+                return false;
+            }
+            let p_trial = from_normalised(trial);
+            let samples_trial = SigmoidSamples::new(&p_trial);
+            let r_trial = samples_trial.residual(weights, target);
+            let cost_trial = norm2(r_trial);
+            if cost_trial < cost {
+                (c, p, r, cost) = (trial, p_trial, r_trial, cost_trial);
+                samples = samples_trial;
+                return true;
+            }
+            false
+        };
+        // Newton, backtracking: halve the step until the residual drops.
+        if let Some(step) = solve3(jac, r0.map(|v| -v)) {
+            let mut alpha = 1.0;
+            for _ in 0..REFINE_MAX_HALVINGS {
+                if try_step(step, alpha) {
                     accepted = true;
                     break;
                 }
+                alpha *= 0.5;
             }
-            alpha *= 0.5;
+        }
+        // Near-singular Jacobians (large coefficients) can point Newton nowhere useful:
+        // fall back to Levenberg–Marquardt steps (JᵀJ + μ·tr/3·I) δ = −Jᵀr, μ growing.
+        if !accepted {
+            let jt = transpose3(jac);
+            let jtj = mat_mul3(jt, jac);
+            let g: [f64; 3] = std::array::from_fn(|p| (0..3).map(|k| jt[p][k] * r0[k]).sum());
+            let scale = (jtj[0][0] + jtj[1][1] + jtj[2][2]) / 3.0;
+            let mut mu = 1e-6;
+            for _ in 0..8 {
+                let mut a = jtj;
+                for (k, row) in a.iter_mut().enumerate() {
+                    row[k] += mu * scale;
+                }
+                if let Some(step) = solve3(a, g.map(|v| -v)) {
+                    if try_step(step, 1.0) {
+                        accepted = true;
+                        break;
+                    }
+                }
+                mu *= 10.0;
+            }
         }
         // No stall test: colours near the solid's boundary converge through many small
         // steps from a poor lookup (a 1 % stall test left 8 reachable grid points > 1e-3).
@@ -1010,6 +1084,17 @@ mod tests {
                     gamut.name()
                 );
             }
+        }
+        // Light colours whose lookup lands in a steep basin (|A| ~ 1e4 where ~1e3 fits):
+        // Newton needs more than 8 steps here (8 left 6.0e-4 and 3.2e-4).
+        for (gamut, rgb) in [
+            (RgbGamut::Rec2020, [0.9375f32, 0.25, 0.125]),
+            (RgbGamut::AcesCg, [0.9375, 0.9375, 1.0]),
+        ] {
+            let weights = gamut.reflectance_rgb_weights();
+            let refined = gamut.table().coefficients_refined(rgb);
+            let e = max_abs(rgb_residual(weights, &refined, rgb.map(|c| c as f64)));
+            assert!(e < 1e-5, "{} {rgb:?}: {e:.2e}", gamut.name());
         }
         // A table that names no built-in gamut has no colorimetry to refine against.
         let t = RgbToSpectrumTable::new(2, "test", z_nodes(2), vec![0.0; 3 * 8 * 3]).unwrap();
