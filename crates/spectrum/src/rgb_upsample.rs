@@ -657,6 +657,7 @@ fn max_abs(v: [f64; 3]) -> f64 {
 }
 
 /// Solves a x = b (3 × 3, partial pivoting); `None` if singular.
+#[allow(clippy::needless_range_loop)] // 3 × 3 elimination reads best with indices
 fn solve3(mut a: [[f64; 3]; 3], mut b: [f64; 3]) -> Option<[f64; 3]> {
     for col in 0..3 {
         let mut pivot = col;
@@ -665,7 +666,8 @@ fn solve3(mut a: [[f64; 3]; 3], mut b: [f64; 3]) -> Option<[f64; 3]> {
                 pivot = row;
             }
         }
-        if !(a[pivot][col].abs() > 1e-300) {
+        // Also rejects NaN.
+        if a[pivot][col].abs().partial_cmp(&1e-300) != Some(std::cmp::Ordering::Greater) {
             return None;
         }
         a.swap(col, pivot);
