@@ -124,6 +124,40 @@ impl RgbGamut {
     }
 }
 
+impl RgbGamut {
+    /// Linear RGB (in this gamut) per unit reflectance at each whole nm 360–830: the white
+    /// illuminant (normalised so that its own Y = 1) × the CIE 1931 CMFs, through the
+    /// space's XYZ → RGB matrix. Σ weights·r is the RGB of reflectance r; a flat 1 gives
+    /// RGB ≈ (1, 1, 1).
+    pub fn reflectance_rgb_weights(self) -> &'static [[f64; 3]; DENSE_SAMPLE_COUNT] {
+        static SRGB: OnceLock<[[f64; 3]; DENSE_SAMPLE_COUNT]> = OnceLock::new();
+        static REC2020: OnceLock<[[f64; 3]; DENSE_SAMPLE_COUNT]> = OnceLock::new();
+        static ACESCG: OnceLock<[[f64; 3]; DENSE_SAMPLE_COUNT]> = OnceLock::new();
+        let cell = match self {
+            RgbGamut::Srgb => &SRGB,
+            RgbGamut::Rec2020 => &REC2020,
+            RgbGamut::AcesCg => &ACESCG,
+        };
+        cell.get_or_init(|| {
+            let space = self.color_space();
+            let c = cmfs(Observer::Cie1931);
+            let illum = white_illuminant_dense(&space);
+            let y_sum: f64 = c.y_bar.values().iter().sum();
+            let mut out = [[0.0; 3]; DENSE_SAMPLE_COUNT];
+            for (i, o) in out.iter_mut().enumerate() {
+                let w = illum[i] / y_sum;
+                let xyz = glam::DVec3::new(
+                    w * c.x_bar.values()[i],
+                    w * c.y_bar.values()[i],
+                    w * c.z_bar.values()[i],
+                );
+                *o = (space.xyz_to_rgb * xyz).to_array();
+            }
+            out
+        })
+    }
+}
+
 /// The space's white illuminant on the 1 nm grid, normalised to Σ I ȳ = Σ ȳ (f64).
 pub fn white_illuminant_dense(space: &RgbColorSpace) -> Vec<f64> {
     let y_bar = &cmfs(Observer::Cie1931).y_bar;
@@ -181,11 +215,31 @@ pub struct SigmoidPolynomial {
     pub c1: f32,
     /// Constant term.
     pub c2: f32,
+    /// The same polynomial in u = λ − `EVAL_CENTRE_NM` (a u² + b u + c, computed in f64 and
+    /// rounded once), which `eval` uses: large sigmoid coefficients make c0 λ² + c1 λ + c2
+    /// cancel catastrophically in f32 (terms ~1e4 for x ~ 1), while |u| ≤ 235 nm keeps the
+    /// terms 10–25× smaller.
+    centred: [f32; 3],
 }
+
+/// Centre of the f32 evaluation variable u = λ − 595 nm (middle of 360–830 nm; the
+/// subtraction is exact in f32 for λ in [297.5, 1190] nm).
+const EVAL_CENTRE_NM: f32 = 595.0;
 
 impl SigmoidPolynomial {
     pub fn new(c0: f32, c1: f32, c2: f32) -> Self {
-        Self { c0, c1, c2 }
+        let (a, b, c, l) = (c0 as f64, c1 as f64, c2 as f64, EVAL_CENTRE_NM as f64);
+        let centred = [
+            a as f32,
+            (b + 2.0 * a * l) as f32,
+            (c + (b + a * l) * l) as f32,
+        ];
+        Self {
+            c0,
+            c1,
+            c2,
+            centred,
+        }
     }
 
     /// The flat spectrum `value` ∈ [0, 1]: c0 = c1 = 0, S(c2) = value (pbrt-v4's special
@@ -197,10 +251,12 @@ impl SigmoidPolynomial {
         Self::new(0.0, 0.0, c2.clamp(-FLAT_C2_LIMIT, FLAT_C2_LIMIT))
     }
 
-    /// s(λ) at one wavelength in nm (Horner form, branch-free).
+    /// s(λ) at one wavelength in nm (Horner form in λ − 595 nm, branch-free).
     #[inline]
     pub fn eval(&self, wavelength_nm: f32) -> f32 {
-        sigmoid_f32((self.c0 * wavelength_nm + self.c1) * wavelength_nm + self.c2)
+        let [a, b, c] = self.centred;
+        let u = wavelength_nm - EVAL_CENTRE_NM;
+        sigmoid_f32((a * u + b) * u + c)
     }
 
     /// s(λ) at four wavelengths in nm (the hero wavelength and its three rotations).
@@ -244,6 +300,9 @@ pub fn z_nodes(resolution: usize) -> Vec<f32> {
 pub struct RgbToSpectrumTable {
     resolution: usize,
     gamut_name: String,
+    /// The built-in gamut named by `gamut_name`, if any: its colorimetry drives
+    /// [`RgbToSpectrumTable::coefficients_refined`].
+    gamut: Option<RgbGamut>,
     z_nodes: Vec<f32>,
     /// `[3][res][res][res][3]` flattened: [max component][z][y][x][c0, c1, c2].
     coefficients: Vec<f32>,
@@ -292,6 +351,7 @@ impl RgbToSpectrumTable {
         Ok(Self {
             resolution,
             gamut_name: gamut_name.to_string(),
+            gamut: RgbGamut::from_name(gamut_name).ok(),
             z_nodes,
             coefficients,
         })
@@ -303,6 +363,11 @@ impl RgbToSpectrumTable {
 
     pub fn gamut_name(&self) -> &str {
         &self.gamut_name
+    }
+
+    /// The built-in gamut this table's name refers to (`None` for other names).
+    pub fn gamut(&self) -> Option<RgbGamut> {
+        self.gamut
     }
 
     pub fn z_nodes(&self) -> &[f32] {
@@ -444,6 +509,261 @@ impl RgbToSpectrumTable {
         }
         SigmoidPolynomial::new(c[0], c[1], c[2])
     }
+
+    /// The table's coefficients ([`RgbToSpectrumTable::coefficients`]) polished by at most
+    /// [`REFINE_MAX_ITERATIONS`] damped Newton steps on the linear-RGB residual of the
+    /// reflectance under the gamut's white illuminant (1 nm sums, CIE 1931; see
+    /// [`RgbGamut::reflectance_rgb_weights`]). Every accepted step lowers the residual, so
+    /// the result is never worse than the lookup; colours outside the object-colour solid
+    /// stop at the iteration or coefficient limit. A few µs: meant for constant colours
+    /// (materials, lights), not per-texel lookups. Tables whose name is not a built-in
+    /// gamut return the plain lookup.
+    pub fn coefficients_refined(&self, rgb: [f32; 3]) -> SigmoidPolynomial {
+        let start = self.coefficients(rgb);
+        let Some(gamut) = self.gamut else {
+            return start;
+        };
+        let rgb = rgb.map(|c| c.max(0.0).clamp(0.0, 1.0));
+        if rgb[0] == rgb[1] && rgb[1] == rgb[2] {
+            return start; // flat, exact
+        }
+        refine_polynomial(
+            gamut.reflectance_rgb_weights(),
+            start,
+            rgb.map(|c| c as f64),
+        )
+        .0
+    }
+}
+
+/// Most Newton steps of [`RgbToSpectrumTable::coefficients_refined`].
+pub const REFINE_MAX_ITERATIONS: usize = 24;
+/// Most step halvings per Newton step.
+const REFINE_MAX_HALVINGS: usize = 12;
+/// Refinement stops once every RGB component is this close (f32 evaluation noise is
+/// ~1e-7).
+const REFINE_TOLERANCE: f64 = 2e-6;
+/// Bound on the normalised coefficients (t = (λ − 360)/470) during refinement: larger
+/// values only chase colours on or beyond the boundary of the object-colour solid.
+const REFINE_COEFFICIENT_LIMIT: f64 = 1e5;
+const NORMALISED_RANGE_NM: f64 = (LAMBDA_MAX_NM - LAMBDA_MIN_NM) as f64;
+
+/// nm coefficients (c0, c1, c2) → normalised (A, B, C) of A t² + B t + C,
+/// λ = 360 + 470 t.
+fn to_normalised(p: &SigmoidPolynomial) -> [f64; 3] {
+    let (c0, c1, c2) = (p.c0 as f64, p.c1 as f64, p.c2 as f64);
+    let (l0, r) = (LAMBDA_MIN_NM as f64, NORMALISED_RANGE_NM);
+    [
+        c0 * r * r,
+        r * (c1 + 2.0 * c0 * l0),
+        c2 + c1 * l0 + c0 * l0 * l0,
+    ]
+}
+
+/// Normalised (A, B, C) → nm coefficients, rounded to f32 (as `tools/rgb2spec` stores them).
+fn from_normalised(c: [f64; 3]) -> SigmoidPolynomial {
+    let (l0, inv) = (LAMBDA_MIN_NM as f64, 1.0 / NORMALISED_RANGE_NM);
+    let [a, b, cc] = c;
+    SigmoidPolynomial::new(
+        (a * inv * inv) as f32,
+        (b * inv - 2.0 * a * l0 * inv * inv) as f32,
+        (cc - b * l0 * inv + a * (l0 * inv) * (l0 * inv)) as f32,
+    )
+}
+
+/// Samples on the 1 nm grid, padded to whole groups of four.
+const PADDED_SAMPLES: usize = DENSE_SAMPLE_COUNT.div_ceil(4) * 4;
+
+/// s(λ) and S'(x(λ)) at every whole nm 360–830, in f32 groups of four (so the square roots
+/// and divisions vectorise). s is computed exactly as `SigmoidPolynomial::eval` does, so
+/// the residual is that of what the renderer evaluates.
+struct SigmoidSamples {
+    value: [f32; PADDED_SAMPLES],
+    slope: [f32; PADDED_SAMPLES],
+}
+
+impl SigmoidSamples {
+    fn new(p: &SigmoidPolynomial) -> Self {
+        let [a, b, c] = p.centred;
+        let mut out = Self {
+            value: [0.0; PADDED_SAMPLES],
+            slope: [0.0; PADDED_SAMPLES],
+        };
+        for (i, (v, d)) in out.value.iter_mut().zip(out.slope.iter_mut()).enumerate() {
+            let u = LAMBDA_MIN_NM + i as f32 - EVAL_CENTRE_NM;
+            let x = ((a * u + b) * u + c).clamp(-SIGMOID_ARG_LIMIT, SIGMOID_ARG_LIMIT);
+            let q = (1.0 + x * x).sqrt();
+            *v = 0.5 + 0.5 * x / q;
+            // S'(x) = 1 / (2 (1 + x²)^{3/2}).
+            *d = 0.5 / (q * q * q);
+        }
+        out
+    }
+
+    /// Linear RGB of the samples minus `target`.
+    fn residual(&self, weights: &[[f64; 3]; DENSE_SAMPLE_COUNT], target: [f64; 3]) -> [f64; 3] {
+        let mut rgb = [0.0; 3];
+        for (w, &v) in weights.iter().zip(&self.value) {
+            for k in 0..3 {
+                rgb[k] += w[k] * v as f64;
+            }
+        }
+        std::array::from_fn(|k| rgb[k] - target[k])
+    }
+
+    /// d(RGB)/d(A, B, C), (A, B, C) the normalised coefficients (row = RGB component):
+    /// Σ w S'(x) (t², t, 1), t = (λ − 360)/470.
+    fn jacobian(&self, weights: &[[f64; 3]; DENSE_SAMPLE_COUNT]) -> [[f64; 3]; 3] {
+        let mut jac = [[0.0; 3]; 3];
+        for (i, (w, &ds)) in weights.iter().zip(&self.slope).enumerate() {
+            let t = i as f64 / NORMALISED_RANGE_NM;
+            let ds = ds as f64;
+            let d = [ds * t * t, ds * t, ds];
+            for k in 0..3 {
+                for p in 0..3 {
+                    jac[k][p] += w[k] * d[p];
+                }
+            }
+        }
+        jac
+    }
+}
+
+/// Linear RGB of the reflectance `p` as the renderer evaluates it (f32 `eval` at every
+/// whole nm) minus `target`.
+#[cfg(test)]
+fn rgb_residual(
+    weights: &[[f64; 3]; DENSE_SAMPLE_COUNT],
+    p: &SigmoidPolynomial,
+    target: [f64; 3],
+) -> [f64; 3] {
+    SigmoidSamples::new(p).residual(weights, target)
+}
+
+fn transpose3(m: [[f64; 3]; 3]) -> [[f64; 3]; 3] {
+    std::array::from_fn(|r| std::array::from_fn(|c| m[c][r]))
+}
+
+fn mat_mul3(a: [[f64; 3]; 3], b: [[f64; 3]; 3]) -> [[f64; 3]; 3] {
+    std::array::from_fn(|r| std::array::from_fn(|c| (0..3).map(|k| a[r][k] * b[k][c]).sum()))
+}
+
+fn norm2(v: [f64; 3]) -> f64 {
+    v[0] * v[0] + v[1] * v[1] + v[2] * v[2]
+}
+
+fn max_abs(v: [f64; 3]) -> f64 {
+    v[0].abs().max(v[1].abs()).max(v[2].abs())
+}
+
+/// Solves a x = b (3 × 3, partial pivoting); `None` if singular.
+#[allow(clippy::needless_range_loop)] // 3 × 3 elimination reads best with indices
+fn solve3(mut a: [[f64; 3]; 3], mut b: [f64; 3]) -> Option<[f64; 3]> {
+    for col in 0..3 {
+        let mut pivot = col;
+        for row in col + 1..3 {
+            if a[row][col].abs() > a[pivot][col].abs() {
+                pivot = row;
+            }
+        }
+        // Also rejects NaN.
+        if a[pivot][col].abs().partial_cmp(&1e-300) != Some(std::cmp::Ordering::Greater) {
+            return None;
+        }
+        a.swap(col, pivot);
+        b.swap(col, pivot);
+        for row in col + 1..3 {
+            let f = a[row][col] / a[col][col];
+            for k in col..3 {
+                a[row][k] -= f * a[col][k];
+            }
+            b[row] -= f * b[col];
+        }
+    }
+    let mut x = [0.0; 3];
+    for row in (0..3).rev() {
+        let s: f64 = (row + 1..3).map(|k| a[row][k] * x[k]).sum();
+        x[row] = (b[row] - s) / a[row][row];
+    }
+    x.iter().all(|v| v.is_finite()).then_some(x)
+}
+
+/// Damped Newton on RGB(p) = target from `start` (see
+/// [`RgbToSpectrumTable::coefficients_refined`]); returns the polynomial and its max |Δ|
+/// in linear RGB.
+pub fn refine_polynomial(
+    weights: &[[f64; 3]; DENSE_SAMPLE_COUNT],
+    start: SigmoidPolynomial,
+    target: [f64; 3],
+) -> (SigmoidPolynomial, f64) {
+    let mut p = start;
+    let mut c = to_normalised(&p);
+    let mut samples = SigmoidSamples::new(&p);
+    let mut r = samples.residual(weights, target);
+    let mut cost = norm2(r);
+    for _ in 0..REFINE_MAX_ITERATIONS {
+        if max_abs(r) <= REFINE_TOLERANCE {
+            break;
+        }
+        let jac = samples.jacobian(weights);
+        let r0 = r;
+        let mut accepted = false;
+        let mut try_step = |step: [f64; 3], alpha: f64| {
+            let trial: [f64; 3] = std::array::from_fn(|k| c[k] + alpha * step[k]);
+            if !trial.iter().all(|v| v.abs() <= REFINE_COEFFICIENT_LIMIT) {
+                return false;
+            }
+            let p_trial = from_normalised(trial);
+            let samples_trial = SigmoidSamples::new(&p_trial);
+            let r_trial = samples_trial.residual(weights, target);
+            let cost_trial = norm2(r_trial);
+            if cost_trial < cost {
+                (c, p, r, cost) = (trial, p_trial, r_trial, cost_trial);
+                samples = samples_trial;
+                return true;
+            }
+            false
+        };
+        // Newton, backtracking: halve the step until the residual drops.
+        if let Some(step) = solve3(jac, r0.map(|v| -v)) {
+            let mut alpha = 1.0;
+            for _ in 0..REFINE_MAX_HALVINGS {
+                if try_step(step, alpha) {
+                    accepted = true;
+                    break;
+                }
+                alpha *= 0.5;
+            }
+        }
+        // Near-singular Jacobians (large coefficients) can point Newton nowhere useful:
+        // fall back to Levenberg–Marquardt steps (JᵀJ + μ·tr/3·I) δ = −Jᵀr, μ growing.
+        if !accepted {
+            let jt = transpose3(jac);
+            let jtj = mat_mul3(jt, jac);
+            let g: [f64; 3] = std::array::from_fn(|p| (0..3).map(|k| jt[p][k] * r0[k]).sum());
+            let scale = (jtj[0][0] + jtj[1][1] + jtj[2][2]) / 3.0;
+            let mut mu = 1e-6;
+            for _ in 0..8 {
+                let mut a = jtj;
+                for (k, row) in a.iter_mut().enumerate() {
+                    row[k] += mu * scale;
+                }
+                if let Some(step) = solve3(a, g.map(|v| -v)) {
+                    if try_step(step, 1.0) {
+                        accepted = true;
+                        break;
+                    }
+                }
+                mu *= 10.0;
+            }
+        }
+        // No stall test: colours near the solid's boundary converge through many small
+        // steps from a poor lookup (a 1 % stall test left 8 reachable grid points > 1e-3).
+        if !accepted {
+            break;
+        }
+    }
+    (p, max_abs(r))
 }
 
 /// Checks that every component is finite (and ≥ `min`, ≤ `max`).
@@ -470,12 +790,16 @@ fn validate_rgb(kind: &str, rgb: [f32; 3], min: f32, max: f32) -> Result<(), Rgb
 #[inline]
 fn dense_lookup(table: &[f32; DENSE_SAMPLE_COUNT], wavelength_nm: f32) -> f32 {
     let x = wavelength_nm - LAMBDA_MIN_NM;
-    if !(x >= 0.0 && x <= (DENSE_SAMPLE_COUNT - 1) as f32) {
-        return 0.0;
+    // Branch-free: clamped index (NaN gives 0), select zero outside.
+    let last_segment = DENSE_SAMPLE_COUNT - 2;
+    let (i, i_f32) = crate::spectrum::floor_index_and_value(x, last_segment);
+    let t = x - i_f32;
+    let v = table[i] + t * (table[i + 1] - table[i]);
+    if x >= 0.0 && x <= (DENSE_SAMPLE_COUNT - 1) as f32 {
+        v
+    } else {
+        0.0
     }
-    let i = (x as usize).min(DENSE_SAMPLE_COUNT - 2);
-    let t = x - i as f32;
-    table[i] + t * (table[i + 1] - table[i])
 }
 
 /// A reflectance (or transmittance) from an RGB in [0, 1]³: values in [0, 1]
@@ -486,8 +810,20 @@ pub struct RgbAlbedoSpectrum {
 }
 
 impl RgbAlbedoSpectrum {
-    /// `rgb` is linear in `gamut`; each component must be finite and in [0, 1].
+    /// `rgb` is linear in `gamut`; each component must be finite and in [0, 1]. Uses the
+    /// refined coefficients ([`RgbToSpectrumTable::coefficients_refined`], a few µs): for
+    /// constant colours such as material parameters.
     pub fn new(gamut: RgbGamut, rgb: [f32; 3]) -> Result<Self, RgbUpsampleError> {
+        validate_rgb("albedo", rgb, 0.0, 1.0)?;
+        Ok(Self {
+            polynomial: gamut.table().coefficients_refined(rgb),
+        })
+    }
+
+    /// As [`RgbAlbedoSpectrum::new`] with the pure table lookup (trilinear interpolation,
+    /// ~20 ns): for per-texel colours. Less accurate for saturated wide-gamut colours (see
+    /// docs/rgb-upsampling.md).
+    pub fn from_table(gamut: RgbGamut, rgb: [f32; 3]) -> Result<Self, RgbUpsampleError> {
         validate_rgb("albedo", rgb, 0.0, 1.0)?;
         Ok(Self {
             polynomial: gamut.table().coefficients(rgb),
@@ -521,7 +857,14 @@ impl RgbUnboundedSpectrum {
     /// `rgb` is linear in `gamut`; each component must be finite and ≥ 0.
     pub fn new(gamut: RgbGamut, rgb: [f32; 3]) -> Result<Self, RgbUpsampleError> {
         validate_rgb("unbounded", rgb, 0.0, f32::INFINITY)?;
-        let (scale, polynomial) = scaled_polynomial(gamut, rgb);
+        let (scale, polynomial) = scaled_polynomial(gamut, rgb, true);
+        Ok(Self { scale, polynomial })
+    }
+
+    /// As [`RgbUnboundedSpectrum::new`] with the pure table lookup (for textures).
+    pub fn from_table(gamut: RgbGamut, rgb: [f32; 3]) -> Result<Self, RgbUpsampleError> {
+        validate_rgb("unbounded", rgb, 0.0, f32::INFINITY)?;
+        let (scale, polynomial) = scaled_polynomial(gamut, rgb, false);
         Ok(Self { scale, polynomial })
     }
 
@@ -541,15 +884,22 @@ impl RgbUnboundedSpectrum {
     }
 }
 
-/// scale = 2 · max(rgb) and the polynomial of rgb / scale (pbrt-v4); black → (0, flat 0).
-fn scaled_polynomial(gamut: RgbGamut, rgb: [f32; 3]) -> (f32, SigmoidPolynomial) {
+/// scale = 2 · max(rgb) and the polynomial of rgb / scale (pbrt-v4), refined or looked up;
+/// black → (0, flat 0).
+fn scaled_polynomial(gamut: RgbGamut, rgb: [f32; 3], refined: bool) -> (f32, SigmoidPolynomial) {
     let scale = 2.0 * rgb[0].max(rgb[1]).max(rgb[2]);
     let normalised = if scale > 0.0 {
         rgb.map(|c| c / scale)
     } else {
         [0.0; 3]
     };
-    (scale, gamut.table().coefficients(normalised))
+    let table = gamut.table();
+    let polynomial = if refined {
+        table.coefficients_refined(normalised)
+    } else {
+        table.coefficients(normalised)
+    };
+    (scale, polynomial)
 }
 
 /// An emission spectrum from a non-negative RGB: the unbounded spectrum times the space's
@@ -565,13 +915,30 @@ pub struct RgbIlluminantSpectrum {
 impl RgbIlluminantSpectrum {
     /// `rgb` is linear in `gamut`; each component must be finite and ≥ 0.
     pub fn new(gamut: RgbGamut, rgb: [f32; 3]) -> Result<Self, RgbUpsampleError> {
+        Self::build(gamut, rgb, true)
+    }
+
+    /// As [`RgbIlluminantSpectrum::new`] with the pure table lookup (for textures).
+    pub fn from_table(gamut: RgbGamut, rgb: [f32; 3]) -> Result<Self, RgbUpsampleError> {
+        Self::build(gamut, rgb, false)
+    }
+
+    fn build(gamut: RgbGamut, rgb: [f32; 3], refined: bool) -> Result<Self, RgbUpsampleError> {
         validate_rgb("illuminant", rgb, 0.0, f32::INFINITY)?;
-        let (scale, polynomial) = scaled_polynomial(gamut, rgb);
+        let (scale, polynomial) = scaled_polynomial(gamut, rgb, refined);
         Ok(Self {
             scale,
             polynomial,
             illuminant: gamut.white_illuminant(),
         })
+    }
+
+    /// This spectrum multiplied by `factor` (the scale absorbs it).
+    pub fn scaled(self, factor: f32) -> Self {
+        Self {
+            scale: self.scale * factor,
+            ..self
+        }
     }
 
     /// The white illuminant on the 1 nm grid (360–830 nm).
@@ -669,6 +1036,75 @@ mod tests {
             .unwrap_err()
             .message
             .contains("srgb"));
+    }
+
+    #[test]
+    fn centred_f32_evaluation_matches_the_nm_polynomial() {
+        // A saturated band-pass: normalised coefficients ~1e4.
+        let p = from_normalised([-2.0e4, 2.1e4, -5.4e3]);
+        for nm in [360.0f32, 480.0, 520.0, 525.5, 600.0, 830.0] {
+            let reference = p.eval_f64(nm as f64);
+            assert!(
+                (p.eval(nm) as f64 - reference).abs() < 1e-4,
+                "{nm}: {} vs {reference}",
+                p.eval(nm)
+            );
+        }
+        let back = to_normalised(&p);
+        assert!((back[0] / -2.0e4 - 1.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn refinement_never_increases_the_rgb_error_and_reaches_saturated_colours() {
+        // Reachable colours (LP-checked in tests/rgb_upsample.rs), the last two saturated
+        // ones whose table lookup is off by 1e-2.
+        for (gamut, saturated) in [
+            (RgbGamut::Srgb, [[0.9f32, 0.1, 0.05], [0.05, 0.9, 0.1]]),
+            (
+                RgbGamut::Rec2020,
+                [[0.5625, 0.0, 0.25], [0.0625, 0.8125, 0.1875]],
+            ),
+            (
+                RgbGamut::AcesCg,
+                [[0.0625, 0.8125, 0.25], [0.125, 0.8125, 0.8125]],
+            ),
+        ] {
+            let weights = gamut.reflectance_rgb_weights();
+            for rgb in [[0.6875f32, 0.1875, 0.125], [0.125, 0.125, 0.875]]
+                .into_iter()
+                .chain(saturated)
+            {
+                let target = rgb.map(|c| c as f64);
+                let lookup = gamut.table().coefficients(rgb);
+                let refined = gamut.table().coefficients_refined(rgb);
+                let e_lookup = max_abs(rgb_residual(weights, &lookup, target));
+                let e_refined = max_abs(rgb_residual(weights, &refined, target));
+                assert!(e_refined <= e_lookup, "{} {rgb:?}", gamut.name());
+                assert!(
+                    e_refined < 1e-4,
+                    "{} {rgb:?}: {e_refined:.2e}",
+                    gamut.name()
+                );
+            }
+        }
+        // Light colours whose lookup lands in a steep basin (|A| ~ 1e4 where ~1e3 fits):
+        // Newton needs more than 8 steps here (8 left 6.0e-4 and 3.2e-4).
+        for (gamut, rgb) in [
+            (RgbGamut::Rec2020, [0.9375f32, 0.25, 0.125]),
+            (RgbGamut::AcesCg, [0.9375, 0.9375, 1.0]),
+        ] {
+            let weights = gamut.reflectance_rgb_weights();
+            let refined = gamut.table().coefficients_refined(rgb);
+            let e = max_abs(rgb_residual(weights, &refined, rgb.map(|c| c as f64)));
+            assert!(e < 1e-5, "{} {rgb:?}: {e:.2e}", gamut.name());
+        }
+        // A table that names no built-in gamut has no colorimetry to refine against.
+        let t = RgbToSpectrumTable::new(2, "test", z_nodes(2), vec![0.0; 3 * 8 * 3]).unwrap();
+        assert_eq!(t.gamut(), None);
+        assert_eq!(
+            t.coefficients_refined([0.2, 0.5, 0.1]),
+            t.coefficients([0.2, 0.5, 0.1])
+        );
     }
 
     #[test]

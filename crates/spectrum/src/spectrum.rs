@@ -9,6 +9,9 @@ use std::sync::Arc;
 use crate::blackbody::{blackbody_peak_radiance, blackbody_radiance, blackbody_radiance_4};
 use crate::constants::{DENSE_SAMPLE_COUNT, LAMBDA_MIN_NM};
 use crate::data;
+use crate::rgb_upsample::{
+    RgbAlbedoSpectrum, RgbGamut, RgbIlluminantSpectrum, RgbUnboundedSpectrum, RgbUpsampleError,
+};
 use crate::sampled_spectrum::{SampledSpectrum, N_SPECTRUM_SAMPLES};
 use crate::sampled_wavelengths::SampledWavelengths;
 use crate::table::{DenseSpectrum, Tabulated};
@@ -48,8 +51,14 @@ pub enum Spectrum {
     /// `scale` · B(λ, T), Planck's law in W·m⁻²·sr⁻¹·nm⁻¹ (see `blackbody.rs`).
     /// `Spectrum::blackbody_normalized` sets `scale = 1 / B(λ_max, T)`.
     Blackbody { temperature_k: f32, scale: f32 },
-    // RGB-upsampled spectra (Jakob & Hanika 2019) go here: `RgbAlbedo`, `RgbUnbounded`,
-    // `RgbIlluminant`, with an arm each in `eval`, `eval_nm` and `scaled`.
+    /// A reflectance in [0, 1] upsampled from RGB (Jakob & Hanika 2019 sigmoid polynomial).
+    RgbAlbedo(RgbAlbedoSpectrum),
+    /// scale · sigmoid polynomial, from a non-negative RGB (pbrt-v4 `RGBUnboundedSpectrum`);
+    /// also what a scaled `RgbAlbedo` becomes.
+    RgbUnbounded(RgbUnboundedSpectrum),
+    /// The unbounded spectrum times the gamut's white illuminant (pbrt-v4
+    /// `RGBIlluminantSpectrum`), for emission.
+    RgbIlluminant(RgbIlluminantSpectrum),
 }
 
 impl Spectrum {
@@ -59,8 +68,9 @@ impl Spectrum {
     }
 
     /// A piecewise-linear spectrum (zero outside the table). Uniformly spaced tables are
-    /// detected and evaluated by direct indexing, others through a guide table (2 cells per
-    /// segment) and a short scan; `eval_nm` binary-searches.
+    /// detected and evaluated by direct indexing, others through a per-1-nm segment index
+    /// (one lookup, plus a forward step per node inside the cell); `eval_nm`
+    /// binary-searches.
     pub fn piecewise_linear(
         wavelengths_nm: &[f64],
         values: &[f64],
@@ -122,6 +132,23 @@ impl Spectrum {
         })
     }
 
+    /// A reflectance from a linear RGB in `gamut`, each component in [0, 1]; values stay in
+    /// [0, 1]. Uses the refined coefficients (`RgbAlbedoSpectrum::new`).
+    pub fn rgb_albedo(gamut: RgbGamut, rgb: [f32; 3]) -> Result<Self, RgbUpsampleError> {
+        RgbAlbedoSpectrum::new(gamut, rgb).map(Spectrum::RgbAlbedo)
+    }
+
+    /// An unbounded spectrum (scattering coefficients, …) from a linear RGB ≥ 0 in `gamut`.
+    pub fn rgb_unbounded(gamut: RgbGamut, rgb: [f32; 3]) -> Result<Self, RgbUpsampleError> {
+        RgbUnboundedSpectrum::new(gamut, rgb).map(Spectrum::RgbUnbounded)
+    }
+
+    /// An emission spectrum from a linear RGB ≥ 0 in `gamut`: RGB (1, 1, 1) is the gamut's
+    /// white illuminant at luminance Y = 1.
+    pub fn rgb_illuminant(gamut: RgbGamut, rgb: [f32; 3]) -> Result<Self, RgbUpsampleError> {
+        RgbIlluminantSpectrum::new(gamut, rgb).map(Spectrum::RgbIlluminant)
+    }
+
     /// This spectrum multiplied by `factor` (tables are copied once, here, not per evaluation).
     pub fn scaled(self, factor: f32) -> Self {
         match self {
@@ -135,6 +162,16 @@ impl Spectrum {
                 temperature_k,
                 scale: scale * factor,
             },
+            // A scaled reflectance is no longer bounded by 1: same polynomial, with a scale.
+            Spectrum::RgbAlbedo(a) => Spectrum::RgbUnbounded(RgbUnboundedSpectrum {
+                scale: factor,
+                polynomial: a.polynomial,
+            }),
+            Spectrum::RgbUnbounded(u) => Spectrum::RgbUnbounded(RgbUnboundedSpectrum {
+                scale: u.scale * factor,
+                ..u
+            }),
+            Spectrum::RgbIlluminant(i) => Spectrum::RgbIlluminant(i.scaled(factor)),
         }
     }
 
@@ -150,6 +187,9 @@ impl Spectrum {
                 temperature_k,
                 scale,
             } => blackbody_radiance_4(lambda_nm, *temperature_k, *scale),
+            Spectrum::RgbAlbedo(a) => SampledSpectrum::new(a.eval4(lambda_nm)),
+            Spectrum::RgbUnbounded(u) => SampledSpectrum::new(u.eval4(lambda_nm)),
+            Spectrum::RgbIlluminant(i) => SampledSpectrum::new(i.eval4(lambda_nm)),
         }
     }
 
@@ -163,6 +203,9 @@ impl Spectrum {
                 temperature_k,
                 scale,
             } => *scale as f64 * blackbody_radiance(wavelength_nm, *temperature_k as f64),
+            Spectrum::RgbAlbedo(a) => a.eval_nm(wavelength_nm),
+            Spectrum::RgbUnbounded(u) => u.eval_nm(wavelength_nm),
+            Spectrum::RgbIlluminant(i) => i.eval_nm(wavelength_nm),
         }
     }
 
@@ -180,6 +223,31 @@ fn check_temperature(temperature_k: f32) -> Result<(), InvalidSpectrum> {
             "blackbody temperature must be a finite number of kelvin above 0, got {temperature_k}"
         )))
     }
+}
+
+/// Most samples of a piecewise-linear table (keeps every index exact in f32, see
+/// `floor_index`).
+pub const MAX_TABLE_SAMPLES: usize = 1 << 24;
+
+/// ⌊x⌋ clamped to [0, max] (NaN → 0), for table indices. The clamp makes the float → int
+/// conversion's own range and NaN checks (Rust's saturating `as`) redundant, so this uses
+/// the bare truncation: 2–3× fewer instructions per lane.
+#[inline(always)]
+pub(crate) fn floor_index(x: f32, max: usize) -> usize {
+    floor_index_and_value(x, max).0
+}
+
+/// `floor_index` and the same index as f32 (converted from i32: one instruction, where
+/// `usize as f32` branches on the sign bit).
+#[inline(always)]
+pub(crate) fn floor_index_and_value(x: f32, max: usize) -> (usize, f32) {
+    let m = max.min(MAX_TABLE_SAMPLES) as u32 as f32;
+    // `x > 0.0` is false for NaN.
+    let x = if x > 0.0 { x } else { 0.0 };
+    let x = if x < m { x } else { m };
+    // SAFETY: x is finite and in [0, 2²⁴], so truncating it to i32 is defined.
+    let k = unsafe { x.to_int_unchecked::<i32>() };
+    (k as usize, k as f32)
 }
 
 /// Converts table values to f32, rejecting NaN, ±∞ and values f32 cannot hold.
@@ -211,16 +279,30 @@ pub struct PiecewiseLinear {
     last_nm: f32,
     /// 1 / spacing in nm⁻¹ when the wavelengths are uniformly spaced, else 0.
     inv_step_per_nm: f32,
-    /// Non-uniform tables: `guide[c]` is the segment holding the start of cell c of
-    /// `GUIDE_CELLS_PER_SEGMENT·(n − 1)` equal cells over [first, last] (empty when uniform).
-    /// Evaluation scans only the few nodes between neighbouring guide entries.
-    guide: Arc<[u32]>,
-    /// Cells per nm of the guide.
-    guide_cells_per_nm: f32,
+    /// Non-uniform tables: `segment_at_cell[c]` is a segment i ≤ n − 2 with
+    /// w[i] ≤ every wavelength that maps to cell c of the `cell_nm`-wide cells over
+    /// [first, last] (empty when uniform). Lookup = this entry + a forward step over the
+    /// nodes inside the cell (none for tables spaced ≥ 1 nm, apart from the rare node
+    /// within rounding distance of a cell start).
+    segment_at_cell: Arc<[CellEntry]>,
+    /// Non-uniform tables: per segment [w0, w1, v0, slope] (one 16-byte load per lane;
+    /// v = v0 + (λ − w0)·slope, slope rounded once from f64). Empty when uniform.
+    segments: Arc<[[f32; 4]]>,
+    /// Uniform tables: per segment [v0, v1 − v0] (one 8-byte load per lane, the same
+    /// arithmetic as values[i] + t·(values[i + 1] − values[i])). Empty otherwise.
+    uniform_pairs: Arc<[[f32; 2]]>,
+    /// Cells per nm (1 for tables up to 65,536 nm wide).
+    cells_per_nm: f32,
+    /// Every cell holds at most one segment start beyond its entry (cells are narrower
+    /// than the closest node spacing), so lookup is one entry + one branch-free step.
+    single_step: bool,
 }
 
-/// Guide cells per table segment: enough that a cell rarely spans more than one node.
-const GUIDE_CELLS_PER_SEGMENT: usize = 2;
+/// Width of the segment-index cells of non-uniform tables, in nm (widened for tables
+/// wider than `MAX_SEGMENT_CELLS` nm).
+const SEGMENT_CELL_NM: f64 = 1.0;
+/// Most cells of a segment-index table.
+const MAX_SEGMENT_CELLS: usize = 1 << 16;
 
 /// Relative tolerance (in units of the spacing) under which a table counts as uniform.
 const UNIFORM_SPACING_TOLERANCE: f64 = 1e-6;
@@ -237,6 +319,12 @@ impl PiecewiseLinear {
                 "spectrum table has {} wavelengths but {} values",
                 wavelengths_nm.len(),
                 values.len()
+            )));
+        }
+        if wavelengths_nm.len() > MAX_TABLE_SAMPLES {
+            return Err(InvalidSpectrum::new(format!(
+                "spectrum table has {} samples, more than the {MAX_TABLE_SAMPLES} supported",
+                wavelengths_nm.len()
             )));
         }
         let wl32: Vec<f32> = wavelengths_nm.iter().map(|&w| w as f32).collect();
@@ -272,14 +360,27 @@ impl PiecewiseLinear {
         } else {
             0.0
         };
-        let (guide, guide_cells_per_nm) = if inv_step_per_nm == 0.0 && n >= 2 {
-            build_guide(&wl32)
+        let (segment_at_cell, cells_per_nm, single_step) = if inv_step_per_nm == 0.0 && n >= 2 {
+            build_segment_index(&wl32)
         } else {
-            (Vec::new(), 0.0)
+            (Vec::new(), 0.0, false)
+        };
+        let segments = if segment_at_cell.is_empty() {
+            Vec::new()
+        } else {
+            build_segments(&wl32, &values32)
+        };
+        let uniform_pairs = if inv_step_per_nm > 0.0 {
+            build_uniform_pairs(&values32)
+        } else {
+            Vec::new()
         };
         Ok(Self {
-            guide: guide.into(),
-            guide_cells_per_nm,
+            uniform_pairs: uniform_pairs.into(),
+            segments: segments.into(),
+            segment_at_cell: segment_at_cell.into(),
+            cells_per_nm,
+            single_step,
             first_nm: wl32[0],
             last_nm: wl32[n - 1],
             wavelengths_nm: wl32.into(),
@@ -302,8 +403,21 @@ impl PiecewiseLinear {
     }
 
     fn scaled(&self, factor: f32) -> Self {
+        let values: Vec<f32> = self.values.iter().map(|v| v * factor).collect();
+        let segments = if self.segments.is_empty() {
+            Vec::new()
+        } else {
+            build_segments(&self.wavelengths_nm, &values)
+        };
+        let uniform_pairs = if self.uniform_pairs.is_empty() {
+            Vec::new()
+        } else {
+            build_uniform_pairs(&values)
+        };
         Self {
-            values: self.values.iter().map(|v| v * factor).collect(),
+            values: values.into(),
+            segments: segments.into(),
+            uniform_pairs: uniform_pairs.into(),
             ..self.clone()
         }
     }
@@ -327,11 +441,11 @@ impl PiecewiseLinear {
             let inv_step = self.inv_step_per_nm;
             SampledSpectrum::new(lambda_nm.map(|wl| {
                 let x = (wl - first) * inv_step;
-                // Clamp, then a native f32 → i32 conversion (NaN gives 0); lanes outside the
-                // table are zeroed below.
-                let i = (x.clamp(0.0, (n - 2) as f32) as i32 as usize).min(n - 2);
-                let t = x - i as f32;
-                let v = values[i] + t * (values[i + 1] - values[i]);
+                // Clamped index (NaN gives 0); lanes outside the table are zeroed below.
+                let (i, i_f32) = floor_index_and_value(x, n - 2);
+                let t = x - i_f32;
+                let [v0, dv] = self.uniform_pairs[i];
+                let v = v0 + t * dv;
                 if wl >= first && wl <= last {
                     v
                 } else {
@@ -339,35 +453,67 @@ impl PiecewiseLinear {
                 }
             }))
         } else {
-            // The guide cell of λ narrows the search to the segments between the guide
-            // entries one cell either side (a margin for rounding), usually one or two.
-            let wavelengths = &*self.wavelengths_nm;
-            let guide = &*self.guide;
-            let last_cell = guide.len() - 1;
-            let mut segment = [0usize; N_SPECTRUM_SAMPLES];
-            for (i, &wl) in segment.iter_mut().zip(lambda_nm.iter()) {
-                let cell = (((wl - first) * self.guide_cells_per_nm).clamp(0.0, last_cell as f32)
-                    as i32 as usize)
-                    .min(last_cell);
-                let lo = guide[cell.saturating_sub(1)] as usize;
-                let hi = guide[(cell + 2).min(last_cell)] as usize;
-                // Count the nodes in (lo, hi] at or below λ (branch-free, usually 1–3 nodes).
-                *i = lo
-                    + wavelengths[lo + 1..=hi]
-                        .iter()
-                        .map(|&w| (w <= wl) as usize)
-                        .sum::<usize>();
-            }
             let mut out = [0.0f32; N_SPECTRUM_SAMPLES];
-            for lane in 0..N_SPECTRUM_SAMPLES {
-                let (i, wl) = (segment[lane], lambda_nm[lane]);
-                let (w0, w1) = (wavelengths[i], wavelengths[i + 1]);
-                let t = (wl - w0) / (w1 - w0);
-                let v = values[i] + t * (values[i + 1] - values[i]);
-                out[lane] = if wl >= first && wl <= last { v } else { 0.0 };
+            // A per-table constant: the branch is always predicted.
+            if self.single_step {
+                for lane in 0..N_SPECTRUM_SAMPLES {
+                    let wl = lambda_nm[lane];
+                    let [w0, _, v0, slope] = self.segments[self.segment_single_step(wl)];
+                    let v = v0 + (wl - w0) * slope;
+                    out[lane] = if wl >= first && wl <= last { v } else { 0.0 };
+                }
+            } else {
+                for lane in 0..N_SPECTRUM_SAMPLES {
+                    let wl = lambda_nm[lane];
+                    let [w0, _, v0, slope] = self.segment_data(wl);
+                    let v = v0 + (wl - w0) * slope;
+                    out[lane] = if wl >= first && wl <= last { v } else { 0.0 };
+                }
             }
             SampledSpectrum::new(out)
         }
+    }
+
+    /// `segment_of` for tables whose cells hold at most one node (`single_step`): the
+    /// entry plus one branch-free step, no loop.
+    #[inline(always)]
+    fn segment_single_step(&self, wl: f32) -> usize {
+        let cells = &*self.segment_at_cell;
+        let x = (wl - self.first_nm) * self.cells_per_nm;
+        let entry = cells[floor_index(x, cells.len() - 1)];
+        // next_nm is +∞ for the last segment, so this never steps past it.
+        entry.segment as usize + (entry.next_nm <= wl) as usize
+    }
+
+    /// `segments[segment_of(wl)]`: [w0, w1, v0, slope] of the segment holding `wl`.
+    #[inline(always)]
+    fn segment_data(&self, wl: f32) -> [f32; 4] {
+        self.segments[self.segment_of(wl)]
+    }
+
+    /// Non-uniform tables with n ≥ 2: the segment i ∈ [0, n − 2] holding `wl` — the last
+    /// i ≤ n − 2 with w[i] ≤ wl, or 0 below the table (and for NaN). One cell lookup plus
+    /// a forward step per node inside the cell.
+    #[inline(always)]
+    fn segment_of(&self, wl: f32) -> usize {
+        let segments = &*self.segments;
+        let cells = &*self.segment_at_cell;
+        let last_cell = cells.len() - 1;
+        let last_segment = segments.len() - 1;
+        // Clamped cell index (NaN gives 0).
+        let x = (wl - self.first_nm) * self.cells_per_nm;
+        let cell = floor_index(x, last_cell);
+        let entry = cells[cell];
+        // Tables spaced ≥ 1 nm hold at most one node per cell: one branch-free step against
+        // the node cached in the entry (a node inside the cell is common, ~spacing⁻¹ per
+        // lane, so a branch would mispredict, and reading it from `segments` would add a
+        // dependent load).
+        let mut i = (entry.segment as usize + (entry.next_nm <= wl) as usize).min(last_segment);
+        // More nodes per cell only in sub-nm clusters (w1 of segment i is w[i + 1]).
+        while i < last_segment && segments[i][1] <= wl {
+            i += 1;
+        }
+        i
     }
 
     fn eval_nm(&self, wavelength_nm: f64) -> f64 {
@@ -397,22 +543,89 @@ impl PiecewiseLinear {
     }
 }
 
-/// Guide table of a non-uniform piecewise-linear table: for each of
-/// `GUIDE_CELLS_PER_SEGMENT·(n − 1)` equal cells over [first, last] (plus one entry for
-/// λ = last), the last segment i ≤ n − 2 whose start wavelength is ≤ the cell's start.
-fn build_guide(wavelengths_nm: &[f32]) -> (Vec<u32>, f32) {
+/// [v0, v1 − v0] of every segment of a uniform table (n ≥ 2).
+fn build_uniform_pairs(values: &[f32]) -> Vec<[f32; 2]> {
+    values.windows(2).map(|v| [v[0], v[1] - v[0]]).collect()
+}
+
+/// [w0, w1, v0, slope] of every segment (n ≥ 2), slope = (v1 − v0)/(w1 − w0) in f64.
+fn build_segments(wavelengths_nm: &[f32], values: &[f32]) -> Vec<[f32; 4]> {
+    wavelengths_nm
+        .windows(2)
+        .zip(values.windows(2))
+        .map(|(w, v)| {
+            let slope = (v[1] as f64 - v[0] as f64) / (w[1] as f64 - w[0] as f64);
+            [w[0], w[1], v[0], slope as f32]
+        })
+        .collect()
+}
+
+/// Segment-index table of a non-uniform piecewise-linear table (n ≥ 2): cells of
+/// `SEGMENT_CELL_NM` (or wider, at most `MAX_SEGMENT_CELLS` cells) over [first, last]; entry
+/// c is the last segment i ≤ n − 2 with w[i] ≤ (start of cell c) − margin, where the margin
+/// exceeds the f32 rounding of the cell computation in `segment_of`, so the entry never
+/// lies beyond the segment of any wavelength mapped to the cell. Returns the entries and
+/// cells per nm.
+fn build_segment_index(wavelengths_nm: &[f32]) -> (Vec<CellEntry>, f32, bool) {
     let n = wavelengths_nm.len();
-    let cells = GUIDE_CELLS_PER_SEGMENT * (n - 1);
     let (first, last) = (wavelengths_nm[0] as f64, wavelengths_nm[n - 1] as f64);
-    let cell_nm = (last - first) / cells as f64;
-    let guide = (0..=cells)
+    let range = last - first;
+    // Cells of 1 nm, narrower (down to half the closest spacing) where nodes are closer,
+    // within a budget of cells, so that most tables need one step at most.
+    let min_spacing = wavelengths_nm
+        .windows(2)
+        .map(|w| w[1] as f64 - w[0] as f64)
+        .fold(f64::INFINITY, f64::min);
+    let cell_budget = (4 * n)
+        .max(range.ceil() as usize + 1)
+        .min(MAX_SEGMENT_CELLS);
+    let cell_nm = SEGMENT_CELL_NM
+        .min(0.5 * min_spacing)
+        .max(range / (cell_budget - 1) as f64)
+        .max(range / (MAX_SEGMENT_CELLS - 1) as f64);
+    let cells = (range / cell_nm).ceil() as usize + 1;
+    let cells_per_nm = (1.0 / cell_nm) as f32;
+    // f32 error of (wl − first)·cells_per_nm, in nm: the subtraction (a few ulp of the
+    // largest wavelength) and the relative error of the product (a few f32 ε of x).
+    let scale = first.abs().max(last.abs());
+    let margin_nm = 8.0 * f32::EPSILON as f64 * (scale + cells as f64 * cell_nm);
+    let entries = (0..cells)
         .map(|c| {
-            let start = first + c as f64 * cell_nm;
-            let i = wavelengths_nm.partition_point(|&w| w as f64 <= start);
-            i.saturating_sub(1).min(n - 2) as u32
+            let start = first + c as f64 * cell_nm - margin_nm;
+            let i = wavelengths_nm
+                .partition_point(|&w| w as f64 <= start)
+                .saturating_sub(1)
+                .min(n - 2);
+            CellEntry {
+                segment: i as u32,
+                // The last segment never steps on (λ = last stays in it).
+                next_nm: if i + 1 < n - 1 {
+                    wavelengths_nm[i + 1]
+                } else {
+                    f32::INFINITY
+                },
+            }
         })
         .collect();
-    (guide, (1.0 / cell_nm) as f32)
+    // One step suffices iff no cell sees two segment starts (nodes 1..n − 2) in
+    // (start − margin, end + margin].
+    let single_step = (0..cells).all(|c| {
+        let start = first + c as f64 * cell_nm - margin_nm;
+        let end = first + (c + 1) as f64 * cell_nm + margin_nm;
+        let starts = &wavelengths_nm[1..n - 1];
+        let lo = starts.partition_point(|&w| w as f64 <= start);
+        let hi = starts.partition_point(|&w| w as f64 <= end);
+        hi - lo <= 1
+    });
+    (entries, cells_per_nm, single_step)
+}
+
+/// One cell of the segment index: a segment whose start lies at or below every wavelength
+/// of the cell, and the wavelength where the next segment starts (+∞ for the last).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct CellEntry {
+    segment: u32,
+    next_nm: f32,
 }
 
 /// A spectrum on the 1 nm grid 360, 361, …, 830 nm in f32.
@@ -447,11 +660,10 @@ impl DenseTable {
         let values = &*self.values;
         SampledSpectrum::new(lambda_nm.map(|wl| {
             let x = wl - LAMBDA_MIN_NM;
-            // Clamp, then a native f32 → i32 conversion (NaN gives 0); lanes outside
-            // 360–830 nm are zeroed below.
+            // Clamped index (NaN gives 0); lanes outside 360–830 nm are zeroed below.
             let last_segment = DENSE_SAMPLE_COUNT - 2;
-            let i = (x.clamp(0.0, last_segment as f32) as i32 as usize).min(last_segment);
-            let t = x - i as f32;
+            let (i, i_f32) = floor_index_and_value(x, last_segment);
+            let t = x - i_f32;
             let v = values[i] + t * (values[i + 1] - values[i]);
             if x >= 0.0 && x <= (DENSE_SAMPLE_COUNT - 1) as f32 {
                 v
@@ -507,6 +719,22 @@ mod tests {
             ),
             ("F11", Spectrum::cie_illuminant("F11").unwrap()),
             ("D65", Spectrum::cie_illuminant("d65").unwrap()),
+            (
+                "rgb albedo",
+                Spectrum::rgb_albedo(RgbGamut::Srgb, [0.8, 0.3, 0.1]).unwrap(),
+            ),
+            (
+                "rgb albedo rec2020 saturated",
+                Spectrum::rgb_albedo(RgbGamut::Rec2020, [0.1, 0.9, 0.05]).unwrap(),
+            ),
+            (
+                "rgb unbounded",
+                Spectrum::rgb_unbounded(RgbGamut::AcesCg, [3.0, 0.5, 1.25]).unwrap(),
+            ),
+            (
+                "rgb illuminant",
+                Spectrum::rgb_illuminant(RgbGamut::Srgb, [2.0, 1.0, 0.25]).unwrap(),
+            ),
         ]
     }
 
@@ -542,8 +770,20 @@ mod tests {
                 for lane in 0..4 {
                     let expected = spectrum.eval_nm(lambda[lane] as f64);
                     let got_lane = got[lane] as f64;
+                    // The sigmoid kinds are defined at every wavelength: NaN in, NaN out.
+                    if expected.is_nan() && got_lane.is_nan() {
+                        continue;
+                    }
+                    // Saturated sigmoid polynomials have terms ~1e3 for an argument ~1, so
+                    // the f32 argument carries ~1e-4 of rounding (f64 `eval_nm` does not).
+                    let sigmoid_slack = if name.starts_with("rgb") {
+                        1e-4 * scale
+                    } else {
+                        0.0
+                    };
                     assert!(
-                        (got_lane - expected).abs() <= 2e-6 * scale + 1e-5 * expected.abs(),
+                        (got_lane - expected).abs()
+                            <= 2e-6 * scale + 1e-5 * expected.abs() + sigmoid_slack,
                         "{name} at {} nm: eval {got_lane}, eval_nm {expected}",
                         lambda[lane]
                     );
@@ -554,7 +794,7 @@ mod tests {
 
     #[test]
     fn clustered_non_uniform_tables_evaluate_exactly() {
-        // Nodes crowded at both ends and sparse in the middle stress the guide table.
+        // Nodes crowded at both ends and sparse in the middle stress the segment index.
         let mut wavelengths_nm: Vec<f64> = (0..40).map(|i| 380.0 + 0.05 * i as f64).collect();
         wavelengths_nm.extend([450.0, 455.5, 600.0]);
         wavelengths_nm.extend((0..40).map(|i| 700.0 + 0.01 * i as f64));
@@ -585,6 +825,118 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// SplitMix64, uniform f64 in [0, 1).
+    fn next_unit(state: &mut u64) -> f64 {
+        *state = state.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = *state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        ((z ^ (z >> 31)) >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
+    }
+
+    #[test]
+    fn segment_index_matches_binary_search_exactly_on_random_tables() {
+        let mut state = 0x5e9_0001u64;
+        let mut modes_seen = [0usize; 2];
+        for table_no in 0..200 {
+            // Random increasing wavelengths: gaps from 0.001 nm to 40 nm, some tables wide
+            // (IOR data reach far into the infrared), some starting at negative or odd values.
+            let n = 2 + (next_unit(&mut state) * 120.0) as usize;
+            let mut w = 200.0 + next_unit(&mut state) * 400.0;
+            let wide = table_no % 5 == 0;
+            let mut wavelengths_nm = Vec::with_capacity(n);
+            for _ in 0..n {
+                wavelengths_nm.push(w);
+                let u = next_unit(&mut state);
+                // Odd tables: no sub-nm gaps (the single-step lookup); even: clusters.
+                w += if u < 0.2 && table_no % 2 == 0 {
+                    0.001 + u * 0.01
+                } else if wide {
+                    1.0 + u * 400.0
+                } else {
+                    0.7 + u * 40.0
+                };
+            }
+            let values: Vec<f64> = (0..n).map(|_| next_unit(&mut state) * 10.0 - 2.0).collect();
+            let Ok(Spectrum::PiecewiseLinear(p)) =
+                Spectrum::piecewise_linear(&wavelengths_nm, &values)
+            else {
+                continue; // rounding to f32 merged two nodes
+            };
+            if p.is_uniform() {
+                continue;
+            }
+            modes_seen[p.single_step as usize] += 1;
+            let w32 = p.wavelengths_nm().to_vec();
+            let (first, last) = (w32[0], w32[n - 1]);
+            let mut probes: Vec<f32> = w32.clone();
+            // Nodes, their f32 neighbours, random points, and points outside.
+            for &x in &w32 {
+                probes.push(f32::from_bits(x.to_bits() - 1));
+                probes.push(f32::from_bits(x.to_bits() + 1));
+            }
+            for _ in 0..4000 {
+                let u = next_unit(&mut state);
+                probes.push((first as f64 - 5.0 + u * (last - first + 10.0) as f64) as f32);
+            }
+            probes.extend([f32::NAN, -1e30, 1e30, first - 1.0, last + 1.0]);
+            while !probes.len().is_multiple_of(4) {
+                probes.push(first);
+            }
+            let tabulated = Tabulated::new(wavelengths_nm.clone(), values.clone()).unwrap();
+            let spectrum = Spectrum::PiecewiseLinear(p.clone());
+            for chunk in probes.chunks(4) {
+                let lambda: [f32; 4] = chunk.try_into().unwrap();
+                let got = spectrum.eval(&wavelengths(lambda));
+                for lane in 0..4 {
+                    let wl = lambda[lane];
+                    // Reference: binary search over the f32 nodes, same f32 arithmetic.
+                    let i = w32.partition_point(|&x| x <= wl).clamp(1, n - 1) - 1;
+                    if wl >= first && wl <= last {
+                        assert_eq!(p.segment_of(wl), i, "table {table_no} at {wl} nm");
+                        assert_eq!(p.segment_data(wl), p.segments[i]);
+                        if p.single_step {
+                            assert_eq!(p.segment_single_step(wl), i, "table {table_no} at {wl}");
+                        }
+                    }
+                    let (w0, w1) = (w32[i], w32[i + 1]);
+                    let vals = p.values();
+                    let [sw0, sw1, v0, slope] = p.segments[i];
+                    assert_eq!((sw0, sw1, v0), (w0, w1, vals[i]));
+                    let v = v0 + (wl - w0) * slope;
+                    let expected = if wl >= first && wl <= last { v } else { 0.0 };
+                    assert_eq!(
+                        got[lane].to_bits(),
+                        expected.to_bits(),
+                        "table {table_no} at {wl} nm: {} vs {expected}",
+                        got[lane]
+                    );
+                    // And the f64 table agrees up to f32 rounding.
+                    // (inside both the f32 and the f64 node ranges).
+                    let inside_f64 =
+                        wl as f64 >= wavelengths_nm[0] && wl as f64 <= wavelengths_nm[n - 1];
+                    if wl >= first && wl <= last && inside_f64 {
+                        let reference = tabulated.eval(wl as f64);
+                        // Nodes rounded to f32 move by ≤ ½ ulp: the value by slope × that.
+                        // (the f64 table may put λ in a neighbouring segment).
+                        let slope = (i.saturating_sub(1)..(i + 2).min(n - 1))
+                            .map(|k| ((vals[k + 1] - vals[k]) / (w32[k + 1] - w32[k])).abs())
+                            .fold(0.0f32, f32::max) as f64;
+                        let tol = slope * 2.0 * f32::EPSILON as f64 * wl.abs() as f64
+                            + 1e-5 * (1.0 + reference.abs());
+                        assert!(
+                            (got[lane] as f64 - reference).abs() <= tol,
+                            "table {table_no} at {wl} nm: {} vs Tabulated {reference}",
+                            got[lane]
+                        );
+                    }
+                }
+            }
+        }
+        // Both lookups were exercised.
+        assert!(modes_seen[0] > 20 && modes_seen[1] > 20, "{modes_seen:?}");
     }
 
     #[test]

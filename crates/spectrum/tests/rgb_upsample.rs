@@ -9,12 +9,20 @@
 //! ∃ r ∈ [0, 1]^471 with M r = rgb, decided as a linear programme with `microlp`. Each point
 //! is classed by the largest margin m ∈ {2e-2, 1e-2, 1e-3, 1e-4, 0} for which it stays
 //! reachable with r ∈ [m, 1 − m]^471, i.e. lies in the object-colour solid contracted by
-//! 1 − 2m about its centre M·½. Measured: the 1e-3 bound does NOT hold on every reachable
-//! point of these two gamuts (≈4–5 % exceed it, up to ~2e-2, mostly saturated colours near
-//! the solid's boundary whose spectra are near-bang-bang, needing huge coefficients that
-//! interpolate poorly, or whose table cell straddles the boundary); even at m ≥ 2e-2 a few
-//! exceed it (max ≈ 6e-3). The tests pin those measured bounds and write every point's
-//! error to target/tmp/rgb_upsample_error_map_<gamut>.csv.
+//! 1 − 2m about its centre M·½.
+//!
+//! Two paths are checked:
+//! - `Path::Refined` (`RgbAlbedoSpectrum::new`, i.e. `RgbToSpectrumTable::coefficients_refined`:
+//!   table lookup + a few Newton steps in linear RGB) — asserted ≤ 1e-3 on every point of
+//!   sRGB and on every LP-reachable point of Rec.2020 and ACEScg.
+//! - `Path::Table` (`RgbAlbedoSpectrum::from_table`, pure trilinear lookup, for textures) —
+//!   ≤ 1e-3 on sRGB; on Rec.2020/ACEScg ≈4–5 % of the reachable points exceed it (up to
+//!   ~2e-2: saturated colours near the solid's boundary, whose near-bang-bang spectra need
+//!   huge coefficients that interpolate poorly, or whose cell straddles the boundary), so
+//!   those tests pin the measured bounds.
+//!
+//! Every point's class and error is written to
+//! target/tmp/rgb_upsample_error_map_<gamut>_<path>.csv.
 
 use std::fmt::Write as _;
 
@@ -171,21 +179,59 @@ impl Summary {
     }
 }
 
-/// Round-trips the 17³ grid; with `classify_points`, classes each point by LP margin (see
-/// [`MARGINS`]). Returns the per-class summaries and the printed report.
-fn round_trip_grid(gamut: RgbGamut, classify_points: bool) -> (Vec<Summary>, String) {
+/// Which path turns an RGB into coefficients.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+enum Path {
+    /// Trilinear interpolation of the table only (`RgbAlbedoSpectrum::from_table`).
+    Table,
+    /// Table + Newton polish (`RgbAlbedoSpectrum::new`, `coefficients_refined`).
+    Refined,
+}
+
+impl Path {
+    fn name(self) -> &'static str {
+        match self {
+            Path::Table => "table",
+            Path::Refined => "refined",
+        }
+    }
+
+    fn albedo(self, gamut: RgbGamut, rgb: [f32; 3]) -> RgbAlbedoSpectrum {
+        match self {
+            Path::Table => RgbAlbedoSpectrum::from_table(gamut, rgb).unwrap(),
+            Path::Refined => RgbAlbedoSpectrum::new(gamut, rgb).unwrap(),
+        }
+    }
+}
+
+/// LP margin class of every grid point (see [`MARGINS`]), computed once per gamut and
+/// shared by the tests of this binary.
+fn classes(gamut: RgbGamut) -> &'static [usize] {
+    use std::sync::OnceLock;
+    static CLASSES: [OnceLock<Vec<usize>>; 3] = [OnceLock::new(), OnceLock::new(), OnceLock::new()];
+    let i = RgbGamut::ALL.iter().position(|&g| g == gamut).unwrap();
+    CLASSES[i].get_or_init(|| {
+        let weights = reflectance_to_rgb(gamut);
+        grid()
+            .into_iter()
+            .map(|rgb| classify(&weights, rgb))
+            .collect()
+    })
+}
+
+/// Round-trips the 17³ grid along `path`; with `classify_points`, classes each point by LP
+/// margin (see [`MARGINS`]). Returns the per-class summaries and the printed report, and
+/// writes the error map to target/tmp/rgb_upsample_error_map_<gamut>_<path>.csv.
+fn round_trip_grid(gamut: RgbGamut, path: Path, classify_points: bool) -> (Vec<Summary>, String) {
     let weights = reflectance_to_rgb(gamut);
+    let classes = classify_points.then(|| classes(gamut));
     let mut summaries: Vec<Summary> = (0..CLASS_LABELS.len()).map(|_| Summary::new()).collect();
     let mut csv = String::from("r,g,b,class,max_abs_error,r_out,g_out,b_out\n");
-    for rgb in grid() {
-        let s = RgbAlbedoSpectrum::new(gamut, rgb).unwrap();
+    for (n, rgb) in grid().into_iter().enumerate() {
+        let s = path.albedo(gamut, rgb);
         let out = project(&weights, &sample_dense(|wl| s.eval4(wl)));
         let err = max_abs_diff(out, rgb.map(|c| c as f64));
-        let class = if classify_points {
-            classify(&weights, rgb)
-        } else {
-            0
-        };
+        let class = classes.map_or(0, |c| c[n]);
         summaries[class].add(rgb, err);
         writeln!(
             csv,
@@ -194,7 +240,11 @@ fn round_trip_grid(gamut: RgbGamut, classify_points: bool) -> (Vec<Summary>, Str
         )
         .unwrap();
     }
-    let mut report = format!("{} round trip over the 17³ grid:\n", gamut.name());
+    let mut report = format!(
+        "{} round trip over the 17³ grid, {} path:\n",
+        gamut.name(),
+        path.name()
+    );
     for (s, label) in summaries.iter().zip(CLASS_LABELS) {
         if s.count > 0 {
             report += &format!(
@@ -203,18 +253,22 @@ fn round_trip_grid(gamut: RgbGamut, classify_points: bool) -> (Vec<Summary>, Str
             );
         }
     }
+    let path_csv = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!(
+        "rgb_upsample_error_map_{}_{}.csv",
+        gamut.name(),
+        path.name()
+    ));
+    std::fs::write(&path_csv, &csv).unwrap();
+    report += &format!("  error map: {}\n", path_csv.display());
     println!("{report}");
-    let path = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
-        .join(format!("rgb_upsample_error_map_{}.csv", gamut.name()));
-    std::fs::write(&path, &csv).unwrap();
-    println!("  error map: {}", path.display());
     (summaries, report)
 }
 
-/// Rec.2020 / ACEScg: the 1e-3 bound does not hold on every reachable point (see the file
-/// comment and docs/rgb-upsampling.md); these bounds pin the measured behaviour.
-fn check_wide_gamut(gamut: RgbGamut) {
-    let (s, report) = round_trip_grid(gamut, true);
+/// Pure table lookup, Rec.2020 / ACEScg: the 1e-3 bound does not hold on every reachable
+/// point (see the file comment and docs/rgb-upsampling.md); these bounds pin the measured
+/// behaviour.
+fn check_wide_gamut_table(gamut: RgbGamut) {
+    let (s, report) = round_trip_grid(gamut, Path::Table, true);
     let deep = &s[ASSERTED_MARGIN_CLASS];
     assert!(deep.count > 3000, "{report}");
     assert!(deep.max <= WIDE_GAMUT_DEEP_MAX_ERROR, "{report}");
@@ -226,28 +280,63 @@ fn check_wide_gamut(gamut: RgbGamut) {
     );
 }
 
-#[test]
-fn srgb_round_trip_over_the_whole_grid_is_within_1e_3() {
-    let (s, report) = round_trip_grid(RgbGamut::Srgb, false);
-    assert_eq!(s[0].count, 17 * 17 * 17);
-    assert!(s[0].max <= ROUND_TRIP_TOLERANCE, "{report}");
+/// Refined path (what `RgbAlbedoSpectrum::new` uses): ≤ 1e-3 on every LP-reachable point
+/// except at most `allowed_boundary_failures` points of margin class m < 1e-3 (on the
+/// boundary of the object-colour solid, reachable by a sigmoid only in the limit).
+fn check_wide_gamut_refined(gamut: RgbGamut, allowed_boundary_failures: usize) {
+    let (s, report) = round_trip_grid(gamut, Path::Refined, true);
+    // m ≥ 1e-3: every point within tolerance.
+    for (class, label) in s[..3].iter().zip(CLASS_LABELS) {
+        assert!(
+            class.max <= ROUND_TRIP_TOLERANCE,
+            "{label}: max {:.3e}\n{report}",
+            class.max
+        );
+    }
+    let boundary_failures: usize = s[3..MARGINS.len()].iter().map(|c| c.over_tolerance).sum();
+    assert!(
+        boundary_failures <= allowed_boundary_failures,
+        "{boundary_failures} boundary points exceed 1e-3\n{report}"
+    );
 }
 
 #[test]
-fn rec2020_round_trip_on_reachable_points() {
-    check_wide_gamut(RgbGamut::Rec2020);
+fn srgb_round_trip_over_the_whole_grid_is_within_1e_3_table_and_refined() {
+    for path in [Path::Table, Path::Refined] {
+        let (s, report) = round_trip_grid(RgbGamut::Srgb, path, false);
+        assert_eq!(s[0].count, 17 * 17 * 17);
+        assert!(s[0].max <= ROUND_TRIP_TOLERANCE, "{report}");
+    }
 }
 
 #[test]
-fn acescg_round_trip_on_reachable_points() {
-    check_wide_gamut(RgbGamut::AcesCg);
+fn rec2020_table_lookup_round_trip_error_map_on_reachable_points() {
+    check_wide_gamut_table(RgbGamut::Rec2020);
+}
+
+#[test]
+fn acescg_table_lookup_round_trip_error_map_on_reachable_points() {
+    check_wide_gamut_table(RgbGamut::AcesCg);
+}
+
+#[test]
+fn rec2020_refined_round_trip_is_within_1e_3_on_reachable_points() {
+    check_wide_gamut_refined(RgbGamut::Rec2020, 0);
+}
+
+#[test]
+fn acescg_refined_round_trip_is_within_1e_3_on_reachable_points() {
+    check_wide_gamut_refined(RgbGamut::AcesCg, 0);
 }
 
 #[test]
 fn albedo_spectra_stay_within_0_and_1_at_every_nanometre() {
     for gamut in RgbGamut::ALL {
-        for rgb in grid() {
-            let s = RgbAlbedoSpectrum::new(gamut, rgb).unwrap();
+        for (rgb, path) in grid()
+            .into_iter()
+            .flat_map(|rgb| [(rgb, Path::Table), (rgb, Path::Refined)])
+        {
+            let s = path.albedo(gamut, rgb);
             let dense = sample_dense(|wl| s.eval4(wl));
             for (i, v) in dense.iter().enumerate() {
                 let nm = 360.0 + i as f64;
@@ -353,5 +442,93 @@ fn illuminant_spectra_emit_their_rgb_with_white_at_unit_luminance() {
             let mid = s.eval_nm(560.0);
             assert!((mid - s.eval4([560.0; 4])[0] as f64).abs() < 1e-5 * mid.max(1.0));
         }
+    }
+}
+
+/// Diagnosis of the pure-table failures (run with `--ignored --nocapture`): for every
+/// LP-reachable grid point whose table round trip exceeds 1e-3, the 8 nodes of its
+/// interpolation cell — how many are themselves off (node RGB error > 1e-4, i.e. colours
+/// the sigmoid family cannot reach: the fit stopped at the coefficient bound), and the
+/// largest normalised coefficient among them.
+#[test]
+#[ignore]
+fn diagnose_wide_gamut_table_failures() {
+    use prism_spectrum::rgb_upsample::{refine_polynomial, SigmoidPolynomial};
+    for gamut in [RgbGamut::Rec2020, RgbGamut::AcesCg] {
+        let weights = reflectance_to_rgb(gamut);
+        let table = gamut.table();
+        let res = table.resolution();
+        let z_nodes = table.z_nodes();
+        let classes = classes(gamut);
+        let node_rgb_error = |rgb: [f64; 3], p: SigmoidPolynomial| {
+            let out = project(&weights, &sample_dense(|wl| p.eval4(wl)));
+            max_abs_diff(out, rgb)
+        };
+        let (mut failing, mut with_bad_node, mut with_huge) = (0, 0, 0);
+        let mut bad_nodes_hist = [0usize; 9];
+        for (n, rgb) in grid().into_iter().enumerate() {
+            if classes[n] >= MARGINS.len() || rgb[0] == rgb[1] && rgb[1] == rgb[2] {
+                continue;
+            }
+            let s = RgbAlbedoSpectrum::from_table(gamut, rgb).unwrap();
+            let out = project(&weights, &sample_dense(|wl| s.eval4(wl)));
+            if max_abs_diff(out, rgb.map(|c| c as f64)) <= ROUND_TRIP_TOLERANCE {
+                continue;
+            }
+            failing += 1;
+            // The cell, as `RgbToSpectrumTable::coefficients` finds it.
+            let l = if rgb[0] > rgb[1] {
+                if rgb[0] > rgb[2] {
+                    0
+                } else {
+                    2
+                }
+            } else if rgb[1] > rgb[2] {
+                1
+            } else {
+                2
+            };
+            let z = rgb[l];
+            let last = (res - 1) as f32;
+            let xi = ((rgb[(l + 1) % 3] * last / z) as usize).min(res - 2);
+            let yi = ((rgb[(l + 2) % 3] * last / z) as usize).min(res - 2);
+            let zi = z_nodes
+                .partition_point(|&v| v < z)
+                .saturating_sub(1)
+                .min(res - 2);
+            let (mut bad, mut max_coeff) = (0, 0.0f64);
+            for d in 0..8 {
+                let (k, j, i) = (zi + (d >> 2), yi + ((d >> 1) & 1), xi + (d & 1));
+                let zk = z_nodes[k] as f64;
+                let mut node_rgb = [0.0; 3];
+                node_rgb[l] = zk;
+                node_rgb[(l + 1) % 3] = i as f64 / last as f64 * zk;
+                node_rgb[(l + 2) % 3] = j as f64 / last as f64 * zk;
+                let c = table.node(l, k, j, i);
+                let p = SigmoidPolynomial::new(c[0], c[1], c[2]);
+                // Normalised |A| (t = (λ − 360)/470).
+                max_coeff = max_coeff.max((c[0] as f64 * 470.0 * 470.0).abs());
+                if k > 0 && node_rgb_error(node_rgb, p) > 1e-4 {
+                    // Confirm with the refinement: still off → the sigmoid cannot reach it.
+                    let (_, e) = refine_polynomial(gamut.reflectance_rgb_weights(), p, node_rgb);
+                    if e > 1e-4 {
+                        bad += 1;
+                    }
+                }
+            }
+            bad_nodes_hist[bad] += 1;
+            if bad > 0 {
+                with_bad_node += 1;
+            }
+            if max_coeff > 1e3 {
+                with_huge += 1;
+            }
+        }
+        println!(
+            "{}: {failing} reachable points over 1e-3; {with_bad_node} have ≥ 1 unreachable \
+             node in their cell (histogram of bad nodes 0..8: {bad_nodes_hist:?}); \
+             {with_huge} have a node with |A| > 1e3",
+            gamut.name()
+        );
     }
 }

@@ -1,15 +1,20 @@
 //! `cargo run --release -p bench-spectrum`: nanoseconds per 4-wavelength `Spectrum::eval`
 //! for every spectrum kind, per hero-wavelength sample, and per spectrum → XYZ of a 1 nm
-//! table. Prints one JSON object (median of several runs) for tools/ to chart.
+//! table, and per RGB → coefficients conversion. Prints one JSON object for tools/ to chart;
+//! docs/spectrum-benchmark.md explains the fields.
 
 use std::hint::black_box;
 use std::time::Instant;
 
 use prism_spectrum::data::{cmfs, Observer};
-use prism_spectrum::{DenseSpectrum, SampledSpectrum, SampledWavelengths, Spectrum};
+use prism_spectrum::{
+    DenseSpectrum, RgbAlbedoSpectrum, RgbGamut, SampledSpectrum, SampledWavelengths, Spectrum,
+};
 
 const RUNS: usize = 9;
-const EVALS_PER_RUN: usize = 2_000_000;
+/// Interleaved rounds over all kinds for the eval timings.
+const ROUNDS: usize = 15;
+const EVALS_PER_RUN: usize = 1_000_000;
 const WAVELENGTH_SETS: usize = 4096;
 
 /// Median and minimum of `RUNS` timings of `per_run` calls of `body(i)`, in ns per call
@@ -37,13 +42,23 @@ fn splitmix(state: &mut u64) -> f32 {
     ((z ^ (z >> 31)) >> 40) as f32 * (1.0 / (1u64 << 24) as f32)
 }
 
-fn bench_eval(spectrum: &Spectrum, wavelengths: &[SampledWavelengths]) -> (f64, f64) {
+/// `Spectrum::eval` as one out-of-line call per evaluation, as a renderer's BSDF or light
+/// code calls it (and one symbol to disassemble).
+#[inline(never)]
+fn eval_not_inlined(spectrum: &Spectrum, wavelengths: &SampledWavelengths) -> SampledSpectrum {
+    spectrum.eval(wavelengths)
+}
+
+/// ns per `eval` over one run of `EVALS_PER_RUN` calls.
+fn bench_eval(spectrum: &Spectrum, wavelengths: &[SampledWavelengths]) -> f64 {
     let mut acc = SampledSpectrum::zero();
-    let ns = median_ns(EVALS_PER_RUN, |i| {
+    let start = Instant::now();
+    for i in 0..EVALS_PER_RUN {
         // Wavelengths vary every call; black_box keeps the spectrum from being hoisted.
         let w = &wavelengths[i % WAVELENGTH_SETS];
-        acc += black_box(spectrum).eval(black_box(w));
-    });
+        acc += eval_not_inlined(black_box(spectrum), black_box(w));
+    }
+    let ns = start.elapsed().as_secs_f64() * 1e9 / EVALS_PER_RUN as f64;
     black_box(acc);
     ns
 }
@@ -104,15 +119,58 @@ fn main() {
             "named_illuminant_d65",
             Spectrum::cie_illuminant("D65").unwrap(),
         ),
-        // RGB-upsampled kinds (rgb_albedo, rgb_unbounded, rgb_illuminant) are added here
-        // with their variants.
+        (
+            "rgb_albedo",
+            Spectrum::rgb_albedo(RgbGamut::Srgb, [0.8, 0.3, 0.1]).unwrap(),
+        ),
+        (
+            "rgb_unbounded",
+            Spectrum::rgb_unbounded(RgbGamut::Rec2020, [2.0, 0.5, 0.25]).unwrap(),
+        ),
+        (
+            "rgb_illuminant",
+            Spectrum::rgb_illuminant(RgbGamut::AcesCg, [4.0, 2.0, 1.0]).unwrap(),
+        ),
     ];
 
-    let (mut medians, mut minima) = (Vec::new(), Vec::new());
-    for (name, spectrum) in &kinds {
-        let (median, min) = bench_eval(spectrum, &wavelengths);
+    // `BENCH_SPECTRUM_ONLY=<kind>`: time that kind alone (e.g. under `perf stat`, whose
+    // per-task cycle counts do not see other processes' load) and stop.
+    if let Ok(only) = std::env::var("BENCH_SPECTRUM_ONLY") {
+        let (_, spectrum) = kinds
+            .iter()
+            .find(|(name, _)| *name == only)
+            .unwrap_or_else(|| panic!("no kind {only}"));
+        let ns: Vec<f64> = (0..ROUNDS)
+            .map(|_| bench_eval(spectrum, &wavelengths))
+            .collect();
+        let min = ns.iter().copied().fold(f64::INFINITY, f64::min);
+        println!(
+            "{{\"kind\": \"{only}\", \"evals\": {}, \"min_ns\": {min:.2}}}",
+            ROUNDS * EVALS_PER_RUN
+        );
+        return;
+    }
+
+    // Rounds interleave the kinds, so load from other processes spreads over all of them
+    // and ratios between kinds measured in the same run stay meaningful.
+    let mut timings: Vec<Vec<f64>> = vec![Vec::new(); kinds.len()];
+    for _ in 0..ROUNDS {
+        for (t, (_, spectrum)) in timings.iter_mut().zip(&kinds) {
+            t.push(bench_eval(spectrum, &wavelengths));
+        }
+    }
+    let (mut medians, mut minima, mut ratios) = (Vec::new(), Vec::new(), Vec::new());
+    let dense_min = kinds
+        .iter()
+        .position(|(name, _)| *name == "dense")
+        .map(|k| timings[k].iter().copied().fold(f64::INFINITY, f64::min))
+        .unwrap();
+    for ((name, _), t) in kinds.iter().zip(&mut timings) {
+        t.sort_by(|a, b| a.total_cmp(b));
+        let (median, min) = (t[t.len() / 2], t[0]);
         medians.push(format!("\"{name}\": {median:.2}"));
         minima.push(format!("\"{name}\": {min:.2}"));
+        ratios.push(format!("\"{name}\": {:.2}", min / dense_min));
     }
 
     let mut u_state = 7u64;
@@ -134,17 +192,65 @@ fn main() {
     });
     black_box(xyz_sink);
 
+    // RGB → coefficients: the pure table lookup (textures) and the refined path
+    // (`RgbAlbedoSpectrum::new`, constant colours), over saturated Rec.2020 colours (one
+    // component scaled by 0.1; many lie outside the object-colour solid, where the
+    // refinement runs to its iteration limit).
+    let colours: Vec<[f32; 3]> = (0..256)
+        .map(|_| {
+            let mut c = [
+                splitmix(&mut u_state),
+                splitmix(&mut u_state),
+                splitmix(&mut u_state),
+            ];
+            c[(u_state % 3) as usize] *= 0.1;
+            c
+        })
+        .collect();
+    let mut poly_sink = 0.0f32;
+    let lookup_ns = median_ns(200_000, |i| {
+        let s = RgbAlbedoSpectrum::from_table(RgbGamut::Rec2020, black_box(colours[i % 256]));
+        poly_sink += s.unwrap().polynomial.c2;
+    });
+    let refined_ns = median_ns(2_000, |i| {
+        let s = RgbAlbedoSpectrum::new(RgbGamut::Rec2020, black_box(colours[i % 256]));
+        poly_sink += s.unwrap().polynomial.c2;
+    });
+    // Moderate colours (components in [0.2, 0.8]): reachable, Newton converges in a few steps.
+    let moderate: Vec<[f32; 3]> = (0..256)
+        .map(|_| std::array::from_fn(|_| 0.2 + 0.6 * splitmix(&mut u_state)))
+        .collect();
+    let refined_moderate_ns = median_ns(2_000, |i| {
+        let s = RgbAlbedoSpectrum::new(RgbGamut::Rec2020, black_box(moderate[i % 256]));
+        poly_sink += s.unwrap().polynomial.c2;
+    });
+    black_box(poly_sink);
+
     println!(
-        "{{\"benchmark\": \"prism-spectrum\", \"unit\": \"ns\", \"runs\": {RUNS}, \"statistic\": \"median\", \
+        "{{\"benchmark\": \"prism-spectrum\", \"unit\": \"ns\", \"runs\": {RUNS}, \"eval_rounds\": {ROUNDS}, \"statistic\": \"median\", \
 \"eval_4_wavelengths_ns\": {{{}}}, \
 \"eval_4_wavelengths_min_ns\": {{{}}}, \
+\"eval_4_wavelengths_min_over_dense_min\": {{{}}}, \
 \"sample_visible_wavelengths_ns\": {:.2}, \
 \"spectrum_to_xyz_1nm_ns\": {:.1}, \
-\"spectrum_to_xyz_1nm_min_ns\": {:.1}}}",
+\"spectrum_to_xyz_1nm_min_ns\": {:.1}, \
+\"rgb_albedo_from_table_ns\": {:.1}, \
+\"rgb_albedo_from_table_min_ns\": {:.1}, \
+\"rgb_albedo_refined_ns\": {:.0}, \
+\"rgb_albedo_refined_min_ns\": {:.0}, \
+\"rgb_albedo_refined_moderate_ns\": {:.0}, \
+\"rgb_albedo_refined_moderate_min_ns\": {:.0}}}",
         medians.join(", "),
         minima.join(", "),
+        ratios.join(", "),
         (sample_ns.0 - rng_ns.0).max(0.0),
         xyz_ns.0,
-        xyz_ns.1
+        xyz_ns.1,
+        lookup_ns.0,
+        lookup_ns.1,
+        refined_ns.0,
+        refined_ns.1,
+        refined_moderate_ns.0,
+        refined_moderate_ns.1
     );
 }
