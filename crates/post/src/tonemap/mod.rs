@@ -6,17 +6,22 @@
 
 mod aces;
 mod agx;
+pub mod bilateral_grid;
 mod drago03;
+mod durand02;
 mod exponential;
 mod ferwerda96;
+pub mod gaussian;
 mod linear;
 mod logarithmic;
 mod mean_value;
 pub mod pixels;
 mod reinhard02;
+mod reinhard02_local;
 mod schlick94;
 mod tumblin_rushmeier;
 mod ward94;
+mod ward97_histogram;
 
 use std::collections::BTreeMap;
 
@@ -47,7 +52,7 @@ pub struct OperatorInfo {
     pub params: &'static [ParamSpec],
 }
 
-/// The tone operators implemented so far.
+/// The tone operators (CLI names in each file's `INFO`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ToneOperator {
     Linear,
@@ -59,7 +64,10 @@ pub enum ToneOperator {
     Schlick94,
     TumblinRushmeier,
     Reinhard02,
+    Reinhard02Local,
     Ferwerda96,
+    Ward97Histogram,
+    Durand02,
     Aces,
     Agx,
 }
@@ -157,7 +165,7 @@ pub(crate) struct Output {
 }
 
 impl ToneOperator {
-    pub const ALL: [ToneOperator; 12] = [
+    pub const ALL: [ToneOperator; 15] = [
         ToneOperator::Linear,
         ToneOperator::MeanValue,
         ToneOperator::Ward94,
@@ -167,7 +175,10 @@ impl ToneOperator {
         ToneOperator::Schlick94,
         ToneOperator::TumblinRushmeier,
         ToneOperator::Reinhard02,
+        ToneOperator::Reinhard02Local,
         ToneOperator::Ferwerda96,
+        ToneOperator::Ward97Histogram,
+        ToneOperator::Durand02,
         ToneOperator::Aces,
         ToneOperator::Agx,
     ];
@@ -183,6 +194,9 @@ impl ToneOperator {
             ToneOperator::Schlick94 => &schlick94::INFO,
             ToneOperator::TumblinRushmeier => &tumblin_rushmeier::INFO,
             ToneOperator::Reinhard02 => &reinhard02::INFO,
+            ToneOperator::Reinhard02Local => &reinhard02_local::INFO,
+            ToneOperator::Ward97Histogram => &ward97_histogram::INFO,
+            ToneOperator::Durand02 => &durand02::INFO,
             ToneOperator::Ferwerda96 => &ferwerda96::INFO,
             ToneOperator::Aces => &aces::INFO,
             ToneOperator::Agx => &agx::INFO,
@@ -273,6 +287,9 @@ impl ToneOperator {
             ToneOperator::Schlick94 => schlick94::apply(&ctx),
             ToneOperator::TumblinRushmeier => tumblin_rushmeier::apply(&ctx)?,
             ToneOperator::Reinhard02 => reinhard02::apply(&ctx),
+            ToneOperator::Reinhard02Local => reinhard02_local::apply(&ctx),
+            ToneOperator::Ward97Histogram => ward97_histogram::apply(&ctx)?,
+            ToneOperator::Durand02 => durand02::apply(&ctx),
             ToneOperator::Ferwerda96 => ferwerda96::apply(&ctx)?,
             ToneOperator::Aces => aces::apply(&ctx),
             ToneOperator::Agx => agx::apply(&ctx),

@@ -141,17 +141,60 @@ pub(crate) fn map_pixels(
     scale: f32,
     f: impl Fn([f32; 3]) -> [f32; 3] + Sync,
 ) -> Mapped {
+    map_pixels_indexed(image, scale, |_, c| f(c))
+}
+
+/// The sanitised luminance plane `w · sanitise(p, scale)` (row-major), for local operators.
+pub(crate) fn luminance_plane(image: &Image, scale: f32, w: [f32; 3]) -> Vec<f32> {
+    let mut plane = vec![0.0f32; image.pixels().len()];
+    plane
+        .par_chunks_mut(CHUNK)
+        .zip(image.pixels().par_chunks(CHUNK))
+        .for_each(|(o, i)| {
+            for (o, p) in o.iter_mut().zip(i) {
+                *o = dot(w, sanitise(*p, scale));
+            }
+        });
+    plane
+}
+
+/// As [`map_luminance`], with the pixel index passed to `curve` (local operators look up
+/// their per-pixel adaptation by index).
+pub(crate) fn map_luminance_indexed(
+    image: &Image,
+    scale: f32,
+    w: [f32; 3],
+    curve: impl Fn(usize, f32) -> f32 + Sync,
+) -> Mapped {
+    map_pixels_indexed(image, scale, |i, c| {
+        let l = dot(w, c);
+        if l > 0.0 {
+            let ratio = curve(i, l) / l;
+            [c[0] * ratio, c[1] * ratio, c[2] * ratio]
+        } else {
+            [0.0; 3]
+        }
+    })
+}
+
+/// Maps every sanitised pixel through `f(index, rgb)`; non-finite results become 0.
+pub(crate) fn map_pixels_indexed(
+    image: &Image,
+    scale: f32,
+    f: impl Fn(usize, [f32; 3]) -> [f32; 3] + Sync,
+) -> Mapped {
     let mut pixels = vec![[0.0f32; 3]; image.pixels().len()];
     let (non_finite, negative) = pixels
         .par_chunks_mut(CHUNK)
         .zip(image.pixels().par_chunks(CHUNK))
-        .map(|(o, i)| {
+        .enumerate()
+        .map(|(k, (o, i))| {
             let (mut non_finite, mut negative) = (0u64, 0u64);
-            for (o, p) in o.iter_mut().zip(i) {
+            for (j, (o, p)) in o.iter_mut().zip(i).enumerate() {
                 let finite = p[0].is_finite() && p[1].is_finite() && p[2].is_finite();
                 non_finite += !finite as u64;
                 negative += (finite && (p[0] < 0.0 || p[1] < 0.0 || p[2] < 0.0)) as u64;
-                let v = f(sanitise(*p, scale));
+                let v = f(k * CHUNK + j, sanitise(*p, scale));
                 *o = v.map(|x| if x.is_finite() { x } else { 0.0 });
             }
             (non_finite, negative)
