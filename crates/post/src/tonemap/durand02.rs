@@ -16,6 +16,7 @@
 //! filter.
 
 use super::bilateral_grid::bilateral_grid;
+use super::fast_math;
 use super::pixels::{luminance_plane, map_luminance_indexed};
 use super::{Context, OperatorInfo, Output, ParamSpec};
 use rayon::prelude::*;
@@ -58,7 +59,11 @@ pub(crate) fn apply(ctx: &Context) -> Output {
     let sigma_range = ctx.value("sigma_range") as f32;
     let mut log_l = luminance_plane(ctx.image, ctx.exposure, ctx.weights);
     log_l.par_iter_mut().for_each(|v| {
-        *v = if *v > 0.0 { v.log10() } else { f32::NAN };
+        *v = if *v > 0.0 {
+            fast_math::log2(*v) * std::f32::consts::LOG10_2
+        } else {
+            f32::NAN
+        };
     });
     let (base, [base_min, base_max]) = bilateral_grid(&log_l, w, h, sigma_space_px, sigma_range);
     drop(log_l);
@@ -73,8 +78,8 @@ pub(crate) fn apply(ctx: &Context) -> Output {
         (gamma - 1.0) as f32 * std::f32::consts::LN_10,
         -(gamma * base_max as f64) as f32 * std::f32::consts::LN_10,
     );
-    let mapped = map_luminance_indexed(ctx.image, ctx.exposure, ctx.weights, |i, l| {
-        l * (g1 * base[i] + offset).exp()
+    let mapped = map_luminance_indexed(ctx, ctx.exposure, ctx.weights, |i, l| {
+        l * fast_math::exp(g1 * base[i] + offset)
     });
     Output {
         mapped,

@@ -10,6 +10,7 @@ pub mod bilateral_grid;
 mod drago03;
 mod durand02;
 mod exponential;
+pub mod fast_math;
 mod ferwerda96;
 pub mod gaussian;
 mod linear;
@@ -122,9 +123,24 @@ pub(crate) struct Context<'a> {
     pub exposure: f32,
     /// Y = w · RGB in the image's colour space.
     pub weights: [f32; 3],
+    /// An output buffer to reuse (from [`ToneOperator::apply_into`]).
+    pub buffer: std::sync::Mutex<Option<Vec<[f32; 3]>>>,
 }
 
 impl Context<'_> {
+    /// The output pixel buffer, `n` long: the reused one when given, else a new one.
+    /// Its contents are overwritten by the mapping pass.
+    pub fn output_buffer(&self, n: usize) -> Vec<[f32; 3]> {
+        let reused = self.buffer.lock().ok().and_then(|mut b| b.take());
+        match reused {
+            Some(mut v) => {
+                v.resize(n, [0.0; 3]);
+                v
+            }
+            None => vec![[0.0; 3]; n],
+        }
+    }
+
     /// The parameter's value: the override if given, else its default (`None` when the
     /// default is computed from the image).
     pub fn param(&self, name: &str) -> Option<f64> {
@@ -269,6 +285,19 @@ impl ToneOperator {
 
     /// Tone-maps `image` to linear display values in its own colour space.
     pub fn apply(self, image: &Image, params: &ToneParams) -> Result<ToneResult> {
+        self.apply_into(image, params, Vec::new())
+    }
+
+    /// As [`ToneOperator::apply`], writing into `buffer` (resized to the pixel count; its
+    /// old contents are ignored) instead of allocating: pass the pixels of a previous
+    /// result (`result.image.into_pixels()`) to tone-map many frames or operators without
+    /// allocating and page-faulting a new output each time.
+    pub fn apply_into(
+        self,
+        image: &Image,
+        params: &ToneParams,
+        buffer: Vec<[f32; 3]>,
+    ) -> Result<ToneResult> {
         self.validate(params)?;
         let ctx = Context {
             image,
@@ -276,6 +305,7 @@ impl ToneOperator {
             info: self.info(),
             exposure: 2f64.powf(params.exposure_ev) as f32,
             weights: image.luminance_weights(),
+            buffer: std::sync::Mutex::new((buffer.capacity() > 0).then_some(buffer)),
         };
         let output = match self {
             ToneOperator::Linear => linear::apply(&ctx),

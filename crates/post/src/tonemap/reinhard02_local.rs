@@ -117,7 +117,7 @@ pub(crate) fn apply(ctx: &Context) -> Output {
         s *= SCALE_RATIO;
     }
     drop((v1, v2, scratch, active));
-    let mapped = map_luminance_indexed(ctx.image, ctx.exposure, ctx.weights, |i, lw| {
+    let mapped = map_luminance_indexed(ctx, ctx.exposure, ctx.weights, |i, lw| {
         key_scale * lw / (1.0 + selected[i])
     });
     Output {

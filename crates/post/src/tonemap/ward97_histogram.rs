@@ -20,6 +20,7 @@
 
 use rayon::prelude::*;
 
+use super::fast_math;
 use super::pixels::{dot, map_luminance, sanitise};
 use super::{Context, OperatorInfo, Output, ParamSpec};
 use crate::error::Result;
@@ -182,7 +183,7 @@ pub(crate) fn apply(ctx: &Context) -> Result<Output> {
         let factor = (1.0 / top) as f32;
         values.push(("linear_factor", factor as f64));
         return Ok(Output {
-            mapped: map_luminance(ctx.image, scale, ctx.weights, |l| (factor * l).min(1.0)),
+            mapped: map_luminance(ctx, scale, ctx.weights, |l| (factor * l).min(1.0)),
             values,
         });
     }
@@ -199,11 +200,11 @@ pub(crate) fn apply(ctx: &Context) -> Result<Output> {
     let (b_min32, inv_bw) = (b_min as f32, (1.0 / bin_width) as f32);
     let (ln_dmin, range32, inv_dmax) = (l_dmin.ln() as f32, display_range as f32, 1.0 / l_dmax);
     let inv_dmax = inv_dmax as f32;
-    let mapped = map_luminance(ctx.image, scale, ctx.weights, |l| {
-        let t = ((l.ln() - b_min32) * inv_bw).clamp(0.0, bins as f32);
+    let mapped = map_luminance(ctx, scale, ctx.weights, |l| {
+        let t = ((fast_math::ln(l) - b_min32) * inv_bw).clamp(0.0, bins as f32);
         let k = (t as usize).min(bins - 1);
         let p = cdf[k] + (t - k as f32) * (cdf[k + 1] - cdf[k]);
-        (ln_dmin + range32 * p).exp() * inv_dmax
+        fast_math::exp(ln_dmin + range32 * p) * inv_dmax
     });
     Ok(Output { mapped, values })
 }
