@@ -39,7 +39,7 @@ pub fn gaussian_blur(
 ) {
     debug_assert!(src.len() == width * height && dst.len() == src.len());
     debug_assert!(scratch.len() == src.len());
-    if !(sigma_px > 0.0) {
+    if sigma_px.is_nan() || sigma_px <= 0.0 {
         dst.copy_from_slice(src);
         return;
     }
@@ -158,6 +158,7 @@ impl YoungVanVliet {
 
     /// [`Self::filter_row`] on up to [`ROW_GROUP`] consecutive rows (`rows` holds them
     /// back to back, each `width` long), their recursions interleaved.
+    #[allow(clippy::needless_range_loop)] // r indexes both the state and the row offset
     pub fn filter_rows(&self, rows: &mut [f32], width: usize) {
         let n = rows.len() / width;
         if n < ROW_GROUP {

@@ -14,6 +14,7 @@
 //!    original total (their Fig. 6 procedure); if T falls below that tolerance the scene
 //!    range fits the display and a linear scale maps the foveal maximum to L_dmax (their
 //!    fallback).
+//!
 //! Output display values are L_d / L_dmax; colour scaled by L_d / L_w. Needs absolute
 //! luminance (`--luminance-scale` or `prism:cd_m2_per_unit`). The human-contrast-
 //! sensitivity ceiling (their §5, eq. 10) is not implemented.
