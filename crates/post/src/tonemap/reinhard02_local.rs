@@ -87,6 +87,7 @@ pub(crate) fn apply(ctx: &Context) -> Output {
     let mut active = vec![true; n];
     let sharpen = (2f64.powf(phi) * key) as f32;
     let mut s = 1.0f32;
+    let mut scales_done = 0usize;
     for _ in 0..scales {
         gaussian_blur(
             &l,
@@ -97,22 +98,31 @@ pub(crate) fn apply(ctx: &Context) -> Output {
             centre_sigma_px(s * SCALE_RATIO),
         );
         let denominator_offset = sharpen / (s * s);
-        selected
+        let still_active: usize = selected
             .par_chunks_mut(CHUNK)
             .zip(active.par_chunks_mut(CHUNK))
             .zip(v1.par_chunks(CHUNK).zip(v2.par_chunks(CHUNK)))
-            .for_each(|((sel, act), (a, b))| {
+            .map(|((sel, act), (a, b))| {
+                let mut n = 0;
                 for k in 0..sel.len() {
                     if act[k] {
                         let v = (a[k] - b[k]) / (denominator_offset + a[k]);
                         if v.abs() < epsilon {
                             sel[k] = a[k];
+                            n += 1;
                         } else {
                             act[k] = false;
                         }
                     }
                 }
-            });
+                n
+            })
+            .sum();
+        scales_done += 1;
+        // Every pixel has found its scale: larger scales cannot change the result.
+        if still_active == 0 {
+            break;
+        }
         std::mem::swap(&mut v1, &mut v2);
         s *= SCALE_RATIO;
     }
@@ -128,6 +138,7 @@ pub(crate) fn apply(ctx: &Context) -> Output {
             ("phi", phi),
             ("epsilon", epsilon as f64),
             ("scales", scales as f64),
+            ("scales_evaluated", scales_done as f64),
         ],
     }
 }
