@@ -1,7 +1,8 @@
 //! prism-post: the image type, EXR (RGB, AOV layers, spectral layout of Fichet et al. 2021),
 //! Radiance RGBE and PNG I/O, tone operators and image metrics.
 //!
-//! Data flow (DESIGN.md): white balance → gamut mapping → tone operator → display encoding.
+//! File pipeline (`tonemap_file`): read → exposure → white balance → tone operator →
+//! gamut mapping → display encoding.
 
 pub mod colour;
 pub mod error;
@@ -12,8 +13,12 @@ pub use error::{PostError, Result};
 pub use image::{AovLayer, Image};
 pub mod metrics;
 pub mod pipeline;
+pub mod sheet;
 pub mod tonemap;
 
 pub use metrics::{compare, Comparison};
-pub use pipeline::{compare_files, tonemap_file, TonemapFileReport, TonemapOptions};
+pub use pipeline::{
+    compare_files, tonemap_file, OperatorChoice, TonemapFileReport, TonemapOptions, TonemapTimings,
+};
+pub use sheet::{contact_sheet, contact_sheet_with_reports, ContactSheet};
 pub use tonemap::{ToneOperator, ToneParams, ToneReport, ToneResult};

@@ -1,27 +1,102 @@
 //! File-to-file entry points for the CLI (`prism tonemap`, `prism compare`), which stays a
 //! thin wrapper: parse arguments, call these, print the serialisable report.
-//! Pipeline (DESIGN.md): read → convert to the target primaries → tone operator →
-//! per-channel clip to [0, 1] (the only gamut method so far) → write (EXR: linear display
-//! values; PNG: encoded with the target's transfer function).
+//!
+//! `tonemap_file` order: read → exposure (× 2^EV) → white balance
+//! ([`crate::colour::apply_white_balance`], Bradford) → tone operator (or, for `--op all`,
+//! the contact sheet of every operator) → gamut mapping into the target
+//! ([`crate::colour::map_gamut`], fraction outside reported) → write. An EXR output holds
+//! linear display values of the target in [0, 1]; a PNG is encoded with the target's
+//! transfer function.
 
+use std::collections::BTreeMap;
 use std::path::Path;
+use std::time::Instant;
 
-use prism_spectrum::rgb_space::RgbColorSpace;
+use prism_spectrum::AdaptationMethod;
 use rayon::prelude::*;
 use serde::Serialize;
 
+use crate::colour::{apply_white_balance, map_gamut, GamutMethod, GamutTarget, WhiteBalance};
 use crate::error::{PostError, Result};
-use crate::io::{convert_pixels, read_image, write_image};
+use crate::io::{read_image, write_image};
 use crate::metrics::{compare, Comparison};
+use crate::sheet::{contact_sheet_with_reports, SheetFailure};
 use crate::tonemap::{ToneOperator, ToneParams, ToneReport};
 
-/// Options of `prism tonemap`.
+/// `--op NAME` or `--op all` (contact sheet).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum OperatorChoice {
+    One(ToneOperator),
+    /// Every operator of [`ToneOperator::ALL`] on one labelled contact sheet.
+    All,
+}
+
+impl OperatorChoice {
+    /// `all` or an operator name (errors list the valid names).
+    pub fn parse(name: &str) -> Result<Self> {
+        if name.trim().eq_ignore_ascii_case("all") {
+            Ok(Self::All)
+        } else {
+            ToneOperator::from_name(name.trim()).map(Self::One)
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::One(op) => op.name(),
+            Self::All => "all",
+        }
+    }
+}
+
+impl From<ToneOperator> for OperatorChoice {
+    fn from(op: ToneOperator) -> Self {
+        Self::One(op)
+    }
+}
+
+/// Options of `prism tonemap` (CLI defaults in [`Default`]: `--wb none`, `--gamut clip`,
+/// `--target srgb`, `--exposure 0`).
 #[derive(Debug, Clone)]
 pub struct TonemapOptions {
-    pub operator: ToneOperator,
-    pub params: ToneParams,
-    /// Output primaries (`--target srgb|p3|rec2020`).
-    pub target: RgbColorSpace,
+    pub operator: OperatorChoice,
+    /// `--param key=value` (checked against the operator's `ParamSpec`s).
+    pub params: BTreeMap<String, f64>,
+    /// `--wb METHOD`.
+    pub wb: WhiteBalance,
+    /// `--gamut METHOD`.
+    pub gamut: GamutMethod,
+    /// `--target srgb|p3|rec2020`: output primaries and, for PNG, transfer function.
+    pub target: GamutTarget,
+    /// `--exposure EV`: input × 2^EV before white balance.
+    pub exposure_ev: f64,
+    /// `--luminance-scale CD_M2`: cd/m² per unit, overriding `prism:cd_m2_per_unit`.
+    pub luminance_scale_cd_m2: Option<f64>,
+}
+
+impl Default for TonemapOptions {
+    fn default() -> Self {
+        Self {
+            operator: OperatorChoice::One(ToneOperator::Reinhard02),
+            params: BTreeMap::new(),
+            wb: WhiteBalance::None,
+            gamut: GamutMethod::Clip,
+            target: GamutTarget::Srgb,
+            exposure_ev: 0.0,
+            luminance_scale_cd_m2: None,
+        }
+    }
+}
+
+/// Wall-clock milliseconds of each stage.
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct TonemapTimings {
+    pub read_ms: f64,
+    pub exposure_white_balance_ms: f64,
+    pub tone_ms: f64,
+    pub gamut_ms: f64,
+    pub write_ms: f64,
+    pub total_ms: f64,
 }
 
 /// What `prism tonemap --json` prints.
@@ -29,50 +104,144 @@ pub struct TonemapOptions {
 pub struct TonemapFileReport {
     pub input: String,
     pub output: String,
+    /// Output size (the sheet's for `--op all`).
     pub width: usize,
     pub height: usize,
+    /// `NAME` or `all`.
+    pub operator: &'static str,
+    pub params: BTreeMap<String, f64>,
+    pub exposure_ev: f64,
+    pub luminance_scale_cd_m2: Option<f64>,
+    pub white_balance: String,
+    /// Estimated scene white (CIE 1931 xy) when white balance ran.
+    pub white_balance_source_xy: Option<[f64; 2]>,
+    pub gamut_method: &'static str,
     pub target: &'static str,
-    pub tone: ToneReport,
-    /// Fraction of pixels with a channel outside [0, 1] before clipping.
-    pub clipped_fraction: f64,
+    /// One report per operator that ran (one, or every operator of the sheet).
+    pub tone: Vec<ToneReport>,
+    /// Sheet operators that produced no tile (e.g. absolute ones without a scale).
+    pub failures: Vec<SheetFailure>,
+    /// Input pixels with a NaN/∞ component (reported, mapped as black).
+    pub non_finite_pixels: u64,
+    /// Fraction of pixels outside the target gamut before gamut mapping.
+    pub gamut_fraction_outside: f64,
+    pub timings: TonemapTimings,
 }
 
-/// Tone-maps `input` into `output` (format from its extension).
+fn ms(t: Instant) -> f64 {
+    t.elapsed().as_secs_f64() * 1e3
+}
+
+/// Tone-maps `input` into `output` (formats from the extensions); see the module text for
+/// the order of stages. Errors name the file or the option at fault; nothing panics on
+/// user input.
 pub fn tonemap_file(
     input: &Path,
     output: &Path,
     options: &TonemapOptions,
 ) -> Result<TonemapFileReport> {
+    let start = Instant::now();
+    let t = Instant::now();
     let mut image = read_image(input)?;
-    let source = image.color_space.clone();
-    convert_pixels(image.pixels_mut(), &source, &options.target);
-    image.color_space = options.target.clone();
-    let result = options
-        .operator
-        .apply(&image, &options.params)
-        .map_err(|e| match e {
-            PostError::Invalid(m) => PostError::format(input, m),
-            other => other,
-        })?;
-    let mut out = result.image;
-    let clipped = out
-        .pixels_mut()
-        .par_iter_mut()
-        .map(|p| {
-            let outside = p.iter().any(|c| !(0.0..=1.0).contains(c));
-            *p = p.map(|c| c.clamp(0.0, 1.0));
-            outside as u64
-        })
-        .sum::<u64>();
+    let read_ms = ms(t);
+
+    let t = Instant::now();
+    if !options.exposure_ev.is_finite() {
+        return Err(PostError::invalid(format!(
+            "--exposure {}: expected a finite number of stops",
+            options.exposure_ev
+        )));
+    }
+    if options.exposure_ev != 0.0 {
+        let factor = 2f64.powf(options.exposure_ev) as f32;
+        image
+            .pixels_mut()
+            .par_iter_mut()
+            .for_each(|p| *p = p.map(|c| c * factor));
+    }
+    let space = image.color_space.clone();
+    let wb_source_xy = if options.wb == WhiteBalance::None {
+        None
+    } else {
+        let report = apply_white_balance(
+            image.pixels_mut(),
+            &space,
+            &options.wb,
+            AdaptationMethod::Bradford,
+        )
+        .map_err(|e| PostError::format(input, e.to_string()))?;
+        Some(report.source_white_xy)
+    };
+    let exposure_white_balance_ms = ms(t);
+
+    let params = ToneParams {
+        exposure_ev: 0.0,
+        luminance_scale_cd_m2: options.luminance_scale_cd_m2,
+        values: options.params.clone(),
+    };
+    let in_file = |e: PostError| match e {
+        PostError::Invalid(m) => PostError::format(input, m),
+        other => other,
+    };
+    let t = Instant::now();
+    let (mut out, tone, failures, sheet_outside) = match options.operator {
+        OperatorChoice::One(op) => {
+            let result = op.apply(&image, &params).map_err(in_file)?;
+            (result.image, vec![result.report], Vec::new(), None)
+        }
+        OperatorChoice::All => {
+            let sheet = contact_sheet_with_reports(
+                &image,
+                &ToneOperator::ALL,
+                &params,
+                options.target,
+                options.gamut,
+            )
+            .map_err(in_file)?;
+            (
+                sheet.image,
+                sheet.reports,
+                sheet.failures,
+                Some(sheet.gamut_fraction_outside),
+            )
+        }
+    };
+    let tone_ms = ms(t);
+
+    let t = Instant::now();
+    let out_space = out.color_space.clone();
+    let gamut = map_gamut(out.pixels_mut(), &out_space, options.target, options.gamut);
+    out.color_space = options.target.space();
+    let gamut_ms = ms(t);
+
+    let t = Instant::now();
     write_image(output, &out)?;
+    let write_ms = ms(t);
     Ok(TonemapFileReport {
         input: input.display().to_string(),
         output: output.display().to_string(),
         width: out.width(),
         height: out.height(),
-        target: options.target.name,
-        clipped_fraction: clipped as f64 / out.pixels().len() as f64,
-        tone: result.report,
+        operator: options.operator.name(),
+        params: options.params.clone(),
+        exposure_ev: options.exposure_ev,
+        luminance_scale_cd_m2: options.luminance_scale_cd_m2,
+        white_balance: options.wb.name(),
+        white_balance_source_xy: wb_source_xy,
+        gamut_method: options.gamut.name(),
+        target: options.target.name(),
+        non_finite_pixels: tone.first().map_or(0, |r| r.non_finite_pixels),
+        tone,
+        failures,
+        gamut_fraction_outside: sheet_outside.unwrap_or(gamut.fraction_outside),
+        timings: TonemapTimings {
+            read_ms,
+            exposure_white_balance_ms,
+            tone_ms,
+            gamut_ms,
+            write_ms,
+            total_ms: ms(start),
+        },
     })
 }
 

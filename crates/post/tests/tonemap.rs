@@ -144,9 +144,8 @@ fn tonemap_file_writes_png_and_exr_and_compare_files_reads_them_back() {
     )
     .unwrap();
     let options = TonemapOptions {
-        operator: ToneOperator::Reinhard02,
-        params: ToneParams::default(),
-        target: RgbColorSpace::srgb(),
+        operator: ToneOperator::Reinhard02.into(),
+        ..Default::default()
     };
     let exr_out = dir.join("out.exr");
     let png_out = dir.join("out.png");
@@ -188,6 +187,78 @@ fn tonemap_file_writes_png_and_exr_and_compare_files_reads_them_back() {
     let err = compare_files(&small, &exr_out).unwrap_err().to_string();
     assert!(
         err.contains("small.exr") && err.contains("out.exr"),
+        "{err}"
+    );
+}
+
+#[test]
+fn tonemap_file_runs_exposure_white_balance_operator_gamut_and_the_contact_sheet() {
+    use prism_post::colour::{GamutMethod, GamutTarget, WhiteBalance};
+    use prism_post::{io, tonemap_file, OperatorChoice, TonemapOptions};
+    let dir = std::env::temp_dir().join(format!("prism-post-sheet-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let input = dir.join("in.exr");
+    let (w, h) = (96, 54);
+    let pixels = (0..w * h)
+        .map(|i| {
+            let v = 10f32.powf(-2.0 + 4.0 * (i % w) as f32 / (w - 1) as f32);
+            [v, 0.8 * v, 0.3 * v]
+        })
+        .collect();
+    let mut img = Image::new(w, h, pixels, RgbColorSpace::srgb()).unwrap();
+    img.pixels_mut()[0] = [f32::NAN, 1.0, 1.0];
+    io::write_image(&input, &img).unwrap();
+
+    // Linear operator, exposure −3 EV: EXR holds clip(2^−3 · x) (same space, clip).
+    let exr_out = dir.join("linear.exr");
+    let options = TonemapOptions {
+        operator: OperatorChoice::parse("linear").unwrap(),
+        exposure_ev: -3.0,
+        ..Default::default()
+    };
+    let report = tonemap_file(&input, &exr_out, &options).unwrap();
+    let out = io::read_image(&exr_out).unwrap();
+    for (o, i) in out.pixels().iter().zip(img.pixels()).skip(1) {
+        for c in 0..3 {
+            assert!((o[c] - (i[c] / 8.0).clamp(0.0, 1.0)).abs() <= 1e-6 * i[c].max(1.0));
+        }
+    }
+    assert_eq!(report.non_finite_pixels, 1);
+    assert!(report.gamut_fraction_outside > 0.1 && report.gamut_fraction_outside < 0.9);
+
+    // Grey world, P3 target, local gamut mapping, the contact sheet of every operator.
+    let sheet_out = dir.join("sheet.png");
+    let options = TonemapOptions {
+        operator: OperatorChoice::parse("ALL").unwrap(),
+        wb: WhiteBalance::parse("grey-world").unwrap(),
+        gamut: GamutMethod::parse("local-lch").unwrap(),
+        target: GamutTarget::parse("p3").unwrap(),
+        luminance_scale_cd_m2: Some(100.0),
+        ..Default::default()
+    };
+    let report = tonemap_file(&input, &sheet_out, &options).unwrap();
+    assert_eq!(report.tone.len(), ToneOperator::ALL.len());
+    assert!(report.failures.is_empty());
+    assert!(report.white_balance_source_xy.is_some());
+    let json = serde_json::to_string(&report).unwrap();
+    for key in [
+        "\"operator\":\"all\"",
+        "\"target\":\"p3\"",
+        "timings",
+        "tone_ms",
+    ] {
+        assert!(json.contains(key), "{key} in {json}");
+    }
+    let sheet = io::read_image(&sheet_out).unwrap();
+    assert_eq!(
+        (sheet.width(), sheet.height()),
+        (report.width, report.height)
+    );
+    assert!(sheet.width() > 4 * w);
+    // Unknown names fail with the list of valid ones.
+    let err = OperatorChoice::parse("reinhard03").unwrap_err().to_string();
+    assert!(
+        err.contains("reinhard02-local") && err.contains("durand02"),
         "{err}"
     );
 }

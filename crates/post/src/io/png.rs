@@ -61,6 +61,10 @@ pub fn write_png(path: &Path, image: &Image, depth: PngBitDepth) -> Result<()> {
     write_stream_atomically(path, |out| {
         let mut encoder = Encoder::new(out, w as u32, h as u32);
         encoder.set_color(ColorType::Rgb);
+        // Fast deflate (fdeflate): lossless, ~2× larger files than the default level but
+        // several times faster to write — a 4K 16-bit frame is ~50 MB of samples and the
+        // default zlib level dominated `tonemap_file`'s time (docs/post.md, benchmark).
+        encoder.set_compression(png::Compression::Fast);
         encoder.set_depth(match depth {
             PngBitDepth::Eight => BitDepth::Eight,
             PngBitDepth::Sixteen => BitDepth::Sixteen,

@@ -59,7 +59,7 @@ pub(crate) fn apply(ctx: &Context) -> Output {
     let input = from_rows(INPUT_ROWS) * to_srgb;
     let output = from_rows(OUTPUT_ROWS);
     Output {
-        mapped: map_pixels(ctx.image, ctx.exposure, |c| {
+        mapped: map_pixels(ctx, ctx.exposure, |c| {
             let v = input * Vec3::from(c);
             let f = Vec3::new(rrt_odt_fit(v.x), rrt_odt_fit(v.y), rrt_odt_fit(v.z));
             let srgb = (output * f).clamp(Vec3::ZERO, Vec3::ONE);

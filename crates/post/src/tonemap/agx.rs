@@ -10,6 +10,7 @@
 use glam::{Mat3, Vec3};
 
 use super::aces::srgb_matrices;
+use super::fast_math;
 use super::pixels::map_pixels;
 use super::{Context, OperatorInfo, Output};
 
@@ -60,7 +61,7 @@ pub fn contrast(x: f32) -> f32 {
 
 /// Log2 encoding of one channel onto [0, 1].
 pub fn log_encode(v: f32) -> f32 {
-    (v.log2().clamp(EV_MIN, EV_MAX) - EV_MIN) / (EV_MAX - EV_MIN)
+    (fast_math::log2(v).clamp(EV_MIN, EV_MAX) - EV_MIN) / (EV_MAX - EV_MIN)
 }
 
 pub(crate) fn apply(ctx: &Context) -> Output {
@@ -68,7 +69,7 @@ pub(crate) fn apply(ctx: &Context) -> Output {
     let inset = Mat3::from_cols_array(&INSET) * to_srgb;
     let outset = Mat3::from_cols_array(&OUTSET);
     Output {
-        mapped: map_pixels(ctx.image, ctx.exposure, |c| {
+        mapped: map_pixels(ctx, ctx.exposure, |c| {
             let v = inset * Vec3::from(c);
             let s = Vec3::new(
                 contrast(log_encode(v.x)),
@@ -76,7 +77,11 @@ pub(crate) fn apply(ctx: &Context) -> Output {
                 contrast(log_encode(v.z)),
             );
             let d = (outset * s).max(Vec3::ZERO);
-            let linear = Vec3::new(d.x.powf(2.2), d.y.powf(2.2), d.z.powf(2.2));
+            let linear = Vec3::new(
+                fast_math::powf(d.x, 2.2),
+                fast_math::powf(d.y, 2.2),
+                fast_math::powf(d.z, 2.2),
+            );
             (from_srgb * linear).to_array()
         }),
         values: vec![],

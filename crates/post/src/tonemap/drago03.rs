@@ -5,6 +5,7 @@
 //! b = 0.85 and L_dmax = 100 cd/m² (so the prefactor is 1/log10(L_wmax + 1) and the
 //! brightest pixel maps to 1).
 
+use super::fast_math;
 use super::pixels::{luminance_stats, map_luminance};
 use super::{Context, OperatorInfo, Output, ParamSpec};
 
@@ -48,9 +49,10 @@ pub(crate) fn apply(ctx: &Context) -> Output {
     } else {
         0.0
     };
-    let mapped = map_luminance(ctx.image, ctx.exposure, ctx.weights, |l| {
+    let mapped = map_luminance(ctx, ctx.exposure, ctx.weights, |l| {
         let lw = l * inv_avg;
-        prefactor * lw.ln_1p() / (2.0 + 8.0 * (lw * inv_max).powf(exponent)).ln()
+        prefactor * fast_math::ln(1.0 + lw)
+            / fast_math::ln(2.0 + 8.0 * fast_math::powf(lw * inv_max, exponent))
     });
     Output {
         mapped,

@@ -86,7 +86,7 @@ pub(crate) fn apply(ctx: &Context) -> Result<Output> {
     let photopic = (m_p / l_dmax) as f32;
     let scotopic = (k * m_s / l_dmax) as f32;
     let m = ctx.image.color_space.rgb_to_xyz.as_mat3();
-    let mapped = map_pixels(ctx.image, absolute, |c| {
+    let mapped = map_pixels(ctx, absolute, |c| {
         let xyz = m * glam::Vec3::from(c);
         let l_scot = if xyz.x > 0.0 {
             (xyz.y * (1.33 * (1.0 + (xyz.y + xyz.z) / xyz.x) - 1.68)).max(0.0)

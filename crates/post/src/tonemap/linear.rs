@@ -13,7 +13,7 @@ pub(crate) static INFO: OperatorInfo = OperatorInfo {
 
 pub(crate) fn apply(ctx: &Context) -> Output {
     Output {
-        mapped: map_pixels(ctx.image, ctx.exposure, |c| c),
+        mapped: map_pixels(ctx, ctx.exposure, |c| c),
         values: vec![("scale", ctx.exposure as f64)],
     }
 }

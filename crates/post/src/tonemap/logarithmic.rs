@@ -3,6 +3,7 @@
 //! ch. 3, "logarithmic mapping"; the base of Drago et al. 2003). The brightest pixel maps
 //! to 1 when q = k.
 
+use super::fast_math;
 use super::pixels::{luminance_stats, map_luminance};
 use super::{Context, OperatorInfo, Output, ParamSpec};
 
@@ -41,8 +42,8 @@ pub(crate) fn apply(ctx: &Context) -> Output {
     let q32 = q as f32;
     Output {
         // log10 a / log10 b = ln a / ln b.
-        mapped: map_luminance(ctx.image, ctx.exposure, ctx.weights, |l| {
-            (q32 * l).ln_1p() * inv
+        mapped: map_luminance(ctx, ctx.exposure, ctx.weights, |l| {
+            fast_math::ln(1.0 + q32 * l) * inv
         }),
         values: vec![("max_luminance", stats.max), ("q", q), ("k", k)],
     }

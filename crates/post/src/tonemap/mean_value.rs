@@ -28,7 +28,7 @@ pub(crate) fn apply(ctx: &Context) -> Output {
         0.0
     };
     Output {
-        mapped: map_luminance(ctx.image, ctx.exposure, ctx.weights, |l| factor * l),
+        mapped: map_luminance(ctx, ctx.exposure, ctx.weights, |l| factor * l),
         values: vec![("mean_luminance", stats.mean), ("scale", factor as f64)],
     }
 }

@@ -6,17 +6,23 @@
 
 mod aces;
 mod agx;
+pub mod bilateral_grid;
 mod drago03;
+mod durand02;
 mod exponential;
+pub mod fast_math;
 mod ferwerda96;
+pub mod gaussian;
 mod linear;
 mod logarithmic;
 mod mean_value;
 pub mod pixels;
 mod reinhard02;
+mod reinhard02_local;
 mod schlick94;
 mod tumblin_rushmeier;
 mod ward94;
+mod ward97_histogram;
 
 use std::collections::BTreeMap;
 
@@ -47,7 +53,7 @@ pub struct OperatorInfo {
     pub params: &'static [ParamSpec],
 }
 
-/// The tone operators implemented so far.
+/// The tone operators (CLI names in each file's `INFO`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ToneOperator {
     Linear,
@@ -59,7 +65,10 @@ pub enum ToneOperator {
     Schlick94,
     TumblinRushmeier,
     Reinhard02,
+    Reinhard02Local,
     Ferwerda96,
+    Ward97Histogram,
+    Durand02,
     Aces,
     Agx,
 }
@@ -114,9 +123,24 @@ pub(crate) struct Context<'a> {
     pub exposure: f32,
     /// Y = w · RGB in the image's colour space.
     pub weights: [f32; 3],
+    /// An output buffer to reuse (from [`ToneOperator::apply_into`]).
+    pub buffer: std::sync::Mutex<Option<Vec<[f32; 3]>>>,
 }
 
 impl Context<'_> {
+    /// The output pixel buffer, `n` long: the reused one when given, else a new one.
+    /// Its contents are overwritten by the mapping pass.
+    pub fn output_buffer(&self, n: usize) -> Vec<[f32; 3]> {
+        let reused = self.buffer.lock().ok().and_then(|mut b| b.take());
+        match reused {
+            Some(mut v) => {
+                v.resize(n, [0.0; 3]);
+                v
+            }
+            None => vec![[0.0; 3]; n],
+        }
+    }
+
     /// The parameter's value: the override if given, else its default (`None` when the
     /// default is computed from the image).
     pub fn param(&self, name: &str) -> Option<f64> {
@@ -157,7 +181,7 @@ pub(crate) struct Output {
 }
 
 impl ToneOperator {
-    pub const ALL: [ToneOperator; 12] = [
+    pub const ALL: [ToneOperator; 15] = [
         ToneOperator::Linear,
         ToneOperator::MeanValue,
         ToneOperator::Ward94,
@@ -167,7 +191,10 @@ impl ToneOperator {
         ToneOperator::Schlick94,
         ToneOperator::TumblinRushmeier,
         ToneOperator::Reinhard02,
+        ToneOperator::Reinhard02Local,
         ToneOperator::Ferwerda96,
+        ToneOperator::Ward97Histogram,
+        ToneOperator::Durand02,
         ToneOperator::Aces,
         ToneOperator::Agx,
     ];
@@ -183,6 +210,9 @@ impl ToneOperator {
             ToneOperator::Schlick94 => &schlick94::INFO,
             ToneOperator::TumblinRushmeier => &tumblin_rushmeier::INFO,
             ToneOperator::Reinhard02 => &reinhard02::INFO,
+            ToneOperator::Reinhard02Local => &reinhard02_local::INFO,
+            ToneOperator::Ward97Histogram => &ward97_histogram::INFO,
+            ToneOperator::Durand02 => &durand02::INFO,
             ToneOperator::Ferwerda96 => &ferwerda96::INFO,
             ToneOperator::Aces => &aces::INFO,
             ToneOperator::Agx => &agx::INFO,
@@ -255,6 +285,19 @@ impl ToneOperator {
 
     /// Tone-maps `image` to linear display values in its own colour space.
     pub fn apply(self, image: &Image, params: &ToneParams) -> Result<ToneResult> {
+        self.apply_into(image, params, Vec::new())
+    }
+
+    /// As [`ToneOperator::apply`], writing into `buffer` (resized to the pixel count; its
+    /// old contents are ignored) instead of allocating: pass the pixels of a previous
+    /// result (`result.image.into_pixels()`) to tone-map many frames or operators without
+    /// allocating and page-faulting a new output each time.
+    pub fn apply_into(
+        self,
+        image: &Image,
+        params: &ToneParams,
+        buffer: Vec<[f32; 3]>,
+    ) -> Result<ToneResult> {
         self.validate(params)?;
         let ctx = Context {
             image,
@@ -262,6 +305,7 @@ impl ToneOperator {
             info: self.info(),
             exposure: 2f64.powf(params.exposure_ev) as f32,
             weights: image.luminance_weights(),
+            buffer: std::sync::Mutex::new((buffer.capacity() > 0).then_some(buffer)),
         };
         let output = match self {
             ToneOperator::Linear => linear::apply(&ctx),
@@ -273,6 +317,9 @@ impl ToneOperator {
             ToneOperator::Schlick94 => schlick94::apply(&ctx),
             ToneOperator::TumblinRushmeier => tumblin_rushmeier::apply(&ctx)?,
             ToneOperator::Reinhard02 => reinhard02::apply(&ctx),
+            ToneOperator::Reinhard02Local => reinhard02_local::apply(&ctx),
+            ToneOperator::Ward97Histogram => ward97_histogram::apply(&ctx)?,
+            ToneOperator::Durand02 => durand02::apply(&ctx),
             ToneOperator::Ferwerda96 => ferwerda96::apply(&ctx)?,
             ToneOperator::Aces => aces::apply(&ctx),
             ToneOperator::Agx => agx::apply(&ctx),

@@ -6,6 +6,8 @@
 
 use rayon::prelude::*;
 
+use super::fast_math;
+use super::Context;
 use crate::image::Image;
 
 /// Pixels per rayon task (≈ 48 KiB of RGB f32: big enough to amortise scheduling, small
@@ -26,6 +28,37 @@ pub(crate) fn sanitise(p: [f32; 3], scale: f32) -> [f32; 3] {
         (p[1] * scale).max(0.0),
         (p[2] * scale).max(0.0),
     ]
+}
+
+/// Independent accumulators per chunk (8 f32 = one AVX register).
+const LANES: usize = 8;
+
+/// `w · sanitise(p, scale)` without branches (a select instead), so loops over it
+/// vectorise.
+#[inline(always)]
+pub(crate) fn sanitised_luminance(p: [f32; 3], scale: f32, w: [f32; 3]) -> f32 {
+    let finite = p[0].is_finite() & p[1].is_finite() & p[2].is_finite();
+    // f32::max returns the other operand for NaN, so every term is ≥ 0 or +∞.
+    let l = w[0] * (p[0] * scale).max(0.0)
+        + w[1] * (p[1] * scale).max(0.0)
+        + w[2] * (p[2] * scale).max(0.0);
+    if finite {
+        l
+    } else {
+        0.0
+    }
+}
+
+/// Counts (non-finite, negative) input pixels of a chunk (integer sums, vectorisable).
+#[inline(always)]
+fn count_problems(chunk: &[[f32; 3]]) -> (u64, u64) {
+    let (mut non_finite, mut negative) = (0u32, 0u32);
+    for p in chunk {
+        let finite = p[0].is_finite() & p[1].is_finite() & p[2].is_finite();
+        non_finite += !finite as u32;
+        negative += (finite & ((p[0] < 0.0) | (p[1] < 0.0) | (p[2] < 0.0))) as u32;
+    }
+    (non_finite as u64, negative as u64)
 }
 
 #[inline(always)]
@@ -71,28 +104,54 @@ impl Acc {
     }
 }
 
-/// Statistics of `w · sanitise(p, scale)` over the image (one parallel pass).
+/// Statistics of `w · sanitise(p, scale)` over the image (one parallel pass; the log sum
+/// uses [`fast_math::ln`], error ≤ 3e-7 per term plus rounding, so ~3e-7 relative on
+/// L_avg). Per chunk, luminance goes to a stack array first and the sums run in
+/// [`LANES`] independent lanes, so the compiler can vectorise both loops.
 pub(crate) fn luminance_stats(image: &Image, scale: f32, w: [f32; 3]) -> LuminanceStats {
     let delta = LOG_AVERAGE_DELTA as f32;
     let acc = image
         .pixels()
         .par_chunks(CHUNK)
         .map(|chunk| {
-            let mut a = Acc::EMPTY;
-            // f32 partial sums per chunk (≤ 4096 terms), f64 across chunks.
-            let (mut sum_log, mut sum) = (0.0f32, 0.0f32);
-            for p in chunk {
-                let l = dot(w, sanitise(*p, scale));
-                sum_log += (delta + l).ln();
-                sum += l;
-                a.max = a.max.max(l);
-                if l > 0.0 {
-                    a.min_positive = a.min_positive.min(l);
+            let mut lum = [0.0f32; CHUNK];
+            let lum = &mut lum[..chunk.len()];
+            for (l, p) in lum.iter_mut().zip(chunk) {
+                *l = sanitised_luminance(*p, scale, w);
+            }
+            // f32 partial sums per lane (≤ 512 terms), f64 across lanes and chunks.
+            let mut sum_log = [0.0f32; LANES];
+            let mut sum = [0.0f32; LANES];
+            let mut max = [0.0f32; LANES];
+            let mut min_positive = [f32::INFINITY; LANES];
+            let mut lanes = lum.chunks_exact(LANES);
+            for group in &mut lanes {
+                for k in 0..LANES {
+                    let l = group[k];
+                    sum_log[k] += fast_math::ln(delta + l);
+                    sum[k] += l;
+                    max[k] = max[k].max(l);
+                    min_positive[k] = if l > 0.0 {
+                        min_positive[k].min(l)
+                    } else {
+                        min_positive[k]
+                    };
                 }
             }
-            a.sum_log = sum_log as f64;
-            a.sum = sum as f64;
-            a
+            for (k, l) in lanes.remainder().iter().enumerate() {
+                sum_log[k] += fast_math::ln(delta + l);
+                sum[k] += l;
+                max[k] = max[k].max(*l);
+                if *l > 0.0 {
+                    min_positive[k] = min_positive[k].min(*l);
+                }
+            }
+            Acc {
+                sum_log: sum_log.iter().map(|v| *v as f64).sum(),
+                sum: sum.iter().map(|v| *v as f64).sum(),
+                max: max.iter().fold(0.0f32, |a, b| a.max(*b)),
+                min_positive: min_positive.iter().fold(f32::INFINITY, |a, b| a.min(*b)),
+            }
         })
         .reduce(|| Acc::EMPTY, Acc::merge);
     let n = image.pixels().len() as f64;
@@ -119,39 +178,107 @@ pub(crate) struct Mapped {
 /// saturation kept, Reinhard et al. 2002 §3 "colour scaled by L_d / L_w"); black stays
 /// black and any non-finite result becomes 0.
 pub(crate) fn map_luminance(
-    image: &Image,
+    ctx: &Context,
     scale: f32,
     w: [f32; 3],
     curve: impl Fn(f32) -> f32 + Sync,
 ) -> Mapped {
-    map_pixels(image, scale, |c| {
-        let l = dot(w, c);
-        if l > 0.0 {
-            let ratio = curve(l) / l;
-            [c[0] * ratio, c[1] * ratio, c[2] * ratio]
-        } else {
-            [0.0; 3]
-        }
-    })
+    map_luminance_indexed(ctx, scale, w, |_, l| curve(l))
 }
 
 /// Maps every sanitised pixel through `f`; non-finite results become 0.
 pub(crate) fn map_pixels(
-    image: &Image,
+    ctx: &Context,
     scale: f32,
     f: impl Fn([f32; 3]) -> [f32; 3] + Sync,
 ) -> Mapped {
-    let mut pixels = vec![[0.0f32; 3]; image.pixels().len()];
+    map_pixels_indexed(ctx, scale, |_, c| f(c))
+}
+
+/// The sanitised luminance plane `w · sanitise(p, scale)` (row-major), for local operators.
+pub(crate) fn luminance_plane(image: &Image, scale: f32, w: [f32; 3]) -> Vec<f32> {
+    let mut plane = vec![0.0f32; image.pixels().len()];
+    plane
+        .par_chunks_mut(CHUNK)
+        .zip(image.pixels().par_chunks(CHUNK))
+        .for_each(|(o, i)| {
+            for (o, p) in o.iter_mut().zip(i) {
+                *o = dot(w, sanitise(*p, scale));
+            }
+        });
+    plane
+}
+
+/// As [`map_luminance`], with the pixel index passed to `curve` (local operators look up
+/// their per-pixel adaptation by index). Per chunk: luminance into a stack array, the
+/// curve's ratio L_d / L over that array (a tight loop the compiler can vectorise when the
+/// curve is branch-free), then the colour scaled by the ratio.
+pub(crate) fn map_luminance_indexed(
+    ctx: &Context,
+    scale: f32,
+    w: [f32; 3],
+    curve: impl Fn(usize, f32) -> f32 + Sync,
+) -> Mapped {
+    let image = ctx.image;
+    let mut pixels = ctx.output_buffer(image.pixels().len());
     let (non_finite, negative) = pixels
         .par_chunks_mut(CHUNK)
         .zip(image.pixels().par_chunks(CHUNK))
-        .map(|(o, i)| {
+        .enumerate()
+        .map(|(k, (o, i))| {
+            let mut ratio = [0.0f32; CHUNK];
+            let ratio = &mut ratio[..i.len()];
+            for (r, p) in ratio.iter_mut().zip(i) {
+                *r = sanitised_luminance(*p, scale, w);
+            }
+            let base = k * CHUNK;
+            for (j, r) in ratio.iter_mut().enumerate() {
+                let l = *r;
+                let v = curve(base + j, l) / l;
+                *r = if l > 0.0 && v.is_finite() { v } else { 0.0 };
+            }
+            for ((o, p), r) in o.iter_mut().zip(i).zip(ratio.iter()) {
+                let finite = p[0].is_finite() & p[1].is_finite() & p[2].is_finite();
+                let r = if finite { *r } else { 0.0 };
+                // r = 0 for non-finite pixels; max(0) clamps negatives (and NaN·0).
+                *o = [
+                    ((p[0] * scale).max(0.0) * r).max(0.0),
+                    ((p[1] * scale).max(0.0) * r).max(0.0),
+                    ((p[2] * scale).max(0.0) * r).max(0.0),
+                ];
+                if !o.iter().all(|c| c.is_finite()) {
+                    *o = [0.0; 3];
+                }
+            }
+            count_problems(i)
+        })
+        .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
+    Mapped {
+        pixels,
+        non_finite_pixels: non_finite,
+        negative_pixels: negative,
+    }
+}
+
+/// Maps every sanitised pixel through `f(index, rgb)`; non-finite results become 0.
+pub(crate) fn map_pixels_indexed(
+    ctx: &Context,
+    scale: f32,
+    f: impl Fn(usize, [f32; 3]) -> [f32; 3] + Sync,
+) -> Mapped {
+    let image = ctx.image;
+    let mut pixels = ctx.output_buffer(image.pixels().len());
+    let (non_finite, negative) = pixels
+        .par_chunks_mut(CHUNK)
+        .zip(image.pixels().par_chunks(CHUNK))
+        .enumerate()
+        .map(|(k, (o, i))| {
             let (mut non_finite, mut negative) = (0u64, 0u64);
-            for (o, p) in o.iter_mut().zip(i) {
+            for (j, (o, p)) in o.iter_mut().zip(i).enumerate() {
                 let finite = p[0].is_finite() && p[1].is_finite() && p[2].is_finite();
                 non_finite += !finite as u64;
                 negative += (finite && (p[0] < 0.0 || p[1] < 0.0 || p[2] < 0.0)) as u64;
-                let v = f(sanitise(*p, scale));
+                let v = f(k * CHUNK + j, sanitise(*p, scale));
                 *o = v.map(|x| if x.is_finite() { x } else { 0.0 });
             }
             (non_finite, negative)

@@ -45,7 +45,7 @@ pub(crate) fn apply(ctx: &Context) -> Output {
         0.0
     };
     let s = scale as f32;
-    let mapped = map_luminance(ctx.image, ctx.exposure, ctx.weights, |lw| {
+    let mapped = map_luminance(ctx, ctx.exposure, ctx.weights, |lw| {
         let l = s * lw;
         l * (1.0 + l * inv_white2) / (1.0 + l)
     });

@@ -41,7 +41,7 @@ pub(crate) fn apply(ctx: &Context) -> Output {
         }
     });
     let (p32, l_max) = (p as f32, stats.max as f32);
-    let mapped = map_luminance(ctx.image, ctx.exposure, ctx.weights, |l| {
+    let mapped = map_luminance(ctx, ctx.exposure, ctx.weights, |l| {
         p32 * l / ((p32 - 1.0) * l + l_max)
     });
     Output {

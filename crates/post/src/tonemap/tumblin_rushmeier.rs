@@ -9,6 +9,7 @@
 //! adaptation luminance, C_max the display contrast. Defaults L_da = 20 cd/m², C_max = 100,
 //! L_dmax = 100 cd/m² (those of Banterle's HDR Toolbox).
 
+use super::fast_math;
 use super::pixels::{luminance_stats, map_luminance};
 use super::{Context, OperatorInfo, Output, ParamSpec};
 use crate::error::Result;
@@ -66,8 +67,8 @@ pub(crate) fn apply(ctx: &Context) -> Result<Output> {
     let factor = (m * l_da / l_dmax) as f32;
     let inv_wa = (1.0 / l_wa) as f32;
     Ok(Output {
-        mapped: map_luminance(ctx.image, absolute, ctx.weights, |l| {
-            factor * (l * inv_wa).powf(exponent)
+        mapped: map_luminance(ctx, absolute, ctx.weights, |l| {
+            factor * fast_math::powf(l * inv_wa, exponent)
         }),
         values: vec![
             ("world_adaptation_cd_m2", l_wa),

@@ -34,7 +34,7 @@ pub(crate) fn apply(ctx: &Context) -> Result<Output> {
     let sf = scale_factor(stats.log_average, l_dmax);
     let factor = (sf / l_dmax) as f32;
     Ok(Output {
-        mapped: map_luminance(ctx.image, absolute, ctx.weights, |l| factor * l),
+        mapped: map_luminance(ctx, absolute, ctx.weights, |l| factor * l),
         values: vec![
             ("world_adaptation_cd_m2", stats.log_average),
             ("scale_factor", sf),

@@ -1,0 +1,291 @@
+//! Contact sheet (`prism tonemap IN --op all -o sheet.png`): one tile per tone operator,
+//! side by side, each labelled with the operator's name and its resolved parameters in a
+//! 5×7 bitmap font ([`font5x7`]).
+//!
+//! Each operator maps the full-resolution image (so local operators see their real
+//! scales); the result is box-downsampled by an integer factor to at most
+//! [`TILE_MAX_WIDTH`] pixels wide, gamut-mapped into the target, and placed on a grid of
+//! ⌈√n⌉ columns. Operators that fail (an absolute operator without a luminance scale) get
+//! a grey tile whose label says why; the sheet itself only fails on bad parameters.
+//! The sheet holds linear display values of the target space in [0, 1].
+
+pub mod font5x7;
+
+use std::collections::BTreeMap;
+
+use serde::Serialize;
+
+use crate::colour::{map_gamut, GamutMethod, GamutTarget};
+use crate::error::{PostError, Result};
+use crate::image::Image;
+use crate::tonemap::{ToneOperator, ToneParams, ToneReport};
+use font5x7::{draw_text, ADVANCE, GLYPH_HEIGHT};
+
+/// Largest tile width in pixels (a 4K input gives 960-pixel tiles, factor 4).
+pub const TILE_MAX_WIDTH: usize = 960;
+/// Gap between tiles and around the sheet, in pixels.
+const GAP_PX: usize = 6;
+/// Background (linear display value), label text and failed-tile colours.
+const BACKGROUND: [f32; 3] = [0.02; 3];
+const TEXT: [f32; 3] = [1.0; 3];
+const FAILED_TILE: [f32; 3] = [0.18; 3];
+
+/// An operator that produced no tile, and why.
+#[derive(Debug, Clone, Serialize)]
+pub struct SheetFailure {
+    pub operator: &'static str,
+    pub error: String,
+}
+
+/// A contact sheet with what each operator reported.
+#[derive(Debug, Clone)]
+pub struct ContactSheet {
+    pub image: Image,
+    pub reports: Vec<ToneReport>,
+    pub failures: Vec<SheetFailure>,
+    /// Fraction of tile pixels outside the target gamut before mapping.
+    pub gamut_fraction_outside: f64,
+}
+
+/// One tile per operator, labelled, gamut-clipped into `target` (see the module text).
+/// Parameters in `params.values` go to the operators that have them.
+pub fn contact_sheet(
+    image: &Image,
+    operators: &[ToneOperator],
+    params: &ToneParams,
+    target: GamutTarget,
+) -> Result<Image> {
+    Ok(contact_sheet_with_reports(image, operators, params, target, GamutMethod::Clip)?.image)
+}
+
+/// [`contact_sheet`] with a chosen gamut method, returning the operators' reports.
+pub fn contact_sheet_with_reports(
+    image: &Image,
+    operators: &[ToneOperator],
+    params: &ToneParams,
+    target: GamutTarget,
+    gamut: GamutMethod,
+) -> Result<ContactSheet> {
+    if operators.is_empty() {
+        return Err(PostError::invalid(
+            "contact sheet: no operators to show".to_string(),
+        ));
+    }
+    // Every --param must belong to at least one operator shown.
+    for name in params.values.keys() {
+        if !operators
+            .iter()
+            .any(|op| op.info().params.iter().any(|p| p.name == name))
+        {
+            return Err(PostError::invalid(format!(
+                "--param {name}: none of the operators on the sheet has this parameter"
+            )));
+        }
+    }
+    let factor = image.width().div_ceil(TILE_MAX_WIDTH).max(1);
+    let (tw, th) = (
+        image.width().div_ceil(factor),
+        image.height().div_ceil(factor),
+    );
+    let scale = if tw >= 480 { 2 } else { 1 };
+    let label_h = GLYPH_HEIGHT * scale + 2 * scale;
+    let cols = (operators.len() as f64).sqrt().ceil() as usize;
+    let rows = operators.len().div_ceil(cols);
+    let (sw, sh) = (
+        cols * (tw + GAP_PX) + GAP_PX,
+        rows * (th + label_h + GAP_PX) + GAP_PX,
+    );
+    let mut sheet = vec![BACKGROUND; sw * sh];
+    let mut reports = Vec::new();
+    let mut failures = Vec::new();
+    let (mut outside, mut counted) = (0usize, 0usize);
+    let mut buffer = Vec::new();
+    for (k, op) in operators.iter().enumerate() {
+        let own = ToneParams {
+            values: params
+                .values
+                .iter()
+                .filter(|(n, _)| op.info().params.iter().any(|p| p.name == n.as_str()))
+                .map(|(n, v)| (n.clone(), *v))
+                .collect(),
+            ..params.clone()
+        };
+        let (x0, y0) = (
+            GAP_PX + (k % cols) * (tw + GAP_PX),
+            GAP_PX + (k / cols) * (th + label_h + GAP_PX),
+        );
+        let label = match op.apply_into(image, &own, std::mem::take(&mut buffer)) {
+            Ok(result) => {
+                let mut tile = downsample(&result.image, factor, tw, th);
+                let g = map_gamut(&mut tile, &result.image.color_space, target, gamut);
+                outside += g.pixels_outside;
+                counted += g.pixel_count;
+                for y in 0..th {
+                    let row = &tile[y * tw..(y + 1) * tw];
+                    sheet[(y0 + y) * sw + x0..(y0 + y) * sw + x0 + tw].copy_from_slice(row);
+                }
+                let label = label_for(*op, &own.values, &result.report.values);
+                reports.push(result.report);
+                buffer = result.image.into_pixels();
+                label
+            }
+            Err(PostError::Invalid(message)) => {
+                for y in 0..th {
+                    sheet[(y0 + y) * sw + x0..(y0 + y) * sw + x0 + tw].fill(FAILED_TILE);
+                }
+                let short = if op.info().absolute {
+                    "needs --luminance-scale"
+                } else {
+                    "failed"
+                };
+                failures.push(SheetFailure {
+                    operator: op.name(),
+                    error: message,
+                });
+                format!("{}: {short}", op.name())
+            }
+            Err(other) => return Err(other),
+        };
+        let max_chars = (tw / (ADVANCE * scale)).max(1);
+        let text: String = label.chars().take(max_chars).collect();
+        draw_text(&mut sheet, sw, (x0, y0 + th + scale), &text, scale, TEXT);
+    }
+    let mut out = Image::new(sw, sh, sheet, target.space())?;
+    out.metadata
+        .insert("prism:contact_sheet".into(), operators.len().to_string());
+    Ok(ContactSheet {
+        image: out,
+        reports,
+        failures,
+        gamut_fraction_outside: if counted > 0 {
+            outside as f64 / counted as f64
+        } else {
+            0.0
+        },
+    })
+}
+
+/// `name k=v …`: each parameter's given value, else the value the operator resolved (in
+/// its report), else its default; `auto` when none is known.
+pub fn label_for(
+    op: ToneOperator,
+    given: &BTreeMap<String, f64>,
+    resolved: &BTreeMap<String, f64>,
+) -> String {
+    let mut label = op.name().to_string();
+    for spec in op.info().params {
+        let value = given
+            .get(spec.name)
+            .or_else(|| resolved.get(spec.name))
+            .copied()
+            .or(spec.default);
+        label.push(' ');
+        label.push_str(spec.name);
+        label.push('=');
+        label.push_str(&value.map_or("auto".to_string(), short_number));
+    }
+    label
+}
+
+/// Up to 3 significant digits, trailing zeros dropped; exponent form outside [1e-3, 1e5).
+pub fn short_number(v: f64) -> String {
+    if v == 0.0 {
+        return "0".into();
+    }
+    if !(1e-3..1e5).contains(&v.abs()) {
+        return format!("{v:.2e}");
+    }
+    let decimals = (2 - v.abs().log10().floor() as i32).max(0) as usize;
+    let s = format!("{v:.decimals$}");
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    }
+}
+
+/// Box average over `factor × factor` blocks (partial blocks at the edges averaged over
+/// what they hold).
+fn downsample(image: &Image, factor: usize, tw: usize, th: usize) -> Vec<[f32; 3]> {
+    if factor == 1 {
+        return image.pixels().to_vec();
+    }
+    let (w, h) = (image.width(), image.height());
+    let mut out = vec![[0.0f32; 3]; tw * th];
+    for (i, o) in out.iter_mut().enumerate() {
+        let (tx, ty) = (i % tw, i / tw);
+        let mut acc = [0.0f32; 3];
+        let mut n = 0.0f32;
+        for y in ty * factor..((ty + 1) * factor).min(h) {
+            for x in tx * factor..((tx + 1) * factor).min(w) {
+                let p = image.pixels()[y * w + x];
+                acc = [acc[0] + p[0], acc[1] + p[1], acc[2] + p[2]];
+                n += 1.0;
+            }
+        }
+        *o = acc.map(|c| c / n);
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use prism_spectrum::rgb_space::RgbColorSpace;
+
+    #[test]
+    fn sheet_has_one_labelled_tile_per_operator() {
+        let (w, h) = (64, 40);
+        let pixels = (0..w * h)
+            .map(|i| {
+                let v = 10f32.powf(-2.0 + 4.0 * (i % w) as f32 / (w - 1) as f32);
+                [v, 0.7 * v, 0.4 * v]
+            })
+            .collect();
+        let img = Image::new(w, h, pixels, RgbColorSpace::srgb()).unwrap();
+        let ops = ToneOperator::ALL;
+        let sheet = contact_sheet_with_reports(
+            &img,
+            &ops,
+            &ToneParams::default(),
+            GamutTarget::Srgb,
+            GamutMethod::Clip,
+        )
+        .unwrap();
+        // 15 operators → 4 columns × 4 rows of 64×40 tiles plus 9-pixel label strips.
+        let label_h = GLYPH_HEIGHT + 2;
+        assert_eq!(sheet.image.width(), 4 * (64 + GAP_PX) + GAP_PX);
+        assert_eq!(sheet.image.height(), 4 * (40 + label_h + GAP_PX) + GAP_PX);
+        // No absolute scale: the three absolute operators (and ward97) fail, labelled.
+        let absolute = ops.iter().filter(|o| o.info().absolute).count();
+        assert_eq!(sheet.failures.len(), absolute);
+        assert_eq!(sheet.reports.len(), ops.len() - absolute);
+        assert!(sheet
+            .image
+            .pixels()
+            .iter()
+            .flatten()
+            .all(|c| (0.0..=1.0).contains(c)));
+        // The first tile's label strip holds white text pixels; the tile holds the image.
+        let sw = sheet.image.width();
+        let strip = (GAP_PX + 40)..(GAP_PX + 40 + label_h);
+        let text_pixels = strip
+            .flat_map(|y| (GAP_PX..GAP_PX + 64).map(move |x| y * sw + x))
+            .filter(|i| sheet.image.pixels()[*i] == TEXT)
+            .count();
+        assert!(text_pixels > 20, "{text_pixels}");
+        assert_eq!(
+            label_for(ToneOperator::Reinhard02, &BTreeMap::new(), &BTreeMap::new()),
+            "reinhard02 key=0.18 white=auto"
+        );
+    }
+
+    #[test]
+    fn numbers_are_short() {
+        assert_eq!(short_number(0.18), "0.18");
+        assert_eq!(short_number(100.0), "100");
+        assert_eq!(short_number(0.85), "0.85");
+        assert_eq!(short_number(12.3456), "12.3");
+        assert_eq!(short_number(1e30), "1.00e30");
+    }
+}
