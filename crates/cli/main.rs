@@ -3,6 +3,7 @@
 mod color;
 mod compare;
 mod render;
+mod tonemap;
 
 use std::process::ExitCode;
 
@@ -27,14 +28,23 @@ enum Command {
     Compare(compare::CompareArgs),
     /// Render a scene file to an EXR or PNG image (docs/rendering.md).
     Render(render::RenderArgs),
+    /// Tone-map an HDR image (EXR/HDR): white balance, tone operator, gamut mapping, encoding.
+    Tonemap(tonemap::TonemapArgs),
 }
 
 fn main() -> ExitCode {
+    // Rust ignores SIGPIPE, so printing into a closed pipe (`prism tonemap --list | head`)
+    // would panic; the default action ends the process quietly like other Unix tools.
+    #[cfg(unix)]
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Color(args) => color::run(&args),
         Command::Compare(args) => compare::run(&args),
         Command::Render(args) => render::run(&args),
+        Command::Tonemap(args) => tonemap::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,0 +1,146 @@
+//! `prism tonemap`: white balance, tone operator, gamut mapping and encoding of an HDR image
+//! (any EXR/HDR, not only Prism's), or a labelled contact sheet of every operator.
+
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+
+use clap::Args;
+use prism_post::colour::{GamutMethod, GamutTarget, WhiteBalance};
+use prism_post::pipeline::{tonemap_file, OperatorChoice, TonemapFileReport, TonemapOptions};
+use prism_post::tonemap::ToneOperator;
+
+#[derive(Args, Debug)]
+pub struct TonemapArgs {
+    /// HDR input: OpenEXR (RGB or spectral) or Radiance .hdr.
+    #[arg(required_unless_present = "list")]
+    pub input: Option<PathBuf>,
+    /// Output: .png (encoded with the target's transfer function) or .exr (linear display
+    /// values in [0, 1], after gamut mapping).
+    #[arg(short = 'o', long = "output", required_unless_present = "list")]
+    pub output: Option<PathBuf>,
+    /// Tone operator name (see --list), or `all` for a contact sheet of every operator.
+    #[arg(long = "op", required_unless_present = "list")]
+    pub op: Option<String>,
+    /// Operator parameter override, repeatable: --param key=0.18 --param l_white=4.
+    #[arg(long = "param", value_name = "KEY=VALUE")]
+    pub params: Vec<String>,
+    /// White balance: none, grey-world, white-patch, white-patch:PERCENTILE,
+    /// illuminant:NAME (or a bare CIE name such as A), cct:KELVIN.
+    #[arg(long, default_value = "none")]
+    pub wb: String,
+    /// Gamut mapping: clip, local-lch, local-oklab, global, aces-rgc.
+    #[arg(long, default_value = "clip")]
+    pub gamut: String,
+    /// Output primaries: srgb, p3 or rec2020.
+    #[arg(long, default_value = "srgb")]
+    pub target: String,
+    /// Exposure in stops applied first (input × 2^EV).
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    pub exposure: f64,
+    /// cd/m² per unit of the input, for the absolute operators when the file has no
+    /// `prism:cd_m2_per_unit` header (overrides it when it has).
+    #[arg(long, value_name = "CD_M2")]
+    pub luminance_scale: Option<f64>,
+    /// List every operator with its parameters, defaults and reference.
+    #[arg(long)]
+    pub list: bool,
+    /// Print the report (or the --list catalogue) as JSON.
+    #[arg(long)]
+    pub json: bool,
+}
+
+fn parse_params(raw: &[String]) -> Result<BTreeMap<String, f64>, String> {
+    let mut params = BTreeMap::new();
+    for item in raw {
+        let (key, value) = item
+            .split_once('=')
+            .ok_or_else(|| format!("--param {item}: expected KEY=VALUE, e.g. --param key=0.18"))?;
+        let number: f64 = value
+            .trim()
+            .parse()
+            .map_err(|_| format!("--param {item}: expected a number after `=`, found `{value}`"))?;
+        if !number.is_finite() {
+            return Err(format!("--param {item}: expected a finite number"));
+        }
+        params.insert(key.trim().to_string(), number);
+    }
+    Ok(params)
+}
+
+fn print_list(json: bool) -> Result<(), String> {
+    let catalogue = ToneOperator::catalogue();
+    if json {
+        let text = serde_json::to_string_pretty(&catalogue).map_err(|e| e.to_string())?;
+        println!("{text}");
+        return Ok(());
+    }
+    for info in catalogue {
+        let absolute = if info.absolute {
+            "  [needs absolute luminance: prism:cd_m2_per_unit or --luminance-scale]"
+        } else {
+            ""
+        };
+        println!("{}{absolute}", info.name);
+        println!("    {}", info.reference);
+        for p in info.params {
+            let default = p
+                .default
+                .map(|d| format!("{d}"))
+                .unwrap_or_else(|| "from the image".to_string());
+            println!(
+                "    --param {}=…   default {default}, range [{}, {}]: {}",
+                p.name, p.min, p.max, p.doc
+            );
+        }
+    }
+    Ok(())
+}
+
+fn print_summary(report: &TonemapFileReport) {
+    println!(
+        "wrote {} ({}×{}, {}, {} → {}, {:.2} % of pixels outside the gamut before mapping)",
+        report.output,
+        report.width,
+        report.height,
+        report.operator,
+        report.gamut_method,
+        report.target,
+        100.0 * report.gamut_fraction_outside
+    );
+    if report.non_finite_pixels > 0 {
+        println!(
+            "note: {} input pixels had NaN/∞ components (mapped to black)",
+            report.non_finite_pixels
+        );
+    }
+    for failure in &report.failures {
+        println!("note: no tile for {failure:?}");
+    }
+}
+
+pub fn run(args: &TonemapArgs) -> Result<(), String> {
+    if args.list {
+        return print_list(args.json);
+    }
+    let (input, output, op) = match (&args.input, &args.output, &args.op) {
+        (Some(i), Some(o), Some(op)) => (i, o, op),
+        _ => return Err("tonemap needs IN, -o OUT and --op NAME (or --list)".to_string()),
+    };
+    let options = TonemapOptions {
+        operator: OperatorChoice::parse(op).map_err(|e| format!("--op {op}: {e}"))?,
+        params: parse_params(&args.params)?,
+        wb: WhiteBalance::parse(&args.wb).map_err(|e| e.to_string())?,
+        gamut: GamutMethod::parse(&args.gamut).map_err(|e| e.to_string())?,
+        target: GamutTarget::parse(&args.target).map_err(|e| e.to_string())?,
+        exposure_ev: args.exposure,
+        luminance_scale_cd_m2: args.luminance_scale,
+    };
+    let report = tonemap_file(input, output, &options).map_err(|e| e.to_string())?;
+    if args.json {
+        let text = serde_json::to_string_pretty(&report).map_err(|e| e.to_string())?;
+        println!("{text}");
+    } else {
+        print_summary(&report);
+    }
+    Ok(())
+}

@@ -1,0 +1,287 @@
+//! End-to-end checks of `prism tonemap` and `prism compare` on images Prism renders itself
+//! and on a plain Radiance HDR without absolute scale.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use prism_post::image::Image;
+use prism_post::io::{read_image, write_image};
+use prism_spectrum::rgb_space::RgbColorSpace;
+use serde_json::Value;
+
+const OPERATORS: [&str; 15] = [
+    "linear",
+    "mean-value",
+    "ward94",
+    "exponential",
+    "logarithmic",
+    "drago03",
+    "schlick94",
+    "tumblin-rushmeier",
+    "reinhard02",
+    "reinhard02-local",
+    "ferwerda96",
+    "ward97-histogram",
+    "durand02",
+    "aces",
+    "agx",
+];
+
+fn prism(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_prism"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .args(args)
+        .output()
+        .expect("prism runs")
+}
+
+fn ok(args: &[&str]) -> String {
+    let out = prism(args);
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout).unwrap()
+}
+
+fn fails_with(args: &[&str], needles: &[&str]) {
+    let out = prism(args);
+    assert!(!out.status.success(), "{args:?} should fail");
+    let err = String::from_utf8_lossy(&out.stderr);
+    for needle in needles {
+        assert!(err.contains(needle), "{args:?}: `{needle}` not in: {err}");
+    }
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("prism-post-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+/// A small render of the camera-gallery room (absolute scale in its header).
+fn rendered_exr() -> PathBuf {
+    let path = scratch("room.exr");
+    if !path.exists() {
+        ok(&[
+            "render",
+            "scenes/cameras/pinhole.json",
+            "--resolution",
+            "48x32",
+            "--spp",
+            "4",
+            "-o",
+            path.to_str().unwrap(),
+        ]);
+    }
+    path
+}
+
+/// An HDR gradient with a bright spot and no absolute scale, as any other program writes.
+fn plain_hdr(path: &Path) {
+    let (w, h) = (40usize, 30usize);
+    let pixels = (0..w * h)
+        .map(|i| {
+            let (x, y) = ((i % w) as f32, (i / w) as f32);
+            let v = 0.01 * (1.0 + x) * (1.0 + 0.3 * y);
+            if x > 30.0 && y < 5.0 {
+                [200.0, 150.0, 90.0]
+            } else {
+                [v, 0.8 * v, 0.6 * v]
+            }
+        })
+        .collect();
+    let image = Image::new(w, h, pixels, RgbColorSpace::srgb()).unwrap();
+    write_image(path, &image).unwrap();
+}
+
+#[test]
+fn list_names_every_operator_with_parameters_and_reference() {
+    let text = ok(&["tonemap", "--list"]);
+    for op in OPERATORS {
+        assert!(
+            text.lines().any(|l| l.starts_with(op)),
+            "{op} missing:\n{text}"
+        );
+    }
+    assert!(text.contains("--param key=") && text.contains("Reinhard"));
+    let json: Value = serde_json::from_str(&ok(&["tonemap", "--list", "--json"])).unwrap();
+    assert_eq!(json.as_array().unwrap().len(), OPERATORS.len());
+}
+
+#[test]
+fn every_operator_maps_a_render_to_png_and_to_exr_in_unit_range() {
+    let input = rendered_exr();
+    for op in OPERATORS {
+        let png = scratch(&format!("{op}.png"));
+        ok(&[
+            "tonemap",
+            input.to_str().unwrap(),
+            "-o",
+            png.to_str().unwrap(),
+            "--op",
+            op,
+        ]);
+        assert!(std::fs::read(&png).unwrap().starts_with(b"\x89PNG"), "{op}");
+        let exr = scratch(&format!("{op}.exr"));
+        let report: Value = serde_json::from_str(&ok(&[
+            "tonemap",
+            input.to_str().unwrap(),
+            "-o",
+            exr.to_str().unwrap(),
+            "--op",
+            op,
+            "--gamut",
+            "local-oklab",
+            "--target",
+            "p3",
+            "--wb",
+            "grey-world",
+            "--json",
+        ]))
+        .unwrap();
+        assert_eq!(report["operator"], op);
+        let image = read_image(&exr).unwrap();
+        for p in image.pixels() {
+            assert!(p.iter().all(|c| (0.0..=1.0).contains(c)), "{op}: {p:?}");
+        }
+    }
+}
+
+#[test]
+fn contact_sheet_has_one_tile_per_operator() {
+    let input = rendered_exr();
+    let sheet = scratch("sheet.png");
+    let report: Value = serde_json::from_str(&ok(&[
+        "tonemap",
+        input.to_str().unwrap(),
+        "-o",
+        sheet.to_str().unwrap(),
+        "--op",
+        "all",
+        "--json",
+    ]))
+    .unwrap();
+    assert_eq!(report["tone"].as_array().unwrap().len(), OPERATORS.len());
+    let image = read_image(&sheet).unwrap();
+    assert!(image.width() > 4 * 48 && image.height() > 3 * 32);
+}
+
+#[test]
+fn absolute_operators_need_a_scale_on_foreign_images() {
+    let hdr = scratch("plain.hdr");
+    plain_hdr(&hdr);
+    let out = scratch("abs.png");
+    for op in ["ward94", "ferwerda96", "ward97-histogram"] {
+        fails_with(
+            &[
+                "tonemap",
+                hdr.to_str().unwrap(),
+                "-o",
+                out.to_str().unwrap(),
+                "--op",
+                op,
+            ],
+            &["--luminance-scale"],
+        );
+        ok(&[
+            "tonemap",
+            hdr.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "--op",
+            op,
+            "--luminance-scale",
+            "179",
+        ]);
+    }
+}
+
+#[test]
+fn bad_tonemap_input_is_named() {
+    let input = rendered_exr();
+    let out = scratch("bad.png");
+    let (i, o) = (input.to_str().unwrap(), out.to_str().unwrap());
+    fails_with(
+        &["tonemap", i, "-o", o, "--op", "reinhart02"],
+        &["reinhart02", "`reinhard02`"],
+    );
+    fails_with(
+        &[
+            "tonemap",
+            i,
+            "-o",
+            o,
+            "--op",
+            "reinhard02",
+            "--param",
+            "key",
+        ],
+        &["KEY=VALUE"],
+    );
+    fails_with(
+        &[
+            "tonemap",
+            i,
+            "-o",
+            o,
+            "--op",
+            "reinhard02",
+            "--gamut",
+            "lch",
+        ],
+        &["lch"],
+    );
+    fails_with(
+        &[
+            "tonemap",
+            i,
+            "-o",
+            o,
+            "--op",
+            "reinhard02",
+            "--target",
+            "adobe",
+        ],
+        &["adobe"],
+    );
+    fails_with(
+        &["tonemap", "no/such.exr", "-o", o, "--op", "aces"],
+        &["no/such.exr"],
+    );
+}
+
+#[test]
+fn compare_reports_every_metric_and_refuses_mismatched_sizes() {
+    let a = scratch("a.hdr");
+    plain_hdr(&a);
+    let same: Value = serde_json::from_str(&ok(&[
+        "compare",
+        a.to_str().unwrap(),
+        a.to_str().unwrap(),
+        "--json",
+    ]))
+    .unwrap();
+    for key in [
+        "mse",
+        "rmse",
+        "relmse",
+        "psnr_db",
+        "ssim",
+        "delta_e2000_mean",
+        "delta_e2000_p95",
+    ] {
+        assert!(same.get(key).is_some(), "{key} missing: {same}");
+    }
+    assert_eq!(same["mse"].as_f64().unwrap(), 0.0);
+    assert_eq!(same["ssim"].as_f64().unwrap(), 1.0);
+    assert_eq!(same["per_channel"]["rmse"].as_array().unwrap().len(), 3);
+    let table = ok(&["compare", a.to_str().unwrap(), a.to_str().unwrap()]);
+    assert!(table.contains("RMSE") && table.contains("SSIM"));
+    let room = rendered_exr();
+    fails_with(
+        &["compare", a.to_str().unwrap(), room.to_str().unwrap()],
+        &["40×30", "48×32"],
+    );
+}
