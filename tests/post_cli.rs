@@ -229,9 +229,9 @@ fn bad_tonemap_input_is_named() {
             "--op",
             "reinhard02",
             "--gamut",
-            "lch",
+            "lhc",
         ],
-        &["lch"],
+        &["lhc"],
     );
     fails_with(
         &[
