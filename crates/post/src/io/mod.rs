@@ -4,6 +4,7 @@
 
 pub mod exr;
 pub mod png;
+pub mod quantise;
 pub mod rgbe;
 pub mod spectral_exr;
 

@@ -12,6 +12,7 @@ use png::{BitDepth, ColorType, Decoder, Encoder, SourceChromaticities, Transform
 use prism_spectrum::rgb_space::RgbColorSpace;
 use rayon::prelude::*;
 
+use super::quantise::Quantiser;
 use super::{color_space_from_chromaticities, write_stream_atomically};
 use crate::error::{PostError, Result};
 use crate::image::Image;
@@ -20,15 +21,6 @@ use crate::image::Image;
 pub enum PngBitDepth {
     Eight,
     Sixteen,
-}
-
-fn quantise(linear: f32, encode: &impl Fn(f64) -> f64, max_code: f64) -> u16 {
-    let v = if linear.is_finite() {
-        (linear as f64).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    (encode(v).clamp(0.0, 1.0) * max_code).round() as u16
 }
 
 /// Writes `image` as an RGB PNG of the given depth (see the module notes on encoding).
@@ -40,22 +32,32 @@ pub fn write_png(path: &Path, image: &Image, depth: PngBitDepth) -> Result<()> {
             path.display()
         )));
     }
+    // Exact codes without a transcendental per sample (io/quantise.rs).
     let transfer = image.color_space.transfer;
-    let encode = move |v: f64| transfer.encode(v);
     let bytes: Vec<u8> = match depth {
-        PngBitDepth::Eight => image
-            .pixels()
-            .par_iter()
-            .flat_map_iter(|p| p.map(|c| quantise(c, &encode, 255.0) as u8))
-            .collect(),
-        PngBitDepth::Sixteen => image
-            .pixels()
-            .par_iter()
-            .flat_map_iter(|p| {
-                let [r, g, b] = p.map(|c| quantise(c, &encode, 65535.0).to_be_bytes());
-                [r[0], r[1], g[0], g[1], b[0], b[1]]
-            })
-            .collect(),
+        PngBitDepth::Eight => {
+            let q = Quantiser::new(transfer, 255);
+            image
+                .pixels()
+                .par_iter()
+                .flat_map_iter(|p| p.map(|c| q.code(c) as u8))
+                .collect()
+        }
+        PngBitDepth::Sixteen => {
+            let q = Quantiser::new(transfer, 65535);
+            let mut bytes = vec![0u8; image.pixels().len() * 6];
+            bytes
+                .par_chunks_mut(6 * 4096)
+                .zip(image.pixels().par_chunks(4096))
+                .for_each(|(o, i)| {
+                    for (o, p) in o.chunks_exact_mut(6).zip(i) {
+                        for c in 0..3 {
+                            o[2 * c..2 * c + 2].copy_from_slice(&q.code(p[c]).to_be_bytes());
+                        }
+                    }
+                });
+            bytes
+        }
     };
     let space = &image.color_space;
     write_stream_atomically(path, |out| {
