@@ -13,9 +13,9 @@
 //!   normalised so that RGB (1, 1, 1) (Y = 1) is the reference white (L* = 100), i.e.
 //!   display-referred relative colorimetry; mean and 95th percentile (nearest rank).
 
-mod delta_e2000;
 mod ssim;
 
+use prism_spectrum::colorimetry::{delta_e_2000, xyz_to_lab};
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -128,15 +128,15 @@ pub fn compare(test: &Image, reference: &Image) -> Result<Comparison> {
     );
 
     let m = space.rgb_to_xyz;
-    let white = space.white_xyz().to_array();
+    let white = space.white_xyz();
     let lab = |p: [f32; 3]| {
         let xyz = m * glam::DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64);
-        delta_e2000::xyz_to_lab(xyz.to_array(), white)
+        xyz_to_lab(xyz, white)
     };
     let mut de: Vec<f64> = a
         .par_iter()
         .zip(b.par_iter())
-        .map(|(p, q)| delta_e2000::delta_e2000(lab(*p), lab(*q)))
+        .map(|(p, q)| delta_e_2000(lab(*p), lab(*q)))
         .collect();
     let de_mean = de.par_iter().sum::<f64>() / n;
     let rank = ((0.95 * de.len() as f64).ceil() as usize).clamp(1, de.len()) - 1;
