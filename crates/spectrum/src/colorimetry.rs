@@ -9,6 +9,8 @@ use glam::{DVec2, DVec3};
 
 use crate::constants::K_M_PHOTOPIC_LM_PER_W;
 use crate::data::{cmfs, Observer};
+use crate::sampled_spectrum::{SampledSpectrum, N_SPECTRUM_SAMPLES};
+use crate::sampled_wavelengths::SampledWavelengths;
 use crate::table::DenseSpectrum;
 
 /// The unnormalised tristimulus sums (Σ S x̄ Δλ, Σ S ȳ Δλ, Σ S z̄ Δλ) of a spectrum,
@@ -57,6 +59,36 @@ pub fn illuminant_white_xyz(illuminant: &DenseSpectrum, observer: Observer) -> D
 /// Prism's convention (CIE gives no K_m for the 10° observer).
 pub fn emission_to_xyz_cd_per_m2(radiance: &DenseSpectrum, observer: Observer) -> DVec3 {
     tristimulus_sums(radiance, observer) * K_M_PHOTOPIC_LM_PER_W
+}
+
+/// The XYZ estimate of one hero-wavelength sample of spectral radiance in Prism's output
+/// normalisation: (1/4) Σᵢ L(λᵢ) (x̄, ȳ, z̄)(λᵢ) / p(λᵢ) / ∫ ȳ dλ with the CIE 1931 CMFs linearly
+/// interpolated on their 1 nm table (pbrt-v4 `SampledSpectrum::ToXYZ`), so a flat radiance of
+/// 1 gives Y = 1 in expectation. Lanes with pdf 0 (terminated secondaries) contribute nothing.
+pub fn sampled_radiance_to_xyz(
+    radiance: SampledSpectrum,
+    wavelengths: &SampledWavelengths,
+) -> DVec3 {
+    let c = cmfs(Observer::Cie1931);
+    let pdf = wavelengths.pdf();
+    let mut xyz = DVec3::ZERO;
+    for lane in 0..N_SPECTRUM_SAMPLES {
+        let p = f64::from(pdf[lane]);
+        let l = f64::from(radiance[lane]);
+        if p <= 0.0 || l == 0.0 {
+            continue;
+        }
+        let wl = f64::from(wavelengths.wavelength_nm(lane));
+        let bar = DVec3::new(c.x_bar.eval(wl), c.y_bar.eval(wl), c.z_bar.eval(wl));
+        xyz += bar * (l / p);
+    }
+    xyz / (N_SPECTRUM_SAMPLES as f64 * y_bar_integral_1931_nm())
+}
+
+/// ∫ ȳ dλ of CIE 1931, cached (the hot-path normaliser of [`sampled_radiance_to_xyz`]).
+fn y_bar_integral_1931_nm() -> f64 {
+    static Y: std::sync::OnceLock<f64> = std::sync::OnceLock::new();
+    *Y.get_or_init(|| crate::photometry::y_bar_integral_nm(Observer::Cie1931))
 }
 
 /// Chromaticity (x, y) of XYZ; `None` for black (X + Y + Z = 0) or non-finite input.

@@ -2,7 +2,7 @@
 //! (or irradiance) by 1 nm summation over 360–830 nm (CIE 15:2018 §7.3; CIE S 010/E:2004).
 
 use crate::constants::{K_M_PHOTOPIC_LM_PER_W, K_M_SCOTOPIC_LM_PER_W};
-use crate::data::{photopic_efficiency, scotopic_efficiency};
+use crate::data::{cmfs, photopic_efficiency, scotopic_efficiency, Observer};
 use crate::table::DenseSpectrum;
 
 /// Photopic luminance L_v = K_m Σ L_e,λ V(λ) Δλ in cd/m² from spectral radiance in
@@ -56,4 +56,16 @@ mod tests {
         let sp = scotopic_photopic_ratio(&DenseSpectrum::constant(1.0)).unwrap();
         assert!((sp - 2.261_076_340_49).abs() < 1e-9, "{sp}");
     }
+}
+
+/// ∫ ȳ(λ) dλ of `observer` over 360–830 nm on its 1 nm table (Σ ȳ · 1 nm), in nm; ≈ 106.857
+/// for CIE 1931. The normaliser of Prism's output XYZ = ∫ L (x̄, ȳ, z̄) dλ / ∫ ȳ dλ (DESIGN.md).
+pub fn y_bar_integral_nm(observer: Observer) -> f64 {
+    cmfs(observer).y_bar.values().iter().sum()
+}
+
+/// Luminance in cd/m² of an output value Y = 1 in that normalisation: K_m · ∫ ȳ dλ
+/// (the EXR header `prism:cd_m2_per_unit`, ≈ 72 983 for CIE 1931).
+pub fn cd_m2_per_unit(observer: Observer) -> f64 {
+    K_M_PHOTOPIC_LM_PER_W * y_bar_integral_nm(observer)
 }

@@ -15,8 +15,9 @@ use std::path::Path;
 use ::exr::meta::attribute::AttributeValue;
 use glam::DVec3;
 use prism_spectrum::data::cmfs;
+use prism_spectrum::photometry::y_bar_integral_nm;
 use prism_spectrum::rgb_space::RgbColorSpace;
-use prism_spectrum::{Observer, DENSE_SAMPLE_COUNT, K_M_PHOTOPIC_LM_PER_W, LAMBDA_MIN_NM};
+use prism_spectrum::{Observer, DENSE_SAMPLE_COUNT, LAMBDA_MIN_NM};
 use rayon::prelude::*;
 
 use super::exr::{
@@ -165,7 +166,7 @@ impl SpectralImage {
     pub fn xyz_weights(&self, observer: Observer) -> Vec<DVec3> {
         let cmf = cmfs(observer);
         let (xb, yb, zb) = (cmf.x_bar.values(), cmf.y_bar.values(), cmf.z_bar.values());
-        let y_integral: f64 = yb.iter().sum();
+        let y_integral = y_bar_integral_nm(observer);
         let wl = &self.wavelengths_nm;
         let mut weights = vec![DVec3::ZERO; wl.len()];
         let mut band = 0;
@@ -187,7 +188,7 @@ impl SpectralImage {
 
     /// cd/m² per unit of Y for radiance in W·m⁻²·sr⁻¹·nm⁻¹: 683.002 lm/W × Σ ȳ Δλ.
     pub fn cd_m2_per_unit(observer: Observer) -> f64 {
-        K_M_PHOTOPIC_LM_PER_W * cmfs(observer).y_bar.values().iter().sum::<f64>()
+        prism_spectrum::photometry::cd_m2_per_unit(observer)
     }
 
     /// Reduces every pixel to CIE XYZ (interleaved, Y = 1 for a flat spectrum of 1).

@@ -7,24 +7,22 @@ use std::sync::OnceLock;
 
 use glam::DVec3;
 use prism_spectrum::data::{cmfs, Cmfs};
-use prism_spectrum::{
-    Observer, SampledSpectrum, SampledWavelengths, K_M_PHOTOPIC_LM_PER_W, N_SPECTRUM_SAMPLES,
-};
+use prism_spectrum::photometry::{cd_m2_per_unit as photometry_cd_m2_per_unit, y_bar_integral_nm};
+use prism_spectrum::Observer;
 
 fn cie1931() -> &'static Cmfs {
     cmfs(Observer::Cie1931)
 }
 
-/// ∫ ȳ(λ) dλ over 360–830 nm of the CIE 1931 2° observer on its 1 nm table (Σ ȳ · 1 nm),
-/// ≈ 106.857 nm.
+/// ∫ ȳ dλ of CIE 1931 (prism-spectrum `photometry::y_bar_integral_nm`), cached.
 pub fn cie_y_integral_nm() -> f64 {
     static Y: OnceLock<f64> = OnceLock::new();
-    *Y.get_or_init(|| cie1931().y_bar.values().iter().sum())
+    *Y.get_or_init(|| y_bar_integral_nm(Observer::Cie1931))
 }
 
-/// Luminance in cd/m² of an output value Y = 1: 683.002 lm/W · ∫ ȳ dλ.
+/// Luminance in cd/m² of an output value Y = 1 (prism-spectrum `photometry::cd_m2_per_unit`).
 pub fn cd_m2_per_unit() -> f64 {
-    K_M_PHOTOPIC_LM_PER_W * cie_y_integral_nm()
+    photometry_cd_m2_per_unit(Observer::Cie1931)
 }
 
 /// XYZ of a flat spectral radiance of 1 in the output normalisation:
@@ -52,29 +50,14 @@ pub fn rec709_to_xyz(rgb: [f32; 3]) -> DVec3 {
     *m * DVec3::from(rgb.map(f64::from))
 }
 
-/// The XYZ estimate of one sample with hero-wavelength sampling:
-/// (1/4) Σᵢ L(λᵢ) (x̄, ȳ, z̄)(λᵢ) / p(λᵢ) / ∫ ȳ dλ, with the CMFs linearly interpolated on
-/// their 1 nm table. Lanes with pdf 0 (terminated secondaries) contribute nothing.
-pub fn xyz_of_sample(radiance: SampledSpectrum, wavelengths: &SampledWavelengths) -> DVec3 {
-    let c = cie1931();
-    let pdf = wavelengths.pdf();
-    let mut xyz = DVec3::ZERO;
-    for lane in 0..N_SPECTRUM_SAMPLES {
-        let p = f64::from(pdf[lane]);
-        let l = f64::from(radiance[lane]);
-        if p <= 0.0 || l == 0.0 {
-            continue;
-        }
-        let wl = f64::from(wavelengths.wavelength_nm(lane));
-        let bar = DVec3::new(c.x_bar.eval(wl), c.y_bar.eval(wl), c.z_bar.eval(wl));
-        xyz += bar * (l / p);
-    }
-    xyz / (N_SPECTRUM_SAMPLES as f64 * cie_y_integral_nm())
-}
+/// The XYZ estimate of one hero-wavelength sample (prism-spectrum
+/// `colorimetry::sampled_radiance_to_xyz`).
+pub use prism_spectrum::colorimetry::sampled_radiance_to_xyz as xyz_of_sample;
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use prism_spectrum::{SampledSpectrum, SampledWavelengths};
 
     #[test]
     fn y_integral_matches_the_cie_table() {
