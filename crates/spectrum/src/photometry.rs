@@ -34,6 +34,18 @@ pub fn luminous_efficacy_lm_per_w(spectrum: &DenseSpectrum) -> Option<f64> {
     k.is_finite().then_some(k)
 }
 
+/// ∫ ȳ(λ) dλ of `observer` over 360–830 nm on its 1 nm table (Σ ȳ · 1 nm), in nm; ≈ 106.857
+/// for CIE 1931. The normaliser of Prism's output XYZ = ∫ L (x̄, ȳ, z̄) dλ / ∫ ȳ dλ (DESIGN.md).
+pub fn y_bar_integral_nm(observer: Observer) -> f64 {
+    cmfs(observer).y_bar.values().iter().sum()
+}
+
+/// Luminance in cd/m² of an output value Y = 1 in that normalisation: K_m · ∫ ȳ dλ
+/// (the EXR header `prism:cd_m2_per_unit`, ≈ 72 983 for CIE 1931).
+pub fn cd_m2_per_unit(observer: Observer) -> f64 {
+    K_M_PHOTOPIC_LM_PER_W * y_bar_integral_nm(observer)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -56,16 +68,4 @@ mod tests {
         let sp = scotopic_photopic_ratio(&DenseSpectrum::constant(1.0)).unwrap();
         assert!((sp - 2.261_076_340_49).abs() < 1e-9, "{sp}");
     }
-}
-
-/// ∫ ȳ(λ) dλ of `observer` over 360–830 nm on its 1 nm table (Σ ȳ · 1 nm), in nm; ≈ 106.857
-/// for CIE 1931. The normaliser of Prism's output XYZ = ∫ L (x̄, ȳ, z̄) dλ / ∫ ȳ dλ (DESIGN.md).
-pub fn y_bar_integral_nm(observer: Observer) -> f64 {
-    cmfs(observer).y_bar.values().iter().sum()
-}
-
-/// Luminance in cd/m² of an output value Y = 1 in that normalisation: K_m · ∫ ȳ dλ
-/// (the EXR header `prism:cd_m2_per_unit`, ≈ 72 983 for CIE 1931).
-pub fn cd_m2_per_unit(observer: Observer) -> f64 {
-    K_M_PHOTOPIC_LM_PER_W * y_bar_integral_nm(observer)
 }
