@@ -658,7 +658,7 @@ fn max_abs(v: [f64; 3]) -> f64 {
 
 /// Solves a x = b (3 × 3, partial pivoting); `None` if singular.
 #[allow(clippy::needless_range_loop)] // 3 × 3 elimination reads best with indices
-fn solve3(mut a: [[f64; 3]; 3], mut b: [f64; 3]) -> Option<[f64; 3]> {
+pub fn solve3(mut a: [[f64; 3]; 3], mut b: [f64; 3]) -> Option<[f64; 3]> {
     for col in 0..3 {
         let mut pivot = col;
         for row in col + 1..3 {

@@ -24,7 +24,9 @@ use std::process::ExitCode;
 use std::time::Instant;
 
 use prism_spectrum::data::{cmfs, Observer};
-use prism_spectrum::rgb_upsample::{white_illuminant_dense, z_nodes, RgbGamut, RgbToSpectrumTable};
+use prism_spectrum::rgb_upsample::{
+    solve3, white_illuminant_dense, z_nodes, RgbGamut, RgbToSpectrumTable,
+};
 use rayon::prelude::*;
 
 const LAMBDA_MIN_NM: f64 = 360.0;
@@ -228,31 +230,6 @@ fn transpose(m: [[f64; 3]; 3]) -> [[f64; 3]; 3] {
 
 fn mat_mul(a: [[f64; 3]; 3], b: [[f64; 3]; 3]) -> [[f64; 3]; 3] {
     std::array::from_fn(|r| std::array::from_fn(|c| (0..3).map(|k| a[r][k] * b[k][c]).sum()))
-}
-
-/// Solves a x = b by Gaussian elimination with partial pivoting; `None` if singular.
-fn solve3(mut a: [[f64; 3]; 3], mut b: [f64; 3]) -> Option<[f64; 3]> {
-    for col in 0..3 {
-        let pivot = (col..3).max_by(|&i, &j| a[i][col].abs().total_cmp(&a[j][col].abs()))?;
-        if a[pivot][col].abs() < 1e-300 || !a[pivot][col].is_finite() {
-            return None;
-        }
-        a.swap(col, pivot);
-        b.swap(col, pivot);
-        for row in col + 1..3 {
-            let f = a[row][col] / a[col][col];
-            for k in col..3 {
-                a[row][k] -= f * a[col][k];
-            }
-            b[row] -= f * b[col];
-        }
-    }
-    let mut x = [0.0; 3];
-    for row in (0..3).rev() {
-        let s: f64 = (row + 1..3).map(|k| a[row][k] * x[k]).sum();
-        x[row] = (b[row] - s) / a[row][row];
-    }
-    x.iter().all(|v| v.is_finite()).then_some(x)
 }
 
 /// (A, B, C) for t = (λ − 360) / 470 → (c0, c1, c2) for λ in nm (pbrt-v4 rgb2spec_opt).
