@@ -133,14 +133,13 @@ pub fn color_space_from_chromaticities(
 /// Converts linear RGB pixels from one colour space to another through XYZ (no chromatic
 /// adaptation: white balance is a separate, explicit step).
 pub fn convert_pixels(pixels: &mut [[f32; 3]], from: &RgbColorSpace, to: &RgbColorSpace) {
-    use rayon::prelude::*;
     if from.primaries_xy == to.primaries_xy && from.white_xy == to.white_xy {
         return;
     }
-    let m = (to.xyz_to_rgb * from.rgb_to_xyz).as_mat3();
-    pixels.par_chunks_mut(4096).for_each(|chunk| {
-        for p in chunk {
-            *p = (m * glam::Vec3::from(*p)).to_array();
-        }
-    });
+    let m = crate::colour::rgb_matrix::rgb_to_rgb_matrix(
+        from,
+        to,
+        prism_spectrum::adaptation::AdaptationMethod::None,
+    );
+    crate::colour::rgb_matrix::apply_rgb_matrix(pixels, m);
 }
