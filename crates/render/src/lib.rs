@@ -8,10 +8,14 @@
 //! centre is (i + ½, j + ½) (pbrt-v4 §5.4 "Film and imaging", discrete vs continuous pixel
 //! coordinates, §8.1.4).
 
+pub mod bsdf;
 pub mod camera;
+pub mod chi2;
 pub mod error;
 pub mod film;
 pub mod integrator;
+pub mod light;
+pub mod material;
 pub mod sampler;
 pub mod sampling;
 pub mod scene_build;

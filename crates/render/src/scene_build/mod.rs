@@ -6,6 +6,7 @@ mod camera;
 mod error;
 mod filter;
 mod geometry;
+pub mod spectrum;
 mod transform;
 
 pub use albedo::{material_albedo, reflectance_rgb, DEFAULT_ALBEDO};
@@ -23,6 +24,8 @@ use prism_scene::SceneDescription;
 use crate::camera::Camera;
 use crate::film::{AovSelection, Film};
 use crate::integrator::Integrator;
+use crate::light::LightSet;
+use crate::material::{build_materials, Material};
 
 /// Everything a render needs, built from a scene description.
 pub struct RenderScene {
@@ -39,6 +42,9 @@ pub struct RenderScene {
     pub seed: u64,
     /// Albedo (linear Rec.709) per scene material, then one for the default material.
     pub albedo_rgb: Vec<[f32; 3]>,
+    /// Runtime materials indexed by `material_id` (the default material last).
+    pub materials: Vec<Material>,
+    pub lights: LightSet,
 }
 
 impl RenderScene {
@@ -63,6 +69,8 @@ impl RenderScene {
             .collect();
         albedo_rgb.push(DEFAULT_ALBEDO);
         let geometry = build_geometry(scene)?;
+        let materials = build_materials(scene)?;
+        let lights = LightSet::build(scene, &geometry)?;
         Ok(Self {
             file,
             geometry,
@@ -73,6 +81,8 @@ impl RenderScene {
             spp: scene.film.spp,
             seed: scene.film.seed,
             albedo_rgb,
+            materials,
+            lights,
         })
     }
 

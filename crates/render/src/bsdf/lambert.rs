@@ -1,0 +1,81 @@
+//! Lambert's ideal diffuse reflector: f = R/π on the upper side, cosine-weighted sampling
+//! (Lambert 1760; pbrt-v4 §9.2). One-sided: zero when either direction is below the surface.
+
+use glam::{Vec2, Vec3A};
+use prism_spectrum::SampledSpectrum;
+
+use super::{BsdfSample, TransportMode};
+use crate::sampling::sample_cosine_hemisphere;
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Lambert {
+    /// Reflectance R(λ) ∈ [0, 1] at the path's wavelengths.
+    pub reflectance: SampledSpectrum,
+}
+
+impl Lambert {
+    #[inline]
+    pub fn eval(&self, wo: Vec3A, wi: Vec3A, _mode: TransportMode) -> SampledSpectrum {
+        if wo.z <= 0.0 || wi.z <= 0.0 {
+            return SampledSpectrum::splat(0.0);
+        }
+        self.reflectance * std::f32::consts::FRAC_1_PI
+    }
+
+    #[inline]
+    pub fn pdf(&self, wo: Vec3A, wi: Vec3A, _mode: TransportMode) -> f32 {
+        if wo.z <= 0.0 || wi.z <= 0.0 {
+            return 0.0;
+        }
+        wi.z * std::f32::consts::FRAC_1_PI
+    }
+
+    #[inline]
+    pub fn sample(
+        &self,
+        wo: Vec3A,
+        _u_lobe: f32,
+        u: Vec2,
+        mode: TransportMode,
+    ) -> Option<BsdfSample> {
+        if wo.z <= 0.0 {
+            return None;
+        }
+        let wi = sample_cosine_hemisphere(u);
+        let pdf = self.pdf(wo, wi, mode);
+        if pdf <= 0.0 {
+            return None;
+        }
+        Some(BsdfSample {
+            wi,
+            f: self.eval(wo, wi, mode),
+            pdf,
+            specular: false,
+            transmission: false,
+            eta: 1.0,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::chi2::{chi2_test, Chi2Config};
+
+    #[test]
+    fn chi2_lambert() {
+        let l = Lambert {
+            reflectance: SampledSpectrum::splat(0.5),
+        };
+        let wo = Vec3A::new(0.3, 0.2, 0.9).normalize();
+        let r = chi2_test(
+            &Chi2Config {
+                sample_count: 200_000,
+                ..Chi2Config::default()
+            },
+            |ul, u| l.sample(wo, ul, u, TransportMode::Radiance).map(|s| s.wi),
+            |wi| f64::from(l.pdf(wo, wi, TransportMode::Radiance)),
+        );
+        assert!(r.passed, "{}", r.message);
+    }
+}
