@@ -230,6 +230,9 @@ fn write_stats(
         "threads": threads,
         "integrator": scene.integrator.name(),
         "non_finite_samples": stats.non_finite_samples,
+        "non_finite_contributions": stats.non_finite_contributions,
+        "bounces": stats.bounces,
+        "roulette_terminations": stats.roulette_terminations,
     });
     let text = serde_json::to_string_pretty(&value).map_err(|e| e.to_string())? + "\n";
     // Atomic like the image: a temporary sibling renamed over the destination.

@@ -9,6 +9,9 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 use glam::{DVec3, UVec2};
 
+use prism_spectrum::{SampledSpectrum, SampledWavelengths};
+
+use super::{Integrator, PathCounters};
 use crate::film::{FilmImage, SurfaceAov};
 use crate::sampler::PixelSampler;
 use crate::scene_build::RenderScene;
@@ -26,6 +29,17 @@ pub struct RenderSettings {
     pub tile_size_px: u32,
 }
 
+impl Default for RenderSettings {
+    /// 16 spp, seed 0, the default tile size.
+    fn default() -> Self {
+        Self {
+            spp: 16,
+            seed: 0,
+            tile_size_px: DEFAULT_TILE_SIZE_PX,
+        }
+    }
+}
+
 /// What a render did.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct RenderStats {
@@ -35,6 +49,13 @@ pub struct RenderStats {
     pub samples: u64,
     /// Samples whose value was NaN or infinite (dropped by the film as zero).
     pub non_finite_samples: u64,
+    /// Scattering events of all paths (path tracer).
+    pub bounces: u64,
+    /// Paths ended by Russian roulette.
+    pub roulette_terminations: u64,
+    /// Single light or emission contributions that were NaN/∞ and were dropped before they
+    /// reached the film (path tracer).
+    pub non_finite_contributions: u64,
 }
 
 /// Renders `scene` and returns the finished film with statistics. `progress` is called
@@ -50,54 +71,97 @@ pub fn render(
     let rays_total = AtomicU64::new(0);
     let samples_total = AtomicU64::new(0);
     let non_finite_total = AtomicU64::new(0);
+    let bounces_total = AtomicU64::new(0);
+    let roulette_total = AtomicU64::new(0);
+    let non_finite_contributions_total = AtomicU64::new(0);
     film.render_tiles(settings.tile_size_px, |tile| {
         let (mut rays, mut samples, mut non_finite) = (0u64, 0u64, 0u64);
+        let mut counters = PathCounters::default();
         for pixel in tile.bounds().pixels() {
             for s in 0..spp {
                 let mut stream = sampler.stream(pixel, s);
                 let (film_point, weight) = tile.sample_film_point(pixel, stream.get_2d());
                 let lens = stream.get_2d();
-                let (xyz, aov) = match scene.camera.generate_ray(film_point, lens) {
-                    None => (DVec3::ZERO, None),
-                    Some(ray) => {
-                        rays += 1;
-                        match scene.geometry.intersect(&ray.ray) {
-                            None => (DVec3::ZERO, None),
-                            Some(h) => {
-                                let si = scene.geometry.interaction(&ray.ray, &h);
-                                let xyz = scene.integrator.shade(
+                match &scene.integrator {
+                    Integrator::Path(tracer) => {
+                        let mut wavelengths = SampledWavelengths::sample_visible(stream.get_1d());
+                        let (radiance, aov) = match scene.camera.generate_ray(film_point, lens) {
+                            None => (SampledSpectrum::splat(0.0), None),
+                            Some(camera_ray) => {
+                                rays += 1;
+                                let r = tracer.radiance(
                                     scene,
-                                    &ray.ray,
-                                    &si,
+                                    &camera_ray.ray,
+                                    &mut wavelengths,
                                     &mut stream,
-                                    &mut rays,
+                                    1,
+                                    false,
+                                    &mut counters,
                                 );
-                                let aov = SurfaceAov {
-                                    depth_m: h.t,
+                                let aov = r.first_hit.map(|si| SurfaceAov {
+                                    depth_m: si.t,
                                     normal: si.n_shading,
                                     albedo_rgb: scene.albedo(si.material_id),
-                                };
-                                (xyz, Some(aov))
+                                });
+                                (r.radiance, aov)
                             }
+                        };
+                        if radiance.has_non_finite() {
+                            non_finite += 1;
                         }
+                        tile.add_sample(pixel, radiance, &wavelengths, weight, aov.as_ref());
                     }
-                };
-                if !xyz.is_finite() {
-                    non_finite += 1;
+                    diagnostic => {
+                        let (xyz, aov) = match scene.camera.generate_ray(film_point, lens) {
+                            None => (DVec3::ZERO, None),
+                            Some(ray) => {
+                                rays += 1;
+                                match scene.geometry.intersect(&ray.ray) {
+                                    None => (DVec3::ZERO, None),
+                                    Some(h) => {
+                                        let si = scene.geometry.interaction(&ray.ray, &h);
+                                        let xyz = diagnostic.shade(
+                                            scene,
+                                            &ray.ray,
+                                            &si,
+                                            &mut stream,
+                                            &mut rays,
+                                        );
+                                        let aov = SurfaceAov {
+                                            depth_m: h.t,
+                                            normal: si.n_shading,
+                                            albedo_rgb: scene.albedo(si.material_id),
+                                        };
+                                        (xyz, Some(aov))
+                                    }
+                                }
+                            }
+                        };
+                        if !xyz.is_finite() {
+                            non_finite += 1;
+                        }
+                        tile.add_sample_xyz(pixel, xyz, weight, aov.as_ref());
+                    }
                 }
-                tile.add_sample_xyz(pixel, xyz, weight, aov.as_ref());
                 samples += 1;
             }
         }
-        rays_total.fetch_add(rays, Ordering::Relaxed);
+        rays_total.fetch_add(rays + counters.rays, Ordering::Relaxed);
         samples_total.fetch_add(samples, Ordering::Relaxed);
         non_finite_total.fetch_add(non_finite, Ordering::Relaxed);
+        bounces_total.fetch_add(counters.bounces, Ordering::Relaxed);
+        roulette_total.fetch_add(counters.roulette_terminations, Ordering::Relaxed);
+        non_finite_contributions_total
+            .fetch_add(counters.non_finite_contributions, Ordering::Relaxed);
         progress(samples);
     });
     let stats = RenderStats {
         rays_traced: rays_total.into_inner(),
         samples: samples_total.into_inner(),
         non_finite_samples: non_finite_total.into_inner(),
+        bounces: bounces_total.into_inner(),
+        roulette_terminations: roulette_total.into_inner(),
+        non_finite_contributions: non_finite_contributions_total.into_inner(),
     };
     (film.finish(), stats)
 }

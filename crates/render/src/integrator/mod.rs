@@ -12,8 +12,10 @@ mod ambient_occlusion;
 mod depth;
 mod driver;
 mod normal;
+mod path;
 
 pub use ambient_occlusion::AmbientOcclusion;
+pub use path::{mis_weight, PathCounters, PathResult, PathTracer};
 pub use driver::{render, total_samples, RenderSettings, RenderStats, DEFAULT_TILE_SIZE_PX};
 
 use glam::DVec3;
@@ -32,6 +34,8 @@ pub enum Integrator {
     /// First-hit material albedo (linear Rec.709).
     Albedo,
     AmbientOcclusion(AmbientOcclusion),
+    /// The spectral path tracer (NEE + MIS).
+    Path(PathTracer),
 }
 
 impl Integrator {
@@ -49,14 +53,16 @@ impl Integrator {
                 max_distance_m.map_or(f32::INFINITY, |d| d as f32),
                 samples,
             )?),
-            prism_scene::Integrator::Path { .. } => {
-                return Err(
-                    "the `path` integrator is not implemented yet; use `depth`, \
-                            `normal`, `albedo` or `ambient_occlusion` (note: `path` is the \
-                            default when a scene has no `integrator`)"
-                        .into(),
-                )
-            }
+            prism_scene::Integrator::Path {
+                max_depth,
+                mis,
+                rr_depth,
+                ..
+            } => Integrator::Path(PathTracer {
+                max_depth: max_depth.max(1),
+                rr_depth,
+                mis,
+            }),
         })
     }
 
@@ -67,6 +73,7 @@ impl Integrator {
             Integrator::Normal => "normal",
             Integrator::Albedo => "albedo",
             Integrator::AmbientOcclusion(_) => "ambient_occlusion",
+            Integrator::Path(_) => "path",
         }
     }
 
@@ -86,6 +93,8 @@ impl Integrator {
             Integrator::Normal => normal::shade(hit),
             Integrator::Albedo => albedo::shade(scene, hit),
             Integrator::AmbientOcclusion(ao) => ao.shade(&scene.geometry, ray, hit, stream, rays),
+            // Spectral: the driver calls `PathTracer::radiance` directly.
+            Integrator::Path(_) => DVec3::ZERO,
         }
     }
 }

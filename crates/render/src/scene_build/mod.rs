@@ -45,6 +45,8 @@ pub struct RenderScene {
     /// Runtime materials indexed by `material_id` (the default material last).
     pub materials: Vec<Material>,
     pub lights: LightSet,
+    /// Some material has an opacity mask: shadow rays must look through masked surfaces.
+    pub has_masks: bool,
 }
 
 impl RenderScene {
@@ -71,6 +73,7 @@ impl RenderScene {
         let geometry = build_geometry(scene)?;
         let materials = build_materials(scene)?;
         let lights = LightSet::build(scene, &geometry)?;
+        let has_masks = materials.iter().any(|m| m.opacity() < 1.0);
         Ok(Self {
             file,
             geometry,
@@ -83,6 +86,7 @@ impl RenderScene {
             albedo_rgb,
             materials,
             lights,
+            has_masks,
         })
     }
 
@@ -91,6 +95,14 @@ impl RenderScene {
         // The resolution was checked when the camera frame was built.
         Film::new(self.resolution, self.filter, AovSelection::ALL)
             .expect("resolution checked by CameraFrame::new")
+    }
+
+    /// The runtime material of a hit's `material_id` (the default material for ids
+    /// without one).
+    #[inline]
+    pub fn material(&self, material_id: u32) -> &Material {
+        let last = self.materials.len() - 1;
+        &self.materials[(material_id as usize).min(last)]
     }
 
     /// Albedo of a hit's `material_id`.

@@ -1,0 +1,439 @@
+//! The spectral path tracer: unidirectional path tracing with next-event estimation and
+//! multiple importance sampling (Veach 1997, ch. 9; pbrt-v4 §13.4 `PathIntegrator`),
+//! Russian roulette (Arvo & Kirk 1990) and hero-wavelength transport (Wilkie et al. 2014):
+//! four wavelengths travel together; a dispersive interface keeps only the hero.
+//!
+//! `max_depth` counts scattering events: 1 is direct lighting only (pbrt-v4 convention;
+//! Mitsuba 3's `max_depth` is one more, since it counts the camera segment).
+//!
+//! Sample dimensions per camera sample (after the driver's filter 2 + lens 2 + wavelength 1):
+//! per vertex 8 — mask 1, light choice 1, light position 2, BSDF lobe 1, BSDF direction 2,
+//! roulette 1 — drawn in that order whether used or not, so a low-discrepancy sampler's
+//! dimensions mean the same thing in every path; extra light samples (a `SamplePlan` with
+//! more than one light sample per hit) draw 3 more each.
+
+use glam::{Vec2, Vec3A};
+use prism_geometry::{Frame, Ray, SurfaceInteraction};
+use prism_scene::MisHeuristic;
+use prism_spectrum::{SampledSpectrum, SampledWavelengths};
+
+use crate::bsdf::{Bsdf, TransportMode};
+use crate::light::{LightHit, LightSampleContext};
+use crate::sampler::SampleStream;
+use crate::scene_build::RenderScene;
+
+/// Parameters of the path tracer.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PathTracer {
+    /// Most scattering events (≥ 1; 1 = direct lighting only).
+    pub max_depth: u32,
+    /// Russian roulette starts after this many scattering events.
+    pub rr_depth: u32,
+    pub mis: MisHeuristic,
+}
+
+/// Per-sample counters the driver sums into `RenderStats`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct PathCounters {
+    /// Extension and shadow rays (the camera ray is counted by the driver).
+    pub rays: u64,
+    /// Scattering events.
+    pub bounces: u64,
+    /// Paths ended by Russian roulette.
+    pub roulette_terminations: u64,
+    /// Light-sample or emission contributions that were NaN or infinite (dropped).
+    pub non_finite_contributions: u64,
+}
+
+/// What one camera path returns.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PathResult {
+    /// Radiance arriving at the camera along the ray, W·m⁻²·sr⁻¹·nm⁻¹ per lane.
+    pub radiance: SampledSpectrum,
+    /// The first surface hit, when there is one.
+    pub first_hit: Option<SurfaceInteraction>,
+    /// Radiance a neutral white Lambertian (R = 1) would reflect towards the camera at the
+    /// first hit (direct light by light sampling plus the path's indirect estimate), for
+    /// scene-based white balance; `None` when the first hit is specular or there is none.
+    pub illumination: Option<SampledSpectrum>,
+}
+
+/// Multiple importance sampling weight of a strategy with pdf `a` against one with pdf `b`
+/// (Veach 1997, eqs. 9.12–9.13; one sample per strategy).
+#[inline]
+pub fn mis_weight(heuristic: MisHeuristic, a: f32, b: f32) -> f32 {
+    match heuristic {
+        MisHeuristic::Balance => {
+            if a + b > 0.0 {
+                a / (a + b)
+            } else {
+                0.0
+            }
+        }
+        MisHeuristic::Power => {
+            let (a2, b2) = (a * a, b * b);
+            if a2 + b2 > 0.0 {
+                a2 / (a2 + b2)
+            } else {
+                0.0
+            }
+        }
+    }
+}
+
+/// A shading point: where the path scatters.
+struct Vertex {
+    si: SurfaceInteraction,
+    frame: Frame,
+    wo_local: Vec3A,
+}
+
+impl PathTracer {
+    /// Radiance along `camera_ray` (unit direction) at `wavelengths` (which a dispersive
+    /// hit may reduce to the hero); `light_samples` light samples per scattering event.
+    pub fn radiance(
+        &self,
+        scene: &RenderScene,
+        camera_ray: &Ray,
+        wavelengths: &mut SampledWavelengths,
+        stream: &mut SampleStream,
+        light_samples: u32,
+        want_illumination: bool,
+        counters: &mut PathCounters,
+    ) -> PathResult {
+        let lights = &scene.lights;
+        let mut radiance = SampledSpectrum::splat(0.0);
+        let mut beta = SampledSpectrum::splat(1.0);
+        // Indirect light arriving at the first hit, for the illumination AOV: contributions
+        // after the first bounce divided by the first bounce's throughput factor.
+        let mut first_bounce_beta: Option<SampledSpectrum> = None;
+        let mut incident_after_first = SampledSpectrum::splat(0.0);
+        let mut illumination_direct: Option<SampledSpectrum> = None;
+        let mut first_hit: Option<SurfaceInteraction> = None;
+        let mut ray = *camera_ray;
+        let mut depth = 0u32;
+        let mut specular_bounce = true;
+        let mut prev_ctx = LightSampleContext {
+            p: ray.origin,
+            n: Vec3A::ZERO,
+        };
+        let mut prev_bsdf_pdf = 0.0f32;
+        // Product of η² over refractions: roulette compares radiance, not the 1/η²-scaled
+        // throughput (pbrt-v4 §13.4.4 `etaScale`).
+        let mut eta_scale = 1.0f32;
+        // Pass-throughs of masked surfaces do not count as bounces; cap them anyway.
+        let mut pass_throughs = 0u32;
+        let n_light = light_samples.max(1);
+
+        // Adds beta·x unless it is NaN/∞ (then counts it: one bad contribution cannot poison
+        // a pixel, and the stats say so). `count_incident`: also part of the indirect light
+        // at the first hit (not emission met right after the first bounce — the white
+        // Lambertian's direct light comes from light sampling alone).
+        let add = |radiance: &mut SampledSpectrum,
+                   incident: &mut SampledSpectrum,
+                   first: &Option<SampledSpectrum>,
+                   beta: SampledSpectrum,
+                   x: SampledSpectrum,
+                   count_incident: bool,
+                   counters: &mut PathCounters| {
+            let c = beta * x;
+            if c.has_non_finite() {
+                counters.non_finite_contributions += 1;
+                return;
+            }
+            *radiance += c;
+            if let (Some(b1), true) = (first, count_incident) {
+                *incident += c.safe_div(*b1);
+            }
+        };
+
+        loop {
+            let Some(hit) = scene.geometry.intersect(&ray) else {
+                // Escaped: infinite lights.
+                for &l in lights.infinite_lights() {
+                    let light = lights.light(l);
+                    let le = light.infinite_radiance(ray.direction, wavelengths);
+                    if le.is_black() {
+                        continue;
+                    }
+                    let w = if specular_bounce {
+                        1.0
+                    } else {
+                        let light_pdf = lights.pmf(l) * light.pdf_li(&prev_ctx, ray.direction, None);
+                        mis_weight(self.mis, prev_bsdf_pdf, light_pdf)
+                    };
+                    add(
+                        &mut radiance,
+                        &mut incident_after_first,
+                        &first_bounce_beta,
+                        beta,
+                        le * w,
+                        depth >= 2,
+                        counters,
+                    );
+                }
+                break;
+            };
+            let si = scene.geometry.interaction(&ray, &hit);
+            let material = scene.material(si.material_id);
+            let u_mask = stream.get_1d();
+            let u_light_choice = stream.get_1d();
+            let u_light = stream.get_2d();
+            let u_lobe = stream.get_1d();
+            let u_bsdf = stream.get_2d();
+            let u_roulette = stream.get_1d();
+
+            // Opacity mask: pass straight through with probability 1 − α.
+            let opacity = material.opacity();
+            if opacity < 1.0 && u_mask >= opacity {
+                pass_throughs += 1;
+                if pass_throughs > 256 {
+                    break;
+                }
+                ray = Ray::spawn(si.p, ray.direction);
+                continue;
+            }
+            if first_hit.is_none() {
+                first_hit = Some(si);
+            }
+
+            // Emission of a hit area light.
+            if let Some(l) = lights.area_light_of_instance(hit.instance_id) {
+                let light = lights.light(l);
+                let light_hit = LightHit {
+                    p: si.p,
+                    n: si.n_geometric,
+                    uv: si.uv,
+                    distance_m: hit.t,
+                };
+                let le = light.emitted_radiance(&light_hit, -ray.direction, wavelengths);
+                if !le.is_black() {
+                    let w = if specular_bounce {
+                        1.0
+                    } else {
+                        let light_pdf =
+                            lights.pmf(l) * light.pdf_li(&prev_ctx, ray.direction, Some(&light_hit));
+                        mis_weight(self.mis, prev_bsdf_pdf, light_pdf)
+                    };
+                    add(
+                        &mut radiance,
+                        &mut incident_after_first,
+                        &first_bounce_beta,
+                        beta,
+                        le * w,
+                        depth >= 2,
+                        counters,
+                    );
+                }
+            }
+            if depth == self.max_depth {
+                break;
+            }
+            depth += 1;
+            counters.bounces += 1;
+
+            if material.is_dispersive() {
+                wavelengths.terminate_secondary();
+            }
+            let bsdf = material.bsdf(&si, wavelengths);
+            let frame = Frame::from_zx(si.n_shading, si.dpdu);
+            let vertex = Vertex {
+                si,
+                frame,
+                wo_local: frame.to_local(-ray.direction),
+            };
+            let ctx = LightSampleContext {
+                p: si.p,
+                n: si.n_geometric,
+            };
+
+            // Next-event estimation.
+            if !bsdf.is_specular() && !lights.is_empty() {
+                let mut direct = SampledSpectrum::splat(0.0);
+                let mut white = SampledSpectrum::splat(0.0);
+                for k in 0..n_light {
+                    let (uc, ul) = if k == 0 {
+                        (u_light_choice, u_light)
+                    } else {
+                        (stream.get_1d(), stream.get_2d())
+                    };
+                    let (d, w) = self.sample_light(
+                        scene,
+                        &vertex,
+                        &bsdf,
+                        &ctx,
+                        uc,
+                        ul,
+                        wavelengths,
+                        want_illumination && depth == 1,
+                        counters,
+                    );
+                    direct += d;
+                    white += w;
+                }
+                let inv = 1.0 / n_light as f32;
+                add(
+                    &mut radiance,
+                    &mut incident_after_first,
+                    &first_bounce_beta,
+                    beta,
+                    direct * inv,
+                    true,
+                    counters,
+                );
+                if want_illumination && depth == 1 {
+                    illumination_direct = Some(white * inv);
+                }
+            }
+
+            // Continue the path by sampling the BSDF.
+            let Some(bs) = bsdf.sample(vertex.wo_local, u_lobe, u_bsdf, TransportMode::Radiance)
+            else {
+                break;
+            };
+            let weight = bs.weight();
+            if weight.is_black() || weight.has_non_finite() {
+                if weight.has_non_finite() {
+                    counters.non_finite_contributions += 1;
+                }
+                break;
+            }
+            beta *= weight;
+            if depth == 1 {
+                if want_illumination && !bs.specular {
+                    // White Lambertian weight of this direction: (cos/π)/pdf.
+                    let white_weight = bs.wi.z.max(0.0) * std::f32::consts::FRAC_1_PI / bs.pdf;
+                    first_bounce_beta = Some(weight * (1.0 / white_weight.max(1e-20)));
+                    if white_weight <= 0.0 {
+                        first_bounce_beta = None;
+                    }
+                } else {
+                    illumination_direct = None;
+                }
+            }
+            specular_bounce = bs.specular;
+            prev_bsdf_pdf = bs.pdf;
+            if bs.transmission {
+                eta_scale *= bs.eta * bs.eta;
+            }
+            prev_ctx = ctx;
+            let wi_world = vertex.frame.from_local(bs.wi);
+            ray = Ray::spawn(vertex.si.p, wi_world.normalize());
+            counters.rays += 1;
+
+            // Russian roulette on the radiance-scaled throughput.
+            if depth >= self.rr_depth {
+                let q = (1.0 - (beta * eta_scale).max_component()).max(0.0);
+                if u_roulette < q {
+                    counters.roulette_terminations += 1;
+                    break;
+                }
+                beta = beta * (1.0 / (1.0 - q));
+            }
+        }
+        let illumination = illumination_direct.map(|d| {
+            if first_bounce_beta.is_some() {
+                d + incident_after_first
+            } else {
+                d
+            }
+        });
+        PathResult {
+            radiance,
+            first_hit,
+            illumination,
+        }
+    }
+
+    /// One light sample at `vertex`, MIS-weighted against BSDF sampling: (contribution for
+    /// the path, contribution a white Lambertian would get — for the illumination AOV).
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    fn sample_light(
+        &self,
+        scene: &RenderScene,
+        vertex: &Vertex,
+        bsdf: &Bsdf,
+        ctx: &LightSampleContext,
+        u_choice: f32,
+        u: Vec2,
+        wavelengths: &SampledWavelengths,
+        want_white: bool,
+        counters: &mut PathCounters,
+    ) -> (SampledSpectrum, SampledSpectrum) {
+        let zero = SampledSpectrum::splat(0.0);
+        let lights = &scene.lights;
+        let Some((l, pmf)) = lights.sample(u_choice) else {
+            return (zero, zero);
+        };
+        let light = lights.light(l);
+        let Some(ls) = light.sample_li(ctx, u, wavelengths) else {
+            return (zero, zero);
+        };
+        if ls.pdf <= 0.0 || ls.radiance.is_black() {
+            return (zero, zero);
+        }
+        let wi_local = vertex.frame.to_local(ls.wi);
+        let f = bsdf.eval(vertex.wo_local, wi_local, TransportMode::Radiance) * wi_local.z.abs();
+        let white_cos = if want_white {
+            wi_local.z.max(0.0) * std::f32::consts::FRAC_1_PI
+        } else {
+            0.0
+        };
+        if f.is_black() && white_cos <= 0.0 {
+            return (zero, zero);
+        }
+        counters.rays += 1;
+        let transmittance = self.transmittance(scene, vertex.si.p, &ls, counters);
+        if transmittance <= 0.0 {
+            return (zero, zero);
+        }
+        let light_pdf = pmf * ls.pdf;
+        let w = if ls.delta {
+            1.0
+        } else {
+            let bsdf_pdf = bsdf.pdf(vertex.wo_local, wi_local, TransportMode::Radiance);
+            mis_weight(self.mis, light_pdf, bsdf_pdf)
+        };
+        let direct = f * ls.radiance * (w * transmittance / light_pdf);
+        let white = ls.radiance * (white_cos * transmittance / light_pdf);
+        (direct, white)
+    }
+
+    /// Fraction of light that reaches `p` from the light sample: 0 or 1, unless the scene
+    /// has opacity masks (the plan's choice, `RenderScene::has_masks`): then each masked
+    /// surface on the way multiplies by 1 − α (exact, no extra noise).
+    #[inline]
+    fn transmittance(
+        &self,
+        scene: &RenderScene,
+        p: Vec3A,
+        ls: &crate::light::LightSample,
+        counters: &mut PathCounters,
+    ) -> f32 {
+        let mut shadow = if ls.distance_m.is_finite() {
+            Ray::spawn_to(p, ls.p_light)
+        } else {
+            Ray::spawn(p, ls.wi)
+        };
+        if !scene.has_masks {
+            return if scene.geometry.occluded(&shadow) { 0.0 } else { 1.0 };
+        }
+        let mut transmittance = 1.0f32;
+        for _ in 0..256 {
+            let Some(hit) = scene.geometry.intersect(&shadow) else {
+                return transmittance;
+            };
+            let si = scene.geometry.interaction(&shadow, &hit);
+            let opacity = scene.material(si.material_id).opacity();
+            transmittance *= 1.0 - opacity;
+            if transmittance <= 0.0 {
+                return 0.0;
+            }
+            counters.rays += 1;
+            // Continue past the masked surface, keeping the same end point.
+            shadow.t_min = hit.t * (1.0 + 1e-5) + shadow.t_min;
+        }
+        0.0
+    }
+}
