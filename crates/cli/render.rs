@@ -17,7 +17,10 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use prism_post::io::{write_image, ImageFormat};
 use prism_post::Image;
 use prism_render::integrator::DEFAULT_TILE_SIZE_PX;
-use prism_render::{render, total_samples, FilmImage, RenderScene, RenderSettings, RenderStats};
+use prism_render::{
+    render, total_samples, FilmImage, PlanRequest, RenderPlan, RenderScene, RenderSettings,
+    RenderStats,
+};
 use prism_spectrum::rgb_space::RgbColorSpace;
 use serde_json::json;
 
@@ -41,6 +44,9 @@ pub struct RenderArgs {
     /// Film resolution override, WIDTHxHEIGHT (e.g. 64x48), for previews and tests.
     #[arg(long, value_parser = parse_resolution)]
     pub resolution: Option<UVec2>,
+    /// Print the render plan (what the scene needs and why) and exit without rendering.
+    #[arg(long)]
+    pub explain: bool,
     /// Write render statistics as JSON to this file.
     #[arg(long = "stats-json")]
     pub stats_json: Option<PathBuf>,
@@ -166,7 +172,9 @@ fn progress_bar(total: u64) -> ProgressBar {
 pub fn run(args: &RenderArgs) -> Result<(), String> {
     let description = prism_scene::load_scene(&args.scene).map_err(|e| e.to_string())?;
     let output = output_path(args, description.film.output.as_deref());
-    check_output(&output)?;
+    if !args.explain {
+        check_output(&output)?;
+    }
     let scene = RenderScene::build(&description, args.resolution).map_err(|e| e.to_string())?;
     let settings = RenderSettings {
         spp: args.spp.unwrap_or(scene.spp),
@@ -175,6 +183,16 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
     };
     if settings.spp == 0 {
         return Err("--spp must be at least 1".into());
+    }
+    if args.explain {
+        let request = PlanRequest {
+            spp: settings.spp,
+            spectral_bins: None,
+            aov_output: ImageFormat::from_path(&output).is_ok_and(|f| f == ImageFormat::Exr),
+            sampler: "sobol",
+        };
+        print!("{}", RenderPlan::new(&scene, &request));
+        return Ok(());
     }
     let mut pool = rayon::ThreadPoolBuilder::new();
     if let Some(n) = args.threads {

@@ -16,6 +16,7 @@ pub mod film;
 pub mod integrator;
 pub mod light;
 pub mod material;
+pub mod plan;
 pub mod sampler;
 pub mod sampling;
 pub mod scene_build;
@@ -30,5 +31,6 @@ pub use film::{
     SurfaceAov, TileBounds,
 };
 pub use integrator::{render, total_samples, Integrator, RenderSettings, RenderStats};
+pub use plan::{PlanChoice, PlanRequest, RenderPlan};
 pub use sampler::{PixelSampler, SampleStream};
 pub use scene_build::{RenderScene, SceneBuildError};

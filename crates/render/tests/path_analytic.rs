@@ -47,7 +47,10 @@ fn assert_matches(image: &FilmImage, expected: &[f64], max_sigma: f64) {
     let sigma = (rel.iter().map(|r| (r - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
     let worst = rel.iter().fold(0.0f64, |m, r| m.max(r.abs()));
     eprintln!("mean rel. error {mean:.2e}, σ {sigma:.2e}, worst {worst:.2e}");
-    assert!(sigma < max_sigma, "per-pixel noise σ = {sigma} above {max_sigma}");
+    assert!(
+        sigma < max_sigma,
+        "per-pixel noise σ = {sigma} above {max_sigma}"
+    );
     assert!(
         mean.abs() < 5.0 * sigma / n.sqrt() + 1e-4,
         "biased: mean relative error {mean} (σ/√n = {})",

@@ -15,8 +15,8 @@ mod normal;
 mod path;
 
 pub use ambient_occlusion::AmbientOcclusion;
-pub use path::{mis_weight, PathCounters, PathResult, PathTracer};
 pub use driver::{render, total_samples, RenderSettings, RenderStats, DEFAULT_TILE_SIZE_PX};
+pub use path::{mis_weight, PathCounters, PathResult, PathTracer};
 
 use glam::DVec3;
 use prism_geometry::{Ray, SurfaceInteraction};

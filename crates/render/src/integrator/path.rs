@@ -91,6 +91,7 @@ struct Vertex {
 impl PathTracer {
     /// Radiance along `camera_ray` (unit direction) at `wavelengths` (which a dispersive
     /// hit may reduce to the hero); `light_samples` light samples per scattering event.
+    #[allow(clippy::too_many_arguments)]
     pub fn radiance(
         &self,
         scene: &RenderScene,
@@ -159,7 +160,8 @@ impl PathTracer {
                     let w = if specular_bounce {
                         1.0
                     } else {
-                        let light_pdf = lights.pmf(l) * light.pdf_li(&prev_ctx, ray.direction, None);
+                        let light_pdf =
+                            lights.pmf(l) * light.pdf_li(&prev_ctx, ray.direction, None);
                         mis_weight(self.mis, prev_bsdf_pdf, light_pdf)
                     };
                     add(
@@ -211,8 +213,8 @@ impl PathTracer {
                     let w = if specular_bounce {
                         1.0
                     } else {
-                        let light_pdf =
-                            lights.pmf(l) * light.pdf_li(&prev_ctx, ray.direction, Some(&light_hit));
+                        let light_pdf = lights.pmf(l)
+                            * light.pdf_li(&prev_ctx, ray.direction, Some(&light_hit));
                         mis_weight(self.mis, prev_bsdf_pdf, light_pdf)
                     };
                     add(
@@ -328,7 +330,7 @@ impl PathTracer {
                     counters.roulette_terminations += 1;
                     break;
                 }
-                beta = beta * (1.0 / (1.0 - q));
+                beta *= 1.0 / (1.0 - q);
             }
         }
         let illumination = illumination_direct.map(|d| {
@@ -417,9 +419,14 @@ impl PathTracer {
             Ray::spawn(p, ls.wi)
         };
         if !scene.has_masks {
-            return if scene.geometry.occluded(&shadow) { 0.0 } else { 1.0 };
+            return if scene.geometry.occluded(&shadow) {
+                0.0
+            } else {
+                1.0
+            };
         }
         let mut transmittance = 1.0f32;
+        let offset = shadow.t_min;
         for _ in 0..256 {
             let Some(hit) = scene.geometry.intersect(&shadow) else {
                 return transmittance;
@@ -432,7 +439,7 @@ impl PathTracer {
             }
             counters.rays += 1;
             // Continue past the masked surface, keeping the same end point.
-            shadow.t_min = hit.t * (1.0 + 1e-5) + shadow.t_min;
+            shadow.t_min = hit.t * (1.0 + 1e-5) + offset;
         }
         0.0
     }

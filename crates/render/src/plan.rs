@@ -1,0 +1,276 @@
+//! The render plan: before rendering, look at the scene and switch on only what it uses
+//! ("model no more than a scene needs", DESIGN.md). Each choice records why it was made;
+//! `prism render --explain` prints them without rendering.
+//!
+//! The integrator follows the same facts at run time (a delta light gets MIS weight 1, a
+//! purely specular BSDF skips light sampling, dispersion keeps only the hero wavelength),
+//! so the plan is a faithful description, not a second code path.
+
+use std::fmt;
+
+use glam::{Vec2, Vec3A};
+use prism_geometry::{Curvature, Differentials, SurfaceInteraction};
+use prism_spectrum::SampledWavelengths;
+
+use crate::integrator::Integrator;
+use crate::scene_build::RenderScene;
+
+/// One decision of the plan.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct PlanChoice {
+    /// What is decided (e.g. "dispersion").
+    pub feature: &'static str,
+    /// On, off, or a value.
+    pub setting: String,
+    /// Why, in terms of the scene.
+    pub reason: String,
+}
+
+/// What a render will do, and why.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct RenderPlan {
+    pub choices: Vec<PlanChoice>,
+}
+
+/// Options that come from the command line rather than the scene.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct PlanRequest {
+    pub spp: u32,
+    /// Spectral bins asked for with `--spectral-bins`.
+    pub spectral_bins: Option<u32>,
+    /// The output can hold AOV layers (EXR).
+    pub aov_output: bool,
+    /// The sampler's name.
+    pub sampler: &'static str,
+}
+
+/// A neutral hit for asking a material which lobes it has.
+fn probe_hit() -> SurfaceInteraction {
+    SurfaceInteraction {
+        p: Vec3A::ZERO,
+        t: 1.0,
+        n_geometric: Vec3A::Z,
+        n_shading: Vec3A::Z,
+        uv: Vec2::splat(0.5),
+        dpdu: Vec3A::X,
+        dpdv: Vec3A::Y,
+        dndu: Vec3A::ZERO,
+        dndv: Vec3A::ZERO,
+        curvature: Curvature::default(),
+        differentials: Differentials::default(),
+        primitive_id: 0,
+        material_id: 0,
+        object_id: 0,
+        instance_id: 0,
+    }
+}
+
+fn on_off(b: bool) -> String {
+    if b { "on" } else { "off" }.to_string()
+}
+
+impl RenderPlan {
+    /// The plan for `scene` with the command line's `request`.
+    pub fn new(scene: &RenderScene, request: &PlanRequest) -> Self {
+        let mut choices = Vec::new();
+        let mut choose = |feature: &'static str, setting: String, reason: String| {
+            choices.push(PlanChoice {
+                feature,
+                setting,
+                reason,
+            })
+        };
+        // Materials that some instance uses (the default one only if a shape has none).
+        let mut used = vec![false; scene.materials.len()];
+        for inst in scene.geometry.instances() {
+            let id = inst.material.unwrap_or(u32::MAX) as usize;
+            used[id.min(scene.materials.len() - 1)] = true;
+        }
+        let wavelengths = SampledWavelengths::sample_visible(0.5);
+        let hit = probe_hit();
+        let mut dispersive = Vec::new();
+        let mut any_non_specular = false;
+        for (i, m) in scene.materials.iter().enumerate() {
+            if !used[i] {
+                continue;
+            }
+            if m.is_dispersive() {
+                dispersive.push(i);
+            }
+            let bsdf = m.bsdf(&hit, &wavelengths);
+            any_non_specular |= !bsdf.is_specular();
+        }
+        let lights = scene.lights.lights();
+        let delta_lights = lights.iter().filter(|l| l.is_delta()).count();
+        let hittable_lights = lights.len() - delta_lights;
+        let env_lights = lights.iter().filter(|l| l.is_infinite()).count();
+
+        match &scene.integrator {
+            Integrator::Path(p) => {
+                choose(
+                    "integrator",
+                    format!(
+                        "path tracing, max_depth {} (1 = direct light only), MIS {:?}",
+                        p.max_depth, p.mis
+                    ),
+                    "the scene's `integrator` section (default `path`)".into(),
+                );
+                choose(
+                    "sampler",
+                    format!(
+                        "{}, {} spp, uniform sample plan",
+                        request.sampler, request.spp
+                    ),
+                    "no predicted plan was asked for: every pixel gets the same samples".into(),
+                );
+                choose(
+                    "wavelengths",
+                    "hero + 3 rotated wavelengths per path, visible-importance density".into(),
+                    "spectral transport (Wilkie et al. 2014); 4 wavelengths share every ray".into(),
+                );
+                let names: Vec<String> = dispersive
+                    .iter()
+                    .map(|&i| format!("material {i}"))
+                    .collect();
+                choose(
+                    "dispersion",
+                    on_off(!dispersive.is_empty()),
+                    if dispersive.is_empty() {
+                        "no material's index of refraction varies with wavelength: all 4 \
+                         wavelengths follow every path"
+                            .into()
+                    } else {
+                        format!(
+                            "{} refract with a wavelength-dependent IOR: paths that meet them \
+                             keep only the hero wavelength",
+                            names.join(", ")
+                        )
+                    },
+                );
+                let nee = !lights.is_empty() && any_non_specular;
+                choose(
+                    "light sampling (next-event estimation)",
+                    on_off(nee),
+                    if lights.is_empty() {
+                        "the scene has no lights".into()
+                    } else if !any_non_specular {
+                        "every material is purely specular: no light sample can be weighted \
+                         by a Dirac BSDF"
+                            .into()
+                    } else {
+                        format!(
+                            "{} light(s), chosen in proportion to power; {} delta (point/spot/\
+                             parallel), {} with area or extent",
+                            lights.len(),
+                            delta_lights,
+                            hittable_lights
+                        )
+                    },
+                );
+                let mis = nee && hittable_lights > 0;
+                choose(
+                    "multiple importance sampling",
+                    on_off(mis),
+                    if !nee {
+                        "only BSDF sampling is used, nothing to combine".into()
+                    } else if hittable_lights == 0 {
+                        "all lights are delta lights: BSDF-sampled rays never hit them, so \
+                         light samples get weight 1"
+                            .into()
+                    } else {
+                        "lights with area or extent can be reached by both light and BSDF \
+                         sampling: weights by the chosen heuristic (Veach 1997, §9.2)"
+                            .into()
+                    },
+                );
+                choose(
+                    "environment importance table",
+                    on_off(env_lights > 0),
+                    if env_lights > 0 {
+                        format!("{env_lights} infinite light(s) (environment, sky, sun disk)")
+                    } else {
+                        "no environment or sky".into()
+                    },
+                );
+                choose(
+                    "opacity masks in shadow rays",
+                    on_off(scene.has_masks),
+                    if scene.has_masks {
+                        "a `mask` material is present: shadow rays multiply 1 − α through \
+                         masked surfaces"
+                            .into()
+                    } else {
+                        "no `mask` material: shadow rays stop at the first hit".into()
+                    },
+                );
+                choose(
+                    "Russian roulette",
+                    if p.rr_depth < p.max_depth {
+                        format!("after {} bounces", p.rr_depth)
+                    } else {
+                        "off".into()
+                    },
+                    if p.rr_depth < p.max_depth {
+                        "long paths end with probability 1 − throughput (Arvo & Kirk 1990)".into()
+                    } else {
+                        format!(
+                            "rr_depth {} ≥ max_depth {}: paths never get that long",
+                            p.rr_depth, p.max_depth
+                        )
+                    },
+                );
+            }
+            other => choose(
+                "integrator",
+                other.name().to_string(),
+                "a diagnostic integrator: no light transport, lights and BSDFs are unused".into(),
+            ),
+        }
+        choose(
+            "spectral output bins",
+            match request.spectral_bins {
+                Some(n) => format!("{n} bins over 360–830 nm"),
+                None => "off".into(),
+            },
+            if request.spectral_bins.is_some() {
+                "asked for with --spectral-bins".into()
+            } else {
+                "not asked for (--spectral-bins N)".into()
+            },
+        );
+        choose(
+            "AOV layers",
+            on_off(request.aov_output),
+            if request.aov_output {
+                "EXR output: depth, normal, albedo, illumination, spp and luminance layers".into()
+            } else {
+                "the output format holds no layers".into()
+            },
+        );
+        Self { choices }
+    }
+}
+
+impl fmt::Display for RenderPlan {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let width = self
+            .choices
+            .iter()
+            .map(|c| c.feature.chars().count())
+            .max()
+            .unwrap_or(0);
+        for c in &self.choices {
+            let pad = width - c.feature.chars().count();
+            writeln!(
+                f,
+                "{}{} : {}\n{}   why: {}",
+                c.feature,
+                " ".repeat(pad),
+                c.setting,
+                " ".repeat(width),
+                c.reason
+            )?;
+        }
+        Ok(())
+    }
+}
