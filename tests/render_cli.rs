@@ -277,3 +277,30 @@ fn unimplemented_path_integrator_is_a_clear_error() {
         stderr(&o)
     );
 }
+
+#[test]
+fn explain_prints_the_plan_and_renders_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("s.json");
+    std::fs::write(
+        &scene,
+        r#"{"integrator": {"type": "path", "max_depth": 2},
+            "shapes": [{"type": "sphere"}],
+            "lights": [{"type": "point", "position_m": [0, 3, 0]}]}"#,
+    )
+    .unwrap();
+    let out = dir.path().join("x.exr");
+    let o = prism(&["render", s(&scene), "-o", s(&out), "--explain"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = String::from_utf8_lossy(&o.stdout);
+    for needle in [
+        "dispersion",
+        "multiple importance sampling",
+        "all lights are delta lights",
+        "Russian roulette",
+        "spectral output bins",
+    ] {
+        assert!(text.contains(needle), "missing `{needle}` in:\n{text}");
+    }
+    assert!(!out.exists(), "--explain must not render");
+}

@@ -41,14 +41,29 @@ impl Curvature {
     /// Curvature from tangents and unit-normal derivatives; `n` is the unit normal the
     /// derivatives belong to (used for directions at umbilic points and degenerate input).
     pub fn from_derivatives(dpdu: Vec3A, dpdv: Vec3A, dndu: Vec3A, dndv: Vec3A, n: Vec3A) -> Self {
+        let fallback_dir = || {
+            dpdu.try_normalize()
+                .map(|d| (d - n * n.dot(d)).normalize_or_zero())
+                .unwrap_or(Vec3A::ZERO)
+        };
+        // Flat (every face of a polygon mesh without vertex normals, rectangles, disks):
+        // the second fundamental form is zero, so both curvatures are exactly 0 — the same
+        // result as the general path below, without its arithmetic (path tracers ask for
+        // an interaction at every vertex).
+        if dndu == Vec3A::ZERO && dndv == Vec3A::ZERO {
+            let dir1 = fallback_dir();
+            return Self {
+                k1: 0.0,
+                k2: 0.0,
+                dir1,
+                dir2: n.cross(dir1),
+            };
+        }
         let (e1, f1, g1) = (dpdu.dot(dpdu), dpdu.dot(dpdv), dpdv.dot(dpdv));
         let (e2, g2) = (dpdu.dot(dndu), dpdv.dot(dndv));
         let f2 = 0.5 * (dpdu.dot(dndv) + dpdv.dot(dndu));
         let det = e1 * g1 - f1 * f1;
-        let fallback_dir = dpdu
-            .try_normalize()
-            .map(|d| (d - n * n.dot(d)).normalize_or_zero())
-            .unwrap_or(Vec3A::ZERO);
+        let fallback_dir = fallback_dir();
         if det.is_nan() || det <= 0.0 || det.is_infinite() {
             return Self {
                 k1: 0.0,
