@@ -184,6 +184,13 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
     if settings.spp == 0 {
         return Err("--spp must be at least 1".into());
     }
+    if matches!(scene.integrator, prism_render::Integrator::Path(_)) && scene.lights.is_empty() {
+        eprintln!(
+            "{}: warning: the scene has no lights: the path tracer's image is black \
+             (add a `lights` entry, or choose a diagnostic `integrator`)",
+            args.scene.display()
+        );
+    }
     if args.explain {
         let request = PlanRequest {
             spp: settings.spp,
