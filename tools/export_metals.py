@@ -46,6 +46,7 @@ def floats(raw, n):
 def plain(html):
     """The reference string without its HTML markup, on one line."""
     text = re.sub(r"<[^>]+>", "", html or "")
+    text = re.sub(r"\[[^\]]*\]", "", text)  # links to calculation scripts
     return " ".join(text.split())
 
 

@@ -155,12 +155,6 @@ pub fn fresnel_complex_spectrum(
     })
 }
 
-/// `fresnel_dielectric` at each of the four wavelengths (dispersion).
-#[inline]
-pub fn fresnel_dielectric_spectrum(cos_theta_i: f32, eta: SampledSpectrum) -> SampledSpectrum {
-    SampledSpectrum::from_fn(|i| fresnel_dielectric(cos_theta_i, eta[i]))
-}
-
 /// `wo` mirrored about `n` (both pointing away from the surface): 2(wo·n)n − wo.
 #[inline]
 pub fn reflect(wo: Vec3A, n: Vec3A) -> Vec3A {

@@ -181,7 +181,10 @@ fn negative_k_in_a_data_file_is_refused_with_its_place() {
     );
     // Caught by the scene parser (value ≥ 0 per line) or, failing that, by the build.
     match parse_scene_str(&json, "scenes/test.json") {
-        Err(e) => assert!(e.to_string().contains("k"), "{e}"),
+        Err(e) => {
+            eprintln!("negative k: {e}");
+            assert!(e.to_string().contains("materials.m.k"), "{e}")
+        }
         Ok(scene) => {
             let e = build_materials(&scene).unwrap_err();
             assert_eq!(e.place, "materials.m.k");
