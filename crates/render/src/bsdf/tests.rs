@@ -539,3 +539,70 @@ fn bsdf_timing() {
         eprintln!("{name}: eval {eval_ns:.1} ns, pdf {pdf_ns:.1} ns, sample {sample_ns:.1} ns (incl. 3 variates)");
     }
 }
+
+#[test]
+fn index_matched_dielectric_passes_straight_through() {
+    // η = 1 is a Dirac pass-through even when rough (no refraction, no reflection).
+    let b = dielectric(MicrofacetModel::Ggx, 0.4, 0.4, 1.0);
+    assert!(b.is_specular());
+    let wo = direction(40.0, 70.0);
+    let s = b
+        .sample(wo, 0.5, Vec2::splat(0.3), TransportMode::Radiance)
+        .unwrap();
+    assert!(s.transmission && s.specular && (s.wi + wo).length() < 1e-6);
+    assert!((s.weight()[0] - 1.0).abs() < 1e-6 && s.eta == 1.0);
+}
+
+#[test]
+fn every_lobe_stays_finite_on_edge_directions() {
+    let mut lobes = vec![Bsdf::new(BsdfLobe::Lambert(Lambert {
+        reflectance: SampledSpectrum::splat(0.5),
+    }))];
+    for model in [MicrofacetModel::Ggx, MicrofacetModel::Beckmann] {
+        for (ax, ay) in [(0.0, 0.0), (1e-4, 1e-4), (0.0, 0.3), (0.3, 0.3), (1.0, 1.0)] {
+            lobes.push(conductor(model, ax, ay));
+            lobes.push(dielectric(model, ax, ay, 1.5));
+            lobes.push(dielectric(model, ax, ay, 0.7));
+        }
+    }
+    let mut dirs = vec![
+        Vec3A::Z,
+        -Vec3A::Z,
+        Vec3A::X,
+        Vec3A::new(0.0, -1.0, 0.0),
+        Vec3A::new(1.0, 0.0, 1e-7).normalize(),
+        Vec3A::new(0.6, 0.0, -0.8),
+    ];
+    dirs.extend(
+        upper_directions(20, 4)
+            .into_iter()
+            .map(|w| w * Vec3A::new(1.0, 1.0, -1.0)),
+    );
+    dirs.extend(upper_directions(20, 5));
+    let mut rng = SplitMix64(13);
+    for b in &lobes {
+        for &wo in &dirs {
+            for &wi in &dirs {
+                for mode in [TransportMode::Radiance, TransportMode::Importance] {
+                    let f = b.eval(wo, wi, mode);
+                    let p = b.pdf(wo, wi, mode);
+                    assert!(
+                        !f.has_non_finite() && f.min_component() >= 0.0,
+                        "{b:?} {wo} {wi}: {f:?}"
+                    );
+                    assert!(p.is_finite() && p >= 0.0, "{b:?} {wo} {wi}: {p}");
+                }
+            }
+            for _ in 0..50 {
+                let u = Vec2::new(rng.next_f32(), rng.next_f32());
+                if let Some(s) = b.sample(wo, rng.next_f32(), u, TransportMode::Radiance) {
+                    assert!((s.wi.length() - 1.0).abs() < 1e-4, "{b:?} {wo}: {s:?}");
+                    assert!(
+                        s.pdf > 0.0 && !s.weight().has_non_finite(),
+                        "{b:?} {wo}: {s:?}"
+                    );
+                }
+            }
+        }
+    }
+}
