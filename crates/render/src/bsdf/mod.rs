@@ -13,10 +13,21 @@
 //!   (with `f` then the Dirac lobe's weight, so f·|cos|/pdf is the throughput factor).
 //! - `TransportMode::Importance` is the adjoint (light tracing / photons): it removes the
 //!   1/η² radiance scaling of refraction.
+//!
+//! Lobes: `Lambert`, `Conductor` (smooth mirror or rough microfacet metal), `Dielectric`
+//! (smooth or rough glass, reflection and refraction, optionally dispersive). Their
+//! formulas and references are in each file and in docs/materials.md.
 
+mod conductor;
+mod dielectric;
+pub mod fresnel;
 mod lambert;
+pub mod microfacet;
 
+pub use conductor::Conductor;
+pub use dielectric::Dielectric;
 pub use lambert::Lambert;
+pub use microfacet::{MicrofacetDistribution, MicrofacetModel};
 
 use glam::{Vec2, Vec3A};
 use prism_spectrum::SampledSpectrum;
@@ -64,6 +75,19 @@ impl BsdfSample {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum BsdfLobe {
     Lambert(Lambert),
+    Conductor(Conductor),
+    Dielectric(Dielectric),
+}
+
+impl BsdfLobe {
+    /// True for lobes that only reflect (one-sided, so `Bsdf::two_sided` applies to them).
+    #[inline]
+    pub fn is_reflection_only(&self) -> bool {
+        match self {
+            BsdfLobe::Lambert(_) | BsdfLobe::Conductor(_) => true,
+            BsdfLobe::Dielectric(_) => false,
+        }
+    }
 }
 
 /// A BSDF at one hit and four wavelengths.
@@ -71,7 +95,8 @@ pub enum BsdfLobe {
 pub struct Bsdf {
     pub lobe: BsdfLobe,
     /// Reflection-only lobes are one-sided (zero seen from below, as in Mitsuba 3) unless
-    /// this is set: then a `wo` below the surface is mirrored to the upper side.
+    /// this is set: then a `wo` below the surface is mirrored to the upper side. Ignored
+    /// for transmissive lobes (a dielectric already scatters on both sides).
     pub two_sided: bool,
 }
 
@@ -83,10 +108,17 @@ impl Bsdf {
         }
     }
 
+    /// True when `wo` is below a two-sided reflection-only lobe, which then sees the
+    /// mirrored configuration.
+    #[inline]
+    fn flips(&self, wo: Vec3A) -> bool {
+        self.two_sided && wo.z < 0.0 && self.lobe.is_reflection_only()
+    }
+
     /// Flips both directions to the upper side for two-sided reflection-only lobes.
     #[inline]
     fn oriented(&self, wo: Vec3A, wi: Vec3A) -> (Vec3A, Vec3A) {
-        if self.two_sided && wo.z < 0.0 {
+        if self.flips(wo) {
             (
                 wo * Vec3A::new(1.0, 1.0, -1.0),
                 wi * Vec3A::new(1.0, 1.0, -1.0),
@@ -102,6 +134,8 @@ impl Bsdf {
         let (wo, wi) = self.oriented(wo, wi);
         match &self.lobe {
             BsdfLobe::Lambert(l) => l.eval(wo, wi, mode),
+            BsdfLobe::Conductor(c) => c.eval(wo, wi, mode),
+            BsdfLobe::Dielectric(d) => d.eval(wo, wi, mode),
         }
     }
 
@@ -111,6 +145,8 @@ impl Bsdf {
         let (wo, wi) = self.oriented(wo, wi);
         match &self.lobe {
             BsdfLobe::Lambert(l) => l.pdf(wo, wi, mode),
+            BsdfLobe::Conductor(c) => c.pdf(wo, wi, mode),
+            BsdfLobe::Dielectric(d) => d.pdf(wo, wi, mode),
         }
     }
 
@@ -123,7 +159,7 @@ impl Bsdf {
         u: Vec2,
         mode: TransportMode,
     ) -> Option<BsdfSample> {
-        let flip = self.two_sided && wo.z < 0.0;
+        let flip = self.flips(wo);
         let wo = if flip {
             wo * Vec3A::new(1.0, 1.0, -1.0)
         } else {
@@ -131,6 +167,8 @@ impl Bsdf {
         };
         let mut s = match &self.lobe {
             BsdfLobe::Lambert(l) => l.sample(wo, u_lobe, u, mode),
+            BsdfLobe::Conductor(c) => c.sample(wo, u_lobe, u, mode),
+            BsdfLobe::Dielectric(d) => d.sample(wo, u_lobe, u, mode),
         }?;
         if flip {
             s.wi *= Vec3A::new(1.0, 1.0, -1.0);
@@ -143,6 +181,8 @@ impl Bsdf {
     pub fn is_specular(&self) -> bool {
         match &self.lobe {
             BsdfLobe::Lambert(_) => false,
+            BsdfLobe::Conductor(c) => c.is_specular(),
+            BsdfLobe::Dielectric(d) => d.is_specular(),
         }
     }
 
@@ -153,6 +193,9 @@ impl Bsdf {
         self.is_specular()
     }
 }
+
+#[cfg(test)]
+mod tests;
 
 /// cos θ of a local direction.
 #[inline]

@@ -3,22 +3,73 @@
 //!
 //! `build_materials` returns one entry per scene material plus, last, the default material
 //! (lambert 0.5) that shapes without a material use — matching the `material_id`s that
-//! `build_geometry` gives the instances.
+//! `build_geometry` gives the instances. Wrappers (`two_sided`, `mask`) hold their inner
+//! material, resolved at build time (prism-scene already refuses cycles).
+//!
+//! Shading frame: the integrator evaluates BSDFs in `Frame::from_zx(n_shading, dpdu)`: z is
+//! the shading normal and x is dP/du projected onto the tangent plane (Gram–Schmidt), y =
+//! z × x. So an anisotropic roughness `[α_u, α_v]` has α_u along the surface's u direction
+//! and α_v along v (the lobe, and a highlight, stretches along the axis with the larger α;
+//! brushed metal whose grooves run along u tilts its normals across them: α_u < α_v).
+//! Where dP/du is zero or parallel to the normal, `from_zx` falls back to an arbitrary
+//! tangent (Duff et al. 2017), and an anisotropic lobe's orientation is then arbitrary. The two-sided and mask wrappers
+//! do not change the frame.
+//!
+//! The formulas, parameters and validity ranges are in docs/materials.md.
+
+pub mod ior;
+pub mod metals;
 
 use std::path::Path;
 
 use prism_geometry::SurfaceInteraction;
-use prism_scene::{MaterialKind, SceneDescription};
+use prism_scene::{
+    ConductorOptics, MaterialKind, Microfacet, Roughness, SceneDescription, SpectrumRef,
+};
+use prism_spectrum::constants::{LAMBDA_MAX_NM, LAMBDA_MIN_NM};
 use prism_spectrum::{SampledWavelengths, Spectrum};
 
-use crate::bsdf::{Bsdf, BsdfLobe, Lambert};
+use crate::bsdf::{
+    Bsdf, BsdfLobe, Conductor, Dielectric, Lambert, MicrofacetDistribution, MicrofacetModel,
+};
 use crate::scene_build::spectrum::{build_spectrum, SpectrumRole};
 use crate::scene_build::SceneBuildError;
+
+pub use ior::Ior;
+pub use metals::{metal_optics, MetalOptics};
+
+/// Wrapper chains deeper than this are refused (prism-scene rejects cycles; a guard).
+const MAX_WRAPPER_DEPTH: usize = 16;
 
 /// A material ready to make BSDFs.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Material {
-    Lambert { reflectance: Spectrum },
+    Lambert {
+        reflectance: Spectrum,
+    },
+    /// A metal: complex index η + ik relative to the outside medium; a Dirac mirror when
+    /// the distribution is effectively smooth.
+    Conductor {
+        eta: Spectrum,
+        k: Spectrum,
+        distribution: MicrofacetDistribution,
+    },
+    /// Glass-like interface; `ior` is the index of the inside (below the shading normal,
+    /// i.e. opposite the geometric normal's side for closed shapes) relative to the
+    /// outside.
+    Dielectric {
+        ior: Ior,
+        distribution: MicrofacetDistribution,
+    },
+    /// The inner material on both sides (reflection-only lobes; dielectrics already are).
+    TwoSided {
+        material: Box<Material>,
+    },
+    /// The inner material with coverage `opacity` ∈ [0, 1]; the rest passes straight through.
+    Mask {
+        material: Box<Material>,
+        opacity: f32,
+    },
 }
 
 impl Material {
@@ -29,50 +80,194 @@ impl Material {
         }
     }
 
-    /// The BSDF at `hit` for `wavelengths`.
+    /// The BSDF at `hit` for `wavelengths`. (No parameter reads the hit yet: textures will.)
     #[inline]
-    pub fn bsdf(&self, _hit: &SurfaceInteraction, wavelengths: &SampledWavelengths) -> Bsdf {
+    #[allow(clippy::only_used_in_recursion)]
+    pub fn bsdf(&self, hit: &SurfaceInteraction, wavelengths: &SampledWavelengths) -> Bsdf {
         match self {
             Material::Lambert { reflectance } => Bsdf::new(BsdfLobe::Lambert(Lambert {
                 reflectance: reflectance.eval(wavelengths),
             })),
+            Material::Conductor {
+                eta,
+                k,
+                distribution,
+            } => Bsdf::new(BsdfLobe::Conductor(Conductor {
+                eta: eta.eval(wavelengths),
+                k: k.eval(wavelengths),
+                distribution: *distribution,
+            })),
+            Material::Dielectric { ior, distribution } => {
+                Bsdf::new(BsdfLobe::Dielectric(Dielectric {
+                    eta: ior.eval(wavelengths),
+                    distribution: *distribution,
+                }))
+            }
+            Material::TwoSided { material } => {
+                let mut b = material.bsdf(hit, wavelengths);
+                b.two_sided = b.lobe.is_reflection_only();
+                b
+            }
+            Material::Mask { material, .. } => material.bsdf(hit, wavelengths),
         }
     }
 
     /// Probability that a ray hitting this surface interacts with it (an opacity mask's
-    /// α); otherwise it passes straight through. 1 for every unmasked material.
+    /// α, the product of nested masks' α); otherwise it passes straight through. 1 for
+    /// every unmasked material.
     #[inline]
     pub fn opacity(&self) -> f32 {
-        1.0
+        match self {
+            Material::Mask { material, opacity } => opacity * material.opacity(),
+            Material::TwoSided { material } => material.opacity(),
+            _ => 1.0,
+        }
     }
 
     /// True when the material's BSDF depends on wavelength through its index of refraction
     /// (dispersion): the integrator keeps only the hero wavelength after such a hit.
     #[inline]
     pub fn is_dispersive(&self) -> bool {
-        false
+        match self {
+            Material::Dielectric { ior, .. } => ior.is_dispersive(),
+            Material::TwoSided { material } | Material::Mask { material, .. } => {
+                material.is_dispersive()
+            }
+            _ => false,
+        }
     }
+}
+
+fn distribution(r: &Roughness, d: Microfacet) -> Result<MicrofacetDistribution, String> {
+    // `contains` is false for NaN.
+    if !((0.0..=1.0).contains(&r.alpha_u) && (0.0..=1.0).contains(&r.alpha_v)) {
+        return Err(format!(
+            "roughness α must be finite and in [0, 1], got [{}, {}]",
+            r.alpha_u, r.alpha_v
+        ));
+    }
+    let model = match d {
+        Microfacet::Ggx => MicrofacetModel::Ggx,
+        Microfacet::Beckmann => MicrofacetModel::Beckmann,
+    };
+    Ok(MicrofacetDistribution::new(
+        model,
+        r.alpha_u as f32,
+        r.alpha_v as f32,
+    ))
+}
+
+/// Checks a conductor's η (> 0) or k (≥ 0) over the whole rendered range, every 1 nm.
+fn check_optical_constant(s: &Spectrum, what: &str, positive: bool) -> Result<(), String> {
+    let (lo, hi) = (LAMBDA_MIN_NM as u32, LAMBDA_MAX_NM as u32);
+    for wl in lo..=hi {
+        let v = s.eval_nm(f64::from(wl));
+        let ok = v.is_finite() && if positive { v > 0.0 } else { v >= 0.0 };
+        if !ok {
+            let need = if positive { "> 0" } else { "≥ 0" };
+            return Err(format!(
+                "{what} is {v} at {wl} nm; it must be {need} over {lo}–{hi} nm (a table that \
+                 stops short of that range is 0 outside it: extend it to cover {lo}–{hi} nm)"
+            ));
+        }
+    }
+    Ok(())
+}
+
+fn build_one(
+    scene: &SceneDescription,
+    index: usize,
+    depth: usize,
+) -> Result<Material, SceneBuildError> {
+    let file: &Path = &scene.file;
+    let m = &scene.materials[index];
+    let place = format!("materials.{}", m.name);
+    let err = |field: &str, message: String| {
+        let place = if field.is_empty() {
+            place.clone()
+        } else {
+            format!("{place}.{field}")
+        };
+        SceneBuildError::new(file, place, message)
+    };
+    if depth > MAX_WRAPPER_DEPTH {
+        return Err(err(
+            "material",
+            format!("wrappers nested deeper than {MAX_WRAPPER_DEPTH} levels"),
+        ));
+    }
+    Ok(match &m.kind {
+        MaterialKind::Lambert { reflectance } => Material::Lambert {
+            reflectance: build_spectrum(reflectance, SpectrumRole::Albedo)
+                .map_err(|e| err("reflectance", e))?,
+        },
+        MaterialKind::Conductor {
+            optics,
+            roughness,
+            distribution: d,
+        } => {
+            let distribution = distribution(roughness, *d).map_err(|e| err("roughness", e))?;
+            let (eta, k) = match optics {
+                ConductorOptics::Named(symbol) => metal_optics(symbol)
+                    .ok_or_else(|| {
+                        err(
+                            "metal",
+                            format!("no optical constants are shipped for metal `{symbol}`"),
+                        )
+                    })?
+                    .spectra(),
+                ConductorOptics::Spectra { eta, k } => {
+                    let build = |s: &SpectrumRef, field: &str, positive: bool| {
+                        let spectrum = build_spectrum(s, SpectrumRole::Unbounded)
+                            .map_err(|e| err(field, e))?;
+                        check_optical_constant(&spectrum, field, positive)
+                            .map_err(|e| err(field, e))?;
+                        Ok::<_, SceneBuildError>(spectrum)
+                    };
+                    (build(eta, "eta", true)?, build(k, "k", false)?)
+                }
+            };
+            Material::Conductor {
+                eta,
+                k,
+                distribution,
+            }
+        }
+        MaterialKind::Dielectric {
+            ior,
+            roughness,
+            distribution: d,
+        } => Material::Dielectric {
+            ior: Ior::from_scene(ior).map_err(|e| err("ior", e))?,
+            distribution: distribution(roughness, *d).map_err(|e| err("roughness", e))?,
+        },
+        MaterialKind::TwoSided { material } => Material::TwoSided {
+            material: Box::new(build_one(scene, *material, depth + 1)?),
+        },
+        MaterialKind::Mask { material, opacity } => {
+            if !(opacity.is_finite() && (0.0..=1.0).contains(opacity)) {
+                return Err(err(
+                    "opacity",
+                    format!("opacity must be in [0, 1], got {opacity}"),
+                ));
+            }
+            Material::Mask {
+                material: Box::new(build_one(scene, *material, depth + 1)?),
+                opacity: *opacity as f32,
+            }
+        }
+    })
 }
 
 /// Every scene material, then the default one.
 pub fn build_materials(scene: &SceneDescription) -> Result<Vec<Material>, SceneBuildError> {
-    let file: &Path = &scene.file;
     let mut out = Vec::with_capacity(scene.materials.len() + 1);
-    for (i, m) in scene.materials.iter().enumerate() {
-        let place = format!("materials.{}", m.name);
-        let material = match &m.kind {
-            MaterialKind::Lambert { reflectance } => Material::Lambert {
-                reflectance: build_spectrum(reflectance, SpectrumRole::Albedo)
-                    .map_err(|e| SceneBuildError::new(file, format!("{place}.reflectance"), e))?,
-            },
-            // Interface skeleton: the BSDF work replaces this fallback.
-            _ => {
-                let _ = i;
-                Material::default_material()
-            }
-        };
-        out.push(material);
+    for i in 0..scene.materials.len() {
+        out.push(build_one(scene, i, 0)?);
     }
     out.push(Material::default_material());
     Ok(out)
 }
+
+#[cfg(test)]
+mod tests;

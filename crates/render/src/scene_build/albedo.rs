@@ -9,9 +9,9 @@
 //!
 //! Materials without a diffuse reflectance: a dielectric is white (1, 1, 1) (it reflects or
 //! transmits all light); a conductor given by η, k spectra has its normal-incidence Fresnel
-//! reflectance F₀ = ((η−1)² + k²)/((η+1)² + k²) (Born & Wolf §14.2); a named metal is white
-//! until render ships the metal tables; `two_sided` and `mask` take their inner material's
-//! albedo.
+//! reflectance F₀ = ((η−1)² + k²)/((η+1)² + k²) (Born & Wolf §14.2), and so has a named
+//! metal, from the η, k tables render ships (`material::metal_optics`, spectra/metals/);
+//! `two_sided` and `mask` take their inner material's albedo.
 
 use prism_scene::{ConductorOptics, Material, MaterialKind, SpectrumRef};
 use prism_spectrum::colorimetry::reflectance_to_xyz;
@@ -74,7 +74,10 @@ fn albedo_at_depth(materials: &[Material], index: usize, depth: usize) -> [f32; 
         MaterialKind::Lambert { reflectance } => reflectance_rgb(reflectance),
         MaterialKind::Dielectric { .. } => [1.0; 3],
         MaterialKind::Conductor { optics, .. } => match optics {
-            ConductorOptics::Named(_) => [1.0; 3],
+            ConductorOptics::Named(symbol) => match crate::material::metal_optics(symbol) {
+                Some(metal) => dense_rgb(&metal.normal_reflectance()),
+                None => [1.0; 3],
+            },
             ConductorOptics::Spectra { eta, k } => {
                 let (eta, k) = (dense(eta), dense(k));
                 dense_rgb(&DenseSpectrum::from_fn(|wl| {
@@ -92,6 +95,27 @@ fn albedo_at_depth(materials: &[Material], index: usize, depth: usize) -> [f32; 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn named_metals_get_the_colour_of_their_normal_reflectance() {
+        let metal = |symbol: &'static str| Material {
+            name: symbol.to_string(),
+            kind: MaterialKind::Conductor {
+                optics: ConductorOptics::Named(symbol),
+                roughness: prism_scene::Roughness {
+                    alpha_u: 0.0,
+                    alpha_v: 0.0,
+                },
+                distribution: prism_scene::Microfacet::Ggx,
+            },
+        };
+        let materials = [metal("Au"), metal("Ag"), metal("Cu")];
+        let [au, ag, cu] = [0, 1, 2].map(|i| material_albedo(&materials, i));
+        // Gold and copper: red > green > blue; silver: near-white, neutral.
+        assert!(au[0] > au[1] && au[1] > au[2] && au[2] < 0.5, "{au:?}");
+        assert!(cu[0] > cu[1] && cu[1] > cu[2], "{cu:?}");
+        assert!(ag.iter().all(|&c| (0.9..1.05).contains(&c)), "{ag:?}");
+    }
 
     #[test]
     fn constant_and_rgb_reflectances_are_exact_and_a_flat_table_matches_the_constant() {
