@@ -232,6 +232,16 @@ impl Geometry {
 
     /// Full world-space record of `hit` (found for `ray`).
     pub fn interaction(&self, ray: &Ray, hit: &Hit) -> SurfaceInteraction {
+        self.interaction_with(ray, hit, true)
+    }
+
+    /// The record of `hit` without the principal curvatures (left at zero): what shading
+    /// needs, for less work per path vertex.
+    pub fn shading_interaction(&self, ray: &Ray, hit: &Hit) -> SurfaceInteraction {
+        self.interaction_with(ray, hit, false)
+    }
+
+    fn interaction_with(&self, ray: &Ray, hit: &Hit, with_curvature: bool) -> SurfaceInteraction {
         let inst = &self.instances[hit.instance_id as usize];
         let (o, d) = object_ray(inst, ray);
         let p_obj = o + hit.t * d;
@@ -251,7 +261,8 @@ impl Geometry {
             Shape::Disk(dk) => (dk.local_geometry(p_obj), 0, NO_MATERIAL, 0),
             Shape::Rectangle(r) => (r.local_geometry(p_obj), 0, NO_MATERIAL, 0),
         };
-        let mut si = SurfaceInteraction::from_local(&local, &inst.to_world, hit.t);
+        let mut si =
+            SurfaceInteraction::from_local_with(&local, &inst.to_world, hit.t, with_curvature);
         si.primitive_id = primitive_id;
         si.material_id = inst.material.unwrap_or(face_material);
         si.object_id = object_id;

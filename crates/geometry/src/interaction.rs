@@ -69,6 +69,17 @@ pub struct SurfaceInteraction {
 impl SurfaceInteraction {
     /// World-space interaction from object-space local geometry under `to_world`.
     pub fn from_local(local: &LocalGeometry, to_world: &Transform, t: f32) -> Self {
+        Self::from_local_with(local, to_world, t, true)
+    }
+
+    /// As `from_local`; `with_curvature = false` leaves `curvature` at its default (zero)
+    /// for callers that never read it (the path tracer's vertices after the first).
+    pub fn from_local_with(
+        local: &LocalGeometry,
+        to_world: &Transform,
+        t: f32,
+        with_curvature: bool,
+    ) -> Self {
         let (p, dpdu, dpdv, ng, ns, dndu, dndv) = if to_world.is_identity() {
             (
                 local.p,
@@ -94,13 +105,17 @@ impl SurfaceInteraction {
         };
         let n_geometric = ng.normalize_or_zero();
         let n_shading = ns.try_normalize().unwrap_or(n_geometric);
-        let curvature = Curvature::from_derivatives(
-            dpdu,
-            dpdv,
-            unit_normal_derivative(ns, dndu),
-            unit_normal_derivative(ns, dndv),
-            n_shading,
-        );
+        let curvature = if with_curvature {
+            Curvature::from_derivatives(
+                dpdu,
+                dpdv,
+                unit_normal_derivative(ns, dndu),
+                unit_normal_derivative(ns, dndv),
+                n_shading,
+            )
+        } else {
+            Curvature::default()
+        };
         Self {
             p,
             t,

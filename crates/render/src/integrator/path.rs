@@ -176,7 +176,12 @@ impl PathTracer {
                 }
                 break;
             };
-            let si = scene.geometry.interaction(&ray, &hit);
+            // Curvature only at the first hit (the G-buffer's); shading never reads it.
+            let si = if first_hit.is_none() {
+                scene.geometry.interaction(&ray, &hit)
+            } else {
+                scene.geometry.shading_interaction(&ray, &hit)
+            };
             let material = scene.material(si.material_id);
             let u_mask = stream.get_1d();
             let u_light_choice = stream.get_1d();
@@ -431,7 +436,7 @@ impl PathTracer {
             let Some(hit) = scene.geometry.intersect(&shadow) else {
                 return transmittance;
             };
-            let si = scene.geometry.interaction(&shadow, &hit);
+            let si = scene.geometry.shading_interaction(&shadow, &hit);
             let opacity = scene.material(si.material_id).opacity();
             transmittance *= 1.0 - opacity;
             if transmittance <= 0.0 {
