@@ -26,5 +26,5 @@ pub use film::{
     SurfaceAov, TileBounds,
 };
 pub use integrator::{render, total_samples, Integrator, RenderSettings, RenderStats};
-pub use sampler::{PixelSampler, SampleStream};
+pub use sampler::{PixelSampler, SampleStream, SamplerKind};
 pub use scene_build::{RenderScene, SceneBuildError};
