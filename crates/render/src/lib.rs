@@ -23,7 +23,7 @@ pub use camera::{
 pub use error::InvalidParameter;
 pub use film::{
     AovPlane, AovSelection, Film, FilmImage, FilmTile, Filter, FilterSample, FilterSampler,
-    SurfaceAov, TileBounds,
+    SpectralBins, SpectralPlanes, SurfaceAov, TileBounds,
 };
 pub use integrator::{render, total_samples, Integrator, RenderSettings, RenderStats};
 pub use sampler::{PixelSampler, SampleStream, SamplerKind};

@@ -9,8 +9,8 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 use glam::{DVec3, UVec2};
 
-use crate::film::{FilmImage, SurfaceAov};
-use crate::sampler::PixelSampler;
+use crate::film::{AovSelection, Film, FilmImage, SpectralBins, SurfaceAov};
+use crate::sampler::{PixelSampler, SamplerKind};
 use crate::scene_build::RenderScene;
 
 /// Tile edge in pixels: 16 × 16 tiles give a 640 × 480 film 1200 work items, plenty for
@@ -24,6 +24,42 @@ pub struct RenderSettings {
     pub spp: u32,
     pub seed: u64,
     pub tile_size_px: u32,
+    /// Sampler of every camera sample's stream (default Sobol).
+    pub sampler: SamplerKind,
+    /// Spectral bins of the film (`None`: XYZ only). Validated by `SpectralBins::new`.
+    pub spectral_bins: Option<SpectralBins>,
+    /// Record the `illumination.X/Y/Z` AOV (filled by `FilmTile::add_illumination`).
+    pub illumination_aov: bool,
+}
+
+impl Default for RenderSettings {
+    /// 16 spp, seed 0, 16-pixel tiles, Sobol, no spectral bins, no illumination AOV.
+    fn default() -> Self {
+        Self {
+            spp: 16,
+            seed: 0,
+            tile_size_px: DEFAULT_TILE_SIZE_PX,
+            sampler: SamplerKind::Sobol,
+            spectral_bins: None,
+            illumination_aov: false,
+        }
+    }
+}
+
+/// The scene's film with the spectral bins and illumination AOV `settings` ask for.
+fn film_for(scene: &RenderScene, settings: &RenderSettings) -> Film {
+    let mut film = scene.new_film();
+    if settings.illumination_aov {
+        let aovs = AovSelection {
+            illumination: true,
+            ..film.aov_selection()
+        };
+        film = film.with_aovs(aovs);
+    }
+    match settings.spectral_bins {
+        Some(bins) => film.with_bins(bins),
+        None => film,
+    }
 }
 
 /// What a render did.
@@ -44,8 +80,8 @@ pub fn render(
     settings: &RenderSettings,
     progress: &(dyn Fn(u64) + Sync),
 ) -> (FilmImage, RenderStats) {
-    let mut film = scene.new_film();
-    let sampler = PixelSampler::new(settings.seed);
+    let mut film = film_for(scene, settings);
+    let sampler = PixelSampler::with_kind(settings.sampler, settings.seed);
     let spp = settings.spp.max(1);
     let rays_total = AtomicU64::new(0);
     let samples_total = AtomicU64::new(0);
