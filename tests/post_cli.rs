@@ -285,3 +285,117 @@ fn compare_reports_every_metric_and_refuses_mismatched_sizes() {
         &["40×30", "48×32"],
     );
 }
+
+/// Linear sRGB of a neutral reflectance under CIE A (1 nm integration, white diffuser
+/// Y = 1), and the XYZ of the white diffuser itself: what a renderer's beauty and
+/// illumination AOV hold for a grey surface lit by A.
+fn neutral_under_a(reflectance: f64) -> ([f32; 3], [f32; 3]) {
+    use prism_spectrum::colorimetry::reflectance_to_xyz;
+    use prism_spectrum::{data::illuminant, DenseSpectrum, Observer};
+    let a = illuminant("A").unwrap().to_dense();
+    let white = reflectance_to_xyz(&DenseSpectrum::constant(1.0), &a, Observer::Cie1931) / 100.0;
+    let rgb = RgbColorSpace::srgb().xyz_to_rgb * (white * reflectance);
+    (rgb.as_vec3().to_array(), white.as_vec3().to_array())
+}
+
+#[test]
+fn wb_scene_takes_the_white_from_the_illumination_layer() {
+    use prism_spectrum::colorimetry::xyz_to_lab;
+    // 10×6 pixels: a grey card (0.18) and a lighter grey (0.5) under A, at two light
+    // levels, plus a column of misses (black, no illumination).
+    let (w, h) = (10usize, 6usize);
+    let mut pixels = Vec::new();
+    let mut illumination = Vec::new();
+    for i in 0..w * h {
+        let (x, y) = (i % w, i / w);
+        let level = if y < 3 { 1.0 } else { 0.4 };
+        let reflectance = if x < 5 { 0.18 } else { 0.5 };
+        let (rgb, white) = neutral_under_a(reflectance);
+        if x == 9 {
+            pixels.push([0.0; 3]);
+            illumination.extend([0.0; 3]);
+        } else {
+            pixels.push(rgb.map(|c| c * level));
+            illumination.extend(white.map(|c| c * level));
+        }
+    }
+    let mut image = Image::new(w, h, pixels, RgbColorSpace::srgb()).unwrap();
+    image
+        .set_layer("illumination", &["X", "Y", "Z"], illumination)
+        .unwrap();
+    let input = scratch("under_a.exr");
+    write_image(&input, &image).unwrap();
+    let output = scratch("under_a_balanced.exr");
+    let json: Value = serde_json::from_str(&ok(&[
+        "tonemap",
+        input.to_str().unwrap(),
+        "-o",
+        output.to_str().unwrap(),
+        "--op",
+        "linear",
+        "--wb",
+        "scene",
+        "--json",
+    ]))
+    .unwrap();
+    assert_eq!(json["white_balance"], "scene");
+    // The estimated white is A's: (0.44757, 0.40745), CIE 15:2018 Table 1.
+    let xy = &json["white_balance_source_xy"];
+    let (sx, sy) = (xy[0].as_f64().unwrap(), xy[1].as_f64().unwrap());
+    assert!(
+        (sx - 0.44757).abs() < 5e-5 && (sy - 0.40745).abs() < 5e-5,
+        "{xy}"
+    );
+    // Before: the grey card is strongly yellow; after: neutral against D65.
+    let srgb = RgbColorSpace::srgb();
+    let lab = |p: [f32; 3]| {
+        let xyz = srgb.rgb_to_xyz * glam::DVec3::from(p.map(f64::from));
+        xyz_to_lab(xyz, srgb.white_xyz())
+    };
+    let before = lab(image.pixel(0, 0));
+    assert!(before.y.hypot(before.z) > 20.0, "{before}");
+    let out = read_image(&output).unwrap();
+    for (x, y) in [(0, 0), (7, 1), (2, 4), (6, 5)] {
+        let after = lab(out.pixel(x, y));
+        assert!(
+            after.y.abs() < 0.5 && after.z.abs() < 0.5,
+            "pixel ({x}, {y}): Lab {after}"
+        );
+    }
+}
+
+#[test]
+fn wb_scene_without_an_illumination_layer_names_the_file_and_the_layer() {
+    let hdr = scratch("no_layer.hdr");
+    plain_hdr(&hdr);
+    let out = scratch("no_layer.png");
+    fails_with(
+        &[
+            "tonemap",
+            hdr.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "--op",
+            "linear",
+            "--wb",
+            "scene",
+        ],
+        &["no_layer.hdr", "illumination", "prism render"],
+    );
+    assert!(!out.exists());
+    // A render whose integrator leaves the layer at zero (the diagnostic ones) says so.
+    let render = rendered_exr();
+    fails_with(
+        &[
+            "tonemap",
+            render.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "--op",
+            "linear",
+            "--wb",
+            "scene",
+        ],
+        &["room.exr", "illumination layer is zero"],
+    );
+}

@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 use prism_post::io::exr::read_exr;
+use prism_post::io::spectral_exr::{read_spectral_exr, RADIANCE_UNITS};
 use serde_json::Value;
 
 fn prism(args: &[&str]) -> Output {
@@ -118,6 +119,7 @@ fn exr_has_rgb_the_aov_and_luminance_layers_and_the_absolute_scale() {
         ("albedo", vec!["R", "G", "B"]),
         ("spp", vec!["Y"]),
         ("luminance", vec!["Y"]),
+        ("illumination", vec!["X", "Y", "Z"]),
     ] {
         let l = image
             .layer(layer)
@@ -141,6 +143,70 @@ fn exr_has_rgb_the_aov_and_luminance_layers_and_the_absolute_scale() {
         .samples
         .iter()
         .all(|&v| v == 2.0));
+}
+
+#[test]
+fn spectral_bins_go_into_the_same_exr_in_the_fichet_layout() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("bins.exr");
+    let o = prism(&[
+        "render",
+        "scenes/minimal.json",
+        "-o",
+        s(&out),
+        "--resolution",
+        "12x8",
+        "--spp",
+        "1",
+        "--spectral-bins",
+        "10",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    // The spectral reading: ten bands at the bin centres 383.5, 430.5, …, 806.5 nm.
+    let spectral = read_spectral_exr(&out).unwrap();
+    let centres: Vec<f64> = (0..10).map(|b| 360.0 + 47.0 * (b as f64 + 0.5)).collect();
+    assert_eq!(spectral.wavelengths_nm, centres);
+    assert_eq!(spectral.emissive_units, RADIANCE_UNITS);
+    assert_eq!((spectral.width, spectral.height), (12, 8));
+    // The RGB reading of the same file: pixels, layers and luminance in cd/m² as always.
+    let image = read_exr(&out).unwrap();
+    for layer in ["luminance", "illumination", "spp", "depth"] {
+        assert!(image.layer(layer).is_some(), "{layer}");
+    }
+    assert!(image.layer("S0").is_none());
+    assert!(image.cd_m2_per_unit.is_some());
+}
+
+#[test]
+fn spectral_bins_out_of_range_or_with_a_png_fail_before_rendering() {
+    let dir = tempfile::tempdir().unwrap();
+    for (n, file) in [
+        ("0", "a.exr"),
+        ("472", "b.exr"),
+        ("16", "c.png"),
+        ("16", "d.hdr"),
+    ] {
+        let out = dir.path().join(file);
+        let o = prism(&[
+            "render",
+            "scenes/minimal.json",
+            "-o",
+            s(&out),
+            "--resolution",
+            "8x8",
+            "--spectral-bins",
+            n,
+        ]);
+        assert!(!o.status.success(), "{n} {file}");
+        let e = stderr(&o);
+        assert!(e.contains("--spectral-bins"), "{e}");
+        if file.ends_with(".exr") {
+            assert!(e.contains("1 to 471"), "{e}");
+        } else {
+            assert!(e.contains(".exr") && e.contains(file), "{e}");
+        }
+        assert!(!out.exists());
+    }
 }
 
 #[test]

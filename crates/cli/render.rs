@@ -4,8 +4,9 @@
 //! Output: `-o`, else the scene's `film.output` (relative to the scene file), else
 //! `<scene stem>.exr` in the current directory. EXR: unprefixed R, G, B linear Rec.709,
 //! header `prism:cd_m2_per_unit`, layers `luminance.Y` (cd/m²), `depth.Z` (m),
-//! `normal.X/Y/Z`, `albedo.R/G/B` and `spp.Y`. PNG: the RGB sRGB-encoded (16 bit). See
-//! docs/rendering.md.
+//! `normal.X/Y/Z`, `albedo.R/G/B`, `illumination.X/Y/Z` and `spp.Y`, and with
+//! `--spectral-bins N` the bins as `S0.<centre>nm` channels (Fichet et al. 2021 layout,
+//! W·m⁻²·sr⁻¹·nm⁻¹). PNG: the RGB sRGB-encoded (16 bit). See docs/rendering.md.
 
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -14,12 +15,15 @@ use std::time::{Duration, Instant};
 use clap::Args;
 use glam::UVec2;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use prism_post::io::exr::ExrWriteOptions;
+use prism_post::io::spectral_exr::write_exr_with_spectral_bands;
 use prism_post::io::{write_image, ImageFormat};
 use prism_post::Image;
+use prism_render::film::spectral_bins::{MAX_SPECTRAL_BINS, MIN_SPECTRAL_BINS};
 use prism_render::integrator::DEFAULT_TILE_SIZE_PX;
 use prism_render::{
     render, total_samples, FilmImage, PlanRequest, RenderPlan, RenderScene, RenderSettings,
-    RenderStats,
+    RenderStats, SamplerKind, SpectralBins,
 };
 use prism_spectrum::rgb_space::RgbColorSpace;
 use serde_json::json;
@@ -50,6 +54,10 @@ pub struct RenderArgs {
     /// Write render statistics as JSON to this file.
     #[arg(long = "stats-json")]
     pub stats_json: Option<PathBuf>,
+    /// Also write the spectral radiance in N equal bins over 360–830 nm (1–471) as
+    /// `S0.<λ>nm` channels of the EXR (Fichet et al. 2021 layout, W·m⁻²·sr⁻¹·nm⁻¹).
+    #[arg(long = "spectral-bins", value_name = "N")]
+    pub spectral_bins: Option<u32>,
 }
 
 fn parse_resolution(s: &str) -> Result<UVec2, String> {
@@ -100,6 +108,27 @@ fn check_output(path: &Path) -> Result<(), String> {
             "output {}: cannot use the directory {}: {e}",
             path.display(),
             dir.display()
+        )),
+    }
+}
+
+/// `--spectral-bins N` checked against its range and the output format (before rendering).
+fn spectral_bins(args: &RenderArgs, output: &Path) -> Result<Option<SpectralBins>, String> {
+    let Some(n) = args.spectral_bins else {
+        return Ok(None);
+    };
+    let bins = SpectralBins::new(n).map_err(|_| {
+        format!(
+            "--spectral-bins {n}: expected {MIN_SPECTRAL_BINS} to {MAX_SPECTRAL_BINS} equal bins \
+             over 360–830 nm"
+        )
+    })?;
+    match ImageFormat::from_path(output) {
+        Ok(ImageFormat::Exr) => Ok(Some(bins)),
+        _ => Err(format!(
+            "--spectral-bins needs an .exr output (spectral channels S0.<λ>nm beside R, G, B); \
+             {} cannot hold them",
+            output.display()
         )),
     }
 }
@@ -175,11 +204,20 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
     if !args.explain {
         check_output(&output)?;
     }
+    let spectral_bins = spectral_bins(args, &output)?;
     let scene = RenderScene::build(&description, args.resolution).map_err(|e| e.to_string())?;
     let settings = RenderSettings {
         spp: args.spp.unwrap_or(scene.spp),
         seed: args.seed.unwrap_or(scene.seed),
         tile_size_px: DEFAULT_TILE_SIZE_PX,
+        // The path tracer's sampler is the scene's choice; every other integrator uses Sobol.
+        sampler: match description.integrator {
+            prism_scene::Integrator::Path { sampler, .. } => sampler,
+            _ => SamplerKind::Sobol,
+        },
+        spectral_bins,
+        // Cheap, and what `prism tonemap --wb scene` reads: always in EXR outputs.
+        illumination_aov: matches!(ImageFormat::from_path(&output), Ok(ImageFormat::Exr)),
     };
     if settings.spp == 0 {
         return Err("--spp must be at least 1".into());
@@ -194,9 +232,12 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
     if args.explain {
         let request = PlanRequest {
             spp: settings.spp,
-            spectral_bins: None,
+            spectral_bins: settings.spectral_bins.map(|b| b.count()),
             aov_output: ImageFormat::from_path(&output).is_ok_and(|f| f == ImageFormat::Exr),
-            sampler: "sobol",
+            sampler: match settings.sampler {
+                SamplerKind::Sobol => "Owen-scrambled Sobol",
+                SamplerKind::Independent => "independent",
+            },
         };
         print!("{}", RenderPlan::new(&scene, &request));
         return Ok(());
@@ -220,7 +261,17 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
     bar.finish_and_clear();
 
     let image = to_image(&film)?;
-    write_image(&output, &image).map_err(|e| e.to_string())?;
+    match &film.spectral {
+        Some(bins) => write_exr_with_spectral_bands(
+            &output,
+            &image,
+            &bins.centres_nm,
+            &bins.planes,
+            &ExrWriteOptions::default(),
+        ),
+        None => write_image(&output, &image),
+    }
+    .map_err(|e| e.to_string())?;
     if let Some(path) = &args.stats_json {
         write_stats(path, &scene, &settings, threads, wall_time_s, &stats)?;
     }

@@ -25,7 +25,8 @@ pub struct TonemapArgs {
     #[arg(long = "param", value_name = "KEY=VALUE")]
     pub params: Vec<String>,
     /// White balance: none, grey-world, white-patch, white-patch:PERCENTILE,
-    /// illuminant:NAME (or a bare CIE name such as A), cct:KELVIN.
+    /// illuminant:NAME (or a bare CIE name such as A), cct:KELVIN, or scene (the white of
+    /// the light in the scene, from the `illumination` layer `prism render` writes).
     #[arg(long, default_value = "none")]
     pub wb: String,
     /// Gamut mapping: clip, local-lch, local-oklab, global, aces-rgc.

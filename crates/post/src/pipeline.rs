@@ -2,7 +2,8 @@
 //! thin wrapper: parse arguments, call these, print the serialisable report.
 //!
 //! `tonemap_file` order: read → exposure (× 2^EV) → white balance
-//! ([`crate::colour::apply_white_balance`], Bradford) → tone operator (or, for `--op all`,
+//! ([`crate::colour::apply_white_balance`], Bradford; for `--wb scene` the white comes from
+//! the file's `illumination` layer, [`scene_white_of`]) → tone operator (or, for `--op all`,
 //! the contact sheet of every operator) → gamut mapping into the target
 //! ([`crate::colour::map_gamut`], fraction outside reported) → write. An EXR output holds
 //! linear display values of the target in [0, 1]; a PNG is encoded with the target's
@@ -16,8 +17,13 @@ use prism_spectrum::AdaptationMethod;
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::colour::{apply_white_balance, map_gamut, GamutMethod, GamutTarget, WhiteBalance};
+use crate::colour::scene_illumination::ILLUMINATION_CHANNELS;
+use crate::colour::{
+    apply_white_balance, apply_with_source_white, illumination_white_xyz, map_gamut, GamutMethod,
+    GamutTarget, SceneWhite, WhiteBalance, ILLUMINATION_LAYER,
+};
 use crate::error::{PostError, Result};
+use crate::image::Image;
 use crate::io::{read_image, write_image};
 use crate::metrics::{compare, Comparison};
 use crate::sheet::{contact_sheet_with_reports, SheetFailure};
@@ -160,17 +166,29 @@ pub fn tonemap_file(
             .for_each(|p| *p = p.map(|c| c * factor));
     }
     let space = image.color_space.clone();
-    let wb_source_xy = if options.wb == WhiteBalance::None {
-        None
-    } else {
-        let report = apply_white_balance(
-            image.pixels_mut(),
-            &space,
-            &options.wb,
-            AdaptationMethod::Bradford,
-        )
-        .map_err(|e| PostError::format(input, e.to_string()))?;
-        Some(report.source_white_xy)
+    let wb_source_xy = match &options.wb {
+        WhiteBalance::None => None,
+        WhiteBalance::Scene => {
+            let white = scene_white_of(&image, input)?;
+            let report = apply_with_source_white(
+                image.pixels_mut(),
+                &space,
+                &options.wb,
+                white,
+                AdaptationMethod::Bradford,
+            );
+            Some(report.source_white_xy)
+        }
+        method => {
+            let report = apply_white_balance(
+                image.pixels_mut(),
+                &space,
+                method,
+                AdaptationMethod::Bradford,
+            )
+            .map_err(|e| PostError::format(input, e.to_string()))?;
+            Some(report.source_white_xy)
+        }
     };
     let exposure_white_balance_ms = ms(t);
 
@@ -243,6 +261,43 @@ pub fn tonemap_file(
             total_ms: ms(start),
         },
     })
+}
+
+/// The scene white for `--wb scene`: the luminance-weighted mean chromaticity of the
+/// `illumination.X/Y/Z` layer of `image` (read from `path`, which errors name).
+pub fn scene_white_of(image: &Image, path: &Path) -> Result<SceneWhite> {
+    let missing = |found: String| {
+        PostError::format(
+            path,
+            format!(
+                "`--wb scene` needs the `{ILLUMINATION_LAYER}` layer (channels \
+                 {ILLUMINATION_LAYER}.X, {ILLUMINATION_LAYER}.Y, {ILLUMINATION_LAYER}.Z), \
+                 {found}; `prism render` writes it into its EXR outputs"
+            ),
+        )
+    };
+    let Some(layer) = image.layer(ILLUMINATION_LAYER) else {
+        let names: Vec<&str> = image.layers().iter().map(|l| l.name.as_str()).collect();
+        return Err(missing(if names.is_empty() {
+            "and this file has no layers".to_string()
+        } else {
+            format!("which this file lacks (its layers: {})", names.join(", "))
+        }));
+    };
+    let position = |c: &str| layer.channels.iter().position(|x| x == c);
+    let [Some(x), Some(y), Some(z)] = ILLUMINATION_CHANNELS.map(position) else {
+        return Err(missing(format!(
+            "but this file's layer has channels {}",
+            layer.channels.join(", ")
+        )));
+    };
+    let k = layer.channels.len();
+    let xyz: Vec<[f32; 3]> = layer
+        .samples
+        .chunks_exact(k)
+        .map(|p| [p[x], p[y], p[z]])
+        .collect();
+    illumination_white_xyz(&xyz).map_err(|e| PostError::format(path, e.to_string()))
 }
 
 /// Compares the image at `test` with the reference at `reference`; mismatched sizes are an

@@ -6,8 +6,9 @@ use prism_post::io::exr::{read_exr, write_exr, ExrCompression, ExrSampleType, Ex
 use prism_post::io::png::{read_png, write_png, PngBitDepth};
 use prism_post::io::rgbe::{decode_rgbe, encode_rgbe, read_hdr, write_hdr};
 use prism_post::io::spectral_exr::{
-    emissive_channel_name, parse_spectral_channel, read_spectral_exr, write_spectral_exr,
-    SpectralChannelKind, SpectralImage,
+    emissive_channel_name, parse_spectral_channel, read_spectral_exr,
+    write_exr_with_spectral_bands, write_spectral_exr, SpectralChannelKind, SpectralImage,
+    EMISSIVE_UNITS_ATTRIBUTE, RADIANCE_UNITS, VERSION_ATTRIBUTE,
 };
 use prism_post::io::{read_image, write_image};
 use prism_post::Image;
@@ -302,6 +303,65 @@ fn spectral_exr_round_trip_has_layout_names_and_flat_spectrum_gives_y_one() {
         .map(|(c, w)| c * w)
         .sum();
     assert!((y_rgb - 1.0).abs() < 1e-5);
+}
+
+#[test]
+fn rgb_image_with_spectral_bands_keeps_rgb_layers_and_bands_in_one_file() {
+    let mut img = hdr_image(RgbColorSpace::srgb());
+    let n = img.width() * img.height();
+    img.set_layer("luminance", &["Y"], vec![3.0; n]).unwrap();
+    img.cd_m2_per_unit = Some(72_983.0);
+    let wavelengths = [400.0, 500.0, 600.0];
+    let planes: Vec<Vec<f32>> = (0..3)
+        .map(|k| (0..n).map(|i| (k * 1000 + i) as f32).collect())
+        .collect();
+    // Its own directory: the atomic-write test checks the shared scratch folder for
+    // temporary files while the tests run in parallel.
+    let dir = std::env::temp_dir().join(format!("prism-post-bands-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("rgb_and_bands.exr");
+    write_exr_with_spectral_bands(
+        &path,
+        &img,
+        &wavelengths,
+        &planes,
+        &ExrWriteOptions::default(),
+    )
+    .unwrap();
+    // As an RGB image: the same pixels, layers and scale; the bands are not a layer.
+    let back = read_exr(&path).unwrap();
+    assert_eq!(back.pixels(), img.pixels());
+    assert_eq!(back.layer("luminance").unwrap().samples, vec![3.0; n]);
+    assert!(back.layer("S0").is_none());
+    assert_eq!(back.cd_m2_per_unit, Some(72_983.0));
+    assert_eq!(back.metadata[VERSION_ATTRIBUTE], "1.0");
+    assert_eq!(back.metadata[EMISSIVE_UNITS_ATTRIBUTE], RADIANCE_UNITS);
+    // As a spectral image: the bands, pixel-major.
+    let spectral = read_spectral_exr(&path).unwrap();
+    assert_eq!(spectral.wavelengths_nm, wavelengths);
+    assert_eq!(spectral.emissive_units, RADIANCE_UNITS);
+    for i in [0, 17, n - 1] {
+        for (k, plane) in planes.iter().enumerate() {
+            assert_eq!(spectral.samples[i * 3 + k], plane[i]);
+        }
+    }
+    // Mismatched input is an error, not a panic, and writes nothing.
+    let bad = dir.join("bad_bands.exr");
+    for (wl, pl) in [
+        (&[500.0, 400.0][..], &planes[..2]),
+        (&wavelengths[..], &planes[..2]),
+        (&[][..], &[][..]),
+    ] {
+        assert!(
+            write_exr_with_spectral_bands(&bad, &img, wl, pl, &ExrWriteOptions::default()).is_err()
+        );
+    }
+    let short = vec![vec![0.0f32; n - 1]];
+    let e =
+        write_exr_with_spectral_bands(&bad, &img, &[500.0], &short, &ExrWriteOptions::default())
+            .unwrap_err();
+    assert!(e.to_string().contains("500 nm"), "{e}");
+    assert!(!bad.exists());
 }
 
 #[test]

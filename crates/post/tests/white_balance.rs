@@ -3,7 +3,10 @@
 
 use glam::DVec3;
 use prism_post::colour::white_balance::{cct_white_xyz, daylight_locus_xy};
-use prism_post::colour::{apply_white_balance, PostColourError, WhiteBalance};
+use prism_post::colour::{
+    apply_white_balance, apply_with_source_white, estimate_source_white_xyz,
+    illumination_white_xyz, PostColourError, WhiteBalance,
+};
 use prism_spectrum::colorimetry::{reflectance_to_xyz, xyz_to_lab, xyz_to_xy};
 use prism_spectrum::data::{colorchecker_patch, illuminant};
 use prism_spectrum::rgb_space::RgbColorSpace;
@@ -162,7 +165,7 @@ fn estimates_ignore_non_finite_pixels_and_fail_cleanly_on_black_or_empty() {
 
 #[test]
 fn parses_every_documented_form() {
-    let cases: [(&str, WhiteBalance); 12] = [
+    let cases: [(&str, WhiteBalance); 14] = [
         ("none", WhiteBalance::None),
         ("grey-world", WhiteBalance::GreyWorld),
         ("Gray-World", WhiteBalance::GreyWorld),
@@ -178,6 +181,8 @@ fn parses_every_documented_form() {
         ("LED-B3", WhiteBalance::Illuminant("LED-B3".into())),
         ("cct:3200", WhiteBalance::Cct(3200.0)),
         ("cct: 6504K", WhiteBalance::Cct(6504.0)),
+        ("scene", WhiteBalance::Scene),
+        ("Scene", WhiteBalance::Scene),
     ];
     for (text, expected) in cases {
         let parsed = WhiteBalance::parse(text).unwrap();
@@ -231,4 +236,47 @@ fn cct_whites_follow_planckian_then_daylight_locus() {
     );
     assert!(cct_white_xyz(999.0).is_none() && cct_white_xyz(25_001.0).is_none());
     assert!(cct_white_xyz(f64::NAN).is_none());
+}
+
+#[test]
+fn scene_white_from_an_illumination_layer_of_a_makes_the_grey_card_neutral() {
+    // The illumination layer holds the XYZ of a white diffuser under A at each pixel, at
+    // varying levels (a falloff) and with some misses (0); the pixels are neutral patches
+    // under A.
+    let a = illuminant("A").unwrap().to_dense();
+    let white = reflectance_to_xyz(&DenseSpectrum::constant(1.0), &a, Observer::Cie1931) / 100.0;
+    let layer: Vec<[f32; 3]> = (0..100)
+        .map(|i| {
+            if i % 10 == 0 {
+                [0.0; 3]
+            } else {
+                (white * (0.2 + 0.01 * i as f64)).as_vec3().to_array()
+            }
+        })
+        .collect();
+    let scene = illumination_white_xyz(&layer).unwrap();
+    assert_eq!(scene.pixels_used, 90);
+    let xy = xyz_to_xy(scene.xyz).unwrap();
+    // CIE 15:2018 Table 1: A is (0.44757, 0.40745).
+    assert!(
+        (xy.x - 0.44757).abs() < 5e-5 && (xy.y - 0.40745).abs() < 5e-5,
+        "{xy}"
+    );
+    let srgb = RgbColorSpace::srgb();
+    for adaptation in ADAPTATIONS {
+        let mut pixels = neutral_scene();
+        let report =
+            apply_with_source_white(&mut pixels, &srgb, &WhiteBalance::Scene, scene, adaptation);
+        assert_eq!(report.method, "scene");
+        let lab = lab_d65(pixels[20]);
+        assert!(
+            lab.y.abs() < NEUTRALITY_TOLERANCE_AB && lab.z.abs() < NEUTRALITY_TOLERANCE_AB,
+            "{adaptation}: grey card Lab {lab}"
+        );
+    }
+    // The pixel-based entry points cannot see layers and say so.
+    let e = estimate_source_white_xyz(&neutral_scene(), &srgb, &WhiteBalance::Scene)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("illumination layer"), "{e}");
 }

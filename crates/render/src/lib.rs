@@ -28,9 +28,9 @@ pub use camera::{
 pub use error::InvalidParameter;
 pub use film::{
     AovPlane, AovSelection, Film, FilmImage, FilmTile, Filter, FilterSample, FilterSampler,
-    SurfaceAov, TileBounds,
+    SpectralBins, SpectralPlanes, SurfaceAov, TileBounds,
 };
-pub use integrator::{render, total_samples, Integrator, RenderSettings, RenderStats};
+pub use integrator::{render, render_plan, total_samples, Integrator, RenderSettings, RenderStats};
 pub use plan::{PlanChoice, PlanRequest, RenderPlan};
-pub use sampler::{PixelSampler, SampleStream};
+pub use sampler::{PixelSampler, SampleStream, SamplerKind};
 pub use scene_build::{RenderScene, SceneBuildError};

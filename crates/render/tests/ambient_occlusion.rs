@@ -36,6 +36,7 @@ fn rendered_visibility(scene_json: &str, spp: u32) -> Vec<f32> {
         spp,
         seed: 7,
         tile_size_px: 16,
+        ..RenderSettings::default()
     };
     let (image, stats) = render(&scene, &settings, &|_| {});
     assert_eq!(stats.non_finite_samples, 0);

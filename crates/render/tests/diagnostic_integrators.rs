@@ -25,6 +25,7 @@ fn render_scene(json: &str, threads: usize) -> FilmImage {
         spp: 4,
         seed: 3,
         tile_size_px: 3,
+        ..RenderSettings::default()
     };
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
@@ -133,6 +134,7 @@ fn mesh_instances_are_placed_by_their_own_then_the_shape_transform() {
             spp: 4,
             seed: 0,
             tile_size_px: 16,
+            ..RenderSettings::default()
         },
         &|_| {},
     );

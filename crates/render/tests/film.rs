@@ -133,7 +133,7 @@ fn render_with_threads(threads: usize, tile_size: u32, filter: Filter) -> FilmIm
     .unwrap();
     let camera = Camera::Pinhole(PinholeCamera::new(frame, 1.0).unwrap());
     let sampler = PixelSampler::new(1234);
-    let mut film = Film::new(res, filter, AovSelection::ALL).unwrap();
+    let mut film = Film::new(res, filter, AovSelection::SURFACE).unwrap();
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()

@@ -11,11 +11,13 @@ pub mod error;
 pub mod gamut;
 pub mod oklab;
 pub mod rgb_matrix;
+pub mod scene_illumination;
 pub mod white_balance;
 
 pub use error::PostColourError;
 pub use gamut::{map_gamut, map_gamut_to_space, GamutMethod, GamutReport, GamutTarget};
+pub use scene_illumination::{illumination_white_xyz, ILLUMINATION_LAYER};
 pub use white_balance::{
-    apply as apply_white_balance, estimate_source_white_xyz, SceneWhite, WhiteBalance,
-    WhiteBalanceReport,
+    apply as apply_white_balance, apply_with_source_white, estimate_source_white_xyz, SceneWhite,
+    WhiteBalance, WhiteBalanceReport,
 };

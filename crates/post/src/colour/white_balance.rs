@@ -21,6 +21,11 @@
 //!   daylight locus, as the CIE D-series illuminants are defined (CIE 15:2004 §3.1,
 //!   eqs. 3.3–3.4; CIE 15:2018 §4.1). So `cct:2856` ≈ illuminant A and
 //!   `cct:6504` ≈ D65.
+//! - `scene`: the white of the light in the scene, from the image's `illumination` layer
+//!   (`illumination.X/Y/Z`, written by `prism render`: the light a neutral white surface
+//!   reflects at each pixel's first hit), not from its pixels; see `scene_illumination`.
+//!   [`estimate_source_white_xyz`] cannot see layers, so it refuses `scene`: estimate with
+//!   `scene_illumination::illumination_white_xyz` and apply with [`apply_with_source_white`].
 
 use std::fmt;
 use std::str::FromStr;
@@ -49,7 +54,7 @@ pub const DAYLIGHT_LOCUS_MIN_K: f64 = 4000.0;
 /// The forms `--wb` accepts, for error messages.
 pub const WHITE_BALANCE_SYNTAX: &str = "none, grey-world (or gray-world), white-patch, \
      white-patch:<percentile 0–100>, illuminant:<CIE name> or a bare CIE name (A, D50, F11, …), \
-     cct:<kelvin 1000–25000>";
+     cct:<kelvin 1000–25000>, scene (the illumination layer of a `prism render` EXR)";
 
 /// How the scene white is found.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -67,6 +72,8 @@ pub enum WhiteBalance {
     Illuminant(String),
     /// White at a colour temperature in K (Planckian below 4000 K, daylight from 4000 K).
     Cct(f64),
+    /// The scene illuminant's white from the image's `illumination` layer.
+    Scene,
 }
 
 fn invalid(given: &str, message: String) -> PostColourError {
@@ -86,6 +93,7 @@ impl WhiteBalance {
             "none" => return Ok(Self::None),
             "grey-world" | "gray-world" => return Ok(Self::GreyWorld),
             "white-patch" => return Ok(Self::WhitePatchMax),
+            "scene" => return Ok(Self::Scene),
             _ => {}
         }
         if let Some((key, argument)) = trimmed.split_once(':') {
@@ -106,7 +114,7 @@ impl WhiteBalance {
         if let Some(name) = canonical_illuminant_name(trimmed) {
             return Ok(Self::Illuminant(name.to_string()));
         }
-        let candidates = ["none", "grey-world", "gray-world", "white-patch"]
+        let candidates = ["none", "grey-world", "gray-world", "white-patch", "scene"]
             .into_iter()
             .chain(ILLUMINANT_NAMES.iter().copied());
         Err(invalid(
@@ -127,6 +135,7 @@ impl WhiteBalance {
             Self::WhitePatchPercentile(p) => format!("white-patch:{p}"),
             Self::Illuminant(name) => format!("illuminant:{name}"),
             Self::Cct(t) => format!("cct:{t}"),
+            Self::Scene => "scene".into(),
         }
     }
 }
@@ -281,6 +290,12 @@ pub fn estimate_source_white_xyz(
                 pixels_used: 0,
             });
         }
+        WhiteBalance::Scene => {
+            return Err(no_white(
+                "`scene` takes the white from the image's illumination layer, not from its \
+                 pixels (scene_illumination::illumination_white_xyz)",
+            ))
+        }
         WhiteBalance::GreyWorld => sum_where(pixels, |_| true),
         WhiteBalance::WhitePatchMax => {
             let max = pixels
@@ -396,6 +411,21 @@ pub fn apply(
     adaptation: AdaptationMethod,
 ) -> Result<WhiteBalanceReport, PostColourError> {
     let scene = estimate_source_white_xyz(pixels, space, method)?;
+    Ok(apply_with_source_white(
+        pixels, space, method, scene, adaptation,
+    ))
+}
+
+/// White-balances `pixels` from an already estimated scene white `scene` (e.g. from the
+/// illumination layer for `scene`) to the space's white, as [`apply`] does after its
+/// estimate; `method` is reported (and `None` leaves the pixels untouched).
+pub fn apply_with_source_white(
+    pixels: &mut [[f32; 3]],
+    space: &RgbColorSpace,
+    method: &WhiteBalance,
+    scene: SceneWhite,
+    adaptation: AdaptationMethod,
+) -> WhiteBalanceReport {
     let destination = space.white_xyz();
     let matrix = if *method == WhiteBalance::None {
         DMat3::IDENTITY
@@ -407,7 +437,7 @@ pub fn apply(
     }
     let xy = xyz_to_xy(scene.xyz).unwrap_or(DVec2::ZERO);
     let rows = matrix.transpose().to_cols_array_2d();
-    Ok(WhiteBalanceReport {
+    WhiteBalanceReport {
         method: method.name(),
         adaptation,
         source_white_xyz: scene.xyz.to_array(),
@@ -416,5 +446,5 @@ pub fn apply(
         destination_white_xyz: destination.to_array(),
         rgb_matrix: rows,
         pixels_used: scene.pixels_used,
-    })
+    }
 }

@@ -351,6 +351,28 @@ pub(crate) fn write_exr_channels(
 /// with its name, `chromaticities` from the colour space, `prism:cd_m2_per_unit` (double)
 /// when the image has an absolute scale, and the metadata as text attributes.
 pub fn write_exr(path: &Path, image: &Image, options: &ExrWriteOptions) -> Result<()> {
+    let (channels, attributes) = image_channels(path, image, options)?;
+    write_exr_channels(
+        path,
+        image.width(),
+        image.height(),
+        channels,
+        Some(chromaticities_of(&image.color_space)),
+        attributes,
+        options,
+    )
+}
+
+/// Channels and header attributes of `image` as [`write_exr`] writes them.
+pub(crate) type ChannelsAndAttributes = (Vec<(String, FlatSamples)>, Vec<(String, AttributeValue)>);
+
+/// The channels (R, G, B, then prefixed layer channels) and attributes (absolute scale,
+/// metadata as text) of `image`, as [`write_exr`] writes them.
+pub(crate) fn image_channels(
+    path: &Path,
+    image: &Image,
+    options: &ExrWriteOptions,
+) -> Result<ChannelsAndAttributes> {
     let n = image.width() * image.height();
     let mut planes = [vec![0.0f32; n], vec![0.0f32; n], vec![0.0f32; n]];
     {
@@ -398,13 +420,5 @@ pub fn write_exr(path: &Path, image: &Image, options: &ExrWriteOptions) -> Resul
         }
         attributes.push((key.clone(), AttributeValue::Text(text(path, value)?)));
     }
-    write_exr_channels(
-        path,
-        image.width(),
-        image.height(),
-        channels,
-        Some(chromaticities_of(&image.color_space)),
-        attributes,
-        options,
-    )
+    Ok((channels, attributes))
 }

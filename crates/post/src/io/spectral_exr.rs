@@ -21,8 +21,8 @@ use prism_spectrum::{Observer, DENSE_SAMPLE_COUNT, LAMBDA_MIN_NM};
 use rayon::prelude::*;
 
 use super::exr::{
-    chromaticities_of, flat_samples, read_exr_channels, text, write_exr_channels, ExrChannels,
-    ExrWriteOptions,
+    chromaticities_of, flat_samples, image_channels, read_exr_channels, text, write_exr_channels,
+    ExrChannels, ExrWriteOptions,
 };
 use crate::error::{PostError, Result};
 use crate::image::Image;
@@ -323,6 +323,68 @@ pub fn write_spectral_exr(
         image.height,
         channels,
         Some(chromaticities_of(&space)),
+        attributes,
+        options,
+    )
+}
+
+/// Writes `image` (R, G, B, its layers and attributes, as `exr::write_exr`) with spectral
+/// radiance bands beside them in the same part, in the Fichet et al. 2021 layout: one
+/// channel `S0.<λ>nm` per entry of `wavelengths_nm` (strictly increasing, > 0) holding the
+/// row-major plane of the same index, in W·m⁻²·sr⁻¹·nm⁻¹, and the attributes
+/// `spectralLayoutVersion` = "1.0" and `emissiveUnits` = "W.m^-2.sr^-1". What `prism
+/// render --spectral-bins` writes (bin centres as the wavelengths). One band is allowed
+/// here; [`read_spectral_exr`] needs two to interpolate.
+pub fn write_exr_with_spectral_bands(
+    path: &Path,
+    image: &Image,
+    wavelengths_nm: &[f64],
+    planes: &[Vec<f32>],
+    options: &ExrWriteOptions,
+) -> Result<()> {
+    let pixels = image.width() * image.height();
+    if wavelengths_nm.is_empty() || planes.len() != wavelengths_nm.len() {
+        return Err(PostError::invalid(format!(
+            "spectral bands: {} wavelengths and {} planes; expected the same number, at least 1",
+            wavelengths_nm.len(),
+            planes.len()
+        )));
+    }
+    if !(wavelengths_nm[0] > 0.0 && wavelengths_nm.windows(2).all(|w| w[0] < w[1])) {
+        return Err(PostError::invalid(
+            "spectral band wavelengths must be positive and strictly increasing",
+        ));
+    }
+    if let Some((k, p)) = planes.iter().enumerate().find(|(_, p)| p.len() != pixels) {
+        return Err(PostError::invalid(format!(
+            "spectral band {k} ({} nm) has {} values; a {}×{} image needs {pixels}",
+            wavelengths_nm[k],
+            p.len(),
+            image.width(),
+            image.height()
+        )));
+    }
+    let (mut channels, mut attributes) = image_channels(path, image, options)?;
+    for (wl, plane) in wavelengths_nm.iter().zip(planes) {
+        channels.push((
+            emissive_channel_name(*wl),
+            flat_samples(plane.clone(), options.sample_type),
+        ));
+    }
+    attributes.push((
+        VERSION_ATTRIBUTE.to_string(),
+        AttributeValue::Text(text(path, "1.0")?),
+    ));
+    attributes.push((
+        EMISSIVE_UNITS_ATTRIBUTE.to_string(),
+        AttributeValue::Text(text(path, RADIANCE_UNITS)?),
+    ));
+    write_exr_channels(
+        path,
+        image.width(),
+        image.height(),
+        channels,
+        Some(chromaticities_of(&image.color_space)),
         attributes,
         options,
     )

@@ -5,9 +5,22 @@
 /// One AOV channel, row-major, `width × height` values.
 #[derive(Clone, Debug, PartialEq)]
 pub struct AovPlane {
-    /// EXR channel name: `spp.Y`, `depth.Z`, `normal.X`/`.Y`/`.Z`, `albedo.R`/`.G`/`.B`.
+    /// EXR channel name: `spp.Y`, `depth.Z`, `normal.X`/`.Y`/`.Z`, `albedo.R`/`.G`/`.B`,
+    /// `illumination.X`/`.Y`/`.Z`.
     pub name: String,
     pub values: Vec<f32>,
+}
+
+/// The spectral bins of a finished film: equal bins over 360–830 nm.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SpectralPlanes {
+    /// Bin centres in nm, increasing.
+    pub centres_nm: Vec<f64>,
+    /// Width of every bin in nm (470 nm / number of bins).
+    pub width_nm: f64,
+    /// One row-major plane per bin: the pixel's mean spectral radiance over the bin,
+    /// W·m⁻²·sr⁻¹·nm⁻¹, filter-weighted like the XYZ.
+    pub planes: Vec<Vec<f32>>,
 }
 
 /// A finished film. All planes are row-major, top row first.
@@ -24,8 +37,10 @@ pub struct FilmImage {
     pub y: Vec<f32>,
     /// Multiply Y by this for luminance in cd/m²: 683.002 · ∫ȳ dλ.
     pub cd_m2_per_unit: f64,
-    /// AOV channels: always `spp.Y` (samples per pixel), then the enabled surface AOVs.
+    /// AOV channels: always `spp.Y` (samples per pixel), then the enabled AOVs.
     pub aovs: Vec<AovPlane>,
+    /// Spectral bins, when the film has them (`Film::with_spectral_bins`).
+    pub spectral: Option<SpectralPlanes>,
 }
 
 impl FilmImage {

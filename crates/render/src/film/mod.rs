@@ -1,6 +1,7 @@
 //! Film: per-pixel XYZ accumulation in f64 with filter weights and sample counts, optional
-//! surface AOVs, tile-parallel rendering with deterministic merging, and the finished image
-//! (pbrt-v4 §5.4 "Film and imaging", `RGBFilm` / `GBufferFilm`, with XYZ in place of RGB).
+//! surface AOVs, an optional illumination AOV and optional spectral bins, tile-parallel
+//! rendering with deterministic merging, and the finished image (pbrt-v4 §5.4 "Film and
+//! imaging", `RGBFilm` / `GBufferFilm` / `SpectralFilm`, with XYZ in place of RGB).
 //!
 //! Pixels may receive different sample counts (a `SamplePlan` decides); each pixel's value
 //! is Σ wᵢ XYZᵢ / Σ wᵢ with wᵢ = f/p from filter importance sampling, and `spp.Y` records
@@ -9,12 +10,14 @@
 pub mod filter;
 mod filter_sampler;
 mod image;
+pub mod spectral_bins;
 mod tile;
 pub mod xyz;
 
 pub use filter::Filter;
 pub use filter_sampler::{FilterSample, FilterSampler};
-pub use image::{AovPlane, FilmImage};
+pub use image::{AovPlane, FilmImage, SpectralPlanes};
+pub use spectral_bins::SpectralBins;
 pub use tile::{FilmTile, SurfaceAov, TileBounds};
 
 use std::sync::Arc;
@@ -26,7 +29,7 @@ use rayon::prelude::*;
 use crate::error::InvalidParameter;
 use tile::{AovAccum, PixelAccum};
 
-/// Which surface AOVs the film records (`spp.Y` is always recorded).
+/// Which AOVs the film records (`spp.Y` is always recorded).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub struct AovSelection {
     /// `depth.Z`: mean distance to the first hit over the samples that hit (m; +∞ if none).
@@ -35,6 +38,11 @@ pub struct AovSelection {
     pub normal: bool,
     /// `albedo.R/G/B`: mean first-hit albedo over all samples (misses count 0).
     pub albedo: bool,
+    /// `illumination.X/Y/Z`: mean XYZ (beauty normalisation) over all samples of the light
+    /// a neutral white Lambertian surface would reflect at the first hit
+    /// (`FilmTile::add_illumination`; misses count 0). For scene-based white balance
+    /// (`prism tonemap --wb scene`).
+    pub illumination: bool,
 }
 
 impl AovSelection {
@@ -42,15 +50,25 @@ impl AovSelection {
         depth: false,
         normal: false,
         albedo: false,
+        illumination: false,
     };
+    /// The first-hit surface AOVs: depth, normal, albedo.
+    pub const SURFACE: AovSelection = AovSelection {
+        depth: true,
+        normal: true,
+        albedo: true,
+        illumination: false,
+    };
+    /// Every AOV.
     pub const ALL: AovSelection = AovSelection {
         depth: true,
         normal: true,
         albedo: true,
+        illumination: true,
     };
 
     pub fn any(&self) -> bool {
-        self.depth || self.normal || self.albedo
+        self.depth || self.normal || self.albedo || self.illumination
     }
 }
 
@@ -62,6 +80,9 @@ pub struct Film {
     aov_selection: AovSelection,
     pixels: Vec<PixelAccum>,
     aovs: Vec<AovAccum>,
+    spectral_bins: Option<SpectralBins>,
+    /// Σ w · L̂_b per pixel and bin, pixel-major; empty without spectral bins.
+    spectral: Vec<f64>,
 }
 
 impl Film {
@@ -90,7 +111,38 @@ impl Film {
             } else {
                 Vec::new()
             },
+            spectral_bins: None,
+            spectral: Vec::new(),
         })
+    }
+
+    /// The same film with `count` equal spectral bins over 360–830 nm (1..=471; else an
+    /// error naming `spectral_bins`). Call before rendering: the spectral sums start at 0.
+    pub fn with_spectral_bins(self, count: u32) -> Result<Self, InvalidParameter> {
+        Ok(self.with_bins(SpectralBins::new(count)?))
+    }
+
+    /// The same film with spectral `bins` (see `with_spectral_bins`).
+    pub fn with_bins(mut self, bins: SpectralBins) -> Self {
+        self.spectral = vec![0.0; self.pixels.len() * bins.count() as usize];
+        self.spectral_bins = Some(bins);
+        self
+    }
+
+    /// The same film recording `selection`. Call before rendering: the AOV sums start at 0.
+    pub fn with_aovs(mut self, selection: AovSelection) -> Self {
+        self.aov_selection = selection;
+        self.aovs = if selection.any() {
+            vec![AovAccum::default(); self.pixels.len()]
+        } else {
+            Vec::new()
+        };
+        self
+    }
+
+    /// The spectral bins, if the film has them.
+    pub fn spectral_bins(&self) -> Option<SpectralBins> {
+        self.spectral_bins
     }
 
     pub fn resolution(&self) -> UVec2 {
@@ -148,7 +200,8 @@ impl Film {
         };
         FilmTile::new(
             b,
-            self.aov_selection.any(),
+            self.aov_selection,
+            self.spectral_bins,
             Arc::clone(&self.filter_sampler),
         )
     }
@@ -163,6 +216,13 @@ impl Film {
             self.pixels[i].merge(&tile.pixels[k]);
             if let (Some(dst), Some(src)) = (self.aovs.get_mut(i), tile.aovs.get(k)) {
                 dst.merge(src);
+            }
+            if let Some(bins) = self.spectral_bins {
+                let n = bins.count() as usize;
+                let src = &tile.spectral[k * n..(k + 1) * n];
+                for (d, s) in self.spectral[i * n..(i + 1) * n].iter_mut().zip(src) {
+                    *d += s;
+                }
             }
         }
     }
@@ -267,7 +327,36 @@ impl Film {
                     ["albedo.R", "albedo.G", "albedo.B"],
                 ));
             }
+            if sel.illumination {
+                aovs.extend(planes(
+                    |a| a.illumination_sum,
+                    ["illumination.X", "illumination.Y", "illumination.Z"],
+                ));
+            }
         }
+        let spectral = self.spectral_bins.map(|bins| {
+            let n = bins.count() as usize;
+            let planes = (0..n)
+                .map(|b| {
+                    self.pixels
+                        .iter()
+                        .zip(self.spectral.chunks_exact(n))
+                        .map(|(p, sums)| {
+                            if p.weight_sum != 0.0 {
+                                (sums[b] / p.weight_sum) as f32
+                            } else {
+                                0.0
+                            }
+                        })
+                        .collect()
+                })
+                .collect();
+            SpectralPlanes {
+                centres_nm: bins.centres_nm(),
+                width_nm: bins.width_nm(),
+                planes,
+            }
+        });
         FilmImage {
             width: self.resolution.x,
             height: self.resolution.y,
@@ -276,6 +365,7 @@ impl Film {
             y,
             cd_m2_per_unit: xyz::cd_m2_per_unit(),
             aovs,
+            spectral,
         }
     }
 }

@@ -9,7 +9,9 @@ use glam::{DVec3, UVec2, Vec2, Vec3A};
 use prism_spectrum::{SampledSpectrum, SampledWavelengths};
 
 use super::filter_sampler::FilterSampler;
+use super::spectral_bins::SpectralBins;
 use super::xyz::xyz_of_sample;
+use super::AovSelection;
 
 /// A half-open pixel rectangle [min, max).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -69,6 +71,8 @@ pub(crate) struct AovAccum {
     pub depth_sum: f64,
     pub normal_sum: DVec3,
     pub albedo_sum: DVec3,
+    /// Σ XYZ of the illumination spectra (`FilmTile::add_illumination`).
+    pub illumination_sum: DVec3,
 }
 
 impl PixelAccum {
@@ -85,6 +89,7 @@ impl AovAccum {
         self.depth_sum += other.depth_sum;
         self.normal_sum += other.normal_sum;
         self.albedo_sum += other.albedo_sum;
+        self.illumination_sum += other.illumination_sum;
     }
 }
 
@@ -95,26 +100,41 @@ pub struct FilmTile {
     pub(crate) pixels: Vec<PixelAccum>,
     /// Empty when the film records no surface AOVs.
     pub(crate) aovs: Vec<AovAccum>,
+    /// Σ w · L̂_b per pixel and bin (pixel-major, `bins.count()` per pixel); empty without
+    /// spectral bins.
+    pub(crate) spectral: Vec<f64>,
+    spectral_bins: Option<SpectralBins>,
+    /// Whether `add_illumination` records anything.
+    record_illumination: bool,
     filter_sampler: Arc<FilterSampler>,
 }
 
 impl FilmTile {
     pub(crate) fn new(
         bounds: TileBounds,
-        with_aovs: bool,
+        aov_selection: AovSelection,
+        spectral_bins: Option<SpectralBins>,
         filter_sampler: Arc<FilterSampler>,
     ) -> Self {
         let n = bounds.pixel_count();
         Self {
             bounds,
             pixels: vec![PixelAccum::default(); n],
-            aovs: if with_aovs {
+            aovs: if aov_selection.any() {
                 vec![AovAccum::default(); n]
             } else {
                 Vec::new()
             },
+            spectral: spectral_bins.map_or_else(Vec::new, |b| vec![0.0; n * b.count() as usize]),
+            spectral_bins,
+            record_illumination: aov_selection.illumination,
             filter_sampler,
         }
+    }
+
+    /// The spectral bins this tile accumulates, if any.
+    pub fn spectral_bins(&self) -> Option<SpectralBins> {
+        self.spectral_bins
     }
 
     /// The film point (px) of a camera sample of `pixel` with filter variate `u`, and the
@@ -138,9 +158,10 @@ impl FilmTile {
 
     /// Adds one camera sample of `pixel`: its radiance at the sampled wavelengths, the
     /// filter weight f/p of its film offset (`FilterSampler`), and the first hit's AOVs
-    /// (`None` for a miss). Non-finite radiance is dropped (counted as a sample with zero
-    /// radiance) so one bad path cannot poison a pixel. Returns false, adding nothing, when
-    /// `pixel` is outside the tile.
+    /// (`None` for a miss). When the film has spectral bins the radiance also goes into them
+    /// (`spectral_bins` module). Non-finite radiance is dropped (counted as a sample with
+    /// zero radiance) so one bad path cannot poison a pixel. Returns false, adding nothing,
+    /// when `pixel` is outside the tile.
     #[inline]
     pub fn add_sample(
         &mut self,
@@ -150,16 +171,53 @@ impl FilmTile {
         filter_weight: f32,
         aov: Option<&SurfaceAov>,
     ) -> bool {
-        if !self.bounds.contains(pixel) {
+        let Some(i) = self.index(pixel) else {
             debug_assert!(false, "pixel {pixel} outside tile {:?}", self.bounds);
             return false;
-        }
-        let xyz = if radiance.has_non_finite() {
-            DVec3::ZERO
-        } else {
-            xyz_of_sample(radiance, wavelengths)
         };
+        let finite = !radiance.has_non_finite();
+        let xyz = if finite {
+            xyz_of_sample(radiance, wavelengths)
+        } else {
+            DVec3::ZERO
+        };
+        if let (Some(bins), true) = (self.spectral_bins, finite && filter_weight.is_finite()) {
+            let n = bins.count() as usize;
+            bins.accumulate(
+                &mut self.spectral[i * n..(i + 1) * n],
+                radiance,
+                wavelengths,
+                f64::from(filter_weight),
+            );
+        }
         self.add_sample_xyz(pixel, xyz, filter_weight, aov)
+    }
+
+    /// Adds the illumination AOV of one camera sample of `pixel`: `radiance` is the
+    /// spectral radiance a neutral white Lambertian surface (albedo 1) would reflect
+    /// towards the camera at the sample's first hit, at `wavelengths` (the integrator
+    /// computes it). Its XYZ (same normalisation as the beauty) is summed; `finish` divides
+    /// by the pixel's sample count (from `add_sample`), so misses count as zero, like the
+    /// normal and albedo AOVs. Does nothing (returns true) when the film does not record
+    /// `illumination`; returns false when `pixel` is outside the tile. Non-finite radiance
+    /// is dropped.
+    #[inline]
+    pub fn add_illumination(
+        &mut self,
+        pixel: UVec2,
+        radiance: SampledSpectrum,
+        wavelengths: &SampledWavelengths,
+    ) -> bool {
+        let Some(i) = self.index(pixel) else {
+            debug_assert!(false, "pixel {pixel} outside tile {:?}", self.bounds);
+            return false;
+        };
+        if let (true, Some(a)) = (self.record_illumination, self.aovs.get_mut(i)) {
+            if !radiance.has_non_finite() {
+                a.illumination_sum += xyz_of_sample(radiance, wavelengths);
+            }
+        }
+        true
     }
 
     /// Adds one camera sample whose colour is already CIE 1931 XYZ in the output

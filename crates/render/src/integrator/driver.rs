@@ -12,9 +12,10 @@ use glam::{DVec3, UVec2};
 use prism_spectrum::{SampledSpectrum, SampledWavelengths};
 
 use super::{Integrator, PathCounters};
-use crate::film::{FilmImage, SurfaceAov};
-use crate::sampler::PixelSampler;
+use crate::film::{AovSelection, Film, FilmImage, SpectralBins, SurfaceAov};
+use crate::sampler::{PixelSampler, SamplerKind};
 use crate::scene_build::RenderScene;
+use prism_bandwidth::{BandwidthError, SamplePlan};
 
 /// Tile edge in pixels: 16 × 16 tiles give a 640 × 480 film 1200 work items, plenty for
 /// load balancing, while a tile's accumulators (≈ 20 KiB) stay in L1/L2.
@@ -27,16 +28,41 @@ pub struct RenderSettings {
     pub spp: u32,
     pub seed: u64,
     pub tile_size_px: u32,
+    /// Sampler of every camera sample's stream (default Sobol).
+    pub sampler: SamplerKind,
+    /// Spectral bins of the film (`None`: XYZ only). Validated by `SpectralBins::new`.
+    pub spectral_bins: Option<SpectralBins>,
+    /// Record the `illumination.X/Y/Z` AOV (filled by `FilmTile::add_illumination`).
+    pub illumination_aov: bool,
 }
 
 impl Default for RenderSettings {
-    /// 16 spp, seed 0, the default tile size.
+    /// 16 spp, seed 0, 16-pixel tiles, Sobol, no spectral bins, no illumination AOV.
     fn default() -> Self {
         Self {
             spp: 16,
             seed: 0,
             tile_size_px: DEFAULT_TILE_SIZE_PX,
+            sampler: SamplerKind::Sobol,
+            spectral_bins: None,
+            illumination_aov: false,
         }
+    }
+}
+
+/// The scene's film with the spectral bins and illumination AOV `settings` ask for.
+fn film_for(scene: &RenderScene, settings: &RenderSettings) -> Film {
+    let mut film = scene.new_film();
+    if settings.illumination_aov {
+        let aovs = AovSelection {
+            illumination: true,
+            ..film.aov_selection()
+        };
+        film = film.with_aovs(aovs);
+    }
+    match settings.spectral_bins {
+        Some(bins) => film.with_bins(bins),
+        None => film,
     }
 }
 
@@ -58,16 +84,31 @@ pub struct RenderStats {
     pub non_finite_contributions: u64,
 }
 
-/// Renders `scene` and returns the finished film with statistics. `progress` is called
-/// after each tile with the number of camera samples that tile took (from worker threads).
+/// Renders `scene` with the uniform plan (`settings.spp` camera samples and one light
+/// sample per hit everywhere) and returns the finished film with statistics. `progress` is
+/// called after each tile with the number of camera samples that tile took.
 pub fn render(
     scene: &RenderScene,
     settings: &RenderSettings,
     progress: &(dyn Fn(u64) + Sync),
 ) -> (FilmImage, RenderStats) {
-    let mut film = scene.new_film();
-    let sampler = PixelSampler::new(settings.seed);
-    let spp = settings.spp.max(1);
+    let plan = SamplePlan::uniform(scene.resolution, settings.spp.max(1))
+        .expect("the resolution was checked when the camera frame was built");
+    render_plan(scene, settings, &plan, progress).expect("a uniform plan has the film's resolution")
+}
+
+/// Renders `scene` executing `plan` (prism-bandwidth): per pixel its camera samples (0 is
+/// allowed: the pixel stays empty, `spp.Y` = 0) and per hit its light samples. Errors when
+/// the plan's resolution is not the film's. `settings.spp` is ignored.
+pub fn render_plan(
+    scene: &RenderScene,
+    settings: &RenderSettings,
+    plan: &SamplePlan,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Result<(FilmImage, RenderStats), BandwidthError> {
+    plan.check_resolution(scene.resolution)?;
+    let mut film = film_for(scene, settings);
+    let sampler = PixelSampler::with_kind(settings.sampler, settings.seed);
     let rays_total = AtomicU64::new(0);
     let samples_total = AtomicU64::new(0);
     let non_finite_total = AtomicU64::new(0);
@@ -78,7 +119,8 @@ pub fn render(
         let (mut rays, mut samples, mut non_finite) = (0u64, 0u64, 0u64);
         let mut counters = PathCounters::default();
         for pixel in tile.bounds().pixels() {
-            for s in 0..spp {
+            let light_samples = plan.light_samples(pixel);
+            for s in 0..plan.camera_samples(pixel) {
                 let mut stream = sampler.stream(pixel, s);
                 let (film_point, weight) = tile.sample_film_point(pixel, stream.get_2d());
                 let lens = stream.get_2d();
@@ -94,10 +136,13 @@ pub fn render(
                                     &camera_ray.ray,
                                     &mut wavelengths,
                                     &mut stream,
-                                    1,
-                                    false,
+                                    light_samples,
+                                    settings.illumination_aov,
                                     &mut counters,
                                 );
+                                if let Some(white) = r.illumination {
+                                    tile.add_illumination(pixel, white, &wavelengths);
+                                }
                                 let aov = r.first_hit.map(|si| SurfaceAov {
                                     depth_m: si.t,
                                     normal: si.n_shading,
@@ -163,7 +208,7 @@ pub fn render(
         roulette_terminations: roulette_total.into_inner(),
         non_finite_contributions: non_finite_contributions_total.into_inner(),
     };
-    (film.finish(), stats)
+    Ok((film.finish(), stats))
 }
 
 /// Total camera samples of a render: pixels × spp (for progress bars).

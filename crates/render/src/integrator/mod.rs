@@ -15,7 +15,9 @@ mod normal;
 mod path;
 
 pub use ambient_occlusion::AmbientOcclusion;
-pub use driver::{render, total_samples, RenderSettings, RenderStats, DEFAULT_TILE_SIZE_PX};
+pub use driver::{
+    render, render_plan, total_samples, RenderSettings, RenderStats, DEFAULT_TILE_SIZE_PX,
+};
 pub use path::{mis_weight, PathCounters, PathResult, PathTracer};
 
 use glam::DVec3;

@@ -90,10 +90,10 @@ impl RenderScene {
         })
     }
 
-    /// An empty film for this scene recording every surface AOV.
+    /// An empty film for this scene recording the surface AOVs (depth, normal, albedo).
     pub fn new_film(&self) -> Film {
         // The resolution was checked when the camera frame was built.
-        Film::new(self.resolution, self.filter, AovSelection::ALL)
+        Film::new(self.resolution, self.filter, AovSelection::SURFACE)
             .expect("resolution checked by CameraFrame::new")
     }
 

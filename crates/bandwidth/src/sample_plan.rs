@@ -1,0 +1,170 @@
+//! The sample plan: how many camera samples each pixel gets and how many light samples
+//! each hit of that pixel takes — what the predictor hands to the integrator (Bagher et al.
+//! 2013: N_p of §2.4 per pixel; DESIGN.md "Uniform plan = same spp everywhere; Predicted
+//! plan = per-pixel spp").
+//!
+//! Light samples are stored **per pixel**: every camera sample of pixel p takes
+//! `light_samples(p)` light samples at each hit (the integrator decides which hits: at
+//! least the first; Bagher's N_p is for the first hit). Per pixel, because the predictor's
+//! variance bound (eq. 9) is a per-pixel quantity; a global count is the special case
+//! `with_uniform_light_samples`.
+//!
+//! A pixel may get 0 camera samples: a predicted plan leaves pixels whose value the
+//! reconstruction step up-samples from their neighbours (Bagher §3.2); the film then
+//! records `spp.Y` = 0 for them.
+
+use glam::UVec2;
+
+use crate::error::{pixel_count, pixel_index, BandwidthError};
+
+/// Light samples per hit of a uniform plan.
+pub const DEFAULT_LIGHT_SAMPLES: u32 = 1;
+
+/// Per-pixel camera and light sample counts, row-major like the film.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct SamplePlan {
+    resolution: UVec2,
+    camera_samples: Vec<u32>,
+    light_samples: Vec<u32>,
+}
+
+impl SamplePlan {
+    /// `spp` camera samples (0 allowed) and one light sample per hit everywhere: the
+    /// default plan. Errors for a zero resolution.
+    pub fn uniform(resolution: UVec2, spp: u32) -> Result<Self, BandwidthError> {
+        let n = pixel_count("sample plan", resolution)?;
+        Ok(Self {
+            resolution,
+            camera_samples: vec![spp; n],
+            light_samples: vec![DEFAULT_LIGHT_SAMPLES; n],
+        })
+    }
+
+    /// A plan from per-pixel counts (row-major, one entry per pixel each).
+    pub fn from_counts(
+        resolution: UVec2,
+        camera_samples: Vec<u32>,
+        light_samples: Vec<u32>,
+    ) -> Result<Self, BandwidthError> {
+        let n = pixel_count("sample plan", resolution)?;
+        for (what, list) in [
+            ("sample plan camera samples", &camera_samples),
+            ("sample plan light samples", &light_samples),
+        ] {
+            if list.len() != n {
+                return Err(BandwidthError::LengthMismatch {
+                    what,
+                    resolution,
+                    found: list.len(),
+                });
+            }
+        }
+        Ok(Self {
+            resolution,
+            camera_samples,
+            light_samples,
+        })
+    }
+
+    /// The same plan with `light_samples` per hit in every pixel.
+    pub fn with_uniform_light_samples(mut self, light_samples: u32) -> Self {
+        self.light_samples.fill(light_samples);
+        self
+    }
+
+    /// Sets the counts of one pixel (an error when it lies outside the plan).
+    pub fn set(
+        &mut self,
+        pixel: UVec2,
+        camera_samples: u32,
+        light_samples: u32,
+    ) -> Result<(), BandwidthError> {
+        let i = pixel_index("sample plan", pixel, self.resolution)?;
+        self.camera_samples[i] = camera_samples;
+        self.light_samples[i] = light_samples;
+        Ok(())
+    }
+
+    pub fn resolution(&self) -> UVec2 {
+        self.resolution
+    }
+
+    /// Camera samples of `pixel` (0 outside the plan).
+    #[inline]
+    pub fn camera_samples(&self, pixel: UVec2) -> u32 {
+        pixel_index("sample plan", pixel, self.resolution).map_or(0, |i| self.camera_samples[i])
+    }
+
+    /// Light samples per hit of `pixel` (0 outside the plan).
+    #[inline]
+    pub fn light_samples(&self, pixel: UVec2) -> u32 {
+        pixel_index("sample plan", pixel, self.resolution).map_or(0, |i| self.light_samples[i])
+    }
+
+    /// Σ camera samples over all pixels (for progress bars and statistics).
+    pub fn total_camera_samples(&self) -> u64 {
+        self.camera_samples.iter().map(|&n| u64::from(n)).sum()
+    }
+
+    /// The largest per-pixel camera sample count.
+    pub fn max_camera_samples(&self) -> u32 {
+        self.camera_samples.iter().copied().max().unwrap_or(0)
+    }
+
+    /// Ok when the plan was made for a film of `resolution`; else an error giving both.
+    pub fn check_resolution(&self, resolution: UVec2) -> Result<(), BandwidthError> {
+        if resolution == self.resolution {
+            Ok(())
+        } else {
+            Err(BandwidthError::ResolutionMismatch {
+                what: "sample plan",
+                expected: resolution,
+                found: self.resolution,
+            })
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn uniform_plan_has_spp_and_one_light_sample_everywhere() {
+        let plan = SamplePlan::uniform(UVec2::new(5, 3), 16).unwrap();
+        assert_eq!(plan.camera_samples(UVec2::new(4, 2)), 16);
+        assert_eq!(plan.light_samples(UVec2::new(0, 0)), DEFAULT_LIGHT_SAMPLES);
+        assert_eq!(plan.total_camera_samples(), 5 * 3 * 16);
+        assert_eq!(plan.max_camera_samples(), 16);
+        assert_eq!(plan.camera_samples(UVec2::new(5, 0)), 0, "outside");
+        let zero = SamplePlan::uniform(UVec2::new(2, 2), 0).unwrap();
+        assert_eq!(zero.total_camera_samples(), 0);
+    }
+
+    #[test]
+    fn per_pixel_counts_are_row_major_and_editable() {
+        let mut plan =
+            SamplePlan::from_counts(UVec2::new(2, 2), vec![0, 1, 2, 3], vec![4, 5, 6, 7]).unwrap();
+        assert_eq!(plan.camera_samples(UVec2::new(1, 1)), 3);
+        assert_eq!(plan.light_samples(UVec2::new(0, 1)), 6);
+        plan.set(UVec2::new(0, 0), 9, 2).unwrap();
+        assert_eq!(plan.total_camera_samples(), 15);
+        assert!(plan.set(UVec2::new(0, 2), 1, 1).is_err());
+        let plan = plan.with_uniform_light_samples(3);
+        assert_eq!(plan.light_samples(UVec2::new(1, 0)), 3);
+    }
+
+    #[test]
+    fn mismatches_are_errors_naming_both_sides() {
+        let e = SamplePlan::from_counts(UVec2::new(2, 2), vec![1; 4], vec![1; 5]).unwrap_err();
+        assert!(e.to_string().contains("light samples"), "{e}");
+        assert!(SamplePlan::uniform(UVec2::new(3, 0), 1).is_err());
+        let plan = SamplePlan::uniform(UVec2::new(4, 3), 1).unwrap();
+        assert!(plan.check_resolution(UVec2::new(4, 3)).is_ok());
+        let e = plan.check_resolution(UVec2::new(3, 4)).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "sample plan: resolution 4×3 does not match the expected 3×4"
+        );
+    }
+}
