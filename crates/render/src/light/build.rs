@@ -130,7 +130,8 @@ fn vec3(v: &[f64; 3]) -> Vec3A {
     DVec3::from(*v).as_vec3a()
 }
 
-/// The emitting shape of `shapes[shape_index]`, from its instances in `geometry`.
+/// The emitting shape placed by the geometry instances `instances` (one analytic shape, or
+/// every instance of one mesh).
 fn area_shape(geometry: &Geometry, instances: Range<u32>) -> Result<AreaShape, &'static str> {
     let all = geometry.instances();
     let slice = all
