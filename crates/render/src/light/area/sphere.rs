@@ -19,6 +19,10 @@ use super::{area_to_solid_angle, ShapeSample};
 use crate::light::warp::sample_uniform_sphere;
 use crate::light::LightHit;
 
+/// Relative band around r² within which a reference point counts as on the sphere (hit
+/// points are within a few ulps, ~1e-6, of the surface).
+const SURFACE_BAND: f32 = 1e-4;
+
 #[derive(Clone, Debug, PartialEq)]
 pub struct SphereEmitter {
     pub sphere: Sphere,
@@ -72,10 +76,17 @@ impl SphereEmitter {
 
     /// World centre and radius of a sphere seen from outside at `reference` (cone
     /// sampling applies), else `None`.
+    ///
+    /// Points on the surface itself (within `SURFACE_BAND` of r², where rounding puts hit
+    /// points on either side) count as inside: from a point of the sphere the subtended
+    /// cone degenerates to the point itself, while area sampling stays well-behaved there
+    /// (for two points of a sphere cos θ · cos θ' / d² = 1/(4r²)) and sees the whole
+    /// interior that a path inside a closed emitter needs. pbrt-v4 gets the same effect by
+    /// offsetting the reference point towards the centre.
     #[inline]
     fn cone_from(&self, reference: Vec3A) -> Option<(Vec3A, f32)> {
         let (c, r) = self.similarity?;
-        ((reference - c).length_squared() > r * r).then_some((c, r))
+        ((reference - c).length_squared() > r * r * (1.0 + SURFACE_BAND)).then_some((c, r))
     }
 
     /// 1 − cos θ_max and sin θ_max for a sphere of radius r at distance² d2 (> r²).

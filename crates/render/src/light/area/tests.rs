@@ -230,6 +230,43 @@ fn sphere_light_irradiance_is_pi_l_r2_over_d2() {
 }
 
 #[test]
+fn inside_a_closed_emitting_sphere_the_irradiance_is_pi_l_even_on_its_wall() {
+    // An enclosure of uniform radiance L gives E = π L at every point and orientation.
+    // Reference points on the wall itself (as hits give them, rounded to either side of
+    // the surface) must sample the interior, not the degenerate cone of an outside point.
+    let dir = tempfile::tempdir().unwrap();
+    let json = scene(
+        r#"{"type": "sphere", "name": "lamp", "radius_m": 2, "transform": {"translate": [0.5, 0, 0]}}"#,
+        r#", "two_sided": true, "scale": 0.25"#,
+    );
+    let (_, lights) = build_scene(dir.path(), &json).unwrap();
+    let c = Vec3A::new(0.5, 0.0, 0.0);
+    // On the wall facing inwards, and inside (any orientation).
+    for (k, (radial, n)) in [
+        (Vec3A::new(1.0, 2.0, -2.0).normalize(), None),
+        (Vec3A::new(-0.3, 0.1, 0.9).normalize(), None),
+        (Vec3A::Y * 0.4, Some(Vec3A::new(0.3, 0.4, 0.2).normalize())),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        for scale in [1.0 - 1e-6, 1.0, 1.0 + 1e-6] {
+            let p = c + radial * (2.0 * scale);
+            let ctx = LightSampleContext {
+                p,
+                n: n.unwrap_or(-radial),
+            };
+            let (e, se) = irradiance_estimate(lights.light(0), ctx, 100_000, 20 + k as u64);
+            let exact = std::f64::consts::PI * 0.25;
+            assert!(
+                (e - exact).abs() < 4.0 * se + 1e-4 * exact,
+                "point {k} at {scale}: {e} ± {se} vs {exact}"
+            );
+        }
+    }
+}
+
+#[test]
 fn area_light_luminance_and_flux_are_exact() {
     // 100 cd/m² on a 2 m × 3 m rectangle scaled by 1.5 (A = 13.5 m²): Φ = π · 100 · A lm,
     // and a light given that flux has the same luminance; two-sided halves it.
