@@ -2,14 +2,15 @@
 //! `PowerLightSampler`), the map from hit instances to area lights, and the infinite lights
 //! that escaping rays see.
 
-use std::path::Path;
+use std::ops::Range;
 
 use prism_geometry::Geometry;
-use prism_scene::{LightKind, SceneDescription, Strength};
+use prism_scene::SceneDescription;
 
-use super::{Light, PointLight};
-use crate::scene_build::spectrum::{build_spectrum, SpectrumRole};
-use crate::scene_build::SceneBuildError;
+use super::build::build_lights;
+use super::scene_sphere::SceneSphere;
+use super::Light;
+use crate::scene_build::{shape_instance_ranges, SceneBuildError};
 
 /// `area_light_of_instance` value of instances that do not emit.
 pub const NO_LIGHT: u32 = u32::MAX;
@@ -23,6 +24,8 @@ pub struct LightSet {
     /// Per geometry instance: index of the area light it carries, or `NO_LIGHT`.
     instance_light: Vec<u32>,
     infinite: Vec<u32>,
+    /// The scene's bounding sphere (set by `build`; zero radius from `new`).
+    scene: SceneSphere,
 }
 
 impl LightSet {
@@ -49,7 +52,7 @@ impl LightSet {
         let infinite = lights
             .iter()
             .enumerate()
-            .filter(|(_, l)| l.is_infinite())
+            .filter(|(_, l)| l.is_infinite() && !l.is_delta())
             .map(|(i, _)| i as u32)
             .collect();
         Self {
@@ -58,40 +61,47 @@ impl LightSet {
             cdf,
             instance_light,
             infinite,
+            scene: SceneSphere {
+                center_m: glam::Vec3A::ZERO,
+                radius_m: scene_radius_m,
+            },
         }
     }
 
-    /// Builds the scene's lights; `geometry` gives instance ids of area-light shapes.
+    /// Builds the scene's lights; `geometry` must have been built from `scene`
+    /// (`build_geometry`): area lights find their shape's instances in it by the order in
+    /// which shapes add instances (`shape_instance_ranges`).
     pub fn build(scene: &SceneDescription, geometry: &Geometry) -> Result<Self, SceneBuildError> {
-        let file: &Path = &scene.file;
-        let mut lights = Vec::new();
-        for (i, l) in scene.lights.iter().enumerate() {
-            let place = format!("lights[{i}]");
-            let spectrum = build_spectrum(&l.spectrum, SpectrumRole::Illuminant)
-                .map_err(|e| SceneBuildError::new(file, format!("{place}.spectrum"), e))?;
-            match &l.kind {
-                LightKind::Point { position_m } => {
-                    let scale = match l.strength {
-                        Strength::Scale(s) => s,
-                        _ => {
-                            return Err(SceneBuildError::new(
-                                file,
-                                place,
-                                "photometric strengths are not implemented yet",
-                            ))
-                        }
-                    };
-                    lights.push(Light::Point(PointLight {
-                        position_m: glam::DVec3::from(*position_m).as_vec3a(),
-                        intensity: spectrum.scaled(scale as f32),
-                    }));
-                }
-                // Interface skeleton: the emitter work replaces this.
-                _ => {}
-            }
+        let ranges = shape_instance_ranges(scene);
+        let expected = ranges.last().map_or(0, |r| r.end as usize);
+        if expected != geometry.instances().len() {
+            return Err(SceneBuildError::new(
+                &scene.file,
+                "lights",
+                format!(
+                    "internal error: the geometry has {} instances but the scene's shapes make {expected}",
+                    geometry.instances().len()
+                ),
+            ));
         }
-        let instance_light = vec![NO_LIGHT; geometry.instances().len()];
-        Ok(Self::new(lights, instance_light, 1.0))
+        Self::build_with_instances(scene, geometry, &ranges)
+    }
+
+    /// As `build`, with the instance ids of each shape given (`build_geometry_with_instances`).
+    pub fn build_with_instances(
+        scene: &SceneDescription,
+        geometry: &Geometry,
+        shape_instances: &[Range<u32>],
+    ) -> Result<Self, SceneBuildError> {
+        let built = build_lights(scene, geometry, shape_instances)?;
+        let mut set = Self::new(built.lights, built.instance_light, built.scene.radius_m);
+        set.scene = built.scene;
+        Ok(set)
+    }
+
+    /// The scene's bounding sphere that the infinite lights use.
+    pub fn scene_sphere(&self) -> SceneSphere {
+        self.scene
     }
 
     pub fn len(&self) -> usize {
@@ -140,8 +150,82 @@ impl LightSet {
         }
     }
 
-    /// Indices of the infinite lights (environment, sky, directional with a size).
+    /// Indices of the lights that rays leaving the scene see (environment, sky,
+    /// directional with an angular diameter > 0; not ideal directional light).
     pub fn infinite_lights(&self) -> &[u32] {
         &self.infinite
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::light::test_support::build_scene;
+
+    #[test]
+    fn lights_are_chosen_in_proportion_to_power() {
+        let dir = tempfile::tempdir().unwrap();
+        let json = r#"{"lights": [{"type": "point", "power_lm": 100}, {"type": "point", "power_lm": 300}]}"#;
+        let (_, lights) = build_scene(dir.path(), json).unwrap();
+        assert!((lights.pmf(0) - 0.25).abs() < 1e-6 && (lights.pmf(1) - 0.75).abs() < 1e-6);
+        assert_eq!(lights.sample(0.2).map(|s| s.0), Some(0));
+        assert_eq!(lights.sample(0.3).map(|s| s.0), Some(1));
+        assert!(lights.infinite_lights().is_empty());
+    }
+
+    #[test]
+    fn infinite_lights_take_their_power_from_the_scene_radius() {
+        // A unit sphere: bounding box [−1, 1]³, radius √3. A sky of radiance L sends
+        // 4π · π r² ∫L dλ into it; a point of intensity I emits 4π ∫I dλ.
+        let dir = tempfile::tempdir().unwrap();
+        let json = r#"{"shapes": [{"type": "sphere"}],
+            "lights": [{"type": "sky", "scale": 2, "spectrum": 1}, {"type": "point", "scale": 3, "spectrum": 1},
+                       {"type": "directional", "scale": 1, "spectrum": 1}]}"#;
+        let scene = prism_scene::parse_scene_str(json, dir.path().join("scene.json")).unwrap();
+        let geometry = crate::scene_build::build_geometry(&scene).unwrap();
+        let lights = LightSet::build(&scene, &geometry).unwrap();
+        assert!((lights.scene_sphere().radius_m - 3f32.sqrt()).abs() < 1e-5);
+        let pi = std::f64::consts::PI;
+        let span = 470.0; // ∫ 1 dλ over 360–830 nm
+        let sky = 4.0 * pi * pi * 3.0 * 2.0 * span;
+        let point = 4.0 * pi * 3.0 * span;
+        let sun = pi * 3.0 * span;
+        let total = sky + point + sun;
+        for (i, p) in [sky, point, sun].into_iter().enumerate() {
+            let pmf = f64::from(lights.pmf(i as u32));
+            assert!(
+                (pmf - p / total).abs() < 1e-5,
+                "light {i}: {pmf} vs {}",
+                p / total
+            );
+        }
+        // The ideal directional light is infinite but no escaping ray sees it.
+        assert!(lights.light(2).is_infinite() && lights.light(2).is_delta());
+        assert_eq!(lights.infinite_lights(), &[0]);
+        let (_, with_ranges) = build_scene(dir.path(), json).unwrap();
+        assert_eq!(with_ranges, lights);
+    }
+
+    #[test]
+    fn every_example_scene_builds_its_lights() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
+        let mut stack = vec![root];
+        let mut count = 0;
+        while let Some(dir) = stack.pop() {
+            for entry in std::fs::read_dir(&dir).unwrap() {
+                let path = entry.unwrap().path();
+                if path.is_dir() {
+                    stack.push(path);
+                } else if path.extension().is_some_and(|e| e == "json") {
+                    let scene = prism_scene::load_scene(&path).unwrap();
+                    let geometry = crate::scene_build::build_geometry(&scene).unwrap();
+                    let lights = LightSet::build(&scene, &geometry)
+                        .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+                    assert_eq!(lights.len(), scene.lights.len());
+                    count += 1;
+                }
+            }
+        }
+        assert!(count > 0);
     }
 }

@@ -10,12 +10,36 @@
 //! (point, spot, ideal directional) `LightSample::radiance` is the incident irradiance per
 //! unit projected solid angle in the same sense pbrt-v4 uses: the contribution of a light
 //! sample is f · |cos θ| · radiance / pdf, with pdf = 1 for a delta light.
+//!
+//! One file per emitter: `point`, `spot`, `directional` (ideal or with an angular
+//! diameter), `area` (sphere, disk, rectangle, triangle meshes), `environment`
+//! (equirectangular map), `sky` (uniform). `build` turns the scene's light descriptions
+//! into them (photometric strengths through `photometry`); docs/lights.md has every
+//! formula.
 
+pub mod area;
+mod build;
+pub mod directional;
+pub mod environment;
 mod light_set;
+pub mod photometry;
+pub mod piecewise_constant;
 mod point;
+pub mod scene_sphere;
+pub mod sky;
+pub mod spot;
+#[cfg(test)]
+mod test_support;
+pub mod warp;
 
+pub use area::{AreaLight, AreaShape};
+pub use directional::DirectionalLight;
+pub use environment::EnvironmentLight;
 pub use light_set::{LightSet, NO_LIGHT};
 pub use point::PointLight;
+pub use scene_sphere::SceneSphere;
+pub use sky::UniformSky;
+pub use spot::SpotLight;
 
 use glam::{Vec2, Vec3A};
 use prism_spectrum::{SampledSpectrum, SampledWavelengths};
@@ -64,6 +88,11 @@ pub struct LightHit {
 #[derive(Clone, Debug, PartialEq)]
 pub enum Light {
     Point(PointLight),
+    Spot(SpotLight),
+    Directional(DirectionalLight),
+    Area(AreaLight),
+    Environment(Box<EnvironmentLight>),
+    Sky(UniformSky),
 }
 
 impl Light {
@@ -77,22 +106,32 @@ impl Light {
     ) -> Option<LightSample> {
         match self {
             Light::Point(l) => l.sample_li(ctx, u, wavelengths),
+            Light::Spot(l) => l.sample_li(ctx, u, wavelengths),
+            Light::Directional(l) => l.sample_li(ctx, u, wavelengths),
+            Light::Area(l) => l.sample_li(ctx, u, wavelengths),
+            Light::Environment(l) => l.sample_li(ctx, u, wavelengths),
+            Light::Sky(l) => l.sample_li(ctx, u, wavelengths),
         }
     }
 
     /// Solid-angle pdf with which `sample_li` from `ctx` produces `wi`; `hit` is where a
     /// ray along `wi` met the light's surface (`None` for infinite lights). 0 for delta
-    /// lights.
+    /// lights, for an area light without `hit`, and for directions `sample_li` never
+    /// returns (the back of a one-sided area light, outside the sun's disk).
     #[inline]
     pub fn pdf_li(&self, ctx: &LightSampleContext, wi: Vec3A, hit: Option<&LightHit>) -> f32 {
-        let _ = (ctx, wi, hit);
         match self {
-            Light::Point(_) => 0.0,
+            Light::Point(_) | Light::Spot(_) => 0.0,
+            Light::Directional(l) => l.pdf_li(wi),
+            Light::Area(l) => l.pdf_li(ctx, wi, hit),
+            Light::Environment(l) => l.pdf_li(wi),
+            Light::Sky(l) => l.pdf_li(ctx, wi),
         }
     }
 
     /// Radiance leaving an emitting surface at `hit` in direction `wo` (unit, away from
-    /// the surface, towards the previous path vertex). Zero for lights without a surface.
+    /// the surface, towards the previous path vertex). Zero for lights without a surface
+    /// and on the back of a one-sided area light.
     #[inline]
     pub fn emitted_radiance(
         &self,
@@ -100,49 +139,61 @@ impl Light {
         wo: Vec3A,
         wavelengths: &SampledWavelengths,
     ) -> SampledSpectrum {
-        let _ = (hit, wo, wavelengths);
         match self {
-            Light::Point(_) => SampledSpectrum::splat(0.0),
+            Light::Area(l) => l.emitted_radiance(hit, wo, wavelengths),
+            _ => SampledSpectrum::splat(0.0),
         }
     }
 
     /// Radiance arriving from an infinitely distant light along the ray direction
     /// `direction` (unit, pointing away from the scene, towards the light). Zero for
-    /// lights at finite distance.
+    /// lights at finite distance and for ideal directional light.
     #[inline]
     pub fn infinite_radiance(
         &self,
         direction: Vec3A,
         wavelengths: &SampledWavelengths,
     ) -> SampledSpectrum {
-        let _ = (direction, wavelengths);
         match self {
-            Light::Point(_) => SampledSpectrum::splat(0.0),
+            Light::Directional(l) => l.infinite_radiance(direction, wavelengths),
+            Light::Environment(l) => l.infinite_radiance(direction, wavelengths),
+            Light::Sky(l) => l.infinite_radiance(wavelengths),
+            _ => SampledSpectrum::splat(0.0),
         }
     }
 
-    /// Dirac in position or direction: BSDF-sampled rays never hit it.
+    /// Dirac in position or direction: BSDF-sampled rays never hit it (point, spot,
+    /// directional with angular diameter 0).
     #[inline]
     pub fn is_delta(&self) -> bool {
         match self {
-            Light::Point(_) => true,
+            Light::Point(_) | Light::Spot(_) => true,
+            Light::Directional(l) => l.is_delta(),
+            Light::Area(_) | Light::Environment(_) | Light::Sky(_) => false,
         }
     }
 
-    /// At infinity (environment, sky, directional): seen by rays that leave the scene.
+    /// At infinity (environment, sky, directional — ideal or not): shadow rays go to
+    /// infinity and the power uses the scene's bounding sphere. Rays that leave the scene
+    /// see the non-delta ones (`LightSet::infinite_lights`).
     #[inline]
     pub fn is_infinite(&self) -> bool {
-        match self {
-            Light::Point(_) => false,
-        }
+        matches!(
+            self,
+            Light::Directional(_) | Light::Environment(_) | Light::Sky(_)
+        )
     }
 
     /// Radiant power in W (the integral of its spectrum over 360–830 nm), for choosing
     /// lights in proportion to power. Infinite lights use the scene's bounding sphere.
     pub fn power_w(&self, scene_radius_m: f32) -> f64 {
-        let _ = scene_radius_m;
         match self {
             Light::Point(l) => l.power_w(),
+            Light::Spot(l) => l.power_w(),
+            Light::Directional(l) => l.power_w(scene_radius_m),
+            Light::Area(l) => l.power_w(),
+            Light::Environment(l) => l.power_w(scene_radius_m),
+            Light::Sky(l) => l.power_w(scene_radius_m),
         }
     }
 }

@@ -53,3 +53,81 @@ pub(crate) fn integrate_nm(s: &Spectrum) -> f64 {
     }
     sum
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::light::test_support::{build_error, build_scene, photometric_sum};
+    use crate::light::Light;
+
+    fn intensity_cd(light: &Light) -> f64 {
+        match light {
+            Light::Point(p) => photometric_sum(|wl| p.intensity.eval(wl)),
+            _ => panic!(),
+        }
+    }
+
+    #[test]
+    fn point_light_of_1000_lm_has_1000_over_4pi_cd() {
+        let dir = tempfile::tempdir().unwrap();
+        let json = r#"{"lights": [{"type": "point", "power_lm": 1000, "spectrum": {"blackbody_k": 2700}},
+            {"type": "point", "intensity_cd": 250, "spectrum": "F11"}]}"#;
+        let (_, lights) = build_scene(dir.path(), json).unwrap();
+        let i = intensity_cd(lights.light(0));
+        let exact = 1000.0 / (4.0 * std::f64::consts::PI);
+        assert!((i - exact).abs() < 1e-5 * exact, "{i} vs {exact}");
+        assert!((intensity_cd(lights.light(1)) - 250.0).abs() < 1e-5 * 250.0);
+    }
+
+    #[test]
+    fn point_light_illuminance_is_intensity_over_distance_squared() {
+        let dir = tempfile::tempdir().unwrap();
+        let json =
+            r#"{"lights": [{"type": "point", "position_m": [1, 2, 3], "intensity_cd": 500}]}"#;
+        let (_, lights) = build_scene(dir.path(), json).unwrap();
+        for d in [0.5f32, 2.0, 7.0] {
+            let to = Vec3A::new(2.0, -1.0, 2.0).normalize();
+            let ctx = LightSampleContext {
+                p: Vec3A::new(1.0, 2.0, 3.0) - to * d,
+                n: to,
+            };
+            // Facing the light: E = I/d² (cos = 1, pdf = 1).
+            let e = photometric_sum(|wl| {
+                let s = lights.light(0).sample_li(&ctx, Vec2::ZERO, wl).unwrap();
+                assert!(s.delta && (s.distance_m - d).abs() < 1e-5 * d);
+                s.radiance * s.wi.dot(ctx.n)
+            });
+            let exact = 500.0 / f64::from(d * d);
+            assert!((e - exact).abs() < 1e-5 * exact, "d {d}: {e} vs {exact}");
+        }
+    }
+
+    #[test]
+    fn photometric_strengths_a_kind_does_not_take_are_errors() {
+        let dir = tempfile::tempdir().unwrap();
+        let json = r#"{"lights": [{"type": "point", "intensity_cd": 5}]}"#;
+        let mut scene = prism_scene::parse_scene_str(json, dir.path().join("scene.json")).unwrap();
+        scene.lights[0].strength = prism_scene::Strength::IlluminanceLx(3.0);
+        let geometry = crate::scene_build::build_geometry(&scene).unwrap();
+        let e = crate::light::LightSet::build(&scene, &geometry)
+            .unwrap_err()
+            .to_string();
+        assert!(e.ends_with("scene.json: lights[0].illuminance_lx: a point light does not take `illuminance_lx` (see docs/scene-format.md, lights)"), "{e}");
+        scene.lights[0].strength = prism_scene::Strength::Scale(f64::NAN);
+        let e = crate::light::LightSet::build(&scene, &geometry)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("lights[0].scale: expected a finite value ≥ 0, found NaN"),
+            "{e}"
+        );
+        let e = build_error(
+            dir.path(),
+            r#"{"lights": [{"type": "point", "intensity_cd": 5, "spectrum": 0}]}"#,
+        );
+        assert!(
+            e.contains("lights[0].intensity_cd: the emission spectrum has no luminous content"),
+            "{e}"
+        );
+    }
+}

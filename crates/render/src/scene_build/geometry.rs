@@ -10,7 +10,11 @@
 //! - Every instance carries `material = Some(index)` with index into the scene's
 //!   `materials`, or `materials.len()` for the default lambert 0.5; hits report it as
 //!   `material_id`.
+//! - Instances are added in shape order, so the instances of `shapes[i]` are a contiguous
+//!   range of ids (`build_geometry_with_instances`, `shape_instance_ranges`); area lights
+//!   use it to find the instances of their shape.
 
+use std::ops::Range;
 use std::path::Path;
 
 use glam::{DMat4, DVec3, Vec3A};
@@ -35,7 +39,37 @@ fn load_mesh(asset: &prism_scene::MeshAsset) -> Result<TriangleMesh, String> {
 
 /// Builds the geometry of every shape in `scene`.
 pub fn build_geometry(scene: &SceneDescription) -> Result<Geometry, SceneBuildError> {
+    build_geometry_with_instances(scene).map(|(geometry, _)| geometry)
+}
+
+/// The instance ids of each scene shape, in shape order, without building anything: one
+/// per shape, `transforms.len()` for an `instances` shape. Equal to the ranges
+/// `build_geometry_with_instances` returns for the same scene.
+pub fn shape_instance_ranges(scene: &SceneDescription) -> Vec<Range<u32>> {
+    let mut next = 0u32;
+    scene
+        .shapes
+        .iter()
+        .map(|shape| {
+            let count = match &shape.kind {
+                ShapeKind::Instances { transforms, .. } => transforms.len() as u32,
+                _ => 1,
+            };
+            let range = next..next + count;
+            next += count;
+            range
+        })
+        .collect()
+}
+
+/// Builds the geometry and returns, per scene shape (in order), the range of instance ids
+/// it was given.
+pub fn build_geometry_with_instances(
+    scene: &SceneDescription,
+) -> Result<(Geometry, Vec<Range<u32>>), SceneBuildError> {
     let file: &Path = &scene.file;
+    let mut ranges: Vec<Range<u32>> = Vec::with_capacity(scene.shapes.len());
+    let mut instance_count = 0u32;
     let default_material = scene.materials.len() as u32;
     let mut builder = GeometryBuilder::new();
     let mut mesh_ids: Vec<Option<MeshId>> = vec![None; scene.meshes.len()];
@@ -97,6 +131,7 @@ pub fn build_geometry(scene: &SceneDescription) -> Result<Geometry, SceneBuildEr
                 placements.push((Shape::Mesh(id), m * DMat4::from_scale(DVec3::from(*size_m))));
             }
         }
+        let first = instance_count;
         for (k, (geometry_shape, matrix)) in placements.into_iter().enumerate() {
             let to_world = to_geometry_transform(&matrix).ok_or_else(|| {
                 err(format!(
@@ -113,11 +148,37 @@ pub fn build_geometry(scene: &SceneDescription) -> Result<Geometry, SceneBuildEr
                 .ok_or_else(|| {
                     err("internal error: instance of a mesh that was not added".into())
                 })?;
+            instance_count += 1;
         }
+        ranges.push(first..instance_count);
     }
-    Ok(builder.build(BuildQuality::default()))
+    Ok((builder.build(BuildQuality::default()), ranges))
 }
 
 fn builder_add_mesh(builder: &mut GeometryBuilder, mesh: TriangleMesh) -> MeshId {
     builder.add_mesh(mesh)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shape_instance_ranges_match_the_built_geometry() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(
+            dir.path().join("tri.obj"),
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+        )
+        .unwrap();
+        let json = r#"{"meshes": {"tri": "tri.obj"}, "shapes": [
+            {"type": "sphere"},
+            {"type": "instances", "mesh": "tri", "instances": [{"translate": [1, 0, 0]}, {"translate": [2, 0, 0]}, {"scale": 2}]},
+            {"type": "cuboid"}, {"type": "mesh", "mesh": "tri"}, {"type": "disk"}]}"#;
+        let scene = prism_scene::parse_scene_str(json, dir.path().join("scene.json")).unwrap();
+        let (geometry, ranges) = build_geometry_with_instances(&scene).unwrap();
+        assert_eq!(ranges, vec![0..1, 1..4, 4..5, 5..6, 6..7]);
+        assert_eq!(shape_instance_ranges(&scene), ranges);
+        assert_eq!(geometry.instances().len(), 7);
+    }
 }

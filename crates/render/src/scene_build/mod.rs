@@ -13,7 +13,7 @@ pub use albedo::{material_albedo, reflectance_rgb, DEFAULT_ALBEDO};
 pub use camera::{build_camera, horizontal_fov_rad};
 pub use error::SceneBuildError;
 pub use filter::build_filter;
-pub use geometry::build_geometry;
+pub use geometry::{build_geometry, build_geometry_with_instances, shape_instance_ranges};
 
 use std::path::PathBuf;
 

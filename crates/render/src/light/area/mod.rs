@@ -1,0 +1,213 @@
+//! Area lights: a shape of the scene that emits a uniform radiance L(λ) (Lambertian
+//! emission, pbrt-v4 §12.3 `DiffuseAreaLight`) from the side its geometric normal points
+//! to, or from both sides when `two_sided`.
+//!
+//! Each shape samples a point as seen from the reference point and gives the solid-angle
+//! density of the direction towards it:
+//! - sphere: uniform in the cone that the sphere subtends (only its visible cap) from
+//!   outside (pbrt-v4 §6.2.4); uniform in area from inside, and under a non-uniform scale
+//!   (an ellipsoid);
+//! - disk, rectangle: uniform in area;
+//! - triangle meshes (every instance of the shape): a triangle in proportion to its world
+//!   area, then a uniform point in it (Heitz 2019).
+//!
+//! An area density p_A becomes a solid-angle density p_ω = p_A · d² / |cos θ_light|
+//! (pbrt-v4 eq. 4.9), d the distance and θ_light the angle between the emitter's normal
+//! and the direction back to the reference point.
+//!
+//! Directions towards points that do not emit towards the reference point (the back of a
+//! one-sided emitter) are not sampled (`sample_li` returns `None`) and have density 0 in
+//! `pdf_li`, so the two stay consistent.
+
+mod disk;
+mod mesh;
+mod rectangle;
+mod sphere;
+
+pub use disk::DiskEmitter;
+pub use mesh::{EmitterMesh, MeshEmitter};
+pub use rectangle::RectangleEmitter;
+pub use sphere::SphereEmitter;
+
+use glam::{Vec2, Vec3A};
+use prism_spectrum::{SampledSpectrum, SampledWavelengths, Spectrum};
+
+use super::point::integrate_nm;
+use super::{LightHit, LightSample, LightSampleContext};
+
+/// A point sampled on a shape as seen from a reference point.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShapeSample {
+    /// World position, metres.
+    pub p: Vec3A,
+    /// Unit geometric normal there (the same one a ray hitting the point reports).
+    pub n: Vec3A,
+    /// Solid-angle density of the direction from the reference point to `p`, sr⁻¹.
+    pub pdf: f32,
+}
+
+/// p_ω = p_A · d² / |cos θ_light|: area density → solid-angle density at `reference`
+/// (pbrt-v4 eq. 4.9). 0 at grazing angles.
+#[inline]
+pub fn area_to_solid_angle(pdf_area: f32, reference: Vec3A, p: Vec3A, n: Vec3A) -> f32 {
+    let to = p - reference;
+    let d2 = to.length_squared();
+    if d2 <= 0.0 {
+        return 0.0;
+    }
+    let cos = n.dot(to).abs() / d2.sqrt();
+    if cos <= 0.0 {
+        return 0.0;
+    }
+    let pdf = pdf_area * d2 / cos;
+    if pdf.is_finite() {
+        pdf
+    } else {
+        0.0
+    }
+}
+
+/// The emitting shape of an area light.
+#[derive(Clone, Debug, PartialEq)]
+pub enum AreaShape {
+    Sphere(SphereEmitter),
+    Disk(DiskEmitter),
+    Rectangle(RectangleEmitter),
+    Mesh(MeshEmitter),
+}
+
+impl AreaShape {
+    #[inline]
+    pub fn sample(&self, reference: Vec3A, u: Vec2) -> Option<ShapeSample> {
+        match self {
+            AreaShape::Sphere(s) => s.sample(reference, u),
+            AreaShape::Disk(s) => s.sample(reference, u),
+            AreaShape::Rectangle(s) => s.sample(reference, u),
+            AreaShape::Mesh(s) => s.sample(reference, u),
+        }
+    }
+
+    /// Solid-angle density with which `sample` from `reference` picks the direction to
+    /// `hit`, a point of this shape.
+    #[inline]
+    pub fn pdf(&self, reference: Vec3A, hit: &LightHit) -> f32 {
+        match self {
+            AreaShape::Sphere(s) => s.pdf(reference, hit),
+            AreaShape::Disk(s) => s.pdf(reference, hit),
+            AreaShape::Rectangle(s) => s.pdf(reference, hit),
+            AreaShape::Mesh(s) => s.pdf(reference, hit),
+        }
+    }
+
+    /// World-space surface area, m².
+    pub fn area_m2(&self) -> f64 {
+        match self {
+            AreaShape::Sphere(s) => s.area_m2(),
+            AreaShape::Disk(s) => s.area_m2(),
+            AreaShape::Rectangle(s) => s.area_m2(),
+            AreaShape::Mesh(s) => s.area_m2(),
+        }
+    }
+}
+
+/// A shape emitting radiance L(λ).
+#[derive(Clone, Debug, PartialEq)]
+pub struct AreaLight {
+    pub shape: AreaShape,
+    /// L(λ), W·m⁻²·sr⁻¹·nm⁻¹ (absolute).
+    pub radiance: Spectrum,
+    /// Emits from both sides instead of only the side of the geometric normal.
+    pub two_sided: bool,
+}
+
+impl AreaLight {
+    /// Whether a surface point of normal `n` emits in the unit direction `wo`.
+    #[inline]
+    fn emits_towards(&self, n: Vec3A, wo: Vec3A) -> bool {
+        let cos = n.dot(wo);
+        if self.two_sided {
+            cos != 0.0
+        } else {
+            cos > 0.0
+        }
+    }
+
+    #[inline]
+    pub fn sample_li(
+        &self,
+        ctx: &LightSampleContext,
+        u: Vec2,
+        wavelengths: &SampledWavelengths,
+    ) -> Option<LightSample> {
+        let s = self.shape.sample(ctx.p, u)?;
+        let to = s.p - ctx.p;
+        let d = to.length();
+        if !(d > 0.0 && d.is_finite() && s.pdf > 0.0 && s.pdf.is_finite()) {
+            return None;
+        }
+        let wi = to / d;
+        if !self.emits_towards(s.n, -wi) {
+            return None;
+        }
+        Some(LightSample {
+            wi,
+            radiance: self.radiance.eval(wavelengths),
+            pdf: s.pdf,
+            p_light: s.p,
+            distance_m: d,
+            delta: false,
+        })
+    }
+
+    #[inline]
+    pub fn pdf_li(&self, ctx: &LightSampleContext, wi: Vec3A, hit: Option<&LightHit>) -> f32 {
+        match hit {
+            Some(hit) if self.emits_towards(hit.n, -wi) => self.shape.pdf(ctx.p, hit),
+            _ => 0.0,
+        }
+    }
+
+    #[inline]
+    pub fn emitted_radiance(
+        &self,
+        hit: &LightHit,
+        wo: Vec3A,
+        wavelengths: &SampledWavelengths,
+    ) -> SampledSpectrum {
+        if self.emits_towards(hit.n, wo) {
+            self.radiance.eval(wavelengths)
+        } else {
+            SampledSpectrum::splat(0.0)
+        }
+    }
+
+    /// Number of emitting sides (1, or 2 when two-sided).
+    pub fn sides(&self) -> f64 {
+        if self.two_sided {
+            2.0
+        } else {
+            1.0
+        }
+    }
+
+    /// Φ = π A · sides · ∫ L dλ (Lambertian emission), W.
+    pub fn power_w(&self) -> f64 {
+        std::f64::consts::PI * self.shape.area_m2() * self.sides() * integrate_nm(&self.radiance)
+    }
+}
+
+/// For a shape in its local XY plane placed by `to_world`: the world unit normal (the
+/// image of +Z under the inverse transpose, as hits report it) and the factor by which
+/// areas grow, |M x̂ × M ŷ| (the affine map sends a uniform density on the plane to a
+/// uniform density on its image).
+pub(crate) fn plane_normal_and_area_scale(to_world: &prism_geometry::Transform) -> (Vec3A, f32) {
+    let normal = to_world.normal(Vec3A::Z).normalize_or_zero();
+    let scale = to_world
+        .vector(Vec3A::X)
+        .cross(to_world.vector(Vec3A::Y))
+        .length();
+    (normal, scale)
+}
+
+#[cfg(test)]
+mod tests;
