@@ -51,16 +51,18 @@ fn cornell_box_matches_mitsuba_within_one_percent_per_channel() {
     let mut diffs = Vec::new();
     for by in 0..film.height as usize / block {
         for bx in 0..w / block {
-            let (mut sa, mut sb) = (0.0, 0.0);
+            let (mut sa, mut sb, mut emitter) = (0.0, 0.0, false);
             for y in by * block..(by + 1) * block {
                 for x in bx * block..(bx + 1) * block {
                     let i = y * w + x;
                     sa += ours[i].iter().sum::<f64>();
                     sb += reference[i].iter().sum::<f64>();
+                    // Any pixel brighter than every wall sees the emitter (or its edge,
+                    // where 64 spp of a 0/1 coverage are far noisier than the walls).
+                    emitter |= reference[i].iter().sum::<f64>() > 3.0;
                 }
             }
-            // The light occupies the top-centre blocks; skip blocks brighter than any wall.
-            if sb / (block * block) as f64 > 3.0 {
+            if emitter {
                 continue;
             }
             diffs.push((sa - sb) / sb);

@@ -103,7 +103,7 @@ impl RenderPlan {
         let lights = scene.lights.lights();
         let delta_lights = lights.iter().filter(|l| l.is_delta()).count();
         let hittable_lights = lights.len() - delta_lights;
-        let env_lights = lights.iter().filter(|l| l.is_infinite()).count();
+        let env_lights = scene.lights.infinite_lights().len();
 
         match &scene.integrator {
             Integrator::Path(p) => {
