@@ -17,6 +17,7 @@ pub mod integrator;
 pub mod light;
 pub mod material;
 pub mod plan;
+pub mod probe;
 pub mod sampler;
 pub mod sampling;
 pub mod scene_build;

@@ -130,7 +130,7 @@ impl RenderPlan {
                 );
                 let names: Vec<String> = dispersive
                     .iter()
-                    .map(|&i| format!("material {i}"))
+                    .map(|&i| format!("`{}`", scene.material_names[i]))
                     .collect();
                 choose(
                     "dispersion",
@@ -141,7 +141,7 @@ impl RenderPlan {
                             .into()
                     } else {
                         format!(
-                            "{} refract with a wavelength-dependent IOR: paths that meet them \
+                            "{} refract(s) with a wavelength-dependent IOR: paths that meet it \
                              keep only the hero wavelength",
                             names.join(", ")
                         )

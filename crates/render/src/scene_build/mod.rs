@@ -42,6 +42,8 @@ pub struct RenderScene {
     pub seed: u64,
     /// Albedo (linear Rec.709) per scene material, then one for the default material.
     pub albedo_rgb: Vec<[f32; 3]>,
+    /// Material names in `materials` order, then `default` (for messages and the plan).
+    pub material_names: Vec<String>,
     /// Runtime materials indexed by `material_id` (the default material last).
     pub materials: Vec<Material>,
     pub lights: LightSet,
@@ -84,6 +86,12 @@ impl RenderScene {
             spp: scene.film.spp,
             seed: scene.film.seed,
             albedo_rgb,
+            material_names: scene
+                .materials
+                .iter()
+                .map(|m| m.name.clone())
+                .chain(std::iter::once("default".to_string()))
+                .collect(),
             materials,
             lights,
             has_masks,
