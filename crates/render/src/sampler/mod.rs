@@ -12,6 +12,10 @@
 //!   `get_1d` a stratified set of 2^m points, for every m; values of different calls (e.g.
 //!   the x of one `get_2d` and the x of the next) are decorrelated by the hash, not
 //!   stratified jointly. See `sobol.rs`.
+//!   Dimensions from `SOBOL_DIMENSIONS` on (deep path vertices) are independent hashes of
+//!   (seed, pixel, sample index, dimension): stratification matters most for the first
+//!   dimensions (pixel, lens, wavelength, the first bounces) and a scrambled Sobol value
+//!   costs about four hashes, so the tail of a long path is not worth it.
 //! - `Independent`: every value an independent hash (SplitMix64 of the inputs), uniform
 //!   and uncorrelated; the reference for tests and convergence studies.
 //!
@@ -84,7 +88,19 @@ impl PixelSampler {
     }
 }
 
+/// Dimensions drawn from Sobol points per camera sample: the path tracer's filter 2, lens
+/// 2, wavelength 1 and 8 per vertex for its first three vertices. Later dimensions are
+/// independent.
+pub const SOBOL_DIMENSIONS: u32 = 5 + 3 * 8;
+
 impl SampleStream {
+    /// Independent value for dimensions past `SOBOL_DIMENSIONS` of a Sobol stream.
+    #[inline(always)]
+    fn sobol_tail(&self) -> u32 {
+        let sample_key = independent::sample_key(self.key, self.index_reversed.reverse_bits());
+        independent::value(sample_key, self.dimension)
+    }
+
     /// The hash of (seed, pixel, dimension) that scrambles one Sobol call.
     #[inline(always)]
     fn dimension_hash(&self) -> u64 {
@@ -95,6 +111,7 @@ impl SampleStream {
     #[inline]
     pub fn get_1d(&mut self) -> f32 {
         let bits = match self.kind {
+            SamplerKind::Sobol if self.dimension >= SOBOL_DIMENSIONS => self.sobol_tail(),
             SamplerKind::Sobol => {
                 let h = self.dimension_hash();
                 let index = sobol::shuffle_reversed_index(self.index_reversed, h as u32);
@@ -110,7 +127,7 @@ impl SampleStream {
     #[inline]
     pub fn get_2d(&mut self) -> Vec2 {
         match self.kind {
-            SamplerKind::Sobol => {
+            SamplerKind::Sobol if self.dimension + 1 < SOBOL_DIMENSIONS => {
                 let h = self.dimension_hash();
                 let index = sobol::shuffle_reversed_index(self.index_reversed, h as u32);
                 let seed_y = (mix64(h) >> 32) as u32;
@@ -120,7 +137,7 @@ impl SampleStream {
                     hash::u32_to_unit_f32(sobol::scrambled_dimension_1(index, seed_y)),
                 )
             }
-            SamplerKind::Independent => {
+            _ => {
                 let x = self.get_1d();
                 Vec2::new(x, self.get_1d())
             }
