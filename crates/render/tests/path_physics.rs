@@ -68,7 +68,15 @@ fn white_furnace_convex_sphere_in_a_uniform_sky_reflects_r_times_l() {
       "shapes": [{"type": "sphere", "radius_m": 1, "material": "white"}],
       "lights": [{"type": "sky", "spectrum": 1.0, "scale": 1.0}]
     }"#;
-    let (image, stats) = render_json(json, 256, 3);
+    let description = parse_scene_str(json, "test.json").expect("test scene parses");
+    let scene = RenderScene::build(&description, None).expect("test scene builds");
+    let settings = RenderSettings {
+        spp: 256,
+        seed: 3,
+        spectral_bins: Some(prism_render::SpectralBins::new(10).unwrap()),
+        ..RenderSettings::default()
+    };
+    let (image, stats) = render(&scene, &settings, &|_| {});
     assert_eq!(stats.non_finite_samples, 0);
     let depth = image.aov("depth.Z").expect("depth layer").values.clone();
     let (mut on, mut on_expected, mut off, mut off_expected) = (vec![], vec![], vec![], vec![]);
@@ -86,6 +94,19 @@ fn white_furnace_convex_sphere_in_a_uniform_sky_reflects_r_times_l() {
     assert!(on.len() > 100 && off.len() > 50);
     assert_unbiased("furnace sphere", &on, &on_expected, 0.05);
     assert_unbiased("furnace background", &off, &off_expected, 0.05);
+    // At every wavelength: each of 10 spectral bins (47 nm wide) over the sphere's pixels.
+    let bins = image.spectral.as_ref().expect("spectral bins");
+    for (b, plane) in bins.planes.iter().enumerate() {
+        let values: Vec<f64> = depth
+            .iter()
+            .zip(plane)
+            .filter(|(d, _)| d.is_finite() && **d < 4.5)
+            .map(|(_, &v)| f64::from(v))
+            .collect();
+        let expected = vec![0.8; values.len()];
+        let label = format!("furnace sphere, bin at {:.0} nm", bins.centres_nm[b]);
+        assert_unbiased(&label, &values, &expected, 0.1);
+    }
 }
 
 #[test]
