@@ -1,5 +1,7 @@
 //! prism-render: cameras, samplers, film, scene building (description → geometry, camera,
-//! film) and the diagnostic integrators; BSDFs, lights, media and the path tracer follow.
+//! film, materials, lights), BSDFs, emitters, the render plan, the spectral path tracer and
+//! the diagnostic integrators, and the `ShadingProbe` the bandwidth predictor uses. Media
+//! follow.
 //!
 //! Conventions (DESIGN.md "Units and conventions"): metres, radians, right-handed with Y up.
 //! Camera space looks down −Z with +X right and +Y up (`prism_geometry::Transform::look_at`).
