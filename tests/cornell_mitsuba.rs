@@ -19,9 +19,15 @@ fn cornell_box_matches_mitsuba_within_one_percent_per_channel() {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
     let description = prism_scene::load_scene(root.join("scenes/cornell-box.json")).unwrap();
     let scene = RenderScene::build(&description, None).unwrap();
+    // The scene's sampler (independent, as Mitsuba's) and its splatting film.
+    let sampler = match description.integrator {
+        prism_scene::Integrator::Path { sampler, .. } => sampler,
+        _ => unreachable!("the Cornell box uses the path tracer"),
+    };
     let settings = RenderSettings {
         spp: 64,
         seed: 1,
+        sampler,
         ..RenderSettings::default()
     };
     let (film, stats) = render(&scene, &settings, &|_| {});

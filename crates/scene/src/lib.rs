@@ -19,7 +19,7 @@ pub mod transform;
 
 pub use camera::{Camera, CameraKind, FisheyeFit, FisheyeProjection, FovAxis};
 pub use error::{JsonPath, PathSegment, Position, SceneError};
-pub use film::{Aov, Film, PixelFilter};
+pub use film::{Aov, Film, PixelFilter, Reconstruction};
 pub use integrator::{Integrator, MisHeuristic, SamplerKind};
 pub use light::{Light, LightKind, Strength};
 pub use material::{ConductorOptics, Ior, Material, MaterialKind, Microfacet, Roughness};

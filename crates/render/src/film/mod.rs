@@ -83,6 +83,8 @@ pub struct Film {
     spectral_bins: Option<SpectralBins>,
     /// Σ w · L̂_b per pixel and bin, pixel-major; empty without spectral bins.
     spectral: Vec<f64>,
+    /// Reconstruct by splatting (see `with_splatting`).
+    splat: bool,
 }
 
 impl Film {
@@ -113,6 +115,7 @@ impl Film {
             },
             spectral_bins: None,
             spectral: Vec::new(),
+            splat: false,
         })
     }
 
@@ -198,18 +201,48 @@ impl Film {
                 .min(self.resolution)
                 .max(bounds.min.min(self.resolution)),
         };
-        FilmTile::new(
+        let mut tile = FilmTile::new(
             b,
             self.aov_selection,
             self.spectral_bins,
             Arc::clone(&self.filter_sampler),
-        )
+        );
+        if self.splat {
+            tile.splat = Some(tile::SplatBuffer::new(
+                b,
+                self.resolution,
+                self.filter_sampler.filter().radius_px(),
+            ));
+        }
+        tile
+    }
+
+    /// The same film reconstructing by splatting (`true`: every sample reaches every pixel
+    /// within the filter radius, Mitsuba 3's `ImageBlock`) or by filter importance sampling
+    /// (`false`, the default of `Film::new`; pbrt-v4 §8.8).
+    pub fn with_splatting(mut self, splat: bool) -> Self {
+        self.splat = splat;
+        self
+    }
+
+    /// True when the film splats.
+    pub fn splats(&self) -> bool {
+        self.splat
     }
 
     /// Adds a tile's sums into the film. Merging tiles in any fixed order gives the same
     /// result; tiles of one pass never overlap, so within a pass the order does not matter
     /// at all.
     pub fn merge_tile(&mut self, tile: &FilmTile) {
+        if let Some(buffer) = &tile.splat {
+            let width = self.resolution.x as usize;
+            for (k, pixel) in buffer.bounds.pixels().enumerate() {
+                let i = pixel.y as usize * width + pixel.x as usize;
+                let (xyz, w) = buffer.sums[k];
+                self.pixels[i].xyz_sum += xyz;
+                self.pixels[i].weight_sum += w;
+            }
+        }
         let b = tile.bounds();
         for (k, pixel) in b.pixels().enumerate() {
             let i = pixel.y as usize * self.resolution.x as usize + pixel.x as usize;
@@ -342,8 +375,8 @@ impl Film {
                         .iter()
                         .zip(self.spectral.chunks_exact(n))
                         .map(|(p, sums)| {
-                            if p.weight_sum != 0.0 {
-                                (sums[b] / p.weight_sum) as f32
+                            if p.own_weight_sum != 0.0 {
+                                (sums[b] / p.own_weight_sum) as f32
                             } else {
                                 0.0
                             }

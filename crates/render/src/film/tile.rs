@@ -61,6 +61,9 @@ pub(crate) struct PixelAccum {
     pub weight_sum: f64,
     /// Number of samples added.
     pub sample_count: u32,
+    /// Σ wᵢ of the pixel's own samples (equals `weight_sum` unless the film splats); the
+    /// spectral bins are normalised by it.
+    pub own_weight_sum: f64,
 }
 
 /// AOV sums of one pixel (plain sample means, not filter-weighted, so negative filter
@@ -80,6 +83,7 @@ impl PixelAccum {
         self.xyz_sum += other.xyz_sum;
         self.weight_sum += other.weight_sum;
         self.sample_count += other.sample_count;
+        self.own_weight_sum += other.own_weight_sum;
     }
 }
 
@@ -90,6 +94,60 @@ impl AovAccum {
         self.normal_sum += other.normal_sum;
         self.albedo_sum += other.albedo_sum;
         self.illumination_sum += other.illumination_sum;
+    }
+}
+
+/// Splatting (Mitsuba 3's `ImageBlock`): a tile's samples also reach pixels up to the
+/// filter radius outside it, so it keeps Σ f·XYZ and Σ f over its bounds grown by the
+/// radius (clipped to the film); `Film::merge_tile` adds them in a fixed order.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct SplatBuffer {
+    pub bounds: TileBounds,
+    pub sums: Vec<(DVec3, f64)>,
+    pub radius_px: f32,
+}
+
+impl SplatBuffer {
+    pub fn new(tile: TileBounds, film_size: UVec2, radius_px: f32) -> Self {
+        let pad = radius_px.ceil() as u32;
+        let bounds = TileBounds {
+            min: tile.min.saturating_sub(UVec2::splat(pad)),
+            max: (tile.max + UVec2::splat(pad)).min(film_size),
+        };
+        Self {
+            bounds,
+            sums: vec![(DVec3::ZERO, 0.0); bounds.pixel_count()],
+            radius_px,
+        }
+    }
+
+    /// Adds `xyz` at film point `p` to every pixel whose centre is within the radius.
+    #[inline]
+    pub fn splat(&mut self, p: Vec2, xyz: DVec3, filter: &super::Filter) {
+        let r = self.radius_px;
+        let lo = (p - Vec2::splat(0.5 + r))
+            .ceil()
+            .max(self.bounds.min.as_vec2());
+        let hi = (p - Vec2::splat(0.5) + Vec2::splat(r))
+            .floor()
+            .min(self.bounds.max.as_vec2() - Vec2::ONE);
+        if lo.x > hi.x || lo.y > hi.y {
+            return;
+        }
+        let width = self.bounds.size().x as usize;
+        for y in lo.y as u32..=hi.y as u32 {
+            for x in lo.x as u32..=hi.x as u32 {
+                let d = Vec2::new(x as f32 + 0.5, y as f32 + 0.5) - p;
+                let w = filter.eval(d);
+                if w == 0.0 {
+                    continue;
+                }
+                let i = (y - self.bounds.min.y) as usize * width + (x - self.bounds.min.x) as usize;
+                let s = &mut self.sums[i];
+                s.0 += f64::from(w) * xyz;
+                s.1 += f64::from(w);
+            }
+        }
     }
 }
 
@@ -107,6 +165,9 @@ pub struct FilmTile {
     /// Whether `add_illumination` records anything.
     record_illumination: bool,
     filter_sampler: Arc<FilterSampler>,
+    /// `Some` when the film splats (then `sample_film_point` jitters within the pixel and
+    /// colour goes here instead of into the own pixel's sums).
+    pub(crate) splat: Option<SplatBuffer>,
 }
 
 impl FilmTile {
@@ -129,6 +190,7 @@ impl FilmTile {
             spectral_bins,
             record_illumination: aov_selection.illumination,
             filter_sampler,
+            splat: None,
         }
     }
 
@@ -141,6 +203,11 @@ impl FilmTile {
     /// weight to pass to `add_sample` (see `FilterSampler`).
     #[inline]
     pub fn sample_film_point(&self, pixel: UVec2, u: Vec2) -> (Vec2, f32) {
+        if self.splat.is_some() {
+            // Splatting: a uniform position in the pixel, weight 1 (the filter weights are
+            // applied per receiving pixel).
+            return (pixel.as_vec2() + u, 1.0);
+        }
         self.filter_sampler.sample_film_point(pixel, u)
     }
 
@@ -242,10 +309,91 @@ impl FilmTile {
         } else {
             0.0
         };
+        let centre = pixel.as_vec2() + Vec2::splat(0.5);
+        self.accumulate(i, centre, xyz, w, aov)
+    }
+
+    /// `add_sample` for a sample at `film_point` (px): a splatting film spreads it over the
+    /// pixels within the filter radius; otherwise it is `add_sample`.
+    #[inline]
+    pub fn add_sample_at(
+        &mut self,
+        pixel: UVec2,
+        film_point: Vec2,
+        radiance: SampledSpectrum,
+        wavelengths: &SampledWavelengths,
+        filter_weight: f32,
+        aov: Option<&SurfaceAov>,
+    ) -> bool {
+        if self.splat.is_none() {
+            return self.add_sample(pixel, radiance, wavelengths, filter_weight, aov);
+        }
+        let Some(i) = self.index(pixel) else {
+            debug_assert!(false, "pixel {pixel} outside tile {:?}", self.bounds);
+            return false;
+        };
+        let finite = !radiance.has_non_finite();
+        let xyz = if finite {
+            xyz_of_sample(radiance, wavelengths)
+        } else {
+            DVec3::ZERO
+        };
+        if let (Some(bins), true) = (self.spectral_bins, finite) {
+            let n = bins.count() as usize;
+            bins.accumulate(
+                &mut self.spectral[i * n..(i + 1) * n],
+                radiance,
+                wavelengths,
+                1.0,
+            );
+        }
+        self.accumulate(i, film_point, xyz, 1.0, aov)
+    }
+
+    /// `add_sample_xyz` for a sample at `film_point` (px) (see `add_sample_at`).
+    #[inline]
+    pub fn add_sample_xyz_at(
+        &mut self,
+        pixel: UVec2,
+        film_point: Vec2,
+        xyz: DVec3,
+        filter_weight: f32,
+        aov: Option<&SurfaceAov>,
+    ) -> bool {
+        let Some(i) = self.index(pixel) else {
+            debug_assert!(false, "pixel {pixel} outside tile {:?}", self.bounds);
+            return false;
+        };
+        let xyz = if xyz.is_finite() { xyz } else { DVec3::ZERO };
+        let w = if filter_weight.is_finite() {
+            f64::from(filter_weight)
+        } else {
+            0.0
+        };
+        self.accumulate(i, film_point, xyz, w, aov)
+    }
+
+    /// Own-pixel counts and AOVs, and the colour: into the own pixel with weight `w`, or
+    /// splatted from `film_point` (then `w` only counts for the spectral bins' normaliser).
+    #[inline]
+    fn accumulate(
+        &mut self,
+        i: usize,
+        film_point: Vec2,
+        xyz: DVec3,
+        w: f64,
+        aov: Option<&SurfaceAov>,
+    ) -> bool {
         let p = &mut self.pixels[i];
-        p.xyz_sum += w * xyz;
-        p.weight_sum += w;
         p.sample_count += 1;
+        p.own_weight_sum += w;
+        match &mut self.splat {
+            Some(buffer) => buffer.splat(film_point, xyz, self.filter_sampler.filter()),
+            None => {
+                p.xyz_sum += w * xyz;
+                p.weight_sum += w;
+            }
+        }
         if let (Some(a), Some(hit)) = (self.aovs.get_mut(i), aov) {
             a.hit_count += 1;
             a.depth_sum += f64::from(hit.depth_m);

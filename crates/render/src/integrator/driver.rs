@@ -154,7 +154,14 @@ pub fn render_plan(
                         if radiance.has_non_finite() {
                             non_finite += 1;
                         }
-                        tile.add_sample(pixel, radiance, &wavelengths, weight, aov.as_ref());
+                        tile.add_sample_at(
+                            pixel,
+                            film_point,
+                            radiance,
+                            &wavelengths,
+                            weight,
+                            aov.as_ref(),
+                        );
                     }
                     diagnostic => {
                         let (xyz, aov) = match scene.camera.generate_ray(film_point, lens) {
@@ -185,7 +192,7 @@ pub fn render_plan(
                         if !xyz.is_finite() {
                             non_finite += 1;
                         }
-                        tile.add_sample_xyz(pixel, xyz, weight, aov.as_ref());
+                        tile.add_sample_xyz_at(pixel, film_point, xyz, weight, aov.as_ref());
                     }
                 }
                 samples += 1;

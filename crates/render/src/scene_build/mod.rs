@@ -47,6 +47,8 @@ pub struct RenderScene {
     /// Runtime materials indexed by `material_id` (the default material last).
     pub materials: Vec<Material>,
     pub lights: LightSet,
+    /// The film splats samples over the filter radius (`film.reconstruction`).
+    pub splat: bool,
     /// Some material has an opacity mask: shadow rays must look through masked surfaces.
     pub has_masks: bool,
 }
@@ -95,6 +97,7 @@ impl RenderScene {
             materials,
             lights,
             has_masks,
+            splat: scene.film.reconstruction == prism_scene::Reconstruction::Splat,
         })
     }
 
@@ -103,6 +106,7 @@ impl RenderScene {
         // The resolution was checked when the camera frame was built.
         Film::new(self.resolution, self.filter, AovSelection::SURFACE)
             .expect("resolution checked by CameraFrame::new")
+            .with_splatting(self.splat)
     }
 
     /// The runtime material of a hit's `material_id` (the default material for ids
