@@ -134,18 +134,55 @@ impl SplatBuffer {
         if lo.x > hi.x || lo.y > hi.y {
             return;
         }
+        // Separable filters (f = f₁(x) f₁(y)): one profile evaluation per row and column.
+        const MAX_TAPS: usize = 16;
+        let (x0, x1, y0, y1) = (lo.x as u32, hi.x as u32, lo.y as u32, hi.y as u32);
+        if (x1 - x0) as usize >= MAX_TAPS || (y1 - y0) as usize >= MAX_TAPS {
+            return self.splat_wide(p, xyz, filter, (x0, x1, y0, y1));
+        }
+        let mut wx = [0.0f32; MAX_TAPS];
+        for (k, x) in (x0..=x1).enumerate() {
+            wx[k] = filter.eval_1d(x as f32 + 0.5 - p.x);
+        }
         let width = self.bounds.size().x as usize;
-        for y in lo.y as u32..=hi.y as u32 {
-            for x in lo.x as u32..=hi.x as u32 {
+        for y in y0..=y1 {
+            let wy = filter.eval_1d(y as f32 + 0.5 - p.y);
+            if wy == 0.0 {
+                continue;
+            }
+            let row = (y - self.bounds.min.y) as usize * width;
+            for (k, x) in (x0..=x1).enumerate() {
+                let w = f64::from(wx[k] * wy);
+                if w == 0.0 {
+                    continue;
+                }
+                let s = &mut self.sums[row + (x - self.bounds.min.x) as usize];
+                s.0 += w * xyz;
+                s.1 += w;
+            }
+        }
+    }
+
+    /// `splat` for filters wider than 16 taps (not reached by the shipped filters' radii).
+    fn splat_wide(
+        &mut self,
+        p: Vec2,
+        xyz: DVec3,
+        filter: &super::Filter,
+        (x0, x1, y0, y1): (u32, u32, u32, u32),
+    ) {
+        let width = self.bounds.size().x as usize;
+        for y in y0..=y1 {
+            for x in x0..=x1 {
                 let d = Vec2::new(x as f32 + 0.5, y as f32 + 0.5) - p;
-                let w = filter.eval(d);
+                let w = f64::from(filter.eval(d));
                 if w == 0.0 {
                     continue;
                 }
                 let i = (y - self.bounds.min.y) as usize * width + (x - self.bounds.min.x) as usize;
                 let s = &mut self.sums[i];
-                s.0 += f64::from(w) * xyz;
-                s.1 += f64::from(w);
+                s.0 += w * xyz;
+                s.1 += w;
             }
         }
     }
