@@ -8,6 +8,9 @@
 //!
 //! Prints one JSON object. `bench-post --write-input PATH [WIDTH HEIGHT]` only writes the
 //! synthetic image as a float EXR (for peers: tools/bench-tonemap-pfstmo.sh).
+//! `--ops NAME,NAME` limits the run to those operators; `--no-file` skips `file_ms`
+//! (for profiling one operator's compute); `--input PATH.exr` times `file_ms` on that
+//! file instead of writing the synthetic image first (for profiling the file pipeline).
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -46,7 +49,7 @@ fn synthetic(w: usize, h: usize) -> Image {
 
 fn usage() -> ! {
     eprintln!(
-        "usage: bench-post [WIDTH HEIGHT RUNS]\n       bench-post --write-input PATH.exr [WIDTH HEIGHT]"
+        "usage: bench-post [WIDTH HEIGHT RUNS] [--ops NAME,NAME] [--no-file] [--input PATH.exr]\n       bench-post --write-input PATH.exr [WIDTH HEIGHT]"
     );
     std::process::exit(2)
 }
@@ -69,7 +72,27 @@ fn main() {
         }
         return;
     }
-    let n = numbers(&args);
+    let mut only: Option<Vec<ToneOperator>> = None;
+    let mut with_file = true;
+    let mut given_input: Option<PathBuf> = None;
+    let mut rest = Vec::new();
+    let mut it = args.iter();
+    while let Some(a) = it.next() {
+        match a.as_str() {
+            "--ops" => {
+                let list = it.next().unwrap_or_else(|| usage());
+                only = Some(
+                    list.split(',')
+                        .map(|n| ToneOperator::from_name(n).unwrap_or_else(|_| usage()))
+                        .collect(),
+                );
+            }
+            "--no-file" => with_file = false,
+            "--input" => given_input = Some(PathBuf::from(it.next().unwrap_or_else(|| usage()))),
+            _ => rest.push(a.clone()),
+        }
+    }
+    let n = numbers(&rest);
     let (w, h, runs) = (
         *n.first().unwrap_or(&3840),
         *n.get(1).unwrap_or(&2160),
@@ -89,21 +112,30 @@ fn main() {
 
     let dir = std::env::temp_dir().join(format!("bench-post-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let input = dir.join("in.exr");
-    prism_post::io::write_image(&input, &image).unwrap();
+    let input = given_input.unwrap_or_else(|| dir.join("in.exr"));
+    if with_file && !input.exists() {
+        prism_post::io::write_image(&input, &image).unwrap();
+    }
     let file_runs = runs.clamp(1, 3);
 
     let mut operators = serde_json::Map::new();
     // Output buffer reused across runs and operators (ToneOperator::apply_into).
     let mut buffer = copy;
     for op in ToneOperator::ALL {
+        if only.as_ref().is_some_and(|o| !o.contains(&op)) {
+            continue;
+        }
         let params = ToneParams::default();
         let compute_ms = median_ms(runs, || {
             let b = std::mem::take(&mut buffer);
             let result = op.apply_into(&image, &params, b).unwrap();
             buffer = std::hint::black_box(result).image.into_pixels();
         });
-        let (file_ms, stages) = file_pipeline(&input, &dir.join("out.png"), op, file_runs);
+        let (file_ms, stages) = if with_file {
+            file_pipeline(&input, &dir.join("out.png"), op, file_runs)
+        } else {
+            (f64::NAN, serde_json::Value::Null)
+        };
         operators.insert(
             op.name().to_string(),
             serde_json::json!({
