@@ -17,7 +17,7 @@
 
 use super::bilateral_grid::bilateral_grid;
 use super::fast_math;
-use super::pixels::{luminance_plane, map_luminance_indexed};
+use super::pixels::{luminance_plane, map_luminance, LuminanceCurve};
 use super::{Context, OperatorInfo, Output, ParamSpec};
 use rayon::prelude::*;
 
@@ -52,6 +52,25 @@ pub(crate) static INFO: OperatorInfo = OperatorInfo {
     ],
 };
 
+/// L_d = L_w · 10^{(γ − 1) B − γ max B}, as exp(g1 B + offset).
+struct Curve<'a> {
+    g1: f32,
+    offset: f32,
+    base: &'a [f32],
+}
+
+impl LuminanceCurve for Curve<'_> {
+    #[inline(always)]
+    fn ratio(&self, start: usize, l: &mut [f32]) {
+        // L_d / L_w = 10^{(γ − 1) B − γ max B}.
+        let base = &self.base[start..start + l.len()];
+        let (g1, offset) = (self.g1, self.offset);
+        for (v, b) in l.iter_mut().zip(base) {
+            *v = fast_math::exp(g1 * b + offset);
+        }
+    }
+}
+
 pub(crate) fn apply(ctx: &Context) -> Output {
     let (w, h) = (ctx.image.width(), ctx.image.height());
     let contrast = ctx.value("base_contrast");
@@ -78,9 +97,12 @@ pub(crate) fn apply(ctx: &Context) -> Output {
         (gamma - 1.0) as f32 * std::f32::consts::LN_10,
         -(gamma * base_max as f64) as f32 * std::f32::consts::LN_10,
     );
-    let mapped = map_luminance_indexed(ctx, ctx.exposure, ctx.weights, |i, l| {
-        l * fast_math::exp(g1 * base[i] + offset)
-    });
+    let curve = Curve {
+        g1,
+        offset,
+        base: &base,
+    };
+    let mapped = map_luminance(ctx, ctx.exposure, ctx.weights, &curve);
     Output {
         mapped,
         values: vec![

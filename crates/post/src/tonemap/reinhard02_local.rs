@@ -20,7 +20,7 @@
 use rayon::prelude::*;
 
 use super::gaussian::gaussian_blur;
-use super::pixels::{luminance_plane, luminance_stats, map_luminance_indexed, CHUNK};
+use super::pixels::{luminance_plane, luminance_stats, map_luminance, LuminanceCurve, CHUNK};
 use super::{Context, OperatorInfo, Output, ParamSpec};
 
 pub(crate) static INFO: OperatorInfo = OperatorInfo {
@@ -66,6 +66,24 @@ pub const SCALE_RATIO: f32 = 1.6;
 /// σ in pixels of the centre Gaussian R_1 at scale s: α_1 s / √2 = s / 4 (eq. 5).
 pub fn centre_sigma_px(s: f32) -> f32 {
     s / 4.0
+}
+
+/// Eq. 9 with eq. 2: L_d = a L_w / L_avg / (1 + V_1(s_m)).
+struct Curve<'a> {
+    key_scale: f32,
+    selected: &'a [f32],
+}
+
+impl LuminanceCurve for Curve<'_> {
+    #[inline(always)]
+    fn ratio(&self, start: usize, l: &mut [f32]) {
+        // L_d / L_w = (a / L_avg) / (1 + V_1(s_m)).
+        let selected = &self.selected[start..start + l.len()];
+        let key_scale = self.key_scale;
+        for (v, s) in l.iter_mut().zip(selected) {
+            *v = key_scale / (1.0 + s);
+        }
+    }
 }
 
 pub(crate) fn apply(ctx: &Context) -> Output {
@@ -127,9 +145,11 @@ pub(crate) fn apply(ctx: &Context) -> Output {
         s *= SCALE_RATIO;
     }
     drop((v1, v2, scratch, active));
-    let mapped = map_luminance_indexed(ctx, ctx.exposure, ctx.weights, |i, lw| {
-        key_scale * lw / (1.0 + selected[i])
-    });
+    let curve = Curve {
+        key_scale,
+        selected: &selected,
+    };
+    let mapped = map_luminance(ctx, ctx.exposure, ctx.weights, &curve);
     Output {
         mapped,
         values: vec![
