@@ -17,7 +17,8 @@
 
 use super::bilateral_grid::bilateral_grid;
 use super::fast_math;
-use super::pixels::{luminance_plane, map_luminance, LuminanceCurve};
+use super::pixels::{luminance_plane, map_luminance, LuminanceCurve, CHUNK};
+use super::simd::avx2;
 use super::{Context, OperatorInfo, Output, ParamSpec};
 use rayon::prelude::*;
 
@@ -71,19 +72,24 @@ impl LuminanceCurve for Curve<'_> {
     }
 }
 
+/// log10 L, NaN for L = 0 (black pixels take no part in the filter).
+#[inline(always)]
+fn log10_or_nan(plane: &mut [f32]) {
+    for v in plane {
+        let log = fast_math::log2(*v) * std::f32::consts::LOG10_2;
+        *v = if *v > 0.0 { log } else { f32::NAN };
+    }
+}
+
 pub(crate) fn apply(ctx: &Context) -> Output {
     let (w, h) = (ctx.image.width(), ctx.image.height());
     let contrast = ctx.value("base_contrast");
     let sigma_space_px = (ctx.value("sigma_space") * w.max(h) as f64) as f32;
     let sigma_range = ctx.value("sigma_range") as f32;
     let mut log_l = luminance_plane(ctx.image, ctx.exposure, ctx.weights);
-    log_l.par_iter_mut().for_each(|v| {
-        *v = if *v > 0.0 {
-            fast_math::log2(*v) * std::f32::consts::LOG10_2
-        } else {
-            f32::NAN
-        };
-    });
+    log_l
+        .par_chunks_mut(CHUNK)
+        .for_each(|c| avx2!(log10_or_nan(c)));
     let (base, [base_min, base_max]) = bilateral_grid(&log_l, w, h, sigma_space_px, sigma_range);
     drop(log_l);
     let range = (base_max - base_min) as f64;
