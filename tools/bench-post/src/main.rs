@@ -2,12 +2,18 @@
 //! synthetic HDR image (default 3840×2160, 7 runs, median):
 //! - `compute_ms`: `ToneOperator::apply_into` with a reused output buffer, next to one
 //!   read+write copy pass over the same pixels into a preallocated output (the issue's
-//!   reference: global operators should take ≤ 3× that, local ones ≤ 300 ms);
+//!   reference: global operators should take ≤ 3× that, local ones ≤ 300 ms); operator
+//!   runs alternate with copy passes, and `ratio_to_copy` divides the operator's median by
+//!   the median of its own interleaved copy passes (`copy_pass_ms` per operator; the
+//!   top-level `copy_pass_ms` is the median over all of them);
 //! - `file_ms`: the whole in-process pipeline `tonemap_file` from a float EXR to a 16-bit
 //!   PNG (read, operator, gamut clip, encode, write), with its stage breakdown.
 //!
 //! Prints one JSON object. `bench-post --write-input PATH [WIDTH HEIGHT]` only writes the
 //! synthetic image as a float EXR (for peers: tools/bench-tonemap-pfstmo.sh).
+//! `--ops NAME,NAME` limits the run to those operators; `--no-file` skips `file_ms`
+//! (for profiling one operator's compute); `--input PATH.exr` times `file_ms` on that
+//! file instead of writing the synthetic image first (for profiling the file pipeline).
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -16,16 +22,9 @@ use prism_post::{tonemap_file, Image, OperatorChoice, ToneOperator, ToneParams, 
 use prism_spectrum::rgb_space::RgbColorSpace;
 use rayon::prelude::*;
 
-fn median_ms(runs: usize, mut f: impl FnMut()) -> f64 {
-    let mut times: Vec<f64> = (0..runs)
-        .map(|_| {
-            let t = Instant::now();
-            f();
-            t.elapsed().as_secs_f64() * 1e3
-        })
-        .collect();
+fn median(mut times: Vec<f64>) -> f64 {
     times.sort_by(f64::total_cmp);
-    times[runs / 2]
+    times[times.len() / 2]
 }
 
 /// Luminance spanning 1e-3 … 1e4 over the image, with colour variation and texture; the
@@ -46,7 +45,7 @@ fn synthetic(w: usize, h: usize) -> Image {
 
 fn usage() -> ! {
     eprintln!(
-        "usage: bench-post [WIDTH HEIGHT RUNS]\n       bench-post --write-input PATH.exr [WIDTH HEIGHT]"
+        "usage: bench-post [WIDTH HEIGHT RUNS] [--ops NAME,NAME] [--no-file] [--input PATH.exr]\n       bench-post --write-input PATH.exr [WIDTH HEIGHT]"
     );
     std::process::exit(2)
 }
@@ -69,7 +68,27 @@ fn main() {
         }
         return;
     }
-    let n = numbers(&args);
+    let mut only: Option<Vec<ToneOperator>> = None;
+    let mut with_file = true;
+    let mut given_input: Option<PathBuf> = None;
+    let mut rest = Vec::new();
+    let mut it = args.iter();
+    while let Some(a) = it.next() {
+        match a.as_str() {
+            "--ops" => {
+                let list = it.next().unwrap_or_else(|| usage());
+                only = Some(
+                    list.split(',')
+                        .map(|n| ToneOperator::from_name(n).unwrap_or_else(|_| usage()))
+                        .collect(),
+                );
+            }
+            "--no-file" => with_file = false,
+            "--input" => given_input = Some(PathBuf::from(it.next().unwrap_or_else(|| usage()))),
+            _ => rest.push(a.clone()),
+        }
+    }
+    let n = numbers(&rest);
     let (w, h, runs) = (
         *n.first().unwrap_or(&3840),
         *n.get(1).unwrap_or(&2160),
@@ -80,36 +99,59 @@ fn main() {
     // Copy pass: read every pixel and write it to a preallocated output, in parallel,
     // no allocation (the reference for "≤ 3× a copy pass").
     let mut copy = vec![[0.0f32; 3]; w * h];
-    let copy_ms = median_ms(runs, || {
+    let mut copy_pass = || {
+        let t = Instant::now();
         copy.par_chunks_mut(4096)
             .zip(image.pixels().par_chunks(4096))
             .for_each(|(o, i)| o.copy_from_slice(i));
         std::hint::black_box(&copy);
-    });
+        t.elapsed().as_secs_f64() * 1e3
+    };
+    let mut all_copies: Vec<f64> = (0..runs).map(|_| copy_pass()).collect();
 
     let dir = std::env::temp_dir().join(format!("bench-post-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let input = dir.join("in.exr");
-    prism_post::io::write_image(&input, &image).unwrap();
+    let input = given_input.unwrap_or_else(|| dir.join("in.exr"));
+    if with_file && !input.exists() {
+        prism_post::io::write_image(&input, &image).unwrap();
+    }
     let file_runs = runs.clamp(1, 3);
 
     let mut operators = serde_json::Map::new();
     // Output buffer reused across runs and operators (ToneOperator::apply_into).
-    let mut buffer = copy;
+    let mut buffer = vec![[0.0f32; 3]; w * h];
     for op in ToneOperator::ALL {
+        if only.as_ref().is_some_and(|o| !o.contains(&op)) {
+            continue;
+        }
         let params = ToneParams::default();
-        let compute_ms = median_ms(runs, || {
+        // Operator runs alternate with copy passes, so that the ratio compares medians
+        // taken under the same machine load (the shared machine's load drifts).
+        let mut copies = Vec::with_capacity(runs);
+        let mut times = Vec::with_capacity(runs);
+        for _ in 0..runs {
+            copies.push(copy_pass());
             let b = std::mem::take(&mut buffer);
+            let t = Instant::now();
             let result = op.apply_into(&image, &params, b).unwrap();
             buffer = std::hint::black_box(result).image.into_pixels();
-        });
-        let (file_ms, stages) = file_pipeline(&input, &dir.join("out.png"), op, file_runs);
+            times.push(t.elapsed().as_secs_f64() * 1e3);
+        }
+        let compute_ms = median(times);
+        all_copies.extend(&copies);
+        let copy_ms = median(copies);
+        let (file_ms, stages) = if with_file {
+            file_pipeline(&input, &dir.join("out.png"), op, file_runs)
+        } else {
+            (f64::NAN, serde_json::Value::Null)
+        };
         operators.insert(
             op.name().to_string(),
             serde_json::json!({
                 "local": is_local(op),
                 "compute_ms": compute_ms,
                 "ratio_to_copy": compute_ms / copy_ms,
+                "copy_pass_ms": copy_ms,
                 "file_ms": file_ms,
                 "file_stages_ms": stages,
             }),
@@ -122,7 +164,7 @@ fn main() {
         "runs": runs,
         "file_runs": file_runs,
         "threads": rayon::current_num_threads(),
-        "copy_pass_ms": copy_ms,
+        "copy_pass_ms": median(all_copies),
         "operators": operators,
     });
     println!("{}", serde_json::to_string_pretty(&out).unwrap());

@@ -149,6 +149,13 @@ pub(crate) fn sample_at(samples: &FlatSamples, i: usize) -> f32 {
 /// channels become layers split at their last `.`; a spectral EXR without RGB channels is
 /// reduced to XYZ with the CIE 1931 observer, then to linear sRGB.
 pub fn read_exr(path: &Path) -> Result<Image> {
+    if let Some(rgb) = super::exr_rgb::read_rgb_exr(path) {
+        let space = space_of(&rgb.chromaticities);
+        let mut image = Image::new(rgb.width, rgb.height, rgb.pixels, space)
+            .map_err(|e| PostError::format(path, e.to_string()))?;
+        apply_attributes(path, &mut image, &rgb.attributes)?;
+        return Ok(image);
+    }
     let data = read_exr_channels(path)?;
     let find = |n: &str| data.channels.iter().position(|(name, _)| name == n);
     let rgb = match (find("R"), find("G"), find("B"), find("Y")) {
@@ -192,18 +199,7 @@ pub fn read_exr(path: &Path) -> Result<Image> {
                 *p = [sample_at(r, i), sample_at(g, i), sample_at(b, i)];
             }
         });
-    let space = match &data.chromaticities {
-        Some(c) => color_space_from_chromaticities(
-            [
-                [c.red.0 as f64, c.red.1 as f64],
-                [c.green.0 as f64, c.green.1 as f64],
-                [c.blue.0 as f64, c.blue.1 as f64],
-            ],
-            [c.white.0 as f64, c.white.1 as f64],
-        ),
-        // OpenEXR's default chromaticities are those of ITU-R BT.709 (= sRGB).
-        None => RgbColorSpace::srgb(),
-    };
+    let space = space_of(&data.chromaticities);
     let mut image = Image::new(data.width, data.height, pixels, space)
         .map_err(|e| PostError::format(path, e.to_string()))?;
 
@@ -241,7 +237,33 @@ pub fn read_exr(path: &Path) -> Result<Image> {
             .map_err(|e| PostError::format(path, e.to_string()))?;
     }
 
-    for (name, value) in &data.attributes {
+    apply_attributes(path, &mut image, &data.attributes)?;
+    Ok(image)
+}
+
+/// The colour space of a `chromaticities` attribute; OpenEXR's default (none) is that of
+/// ITU-R BT.709 (= sRGB).
+fn space_of(chromaticities: &Option<Chromaticities>) -> RgbColorSpace {
+    match chromaticities {
+        Some(c) => color_space_from_chromaticities(
+            [
+                [c.red.0 as f64, c.red.1 as f64],
+                [c.green.0 as f64, c.green.1 as f64],
+                [c.blue.0 as f64, c.blue.1 as f64],
+            ],
+            [c.white.0 as f64, c.white.1 as f64],
+        ),
+        None => RgbColorSpace::srgb(),
+    }
+}
+
+/// `prism:cd_m2_per_unit` (checked) and text attributes as metadata.
+fn apply_attributes(
+    path: &Path,
+    image: &mut Image,
+    attributes: &BTreeMap<String, AttributeValue>,
+) -> Result<()> {
+    for (name, value) in attributes {
         match (name.as_str(), value) {
             (CD_M2_PER_UNIT_ATTRIBUTE, AttributeValue::F32(v)) => {
                 image.cd_m2_per_unit = Some(*v as f64)
@@ -267,7 +289,7 @@ pub fn read_exr(path: &Path) -> Result<Image> {
             ));
         }
     }
-    Ok(image)
+    Ok(())
 }
 
 /// `chromaticities` attribute of a colour space.

@@ -3,6 +3,7 @@
 //! over the destination only once complete, so a failed write never leaves half a file.
 
 pub mod exr;
+mod exr_rgb;
 pub mod png;
 pub mod quantise;
 pub mod rgbe;

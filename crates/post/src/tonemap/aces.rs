@@ -9,7 +9,7 @@
 use glam::{Mat3, Vec3};
 use prism_spectrum::rgb_space::RgbColorSpace;
 
-use super::pixels::map_pixels;
+use super::pixels::{map_pixels, PixelMap};
 use super::{Context, OperatorInfo, Output};
 
 pub(crate) static INFO: OperatorInfo = OperatorInfo {
@@ -42,6 +42,7 @@ pub(crate) fn from_rows(r: [[f32; 3]; 3]) -> Mat3 {
 
 /// Hill's RRTAndODTFit.
 #[allow(clippy::excessive_precision)] // the published digits, kept verbatim
+#[inline(always)]
 pub fn rrt_odt_fit(v: f32) -> f32 {
     (v * (v + 0.0245786) - 0.000090537) / (v * (0.983729 * v + 0.4329510) + 0.238081)
 }
@@ -54,17 +55,38 @@ pub(crate) fn srgb_matrices(space: &RgbColorSpace) -> (Mat3, Mat3) {
     (to, from)
 }
 
-pub(crate) fn apply(ctx: &Context) -> Output {
-    let (to_srgb, from_srgb) = srgb_matrices(&ctx.image.color_space);
-    let input = from_rows(INPUT_ROWS) * to_srgb;
-    let output = from_rows(OUTPUT_ROWS);
-    Output {
-        mapped: map_pixels(ctx, ctx.exposure, |c| {
-            let v = input * Vec3::from(c);
+/// M_in, the fit per channel, M_out, clamp, back to the image's space.
+struct Map {
+    input: Mat3,
+    output: Mat3,
+    from_srgb: Mat3,
+}
+
+impl PixelMap for Map {
+    #[inline(always)]
+    fn map(&self, _start: usize, r: &mut [f32], g: &mut [f32], b: &mut [f32]) {
+        // Locals, not fields, in the loop: the planes could alias `self` as far as the
+        // compiler knows, which would keep the loop scalar.
+        let (input, output, from_srgb) = (self.input, self.output, self.from_srgb);
+        for ((r, g), b) in r.iter_mut().zip(g.iter_mut()).zip(b.iter_mut()) {
+            let v = input * Vec3::new(*r, *g, *b);
             let f = Vec3::new(rrt_odt_fit(v.x), rrt_odt_fit(v.y), rrt_odt_fit(v.z));
             let srgb = (output * f).clamp(Vec3::ZERO, Vec3::ONE);
-            (from_srgb * srgb).to_array()
-        }),
+            let c = from_srgb * srgb;
+            (*r, *g, *b) = (c.x, c.y, c.z);
+        }
+    }
+}
+
+pub(crate) fn apply(ctx: &Context) -> Output {
+    let (to_srgb, from_srgb) = srgb_matrices(&ctx.image.color_space);
+    let map = Map {
+        input: from_rows(INPUT_ROWS) * to_srgb,
+        output: from_rows(OUTPUT_ROWS),
+        from_srgb,
+    };
+    Output {
+        mapped: map_pixels(ctx, ctx.exposure, &map),
         values: vec![],
     }
 }

@@ -11,7 +11,7 @@ use glam::{Mat3, Vec3};
 
 use super::aces::srgb_matrices;
 use super::fast_math;
-use super::pixels::map_pixels;
+use super::pixels::{map_pixels, PixelMap};
 use super::{Context, OperatorInfo, Output};
 
 pub(crate) static INFO: OperatorInfo = OperatorInfo {
@@ -52,6 +52,7 @@ const OUTSET: [f32; 9] = [
 ];
 
 /// The polynomial fit of the AgX default contrast curve on [0, 1].
+#[inline(always)]
 pub fn contrast(x: f32) -> f32 {
     let x2 = x * x;
     let x4 = x2 * x2;
@@ -60,17 +61,24 @@ pub fn contrast(x: f32) -> f32 {
 }
 
 /// Log2 encoding of one channel onto [0, 1].
+#[inline(always)]
 pub fn log_encode(v: f32) -> f32 {
     (fast_math::log2(v).clamp(EV_MIN, EV_MAX) - EV_MIN) / (EV_MAX - EV_MIN)
 }
 
-pub(crate) fn apply(ctx: &Context) -> Output {
-    let (to_srgb, from_srgb) = srgb_matrices(&ctx.image.color_space);
-    let inset = Mat3::from_cols_array(&INSET) * to_srgb;
-    let outset = Mat3::from_cols_array(&OUTSET);
-    Output {
-        mapped: map_pixels(ctx, ctx.exposure, |c| {
-            let v = inset * Vec3::from(c);
+/// Inset, log encoding, contrast curve, outset, 2.2 power, back to the image's space.
+struct Map {
+    inset: Mat3,
+    outset: Mat3,
+    from_srgb: Mat3,
+}
+
+impl PixelMap for Map {
+    #[inline(always)]
+    fn map(&self, _start: usize, r: &mut [f32], g: &mut [f32], b: &mut [f32]) {
+        let (inset, outset, from_srgb) = (self.inset, self.outset, self.from_srgb);
+        for ((r, g), b) in r.iter_mut().zip(g.iter_mut()).zip(b.iter_mut()) {
+            let v = inset * Vec3::new(*r, *g, *b);
             let s = Vec3::new(
                 contrast(log_encode(v.x)),
                 contrast(log_encode(v.y)),
@@ -82,8 +90,21 @@ pub(crate) fn apply(ctx: &Context) -> Output {
                 fast_math::powf(d.y, 2.2),
                 fast_math::powf(d.z, 2.2),
             );
-            (from_srgb * linear).to_array()
-        }),
+            let c = from_srgb * linear;
+            (*r, *g, *b) = (c.x, c.y, c.z);
+        }
+    }
+}
+
+pub(crate) fn apply(ctx: &Context) -> Output {
+    let (to_srgb, from_srgb) = srgb_matrices(&ctx.image.color_space);
+    let map = Map {
+        inset: Mat3::from_cols_array(&INSET) * to_srgb,
+        outset: Mat3::from_cols_array(&OUTSET),
+        from_srgb,
+    };
+    Output {
+        mapped: map_pixels(ctx, ctx.exposure, &map),
         values: vec![],
     }
 }

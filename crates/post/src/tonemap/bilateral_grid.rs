@@ -16,6 +16,8 @@
 
 use rayon::prelude::*;
 
+use super::simd::avx2;
+
 /// Grid nodes of padding on each side of every axis (covers the radius-2 blur and the
 /// trilinear neighbour).
 const PAD: usize = 3;
@@ -70,28 +72,34 @@ pub fn bilateral_grid(
         )
     };
 
-    // Splat (nearest node), rows in parallel into per-task grids, summed.
+    // Per column and per row, the grid coordinate and its nearest node / lower corner and
+    // weight: the same values the per-pixel expressions gave, computed once.
+    let fxs: Vec<f32> = (0..width).map(|x| coord(x, 0, lo).0).collect();
+    let fys: Vec<f32> = (0..height).map(|y| coord(0, y, lo).1).collect();
+    let nearest_x: Vec<usize> = fxs.iter().map(|fx| (fx + 0.5) as usize).collect();
+
+    // Splat (nearest node), rows in parallel into per-task grids, summed. Per row the z
+    // coordinates are computed first in a vectorisable loop (module simd), then the
+    // scatter runs.
     let grid = values
         .par_chunks(width)
         .enumerate()
         .fold(
-            || vec![[0.0f32; 2]; cells],
-            |mut g, (y, row)| {
-                for (x, v) in row.iter().enumerate() {
+            || (vec![[0.0f32; 2]; cells], vec![0.0f32; width]),
+            |(mut g, mut fz), (y, row)| {
+                avx2!(z_coordinates(row, &mut fz, lo, sr));
+                let ny = (fys[y] + 0.5) as usize;
+                for ((v, fz), nx) in row.iter().zip(&fz).zip(&nearest_x) {
                     if v.is_finite() {
-                        let (fx, fy, fz) = coord(x, y, *v);
-                        let cell = &mut g[index(
-                            (fx + 0.5) as usize,
-                            (fy + 0.5) as usize,
-                            (fz + 0.5) as usize,
-                        )];
+                        let cell = &mut g[index(*nx, ny, (fz + 0.5) as usize)];
                         cell[0] += v;
                         cell[1] += 1.0;
                     }
                 }
-                g
+                (g, fz)
             },
         )
+        .map(|(g, _)| g)
         .reduce(
             || vec![[0.0f32; 2]; cells],
             |mut a, b| {
@@ -124,46 +132,73 @@ pub fn bilateral_grid(
     }
 
     // Slice: trilinear interpolation of (Σ w I, Σ w), then divide.
+    let corner_x: Vec<(usize, [f32; 2])> = fxs
+        .iter()
+        .map(|fx| {
+            let x0 = *fx as usize;
+            let tx = fx - x0 as f32;
+            (x0, [1.0 - tx, tx])
+        })
+        .collect();
     let mut out = vec![0.0f32; values.len()];
     let range = out
         .par_chunks_mut(width)
         .zip(values.par_chunks(width))
         .enumerate()
-        .map(|(y, (o, row))| {
-            let (mut lo_b, mut hi_b) = (f32::INFINITY, f32::NEG_INFINITY);
-            for (x, (o, v)) in o.iter_mut().zip(row).enumerate() {
-                if !v.is_finite() {
-                    *o = f32::NAN;
-                    continue;
-                }
-                let (fx, fy, fz) = coord(x, y, *v);
-                let (x0, y0, z0) = (fx as usize, fy as usize, fz as usize);
-                let (tx, ty, tz) = (fx - x0 as f32, fy - y0 as f32, fz - z0 as f32);
-                let mut acc = [0.0f32; 2];
-                for (dz, wz) in [(0, 1.0 - tz), (1, tz)] {
-                    for (dy, wy) in [(0, 1.0 - ty), (1, ty)] {
-                        for (dx, wx) in [(0, 1.0 - tx), (1, tx)] {
-                            let c = grid[index(x0 + dx, y0 + dy, z0 + dz)];
-                            let w = wx * wy * wz;
-                            acc[0] += w * c[0];
-                            acc[1] += w * c[1];
+        .map_init(
+            || vec![0.0f32; width],
+            |fz, (y, (o, row))| {
+                avx2!(z_coordinates(row, fz, lo, sr));
+                let fy = fys[y];
+                let y0 = fy as usize;
+                let ty = fy - y0 as f32;
+                let wys = [(0, 1.0 - ty), (1, ty)];
+                let (mut lo_b, mut hi_b) = (f32::INFINITY, f32::NEG_INFINITY);
+                for (((o, v), fz), (x0, wxs)) in o.iter_mut().zip(row).zip(fz.iter()).zip(&corner_x)
+                {
+                    if !v.is_finite() {
+                        *o = f32::NAN;
+                        continue;
+                    }
+                    let z0 = *fz as usize;
+                    let tz = fz - z0 as f32;
+                    let mut acc = [0.0f32; 2];
+                    for (dz, wz) in [(0, 1.0 - tz), (1, tz)] {
+                        for (dy, wy) in wys {
+                            // The two x neighbours are adjacent in the grid.
+                            let base = index(*x0, y0 + dy, z0 + dz);
+                            for (dx, wx) in wxs.iter().enumerate() {
+                                let c = grid[base + dx];
+                                let w = wx * wy * wz;
+                                acc[0] += w * c[0];
+                                acc[1] += w * c[1];
+                            }
                         }
                     }
+                    // The pixel's own node is one of the 8 corners (weight ≥ 1/8) and holds
+                    // its own splat, so acc[1] > 0; the guard is for safety only.
+                    let b = if acc[1] > 0.0 { acc[0] / acc[1] } else { *v };
+                    *o = b;
+                    lo_b = lo_b.min(b);
+                    hi_b = hi_b.max(b);
                 }
-                // The pixel's own node is one of the 8 corners (weight ≥ 1/8) and holds its
-                // own splat, so acc[1] > 0; the guard is for safety only.
-                let b = if acc[1] > 0.0 { acc[0] / acc[1] } else { *v };
-                *o = b;
-                lo_b = lo_b.min(b);
-                hi_b = hi_b.max(b);
-            }
-            (lo_b, hi_b)
-        })
+                (lo_b, hi_b)
+            },
+        )
         .reduce(
             || (f32::INFINITY, f32::NEG_INFINITY),
             |a, b| (a.0.min(b.0), a.1.max(b.1)),
         );
     (out, [range.0, range.1])
+}
+
+/// z grid coordinates (v − lo)/σ_r + PAD of a row (NaN stays NaN; such pixels are
+/// skipped by the callers).
+#[inline(always)]
+fn z_coordinates(row: &[f32], fz: &mut [f32], lo: f32, sr: f32) {
+    for (z, v) in fz.iter_mut().zip(row) {
+        *z = (v - lo) / sr + PAD as f32;
+    }
 }
 
 #[cfg(test)]

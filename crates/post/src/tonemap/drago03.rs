@@ -6,7 +6,7 @@
 //! brightest pixel maps to 1).
 
 use super::fast_math;
-use super::pixels::{luminance_stats, map_luminance};
+use super::pixels::{luminance_stats, map_luminance, LuminanceCurve};
 use super::{Context, OperatorInfo, Output, ParamSpec};
 
 pub(crate) static INFO: OperatorInfo = OperatorInfo {
@@ -32,6 +32,37 @@ pub(crate) static INFO: OperatorInfo = OperatorInfo {
     ],
 };
 
+/// Eq. 4 on L_w / L_wa, as the ratio L_d / L: prefactor · log2(1 + L_w) / (L ·
+/// log2(2 + 8 (L_w / L_wmax)^e)) (the ln 2 of both logs cancels). The two logs of L_w go
+/// through [`fast_math::log2_pair`] (one division for both), and the division by L joins
+/// the final one: three divisions per pixel instead of five.
+struct Curve {
+    inv_avg: f32,
+    inv_max: f32,
+    exponent: f32,
+    prefactor: f32,
+}
+
+impl LuminanceCurve for Curve {
+    #[inline(always)]
+    fn ratio(&self, _start: usize, l: &mut [f32]) {
+        let (inv_avg, inv_max, exponent, prefactor) =
+            (self.inv_avg, self.inv_max, self.exponent, self.prefactor);
+        for v in l {
+            let lw = *v * inv_avg;
+            let x = lw * inv_max;
+            let (log_num, log_x) = fast_math::log2_pair(1.0 + lw, x);
+            // (L_w / L_wmax)^e = exp2(e log2 x), 0 at x = 0 (as fast_math::powf).
+            let power = if x > 0.0 {
+                fast_math::exp2(exponent * log_x)
+            } else {
+                0.0
+            };
+            *v = prefactor * log_num / (*v * fast_math::log2(2.0 + 8.0 * power));
+        }
+    }
+}
+
 pub(crate) fn apply(ctx: &Context) -> Output {
     let stats = luminance_stats(ctx.image, ctx.exposure, ctx.weights);
     let bias = ctx.value("bias");
@@ -49,11 +80,13 @@ pub(crate) fn apply(ctx: &Context) -> Output {
     } else {
         0.0
     };
-    let mapped = map_luminance(ctx, ctx.exposure, ctx.weights, |l| {
-        let lw = l * inv_avg;
-        prefactor * fast_math::ln(1.0 + lw)
-            / fast_math::ln(2.0 + 8.0 * fast_math::powf(lw * inv_max, exponent))
-    });
+    let curve = Curve {
+        inv_avg,
+        inv_max,
+        exponent,
+        prefactor,
+    };
+    let mapped = map_luminance(ctx, ctx.exposure, ctx.weights, &curve);
     Output {
         mapped,
         values: vec![

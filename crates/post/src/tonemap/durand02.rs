@@ -17,7 +17,8 @@
 
 use super::bilateral_grid::bilateral_grid;
 use super::fast_math;
-use super::pixels::{luminance_plane, map_luminance_indexed};
+use super::pixels::{luminance_plane, map_luminance, LuminanceCurve, CHUNK};
+use super::simd::avx2;
 use super::{Context, OperatorInfo, Output, ParamSpec};
 use rayon::prelude::*;
 
@@ -52,19 +53,43 @@ pub(crate) static INFO: OperatorInfo = OperatorInfo {
     ],
 };
 
+/// L_d = L_w · 10^{(γ − 1) B − γ max B}, as exp(g1 B + offset).
+struct Curve<'a> {
+    g1: f32,
+    offset: f32,
+    base: &'a [f32],
+}
+
+impl LuminanceCurve for Curve<'_> {
+    #[inline(always)]
+    fn ratio(&self, start: usize, l: &mut [f32]) {
+        // L_d / L_w = 10^{(γ − 1) B − γ max B}.
+        let base = &self.base[start..start + l.len()];
+        let (g1, offset) = (self.g1, self.offset);
+        for (v, b) in l.iter_mut().zip(base) {
+            *v = fast_math::exp(g1 * b + offset);
+        }
+    }
+}
+
+/// log10 L, NaN for L = 0 (black pixels take no part in the filter).
+#[inline(always)]
+fn log10_or_nan(plane: &mut [f32]) {
+    for v in plane {
+        let log = fast_math::log2(*v) * std::f32::consts::LOG10_2;
+        *v = if *v > 0.0 { log } else { f32::NAN };
+    }
+}
+
 pub(crate) fn apply(ctx: &Context) -> Output {
     let (w, h) = (ctx.image.width(), ctx.image.height());
     let contrast = ctx.value("base_contrast");
     let sigma_space_px = (ctx.value("sigma_space") * w.max(h) as f64) as f32;
     let sigma_range = ctx.value("sigma_range") as f32;
     let mut log_l = luminance_plane(ctx.image, ctx.exposure, ctx.weights);
-    log_l.par_iter_mut().for_each(|v| {
-        *v = if *v > 0.0 {
-            fast_math::log2(*v) * std::f32::consts::LOG10_2
-        } else {
-            f32::NAN
-        };
-    });
+    log_l
+        .par_chunks_mut(CHUNK)
+        .for_each(|c| avx2!(log10_or_nan(c)));
     let (base, [base_min, base_max]) = bilateral_grid(&log_l, w, h, sigma_space_px, sigma_range);
     drop(log_l);
     let range = (base_max - base_min) as f64;
@@ -78,9 +103,12 @@ pub(crate) fn apply(ctx: &Context) -> Output {
         (gamma - 1.0) as f32 * std::f32::consts::LN_10,
         -(gamma * base_max as f64) as f32 * std::f32::consts::LN_10,
     );
-    let mapped = map_luminance_indexed(ctx, ctx.exposure, ctx.weights, |i, l| {
-        l * fast_math::exp(g1 * base[i] + offset)
-    });
+    let curve = Curve {
+        g1,
+        offset,
+        base: &base,
+    };
+    let mapped = map_luminance(ctx, ctx.exposure, ctx.weights, &curve);
     Output {
         mapped,
         values: vec![

@@ -5,7 +5,7 @@
 //! 1 − e^(−q/k) (0.63 by default); compresses bright pixels more than a linear scale.
 
 use super::fast_math;
-use super::pixels::{luminance_stats, map_luminance};
+use super::pixels::{luminance_stats, map_luminance, LuminanceCurve};
 use super::{Context, OperatorInfo, Output, ParamSpec};
 
 pub(crate) static INFO: OperatorInfo = OperatorInfo {
@@ -31,22 +31,35 @@ pub(crate) static INFO: OperatorInfo = OperatorInfo {
     ],
 };
 
+/// 1 − e^{−rate · L}.
+struct Curve {
+    rate: f32,
+}
+
+impl LuminanceCurve for Curve {
+    #[inline(always)]
+    fn ratio(&self, _start: usize, l: &mut [f32]) {
+        let rate = self.rate;
+        for v in l {
+            // (1 − e^{−x}) / L: fast exp (relative error ≤ 3e-7, module fast_math) except
+            // for x < 0.01, where the cancellation would cost digits and the series
+            // x (1 − x/2 (1 − x/3 (1 − x/4))) is exact to x⁵/120 ≤ 1e-12 (divided by
+            // L = x / rate: rate · (1 − …)). Both are evaluated and one selected, so the
+            // loop stays branch-free.
+            let x = rate * *v;
+            let series = rate * (1.0 - 0.5 * x * (1.0 - x / 3.0 * (1.0 - 0.25 * x)));
+            let direct = (1.0 - fast_math::exp(-x)) / *v;
+            *v = if x < 0.01 { series } else { direct };
+        }
+    }
+}
+
 pub(crate) fn apply(ctx: &Context) -> Output {
     let stats = luminance_stats(ctx.image, ctx.exposure, ctx.weights);
     let (q, k) = (ctx.value("q"), ctx.value("k"));
     let rate = (q / k / stats.log_average) as f32;
     Output {
-        mapped: map_luminance(ctx, ctx.exposure, ctx.weights, |l| {
-            // 1 − e^{−x}: fast exp (relative error ≤ 3e-7, module fast_math) except for
-            // x < 0.01, where the cancellation would cost digits and the series
-            // x (1 − x/2 (1 − x/3 (1 − x/4))) is exact to x⁵/120 ≤ 1e-12.
-            let x = rate * l;
-            if x < 0.01 {
-                x * (1.0 - 0.5 * x * (1.0 - x / 3.0 * (1.0 - 0.25 * x)))
-            } else {
-                1.0 - fast_math::exp(-x)
-            }
-        }),
+        mapped: map_luminance(ctx, ctx.exposure, ctx.weights, &Curve { rate }),
         values: vec![("log_average", stats.log_average), ("q", q), ("k", k)],
     }
 }

@@ -12,7 +12,7 @@
 //! 0.01) / (10 − 0.01) clamped to [0, 1] (as in Banterle's HDR Toolbox): scotopic below
 //! 0.01 cd/m², photopic above 10.
 
-use super::pixels::{luminance_stats, map_pixels};
+use super::pixels::{luminance_stats_without_log, map_pixels, PixelMap};
 use super::{Context, OperatorInfo, Output, ParamSpec};
 use crate::error::Result;
 
@@ -71,9 +71,31 @@ pub fn mesopic_weight(l_wa: f64) -> f64 {
     (1.0 - t) * (1.0 - t)
 }
 
+/// m_p · RGB + k m_s L_scot (both already divided by L_dmax).
+struct Map {
+    rgb_to_xyz: glam::Mat3,
+    photopic: f32,
+    scotopic: f32,
+}
+
+impl PixelMap for Map {
+    #[inline(always)]
+    fn map(&self, _start: usize, r: &mut [f32], g: &mut [f32], b: &mut [f32]) {
+        let (m, photopic, scotopic) = (self.rgb_to_xyz, self.photopic, self.scotopic);
+        for ((r, g), b) in r.iter_mut().zip(g.iter_mut()).zip(b.iter_mut()) {
+            let xyz = m * glam::Vec3::new(*r, *g, *b);
+            // Ward Larson et al. 1997, eq. 3; both sides evaluated and one selected.
+            let l_scot = (xyz.y * (1.33 * (1.0 + (xyz.y + xyz.z) / xyz.x) - 1.68)).max(0.0);
+            let l_scot = if xyz.x > 0.0 { l_scot } else { 0.0 };
+            let s = scotopic * l_scot;
+            (*r, *g, *b) = (photopic * *r + s, photopic * *g + s, photopic * *b + s);
+        }
+    }
+}
+
 pub(crate) fn apply(ctx: &Context) -> Result<Output> {
     let absolute = ctx.exposure * ctx.absolute_scale()? as f32;
-    let stats = luminance_stats(ctx.image, absolute, ctx.weights);
+    let stats = luminance_stats_without_log(ctx.image, absolute, ctx.weights);
     let l_dmax = ctx.value("display_max");
     let l_wa = ctx
         .param("world_adaptation")
@@ -85,21 +107,12 @@ pub(crate) fn apply(ctx: &Context) -> Result<Output> {
     let k = mesopic_weight(l_wa);
     let photopic = (m_p / l_dmax) as f32;
     let scotopic = (k * m_s / l_dmax) as f32;
-    let m = ctx.image.color_space.rgb_to_xyz.as_mat3();
-    let mapped = map_pixels(ctx, absolute, |c| {
-        let xyz = m * glam::Vec3::from(c);
-        let l_scot = if xyz.x > 0.0 {
-            (xyz.y * (1.33 * (1.0 + (xyz.y + xyz.z) / xyz.x) - 1.68)).max(0.0)
-        } else {
-            0.0
-        };
-        let s = scotopic * l_scot;
-        [
-            photopic * c[0] + s,
-            photopic * c[1] + s,
-            photopic * c[2] + s,
-        ]
-    });
+    let map = Map {
+        rgb_to_xyz: ctx.image.color_space.rgb_to_xyz.as_mat3(),
+        photopic,
+        scotopic,
+    };
+    let mapped = map_pixels(ctx, absolute, &map);
     Ok(Output {
         mapped,
         values: vec![

@@ -16,6 +16,8 @@
 
 use rayon::prelude::*;
 
+use super::simd::avx2;
+
 /// Below this σ (pixels) the blur is a direct FIR (the recursive filter's q formula is
 /// only fitted for σ ≥ 0.5, and is less accurate than a short FIR below a few pixels).
 pub const RECURSIVE_MIN_SIGMA: f32 = 3.0;
@@ -49,11 +51,13 @@ pub fn gaussian_blur(
         fir_columns(scratch, dst, width, height, &kernel);
     } else {
         let c = YoungVanVliet::new(sigma_px);
-        dst.copy_from_slice(src);
-        // Rows in groups of ROW_GROUP: independent recursions interleaved, so the
-        // latency of each one's dependency chain is hidden by the others.
+        // Rows in groups of ROW_GROUP, read from src and written to dst, the group's
+        // recursions run side by side as one vector recursion.
         dst.par_chunks_mut(width * ROW_GROUP)
-            .for_each(|rows| c.filter_rows(rows, width));
+            .zip(src.par_chunks(width * ROW_GROUP))
+            .for_each_init(Vec::new, |lanes, (rows, from)| {
+                avx2!(filter_rows_kernel(&c, from, rows, width, lanes))
+            });
         c.filter_columns(dst, width, height);
     }
 }
@@ -69,42 +73,106 @@ pub fn sampled_kernel(sigma: f32) -> Vec<f32> {
     k
 }
 
-/// Horizontal FIR: each row is copied with `r` replicated edge pixels on both sides, then
-/// accumulated tap by tap (out[x] += k_j · padded[x + j]): the inner loop runs along the
-/// row and vectorises.
+/// Largest FIR radius: ⌈3σ⌉ for σ < [`RECURSIVE_MIN_SIGMA`].
+const MAX_FIR_RADIUS: usize = 9;
+
+/// `out[x] = Σ_j k[j] · taps[j][x]`, the terms added in tap order j = 0 … 2R from 0
+/// (the order of the accumulate-per-tap loop this replaces, so the same bits). Outputs
+/// are computed 8 at a time in a local accumulator (one vector register), the tap loop
+/// unrolled (R is a constant): one load per tap and one store per 8 outputs, instead of a
+/// load and store of the output row per tap.
+#[inline(always)]
+fn fir_taps<const R: usize>(taps: &[&[f32]], kernel: &[f32], out: &mut [f32]) {
+    const W: usize = 8;
+    let n = out.len();
+    assert!(taps.len() == 2 * R + 1 && kernel.len() == 2 * R + 1);
+    assert!(taps.iter().all(|t| t.len() >= n));
+    let mut k = [0.0f32; 2 * MAX_FIR_RADIUS + 1];
+    k[..2 * R + 1].copy_from_slice(kernel);
+    let full = n / W * W;
+    let mut x = 0;
+    while x < full {
+        let mut acc = [0.0f32; W];
+        for j in 0..2 * R + 1 {
+            let t = &taps[j][x..x + W];
+            for l in 0..W {
+                acc[l] += k[j] * t[l];
+            }
+        }
+        out[x..x + W].copy_from_slice(&acc);
+        x += W;
+    }
+    for (x, o) in out.iter_mut().enumerate().skip(full) {
+        let mut acc = 0.0f32;
+        for j in 0..2 * R + 1 {
+            acc += k[j] * taps[j][x];
+        }
+        *o = acc;
+    }
+}
+
+/// [`fir_taps`] for the kernel's radius.
+#[inline(always)]
+fn fir_any(taps: &[&[f32]], kernel: &[f32], out: &mut [f32]) {
+    match kernel.len() / 2 {
+        0 => fir_taps::<0>(taps, kernel, out),
+        1 => fir_taps::<1>(taps, kernel, out),
+        2 => fir_taps::<2>(taps, kernel, out),
+        3 => fir_taps::<3>(taps, kernel, out),
+        4 => fir_taps::<4>(taps, kernel, out),
+        5 => fir_taps::<5>(taps, kernel, out),
+        6 => fir_taps::<6>(taps, kernel, out),
+        7 => fir_taps::<7>(taps, kernel, out),
+        8 => fir_taps::<8>(taps, kernel, out),
+        9 => fir_taps::<9>(taps, kernel, out),
+        r => unreachable!("FIR radius {r} > {MAX_FIR_RADIUS}"),
+    }
+}
+
+/// One row of the horizontal FIR: the row with `r` replicated edge pixels on both sides,
+/// and the taps as shifted views of it.
+#[inline(always)]
+fn fir_row(i: &[f32], o: &mut [f32], padded: &mut [f32], kernel: &[f32]) {
+    let (r, width) = (kernel.len() / 2, i.len());
+    padded[..r].fill(i[0]);
+    padded[r..r + width].copy_from_slice(i);
+    padded[r + width..].fill(i[width - 1]);
+    let mut taps: [&[f32]; 2 * MAX_FIR_RADIUS + 1] = [&[]; 2 * MAX_FIR_RADIUS + 1];
+    for (j, t) in taps.iter_mut().enumerate().take(kernel.len()) {
+        *t = &padded[j..j + width];
+    }
+    fir_any(&taps[..kernel.len()], kernel, o);
+}
+
+/// Horizontal FIR, rows in parallel (edge pixels replicated).
 fn fir_rows(src: &[f32], dst: &mut [f32], width: usize, kernel: &[f32]) {
     let r = kernel.len() / 2;
     dst.par_chunks_mut(width)
         .zip(src.par_chunks(width))
         .for_each_init(
             || vec![0.0f32; width + 2 * r],
-            |padded, (o, i)| {
-                padded[..r].fill(i[0]);
-                padded[r..r + width].copy_from_slice(i);
-                padded[r + width..].fill(i[width - 1]);
-                o.fill(0.0);
-                for (j, k) in kernel.iter().enumerate() {
-                    for (out, v) in o.iter_mut().zip(&padded[j..j + width]) {
-                        *out += k * v;
-                    }
-                }
-            },
+            |padded, (o, i)| avx2!(fir_row(i, o, padded, kernel)),
         );
 }
 
-fn fir_columns(src: &[f32], dst: &mut [f32], width: usize, height: usize, kernel: &[f32]) {
-    let r = (kernel.len() / 2) as isize;
+/// One output row of the vertical FIR: the taps are the source rows y − r … y + r,
+/// clamped at the edges.
+#[inline(always)]
+fn fir_column_row(src: &[f32], o: &mut [f32], y: usize, height: usize, kernel: &[f32]) {
+    let (r, width) = ((kernel.len() / 2) as isize, o.len());
     let last = height as isize - 1;
-    dst.par_chunks_mut(width).enumerate().for_each(|(y, o)| {
-        o.fill(0.0);
-        for (j, k) in kernel.iter().enumerate() {
-            let yy = (y as isize + j as isize - r).clamp(0, last) as usize;
-            let row = &src[yy * width..(yy + 1) * width];
-            for (out, v) in o.iter_mut().zip(row) {
-                *out += k * v;
-            }
-        }
-    });
+    let mut taps: [&[f32]; 2 * MAX_FIR_RADIUS + 1] = [&[]; 2 * MAX_FIR_RADIUS + 1];
+    for (j, t) in taps.iter_mut().enumerate().take(kernel.len()) {
+        let yy = (y as isize + j as isize - r).clamp(0, last) as usize;
+        *t = &src[yy * width..(yy + 1) * width];
+    }
+    fir_any(&taps[..kernel.len()], kernel, o);
+}
+
+fn fir_columns(src: &[f32], dst: &mut [f32], width: usize, height: usize, kernel: &[f32]) {
+    dst.par_chunks_mut(width)
+        .enumerate()
+        .for_each(|(y, o)| avx2!(fir_column_row(src, o, y, height, kernel)));
 }
 
 /// Coefficients of the Young–van Vliet recursive Gaussian, normalised by b0.
@@ -156,47 +224,55 @@ impl YoungVanVliet {
         }
     }
 
-    /// [`Self::filter_row`] on up to [`ROW_GROUP`] consecutive rows (`rows` holds them
-    /// back to back, each `width` long), their recursions interleaved.
+    /// [`Self::filter_row`] on up to [`ROW_GROUP`] consecutive rows of `from` (back to
+    /// back, each `width` long), written to `rows`. A full group is transposed into `lanes` (pixel x
+    /// of the 8 rows side by side), so the 8 recursions run as one 8-wide vector recursion
+    /// with the same operations per row as [`Self::filter_row`], then transposed back.
     #[allow(clippy::needless_range_loop)] // r indexes both the state and the row offset
-    pub fn filter_rows(&self, rows: &mut [f32], width: usize) {
+    #[inline(always)]
+    pub fn filter_rows(
+        &self,
+        from: &[f32],
+        rows: &mut [f32],
+        width: usize,
+        lanes: &mut Vec<[f32; ROW_GROUP]>,
+    ) {
         let n = rows.len() / width;
         if n < ROW_GROUP {
+            rows.copy_from_slice(from);
             rows.chunks_mut(width).for_each(|row| self.filter_row(row));
             return;
         }
-        let (b, [a1, a2, a3]) = (self.b, self.a);
-        let mut s = [[0.0f32; ROW_GROUP]; 3];
-        for r in 0..ROW_GROUP {
-            let v = rows[r * width];
-            s[0][r] = v;
-            s[1][r] = v;
-            s[2][r] = v;
-        }
-        for x in 0..width {
-            for r in 0..ROW_GROUP {
-                let i = r * width + x;
-                let w = b * rows[i] + a1 * s[0][r] + a2 * s[1][r] + a3 * s[2][r];
-                s[2][r] = s[1][r];
-                s[1][r] = s[0][r];
-                s[0][r] = w;
-                rows[i] = w;
+        lanes.resize(width, [0.0; ROW_GROUP]);
+        for (r, row) in from.chunks_exact(width).enumerate() {
+            for (l, v) in lanes.iter_mut().zip(row) {
+                l[r] = *v;
             }
         }
-        for r in 0..ROW_GROUP {
-            let v = rows[r * width + width - 1];
-            s[0][r] = v;
-            s[1][r] = v;
-            s[2][r] = v;
-        }
-        for x in (0..width).rev() {
+        let (b, [a1, a2, a3]) = (self.b, self.a);
+        let mut s = [lanes[0]; 3];
+        for l in lanes.iter_mut() {
             for r in 0..ROW_GROUP {
-                let i = r * width + x;
-                let w = b * rows[i] + a1 * s[0][r] + a2 * s[1][r] + a3 * s[2][r];
+                let w = b * l[r] + a1 * s[0][r] + a2 * s[1][r] + a3 * s[2][r];
                 s[2][r] = s[1][r];
                 s[1][r] = s[0][r];
                 s[0][r] = w;
-                rows[i] = w;
+                l[r] = w;
+            }
+        }
+        s = [lanes[width - 1]; 3];
+        for l in lanes.iter_mut().rev() {
+            for r in 0..ROW_GROUP {
+                let w = b * l[r] + a1 * s[0][r] + a2 * s[1][r] + a3 * s[2][r];
+                s[2][r] = s[1][r];
+                s[1][r] = s[0][r];
+                s[0][r] = w;
+                l[r] = w;
+            }
+        }
+        for (r, row) in rows.chunks_exact_mut(width).enumerate() {
+            for (v, l) in row.iter_mut().zip(lanes.iter()) {
+                *v = l[r];
             }
         }
     }
@@ -213,10 +289,11 @@ impl YoungVanVliet {
             let row = |y: usize| unsafe {
                 std::slice::from_raw_parts_mut(ptr.get().add(y * width + x0), n)
             };
-            self.columns_strip(row, n, height);
+            avx2!(columns_strip_kernel(self, row, n, height));
         });
     }
 
+    #[inline(always)]
     fn columns_strip<'a>(&self, row: impl Fn(usize) -> &'a mut [f32], n: usize, height: usize) {
         let (b, [a1, a2, a3]) = (self.b, self.a);
         let mut s = [[0.0f32; COLUMN_STRIP]; 3];
@@ -251,6 +328,27 @@ impl YoungVanVliet {
             }
         }
     }
+}
+
+#[inline(always)]
+fn filter_rows_kernel(
+    c: &YoungVanVliet,
+    from: &[f32],
+    rows: &mut [f32],
+    width: usize,
+    lanes: &mut Vec<[f32; ROW_GROUP]>,
+) {
+    c.filter_rows(from, rows, width, lanes)
+}
+
+#[inline(always)]
+fn columns_strip_kernel<'a>(
+    c: &YoungVanVliet,
+    row: impl Fn(usize) -> &'a mut [f32],
+    n: usize,
+    height: usize,
+) {
+    c.columns_strip(row, n, height)
 }
 
 #[derive(Clone, Copy)]

@@ -1,7 +1,7 @@
 //! Linear exposure: L_d = 2^EV · L_w per channel (no compression; values above 1 are left
 //! to the clipping / gamut stage).
 
-use super::pixels::map_pixels;
+use super::pixels::{map_pixels, PixelMap};
 use super::{Context, OperatorInfo, Output};
 
 pub(crate) static INFO: OperatorInfo = OperatorInfo {
@@ -11,9 +11,17 @@ pub(crate) static INFO: OperatorInfo = OperatorInfo {
     params: &[],
 };
 
+/// The identity (the exposure is the sanitising scale).
+struct Identity;
+
+impl PixelMap for Identity {
+    #[inline(always)]
+    fn map(&self, _start: usize, _r: &mut [f32], _g: &mut [f32], _b: &mut [f32]) {}
+}
+
 pub(crate) fn apply(ctx: &Context) -> Output {
     Output {
-        mapped: map_pixels(ctx, ctx.exposure, |c| c),
+        mapped: map_pixels(ctx, ctx.exposure, &Identity),
         values: vec![("scale", ctx.exposure as f64)],
     }
 }

@@ -4,7 +4,7 @@
 //! to 1 when q = k.
 
 use super::fast_math;
-use super::pixels::{luminance_stats, map_luminance};
+use super::pixels::{luminance_stats_without_log, map_luminance, LuminanceCurve};
 use super::{Context, OperatorInfo, Output, ParamSpec};
 
 pub(crate) static INFO: OperatorInfo = OperatorInfo {
@@ -30,8 +30,24 @@ pub(crate) static INFO: OperatorInfo = OperatorInfo {
     ],
 };
 
+/// ln(1 + q L) / ln(1 + k L_max) (log10 a / log10 b = ln a / ln b).
+struct Curve {
+    q: f32,
+    inv: f32,
+}
+
+impl LuminanceCurve for Curve {
+    #[inline(always)]
+    fn ratio(&self, _start: usize, l: &mut [f32]) {
+        let (q, inv) = (self.q, self.inv);
+        for v in l {
+            *v = fast_math::ln(1.0 + q * *v) * inv / *v;
+        }
+    }
+}
+
 pub(crate) fn apply(ctx: &Context) -> Output {
-    let stats = luminance_stats(ctx.image, ctx.exposure, ctx.weights);
+    let stats = luminance_stats_without_log(ctx.image, ctx.exposure, ctx.weights);
     let (q, k) = (ctx.value("q"), ctx.value("k"));
     let denominator = (k * stats.max).ln_1p();
     let inv = if denominator > 0.0 {
@@ -41,10 +57,7 @@ pub(crate) fn apply(ctx: &Context) -> Output {
     };
     let q32 = q as f32;
     Output {
-        // log10 a / log10 b = ln a / ln b.
-        mapped: map_luminance(ctx, ctx.exposure, ctx.weights, |l| {
-            fast_math::ln(1.0 + q32 * l) * inv
-        }),
+        mapped: map_luminance(ctx, ctx.exposure, ctx.weights, &Curve { q: q32, inv }),
         values: vec![("max_luminance", stats.max), ("q", q), ("k", k)],
     }
 }

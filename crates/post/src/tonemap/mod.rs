@@ -20,6 +20,7 @@ pub mod pixels;
 mod reinhard02;
 mod reinhard02_local;
 mod schlick94;
+pub(crate) mod simd;
 mod tumblin_rushmeier;
 mod ward94;
 mod ward97_histogram;

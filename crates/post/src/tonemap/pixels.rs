@@ -3,10 +3,19 @@
 //! operator never sees (and never outputs) NaN, ±∞ or negative values:
 //! a pixel with any non-finite component is counted and treated as black; a pixel with a
 //! negative component is counted and that component clamped to 0.
+//!
+//! Layout of both passes: rayon tasks of [`CHUNK`] pixels; inside a task, blocks of
+//! [`BLOCK`] pixels are de-interleaved into stack planes (R, G, B, L: a few KiB, in L1),
+//! the operator's curve runs over a plane, and the result is interleaved back. Every loop
+//! over a plane is branch-free, so it vectorises, and each task's kernel is compiled twice
+//! (baseline SSE2 and AVX2, chosen at run time: module [`super::simd`]). Operators hand
+//! their curve over as a [`LuminanceCurve`] or [`PixelMap`] whose method is
+//! `#[inline(always)]`, so it is compiled into the vector loop rather than called per pixel.
 
 use rayon::prelude::*;
 
 use super::fast_math;
+use super::simd::avx2;
 use super::Context;
 use crate::image::Image;
 
@@ -33,6 +42,79 @@ pub(crate) fn sanitise(p: [f32; 3], scale: f32) -> [f32; 3] {
 /// Independent accumulators per chunk (8 f32 = one AVX register).
 const LANES: usize = 8;
 
+/// Pixels per de-interleaved block inside a task (a multiple of [`LANES`]; five planes of
+/// 1 KiB).
+const BLOCK: usize = 256;
+
+/// A luminance curve L ↦ L_d for [`map_luminance`], given as the ratio L_d / L by which
+/// the pixel's colour is scaled: an operator folds the division by L into its own
+/// formula (often removing a division or a power: a division costs as much as a fast
+/// log here). Implementations mark [`Self::ratio`] `#[inline(always)]`, keep its loop
+/// branch-free (module [`super::simd`]) and copy their fields into locals before the loop
+/// (the compiler cannot tell that `l` does not alias `self`, and would reload the fields
+/// per pixel and keep the loop scalar).
+pub(crate) trait LuminanceCurve: Sync {
+    /// Replaces every `l[j]`, the sanitised luminance of pixel `start + j` (row-major
+    /// index), by L_d / L. Only used where L > 0 (black pixels stay black whatever is
+    /// written for them).
+    fn ratio(&self, start: usize, l: &mut [f32]);
+}
+
+/// A per-pixel colour map for [`map_pixels`], on de-interleaved planes; implementations
+/// mark [`Self::map`] `#[inline(always)]`.
+pub(crate) trait PixelMap: Sync {
+    /// Maps the sanitised pixels `start + j`, given as `(r[j], g[j], b[j])`, in place.
+    fn map(&self, start: usize, r: &mut [f32], g: &mut [f32], b: &mut [f32]);
+}
+
+/// L_d = factor · L (a linear scale of luminance): the ratio is the factor.
+pub(crate) struct Scale(pub f32);
+
+impl LuminanceCurve for Scale {
+    #[inline(always)]
+    fn ratio(&self, _start: usize, l: &mut [f32]) {
+        l.fill(self.0);
+    }
+}
+
+/// Sanitised planes of one block: `scale · rgb` clamped to ≥ 0, black for non-finite
+/// pixels, and its luminance `w · rgb`; returns the (non-finite, negative) pixel counts.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn load_block(
+    input: &[[f32; 3]],
+    scale: f32,
+    w: [f32; 3],
+    r: &mut [f32],
+    g: &mut [f32],
+    b: &mut [f32],
+    l: &mut [f32],
+) -> (u32, u32) {
+    let n = input.len();
+    let (r, g, b, l) = (&mut r[..n], &mut g[..n], &mut b[..n], &mut l[..n]);
+    let (mut non_finite, mut negative) = (0u32, 0u32);
+    for j in 0..n {
+        let p = input[j];
+        let finite = p[0].is_finite() & p[1].is_finite() & p[2].is_finite();
+        non_finite += !finite as u32;
+        negative += (finite & ((p[0] < 0.0) | (p[1] < 0.0) | (p[2] < 0.0))) as u32;
+        let c = [
+            if finite { (p[0] * scale).max(0.0) } else { 0.0 },
+            if finite { (p[1] * scale).max(0.0) } else { 0.0 },
+            if finite { (p[2] * scale).max(0.0) } else { 0.0 },
+        ];
+        r[j] = c[0];
+        g[j] = c[1];
+        b[j] = c[2];
+        // As sanitised_luminance: the same sum, in the same order.
+        let y = w[0] * (p[0] * scale).max(0.0)
+            + w[1] * (p[1] * scale).max(0.0)
+            + w[2] * (p[2] * scale).max(0.0);
+        l[j] = if finite { y } else { 0.0 };
+    }
+    (non_finite, negative)
+}
+
 /// `w · sanitise(p, scale)` without branches (a select instead), so loops over it
 /// vectorise.
 #[inline(always)]
@@ -47,18 +129,6 @@ pub(crate) fn sanitised_luminance(p: [f32; 3], scale: f32, w: [f32; 3]) -> f32 {
     } else {
         0.0
     }
-}
-
-/// Counts (non-finite, negative) input pixels of a chunk (integer sums, vectorisable).
-#[inline(always)]
-fn count_problems(chunk: &[[f32; 3]]) -> (u64, u64) {
-    let (mut non_finite, mut negative) = (0u32, 0u32);
-    for p in chunk {
-        let finite = p[0].is_finite() & p[1].is_finite() & p[2].is_finite();
-        non_finite += !finite as u32;
-        negative += (finite & ((p[0] < 0.0) | (p[1] < 0.0) | (p[2] < 0.0))) as u32;
-    }
-    (non_finite as u64, negative as u64)
 }
 
 #[inline(always)]
@@ -104,59 +174,120 @@ impl Acc {
     }
 }
 
-/// Statistics of `w · sanitise(p, scale)` over the image (one parallel pass; the log sum
-/// uses [`fast_math::ln`], error ≤ 3e-7 per term plus rounding, so ~3e-7 relative on
-/// L_avg). Per chunk, luminance goes to a stack array first and the sums run in
-/// [`LANES`] independent lanes, so the compiler can vectorise both loops.
-pub(crate) fn luminance_stats(image: &Image, scale: f32, w: [f32; 3]) -> LuminanceStats {
+/// x = 2^e · m, m ∈ [1, 2), for a positive normal (or infinite) f32: (e, m) exactly.
+#[inline(always)]
+fn split_exponent(x: f32) -> (i32, f32) {
+    let bits = x.to_bits();
+    (
+        (bits >> 23) as i32 - 127,
+        f32::from_bits((bits & 0x007f_ffff) | 0x3f80_0000),
+    )
+}
+
+/// One task of [`luminance_stats`]: luminance per block into a stack plane, then the sums
+/// in [`LANES`] independent lanes (pixel i of the chunk in lane i mod 8), f64 across lanes.
+///
+/// The log sum uses the exact identity Σ log2 x_i = Σ e_i + log2 Π m_i (x_i = 2^e_i m_i,
+/// m_i ∈ [1, 2)): per lane, the exponents are summed as integers (exactly) and the
+/// mantissas multiplied (at most 32 per block and lane, product < 2^32, each product
+/// rounded to 2⁻²⁴ relative), and [`fast_math::log2`] runs once per block and lane
+/// instead of once per pixel. Error: ≤ 32 · 6e-8 relative on a product, i.e. ≤ 2.8e-6 on
+/// its log2 — 9e-8 per term, below the 3e-7 per term of a log per pixel.
+#[inline(always)]
+fn stats_chunk<const LOG: bool>(chunk: &[[f32; 3]], scale: f32, w: [f32; 3]) -> Acc {
     let delta = LOG_AVERAGE_DELTA as f32;
-    let acc = image
+    let mut sum_log2 = [0.0f32; LANES];
+    let mut exponents = [0i32; LANES];
+    let mut sum = [0.0f32; LANES];
+    let mut max = [0.0f32; LANES];
+    let mut min_positive = [f32::INFINITY; LANES];
+    let mut lum = [0.0f32; BLOCK];
+    for block in chunk.chunks(BLOCK) {
+        let lum = &mut lum[..block.len()];
+        for (l, p) in lum.iter_mut().zip(block) {
+            *l = sanitised_luminance(*p, scale, w);
+        }
+        let mut product = [1.0f32; LANES];
+        let mut lanes = lum.chunks_exact(LANES);
+        for group in &mut lanes {
+            for k in 0..LANES {
+                let l = group[k];
+                if LOG {
+                    let (e, m) = split_exponent(delta + l);
+                    exponents[k] += e;
+                    product[k] *= m;
+                }
+                sum[k] += l;
+                max[k] = max[k].max(l);
+                min_positive[k] = if l > 0.0 {
+                    min_positive[k].min(l)
+                } else {
+                    min_positive[k]
+                };
+            }
+        }
+        // Only the image's last block can leave a remainder (BLOCK and CHUNK are
+        // multiples of LANES).
+        for (k, l) in lanes.remainder().iter().enumerate() {
+            if LOG {
+                let (e, m) = split_exponent(delta + l);
+                exponents[k] += e;
+                product[k] *= m;
+            }
+            sum[k] += l;
+            max[k] = max[k].max(*l);
+            if *l > 0.0 {
+                min_positive[k] = min_positive[k].min(*l);
+            }
+        }
+        if LOG {
+            for k in 0..LANES {
+                sum_log2[k] += fast_math::log2(product[k]);
+            }
+        }
+    }
+    let log2_total = exponents.iter().map(|e| *e as f64).sum::<f64>()
+        + sum_log2.iter().map(|v| *v as f64).sum::<f64>();
+    Acc {
+        sum_log: log2_total * std::f64::consts::LN_2,
+        sum: sum.iter().map(|v| *v as f64).sum(),
+        max: max.iter().fold(0.0f32, |a, b| a.max(*b)),
+        min_positive: min_positive.iter().fold(f32::INFINITY, |a, b| a.min(*b)),
+    }
+}
+
+/// Statistics of `w · sanitise(p, scale)` over the image in one parallel pass (the log
+/// sum as in [`stats_chunk`]: ≲ 1e-7 per term, so ~1e-7 relative on L_avg). The
+/// per-task partial sums are added in image order, so the result does not depend on the
+/// thread count.
+pub(crate) fn luminance_stats(image: &Image, scale: f32, w: [f32; 3]) -> LuminanceStats {
+    stats::<true>(image, scale, w)
+}
+
+/// As [`luminance_stats`] without the log-average (`log_average` is NaN), for operators
+/// that need only the mean, maximum or minimum: no per-pixel log work.
+pub(crate) fn luminance_stats_without_log(
+    image: &Image,
+    scale: f32,
+    w: [f32; 3],
+) -> LuminanceStats {
+    stats::<false>(image, scale, w)
+}
+
+fn stats<const LOG: bool>(image: &Image, scale: f32, w: [f32; 3]) -> LuminanceStats {
+    let partial: Vec<Acc> = image
         .pixels()
         .par_chunks(CHUNK)
-        .map(|chunk| {
-            let mut lum = [0.0f32; CHUNK];
-            let lum = &mut lum[..chunk.len()];
-            for (l, p) in lum.iter_mut().zip(chunk) {
-                *l = sanitised_luminance(*p, scale, w);
-            }
-            // f32 partial sums per lane (≤ 512 terms), f64 across lanes and chunks.
-            let mut sum_log = [0.0f32; LANES];
-            let mut sum = [0.0f32; LANES];
-            let mut max = [0.0f32; LANES];
-            let mut min_positive = [f32::INFINITY; LANES];
-            let mut lanes = lum.chunks_exact(LANES);
-            for group in &mut lanes {
-                for k in 0..LANES {
-                    let l = group[k];
-                    sum_log[k] += fast_math::ln(delta + l);
-                    sum[k] += l;
-                    max[k] = max[k].max(l);
-                    min_positive[k] = if l > 0.0 {
-                        min_positive[k].min(l)
-                    } else {
-                        min_positive[k]
-                    };
-                }
-            }
-            for (k, l) in lanes.remainder().iter().enumerate() {
-                sum_log[k] += fast_math::ln(delta + l);
-                sum[k] += l;
-                max[k] = max[k].max(*l);
-                if *l > 0.0 {
-                    min_positive[k] = min_positive[k].min(*l);
-                }
-            }
-            Acc {
-                sum_log: sum_log.iter().map(|v| *v as f64).sum(),
-                sum: sum.iter().map(|v| *v as f64).sum(),
-                max: max.iter().fold(0.0f32, |a, b| a.max(*b)),
-                min_positive: min_positive.iter().fold(f32::INFINITY, |a, b| a.min(*b)),
-            }
-        })
-        .reduce(|| Acc::EMPTY, Acc::merge);
+        .map(|chunk| avx2!(stats_chunk::<LOG>(chunk, scale, w)))
+        .collect();
+    let acc = partial.into_iter().fold(Acc::EMPTY, Acc::merge);
     let n = image.pixels().len() as f64;
     LuminanceStats {
-        log_average: (acc.sum_log / n).exp(),
+        log_average: if LOG {
+            (acc.sum_log / n).exp()
+        } else {
+            f64::NAN
+        },
         mean: acc.sum / n,
         max: acc.max as f64,
         min_positive: if acc.min_positive.is_finite() {
@@ -174,25 +305,123 @@ pub(crate) struct Mapped {
     pub negative_pixels: u64,
 }
 
-/// Maps every pixel through `curve` on luminance: c_out = c · curve(L) / L (hue and
+/// One task of [`map_luminance`] (pixels `start …` of the image).
+#[inline(always)]
+fn map_luminance_chunk<C: LuminanceCurve>(
+    input: &[[f32; 3]],
+    out: &mut [[f32; 3]],
+    start: usize,
+    scale: f32,
+    w: [f32; 3],
+    curve: &C,
+) -> (u64, u64) {
+    let mut r = [0.0f32; BLOCK];
+    let mut g = [0.0f32; BLOCK];
+    let mut b = [0.0f32; BLOCK];
+    let mut l = [0.0f32; BLOCK];
+    let mut ld = [0.0f32; BLOCK];
+    let (mut non_finite, mut negative) = (0u64, 0u64);
+    for (k, (i, o)) in input.chunks(BLOCK).zip(out.chunks_mut(BLOCK)).enumerate() {
+        let n = i.len();
+        let (nf, neg) = load_block(i, scale, w, &mut r, &mut g, &mut b, &mut l);
+        non_finite += nf as u64;
+        negative += neg as u64;
+        ld[..n].copy_from_slice(&l[..n]);
+        curve.ratio(start + k * BLOCK, &mut ld[..n]);
+        let (r, g, b, l, ld, o) = (&r[..n], &g[..n], &b[..n], &l[..n], &ld[..n], &mut o[..n]);
+        for j in 0..n {
+            let v = ld[j];
+            // Black (and non-finite input, whose L is 0) stays black.
+            let ratio = if l[j] > 0.0 && v.is_finite() { v } else { 0.0 };
+            // max(0) turns ∞ · 0 = NaN into 0, as for a non-finite input.
+            let c = [
+                (r[j] * ratio).max(0.0),
+                (g[j] * ratio).max(0.0),
+                (b[j] * ratio).max(0.0),
+            ];
+            let finite = c[0].is_finite() & c[1].is_finite() & c[2].is_finite();
+            o[j] = if finite { c } else { [0.0; 3] };
+        }
+    }
+    (non_finite, negative)
+}
+
+/// Maps every pixel through `curve` on luminance: c_out = c · L_d / L (hue and
 /// saturation kept, Reinhard et al. 2002 §3 "colour scaled by L_d / L_w"); black stays
-/// black and any non-finite result becomes 0.
-pub(crate) fn map_luminance(
+/// black and any non-finite result becomes 0. Curves that need the pixel index (local
+/// operators' adaptation planes) get it as `start + j`.
+pub(crate) fn map_luminance<C: LuminanceCurve>(
     ctx: &Context,
     scale: f32,
     w: [f32; 3],
-    curve: impl Fn(f32) -> f32 + Sync,
+    curve: &C,
 ) -> Mapped {
-    map_luminance_indexed(ctx, scale, w, |_, l| curve(l))
+    let image = ctx.image;
+    let mut pixels = ctx.output_buffer(image.pixels().len());
+    let (non_finite, negative) = pixels
+        .par_chunks_mut(CHUNK)
+        .zip(image.pixels().par_chunks(CHUNK))
+        .enumerate()
+        .map(|(k, (o, i))| avx2!(map_luminance_chunk(i, o, k * CHUNK, scale, w, curve)))
+        .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
+    Mapped {
+        pixels,
+        non_finite_pixels: non_finite,
+        negative_pixels: negative,
+    }
 }
 
-/// Maps every sanitised pixel through `f`; non-finite results become 0.
-pub(crate) fn map_pixels(
-    ctx: &Context,
+/// One task of [`map_pixels`].
+#[inline(always)]
+fn map_pixels_chunk<M: PixelMap>(
+    input: &[[f32; 3]],
+    out: &mut [[f32; 3]],
+    start: usize,
     scale: f32,
-    f: impl Fn([f32; 3]) -> [f32; 3] + Sync,
-) -> Mapped {
-    map_pixels_indexed(ctx, scale, |_, c| f(c))
+    f: &M,
+) -> (u64, u64) {
+    let mut r = [0.0f32; BLOCK];
+    let mut g = [0.0f32; BLOCK];
+    let mut b = [0.0f32; BLOCK];
+    let mut l = [0.0f32; BLOCK];
+    let (mut non_finite, mut negative) = (0u64, 0u64);
+    for (k, (i, o)) in input.chunks(BLOCK).zip(out.chunks_mut(BLOCK)).enumerate() {
+        let n = i.len();
+        let (nf, neg) = load_block(i, scale, [0.0; 3], &mut r, &mut g, &mut b, &mut l);
+        non_finite += nf as u64;
+        negative += neg as u64;
+        f.map(start + k * BLOCK, &mut r[..n], &mut g[..n], &mut b[..n]);
+        let clean = |x: f32| if x.is_finite() { x } else { 0.0 };
+        for (j, o) in o.iter_mut().enumerate() {
+            *o = [clean(r[j]), clean(g[j]), clean(b[j])];
+        }
+    }
+    (non_finite, negative)
+}
+
+/// Maps every sanitised pixel through `f` (on de-interleaved planes); non-finite results
+/// become 0.
+pub(crate) fn map_pixels<M: PixelMap>(ctx: &Context, scale: f32, f: &M) -> Mapped {
+    let image = ctx.image;
+    let mut pixels = ctx.output_buffer(image.pixels().len());
+    let (non_finite, negative) = pixels
+        .par_chunks_mut(CHUNK)
+        .zip(image.pixels().par_chunks(CHUNK))
+        .enumerate()
+        .map(|(k, (o, i))| avx2!(map_pixels_chunk(i, o, k * CHUNK, scale, f)))
+        .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
+    Mapped {
+        pixels,
+        non_finite_pixels: non_finite,
+        negative_pixels: negative,
+    }
+}
+
+#[inline(always)]
+fn luminance_chunk(input: &[[f32; 3]], out: &mut [f32], scale: f32, w: [f32; 3]) {
+    for (o, p) in out.iter_mut().zip(input) {
+        *o = sanitised_luminance(*p, scale, w);
+    }
 }
 
 /// The sanitised luminance plane `w · sanitise(p, scale)` (row-major), for local operators.
@@ -201,92 +430,6 @@ pub(crate) fn luminance_plane(image: &Image, scale: f32, w: [f32; 3]) -> Vec<f32
     plane
         .par_chunks_mut(CHUNK)
         .zip(image.pixels().par_chunks(CHUNK))
-        .for_each(|(o, i)| {
-            for (o, p) in o.iter_mut().zip(i) {
-                *o = dot(w, sanitise(*p, scale));
-            }
-        });
+        .for_each(|(o, i)| avx2!(luminance_chunk(i, o, scale, w)));
     plane
-}
-
-/// As [`map_luminance`], with the pixel index passed to `curve` (local operators look up
-/// their per-pixel adaptation by index). Per chunk: luminance into a stack array, the
-/// curve's ratio L_d / L over that array (a tight loop the compiler can vectorise when the
-/// curve is branch-free), then the colour scaled by the ratio.
-pub(crate) fn map_luminance_indexed(
-    ctx: &Context,
-    scale: f32,
-    w: [f32; 3],
-    curve: impl Fn(usize, f32) -> f32 + Sync,
-) -> Mapped {
-    let image = ctx.image;
-    let mut pixels = ctx.output_buffer(image.pixels().len());
-    let (non_finite, negative) = pixels
-        .par_chunks_mut(CHUNK)
-        .zip(image.pixels().par_chunks(CHUNK))
-        .enumerate()
-        .map(|(k, (o, i))| {
-            let mut ratio = [0.0f32; CHUNK];
-            let ratio = &mut ratio[..i.len()];
-            for (r, p) in ratio.iter_mut().zip(i) {
-                *r = sanitised_luminance(*p, scale, w);
-            }
-            let base = k * CHUNK;
-            for (j, r) in ratio.iter_mut().enumerate() {
-                let l = *r;
-                let v = curve(base + j, l) / l;
-                *r = if l > 0.0 && v.is_finite() { v } else { 0.0 };
-            }
-            for ((o, p), r) in o.iter_mut().zip(i).zip(ratio.iter()) {
-                let finite = p[0].is_finite() & p[1].is_finite() & p[2].is_finite();
-                let r = if finite { *r } else { 0.0 };
-                // r = 0 for non-finite pixels; max(0) clamps negatives (and NaN·0).
-                *o = [
-                    ((p[0] * scale).max(0.0) * r).max(0.0),
-                    ((p[1] * scale).max(0.0) * r).max(0.0),
-                    ((p[2] * scale).max(0.0) * r).max(0.0),
-                ];
-                if !o.iter().all(|c| c.is_finite()) {
-                    *o = [0.0; 3];
-                }
-            }
-            count_problems(i)
-        })
-        .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
-    Mapped {
-        pixels,
-        non_finite_pixels: non_finite,
-        negative_pixels: negative,
-    }
-}
-
-/// Maps every sanitised pixel through `f(index, rgb)`; non-finite results become 0.
-pub(crate) fn map_pixels_indexed(
-    ctx: &Context,
-    scale: f32,
-    f: impl Fn(usize, [f32; 3]) -> [f32; 3] + Sync,
-) -> Mapped {
-    let image = ctx.image;
-    let mut pixels = ctx.output_buffer(image.pixels().len());
-    let (non_finite, negative) = pixels
-        .par_chunks_mut(CHUNK)
-        .zip(image.pixels().par_chunks(CHUNK))
-        .enumerate()
-        .map(|(k, (o, i))| {
-            let (mut non_finite, mut negative) = (0u64, 0u64);
-            for (j, (o, p)) in o.iter_mut().zip(i).enumerate() {
-                let finite = p[0].is_finite() && p[1].is_finite() && p[2].is_finite();
-                non_finite += !finite as u64;
-                negative += (finite && (p[0] < 0.0 || p[1] < 0.0 || p[2] < 0.0)) as u64;
-                let v = f(k * CHUNK + j, sanitise(*p, scale));
-                *o = v.map(|x| if x.is_finite() { x } else { 0.0 });
-            }
-            (non_finite, negative)
-        })
-        .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
-    Mapped {
-        pixels,
-        non_finite_pixels: non_finite,
-        negative_pixels: negative,
-    }
 }

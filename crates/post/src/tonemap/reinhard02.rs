@@ -6,7 +6,7 @@
 //! colour scaled by L_d / L_w. Defaults: key 0.18, L_white = the largest scaled L (so the
 //! brightest pixel maps to 1).
 
-use super::pixels::{luminance_stats, map_luminance};
+use super::pixels::{luminance_stats, map_luminance, LuminanceCurve};
 use super::{Context, OperatorInfo, Output, ParamSpec};
 
 pub(crate) static INFO: OperatorInfo = OperatorInfo {
@@ -33,6 +33,24 @@ pub(crate) static INFO: OperatorInfo = OperatorInfo {
     ],
 };
 
+/// Eqs. 2 and 4: L = s · L_w, L_d = L (1 + L / L_white²) / (1 + L).
+struct Curve {
+    s: f32,
+    inv_white2: f32,
+}
+
+impl LuminanceCurve for Curve {
+    #[inline(always)]
+    fn ratio(&self, _start: usize, l: &mut [f32]) {
+        // L_d / L_w = s (1 + L / L_white²) / (1 + L).
+        let (s, inv_white2) = (self.s, self.inv_white2);
+        for v in l {
+            let x = s * *v;
+            *v = s * (1.0 + x * inv_white2) / (1.0 + x);
+        }
+    }
+}
+
 pub(crate) fn apply(ctx: &Context) -> Output {
     let stats = luminance_stats(ctx.image, ctx.exposure, ctx.weights);
     let key = ctx.value("key");
@@ -45,10 +63,7 @@ pub(crate) fn apply(ctx: &Context) -> Output {
         0.0
     };
     let s = scale as f32;
-    let mapped = map_luminance(ctx, ctx.exposure, ctx.weights, |lw| {
-        let l = s * lw;
-        l * (1.0 + l * inv_white2) / (1.0 + l)
-    });
+    let mapped = map_luminance(ctx, ctx.exposure, ctx.weights, &Curve { s, inv_white2 });
     Output {
         mapped,
         values: vec![

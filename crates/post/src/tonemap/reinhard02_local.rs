@@ -20,7 +20,8 @@
 use rayon::prelude::*;
 
 use super::gaussian::gaussian_blur;
-use super::pixels::{luminance_plane, luminance_stats, map_luminance_indexed, CHUNK};
+use super::pixels::{luminance_plane, luminance_stats, map_luminance, LuminanceCurve, CHUNK};
+use super::simd::avx2;
 use super::{Context, OperatorInfo, Output, ParamSpec};
 
 pub(crate) static INFO: OperatorInfo = OperatorInfo {
@@ -68,6 +69,49 @@ pub fn centre_sigma_px(s: f32) -> f32 {
     s / 4.0
 }
 
+/// Eqs. 7–8 for one scale over a task's pixels: a pixel still searching (`act`) whose
+/// |V| < ε takes V_1 of this scale as its selection; one with |V| ≥ ε stops searching.
+/// Branch-free (selects), so it vectorises; returns how many pixels passed.
+#[inline(always)]
+fn select_scale(
+    sel: &mut [f32],
+    act: &mut [bool],
+    v1: &[f32],
+    v2: &[f32],
+    denominator_offset: f32,
+    epsilon: f32,
+) -> usize {
+    let n = sel.len();
+    let (act, v1, v2) = (&mut act[..n], &v1[..n], &v2[..n]);
+    let mut passed = 0u32;
+    for k in 0..n {
+        let v = (v1[k] - v2[k]) / (denominator_offset + v1[k]);
+        let pass = act[k] & (v.abs() < epsilon);
+        sel[k] = if pass { v1[k] } else { sel[k] };
+        act[k] = pass;
+        passed += pass as u32;
+    }
+    passed as usize
+}
+
+/// Eq. 9 with eq. 2: L_d = a L_w / L_avg / (1 + V_1(s_m)).
+struct Curve<'a> {
+    key_scale: f32,
+    selected: &'a [f32],
+}
+
+impl LuminanceCurve for Curve<'_> {
+    #[inline(always)]
+    fn ratio(&self, start: usize, l: &mut [f32]) {
+        // L_d / L_w = (a / L_avg) / (1 + V_1(s_m)).
+        let selected = &self.selected[start..start + l.len()];
+        let key_scale = self.key_scale;
+        for (v, s) in l.iter_mut().zip(selected) {
+            *v = key_scale / (1.0 + s);
+        }
+    }
+}
+
 pub(crate) fn apply(ctx: &Context) -> Output {
     let stats = luminance_stats(ctx.image, ctx.exposure, ctx.weights);
     let key = ctx.value("key");
@@ -103,19 +147,7 @@ pub(crate) fn apply(ctx: &Context) -> Output {
             .zip(active.par_chunks_mut(CHUNK))
             .zip(v1.par_chunks(CHUNK).zip(v2.par_chunks(CHUNK)))
             .map(|((sel, act), (a, b))| {
-                let mut n = 0;
-                for k in 0..sel.len() {
-                    if act[k] {
-                        let v = (a[k] - b[k]) / (denominator_offset + a[k]);
-                        if v.abs() < epsilon {
-                            sel[k] = a[k];
-                            n += 1;
-                        } else {
-                            act[k] = false;
-                        }
-                    }
-                }
-                n
+                avx2!(select_scale(sel, act, a, b, denominator_offset, epsilon))
             })
             .sum();
         scales_done += 1;
@@ -127,9 +159,11 @@ pub(crate) fn apply(ctx: &Context) -> Output {
         s *= SCALE_RATIO;
     }
     drop((v1, v2, scratch, active));
-    let mapped = map_luminance_indexed(ctx, ctx.exposure, ctx.weights, |i, lw| {
-        key_scale * lw / (1.0 + selected[i])
-    });
+    let curve = Curve {
+        key_scale,
+        selected: &selected,
+    };
+    let mapped = map_luminance(ctx, ctx.exposure, ctx.weights, &curve);
     Output {
         mapped,
         values: vec![

@@ -5,7 +5,7 @@
 //! smallest non-zero luminance: for small x = L_w / L_max the map is ≈ p·x, so this puts
 //! the darkest non-black pixel on the first display level 1/N (Schlick's calibration).
 
-use super::pixels::{luminance_stats, map_luminance};
+use super::pixels::{luminance_stats_without_log, map_luminance, LuminanceCurve};
 use super::{Context, OperatorInfo, Output, ParamSpec};
 
 pub(crate) static INFO: OperatorInfo = OperatorInfo {
@@ -31,8 +31,25 @@ pub(crate) static INFO: OperatorInfo = OperatorInfo {
     ],
 };
 
+/// p L / ((p − 1) L + L_max).
+struct Curve {
+    p: f32,
+    l_max: f32,
+}
+
+impl LuminanceCurve for Curve {
+    #[inline(always)]
+    fn ratio(&self, _start: usize, l: &mut [f32]) {
+        // L_d / L = p / ((p − 1) L + L_max).
+        let (p, l_max) = (self.p, self.l_max);
+        for v in l {
+            *v = p / ((p - 1.0) * *v + l_max);
+        }
+    }
+}
+
 pub(crate) fn apply(ctx: &Context) -> Output {
-    let stats = luminance_stats(ctx.image, ctx.exposure, ctx.weights);
+    let stats = luminance_stats_without_log(ctx.image, ctx.exposure, ctx.weights);
     let p = ctx.param("p").unwrap_or_else(|| {
         if stats.min_positive > 0.0 {
             (stats.max / (ctx.value("levels") * stats.min_positive)).max(1.0)
@@ -41,9 +58,7 @@ pub(crate) fn apply(ctx: &Context) -> Output {
         }
     });
     let (p32, l_max) = (p as f32, stats.max as f32);
-    let mapped = map_luminance(ctx, ctx.exposure, ctx.weights, |l| {
-        p32 * l / ((p32 - 1.0) * l + l_max)
-    });
+    let mapped = map_luminance(ctx, ctx.exposure, ctx.weights, &Curve { p: p32, l_max });
     Output {
         mapped,
         values: vec![("p", p), ("max_luminance", stats.max)],

@@ -10,7 +10,7 @@
 //! L_dmax = 100 cd/m² (those of Banterle's HDR Toolbox).
 
 use super::fast_math;
-use super::pixels::{luminance_stats, map_luminance};
+use super::pixels::{luminance_stats, map_luminance, LuminanceCurve};
 use super::{Context, OperatorInfo, Output, ParamSpec};
 use crate::error::Result;
 
@@ -53,6 +53,25 @@ pub fn gamma(l: f64) -> f64 {
     }
 }
 
+/// L_d = factor · (L / L_wa)^exponent, as the ratio L_d / L = (factor / L_wa) ·
+/// (L / L_wa)^(exponent − 1): one power and no division per pixel.
+struct Curve {
+    factor: f32,
+    inv_wa: f32,
+    exponent: f32,
+}
+
+impl LuminanceCurve for Curve {
+    #[inline(always)]
+    fn ratio(&self, _start: usize, l: &mut [f32]) {
+        let (factor, inv_wa, exponent) = (self.factor, self.inv_wa, self.exponent);
+        let (scale, exponent) = (factor * inv_wa, exponent - 1.0);
+        for v in l {
+            *v = scale * fast_math::powf(*v * inv_wa, exponent);
+        }
+    }
+}
+
 pub(crate) fn apply(ctx: &Context) -> Result<Output> {
     let absolute = ctx.exposure * ctx.absolute_scale()? as f32;
     let stats = luminance_stats(ctx.image, absolute, ctx.weights);
@@ -67,9 +86,16 @@ pub(crate) fn apply(ctx: &Context) -> Result<Output> {
     let factor = (m * l_da / l_dmax) as f32;
     let inv_wa = (1.0 / l_wa) as f32;
     Ok(Output {
-        mapped: map_luminance(ctx, absolute, ctx.weights, |l| {
-            factor * fast_math::powf(l * inv_wa, exponent)
-        }),
+        mapped: map_luminance(
+            ctx,
+            absolute,
+            ctx.weights,
+            &Curve {
+                factor,
+                inv_wa,
+                exponent,
+            },
+        ),
         values: vec![
             ("world_adaptation_cd_m2", l_wa),
             ("m", m),

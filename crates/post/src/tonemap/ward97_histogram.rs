@@ -22,7 +22,7 @@
 use rayon::prelude::*;
 
 use super::fast_math;
-use super::pixels::{dot, map_luminance, sanitise};
+use super::pixels::{dot, map_luminance, sanitise, LuminanceCurve};
 use super::{Context, OperatorInfo, Output, ParamSpec};
 use crate::error::Result;
 
@@ -136,6 +136,45 @@ fn foveal_means(ctx: &Context, scale: f32, fw: usize, fh: usize) -> Vec<f64> {
         .collect()
 }
 
+/// Linear fallback: min(factor · L, 1).
+struct Linear(f32);
+
+impl LuminanceCurve for Linear {
+    #[inline(always)]
+    fn ratio(&self, _start: usize, l: &mut [f32]) {
+        let factor = self.0;
+        for v in l {
+            *v = (factor * *v).min(1.0) / *v;
+        }
+    }
+}
+
+/// Eq. 5: L_d = exp(ln L_dmin + ln(L_dmax / L_dmin) P(ln L)) / L_dmax, P the cumulative
+/// histogram interpolated linearly within a bin.
+struct Histogram<'a> {
+    cdf: &'a [f32],
+    bins: usize,
+    b_min: f32,
+    inv_bw: f32,
+    ln_dmin: f32,
+    range: f32,
+    inv_dmax: f32,
+}
+
+impl LuminanceCurve for Histogram<'_> {
+    #[inline(always)]
+    fn ratio(&self, _start: usize, l: &mut [f32]) {
+        let (cdf, bins, b_min, inv_bw) = (self.cdf, self.bins, self.b_min, self.inv_bw);
+        let (ln_dmin, range, inv_dmax) = (self.ln_dmin, self.range, self.inv_dmax);
+        for v in l {
+            let t = ((fast_math::ln(*v) - b_min) * inv_bw).clamp(0.0, bins as f32);
+            let k = (t as usize).min(bins - 1);
+            let p = cdf[k] + (t - k as f32) * (cdf[k + 1] - cdf[k]);
+            *v = fast_math::exp(ln_dmin + range * p) * inv_dmax / *v;
+        }
+    }
+}
+
 pub(crate) fn apply(ctx: &Context) -> Result<Output> {
     let scale = ctx.exposure * ctx.absolute_scale()? as f32;
     let l_dmin = ctx.value("display_min");
@@ -184,7 +223,7 @@ pub(crate) fn apply(ctx: &Context) -> Result<Output> {
         let factor = (1.0 / top) as f32;
         values.push(("linear_factor", factor as f64));
         return Ok(Output {
-            mapped: map_luminance(ctx, scale, ctx.weights, |l| (factor * l).min(1.0)),
+            mapped: map_luminance(ctx, scale, ctx.weights, &Linear(factor)),
             values,
         });
     }
@@ -201,12 +240,16 @@ pub(crate) fn apply(ctx: &Context) -> Result<Output> {
     let (b_min32, inv_bw) = (b_min as f32, (1.0 / bin_width) as f32);
     let (ln_dmin, range32, inv_dmax) = (l_dmin.ln() as f32, display_range as f32, 1.0 / l_dmax);
     let inv_dmax = inv_dmax as f32;
-    let mapped = map_luminance(ctx, scale, ctx.weights, |l| {
-        let t = ((fast_math::ln(l) - b_min32) * inv_bw).clamp(0.0, bins as f32);
-        let k = (t as usize).min(bins - 1);
-        let p = cdf[k] + (t - k as f32) * (cdf[k + 1] - cdf[k]);
-        fast_math::exp(ln_dmin + range32 * p) * inv_dmax
-    });
+    let curve = Histogram {
+        cdf: &cdf,
+        bins,
+        b_min: b_min32,
+        inv_bw,
+        ln_dmin,
+        range: range32,
+        inv_dmax,
+    };
+    let mapped = map_luminance(ctx, scale, ctx.weights, &curve);
     Ok(Output { mapped, values })
 }
 
