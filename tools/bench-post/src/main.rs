@@ -5,7 +5,9 @@
 //!   reference: global operators should take ≤ 3× that, local ones ≤ 300 ms); operator
 //!   runs alternate with copy passes, and `ratio_to_copy` divides the operator's median by
 //!   the median of its own interleaved copy passes (`copy_pass_ms` per operator; the
-//!   top-level `copy_pass_ms` is the median over all of them);
+//!   top-level `copy_pass_ms` is the median over all of them); `compute_cpu_ms`,
+//!   `copy_pass_cpu_ms` and `ratio_to_copy_cpu` are the same in CPU time of all threads
+//!   (medians), which the shared machine's load does not stretch;
 //! - `file_ms`: the whole in-process pipeline `tonemap_file` from a float EXR to a 16-bit
 //!   PNG (read, operator, gamut clip, encode, write), with its stage breakdown.
 //!
@@ -21,6 +23,25 @@ use std::time::Instant;
 use prism_post::{tonemap_file, Image, OperatorChoice, ToneOperator, ToneParams, TonemapOptions};
 use prism_spectrum::rgb_space::RgbColorSpace;
 use rayon::prelude::*;
+
+/// CPU time of all the process's threads, ms (NaN where unavailable). On the shared
+/// machine other processes' load stretches wall time; CPU time counts only the work done
+/// (plus rayon's brief spinning), so `compute_cpu_ms / threads` estimates the wall time
+/// on an idle machine.
+fn process_cpu_ms() -> f64 {
+    #[cfg(unix)]
+    {
+        let mut ts = libc::timespec {
+            tv_sec: 0,
+            tv_nsec: 0,
+        };
+        // SAFETY: ts is a valid timespec to write to.
+        if unsafe { libc::clock_gettime(libc::CLOCK_PROCESS_CPUTIME_ID, &mut ts) } == 0 {
+            return ts.tv_sec as f64 * 1e3 + ts.tv_nsec as f64 * 1e-6;
+        }
+    }
+    f64::NAN
+}
 
 fn median(mut times: Vec<f64>) -> f64 {
     times.sort_by(f64::total_cmp);
@@ -100,14 +121,14 @@ fn main() {
     // no allocation (the reference for "≤ 3× a copy pass").
     let mut copy = vec![[0.0f32; 3]; w * h];
     let mut copy_pass = || {
-        let t = Instant::now();
+        let (t, cpu) = (Instant::now(), process_cpu_ms());
         copy.par_chunks_mut(4096)
             .zip(image.pixels().par_chunks(4096))
             .for_each(|(o, i)| o.copy_from_slice(i));
         std::hint::black_box(&copy);
-        t.elapsed().as_secs_f64() * 1e3
+        (t.elapsed().as_secs_f64() * 1e3, process_cpu_ms() - cpu)
     };
-    let mut all_copies: Vec<f64> = (0..runs).map(|_| copy_pass()).collect();
+    let mut all_copies: Vec<f64> = (0..runs).map(|_| copy_pass().0).collect();
 
     let dir = std::env::temp_dir().join(format!("bench-post-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
@@ -128,18 +149,24 @@ fn main() {
         // Operator runs alternate with copy passes, so that the ratio compares medians
         // taken under the same machine load (the shared machine's load drifts).
         let mut copies = Vec::with_capacity(runs);
+        let mut copies_cpu = Vec::with_capacity(runs);
         let mut times = Vec::with_capacity(runs);
+        let mut times_cpu = Vec::with_capacity(runs);
         for _ in 0..runs {
-            copies.push(copy_pass());
+            let (wall, cpu) = copy_pass();
+            copies.push(wall);
+            copies_cpu.push(cpu);
             let b = std::mem::take(&mut buffer);
-            let t = Instant::now();
+            let (t, cpu) = (Instant::now(), process_cpu_ms());
             let result = op.apply_into(&image, &params, b).unwrap();
             buffer = std::hint::black_box(result).image.into_pixels();
             times.push(t.elapsed().as_secs_f64() * 1e3);
+            times_cpu.push(process_cpu_ms() - cpu);
         }
         let compute_ms = median(times);
         all_copies.extend(&copies);
         let copy_ms = median(copies);
+        let (compute_cpu_ms, copy_cpu_ms) = (median(times_cpu), median(copies_cpu));
         let (file_ms, stages) = if with_file {
             file_pipeline(&input, &dir.join("out.png"), op, file_runs)
         } else {
@@ -152,6 +179,9 @@ fn main() {
                 "compute_ms": compute_ms,
                 "ratio_to_copy": compute_ms / copy_ms,
                 "copy_pass_ms": copy_ms,
+                "compute_cpu_ms": compute_cpu_ms,
+                "copy_pass_cpu_ms": copy_cpu_ms,
+                "ratio_to_copy_cpu": compute_cpu_ms / copy_cpu_ms,
                 "file_ms": file_ms,
                 "file_stages_ms": stages,
             }),

@@ -2,9 +2,10 @@
 //! single-level tiles (what the `exr` crate, and so Prism, writes by default), exactly the
 //! channels B, G, R of one sample type (float or half), no layer name. It uses the `exr`
 //! crate's block-level API: the compressed chunks are read in file order and grouped into
-//! bands of rows (a scan-line block, or a row of tiles), then the bands are decompressed
-//! in parallel on the global rayon pool and each block's lines written straight into its
-//! rows of the interleaved RGB pixels — no per-channel planes, no separate interleaving
+//! bands of rows (a scan-line block, or a row of tiles); each complete band is
+//! decompressed by a task on the global rayon pool while the file is still being read,
+//! and each block's lines are written straight into its rows of the interleaved RGB
+//! pixels — no per-channel planes, no separate interleaving
 //! pass, no second thread pool (the general reader builds one per file). Anything else (or
 //! any error here) goes to the general reader, which also gives the error messages.
 
@@ -18,7 +19,7 @@ use ::exr::block::UncompressedBlock;
 use ::exr::meta::attribute::{AttributeValue, Chromaticities, LevelMode, SampleType};
 use ::exr::meta::BlockDescription;
 use ::exr::prelude::f16;
-use rayon::prelude::*;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// What the fast path read: size, interleaved pixels, chromaticities and the attributes the
 /// general path collects (custom attributes and `software`).
@@ -74,62 +75,71 @@ pub(crate) fn read_rgb_exr(path: &Path) -> Option<RgbExr> {
     }
     let top = header.own_attributes.layer_position.1 as i64;
 
-    // Chunks in file order, each put in its band.
+    // Chunks in file order, each put in its band; a band whose chunks have all arrived
+    // (1 scan-line block, or a full row of tiles) is decompressed and scattered by a rayon
+    // task at once, so decompression overlaps the reading of the rest of the file.
     let bands = height.div_ceil(band_rows);
-    let mut slots: Vec<Vec<Chunk>> = (0..bands).map(|_| Vec::new()).collect();
-    for chunk in reader.all_chunks(false).ok()? {
-        let chunk = chunk.ok()?;
-        let band = match &chunk.compressed_block {
-            CompressedBlock::ScanLine(block) => {
-                let offset = block.y_coordinate as i64 - top;
-                if offset < 0 || offset % band_rows as i64 != 0 {
-                    return None;
-                }
-                (offset / band_rows as i64) as usize
-            }
-            CompressedBlock::Tile(tile) => {
-                if tile.coordinates.level_index.0 != 0 || tile.coordinates.level_index.1 != 0 {
-                    return None;
-                }
-                tile.coordinates.tile_index.1
-            }
-            _ => return None,
-        };
-        slots.get_mut(band)?.push(chunk);
-    }
-
+    let per_band = match header.blocks {
+        BlockDescription::ScanLines => 1,
+        BlockDescription::Tiles(t) => width.div_ceil(t.tile_size.0.max(1)),
+    };
     let mut pixels = vec![[0.0f32; 3]; width * height];
-    let ok = pixels
-        .par_chunks_mut(width * band_rows)
-        .zip(slots.into_par_iter())
-        .enumerate()
-        .all(|(b, (rows, chunks))| {
-            let rows_here = rows.len() / width;
-            // Every column of the band written exactly once.
-            let mut covered = vec![false; width];
-            for chunk in chunks {
-                let Ok(block) = UncompressedBlock::decompress_chunk(chunk, &meta, false) else {
-                    return false;
-                };
-                let (x0, y0) = (block.index.pixel_position.0, block.index.pixel_position.1);
-                let (w, h) = (block.index.pixel_size.0, block.index.pixel_size.1);
-                if y0 != b * band_rows
-                    || h != rows_here
-                    || x0 + w > width
-                    || covered[x0..x0 + w].iter().any(|c| *c)
-                {
-                    return false;
+    let mut rows: Vec<Option<&mut [[f32; 3]]>> =
+        pixels.chunks_mut(width * band_rows).map(Some).collect();
+    let mut pending: Vec<Vec<Chunk>> = (0..bands).map(|_| Vec::new()).collect();
+    let failed = AtomicBool::new(false);
+    let meta = &meta;
+    let complete = rayon::scope(|scope| {
+        for chunk in reader.all_chunks(false).ok()? {
+            let chunk = chunk.ok()?;
+            let band = match &chunk.compressed_block {
+                CompressedBlock::ScanLine(block) => {
+                    let offset = block.y_coordinate as i64 - top;
+                    if offset < 0 || offset % band_rows as i64 != 0 {
+                        return None;
+                    }
+                    (offset / band_rows as i64) as usize
                 }
-                covered[x0..x0 + w].fill(true);
-                if !scatter_block(&block.data, rows, width, x0, w, order, sample_type) {
-                    return false;
+                CompressedBlock::Tile(tile) => {
+                    if tile.coordinates.level_index.0 != 0 || tile.coordinates.level_index.1 != 0 {
+                        return None;
+                    }
+                    tile.coordinates.tile_index.1
                 }
+                _ => return None,
+            };
+            let chunks = pending.get_mut(band)?;
+            chunks.push(chunk);
+            if chunks.len() == per_band {
+                let chunks = std::mem::take(chunks);
+                let band_pixels = rows[band].take()?;
+                let failed = &failed;
+                scope.spawn(move |_| {
+                    let ok = decode_band(
+                        chunks,
+                        band_pixels,
+                        band,
+                        band_rows,
+                        width,
+                        meta,
+                        order,
+                        sample_type,
+                    );
+                    if !ok {
+                        failed.store(true, Ordering::Relaxed);
+                    }
+                });
+            } else if chunks.len() > per_band {
+                return None;
             }
-            covered.iter().all(|c| *c)
-        });
-    if !ok {
+        }
+        Some(())
+    });
+    // Every band complete (no rows left unclaimed) and decoded.
+    if complete.is_none() || rows.iter().any(Option::is_some) || failed.load(Ordering::Relaxed) {
         return None;
     }
+    drop(rows);
 
     let mut attributes = BTreeMap::new();
     for (name, value) in &header.own_attributes.other {
@@ -147,6 +157,42 @@ pub(crate) fn read_rgb_exr(path: &Path) -> Option<RgbExr> {
         chromaticities: header.shared_attributes.chromaticities,
         attributes,
     })
+}
+
+/// Decompresses the chunks of band `band` and writes them into its rows; false on any
+/// mismatch (wrong position or size, a column written twice or never).
+#[allow(clippy::too_many_arguments)]
+fn decode_band(
+    chunks: Vec<Chunk>,
+    rows: &mut [[f32; 3]],
+    band: usize,
+    band_rows: usize,
+    width: usize,
+    meta: &::exr::meta::MetaData,
+    order: [usize; 3],
+    sample_type: SampleType,
+) -> bool {
+    let rows_here = rows.len() / width;
+    let mut covered = vec![false; width];
+    for chunk in chunks {
+        let Ok(block) = UncompressedBlock::decompress_chunk(chunk, meta, false) else {
+            return false;
+        };
+        let (x0, y0) = (block.index.pixel_position.0, block.index.pixel_position.1);
+        let (w, h) = (block.index.pixel_size.0, block.index.pixel_size.1);
+        if y0 != band * band_rows
+            || h != rows_here
+            || x0 + w > width
+            || covered[x0..x0 + w].iter().any(|c| *c)
+        {
+            return false;
+        }
+        covered[x0..x0 + w].fill(true);
+        if !scatter_block(&block.data, rows, width, x0, w, order, sample_type) {
+            return false;
+        }
+    }
+    covered.iter().all(|c| *c)
 }
 
 /// Writes one decompressed block `w` pixels wide at column `x0` (per line: each channel's
