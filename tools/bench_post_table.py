@@ -13,14 +13,18 @@ def main():
     p = d["prism"]
     copy = p["copy_pass_ms"]
     print(f"Copy pass (read+write 4K float RGB, preallocated, {p['threads']} threads): "
-          f"{copy:.1f} ms.\n")
+          f"{copy:.1f} ms (median over the run; × copy uses the copy passes interleaved "
+          f"with each operator's runs).\n")
     print("| operator | kind | compute ms | × copy | target | tonemap_file EXR→PNG ms "
           "(read / tone / write) | pfstmo whole process s |")
     print("|---|---|---:|---:|---|---:|---:|")
     for name, v in p["operators"].items():
         local = v["local"]
-        target = "≤ 300 ms" if local else f"≤ {3 * copy:.0f} ms"
-        ok = v["compute_ms"] <= (300 if local else 3 * copy)
+        # bench-post ≥ 2026-11-22 times copy passes interleaved with each operator's runs
+        # and divides by their median; older JSON has only the global copy pass.
+        own_copy = v.get("copy_pass_ms", copy)
+        target = "≤ 300 ms" if local else f"≤ 3× ({3 * own_copy:.0f} ms)"
+        ok = v["compute_ms"] <= 300 if local else v["ratio_to_copy"] <= 3
         s = v["file_stages_ms"]
         peer = d["pfstmo"].get(PEERS.get(name, ""), {}).get("whole_process_s")
         print(f"| {name} | {'local' if local else 'global'} | {v['compute_ms']:.0f} | "

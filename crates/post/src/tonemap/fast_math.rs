@@ -64,6 +64,17 @@ pub fn log2_pair(a: f32, b: f32) -> (f32, f32) {
     (series(ea, na * db * r), series(eb, nb * da * r))
 }
 
+/// (log2 x, 1/y) with one division instead of two, as [`log2_pair`]: t = n · y · r and
+/// 1/y = d · r with r = 1/(d y), d = m + 1 ∈ [1.7, 2.5] (for a normal y ≥ 1.2e-38 and
+/// y ≤ 1e38 nothing under- or overflows). For curves of the form log(…) / L.
+#[inline(always)]
+pub fn log2_and_recip(x: f32, y: f32) -> (f32, f32) {
+    let (e, m) = reduce(x);
+    let (n, d) = (m - 1.0, m + 1.0);
+    let r = 1.0 / (d * y);
+    (series(e, n * y * r), d * r)
+}
+
 /// 2^x (see the module text for accuracy and range).
 #[inline(always)]
 pub fn exp2(x: f32) -> f32 {
@@ -150,6 +161,24 @@ mod tests {
             }
         }
         assert!(worst_pair <= 3e-7, "log2_pair error {worst_pair}");
+        // log2_and_recip: the log within the same bound, the reciprocal within 3 ulp.
+        let mut x = 1.2e-38f32;
+        let mut y = 3.3e-7f32;
+        while x < 3e38 {
+            let (l, r) = log2_and_recip(x, y);
+            let want = (x as f64).log2();
+            let err = (l as f64 - want).abs() - want.abs() * 2f64.powi(-24);
+            assert!(err <= 3e-7, "log2_and_recip({x:e}, {y:e}): {l} vs {want}");
+            assert!(
+                (r as f64 * y as f64 - 1.0).abs() <= 3.0 * 2f64.powi(-24),
+                "1/{y:e}"
+            );
+            x *= 1.000_37;
+            y *= 1.007_3;
+            if y > 1e30 {
+                y = 2.1e-30;
+            }
+        }
         let mut worst_exp = 0.0f64;
         let mut y = -125.9f32;
         while y < 127.0 {

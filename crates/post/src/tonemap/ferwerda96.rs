@@ -12,7 +12,7 @@
 //! 0.01) / (10 − 0.01) clamped to [0, 1] (as in Banterle's HDR Toolbox): scotopic below
 //! 0.01 cd/m², photopic above 10.
 
-use super::pixels::{luminance_stats_without_log, map_pixels, PixelMap};
+use super::pixels::{luminance_stats, map_pixels, PixelMap};
 use super::{Context, OperatorInfo, Output, ParamSpec};
 use crate::error::Result;
 
@@ -95,7 +95,7 @@ impl PixelMap for Map {
 
 pub(crate) fn apply(ctx: &Context) -> Result<Output> {
     let absolute = ctx.exposure * ctx.absolute_scale()? as f32;
-    let stats = luminance_stats_without_log(ctx.image, absolute, ctx.weights);
+    let stats = luminance_stats(ctx.image, absolute, ctx.weights);
     let l_dmax = ctx.value("display_max");
     let l_wa = ctx
         .param("world_adaptation")

@@ -4,7 +4,7 @@
 //! to 1 when q = k.
 
 use super::fast_math;
-use super::pixels::{luminance_stats_without_log, map_luminance, LuminanceCurve};
+use super::pixels::{luminance_stats, map_luminance, LuminanceCurve};
 use super::{Context, OperatorInfo, Output, ParamSpec};
 
 pub(crate) static INFO: OperatorInfo = OperatorInfo {
@@ -39,15 +39,18 @@ struct Curve {
 impl LuminanceCurve for Curve {
     #[inline(always)]
     fn ratio(&self, _start: usize, l: &mut [f32]) {
-        let (q, inv) = (self.q, self.inv);
+        // ln(1 + qL) · inv / L = log2(1 + qL) · (ln 2 · inv) · (1/L), the log's division
+        // and 1/L sharing one (fast_math::log2_and_recip).
+        let (q, inv) = (self.q, self.inv * std::f32::consts::LN_2);
         for v in l {
-            *v = fast_math::ln(1.0 + q * *v) * inv / *v;
+            let (log, recip) = fast_math::log2_and_recip(1.0 + q * *v, *v);
+            *v = log * inv * recip;
         }
     }
 }
 
 pub(crate) fn apply(ctx: &Context) -> Output {
-    let stats = luminance_stats_without_log(ctx.image, ctx.exposure, ctx.weights);
+    let stats = luminance_stats(ctx.image, ctx.exposure, ctx.weights);
     let (q, k) = (ctx.value("q"), ctx.value("k"));
     let denominator = (k * stats.max).ln_1p();
     let inv = if denominator > 0.0 {

@@ -3,7 +3,7 @@
 //! histogram is mapped to 0.5"; Wilkie, Rendering lecture notes SS2011, §12.3.1). Values
 //! outside the display range are clipped afterwards.
 
-use super::pixels::{luminance_stats_without_log, map_luminance, Scale};
+use super::pixels::{luminance_stats, map_luminance, Scale};
 use super::{Context, OperatorInfo, Output, ParamSpec};
 
 pub(crate) static INFO: OperatorInfo = OperatorInfo {
@@ -20,7 +20,7 @@ pub(crate) static INFO: OperatorInfo = OperatorInfo {
 };
 
 pub(crate) fn apply(ctx: &Context) -> Output {
-    let stats = luminance_stats_without_log(ctx.image, ctx.exposure, ctx.weights);
+    let stats = luminance_stats(ctx.image, ctx.exposure, ctx.weights);
     let target = ctx.value("target");
     let factor = if stats.mean > 0.0 {
         (target / stats.mean) as f32

@@ -194,7 +194,7 @@ fn split_exponent(x: f32) -> (i32, f32) {
 /// instead of once per pixel. Error: ≤ 32 · 6e-8 relative on a product, i.e. ≤ 2.8e-6 on
 /// its log2 — 9e-8 per term, below the 3e-7 per term of a log per pixel.
 #[inline(always)]
-fn stats_chunk<const LOG: bool>(chunk: &[[f32; 3]], scale: f32, w: [f32; 3]) -> Acc {
+fn stats_chunk(chunk: &[[f32; 3]], scale: f32, w: [f32; 3]) -> Acc {
     let delta = LOG_AVERAGE_DELTA as f32;
     let mut sum_log2 = [0.0f32; LANES];
     let mut exponents = [0i32; LANES];
@@ -212,11 +212,9 @@ fn stats_chunk<const LOG: bool>(chunk: &[[f32; 3]], scale: f32, w: [f32; 3]) -> 
         for group in &mut lanes {
             for k in 0..LANES {
                 let l = group[k];
-                if LOG {
-                    let (e, m) = split_exponent(delta + l);
-                    exponents[k] += e;
-                    product[k] *= m;
-                }
+                let (e, m) = split_exponent(delta + l);
+                exponents[k] += e;
+                product[k] *= m;
                 sum[k] += l;
                 max[k] = max[k].max(l);
                 min_positive[k] = if l > 0.0 {
@@ -229,21 +227,17 @@ fn stats_chunk<const LOG: bool>(chunk: &[[f32; 3]], scale: f32, w: [f32; 3]) -> 
         // Only the image's last block can leave a remainder (BLOCK and CHUNK are
         // multiples of LANES).
         for (k, l) in lanes.remainder().iter().enumerate() {
-            if LOG {
-                let (e, m) = split_exponent(delta + l);
-                exponents[k] += e;
-                product[k] *= m;
-            }
+            let (e, m) = split_exponent(delta + l);
+            exponents[k] += e;
+            product[k] *= m;
             sum[k] += l;
             max[k] = max[k].max(*l);
             if *l > 0.0 {
                 min_positive[k] = min_positive[k].min(*l);
             }
         }
-        if LOG {
-            for k in 0..LANES {
-                sum_log2[k] += fast_math::log2(product[k]);
-            }
+        for k in 0..LANES {
+            sum_log2[k] += fast_math::log2(product[k]);
         }
     }
     let log2_total = exponents.iter().map(|e| *e as f64).sum::<f64>()
@@ -260,34 +254,19 @@ fn stats_chunk<const LOG: bool>(chunk: &[[f32; 3]], scale: f32, w: [f32; 3]) -> 
 /// sum as in [`stats_chunk`]: ≲ 1e-7 per term, so ~1e-7 relative on L_avg). The
 /// per-task partial sums are added in image order, so the result does not depend on the
 /// thread count.
+///
+/// Every operator takes this one pass, log-average or not: a variant without the log sum
+/// measured slower (its loop vectorised worse), and the identity makes the log nearly free.
 pub(crate) fn luminance_stats(image: &Image, scale: f32, w: [f32; 3]) -> LuminanceStats {
-    stats::<true>(image, scale, w)
-}
-
-/// As [`luminance_stats`] without the log-average (`log_average` is NaN), for operators
-/// that need only the mean, maximum or minimum: no per-pixel log work.
-pub(crate) fn luminance_stats_without_log(
-    image: &Image,
-    scale: f32,
-    w: [f32; 3],
-) -> LuminanceStats {
-    stats::<false>(image, scale, w)
-}
-
-fn stats<const LOG: bool>(image: &Image, scale: f32, w: [f32; 3]) -> LuminanceStats {
     let partial: Vec<Acc> = image
         .pixels()
         .par_chunks(CHUNK)
-        .map(|chunk| avx2!(stats_chunk::<LOG>(chunk, scale, w)))
+        .map(|chunk| avx2!(stats_chunk(chunk, scale, w)))
         .collect();
     let acc = partial.into_iter().fold(Acc::EMPTY, Acc::merge);
     let n = image.pixels().len() as f64;
     LuminanceStats {
-        log_average: if LOG {
-            (acc.sum_log / n).exp()
-        } else {
-            f64::NAN
-        },
+        log_average: (acc.sum_log / n).exp(),
         mean: acc.sum / n,
         max: acc.max as f64,
         min_positive: if acc.min_positive.is_finite() {

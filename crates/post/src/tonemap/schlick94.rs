@@ -5,7 +5,7 @@
 //! smallest non-zero luminance: for small x = L_w / L_max the map is ≈ p·x, so this puts
 //! the darkest non-black pixel on the first display level 1/N (Schlick's calibration).
 
-use super::pixels::{luminance_stats_without_log, map_luminance, LuminanceCurve};
+use super::pixels::{luminance_stats, map_luminance, LuminanceCurve};
 use super::{Context, OperatorInfo, Output, ParamSpec};
 
 pub(crate) static INFO: OperatorInfo = OperatorInfo {
@@ -49,7 +49,7 @@ impl LuminanceCurve for Curve {
 }
 
 pub(crate) fn apply(ctx: &Context) -> Output {
-    let stats = luminance_stats_without_log(ctx.image, ctx.exposure, ctx.weights);
+    let stats = luminance_stats(ctx.image, ctx.exposure, ctx.weights);
     let p = ctx.param("p").unwrap_or_else(|| {
         if stats.min_positive > 0.0 {
             (stats.max / (ctx.value("levels") * stats.min_positive)).max(1.0)
