@@ -275,26 +275,8 @@ impl FilmTile {
         filter_weight: f32,
         aov: Option<&SurfaceAov>,
     ) -> bool {
-        let Some(i) = self.index(pixel) else {
-            debug_assert!(false, "pixel {pixel} outside tile {:?}", self.bounds);
-            return false;
-        };
-        let finite = !radiance.has_non_finite();
-        let xyz = if finite {
-            xyz_of_sample(radiance, wavelengths)
-        } else {
-            DVec3::ZERO
-        };
-        if let (Some(bins), true) = (self.spectral_bins, finite && filter_weight.is_finite()) {
-            let n = bins.count() as usize;
-            bins.accumulate(
-                &mut self.spectral[i * n..(i + 1) * n],
-                radiance,
-                wavelengths,
-                f64::from(filter_weight),
-            );
-        }
-        self.add_sample_xyz(pixel, xyz, filter_weight, aov)
+        let centre = pixel.as_vec2() + Vec2::splat(0.5);
+        self.add_sample_at(pixel, centre, radiance, wavelengths, filter_weight, aov)
     }
 
     /// Adds the illumination AOV of one camera sample of `pixel`: `radiance` is the
@@ -336,18 +318,8 @@ impl FilmTile {
         filter_weight: f32,
         aov: Option<&SurfaceAov>,
     ) -> bool {
-        let Some(i) = self.index(pixel) else {
-            debug_assert!(false, "pixel {pixel} outside tile {:?}", self.bounds);
-            return false;
-        };
-        let xyz = if xyz.is_finite() { xyz } else { DVec3::ZERO };
-        let w = if filter_weight.is_finite() {
-            f64::from(filter_weight)
-        } else {
-            0.0
-        };
         let centre = pixel.as_vec2() + Vec2::splat(0.5);
-        self.accumulate(i, centre, xyz, w, aov)
+        self.add_sample_xyz_at(pixel, centre, xyz, filter_weight, aov)
     }
 
     /// `add_sample` for a sample at `film_point` (px): a splatting film spreads it over the
@@ -362,9 +334,6 @@ impl FilmTile {
         filter_weight: f32,
         aov: Option<&SurfaceAov>,
     ) -> bool {
-        if self.splat.is_none() {
-            return self.add_sample(pixel, radiance, wavelengths, filter_weight, aov);
-        }
         let Some(i) = self.index(pixel) else {
             debug_assert!(false, "pixel {pixel} outside tile {:?}", self.bounds);
             return false;
@@ -375,16 +344,16 @@ impl FilmTile {
         } else {
             DVec3::ZERO
         };
-        if let (Some(bins), true) = (self.spectral_bins, finite) {
+        if let (Some(bins), true) = (self.spectral_bins, finite && filter_weight.is_finite()) {
             let n = bins.count() as usize;
             bins.accumulate(
                 &mut self.spectral[i * n..(i + 1) * n],
                 radiance,
                 wavelengths,
-                1.0,
+                f64::from(filter_weight),
             );
         }
-        self.accumulate(i, film_point, xyz, 1.0, aov)
+        self.add_sample_xyz_at(pixel, film_point, xyz, filter_weight, aov)
     }
 
     /// `add_sample_xyz` for a sample at `film_point` (px) (see `add_sample_at`).
