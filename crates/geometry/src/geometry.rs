@@ -1,21 +1,25 @@
-//! All shapes of a scene under one two-level BVH.
+//! All shapes of a scene under one BVH, flattened where that is cheap.
 //!
-//! Design: meshes get their own BVH in object space (bottom level) and are placed by
-//! instances (transform + shape); a top-level BVH over the instances' world bounds finds the
-//! candidates, and each candidate is intersected with the ray taken into its object space
-//! (direction not renormalised, so `t` is shared by all levels). One mesh under many
-//! transforms is stored once. A scene with a single identity instance pays one extra
-//! top-level box test per ray. Analytic shapes (sphere, disk, rectangle) are instances too,
-//! intersected in closed form. Cuboids are 12-triangle meshes: their faces are flat (zero
-//! curvature is exact), their shared edges get the same watertight test as any closed mesh,
-//! and they need no separate intersector.
+//! Design: meshes are placed by instances (transform + shape). At build time every instance
+//! of a mesh that is used once, or that is small and shared by a few instances
+//! ([`FLATTEN_MAX_SHARED_MESH_TRIANGLES`], [`FLATTEN_SHARED_TRIANGLE_BUDGET`]), is *baked*:
+//! its vertices are transformed to world space once each and its triangles become leaves of
+//! the scene BVH, tested with the watertight test against the world ray. Everything else —
+//! analytic shapes (sphere, disk, rectangle: exact; a rectangle baked as two world-space
+//! triangles measured slower, docs/geometry.md), large shared meshes — is an *instance leaf*
+//! of the same BVH, with the world box of the instance: the ray is taken into its object space
+//! (direction not renormalised, so `t` is shared) and intersected in closed form or against
+//! the mesh's own object-space BVH, which is stored once for all its instances. A scene that
+//! is a single instance skips the BVH. Baked hits are re-tested on the object-space
+//! triangle (once per closest-hit query) so that `t`, `b1`, `b2` carry the same bits as when
+//! the mesh is traced as an instance; [`BuildOptions::flatten`] `= false` builds the
+//! unflattened reference (every instance a leaf). Cuboids are 12-triangle meshes: their
+//! faces are flat (zero curvature is exact), their shared edges get the same watertight
+//! test as any closed mesh, and they need no separate intersector.
 
 use glam::Vec3A;
-use obvhs::aabb::Aabb;
-use obvhs::cwbvh::CwBvh;
-use obvhs::ray::RayHit;
 
-use crate::bvh_build::{build_bvh, bvh_ray, padded_aabb, BuildQuality};
+use crate::bvh_build::BuildQuality;
 use crate::disk::Disk;
 use crate::interaction::SurfaceInteraction;
 use crate::mesh::{TriangleMesh, NO_MATERIAL};
@@ -24,6 +28,8 @@ use crate::ray::{Ray, RayDifferential};
 use crate::rectangle::Rectangle;
 use crate::sphere::Sphere;
 use crate::transform::Transform;
+use crate::triangle::{TriangleHit, WatertightRay};
+use crate::triangle_bvh::TriangleBvh;
 use crate::triangle_geometry::triangle_local_geometry;
 
 /// Index of a mesh added to a [`GeometryBuilder`].
@@ -60,6 +66,47 @@ pub struct Hit {
     /// Barycentrics of vertices 1 and 2 (0 for analytic shapes).
     pub b1: f32,
     pub b2: f32,
+}
+
+/// Shared meshes (placed by more than one instance) with at most this many triangles are
+/// baked into the world-space soup, one copy per instance (docs/geometry.md, "Flattening").
+/// A mesh placed by exactly one instance is always baked: its copy replaces the mesh's own
+/// BVH, so baking costs no memory.
+pub const FLATTEN_MAX_SHARED_MESH_TRIANGLES: usize = 4096;
+
+/// At most this many triangles are added to the soup by copies of shared meshes (≈ 70 bytes
+/// each with leaf vertices, ids and BVH nodes, so ≈ 70 MiB); meshes are taken smallest first
+/// until the budget is spent, the rest stay instanced.
+pub const FLATTEN_SHARED_TRIANGLE_BUDGET: usize = 1 << 20;
+
+/// How [`GeometryBuilder::build_with`] builds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct BuildOptions {
+    pub quality: BuildQuality,
+    /// Flatten (default `true`): one BVH over the whole scene whose leaves are the
+    /// world-space triangles of small or single-use meshes and the remaining instances
+    /// (analytic shapes, large shared meshes). `false` bakes nothing: the leaves are all
+    /// instances, the two-level reference the flattened geometry is tested and benchmarked
+    /// against.
+    pub flatten: bool,
+}
+
+impl Default for BuildOptions {
+    fn default() -> Self {
+        Self {
+            quality: BuildQuality::default(),
+            flatten: true,
+        }
+    }
+}
+
+impl From<BuildQuality> for BuildOptions {
+    fn from(quality: BuildQuality) -> Self {
+        Self {
+            quality,
+            ..Self::default()
+        }
+    }
 }
 
 /// Collects meshes and instances, then builds a [`Geometry`].
@@ -100,46 +147,193 @@ impl GeometryBuilder {
         Some(self.instances.len() as u32 - 1)
     }
 
-    /// Build both BVH levels (meshes in parallel inside obvhs when its `parallel` feature is on).
+    /// Build with flattening (the default [`BuildOptions`]) at `quality`.
     pub fn build(self, quality: BuildQuality) -> Geometry {
+        self.build_with(quality.into())
+    }
+
+    /// Bake the flattened mesh instances into world-space triangles, build the object-space
+    /// BVHs of the meshes that stay instanced, and one BVH over the triangles and the
+    /// remaining instances' world boxes (in parallel inside obvhs when its `parallel`
+    /// feature is on).
+    pub fn build_with(self, options: BuildOptions) -> Geometry {
+        let quality = options.quality;
+        let bake_mesh = if options.flatten {
+            meshes_to_bake(&self.meshes, &self.instances)
+        } else {
+            vec![false; self.meshes.len()]
+        };
+        let mut leaves: Vec<[Vec3A; 3]> = Vec::new();
+        let mut leaf_ids: Vec<Leaf> = Vec::new();
+        let mut kept: Vec<u32> = Vec::new();
+        let mut mesh_needs_bvh = vec![false; self.meshes.len()];
+        for (i, inst) in self.instances.iter().enumerate() {
+            let instance = i as u32;
+            match inst.shape {
+                Shape::Mesh(MeshId(m)) if bake_mesh[m as usize] => bake_mesh_instance(
+                    &self.meshes[m as usize],
+                    &inst.to_world,
+                    instance,
+                    &mut leaves,
+                    &mut leaf_ids,
+                ),
+                Shape::Mesh(MeshId(m)) => {
+                    mesh_needs_bvh[m as usize] = true;
+                    kept.push(instance);
+                }
+                _ => kept.push(instance),
+            }
+        }
+        let triangles = leaves.len();
         let meshes: Vec<MeshBvh> = self
             .meshes
             .into_iter()
-            .map(|m| MeshBvh::build(m, quality))
-            .collect();
-        let boxes: Vec<Aabb> = self
-            .instances
-            .iter()
-            .map(|inst| {
-                let (lo, hi) = match inst.shape {
-                    Shape::Mesh(MeshId(m)) => meshes[m as usize].bounds(),
-                    Shape::Sphere(s) => s.bounds(),
-                    Shape::Disk(d) => d.bounds(),
-                    Shape::Rectangle(r) => r.bounds(),
-                };
-                if lo.cmpgt(hi).any() {
-                    // Empty mesh: a box no ray reaches.
-                    return Aabb::new(Vec3A::splat(f32::MAX), Vec3A::splat(f32::MAX));
+            .zip(mesh_needs_bvh)
+            .map(|(m, needs_bvh)| {
+                if needs_bvh {
+                    MeshBvh::build(m, quality)
+                } else {
+                    MeshBvh::without_bvh(m)
                 }
-                let (lo, hi) = inst.to_world.bounds(lo, hi);
-                padded_aabb(lo, hi)
             })
             .collect();
-        let top = build_bvh(&boxes, quality);
+        // Instance leaves carry their world box (min, max) in place of triangle vertices.
+        for &i in &kept {
+            if let Some((lo, hi)) = instance_bounds(&self.instances[i as usize], &meshes) {
+                leaves.push([lo, hi, Vec3A::ZERO]);
+                leaf_ids.push(Leaf {
+                    instance: i,
+                    primitive: Leaf::INSTANCE,
+                });
+            }
+        }
+        let instance_leaves = leaves.len() - triangles;
+        let single = match leaf_ids.as_slice() {
+            // One instance: its box test would only repeat its own root test.
+            [only] if only.is_instance() => Some(only.instance),
+            _ => None,
+        };
+        let scene = (!leaves.is_empty() && single.is_none())
+            .then(|| TriangleBvh::build_with_bounds(&leaves, &leaf_ids, leaf_bounds, quality));
         Geometry {
             meshes,
             instances: self.instances,
-            top,
+            scene,
+            single,
+            triangles,
+            instance_leaves,
         }
     }
 }
 
-/// Every shape of a scene with its acceleration structure; immutable and `Sync`, so many
+/// Which meshes get baked: every mesh placed exactly once, and shared meshes of at most
+/// [`FLATTEN_MAX_SHARED_MESH_TRIANGLES`] triangles, smallest first, while their copies fit in
+/// [`FLATTEN_SHARED_TRIANGLE_BUDGET`].
+fn meshes_to_bake(meshes: &[TriangleMesh], instances: &[Instance]) -> Vec<bool> {
+    let mut uses = vec![0usize; meshes.len()];
+    for inst in instances {
+        if let Shape::Mesh(MeshId(m)) = inst.shape {
+            uses[m as usize] += 1;
+        }
+    }
+    let mut bake: Vec<bool> = uses.iter().map(|&u| u == 1).collect();
+    let mut shared: Vec<usize> = (0..meshes.len())
+        .filter(|&m| uses[m] > 1 && meshes[m].triangle_count() <= FLATTEN_MAX_SHARED_MESH_TRIANGLES)
+        .collect();
+    shared.sort_by_key(|&m| (meshes[m].triangle_count(), m));
+    let mut budget = FLATTEN_SHARED_TRIANGLE_BUDGET;
+    for m in shared {
+        let cost = meshes[m].triangle_count() * uses[m];
+        if cost <= budget {
+            budget -= cost;
+            bake[m] = true;
+        }
+    }
+    bake
+}
+
+/// The world-space triangles of one mesh instance. Each vertex is transformed once, so
+/// triangles that share a vertex in the mesh share its world-space bits and the watertight
+/// test keeps closed meshes closed; an identity transform copies the positions exactly.
+fn bake_mesh_instance(
+    mesh: &TriangleMesh,
+    to_world: &Transform,
+    instance: u32,
+    leaves: &mut Vec<[Vec3A; 3]>,
+    ids: &mut Vec<Leaf>,
+) {
+    let transformed: Vec<Vec3A>;
+    let world: &[Vec3A] = if to_world.is_identity() {
+        &mesh.positions
+    } else {
+        transformed = mesh.positions.iter().map(|&p| to_world.point(p)).collect();
+        &transformed
+    };
+    leaves.extend(
+        mesh.indices
+            .iter()
+            .map(|&[a, b, c]| [world[a as usize], world[b as usize], world[c as usize]]),
+    );
+    ids.extend((0..mesh.triangle_count() as u32).map(|primitive| Leaf {
+        instance,
+        primitive,
+    }));
+}
+
+/// World bounds of an instance left as a leaf; `None` for an empty mesh (no ray reaches it).
+fn instance_bounds(inst: &Instance, meshes: &[MeshBvh]) -> Option<(Vec3A, Vec3A)> {
+    let (lo, hi) = match inst.shape {
+        Shape::Mesh(MeshId(m)) => meshes[m as usize].bounds(),
+        Shape::Sphere(s) => s.bounds(),
+        Shape::Disk(d) => d.bounds(),
+        Shape::Rectangle(r) => r.bounds(),
+    };
+    if lo.cmpgt(hi).any() {
+        return None;
+    }
+    Some(inst.to_world.bounds(lo, hi))
+}
+
+/// Bounds of a leaf: a triangle's vertices, or the box an instance leaf carries.
+#[inline]
+fn leaf_bounds(p: &[Vec3A; 3], id: Leaf) -> (Vec3A, Vec3A) {
+    if id.is_instance() {
+        (p[0], p[1])
+    } else {
+        (p[0].min(p[1]).min(p[2]), p[0].max(p[1]).max(p[2]))
+    }
+}
+
+/// What a leaf of the scene BVH stands for.
+#[derive(Clone, Copy, Debug)]
+struct Leaf {
+    instance: u32,
+    /// Triangle index in the instance's mesh (a baked triangle), or [`Leaf::INSTANCE`].
+    primitive: u32,
+}
+
+impl Leaf {
+    /// The leaf is a whole instance, intersected in its object space.
+    const INSTANCE: u32 = u32::MAX;
+
+    #[inline(always)]
+    fn is_instance(self) -> bool {
+        self.primitive == Self::INSTANCE
+    }
+}
+
+/// Every shape of a scene with its acceleration structures; immutable and `Sync`, so many
 /// threads can trace against it.
 pub struct Geometry {
     meshes: Vec<MeshBvh>,
     instances: Vec<Instance>,
-    top: Option<CwBvh>,
+    /// One BVH over baked world-space triangles and instance leaves; `None` when the scene
+    /// is empty or is a single instance.
+    scene: Option<TriangleBvh<Leaf>>,
+    /// The only leaf, an instance, traced without a box test.
+    single: Option<u32>,
+    triangles: usize,
+    instance_leaves: usize,
 }
 
 impl Geometry {
@@ -156,25 +350,81 @@ impl Geometry {
         &self.meshes[id.0 as usize].mesh
     }
 
+    /// Number of world-space triangles the flattened mesh instances were baked into.
+    pub fn flattened_triangle_count(&self) -> usize {
+        self.triangles
+    }
+
+    /// Number of instances traced in their object space (analytic shapes, meshes that were
+    /// not flattened).
+    pub fn instance_leaf_count(&self) -> usize {
+        self.instance_leaves
+    }
+
     /// Closest hit of `ray` in `(t_min, t_max)`.
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
-        let top = self.top.as_ref()?;
-        if self.instances.len() == 1 {
-            // One instance: its box test would only repeat the bottom level's root test.
-            return self.intersect_instance(0, ray, ray.t_max);
-        }
-        let mut best: Option<Hit> = None;
-        let mut hit = RayHit::none();
-        top.ray_traverse(to_bvh_ray(ray), &mut hit, |r, leaf| {
-            match self.intersect_instance(top.primitive_indices[leaf], ray, r.tmax) {
-                Some(h) => {
-                    best = Some(h);
-                    h.t
+        let Some(scene) = &self.scene else {
+            return self
+                .single
+                .and_then(|i| self.intersect_instance(i, ray, ray.t_max));
+        };
+        let (o, d) = (ray.origin, ray.direction);
+        let wt = WatertightRay::new(o, d, ray.t_min);
+        let mut best_instance: Option<Hit> = None;
+        let mut best_triangle: Option<(TriangleHit, Leaf)> = None;
+        scene.traverse(o, d, ray.t_min, ray.t_max, |p, leaf, t_max| {
+            if leaf.is_instance() {
+                match self.intersect_instance(leaf.instance, ray, t_max) {
+                    Some(h) => {
+                        best_instance = Some(h);
+                        best_triangle = None;
+                        h.t
+                    }
+                    None => f32::INFINITY,
                 }
-                None => f32::INFINITY,
+            } else {
+                match wt.intersect(p[0], p[1], p[2], t_max) {
+                    Some(h) => {
+                        best_triangle = Some((h, leaf));
+                        best_instance = None;
+                        h.t
+                    }
+                    None => f32::INFINITY,
+                }
             }
         });
-        best
+        best_instance.or_else(|| best_triangle.map(|(h, leaf)| self.baked_hit(ray, &h, leaf)))
+    }
+
+    /// The [`Hit`] of a baked triangle, with `t`, `b1` and `b2` recomputed by the watertight
+    /// test on the object-space triangle and ray (one triangle test per closest-hit query),
+    /// so that a flattened instance reports the same bits as when it is traced as an
+    /// instance. The world-space triangles decide *whether* and *which* triangle is hit;
+    /// should the object-space test round the other way at an edge, the world-space values
+    /// are kept.
+    #[inline]
+    fn baked_hit(&self, ray: &Ray, h: &TriangleHit, leaf: Leaf) -> Hit {
+        let mut hit = Hit {
+            t: h.t,
+            instance_id: leaf.instance,
+            primitive_id: leaf.primitive,
+            b1: h.b1,
+            b2: h.b2,
+        };
+        let inst = &self.instances[leaf.instance as usize];
+        // Identity instances were baked with their own vertex bits: nothing to redo.
+        if let (Shape::Mesh(MeshId(m)), false) = (inst.shape, inst.to_world.is_identity()) {
+            let (o, d) = object_ray(inst, ray);
+            let [a, b, c] = self.meshes[m as usize]
+                .mesh
+                .triangle(leaf.primitive as usize);
+            if let Some(oh) = WatertightRay::new(o, d, ray.t_min).intersect(a, b, c, ray.t_max) {
+                hit.t = oh.t;
+                hit.b1 = oh.b1;
+                hit.b2 = oh.b2;
+            }
+        }
+        hit
     }
 
     /// Closest hit on one instance with `t` in `(ray.t_min, t_max)`.
@@ -205,17 +455,16 @@ impl Geometry {
     /// Whether anything blocks `ray` in `(t_min, t_max)` — the shadow-ray query; it stops at
     /// the first hit (obvhs `ray_traverse_miss`).
     pub fn occluded(&self, ray: &Ray) -> bool {
-        let Some(top) = self.top.as_ref() else {
-            return false;
+        let Some(scene) = &self.scene else {
+            return self.single.is_some_and(|i| self.occludes(i, ray));
         };
-        if self.instances.len() == 1 {
-            return self.occludes(0, ray);
-        }
-        !top.ray_traverse_miss(to_bvh_ray(ray), |_, leaf| {
-            if self.occludes(top.primitive_indices[leaf], ray) {
-                ray.t_min
+        let (o, d) = (ray.origin, ray.direction);
+        let wt = WatertightRay::new(o, d, ray.t_min);
+        scene.any(o, d, ray.t_min, ray.t_max, |p, leaf, t_max| {
+            if leaf.is_instance() {
+                self.occludes(leaf.instance, ray)
             } else {
-                f32::INFINITY
+                wt.intersect(p[0], p[1], p[2], t_max).is_some()
             }
         })
     }
@@ -277,11 +526,6 @@ impl Geometry {
         si.compute_differentials(ray);
         Some(si)
     }
-}
-
-#[inline]
-fn to_bvh_ray(ray: &Ray) -> obvhs::ray::Ray {
-    bvh_ray(ray.origin, ray.direction, ray.t_min, ray.t_max)
 }
 
 #[inline]

@@ -1,7 +1,8 @@
 //! prism-geometry: rays, frames, transforms, shapes (triangle meshes, spheres, disks,
-//! rectangles, cuboids), OBJ/PLY loading, a two-level BVH (obvhs) with watertight triangle
-//! intersection, and hit records with uv, ∂p/∂u, ∂n/∂u, principal curvatures and
-//! ray differentials.
+//! rectangles, cuboids), OBJ/PLY loading, one BVH (obvhs) over the scene — small and
+//! single-use meshes flattened into world-space triangles, everything else as instances — with
+//! watertight triangle intersection, and hit records with uv, ∂p/∂u, ∂n/∂u, principal
+//! curvatures and ray differentials.
 //!
 //! Units: positions and distances in metres, angles in radians, curvature in 1/m.
 
@@ -21,6 +22,7 @@ pub mod rectangle;
 pub mod sphere;
 pub mod transform;
 pub mod triangle;
+mod triangle_bvh;
 pub mod triangle_geometry;
 
 pub use bvh_build::BuildQuality;
@@ -28,7 +30,10 @@ pub use curvature::Curvature;
 pub use disk::Disk;
 pub use error::MeshLoadError;
 pub use frame::Frame;
-pub use geometry::{Geometry, GeometryBuilder, Hit, Instance, MeshId, Shape};
+pub use geometry::{
+    BuildOptions, Geometry, GeometryBuilder, Hit, Instance, MeshId, Shape,
+    FLATTEN_MAX_SHARED_MESH_TRIANGLES, FLATTEN_SHARED_TRIANGLE_BUDGET,
+};
 pub use interaction::{Differentials, LocalGeometry, SurfaceInteraction};
 pub use mesh::{TriangleMesh, NO_MATERIAL};
 pub use obj::load_obj;

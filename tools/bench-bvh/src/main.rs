@@ -2,16 +2,24 @@
 //! with every obvhs preset and traces coherent (pinhole grid) and incoherent (random) rays,
 //! closest hit and occlusion, on 1 and 2 threads. Prints JSON on stdout.
 //!
-//! Run: `cargo run --release -p bench-bvh` (numbers recorded in docs/geometry.md).
+//! Then, for scenes of many small instances (the Cornell box; a mixed scene of cuboids,
+//! icospheres, rectangles and spheres; 64 instances of icospheres of growing size), it traces
+//! the same rays against the flattened geometry (the default build) and against the
+//! unflattened two-level geometry (`BuildOptions { flatten: false }`), alternating the two.
+//!
+//! Run: `cargo run --release -p bench-bvh` (numbers recorded in docs/geometry.md);
+//! `cargo run --release -p bench-bvh -- --instanced-only [--scene NAME_PART]` runs only the
+//! instanced scenes (those whose name contains `NAME_PART`).
 
 use std::time::Instant;
 
-use glam::Vec3A;
+use glam::{Mat4, Vec3A};
 use obvhs::cwbvh::builder::build_cwbvh_from_tris;
 use obvhs::ray::RayHit;
 use obvhs::triangle::Triangle;
 use prism_geometry::{
-    BuildQuality, Geometry, GeometryBuilder, Ray, Shape, Transform, TriangleMesh,
+    BuildOptions, BuildQuality, Geometry, GeometryBuilder, Ray, Rectangle, Shape, Sphere,
+    Transform, TriangleMesh,
 };
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
@@ -163,10 +171,20 @@ impl Throughput {
 
 /// Best of 3 runs of `f` over `rays` on `threads` threads.
 fn trace(rays: &[Ray], threads: usize, f: &(dyn Fn(&Ray) -> bool + Sync)) -> Throughput {
+    trace_runs(rays, threads, 3, f)
+}
+
+/// Best of `runs` runs of `f` over `rays` on `threads` threads.
+fn trace_runs(
+    rays: &[Ray],
+    threads: usize,
+    runs: usize,
+    f: &(dyn Fn(&Ray) -> bool + Sync),
+) -> Throughput {
     let p = &POOLS.with(|p| p[threads - 1].clone());
     let mut best = (f64::INFINITY, None);
     let mut hits = 0usize;
-    for _ in 0..3 {
+    for _ in 0..runs {
         let cpu0 = thread_cpu_ns();
         let start = Instant::now();
         hits = p.install(|| {
@@ -218,12 +236,33 @@ fn load_average() -> Option<f64> {
         .ok()
 }
 
+const UNITS: &str = "mrays_s: million rays per wall-clock second; mrays_per_cpu_s: million rays per CPU-second of this process (all threads)";
+
 fn mrays(x: f64) -> Value {
     json!((x / 1e4).round() / 100.0)
 }
 
 fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let instanced_only = args.iter().any(|a| a == "--instanced-only");
+    let filter = args
+        .iter()
+        .position(|a| a == "--scene")
+        .and_then(|i| args.get(i + 1))
+        .map_or("", |s| s.as_str());
     let load_at_start = load_average();
+    let instanced = instanced_scenes(filter);
+    if instanced_only {
+        let out = json!({
+            "command": format!("cargo run --release -p bench-bvh -- {}", args[1..].join(" ")),
+            "load_average_1min_at_start": load_at_start,
+            "load_average_1min_at_end": load_average(),
+            "units": UNITS,
+            "instanced_scenes": instanced,
+        });
+        println!("{}", serde_json::to_string_pretty(&out).expect("json"));
+        return;
+    }
     let mesh = bench_mesh();
     let primary = primary_rays();
     let random = random_rays(1);
@@ -328,7 +367,7 @@ fn main() {
         "mesh": { "triangles": mesh.triangle_count(), "kind": "displaced uv sphere, 501 x 1000" },
         "ray_count": RAY_COUNT,
         "threads_available": std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1),
-        "units": "mrays_s: million rays per wall-clock second; mrays_per_cpu_s: million rays per CPU-second of this process (all threads)",
+        "units": UNITS,
         "default_preset": BuildQuality::default().name(),
         "presets": presets,
         "traversal_default_preset": traversal,
@@ -338,6 +377,315 @@ fn main() {
             "incoherent_closest_1t": ob1.json(),
             "incoherent_closest_2t": ob2.json(),
         },
+        "instanced_scenes": instanced,
     });
     println!("{}", serde_json::to_string_pretty(&out).expect("json"));
+}
+
+/// Runs of each build per instanced-scene measurement, alternated.
+const ALTERNATIONS: usize = 8;
+
+/// Rays per instanced-scene measurement.
+const INSTANCED_RAY_COUNT: usize = 1 << 19;
+
+/// The Cornell box of scenes/cornell-box.json as prism-render builds it: six 2 m rectangles
+/// (light, floor, ceiling, back, green and red walls) and two cuboids sharing one unit cube
+/// (half size 0.5, scaled by the 2 m size, then placed), matrices copied from the scene file.
+fn cornell_box(b: &mut GeometryBuilder) {
+    let m = |rows: [[f32; 4]; 3]| {
+        let mut all = [[0.0, 0.0, 0.0, 1.0]; 4];
+        all[..3].copy_from_slice(&rows);
+        Transform::from_matrix(Mat4::from_cols_array_2d(&all).transpose()).expect("invertible")
+    };
+    let rectangles = [
+        [
+            [0.23, 0.0, 0.0, 0.0],
+            [0.0, -8.305164e-09, -0.19, 0.99],
+            [0.0, 0.19, -8.305164e-09, 0.01],
+        ],
+        [
+            [0.99999994, 0.0, 0.0, 0.0],
+            [0.0, -4.371139e-08, 1.0, -1.0],
+            [0.0, -1.0, -4.371139e-08, 0.0],
+        ],
+        [
+            [0.99999994, 0.0, 0.0, 0.0],
+            [0.0, -4.371139e-08, -1.0, 1.0],
+            [0.0, 1.0, -4.371139e-08, 0.0],
+        ],
+        [
+            [1.0, 0.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0, 0.0],
+            [0.0, 0.0, 1.0, -1.0],
+        ],
+        [
+            [-4.371139e-08, 0.0, -1.0, 1.0],
+            [0.0, 0.99999994, 0.0, 0.0],
+            [1.0, 0.0, -4.371139e-08, 0.0],
+        ],
+        [
+            [-4.371139e-08, 0.0, 1.0, -1.0],
+            [0.0, 0.99999994, 0.0, 0.0],
+            [-1.0, 0.0, -4.371139e-08, 0.0],
+        ],
+    ];
+    for rows in rectangles {
+        let r = Rectangle {
+            half_width_m: 1.0,
+            half_height_m: 1.0,
+        };
+        b.add_instance(Shape::Rectangle(r), m(rows), None);
+    }
+    let cube = b.add_mesh(TriangleMesh::cuboid(Vec3A::splat(0.5)));
+    let size = Transform::scale(Vec3A::splat(2.0)).expect("scale");
+    for rows in [
+        [
+            [0.28689146, 0.0, -0.08771151, 0.335],
+            [0.0, 0.3, 0.0, -0.7],
+            [0.08771151, 0.0, 0.28689146, 0.38],
+        ],
+        [
+            [0.28490975, 0.0, 0.09394914, -0.33],
+            [0.0, 0.61, 0.0, -0.4],
+            [-0.09394914, 0.0, 0.28490975, -0.28],
+        ],
+    ] {
+        b.add_instance(Shape::Mesh(cube), m(rows).compose(&size), None);
+    }
+}
+
+/// Cornell box rays: the camera's pinhole grid (eye (0, 0, 3.9), 39.3° horizontal field),
+/// bounce-like rays (origins uniform in the box, uniform directions) and shadow segments
+/// from points in the box to points on the light.
+fn cornell_rays() -> [(&'static str, Vec<Ray>); 3] {
+    let side = (INSTANCED_RAY_COUNT as f64).sqrt() as usize;
+    let tan = (0.5 * 39.3077f32.to_radians()).tan();
+    let primary = (0..side * side)
+        .map(|i| {
+            let (x, y) = ((i % side) as f32, (i / side) as f32);
+            let sx = (2.0 * (x + 0.5) / side as f32 - 1.0) * tan;
+            let sy = (1.0 - 2.0 * (y + 0.5) / side as f32) * tan;
+            Ray::infinite(
+                Vec3A::new(0.0, 0.0, 3.9),
+                Vec3A::new(sx, sy, -1.0).normalize(),
+            )
+        })
+        .collect();
+    let mut rng = Pcg64::seed_from_u64(2);
+    let in_box = |rng: &mut Pcg64| {
+        Vec3A::new(
+            rng.gen_range(-0.99..0.99),
+            rng.gen_range(-0.99..0.99),
+            rng.gen_range(-0.99..0.99),
+        )
+    };
+    let bounce = (0..INSTANCED_RAY_COUNT)
+        .map(|_| {
+            let o = in_box(&mut rng);
+            Ray::spawn(o, random_direction(&mut rng))
+        })
+        .collect();
+    let shadow = (0..INSTANCED_RAY_COUNT)
+        .map(|_| {
+            let o = in_box(&mut rng);
+            let on_light = Vec3A::new(
+                rng.gen_range(-0.23..0.23),
+                0.99,
+                0.01 + rng.gen_range(-0.19..0.19),
+            );
+            Ray::spawn_to(o, on_light)
+        })
+        .collect();
+    [("primary", primary), ("bounce", bounce), ("shadow", shadow)]
+}
+
+fn random_direction(rng: &mut Pcg64) -> Vec3A {
+    loop {
+        let v = Vec3A::new(
+            rng.gen_range(-1.0..1.0),
+            rng.gen_range(-1.0..1.0),
+            rng.gen_range(-1.0..1.0),
+        );
+        let l2 = v.length_squared();
+        if l2 > 1e-6 && l2 <= 1.0 {
+            return v / l2.sqrt();
+        }
+    }
+}
+
+/// Translation in a `spread` cube, random rotation, non-uniform scale `[0.5, 1.5]·size`.
+fn random_placement(rng: &mut Pcg64, spread: f32, size: f32) -> Transform {
+    Transform::translate(Vec3A::new(
+        rng.gen_range(-spread..spread),
+        rng.gen_range(-spread..spread),
+        rng.gen_range(-spread..spread),
+    ))
+    .compose(&Transform::rotate(random_direction(rng), rng.gen_range(0.0..6.3)).expect("axis"))
+    .compose(
+        &Transform::scale(Vec3A::new(
+            rng.gen_range(0.5..1.5) * size,
+            rng.gen_range(0.5..1.5) * size,
+            rng.gen_range(0.5..1.5) * size,
+        ))
+        .expect("scale"),
+    )
+}
+
+/// 400 cuboids (one shared mesh), 100 instances of a 320-triangle icosphere, 100 rectangles
+/// and 50 spheres in a 10 m cube.
+fn mixed_scene(b: &mut GeometryBuilder) {
+    let mut rng = Pcg64::seed_from_u64(9);
+    let cube = b.add_mesh(TriangleMesh::cuboid(Vec3A::splat(0.5)));
+    let ico = b.add_mesh(TriangleMesh::icosphere(0.5, 2));
+    for _ in 0..400 {
+        b.add_instance(
+            Shape::Mesh(cube),
+            random_placement(&mut rng, 5.0, 0.4),
+            None,
+        );
+    }
+    for _ in 0..100 {
+        b.add_instance(Shape::Mesh(ico), random_placement(&mut rng, 5.0, 0.5), None);
+    }
+    for _ in 0..100 {
+        let r = Rectangle {
+            half_width_m: 0.3,
+            half_height_m: 0.3,
+        };
+        b.add_instance(
+            Shape::Rectangle(r),
+            random_placement(&mut rng, 5.0, 1.0),
+            None,
+        );
+    }
+    for _ in 0..50 {
+        let s = Sphere { radius_m: 0.2 };
+        b.add_instance(Shape::Sphere(s), random_placement(&mut rng, 5.0, 1.0), None);
+    }
+}
+
+/// 64 icospheres of `subdivisions` (20·4ˢ triangles), each its own mesh (single use, so
+/// always baked), in a 6 m cube.
+fn icosphere_scene(b: &mut GeometryBuilder, subdivisions: u32) {
+    let mut rng = Pcg64::seed_from_u64(4);
+    for _ in 0..64 {
+        let m = b.add_mesh(TriangleMesh::icosphere(0.5, subdivisions));
+        b.add_instance(Shape::Mesh(m), random_placement(&mut rng, 3.0, 1.0), None);
+    }
+}
+
+/// Origins uniform in a `spread` cube, uniform directions.
+fn rays_in_cube(spread: f32, seed: u64) -> Vec<Ray> {
+    let mut rng = Pcg64::seed_from_u64(seed);
+    (0..INSTANCED_RAY_COUNT)
+        .map(|_| {
+            let o = Vec3A::new(
+                rng.gen_range(-spread..spread),
+                rng.gen_range(-spread..spread),
+                rng.gen_range(-spread..spread),
+            );
+            Ray::infinite(o, random_direction(&mut rng))
+        })
+        .collect()
+}
+
+/// Closest-hit and any-hit throughput of the same rays against the unflattened and the
+/// flattened build of a scene, 1 thread, the two builds alternated run by run (best of
+/// [`ALTERNATIONS`] runs each), so that load from other processes affects both alike.
+fn compare_builds(
+    name: &str,
+    scene: &dyn Fn(&mut GeometryBuilder),
+    rays: &[(&str, Vec<Ray>)],
+) -> Value {
+    let build = |flatten: bool| {
+        let mut b = GeometryBuilder::new();
+        scene(&mut b);
+        let p = POOLS.with(|p| p[1].clone());
+        let start = Instant::now();
+        let g = p.install(|| {
+            b.build_with(BuildOptions {
+                quality: BuildQuality::default(),
+                flatten,
+            })
+        });
+        (g, start.elapsed().as_secs_f64())
+    };
+    let (off, off_build_s) = build(false);
+    let (on, on_build_s) = build(true);
+    let mut sets = Vec::new();
+    for (ray_name, rays) in rays {
+        let mut best: [[Option<Throughput>; 2]; 2] = Default::default(); // [query][flatten]
+        for _ in 0..ALTERNATIONS {
+            for (k, g) in [&off, &on].into_iter().enumerate() {
+                let closest = trace_runs(rays, 1, 1, &|r| g.intersect(r).is_some());
+                let any = trace_runs(rays, 1, 1, &|r| g.occluded(r));
+                for (q, t) in [closest, any].into_iter().enumerate() {
+                    if best[q][k]
+                        .as_ref()
+                        .is_none_or(|b| t.rays_per_s > b.rays_per_s)
+                    {
+                        best[q][k] = Some(t);
+                    }
+                }
+            }
+        }
+        let [[c_off, c_on], [a_off, a_on]] = best.map(|q| q.map(|t| t.expect("measured")));
+        eprintln!(
+            "{name}/{ray_name}: closest {} -> {} ({:.2}x), any hit {} -> {} ({:.2}x), hit fraction {:.3}",
+            c_off.show(),
+            c_on.show(),
+            c_on.rays_per_s / c_off.rays_per_s,
+            a_off.show(),
+            a_on.show(),
+            a_on.rays_per_s / a_off.rays_per_s,
+            c_on.hit_fraction
+        );
+        sets.push(json!({
+            "rays": ray_name,
+            "hit_fraction": (c_on.hit_fraction * 1000.0).round() / 1000.0,
+            "closest_unflattened": c_off.json(),
+            "closest_flattened": c_on.json(),
+            "closest_speedup": ((c_on.rays_per_s / c_off.rays_per_s) * 100.0).round() / 100.0,
+            "any_hit_unflattened": a_off.json(),
+            "any_hit_flattened": a_on.json(),
+            "any_hit_speedup": ((a_on.rays_per_s / a_off.rays_per_s) * 100.0).round() / 100.0,
+        }));
+    }
+    json!({
+        "scene": name,
+        "instances": on.instances().len(),
+        "flattened_triangles": on.flattened_triangle_count(),
+        "instance_leaves_flattened": on.instance_leaf_count(),
+        "build_s_unflattened": (off_build_s * 1e4).round() / 1e4,
+        "build_s_flattened": (on_build_s * 1e4).round() / 1e4,
+        "threads": 1,
+        "ray_sets": sets,
+    })
+}
+
+/// The instanced scenes whose name contains `filter` (all for an empty filter).
+fn instanced_scenes(filter: &str) -> Vec<Value> {
+    let mut out = Vec::new();
+    let wanted = |name: &str| name.contains(filter);
+    if wanted("cornell_box") {
+        out.push(compare_builds("cornell_box", &cornell_box, &cornell_rays()));
+    }
+    if wanted("mixed_650_instances") {
+        out.push(compare_builds(
+            "mixed_650_instances",
+            &mixed_scene,
+            &[("incoherent", rays_in_cube(6.0, 5))],
+        ));
+    }
+    for s in 1..=5 {
+        let name = format!("64_icospheres_{}_triangles", 20 << (2 * s));
+        if wanted(&name) {
+            out.push(compare_builds(
+                &name,
+                &|b| icosphere_scene(b, s),
+                &[("incoherent", rays_in_cube(4.0, 6))],
+            ));
+        }
+    }
+    out
 }
