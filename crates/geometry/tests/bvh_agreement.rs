@@ -9,6 +9,9 @@ use prism_geometry::{
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 
+mod support;
+use support::{edge_and_vertex_targets, random_unit, triangle_soup};
+
 fn single(mesh: &TriangleMesh, quality: BuildQuality) -> Geometry {
     let mut b = GeometryBuilder::new();
     let id = b.add_mesh(mesh.clone());
@@ -31,46 +34,13 @@ fn brute_force(mesh: &TriangleMesh, ray: &Ray) -> Option<(f32, usize)> {
     best
 }
 
-fn random_unit(rng: &mut Pcg64) -> Vec3A {
-    loop {
-        let v = Vec3A::new(
-            rng.gen_range(-1.0..1.0),
-            rng.gen_range(-1.0..1.0),
-            rng.gen_range(-1.0..1.0),
-        );
-        let l2 = v.length_squared();
-        if l2 > 1e-4 && l2 <= 1.0 {
-            return v / l2.sqrt();
-        }
-    }
-}
-
-fn triangle_soup(n: usize, rng: &mut Pcg64) -> TriangleMesh {
-    let mut positions = Vec::new();
-    let mut indices = Vec::new();
-    for i in 0..n {
-        let c = Vec3A::new(
-            rng.gen_range(-1.5..1.5),
-            rng.gen_range(-1.5..1.5),
-            rng.gen_range(-1.5..1.5),
-        );
-        let size = rng.gen_range(0.02..0.4);
-        for _ in 0..3 {
-            positions.push(c + random_unit(rng) * size);
-        }
-        let k = 3 * i as u32;
-        indices.push([k, k + 1, k + 2]);
-    }
-    TriangleMesh::new(positions, indices)
-}
-
 fn test_meshes() -> Vec<(&'static str, TriangleMesh)> {
     let mut rng = Pcg64::seed_from_u64(7);
     vec![
         ("icosphere", TriangleMesh::icosphere(1.0, 3)),
         ("uv_sphere", TriangleMesh::uv_sphere(1.2, 16, 32)),
         ("cube", TriangleMesh::cuboid(Vec3A::new(1.0, 0.6, 0.8))),
-        ("soup", triangle_soup(600, &mut rng)),
+        ("soup", triangle_soup(600, 1.5, 0.02..0.4, &mut rng)),
     ]
 }
 
@@ -124,22 +94,6 @@ fn closest_and_any_hit_agree_with_brute_force_on_random_rays() {
         }
     }
     assert!(total >= 100_000);
-}
-
-/// Points on edges and vertices of the mesh, the targets of the leak test.
-fn edge_and_vertex_targets(mesh: &TriangleMesh) -> Vec<Vec3A> {
-    let mut targets: Vec<Vec3A> = mesh.positions.clone();
-    for tri in &mesh.indices {
-        for k in 0..3 {
-            let (a, b) = (
-                mesh.positions[tri[k] as usize],
-                mesh.positions[tri[(k + 1) % 3] as usize],
-            );
-            targets.push(0.5 * (a + b));
-            targets.push(a + 0.25 * (b - a));
-        }
-    }
-    targets
 }
 
 #[test]

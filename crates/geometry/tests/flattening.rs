@@ -13,19 +13,8 @@ use prism_geometry::{
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 
-fn random_unit(rng: &mut Pcg64) -> Vec3A {
-    loop {
-        let v = Vec3A::new(
-            rng.gen_range(-1.0..1.0),
-            rng.gen_range(-1.0..1.0),
-            rng.gen_range(-1.0..1.0),
-        );
-        let l2 = v.length_squared();
-        if l2 > 1e-4 && l2 <= 1.0 {
-            return v / l2.sqrt();
-        }
-    }
-}
+mod support;
+use support::{edge_and_vertex_targets, random_unit, triangle_soup};
 
 /// Translation in `[-spread, spread]³` ∘ random rotation ∘ non-uniform scale in
 /// [0.4, 1.6] per axis, mirrored (one negative factor) when `mirror`.
@@ -50,26 +39,6 @@ fn random_transform(rng: &mut Pcg64, spread: f32, mirror: bool) -> Transform {
     Transform::translate(offset)
         .compose(&Transform::rotate(random_unit(rng), rng.gen_range(0.0..6.3)).unwrap())
         .compose(&Transform::scale(s).unwrap())
-}
-
-/// An open soup of `n` random triangles around the origin.
-fn triangle_soup(n: usize, rng: &mut Pcg64) -> TriangleMesh {
-    let mut positions = Vec::new();
-    let mut indices = Vec::new();
-    for i in 0..n {
-        let c = Vec3A::new(
-            rng.gen_range(-1.0..1.0),
-            rng.gen_range(-1.0..1.0),
-            rng.gen_range(-1.0..1.0),
-        );
-        let size = rng.gen_range(0.05..0.4);
-        for _ in 0..3 {
-            positions.push(c + random_unit(rng) * size);
-        }
-        let k = 3 * i as u32;
-        indices.push([k, k + 1, k + 2]);
-    }
-    TriangleMesh::new(positions, indices)
 }
 
 /// A strip of exactly `n` triangles over a zig-zag of vertices (shared edges).
@@ -101,7 +70,7 @@ fn mixed_scene(seed: u64) -> (GeometryBuilder, MixedCounts) {
     assert!(big_triangles > FLATTEN_MAX_SHARED_MESH_TRIANGLES);
     let big = b.add_mesh(big_mesh);
     let single = b.add_mesh(TriangleMesh::icosphere(0.7, 4));
-    let soup = b.add_mesh(triangle_soup(300, &mut rng));
+    let soup = b.add_mesh(triangle_soup(300, 1.0, 0.05..0.4, &mut rng));
     let identity_cube = b.add_mesh(TriangleMesh::cuboid(Vec3A::new(0.3, 0.2, 0.4)));
     let mut flattened_triangles = 0;
     let mut top_level = 0;
@@ -433,22 +402,6 @@ fn flattening_bakes_small_or_single_use_meshes_and_keeps_analytic_shapes() {
     let g = build(b, true);
     assert_eq!(g.instance_leaf_count(), 1);
     assert_eq!(g.intersect(&ray).map(|h| h.t), Some(2.0));
-}
-
-/// Points on the edges and at the vertices of a mesh, in object space.
-fn edge_and_vertex_targets(mesh: &TriangleMesh) -> Vec<Vec3A> {
-    let mut targets: Vec<Vec3A> = mesh.positions.clone();
-    for tri in &mesh.indices {
-        for k in 0..3 {
-            let (a, b) = (
-                mesh.positions[tri[k] as usize],
-                mesh.positions[tri[(k + 1) % 3] as usize],
-            );
-            targets.push(0.5 * (a + b));
-            targets.push(a + 0.25 * (b - a));
-        }
-    }
-    targets
 }
 
 #[test]
