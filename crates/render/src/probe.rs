@@ -56,6 +56,8 @@ pub fn light_bandwidth(light: &Light) -> Bandwidth {
             bandwidth(0.0, e.resolution().0 as f32 / (4.0 * std::f32::consts::PI))
         }
         Light::Sky(_) => bandwidth(0.0, 0.0),
+        // The sky's indicatrix exp(d χ) (|d| ≤ 3) varies over about 1/3 rad: ≈ 1.5 cycles/rad.
+        Light::Daylight(_) => bandwidth(0.0, 1.5),
     }
 }
 

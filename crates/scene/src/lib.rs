@@ -4,6 +4,7 @@
 //! format is documented in docs/scene-format.md.
 
 pub mod camera;
+pub mod daylight;
 pub mod error;
 pub mod film;
 pub mod integrator;
@@ -18,6 +19,7 @@ pub mod spectrum_ref;
 pub mod transform;
 
 pub use camera::{Camera, CameraKind, FisheyeFit, FisheyeProjection, FovAxis};
+pub use daylight::{DateTime, DaylightSky, SkyModel, SkyNormalisation, SunPosition};
 pub use error::{JsonPath, PathSegment, Position, SceneError};
 pub use film::{Aov, Film, PixelFilter, Reconstruction};
 pub use integrator::{Integrator, MisHeuristic, SamplerKind};

@@ -6,6 +6,7 @@ use std::path::PathBuf;
 
 use glam::DVec3;
 
+use crate::daylight::{parse_daylight, DaylightSky};
 use crate::reader::{quoted_list, suggest, Obj, Result, V};
 use crate::shape::Shape;
 use crate::spectrum_ref::{parse_spectrum, NamedSpectra, SpectrumRef, SpectrumUse};
@@ -69,9 +70,21 @@ pub enum LightKind {
     },
     /// A sky of the same radiance in every direction.
     UniformSky,
+    /// A CIE, Perez or Preetham sky with its sun (crate::daylight).
+    Daylight(Box<DaylightSky>),
 }
 
-pub const LIGHT_TYPES: [&str; 6] = ["point", "spot", "directional", "area", "environment", "sky"];
+pub const LIGHT_TYPES: [&str; 9] = [
+    "point",
+    "spot",
+    "directional",
+    "area",
+    "environment",
+    "sky",
+    "cie_sky",
+    "perez_sky",
+    "preetham_sky",
+];
 
 fn unit_vector(v: &V) -> Result<[f64; 3]> {
     let d = DVec3::from(v.numbers::<3>()?);
@@ -227,6 +240,14 @@ pub(crate) fn parse_light(v: &V, spectra: &NamedSpectra, shapes: &[Shape]) -> Re
                 .get("transform")
                 .map_or(Ok(Transform::IDENTITY), |t| parse_transform(&t))?;
             (o, LightKind::Environment { path, transform }, s)
+        }
+        "cie_sky" | "perez_sky" | "preetham_sky" => {
+            let sky = parse_daylight(v, kind)?;
+            return Ok(Light {
+                kind: LightKind::Daylight(Box::new(sky)),
+                spectrum: default_spectrum(v)?,
+                strength: Strength::Scale(1.0),
+            });
         }
         _ => {
             let o = v.object(&with(&["luminance_cd_m2"]))?;

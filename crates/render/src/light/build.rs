@@ -15,6 +15,7 @@ use prism_spectrum::Spectrum;
 use super::area::{
     AreaLight, AreaShape, DiskEmitter, EmitterMesh, MeshEmitter, RectangleEmitter, SphereEmitter,
 };
+use super::daylight::build_daylight;
 use super::environment::{rotation_of, EnvironmentLight};
 use super::photometry::{
     lambertian_luminance_from_flux, photometric_scale, point_intensity_from_flux,
@@ -177,6 +178,7 @@ pub(super) fn build_lights(
                 LightKind::Area { .. } => "area",
                 LightKind::Environment { .. } => "environment",
                 LightKind::UniformSky => "sky",
+                LightKind::Daylight(_) => "daylight sky",
             },
             strength: l.strength,
         };
@@ -184,6 +186,8 @@ pub(super) fn build_lights(
         let spectrum = || {
             build_spectrum(&l.spectrum, SpectrumRole::Illuminant).map_err(|e| b.err("spectrum", e))
         };
+        // A daylight sky brings its sun as a second emitter, pushed right after it.
+        let mut extra: Option<Light> = None;
         let light = match &l.kind {
             LightKind::Point { position_m } => {
                 let target = match l.strength {
@@ -319,8 +323,14 @@ pub(super) fn build_lights(
                     scene: scene_sphere,
                 })
             }
+            LightKind::Daylight(desc) => {
+                let built = build_daylight(desc, scene_sphere).map_err(|e| b.err("", e))?;
+                extra = built.sun.map(Light::Directional);
+                Light::Daylight(Box::new(built.sky))
+            }
         };
         lights.push(light);
+        lights.extend(extra);
     }
     Ok(BuiltLights {
         lights,

@@ -19,6 +19,7 @@
 
 pub mod area;
 mod build;
+pub mod daylight;
 pub mod directional;
 pub mod environment;
 mod light_set;
@@ -33,6 +34,7 @@ mod test_support;
 pub mod warp;
 
 pub use area::{AreaLight, AreaShape};
+pub use daylight::sky_light::DaylightSkyLight;
 pub use directional::DirectionalLight;
 pub use environment::EnvironmentLight;
 pub use light_set::{LightSet, NO_LIGHT};
@@ -93,6 +95,8 @@ pub enum Light {
     Area(AreaLight),
     Environment(Box<EnvironmentLight>),
     Sky(UniformSky),
+    /// CIE, Perez or Preetham sky (its sun is a separate `Directional`).
+    Daylight(Box<DaylightSkyLight>),
 }
 
 impl Light {
@@ -111,6 +115,7 @@ impl Light {
             Light::Area(l) => l.sample_li(ctx, u, wavelengths),
             Light::Environment(l) => l.sample_li(ctx, u, wavelengths),
             Light::Sky(l) => l.sample_li(ctx, u, wavelengths),
+            Light::Daylight(l) => l.sample_li(ctx, u, wavelengths),
         }
     }
 
@@ -126,6 +131,7 @@ impl Light {
             Light::Area(l) => l.pdf_li(ctx, wi, hit),
             Light::Environment(l) => l.pdf_li(wi),
             Light::Sky(l) => l.pdf_li(ctx, wi),
+            Light::Daylight(l) => l.pdf_li(wi),
         }
     }
 
@@ -158,6 +164,7 @@ impl Light {
             Light::Directional(l) => l.infinite_radiance(direction, wavelengths),
             Light::Environment(l) => l.infinite_radiance(direction, wavelengths),
             Light::Sky(l) => l.infinite_radiance(wavelengths),
+            Light::Daylight(l) => l.radiance(direction, wavelengths),
             _ => SampledSpectrum::splat(0.0),
         }
     }
@@ -169,7 +176,7 @@ impl Light {
         match self {
             Light::Point(_) | Light::Spot(_) => true,
             Light::Directional(l) => l.is_delta(),
-            Light::Area(_) | Light::Environment(_) | Light::Sky(_) => false,
+            Light::Area(_) | Light::Environment(_) | Light::Sky(_) | Light::Daylight(_) => false,
         }
     }
 
@@ -180,7 +187,7 @@ impl Light {
     pub fn is_infinite(&self) -> bool {
         matches!(
             self,
-            Light::Directional(_) | Light::Environment(_) | Light::Sky(_)
+            Light::Directional(_) | Light::Environment(_) | Light::Sky(_) | Light::Daylight(_)
         )
     }
 
@@ -194,6 +201,7 @@ impl Light {
             Light::Area(l) => l.power_w(),
             Light::Environment(l) => l.power_w(scene_radius_m),
             Light::Sky(l) => l.power_w(scene_radius_m),
+            Light::Daylight(l) => l.power_w(scene_radius_m),
         }
     }
 }
