@@ -57,7 +57,20 @@ impl DateTime {
     /// Day of the year, 1 = 1 January.
     pub fn day_of_year(&self) -> u32 {
         let leap = (self.year % 4 == 0 && self.year % 100 != 0) || self.year % 400 == 0;
-        let days = [31, if leap { 29 } else { 28 }, 31, 30, 31, 30, 31, 31, 30, 31, 30, 31];
+        let days = [
+            31,
+            if leap { 29 } else { 28 },
+            31,
+            30,
+            31,
+            30,
+            31,
+            31,
+            30,
+            31,
+            30,
+            31,
+        ];
         days[..(self.month as usize - 1)].iter().sum::<u32>() + self.day
     }
 }
@@ -66,7 +79,10 @@ impl DateTime {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum SunPosition {
     /// Elevation above the horizon and azimuth from north towards east, radians.
-    Angles { elevation_rad: f64, azimuth_rad: f64 },
+    Angles {
+        elevation_rad: f64,
+        azimuth_rad: f64,
+    },
     /// Computed (Michalsky 1988) for this time at latitude (north +) and longitude (east +).
     Time {
         date_time: DateTime,
@@ -140,7 +156,20 @@ fn parse_date_time(v: &V) -> Result<DateTime> {
     let minute: u32 = t[1].parse().map_err(|_| bad())?;
     let second: f64 = t.get(2).map_or(Ok(0.0), |x| x.parse()).map_err(|_| bad())?;
     let leap = (year % 4 == 0 && year % 100 != 0) || year % 400 == 0;
-    let month_days = [31, if leap { 29 } else { 28 }, 31, 30, 31, 30, 31, 31, 30, 31, 30, 31];
+    let month_days = [
+        31,
+        if leap { 29 } else { 28 },
+        31,
+        30,
+        31,
+        30,
+        31,
+        31,
+        30,
+        31,
+        30,
+        31,
+    ];
     let ok = (1..=12).contains(&month)
         && day >= 1
         && day <= month_days[month as usize - 1]
@@ -342,7 +371,9 @@ pub(crate) fn parse_daylight(v: &V, kind: &str) -> Result<DaylightSky> {
         sun_normal_illuminance_lx: optional_non_negative(&o, "sun_normal_illuminance_lx")?,
         sky_cct_k: cct("sky_cct_k", 6500.0)?,
         sun_cct_k: cct("sun_cct_k", 5500.0)?,
-        ground_albedo: o.get("ground_albedo").map_or(Ok(0.0), |x| x.in_range(0.0, 1.0))?,
+        ground_albedo: o
+            .get("ground_albedo")
+            .map_or(Ok(0.0), |x| x.in_range(0.0, 1.0))?,
         north_rad: o
             .get("north_deg")
             .map_or(Ok(0.0), |x| x.in_range(-360.0, 360.0))?

@@ -123,7 +123,10 @@ mod tests {
         // D65's chromaticity from its table (CIE 15:2018 Table T.3) is x = 0.31272,
         // y = 0.32903; the locus formula sits 1e-4 above it in y (the table's rounding).
         let (x, y) = daylight_xy(6504.0).unwrap();
-        assert!((x - 0.31272).abs() < 5e-5 && (y - 0.32903).abs() < 1.5e-4, "{x} {y}");
+        assert!(
+            (x - 0.31272).abs() < 5e-5 && (y - 0.32903).abs() < 1.5e-4,
+            "{x} {y}"
+        );
     }
 
     #[test]

@@ -14,16 +14,16 @@
 /// (a, b, c, d, e) of sky types 1–15 (ISO 15469:2004 Table 1: six gradation groups I–VI,
 /// six indicatrix groups 1–6).
 pub const CIE_SKY_PARAMETERS: [[f64; 5]; 15] = [
-    [4.0, -0.70, 0.0, -1.0, 0.00],   // 1  overcast, steep gradation, azimuthal uniformity
-    [4.0, -0.70, 2.0, -1.5, 0.15],   // 2  overcast, steep gradation, slight brightening to the sun
-    [1.1, -0.80, 0.0, -1.0, 0.00],   // 3  overcast, moderate gradation, azimuthal uniformity
-    [1.1, -0.80, 2.0, -1.5, 0.15],   // 4  overcast, moderate gradation, slight brightening
-    [0.0, -1.00, 0.0, -1.0, 0.00],   // 5  sky of uniform luminance
-    [0.0, -1.00, 2.0, -1.5, 0.15],   // 6  partly cloudy, no gradation, slight brightening
-    [0.0, -1.00, 5.0, -2.5, 0.30],   // 7  partly cloudy, no gradation, brighter circumsolar
-    [0.0, -1.00, 10.0, -3.0, 0.45],  // 8  partly cloudy, no gradation, distinct solar corona
-    [-1.0, -0.55, 2.0, -1.5, 0.15],  // 9  partly cloudy, obscured sun
-    [-1.0, -0.55, 5.0, -2.5, 0.30],  // 10 partly cloudy, brighter circumsolar region
+    [4.0, -0.70, 0.0, -1.0, 0.00], // 1  overcast, steep gradation, azimuthal uniformity
+    [4.0, -0.70, 2.0, -1.5, 0.15], // 2  overcast, steep gradation, slight brightening to the sun
+    [1.1, -0.80, 0.0, -1.0, 0.00], // 3  overcast, moderate gradation, azimuthal uniformity
+    [1.1, -0.80, 2.0, -1.5, 0.15], // 4  overcast, moderate gradation, slight brightening
+    [0.0, -1.00, 0.0, -1.0, 0.00], // 5  sky of uniform luminance
+    [0.0, -1.00, 2.0, -1.5, 0.15], // 6  partly cloudy, no gradation, slight brightening
+    [0.0, -1.00, 5.0, -2.5, 0.30], // 7  partly cloudy, no gradation, brighter circumsolar
+    [0.0, -1.00, 10.0, -3.0, 0.45], // 8  partly cloudy, no gradation, distinct solar corona
+    [-1.0, -0.55, 2.0, -1.5, 0.15], // 9  partly cloudy, obscured sun
+    [-1.0, -0.55, 5.0, -2.5, 0.30], // 10 partly cloudy, brighter circumsolar region
     [-1.0, -0.55, 10.0, -3.0, 0.45], // 11 white-blue sky, distinct solar corona
     [-1.0, -0.32, 10.0, -3.0, 0.45], // 12 CIE standard clear sky, low turbidity
     [-1.0, -0.32, 16.0, -3.0, 0.30], // 13 CIE standard clear sky, polluted atmosphere
@@ -69,7 +69,8 @@ impl CieSky {
             };
         }
         let p = CIE_SKY_PARAMETERS[usize::from(sky_type.clamp(1, 15)) - 1];
-        let norm = 1.0 / (indicatrix(p[2], p[3], p[4], sun_zenith_rad) * gradation(p[0], p[1], 1.0));
+        let norm =
+            1.0 / (indicatrix(p[2], p[3], p[4], sun_zenith_rad) * gradation(p[0], p[1], 1.0));
         Self {
             sky_type,
             params: p,

@@ -66,7 +66,11 @@ impl SkyShape {
 /// ∫ f(cos Z, cos χ) cos Z dω over the upper hemisphere for a sun at zenith angle
 /// `sun_zenith_rad`: midpoint rule in cos Z (`n` cells) and in azimuth over [0, π] (`2n`
 /// cells, doubled by the symmetry about the sun's vertical plane).
-pub fn horizontal_quadrature(sun_zenith_rad: f64, n: usize, mut f: impl FnMut(f64, f64) -> f64) -> f64 {
+pub fn horizontal_quadrature(
+    sun_zenith_rad: f64,
+    n: usize,
+    mut f: impl FnMut(f64, f64) -> f64,
+) -> f64 {
     let (sin_s, cos_s) = sun_zenith_rad.sin_cos();
     let (dmu, dphi) = (1.0 / n as f64, std::f64::consts::PI / (2 * n) as f64);
     let mut sum = 0.0;
@@ -187,11 +191,13 @@ pub fn build_daylight(desc: &DaylightSky, scene: SceneSphere) -> Result<BuiltDay
                 i0,
                 *dew_point_c,
             );
-            let edh = diffuse_horizontal_illuminance_lx.unwrap_or(c.diffuse_horizontal_illuminance_lx);
+            let edh =
+                diffuse_horizontal_illuminance_lx.unwrap_or(c.diffuse_horizontal_illuminance_lx);
             let edn = direct_normal_illuminance_lx.unwrap_or(c.direct_normal_illuminance_lx);
             let shape = SkyShape::Perez(c);
-            let integral =
-                horizontal_quadrature(sun_zenith, QUADRATURE_N, |m, c| shape.relative_luminance(m, c));
+            let integral = horizontal_quadrature(sun_zenith, QUADRATURE_N, |m, c| {
+                shape.relative_luminance(m, c)
+            });
             if !(integral > 0.0) {
                 return Err("the Perez sky distribution integrates to zero".into());
             }
@@ -217,10 +223,9 @@ pub fn build_daylight(desc: &DaylightSky, scene: SceneSphere) -> Result<BuiltDay
                 }
             };
             let b = daylight_basis();
-            let basis = b
-                .s
-                .clone()
-                .map(|s| Spectrum::from_dense(&s).expect("the daylight basis is finite"));
+            let basis =
+                b.s.clone()
+                    .map(|s| Spectrum::from_dense(&s).expect("the daylight basis is finite"));
             (
                 shape,
                 scale,
@@ -238,7 +243,12 @@ pub fn build_daylight(desc: &DaylightSky, scene: SceneSphere) -> Result<BuiltDay
     // Spectral horizontal irradiance of the sky per unit: the fixed colour is one spectrum;
     // the Preetham sky's is a combination c0 S0 + c1 S1 + c2 S2 (linear in the basis).
     let (sky_e_lx, sky_e_spectrum) = match (&colour, &shape) {
-        (SkyColour::Daylight { basis_luminance, .. }, SkyShape::Preetham(p)) => {
+        (
+            SkyColour::Daylight {
+                basis_luminance, ..
+            },
+            SkyShape::Preetham(p),
+        ) => {
             let mut c = [0.0f64; 3];
             let e = horizontal_quadrature(sun_zenith, QUADRATURE_N, |m, cc| {
                 let lv = scale * p.luminance_cd_m2(m, cc);
@@ -273,7 +283,10 @@ pub fn build_daylight(desc: &DaylightSky, scene: SceneSphere) -> Result<BuiltDay
             (e, s.scaled(k as f32))
         }
         _ => (
-            scale * horizontal_quadrature(sun_zenith, QUADRATURE_N, |m, c| shape.relative_luminance(m, c)),
+            scale
+                * horizontal_quadrature(sun_zenith, QUADRATURE_N, |m, c| {
+                    shape.relative_luminance(m, c)
+                }),
             sky_unit.clone(),
         ),
     };
@@ -337,3 +350,6 @@ pub fn build_daylight(desc: &DaylightSky, scene: SceneSphere) -> Result<BuiltDay
         sun_azimuth_deg: azimuth_deg,
     })
 }
+
+#[cfg(test)]
+mod tests;

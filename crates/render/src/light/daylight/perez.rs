@@ -158,8 +158,7 @@ impl PerezConditions {
             / (1.0 + k))
             .clamp(1.0, 11.9);
         let bin = EPSILON_BINS.iter().take_while(|&&b| epsilon >= b).count();
-        let mut delta =
-            (diffuse_horizontal_w_m2 * air_mass(z) / extraterrestrial_w_m2).max(0.01);
+        let mut delta = (diffuse_horizontal_w_m2 * air_mass(z) / extraterrestrial_w_m2).max(0.01);
         let water_cm = (0.07 * dew_point_c - 0.075).exp();
         let e = DIFFUSE_EFFICACY[bin];
         let diffuse_efficacy = e[0] + e[1] * water_cm + e[2] * z.cos() + e[3] * delta.ln();

@@ -152,6 +152,9 @@ mod tests {
         assert!((x - sky.zenith_xy.0).abs() < 1e-12 && (y - sky.zenith_xy.1).abs() < 1e-12);
         // A clear sky's zenith is bluish: x, y below the equal-energy white (1/3, 1/3) and
         // near the daylight locus (x ≈ 0.25–0.31).
-        assert!((0.24..0.31).contains(&x) && (0.24..0.33).contains(&y), "{x} {y}");
+        assert!(
+            (0.24..0.31).contains(&x) && (0.24..0.33).contains(&y),
+            "{x} {y}"
+        );
     }
 }

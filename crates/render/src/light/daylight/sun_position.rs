@@ -26,7 +26,8 @@ pub fn julian_date(t: &DateTime) -> f64 {
     }
     let a = (f64::from(y) / 100.0).floor();
     let b = 2.0 - a + (a / 4.0).floor();
-    (365.25 * (f64::from(y) + 4716.0)).floor() + (30.6001 * f64::from(m + 1)).floor()
+    (365.25 * (f64::from(y) + 4716.0)).floor()
+        + (30.6001 * f64::from(m + 1)).floor()
         + f64::from(t.day)
         + b
         - 1524.5
@@ -44,12 +45,12 @@ pub fn solar_angles(t: &DateTime, lat_deg: f64, lon_deg: f64) -> SolarAngles {
     let n = jd - 2_451_545.0;
     let mean_longitude = wrap_deg(280.460 + 0.985_647_4 * n);
     let mean_anomaly = wrap_deg(357.528 + 0.985_600_3 * n).to_radians();
-    let ecliptic_longitude = (mean_longitude
-        + 1.915 * mean_anomaly.sin()
-        + 0.020 * (2.0 * mean_anomaly).sin())
-    .to_radians();
+    let ecliptic_longitude =
+        (mean_longitude + 1.915 * mean_anomaly.sin() + 0.020 * (2.0 * mean_anomaly).sin())
+            .to_radians();
     let obliquity = (23.439 - 0.000_000_4 * n).to_radians();
-    let right_ascension = (obliquity.cos() * ecliptic_longitude.sin()).atan2(ecliptic_longitude.cos());
+    let right_ascension =
+        (obliquity.cos() * ecliptic_longitude.sin()).atan2(ecliptic_longitude.cos());
     let declination = (obliquity.sin() * ecliptic_longitude.sin()).asin();
     // Greenwich mean sidereal time in hours (n counts the fraction of the day too, so the
     // sidereal rate is 1 + 0.0657098242/24 per UT hour), then the local hour angle.
@@ -113,7 +114,11 @@ mod tests {
         let a = solar_angles(&at(2003, 10, 17, 12, 30, 30.0, -7.0), 39.742476, -105.1786);
         let zenith = 90.0 - a.elevation_deg;
         assert!((zenith - 50.11162).abs() < 0.02, "zenith {zenith}");
-        assert!((a.azimuth_deg - 194.34024).abs() < 0.02, "azimuth {}", a.azimuth_deg);
+        assert!(
+            (a.azimuth_deg - 194.34024).abs() < 0.02,
+            "azimuth {}",
+            a.azimuth_deg
+        );
     }
 
     /// At the June solstice the noon sun on the Tropic of Cancer stands at the zenith, and on
