@@ -11,6 +11,7 @@ mod json;
 pub mod light;
 pub mod material;
 pub mod medium;
+pub mod photometric;
 mod reader;
 pub mod scene;
 pub mod sensor;
