@@ -3,6 +3,7 @@
 mod color;
 mod compare;
 mod render;
+mod sensors;
 mod tonemap;
 
 use std::process::ExitCode;

@@ -7,6 +7,8 @@
 //! `normal.X/Y/Z`, `albedo.R/G/B`, `illumination.X/Y/Z` and `spp.Y`, and with
 //! `--spectral-bins N` the bins as `S0.<centre>nm` channels (Fichet et al. 2021 layout,
 //! W·m⁻²·sr⁻¹·nm⁻¹). PNG: the RGB sRGB-encoded (16 bit). See docs/rendering.md.
+//! A scene with `sensors` also gets `<output stem>.sensors.json` and `.sensors.csv`
+//! (illuminance in lx with standard errors, uniformity; docs/lighting.md).
 
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -58,6 +60,9 @@ pub struct RenderArgs {
     /// `S0.<λ>nm` channels of the EXR (Fichet et al. 2021 layout, W·m⁻²·sr⁻¹·nm⁻¹).
     #[arg(long = "spectral-bins", value_name = "N")]
     pub spectral_bins: Option<u32>,
+    /// Measure the scene's `sensors` only (`<output stem>.sensors.json/.csv`), no image.
+    #[arg(long = "sensors-only")]
+    pub sensors_only: bool,
 }
 
 fn parse_resolution(s: &str) -> Result<UVec2, String> {
@@ -254,6 +259,22 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
         .map_err(|e| format!("cannot start the thread pool: {e}"))?;
     let threads = pool.current_num_threads();
 
+    if args.sensors_only {
+        if description.sensors.is_empty() {
+            return Err(format!(
+                "--sensors-only: {} has no `sensors` (see docs/lighting.md)",
+                args.scene.display()
+            ));
+        }
+        return measure_and_write_sensors(
+            args,
+            &pool,
+            &scene,
+            &description.sensors,
+            &settings,
+            &output,
+        );
+    }
     let bar = progress_bar(total_samples(scene.resolution, settings.spp));
     let start = Instant::now();
     let (film, stats) = pool.install(|| render(&scene, &settings, &|n| bar.inc(n)));
@@ -272,6 +293,16 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
         None => write_image(&output, &image),
     }
     .map_err(|e| e.to_string())?;
+    if !description.sensors.is_empty() {
+        measure_and_write_sensors(
+            args,
+            &pool,
+            &scene,
+            &description.sensors,
+            &settings,
+            &output,
+        )?;
+    }
     if let Some(path) = &args.stats_json {
         write_stats(path, &scene, &settings, threads, wall_time_s, &stats)?;
     }
@@ -325,5 +356,54 @@ fn write_stats(
             path.display()
         ));
     }
+    Ok(())
+}
+
+/// Measures the scene's sensors on `pool` and writes their readings beside the image.
+fn measure_and_write_sensors(
+    args: &RenderArgs,
+    pool: &rayon::ThreadPool,
+    scene: &RenderScene,
+    sensors: &[prism_scene::Sensor],
+    settings: &RenderSettings,
+    output: &Path,
+) -> Result<(), String> {
+    let bar = progress_bar(prism_render::sensor::total_points(sensors));
+    let start = Instant::now();
+    let (readings, stats) = pool.install(|| {
+        prism_render::sensor::measure_sensors(scene, sensors, settings.seed, &|n| bar.inc(n))
+    });
+    let wall_time_s = start.elapsed().as_secs_f64();
+    bar.finish_and_clear();
+    let (json_path, csv_path) = crate::sensors::sensor_paths(output);
+    let value = crate::sensors::readings_json(&args.scene, &readings, &stats, wall_time_s);
+    let text = serde_json::to_string_pretty(&value).map_err(|e| e.to_string())? + "\n";
+    crate::sensors::write_atomic(&json_path, &text, "sensor readings")?;
+    crate::sensors::write_atomic(
+        &csv_path,
+        &crate::sensors::readings_csv(&readings),
+        "sensor readings",
+    )?;
+    for r in &readings {
+        let u = r.uniformity();
+        eprintln!(
+            "sensor {}: {} points, E_avg {:.4} lx, E_min {:.4} lx, E_max {:.4} lx, \
+             E_min/E_avg {:.3}, E_min/E_max {:.3}",
+            r.name,
+            r.points.len(),
+            u.average_lx,
+            u.min_lx,
+            u.max_lx,
+            u.min_over_average,
+            u.min_over_max
+        );
+    }
+    eprintln!(
+        "wrote {} and {} ({} samples, {:.2} s)",
+        json_path.display(),
+        csv_path.display(),
+        stats.samples,
+        wall_time_s
+    );
     Ok(())
 }
