@@ -34,7 +34,9 @@
 //!
 //! **Pass criterion** (as the published validations of Radiance and Iray): every point within
 //! 5 % of the reference and the mean absolute error within 2 %. Each point is measured to a
-//! relative standard error of 0.8 %.
+//! relative standard error of 1 %. The last column compares with the reference for a
+//! pane whose two surfaces each reflect R = (R_s + R_p)/2 — what a renderer without
+//! polarisation computes — to show where glazed differences come from.
 
 use std::f64::consts::PI;
 
@@ -115,7 +117,8 @@ impl Sky {
         let (a, b) = GRADATION[g - 1];
         let (c, dd, e) = INDICATRIX[i - 1];
         let phi = |cos_z: f64| 1.0 + a * (b / cos_z).exp();
-        let f = |chi: f64| 1.0 + c * ((dd * chi).exp() - (dd * PI / 2.0).exp()) + e * chi.cos().powi(2);
+        let f =
+            |chi: f64| 1.0 + c * ((dd * chi).exp() - (dd * PI / 2.0).exp()) + e * chi.cos().powi(2);
         let s = sun_direction();
         let chi = d.dot(s).clamp(-1.0, 1.0).acos();
         let zs = PI / 2.0 - SUN_ELEVATION_DEG.to_radians();
@@ -145,15 +148,29 @@ fn sun_direction() -> DVec3 {
     DVec3::new(e.cos() * a.sin(), e.sin(), -e.cos() * a.cos())
 }
 
-/// Transmittance of a non-absorbing slab of index n at incidence angle θ (cos θ given):
-/// per polarisation (1 − R)/(1 + R), averaged.
-fn slab_transmittance(cos_i: f64) -> f64 {
+/// Fresnel reflectances (R_s, R_p) of one air–glass surface at incidence cos θ.
+fn fresnel_rs_rp(cos_i: f64) -> (f64, f64) {
     let cos_i = cos_i.abs().min(1.0);
     let sin2_t = (1.0 - cos_i * cos_i) / (GLASS_N * GLASS_N);
     let cos_t = (1.0 - sin2_t).sqrt();
     let rs = ((cos_i - GLASS_N * cos_t) / (cos_i + GLASS_N * cos_t)).powi(2);
     let rp = ((GLASS_N * cos_i - cos_t) / (GLASS_N * cos_i + cos_t)).powi(2);
+    (rs, rp)
+}
+
+/// Transmittance of a non-absorbing slab of index n at incidence angle θ (cos θ given):
+/// per polarisation (1 − R)/(1 + R), averaged — the physical value for unpolarised light.
+fn slab_transmittance(cos_i: f64) -> f64 {
+    let (rs, rp) = fresnel_rs_rp(cos_i);
     0.5 * ((1.0 - rs) / (1.0 + rs) + (1.0 - rp) / (1.0 + rp))
+}
+
+/// The same slab for a renderer that does not track polarisation between the two surfaces
+/// (each reflection uses R = (R_s + R_p)/2): (1 − R)/(1 + R). Printed for comparison only.
+fn slab_transmittance_unpolarised(cos_i: f64) -> f64 {
+    let (rs, rp) = fresnel_rs_rp(cos_i);
+    let r = 0.5 * (rs + rp);
+    (1.0 - r) / (1.0 + r)
 }
 
 /// A rectangle with corner `origin` and full edges `u`, `v` (metres), its normal u × v.
@@ -242,32 +259,114 @@ fn scene_json(case: &Case, sky: Sky) -> String {
     let (x0, x1, z0, z1, h) = (-2.0, 2.0, -2.0, 2.0, 3.0);
     let p = DVec3::new;
     // Walls (normals inward; black on both sides makes orientation irrelevant).
-    shapes.push(rect("wall_w", p(x0, 0.0, z0), p(0.0, 0.0, 4.0), p(0.0, h, 0.0), "black"));
-    shapes.push(rect("wall_n", p(x0, 0.0, z0), p(0.0, h, 0.0), p(4.0, 0.0, 0.0), "black"));
-    shapes.push(rect("wall_s", p(x0, 0.0, z1), p(4.0, 0.0, 0.0), p(0.0, h, 0.0), "black"));
+    shapes.push(rect(
+        "wall_w",
+        p(x0, 0.0, z0),
+        p(0.0, 0.0, 4.0),
+        p(0.0, h, 0.0),
+        "black",
+    ));
+    shapes.push(rect(
+        "wall_n",
+        p(x0, 0.0, z0),
+        p(0.0, h, 0.0),
+        p(4.0, 0.0, 0.0),
+        "black",
+    ));
+    shapes.push(rect(
+        "wall_s",
+        p(x0, 0.0, z1),
+        p(4.0, 0.0, 0.0),
+        p(0.0, h, 0.0),
+        "black",
+    ));
     match case.opening {
         Opening::Roof => {
-            shapes.push(rect("wall_e", p(x1, 0.0, z0), p(0.0, h, 0.0), p(0.0, 0.0, 4.0), "black"));
+            shapes.push(rect(
+                "wall_e",
+                p(x1, 0.0, z0),
+                p(0.0, h, 0.0),
+                p(0.0, 0.0, 4.0),
+                "black",
+            ));
             // Roof around the 2 m × 2 m opening, normals down.
-            shapes.push(rect("roof_a", p(x0, h, z0), p(0.0, 0.0, 4.0), p(1.0, 0.0, 0.0), "black"));
-            shapes.push(rect("roof_b", p(1.0, h, z0), p(0.0, 0.0, 4.0), p(1.0, 0.0, 0.0), "black"));
-            shapes.push(rect("roof_c", p(-1.0, h, z0), p(0.0, 0.0, 1.0), p(2.0, 0.0, 0.0), "black"));
-            shapes.push(rect("roof_d", p(-1.0, h, 1.0), p(0.0, 0.0, 1.0), p(2.0, 0.0, 0.0), "black"));
+            shapes.push(rect(
+                "roof_a",
+                p(x0, h, z0),
+                p(0.0, 0.0, 4.0),
+                p(1.0, 0.0, 0.0),
+                "black",
+            ));
+            shapes.push(rect(
+                "roof_b",
+                p(1.0, h, z0),
+                p(0.0, 0.0, 4.0),
+                p(1.0, 0.0, 0.0),
+                "black",
+            ));
+            shapes.push(rect(
+                "roof_c",
+                p(-1.0, h, z0),
+                p(0.0, 0.0, 1.0),
+                p(2.0, 0.0, 0.0),
+                "black",
+            ));
+            shapes.push(rect(
+                "roof_d",
+                p(-1.0, h, 1.0),
+                p(0.0, 0.0, 1.0),
+                p(2.0, 0.0, 0.0),
+                "black",
+            ));
         }
         Opening::Facade => {
-            shapes.push(rect("roof", p(x0, h, z0), p(0.0, 0.0, 4.0), p(4.0, 0.0, 0.0), "black"));
+            shapes.push(rect(
+                "roof",
+                p(x0, h, z0),
+                p(0.0, 0.0, 4.0),
+                p(4.0, 0.0, 0.0),
+                "black",
+            ));
             // East wall around the opening y ∈ [1, 2.5], z ∈ [−1, 1].
-            shapes.push(rect("east_low", p(x1, 0.0, z0), p(0.0, 1.0, 0.0), p(0.0, 0.0, 4.0), "black"));
-            shapes.push(rect("east_high", p(x1, 2.5, z0), p(0.0, 0.5, 0.0), p(0.0, 0.0, 4.0), "black"));
-            shapes.push(rect("east_n", p(x1, 1.0, z0), p(0.0, 1.5, 0.0), p(0.0, 0.0, 1.0), "black"));
-            shapes.push(rect("east_s", p(x1, 1.0, 1.0), p(0.0, 1.5, 0.0), p(0.0, 0.0, 1.0), "black"));
+            shapes.push(rect(
+                "east_low",
+                p(x1, 0.0, z0),
+                p(0.0, 1.0, 0.0),
+                p(0.0, 0.0, 4.0),
+                "black",
+            ));
+            shapes.push(rect(
+                "east_high",
+                p(x1, 2.5, z0),
+                p(0.0, 0.5, 0.0),
+                p(0.0, 0.0, 4.0),
+                "black",
+            ));
+            shapes.push(rect(
+                "east_n",
+                p(x1, 1.0, z0),
+                p(0.0, 1.5, 0.0),
+                p(0.0, 0.0, 1.0),
+                "black",
+            ));
+            shapes.push(rect(
+                "east_s",
+                p(x1, 1.0, 1.0),
+                p(0.0, 1.5, 0.0),
+                p(0.0, 0.0, 1.0),
+                "black",
+            ));
         }
     }
     if case.glazed {
         let (corner, u, v) = opening_geometry(case.opening);
         let c = corner + 0.5 * (u + v);
         let normal = u.normalize().cross(v.normalize());
-        let outward = if normal.dot(DVec3::new(1.0, 1.0, 0.0)) > 0.0 { normal } else { -normal };
+        let outward = if normal.dot(DVec3::new(1.0, 1.0, 0.0)) > 0.0 {
+            normal
+        } else {
+            -normal
+        };
         // The pane lies just outside the opening's plane.
         let centre = c + outward * (0.5 * GLASS_THICKNESS_M);
         let size = u.abs() + v.abs() + outward.abs() * GLASS_THICKNESS_M;
@@ -297,7 +396,7 @@ fn scene_json(case: &Case, sky: Sky) -> String {
             "shapes": [{}],
             "lights": [{}],
             "sensors": [{{"type": "points", "name": "floor", "positions_m": [{}],
-                          "normal": [0, 1, 0], "relative_error": 0.008, "min_samples": 4096,
+                          "normal": [0, 1, 0], "relative_error": 0.01, "min_samples": 4096,
                           "max_samples": 2000000}}]}}"#,
         shapes.join(",\n"),
         sky.json(),
@@ -317,7 +416,7 @@ fn masked(p: DVec3, d: DVec3) -> bool {
 
 /// Reference sky illuminance at `p` (facing +Y) through the opening: midpoint quadrature
 /// over its area.
-fn reference_lx(case: &Case, sky: Sky, p: DVec3) -> f64 {
+fn reference_lx(case: &Case, sky: Sky, p: DVec3, tau_of: fn(f64) -> f64) -> f64 {
     let (corner, u, v) = opening_geometry(case.opening);
     let n_open = u.normalize().cross(v.normalize());
     let (nu, nv) = (500, 500);
@@ -325,7 +424,8 @@ fn reference_lx(case: &Case, sky: Sky, p: DVec3) -> f64 {
     let mut sum = 0.0;
     for i in 0..nu {
         for j in 0..nv {
-            let a = corner + u * ((i as f64 + 0.5) / nu as f64) + v * ((j as f64 + 0.5) / nv as f64);
+            let a =
+                corner + u * ((i as f64 + 0.5) / nu as f64) + v * ((j as f64 + 0.5) / nv as f64);
             let to = a - p;
             let r2 = to.length_squared();
             let d = to / r2.sqrt();
@@ -337,11 +437,7 @@ fn reference_lx(case: &Case, sky: Sky, p: DVec3) -> f64 {
             if case.mask && masked(p, d) {
                 continue;
             }
-            let tau = if case.glazed {
-                slab_transmittance(cos_a)
-            } else {
-                1.0
-            };
+            let tau = if case.glazed { tau_of(cos_a) } else { 1.0 };
             sum += sky.luminance(d) * tau * cos_p * cos_a / r2;
         }
     }
@@ -352,6 +448,8 @@ struct Row {
     sky: String,
     point: DVec3,
     reference: f64,
+    /// With the unpolarised-per-surface slab (glazed cases).
+    reference_unpolarised: f64,
     ours: f64,
     std_error: f64,
 }
@@ -363,8 +461,8 @@ fn run_case(case: &Case) {
         let dir = tempfile::tempdir().unwrap();
         let description = prism_scene::parse_scene_str(&json, dir.path().join("scene.json"))
             .unwrap_or_else(|e| panic!("{e}\n{json}"));
-        let scene = prism_render::RenderScene::build(&description, None)
-            .unwrap_or_else(|e| panic!("{e}"));
+        let scene =
+            prism_render::RenderScene::build(&description, None).unwrap_or_else(|e| panic!("{e}"));
         let (readings, stats) =
             prism_render::sensor::measure_sensors(&scene, &description.sensors, 171, &|_| {});
         assert_eq!(stats.non_finite_contributions, 0);
@@ -378,7 +476,10 @@ fn run_case(case: &Case) {
             rows.push(Row {
                 sky: sky.name(),
                 point: p,
-                reference: 100.0 * reference_lx(case, sky, p) / e_out,
+                reference: 100.0 * reference_lx(case, sky, p, slab_transmittance) / e_out,
+                reference_unpolarised: 100.0
+                    * reference_lx(case, sky, p, slab_transmittance_unpolarised)
+                    / e_out,
                 ours: 100.0 * reading.illuminance_lx / e_out,
                 std_error: 100.0 * reading.std_error_lx / e_out,
             });
@@ -389,8 +490,8 @@ fn run_case(case: &Case) {
         case.id
     );
     println!(
-        "{:<10} {:>22} {:>10} {:>10} {:>9} {:>8}",
-        "sky", "point (m)", "ref SC %", "ours SC %", "± SE %", "error %"
+        "{:<10} {:>22} {:>10} {:>10} {:>9} {:>8} {:>14}",
+        "sky", "point (m)", "ref SC %", "ours SC %", "± SE %", "error %", "vs unpol. τ %"
     );
     let mut worst = 0.0f64;
     let mut sum_abs = 0.0;
@@ -398,14 +499,16 @@ fn run_case(case: &Case) {
         let err = 100.0 * (r.ours - r.reference) / r.reference;
         worst = worst.max(err.abs());
         sum_abs += err.abs();
+        let err_unpolarised = 100.0 * (r.ours - r.reference_unpolarised) / r.reference_unpolarised;
         println!(
-            "{:<10} {:>22} {:>10.4} {:>10.4} {:>9.4} {:>+8.2}",
+            "{:<10} {:>22} {:>10.4} {:>10.4} {:>9.4} {:>+8.2} {:>+14.2}",
             r.sky,
             format!("({:.2}, {:.2}, {:.2})", r.point.x, r.point.y, r.point.z),
             r.reference,
             r.ours,
             r.std_error,
-            err
+            err,
+            err_unpolarised
         );
     }
     let mean_abs = sum_abs / rows.len() as f64;
@@ -413,8 +516,16 @@ fn run_case(case: &Case) {
         "case {}: max |error| {worst:.2} % (limit 5 %), mean |error| {mean_abs:.2} % (limit 2 %)",
         case.id
     );
-    assert!(worst <= 5.0, "case {}: a point is off by {worst:.2} %", case.id);
-    assert!(mean_abs <= 2.0, "case {}: mean |error| {mean_abs:.2} %", case.id);
+    assert!(
+        worst <= 5.0,
+        "case {}: a point is off by {worst:.2} %",
+        case.id
+    );
+    assert!(
+        mean_abs <= 2.0,
+        "case {}: mean |error| {mean_abs:.2} %",
+        case.id
+    );
 }
 
 const SKIES_3: &[Sky] = &[Sky(None), Sky(Some(7)), Sky(Some(12))];
@@ -471,7 +582,7 @@ fn cie171_5_13_facade_unglazed_opening_with_external_mask() {
         opening: Opening::Facade,
         glazed: false,
         mask: true,
-        skies: SKIES_3,
+        skies: SKIES_2,
     });
 }
 
