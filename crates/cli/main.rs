@@ -2,6 +2,7 @@
 
 mod color;
 mod compare;
+mod daylight_factor;
 mod render;
 mod sensors;
 mod tonemap;

@@ -376,14 +376,19 @@ fn measure_and_write_sensors(
     let wall_time_s = start.elapsed().as_secs_f64();
     bar.finish_and_clear();
     let (json_path, csv_path) = crate::sensors::sensor_paths(output);
-    let value = crate::sensors::readings_json(&args.scene, &readings, &stats, wall_time_s);
+    let mut value = crate::sensors::readings_json(&args.scene, &readings, &stats, wall_time_s);
+    let mut csv = crate::sensors::readings_csv(&readings);
+    // Daylight factor under the scene's daylight sky (docs/daylight.md).
+    let outdoor_lx =
+        prism_render::light::daylight::outdoor_horizontal_illuminance_lx(&scene.lights)
+            .filter(|e| *e > 0.0);
+    if let Some(e_out) = outdoor_lx {
+        crate::daylight_factor::add_to_json(&mut value, &readings, e_out);
+        csv = crate::daylight_factor::add_to_csv(&csv, &readings, e_out);
+    }
     let text = serde_json::to_string_pretty(&value).map_err(|e| e.to_string())? + "\n";
     crate::sensors::write_atomic(&json_path, &text, "sensor readings")?;
-    crate::sensors::write_atomic(
-        &csv_path,
-        &crate::sensors::readings_csv(&readings),
-        "sensor readings",
-    )?;
+    crate::sensors::write_atomic(&csv_path, &csv, "sensor readings")?;
     for r in &readings {
         let u = r.uniformity();
         eprintln!(
@@ -397,6 +402,17 @@ fn measure_and_write_sensors(
             u.min_over_average,
             u.min_over_max
         );
+        if let Some(e_out) = outdoor_lx {
+            eprintln!(
+                "sensor {}: daylight factor average {:.3} %, min {:.3} %, max {:.3} % \
+                 (outdoor unobstructed sky {:.1} lx)",
+                r.name,
+                100.0 * u.average_lx / e_out,
+                100.0 * u.min_lx / e_out,
+                100.0 * u.max_lx / e_out,
+                e_out
+            );
+        }
     }
     eprintln!(
         "wrote {} and {} ({} samples, {:.2} s)",

@@ -31,6 +31,19 @@ use super::DirectionalLight;
 /// Apparent diameter of the sun, degrees (mean; 0.524°–0.542° over the year).
 pub const SUN_ANGULAR_DIAMETER_DEG: f64 = 0.533;
 
+/// The illuminance in lx that the scene's daylight sky alone (without the sun disk and the
+/// ground) gives on an unobstructed horizontal plane — the denominator of the daylight factor
+/// DF = E_inside / E_outside (CIE: under the overcast sky; reported for any daylight sky) —
+/// when the scene has exactly one daylight sky, else `None`.
+pub fn outdoor_horizontal_illuminance_lx(lights: &super::LightSet) -> Option<f64> {
+    let mut skies = (0..lights.len() as u32).filter_map(|i| match lights.light(i) {
+        super::Light::Daylight(d) => Some(d.horizontal_illuminance_lx),
+        _ => None,
+    });
+    let first = skies.next()?;
+    skies.next().is_none().then_some(first)
+}
+
 /// The luminance distribution of a sky for one sun position.
 #[derive(Clone, Debug, PartialEq)]
 pub enum SkyShape {
