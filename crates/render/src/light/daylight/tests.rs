@@ -530,3 +530,29 @@ fn daylight_errors_name_the_field() {
         "{e}"
     );
 }
+
+/// scenes/daylight-room.json builds: sky and sun, the sun in front of the south window
+/// (north_deg 180 puts south at −Z), the outdoor reference illuminance is the given 15 klx.
+#[test]
+fn example_daylight_room_builds() {
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/daylight-room.json");
+    let description = prism_scene::load_scene(&path).unwrap_or_else(|e| panic!("{e}"));
+    let scene = crate::scene_build::RenderScene::build(&description, None)
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(scene.lights.len(), 2);
+    let e = outdoor_horizontal_illuminance_lx(&scene.lights).unwrap();
+    assert!((e - 15_000.0).abs() < 1e-6 * e);
+    let Light::Directional(sun) = scene.lights.light(1) else {
+        panic!()
+    };
+    // Paris, 20 March 10:00 UT: ≈ 37° high, south-south-east (≈ 155° azimuth). With
+    // north_deg = 180 north is +Z and east −X, so the sun lies towards −Z and a little −X.
+    let el = sun.to_light.y.asin().to_degrees();
+    assert!((30.0..45.0).contains(&el), "{el}");
+    assert!(
+        sun.to_light.z < -0.5 && sun.to_light.x < 0.0,
+        "{:?}",
+        sun.to_light
+    );
+}
