@@ -61,7 +61,7 @@ enum Target {
     Photometric(f64),
 }
 
-struct LightBuilder<'a> {
+pub(super) struct LightBuilder<'a> {
     file: &'a Path,
     index: usize,
     kind_name: &'static str,
@@ -73,7 +73,7 @@ impl LightBuilder<'_> {
         format!("lights[{}]", self.index)
     }
 
-    fn err(&self, field: &str, message: impl Into<String>) -> SceneBuildError {
+    pub(super) fn err(&self, field: &str, message: impl Into<String>) -> SceneBuildError {
         let place = if field.is_empty() {
             self.place()
         } else {
@@ -95,7 +95,7 @@ impl LightBuilder<'_> {
         }
     }
 
-    fn unsupported(&self) -> SceneBuildError {
+    pub(super) fn unsupported(&self) -> SceneBuildError {
         self.err(
             strength_field(&self.strength),
             format!(
@@ -177,6 +177,7 @@ pub(super) fn build_lights(
                 LightKind::Area { .. } => "area",
                 LightKind::Environment { .. } => "environment",
                 LightKind::UniformSky => "sky",
+                LightKind::Luminaire { .. } => "luminaire",
             },
             strength: l.strength,
         };
@@ -319,6 +320,21 @@ pub(super) fn build_lights(
                     scene: scene_sphere,
                 })
             }
+            LightKind::Luminaire {
+                distribution,
+                position_m,
+                aim,
+                c0_direction,
+            } => super::goniometric_build::build(
+                &b,
+                l.strength,
+                value,
+                distribution,
+                position_m,
+                aim,
+                c0_direction,
+                spectrum()?,
+            )?,
         };
         lights.push(light);
     }

@@ -21,6 +21,8 @@ pub mod area;
 mod build;
 pub mod directional;
 pub mod environment;
+pub mod goniometric;
+mod goniometric_build;
 mod light_set;
 pub mod photometry;
 pub mod piecewise_constant;
@@ -35,6 +37,7 @@ pub mod warp;
 pub use area::{AreaLight, AreaShape};
 pub use directional::DirectionalLight;
 pub use environment::EnvironmentLight;
+pub use goniometric::GoniometricLight;
 pub use light_set::{LightSet, NO_LIGHT};
 pub use point::PointLight;
 pub use scene_sphere::SceneSphere;
@@ -93,6 +96,8 @@ pub enum Light {
     Area(AreaLight),
     Environment(Box<EnvironmentLight>),
     Sky(UniformSky),
+    /// A point luminaire with an IES/EULUMDAT intensity distribution.
+    Goniometric(Box<GoniometricLight>),
 }
 
 impl Light {
@@ -111,6 +116,7 @@ impl Light {
             Light::Area(l) => l.sample_li(ctx, u, wavelengths),
             Light::Environment(l) => l.sample_li(ctx, u, wavelengths),
             Light::Sky(l) => l.sample_li(ctx, u, wavelengths),
+            Light::Goniometric(l) => l.sample_li(ctx, u, wavelengths),
         }
     }
 
@@ -121,7 +127,7 @@ impl Light {
     #[inline]
     pub fn pdf_li(&self, ctx: &LightSampleContext, wi: Vec3A, hit: Option<&LightHit>) -> f32 {
         match self {
-            Light::Point(_) | Light::Spot(_) => 0.0,
+            Light::Point(_) | Light::Spot(_) | Light::Goniometric(_) => 0.0,
             Light::Directional(l) => l.pdf_li(wi),
             Light::Area(l) => l.pdf_li(ctx, wi, hit),
             Light::Environment(l) => l.pdf_li(wi),
@@ -167,7 +173,7 @@ impl Light {
     #[inline]
     pub fn is_delta(&self) -> bool {
         match self {
-            Light::Point(_) | Light::Spot(_) => true,
+            Light::Point(_) | Light::Spot(_) | Light::Goniometric(_) => true,
             Light::Directional(l) => l.is_delta(),
             Light::Area(_) | Light::Environment(_) | Light::Sky(_) => false,
         }
@@ -194,6 +200,7 @@ impl Light {
             Light::Area(l) => l.power_w(),
             Light::Environment(l) => l.power_w(scene_radius_m),
             Light::Sky(l) => l.power_w(scene_radius_m),
+            Light::Goniometric(l) => l.power_w(),
         }
     }
 }
