@@ -42,7 +42,8 @@ fn bandwidth(spatial: f32, angular: f32) -> Bandwidth {
 /// ν_l of a light (see the module docs).
 pub fn light_bandwidth(light: &Light) -> Bandwidth {
     match light {
-        Light::Point(_) | Light::Spot(_) => bandwidth(0.0, f32::INFINITY),
+        // A point source: a Dirac in position (its angular distribution is smooth).
+        Light::Point(_) | Light::Spot(_) | Light::Goniometric(_) => bandwidth(0.0, f32::INFINITY),
         Light::Directional(d) => {
             if d.one_minus_cos_half_angle > 0.0 {
                 let half = (1.0 - d.one_minus_cos_half_angle).clamp(-1.0, 1.0).acos();

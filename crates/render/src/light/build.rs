@@ -62,7 +62,7 @@ enum Target {
     Photometric(f64),
 }
 
-struct LightBuilder<'a> {
+pub(super) struct LightBuilder<'a> {
     file: &'a Path,
     index: usize,
     kind_name: &'static str,
@@ -74,7 +74,7 @@ impl LightBuilder<'_> {
         format!("lights[{}]", self.index)
     }
 
-    fn err(&self, field: &str, message: impl Into<String>) -> SceneBuildError {
+    pub(super) fn err(&self, field: &str, message: impl Into<String>) -> SceneBuildError {
         let place = if field.is_empty() {
             self.place()
         } else {
@@ -96,7 +96,7 @@ impl LightBuilder<'_> {
         }
     }
 
-    fn unsupported(&self) -> SceneBuildError {
+    pub(super) fn unsupported(&self) -> SceneBuildError {
         self.err(
             strength_field(&self.strength),
             format!(
@@ -179,6 +179,7 @@ pub(super) fn build_lights(
                 LightKind::Environment { .. } => "environment",
                 LightKind::UniformSky => "sky",
                 LightKind::Daylight(_) => "daylight sky",
+                LightKind::Luminaire { .. } => "luminaire",
             },
             strength: l.strength,
         };
@@ -328,6 +329,21 @@ pub(super) fn build_lights(
                 extra = built.sun.map(Light::Directional);
                 Light::Daylight(Box::new(built.sky))
             }
+            LightKind::Luminaire {
+                distribution,
+                position_m,
+                aim,
+                c0_direction,
+            } => super::goniometric_build::build(
+                &b,
+                l.strength,
+                value,
+                distribution,
+                position_m,
+                aim,
+                c0_direction,
+                spectrum()?,
+            )?,
         };
         lights.push(light);
         lights.extend(extra);

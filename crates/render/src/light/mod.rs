@@ -22,6 +22,8 @@ mod build;
 pub mod daylight;
 pub mod directional;
 pub mod environment;
+pub mod goniometric;
+mod goniometric_build;
 mod light_set;
 pub mod photometry;
 pub mod piecewise_constant;
@@ -37,6 +39,7 @@ pub use area::{AreaLight, AreaShape};
 pub use daylight::sky_light::DaylightSkyLight;
 pub use directional::DirectionalLight;
 pub use environment::EnvironmentLight;
+pub use goniometric::GoniometricLight;
 pub use light_set::{LightSet, NO_LIGHT};
 pub use point::PointLight;
 pub use scene_sphere::SceneSphere;
@@ -97,6 +100,8 @@ pub enum Light {
     Sky(UniformSky),
     /// CIE, Perez or Preetham sky (its sun is a separate `Directional`).
     Daylight(Box<DaylightSkyLight>),
+    /// A point luminaire with an IES/EULUMDAT intensity distribution.
+    Goniometric(Box<GoniometricLight>),
 }
 
 impl Light {
@@ -116,6 +121,7 @@ impl Light {
             Light::Environment(l) => l.sample_li(ctx, u, wavelengths),
             Light::Sky(l) => l.sample_li(ctx, u, wavelengths),
             Light::Daylight(l) => l.sample_li(ctx, u, wavelengths),
+            Light::Goniometric(l) => l.sample_li(ctx, u, wavelengths),
         }
     }
 
@@ -126,7 +132,7 @@ impl Light {
     #[inline]
     pub fn pdf_li(&self, ctx: &LightSampleContext, wi: Vec3A, hit: Option<&LightHit>) -> f32 {
         match self {
-            Light::Point(_) | Light::Spot(_) => 0.0,
+            Light::Point(_) | Light::Spot(_) | Light::Goniometric(_) => 0.0,
             Light::Directional(l) => l.pdf_li(wi),
             Light::Area(l) => l.pdf_li(ctx, wi, hit),
             Light::Environment(l) => l.pdf_li(wi),
@@ -174,7 +180,7 @@ impl Light {
     #[inline]
     pub fn is_delta(&self) -> bool {
         match self {
-            Light::Point(_) | Light::Spot(_) => true,
+            Light::Point(_) | Light::Spot(_) | Light::Goniometric(_) => true,
             Light::Directional(l) => l.is_delta(),
             Light::Area(_) | Light::Environment(_) | Light::Sky(_) | Light::Daylight(_) => false,
         }
@@ -202,6 +208,7 @@ impl Light {
             Light::Environment(l) => l.power_w(scene_radius_m),
             Light::Sky(l) => l.power_w(scene_radius_m),
             Light::Daylight(l) => l.power_w(scene_radius_m),
+            Light::Goniometric(l) => l.power_w(),
         }
     }
 }
