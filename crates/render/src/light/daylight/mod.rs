@@ -211,7 +211,7 @@ pub fn build_daylight(desc: &DaylightSky, scene: SceneSphere) -> Result<BuiltDay
             let integral = horizontal_quadrature(sun_zenith, QUADRATURE_N, |m, c| {
                 shape.relative_luminance(m, c)
             });
-            if !(integral > 0.0) {
+            if integral.is_nan() || integral <= 0.0 {
                 return Err("the Perez sky distribution integrates to zero".into());
             }
             (
@@ -243,7 +243,7 @@ pub fn build_daylight(desc: &DaylightSky, scene: SceneSphere) -> Result<BuiltDay
                 shape,
                 scale,
                 SkyColour::Daylight {
-                    basis,
+                    basis: Box::new(basis),
                     basis_luminance: b.luminance.map(|v| v as f32),
                 },
                 desc.sun_normal_illuminance_lx,

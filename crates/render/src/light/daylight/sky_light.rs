@@ -39,7 +39,7 @@ pub enum SkyColour {
     /// CIE daylight of each direction's chromaticity (Preetham): S0, S1, S2 and their
     /// photometric values.
     Daylight {
-        basis: [Spectrum; 3],
+        basis: Box<[Spectrum; 3]>,
         basis_luminance: [f32; 3],
     },
 }
@@ -184,7 +184,7 @@ impl DaylightSkyLight {
                 let (m1, m2) = prism_spectrum::daylight::daylight_m1_m2(x, y);
                 let (m1, m2) = (m1 as f32, m2 as f32);
                 let norm = basis_luminance[0] + m1 * basis_luminance[1] + m2 * basis_luminance[2];
-                if !(norm > 0.0) {
+                if norm.is_nan() || norm <= 0.0 {
                     return SampledSpectrum::splat(0.0);
                 }
                 let s = basis[0].eval(wavelengths)
@@ -216,7 +216,7 @@ impl DaylightSkyLight {
         // The density of the cell the direction maps back to (identical but for rounding
         // on a cell boundary), so that sample_li and pdf_li always agree.
         let pdf = self.pdf_li(wi);
-        if !(pdf > 0.0) {
+        if pdf.is_nan() || pdf <= 0.0 {
             return None;
         }
         Some(LightSample {
