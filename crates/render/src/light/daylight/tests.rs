@@ -556,3 +556,39 @@ fn example_daylight_room_builds() {
         sun.to_light
     );
 }
+
+/// The full estimator (illuminance sensors: next-event estimation and cosine-sampled rays that
+/// escape to the sky and the sun disk, combined by MIS) gives the quadrature's horizontal
+/// illuminance of sky + sun, and ρ E_h facing the ground.
+#[test]
+fn sensors_measure_sky_and_sun_by_quadrature() {
+    let (el, az, sun_lx, rho) = (50.0f64, 210.0, 60_000.0, 0.25);
+    let json = format!(
+        r#"{{"lights": [{{"type": "cie_sky", "sky_type": 10, "zenith_luminance_cd_m2": 6000,
+              "sun_normal_illuminance_lx": {sun_lx}, "ground_albedo": {rho},
+              "sun": {{"elevation_deg": {el}, "azimuth_deg": {az}}}}}],
+            "sensors": [{{"type": "points", "positions_m": [[0, 0, 0], [0, 0, 0]],
+                          "normals": [[0, 1, 0], [0, -1, 0]], "samples": 20000}}]}}"#
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let description = prism_scene::parse_scene_str(&json, dir.path().join("scene.json")).unwrap();
+    let scene = crate::scene_build::RenderScene::build(&description, None).unwrap();
+    let (readings, _) = crate::sensor::measure_sensors(&scene, &description.sensors, 5, &|_| {});
+    let zs = (90.0 - el).to_radians();
+    let s = dir_deg(el, az);
+    let sky_lx = quadrature_lx(|d| {
+        let chi = f64::from(d.dot(s)).clamp(-1.0, 1.0).acos();
+        let z = f64::from(d.y).clamp(-1.0, 1.0).acos();
+        6000.0 * iso_15469_relative(10, z, chi, zs)
+    });
+    let e_h = sky_lx + sun_lx * el.to_radians().sin();
+    for (p, exact) in readings[0].points.iter().zip([e_h, rho * e_h]) {
+        assert!(
+            (p.illuminance_lx - exact).abs() < 4.5 * p.std_error_lx + 1e-3 * exact,
+            "{} ± {} vs {exact}",
+            p.illuminance_lx,
+            p.std_error_lx
+        );
+        assert!(p.std_error_lx < 0.02 * exact, "{}", p.std_error_lx);
+    }
+}
