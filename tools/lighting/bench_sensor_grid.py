@@ -3,7 +3,7 @@
 (≈10⁵ triangles, indirect light included) to a per-point standard error, computed by
 Prism (`prism render --sensors-only`, adaptive sensors), Radiance (`rtrace -I`, pure Monte
 Carlo path tracing: -aa 0 -ad 1, each point repeated K times) and Mitsuba 3 (an
-orthographic image of the Lambertian floor seen from 1 cm above it, E = πL/ρ; independent
+orthographic image of the Lambertian floor seen from 1.2 cm above it, E = πL/ρ; independent
 renders give the per-pixel spread). Prints one JSON document.
 
 All three see the same scene in flat-spectrum ("grey") radiometric units: four isotropic
@@ -89,7 +89,7 @@ def uv_sphere(center, r, n_theta, n_phi):
 
 def furniture():
     """Tables with legs, chairs, two shelves and tessellated vases: ≈10⁵ triangles. Legs
-    start 2 cm above the floor so Mitsuba's camera (1 cm above it) is never inside one."""
+    start 2 cm above the floor so Mitsuba's camera (1.2 cm above it) is never inside one."""
     tris = []
     lift = 0.02
     for tx, tz in [(1.5, 1.0), (4.5, 1.0), (1.5, 3.0), (4.5, 3.0)]:
@@ -133,18 +133,22 @@ def room_rects():
     ]
 
 
-def grid_points(n):
+def grid_points(n, block):
+    """Cell centres of the n × n floor grid inside `block` = (i0, j0, size): cells
+    i0…i0+size−1 along x and j0…j0+size−1 along z; row-major, x fastest."""
     X, _, Z = ROOM
-    xs = (np.arange(n) + 0.5) / n * X
-    zs = (np.arange(n) + 0.5) / n * Z
-    return [(x, 0.0, z) for z in zs for x in xs]  # row-major, x fastest
+    i0, j0, m = block
+    xs = (np.arange(i0, i0 + m) + 0.5) / n * X
+    zs = (np.arange(j0, j0 + m) + 0.5) / n * Z
+    return [(x, 0.0, z) for z in zs for x in xs]
 
 
 # ----------------------------------------------------------------------------- Prism
 
 
-def run_prism(work, obj, n, threads, target, exe):
+def run_prism(work, obj, n, block, threads, target, exe):
     X, Y, Z = ROOM
+    i0, j0, m = block
     mats = {k: {"type": "two_sided", "material": k + "_1s"} for k in RHO}
     for k, r in RHO.items():
         mats[k + "_1s"] = {"type": "lambert", "reflectance": r}
@@ -169,10 +173,10 @@ def run_prism(work, obj, n, threads, target, exe):
             {
                 "type": "grid",
                 "name": "floor",
-                "origin_m": [0, 0, 0],
-                "u_m": [X, 0, 0],
-                "v_m": [0, 0, Z],
-                "resolution": [n, n],
+                "origin_m": [i0 * X / n, 0, j0 * Z / n],
+                "u_m": [m * X / n, 0, 0],
+                "v_m": [0, 0, m * Z / n],
+                "resolution": [m, m],
                 "normal": [0, 1, 0],
                 "relative_error": target,
                 "min_samples": 64,
@@ -196,6 +200,7 @@ def run_prism(work, obj, n, threads, target, exe):
     se = np.array([p["std_error_lx"] for p in pts]) / k
     return {
         "wall_time_s": wall,
+        "fixed_time_s": wall - doc["wall_time_s"],
         "measure_time_s": doc["wall_time_s"],
         "samples": doc["samples"],
         "E": e,
@@ -275,7 +280,9 @@ def run_radiance(work, tris, points, threads, target):
     rel_path_sd = np.median(se * math.sqrt(64) / np.maximum(m, 1e-30))
     repeats = int(math.ceil((rel_path_sd / target) ** 2))
     mean, se, wall = rtrace(oct_path, points, repeats, threads)
-    return {"wall_time_s": wall, "paths_per_point": repeats, "E": mean, "se": se}
+    # Start-up (octree load): one path at one point.
+    _, _, fixed = rtrace(oct_path, points[:1], 2, threads)
+    return {"wall_time_s": wall, "fixed_time_s": fixed, "paths_per_point": repeats, "E": mean, "se": se}
 
 
 # ----------------------------------------------------------------------------- Mitsuba
@@ -295,9 +302,10 @@ def bsdf(r):
 scene = {"type": "scene",
   "integrator": {"type": "path", "max_depth": cfg["max_depth"] + 1, "rr_depth": 4},
   "sensor": {"type": "orthographic",
-     "to_world": mi.ScalarTransform4f.look_at(origin=[X/2, 0.01, Z/2], target=[X/2, 0.0, Z/2], up=[0, 0, 1])
-        @ mi.ScalarTransform4f.scale([X/2, Z/2, 1]),
-     "film": {"type": "hdrfilm", "width": cfg["n"], "height": cfg["n"], "rfilter": {"type": "box"}, "pixel_format": "rgb"},
+     "to_world": mi.ScalarTransform4f().look_at(origin=[X/2, 0.012, Z/2], target=[X/2, -1.0, Z/2], up=[0, 0, 1])
+        .scale([X/2, Z/2, 1]),
+     "film": {"type": "hdrfilm", "width": cfg["n"], "height": cfg["n"], "rfilter": {"type": "box"}, "pixel_format": "rgb",
+              "crop_offset_x": cfg["crop"][0], "crop_offset_y": cfg["crop"][1], "crop_width": cfg["crop"][2], "crop_height": cfg["crop"][2]},
      "sampler": {"type": "independent", "sample_count": cfg["spp"]}}}
 for i, (name, mat, path) in enumerate(cfg["meshes"]):
     scene["m%d" % i] = {"type": "obj", "filename": path, "bsdf": bsdf(cfg["rho"][mat])}
@@ -305,12 +313,13 @@ for i, p in enumerate(cfg["lights"]):
     scene["l%d" % i] = {"type": "point", "position": p, "intensity": {"type": "rgb", "value": [cfg["I"]] * 3}}
 t0 = time.perf_counter()
 sc = mi.load_dict(scene)
+load = time.perf_counter() - t0
 imgs = []
 for k in range(cfg["repeats"]):
     img = mi.render(sc, spp=cfg["spp"], seed=k + 1)
     imgs.append(np.array(img)[:, :, 1])
 wall = time.perf_counter() - t0
-json.dump({"wall_time_s": wall, "images": [i.tolist() for i in imgs]}, open(sys.argv[3], "w"))
+json.dump({"wall_time_s": wall, "load_time_s": load, "images": [i.tolist() for i in imgs]}, open(sys.argv[3], "w"))
 '''
 
 
@@ -319,8 +328,11 @@ def mitsuba_python():
     return str(p) if p.exists() else None
 
 
-def mitsuba_render(work, meshes, n, spp, repeats, threads, llvm):
+def mitsuba_render(work, meshes, n, block, spp, repeats, threads, llvm):
+    i0, j0, m = block
     cfg = {
+        # The block's pixels: image columns run along −x and rows along −z (see below).
+        "crop": [n - i0 - m, n - j0 - m, m],
         "room": ROOM, "n": n, "spp": spp, "repeats": repeats, "max_depth": MAX_DEPTH,
         "meshes": meshes, "rho": RHO, "lights": LIGHTS, "I": INTENSITY, "llvm": llvm,
     }
@@ -334,33 +346,40 @@ def mitsuba_render(work, meshes, n, spp, repeats, threads, llvm):
     )
     out = json.loads((work / "mi_out.json").read_text())
     imgs = np.array(out["images"])  # repeats × n × n; row 0 is the top of the image
-    return imgs, out["wall_time_s"]
+    return imgs, out["wall_time_s"], out["load_time_s"]
 
 
-def run_mitsuba(work, obj, n, threads, target):
+def run_mitsuba(work, obj, n, block, threads, target):
     meshes = []
     for name, mat, o, u, v in room_rects():
         meshes.append((name, mat, str(work / f"{name}.obj")))
     meshes.append(("furniture", "furniture", str(obj)))
-    llvm = False
-    # Pilot: per-pixel relative spread of 8 independent 16-spp images.
-    imgs, _ = mitsuba_render(work, meshes, n, 16, 8, threads, llvm)
+    # The LLVM (vectorised, JIT) variant when it runs here, else the scalar one.
+    llvm = True
+    try:
+        imgs, _, _ = mitsuba_render(work, meshes, n, block, 16, 8, threads, llvm)
+    except subprocess.CalledProcessError:
+        llvm = False
+        imgs, _, _ = mitsuba_render(work, meshes, n, block, 16, 8, threads, llvm)
+    # (Pilot above: per-pixel relative spread of 8 independent 16-spp images.)
     m = imgs.mean(0)
     rel = np.median(imgs.std(0, ddof=1) / np.maximum(m, 1e-30))
     spp_total = int(math.ceil(16 * (rel / target) ** 2))
     repeats = 4
     spp = max(1, int(math.ceil(spp_total / repeats)))
-    imgs, wall = mitsuba_render(work, meshes, n, spp, repeats, threads, llvm)
+    imgs, wall, load = mitsuba_render(work, meshes, n, block, spp, repeats, threads, llvm)
     radiance = imgs.mean(0)
     se = imgs.std(0, ddof=1) / math.sqrt(repeats)
     # E = π L / ρ; image row r (top first) looks at z: with up = +Z the top row is z = Z.
     E = math.pi * radiance / RHO["floor"]
     se = math.pi * se / RHO["floor"]
+    if RHO["floor"] == 0:
+        raise RuntimeError("Mitsuba measures E = πL/ρ on the floor: needs ρ_floor > 0")
     # To the grid's order: rows of z increasing, x fastest (flip the image vertically
     # and, with the camera looking down −Y with up +Z, x grows to the left).
     E = E[::-1, ::-1].reshape(-1)
     se = se[::-1, ::-1].reshape(-1)
-    return {"wall_time_s": wall, "spp": spp * repeats, "variant": "llvm_ad_rgb" if llvm else "scalar_rgb", "E": E, "se": se}
+    return {"wall_time_s": wall, "fixed_time_s": load, "spp": spp * repeats, "variant": "llvm_ad_rgb" if llvm else "scalar_rgb", "E": E, "se": se}
 
 
 # ----------------------------------------------------------------------------- main
@@ -382,24 +401,38 @@ def main():
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--target", type=float, default=0.01)
     ap.add_argument("--prism", default=str(ROOT / "target" / "release" / "prism"), help="the prism binary (release build for timings)")
+    ap.add_argument("--rho-scale", type=float, default=1.0, help="multiply every reflectance (0: direct light only, a check)")
+    ap.add_argument("--direct-only", action="store_true", help="black walls, ceiling and furniture (a check of the direct light)")
+    ap.add_argument("--block", type=int, default=0, help="measure only a block of B × B cells of the grid (0: all); times are then per point × grid² for the whole grid")
+    ap.add_argument("--block-shift", type=int, default=0, help="move the block along x by this many cells from the centre")
     ap.add_argument("--keep", action="store_true", help="keep the generated scenes")
     ap.add_argument("--skip", default="", help="comma list of peers to skip: radiance,mitsuba")
     args = ap.parse_args()
+    for k in RHO:
+        RHO[k] *= args.rho_scale
+    if args.direct_only:
+        # Only the floor reflects: every peer measures direct light alone (a check).
+        for k in RHO:
+            if k != "floor":
+                RHO[k] = 0.0
     skip = set(filter(None, args.skip.split(",")))
     work = pathlib.Path(tempfile.mkdtemp(prefix="prism-lighting-bench-"))
     tris = furniture()
     obj = work / "furniture.obj"
     write_obj(obj, tris)
-    points = grid_points(args.grid)
+    m = args.block or args.grid
+    block = ((args.grid - m) // 2 + args.block_shift, (args.grid - m) // 2, m)
+    points = grid_points(args.grid, block)
     result = {
         "scene": {
             "room_m": ROOM, "triangles": len(tris) + 12, "lights": len(LIGHTS),
             "grid": [args.grid, args.grid], "target_relative_se": args.target,
+            "block": {"first_cell_xz": [block[0], block[1]], "size": block[2], "points": len(points)},
             "threads": args.threads, "max_depth": MAX_DEPTH,
         }
     }
     runs = {}
-    runs["prism"] = run_prism(work, obj, args.grid, args.threads, args.target, args.prism)
+    runs["prism"] = run_prism(work, obj, args.grid, block, args.threads, args.target, args.prism)
     if "radiance" not in skip:
         try:
             runs["radiance"] = run_radiance(work, tris, points, args.threads, args.target)
@@ -410,8 +443,10 @@ def main():
             result["radiance_error"] = repr(e)
     if "mitsuba" not in skip and mitsuba_python():
         try:
-            runs["mitsuba"] = run_mitsuba(work, obj, args.grid, args.threads, args.target)
+            runs["mitsuba"] = run_mitsuba(work, obj, args.grid, block, args.threads, args.target)
             result["mitsuba_version"] = "3.6.4 (tools/mitsuba/requirements.txt)"
+        except subprocess.CalledProcessError as e:
+            result["mitsuba_error"] = (e.stderr or b"").decode(errors="replace")[-2000:]
         except Exception as e:  # noqa: BLE001
             result["mitsuba_error"] = repr(e)
     for name, r in runs.items():
@@ -424,10 +459,21 @@ def main():
             "median_relative_se": float(np.median(rel)),
             "p95_relative_se": float(np.percentile(rel, 95)),
         })
+    # Whole grid: start-up once plus the per-point part times the number of points; and
+    # the same scaled to reach the target exactly at the median point (cost ∝ 1/se²).
+    scale = (args.grid * args.grid) / len(points)
+    for name, r in runs.items():
+        fixed = max(0.0, min(r["fixed_time_s"], r["wall_time_s"]))
+        per_points = r["wall_time_s"] - fixed
+        med = result[name]["median_relative_se"]
+        result[name]["whole_grid_time_s"] = fixed + per_points * scale
+        result[name]["whole_grid_time_s_at_target"] = fixed + per_points * scale * (med / args.target) ** 2
     for name in runs:
         if name != "prism":
             result[f"prism_vs_{name}"] = agreement(runs["prism"], runs[name])
-            result[f"prism_speedup_vs_{name}"] = runs[name]["wall_time_s"] / runs["prism"]["wall_time_s"]
+            result[f"prism_speedup_vs_{name}_at_target"] = (
+                result[name]["whole_grid_time_s_at_target"] / result["prism"]["whole_grid_time_s_at_target"]
+            )
     print(json.dumps(result, indent=2, default=float))
     if args.keep:
         print(f"kept {work}", file=sys.stderr)
