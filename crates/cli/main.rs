@@ -2,6 +2,7 @@
 
 mod color;
 mod compare;
+mod falsecolour;
 mod render;
 mod sensors;
 mod tonemap;
