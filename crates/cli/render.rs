@@ -221,6 +221,17 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
         check_output(&output)?;
     }
     let spectral_bins = spectral_bins(args, &output)?;
+    if args.false_colour == Some(crate::falsecolour::FalseColourQuantity::Illuminance)
+        && !description
+            .sensors
+            .iter()
+            .any(|s| matches!(s.kind, prism_scene::SensorKind::Grid { .. }))
+    {
+        return Err(format!(
+            "--false-colour illuminance: {} has no `grid` sensor (see docs/lighting.md)",
+            args.scene.display()
+        ));
+    }
     let scene = RenderScene::build(&description, args.resolution).map_err(|e| e.to_string())?;
     let settings = RenderSettings {
         spp: args.spp.unwrap_or(scene.spp),
