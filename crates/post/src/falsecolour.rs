@@ -111,7 +111,7 @@ pub fn resolve_range(values: &[f32], options: &FalseColourOptions) -> Result<(f6
             "false-colour range [{lo}, {hi}] is empty (every value is the same, or the range is reversed)"
         )));
     }
-    if options.scale == FalseColourScale::Log && !(lo > 0.0) {
+    if options.scale == FalseColourScale::Log && lo <= 0.0 {
         return Err(PostError::Invalid(format!(
             "a log false-colour scale needs a minimum > 0, found {lo}"
         )));
