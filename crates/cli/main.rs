@@ -3,6 +3,7 @@
 mod color;
 mod compare;
 mod daylight_factor;
+mod falsecolour;
 mod render;
 mod sensors;
 mod tonemap;

@@ -63,6 +63,17 @@ pub struct RenderArgs {
     /// Measure the scene's `sensors` only (`<output stem>.sensors.json/.csv`), no image.
     #[arg(long = "sensors-only")]
     pub sensors_only: bool,
+    /// Also write a false-colour PNG with a legend: of the image's luminance (cd/m²) or of
+    /// every grid sensor's illuminance (lx), as `<stem>.<what>.falsecolour.png`.
+    #[arg(long = "false-colour", value_enum)]
+    pub false_colour: Option<crate::falsecolour::FalseColourQuantity>,
+    /// Scale of the false-colour ramp.
+    #[arg(long = "false-colour-scale", value_enum, default_value = "linear")]
+    pub false_colour_scale: crate::falsecolour::ScaleArg,
+    /// Value range of the false-colour ramp, MIN:MAX (default: 0 to the maximum, or three
+    /// decades below the maximum on a log scale).
+    #[arg(long = "false-colour-range", value_parser = crate::falsecolour::parse_range)]
+    pub false_colour_range: Option<(f64, f64)>,
 }
 
 fn parse_resolution(s: &str) -> Result<UVec2, String> {
@@ -210,6 +221,17 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
         check_output(&output)?;
     }
     let spectral_bins = spectral_bins(args, &output)?;
+    if args.false_colour == Some(crate::falsecolour::FalseColourQuantity::Illuminance)
+        && !description
+            .sensors
+            .iter()
+            .any(|s| matches!(s.kind, prism_scene::SensorKind::Grid { .. }))
+    {
+        return Err(format!(
+            "--false-colour illuminance: {} has no `grid` sensor (see docs/lighting.md)",
+            args.scene.display()
+        ));
+    }
     let scene = RenderScene::build(&description, args.resolution).map_err(|e| e.to_string())?;
     let settings = RenderSettings {
         spp: args.spp.unwrap_or(scene.spp),
@@ -260,6 +282,9 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
     let threads = pool.current_num_threads();
 
     if args.sensors_only {
+        if args.false_colour == Some(crate::falsecolour::FalseColourQuantity::Luminance) {
+            return Err("--false-colour luminance needs the image: drop --sensors-only".into());
+        }
         if description.sensors.is_empty() {
             return Err(format!(
                 "--sensors-only: {} has no `sensors` (see docs/lighting.md)",
@@ -293,6 +318,16 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
         None => write_image(&output, &image),
     }
     .map_err(|e| e.to_string())?;
+    if args.false_colour == Some(crate::falsecolour::FalseColourQuantity::Luminance) {
+        let path = crate::falsecolour::write_luminance(
+            &output,
+            &film.luminance_cd_m2(),
+            (film.width as usize, film.height as usize),
+            args.false_colour_scale,
+            args.false_colour_range,
+        )?;
+        eprintln!("wrote {}", path.display());
+    }
     if !description.sensors.is_empty() {
         measure_and_write_sensors(
             args,
@@ -389,6 +424,16 @@ fn measure_and_write_sensors(
     let text = serde_json::to_string_pretty(&value).map_err(|e| e.to_string())? + "\n";
     crate::sensors::write_atomic(&json_path, &text, "sensor readings")?;
     crate::sensors::write_atomic(&csv_path, &csv, "sensor readings")?;
+    if args.false_colour == Some(crate::falsecolour::FalseColourQuantity::Illuminance) {
+        for path in crate::falsecolour::write_illuminance(
+            output,
+            &readings,
+            args.false_colour_scale,
+            args.false_colour_range,
+        )? {
+            eprintln!("wrote {}", path.display());
+        }
+    }
     for r in &readings {
         let u = r.uniformity();
         eprintln!(

@@ -77,6 +77,9 @@ pub fn readings_json(
         "scene": scene.display().to_string(),
         "quantity": "illuminance",
         "unit": "lx",
+        // lx of an irradiance of 1 W·m⁻²·nm⁻¹ at every wavelength (683.002 lm/W × ∫ȳ dλ),
+        // to compare with renderers that report flat-spectrum irradiance.
+        "lx_per_flat_irradiance": prism_render::film::xyz::cd_m2_per_unit(),
         "wall_time_s": wall_time_s,
         "samples": stats.samples,
         "rays_traced": stats.rays_traced,

@@ -103,7 +103,7 @@ pub const MAX_SENSOR_POINTS: usize = 4_000_000;
 
 fn unit(v: &V) -> Result<[f64; 3]> {
     let d = DVec3::from(v.numbers::<3>()?);
-    if !(d.length() > 1e-12) {
+    if d.length() <= 1e-12 {
         return Err(v.err("expected a non-zero direction"));
     }
     Ok(d.normalize().to_array())
@@ -240,7 +240,7 @@ fn parse_sensor(v: &V, index: usize) -> Result<Sensor> {
             let v_v = o.req("v_m", "the second edge of the grid [x, y, z] in metres")?;
             let (u_m, v_m) = (u_v.numbers::<3>()?, v_v.numbers::<3>()?);
             for (e, val) in [(&u_v, u_m), (&v_v, v_m)] {
-                if !(DVec3::from(val).length() > 0.0) {
+                if DVec3::from(val).length() <= 0.0 {
                     return Err(e.err("expected a non-zero edge vector"));
                 }
             }

@@ -306,6 +306,11 @@ impl PathTracer {
                     } else {
                         (stream.get_1d(), stream.get_2d())
                     };
+                    // Stratified light choice: sample k picks from the k-th of n equal
+                    // slices of the selection CDF (each is still a sample of the same
+                    // mixture, so the average stays unbiased; with n ≥ the number of
+                    // equally bright lights every light gets its shadow ray).
+                    let uc = ((k as f32 + uc) / n_light as f32).min(1.0 - f32::EPSILON);
                     let (d, w) = self.sample_light(
                         scene,
                         &vertex,

@@ -29,26 +29,34 @@ use crate::sampler::SampleStream;
 use crate::sampling::sample_cosine_hemisphere;
 use crate::scene_build::RenderScene;
 
-/// One illuminance sample in lux at `p` (metres, world) for a receiver facing `n` (unit).
-/// Draws 1 (wavelength) + 1 + 2 (light) + 2 (direction) dimensions, then the path's.
+/// One illuminance sample in lux at `p` (metres, world) for a receiver facing `n` (unit),
+/// with `light_samples` light samples here and at every path vertex. Draws 1 (wavelength)
+/// + 2 (direction) + 3 per light sample dimensions, then the path's.
+#[allow(clippy::too_many_arguments)]
 pub fn sample_illuminance_lx(
     tracer: &PathTracer,
     scene: &RenderScene,
     p: Vec3A,
     n: Vec3A,
+    light_samples: u32,
     stream: &mut SampleStream,
     counters: &mut PathCounters,
 ) -> f64 {
     let mut wavelengths = SampledWavelengths::sample_visible(stream.get_1d());
-    let u_choice = stream.get_1d();
-    let u_light = stream.get_2d();
     let u_dir = stream.get_2d();
     let ctx = LightSampleContext { p, n };
     let lights = &scene.lights;
     let mut e = SampledSpectrum::splat(0.0);
+    let n_light = light_samples.max(1);
 
-    // Next-event estimation.
-    if let Some((l, pmf)) = lights.sample(u_choice) {
+    // Next-event estimation: `n_light` light samples, the choice stratified over the
+    // selection CDF (see `PathTracer::radiance_from`), averaged.
+    for k in 0..n_light {
+        let u_choice = ((k as f32 + stream.get_1d()) / n_light as f32).min(1.0 - f32::EPSILON);
+        let u_light = stream.get_2d();
+        let Some((l, pmf)) = lights.sample(u_choice) else {
+            continue;
+        };
         if let Some(ls) = lights.light(l).sample_li(&ctx, u_light, &wavelengths) {
             let cos = ls.wi.dot(n);
             if cos > 0.0 && ls.pdf > 0.0 && !ls.radiance.is_black() {
@@ -61,7 +69,7 @@ pub fn sample_illuminance_lx(
                     } else {
                         mis_weight(tracer.mis, light_pdf, cos * FRAC_1_PI)
                     };
-                    let c = ls.radiance * (cos * w * t / light_pdf);
+                    let c = ls.radiance * (cos * w * t / (light_pdf * n_light as f32));
                     if c.has_non_finite() {
                         counters.non_finite_contributions += 1;
                     } else {
@@ -88,7 +96,7 @@ pub fn sample_illuminance_lx(
             }),
             &mut wavelengths,
             stream,
-            1,
+            n_light,
             false,
             counters,
         );

@@ -156,6 +156,12 @@ pub fn sensor_tracer(scene: &RenderScene) -> PathTracer {
     }
 }
 
+/// Light samples per vertex for sensors: one per light up to 8 (stratified, so a few
+/// equally bright lamps each get a shadow ray, as Radiance's direct calculation does).
+pub fn sensor_light_samples(scene: &RenderScene) -> u32 {
+    scene.lights.len().clamp(1, 8) as u32
+}
+
 /// Deterministic per-sensor seed.
 fn sensor_seed(seed: u64, sensor: usize) -> u64 {
     // SplitMix64 finaliser (Steele et al. 2014).
@@ -186,7 +192,15 @@ fn run_samples(
             let mut counters = PathCounters::default();
             for k in c..(c + CHUNK_SAMPLES).min(end) {
                 let mut stream = sampler.stream(point, k);
-                let e = sample_illuminance_lx(tracer, scene, p, n, &mut stream, &mut counters);
+                let e = sample_illuminance_lx(
+                    tracer,
+                    scene,
+                    p,
+                    n,
+                    sensor_light_samples(scene),
+                    &mut stream,
+                    &mut counters,
+                );
                 stats.push(e);
             }
             (stats, counters)

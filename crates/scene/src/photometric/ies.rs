@@ -293,13 +293,13 @@ pub fn parse_ies(text: &str, file: &Path) -> Result<IntensityDistribution, Photo
         "the ballast-lamp photometric factor"
     })?;
     let _input_watts = nums.f64("the input watts")?;
-    if !(multiplier > 0.0) {
+    if multiplier <= 0.0 {
         return Err(err(
             Some(nums.line()),
             format!("the candela multiplier must be > 0, found {multiplier}"),
         ));
     }
-    if !(ballast > 0.0) {
+    if ballast <= 0.0 {
         return Err(err(
             Some(nums.line()),
             format!("the ballast factor must be > 0, found {ballast}"),
@@ -309,7 +309,7 @@ pub fn parse_ies(text: &str, file: &Path) -> Result<IntensityDistribution, Photo
     // 2019 reuses it for the file-generation type (1.00001 …), which does not.
     let factor = multiplier
         * ballast
-        * if format == PhotometricFormat::Ies2019 || !(second > 0.0) {
+        * if format == PhotometricFormat::Ies2019 || second <= 0.0 {
             1.0
         } else {
             second
@@ -333,11 +333,8 @@ pub fn parse_ies(text: &str, file: &Path) -> Result<IntensityDistribution, Photo
         }
     }
     let mut rows = Vec::with_capacity(n_h);
-    for h in 0..n_h {
-        let (row, line) = nums.list(
-            n_v,
-            &format!("candela value at horizontal angle {}", horizontal[h]),
-        )?;
+    for angle in &horizontal {
+        let (row, line) = nums.list(n_v, &format!("candela value at horizontal angle {angle}"))?;
         if let Some(x) = row.iter().find(|x| **x < 0.0) {
             return Err(err(
                 Some(line),

@@ -186,7 +186,7 @@ pub fn parse_ldt(text: &str, file: &Path) -> Result<IntensityDistribution, Photo
             format!("Mc = {mc} C-planes cannot hold the planes symmetry Isym = {isym} stores"),
         ));
     }
-    if isym != 1 && isym != 0 && mc % if isym == 4 { 4 } else { 2 } != 0 {
+    if isym != 1 && isym != 0 && !mc.is_multiple_of(if isym == 4 { 4 } else { 2 }) {
         return Err(l.err(
             4,
             format!(
@@ -202,10 +202,10 @@ pub fn parse_ldt(text: &str, file: &Path) -> Result<IntensityDistribution, Photo
     for &i in &stored {
         let line = l.next + 1;
         let mut row = Vec::with_capacity(ng);
-        for j in 0..ng {
+        for (j, g) in gamma.iter().enumerate() {
             let x = l.f64(&format!(
-                "the intensity at C = {}°, γ = {}° (cd/klm)",
-                c[i], gamma[j]
+                "the intensity at C = {}°, γ = {g}° (cd/klm)",
+                c[i]
             ))?;
             if x < 0.0 {
                 return Err(l.err(line + j, format!("intensities must be ≥ 0, found {x}")));
