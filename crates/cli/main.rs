@@ -2,7 +2,10 @@
 
 mod color;
 mod compare;
+mod daylight_factor;
+mod falsecolour;
 mod render;
+mod sensors;
 mod tonemap;
 
 use std::process::ExitCode;

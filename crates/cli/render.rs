@@ -7,6 +7,8 @@
 //! `normal.X/Y/Z`, `albedo.R/G/B`, `illumination.X/Y/Z` and `spp.Y`, and with
 //! `--spectral-bins N` the bins as `S0.<centre>nm` channels (Fichet et al. 2021 layout,
 //! W·m⁻²·sr⁻¹·nm⁻¹). PNG: the RGB sRGB-encoded (16 bit). See docs/rendering.md.
+//! A scene with `sensors` also gets `<output stem>.sensors.json` and `.sensors.csv`
+//! (illuminance in lx with standard errors, uniformity; docs/lighting.md).
 
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -58,6 +60,20 @@ pub struct RenderArgs {
     /// `S0.<λ>nm` channels of the EXR (Fichet et al. 2021 layout, W·m⁻²·sr⁻¹·nm⁻¹).
     #[arg(long = "spectral-bins", value_name = "N")]
     pub spectral_bins: Option<u32>,
+    /// Measure the scene's `sensors` only (`<output stem>.sensors.json/.csv`), no image.
+    #[arg(long = "sensors-only")]
+    pub sensors_only: bool,
+    /// Also write a false-colour PNG with a legend: of the image's luminance (cd/m²) or of
+    /// every grid sensor's illuminance (lx), as `<stem>.<what>.falsecolour.png`.
+    #[arg(long = "false-colour", value_enum)]
+    pub false_colour: Option<crate::falsecolour::FalseColourQuantity>,
+    /// Scale of the false-colour ramp.
+    #[arg(long = "false-colour-scale", value_enum, default_value = "linear")]
+    pub false_colour_scale: crate::falsecolour::ScaleArg,
+    /// Value range of the false-colour ramp, MIN:MAX (default: 0 to the maximum, or three
+    /// decades below the maximum on a log scale).
+    #[arg(long = "false-colour-range", value_parser = crate::falsecolour::parse_range)]
+    pub false_colour_range: Option<(f64, f64)>,
 }
 
 fn parse_resolution(s: &str) -> Result<UVec2, String> {
@@ -205,6 +221,17 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
         check_output(&output)?;
     }
     let spectral_bins = spectral_bins(args, &output)?;
+    if args.false_colour == Some(crate::falsecolour::FalseColourQuantity::Illuminance)
+        && !description
+            .sensors
+            .iter()
+            .any(|s| matches!(s.kind, prism_scene::SensorKind::Grid { .. }))
+    {
+        return Err(format!(
+            "--false-colour illuminance: {} has no `grid` sensor (see docs/lighting.md)",
+            args.scene.display()
+        ));
+    }
     let scene = RenderScene::build(&description, args.resolution).map_err(|e| e.to_string())?;
     let settings = RenderSettings {
         spp: args.spp.unwrap_or(scene.spp),
@@ -254,6 +281,25 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
         .map_err(|e| format!("cannot start the thread pool: {e}"))?;
     let threads = pool.current_num_threads();
 
+    if args.sensors_only {
+        if args.false_colour == Some(crate::falsecolour::FalseColourQuantity::Luminance) {
+            return Err("--false-colour luminance needs the image: drop --sensors-only".into());
+        }
+        if description.sensors.is_empty() {
+            return Err(format!(
+                "--sensors-only: {} has no `sensors` (see docs/lighting.md)",
+                args.scene.display()
+            ));
+        }
+        return measure_and_write_sensors(
+            args,
+            &pool,
+            &scene,
+            &description.sensors,
+            &settings,
+            &output,
+        );
+    }
     let bar = progress_bar(total_samples(scene.resolution, settings.spp));
     let start = Instant::now();
     let (film, stats) = pool.install(|| render(&scene, &settings, &|n| bar.inc(n)));
@@ -272,6 +318,26 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
         None => write_image(&output, &image),
     }
     .map_err(|e| e.to_string())?;
+    if args.false_colour == Some(crate::falsecolour::FalseColourQuantity::Luminance) {
+        let path = crate::falsecolour::write_luminance(
+            &output,
+            &film.luminance_cd_m2(),
+            (film.width as usize, film.height as usize),
+            args.false_colour_scale,
+            args.false_colour_range,
+        )?;
+        eprintln!("wrote {}", path.display());
+    }
+    if !description.sensors.is_empty() {
+        measure_and_write_sensors(
+            args,
+            &pool,
+            &scene,
+            &description.sensors,
+            &settings,
+            &output,
+        )?;
+    }
     if let Some(path) = &args.stats_json {
         write_stats(path, &scene, &settings, threads, wall_time_s, &stats)?;
     }
@@ -325,5 +391,80 @@ fn write_stats(
             path.display()
         ));
     }
+    Ok(())
+}
+
+/// Measures the scene's sensors on `pool` and writes their readings beside the image.
+fn measure_and_write_sensors(
+    args: &RenderArgs,
+    pool: &rayon::ThreadPool,
+    scene: &RenderScene,
+    sensors: &[prism_scene::Sensor],
+    settings: &RenderSettings,
+    output: &Path,
+) -> Result<(), String> {
+    let bar = progress_bar(prism_render::sensor::total_points(sensors));
+    let start = Instant::now();
+    let (readings, stats) = pool.install(|| {
+        prism_render::sensor::measure_sensors(scene, sensors, settings.seed, &|n| bar.inc(n))
+    });
+    let wall_time_s = start.elapsed().as_secs_f64();
+    bar.finish_and_clear();
+    let (json_path, csv_path) = crate::sensors::sensor_paths(output);
+    let mut value = crate::sensors::readings_json(&args.scene, &readings, &stats, wall_time_s);
+    let mut csv = crate::sensors::readings_csv(&readings);
+    // Daylight factor under the scene's daylight sky (docs/daylight.md).
+    let outdoor_lx =
+        prism_render::light::daylight::outdoor_horizontal_illuminance_lx(&scene.lights)
+            .filter(|e| *e > 0.0);
+    if let Some(e_out) = outdoor_lx {
+        crate::daylight_factor::add_to_json(&mut value, &readings, e_out);
+        csv = crate::daylight_factor::add_to_csv(&csv, &readings, e_out);
+    }
+    let text = serde_json::to_string_pretty(&value).map_err(|e| e.to_string())? + "\n";
+    crate::sensors::write_atomic(&json_path, &text, "sensor readings")?;
+    crate::sensors::write_atomic(&csv_path, &csv, "sensor readings")?;
+    if args.false_colour == Some(crate::falsecolour::FalseColourQuantity::Illuminance) {
+        for path in crate::falsecolour::write_illuminance(
+            output,
+            &readings,
+            args.false_colour_scale,
+            args.false_colour_range,
+        )? {
+            eprintln!("wrote {}", path.display());
+        }
+    }
+    for r in &readings {
+        let u = r.uniformity();
+        eprintln!(
+            "sensor {}: {} points, E_avg {:.4} lx, E_min {:.4} lx, E_max {:.4} lx, \
+             E_min/E_avg {:.3}, E_min/E_max {:.3}",
+            r.name,
+            r.points.len(),
+            u.average_lx,
+            u.min_lx,
+            u.max_lx,
+            u.min_over_average,
+            u.min_over_max
+        );
+        if let Some(e_out) = outdoor_lx {
+            eprintln!(
+                "sensor {}: daylight factor average {:.3} %, min {:.3} %, max {:.3} % \
+                 (outdoor unobstructed sky {:.1} lx)",
+                r.name,
+                100.0 * u.average_lx / e_out,
+                100.0 * u.min_lx / e_out,
+                100.0 * u.max_lx / e_out,
+                e_out
+            );
+        }
+    }
+    eprintln!(
+        "wrote {} and {} ({} samples, {:.2} s)",
+        json_path.display(),
+        csv_path.display(),
+        stats.samples,
+        wall_time_s
+    );
     Ok(())
 }

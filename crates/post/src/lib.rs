@@ -6,6 +6,7 @@
 
 pub mod colour;
 pub mod error;
+pub mod falsecolour;
 pub mod image;
 pub mod io;
 

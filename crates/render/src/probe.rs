@@ -42,7 +42,8 @@ fn bandwidth(spatial: f32, angular: f32) -> Bandwidth {
 /// ν_l of a light (see the module docs).
 pub fn light_bandwidth(light: &Light) -> Bandwidth {
     match light {
-        Light::Point(_) | Light::Spot(_) => bandwidth(0.0, f32::INFINITY),
+        // A point source: a Dirac in position (its angular distribution is smooth).
+        Light::Point(_) | Light::Spot(_) | Light::Goniometric(_) => bandwidth(0.0, f32::INFINITY),
         Light::Directional(d) => {
             if d.one_minus_cos_half_angle > 0.0 {
                 let half = (1.0 - d.one_minus_cos_half_angle).clamp(-1.0, 1.0).acos();
@@ -56,6 +57,8 @@ pub fn light_bandwidth(light: &Light) -> Bandwidth {
             bandwidth(0.0, e.resolution().0 as f32 / (4.0 * std::f32::consts::PI))
         }
         Light::Sky(_) => bandwidth(0.0, 0.0),
+        // The sky's indicatrix exp(d χ) (|d| ≤ 3) varies over about 1/3 rad: ≈ 1.5 cycles/rad.
+        Light::Daylight(_) => bandwidth(0.0, 1.5),
     }
 }
 

@@ -4,6 +4,7 @@
 //! format is documented in docs/scene-format.md.
 
 pub mod camera;
+pub mod daylight;
 pub mod error;
 pub mod film;
 pub mod integrator;
@@ -11,13 +12,16 @@ mod json;
 pub mod light;
 pub mod material;
 pub mod medium;
+pub mod photometric;
 mod reader;
 pub mod scene;
+pub mod sensor;
 pub mod shape;
 pub mod spectrum_ref;
 pub mod transform;
 
 pub use camera::{Camera, CameraKind, FisheyeFit, FisheyeProjection, FovAxis};
+pub use daylight::{DateTime, DaylightSky, SkyModel, SkyNormalisation, SunPosition};
 pub use error::{JsonPath, PathSegment, Position, SceneError};
 pub use film::{Aov, Film, PixelFilter, Reconstruction};
 pub use integrator::{Integrator, MisHeuristic, SamplerKind};
@@ -25,6 +29,7 @@ pub use light::{Light, LightKind, Strength};
 pub use material::{ConductorOptics, Ior, Material, MaterialKind, Microfacet, Roughness};
 pub use medium::{Medium, MediumKind};
 pub use scene::{load_scene, parse_scene_str, SceneDescription};
+pub use sensor::{Sensor, SensorKind, SensorSampling};
 pub use shape::{MeshAsset, MeshFormat, Shape, ShapeKind};
 pub use spectrum_ref::SpectrumRef;
 pub use transform::Transform;

@@ -6,6 +6,8 @@ use std::path::PathBuf;
 
 use glam::DVec3;
 
+use crate::daylight::{parse_daylight, DaylightSky};
+use crate::photometric::{load_photometric_file, IntensityDistribution};
 use crate::reader::{quoted_list, suggest, Obj, Result, V};
 use crate::shape::Shape;
 use crate::spectrum_ref::{parse_spectrum, NamedSpectra, SpectrumRef, SpectrumUse};
@@ -69,9 +71,31 @@ pub enum LightKind {
     },
     /// A sky of the same radiance in every direction.
     UniformSky,
+    /// A CIE, Perez or Preetham sky with its sun (crate::daylight).
+    Daylight(Box<DaylightSky>),
+    /// A point luminaire with the intensity distribution of an IES/EULUMDAT file.
+    Luminaire {
+        distribution: Box<IntensityDistribution>,
+        position_m: [f64; 3],
+        /// Unit vector of the luminaire's γ = 0 axis (nadir as measured).
+        aim: [f64; 3],
+        /// Unit vector of the C = 0 plane's direction, perpendicular to `aim`.
+        c0_direction: [f64; 3],
+    },
 }
 
-pub const LIGHT_TYPES: [&str; 6] = ["point", "spot", "directional", "area", "environment", "sky"];
+pub const LIGHT_TYPES: [&str; 10] = [
+    "point",
+    "spot",
+    "directional",
+    "area",
+    "environment",
+    "sky",
+    "cie_sky",
+    "perez_sky",
+    "preetham_sky",
+    "luminaire",
+];
 
 fn unit_vector(v: &V) -> Result<[f64; 3]> {
     let d = DVec3::from(v.numbers::<3>()?);
@@ -227,6 +251,62 @@ pub(crate) fn parse_light(v: &V, spectra: &NamedSpectra, shapes: &[Shape]) -> Re
                 .get("transform")
                 .map_or(Ok(Transform::IDENTITY), |t| parse_transform(&t))?;
             (o, LightKind::Environment { path, transform }, s)
+        }
+        "cie_sky" | "perez_sky" | "preetham_sky" => {
+            let sky = parse_daylight(v, kind)?;
+            return Ok(Light {
+                kind: LightKind::Daylight(Box::new(sky)),
+                spectrum: default_spectrum(v)?,
+                strength: Strength::Scale(1.0),
+            });
+        }
+        "luminaire" => {
+            let o = v.object(&with(&[
+                "file",
+                "position_m",
+                "aim",
+                "c0_direction",
+                "power_lm",
+            ]))?;
+            let s = strength(&o, &["power_lm"])?;
+            let file_v = o.req("file", "an .ies or .ldt photometric file")?;
+            let path = file_v.asset("photometric", &["ies", "ldt"])?;
+            let distribution = load_photometric_file(&path)
+                .map_err(|e| file_v.err(format!("cannot use the photometric file: {e}")))?;
+            let position_m = o.vec3_or("position_m", [0.0; 3])?;
+            let aim = match o.get("aim") {
+                None => [0.0, -1.0, 0.0],
+                Some(a) => unit_vector(&a)?,
+            };
+            let c0_v = o.get("c0_direction");
+            let c0 = match &c0_v {
+                None => {
+                    // +X, or +Z when aiming along X.
+                    if aim[0].abs() > 0.9 {
+                        [0.0, 0.0, 1.0]
+                    } else {
+                        [1.0, 0.0, 0.0]
+                    }
+                }
+                Some(c) => unit_vector(c)?,
+            };
+            // Gram–Schmidt: the C = 0 direction perpendicular to the aim.
+            let (a, c) = (DVec3::from(aim), DVec3::from(c0));
+            let perp = c - a * a.dot(c);
+            if perp.length() < 1e-6 {
+                let at = c0_v.as_ref().unwrap_or(v);
+                return Err(at.err("expected `c0_direction` not parallel to `aim`"));
+            }
+            (
+                o,
+                LightKind::Luminaire {
+                    distribution: Box::new(distribution),
+                    position_m,
+                    aim,
+                    c0_direction: perp.normalize().to_array(),
+                },
+                s,
+            )
         }
         _ => {
             let o = v.object(&with(&["luminance_cd_m2"]))?;

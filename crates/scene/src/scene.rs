@@ -12,6 +12,7 @@ use crate::light::{parse_light, Light};
 use crate::material::{parse_materials, Material};
 use crate::medium::{parse_media, Medium};
 use crate::reader::{Ctx, Result, V};
+use crate::sensor::{parse_sensors, Sensor};
 use crate::shape::{parse_meshes, parse_shape, MeshAsset, Shape, ShapeContext};
 use crate::spectrum_ref::{parse_spectrum, SpectrumRef, SpectrumUse};
 
@@ -32,9 +33,11 @@ pub struct SceneDescription {
     pub shapes: Vec<Shape>,
     pub lights: Vec<Light>,
     pub media: Vec<Medium>,
+    /// Illuminance sensors (`sensors`), measured by `prism render` beside the image.
+    pub sensors: Vec<Sensor>,
 }
 
-pub const TOP_LEVEL_FIELDS: [&str; 10] = [
+pub const TOP_LEVEL_FIELDS: [&str; 11] = [
     "camera",
     "film",
     "integrator",
@@ -44,6 +47,7 @@ pub const TOP_LEVEL_FIELDS: [&str; 10] = [
     "shapes",
     "lights",
     "media",
+    "sensors",
     "$schema",
 ];
 
@@ -155,6 +159,9 @@ fn parse_root(v: &V) -> Result<SceneDescription> {
     let integrator = o
         .get("integrator")
         .map_or(Ok(Integrator::default()), |i| parse_integrator(&i))?;
+    let sensors = o
+        .get("sensors")
+        .map_or(Ok(Vec::new()), |s| parse_sensors(&s))?;
     Ok(SceneDescription {
         file: v.cx.file.clone(),
         camera,
@@ -166,5 +173,6 @@ fn parse_root(v: &V) -> Result<SceneDescription> {
         shapes,
         lights,
         media,
+        sensors,
     })
 }

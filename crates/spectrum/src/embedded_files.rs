@@ -32,6 +32,10 @@ pub const EMBEDDED_SPECTRA: &[(&str, &str)] = &[
     ("LED-V1", include_str!("../../../spectra/LED-V1.csv")),
     ("LED-V2", include_str!("../../../spectra/LED-V2.csv")),
     (
+        "cie-daylight-basis",
+        include_str!("../../../spectra/cie-daylight-basis.csv"),
+    ),
+    (
         "cie1924-photopic",
         include_str!("../../../spectra/cie1924-photopic.csv"),
     ),

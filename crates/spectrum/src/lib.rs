@@ -10,6 +10,7 @@ pub mod cct;
 pub mod colorimetry;
 pub mod constants;
 pub mod data;
+pub mod daylight;
 pub mod embedded_files;
 pub mod error;
 pub mod names;

@@ -18,7 +18,7 @@ pub use ambient_occlusion::AmbientOcclusion;
 pub use driver::{
     render, render_plan, total_samples, RenderSettings, RenderStats, DEFAULT_TILE_SIZE_PX,
 };
-pub use path::{mis_weight, PathCounters, PathResult, PathTracer};
+pub use path::{mis_weight, PathCounters, PathOrigin, PathResult, PathTracer};
 
 use glam::DVec3;
 use prism_geometry::{Ray, SurfaceInteraction};

@@ -81,6 +81,15 @@ pub fn mis_weight(heuristic: MisHeuristic, a: f32, b: f32) -> f32 {
     }
 }
 
+/// Where a non-camera path starts: the point that sampled the first direction (with its
+/// geometric normal, for the lights' pdfs) and the solid-angle pdf of that direction.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PathOrigin {
+    pub ctx: LightSampleContext,
+    /// Solid-angle pdf with which the first direction was sampled (> 0).
+    pub direction_pdf: f32,
+}
+
 /// A shading point: where the path scatters.
 struct Vertex {
     si: SurfaceInteraction,
@@ -102,6 +111,34 @@ impl PathTracer {
         want_illumination: bool,
         counters: &mut PathCounters,
     ) -> PathResult {
+        self.radiance_from(
+            scene,
+            camera_ray,
+            None,
+            wavelengths,
+            stream,
+            light_samples,
+            want_illumination,
+            counters,
+        )
+    }
+
+    /// Radiance arriving at `ray.origin` along `ray` when the ray was sampled at a
+    /// non-specular point `origin` (an illuminance sensor): emission met by the ray is then
+    /// MIS-weighted against light sampling from `origin` (whose light samples the caller
+    /// takes), instead of counted in full as for a camera ray. `None` is a camera ray.
+    #[allow(clippy::too_many_arguments)]
+    pub fn radiance_from(
+        &self,
+        scene: &RenderScene,
+        camera_ray: &Ray,
+        origin: Option<PathOrigin>,
+        wavelengths: &mut SampledWavelengths,
+        stream: &mut SampleStream,
+        light_samples: u32,
+        want_illumination: bool,
+        counters: &mut PathCounters,
+    ) -> PathResult {
         let lights = &scene.lights;
         let mut radiance = SampledSpectrum::splat(0.0);
         let mut beta = SampledSpectrum::splat(1.0);
@@ -113,12 +150,17 @@ impl PathTracer {
         let mut first_hit: Option<SurfaceInteraction> = None;
         let mut ray = *camera_ray;
         let mut depth = 0u32;
-        let mut specular_bounce = true;
-        let mut prev_ctx = LightSampleContext {
-            p: ray.origin,
-            n: Vec3A::ZERO,
-        };
-        let mut prev_bsdf_pdf = 0.0f32;
+        let mut specular_bounce = origin.is_none();
+        let mut prev_ctx = origin.map_or(
+            LightSampleContext {
+                p: ray.origin,
+                n: Vec3A::ZERO,
+            },
+            |o| o.ctx,
+        );
+        let mut prev_bsdf_pdf = origin.map_or(0.0f32, |o| o.direction_pdf);
+        // Curvature is for the camera's G-buffer; a sensor's first hit needs none.
+        let want_curvature = origin.is_none();
         // Product of η² over refractions: roulette compares radiance, not the 1/η²-scaled
         // throughput (pbrt-v4 §13.4.4 `etaScale`).
         let mut eta_scale = 1.0f32;
@@ -177,7 +219,7 @@ impl PathTracer {
                 break;
             };
             // Curvature only at the first hit (the G-buffer's); shading never reads it.
-            let si = if first_hit.is_none() {
+            let si = if first_hit.is_none() && want_curvature {
                 scene.geometry.interaction(&ray, &hit)
             } else {
                 scene.geometry.shading_interaction(&ray, &hit)
@@ -264,6 +306,11 @@ impl PathTracer {
                     } else {
                         (stream.get_1d(), stream.get_2d())
                     };
+                    // Stratified light choice: sample k picks from the k-th of n equal
+                    // slices of the selection CDF (each is still a sample of the same
+                    // mixture, so the average stays unbiased; with n ≥ the number of
+                    // equally bright lights every light gets its shadow ray).
+                    let uc = ((k as f32 + uc) / n_light as f32).min(1.0 - f32::EPSILON);
                     let (d, w) = self.sample_light(
                         scene,
                         &vertex,
@@ -411,7 +458,7 @@ impl PathTracer {
     /// has opacity masks (the plan's choice, `RenderScene::has_masks`): then each masked
     /// surface on the way multiplies by 1 − α (exact, no extra noise).
     #[inline]
-    fn transmittance(
+    pub(crate) fn transmittance(
         &self,
         scene: &RenderScene,
         p: Vec3A,

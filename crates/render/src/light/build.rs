@@ -15,6 +15,7 @@ use prism_spectrum::Spectrum;
 use super::area::{
     AreaLight, AreaShape, DiskEmitter, EmitterMesh, MeshEmitter, RectangleEmitter, SphereEmitter,
 };
+use super::daylight::build_daylight;
 use super::environment::{rotation_of, EnvironmentLight};
 use super::photometry::{
     lambertian_luminance_from_flux, photometric_scale, point_intensity_from_flux,
@@ -61,7 +62,7 @@ enum Target {
     Photometric(f64),
 }
 
-struct LightBuilder<'a> {
+pub(super) struct LightBuilder<'a> {
     file: &'a Path,
     index: usize,
     kind_name: &'static str,
@@ -73,7 +74,7 @@ impl LightBuilder<'_> {
         format!("lights[{}]", self.index)
     }
 
-    fn err(&self, field: &str, message: impl Into<String>) -> SceneBuildError {
+    pub(super) fn err(&self, field: &str, message: impl Into<String>) -> SceneBuildError {
         let place = if field.is_empty() {
             self.place()
         } else {
@@ -95,7 +96,7 @@ impl LightBuilder<'_> {
         }
     }
 
-    fn unsupported(&self) -> SceneBuildError {
+    pub(super) fn unsupported(&self) -> SceneBuildError {
         self.err(
             strength_field(&self.strength),
             format!(
@@ -177,6 +178,8 @@ pub(super) fn build_lights(
                 LightKind::Area { .. } => "area",
                 LightKind::Environment { .. } => "environment",
                 LightKind::UniformSky => "sky",
+                LightKind::Daylight(_) => "daylight sky",
+                LightKind::Luminaire { .. } => "luminaire",
             },
             strength: l.strength,
         };
@@ -184,6 +187,8 @@ pub(super) fn build_lights(
         let spectrum = || {
             build_spectrum(&l.spectrum, SpectrumRole::Illuminant).map_err(|e| b.err("spectrum", e))
         };
+        // A daylight sky brings its sun as a second emitter, pushed right after it.
+        let mut extra: Option<Light> = None;
         let light = match &l.kind {
             LightKind::Point { position_m } => {
                 let target = match l.strength {
@@ -319,8 +324,29 @@ pub(super) fn build_lights(
                     scene: scene_sphere,
                 })
             }
+            LightKind::Daylight(desc) => {
+                let built = build_daylight(desc, scene_sphere).map_err(|e| b.err("", e))?;
+                extra = built.sun.map(Light::Directional);
+                Light::Daylight(Box::new(built.sky))
+            }
+            LightKind::Luminaire {
+                distribution,
+                position_m,
+                aim,
+                c0_direction,
+            } => super::goniometric_build::build(
+                &b,
+                l.strength,
+                value,
+                distribution,
+                position_m,
+                aim,
+                c0_direction,
+                spectrum()?,
+            )?,
         };
         lights.push(light);
+        lights.extend(extra);
     }
     Ok(BuiltLights {
         lights,

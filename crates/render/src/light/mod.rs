@@ -19,8 +19,11 @@
 
 pub mod area;
 mod build;
+pub mod daylight;
 pub mod directional;
 pub mod environment;
+pub mod goniometric;
+mod goniometric_build;
 mod light_set;
 pub mod photometry;
 pub mod piecewise_constant;
@@ -33,8 +36,10 @@ mod test_support;
 pub mod warp;
 
 pub use area::{AreaLight, AreaShape};
+pub use daylight::sky_light::DaylightSkyLight;
 pub use directional::DirectionalLight;
 pub use environment::EnvironmentLight;
+pub use goniometric::GoniometricLight;
 pub use light_set::{LightSet, NO_LIGHT};
 pub use point::PointLight;
 pub use scene_sphere::SceneSphere;
@@ -93,6 +98,10 @@ pub enum Light {
     Area(AreaLight),
     Environment(Box<EnvironmentLight>),
     Sky(UniformSky),
+    /// CIE, Perez or Preetham sky (its sun is a separate `Directional`).
+    Daylight(Box<DaylightSkyLight>),
+    /// A point luminaire with an IES/EULUMDAT intensity distribution.
+    Goniometric(Box<GoniometricLight>),
 }
 
 impl Light {
@@ -111,6 +120,8 @@ impl Light {
             Light::Area(l) => l.sample_li(ctx, u, wavelengths),
             Light::Environment(l) => l.sample_li(ctx, u, wavelengths),
             Light::Sky(l) => l.sample_li(ctx, u, wavelengths),
+            Light::Daylight(l) => l.sample_li(ctx, u, wavelengths),
+            Light::Goniometric(l) => l.sample_li(ctx, u, wavelengths),
         }
     }
 
@@ -121,11 +132,12 @@ impl Light {
     #[inline]
     pub fn pdf_li(&self, ctx: &LightSampleContext, wi: Vec3A, hit: Option<&LightHit>) -> f32 {
         match self {
-            Light::Point(_) | Light::Spot(_) => 0.0,
+            Light::Point(_) | Light::Spot(_) | Light::Goniometric(_) => 0.0,
             Light::Directional(l) => l.pdf_li(wi),
             Light::Area(l) => l.pdf_li(ctx, wi, hit),
             Light::Environment(l) => l.pdf_li(wi),
             Light::Sky(l) => l.pdf_li(ctx, wi),
+            Light::Daylight(l) => l.pdf_li(wi),
         }
     }
 
@@ -158,6 +170,7 @@ impl Light {
             Light::Directional(l) => l.infinite_radiance(direction, wavelengths),
             Light::Environment(l) => l.infinite_radiance(direction, wavelengths),
             Light::Sky(l) => l.infinite_radiance(wavelengths),
+            Light::Daylight(l) => l.radiance(direction, wavelengths),
             _ => SampledSpectrum::splat(0.0),
         }
     }
@@ -167,9 +180,9 @@ impl Light {
     #[inline]
     pub fn is_delta(&self) -> bool {
         match self {
-            Light::Point(_) | Light::Spot(_) => true,
+            Light::Point(_) | Light::Spot(_) | Light::Goniometric(_) => true,
             Light::Directional(l) => l.is_delta(),
-            Light::Area(_) | Light::Environment(_) | Light::Sky(_) => false,
+            Light::Area(_) | Light::Environment(_) | Light::Sky(_) | Light::Daylight(_) => false,
         }
     }
 
@@ -180,7 +193,7 @@ impl Light {
     pub fn is_infinite(&self) -> bool {
         matches!(
             self,
-            Light::Directional(_) | Light::Environment(_) | Light::Sky(_)
+            Light::Directional(_) | Light::Environment(_) | Light::Sky(_) | Light::Daylight(_)
         )
     }
 
@@ -194,6 +207,8 @@ impl Light {
             Light::Area(l) => l.power_w(),
             Light::Environment(l) => l.power_w(scene_radius_m),
             Light::Sky(l) => l.power_w(scene_radius_m),
+            Light::Daylight(l) => l.power_w(scene_radius_m),
+            Light::Goniometric(l) => l.power_w(),
         }
     }
 }

@@ -1,0 +1,336 @@
+//! Illuminance sensors: points, lists and grids of points (prism-scene `Sensor`), each
+//! measured as E = ∫ L cos θ dω in lux with its standard error (`illuminance`), to a fixed
+//! sample count or until a requested standard error; per sensor the uniformity ratios
+//! E_min/E_avg and E_min/E_max (docs/lighting.md).
+//!
+//! Determinism: sample k of point i of sensor s draws from the independent sampler's
+//! stream (seed, (i, s), k), never from a thread's state, so the readings are the same for
+//! any thread count. The independent sampler (not Sobol) keeps the usual variance
+//! estimate s²/n an honest standard error.
+
+mod illuminance;
+
+pub use illuminance::sample_illuminance_lx;
+
+use glam::{DVec3, UVec2, Vec3A};
+use prism_scene::{Sensor, SensorSampling};
+use rayon::prelude::*;
+
+use crate::integrator::{Integrator, PathCounters, PathTracer};
+use crate::sampler::{PixelSampler, SamplerKind};
+use crate::scene_build::RenderScene;
+
+/// Samples per work item: the unit of parallel work within one point.
+const CHUNK_SAMPLES: u32 = 256;
+
+/// Streaming mean and sum of squared deviations (Welford 1962; Chan, Golub & LeVeque 1979
+/// for merging two sets).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct RunningStats {
+    pub n: u64,
+    pub mean: f64,
+    pub m2: f64,
+}
+
+impl RunningStats {
+    pub fn push(&mut self, x: f64) {
+        self.n += 1;
+        let d = x - self.mean;
+        self.mean += d / self.n as f64;
+        self.m2 += d * (x - self.mean);
+    }
+
+    pub fn merge(&mut self, o: &RunningStats) {
+        if o.n == 0 {
+            return;
+        }
+        if self.n == 0 {
+            *self = *o;
+            return;
+        }
+        let n = self.n + o.n;
+        let d = o.mean - self.mean;
+        self.mean += d * o.n as f64 / n as f64;
+        self.m2 += o.m2 + d * d * (self.n as f64 * o.n as f64) / n as f64;
+        self.n = n;
+    }
+
+    /// Standard error of the mean, s/√n (0 with fewer than 2 samples).
+    pub fn std_error(&self) -> f64 {
+        if self.n < 2 {
+            return 0.0;
+        }
+        (self.m2.max(0.0) / (self.n - 1) as f64 / self.n as f64).sqrt()
+    }
+}
+
+/// One measuring point's result.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PointReading {
+    /// Position, metres (world).
+    pub position_m: [f64; 3],
+    /// Unit normal of the receiving surface.
+    pub normal: [f64; 3],
+    /// Mean illuminance, lx.
+    pub illuminance_lx: f64,
+    /// Standard error of `illuminance_lx`, lx.
+    pub std_error_lx: f64,
+    /// Samples taken.
+    pub samples: u64,
+}
+
+/// Uniformity of a set of illuminances (EN 12464-1 U₀ = E_min/E_avg; E_min/E_max).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Uniformity {
+    pub min_lx: f64,
+    pub max_lx: f64,
+    pub average_lx: f64,
+    /// E_min / E_avg (0 when E_avg = 0).
+    pub min_over_average: f64,
+    /// E_min / E_max (0 when E_max = 0).
+    pub min_over_max: f64,
+}
+
+impl Uniformity {
+    /// `None` for an empty set.
+    pub fn of(values: impl IntoIterator<Item = f64>) -> Option<Self> {
+        let (mut min, mut max, mut sum, mut n) = (f64::INFINITY, f64::NEG_INFINITY, 0.0, 0usize);
+        for v in values {
+            min = min.min(v);
+            max = max.max(v);
+            sum += v;
+            n += 1;
+        }
+        if n == 0 {
+            return None;
+        }
+        let average = sum / n as f64;
+        let ratio = |a: f64, b: f64| if b > 0.0 { a / b } else { 0.0 };
+        Some(Self {
+            min_lx: min,
+            max_lx: max,
+            average_lx: average,
+            min_over_average: ratio(min, average),
+            min_over_max: ratio(min, max),
+        })
+    }
+}
+
+/// One sensor's readings.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SensorReading {
+    pub name: String,
+    /// `[nu, nv]` for grids (points are row-major, u fastest); `None` for point lists.
+    pub grid_resolution: Option<[u32; 2]>,
+    pub points: Vec<PointReading>,
+}
+
+impl SensorReading {
+    pub fn uniformity(&self) -> Uniformity {
+        Uniformity::of(self.points.iter().map(|p| p.illuminance_lx))
+            .expect("a sensor has at least one point")
+    }
+}
+
+/// Totals of a measurement.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct SensorStats {
+    pub samples: u64,
+    pub rays_traced: u64,
+    pub non_finite_contributions: u64,
+}
+
+/// The path tracer sensors use: the scene's, or the default one (max depth 8, roulette
+/// from depth 3, power heuristic) when the scene renders with a diagnostic integrator.
+pub fn sensor_tracer(scene: &RenderScene) -> PathTracer {
+    match scene.integrator {
+        Integrator::Path(t) => t,
+        _ => match Integrator::from_description(&prism_scene::Integrator::default()) {
+            Ok(Integrator::Path(t)) => t,
+            _ => PathTracer {
+                max_depth: 8,
+                rr_depth: 3,
+                mis: prism_scene::MisHeuristic::Power,
+            },
+        },
+    }
+}
+
+/// Light samples per vertex for sensors: one per light up to 8 (stratified, so a few
+/// equally bright lamps each get a shadow ray, as Radiance's direct calculation does).
+pub fn sensor_light_samples(scene: &RenderScene) -> u32 {
+    scene.lights.len().clamp(1, 8) as u32
+}
+
+/// Deterministic per-sensor seed.
+fn sensor_seed(seed: u64, sensor: usize) -> u64 {
+    // SplitMix64 finaliser (Steele et al. 2014).
+    let mut z = seed ^ (sensor as u64 + 1).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+/// Samples [start, end) of one point, in parallel chunks merged in a fixed order.
+#[allow(clippy::too_many_arguments)]
+fn run_samples(
+    tracer: &PathTracer,
+    scene: &RenderScene,
+    sampler: &PixelSampler,
+    point: UVec2,
+    p: Vec3A,
+    n: Vec3A,
+    start: u32,
+    end: u32,
+) -> (RunningStats, PathCounters) {
+    let chunks: Vec<(RunningStats, PathCounters)> = (start..end)
+        .step_by(CHUNK_SAMPLES as usize)
+        .collect::<Vec<_>>()
+        .into_par_iter()
+        .map(|c| {
+            let mut stats = RunningStats::default();
+            let mut counters = PathCounters::default();
+            for k in c..(c + CHUNK_SAMPLES).min(end) {
+                let mut stream = sampler.stream(point, k);
+                let e = sample_illuminance_lx(
+                    tracer,
+                    scene,
+                    p,
+                    n,
+                    sensor_light_samples(scene),
+                    &mut stream,
+                    &mut counters,
+                );
+                stats.push(e);
+            }
+            (stats, counters)
+        })
+        .collect();
+    let mut stats = RunningStats::default();
+    let mut counters = PathCounters::default();
+    for (s, c) in &chunks {
+        stats.merge(s);
+        counters.rays += c.rays;
+        counters.non_finite_contributions += c.non_finite_contributions;
+    }
+    (stats, counters)
+}
+
+/// Measures one point under `sampling`.
+fn measure_point(
+    tracer: &PathTracer,
+    scene: &RenderScene,
+    sampler: &PixelSampler,
+    index: UVec2,
+    position_m: [f64; 3],
+    normal: [f64; 3],
+    sampling: SensorSampling,
+) -> (PointReading, PathCounters) {
+    let p = DVec3::from(position_m).as_vec3a();
+    let n = DVec3::from(normal).normalize().as_vec3a();
+    let mut counters = PathCounters::default();
+    let mut stats = RunningStats::default();
+    let mut take = |stats: &mut RunningStats, start: u32, end: u32| {
+        let (s, c) = run_samples(tracer, scene, sampler, index, p, n, start, end);
+        stats.merge(&s);
+        counters.rays += c.rays;
+        counters.non_finite_contributions += c.non_finite_contributions;
+    };
+    match sampling {
+        SensorSampling::Fixed { samples } => take(&mut stats, 0, samples),
+        SensorSampling::Adaptive {
+            relative_error,
+            absolute_error_lx,
+            min_samples,
+            max_samples,
+        } => {
+            let mut done = 0u32;
+            let mut next = min_samples.min(max_samples);
+            loop {
+                take(&mut stats, done, next);
+                done = next;
+                let target = (relative_error * stats.mean.abs()).max(absolute_error_lx);
+                let se = stats.std_error();
+                if se <= target || done >= max_samples {
+                    break;
+                }
+                // n · (se / target)² samples reach the target if the variance holds; aim
+                // 10 % beyond, never more than 4× the samples so far in one step.
+                let wanted = if target > 0.0 {
+                    (done as f64 * (se / target).powi(2) * 1.1).ceil()
+                } else {
+                    f64::INFINITY
+                };
+                let wanted = wanted.min(4.0 * done as f64).max(done as f64 + 16.0);
+                next = (wanted.min(f64::from(max_samples))) as u32;
+            }
+        }
+    }
+    (
+        PointReading {
+            position_m,
+            normal: n.to_array().map(f64::from),
+            illuminance_lx: stats.mean,
+            std_error_lx: stats.std_error(),
+            samples: stats.n,
+        },
+        counters,
+    )
+}
+
+/// Measures every sensor of `sensors` in `scene` (points in parallel on the current rayon
+/// pool). `progress` is called with the number of points finished.
+pub fn measure_sensors(
+    scene: &RenderScene,
+    sensors: &[Sensor],
+    seed: u64,
+    progress: &(dyn Fn(u64) + Sync),
+) -> (Vec<SensorReading>, SensorStats) {
+    let tracer = sensor_tracer(scene);
+    let mut readings = Vec::with_capacity(sensors.len());
+    let mut stats = SensorStats::default();
+    for (s, sensor) in sensors.iter().enumerate() {
+        let sampler = PixelSampler::with_kind(SamplerKind::Independent, sensor_seed(seed, s));
+        let results: Vec<(PointReading, PathCounters)> = (0..sensor.kind.len())
+            .into_par_iter()
+            .map(|i| {
+                let (position_m, normal) = sensor.kind.point(i);
+                let r = measure_point(
+                    &tracer,
+                    scene,
+                    &sampler,
+                    UVec2::new(i as u32, s as u32),
+                    position_m,
+                    normal,
+                    sensor.sampling,
+                );
+                progress(1);
+                r
+            })
+            .collect();
+        let mut points = Vec::with_capacity(results.len());
+        for (p, c) in results {
+            stats.samples += p.samples;
+            stats.rays_traced += c.rays;
+            stats.non_finite_contributions += c.non_finite_contributions;
+            points.push(p);
+        }
+        readings.push(SensorReading {
+            name: sensor.name.clone(),
+            grid_resolution: match sensor.kind {
+                prism_scene::SensorKind::Grid { resolution, .. } => Some(resolution),
+                _ => None,
+            },
+            points,
+        });
+    }
+    (readings, stats)
+}
+
+/// Total measuring points of `sensors` (for progress bars).
+pub fn total_points(sensors: &[Sensor]) -> u64 {
+    sensors.iter().map(|s| s.kind.len() as u64).sum()
+}
+
+#[cfg(test)]
+mod tests;
