@@ -46,7 +46,10 @@ pub use conductor::Conductor;
 pub use dielectric::Dielectric;
 pub use lafortune::{Lafortune, LafortuneLobe, LAFORTUNE_MAX_LOBES};
 pub use lambert::Lambert;
-pub use merl::{Measured, MerlBrdf, MerlError, MerlTable};
+pub use merl::{
+    merl_bin, merl_bin_centre, merl_directions, Measured, MerlBrdf, MerlError, MerlTable,
+    MERL_ENTRIES, MERL_FILE_BYTES, MERL_SCALE,
+};
 pub use microfacet::{MicrofacetDistribution, MicrofacetModel};
 pub use mix::{Mix, MixComponent, MIX_MAX_COMPONENTS};
 pub use oren_nayar::{OrenNayar, OrenNayarForm};
