@@ -123,8 +123,25 @@ pub fn merl_bin_centre(i_h: usize, i_d: usize, i_phi: usize) -> (f64, f64, f64) 
 }
 
 /// (ωᵢ, ωₒ) in the local frame for half/difference angles, φ_h = 0 (isotropy): the
-/// difference vector and its mirror about the half vector, rotated by θ_h about y.
+/// difference vector and its mirror about the half vector, rotated by θ_h about y. A
+/// direction the bin's centre puts below the horizon is lifted to z = 10⁻⁴ (renormalised):
+/// such bins straddle the horizon and are looked up only by upper-hemisphere pairs near
+/// that edge, so the nearest upper configuration is the value they need (a Lambertian
+/// source then exports exactly 1/π·ρ in every bin).
 pub fn merl_directions(theta_h: f64, theta_d: f64, phi_d: f64) -> (Vec3A, Vec3A) {
+    let (wi, wo) = merl_directions_raw(theta_h, theta_d, phi_d);
+    let lift = |w: Vec3A| {
+        if w.z < 1e-4 {
+            Vec3A::new(w.x, w.y, 1e-4).normalize()
+        } else {
+            w
+        }
+    };
+    (lift(wi), lift(wo))
+}
+
+/// As [`merl_directions`] without lifting (may lie below the horizon).
+pub fn merl_directions_raw(theta_h: f64, theta_d: f64, phi_d: f64) -> (Vec3A, Vec3A) {
     let (st_d, ct_d) = theta_d.sin_cos();
     let (sp_d, cp_d) = phi_d.sin_cos();
     let (st_h, ct_h) = theta_h.sin_cos();

@@ -287,6 +287,9 @@ impl<'a> Bsdf<'a> {
 #[cfg(test)]
 mod tests;
 
+#[cfg(test)]
+mod library_tests;
+
 /// cos θ of a local direction.
 #[inline]
 pub fn cos_theta(w: Vec3A) -> f32 {
