@@ -2,6 +2,7 @@
 
 mod color;
 mod compare;
+mod merl_export;
 mod render;
 mod tonemap;
 
@@ -26,6 +27,8 @@ enum Command {
     Color(color::ColorArgs),
     /// Error metrics of an image against a reference: MSE, RMSE, relMSE, PSNR, SSIM, ΔE2000.
     Compare(compare::CompareArgs),
+    /// Write a material of a scene file as a MERL BRDF table (90×90×180 half/difference angles).
+    MerlExport(merl_export::MerlExportArgs),
     /// Render a scene file to an EXR or PNG image (docs/rendering.md).
     Render(render::RenderArgs),
     /// Tone-map an HDR image (EXR/HDR): white balance, tone operator, gamut mapping, encoding.
@@ -43,6 +46,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Color(args) => color::run(&args),
         Command::Compare(args) => compare::run(&args),
+        Command::MerlExport(args) => merl_export::run(&args),
         Command::Render(args) => render::run(&args),
         Command::Tonemap(args) => tonemap::run(&args),
     };
