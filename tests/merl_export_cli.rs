@@ -44,15 +44,41 @@ fn merl_export_writes_a_table_that_renders() {
     )
     .unwrap();
     let image = dir.path().join("m.exr");
-    let o = prism(&["render", s(&scene), "-o", s(&image), "--resolution", "16x12", "--spp", "2"]);
+    let o = prism(&[
+        "render",
+        s(&scene),
+        "-o",
+        s(&image),
+        "--resolution",
+        "16x12",
+        "--spp",
+        "2",
+    ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert!(image.is_file());
 
-    let o = prism(&["merl-export", "scenes/merl/sources.json", "--material", "nope", "-o", s(&out)]);
+    let o = prism(&[
+        "merl-export",
+        "scenes/merl/sources.json",
+        "--material",
+        "nope",
+        "-o",
+        s(&out),
+    ]);
     let err = String::from_utf8_lossy(&o.stderr);
-    assert!(!o.status.success() && err.contains("no material `nope`") && err.contains("`grey-ggx`"), "{err}");
+    assert!(
+        !o.status.success() && err.contains("no material `nope`") && err.contains("`grey-ggx`"),
+        "{err}"
+    );
     let bad = dir.path().join("missing-dir").join("x.binary");
-    let o = prism(&["merl-export", "scenes/merl/sources.json", "--material", "grey-ggx", "-o", s(&bad)]);
+    let o = prism(&[
+        "merl-export",
+        "scenes/merl/sources.json",
+        "--material",
+        "grey-ggx",
+        "-o",
+        s(&bad),
+    ]);
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(!o.status.success() && err.contains("x.binary"), "{err}");
     assert!(!bad.exists());

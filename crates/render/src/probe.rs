@@ -86,9 +86,7 @@ fn library_lobe_bandwidth(lobe: &BsdfLobe) -> f32 {
     match lobe {
         BsdfLobe::Lambert(_) | BsdfLobe::OrenNayar(_) => 0.0,
         BsdfLobe::Phong(p) if p.specular.max_component() > 0.0 => from_exponent(p.exponent),
-        BsdfLobe::BlinnPhong(p) if p.specular.max_component() > 0.0 => {
-            from_exponent(p.exponent)
-        }
+        BsdfLobe::BlinnPhong(p) if p.specular.max_component() > 0.0 => from_exponent(p.exponent),
         BsdfLobe::Phong(_) | BsdfLobe::BlinnPhong(_) => 0.0,
         BsdfLobe::Ward(w) => from_alpha(w.alpha_x.min(w.alpha_y)),
         BsdfLobe::Lafortune(l) => l.lobes[..l.count]

@@ -49,8 +49,7 @@ fn render_sphere(dir: &Path, material_json: &str, light_json: &str, seed: u64) -
       "lights": [{light_json}]
     }}"#
     );
-    let description =
-        parse_scene_str(&json, dir.join("test.json")).expect("test scene parses");
+    let description = parse_scene_str(&json, dir.join("test.json")).expect("test scene parses");
     let scene = RenderScene::build(&description, None).expect("test scene builds");
     let settings = RenderSettings {
         spp: 128,
@@ -225,7 +224,9 @@ fn bad_material_inputs_are_refused_with_their_place() {
         Err(e) => e.to_string(),
     };
     assert!(
-        err.contains("materials.measured.file") && err.contains("truncated") && err.contains("short.binary"),
+        err.contains("materials.measured.file")
+            && err.contains("truncated")
+            && err.contains("short.binary"),
         "{err}"
     );
     // Negative roughness-like parameters are refused by the parser with line and column.
@@ -233,14 +234,20 @@ fn bad_material_inputs_are_refused_with_their_place() {
         (r#"{"type": "oren_nayar", "sigma_deg": -5}"#, "sigma_deg"),
         (r#"{"type": "ward", "alpha": [0.1, -0.2]}"#, "alpha"),
         (r#"{"type": "phong", "exponent": -1}"#, "exponent"),
-        (r#"{"type": "mix", "materials": ["a", "a"], "weight": 1.5}"#, "weight"),
+        (
+            r#"{"type": "mix", "materials": ["a", "a"], "weight": 1.5}"#,
+            "weight",
+        ),
     ] {
         let json = format!(
             r#"{{"camera": {{"type": "pinhole", "fov_deg": 30}},
                 "materials": {{"a": {{"type": "lambert"}}, "bad": {material}}}}}"#
         );
         let err = parse_scene_str(&json, "s.json").unwrap_err().to_string();
-        assert!(err.contains(expect) && err.contains("s.json:"), "{material}: {err}");
+        assert!(
+            err.contains(expect) && err.contains("s.json:"),
+            "{material}: {err}"
+        );
     }
     // Energy: diffuse + specular above 1 is refused by the builder.
     let json = r#"{"camera": {"type": "pinhole", "fov_deg": 30},
@@ -251,5 +258,8 @@ fn bad_material_inputs_are_refused_with_their_place() {
         Ok(_) => panic!("the scene should not build"),
         Err(e) => e.to_string(),
     };
-    assert!(err.contains("materials.hot.specular") && err.contains("≤ 1"), "{err}");
+    assert!(
+        err.contains("materials.hot.specular") && err.contains("≤ 1"),
+        "{err}"
+    );
 }

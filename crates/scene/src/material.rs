@@ -357,7 +357,10 @@ fn parse_library_material(
             MaterialKind::OrenNayar {
                 reflectance: reflectance_or(&o, "reflectance", spectra, 0.5)?,
                 sigma_deg: o
-                    .req("sigma_deg", "the facet slope deviation σ in degrees, in [0, 90)")?
+                    .req(
+                        "sigma_deg",
+                        "the facet slope deviation σ in degrees, in [0, 90)",
+                    )?
                     .in_range(0.0, 89.999)?,
                 qualitative: tag == "oren_nayar_qualitative",
             }

@@ -13,13 +13,13 @@ use std::hint::black_box;
 use std::time::Instant;
 
 use glam::{Vec2, Vec3A};
+use prism_render::bsdf::merl_directions;
 use prism_render::bsdf::{
     internal_diffuse_reflectance, BlinnPhong, Bsdf, BsdfLobe, Coated, Conductor, Dielectric,
     Lafortune, LafortuneLobe, Lambert, Measured, MerlBrdf, MerlTable, MicrofacetDistribution,
     MicrofacetModel, Mix, MixComponent, OrenNayar, OrenNayarForm, Phong, ThinDielectric,
     TransportMode, Ward, LAFORTUNE_MAX_LOBES,
 };
-use prism_render::bsdf::merl_directions;
 use prism_spectrum::SampledSpectrum;
 use serde_json::{json, Value};
 
@@ -90,27 +90,130 @@ fn main() {
         lobes: [LafortuneLobe::NONE; LAFORTUNE_MAX_LOBES],
         count: 2,
     };
-    lafortune.lobes[0] = LafortuneLobe { cx: -1.1, cy: -1.1, cz: 0.9, exponent: 12.0, albedo: s(0.5) };
-    lafortune.lobes[1] = LafortuneLobe { cx: 0.5, cy: 0.5, cz: 0.7, exponent: 3.0, albedo: s(0.2) };
-    let coated = Coated { diffuse: s(0.5), eta: 1.5, fdr_internal: internal_diffuse_reflectance(1.5), nonlinear: true };
-    let ward = Ward { diffuse: s(0.3), specular: s(0.5), alpha_x: 0.1, alpha_y: 0.3 };
+    lafortune.lobes[0] = LafortuneLobe {
+        cx: -1.1,
+        cy: -1.1,
+        cz: 0.9,
+        exponent: 12.0,
+        albedo: s(0.5),
+    };
+    lafortune.lobes[1] = LafortuneLobe {
+        cx: 0.5,
+        cy: 0.5,
+        cz: 0.7,
+        exponent: 3.0,
+        albedo: s(0.2),
+    };
+    let coated = Coated {
+        diffuse: s(0.5),
+        eta: 1.5,
+        fdr_internal: internal_diffuse_reflectance(1.5),
+        nonlinear: true,
+    };
+    let ward = Ward {
+        diffuse: s(0.3),
+        specular: s(0.5),
+        alpha_x: 0.1,
+        alpha_y: 0.3,
+    };
     let lobes: Vec<(&str, bool, BsdfLobe)> = vec![
-        ("lambert", false, BsdfLobe::Lambert(Lambert { reflectance: s(0.5) })),
+        (
+            "lambert",
+            false,
+            BsdfLobe::Lambert(Lambert {
+                reflectance: s(0.5),
+            }),
+        ),
         ("conductor_ggx", false, BsdfLobe::Conductor(ggx)),
-        ("conductor_beckmann", false, BsdfLobe::Conductor(conductor(MicrofacetModel::Beckmann, 0.3))),
-        ("conductor_smooth", false, BsdfLobe::Conductor(conductor(MicrofacetModel::Ggx, 0.0))),
-        ("dielectric_rough", false, BsdfLobe::Dielectric(Dielectric { eta: s(1.5), distribution: MicrofacetDistribution::new(MicrofacetModel::Ggx, 0.3, 0.3) })),
-        ("dielectric_smooth", false, BsdfLobe::Dielectric(Dielectric { eta: s(1.5), distribution: MicrofacetDistribution::new(MicrofacetModel::Ggx, 0.0, 0.0) })),
-        ("oren_nayar", true, BsdfLobe::OrenNayar(OrenNayar { reflectance: s(0.5), sigma_rad: 0.4, form: OrenNayarForm::Full })),
-        ("oren_nayar_qualitative", true, BsdfLobe::OrenNayar(OrenNayar { reflectance: s(0.5), sigma_rad: 0.4, form: OrenNayarForm::Qualitative })),
-        ("phong", true, BsdfLobe::Phong(Phong { diffuse: s(0.3), specular: s(0.6), exponent: 30.0 })),
-        ("blinn_phong", true, BsdfLobe::BlinnPhong(BlinnPhong { diffuse: s(0.3), specular: s(0.6), exponent: 30.0 })),
+        (
+            "conductor_beckmann",
+            false,
+            BsdfLobe::Conductor(conductor(MicrofacetModel::Beckmann, 0.3)),
+        ),
+        (
+            "conductor_smooth",
+            false,
+            BsdfLobe::Conductor(conductor(MicrofacetModel::Ggx, 0.0)),
+        ),
+        (
+            "dielectric_rough",
+            false,
+            BsdfLobe::Dielectric(Dielectric {
+                eta: s(1.5),
+                distribution: MicrofacetDistribution::new(MicrofacetModel::Ggx, 0.3, 0.3),
+            }),
+        ),
+        (
+            "dielectric_smooth",
+            false,
+            BsdfLobe::Dielectric(Dielectric {
+                eta: s(1.5),
+                distribution: MicrofacetDistribution::new(MicrofacetModel::Ggx, 0.0, 0.0),
+            }),
+        ),
+        (
+            "oren_nayar",
+            true,
+            BsdfLobe::OrenNayar(OrenNayar {
+                reflectance: s(0.5),
+                sigma_rad: 0.4,
+                form: OrenNayarForm::Full,
+            }),
+        ),
+        (
+            "oren_nayar_qualitative",
+            true,
+            BsdfLobe::OrenNayar(OrenNayar {
+                reflectance: s(0.5),
+                sigma_rad: 0.4,
+                form: OrenNayarForm::Qualitative,
+            }),
+        ),
+        (
+            "phong",
+            true,
+            BsdfLobe::Phong(Phong {
+                diffuse: s(0.3),
+                specular: s(0.6),
+                exponent: 30.0,
+            }),
+        ),
+        (
+            "blinn_phong",
+            true,
+            BsdfLobe::BlinnPhong(BlinnPhong {
+                diffuse: s(0.3),
+                specular: s(0.6),
+                exponent: 30.0,
+            }),
+        ),
         ("ward", true, BsdfLobe::Ward(ward)),
         ("lafortune", true, BsdfLobe::Lafortune(lafortune)),
         ("coated", true, BsdfLobe::Coated(coated)),
-        ("thin_dielectric", true, BsdfLobe::ThinDielectric(ThinDielectric { eta: s(1.5) })),
-        ("mix_ward_coated", true, BsdfLobe::Mix(Mix::new(&[(MixComponent::Ward(ward), 0.5), (MixComponent::Coated(coated), 0.5)]).unwrap())),
-        ("merl", true, BsdfLobe::Measured(Measured { brdf: &merl, lambda_nm: [450.0, 550.0, 650.0, 750.0] })),
+        (
+            "thin_dielectric",
+            true,
+            BsdfLobe::ThinDielectric(ThinDielectric { eta: s(1.5) }),
+        ),
+        (
+            "mix_ward_coated",
+            true,
+            BsdfLobe::Mix(
+                Mix::new(&[
+                    (MixComponent::Ward(ward), 0.5),
+                    (MixComponent::Coated(coated), 0.5),
+                ])
+                .unwrap(),
+            ),
+        ),
+        (
+            "merl",
+            true,
+            BsdfLobe::Measured(Measured {
+                brdf: &merl,
+                lambda_nm: [450.0, 550.0, 650.0, 750.0],
+            }),
+        ),
     ];
     let mut rows = Vec::new();
     let mut by_name = std::collections::BTreeMap::new();

@@ -73,8 +73,7 @@ impl Lafortune {
         for (j, lobe) in self.lobes[..self.count].iter().enumerate() {
             let s = lobe.axis(wo).length();
             w[j + 1] = if s > 0.0 {
-                lobe.albedo.average().max(0.0) * s.powf(lobe.exponent) * 2.0
-                    * std::f32::consts::PI
+                lobe.albedo.average().max(0.0) * s.powf(lobe.exponent) * 2.0 * std::f32::consts::PI
                     / (lobe.exponent + 1.0)
             } else {
                 0.0

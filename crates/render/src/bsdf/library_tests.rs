@@ -142,7 +142,10 @@ fn chi2_oren_nayar() {
     let mut bsdfs = Vec::new();
     for form in [OrenNayarForm::Full, OrenNayarForm::Qualitative] {
         for sigma in [10.0, 40.0] {
-            bsdfs.push((format!("{form:?} σ = {sigma}°"), oren_nayar(0.8, sigma, form)));
+            bsdfs.push((
+                format!("{form:?} σ = {sigma}°"),
+                oren_nayar(0.8, sigma, form),
+            ));
         }
     }
     chi2_family("oren_nayar", &bsdfs);
@@ -180,7 +183,10 @@ fn chi2_ward() {
 #[test]
 fn chi2_lafortune() {
     let bsdfs = vec![
-        ("phong-like".to_string(), lafortune(0.3, &[[-1.0, -1.0, 1.0, 20.0, 0.5]])),
+        (
+            "phong-like".to_string(),
+            lafortune(0.3, &[[-1.0, -1.0, 1.0, 20.0, 0.5]]),
+        ),
         (
             "off-specular + retro + anisotropic".to_string(),
             lafortune(
@@ -200,7 +206,12 @@ fn chi2_lafortune() {
 fn chi2_coated() {
     let bsdfs: Vec<_> = [(0.5, 1.5, true), (0.9, 1.33, false), (0.1, 2.0, true)]
         .iter()
-        .map(|&(rho, eta, nl)| (format!("ρ {rho} η {eta} nonlinear {nl}"), coated(rho, eta, nl)))
+        .map(|&(rho, eta, nl)| {
+            (
+                format!("ρ {rho} η {eta} nonlinear {nl}"),
+                coated(rho, eta, nl),
+            )
+        })
         .collect();
     chi2_family("coated", &bsdfs);
 }
@@ -211,16 +222,30 @@ fn chi2_mix() {
         (
             "lambert + rough GGX".to_string(),
             mix(&[
-                (MixComponent::Lambert(Lambert { reflectance: s(0.6) }), 0.3),
+                (
+                    MixComponent::Lambert(Lambert {
+                        reflectance: s(0.6),
+                    }),
+                    0.3,
+                ),
                 (MixComponent::Conductor(ggx(0.2)), 0.7),
             ]),
         ),
         (
             "phong + ward + coated".to_string(),
             mix(&[
-                (MixComponent::from_lobe(phong(0.3, 0.6, 30.0).lobe).unwrap(), 0.2),
-                (MixComponent::from_lobe(ward(0.2, 0.6, 0.1, 0.3).lobe).unwrap(), 0.5),
-                (MixComponent::from_lobe(coated(0.5, 1.5, true).lobe).unwrap(), 0.3),
+                (
+                    MixComponent::from_lobe(phong(0.3, 0.6, 30.0).lobe).unwrap(),
+                    0.2,
+                ),
+                (
+                    MixComponent::from_lobe(ward(0.2, 0.6, 0.1, 0.3).lobe).unwrap(),
+                    0.5,
+                ),
+                (
+                    MixComponent::from_lobe(coated(0.5, 1.5, true).lobe).unwrap(),
+                    0.3,
+                ),
             ]),
         ),
     ];
@@ -258,14 +283,15 @@ fn chi2_thin_dielectric() {
                         assert!((smp.wi - Vec3A::new(-wo.x, -wo.y, wo.z)).length() < 1e-6);
                     }
                 }
-                let r = f64::from(
-                    ThinDielectric { eta: s(e) }.reflectance(wo.z.abs())[0],
-                );
+                let r = f64::from(ThinDielectric { eta: s(e) }.reflectance(wo.z.abs())[0]);
                 let (er, et) = (r * n as f64, (1.0 - r) * n as f64);
                 let (or, ot) = (reflected as f64, (n - reflected) as f64);
                 let stat = (or - er).powi(2) / er + (ot - et).powi(2) / et;
                 let p = 1.0 - chi2.cdf(stat);
-                assert!(p > alpha, "η {e} θ {theta} side {side}: R' {r}, {reflected}/{n}, p {p}");
+                assert!(
+                    p > alpha,
+                    "η {e} θ {theta} side {side}: R' {r}, {reflected}/{n}, p {p}"
+                );
             }
         }
     }
@@ -283,7 +309,10 @@ fn thin_dielectric_sums_the_interreflections() {
             term *= r * r;
         }
         let closed = sheet.reflectance(cos)[0];
-        assert!((total - closed).abs() < 1e-6, "cos {cos}: {total} vs {closed}");
+        assert!(
+            (total - closed).abs() < 1e-6,
+            "cos {cos}: {total} vs {closed}"
+        );
         assert!((closed - 2.0 * r / (1.0 + r)).abs() < 1e-6);
     }
 }
@@ -310,9 +339,18 @@ fn albedo(bsdf: &Bsdf, wo: Vec3A, n: usize, seed: u64) -> (f64, f64) {
 fn albedo_of_the_energy_conserving_models_is_at_most_one() {
     // White parameters, the worst case each paper's bound covers.
     let cases: Vec<(String, Bsdf)> = vec![
-        ("oren_nayar full σ 20°".into(), oren_nayar(1.0, 20.0, OrenNayarForm::Full)),
-        ("oren_nayar full σ 60°".into(), oren_nayar(1.0, 60.0, OrenNayarForm::Full)),
-        ("oren_nayar qualitative σ 60°".into(), oren_nayar(1.0, 60.0, OrenNayarForm::Qualitative)),
+        (
+            "oren_nayar full σ 20°".into(),
+            oren_nayar(1.0, 20.0, OrenNayarForm::Full),
+        ),
+        (
+            "oren_nayar full σ 60°".into(),
+            oren_nayar(1.0, 60.0, OrenNayarForm::Full),
+        ),
+        (
+            "oren_nayar qualitative σ 60°".into(),
+            oren_nayar(1.0, 60.0, OrenNayarForm::Qualitative),
+        ),
         ("phong n 1".into(), phong(0.0, 1.0, 1.0)),
         ("phong n 50".into(), phong(0.0, 1.0, 50.0)),
         ("phong mixed".into(), phong(0.4, 0.6, 10.0)),
@@ -327,8 +365,14 @@ fn albedo_of_the_energy_conserving_models_is_at_most_one() {
         (
             "mix".into(),
             mix(&[
-                (MixComponent::from_lobe(ward(0.0, 1.0, 0.2, 0.2).lobe).unwrap(), 0.5),
-                (MixComponent::from_lobe(coated(1.0, 1.5, true).lobe).unwrap(), 0.5),
+                (
+                    MixComponent::from_lobe(ward(0.0, 1.0, 0.2, 0.2).lobe).unwrap(),
+                    0.5,
+                ),
+                (
+                    MixComponent::from_lobe(coated(1.0, 1.5, true).lobe).unwrap(),
+                    0.5,
+                ),
             ]),
         ),
     ];
@@ -371,17 +415,32 @@ fn albedo_of_the_energy_conserving_models_is_at_most_one() {
 #[test]
 fn reciprocity_of_the_library() {
     let bsdfs: Vec<(&str, Bsdf)> = vec![
-        ("oren_nayar full", oren_nayar(0.7, 30.0, OrenNayarForm::Full)),
-        ("oren_nayar qualitative", oren_nayar(0.7, 30.0, OrenNayarForm::Qualitative)),
+        (
+            "oren_nayar full",
+            oren_nayar(0.7, 30.0, OrenNayarForm::Full),
+        ),
+        (
+            "oren_nayar qualitative",
+            oren_nayar(0.7, 30.0, OrenNayarForm::Qualitative),
+        ),
         ("phong", phong(0.3, 0.6, 20.0)),
         ("blinn_phong", blinn_phong(0.3, 0.6, 20.0)),
         ("ward", ward(0.3, 0.6, 0.1, 0.4)),
-        ("lafortune", lafortune(0.2, &[[-1.1, -0.8, 0.9, 8.0, 0.5], [0.5, 0.5, 0.7, 3.0, 0.2]])),
+        (
+            "lafortune",
+            lafortune(
+                0.2,
+                &[[-1.1, -0.8, 0.9, 8.0, 0.5], [0.5, 0.5, 0.7, 3.0, 0.2]],
+            ),
+        ),
         ("coated", coated(0.6, 1.5, true)),
         (
             "mix",
             mix(&[
-                (MixComponent::from_lobe(phong(0.3, 0.6, 20.0).lobe).unwrap(), 0.4),
+                (
+                    MixComponent::from_lobe(phong(0.3, 0.6, 20.0).lobe).unwrap(),
+                    0.4,
+                ),
                 (MixComponent::Conductor(ggx(0.3)), 0.6),
             ]),
         ),
@@ -435,7 +494,11 @@ fn oren_nayar_at_zero_sigma_is_lambert() {
         // A tiny σ is continuous with it (no jump at 0).
         let on = oren_nayar(0.5, 1e-3, form);
         let l = 0.5 / std::f32::consts::PI;
-        let v = on.eval(direction(40.0, 0.0), direction(70.0, 180.0), TransportMode::Radiance)[0];
+        let v = on.eval(
+            direction(40.0, 0.0),
+            direction(70.0, 180.0),
+            TransportMode::Radiance,
+        )[0];
         assert!((v - l).abs() < 1e-5 * l + 1e-6, "{form:?}: {v}");
     }
 }
@@ -476,7 +539,9 @@ fn merl_from(bsdf: Bsdf) -> MerlTable {
 
 #[test]
 fn merl_files_round_trip_and_bad_files_are_refused() {
-    let lambert = Bsdf::new(BsdfLobe::Lambert(Lambert { reflectance: s(0.5) }));
+    let lambert = Bsdf::new(BsdfLobe::Lambert(Lambert {
+        reflectance: s(0.5),
+    }));
     let table = merl_from(lambert);
     let bytes = table.to_bytes();
     assert_eq!(bytes.len(), MERL_FILE_BYTES);
@@ -493,12 +558,19 @@ fn merl_files_round_trip_and_bad_files_are_refused() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("lambert.binary");
     table.write(&path).unwrap();
-    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1, "no temporary left");
+    assert_eq!(
+        std::fs::read_dir(dir.path()).unwrap().count(),
+        1,
+        "no temporary left"
+    );
     assert_eq!(MerlTable::read(&path, false).unwrap(), back);
 
     let err = |b: &[u8]| MerlTable::from_bytes(b, false).unwrap_err().message;
     let truncated = err(&bytes[..bytes.len() - 8]);
-    assert!(truncated.contains("truncated") && truncated.contains(&MERL_FILE_BYTES.to_string()), "{truncated}");
+    assert!(
+        truncated.contains("truncated") && truncated.contains(&MERL_FILE_BYTES.to_string()),
+        "{truncated}"
+    );
     assert!(err(&bytes[..7]).contains("header"));
     let mut long = bytes.clone();
     long.extend_from_slice(&[0; 8]);
@@ -510,7 +582,12 @@ fn merl_files_round_trip_and_bad_files_are_refused() {
     let at = 12 + 8 * (MERL_ENTRIES + 5); // green table, bin (0, 0, 5)
     negative[at..at + 8].copy_from_slice(&(-1.0f64).to_le_bytes());
     let message = err(&negative);
-    assert!(message.contains("1 negative") && message.contains("green") && message.contains("clamp_negative"), "{message}");
+    assert!(
+        message.contains("1 negative")
+            && message.contains("green")
+            && message.contains("clamp_negative"),
+        "{message}"
+    );
     let clamped = MerlTable::from_bytes(&negative, true).unwrap();
     assert_eq!(clamped.values[MERL_ENTRIES + 5], 0.0);
     let mut nan = bytes.clone();
@@ -576,9 +653,14 @@ fn discretisation_error(table: &Measured, analytic: &Bsdf, wo: Vec3A) -> (f64, f
 fn merl_tables_reproduce_their_analytic_source() {
     let lambda = [450.0, 550.0, 650.0, 750.0];
     // Lambert 0.5: every bin holds 0.5/π, so the table is exact.
-    let lambert = Bsdf::new(BsdfLobe::Lambert(Lambert { reflectance: s(0.5) }));
+    let lambert = Bsdf::new(BsdfLobe::Lambert(Lambert {
+        reflectance: s(0.5),
+    }));
     let brdf = MerlBrdf::new(&merl_from(lambert));
-    let m = Measured { brdf: &brdf, lambda_nm: lambda };
+    let m = Measured {
+        brdf: &brdf,
+        lambda_nm: lambda,
+    };
     let mut rng = SplitMix64(8);
     for _ in 0..500 {
         let wo = direction(89.0 * rng.next_f32(), 360.0 * rng.next_f32());
@@ -591,7 +673,10 @@ fn merl_tables_reproduce_their_analytic_source() {
     // Grey GGX α = 0.3: the piecewise-constant table's error in directional albedo.
     let analytic = Bsdf::new(BsdfLobe::Conductor(ggx(0.3)));
     let brdf = MerlBrdf::new(&merl_from(analytic));
-    let m = Measured { brdf: &brdf, lambda_nm: lambda };
+    let m = Measured {
+        brdf: &brdf,
+        lambda_nm: lambda,
+    };
     let mut worst = (0.0f64, 0.0f64);
     for theta in [0.0f32, 30.0, 60.0, 80.0] {
         let wo = direction(theta, 15.0);
@@ -611,10 +696,20 @@ fn chi2_merl() {
     let sources = [
         ("GGX α 0.3", Bsdf::new(BsdfLobe::Conductor(ggx(0.3)))),
         ("GGX α 0.1", Bsdf::new(BsdfLobe::Conductor(ggx(0.1)))),
-        ("oren_nayar σ 30° + blinn_phong", mix(&[
-            (MixComponent::from_lobe(oren_nayar(0.5, 30.0, OrenNayarForm::Full).lobe).unwrap(), 0.5),
-            (MixComponent::from_lobe(blinn_phong(0.0, 1.0, 60.0).lobe).unwrap(), 0.5),
-        ])),
+        (
+            "oren_nayar σ 30° + blinn_phong",
+            mix(&[
+                (
+                    MixComponent::from_lobe(oren_nayar(0.5, 30.0, OrenNayarForm::Full).lobe)
+                        .unwrap(),
+                    0.5,
+                ),
+                (
+                    MixComponent::from_lobe(blinn_phong(0.0, 1.0, 60.0).lobe).unwrap(),
+                    0.5,
+                ),
+            ]),
+        ),
     ];
     let brdfs: Vec<(String, MerlBrdf)> = sources
         .iter()
@@ -625,7 +720,10 @@ fn chi2_merl() {
         .map(|(name, brdf)| {
             (
                 name.clone(),
-                Bsdf::new(BsdfLobe::Measured(Measured { brdf, lambda_nm: lambda })),
+                Bsdf::new(BsdfLobe::Measured(Measured {
+                    brdf,
+                    lambda_nm: lambda,
+                })),
             )
         })
         .collect();

@@ -178,8 +178,8 @@ fn lookup_index(h: Vec3A, wi: Vec3A) -> usize {
     if phi_d < 0.0 {
         phi_d += std::f32::consts::PI;
     }
-    let i_h = ((theta_h * std::f32::consts::FRAC_2_PI).max(0.0).sqrt() * MERL_THETA_H as f32)
-        as usize;
+    let i_h =
+        ((theta_h * std::f32::consts::FRAC_2_PI).max(0.0).sqrt() * MERL_THETA_H as f32) as usize;
     let i_d = (theta_d * std::f32::consts::FRAC_2_PI * MERL_THETA_D as f32) as usize;
     let i_phi = (phi_d * std::f32::consts::FRAC_1_PI * MERL_PHI_D as f32) as usize;
     i_phi.min(MERL_PHI_D - 1)
@@ -438,7 +438,8 @@ impl MerlBrdf {
         let per_bin: Vec<(Vec<f32>, Vec<f32>, Vec<f32>, bool)> = (0..SAMPLE_THETA_O)
             .into_par_iter()
             .map(|k| {
-                let theta_o = (k as f64 + 0.5) / SAMPLE_THETA_O as f64 * std::f64::consts::FRAC_PI_2;
+                let theta_o =
+                    (k as f64 + 0.5) / SAMPLE_THETA_O as f64 * std::f64::consts::FRAC_PI_2;
                 let wo = Vec3A::new(theta_o.sin() as f32, 0.0, theta_o.cos() as f32);
                 let mut weight = vec![0.0f64; cells];
                 for i in 0..SAMPLE_U {
@@ -447,11 +448,8 @@ impl MerlBrdf {
                     let (st, ct) = theta_h.sin_cos();
                     for j in 0..SAMPLE_V {
                         let phi = (j as f64 + 0.5) / SAMPLE_V as f64 * std::f64::consts::TAU;
-                        let h = Vec3A::new(
-                            (st * phi.cos()) as f32,
-                            (st * phi.sin()) as f32,
-                            ct as f32,
-                        );
+                        let h =
+                            Vec3A::new((st * phi.cos()) as f32, (st * phi.sin()) as f32, ct as f32);
                         let cos_oh = wo.dot(h);
                         if cos_oh <= 0.0 {
                             continue;
@@ -519,11 +517,17 @@ impl MerlBrdf {
             if theta_h >= std::f64::consts::FRAC_PI_4 {
                 break;
             }
-            let w: f64 = (0..SAMPLE_V).map(|j| f64::from(cell_pdf[i * SAMPLE_V + j])).sum();
+            let w: f64 = (0..SAMPLE_V)
+                .map(|j| f64::from(cell_pdf[i * SAMPLE_V + j]))
+                .sum();
             num += w * theta_h.tan().powi(2);
             den += w;
         }
-        let equivalent_alpha = if den > 0.0 { (num / den).sqrt() as f32 } else { 1.0 };
+        let equivalent_alpha = if den > 0.0 {
+            (num / den).sqrt() as f32
+        } else {
+            1.0
+        };
         Self {
             bins,
             cell_pdf,

@@ -13,8 +13,8 @@ use glam::{Vec2, Vec3A};
 use prism_spectrum::SampledSpectrum;
 
 use super::{
-    dispatch_lobe, BlinnPhong, BsdfLobe, BsdfSample, Coated, Conductor, Dielectric, Lafortune, Lambert,
-    LobeKind, Measured, OrenNayar, Phong, ThinDielectric, TransportMode, Ward,
+    dispatch_lobe, BlinnPhong, BsdfLobe, BsdfSample, Coated, Conductor, Dielectric, Lafortune,
+    Lambert, LobeKind, Measured, OrenNayar, Phong, ThinDielectric, TransportMode, Ward,
 };
 
 /// Most leaves a (flattened) mix may have.
@@ -81,7 +81,13 @@ impl<'a> MixComponent<'a> {
         dispatch_lobe!(MixComponent, self, l => l.pdf(wo, wi, mode))
     }
     #[inline]
-    pub fn sample(&self, wo: Vec3A, u_lobe: f32, u: Vec2, mode: TransportMode) -> Option<BsdfSample> {
+    pub fn sample(
+        &self,
+        wo: Vec3A,
+        u_lobe: f32,
+        u: Vec2,
+        mode: TransportMode,
+    ) -> Option<BsdfSample> {
         dispatch_lobe!(MixComponent, self, l => l.sample(wo, u_lobe, u, mode))
     }
     #[inline]

@@ -97,7 +97,8 @@ impl OrenNayar {
                     + cos_dphi * c2 * tan_beta
                     + (1.0 - cos_dphi.abs()) * c3 * (0.5 * (alpha + beta)).tan();
                 // Eq. 9 (inter-reflection), ∝ ρ².
-                let inter = 0.17 * inv_pi * s2 / (s2 + 0.13) * (1.0 - cos_dphi * two_beta_pi * two_beta_pi);
+                let inter =
+                    0.17 * inv_pi * s2 / (s2 + 0.13) * (1.0 - cos_dphi * two_beta_pi * two_beta_pi);
                 self.reflectance * (inv_pi * direct) + self.reflectance * self.reflectance * inter
             }
         }

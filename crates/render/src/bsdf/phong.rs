@@ -59,7 +59,10 @@ impl Phong {
         }
         let cos_alpha = wi.dot(Self::mirror(wo)).min(1.0);
         let lobe = if cos_alpha > 0.0 {
-            (self.exponent + 2.0) * 0.5 * std::f32::consts::FRAC_1_PI * cos_alpha.powf(self.exponent)
+            (self.exponent + 2.0)
+                * 0.5
+                * std::f32::consts::FRAC_1_PI
+                * cos_alpha.powf(self.exponent)
         } else {
             0.0
         };

@@ -12,9 +12,9 @@ use prism_spectrum::{SampledSpectrum, SampledWavelengths, Spectrum};
 
 use super::{Ior, Material};
 use crate::bsdf::{
-    internal_diffuse_reflectance, BlinnPhong, BsdfLobe, Coated, Lafortune, LafortuneLobe,
-    Measured, MerlBrdf, MerlTable, Mix, MixComponent, OrenNayar, OrenNayarForm, Phong,
-    ThinDielectric, Ward, LAFORTUNE_MAX_LOBES, MIX_MAX_COMPONENTS,
+    internal_diffuse_reflectance, BlinnPhong, BsdfLobe, Coated, Lafortune, LafortuneLobe, Measured,
+    MerlBrdf, MerlTable, Mix, MixComponent, OrenNayar, OrenNayarForm, Phong, ThinDielectric, Ward,
+    LAFORTUNE_MAX_LOBES, MIX_MAX_COMPONENTS,
 };
 use crate::scene_build::spectrum::{build_spectrum, SpectrumRole};
 
@@ -111,8 +111,8 @@ pub fn build_library(kind: &MaterialKind) -> Result<Material, FieldError> {
             }
             let mut out = Vec::with_capacity(lobes.len());
             for l in lobes {
-                let a = build_spectrum(&l.albedo, SpectrumRole::Unbounded)
-                    .map_err(|e| ("lobes", e))?;
+                let a =
+                    build_spectrum(&l.albedo, SpectrumRole::Unbounded).map_err(|e| ("lobes", e))?;
                 out.push((
                     [l.cx as f32, l.cy as f32, l.cz as f32, l.exponent as f32],
                     a,
@@ -140,17 +140,13 @@ pub fn build_library(kind: &MaterialKind) -> Result<Material, FieldError> {
             file,
             clamp_negative,
         } => {
-            let table = MerlTable::read(file, *clamp_negative).map_err(|e| ("file", e.to_string()))?;
+            let table =
+                MerlTable::read(file, *clamp_negative).map_err(|e| ("file", e.to_string()))?;
             Material::Measured {
                 brdf: Arc::new(MerlBrdf::new(&table)),
             }
         }
-        other => {
-            return Err((
-                "type",
-                format!("not a material-library type: {other:?}"),
-            ))
-        }
+        other => return Err(("type", format!("not a material-library type: {other:?}"))),
     })
 }
 
@@ -172,7 +168,11 @@ impl Material {
         out: &mut [(MixComponent<'a>, f32); MIX_MAX_COMPONENTS],
         count: &mut usize,
     ) {
-        if let Material::Mix { materials, weight: w } = self {
+        if let Material::Mix {
+            materials,
+            weight: w,
+        } = self
+        {
             let w = w.eval(hit).clamp(0.0, 1.0);
             materials[0].push_leaves(hit, wavelengths, weight * (1.0 - w), out, count);
             materials[1].push_leaves(hit, wavelengths, weight * w, out, count);

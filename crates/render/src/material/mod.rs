@@ -309,7 +309,9 @@ fn build_one(
         | MaterialKind::Lafortune { .. }
         | MaterialKind::Coated { .. }
         | MaterialKind::ThinDielectric { .. }
-        | MaterialKind::Merl { .. } => library::build_library(&m.kind).map_err(|(f, e)| err(f, e))?,
+        | MaterialKind::Merl { .. } => {
+            library::build_library(&m.kind).map_err(|(f, e)| err(f, e))?
+        }
         MaterialKind::Mix { materials, weight } => {
             let build = |k: usize| {
                 let inner = build_one(scene, materials[k], depth + 1)?;
