@@ -132,7 +132,7 @@ impl Coated {
         }
         let wi = sample_cosine_hemisphere(u);
         let pdf = self.pdf(wo, wi, mode);
-        if !(pdf > 0.0) {
+        if pdf.is_nan() || pdf <= 0.0 {
             return None;
         }
         Some(BsdfSample {

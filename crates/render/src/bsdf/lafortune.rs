@@ -154,7 +154,7 @@ impl Lafortune {
             return None;
         }
         let pdf = self.pdf(wo, wi, mode);
-        if !(pdf > 0.0) {
+        if pdf.is_nan() || pdf <= 0.0 {
             return None;
         }
         Some(BsdfSample {

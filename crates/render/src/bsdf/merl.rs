@@ -394,6 +394,9 @@ impl PartialEq for MerlBrdf {
     }
 }
 
+/// One θₒ bin's sampling tables: cell densities, row CDF, per-row cell CDFs, has mass.
+type ThetaOTables = (Vec<f32>, Vec<f32>, Vec<f32>, bool);
+
 /// Luminance weights of linear sRGB (ITU-R BT.709 Y row).
 const LUMINANCE: [f64; 3] = [0.2126, 0.7152, 0.0722];
 
@@ -435,7 +438,7 @@ impl MerlBrdf {
             (0..3).map(|c| LUMINANCE[c] * rgb[c]).sum::<f64>().max(0.0)
         };
         let cells = SAMPLE_U * SAMPLE_V;
-        let per_bin: Vec<(Vec<f32>, Vec<f32>, Vec<f32>, bool)> = (0..SAMPLE_THETA_O)
+        let per_bin: Vec<ThetaOTables> = (0..SAMPLE_THETA_O)
             .into_par_iter()
             .map(|k| {
                 let theta_o =
@@ -579,7 +582,7 @@ impl MerlBrdf {
         let j = ((v * SAMPLE_V as f32) as usize).min(SAMPLE_V - 1);
         let p_uv = self.cell_pdf[(k * SAMPLE_U + i) * SAMPLE_V + j];
         let jacobian = sin_h * std::f32::consts::PI * u * std::f32::consts::TAU;
-        if !(jacobian > 0.0) {
+        if jacobian.is_nan() || jacobian <= 0.0 {
             return 0.0;
         }
         p_uv / jacobian / (4.0 * cos_oh)
@@ -689,7 +692,7 @@ impl Measured<'_> {
             return None;
         }
         let pdf = self.pdf(wo, wi, mode);
-        if !(pdf > 0.0) {
+        if pdf.is_nan() || pdf <= 0.0 {
             return None;
         }
         Some(BsdfSample {

@@ -120,7 +120,7 @@ impl<'a> Mix<'a> {
             return None;
         }
         let total: f32 = parts.iter().map(|p| p.1).sum();
-        if !(total > 0.0 && total.is_finite()) || parts.iter().any(|p| !(p.1 >= 0.0)) {
+        if !(total > 0.0 && total.is_finite()) || parts.iter().any(|p| p.1.is_nan() || p.1 < 0.0) {
             return None;
         }
         let filler = MixComponent::Lambert(Lambert {

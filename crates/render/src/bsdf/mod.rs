@@ -161,7 +161,10 @@ macro_rules! dispatch_lobe {
 }
 pub(crate) use dispatch_lobe;
 
-/// The lobes a material can have.
+/// The lobes a material can have. `Mix` holds its (at most `MIX_MAX_COMPONENTS`) leaves by
+/// value so a `Bsdf` stays `Copy` and allocation-free per hit: the size difference is the
+/// price (boxing would allocate in the integrator's inner loop).
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum BsdfLobe<'a> {
     Lambert(Lambert),

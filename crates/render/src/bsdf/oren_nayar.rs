@@ -5,14 +5,17 @@
 //!
 //! Two forms, named apart:
 //! - `Full`: the paper's eq. 8 direct term L₁ with its three coefficients C₁, C₂, C₃ plus
-//!   the eq. 9 inter-reflection term L₂ (proportional to ρ²). As a BRDF (L/(E₀ cos θᵢ)):
-//!   f = ρ/π [C₁ + cos(Δφ) C₂ tan β + (1 − |cos Δφ|) C₃ tan((α+β)/2)]
-//!     + 0.17 ρ²/π · σ²/(σ² + 0.13) · [1 − cos(Δφ) (2β/π)²],
-//!   C₁ = 1 − 0.5 σ²/(σ² + 0.33),
-//!   C₂ = 0.45 σ²/(σ² + 0.09) sin α            when cos Δφ ≥ 0,
-//!      = 0.45 σ²/(σ² + 0.09) (sin α − (2β/π)³) otherwise,
-//!   C₃ = 0.125 σ²/(σ² + 0.09) (4αβ/π²)²,
-//!   with α = max(θᵢ, θᵣ), β = min(θᵢ, θᵣ), Δφ = φᵣ − φᵢ.
+//!   the eq. 9 inter-reflection term L₂ (proportional to ρ²). As a BRDF (L/(E₀ cos θᵢ)),
+//!   with α = max(θᵢ, θᵣ), β = min(θᵢ, θᵣ), Δφ = φᵣ − φᵢ:
+//!
+//!   ```text
+//!   f  = ρ/π [C₁ + cos(Δφ) C₂ tan β + (1 − |cos Δφ|) C₃ tan((α+β)/2)]
+//!        + 0.17 ρ²/π · σ²/(σ² + 0.13) · [1 − cos(Δφ) (2β/π)²]
+//!   C₁ = 1 − 0.5 σ²/(σ² + 0.33)
+//!   C₂ = 0.45 σ²/(σ² + 0.09) sin α                when cos Δφ ≥ 0
+//!      = 0.45 σ²/(σ² + 0.09) (sin α − (2β/π)³)    otherwise
+//!   C₃ = 0.125 σ²/(σ² + 0.09) (4αβ/π²)²
+//!   ```
 //! - `Qualitative`: the paper's simplified eq. 30,
 //!   f = ρ/π [A + B max(0, cos Δφ) sin α tan β], A = 1 − 0.5 σ²/(σ² + 0.33),
 //!   B = 0.45 σ²/(σ² + 0.09).

@@ -102,7 +102,7 @@ impl Phong {
             return None;
         }
         let pdf = self.pdf(wo, wi, mode);
-        if !(pdf > 0.0) {
+        if pdf.is_nan() || pdf <= 0.0 {
             return None;
         }
         Some(BsdfSample {
