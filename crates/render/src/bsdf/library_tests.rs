@@ -731,3 +731,37 @@ fn chi2_merl() {
     // integrate the expected counts on 32 sub-cells per bin edge.
     chi2_family_with("merl", &bsdfs, 32);
 }
+
+#[test]
+fn merl_samples_carry_the_eval_and_pdf_of_their_direction() {
+    // `Measured::sample` computes f and pdf from the cell it sampled (no second lookup);
+    // they must equal `eval` and `pdf` at the returned direction (up to a sample landing
+    // on a bin edge, where rounding may pick the neighbour: at most 0.5 %).
+    let brdf = MerlBrdf::new(&merl_from(Bsdf::new(BsdfLobe::Conductor(ggx(0.2)))));
+    let m = Measured {
+        brdf: &brdf,
+        lambda_nm: [450.0, 550.0, 650.0, 750.0],
+    };
+    let mut rng = SplitMix64(77);
+    let (mut total, mut off) = (0usize, 0usize);
+    for _ in 0..20_000 {
+        let wo = direction(85.0 * rng.next_f32(), 360.0 * rng.next_f32());
+        let u = Vec2::new(rng.next_f32(), rng.next_f32());
+        let Some(smp) = m.sample(wo, rng.next_f32(), u, TransportMode::Radiance) else {
+            continue;
+        };
+        total += 1;
+        let f = m.eval(wo, smp.wi, TransportMode::Radiance);
+        let p = m.pdf(wo, smp.wi, TransportMode::Radiance);
+        if (f[0] - smp.f[0]).abs() > 1e-4 * f[0].abs() + 1e-7
+            || (p - smp.pdf).abs() > 1e-3 * p.abs()
+        {
+            off += 1;
+        }
+    }
+    assert!(total > 15_000, "{total} samples");
+    assert!(
+        off * 200 <= total,
+        "{off} of {total} samples disagree with eval/pdf"
+    );
+}
