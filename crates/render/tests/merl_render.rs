@@ -249,6 +249,27 @@ fn bad_material_inputs_are_refused_with_their_place() {
             "{material}: {err}"
         );
     }
+    // A mix may not reach itself, directly or through another mix.
+    let json = r#"{"camera": {"type": "pinhole", "fov_deg": 30},
+        "materials": {"a": {"type": "lambert"},
+                      "m1": {"type": "mix", "materials": ["a", "m2"], "weight": 0.5},
+                      "m2": {"type": "mix", "materials": ["m1", "a"], "weight": 0.5}}}"#;
+    let err = parse_scene_str(json, "s.json").unwrap_err().to_string();
+    assert!(err.contains("refers back to itself"), "{err}");
+    // A mix component may not be a wrapper.
+    let json = r#"{"camera": {"type": "pinhole", "fov_deg": 30},
+        "materials": {"a": {"type": "lambert"}, "two": {"type": "two_sided", "material": "a"},
+                      "m": {"type": "mix", "materials": ["a", "two"], "weight": 0.5}},
+        "shapes": [{"type": "sphere", "radius_m": 1, "material": "m"}]}"#;
+    let description = parse_scene_str(json, "s.json").unwrap();
+    let err = match RenderScene::build(&description, None) {
+        Ok(_) => panic!("the scene should not build"),
+        Err(e) => e.to_string(),
+    };
+    assert!(
+        err.contains("materials.m.materials") && err.contains("wrap"),
+        "{err}"
+    );
     // Energy: diffuse + specular above 1 is refused by the builder.
     let json = r#"{"camera": {"type": "pinhole", "fov_deg": 30},
         "materials": {"hot": {"type": "phong", "diffuse": 0.6, "specular": 0.6, "exponent": 10}},
