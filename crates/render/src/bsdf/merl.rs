@@ -164,6 +164,8 @@ pub fn merl_directions_raw(theta_h: f64, theta_d: f64, phi_d: f64) -> (Vec3A, Ve
 /// f32 rounding of the result): √(1 − x)·Σ aₖxᵏ on [0, 1], π − acos(−x) below. About 3×
 /// faster than the library acosf, and the lookup needs two per evaluation.
 #[inline]
+// a₀ = 1.5707963050 is the published fit's coefficient, not π/2.
+#[allow(clippy::approx_constant)]
 fn acos_fast(x: f32) -> f32 {
     let a = x.abs().min(1.0);
     let p = 1.570_796_3
