@@ -4,6 +4,7 @@ mod color;
 mod compare;
 mod daylight_factor;
 mod falsecolour;
+mod merl_export;
 mod render;
 mod sensors;
 mod tonemap;
@@ -29,6 +30,8 @@ enum Command {
     Color(color::ColorArgs),
     /// Error metrics of an image against a reference: MSE, RMSE, relMSE, PSNR, SSIM, ΔE2000.
     Compare(compare::CompareArgs),
+    /// Write a material of a scene file as a MERL BRDF table (90×90×180 half/difference angles).
+    MerlExport(merl_export::MerlExportArgs),
     /// Render a scene file to an EXR or PNG image (docs/rendering.md).
     Render(render::RenderArgs),
     /// Tone-map an HDR image (EXR/HDR): white balance, tone operator, gamut mapping, encoding.
@@ -46,6 +49,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Color(args) => color::run(&args),
         Command::Compare(args) => compare::run(&args),
+        Command::MerlExport(args) => merl_export::run(&args),
         Command::Render(args) => render::run(&args),
         Command::Tonemap(args) => tonemap::run(&args),
     };

@@ -72,10 +72,40 @@ pub fn material_bandwidth(bsdf: &Bsdf) -> MaterialBandwidth {
         BsdfLobe::Dielectric(d) => {
             lobe_bandwidth(d.distribution.alpha_x, d.distribution.alpha_y, bsdf)
         }
+        _ => library_lobe_bandwidth(&bsdf.lobe),
     };
     MaterialBandwidth {
         angular_cycles_per_rad: angular,
         texture_cycles_per_m: 0.0,
+    }
+}
+
+/// The material library's lobes (issue 8): glossy lobes through an equivalent Beckmann
+/// roughness (a cosine power n ≈ Beckmann α = √(2/(n + 2)), Walter et al. 2007 §5.2),
+/// mirror coats as infinite, a mix as its sharpest component.
+fn library_lobe_bandwidth(lobe: &BsdfLobe) -> f32 {
+    let from_exponent = |n: f32| 1.0 / (2.0 * std::f32::consts::PI * (2.0 / (n + 2.0)).sqrt());
+    let from_alpha = |a: f32| 1.0 / (2.0 * std::f32::consts::PI * a.max(1e-4));
+    match lobe {
+        BsdfLobe::Lambert(_) | BsdfLobe::OrenNayar(_) => 0.0,
+        BsdfLobe::Phong(p) if p.specular.max_component() > 0.0 => from_exponent(p.exponent),
+        BsdfLobe::BlinnPhong(p) if p.specular.max_component() > 0.0 => from_exponent(p.exponent),
+        BsdfLobe::Phong(_) | BsdfLobe::BlinnPhong(_) => 0.0,
+        BsdfLobe::Ward(w) => from_alpha(w.alpha_x.min(w.alpha_y)),
+        BsdfLobe::Lafortune(l) => l.lobes[..l.count]
+            .iter()
+            .filter(|j| j.albedo.max_component() > 0.0)
+            .map(|j| from_exponent(j.exponent))
+            .fold(0.0, f32::max),
+        BsdfLobe::Coated(_) | BsdfLobe::ThinDielectric(_) => f32::INFINITY,
+        BsdfLobe::Measured(m) => from_alpha(m.brdf.equivalent_alpha),
+        BsdfLobe::Mix(m) => m.components[..m.count]
+            .iter()
+            .map(|c| material_bandwidth(&Bsdf::new(c.as_lobe())).angular_cycles_per_rad)
+            .fold(0.0, f32::max),
+        BsdfLobe::Conductor(_) | BsdfLobe::Dielectric(_) => {
+            material_bandwidth(&Bsdf::new(*lobe)).angular_cycles_per_rad
+        }
     }
 }
 

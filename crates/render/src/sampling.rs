@@ -33,6 +33,25 @@ pub fn sample_cosine_hemisphere(u: Vec2) -> glam::Vec3A {
     glam::Vec3A::new(d.x, d.y, z)
 }
 
+/// A direction about +Z with density (n + 1)/(2π) cosⁿθ per steradian, the normalised
+/// Phong lobe (Lafortune & Willems 1994 §4; pbrt-v3 §14.1): cos θ = u₁^{1/(n+1)}, φ = 2πu₂.
+#[inline]
+pub fn sample_power_cosine(u: Vec2, exponent: f32) -> glam::Vec3A {
+    let cos_t = u.x.powf(1.0 / (exponent + 1.0));
+    let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
+    let (sin_p, cos_p) = (2.0 * std::f32::consts::PI * u.y).sin_cos();
+    glam::Vec3A::new(sin_t * cos_p, sin_t * sin_p, cos_t)
+}
+
+/// Density of [`sample_power_cosine`] at a direction with this cos θ (0 below the horizon).
+#[inline]
+pub fn power_cosine_pdf(cos_theta: f32, exponent: f32) -> f32 {
+    if cos_theta <= 0.0 {
+        return 0.0;
+    }
+    (exponent + 1.0) * 0.5 * std::f32::consts::FRAC_1_PI * cos_theta.powf(exponent)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -26,7 +26,9 @@ pub use error::{JsonPath, PathSegment, Position, SceneError};
 pub use film::{Aov, Film, PixelFilter, Reconstruction};
 pub use integrator::{Integrator, MisHeuristic, SamplerKind};
 pub use light::{Light, LightKind, Strength};
-pub use material::{ConductorOptics, Ior, Material, MaterialKind, Microfacet, Roughness};
+pub use material::{
+    ConductorOptics, Ior, LafortuneLobe, Material, MaterialKind, Microfacet, Roughness,
+};
 pub use medium::{Medium, MediumKind};
 pub use scene::{load_scene, parse_scene_str, SceneDescription};
 pub use sensor::{Sensor, SensorKind, SensorSampling};

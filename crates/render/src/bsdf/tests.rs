@@ -28,7 +28,7 @@ fn gold_like() -> (SampledSpectrum, SampledSpectrum) {
     )
 }
 
-fn conductor(model: MicrofacetModel, ax: f32, ay: f32) -> Bsdf {
+fn conductor(model: MicrofacetModel, ax: f32, ay: f32) -> Bsdf<'static> {
     let (eta, k) = gold_like();
     Bsdf::new(BsdfLobe::Conductor(Conductor {
         eta,
@@ -37,7 +37,7 @@ fn conductor(model: MicrofacetModel, ax: f32, ay: f32) -> Bsdf {
     }))
 }
 
-fn dielectric(model: MicrofacetModel, ax: f32, ay: f32, eta: f32) -> Bsdf {
+fn dielectric(model: MicrofacetModel, ax: f32, ay: f32, eta: f32) -> Bsdf<'static> {
     Bsdf::new(BsdfLobe::Dielectric(Dielectric {
         eta: SampledSpectrum::splat(eta),
         distribution: MicrofacetDistribution::new(model, ax, ay),
@@ -53,7 +53,7 @@ const ROUGHNESS: [(f32, f32); 3] = [(0.2, 0.2), (0.5, 0.5), (0.1, 0.4)];
 /// Refraction near the critical angle makes the transmission pdf peak sharply, so the
 /// expected counts of transmissive families are integrated on finer sub-cells (at 16 per
 /// bin edge the midpoint rule's error alone fails η = 1.33 at θ = 85°, α = 0.5).
-fn chi2_family(name: &str, sides: &[f32], make: impl Fn(f32, f32) -> Bsdf) {
+fn chi2_family(name: &str, sides: &[f32], make: impl Fn(f32, f32) -> Bsdf<'static>) {
     chi2_family_over(name, &ROUGHNESS, sides, make);
 }
 
@@ -61,7 +61,7 @@ fn chi2_family_over(
     name: &str,
     roughness: &[(f32, f32)],
     sides: &[f32],
-    make: impl Fn(f32, f32) -> Bsdf,
+    make: impl Fn(f32, f32) -> Bsdf<'static>,
 ) {
     let count = roughness.len() * THETAS_DEG.len() * sides.len();
     let transmissive = sides.contains(&-1.0) && !make(0.3, 0.3).lobe.is_reflection_only();

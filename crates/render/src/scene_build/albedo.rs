@@ -89,6 +89,38 @@ fn albedo_at_depth(materials: &[Material], index: usize, depth: usize) -> [f32; 
         MaterialKind::TwoSided { material } | MaterialKind::Mask { material, .. } => {
             albedo_at_depth(materials, *material, depth + 1)
         }
+        // The material library (issue 8): the diffuse reflectance, plus the specular one
+        // where the two share an energy budget; a mix blends its materials' albedos; a
+        // measured BRDF (its table is loaded only when rendering) reports the default.
+        MaterialKind::OrenNayar { reflectance, .. } => reflectance_rgb(reflectance),
+        MaterialKind::Phong {
+            diffuse, specular, ..
+        }
+        | MaterialKind::BlinnPhong {
+            diffuse, specular, ..
+        }
+        | MaterialKind::Ward {
+            diffuse, specular, ..
+        } => {
+            let (d, s) = (reflectance_rgb(diffuse), reflectance_rgb(specular));
+            [d[0] + s[0], d[1] + s[1], d[2] + s[2]]
+        }
+        MaterialKind::Lafortune { diffuse, .. } | MaterialKind::Coated { diffuse, .. } => {
+            reflectance_rgb(diffuse)
+        }
+        MaterialKind::ThinDielectric { .. } => [1.0; 3],
+        MaterialKind::Mix {
+            materials: [a, b],
+            weight,
+        } => {
+            let (a, b) = (
+                albedo_at_depth(materials, *a, depth + 1),
+                albedo_at_depth(materials, *b, depth + 1),
+            );
+            let w = *weight as f32;
+            [0, 1, 2].map(|c| (1.0 - w) * a[c] + w * b[c])
+        }
+        MaterialKind::Merl { .. } => DEFAULT_ALBEDO,
     }
 }
 

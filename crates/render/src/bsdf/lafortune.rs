@@ -1,0 +1,169 @@
+//! Generalized cosine lobes (E. P. F. Lafortune, S.-C. Foo, K. E. Torrance and D. P.
+//! Greenberg, "Non-linear approximation of reflectance functions", SIGGRAPH 1997, eq. 4
+//! with the anisotropic C_x ≠ C_y of §4):
+//!
+//! f(ωₒ, ωᵢ) = ρ_d/π + Σⱼ ρⱼ [C_x,j ωₒ,x ωᵢ,x + C_y,j ωₒ,y ωᵢ,y + C_z,j ωₒ,z ωᵢ,z]₊^{nⱼ},
+//!
+//! each bracket clamped at 0. C_x = C_y = −1, C_z = 1 is a Phong lobe about the mirror
+//! direction; −C_x > C_z moves the lobe towards grazing (off-specular peaks); C_x > 0 makes
+//! it retro-reflective. The model is a fit: its lobes carry no normalisation, so energy
+//! conservation is the fit's business (the paper's own fits stay below 1), not a property
+//! of the model. Symmetric in ωₒ, ωᵢ (reciprocal).
+//!
+//! Sampling: the bracket is (C∘ωₒ)·ωᵢ = |s| cos β with s = (C_x ωₒ,x, C_y ωₒ,y, C_z ωₒ,z),
+//! so lobe j is a cosine power about ŝⱼ and is sampled with density (n + 1)/(2π) cosⁿβ
+//! (as the paper's §5 suggests). A lobe is picked with probability ∝ its weight
+//! ρ̄ⱼ |sⱼ|ⁿ 2π/(n + 1) (its integral over the sphere), the diffuse one ∝ ρ̄_d; the pdf is
+//! the mixture. Samples below the horizon fail. One-sided.
+
+use glam::{Vec2, Vec3A};
+use prism_geometry::Frame;
+use prism_spectrum::SampledSpectrum;
+
+use super::{BsdfSample, LobeKind, TransportMode};
+use crate::sampling::{power_cosine_pdf, sample_cosine_hemisphere, sample_power_cosine};
+
+/// Most lobes a material may have (the paper fits up to three).
+pub const LAFORTUNE_MAX_LOBES: usize = 3;
+
+/// One generalized cosine lobe.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LafortuneLobe {
+    pub cx: f32,
+    pub cy: f32,
+    pub cz: f32,
+    /// Exponent n ≥ 0.
+    pub exponent: f32,
+    /// Spectral scale ρⱼ(λ) ≥ 0 of the lobe.
+    pub albedo: SampledSpectrum,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Lafortune {
+    pub diffuse: SampledSpectrum,
+    pub lobes: [LafortuneLobe; LAFORTUNE_MAX_LOBES],
+    /// Lobes in use (the first `count` of `lobes`).
+    pub count: usize,
+}
+
+impl LobeKind for Lafortune {}
+
+impl LafortuneLobe {
+    /// An unused slot.
+    pub const NONE: LafortuneLobe = LafortuneLobe {
+        cx: 0.0,
+        cy: 0.0,
+        cz: 0.0,
+        exponent: 0.0,
+        albedo: SampledSpectrum::new([0.0; 4]),
+    };
+
+    #[inline]
+    fn axis(&self, wo: Vec3A) -> Vec3A {
+        Vec3A::new(self.cx * wo.x, self.cy * wo.y, self.cz * wo.z)
+    }
+}
+
+impl Lafortune {
+    /// Unnormalised selection weights: diffuse first, then each lobe.
+    #[inline]
+    fn weights(&self, wo: Vec3A) -> [f32; LAFORTUNE_MAX_LOBES + 1] {
+        let mut w = [0.0; LAFORTUNE_MAX_LOBES + 1];
+        w[0] = self.diffuse.average().max(0.0);
+        for (j, lobe) in self.lobes[..self.count].iter().enumerate() {
+            let s = lobe.axis(wo).length();
+            w[j + 1] = if s > 0.0 {
+                lobe.albedo.average().max(0.0) * s.powf(lobe.exponent) * 2.0 * std::f32::consts::PI
+                    / (lobe.exponent + 1.0)
+            } else {
+                0.0
+            };
+        }
+        if w.iter().sum::<f32>() <= 0.0 {
+            w[0] = 1.0;
+        }
+        w
+    }
+
+    #[inline]
+    pub fn eval(&self, wo: Vec3A, wi: Vec3A, _mode: TransportMode) -> SampledSpectrum {
+        if wo.z <= 0.0 || wi.z <= 0.0 {
+            return SampledSpectrum::splat(0.0);
+        }
+        let mut f = self.diffuse * std::f32::consts::FRAC_1_PI;
+        for lobe in &self.lobes[..self.count] {
+            let dot = lobe.axis(wo).dot(wi);
+            if dot > 0.0 {
+                f += lobe.albedo * dot.powf(lobe.exponent);
+            }
+        }
+        f
+    }
+
+    #[inline]
+    pub fn pdf(&self, wo: Vec3A, wi: Vec3A, _mode: TransportMode) -> f32 {
+        if wo.z <= 0.0 || wi.z <= 0.0 {
+            return 0.0;
+        }
+        let w = self.weights(wo);
+        let total: f32 = w.iter().sum();
+        let mut pdf = w[0] * wi.z * std::f32::consts::FRAC_1_PI;
+        for (j, lobe) in self.lobes[..self.count].iter().enumerate() {
+            if w[j + 1] > 0.0 {
+                let axis = lobe.axis(wo).normalize_or_zero();
+                pdf += w[j + 1] * power_cosine_pdf(axis.dot(wi).min(1.0), lobe.exponent);
+            }
+        }
+        pdf / total
+    }
+
+    #[inline]
+    pub fn sample(
+        &self,
+        wo: Vec3A,
+        u_lobe: f32,
+        u: Vec2,
+        mode: TransportMode,
+    ) -> Option<BsdfSample> {
+        if wo.z <= 0.0 {
+            return None;
+        }
+        let w = self.weights(wo);
+        let total: f32 = w.iter().sum();
+        let mut target = u_lobe * total;
+        let mut chosen = 0;
+        for (j, &wj) in w[..=self.count].iter().enumerate() {
+            chosen = j;
+            if target < wj {
+                break;
+            }
+            target -= wj;
+        }
+        // Skip trailing zero-weight lobes a rounding `target` could land on.
+        while w[chosen] <= 0.0 && chosen > 0 {
+            chosen -= 1;
+        }
+        let wi = if chosen == 0 {
+            sample_cosine_hemisphere(u)
+        } else {
+            let lobe = &self.lobes[chosen - 1];
+            let frame = Frame::from_z(lobe.axis(wo).normalize());
+            frame.from_local(sample_power_cosine(u, lobe.exponent))
+        };
+        if wi.z <= 0.0 {
+            return None;
+        }
+        let pdf = self.pdf(wo, wi, mode);
+        if pdf.is_nan() || pdf <= 0.0 {
+            return None;
+        }
+        Some(BsdfSample {
+            wi,
+            f: self.eval(wo, wi, mode),
+            pdf,
+            specular: false,
+            transmission: false,
+            eta: 1.0,
+        })
+    }
+}

@@ -1,0 +1,779 @@
+//! Measured isotropic BRDFs in the MERL format (W. Matusik, H. Pfister, M. Brand and
+//! L. McMillan, "A data-driven reflectance model", SIGGRAPH 2003; the database's reference
+//! reader `BRDFRead.cpp`).
+//!
+//! **File format.** Three little-endian `i32` dimensions (90, 90, 180), then
+//! 3 × 90·90·180 little-endian `f64`: the red, green and blue tables one after the other.
+//! Entry (i_h, i_d, i_φ) sits at i_φ + 180 i_d + 180·90 i_h of each table and holds the
+//! BRDF (1/sr) divided by the channel's scale: red 1/1500, green 1.15/1500, blue 1.66/1500.
+//!
+//! **Parameterisation** (Rusinkiewicz 1998 half/difference angles): ω_h = (ωᵢ + ωₒ)/|·|
+//! at (θ_h, φ_h); the difference vector is ωᵢ rotated by −φ_h about the normal and by −θ_h
+//! about the bitangent, at (θ_d, φ_d). Indices as `BRDFRead.cpp`: i_h = ⌊√(θ_h/(π/2))·90⌋
+//! (the square-root map packs bins near the specular peak), i_d = ⌊θ_d/(π/2)·90⌋,
+//! (θ from a polynomial arccos accurate to 2·10⁻⁸ rad, `acos_fast`),
+//! i_φ = ⌊φ_d/π·180⌋ after folding φ_d < 0 by +π (reciprocity), each clamped to the table.
+//! The lookup is the reference code's: nearest bin, no interpolation, so the table is
+//! piecewise constant; `MerlTable::from_fn` writes each bin's midpoint (in index space).
+//!
+//! **Reading** (`MerlTable::from_bytes`): the header must be (90, 90, 180), the body
+//! exactly 3·90·90·180 doubles (a truncated or overlong file is refused with both sizes),
+//! every value finite; negative entries (measurement artefacts in some database files) are
+//! refused with their count and first bin unless the caller asks to clamp them to 0.
+//!
+//! **Spectral use** (`MerlBrdf`): each bin's linear sRGB triple is upsampled once at load
+//! with the Jakob–Hanika sigmoid table (`RgbUnboundedSpectrum` form: scale 2·max(RGB), the
+//! table's coefficients for RGB/scale; grey gives an exactly flat spectrum), stored as
+//! (c₀, c₁, c₂, scale); an evaluation looks up one bin and evaluates that sigmoid at the
+//! path's four wavelengths.
+//!
+//! **Sampling** by tabulated CDF inversion in half-vector space, per incident angle: for
+//! 32 bins of θₒ a piecewise-constant density over (u, v) ∈ [0,1)², θ_h = (π/2)u² (the
+//! table's own square-root map) and φ_h = φₒ + 2πv, proportional to the luminance of
+//! f·cos θᵢ times the Jacobians (4 ωₒ·ω_h for reflection, sin θ_h·πu·2π for the map),
+//! evaluated at each cell's centre with ωₒ at the bin's centre. A sample inverts the
+//! marginal CDF over the 64 θ_h rows, then the row's conditional CDF over the 64 φ cells,
+//! and reflects ωₒ about ω_h; its density is the cell's value over the Jacobians,
+//! exact for any ωₒ (the bin only decides which table is used). A defensive 10 % of cosine
+//! sampling (Hesterberg 1995) covers bins whose centre missed a thin lobe.
+
+use std::fmt;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use glam::{Vec2, Vec3A};
+use prism_spectrum::{RgbGamut, SampledSpectrum, SigmoidPolynomial};
+use rayon::prelude::*;
+
+use super::{BsdfSample, LobeKind, TransportMode};
+use crate::sampling::sample_cosine_hemisphere;
+
+/// θ_h bins.
+pub const MERL_THETA_H: usize = 90;
+/// θ_d bins.
+pub const MERL_THETA_D: usize = 90;
+/// φ_d bins (over [0, π)).
+pub const MERL_PHI_D: usize = 180;
+/// Entries per colour channel.
+pub const MERL_ENTRIES: usize = MERL_THETA_H * MERL_THETA_D * MERL_PHI_D;
+/// Scale of each channel (`BRDFRead.cpp` RED_SCALE, GREEN_SCALE, BLUE_SCALE).
+pub const MERL_SCALE: [f64; 3] = [1.0 / 1500.0, 1.15 / 1500.0, 1.66 / 1500.0];
+/// Bytes of a well-formed file.
+pub const MERL_FILE_BYTES: usize = 12 + 3 * MERL_ENTRIES * 8;
+
+/// θₒ bins of the sampling tables. The tables (32·64·64 cells, 0.5 MB of densities and
+/// 0.5 MB of CDFs) stay in the processor's caches; the 90·180 resolution of the table itself
+/// (6 MB) made sampling 3× slower through cache misses alone, for no visible gain (the pdf
+/// is exact either way; only how closely it follows f·cos changes).
+const SAMPLE_THETA_O: usize = 32;
+/// θ_h rows (u) of a sampling table.
+const SAMPLE_U: usize = 64;
+/// φ_h columns (v) of a sampling table, over the full circle.
+const SAMPLE_V: usize = 64;
+/// Fraction of cosine-weighted samples (defensive mixture).
+const COSINE_FRACTION: f32 = 0.1;
+
+/// What went wrong reading or writing a MERL file.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MerlError {
+    /// The file, when there is one.
+    pub path: Option<PathBuf>,
+    pub message: String,
+}
+
+impl MerlError {
+    fn new(message: impl Into<String>) -> Self {
+        Self {
+            path: None,
+            message: message.into(),
+        }
+    }
+
+    fn at(mut self, path: &Path) -> Self {
+        self.path = Some(path.to_path_buf());
+        self
+    }
+}
+
+impl fmt::Display for MerlError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match &self.path {
+            Some(p) => write!(f, "{}: {}", p.display(), self.message),
+            None => f.write_str(&self.message),
+        }
+    }
+}
+
+impl std::error::Error for MerlError {}
+
+/// (i_h, i_d, i_φ) of a flat index.
+pub fn merl_bin(index: usize) -> (usize, usize, usize) {
+    (
+        index / (MERL_THETA_D * MERL_PHI_D),
+        (index / MERL_PHI_D) % MERL_THETA_D,
+        index % MERL_PHI_D,
+    )
+}
+
+/// The angles (θ_h, θ_d, φ_d) in radians at the midpoint of a bin in index space.
+pub fn merl_bin_centre(i_h: usize, i_d: usize, i_phi: usize) -> (f64, f64, f64) {
+    use std::f64::consts::{FRAC_PI_2, PI};
+    let u = (i_h as f64 + 0.5) / MERL_THETA_H as f64;
+    (
+        u * u * FRAC_PI_2,
+        (i_d as f64 + 0.5) / MERL_THETA_D as f64 * FRAC_PI_2,
+        (i_phi as f64 + 0.5) / MERL_PHI_D as f64 * PI,
+    )
+}
+
+/// (ωᵢ, ωₒ) in the local frame for half/difference angles, φ_h = 0 (isotropy): the
+/// difference vector and its mirror about the half vector, rotated by θ_h about y. A
+/// direction the bin's centre puts below the horizon is lifted to z = 10⁻⁴ (renormalised):
+/// such bins straddle the horizon and are looked up only by upper-hemisphere pairs near
+/// that edge, so the nearest upper configuration is the value they need (a Lambertian
+/// source then exports exactly 1/π·ρ in every bin).
+pub fn merl_directions(theta_h: f64, theta_d: f64, phi_d: f64) -> (Vec3A, Vec3A) {
+    let (wi, wo) = merl_directions_raw(theta_h, theta_d, phi_d);
+    let lift = |w: Vec3A| {
+        if w.z < 1e-4 {
+            Vec3A::new(w.x, w.y, 1e-4).normalize()
+        } else {
+            w
+        }
+    };
+    (lift(wi), lift(wo))
+}
+
+/// As [`merl_directions`] without lifting (may lie below the horizon).
+pub fn merl_directions_raw(theta_h: f64, theta_d: f64, phi_d: f64) -> (Vec3A, Vec3A) {
+    let (st_d, ct_d) = theta_d.sin_cos();
+    let (sp_d, cp_d) = phi_d.sin_cos();
+    let (st_h, ct_h) = theta_h.sin_cos();
+    let d = [st_d * cp_d, st_d * sp_d, ct_d];
+    let rot = |x: f64, y: f64, z: f64| {
+        Vec3A::new(
+            (ct_h * x + st_h * z) as f32,
+            y as f32,
+            (-st_h * x + ct_h * z) as f32,
+        )
+    };
+    (rot(d[0], d[1], d[2]), rot(-d[0], -d[1], d[2]))
+}
+
+/// arccos for x ∈ [−1, 1] by Abramowitz & Stegun 4.4.46 (|error| ≤ 2·10⁻⁸ rad, below the
+/// f32 rounding of the result): √(1 − x)·Σ aₖxᵏ on [0, 1], π − acos(−x) below. About 3×
+/// faster than the library acosf, and the lookup needs two per evaluation.
+#[inline]
+// a₀ = 1.5707963050 is the published fit's coefficient, not π/2.
+#[allow(clippy::approx_constant)]
+fn acos_fast(x: f32) -> f32 {
+    let a = x.abs().min(1.0);
+    let p = 1.570_796_3
+        + a * (-0.214_598_8
+            + a * (0.088_978_99
+                + a * (-0.050_174_304
+                    + a * (0.030_891_88
+                        + a * (-0.017_088_126 + a * (0.006_670_09 + a * -0.001_262_491))))));
+    let r = (1.0 - a).sqrt() * p;
+    if x < 0.0 {
+        std::f32::consts::PI - r
+    } else {
+        r
+    }
+}
+
+/// The bin `BRDFRead.cpp` reads for a pair of upper-hemisphere directions, from the half
+/// vector `h` (unit, upper) and ωᵢ.
+#[inline]
+fn lookup_index(h: Vec3A, wi: Vec3A) -> usize {
+    let cos_h = h.z.min(1.0);
+    let sin_h = (1.0 - cos_h * cos_h).max(0.0).sqrt();
+    // Rotate ωᵢ by −φ_h about z, then by −θ_h about y.
+    let (cp, sp) = if sin_h > 1e-7 {
+        (h.x / sin_h, h.y / sin_h)
+    } else {
+        (1.0, 0.0)
+    };
+    let x1 = cp * wi.x + sp * wi.y;
+    let y1 = -sp * wi.x + cp * wi.y;
+    let dx = cos_h * x1 - sin_h * wi.z;
+    let dz = sin_h * x1 + cos_h * wi.z;
+    let theta_h = acos_fast(cos_h);
+    let theta_d = acos_fast(dz.clamp(-1.0, 1.0));
+    let mut phi_d = y1.atan2(dx);
+    if phi_d < 0.0 {
+        phi_d += std::f32::consts::PI;
+    }
+    let i_h =
+        ((theta_h * std::f32::consts::FRAC_2_PI).max(0.0).sqrt() * MERL_THETA_H as f32) as usize;
+    let i_d = (theta_d * std::f32::consts::FRAC_2_PI * MERL_THETA_D as f32) as usize;
+    let i_phi = (phi_d * std::f32::consts::FRAC_1_PI * MERL_PHI_D as f32) as usize;
+    i_phi.min(MERL_PHI_D - 1)
+        + MERL_PHI_D * (i_d.min(MERL_THETA_D - 1) + MERL_THETA_D * i_h.min(MERL_THETA_H - 1))
+}
+
+/// The raw table: BRDF values in 1/sr (channel scales applied), red, green, blue tables
+/// in file order.
+#[derive(Clone, PartialEq)]
+pub struct MerlTable {
+    /// 3 × `MERL_ENTRIES` values.
+    pub values: Vec<f64>,
+}
+
+impl fmt::Debug for MerlTable {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "MerlTable({} entries)", self.values.len() / 3)
+    }
+}
+
+impl MerlTable {
+    /// A table from each bin's RGB BRDF (1/sr) at `(θ_h, θ_d, φ_d)` (the bin midpoint,
+    /// `merl_bin_centre`), filled in parallel.
+    pub fn from_fn(f: impl Fn(f64, f64, f64) -> [f64; 3] + Sync) -> Self {
+        let rgb: Vec<[f64; 3]> = (0..MERL_ENTRIES)
+            .into_par_iter()
+            .map(|index| {
+                let (i_h, i_d, i_phi) = merl_bin(index);
+                let (th, td, pd) = merl_bin_centre(i_h, i_d, i_phi);
+                f(th, td, pd)
+            })
+            .collect();
+        let mut values = vec![0.0; 3 * MERL_ENTRIES];
+        for (index, v) in rgb.iter().enumerate() {
+            for c in 0..3 {
+                values[c * MERL_ENTRIES + index] = v[c];
+            }
+        }
+        Self { values }
+    }
+
+    /// RGB of bin `index`, 1/sr.
+    #[inline]
+    pub fn rgb(&self, index: usize) -> [f64; 3] {
+        [
+            self.values[index],
+            self.values[MERL_ENTRIES + index],
+            self.values[2 * MERL_ENTRIES + index],
+        ]
+    }
+
+    /// The table's value for a pair of local directions (0 when either is below the
+    /// surface), by `BRDFRead.cpp`'s lookup.
+    pub fn lookup(&self, wo: Vec3A, wi: Vec3A) -> [f64; 3] {
+        if wo.z <= 0.0 || wi.z <= 0.0 {
+            return [0.0; 3];
+        }
+        self.rgb(lookup_index((wo + wi).normalize(), wi))
+    }
+
+    /// Parses a file's bytes (see the module docs); `clamp_negative` turns negative
+    /// entries into 0 instead of refusing them.
+    pub fn from_bytes(bytes: &[u8], clamp_negative: bool) -> Result<Self, MerlError> {
+        if bytes.len() < 12 {
+            return Err(MerlError::new(format!(
+                "not a MERL BRDF: {} bytes, shorter than the 12-byte header",
+                bytes.len()
+            )));
+        }
+        let dim = |k: usize| i32::from_le_bytes(bytes[4 * k..4 * k + 4].try_into().unwrap());
+        let dims = [dim(0), dim(1), dim(2)];
+        if dims != [90, 90, 180] {
+            return Err(MerlError::new(format!(
+                "header gives table dimensions {dims:?}; a MERL BRDF has [90, 90, 180] \
+                 (θ_h, θ_d, φ_d)"
+            )));
+        }
+        if bytes.len() != MERL_FILE_BYTES {
+            let what = if bytes.len() < MERL_FILE_BYTES {
+                "truncated"
+            } else {
+                "too long"
+            };
+            return Err(MerlError::new(format!(
+                "{what}: {} bytes, a MERL BRDF has exactly {MERL_FILE_BYTES} (12-byte header \
+                 + 3 × 90·90·180 doubles)",
+                bytes.len()
+            )));
+        }
+        let mut values: Vec<f64> = bytes[12..]
+            .chunks_exact(8)
+            .map(|c| f64::from_le_bytes(c.try_into().unwrap()))
+            .collect();
+        let mut negative = 0usize;
+        let mut first_negative = None;
+        for (k, v) in values.iter_mut().enumerate() {
+            let channel = k / MERL_ENTRIES;
+            if !v.is_finite() {
+                let (i_h, i_d, i_phi) = merl_bin(k % MERL_ENTRIES);
+                return Err(MerlError::new(format!(
+                    "value {v} in the {} table at bin (θ_h {i_h}, θ_d {i_d}, φ_d {i_phi}) is \
+                     not finite",
+                    ["red", "green", "blue"][channel]
+                )));
+            }
+            if *v < 0.0 {
+                negative += 1;
+                first_negative.get_or_insert((k, *v));
+                if clamp_negative {
+                    *v = 0.0;
+                }
+            }
+            *v *= MERL_SCALE[channel];
+        }
+        if let (Some((k, v)), false) = (first_negative, clamp_negative) {
+            let (i_h, i_d, i_phi) = merl_bin(k % MERL_ENTRIES);
+            return Err(MerlError::new(format!(
+                "{negative} negative entries (first: {v} in the {} table at bin (θ_h {i_h}, \
+                 θ_d {i_d}, φ_d {i_phi})); a BRDF is ≥ 0 — set \"clamp_negative\": true to \
+                 read them as 0",
+                ["red", "green", "blue"][k / MERL_ENTRIES]
+            )));
+        }
+        Ok(Self { values })
+    }
+
+    /// Reads a file (see `from_bytes`).
+    pub fn read(path: &Path, clamp_negative: bool) -> Result<Self, MerlError> {
+        let bytes = std::fs::read(path)
+            .map_err(|e| MerlError::new(format!("cannot read: {e}")).at(path))?;
+        Self::from_bytes(&bytes, clamp_negative).map_err(|e| e.at(path))
+    }
+
+    /// The file's bytes (values divided by the channel scales).
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let mut out = Vec::with_capacity(MERL_FILE_BYTES);
+        for d in [90i32, 90, 180] {
+            out.extend_from_slice(&d.to_le_bytes());
+        }
+        for (k, v) in self.values.iter().enumerate() {
+            out.extend_from_slice(&(v / MERL_SCALE[k / MERL_ENTRIES]).to_le_bytes());
+        }
+        out
+    }
+
+    /// Writes the file through a temporary file in the same folder, renamed into place, so
+    /// a failure never leaves a half-written table.
+    pub fn write(&self, path: &Path) -> Result<(), MerlError> {
+        let dir = path
+            .parent()
+            .filter(|p| !p.as_os_str().is_empty())
+            .unwrap_or(Path::new("."));
+        let mut tmp = tempfile_in(dir).map_err(|e| e.at(path))?;
+        tmp.1
+            .write_all(&self.to_bytes())
+            .and_then(|_| tmp.1.sync_all())
+            .map_err(|e| MerlError::new(format!("cannot write: {e}")).at(path))?;
+        drop(tmp.1);
+        std::fs::rename(&tmp.0, path).map_err(|e| {
+            let _ = std::fs::remove_file(&tmp.0);
+            MerlError::new(format!("cannot move the written table into place: {e}")).at(path)
+        })
+    }
+}
+
+/// A new file next to the target (its name unique to this process and moment).
+fn tempfile_in(dir: &Path) -> Result<(PathBuf, std::fs::File), MerlError> {
+    let stamp = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_nanos());
+    let path = dir.join(format!(".merl-{}-{stamp}.tmp", std::process::id()));
+    std::fs::OpenOptions::new()
+        .write(true)
+        .create_new(true)
+        .open(&path)
+        .map(|f| (path, f))
+        .map_err(|e| MerlError::new(format!("cannot create a temporary file: {e}")))
+}
+
+/// One bin's upsampled spectrum: scale × S(c₀λ² + c₁λ + c₂).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct BinSpectrum {
+    c: [f32; 3],
+    scale: f32,
+}
+
+/// A measured BRDF ready to render: per-bin spectra and the sampling tables.
+pub struct MerlBrdf {
+    bins: Vec<BinSpectrum>,
+    /// Per θₒ bin: the normalised density of each (u, v) cell, row-major (u rows).
+    cell_pdf: Vec<f32>,
+    /// Per θₒ bin: the CDF over rows, `SAMPLE_U + 1` values from 0 to 1.
+    row_cdf: Vec<f32>,
+    /// Per θₒ bin and row: the conditional CDF over cells, `SAMPLE_V + 1` values.
+    cell_cdf: Vec<f32>,
+    /// Per θₒ bin: true when the tabulated density has mass (else pure cosine sampling).
+    has_table: Vec<bool>,
+    /// An equivalent Beckmann roughness of the specular peak (for the bandwidth predictor):
+    /// √(mean tan²θ_h) of the f·cos-weighted half vectors at θₒ ≈ 0.
+    pub equivalent_alpha: f32,
+}
+
+impl fmt::Debug for MerlBrdf {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "MerlBrdf(α_eq {})", self.equivalent_alpha)
+    }
+}
+
+impl PartialEq for MerlBrdf {
+    fn eq(&self, other: &Self) -> bool {
+        std::ptr::eq(self, other)
+    }
+}
+
+/// One θₒ bin's sampling tables: cell densities, row CDF, per-row cell CDFs, has mass.
+type ThetaOTables = (Vec<f32>, Vec<f32>, Vec<f32>, bool);
+
+/// Luminance weights of linear sRGB (ITU-R BT.709 Y row).
+const LUMINANCE: [f64; 3] = [0.2126, 0.7152, 0.0722];
+
+impl MerlBrdf {
+    /// Upsamples every bin and builds the sampling tables.
+    pub fn new(table: &MerlTable) -> Self {
+        let upsampler = RgbGamut::Srgb.table();
+        let bins: Vec<BinSpectrum> = (0..MERL_ENTRIES)
+            .into_par_iter()
+            .map(|index| {
+                let rgb = table.rgb(index).map(|v| v as f32);
+                let max = rgb[0].max(rgb[1]).max(rgb[2]);
+                if max <= 0.0 {
+                    return BinSpectrum {
+                        c: [0.0, 0.0, -1e18],
+                        scale: 0.0,
+                    };
+                }
+                let min = rgb[0].min(rgb[1]).min(rgb[2]);
+                // Grey within f32 rounding of the channel scales: exactly flat.
+                let poly = if max - min <= 1e-6 * max {
+                    SigmoidPolynomial::constant(0.5)
+                } else {
+                    upsampler.coefficients(rgb.map(|c| c / (2.0 * max)))
+                };
+                let scale = if max - min <= 1e-6 * max {
+                    2.0 * (rgb[0] + rgb[1] + rgb[2]) / 3.0
+                } else {
+                    2.0 * max
+                };
+                BinSpectrum {
+                    c: [poly.c0, poly.c1, poly.c2],
+                    scale,
+                }
+            })
+            .collect();
+        let luminance = |wo: Vec3A, wi: Vec3A| -> f64 {
+            let rgb = table.lookup(wo, wi);
+            (0..3).map(|c| LUMINANCE[c] * rgb[c]).sum::<f64>().max(0.0)
+        };
+        let cells = SAMPLE_U * SAMPLE_V;
+        let per_bin: Vec<ThetaOTables> = (0..SAMPLE_THETA_O)
+            .into_par_iter()
+            .map(|k| {
+                let theta_o =
+                    (k as f64 + 0.5) / SAMPLE_THETA_O as f64 * std::f64::consts::FRAC_PI_2;
+                let wo = Vec3A::new(theta_o.sin() as f32, 0.0, theta_o.cos() as f32);
+                let mut weight = vec![0.0f64; cells];
+                for i in 0..SAMPLE_U {
+                    let u = (i as f64 + 0.5) / SAMPLE_U as f64;
+                    let theta_h = u * u * std::f64::consts::FRAC_PI_2;
+                    let (st, ct) = theta_h.sin_cos();
+                    for j in 0..SAMPLE_V {
+                        let phi = (j as f64 + 0.5) / SAMPLE_V as f64 * std::f64::consts::TAU;
+                        let h =
+                            Vec3A::new((st * phi.cos()) as f32, (st * phi.sin()) as f32, ct as f32);
+                        let cos_oh = wo.dot(h);
+                        if cos_oh <= 0.0 {
+                            continue;
+                        }
+                        let wi = 2.0 * cos_oh * h - wo;
+                        if wi.z <= 0.0 {
+                            continue;
+                        }
+                        // f cos θᵢ · 4(ωₒ·ω_h) · sin θ_h · πu · 2π: the density in (u, v).
+                        weight[i * SAMPLE_V + j] = luminance(wo, wi)
+                            * f64::from(wi.z)
+                            * 4.0
+                            * f64::from(cos_oh)
+                            * st
+                            * std::f64::consts::PI
+                            * u
+                            * std::f64::consts::TAU;
+                    }
+                }
+                let total: f64 = weight.iter().sum();
+                let mut pdf = vec![0.0f32; cells];
+                let mut row_cdf = vec![0.0f32; SAMPLE_U + 1];
+                let mut cell_cdf = vec![0.0f32; SAMPLE_U * (SAMPLE_V + 1)];
+                if !(total > 0.0 && total.is_finite()) {
+                    return (pdf, row_cdf, cell_cdf, false);
+                }
+                let mut acc_rows = 0.0f64;
+                for i in 0..SAMPLE_U {
+                    let row = &weight[i * SAMPLE_V..(i + 1) * SAMPLE_V];
+                    let row_sum: f64 = row.iter().sum();
+                    let mut acc = 0.0f64;
+                    for j in 0..SAMPLE_V {
+                        // Density per unit (u, v) area: mass / (1/(U·V)).
+                        pdf[i * SAMPLE_V + j] = (row[j] / total * cells as f64) as f32;
+                        acc += row[j];
+                        cell_cdf[i * (SAMPLE_V + 1) + j + 1] = if row_sum > 0.0 {
+                            (acc / row_sum) as f32
+                        } else {
+                            (j + 1) as f32 / SAMPLE_V as f32
+                        };
+                    }
+                    cell_cdf[i * (SAMPLE_V + 1) + SAMPLE_V] = 1.0;
+                    acc_rows += row_sum;
+                    row_cdf[i + 1] = (acc_rows / total) as f32;
+                }
+                row_cdf[SAMPLE_U] = 1.0;
+                (pdf, row_cdf, cell_cdf, true)
+            })
+            .collect();
+        let mut cell_pdf = Vec::with_capacity(SAMPLE_THETA_O * cells);
+        let mut row_cdf = Vec::with_capacity(SAMPLE_THETA_O * (SAMPLE_U + 1));
+        let mut cell_cdf = Vec::with_capacity(SAMPLE_THETA_O * SAMPLE_U * (SAMPLE_V + 1));
+        let mut has_table = Vec::with_capacity(SAMPLE_THETA_O);
+        for (p, r, c, h) in per_bin {
+            cell_pdf.extend(p);
+            row_cdf.extend(r);
+            cell_cdf.extend(c);
+            has_table.push(h);
+        }
+        // Equivalent roughness: f·cos-weighted tan²θ_h at normal incidence.
+        let (mut num, mut den) = (0.0f64, 0.0f64);
+        for i in 0..SAMPLE_U {
+            let u = (i as f64 + 0.5) / SAMPLE_U as f64;
+            let theta_h = u * u * std::f64::consts::FRAC_PI_2;
+            if theta_h >= std::f64::consts::FRAC_PI_4 {
+                break;
+            }
+            let w: f64 = (0..SAMPLE_V)
+                .map(|j| f64::from(cell_pdf[i * SAMPLE_V + j]))
+                .sum();
+            num += w * theta_h.tan().powi(2);
+            den += w;
+        }
+        let equivalent_alpha = if den > 0.0 {
+            (num / den).sqrt() as f32
+        } else {
+            1.0
+        };
+        Self {
+            bins,
+            cell_pdf,
+            row_cdf,
+            cell_cdf,
+            has_table,
+            equivalent_alpha,
+        }
+    }
+
+    #[inline]
+    fn spectrum(&self, index: usize, lambda_nm: [f32; 4]) -> SampledSpectrum {
+        let b = self.bins[index];
+        if b.scale == 0.0 {
+            return SampledSpectrum::zero();
+        }
+        let poly = SigmoidPolynomial::new(b.c[0], b.c[1], b.c[2]);
+        SampledSpectrum::new(poly.eval4(lambda_nm)) * b.scale
+    }
+
+    #[inline]
+    fn theta_o_bin(wo: Vec3A) -> usize {
+        let theta_o = acos_fast(wo.z.clamp(0.0, 1.0));
+        ((theta_o * std::f32::consts::FRAC_2_PI * SAMPLE_THETA_O as f32) as usize)
+            .min(SAMPLE_THETA_O - 1)
+    }
+
+    /// (cos φₒ, sin φₒ) of ωₒ (1, 0 along the normal).
+    #[inline]
+    fn azimuth(wo: Vec3A) -> (f32, f32) {
+        let r = (wo.x * wo.x + wo.y * wo.y).sqrt();
+        if r > 1e-7 {
+            (wo.x / r, wo.y / r)
+        } else {
+            (1.0, 0.0)
+        }
+    }
+
+    /// Density (solid angle of ωᵢ) of the tabulated part for cell (i, j) of θₒ bin k, at a
+    /// half vector with θ_h ↦ u, cos θ_h·… given.
+    #[inline]
+    fn cell_density(&self, k: usize, i: usize, j: usize, u: f32, sin_h: f32, cos_oh: f32) -> f32 {
+        let p_uv = self.cell_pdf[(k * SAMPLE_U + i) * SAMPLE_V + j];
+        let jacobian = sin_h * std::f32::consts::PI * u * std::f32::consts::TAU * 4.0 * cos_oh;
+        if jacobian.is_nan() || jacobian <= 0.0 {
+            return 0.0;
+        }
+        p_uv / jacobian
+    }
+
+    /// Density of the tabulated part for ωₒ and a half vector h (unit, upper), solid angle
+    /// of ωᵢ.
+    #[inline]
+    fn table_pdf(&self, k: usize, wo: Vec3A, h: Vec3A) -> f32 {
+        if !self.has_table[k] {
+            return 0.0;
+        }
+        let cos_oh = wo.dot(h);
+        let cos_h = h.z.min(1.0);
+        if cos_oh <= 0.0 || cos_h <= 0.0 {
+            return 0.0;
+        }
+        let sin_h = (1.0 - cos_h * cos_h).max(0.0).sqrt();
+        let u = (acos_fast(cos_h) * std::f32::consts::FRAC_2_PI).sqrt();
+        // φ_h − φₒ from h rotated into ωₒ's azimuth (one atan2).
+        let (c, s) = Self::azimuth(wo);
+        let mut dphi = (c * h.y - s * h.x).atan2(c * h.x + s * h.y);
+        if dphi < 0.0 {
+            dphi += std::f32::consts::TAU;
+        }
+        let v = dphi / std::f32::consts::TAU;
+        let i = ((u * SAMPLE_U as f32) as usize).min(SAMPLE_U - 1);
+        let j = ((v * SAMPLE_V as f32) as usize).min(SAMPLE_V - 1);
+        self.cell_density(k, i, j, u, sin_h, cos_oh)
+    }
+}
+
+/// Index of the CDF interval holding `x` (cdf[0] = 0, cdf[n] = 1), skipping empty ones.
+#[inline]
+fn find_interval(cdf: &[f32], x: f32) -> usize {
+    let n = cdf.len() - 1;
+    // partition_point: first index whose value exceeds x.
+    let i = cdf.partition_point(|&c| c <= x);
+    i.clamp(1, n) - 1
+}
+
+/// A measured lobe at four wavelengths.
+#[derive(Clone, Copy)]
+pub struct Measured<'a> {
+    pub brdf: &'a MerlBrdf,
+    /// The path's wavelengths, nm.
+    pub lambda_nm: [f32; 4],
+}
+
+impl fmt::Debug for Measured<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "Measured({:?}, λ {:?})", self.brdf, self.lambda_nm)
+    }
+}
+
+impl PartialEq for Measured<'_> {
+    fn eq(&self, other: &Self) -> bool {
+        std::ptr::eq(self.brdf, other.brdf) && self.lambda_nm == other.lambda_nm
+    }
+}
+
+impl LobeKind for Measured<'_> {}
+
+impl Measured<'_> {
+    #[inline]
+    pub fn eval(&self, wo: Vec3A, wi: Vec3A, _mode: TransportMode) -> SampledSpectrum {
+        if wo.z <= 0.0 || wi.z <= 0.0 {
+            return SampledSpectrum::zero();
+        }
+        let h = wo + wi;
+        let len2 = h.length_squared();
+        if len2 == 0.0 {
+            return SampledSpectrum::zero();
+        }
+        self.brdf
+            .spectrum(lookup_index(h / len2.sqrt(), wi), self.lambda_nm)
+    }
+
+    #[inline]
+    pub fn pdf(&self, wo: Vec3A, wi: Vec3A, _mode: TransportMode) -> f32 {
+        if wo.z <= 0.0 || wi.z <= 0.0 {
+            return 0.0;
+        }
+        let k = MerlBrdf::theta_o_bin(wo);
+        let cosine = wi.z * std::f32::consts::FRAC_1_PI;
+        if !self.brdf.has_table[k] {
+            return cosine;
+        }
+        let h = (wo + wi).normalize();
+        (1.0 - COSINE_FRACTION) * self.brdf.table_pdf(k, wo, h) + COSINE_FRACTION * cosine
+    }
+
+    #[inline]
+    pub fn sample(
+        &self,
+        wo: Vec3A,
+        u_lobe: f32,
+        u: Vec2,
+        mode: TransportMode,
+    ) -> Option<BsdfSample> {
+        if wo.z <= 0.0 {
+            return None;
+        }
+        let b = self.brdf;
+        let k = MerlBrdf::theta_o_bin(wo);
+        let cosine_pdf = |wi: Vec3A| wi.z * std::f32::consts::FRAC_1_PI;
+        if !b.has_table[k] || u_lobe < COSINE_FRACTION {
+            let wi = sample_cosine_hemisphere(u);
+            let pdf = self.pdf(wo, wi, mode);
+            if wi.z <= 0.0 || pdf.is_nan() || pdf <= 0.0 {
+                return None;
+            }
+            return Some(BsdfSample {
+                wi,
+                f: self.eval(wo, wi, mode),
+                pdf,
+                specular: false,
+                transmission: false,
+                eta: 1.0,
+            });
+        }
+        let rows = &b.row_cdf[k * (SAMPLE_U + 1)..(k + 1) * (SAMPLE_U + 1)];
+        let i = find_interval(rows, u.x);
+        let (r0, r1) = (rows[i], rows[i + 1]);
+        let fu = if r1 > r0 { (u.x - r0) / (r1 - r0) } else { 0.5 };
+        let row = k * SAMPLE_U + i;
+        let cells = &b.cell_cdf[row * (SAMPLE_V + 1)..(row + 1) * (SAMPLE_V + 1)];
+        let j = find_interval(cells, u.y);
+        let (c0, c1) = (cells[j], cells[j + 1]);
+        let fv = if c1 > c0 { (u.y - c0) / (c1 - c0) } else { 0.5 };
+        let uu = (i as f32 + fu.clamp(0.0, 1.0)) / SAMPLE_U as f32;
+        let vv = (j as f32 + fv.clamp(0.0, 1.0)) / SAMPLE_V as f32;
+        let theta_h = uu * uu * std::f32::consts::FRAC_PI_2;
+        let (st, ct) = theta_h.sin_cos();
+        // φ_h = φₒ + 2πv, by rotating (cos 2πv, sin 2πv) by ωₒ's azimuth.
+        let (sv, cv) = (vv * std::f32::consts::TAU).sin_cos();
+        let (co, so) = MerlBrdf::azimuth(wo);
+        let h = Vec3A::new(st * (co * cv - so * sv), st * (so * cv + co * sv), ct);
+        let cos_oh = wo.dot(h);
+        if cos_oh <= 0.0 {
+            return None;
+        }
+        let wi = 2.0 * cos_oh * h - wo;
+        if wi.z <= 0.0 {
+            return None;
+        }
+        // The density of the cell just sampled (no second lookup), plus the cosine part.
+        let pdf = (1.0 - COSINE_FRACTION) * b.cell_density(k, i, j, uu, st, cos_oh)
+            + COSINE_FRACTION * cosine_pdf(wi);
+        if pdf.is_nan() || pdf <= 0.0 {
+            return None;
+        }
+        Some(BsdfSample {
+            wi,
+            f: b.spectrum(lookup_index(h, wi), self.lambda_nm),
+            pdf,
+            specular: false,
+            transmission: false,
+            eta: 1.0,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn fast_arccos_matches_the_library() {
+        for k in 0..=20_000 {
+            let x = -1.0 + 2.0 * k as f32 / 20_000.0;
+            let (a, b) = (super::acos_fast(x), x.acos());
+            // A few f32 ulps (2.4·10⁻⁷ at π/2–π).
+            assert!((a - b).abs() < 1e-6, "acos({x}): {a} vs {b}");
+        }
+    }
+}
