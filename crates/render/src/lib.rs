@@ -23,6 +23,7 @@ pub mod probe;
 pub mod sampler;
 pub mod sampling;
 pub mod scene_build;
+pub mod texture;
 
 pub use camera::{
     ApertureSpec, Camera, CameraFrame, FisheyeCamera, FisheyeCoverage, FisheyeProjection,

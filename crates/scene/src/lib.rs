@@ -15,6 +15,7 @@ mod reader;
 pub mod scene;
 pub mod shape;
 pub mod spectrum_ref;
+pub mod texture;
 pub mod transform;
 
 pub use camera::{Camera, CameraKind, FisheyeFit, FisheyeProjection, FovAxis};
@@ -27,4 +28,8 @@ pub use medium::{Medium, MediumKind};
 pub use scene::{load_scene, parse_scene_str, SceneDescription};
 pub use shape::{MeshAsset, MeshFormat, Shape, ShapeKind};
 pub use spectrum_ref::SpectrumRef;
+pub use texture::{
+    ImageChannel, ImageEncoding, ImageTexture, NoiseKind, NoiseSpace, NoiseTexture, SpectrumParam,
+    Texture, TextureFilter, TextureKind, UvTransform, WrapMode,
+};
 pub use transform::Transform;

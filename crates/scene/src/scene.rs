@@ -14,6 +14,7 @@ use crate::medium::{parse_media, Medium};
 use crate::reader::{Ctx, Result, V};
 use crate::shape::{parse_meshes, parse_shape, MeshAsset, Shape, ShapeContext};
 use crate::spectrum_ref::{parse_spectrum, SpectrumRef, SpectrumUse};
+use crate::texture::{parse_textures, Texture, TextureTable};
 
 /// Everything render needs to build a scene, as plain data: angles in radians, lengths in
 /// metres, asset paths resolved, spectra loaded, references turned into indices.
@@ -32,9 +33,12 @@ pub struct SceneDescription {
     pub shapes: Vec<Shape>,
     pub lights: Vec<Light>,
     pub media: Vec<Medium>,
+    /// The `textures` section, then textures defined inline in materials (materials refer
+    /// to them by index).
+    pub textures: Vec<Texture>,
 }
 
-pub const TOP_LEVEL_FIELDS: [&str; 10] = [
+pub const TOP_LEVEL_FIELDS: [&str; 11] = [
     "camera",
     "film",
     "integrator",
@@ -44,6 +48,7 @@ pub const TOP_LEVEL_FIELDS: [&str; 10] = [
     "shapes",
     "lights",
     "media",
+    "textures",
     "$schema",
 ];
 
@@ -113,9 +118,13 @@ fn parse_root(v: &V) -> Result<SceneDescription> {
     let media = o
         .get("media")
         .map_or(Ok(Vec::new()), |m| parse_media(&m, &spectra))?;
-    let materials = o
-        .get("materials")
-        .map_or(Ok(Vec::new()), |m| parse_materials(&m, &spectra))?;
+    let mut textures = match o.get("textures") {
+        Some(t) => parse_textures(&t, &spectra)?,
+        None => TextureTable::default(),
+    };
+    let materials = o.get("materials").map_or(Ok(Vec::new()), |m| {
+        parse_materials(&m, &spectra, &mut textures)
+    })?;
     let mut meshes = o
         .get("meshes")
         .map_or(Ok(Vec::new()), |m| parse_meshes(&m))?;
@@ -166,5 +175,6 @@ fn parse_root(v: &V) -> Result<SceneDescription> {
         shapes,
         lights,
         media,
+        textures: textures.textures,
     })
 }
