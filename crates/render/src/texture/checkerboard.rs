@@ -1,8 +1,11 @@
 //! The checkerboard: unit cells in st alternating between `a` (⌊s⌋ + ⌊t⌋ even) and `b`
 //! (odd), box-filtered in closed form over the pixel footprint (Apodaca & Gritz 2000,
 //! "Advanced RenderMan", §11.4; pbrt-v3 `Checkerboard2DTexture` with `AAMethod::ClosedForm`).
-//! The filter is a box of one pixel step: half-widths ½·max(|∂s/∂x|, |∂s/∂y|) and
-//! ½·max(|∂t/∂x|, |∂t/∂y|), the convention `MipMap::level_for` uses.
+//! The filter is the st bounding box of the one-pixel footprint parallelogram spanned by
+//! (∂s/∂x, ∂t/∂x) and (∂s/∂y, ∂t/∂y): half-widths ½(|∂s/∂x| + |∂s/∂y|) and
+//! ½(|∂t/∂x| + |∂t/∂y|). (pbrt-v3 uses the larger derivative instead of the sum; at
+//! grazing angles the footprint is sheared in st and the narrower box leaves a visible
+//! residual pattern where a pixel spans about one check.)
 
 use glam::Vec2;
 
@@ -29,8 +32,8 @@ fn odd_fraction(x0: f64, x1: f64) -> f64 {
 /// (1 − w)·a + w·b. Computed in f64 so large st keep their cell parity.
 #[inline]
 pub fn checkerboard_weight(st: Vec2, dst0: Vec2, dst1: Vec2) -> f32 {
-    let ds = 0.5 * f64::from(dst0.x.abs().max(dst1.x.abs()));
-    let dt = 0.5 * f64::from(dst0.y.abs().max(dst1.y.abs()));
+    let ds = 0.5 * f64::from(dst0.x.abs() + dst1.x.abs());
+    let dt = 0.5 * f64::from(dst0.y.abs() + dst1.y.abs());
     let (s, t) = (f64::from(st.x), f64::from(st.y));
     let fs = odd_fraction(s - ds, s + ds);
     let ft = odd_fraction(t - dt, t + dt);
