@@ -45,8 +45,7 @@ fn write_png(path: &Path, w: u32, h: u32, channels: usize, sixteen: bool, codes:
 }
 
 fn build(dir: &Path, json: &str) -> Result<RenderScene, String> {
-    let description =
-        parse_scene_str(json, dir.join("scene.json")).map_err(|e| e.to_string())?;
+    let description = parse_scene_str(json, dir.join("scene.json")).map_err(|e| e.to_string())?;
     RenderScene::build(&description, None).map_err(|e| e.to_string())
 }
 
@@ -102,7 +101,9 @@ fn srgb_png_codes_decode_by_the_iec_formula_and_linear_16_bit_codes_are_exact() 
     write_png(&dir.path().join("ramp.png"), 16, 16, 1, false, &codes);
     // A 16-bit RGB PNG with arbitrary codes, declared linear.
     // (Power-of-two sizes: texel centres are exact in binary, so the weights are exact.)
-    let wide: Vec<u16> = (0..4 * 4 * 3).map(|i| ((i * 5003 + 17) % 65536) as u16).collect();
+    let wide: Vec<u16> = (0..4 * 4 * 3)
+        .map(|i| ((i * 5003 + 17) % 65536) as u16)
+        .collect();
     write_png(&dir.path().join("wide.png"), 4, 4, 3, true, &wide);
     let scene = build(
         dir.path(),
@@ -259,7 +260,13 @@ fn grazing_checkerboard_one_filtered_lookup_per_pixel_matches_the_1024_sample_bo
     let dir = tempfile::tempdir().unwrap();
     // 64² texels, 8-texel cells: 8 × 8 checks per uv unit; codes 0 and 255 decode to 0, 1.
     let codes: Vec<u16> = (0..64 * 64)
-        .map(|i| if ((i % 64) / 8 + (i / 64) / 8) % 2 == 0 { 0 } else { 255 })
+        .map(|i| {
+            if ((i % 64) / 8 + (i / 64) / 8) % 2 == 0 {
+                0
+            } else {
+                255
+            }
+        })
         .collect();
     write_png(&dir.path().join("checks.png"), 64, 64, 1, false, &codes);
     let res = 64;
@@ -292,7 +299,8 @@ fn grazing_checkerboard_one_filtered_lookup_per_pixel_matches_the_1024_sample_bo
         // average is the mean ½ up to the partial checks at its edges (≤ 1/8).
         let far: Vec<usize> = (0..reference.len()).filter(|&i| checks[i] >= 4.0).collect();
         let pick = |v: &[f32]| far.iter().map(|&i| v[i]).collect::<Vec<f32>>();
-        let (far_filtered, far_point, far_reference) = (pick(&filtered), pick(&point), pick(&reference));
+        let (far_filtered, far_point, far_reference) =
+            (pick(&filtered), pick(&point), pick(&reference));
         let mean = |v: &[f32]| v.iter().map(|x| f64::from(*x)).sum::<f64>() / v.len() as f64;
         let far_rmse = rmse(&far_filtered, &far_reference);
         let far_point_rmse = rmse(&far_point, &far_reference);
@@ -312,7 +320,10 @@ fn grazing_checkerboard_one_filtered_lookup_per_pixel_matches_the_1024_sample_bo
         // box average over the image; in the far field it converges to the mean (mean
         // within 0.02) without aliasing (RMSE below the 1/8 residual of the reference).
         assert!(e_filtered < max_rmse, "{label}: RMSE {e_filtered}");
-        assert!((mean(&far_filtered) - mean(&far_reference)).abs() < 0.02, "{label}: far mean");
+        assert!(
+            (mean(&far_filtered) - mean(&far_reference)).abs() < 0.02,
+            "{label}: far mean"
+        );
         assert!(far_rmse < 0.08, "{label}: far-field RMSE {far_rmse}");
     }
 }
@@ -481,14 +492,23 @@ fn white_furnace_with_normal_and_bump_maps_reflects_at_most_what_it_receives() {
     for (label, material, textures) in cases {
         let pixels = furnace_pixels(dir.path(), &furnace_json(&material, textures), 64);
         let (mean, sigma) = mean_sigma(&pixels);
-        eprintln!("furnace, {label}: mean Y {mean:.5} ± {sigma:.5} over {} px", pixels.len());
+        eprintln!(
+            "furnace, {label}: mean Y {mean:.5} ± {sigma:.5} over {} px",
+            pixels.len()
+        );
         assert!(mean <= 1.0 + 5.0 * sigma + 1e-6, "{label}: {mean} > 1");
         // Every pixel too (per-pixel noise is larger: 6σ of the pixel spread).
         let spread = sigma * (pixels.len() as f64).sqrt();
         let worst = pixels.iter().copied().fold(0.0f64, f64::max);
-        assert!(worst <= 1.0 + 6.0 * spread + 1e-6, "{label}: a pixel at {worst}");
+        assert!(
+            worst <= 1.0 + 6.0 * spread + 1e-6,
+            "{label}: a pixel at {worst}"
+        );
         if label == "no map" {
-            assert!((mean - 1.0).abs() < 5.0 * sigma + 1e-6, "unmapped furnace: {mean}");
+            assert!(
+                (mean - 1.0).abs() < 5.0 * sigma + 1e-6,
+                "unmapped furnace: {mean}"
+            );
         } else {
             // The maps tilt normals (energy lost to directions below the geometric
             // surface), but most light is still reflected.
@@ -501,8 +521,22 @@ fn white_furnace_with_normal_and_bump_maps_reflects_at_most_what_it_receives() {
 fn bad_texture_input_gives_errors_naming_the_file_and_the_json_path() {
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("notes.png"), "this is not an image").unwrap();
-    write_png(&dir.path().join("grey.png"), 2, 2, 1, false, &[0, 64, 128, 255]);
-    write_png(&dir.path().join("bright.png"), 1, 1, 3, false, &[255, 255, 255]);
+    write_png(
+        &dir.path().join("grey.png"),
+        2,
+        2,
+        1,
+        false,
+        &[0, 64, 128, 255],
+    );
+    write_png(
+        &dir.path().join("bright.png"),
+        1,
+        1,
+        3,
+        false,
+        &[255, 255, 255],
+    );
     let lambert = |texture: &str| {
         format!(
             r#"{{"materials": {{"m": {{"type": "lambert", "reflectance": {{"texture": {texture}}}}}}}}}"#
@@ -553,7 +587,9 @@ fn bad_texture_input_gives_errors_naming_the_file_and_the_json_path() {
         ),
     ];
     for (json, needles) in cases {
-        let err = build(dir.path(), &json).err().unwrap_or_else(|| panic!("accepted: {json}"));
+        let err = build(dir.path(), &json)
+            .err()
+            .unwrap_or_else(|| panic!("accepted: {json}"));
         for needle in needles {
             assert!(err.contains(needle), "error `{err}` lacks `{needle}`");
         }

@@ -294,7 +294,10 @@ fn parse_material(
         }
         "bump_map" => {
             let o = v.tagged_object(&["type", "material", "texture", "scale_m"])?;
-            let t = o.req("texture", "a texture name or texture object (the height field)")?;
+            let t = o.req(
+                "texture",
+                "a texture name or texture object (the height field)",
+            )?;
             MaterialKind::BumpMap {
                 material: material_index(&o.req("material", "a material name")?, names)?,
                 texture: texture_field(&t, spectra, textures)?,

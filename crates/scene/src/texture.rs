@@ -24,7 +24,10 @@ pub enum TextureKind {
     Image(ImageTexture),
     /// Unit squares in (transformed) uv alternating between `a` (even u+v cell) and `b`,
     /// box-filtered over the ray-differential footprint.
-    Checkerboard { a: SpectrumRef, b: SpectrumRef },
+    Checkerboard {
+        a: SpectrumRef,
+        b: SpectrumRef,
+    },
     /// Perlin's improved noise (Perlin 2002) and its sums, mapped to `a`..`b`.
     Noise(NoiseTexture),
 }
@@ -221,7 +224,9 @@ pub(crate) fn parse_spectrum_param(
     table: &mut TextureTable,
 ) -> Result<SpectrumParam> {
     if is_texture_ref(v) {
-        Ok(SpectrumParam::Texture(parse_texture_ref(v, spectra, table)?))
+        Ok(SpectrumParam::Texture(parse_texture_ref(
+            v, spectra, table,
+        )?))
     } else {
         Ok(SpectrumParam::Spectrum(parse_spectrum(v, spectra, usage)?))
     }

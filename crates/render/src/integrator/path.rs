@@ -239,9 +239,9 @@ impl PathTracer {
             if let Some(footprint) = &scene.texture_footprint {
                 match &current_differential {
                     Some(rd) => si.compute_differentials(rd),
-                    None => si.compute_differentials(
-                        &footprint.approximate(si.p, differential_scale),
-                    ),
+                    None => {
+                        si.compute_differentials(&footprint.approximate(si.p, differential_scale))
+                    }
                 }
             }
             let material = scene.material(si.material_id);

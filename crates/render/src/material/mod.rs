@@ -43,7 +43,7 @@ use crate::scene_build::spectrum::{build_spectrum, SpectrumRole};
 use crate::scene_build::SceneBuildError;
 use crate::texture::shading_normal::{apply_bump_map, apply_normal_map};
 use crate::texture::{
-    build_textures, FloatTexture, RgbUse, TexturePurpose, TextureSet, Texture, TexturedSpectrum,
+    build_textures, FloatTexture, RgbUse, Texture, TexturePurpose, TextureSet, TexturedSpectrum,
 };
 
 pub use ior::Ior;

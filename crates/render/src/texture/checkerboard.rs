@@ -60,7 +60,9 @@ mod tests {
     fn closed_form_matches_numerical_box_average() {
         let mut rng = 12345u64;
         let mut next = || {
-            rng = rng.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            rng = rng
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             (rng >> 40) as f32 / (1u64 << 24) as f32
         };
         for _ in 0..200 {
@@ -79,13 +81,20 @@ mod tests {
                 }
             }
             let reference = acc / (n * n) as f64;
-            assert!((w as f64 - reference).abs() < 6e-3, "{st} {d0} {d1}: {w} vs {reference}");
+            assert!(
+                (w as f64 - reference).abs() < 6e-3,
+                "{st} {d0} {d1}: {w} vs {reference}"
+            );
         }
     }
 
     #[test]
     fn wide_footprints_give_the_mean() {
-        let w = checkerboard_weight(Vec2::new(0.3, 0.7), Vec2::new(100.0, 0.0), Vec2::new(0.0, 100.0));
+        let w = checkerboard_weight(
+            Vec2::new(0.3, 0.7),
+            Vec2::new(100.0, 0.0),
+            Vec2::new(0.0, 100.0),
+        );
         assert!((w - 0.5).abs() < 1e-3);
     }
 }

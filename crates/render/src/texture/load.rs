@@ -18,9 +18,7 @@ use std::collections::HashMap;
 use std::path::Path;
 use std::sync::Arc;
 
-use prism_scene::{
-    ImageChannel, ImageEncoding, SceneDescription, SpectrumRef, TextureKind,
-};
+use prism_scene::{ImageChannel, ImageEncoding, SceneDescription, SpectrumRef, TextureKind};
 use prism_spectrum::rgb_space::RgbColorSpace;
 use prism_spectrum::RgbGamut;
 
@@ -145,7 +143,9 @@ fn build_texture(desc: &prism_scene::Texture, purpose: TexturePurpose) -> Result
                 None,
             )
         }
-        TextureKind::Checkerboard { a, b } => (TextureSource::Checkerboard, Some(blend_values(a, b)?)),
+        TextureKind::Checkerboard { a, b } => {
+            (TextureSource::Checkerboard, Some(blend_values(a, b)?))
+        }
         TextureKind::Noise(n) => (
             TextureSource::Noise(NoiseSource {
                 kind: n.noise,
@@ -207,7 +207,10 @@ fn check_scalar_range(min: f32, max: f32, lo_milli: i64, hi_milli: i64) -> Resul
 }
 
 /// Reads, decodes, validates and MIP-maps an image for `purpose`.
-fn load_image(image: &prism_scene::ImageTexture, purpose: TexturePurpose) -> Result<MipMap, String> {
+fn load_image(
+    image: &prism_scene::ImageTexture,
+    purpose: TexturePurpose,
+) -> Result<MipMap, String> {
     let path = &image.path;
     let (width, height, mut texels, channels) = decode(path, image.encoding, purpose)?;
     if purpose == TexturePurpose::NormalMap && channels < 3 {
@@ -285,7 +288,11 @@ fn load_image(image: &prism_scene::ImageTexture, purpose: TexturePurpose) -> Res
 /// (width, height, RGBA texels with row 0 at the bottom, channel count of the file).
 type Decoded = (usize, usize, Vec<[f32; 4]>, usize);
 
-fn decode(path: &Path, encoding: ImageEncoding, purpose: TexturePurpose) -> Result<Decoded, String> {
+fn decode(
+    path: &Path,
+    encoding: ImageEncoding,
+    purpose: TexturePurpose,
+) -> Result<Decoded, String> {
     let is_png = path
         .extension()
         .and_then(|e| e.to_str())

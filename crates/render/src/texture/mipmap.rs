@@ -85,11 +85,12 @@ impl MipMap {
         let y = st.y * l.height as f32 - 0.5;
         let (xf, yf) = (x.floor(), y.floor());
         let (dx, dy) = (x - xf, y - yf);
-        let (xi, yi) = (xf as i64, yf as i64);
-        let t00 = self.texel(level, xi, yi);
-        let t10 = self.texel(level, xi + 1, yi);
-        let t01 = self.texel(level, xi, yi + 1);
-        let t11 = self.texel(level, xi + 1, yi + 1);
+        // The two columns and rows, wrapped once each (not per texel).
+        let (x0, x1) = wrap_pair(xf as i64, l.width, self.wrap);
+        let (y0, y1) = wrap_pair(yf as i64, l.height, self.wrap);
+        let (r0, r1) = (y0 * l.width, y1 * l.width);
+        let t = &l.texels;
+        let (t00, t10, t01, t11) = (t[r0 + x0], t[r0 + x1], t[r1 + x0], t[r1 + x1]);
         std::array::from_fn(|c| {
             (1.0 - dx) * (1.0 - dy) * t00[c]
                 + dx * (1.0 - dy) * t10[c]
@@ -136,6 +137,16 @@ impl MipMap {
     /// Mean of every texel (the top level).
     pub fn mean(&self) -> [f32; 4] {
         self.levels[self.levels.len() - 1].texels[0]
+    }
+}
+
+/// Indices i and i + 1 wrapped into `0..n`; no division when both are inside.
+#[inline]
+fn wrap_pair(i: i64, n: usize, mode: WrapMode) -> (usize, usize) {
+    if i >= 0 && i + 1 < n as i64 {
+        (i as usize, i as usize + 1)
+    } else {
+        (wrap(i, n, mode), wrap(i + 1, n, mode))
     }
 }
 
@@ -275,7 +286,10 @@ mod tests {
                     }
                 }
                 let mean = s / (lw * lh) as f64;
-                assert!((mean - mean0).abs() < 1e-4 * mean0.max(1.0), "{w}×{h} level {l}");
+                assert!(
+                    (mean - mean0).abs() < 1e-4 * mean0.max(1.0),
+                    "{w}×{h} level {l}"
+                );
             }
         }
     }
@@ -287,7 +301,10 @@ mod tests {
         // One pixel step covers 4 texels in s → level 2; anisotropic: the larger axis.
         let l = m.level_for(Vec2::new(4.0 / 256.0, 0.0), Vec2::new(0.0, 1.0 / 256.0));
         assert!((l - 2.0).abs() < 1e-6);
-        let l = m.level_for(Vec2::new(1.0 / 256.0, 0.5 / 256.0), Vec2::new(0.0, 8.0 / 256.0));
+        let l = m.level_for(
+            Vec2::new(1.0 / 256.0, 0.5 / 256.0),
+            Vec2::new(0.0, 8.0 / 256.0),
+        );
         assert!((l - 3.0).abs() < 1e-6);
     }
 

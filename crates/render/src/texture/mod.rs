@@ -140,10 +140,7 @@ impl NoiseSource {
     fn weight(&self, ctx: &TextureContext, st: Vec2, dst0: Vec2, dst1: Vec2) -> f32 {
         let f = self.frequency;
         let (p, footprint) = match self.space {
-            NoiseSpace::World => (
-                ctx.p * f,
-                f * ctx.dpdx.length().max(ctx.dpdy.length()),
-            ),
+            NoiseSpace::World => (ctx.p * f, f * ctx.dpdx.length().max(ctx.dpdy.length())),
             NoiseSpace::Uv => (
                 Vec3A::new(st.x * f, st.y * f, 0.0),
                 f * dst0.length().max(dst1.length()),
@@ -241,12 +238,19 @@ pub enum TexturedSpectrum {
 
 impl TexturedSpectrum {
     #[inline]
-    pub fn eval(&self, si: &SurfaceInteraction, wavelengths: &SampledWavelengths) -> SampledSpectrum {
+    pub fn eval(
+        &self,
+        si: &SurfaceInteraction,
+        wavelengths: &SampledWavelengths,
+    ) -> SampledSpectrum {
         match self {
             TexturedSpectrum::Constant(s) => s.eval(wavelengths),
-            TexturedSpectrum::Texture { texture, rgb } => {
-                eval_spectrum(texture, *rgb, &TextureContext::from_interaction(si), wavelengths)
-            }
+            TexturedSpectrum::Texture { texture, rgb } => eval_spectrum(
+                texture,
+                *rgb,
+                &TextureContext::from_interaction(si),
+                wavelengths,
+            ),
         }
     }
 

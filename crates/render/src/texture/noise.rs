@@ -125,7 +125,9 @@ impl Octaves {
 
     /// Σ amplitudes (normalisation of the sums).
     fn amplitude_sum(&self) -> f64 {
-        (0..self.max_octaves).map(|i| self.gain.powi(i as i32)).sum()
+        (0..self.max_octaves)
+            .map(|i| self.gain.powi(i as i32))
+            .sum()
     }
 
     /// fBm normalised to [−1, 1]: Σ gainⁱ n(lacunarityⁱ p) / Σ gainⁱ. Octaves finer than
