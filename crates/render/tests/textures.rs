@@ -430,7 +430,7 @@ fn write_bumpy_normal_map(path: &Path, flat: bool) {
                 return [0.5, 0.5, 1.0];
             }
             let (x, y) = ((i % w) as f32 / w as f32, (i / w) as f32 / h as f32);
-            let t = 6.283_185 * 3.0;
+            let t = std::f32::consts::TAU * 3.0;
             let n = Vec3A::new(0.8 * (t * x).sin(), 0.8 * (t * y).cos(), 1.0).normalize();
             [0.5 * (n.x + 1.0), 0.5 * (n.y + 1.0), 0.5 * (n.z + 1.0)]
         })

@@ -119,8 +119,8 @@ impl MipMap {
     pub fn trilinear(&self, st: Vec2, dst0: Vec2, dst1: Vec2) -> [f32; 4] {
         let level = self.level_for(dst0, dst1);
         let top = (self.levels.len() - 1) as f32;
-        if !(level > 0.0) {
-            // Also NaN-safe: a degenerate footprint magnifies.
+        // `level > 0.0` is false for NaN too: a degenerate footprint magnifies.
+        if level.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
             return self.bilinear(0, st);
         }
         if level >= top {

@@ -117,7 +117,8 @@ impl Octaves {
     /// size lacunarity⁻ⁱ noise units; those smaller than twice the footprint `len` alias.
     /// Continuous, in [0, max_octaves]; `len = 0` keeps them all.
     fn resolved(&self, footprint: f64) -> f64 {
-        if !(footprint > 0.0) {
+        // Zero, negative or NaN footprints keep every octave.
+        if footprint.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
             return f64::from(self.max_octaves);
         }
         (-(1.0 + footprint.log2()) / self.lacunarity.log2()).clamp(0.0, f64::from(self.max_octaves))
@@ -191,7 +192,9 @@ mod tests {
 
     #[test]
     fn reference_value_and_lattice_zeros() {
-        // Perlin's Java reference `ImprovedNoise.noise(3.14, 42, 7)`.
+        // Perlin's Java reference `ImprovedNoise.noise(3.14, 42, 7)` (3.14 is his literal
+        // argument, not π).
+        #[allow(clippy::approx_constant)]
         let n = perlin_noise([3.14, 42.0, 7.0]);
         assert!((n - 0.136_919_958_784).abs() < 1e-9, "{n}");
         for p in [[0.0, 0.0, 0.0], [3.0, -7.0, 12.0], [255.0, 256.0, 1000.0]] {

@@ -53,14 +53,10 @@ pub fn apply_normal_map(texture: &Texture, si: &mut SurfaceInteraction) {
 pub fn apply_bump_map(height: &FloatTexture, scale_m: f32, si: &mut SurfaceInteraction) {
     let ctx = TextureContext::from_interaction(si);
     let d = &si.differentials;
-    let mut du = 0.5 * (d.dudx.abs() + d.dudy.abs());
-    if !(du > 0.0) {
-        du = 0.0005;
-    }
-    let mut dv = 0.5 * (d.dvdx.abs() + d.dvdy.abs());
-    if !(dv > 0.0) {
-        dv = 0.0005;
-    }
+    // Zero (no differentials) or NaN: pbrt-v4's fixed step.
+    let step = |x: f32| if x > 0.0 { x } else { 0.0005 };
+    let du = step(0.5 * (d.dudx.abs() + d.dudy.abs()));
+    let dv = step(0.5 * (d.dvdx.abs() + d.dvdy.abs()));
     let texture = &height.texture;
     let shifted = |dp: Vec3A, duv: Vec2| {
         let c = TextureContext {
