@@ -82,3 +82,85 @@ pub fn apply_bump_map(height: &FloatTexture, scale_m: f32, si: &mut SurfaceInter
     si.dpdu = dpdu;
     si.dpdv = dpdv;
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::texture::{ImageSource, MipMap, TextureSource, UvMapping};
+    use prism_geometry::{LocalGeometry, Transform};
+    use prism_scene::{ImageChannel, TextureFilter, WrapMode};
+    use prism_spectrum::Spectrum;
+    use std::sync::Arc;
+
+    fn image(width: usize, texels: Vec<[f32; 4]>) -> Texture {
+        Texture {
+            mapping: UvMapping::identity(),
+            source: TextureSource::Image(ImageSource {
+                mip: MipMap::new(width, 1, texels, WrapMode::Clamp),
+                filter: TextureFilter::Bilinear,
+                channel: ImageChannel::R,
+            }),
+            a: Spectrum::constant(0.0),
+            b: Spectrum::constant(0.0),
+            a_scalar: 0.0,
+            b_scalar: 0.0,
+            place: "test".into(),
+        }
+    }
+
+    /// A unit plane z = 0 with u along +x, v along +y, at uv.
+    fn plane(uv: Vec2) -> SurfaceInteraction {
+        let local = LocalGeometry {
+            p: Vec3A::new(uv.x, uv.y, 0.0),
+            n_geometric: Vec3A::Z,
+            n_shading: Vec3A::Z,
+            uv,
+            dpdu: Vec3A::X,
+            dpdv: Vec3A::Y,
+            dndu: Vec3A::ZERO,
+            dndv: Vec3A::ZERO,
+        };
+        SurfaceInteraction::from_local(&local, &Transform::IDENTITY, 1.0)
+    }
+
+    #[test]
+    fn normal_map_x_follows_dpdu_and_flat_texels_change_nothing() {
+        // Tangent-space normal (0.5, 0, √0.75): tilted 30° towards +u.
+        let n = Vec3A::new(0.5, 0.0, 0.75f32.sqrt());
+        let texel = [0.5 * (n.x + 1.0), 0.5 * (n.y + 1.0), 0.5 * (n.z + 1.0), 1.0];
+        let mut si = plane(Vec2::splat(0.5));
+        apply_normal_map(&image(1, vec![texel]), &mut si);
+        assert!((si.n_shading - n).length() < 1e-6, "{}", si.n_shading);
+        let mut flat = plane(Vec2::splat(0.5));
+        let before = flat.n_shading;
+        apply_normal_map(&image(1, vec![[0.5, 0.5, 1.0, 1.0]]), &mut flat);
+        assert_eq!(flat.n_shading, before);
+    }
+
+    #[test]
+    fn bump_map_of_a_ramp_tilts_the_normal_against_the_slope() {
+        // Two texels 0 and 1, bilinear: between the texel centres (u ∈ [¼, ¾]) the height
+        // is 2(u − ¼) × scale, slope 2·scale per unit u; n′ ∝ (−2·scale, 0, 1).
+        let height = FloatTexture {
+            texture: Arc::new(image(2, vec![[0.0; 4], [1.0, 1.0, 1.0, 1.0]])),
+        };
+        let scale = 0.1;
+        let mut si = plane(Vec2::new(0.4, 0.5));
+        apply_bump_map(&height, scale, &mut si);
+        let expected = Vec3A::new(-2.0 * scale, 0.0, 1.0).normalize();
+        assert!(
+            (si.n_shading - expected).length() < 1e-4,
+            "{}",
+            si.n_shading
+        );
+        // A negative scale inverts the bumps.
+        let mut si = plane(Vec2::new(0.4, 0.5));
+        apply_bump_map(&height, -scale, &mut si);
+        let expected = Vec3A::new(2.0 * scale, 0.0, 1.0).normalize();
+        assert!(
+            (si.n_shading - expected).length() < 1e-4,
+            "{}",
+            si.n_shading
+        );
+    }
+}
