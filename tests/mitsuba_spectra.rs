@@ -282,7 +282,7 @@ fn cornell_scene_matches_mitsuba() {
     for name in MATERIALS {
         let mat = scene.materials.iter().find(|m| m.name == name).unwrap();
         let MaterialKind::Lambert {
-            reflectance: SpectrumRef::Rgb { rgb },
+            reflectance: prism_scene::SpectrumParam::Spectrum(SpectrumRef::Rgb { rgb }),
         } = &mat.kind
         else {
             panic!("{name} should be lambert with an RGB reflectance");

@@ -14,6 +14,7 @@ use prism_render::bsdf::{
 };
 use prism_render::material::merl_export::export_material;
 use prism_render::material::Material;
+use prism_render::texture::TexturedSpectrum;
 use prism_render::{render, RenderScene, RenderSettings};
 use prism_scene::parse_scene_str;
 use prism_spectrum::{SampledSpectrum, Spectrum};
@@ -25,6 +26,7 @@ fn grey_ggx() -> Material {
         eta: Spectrum::constant(0.2),
         k: Spectrum::constant(3.0),
         distribution: MicrofacetDistribution::new(MicrofacetModel::Ggx, ALPHA, ALPHA),
+        roughness_texture: None,
     }
 }
 
@@ -139,7 +141,7 @@ fn merl_tables_render_like_their_analytic_source() {
     let lambert_path = dir.path().join("lambert.binary");
     let ggx_path = dir.path().join("ggx.binary");
     export_material(&Material::Lambert {
-        reflectance: Spectrum::constant(0.5),
+        reflectance: TexturedSpectrum::Constant(Spectrum::constant(0.5)),
     })
     .write(&lambert_path)
     .unwrap();
@@ -208,7 +210,7 @@ fn bad_material_inputs_are_refused_with_their_place() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("short.binary");
     let table = export_material(&Material::Lambert {
-        reflectance: Spectrum::constant(0.5),
+        reflectance: TexturedSpectrum::Constant(Spectrum::constant(0.5)),
     });
     let bytes = table.to_bytes();
     std::fs::write(&path, &bytes[..bytes.len() / 2]).unwrap();

@@ -18,6 +18,7 @@ pub mod scene;
 pub mod sensor;
 pub mod shape;
 pub mod spectrum_ref;
+pub mod texture;
 pub mod transform;
 
 pub use camera::{Camera, CameraKind, FisheyeFit, FisheyeProjection, FovAxis};
@@ -34,4 +35,8 @@ pub use scene::{load_scene, parse_scene_str, SceneDescription};
 pub use sensor::{Sensor, SensorKind, SensorSampling};
 pub use shape::{MeshAsset, MeshFormat, Shape, ShapeKind};
 pub use spectrum_ref::SpectrumRef;
+pub use texture::{
+    ImageChannel, ImageEncoding, ImageTexture, NoiseKind, NoiseSpace, NoiseTexture, SpectrumParam,
+    Texture, TextureFilter, TextureKind, UvTransform, WrapMode,
+};
 pub use transform::Transform;

@@ -1,9 +1,13 @@
 //! Material descriptions (BSDFs are built from them by render): lambert, conductor,
-//! dielectric, two-sided wrapper and opacity mask. Materials are named in the `materials`
-//! section and referenced by name.
+//! dielectric, two-sided wrapper, opacity mask, and the normal-map and bump-map wrappers.
+//! Materials are named in the `materials` section and referenced by name. Parameters that
+//! accept textures (`{"texture": …}`, see `texture.rs`): lambert `reflectance`, conductor
+//! and dielectric `roughness`, mask `opacity`.
 
 use crate::reader::{quoted_list, suggest, Obj, Result, V};
 use crate::spectrum_ref::{parse_spectrum, NamedSpectra, SpectrumRef, SpectrumUse};
+use crate::texture::{is_texture_ref, parse_spectrum_param, parse_texture_ref};
+use crate::texture::{SpectrumParam, TextureTable};
 
 #[derive(Debug, Clone, PartialEq)]
 pub struct Material {
@@ -14,21 +18,41 @@ pub struct Material {
 #[derive(Debug, Clone, PartialEq)]
 pub enum MaterialKind {
     /// Ideal diffuse reflector.
-    Lambert { reflectance: SpectrumRef },
+    Lambert { reflectance: SpectrumParam },
     Conductor {
         optics: ConductorOptics,
         roughness: Roughness,
         distribution: Microfacet,
+        /// An isotropic α texture (index into `SceneDescription::textures`) that replaces
+        /// `roughness`.
+        roughness_texture: Option<usize>,
     },
     Dielectric {
         ior: Ior,
         roughness: Roughness,
         distribution: Microfacet,
+        /// As for `Conductor`.
+        roughness_texture: Option<usize>,
     },
     /// The referenced material on both sides of the surface (index into `materials`).
     TwoSided { material: usize },
     /// The referenced material with this opacity; the rest passes straight through.
-    Mask { material: usize, opacity: f64 },
+    Mask {
+        material: usize,
+        opacity: f64,
+        /// An opacity texture in [0, 1] that replaces `opacity`.
+        opacity_texture: Option<usize>,
+    },
+    /// The referenced material with its shading normal from a tangent-space normal map
+    /// (texture index; RGB = (n + 1)/2 in the frame (dP/du, n × dP/du, n)).
+    NormalMap { material: usize, texture: usize },
+    /// The referenced material with its shading normal bent by the height field
+    /// `scale_m × texture` along the normal (pbrt-v4 §10.5.2).
+    BumpMap {
+        material: usize,
+        texture: usize,
+        scale_m: f64,
+    },
     /// Oren & Nayar 1994 rough diffuse: the full model (C₁, C₂, C₃ and the
     /// inter-reflection term) or, with `qualitative`, the paper's simplified eq. 30.
     OrenNayar {
@@ -135,7 +159,7 @@ pub enum Ior {
     },
 }
 
-const TYPES: [&str; 15] = [
+const TYPES: [&str; 17] = [
     "lambert",
     "conductor",
     "dielectric",
@@ -151,47 +175,40 @@ const TYPES: [&str; 15] = [
     "thin_dielectric",
     "mix",
     "merl",
+    "normal_map",
+    "bump_map",
 ];
 
 /// Parses the `materials` section: names in file order, references between materials
 /// resolved, cycles refused.
-pub(crate) fn parse_materials(v: &V, spectra: &NamedSpectra) -> Result<Vec<Material>> {
+pub(crate) fn parse_materials(
+    v: &V,
+    spectra: &NamedSpectra,
+    textures: &mut TextureTable,
+) -> Result<Vec<Material>> {
     let entries = v.map()?;
     let names: Vec<&str> = entries.iter().map(|(n, _)| *n).collect();
     let mut materials = Vec::with_capacity(entries.len());
     for (name, entry) in &entries {
         materials.push(Material {
             name: name.to_string(),
-            kind: parse_material(entry, spectra, &names)?,
+            kind: parse_material(entry, spectra, &names, textures)?,
         });
     }
-    // A wrapper chain must end in a real material.
-    for (start, (_, entry)) in entries.iter().enumerate() {
-        let mut current = start;
-        for _ in 0..=materials.len() {
-            match materials[current].kind {
-                MaterialKind::TwoSided { material } | MaterialKind::Mask { material, .. } => {
-                    current = material;
-                    if current == start {
-                        return Err(entry.err(format!(
-                            "material `{}` refers back to itself through `material`",
-                            names[start]
-                        )));
-                    }
-                }
-                _ => break,
-            }
-        }
-    }
-    // Mixes reference two materials each: refuse any cycle through them (depth-first
-    // search with an explicit stack).
+    // Wrappers reference one material, mixes two: refuse any cycle (depth-first search
+    // with an explicit stack), so every wrapper chain ends in a real material.
     for (start, (_, entry)) in entries.iter().enumerate() {
         let mut stack = references(&materials[start].kind);
         let mut seen = vec![false; materials.len()];
         while let Some(m) = stack.pop() {
             if m == start {
+                let field = if matches!(materials[start].kind, MaterialKind::Mix { .. }) {
+                    "materials"
+                } else {
+                    "material"
+                };
                 return Err(entry.err(format!(
-                    "material `{}` refers back to itself through `material`/`materials`",
+                    "material `{}` refers back to itself through `{field}`",
                     names[start]
                 )));
             }
@@ -206,9 +223,10 @@ pub(crate) fn parse_materials(v: &V, spectra: &NamedSpectra) -> Result<Vec<Mater
 /// The materials a material refers to.
 fn references(kind: &MaterialKind) -> Vec<usize> {
     match kind {
-        MaterialKind::TwoSided { material } | MaterialKind::Mask { material, .. } => {
-            vec![*material]
-        }
+        MaterialKind::TwoSided { material }
+        | MaterialKind::Mask { material, .. }
+        | MaterialKind::NormalMap { material, .. }
+        | MaterialKind::BumpMap { material, .. } => vec![*material],
         MaterialKind::Mix { materials, .. } => materials.to_vec(),
         _ => Vec::new(),
     }
@@ -230,12 +248,24 @@ pub(crate) fn material_index(v: &V, names: &[&str]) -> Result<usize> {
     })
 }
 
-fn roughness_and_distribution(o: &Obj) -> Result<(Roughness, Microfacet)> {
+fn roughness_and_distribution(
+    o: &Obj,
+    spectra: &NamedSpectra,
+    textures: &mut TextureTable,
+) -> Result<(Roughness, Microfacet, Option<usize>)> {
+    let mut roughness_texture = None;
     let roughness = match o.get("roughness") {
         None => Roughness {
             alpha_u: 0.0,
             alpha_v: 0.0,
         },
+        Some(r) if is_texture_ref(&r) => {
+            roughness_texture = Some(parse_texture_ref(&r, spectra, textures)?);
+            Roughness {
+                alpha_u: 0.0,
+                alpha_v: 0.0,
+            }
+        }
         Some(r) => match r.f64() {
             Ok(_) => {
                 let a = r.in_range(0.0, 1.0)?;
@@ -270,17 +300,24 @@ fn roughness_and_distribution(o: &Obj) -> Result<(Roughness, Microfacet)> {
         "beckmann" => Microfacet::Beckmann,
         _ => Microfacet::Ggx,
     };
-    Ok((roughness, distribution))
+    Ok((roughness, distribution, roughness_texture))
 }
 
-fn parse_material(v: &V, spectra: &NamedSpectra, names: &[&str]) -> Result<MaterialKind> {
+fn parse_material(
+    v: &V,
+    spectra: &NamedSpectra,
+    names: &[&str],
+    textures: &mut TextureTable,
+) -> Result<MaterialKind> {
     Ok(match v.tag("material", &TYPES, None)? {
         "lambert" => {
             let o = v.tagged_object(&["type", "reflectance"])?;
             MaterialKind::Lambert {
                 reflectance: match o.get("reflectance") {
-                    None => SpectrumRef::Constant(0.5),
-                    Some(r) => parse_spectrum(&r, spectra, SpectrumUse::Reflectance)?,
+                    None => SpectrumParam::Spectrum(SpectrumRef::Constant(0.5)),
+                    Some(r) => {
+                        parse_spectrum_param(&r, spectra, SpectrumUse::Reflectance, textures)?
+                    }
                 },
             }
         }
@@ -299,11 +336,13 @@ fn parse_material(v: &V, spectra: &NamedSpectra, names: &[&str]) -> Result<Mater
                     )
                 }
             };
-            let (roughness, distribution) = roughness_and_distribution(&o)?;
+            let (roughness, distribution, roughness_texture) =
+                roughness_and_distribution(&o, spectra, textures)?;
             MaterialKind::Conductor {
                 optics,
                 roughness,
                 distribution,
+                roughness_texture,
             }
         }
         "dielectric" => {
@@ -312,11 +351,13 @@ fn parse_material(v: &V, spectra: &NamedSpectra, names: &[&str]) -> Result<Mater
                 None => Ior::Constant(1.5),
                 Some(i) => parse_ior(&i)?,
             };
-            let (roughness, distribution) = roughness_and_distribution(&o)?;
+            let (roughness, distribution, roughness_texture) =
+                roughness_and_distribution(&o, spectra, textures)?;
             MaterialKind::Dielectric {
                 ior,
                 roughness,
                 distribution,
+                roughness_texture,
             }
         }
         "two_sided" => {
@@ -325,11 +366,41 @@ fn parse_material(v: &V, spectra: &NamedSpectra, names: &[&str]) -> Result<Mater
                 material: material_index(&o.req("material", "a material name")?, names)?,
             }
         }
+        "normal_map" => {
+            let o = v.tagged_object(&["type", "material", "texture"])?;
+            let t = o.req("texture", "a texture name or an image texture object")?;
+            MaterialKind::NormalMap {
+                material: material_index(&o.req("material", "a material name")?, names)?,
+                texture: texture_field(&t, spectra, textures)?,
+            }
+        }
+        "bump_map" => {
+            let o = v.tagged_object(&["type", "material", "texture", "scale_m"])?;
+            let t = o.req(
+                "texture",
+                "a texture name or texture object (the height field)",
+            )?;
+            MaterialKind::BumpMap {
+                material: material_index(&o.req("material", "a material name")?, names)?,
+                texture: texture_field(&t, spectra, textures)?,
+                scale_m: o
+                    .req("scale_m", "the height in metres of a texture value of 1")?
+                    .f64()?,
+            }
+        }
         "mask" => {
             let o = v.tagged_object(&["type", "material", "opacity"])?;
+            let (opacity, opacity_texture) = match o.get("opacity") {
+                Some(a) if is_texture_ref(&a) => {
+                    (1.0, Some(parse_texture_ref(&a, spectra, textures)?))
+                }
+                Some(a) => (a.in_range(0.0, 1.0)?, None),
+                None => (1.0, None),
+            };
             MaterialKind::Mask {
                 material: material_index(&o.req("material", "a material name")?, names)?,
-                opacity: o.get("opacity").map_or(Ok(1.0), |a| a.in_range(0.0, 1.0))?,
+                opacity,
+                opacity_texture,
             }
         }
         other => parse_library_material(other, v, spectra, names)?,
@@ -520,4 +591,23 @@ fn parse_ior(v: &V) -> Result<Ior> {
         }
         None => Err(v.err("expected `sellmeier` or `cauchy` in an `ior` object")),
     }
+}
+
+/// The `texture` field of a normal or bump map: a texture name, or an inline definition
+/// (given directly, or as `{"texture": …}` like other parameters).
+fn texture_field(t: &V, spectra: &NamedSpectra, textures: &mut TextureTable) -> Result<usize> {
+    if t.is_object() && !is_texture_ref(t) {
+        // `{"type": "image", …}`: wrap it as an inline reference.
+        let (kind, uv) = crate::texture::parse_texture_definition(t, spectra)?;
+        textures.textures.push(crate::texture::Texture {
+            place: t.path.to_string(),
+            kind,
+            uv,
+        });
+        return Ok(textures.textures.len() - 1);
+    }
+    if t.str().is_ok() {
+        return crate::texture::texture_by_name(t, textures);
+    }
+    parse_texture_ref(t, spectra, textures)
 }

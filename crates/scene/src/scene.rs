@@ -15,6 +15,7 @@ use crate::reader::{Ctx, Result, V};
 use crate::sensor::{parse_sensors, Sensor};
 use crate::shape::{parse_meshes, parse_shape, MeshAsset, Shape, ShapeContext};
 use crate::spectrum_ref::{parse_spectrum, SpectrumRef, SpectrumUse};
+use crate::texture::{parse_textures, Texture, TextureTable};
 
 /// Everything render needs to build a scene, as plain data: angles in radians, lengths in
 /// metres, asset paths resolved, spectra loaded, references turned into indices.
@@ -35,9 +36,12 @@ pub struct SceneDescription {
     pub media: Vec<Medium>,
     /// Illuminance sensors (`sensors`), measured by `prism render` beside the image.
     pub sensors: Vec<Sensor>,
+    /// The `textures` section, then textures defined inline in materials (materials refer
+    /// to them by index).
+    pub textures: Vec<Texture>,
 }
 
-pub const TOP_LEVEL_FIELDS: [&str; 11] = [
+pub const TOP_LEVEL_FIELDS: [&str; 12] = [
     "camera",
     "film",
     "integrator",
@@ -48,6 +52,7 @@ pub const TOP_LEVEL_FIELDS: [&str; 11] = [
     "lights",
     "media",
     "sensors",
+    "textures",
     "$schema",
 ];
 
@@ -117,9 +122,13 @@ fn parse_root(v: &V) -> Result<SceneDescription> {
     let media = o
         .get("media")
         .map_or(Ok(Vec::new()), |m| parse_media(&m, &spectra))?;
-    let materials = o
-        .get("materials")
-        .map_or(Ok(Vec::new()), |m| parse_materials(&m, &spectra))?;
+    let mut textures = match o.get("textures") {
+        Some(t) => parse_textures(&t, &spectra)?,
+        None => TextureTable::default(),
+    };
+    let materials = o.get("materials").map_or(Ok(Vec::new()), |m| {
+        parse_materials(&m, &spectra, &mut textures)
+    })?;
     let mut meshes = o
         .get("meshes")
         .map_or(Ok(Vec::new()), |m| parse_meshes(&m))?;
@@ -174,5 +183,6 @@ fn parse_root(v: &V) -> Result<SceneDescription> {
         lights,
         media,
         sensors,
+        textures: textures.textures,
     })
 }

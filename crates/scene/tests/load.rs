@@ -238,7 +238,7 @@ fn every_field_kind_comes_through() {
     assert_eq!(
         s.materials[0].kind,
         MaterialKind::Lambert {
-            reflectance: s.spectra[1].1.clone()
+            reflectance: prism_scene::SpectrumParam::Spectrum(s.spectra[1].1.clone())
         }
     );
     assert_eq!(
@@ -249,7 +249,8 @@ fn every_field_kind_comes_through() {
                 alpha_u: 0.1,
                 alpha_v: 0.3
             },
-            distribution: Microfacet::Beckmann
+            distribution: Microfacet::Beckmann,
+            roughness_texture: None
         }
     );
     assert!(matches!(
@@ -271,7 +272,8 @@ fn every_field_kind_comes_through() {
         MaterialKind::Dielectric {
             ior: Ior::Cauchy { a: 1.67, .. },
             roughness: Roughness { alpha_u: 0.05, .. },
-            distribution: Microfacet::Ggx
+            distribution: Microfacet::Ggx,
+            roughness_texture: None
         }
     ));
     assert!(matches!(
@@ -286,7 +288,8 @@ fn every_field_kind_comes_through() {
         s.materials[7].kind,
         MaterialKind::Mask {
             material: 6,
-            opacity: 0.4
+            opacity: 0.4,
+            opacity_texture: None
         }
     );
 

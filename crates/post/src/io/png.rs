@@ -90,9 +90,25 @@ pub fn write_png(path: &Path, image: &Image, depth: PngBitDepth) -> Result<()> {
     })
 }
 
-/// Reads an 8- or 16-bit PNG (grey, grey+alpha, RGB, RGBA or palette) to linear RGB; an
-/// alpha channel becomes the unprefixed layer channel `A`.
-pub fn read_png(path: &Path) -> Result<Image> {
+/// A PNG's samples as stored (still encoded), for callers that decode them themselves
+/// (textures: linear-coded normal maps, per-channel access, the channel count).
+#[derive(Debug, Clone, PartialEq)]
+pub struct RawPng {
+    pub width: usize,
+    pub height: usize,
+    /// 1 (grey), 2 (grey + alpha), 3 (RGB) or 4 (RGBA); palettes are expanded to RGB(A).
+    pub channels: usize,
+    /// 255 or 65535.
+    pub max_code: u32,
+    /// `width × height × channels` codes, rows top to bottom.
+    pub samples: Vec<u16>,
+    /// The colour space named by the file (`cHRM` without `sRGB`), else sRGB; its transfer
+    /// function is the encoding `read_png` removes.
+    pub space: RgbColorSpace,
+}
+
+/// Reads a PNG's encoded samples (see [`RawPng`]).
+pub fn read_png_raw(path: &Path) -> Result<RawPng> {
     let file = File::open(path).map_err(|e| PostError::io(path, "open", e))?;
     let mut decoder = Decoder::new(BufReader::new(file));
     decoder.set_transformations(Transformations::EXPAND);
@@ -130,35 +146,54 @@ pub fn read_png(path: &Path) -> Result<Image> {
         }
         _ => RgbColorSpace::srgb(),
     };
-    let max_code = if sixteen { 65535usize } else { 255 };
-    let lut: Vec<f32> = (0..=max_code)
-        .map(|code| space.transfer.decode(code as f64 / max_code as f64) as f32)
-        .collect();
-    let bytes_per_sample = if sixteen { 2 } else { 1 };
-    let stride = channels * bytes_per_sample;
-    let sample = |px: &[u8], c: usize| -> usize {
-        if sixteen {
-            u16::from_be_bytes([px[2 * c], px[2 * c + 1]]) as usize
-        } else {
-            px[c] as usize
-        }
+    let n = w * h * channels;
+    let samples: Vec<u16> = if sixteen {
+        buffer[..2 * n]
+            .chunks_exact(2)
+            .map(|b| u16::from_be_bytes([b[0], b[1]]))
+            .collect()
+    } else {
+        buffer[..n].iter().map(|&b| u16::from(b)).collect()
     };
-    let data = &buffer[..w * h * stride];
-    let pixels: Vec<[f32; 3]> = data
-        .par_chunks(stride)
+    Ok(RawPng {
+        width: w,
+        height: h,
+        channels,
+        max_code: if sixteen { 65535 } else { 255 },
+        samples,
+        space,
+    })
+}
+
+/// Reads an 8- or 16-bit PNG (grey, grey+alpha, RGB, RGBA or palette) to linear RGB; an
+/// alpha channel becomes the unprefixed layer channel `A`.
+pub fn read_png(path: &Path) -> Result<Image> {
+    let raw = read_png_raw(path)?;
+    let (channels, max_code) = (raw.channels, raw.max_code as usize);
+    let lut: Vec<f32> = (0..=max_code)
+        .map(|code| raw.space.transfer.decode(code as f64 / max_code as f64) as f32)
+        .collect();
+    let pixels: Vec<[f32; 3]> = raw
+        .samples
+        .par_chunks(channels)
         .map(|px| {
             if channels >= 3 {
-                [lut[sample(px, 0)], lut[sample(px, 1)], lut[sample(px, 2)]]
+                [
+                    lut[px[0] as usize],
+                    lut[px[1] as usize],
+                    lut[px[2] as usize],
+                ]
             } else {
-                [lut[sample(px, 0)]; 3]
+                [lut[px[0] as usize]; 3]
             }
         })
         .collect();
-    let mut image = Image::new(w, h, pixels, space)?;
+    let mut image = Image::new(raw.width, raw.height, pixels, raw.space.clone())?;
     if channels == 2 || channels == 4 {
-        let alpha: Vec<f32> = data
-            .chunks(stride)
-            .map(|px| sample(px, channels - 1) as f32 / max_code as f32)
+        let alpha: Vec<f32> = raw
+            .samples
+            .chunks(channels)
+            .map(|px| px[channels - 1] as f32 / max_code as f32)
             .collect();
         image.set_layer("", &["A"], alpha)?;
     }

@@ -120,6 +120,10 @@ pub fn render_plan(
         let mut counters = PathCounters::default();
         for pixel in tile.bounds().pixels() {
             let light_samples = plan.light_samples(pixel);
+            // Several samples share the pixel: each one's differential covers a fraction of
+            // it (pbrt-v4 `GetCameraSample`/`ScaleDifferentials`: max(1/8, 1/√spp)).
+            let differential_scale =
+                (1.0 / (plan.camera_samples(pixel).max(1) as f32).sqrt()).max(0.125);
             for s in 0..plan.camera_samples(pixel) {
                 let mut stream = sampler.stream(pixel, s);
                 let (film_point, weight) = tile.sample_film_point(pixel, stream.get_2d());
@@ -129,11 +133,14 @@ pub fn render_plan(
                         let mut wavelengths = SampledWavelengths::sample_visible(stream.get_1d());
                         let (radiance, aov) = match scene.camera.generate_ray(film_point, lens) {
                             None => (SampledSpectrum::splat(0.0), None),
-                            Some(camera_ray) => {
+                            Some(mut camera_ray) => {
                                 rays += 1;
-                                let r = tracer.radiance(
+                                camera_ray.scale_differentials(differential_scale);
+                                let r = tracer.radiance_with_differentials(
                                     scene,
                                     &camera_ray.ray,
+                                    Some(&camera_ray),
+                                    differential_scale,
                                     &mut wavelengths,
                                     &mut stream,
                                     light_samples,

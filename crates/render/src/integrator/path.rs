@@ -13,7 +13,7 @@
 //! more than one light sample per hit) draw 3 more each.
 
 use glam::{Vec2, Vec3A};
-use prism_geometry::{Frame, Ray, SurfaceInteraction};
+use prism_geometry::{Frame, Ray, RayDifferential, SurfaceInteraction};
 use prism_scene::MisHeuristic;
 use prism_spectrum::{SampledSpectrum, SampledWavelengths};
 
@@ -95,11 +95,33 @@ struct Vertex {
     si: SurfaceInteraction,
     frame: Frame,
     wo_local: Vec3A,
+    /// The shading normal comes from a normal or bump map: directions whose side of the
+    /// geometric surface disagrees with the BSDF's reflection/transmission are refused
+    /// (see `texture::shading_normal`).
+    check_sides: bool,
+    /// ωo · n_geometric.
+    wo_dot_ng: f32,
+}
+
+impl Vertex {
+    /// True when world direction `wi` lies on the side of the geometric surface that the
+    /// shading frame's reflection (`wi_local.z · wo_local.z > 0`) or transmission implies.
+    #[inline]
+    fn sides_agree(&self, wi: Vec3A, wi_local: Vec3A) -> bool {
+        if !self.check_sides {
+            return true;
+        }
+        let geometric_reflection = wi.dot(self.si.n_geometric) * self.wo_dot_ng > 0.0;
+        let shading_reflection = wi_local.z * self.wo_local.z > 0.0;
+        geometric_reflection == shading_reflection
+    }
 }
 
 impl PathTracer {
     /// Radiance along `camera_ray` (unit direction) at `wavelengths` (which a dispersive
     /// hit may reduce to the hero); `light_samples` light samples per scattering event.
+    /// Without ray differentials: texture lookups use the camera footprint approximation
+    /// at every hit (see `radiance_with_differentials`).
     #[allow(clippy::too_many_arguments)]
     pub fn radiance(
         &self,
@@ -111,10 +133,44 @@ impl PathTracer {
         want_illumination: bool,
         counters: &mut PathCounters,
     ) -> PathResult {
-        self.radiance_from(
+        self.trace(
             scene,
             camera_ray,
             None,
+            None,
+            1.0,
+            wavelengths,
+            stream,
+            light_samples,
+            want_illumination,
+            counters,
+        )
+    }
+
+    /// As `radiance`, with the camera ray's differential (already scaled for the pixel's
+    /// sample count, pbrt-v4 `ScaleDifferentials`) for texture filtering at the first hit
+    /// and behind opacity masks; hits after a scattering event use the camera footprint
+    /// (`RenderScene::texture_footprint`) scaled by `differential_scale` (pbrt-v4 §10.1.2
+    /// `Camera::Approximate_dp_dxy`).
+    #[allow(clippy::too_many_arguments)]
+    pub fn radiance_with_differentials(
+        &self,
+        scene: &RenderScene,
+        camera_ray: &Ray,
+        camera_differential: Option<&RayDifferential>,
+        differential_scale: f32,
+        wavelengths: &mut SampledWavelengths,
+        stream: &mut SampleStream,
+        light_samples: u32,
+        want_illumination: bool,
+        counters: &mut PathCounters,
+    ) -> PathResult {
+        self.trace(
+            scene,
+            camera_ray,
+            None,
+            camera_differential,
+            differential_scale,
             wavelengths,
             stream,
             light_samples,
@@ -127,6 +183,7 @@ impl PathTracer {
     /// non-specular point `origin` (an illuminance sensor): emission met by the ray is then
     /// MIS-weighted against light sampling from `origin` (whose light samples the caller
     /// takes), instead of counted in full as for a camera ray. `None` is a camera ray.
+    /// Textures are filtered with the camera footprint approximation.
     #[allow(clippy::too_many_arguments)]
     pub fn radiance_from(
         &self,
@@ -139,6 +196,36 @@ impl PathTracer {
         want_illumination: bool,
         counters: &mut PathCounters,
     ) -> PathResult {
+        self.trace(
+            scene,
+            camera_ray,
+            origin,
+            None,
+            1.0,
+            wavelengths,
+            stream,
+            light_samples,
+            want_illumination,
+            counters,
+        )
+    }
+
+    /// The path loop behind `radiance`, `radiance_with_differentials` and `radiance_from`.
+    #[allow(clippy::too_many_arguments)]
+    fn trace(
+        &self,
+        scene: &RenderScene,
+        camera_ray: &Ray,
+        origin: Option<PathOrigin>,
+        camera_differential: Option<&RayDifferential>,
+        differential_scale: f32,
+        wavelengths: &mut SampledWavelengths,
+        stream: &mut SampleStream,
+        light_samples: u32,
+        want_illumination: bool,
+        counters: &mut PathCounters,
+    ) -> PathResult {
+        let mut current_differential = camera_differential.copied();
         let lights = &scene.lights;
         let mut radiance = SampledSpectrum::splat(0.0);
         let mut beta = SampledSpectrum::splat(1.0);
@@ -219,11 +306,19 @@ impl PathTracer {
                 break;
             };
             // Curvature only at the first hit (the G-buffer's); shading never reads it.
-            let si = if first_hit.is_none() && want_curvature {
+            let mut si = if first_hit.is_none() && want_curvature {
                 scene.geometry.interaction(&ray, &hit)
             } else {
                 scene.geometry.shading_interaction(&ray, &hit)
             };
+            if let Some(footprint) = &scene.texture_footprint {
+                match &current_differential {
+                    Some(rd) => si.compute_differentials(rd),
+                    None => {
+                        si.compute_differentials(&footprint.approximate(si.p, differential_scale))
+                    }
+                }
+            }
             let material = scene.material(si.material_id);
             let u_mask = stream.get_1d();
             let u_light_choice = stream.get_1d();
@@ -233,7 +328,7 @@ impl PathTracer {
             let u_roulette = stream.get_1d();
 
             // Opacity mask: pass straight through with probability 1 − α.
-            let opacity = material.opacity();
+            let opacity = material.opacity_at(&si);
             if opacity < 1.0 && u_mask >= opacity {
                 pass_throughs += 1;
                 if pass_throughs > 256 {
@@ -241,6 +336,10 @@ impl PathTracer {
                 }
                 ray = Ray::spawn(si.p, ray.direction);
                 continue;
+            }
+            let shading_maps = material.has_shading_maps();
+            if shading_maps {
+                material.apply_shading_maps(&mut si);
             }
             if first_hit.is_none() {
                 first_hit = Some(si);
@@ -290,6 +389,8 @@ impl PathTracer {
                 si,
                 frame,
                 wo_local: frame.to_local(-ray.direction),
+                check_sides: shading_maps,
+                wo_dot_ng: -ray.direction.dot(si.n_geometric),
             };
             let ctx = LightSampleContext {
                 p: si.p,
@@ -345,6 +446,10 @@ impl PathTracer {
             else {
                 break;
             };
+            let wi_world = vertex.frame.from_local(bs.wi);
+            if !vertex.sides_agree(wi_world, bs.wi) {
+                break;
+            }
             let weight = bs.weight();
             if weight.is_black() || weight.has_non_finite() {
                 if weight.has_non_finite() {
@@ -371,8 +476,8 @@ impl PathTracer {
                 eta_scale *= bs.eta * bs.eta;
             }
             prev_ctx = ctx;
-            let wi_world = vertex.frame.from_local(bs.wi);
             ray = Ray::spawn(vertex.si.p, wi_world.normalize());
+            current_differential = None;
             counters.rays += 1;
 
             // Russian roulette on the radiance-scaled throughput.
@@ -428,6 +533,9 @@ impl PathTracer {
             return (zero, zero);
         }
         let wi_local = vertex.frame.to_local(ls.wi);
+        if !vertex.sides_agree(ls.wi, wi_local) {
+            return (zero, zero);
+        }
         let f = bsdf.eval(vertex.wo_local, wi_local, TransportMode::Radiance) * wi_local.z.abs();
         let white_cos = if want_white {
             wi_local.z.max(0.0) * std::f32::consts::FRAC_1_PI
@@ -484,7 +592,7 @@ impl PathTracer {
                 return transmittance;
             };
             let si = scene.geometry.shading_interaction(&shadow, &hit);
-            let opacity = scene.material(si.material_id).opacity();
+            let opacity = scene.material(si.material_id).opacity_at(&si);
             transmittance *= 1.0 - opacity;
             if transmittance <= 0.0 {
                 return 0.0;

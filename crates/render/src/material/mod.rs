@@ -16,6 +16,11 @@
 //! do not change the frame.
 //!
 //! The formulas, parameters and validity ranges are in docs/materials.md.
+//!
+//! Textures (crate::texture): lambert reflectance (RGB images upsampled as albedo),
+//! conductor/dielectric roughness and mask opacity (scalar textures) are read at the hit
+//! in `bsdf`/`opacity_at`; the `NormalMap` and `BumpMap` wrappers change the hit's shading
+//! normal in `apply_shading_maps`, which the integrator calls before it builds the frame.
 
 pub mod ior;
 pub mod library;
@@ -28,7 +33,8 @@ use std::sync::Arc;
 
 use prism_geometry::SurfaceInteraction;
 use prism_scene::{
-    ConductorOptics, MaterialKind, Microfacet, Roughness, SceneDescription, SpectrumRef,
+    ConductorOptics, MaterialKind, Microfacet, Roughness, SceneDescription, SpectrumParam,
+    SpectrumRef,
 };
 use prism_spectrum::constants::{LAMBDA_MAX_NM, LAMBDA_MIN_NM};
 use prism_spectrum::{SampledWavelengths, Spectrum};
@@ -39,6 +45,10 @@ use crate::bsdf::{
 };
 use crate::scene_build::spectrum::{build_spectrum, SpectrumRole};
 use crate::scene_build::SceneBuildError;
+use crate::texture::shading_normal::{apply_bump_map, apply_normal_map};
+use crate::texture::{
+    build_textures, FloatTexture, RgbUse, Texture, TexturePurpose, TextureSet, TexturedSpectrum,
+};
 
 pub use ior::Ior;
 pub use metals::{metal_optics, MetalOptics};
@@ -51,7 +61,7 @@ const MAX_WRAPPER_DEPTH: usize = 16;
 #[derive(Clone, Debug, PartialEq)]
 pub enum Material {
     Lambert {
-        reflectance: Spectrum,
+        reflectance: TexturedSpectrum,
     },
     /// A metal: complex index η + ik relative to the outside medium; a Dirac mirror when
     /// the distribution is effectively smooth.
@@ -59,6 +69,8 @@ pub enum Material {
         eta: Spectrum,
         k: Spectrum,
         distribution: MicrofacetDistribution,
+        /// Isotropic α from a texture, replacing `distribution`'s α at each hit.
+        roughness_texture: Option<FloatTexture>,
     },
     /// Glass-like interface; `ior` is the index of the inside (below the shading normal,
     /// i.e. opposite the geometric normal's side for closed shapes) relative to the
@@ -66,6 +78,8 @@ pub enum Material {
     Dielectric {
         ior: Ior,
         distribution: MicrofacetDistribution,
+        /// As for `Conductor`.
+        roughness_texture: Option<FloatTexture>,
     },
     /// The inner material on both sides (reflection-only lobes; dielectrics already are).
     TwoSided {
@@ -75,6 +89,19 @@ pub enum Material {
     Mask {
         material: Box<Material>,
         opacity: f32,
+        /// Opacity from a texture (then `opacity` is 1).
+        opacity_texture: Option<FloatTexture>,
+    },
+    /// The inner material with its shading normal from a tangent-space normal map.
+    NormalMap {
+        material: Box<Material>,
+        texture: Arc<Texture>,
+    },
+    /// The inner material with its shading normal bent by the height `scale_m × height`.
+    BumpMap {
+        material: Box<Material>,
+        height: FloatTexture,
+        scale_m: f32,
     },
     /// Oren & Nayar 1994 (`form`: full or qualitative), σ in radians.
     OrenNayar {
@@ -132,40 +159,136 @@ impl Material {
     /// The default material of shapes without one: lambert, reflectance 0.5.
     pub fn default_material() -> Self {
         Material::Lambert {
-            reflectance: Spectrum::constant(0.5),
+            reflectance: TexturedSpectrum::Constant(Spectrum::constant(0.5)),
         }
     }
 
-    /// The BSDF at `hit` for `wavelengths`. (No parameter reads the hit yet: textures will.)
+    /// The BSDF at `hit` for `wavelengths` (textures read the hit's uv and differentials).
     #[inline]
-    #[allow(clippy::only_used_in_recursion)]
     pub fn bsdf(&self, hit: &SurfaceInteraction, wavelengths: &SampledWavelengths) -> Bsdf<'_> {
         match self {
             Material::Lambert { reflectance } => Bsdf::new(BsdfLobe::Lambert(Lambert {
-                reflectance: reflectance.eval(wavelengths),
+                reflectance: reflectance.eval(hit, wavelengths),
             })),
             Material::Conductor {
                 eta,
                 k,
                 distribution,
+                roughness_texture,
             } => Bsdf::new(BsdfLobe::Conductor(Conductor {
                 eta: eta.eval(wavelengths),
                 k: k.eval(wavelengths),
-                distribution: *distribution,
+                distribution: textured_distribution(distribution, roughness_texture, hit),
             })),
-            Material::Dielectric { ior, distribution } => {
-                Bsdf::new(BsdfLobe::Dielectric(Dielectric {
-                    eta: ior.eval(wavelengths),
-                    distribution: *distribution,
-                }))
-            }
+            Material::Dielectric {
+                ior,
+                distribution,
+                roughness_texture,
+            } => Bsdf::new(BsdfLobe::Dielectric(Dielectric {
+                eta: ior.eval(wavelengths),
+                distribution: textured_distribution(distribution, roughness_texture, hit),
+            })),
             Material::TwoSided { material } => {
                 let mut b = material.bsdf(hit, wavelengths);
                 b.two_sided = b.lobe.is_reflection_only();
                 b
             }
-            Material::Mask { material, .. } => material.bsdf(hit, wavelengths),
+            Material::Mask { material, .. }
+            | Material::NormalMap { material, .. }
+            | Material::BumpMap { material, .. } => material.bsdf(hit, wavelengths),
             _ => Bsdf::new(self.library_lobe(hit, wavelengths)),
+        }
+    }
+
+    /// Opacity at `hit`: `opacity()` with opacity textures evaluated.
+    #[inline]
+    pub fn opacity_at(&self, hit: &SurfaceInteraction) -> f32 {
+        match self {
+            Material::Mask {
+                material,
+                opacity,
+                opacity_texture,
+            } => {
+                let t = opacity_texture.as_ref().map_or(1.0, |t| t.eval(hit));
+                opacity * t * material.opacity_at(hit)
+            }
+            Material::TwoSided { material }
+            | Material::NormalMap { material, .. }
+            | Material::BumpMap { material, .. } => material.opacity_at(hit),
+            _ => 1.0,
+        }
+    }
+
+    /// True when some hit may be less than fully opaque (a constant opacity < 1 or an
+    /// opacity texture).
+    pub fn has_mask(&self) -> bool {
+        match self {
+            Material::Mask {
+                material,
+                opacity,
+                opacity_texture,
+            } => *opacity < 1.0 || opacity_texture.is_some() || material.has_mask(),
+            Material::TwoSided { material }
+            | Material::NormalMap { material, .. }
+            | Material::BumpMap { material, .. } => material.has_mask(),
+            _ => false,
+        }
+    }
+
+    /// True when a normal or bump map changes the shading normal (`apply_shading_maps`).
+    pub fn has_shading_maps(&self) -> bool {
+        match self {
+            Material::NormalMap { .. } | Material::BumpMap { .. } => true,
+            Material::TwoSided { material } | Material::Mask { material, .. } => {
+                material.has_shading_maps()
+            }
+            _ => false,
+        }
+    }
+
+    /// True when any parameter is a texture (lookups want ray differentials).
+    pub fn has_textures(&self) -> bool {
+        match self {
+            Material::Lambert { reflectance } => reflectance.constant().is_none(),
+            Material::Conductor {
+                roughness_texture, ..
+            }
+            | Material::Dielectric {
+                roughness_texture, ..
+            } => roughness_texture.is_some(),
+            Material::TwoSided { material } => material.has_textures(),
+            Material::Mask {
+                material,
+                opacity_texture,
+                ..
+            } => opacity_texture.is_some() || material.has_textures(),
+            Material::NormalMap { .. } | Material::BumpMap { .. } => true,
+            Material::Mix { materials, .. } => materials.iter().any(Material::has_textures),
+            _ => false,
+        }
+    }
+
+    /// Replaces `hit`'s shading normal by the normal/bump maps of this material (outer
+    /// wrapper first). Call before building the shading frame.
+    #[inline]
+    pub fn apply_shading_maps(&self, hit: &mut SurfaceInteraction) {
+        match self {
+            Material::NormalMap { material, texture } => {
+                apply_normal_map(texture, hit);
+                material.apply_shading_maps(hit);
+            }
+            Material::BumpMap {
+                material,
+                height,
+                scale_m,
+            } => {
+                apply_bump_map(height, *scale_m, hit);
+                material.apply_shading_maps(hit);
+            }
+            Material::TwoSided { material } | Material::Mask { material, .. } => {
+                material.apply_shading_maps(hit)
+            }
+            _ => {}
         }
     }
 
@@ -175,8 +298,12 @@ impl Material {
     #[inline]
     pub fn opacity(&self) -> f32 {
         match self {
-            Material::Mask { material, opacity } => opacity * material.opacity(),
-            Material::TwoSided { material } => material.opacity(),
+            Material::Mask {
+                material, opacity, ..
+            } => opacity * material.opacity(),
+            Material::TwoSided { material }
+            | Material::NormalMap { material, .. }
+            | Material::BumpMap { material, .. } => material.opacity(),
             _ => 1.0,
         }
     }
@@ -187,11 +314,28 @@ impl Material {
     pub fn is_dispersive(&self) -> bool {
         match self {
             Material::Dielectric { ior, .. } => ior.is_dispersive(),
-            Material::TwoSided { material } | Material::Mask { material, .. } => {
-                material.is_dispersive()
-            }
+            Material::TwoSided { material }
+            | Material::Mask { material, .. }
+            | Material::NormalMap { material, .. }
+            | Material::BumpMap { material, .. } => material.is_dispersive(),
             Material::Mix { materials, .. } => materials.iter().any(Material::is_dispersive),
             _ => false,
+        }
+    }
+}
+
+/// The distribution at `hit`: the constant one, or one with the texture's isotropic α.
+#[inline]
+fn textured_distribution(
+    constant: &MicrofacetDistribution,
+    texture: &Option<FloatTexture>,
+    hit: &SurfaceInteraction,
+) -> MicrofacetDistribution {
+    match texture {
+        None => *constant,
+        Some(t) => {
+            let alpha = t.eval(hit);
+            MicrofacetDistribution::new(constant.model, alpha, alpha)
         }
     }
 }
@@ -236,6 +380,7 @@ fn build_one(
     scene: &SceneDescription,
     index: usize,
     depth: usize,
+    textures: &mut TextureSet,
 ) -> Result<Material, SceneBuildError> {
     let file: &Path = &scene.file;
     let m = &scene.materials[index];
@@ -256,13 +401,25 @@ fn build_one(
     }
     Ok(match &m.kind {
         MaterialKind::Lambert { reflectance } => Material::Lambert {
-            reflectance: build_spectrum(reflectance, SpectrumRole::Albedo)
-                .map_err(|e| err("reflectance", e))?,
+            reflectance: match reflectance {
+                SpectrumParam::Spectrum(r) => TexturedSpectrum::Constant(
+                    build_spectrum(r, SpectrumRole::Albedo).map_err(|e| err("reflectance", e))?,
+                ),
+                SpectrumParam::Texture(t) => TexturedSpectrum::Texture {
+                    texture: textures.get(
+                        *t,
+                        TexturePurpose::Albedo,
+                        &format!("{place}.reflectance"),
+                    )?,
+                    rgb: RgbUse::Albedo,
+                },
+            },
         },
         MaterialKind::Conductor {
             optics,
             roughness,
             distribution: d,
+            roughness_texture,
         } => {
             let distribution = distribution(roughness, *d).map_err(|e| err("roughness", e))?;
             let (eta, k) = match optics {
@@ -289,18 +446,25 @@ fn build_one(
                 eta,
                 k,
                 distribution,
+                roughness_texture: roughness_texture
+                    .map(|t| scalar_texture(textures, t, 0.0, 1.0, &place, "roughness"))
+                    .transpose()?,
             }
         }
         MaterialKind::Dielectric {
             ior,
             roughness,
             distribution: d,
+            roughness_texture,
         } => Material::Dielectric {
             ior: Ior::from_scene(ior).map_err(|e| err("ior", e))?,
             distribution: distribution(roughness, *d).map_err(|e| err("roughness", e))?,
+            roughness_texture: roughness_texture
+                .map(|t| scalar_texture(textures, t, 0.0, 1.0, &place, "roughness"))
+                .transpose()?,
         },
         MaterialKind::TwoSided { material } => Material::TwoSided {
-            material: Box::new(build_one(scene, *material, depth + 1)?),
+            material: Box::new(build_one(scene, *material, depth + 1, textures)?),
         },
         MaterialKind::OrenNayar { .. }
         | MaterialKind::Phong { .. }
@@ -313,14 +477,20 @@ fn build_one(
             library::build_library(&m.kind).map_err(|(f, e)| err(f, e))?
         }
         MaterialKind::Mix { materials, weight } => {
-            let build = |k: usize| {
-                let inner = build_one(scene, materials[k], depth + 1)?;
-                if matches!(inner, Material::TwoSided { .. } | Material::Mask { .. }) {
+            let mut build = |k: usize| {
+                let inner = build_one(scene, materials[k], depth + 1, textures)?;
+                if matches!(
+                    inner,
+                    Material::TwoSided { .. }
+                        | Material::Mask { .. }
+                        | Material::NormalMap { .. }
+                        | Material::BumpMap { .. }
+                ) {
                     return Err(err(
                         "materials",
                         format!(
-                            "`{}` is a two_sided or mask wrapper; a mix blends BSDFs, so wrap \
-                             the mix instead",
+                            "`{}` is a two_sided, mask, normal_map or bump_map wrapper; a mix \
+                             blends BSDFs, so wrap the mix instead",
                             scene.materials[materials[k]].name
                         ),
                     ));
@@ -343,7 +513,35 @@ fn build_one(
             }
             mix
         }
-        MaterialKind::Mask { material, opacity } => {
+        MaterialKind::NormalMap { material, texture } => Material::NormalMap {
+            texture: textures.get(
+                *texture,
+                TexturePurpose::NormalMap,
+                &format!("{place}.texture"),
+            )?,
+            material: Box::new(build_one(scene, *material, depth + 1, textures)?),
+        },
+        MaterialKind::BumpMap {
+            material,
+            texture,
+            scale_m,
+        } => Material::BumpMap {
+            height: scalar_texture(
+                textures,
+                *texture,
+                f64::NEG_INFINITY,
+                f64::INFINITY,
+                &place,
+                "texture",
+            )?,
+            scale_m: *scale_m as f32,
+            material: Box::new(build_one(scene, *material, depth + 1, textures)?),
+        },
+        MaterialKind::Mask {
+            material,
+            opacity,
+            opacity_texture,
+        } => {
             if !(opacity.is_finite() && (0.0..=1.0).contains(opacity)) {
                 return Err(err(
                     "opacity",
@@ -351,18 +549,40 @@ fn build_one(
                 ));
             }
             Material::Mask {
-                material: Box::new(build_one(scene, *material, depth + 1)?),
+                material: Box::new(build_one(scene, *material, depth + 1, textures)?),
                 opacity: *opacity as f32,
+                opacity_texture: opacity_texture
+                    .map(|t| scalar_texture(textures, t, 0.0, 1.0, &place, "opacity"))
+                    .transpose()?,
             }
         }
+    })
+}
+
+/// A scalar texture whose values must lie in [lo, hi], used by `place.field`.
+fn scalar_texture(
+    textures: &mut TextureSet,
+    index: usize,
+    lo: f64,
+    hi: f64,
+    place: &str,
+    field: &str,
+) -> Result<FloatTexture, SceneBuildError> {
+    Ok(FloatTexture {
+        texture: textures.get(
+            index,
+            TexturePurpose::scalar(lo, hi),
+            &format!("{place}.{field}"),
+        )?,
     })
 }
 
 /// Every scene material, then the default one.
 pub fn build_materials(scene: &SceneDescription) -> Result<Vec<Material>, SceneBuildError> {
     let mut out = Vec::with_capacity(scene.materials.len() + 1);
+    let mut textures = build_textures(scene);
     for i in 0..scene.materials.len() {
-        out.push(build_one(scene, i, 0)?);
+        out.push(build_one(scene, i, 0, &mut textures)?);
     }
     out.push(Material::default_material());
     Ok(out)

@@ -71,7 +71,11 @@ fn albedo_at_depth(materials: &[Material], index: usize, depth: usize) -> [f32; 
         return DEFAULT_ALBEDO;
     }
     match &m.kind {
-        MaterialKind::Lambert { reflectance } => reflectance_rgb(reflectance),
+        MaterialKind::Lambert {
+            reflectance: prism_scene::SpectrumParam::Spectrum(reflectance),
+        } => reflectance_rgb(reflectance),
+        // The AOV holds one albedo per material; a textured one varies over the surface.
+        MaterialKind::Lambert { .. } => DEFAULT_ALBEDO,
         MaterialKind::Dielectric { .. } => [1.0; 3],
         MaterialKind::Conductor { optics, .. } => match optics {
             ConductorOptics::Named(symbol) => match crate::material::metal_optics(symbol) {
@@ -86,7 +90,10 @@ fn albedo_at_depth(materials: &[Material], index: usize, depth: usize) -> [f32; 
                 }))
             }
         },
-        MaterialKind::TwoSided { material } | MaterialKind::Mask { material, .. } => {
+        MaterialKind::TwoSided { material }
+        | MaterialKind::Mask { material, .. }
+        | MaterialKind::NormalMap { material, .. }
+        | MaterialKind::BumpMap { material, .. } => {
             albedo_at_depth(materials, *material, depth + 1)
         }
         // The material library (issue 8): the diffuse reflectance, plus the specular one
@@ -139,6 +146,7 @@ mod tests {
                     alpha_v: 0.0,
                 },
                 distribution: prism_scene::Microfacet::Ggx,
+                roughness_texture: None,
             },
         };
         let materials = [metal("Au"), metal("Ag"), metal("Cu")];

@@ -17,7 +17,7 @@ pub use geometry::{build_geometry, build_geometry_with_instances, shape_instance
 
 use std::path::PathBuf;
 
-use glam::UVec2;
+use glam::{UVec2, Vec3A};
 use prism_geometry::{Geometry, NO_MATERIAL};
 use prism_scene::SceneDescription;
 
@@ -51,6 +51,9 @@ pub struct RenderScene {
     pub splat: bool,
     /// Some material has an opacity mask: shadow rays must look through masked surfaces.
     pub has_masks: bool,
+    /// Some material reads a texture: hits compute ray differentials, from the camera ray
+    /// or (after a bounce) from this camera footprint. `None` when no material is textured.
+    pub texture_footprint: Option<crate::texture::CameraFootprint>,
 }
 
 impl RenderScene {
@@ -77,7 +80,23 @@ impl RenderScene {
         let geometry = build_geometry(scene)?;
         let materials = build_materials(scene)?;
         let lights = LightSet::build(scene, &geometry)?;
-        let has_masks = materials.iter().any(|m| m.opacity() < 1.0);
+        let has_masks = materials.iter().any(|m| m.has_mask());
+        let texture_footprint = if materials.iter().any(|m| m.has_textures()) {
+            // A camera without a ray at the film centre (a circular fisheye's corner is
+            // never the centre) would leave textures unfiltered: point lookups.
+            Some(
+                crate::texture::CameraFootprint::from_camera(&camera, resolution).unwrap_or(
+                    crate::texture::CameraFootprint {
+                        origin: Vec3A::ZERO,
+                        direction: Vec3A::Z,
+                        direction_spread: 0.0,
+                        position_spread_m: 0.0,
+                    },
+                ),
+            )
+        } else {
+            None
+        };
         Ok(Self {
             file,
             geometry,
@@ -97,6 +116,7 @@ impl RenderScene {
             materials,
             lights,
             has_masks,
+            texture_footprint,
             splat: scene.film.reconstruction == prism_scene::Reconstruction::Splat,
         })
     }
