@@ -2,6 +2,7 @@
 
 mod color;
 mod compare;
+mod converge;
 mod render;
 mod tonemap;
 
@@ -26,6 +27,9 @@ enum Command {
     Color(color::ColorArgs),
     /// Error metrics of an image against a reference: MSE, RMSE, relMSE, PSNR, SSIM, ΔE2000.
     Compare(compare::CompareArgs),
+    /// Error against time for each method: progressive renders, RMSE/relMSE/ΔE2000 at
+    /// checkpoints, a log–log chart (PNG/SVG) with fitted slopes, JSON (docs/converge.md).
+    Converge(converge::ConvergeArgs),
     /// Render a scene file to an EXR or PNG image (docs/rendering.md).
     Render(render::RenderArgs),
     /// Tone-map an HDR image (EXR/HDR): white balance, tone operator, gamut mapping, encoding.
@@ -43,6 +47,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Color(args) => color::run(&args),
         Command::Compare(args) => compare::run(&args),
+        Command::Converge(args) => converge::run(&args),
         Command::Render(args) => render::run(&args),
         Command::Tonemap(args) => tonemap::run(&args),
     };

@@ -60,7 +60,7 @@ pub struct RenderArgs {
     pub spectral_bins: Option<u32>,
 }
 
-fn parse_resolution(s: &str) -> Result<UVec2, String> {
+pub(crate) fn parse_resolution(s: &str) -> Result<UVec2, String> {
     let parse = |t: &str| t.trim().parse::<u32>().ok().filter(|&v| v >= 1);
     match s.split_once(['x', 'X']) {
         Some((w, h)) => match (parse(w), parse(h)) {
