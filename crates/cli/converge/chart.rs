@@ -1,5 +1,5 @@
 //! The error-against-time chart of `prism converge` (plotters): three log–log panels (RMSE,
-//! relMSE, mean ΔE2000 against wall time), one curve per method with its checkpoints as
+//! relMSE, mean ΔE2000 against wall or CPU time), one curve per method with its checkpoints as
 //! dots, the fitted power law dashed, and the fitted slope in the legend. A grey line shows
 //! the Monte Carlo rate (RMSE ∝ t^−½, relMSE ∝ t^−1) through the first method's first point.
 //!
@@ -100,6 +100,7 @@ fn log_range(values: impl Iterator<Item = f64>, pad: f64) -> (f64, f64) {
 fn draw<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     title: &str,
+    x_axis: &str,
     curves: &[Curve],
 ) -> Result<(), String>
 where
@@ -132,7 +133,7 @@ where
             .map_err(err)?;
         chart
             .configure_mesh()
-            .x_desc("wall time (s)")
+            .x_desc(x_axis)
             .y_desc(axis)
             .label_style((FAMILY, 14))
             .axis_desc_style((FAMILY, 15))
@@ -199,7 +200,7 @@ where
 }
 
 /// Draws the chart to `path` (.png or .svg) atomically.
-pub fn write_chart(path: &Path, title: &str, curves: &[Curve]) -> Result<(), String> {
+pub fn write_chart(path: &Path, title: &str, x_axis: &str, curves: &[Curve]) -> Result<(), String> {
     register_font()?;
     let (w, h) = CHART_SIZE_PX;
     let ext = path
@@ -211,7 +212,7 @@ pub fn write_chart(path: &Path, title: &str, curves: &[Curve]) -> Result<(), Str
             let mut text = String::new();
             {
                 let root = SVGBackend::with_string(&mut text, (w, h)).into_drawing_area();
-                draw(&root, title, curves)?;
+                draw(&root, title, x_axis, curves)?;
             }
             text.into_bytes()
         }
@@ -219,7 +220,7 @@ pub fn write_chart(path: &Path, title: &str, curves: &[Curve]) -> Result<(), Str
             let mut rgb = vec![0u8; w as usize * h as usize * 3];
             {
                 let root = BitMapBackend::with_buffer(&mut rgb, (w, h)).into_drawing_area();
-                draw(&root, title, curves)?;
+                draw(&root, title, x_axis, curves)?;
             }
             let mut out = Vec::new();
             let mut encoder = png::Encoder::new(&mut out, w, h);
@@ -270,7 +271,7 @@ mod tests {
     fn svg_and_png_charts_carry_the_fitted_slopes() {
         let dir = tempfile::tempdir().unwrap();
         let svg = dir.path().join("c.svg");
-        write_chart(&svg, "test", &curves()).unwrap();
+        write_chart(&svg, "test", "wall time (s)", &curves()).unwrap();
         let text = std::fs::read_to_string(&svg).unwrap();
         assert!(
             text.contains("path  slope −0.50"),
@@ -280,7 +281,7 @@ mod tests {
         assert!(text.contains("path  slope −0.40"));
         assert!(text.contains("Monte Carlo rate, slope −0.50"));
         let png = dir.path().join("c.png");
-        write_chart(&png, "test", &curves()).unwrap();
+        write_chart(&png, "test", "wall time (s)", &curves()).unwrap();
         let bytes = std::fs::read(&png).unwrap();
         assert_eq!(&bytes[1..4], b"PNG");
         // Text was rasterised: the title row holds dark pixels (no system font needed).
@@ -298,7 +299,7 @@ mod tests {
 
     #[test]
     fn other_extensions_are_refused_before_drawing() {
-        let e = write_chart(Path::new("chart.jpg"), "t", &curves()).unwrap_err();
+        let e = write_chart(Path::new("chart.jpg"), "t", "x", &curves()).unwrap_err();
         assert!(e.contains(".png or .svg"), "{e}");
     }
 }

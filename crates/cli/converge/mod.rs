@@ -88,9 +88,45 @@ pub struct ConvergeArgs {
     /// (`<n>-<method>.exr`), e.g. to check the numbers with `prism compare`.
     #[arg(long = "save-final", value_name = "DIR")]
     pub save_final: Option<PathBuf>,
+    /// The time axis of the chart and fits: `wall` (elapsed time, the default) or `cpu`
+    /// (CPU time of the render threads, which other processes on a shared machine do not
+    /// stretch). Both are in the JSON either way.
+    #[arg(long, value_enum, default_value_t = Clock::Wall)]
+    pub clock: Clock,
     /// Chart title (default: the scene file's name and the resolution).
     #[arg(long)]
     pub title: Option<String>,
+}
+
+/// The time axis of a convergence run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Clock {
+    Wall,
+    Cpu,
+}
+
+impl Clock {
+    fn name(self) -> &'static str {
+        match self {
+            Clock::Wall => "wall",
+            Clock::Cpu => "cpu",
+        }
+    }
+
+    /// The axis label of the chart.
+    fn axis(self) -> &'static str {
+        match self {
+            Clock::Wall => "wall time (s)",
+            Clock::Cpu => "render CPU time, all threads (s)",
+        }
+    }
+
+    fn of(self, c: &progressive::Checkpoint) -> f64 {
+        match self {
+            Clock::Wall => c.time_s,
+            Clock::Cpu => c.cpu_time_s.unwrap_or(c.time_s),
+        }
+    }
 }
 
 /// Writes `bytes` to a temporary sibling and renames it over `path`.
@@ -205,6 +241,7 @@ fn integrator_description(integrator: &prism_render::Integrator) -> String {
 fn checkpoint_json(c: &progressive::Checkpoint) -> Value {
     json!({
         "time_s": c.time_s,
+        "cpu_time_s": c.cpu_time_s,
         "spp": c.spp,
         "samples": c.samples,
         "rmse": c.comparison.rmse,
@@ -387,7 +424,7 @@ pub fn run(args: &ConvergeArgs) -> Result<(), String> {
         let series = |m: usize| -> Vec<(f64, f64)> {
             run.checkpoints
                 .iter()
-                .map(|c| (c.time_s, metric_of(c, m)))
+                .map(|c| (args.clock.of(c), metric_of(c, m)))
                 .collect()
         };
         let fits: [Option<PowerFit>; 3] = [0, 1, 2].map(|m| PowerFit::new(series(m)));
@@ -489,7 +526,7 @@ pub fn run(args: &ConvergeArgs) -> Result<(), String> {
             points: run
                 .checkpoints
                 .iter()
-                .map(|c| (c.time_s, [0, 1, 2].map(|m| metric_of(c, m))))
+                .map(|c| (args.clock.of(c), [0, 1, 2].map(|m| metric_of(c, m))))
                 .collect(),
             fits,
         });
@@ -506,17 +543,21 @@ pub fn run(args: &ConvergeArgs) -> Result<(), String> {
     }
     let title = args.title.clone().unwrap_or_else(|| {
         format!(
-            "{} — {}×{} px — error against wall time",
+            "{} — {}×{} px — error against {}",
             args.scene
                 .file_name()
                 .map(|n| n.to_string_lossy().into_owned())
                 .unwrap_or_default(),
             resolution.x,
-            resolution.y
+            resolution.y,
+            match args.clock {
+                Clock::Wall => "wall time",
+                Clock::Cpu => "render CPU time",
+            }
         )
     });
     for o in &args.outputs {
-        chart::write_chart(o, &title, &curves)?;
+        chart::write_chart(o, &title, args.clock.axis(), &curves)?;
         eprintln!("wrote {}", o.display());
     }
     if let Some(path) = &args.json {
@@ -531,6 +572,7 @@ pub fn run(args: &ConvergeArgs) -> Result<(), String> {
             },
             "seed": seed,
             "threads": pool.current_num_threads(),
+            "clock": args.clock.name(),
             "relmse_target": TARGET_RELMSE,
             "machine_at_start": load_start,
             "machine_at_end": machine_load(),

@@ -13,6 +13,7 @@
 //! given (deterministic), else the count the measured rate reaches within the time budget
 //! (re-estimated after every pass).
 
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::mpsc;
 use std::time::Instant;
 
@@ -65,6 +66,10 @@ pub fn next_target(k: u32, spp_done: u32, elapsed_s: f64, budget: &Budget) -> Op
 pub struct Checkpoint {
     /// Wall time since the method's first pass started, s.
     pub time_s: f64,
+    /// CPU time of the render threads since the first pass started, s: the process's CPU
+    /// time less the metric thread's (`None` without a process clock). On a shared machine
+    /// this is the fairer clock: other processes stretch wall time, not CPU time.
+    pub cpu_time_s: Option<f64>,
     /// Samples per pixel so far.
     pub spp: u32,
     /// Camera samples so far (all pixels).
@@ -85,17 +90,34 @@ pub struct MethodRun {
     pub film: Film,
 }
 
-/// CPU time of the whole process, s.
+#[cfg(unix)]
+fn cpu_clock_s(clock: libc::clockid_t) -> Option<f64> {
+    let mut ts = libc::timespec {
+        tv_sec: 0,
+        tv_nsec: 0,
+    };
+    // SAFETY: `ts` is a valid, writable timespec; the clock id is a constant.
+    let rc = unsafe { libc::clock_gettime(clock, &mut ts) };
+    (rc == 0).then(|| ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9)
+}
+
+/// CPU time of the whole process (all threads), s.
 pub fn process_cpu_s() -> Option<f64> {
     #[cfg(unix)]
     {
-        let mut ts = libc::timespec {
-            tv_sec: 0,
-            tv_nsec: 0,
-        };
-        // SAFETY: `ts` is a valid, writable timespec; the clock id is a constant.
-        let rc = unsafe { libc::clock_gettime(libc::CLOCK_PROCESS_CPUTIME_ID, &mut ts) };
-        (rc == 0).then(|| ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9)
+        cpu_clock_s(libc::CLOCK_PROCESS_CPUTIME_ID)
+    }
+    #[cfg(not(unix))]
+    {
+        None
+    }
+}
+
+/// CPU time of the calling thread, s.
+fn thread_cpu_s() -> Option<f64> {
+    #[cfg(unix)]
+    {
+        cpu_clock_s(libc::CLOCK_THREAD_CPUTIME_ID)
     }
     #[cfg(not(unix))]
     {
@@ -140,22 +162,35 @@ pub fn run_method(
     budget: &Budget,
     pool: &rayon::ThreadPool,
 ) -> Result<MethodRun, String> {
-    let (sender, receiver) = mpsc::channel::<(f64, u32, u64, Film)>();
+    let (sender, receiver) = mpsc::channel::<(f64, Option<f64>, u32, u64, Film)>();
+    // CPU time the metric thread has spent, ns (subtracted from the process's CPU time).
+    let metric_cpu_ns = AtomicU64::new(0);
+    let metric_cpu_ns = &metric_cpu_ns;
     std::thread::scope(|scope| {
         let metrics = scope.spawn(move || -> Result<Vec<Checkpoint>, String> {
+            let thread_start = thread_cpu_s();
             let metric_pool = rayon::ThreadPoolBuilder::new()
                 .num_threads(1)
                 .build()
                 .map_err(|e| format!("cannot start the metric thread: {e}"))?;
             let mut out = Vec::new();
-            for (time_s, spp, samples, film) in receiver {
+            for (time_s, cpu_time_s, spp, samples, film) in receiver {
                 let comparison = metric_pool.install(|| {
                     let image = film_to_image(&film)?;
                     compare_with(&image, reference, &CompareOptions { ssim: false })
                         .map_err(|e| e.to_string())
                 })?;
+                // The pool's worker did the work; the metric thread itself only waited.
+                let worker_cpu = metric_pool.install(thread_cpu_s);
+                let own_cpu = match (thread_start, thread_cpu_s()) {
+                    (Some(a), Some(b)) => b - a,
+                    _ => 0.0,
+                };
+                let spent = worker_cpu.unwrap_or(0.0) + own_cpu;
+                metric_cpu_ns.store((spent * 1e9) as u64, Ordering::Relaxed);
                 out.push(Checkpoint {
                     time_s,
+                    cpu_time_s,
                     spp,
                     samples,
                     comparison,
@@ -181,10 +216,22 @@ pub fn run_method(
             k += 1;
             let snapshot = film.clone();
             render_wall_s = start.elapsed().as_secs_f64();
+            let render_cpu_s = match (cpu_start, process_cpu_s()) {
+                (Some(a), Some(b)) => {
+                    Some(b - a - metric_cpu_ns.load(Ordering::Relaxed) as f64 * 1e-9)
+                }
+                _ => None,
+            };
             // The receiver lives until every snapshot is consumed; a send error means the
             // metric thread failed, and joining it below reports why.
             if sender
-                .send((render_wall_s, spp_done, stats.samples, snapshot))
+                .send((
+                    render_wall_s,
+                    render_cpu_s,
+                    spp_done,
+                    stats.samples,
+                    snapshot,
+                ))
                 .is_err()
             {
                 break;
