@@ -55,7 +55,8 @@ pub struct ConvergeArgs {
     /// ambient_occlusion, depth, normal, albedo; plans: uniform; samplers: independent, sobol.
     #[arg(long = "method", value_name = "METHOD")]
     pub methods: Vec<String>,
-    /// Wall-time budget per method, seconds (default 10 unless --max-spp is given).
+    /// Time budget per method, seconds, on the --clock (wall or render CPU time; default 10
+    /// unless --max-spp is given).
     #[arg(long = "budget-s", value_name = "S")]
     pub budget_s: Option<f64>,
     /// Samples per pixel per method at most; alone, it makes the checkpoint schedule
@@ -217,6 +218,7 @@ fn check_arguments(args: &ConvergeArgs) -> Result<Budget, String> {
             (None, Some(_)) => f64::INFINITY,
             (None, None) => DEFAULT_BUDGET_S,
         },
+        cpu_clock: args.clock == Clock::Cpu,
         max_spp: args.max_spp,
         checkpoints: args.checkpoints,
     })
@@ -567,6 +569,7 @@ pub fn run(args: &ConvergeArgs) -> Result<(), String> {
             "reference": reference_json,
             "budget": {
                 "time_s_per_method": budget.time_s.is_finite().then_some(budget.time_s),
+                "clock": args.clock.name(),
                 "max_spp": budget.max_spp,
                 "checkpoints": budget.checkpoints,
             },

@@ -28,8 +28,11 @@ use super::method::PlanKind;
 /// How long a method may render.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Budget {
-    /// Wall-clock seconds per method (∞: no time limit).
+    /// Seconds per method (∞: no time limit), on the wall clock or, with `cpu_clock`, on
+    /// the render threads' CPU clock.
     pub time_s: f64,
+    /// Count `time_s` in render-thread CPU time (`--clock cpu`).
+    pub cpu_clock: bool,
     /// Samples per pixel at most (`None`: no sample limit).
     pub max_spp: Option<u32>,
     /// Checkpoints at most (≥ 2).
@@ -98,7 +101,7 @@ fn cpu_clock_s(clock: libc::clockid_t) -> Option<f64> {
     };
     // SAFETY: `ts` is a valid, writable timespec; the clock id is a constant.
     let rc = unsafe { libc::clock_gettime(clock, &mut ts) };
-    (rc == 0).then(|| ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9)
+    (rc == 0).then_some(ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9)
 }
 
 /// CPU time of the whole process (all threads), s.
@@ -206,7 +209,12 @@ pub fn run_method(
         let mut spp_done = 0u32;
         let mut k = 0u32;
         let mut render_wall_s = 0.0;
-        while let Some(target) = next_target(k, spp_done, start.elapsed().as_secs_f64(), budget) {
+        let mut render_cpu_s: Option<f64> = Some(0.0);
+        let elapsed = |render_cpu_s: Option<f64>| match (budget.cpu_clock, render_cpu_s) {
+            (true, Some(cpu)) => cpu,
+            _ => start.elapsed().as_secs_f64(),
+        };
+        while let Some(target) = next_target(k, spp_done, elapsed(render_cpu_s), budget) {
             let pass = plan_for_pass(plan, scene, target - spp_done)?;
             let pass_stats = pool
                 .install(|| render_pass(scene, settings, &pass, &mut film, spp_done, &|_| {}))
@@ -216,7 +224,7 @@ pub fn run_method(
             k += 1;
             let snapshot = film.clone();
             render_wall_s = start.elapsed().as_secs_f64();
-            let render_cpu_s = match (cpu_start, process_cpu_s()) {
+            render_cpu_s = match (cpu_start, process_cpu_s()) {
                 (Some(a), Some(b)) => {
                     Some(b - a - metric_cpu_ns.load(Ordering::Relaxed) as f64 * 1e-9)
                 }
@@ -297,6 +305,7 @@ mod tests {
     fn a_sample_budget_gives_a_geometric_deterministic_schedule() {
         let b = Budget {
             time_s: f64::INFINITY,
+            cpu_clock: false,
             max_spp: Some(256),
             checkpoints: 9,
         };
@@ -313,6 +322,7 @@ mod tests {
     fn a_time_budget_ends_near_rate_times_budget() {
         let b = Budget {
             time_s: 10.0,
+            cpu_clock: false,
             max_spp: None,
             checkpoints: 12,
         };
