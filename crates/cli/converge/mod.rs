@@ -445,12 +445,15 @@ pub fn run(args: &ConvergeArgs) -> Result<(), String> {
                 _ => None,
             };
             eprintln!(
-                "{}: overhead of converge: wall {:+.1} % ({:.3} s vs {:.3} s in one pass), CPU {}",
+                "{}: overhead of converge: wall {:+.1} % ({:.3} s vs {:.3} s in one pass), CPU {}; \
+                 metric thread {:.3} s CPU, film copies {:.4} s",
                 method.label,
                 100.0 * wall_fraction,
                 run.render_wall_s,
                 plain_wall,
-                cpu_fraction.map_or("n/a".into(), |f| format!("{:+.1} %", 100.0 * f))
+                cpu_fraction.map_or("n/a".into(), |f| format!("{:+.1} %", 100.0 * f)),
+                run.metric_cpu_s,
+                run.snapshot_wall_s,
             );
             json!({
                 "spp": last.spp,
@@ -514,6 +517,12 @@ pub fn run(args: &ConvergeArgs) -> Result<(), String> {
             "final": checkpoint_json(last),
             "render_wall_s": run.render_wall_s,
             "cpu_s": run.cpu_s,
+            "converge_cost": {
+                "metric_thread_cpu_s": run.metric_cpu_s,
+                "film_copies_wall_s": run.snapshot_wall_s,
+                "metric_cpu_fraction_of_render_cpu": last.cpu_time_s.map(|c| run.metric_cpu_s / c),
+                "film_copies_fraction_of_render_wall": run.snapshot_wall_s / run.render_wall_s,
+            },
             "stats": {
                 "samples": run.stats.samples,
                 "rays_traced": run.stats.rays_traced,

@@ -91,6 +91,11 @@ pub struct MethodRun {
     pub cpu_s: Option<f64>,
     /// The film after the last pass.
     pub film: Film,
+    /// CPU time the metric thread spent computing errors, s (the main cost converge adds;
+    /// it runs beside the render, so on a machine with idle cores it adds no wall time).
+    pub metric_cpu_s: f64,
+    /// Wall time the render thread spent copying the film at checkpoints, s.
+    pub snapshot_wall_s: f64,
 }
 
 #[cfg(unix)]
@@ -209,6 +214,7 @@ pub fn run_method(
         let mut spp_done = 0u32;
         let mut k = 0u32;
         let mut render_wall_s = 0.0;
+        let mut snapshot_wall_s = 0.0;
         let mut render_cpu_s: Option<f64> = Some(0.0);
         let elapsed = |render_cpu_s: Option<f64>| match (budget.cpu_clock, render_cpu_s) {
             (true, Some(cpu)) => cpu,
@@ -222,7 +228,9 @@ pub fn run_method(
             add_stats(&mut stats, &pass_stats);
             spp_done = target;
             k += 1;
+            let copy_start = Instant::now();
             let snapshot = film.clone();
+            snapshot_wall_s += copy_start.elapsed().as_secs_f64();
             render_wall_s = start.elapsed().as_secs_f64();
             render_cpu_s = match (cpu_start, process_cpu_s()) {
                 (Some(a), Some(b)) => {
@@ -259,6 +267,8 @@ pub fn run_method(
             render_wall_s,
             cpu_s,
             film,
+            metric_cpu_s: metric_cpu_ns.load(Ordering::Relaxed) as f64 * 1e-9,
+            snapshot_wall_s,
         })
     })
 }
