@@ -2,6 +2,7 @@
 
 mod color;
 mod compare;
+mod converge;
 mod daylight_factor;
 mod falsecolour;
 mod merl_export;
@@ -30,6 +31,9 @@ enum Command {
     Color(color::ColorArgs),
     /// Error metrics of an image against a reference: MSE, RMSE, relMSE, PSNR, SSIM, ΔE2000.
     Compare(compare::CompareArgs),
+    /// Error against time for each method: progressive renders, RMSE/relMSE/ΔE2000 at
+    /// checkpoints, a log–log chart (PNG/SVG) with fitted slopes, JSON (docs/converge.md).
+    Converge(converge::ConvergeArgs),
     /// Write a material of a scene file as a MERL BRDF table (90×90×180 half/difference angles).
     MerlExport(merl_export::MerlExportArgs),
     /// Render a scene file to an EXR or PNG image (docs/rendering.md).
@@ -49,6 +53,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Color(args) => color::run(&args),
         Command::Compare(args) => compare::run(&args),
+        Command::Converge(args) => converge::run(&args),
         Command::MerlExport(args) => merl_export::run(&args),
         Command::Render(args) => render::run(&args),
         Command::Tonemap(args) => tonemap::run(&args),

@@ -76,7 +76,7 @@ pub struct RenderArgs {
     pub false_colour_range: Option<(f64, f64)>,
 }
 
-fn parse_resolution(s: &str) -> Result<UVec2, String> {
+pub(crate) fn parse_resolution(s: &str) -> Result<UVec2, String> {
     let parse = |t: &str| t.trim().parse::<u32>().ok().filter(|&v| v >= 1);
     match s.split_once(['x', 'X']) {
         Some((w, h)) => match (parse(w), parse(h)) {

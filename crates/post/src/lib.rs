@@ -17,7 +17,7 @@ pub mod pipeline;
 pub mod sheet;
 pub mod tonemap;
 
-pub use metrics::{compare, Comparison};
+pub use metrics::{compare, compare_with, CompareOptions, Comparison};
 pub use pipeline::{
     compare_files, tonemap_file, OperatorChoice, TonemapFileReport, TonemapOptions, TonemapTimings,
 };

@@ -35,7 +35,10 @@ pub use film::{
     AovPlane, AovSelection, Film, FilmImage, FilmTile, Filter, FilterSample, FilterSampler,
     SpectralBins, SpectralPlanes, SurfaceAov, TileBounds,
 };
-pub use integrator::{render, render_plan, total_samples, Integrator, RenderSettings, RenderStats};
+pub use integrator::{
+    film_for, render, render_pass, render_plan, total_samples, Integrator, RenderSettings,
+    RenderStats,
+};
 pub use plan::{PlanChoice, PlanRequest, RenderPlan};
 pub use sampler::{PixelSampler, SampleStream, SamplerKind};
 pub use scene_build::{RenderScene, SceneBuildError};

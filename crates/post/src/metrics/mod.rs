@@ -60,8 +60,32 @@ fn clean(pixels: &[[f32; 3]]) -> (Vec<[f32; 3]>, u64) {
     (pixels.par_iter().map(|p| sanitise(*p, 1.0)).collect(), bad)
 }
 
+/// Which of the costlier metrics `compare_with` computes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct CompareOptions {
+    /// SSIM (an 11×11 window per pixel: the costliest metric). `prism converge` leaves it
+    /// out of its checkpoints so that the metric thread steals less time from the render.
+    pub ssim: bool,
+}
+
+impl Default for CompareOptions {
+    fn default() -> Self {
+        Self { ssim: true }
+    }
+}
+
 /// Compares `test` against `reference`; an error when the sizes differ.
 pub fn compare(test: &Image, reference: &Image) -> Result<Comparison> {
+    compare_with(test, reference, &CompareOptions::default())
+}
+
+/// `compare` with a choice of metrics (`ssim` is `None` when not asked for); every metric
+/// it computes is the one `compare` computes, bit for bit.
+pub fn compare_with(
+    test: &Image,
+    reference: &Image,
+    options: &CompareOptions,
+) -> Result<Comparison> {
     if (test.width(), test.height()) != (reference.width(), reference.height()) {
         return Err(PostError::invalid(format!(
             "image sizes differ: {}×{} vs reference {}×{}",
@@ -117,15 +141,19 @@ pub fn compare(test: &Image, reference: &Image) -> Result<Comparison> {
             .map(|c| w[0] * c[0] + w[1] * c[1] + w[2] * c[2])
             .collect()
     };
-    let (ya, yb) = (luminance(&a), luminance(&b));
-    let y_peak = yb.par_iter().cloned().reduce(|| 0.0, f32::max) as f64;
-    let ssim = ssim::ssim(
-        &ya,
-        &yb,
-        test.width(),
-        test.height(),
-        if y_peak > 0.0 { y_peak } else { 1.0 },
-    );
+    let ssim = if options.ssim {
+        let (ya, yb) = (luminance(&a), luminance(&b));
+        let y_peak = yb.par_iter().cloned().reduce(|| 0.0, f32::max) as f64;
+        ssim::ssim(
+            &ya,
+            &yb,
+            test.width(),
+            test.height(),
+            if y_peak > 0.0 { y_peak } else { 1.0 },
+        )
+    } else {
+        None
+    };
 
     let m = space.rgb_to_xyz;
     let white = space.white_xyz();
@@ -226,6 +254,18 @@ mod tests {
         // The sRGB matrix maps (1,1,1) to its white to 1e-12, and f32 0.18 is exact to 1e-8.
         assert!((c.delta_e2000_mean - (100.0 - l) / s_l).abs() < 1e-5);
         assert_eq!(c.ssim, None);
+    }
+
+    #[test]
+    fn compare_without_ssim_gives_the_same_other_metrics() {
+        let b = gradient(16, 16);
+        let a = b
+            .with_pixels(b.pixels().iter().map(|p| p.map(|c| c * 1.1)).collect())
+            .unwrap();
+        let full = compare(&a, &b).unwrap();
+        let lean = compare_with(&a, &b, &CompareOptions { ssim: false }).unwrap();
+        assert!(full.ssim.is_some());
+        assert_eq!(lean, Comparison { ssim: None, ..full });
     }
 
     #[test]

@@ -50,8 +50,9 @@ impl Default for RenderSettings {
     }
 }
 
-/// The scene's film with the spectral bins and illumination AOV `settings` ask for.
-fn film_for(scene: &RenderScene, settings: &RenderSettings) -> Film {
+/// The scene's film with the spectral bins and illumination AOV `settings` ask for: what
+/// `render_plan` renders into, and what `render_pass` accumulates pass after pass.
+pub fn film_for(scene: &RenderScene, settings: &RenderSettings) -> Film {
     let mut film = scene.new_film();
     if settings.illumination_aov {
         let aovs = AovSelection {
@@ -108,6 +109,26 @@ pub fn render_plan(
 ) -> Result<(FilmImage, RenderStats), BandwidthError> {
     plan.check_resolution(scene.resolution)?;
     let mut film = film_for(scene, settings);
+    let stats = render_pass(scene, settings, plan, &mut film, 0, progress)?;
+    Ok((film.finish(), stats))
+}
+
+/// One pass of a progressive render: adds to `film` (from `film_for`) the camera samples
+/// `first_sample .. first_sample + plan.camera_samples(pixel)` of every pixel. Sample
+/// indices continue the same per-pixel sequence (Sobol points, independent hashes), so
+/// passes over [0, a), [a, b), … give the film of one render of b samples, up to the
+/// order of the f64 additions (`prism converge`, tested). Errors when the plan's or the
+/// film's resolution is not the scene's. `settings.spp` is ignored.
+pub fn render_pass(
+    scene: &RenderScene,
+    settings: &RenderSettings,
+    plan: &SamplePlan,
+    film: &mut Film,
+    first_sample: u32,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Result<RenderStats, BandwidthError> {
+    plan.check_resolution(scene.resolution)?;
+    plan.check_resolution(film.resolution())?;
     let sampler = PixelSampler::with_kind(settings.sampler, settings.seed);
     let rays_total = AtomicU64::new(0);
     let samples_total = AtomicU64::new(0);
@@ -120,11 +141,12 @@ pub fn render_plan(
         let mut counters = PathCounters::default();
         for pixel in tile.bounds().pixels() {
             let light_samples = plan.light_samples(pixel);
+            let count = plan.camera_samples(pixel);
             // Several samples share the pixel: each one's differential covers a fraction of
-            // it (pbrt-v4 `GetCameraSample`/`ScaleDifferentials`: max(1/8, 1/√spp)).
-            let differential_scale =
-                (1.0 / (plan.camera_samples(pixel).max(1) as f32).sqrt()).max(0.125);
-            for s in 0..plan.camera_samples(pixel) {
+            // it (pbrt-v4 `GetCameraSample`/`ScaleDifferentials`: max(1/8, 1/√spp)); a
+            // progressive pass scales by its own sample count.
+            let differential_scale = (1.0 / (count.max(1) as f32).sqrt()).max(0.125);
+            for s in first_sample..first_sample.saturating_add(count) {
                 let mut stream = sampler.stream(pixel, s);
                 let (film_point, weight) = tile.sample_film_point(pixel, stream.get_2d());
                 let lens = stream.get_2d();
@@ -222,7 +244,7 @@ pub fn render_plan(
         roulette_terminations: roulette_total.into_inner(),
         non_finite_contributions: non_finite_contributions_total.into_inner(),
     };
-    Ok((film.finish(), stats))
+    Ok(stats)
 }
 
 /// Total camera samples of a render: pixels × spp (for progress bars).

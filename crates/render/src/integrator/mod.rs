@@ -16,7 +16,8 @@ mod path;
 
 pub use ambient_occlusion::AmbientOcclusion;
 pub use driver::{
-    render, render_plan, total_samples, RenderSettings, RenderStats, DEFAULT_TILE_SIZE_PX,
+    film_for, render, render_pass, render_plan, total_samples, RenderSettings, RenderStats,
+    DEFAULT_TILE_SIZE_PX,
 };
 pub use path::{mis_weight, PathCounters, PathOrigin, PathResult, PathTracer};
 

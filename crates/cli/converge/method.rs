@@ -1,0 +1,244 @@
+//! The method grammar of `prism converge --method`: `INTEGRATOR[+PLAN][:SAMPLER]`.
+//!
+//! - INTEGRATOR: what a camera sample computes — `path` (the spectral path tracer with the
+//!   scene's `max_depth`, `rr_depth` and `mis`, or the defaults when the scene names another
+//!   integrator) or one of the diagnostic integrators (`ambient_occlusion`, `depth`,
+//!   `normal`, `albedo`). `photon` (photon mapping) is a known name that this build does not
+//!   have yet.
+//! - PLAN: how samples are distributed over the pixels — `uniform` (the default: the same
+//!   spp everywhere). `predicted` (the bandwidth predictor's per-pixel plan) is known but not
+//!   built yet.
+//! - SAMPLER: `independent` (the default, so that `path` is plain Monte Carlo with the
+//!   −0.5 RMSE rate) or `sobol` (Owen-scrambled Sobol, Burley 2020).
+//!
+//! Unknown or unavailable names are errors that list what is known.
+
+use prism_render::integrator::AmbientOcclusion;
+use prism_render::{Integrator, SamplerKind};
+
+/// Integrator names: (name, available in this build, what it is).
+pub const INTEGRATORS: [(&str, bool, &str); 6] = [
+    ("path", true, "spectral path tracer (NEE + MIS)"),
+    ("ambient_occlusion", true, "diagnostic"),
+    ("depth", true, "diagnostic"),
+    ("normal", true, "diagnostic"),
+    ("albedo", true, "diagnostic"),
+    ("photon", false, "photon mapping (not built yet)"),
+];
+
+/// Sample plans: (name, available, what it is).
+pub const PLANS: [(&str, bool, &str); 2] = [
+    ("uniform", true, "same spp in every pixel"),
+    (
+        "predicted",
+        false,
+        "bandwidth predictor's per-pixel plan (not built yet)",
+    ),
+];
+
+/// Samplers: (name, what it is).
+pub const SAMPLERS: [(&str, &str); 2] = [
+    ("independent", "independent uniform samples"),
+    ("sobol", "Owen-scrambled Sobol"),
+];
+
+/// Sample plans that exist.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PlanKind {
+    Uniform,
+}
+
+impl PlanKind {
+    pub fn name(&self) -> &'static str {
+        match self {
+            PlanKind::Uniform => "uniform",
+        }
+    }
+}
+
+/// One parsed `--method`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Method {
+    /// As the user wrote it (the chart's legend).
+    pub label: String,
+    /// The integrator's name (one of `INTEGRATORS`).
+    pub integrator: &'static str,
+    pub plan: PlanKind,
+    pub sampler: SamplerKind,
+}
+
+fn list(names: impl Iterator<Item = String>) -> String {
+    names.collect::<Vec<_>>().join(", ")
+}
+
+/// The grammar and every known name, for error messages.
+pub fn known_methods() -> String {
+    format!(
+        "INTEGRATOR[+PLAN][:SAMPLER] with INTEGRATOR one of {}; PLAN one of {}; SAMPLER one of \
+         {} (e.g. `path`, `path+uniform:sobol`)",
+        list(INTEGRATORS.iter().map(|(n, ok, _)| if *ok {
+            (*n).to_string()
+        } else {
+            format!("{n} (not built yet)")
+        })),
+        list(PLANS.iter().map(|(n, ok, _)| if *ok {
+            format!("{n} (default)")
+        } else {
+            format!("{n} (not built yet)")
+        })),
+        list(SAMPLERS.iter().enumerate().map(|(i, (n, _))| if i == 0 {
+            format!("{n} (default)")
+        } else {
+            (*n).to_string()
+        })),
+    )
+}
+
+impl Method {
+    /// Parses `INTEGRATOR[+PLAN][:SAMPLER]` (see the module documentation).
+    pub fn parse(text: &str) -> Result<Self, String> {
+        let bad = |what: String| format!("--method `{text}`: {what}; known: {}", known_methods());
+        let (head, sampler) = match text.split_once(':') {
+            Some((h, s)) => (h, Some(s)),
+            None => (text, None),
+        };
+        let (integrator, plan) = match head.split_once('+') {
+            Some((i, p)) => (i, Some(p)),
+            None => (head, None),
+        };
+        let integrator = match INTEGRATORS.iter().find(|(n, _, _)| *n == integrator) {
+            Some((n, true, _)) => *n,
+            Some((n, false, what)) => {
+                return Err(bad(format!(
+                    "the integrator `{n}` ({what}) is not available"
+                )))
+            }
+            None => return Err(bad(format!("unknown integrator `{integrator}`"))),
+        };
+        let plan = match plan {
+            None | Some("uniform") => PlanKind::Uniform,
+            Some(p) => match PLANS.iter().find(|(n, _, _)| *n == p) {
+                Some((n, _, what)) => {
+                    return Err(bad(format!(
+                        "the sample plan `{n}` ({what}) is not available"
+                    )))
+                }
+                None => return Err(bad(format!("unknown sample plan `{p}`"))),
+            },
+        };
+        let sampler = match sampler {
+            None | Some("independent") => SamplerKind::Independent,
+            Some("sobol") => SamplerKind::Sobol,
+            Some(s) => return Err(bad(format!("unknown sampler `{s}`"))),
+        };
+        Ok(Self {
+            label: text.to_string(),
+            integrator,
+            plan,
+            sampler,
+        })
+    }
+
+    /// The fully spelled name, e.g. `path+uniform:independent`.
+    pub fn canonical(&self) -> String {
+        let sampler = match self.sampler {
+            SamplerKind::Independent => "independent",
+            SamplerKind::Sobol => "sobol",
+        };
+        format!("{}+{}:{sampler}", self.integrator, self.plan.name())
+    }
+
+    /// Whether the method estimates radiance (the path family) rather than a diagnostic
+    /// quantity; a run compares one quantity only.
+    pub fn quantity(&self) -> &'static str {
+        match self.integrator {
+            "path" => "radiance",
+            other => other,
+        }
+    }
+
+    /// The runtime integrator, with the scene's parameters where the scene's own integrator
+    /// is of the same kind, else that kind's defaults.
+    pub fn integrator(&self, scene: &prism_scene::Integrator) -> Result<Integrator, String> {
+        let description = match (self.integrator, scene) {
+            ("path", d @ prism_scene::Integrator::Path { .. }) => *d,
+            ("path", _) => prism_scene::Integrator::default(),
+            ("ambient_occlusion", d @ prism_scene::Integrator::AmbientOcclusion { .. }) => *d,
+            ("ambient_occlusion", _) => {
+                return Ok(Integrator::AmbientOcclusion(AmbientOcclusion::new(
+                    f32::INFINITY,
+                    1,
+                )?))
+            }
+            ("depth", _) => prism_scene::Integrator::Depth,
+            ("normal", _) => prism_scene::Integrator::Normal,
+            ("albedo", _) => prism_scene::Integrator::Albedo,
+            (other, _) => return Err(format!("integrator `{other}` is not available")),
+        };
+        Integrator::from_description(&description)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn path_is_uniform_independent_and_spellings_agree() {
+        let m = Method::parse("path").unwrap();
+        assert_eq!(m.canonical(), "path+uniform:independent");
+        assert_eq!(
+            Method::parse("path+uniform").unwrap().canonical(),
+            m.canonical()
+        );
+        let s = Method::parse("path:sobol").unwrap();
+        assert_eq!(s.sampler, SamplerKind::Sobol);
+        assert_eq!(s.canonical(), "path+uniform:sobol");
+        assert_eq!(
+            Method::parse("ambient_occlusion+uniform:independent")
+                .unwrap()
+                .quantity(),
+            "ambient_occlusion"
+        );
+    }
+
+    #[test]
+    fn unknown_and_unbuilt_names_are_errors_listing_the_known_ones() {
+        for (text, says) in [
+            ("bdpt", "unknown integrator `bdpt`"),
+            (
+                "photon",
+                "`photon` (photon mapping (not built yet)) is not available",
+            ),
+            ("path+predicted", "sample plan `predicted`"),
+            ("path+adaptive", "unknown sample plan `adaptive`"),
+            ("path:halton", "unknown sampler `halton`"),
+        ] {
+            let e = Method::parse(text).unwrap_err();
+            assert!(e.contains(says), "{e}");
+            assert!(
+                e.contains("path") && e.contains("sobol") && e.contains("uniform"),
+                "{e}"
+            );
+        }
+    }
+
+    #[test]
+    fn path_takes_the_scene_parameters_or_the_defaults() {
+        let scene = prism_scene::Integrator::Path {
+            max_depth: 3,
+            sampler: SamplerKind::Sobol,
+            mis: prism_scene::MisHeuristic::Balance,
+            rr_depth: 2,
+        };
+        let m = Method::parse("path").unwrap();
+        match m.integrator(&scene).unwrap() {
+            Integrator::Path(p) => assert_eq!((p.max_depth, p.rr_depth), (3, 2)),
+            other => panic!("{other:?}"),
+        }
+        match m.integrator(&prism_scene::Integrator::Depth).unwrap() {
+            Integrator::Path(p) => assert_eq!(p.max_depth, 8),
+            other => panic!("{other:?}"),
+        }
+    }
+}

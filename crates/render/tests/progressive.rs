@@ -1,0 +1,118 @@
+//! Progressive rendering (`render_pass`, used by `prism converge`): passes that continue the
+//! per-pixel sample sequence add up to one render of the total sample count, for both
+//! samplers and both reconstructions (filter importance sampling and splatting).
+
+use prism_bandwidth::SamplePlan;
+use prism_render::{
+    film_for, render, render_pass, FilmImage, RenderScene, RenderSettings, SamplerKind,
+};
+use prism_scene::parse_scene_str;
+
+fn scene(reconstruction: &str) -> RenderScene {
+    // A small lit box corner: diffuse inter-reflection, an area light, MIS.
+    let json = format!(
+        r#"{{
+      "camera": {{"type": "pinhole", "fov_deg": 50, "transform": {{"look_at": {{"eye": [0, 1, 3], "target": [0, 0.5, 0]}}}}}},
+      "film": {{"resolution": [20, 14], "reconstruction": "{reconstruction}",
+               "filter": {{"type": "gaussian", "radius_px": 1.5, "sigma_px": 0.5}}}},
+      "integrator": {{"type": "path", "max_depth": 5}},
+      "materials": {{"white": {{"type": "lambert", "reflectance": 0.7}},
+                    "red": {{"type": "lambert", "reflectance": {{"rgb": [0.7, 0.1, 0.1]}}}}}},
+      "shapes": [
+        {{"type": "rectangle", "size_m": [4, 4], "material": "white",
+          "transform": {{"rotate": {{"axis": [1, 0, 0], "angle_deg": -90}}}}}},
+        {{"type": "rectangle", "size_m": [4, 4], "material": "red",
+          "transform": {{"translate": [0, 0, -1]}}}},
+        {{"type": "sphere", "radius_m": 0.4, "material": "white", "transform": {{"translate": [0.3, 0.4, 0]}}}},
+        {{"type": "rectangle", "name": "lamp", "size_m": [0.6, 0.6], "material": "white",
+          "transform": [{{"rotate": {{"axis": [1, 0, 0], "angle_deg": 90}}}}, {{"translate": [0, 2, 0]}}]}}
+      ],
+      "lights": [{{"type": "area", "shape": "lamp", "spectrum": "D65", "scale": 5}}]
+    }}"#
+    );
+    let description = parse_scene_str(&json, "progressive.json").expect("test scene parses");
+    RenderScene::build(&description, None).expect("test scene builds")
+}
+
+/// Largest relative difference of two images' XYZ (absolute below 1e-9).
+fn max_relative_difference(a: &FilmImage, b: &FilmImage) -> f64 {
+    a.xyz
+        .iter()
+        .flatten()
+        .zip(b.xyz.iter().flatten())
+        .map(|(&x, &y)| {
+            let (x, y) = (f64::from(x), f64::from(y));
+            (x - y).abs() / x.abs().max(y.abs()).max(1e-9)
+        })
+        .fold(0.0, f64::max)
+}
+
+#[test]
+fn passes_continuing_the_sequence_equal_one_render_of_the_total() {
+    for reconstruction in ["importance", "splat"] {
+        let scene = scene(reconstruction);
+        for sampler in [SamplerKind::Sobol, SamplerKind::Independent] {
+            let settings = RenderSettings {
+                spp: 13,
+                seed: 5,
+                sampler,
+                ..RenderSettings::default()
+            };
+            let (single, single_stats) = render(&scene, &settings, &|_| {});
+            // Passes of 1, 4 and 8 samples: [0, 1), [1, 5), [5, 13).
+            let mut film = film_for(&scene, &settings);
+            let mut first = 0;
+            let mut samples = 0;
+            for pass in [1, 4, 8] {
+                let plan = SamplePlan::uniform(scene.resolution, pass).unwrap();
+                let stats = render_pass(&scene, &settings, &plan, &mut film, first, &|_| {})
+                    .expect("plan and film fit the scene");
+                samples += stats.samples;
+                first += pass;
+            }
+            assert_eq!(samples, single_stats.samples);
+            let passes = film.finish();
+            // f32 images from f64 sums that differ only in the order of additions.
+            let d = max_relative_difference(&single, &passes);
+            assert!(
+                d < 1e-5,
+                "{reconstruction} {sampler:?}: max rel. difference {d}"
+            );
+            assert_eq!(
+                single.aov("spp.Y").unwrap().values,
+                passes.aov("spp.Y").unwrap().values
+            );
+            // And a pass that repeats samples [0, 8) instead is a different image.
+            let mut film = film_for(&scene, &settings);
+            for _ in 0..2 {
+                let plan = SamplePlan::uniform(scene.resolution, 8).unwrap();
+                render_pass(&scene, &settings, &plan, &mut film, 0, &|_| {}).unwrap();
+            }
+            let settings16 = RenderSettings {
+                spp: 16,
+                ..settings
+            };
+            let (sixteen, _) = render(&scene, &settings16, &|_| {});
+            assert!(max_relative_difference(&sixteen, &film.finish()) > 1e-3);
+        }
+    }
+}
+
+#[test]
+fn a_pass_rejects_a_film_of_another_resolution() {
+    let scene = scene("importance");
+    let settings = RenderSettings::default();
+    let small = RenderScene::build(
+        &parse_scene_str(
+            r#"{"camera": {"type": "pinhole", "fov_deg": 40}, "film": {"resolution": [4, 4]}}"#,
+            "small.json",
+        )
+        .unwrap(),
+        None,
+    )
+    .unwrap();
+    let mut film = film_for(&small, &settings);
+    let plan = SamplePlan::uniform(scene.resolution, 1).unwrap();
+    let e = render_pass(&scene, &settings, &plan, &mut film, 0, &|_| {}).unwrap_err();
+    assert!(e.to_string().contains("20×14"), "{e}");
+}

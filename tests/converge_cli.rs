@@ -1,0 +1,279 @@
+//! End-to-end checks of `prism converge` (issue 6): the Monte Carlo rate on the Cornell box
+//! against Mitsuba 3's reference, chart and JSON agreeing, metrics equal to `prism compare`'s,
+//! the cached reference, and bad references refused with nothing written.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+use serde_json::Value;
+
+fn prism(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_prism"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .args(args)
+        .output()
+        .expect("prism runs")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+fn read_json(p: &Path) -> Value {
+    serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
+}
+
+/// Least-squares slope of log10 y on log10 x.
+fn log_log_slope(points: &[(f64, f64)]) -> f64 {
+    let logs: Vec<(f64, f64)> = points
+        .iter()
+        .map(|&(x, y)| (x.log10(), y.log10()))
+        .collect();
+    let n = logs.len() as f64;
+    let mx = logs.iter().map(|p| p.0).sum::<f64>() / n;
+    let my = logs.iter().map(|p| p.1).sum::<f64>() / n;
+    let sxy: f64 = logs.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
+    let sxx: f64 = logs.iter().map(|p| (p.0 - mx).powi(2)).sum();
+    sxy / sxx
+}
+
+/// A small lit scene (a sphere on a floor under an area light) written into `dir`.
+fn small_scene(dir: &Path, name: &str, reflectance: f64) -> std::path::PathBuf {
+    let path = dir.join(name);
+    let json = format!(
+        r#"{{
+      "camera": {{"type": "pinhole", "fov_deg": 45, "transform": {{"look_at": {{"eye": [0, 1, 3], "target": [0, 0.4, 0]}}}}}},
+      "film": {{"resolution": [24, 16], "seed": 1}},
+      "integrator": {{"type": "path", "max_depth": 4, "sampler": "independent"}},
+      "materials": {{"m": {{"type": "lambert", "reflectance": {reflectance}}}}},
+      "shapes": [
+        {{"type": "rectangle", "size_m": [4, 4], "material": "m", "transform": {{"rotate": {{"axis": [1, 0, 0], "angle_deg": -90}}}}}},
+        {{"type": "sphere", "radius_m": 0.4, "material": "m", "transform": {{"translate": [0, 0.4, 0]}}}},
+        {{"type": "rectangle", "name": "lamp", "size_m": [1, 1], "material": "m",
+          "transform": [{{"rotate": {{"axis": [1, 0, 0], "angle_deg": 90}}}}, {{"translate": [0, 2, 0]}}]}}
+      ],
+      "lights": [{{"type": "area", "shape": "lamp", "scale": 3}}]
+    }}"#
+    );
+    std::fs::write(&path, json).unwrap();
+    path
+}
+
+#[test]
+fn cornell_path_rmse_slope_is_the_monte_carlo_rate_and_chart_and_json_agree() {
+    let dir = tempfile::tempdir().unwrap();
+    let (svg, png, json) = (
+        dir.path().join("cornell.svg"),
+        dir.path().join("cornell.png"),
+        dir.path().join("cornell.json"),
+    );
+    // CPU time as the clock: the test machine is shared, and other processes stretch wall
+    // time, not the render's CPU time. 1 → 16 spp at 256×256 against Mitsuba 3's 4096-spp
+    // reference (its noise and the two renderers' difference are ≪ the 16-spp error).
+    let o = prism(&[
+        "converge",
+        "scenes/cornell-box.json",
+        "--reference",
+        "tests/fixtures/cornell_mitsuba_reference.exr",
+        "--method",
+        "path",
+        "--max-spp",
+        "16",
+        "--checkpoints",
+        "5",
+        "--clock",
+        "cpu",
+        "-o",
+        s(&svg),
+        "-o",
+        s(&png),
+        "--json",
+        s(&json),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v = read_json(&json);
+    let m = &v["methods"][0];
+    assert_eq!(m["canonical"], "path+uniform:independent");
+    let checkpoints = m["checkpoints"].as_array().unwrap();
+    let spp: Vec<u64> = checkpoints
+        .iter()
+        .map(|c| c["spp"].as_u64().unwrap())
+        .collect();
+    assert_eq!(
+        spp,
+        [1, 2, 4, 8, 16],
+        "deterministic schedule under --max-spp"
+    );
+    // The JSON's slope is the fit of its own checkpoints.
+    let points: Vec<(f64, f64)> = checkpoints
+        .iter()
+        .map(|c| {
+            (
+                c["cpu_time_s"].as_f64().unwrap(),
+                c["rmse"].as_f64().unwrap(),
+            )
+        })
+        .collect();
+    let slope = m["rmse_slope"].as_f64().unwrap();
+    assert!((log_log_slope(&points) - slope).abs() < 1e-9);
+    assert!(
+        (slope + 0.5).abs() <= 0.1,
+        "rmse_slope {slope}: the Monte Carlo rate is −0.5 ± 0.1 ({checkpoints:?})"
+    );
+    // Against samples the rate does not depend on the machine at all.
+    let per_spp = m["rmse_slope_vs_spp"].as_f64().unwrap();
+    assert!((per_spp + 0.5).abs() <= 0.1, "rmse_slope_vs_spp {per_spp}");
+    // The chart shows the same fit: its legend carries the JSON's slope.
+    let legend = format!("path  slope {}", format!("{slope:.2}").replace('-', "−"));
+    assert_eq!(m["legend"][0], legend.as_str());
+    let text = std::fs::read_to_string(&svg).unwrap();
+    assert!(text.contains(&legend), "the SVG legend shows `{legend}`");
+    assert!(
+        text.contains("render CPU time"),
+        "the x axis names the clock"
+    );
+    assert_eq!(&std::fs::read(&png).unwrap()[1..4], b"PNG");
+    assert_eq!(m["stats"]["non_finite_samples"], 0);
+}
+
+#[test]
+fn converge_metrics_agree_with_prism_compare_and_the_reference_is_cached() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = small_scene(dir.path(), "small.json", 0.6);
+    let finals = dir.path().join("finals");
+    std::fs::create_dir(&finals).unwrap();
+    let json = dir.path().join("run.json");
+    let run = |json: &Path| {
+        prism(&[
+            "converge",
+            s(&scene),
+            "--reference-spp",
+            "256",
+            "--method",
+            "path",
+            "--method",
+            "path+uniform:sobol",
+            "--max-spp",
+            "16",
+            "--checkpoints",
+            "3",
+            "--json",
+            s(json),
+            "--save-final",
+            s(&finals),
+        ])
+    };
+    let o = run(&json);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(
+        err.contains("rendering one at 256 spp") && err.contains("caching it as"),
+        "{err}"
+    );
+    let v = read_json(&json);
+    let reference = v["reference"]["path"].as_str().unwrap().to_string();
+    assert_eq!(v["reference"]["source"], "rendered");
+    assert!(
+        Path::new(&reference).starts_with(dir.path()),
+        "next to the scene"
+    );
+    assert!(reference.contains("small.reference-24x16-256spp-"));
+    for (i, label) in ["path", "path_uniform_sobol"].iter().enumerate() {
+        let image = finals.join(format!("{i}-{label}.exr"));
+        let o = prism(&["compare", s(&image), &reference, "--json"]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let c: Value = serde_json::from_slice(&o.stdout).unwrap();
+        let last = &v["methods"][i]["final"];
+        for key in [
+            "mse",
+            "rmse",
+            "relmse",
+            "delta_e2000_mean",
+            "delta_e2000_p95",
+        ] {
+            let (a, b) = (c[key].as_f64().unwrap(), last[key].as_f64().unwrap());
+            // The same f32 pixels through the same code: equal to rounding of the sums.
+            assert!(
+                (a - b).abs() <= 1e-12 * a.abs().max(1e-300),
+                "{label} {key}: compare {a} vs converge {b}"
+            );
+        }
+    }
+    // Second run: the cached reference is used; editing the scene invalidates it.
+    let o = run(&dir.path().join("again.json"));
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("using the cached"), "{}", stderr(&o));
+    small_scene(dir.path(), "small.json", 0.5);
+    let o = run(&dir.path().join("edited.json"));
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("rendering one"), "{}", stderr(&o));
+    let edited = read_json(&dir.path().join("edited.json"));
+    assert_ne!(edited["reference"]["path"].as_str().unwrap(), reference);
+}
+
+#[test]
+fn bad_references_and_methods_exit_with_a_clear_message_and_write_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = small_scene(dir.path(), "small.json", 0.6);
+    let out = dir.path().join("out");
+    std::fs::create_dir(&out).unwrap();
+    let not_image = dir.path().join("notes.exr");
+    std::fs::write(&not_image, "these are notes, not pixels").unwrap();
+    let cases: [(&str, &[&str], &str); 6] = [
+        (
+            "tests/fixtures/cornell_mitsuba_reference.exr",
+            &[],
+            "is 256×256 px but the render is 24×16 px",
+        ),
+        ("tests/fixtures/missing.exr", &[], "cannot open it"),
+        (s(&not_image), &[], "not a readable image"),
+        ("tests/fixtures/cct.json", &[], "not a readable image"),
+        (
+            "tests/fixtures/cornell_mitsuba_reference.exr",
+            &["--resolution", "256x256", "--method", "bdpt"],
+            "unknown integrator `bdpt`; known: INTEGRATOR[+PLAN][:SAMPLER]",
+        ),
+        (
+            "tests/fixtures/cornell_mitsuba_reference.exr",
+            &["--resolution", "256x256", "--method", "path+predicted"],
+            "the sample plan `predicted`",
+        ),
+    ];
+    for (reference, extra, says) in cases {
+        let chart = out.join("chart.png");
+        let json = out.join("data.json");
+        let mut args = vec![
+            "converge",
+            s(&scene),
+            "--reference",
+            reference,
+            "--max-spp",
+            "4",
+            "-o",
+            s(&chart),
+            "--json",
+            s(&json),
+        ];
+        args.extend_from_slice(extra);
+        let o = prism(&args);
+        assert!(!o.status.success(), "{reference}: should fail");
+        let err = stderr(&o);
+        assert!(
+            err.contains(says),
+            "{reference}: `{err}` should say `{says}`"
+        );
+        assert!(err.starts_with("error: "), "{err}");
+        let written: Vec<_> = std::fs::read_dir(&out).unwrap().collect();
+        assert!(written.is_empty(), "{reference}: wrote {written:?}");
+        let beside: Vec<String> = std::fs::read_dir(dir.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .filter(|n| n.contains("reference"))
+            .collect();
+        assert!(beside.is_empty(), "no reference was rendered: {beside:?}");
+    }
+}

@@ -1,0 +1,258 @@
+#!/usr/bin/env python3
+"""Writes docs/methods.md: for the Cornell box (against Mitsuba 3's reference) and every
+stress scene in scenes/stress/, runs `prism converge` with each method, commits the chart
+(PNG) and JSON under docs/methods/, and tabulates per method the time to reach relMSE 1e-2
+(or the error when the budget ran out), the fitted slopes and a one-line verdict.
+
+Refresh it whenever an integrator changes:
+
+    cargo build --release
+    python3 tools/methods_table.py --budget-s 30            # the issue's 30 s per method
+    python3 tools/methods_table.py --budget-s 3 --reference-spp 2048   # a quick pass
+
+Standard library only. The verdict rules are stated in the generated page.
+"""
+import argparse
+import datetime
+import json
+import os
+import platform
+import subprocess
+import sys
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+TARGET_RELMSE = 1e-2
+
+# (scene, what it is built to break)
+STRESS = [
+    ("small-source", "a 5 mm sphere light (1 Mlm) over a floor: the small-source problem, "
+                     "BSDF sampling almost never hits the light"),
+    ("caustic-glass-sphere", "a glass sphere under a small disk light: the caustic is only "
+                             "reached through light → specular → diffuse paths"),
+    ("glossy-interreflection", "two facing glossy metal plates (Ag α 0.04, Au α 0.12): "
+                               "glossy-to-glossy transport"),
+    ("door-ajar", "the light is in the next room behind a door ajar: almost every path "
+                  "must find a narrow gap (difficult visibility)"),
+    ("grazing-rough-conductor", "rough Al and anisotropic Cu seen at grazing angles "
+                                "(microfacet shadowing, long tails)"),
+    ("hdr-sun-env", "an equirectangular sky whose 0.6° sun carries most of the energy"),
+    ("extreme-dynamic-range", "a 5·10¹⁰ cd/m² point-like sun and a 5·10⁴ cd/m² panel "
+                              "(10⁶ : 1) in one view"),
+    ("spiky-spectrum", "F11 and LED-RGB1 lights on saturated red, green, blue, cyan "
+                       "spheres (spiky spectra × narrow reflectances)"),
+    ("dispersion-prism", "a small light through an SF11 glass prism onto a screen "
+                         "(dispersion: one wavelength per path, a caustic)"),
+]
+
+
+def run(cmd):
+    print("+", " ".join(cmd), file=sys.stderr, flush=True)
+    subprocess.run(cmd, check=True, cwd=ROOT)
+
+
+def fit_time(fit, target):
+    """Time at which the fitted power law reaches `target` (extrapolated)."""
+    if not fit or fit["slope"] >= 0:
+        return None
+    return 10 ** ((__import__("math").log10(target) - fit["intercept_log10"]) / fit["slope"])
+
+
+def tail_slope(checkpoints, key, clock):
+    """relMSE slope of the last half of the checkpoints (bias shows as flattening)."""
+    import math
+    pts = [(c[clock], c[key]) for c in checkpoints if c[clock] and c[key] > 0]
+    pts = pts[len(pts) // 2:]
+    if len(pts) < 3:
+        return None
+    xs = [math.log10(p[0]) for p in pts]
+    ys = [math.log10(p[1]) for p in pts]
+    mx, my = sum(xs) / len(xs), sum(ys) / len(ys)
+    sxx = sum((x - mx) ** 2 for x in xs)
+    return sum((x - mx) * (y - my) for x, y in zip(xs, ys)) / sxx if sxx > 0 else None
+
+
+def verdict(m, clock_key):
+    s = m["relmse_slope"]
+    final = m["final"]["relmse"]
+    reached = m["time_to_relmse_target_s"]
+    tail = tail_slope(m["checkpoints"], "relmse", clock_key)
+    if m["stats"]["non_finite_samples"] or m["stats"]["non_finite_contributions"]:
+        return "fails — NaN/∞ samples"
+    if s is None:
+        return "fails — too few checkpoints to fit"
+    num = lambda v: f"{v:.2f}".replace("-", "−")
+    if final > 1.0:
+        extra = fit_time(m["fits"]["relmse"], TARGET_RELMSE) if s <= -0.8 else None
+        tail_text = (f"; it converges at t^{num(s)}, but the fit needs ≈ {fmt_time(extra)} "
+                     f"for relMSE {TARGET_RELMSE:g}") if extra else f" (slope {num(s)})"
+        return (f"fails — relMSE still {final:.3g} at the end, the error is larger than the "
+                f"signal{tail_text}")
+    if s > -0.6:
+        return (f"fails — relMSE falls at t^{num(s)}, far from t^−1: rare events (fireflies, "
+                "or a feature too small for the samples) dominate the error")
+    if tail is not None and tail > -0.4 and s < -0.7:
+        return (f"biased? — converged at first, then flattens (last-half slope {num(tail)}); "
+                "reference-limited or a bias")
+    if reached is not None:
+        return "works"
+    return "slow — converges at the Monte Carlo rate but misses relMSE 1e-2 within the budget"
+
+
+def fmt_time(t):
+    if t is None:
+        return None
+    if t < 1:
+        return f"{t * 1000:.0f} ms"
+    if t < 120:
+        return f"{t:.1f} s"
+    if t < 7200:
+        return f"{t / 60:.0f} min"
+    return f"{t / 3600:.1f} h"
+
+
+def table(data, clock_key):
+    rows = ["| method | time to relMSE 1e-2 | relMSE at the end (spp) | RMSE slope | relMSE slope | "
+            "verdict |", "|---|---|---|---|---|---|"]
+    for m in data["methods"]:
+        reached = m["time_to_relmse_target_s"]
+        if reached is not None:
+            t = fmt_time(reached)
+        else:
+            extra = fit_time(m["fits"]["relmse"], TARGET_RELMSE)
+            t = f"not reached (fit: ≈ {fmt_time(extra)})" if extra else "not reached"
+        final = m["final"]
+        slope = lambda v: "—" if v is None else f"{v:.2f}".replace("-", "−")
+        rows.append(
+            f"| `{m['method']}` | {t} | {final['relmse']:.3g} after "
+            f"{fmt_time(final[clock_key])} ({final['spp']} spp) | {slope(m['rmse_slope'])} | "
+            f"{slope(m['relmse_slope'])} | {verdict(m, clock_key)} |")
+    return "\n".join(rows)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--prism", default=None, help="the prism binary (default: target/release, "
+                                                  "else target/debug)")
+    ap.add_argument("--budget-s", type=float, default=30.0, help="time budget per method, s")
+    ap.add_argument("--reference-spp", type=int, default=4096)
+    ap.add_argument("--checkpoints", type=int, default=10)
+    ap.add_argument("--max-spp", type=int, default=None,
+                    help="also stop the stress scenes' methods at this spp (keep it ≤ 1/8 of "
+                         "--reference-spp so the reference's noise stays negligible)")
+    ap.add_argument("--clock", choices=["wall", "cpu"], default="cpu")
+    ap.add_argument("--method", action="append", default=None,
+                    help="methods (default: path, path:sobol)")
+    ap.add_argument("--scenes", nargs="*", default=None, help="subset of stress scene names")
+    ap.add_argument("--skip-cornell", action="store_true")
+    ap.add_argument("--no-run", action="store_true",
+                    help="rebuild docs/methods.md from the JSON already in docs/methods/ "
+                         "(pass the options of the run that made them)")
+    args = ap.parse_args()
+    prism = args.prism
+    if prism is None:
+        for p in ("target/release/prism", "target/debug/prism"):
+            if os.path.exists(os.path.join(ROOT, p)):
+                prism = os.path.join(ROOT, p)
+                break
+    if prism is None:
+        sys.exit("build prism first (cargo build --release)")
+    methods = args.method or ["path", "path:sobol"]
+    out_dir = os.path.join(ROOT, "docs", "methods")
+    os.makedirs(out_dir, exist_ok=True)
+    clock_key = "cpu_time_s" if args.clock == "cpu" else "time_s"
+
+    jobs = []
+    if not args.skip_cornell:
+        jobs.append(("cornell-box", "scenes/cornell-box.json",
+                     ["--reference", "tests/fixtures/cornell_mitsuba_reference.exr"],
+                     "Mitsuba 3's built-in Cornell box (256×256), against Mitsuba 3.6.4's 4096-spp "
+                     "reference (tests/fixtures/cornell_mitsuba_reference.json): an independent "
+                     "renderer, so bias would show"))
+    for name, what in STRESS:
+        if args.scenes and name not in args.scenes:
+            continue
+        cap = ["--max-spp", str(args.max_spp)] if args.max_spp else []
+        jobs.append((name, f"scenes/stress/{name}.json",
+                     ["--reference-spp", str(args.reference_spp), *cap], what))
+
+    sections = []
+    loads = []
+    for name, scene, ref_args, what in jobs:
+        chart = f"docs/methods/{name}.png"
+        data_path = f"docs/methods/{name}.json"
+        cmd = [prism, "converge", scene, *ref_args, "--budget-s", str(args.budget_s),
+               "--checkpoints", str(args.checkpoints), "--clock", args.clock,
+               "-o", chart, "--json", data_path]
+        for m in methods:
+            cmd += ["--method", m]
+        if not args.no_run:
+            run(cmd)
+        with open(os.path.join(ROOT, data_path)) as f:
+            data = json.load(f)
+        loads += [data["machine_at_start"]["load_average_1m"],
+                  data["machine_at_end"]["load_average_1m"]]
+        ref = data["reference"]
+        ref_text = ("Mitsuba 3's reference" if ref["source"] == "given"
+                    else f"Prism's own {ref['spp']}-spp Owen-scrambled Sobol render "
+                         f"(seed {ref['seed']})")
+        sections.append(
+            f"### {name}\n\n{what}. `{scene}`, {data['resolution'][0]}×{data['resolution'][1]} px; "
+            f"reference: {ref_text}.\n\n{table(data, clock_key)}\n\n"
+            f"![{name}](methods/{name}.png)\n")
+
+    loads = [l for l in loads if l is not None]
+    now = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
+    cpus = os.cpu_count()
+    clock_text = ("render CPU time (all render threads; the metric thread excluded)"
+                  if args.clock == "cpu" else "wall time")
+    cap_text = (f" or {args.max_spp} spp on the stress scenes, whichever comes first"
+                if args.max_spp else "")
+    cmd_text = (f"python3 tools/methods_table.py --budget-s {args.budget_s:g} "
+                f"--reference-spp {args.reference_spp}"
+                + (f" --max-spp {args.max_spp}" if args.max_spp else ""))
+    head = f"""# Methods: speed against accuracy
+
+Generated by `tools/methods_table.py` on {now} — do not edit by hand; refresh it whenever an
+integrator changes (command below). Each scene is rendered progressively by
+[`prism converge`](converge.md) with every method; each row gives the time to reach
+relMSE {TARGET_RELMSE:g} (interpolated between checkpoints; when the budget ran out first,
+the time the fitted power law predicts), the error at the end of the budget, the fitted
+log–log slopes (Monte Carlo rate: RMSE −0.5, relMSE −1), and a verdict.
+
+**This run:** budget {args.budget_s:g} s per method ({clock_text}){cap_text}, {args.checkpoints}
+checkpoints, stress-scene references at {args.reference_spp} spp, methods
+{", ".join(f"`{m}`" for m in methods)}; machine: {platform.machine()}, {cpus} logical CPUs
+shared with other jobs, 1-minute load average {min(loads):.1f}–{max(loads):.1f} during the
+run. On a machine this busy, wall time is stretched by other processes; CPU time is not,
+which is why the run uses `--clock {args.clock}`. Times are for this machine — compare rows,
+not absolute numbers.
+
+Command: `{cmd_text}`
+(with `prism` built; the script prefers target/release/prism).
+
+Methods (grammar `INTEGRATOR[+PLAN][:SAMPLER]`, [converge.md](converge.md)): `path` is the
+spectral path tracer (next-event estimation + MIS) with the uniform plan and the independent
+sampler; `path:sobol` the same with Owen-scrambled Sobol samples. The bandwidth predictor's
+plan (`path+predicted`) and photon mapping (`photon`) will get rows here when they exist.
+
+**Verdicts**, from the JSON (rules in the script): *works* — relMSE {TARGET_RELMSE:g} reached
+within the budget, error falling at about the Monte Carlo rate; *slow* — converging at the
+rate but {TARGET_RELMSE:g} not reached within the budget; *fails* — relMSE above 1 at the end
+or falling much slower than t⁻¹ (slope > −0.6: rare, high-energy paths, i.e. fireflies,
+dominate), or NaN/∞ samples; *biased?* — the error falls at first and then flattens (slope of
+the last half > −0.4). The stress scenes' references come from Prism's own path tracer (with
+another sampler and seed), so a bias common to both is invisible there; only the Cornell box
+is checked against an independent renderer.
+
+relMSE is mean((a − b)² / (b² + 0.01)) over pixels and channels (`prism compare`); the stress
+scenes are exposed so that lit surfaces have values around 0.1–1, where ε = 0.01 does not hide
+their error.
+
+"""
+    with open(os.path.join(ROOT, "docs", "methods.md"), "w") as f:
+        f.write(head + "\n".join(sections))
+    print("wrote docs/methods.md", file=sys.stderr)
+
+
+if __name__ == "__main__":
+    main()
