@@ -187,6 +187,11 @@ fn main() {
             }),
         );
     }
+    let png_write = if with_file {
+        png_write_times(&image, &dir, file_runs)
+    } else {
+        serde_json::Value::Null
+    };
     let _ = std::fs::remove_dir_all(&dir);
     let out = serde_json::json!({
         "width": w,
@@ -196,8 +201,44 @@ fn main() {
         "threads": rayon::current_num_threads(),
         "copy_pass_ms": median(all_copies),
         "operators": operators,
+        "png_write": png_write,
     });
     println!("{}", serde_json::to_string_pretty(&out).unwrap());
+}
+
+/// 16-bit PNG write of the reinhard02-mapped image: the parallel writer
+/// (`io::png::write_png`) against the `png` crate's sequential encoder
+/// (`write_png_sequential`), wall and CPU time of all threads (medians), and file bytes.
+fn png_write_times(image: &Image, dir: &Path, runs: usize) -> serde_json::Value {
+    use prism_post::io::png::{write_png, write_png_sequential, PngBitDepth};
+    let mapped = ToneOperator::Reinhard02
+        .apply(image, &ToneParams::default())
+        .unwrap()
+        .image;
+    let path = dir.join("write.png");
+    let mut result = serde_json::Map::new();
+    type Writer = fn(&Path, &Image, PngBitDepth) -> prism_post::Result<()>;
+    for (name, write) in [
+        ("parallel", write_png as Writer),
+        ("sequential", write_png_sequential as Writer),
+    ] {
+        let (mut wall, mut cpu) = (Vec::new(), Vec::new());
+        for _ in 0..runs.max(3) {
+            let (t, c) = (Instant::now(), process_cpu_ms());
+            write(&path, &mapped, PngBitDepth::Sixteen).unwrap();
+            wall.push(t.elapsed().as_secs_f64() * 1e3);
+            cpu.push(process_cpu_ms() - c);
+        }
+        result.insert(
+            name.to_string(),
+            serde_json::json!({
+                "wall_ms": median(wall),
+                "cpu_ms": median(cpu),
+                "bytes": std::fs::metadata(&path).unwrap().len(),
+            }),
+        );
+    }
+    serde_json::Value::Object(result)
 }
 
 fn is_local(op: ToneOperator) -> bool {
