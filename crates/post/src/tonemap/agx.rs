@@ -7,7 +7,7 @@
 //! rgb_out = max(M_out · s, 0)^2.2. Works in linear sRGB (Rec.709); other spaces are
 //! converted there and back.
 
-use glam::{Mat3, Vec3};
+use glam::Mat3;
 
 use super::aces::srgb_matrices;
 use super::fast_math;
@@ -83,26 +83,38 @@ struct Map {
     from_srgb: Mat3,
 }
 
+/// `(r, g, b) ← m · (r, g, b)` over planes, as scalar sums per lane (a `glam::Vec3` per
+/// pixel is vectorised across its 3 components, 4 lanes with one wasted, and keeps the
+/// loop from running 8 pixels at a time).
+#[inline(always)]
+fn mat3_planes(m: Mat3, r: &mut [f32], g: &mut [f32], b: &mut [f32]) {
+    let [m00, m10, m20, m01, m11, m21, m02, m12, m22] = m.to_cols_array();
+    for ((r, g), b) in r.iter_mut().zip(g.iter_mut()).zip(b.iter_mut()) {
+        let (x, y, z) = (*r, *g, *b);
+        *r = m00 * x + m01 * y + m02 * z;
+        *g = m10 * x + m11 * y + m12 * z;
+        *b = m20 * x + m21 * y + m22 * z;
+    }
+}
+
 impl PixelMap for Map {
+    /// One pass per step over the block's planes (each a branch-free loop over one plane
+    /// or three, so every step runs 8 pixels per instruction with AVX2).
     #[inline(always)]
     fn map(&self, _start: usize, r: &mut [f32], g: &mut [f32], b: &mut [f32]) {
-        let (inset, outset, from_srgb) = (self.inset, self.outset, self.from_srgb);
-        for ((r, g), b) in r.iter_mut().zip(g.iter_mut()).zip(b.iter_mut()) {
-            let v = inset * Vec3::new(*r, *g, *b);
-            let s = Vec3::new(
-                contrast(log_encode(v.x)),
-                contrast(log_encode(v.y)),
-                contrast(log_encode(v.z)),
-            );
-            let d = (outset * s).max(Vec3::ZERO);
-            let linear = Vec3::new(
-                fast_math::powf(d.x, 2.2),
-                fast_math::powf(d.y, 2.2),
-                fast_math::powf(d.z, 2.2),
-            );
-            let c = from_srgb * linear;
-            (*r, *g, *b) = (c.x, c.y, c.z);
+        mat3_planes(self.inset, r, g, b);
+        for plane in [&mut *r, &mut *g, &mut *b] {
+            for v in plane.iter_mut() {
+                *v = contrast(log_encode(*v));
+            }
         }
+        mat3_planes(self.outset, r, g, b);
+        for plane in [&mut *r, &mut *g, &mut *b] {
+            for v in plane.iter_mut() {
+                *v = fast_math::powf(v.max(0.0), 2.2);
+            }
+        }
+        mat3_planes(self.from_srgb, r, g, b);
     }
 }
 

@@ -134,7 +134,8 @@ mod tests {
             worst_log = worst_log.max(err);
             x *= 1.000_37;
         }
-        assert!(worst_log <= 3e-7, "log2 error {worst_log}");
+        eprintln!("log2: worst error beyond half an ulp {worst_log:e}");
+        assert!(worst_log <= 1.5e-7, "log2 error {worst_log}");
         // The pair, with partners across the whole range (a prime stride through it).
         let mut worst_pair = 0.0f64;
         let mut x = 1.2e-38f32;
@@ -178,6 +179,7 @@ mod tests {
             worst_exp = worst_exp.max((exp2(y) as f64 / want - 1.0).abs());
             y += 0.000_731;
         }
+        eprintln!("exp2: worst relative error {worst_exp:e}");
         assert!(worst_exp <= 3e-7, "exp2 error {worst_exp}");
         assert_eq!(exp2(-1000.0), f32::MIN_POSITIVE);
         assert!(exp2(1000.0).is_finite());
