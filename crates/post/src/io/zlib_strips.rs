@@ -66,9 +66,12 @@ pub(crate) fn compress_strip(data: &[u8]) -> io::Result<CompressedStrip> {
     })
 }
 
-/// Size of [`store_strip`]'s stream for `len` bytes of input.
+/// Size of [`store_strip`]'s stream for `len` bytes of input: zlib header, a 5-byte
+/// header per stored block of at most 65 535 bytes (one block for no input), Adler-32.
+/// (`fdeflate::StoredOnlyCompressor::compressed_size` undercounts exact multiples of
+/// 65 535 bytes by one block.)
 pub(crate) fn stored_size(len: usize) -> usize {
-    fdeflate::StoredOnlyCompressor::<()>::compressed_size(len)
+    2 + len + 5 * len.div_ceil(65_535).max(1) + 4
 }
 
 /// `data` as stored (uncompressed) blocks of at most 65 535 bytes in a zlib stream, for
@@ -279,6 +282,10 @@ mod tests {
             joined.len(),
             2 + long.iter().map(|s| stored_size(s.len()) - 6).sum::<usize>() + 4
         );
+        for (s, blocks) in long.iter().zip([1, 2, 4, 1]) {
+            assert_eq!(stored_size(s.len()), s.len() + 5 * blocks + 6);
+            assert_eq!(store_strip(s).unwrap().len(), stored_size(s.len()));
+        }
         assert_eq!(
             miniz_oxide::inflate::decompress_to_vec_zlib(&joined).unwrap(),
             long.concat()
