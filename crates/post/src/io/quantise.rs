@@ -81,8 +81,8 @@ impl Quantiser {
     /// round(encode(clamp(v, 0, 1)) · max_code); 0 for NaN and ±∞.
     #[inline]
     pub fn code(&self, v: f32) -> u16 {
-        // NaN fails the comparison; −∞ and values below the first threshold give 0.
-        if !(v >= self.thresholds[0]) || v == f32::INFINITY {
+        // NaN, ±∞ and values below the first threshold give 0.
+        if v.is_nan() || v < self.thresholds[0] || v == f32::INFINITY {
             return 0;
         }
         if v >= 1.0 {
