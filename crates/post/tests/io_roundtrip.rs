@@ -219,6 +219,113 @@ fn png_round_trips_within_one_code_value() {
     }
 }
 
+/// Decoded samples (as the file's bytes) and colour chunks of a PNG, read with the `png`
+/// crate's decoder.
+fn decode_png(
+    path: &std::path::Path,
+) -> (
+    png::OutputInfo,
+    Vec<u8>,
+    bool,
+    Option<png::SourceChromaticities>,
+) {
+    let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(path).unwrap()));
+    let mut reader = decoder.read_info().unwrap();
+    let mut buffer = vec![0u8; reader.output_buffer_size()];
+    let info = reader.next_frame(&mut buffer).unwrap();
+    buffer.truncate(info.buffer_size());
+    let srgb = reader.info().srgb.is_some();
+    let chrm = reader.info().source_chromaticities;
+    (info, buffer, srgb, chrm)
+}
+
+#[test]
+fn parallel_png_writer_decodes_to_the_sequential_writers_samples() {
+    use prism_post::io::png::write_png_sequential;
+    // Odd sizes, 1×1, one strip, many strips (641×413 at 16 bits: 68 rows per strip),
+    // rows longer than a strip (50 000 px), and a 1-pixel-wide column of several strips.
+    for (w, h) in [
+        (1, 1),
+        (3, 2),
+        (37, 23),
+        (641, 413),
+        (50_000, 3),
+        (1, 100_003),
+    ] {
+        let pixels: Vec<[f32; 3]> = (0..w * h)
+            .map(|i| {
+                let t = (i as f32 * 0.618_034).fract();
+                let v = 10f32.powf(-4.0 + 5.0 * t);
+                match i % 97 {
+                    13 => [f32::NAN, -1.0, f32::INFINITY],
+                    _ => [v, v * t, (1.0 - t) * 0.8],
+                }
+            })
+            .collect();
+        for space in [RgbColorSpace::srgb(), RgbColorSpace::rec2020()] {
+            let img = Image::new(w, h, pixels.clone(), space.clone()).unwrap();
+            for depth in [PngBitDepth::Eight, PngBitDepth::Sixteen] {
+                let (fast, reference) = (scratch("parallel.png"), scratch("sequential.png"));
+                write_png(&fast, &img, depth).unwrap();
+                write_png_sequential(&reference, &img, depth).unwrap();
+                let (info, samples, srgb, chrm) = decode_png(&fast);
+                let (info_ref, samples_ref, srgb_ref, chrm_ref) = decode_png(&reference);
+                assert_eq!((info.width, info.height), (w as u32, h as u32));
+                assert_eq!(
+                    (info.bit_depth, info.color_type),
+                    (info_ref.bit_depth, info_ref.color_type)
+                );
+                assert!(samples == samples_ref, "{w}×{h} {depth:?} {}", space.name);
+                assert_eq!((srgb, chrm), (srgb_ref, chrm_ref));
+                // Same filter and encoder: no larger than the sequential file but for the
+                // strips' table headers and flushes (this noise-like image is stored
+                // rather than deflated wherever deflate would enlarge it: per strip here,
+                // for the whole image in the `png` crate).
+                let size = |p: &PathBuf| std::fs::metadata(p).unwrap().len() as f64;
+                let strips = 1.0 + (samples.len() as f64 / 262_144.0).ceil();
+                assert!(
+                    size(&fast) <= size(&reference) + 70.0 * strips,
+                    "{w}×{h}: {} vs {} bytes",
+                    size(&fast),
+                    size(&reference)
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn parallel_png_writer_keeps_file_sizes_of_smooth_images() {
+    use prism_post::io::png::write_png_sequential;
+    // A smooth HDR gradient with texture (deflate shrinks it): same filter and encoder,
+    // so the sizes differ only by the strips' 53-byte table headers and 4–5 byte flushes.
+    let (w, h) = (1000, 300);
+    let pixels = (0..w * h)
+        .map(|i| {
+            let (x, y) = ((i % w) as f32 / w as f32, (i / w) as f32 / h as f32);
+            let v = 10f32.powf(-3.0 + 4.0 * x) * (0.5 + 0.5 * (20.0 * y).sin().abs());
+            [v, v * (0.3 + 0.7 * y), v * (1.0 - 0.6 * x)]
+        })
+        .collect();
+    let img = Image::new(w, h, pixels, RgbColorSpace::srgb()).unwrap();
+    for depth in [PngBitDepth::Eight, PngBitDepth::Sixteen] {
+        let (fast, reference) = (scratch("smooth-par.png"), scratch("smooth-seq.png"));
+        write_png(&fast, &img, depth).unwrap();
+        write_png_sequential(&reference, &img, depth).unwrap();
+        assert!(decode_png(&fast).1 == decode_png(&reference).1);
+        let size = |p: &PathBuf| std::fs::metadata(p).unwrap().len() as f64;
+        let raw = (w * h * 3 * if depth == PngBitDepth::Eight { 1 } else { 2 }) as f64;
+        let strips = raw / 262_144.0 + 1.0;
+        assert!(size(&fast) < 0.9 * raw, "deflate did shrink it");
+        assert!(
+            (size(&fast) - size(&reference)).abs() <= 60.0 * strips,
+            "{depth:?}: {} vs {} bytes",
+            size(&fast),
+            size(&reference)
+        );
+    }
+}
+
 #[test]
 fn spectral_channel_names_follow_the_fichet_2021_layout() {
     assert_eq!(emissive_channel_name(550.0), "S0.550,000000nm");

@@ -9,7 +9,10 @@
 //!   `copy_pass_cpu_ms` and `ratio_to_copy_cpu` are the same in CPU time of all threads
 //!   (medians), which the shared machine's load does not stretch;
 //! - `file_ms`: the whole in-process pipeline `tonemap_file` from a float EXR to a 16-bit
-//!   PNG (read, operator, gamut clip, encode, write), with its stage breakdown.
+//!   PNG (read, operator, gamut clip, encode, write), with its stage breakdown, and
+//!   `file_cpu_ms`, its CPU time of all threads (median);
+//! - `png_write`: the 16-bit PNG write alone, parallel writer against the `png` crate's
+//!   sequential encoder (wall, CPU of all threads, bytes).
 //!
 //! Prints one JSON object. `bench-post --write-input PATH [WIDTH HEIGHT]` only writes the
 //! synthetic image as a float EXR (for peers: tools/bench-tonemap-pfstmo.sh).
@@ -167,10 +170,10 @@ fn main() {
         all_copies.extend(&copies);
         let copy_ms = median(copies);
         let (compute_cpu_ms, copy_cpu_ms) = (median(times_cpu), median(copies_cpu));
-        let (file_ms, stages) = if with_file {
+        let (file_ms, file_cpu_ms, stages) = if with_file {
             file_pipeline(&input, &dir.join("out.png"), op, file_runs)
         } else {
-            (f64::NAN, serde_json::Value::Null)
+            (f64::NAN, f64::NAN, serde_json::Value::Null)
         };
         operators.insert(
             op.name().to_string(),
@@ -183,10 +186,16 @@ fn main() {
                 "copy_pass_cpu_ms": copy_cpu_ms,
                 "ratio_to_copy_cpu": compute_cpu_ms / copy_cpu_ms,
                 "file_ms": file_ms,
+                "file_cpu_ms": file_cpu_ms,
                 "file_stages_ms": stages,
             }),
         );
     }
+    let png_write = if with_file {
+        png_write_times(&image, &dir, file_runs)
+    } else {
+        serde_json::Value::Null
+    };
     let _ = std::fs::remove_dir_all(&dir);
     let out = serde_json::json!({
         "width": w,
@@ -196,8 +205,44 @@ fn main() {
         "threads": rayon::current_num_threads(),
         "copy_pass_ms": median(all_copies),
         "operators": operators,
+        "png_write": png_write,
     });
     println!("{}", serde_json::to_string_pretty(&out).unwrap());
+}
+
+/// 16-bit PNG write of the reinhard02-mapped image: the parallel writer
+/// (`io::png::write_png`) against the `png` crate's sequential encoder
+/// (`write_png_sequential`), wall and CPU time of all threads (medians), and file bytes.
+fn png_write_times(image: &Image, dir: &Path, runs: usize) -> serde_json::Value {
+    use prism_post::io::png::{write_png, write_png_sequential, PngBitDepth};
+    let mapped = ToneOperator::Reinhard02
+        .apply(image, &ToneParams::default())
+        .unwrap()
+        .image;
+    let path = dir.join("write.png");
+    let mut result = serde_json::Map::new();
+    type Writer = fn(&Path, &Image, PngBitDepth) -> prism_post::Result<()>;
+    for (name, write) in [
+        ("parallel", write_png as Writer),
+        ("sequential", write_png_sequential as Writer),
+    ] {
+        let (mut wall, mut cpu) = (Vec::new(), Vec::new());
+        for _ in 0..runs.max(3) {
+            let (t, c) = (Instant::now(), process_cpu_ms());
+            write(&path, &mapped, PngBitDepth::Sixteen).unwrap();
+            wall.push(t.elapsed().as_secs_f64() * 1e3);
+            cpu.push(process_cpu_ms() - c);
+        }
+        result.insert(
+            name.to_string(),
+            serde_json::json!({
+                "wall_ms": median(wall),
+                "cpu_ms": median(cpu),
+                "bytes": std::fs::metadata(&path).unwrap().len(),
+            }),
+        );
+    }
+    serde_json::Value::Object(result)
 }
 
 fn is_local(op: ToneOperator) -> bool {
@@ -207,21 +252,32 @@ fn is_local(op: ToneOperator) -> bool {
     )
 }
 
-/// Median wall time of `tonemap_file` (EXR → PNG) and the stages of the median run.
+/// Median wall time of `tonemap_file` (EXR → PNG), median CPU time of all threads, and
+/// the stages of the median run.
 fn file_pipeline(
     input: &Path,
     output: &Path,
     op: ToneOperator,
     runs: usize,
-) -> (f64, serde_json::Value) {
+) -> (f64, f64, serde_json::Value) {
     let options = TonemapOptions {
         operator: OperatorChoice::One(op),
         ..Default::default()
     };
+    let mut cpu = Vec::with_capacity(runs);
     let mut reports: Vec<_> = (0..runs)
-        .map(|_| tonemap_file(input, output, &options).unwrap().timings)
+        .map(|_| {
+            let c = process_cpu_ms();
+            let timings = tonemap_file(input, output, &options).unwrap().timings;
+            cpu.push(process_cpu_ms() - c);
+            timings
+        })
         .collect();
     reports.sort_by(|a, b| a.total_ms.total_cmp(&b.total_ms));
-    let median = &reports[runs / 2];
-    (median.total_ms, serde_json::to_value(median).unwrap())
+    let middle = &reports[runs / 2];
+    (
+        middle.total_ms,
+        median(cpu),
+        serde_json::to_value(middle).unwrap(),
+    )
 }

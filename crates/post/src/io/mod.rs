@@ -8,6 +8,7 @@ pub mod png;
 pub mod quantise;
 pub mod rgbe;
 pub mod spectral_exr;
+mod zlib_strips;
 
 use std::fs::File;
 use std::io::{BufWriter, Write};

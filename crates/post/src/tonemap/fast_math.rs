@@ -2,19 +2,29 @@
 //! of tone operators: the library `ln`/`powf` are calls the compiler cannot inline or
 //! vectorise, and cost 5–20 ns each, several times the memory time of a pixel.
 //!
-//! - [`log2`]: x = 2^e · m with m ∈ [√½, √2); log2 m = (2 / ln 2) · atanh t,
-//!   t = (m − 1)/(m + 1) ∈ [−0.1716, 0.1716], by the odd series t + t³/3 + … + t⁹/9
-//!   (truncation ≤ 2.9 · 0.1716¹¹/11 ≈ 1e-9). Measured: |error| ≤ 3e-7 absolute plus half
-//!   an ulp of the result (|log2 x| · 2⁻²⁴) over the normal f32 range (tested). Subnormal and zero
-//!   inputs are treated as the smallest normal (log2 = −126); the callers never pass them
-//!   where it matters (δ-offset logs, positive luminances).
-//! - [`exp2`]: x = n + f, n = round(x), f ∈ [−½, ½]; 2^f by its Taylor series to degree 7
-//!   in f · ln 2 (truncation ≤ 0.347⁸/8! ≈ 5e-9 relative), times 2^n built in the exponent
-//!   bits. Measured relative error ≤ 3e-7 (tested). x is clamped to [−126, 127]: results
-//!   below 2^−126 become 2^−126 (≈ 1.2e-38), above 2^127 (≈ 1.7e38) become 2^127.
+//! Both are polynomials without a division (a vector division costs as much as the rest
+//! of a log on the CPUs measured, docs/post.md), near-minimax polynomials fitted by
+//! tools/bench-post/fit_fast_math.py (Lawson's reweighted least squares on Chebyshev
+//! nodes, coefficients rounded to f32) and evaluated by Horner's rule:
 //!
-//! With both, powf(x, y) = exp2(y log2 x) has relative error ≈ ln 2 · |y log2 x| · 3e-7 +
-//! 3e-7: 1e-5 for |y log2 x| ≤ 45, i.e. far below one 16-bit display code (1.5e-5).
+//! - [`log2`]: x = 2^e · m with m ∈ [√½, √2), u = m − 1 ∈ [−0.293, 0.414];
+//!   log2(1 + u) ≈ u · q(u), q of degree 7 (f32 fit error 9.4e-8). Measured: |error|
+//!   ≤ 7e-8 absolute plus half an ulp of the result (|log2 x| · 2⁻²⁴) over the normal f32
+//!   range (the test asserts 1.5e-7). Subnormal and zero inputs are treated as the smallest normal
+//!   (log2 = −126); the callers never pass them where it matters (δ-offset logs, positive
+//!   luminances).
+//! - [`exp2`]: x = n + f, n = round(x), f ∈ [−½, ½]; 2^f ≈ 1 + f · r(f), r of degree 4
+//!   (fit error 1.9e-7 relative in f32), times 2^n built in the exponent bits. Measured
+//!   relative error ≤ 1.9e-7 (the test asserts 3e-7). x is clamped to [−126, 127]:
+//!   results below 2^−126 become 2^−126 (≈ 1.2e-38), above 2^127 (≈ 1.7e38) become 2^127.
+//!
+//! (Until 2026-11-22 log2 used the atanh series in t = (m − 1)/(m + 1), one division per
+//! log, and exp2 a degree-7 Taylor series. The polynomials are as accurate or better;
+//! on the shared benchmark machine drago03 and tumblin-rushmeier measured the same speed
+//! within noise, agx (9 logs/exps per pixel) 5–10 % faster: docs/post.md.)
+//!
+//! With both, powf(x, y) = exp2(y log2 x) has relative error ≈ ln 2 · |y log2 x| · 2e-7 +
+//! 3e-7: 1e-5 for |y log2 x| ≤ 60, i.e. far below one 16-bit display code (1.5e-5).
 
 const SQRT_HALF_BITS: u32 = 0x3f35_04f3; // √½ as f32 bits
 
@@ -30,53 +40,39 @@ fn reduce(x: f32) -> (f32, f32) {
     (e, m)
 }
 
-/// e + log2 m from t = (m − 1)/(m + 1): 2/ln 2 · (t + t³/3 + t⁵/5 + t⁷/7 + t⁹/9).
-#[inline(always)]
-fn series(e: f32, t: f32) -> f32 {
-    let t2 = t * t;
-    let p = 1.0 / 9.0;
-    let p = p * t2 + 1.0 / 7.0;
-    let p = p * t2 + 1.0 / 5.0;
-    let p = p * t2 + 1.0 / 3.0;
-    let p = p * t2 + 1.0;
-    e + (2.0 * std::f32::consts::LOG2_E) * t * p
-}
-
 /// log2 of a positive finite f32 (see the module text for accuracy).
 #[inline(always)]
+#[allow(clippy::excessive_precision)] // the fitted f32 coefficients, printed in full
 pub fn log2(x: f32) -> f32 {
     let (e, m) = reduce(x);
-    series(e, (m - 1.0) / (m + 1.0))
+    let u = m - 1.0;
+    let q = -0.145_741_06;
+    let q = q * u + 0.236_889_03;
+    let q = q * u - 0.250_069_65;
+    let q = q * u + 0.286_707_67;
+    let q = q * u - 0.360_087_2;
+    let q = q * u + 0.480_939_45;
+    let q = q * u - 0.721_357_17;
+    let q = q * u + 1.442_694_8;
+    e + u * q
 }
 
-/// (log2 a, log2 b) with one division instead of two — a vector division costs about as
-/// much as the rest of a log: the quotients t = (m − 1)/(m + 1) of [`log2`] are
-/// n_a · d_b · r and n_b · d_a · r with r = 1/(d_a d_b) (d = m + 1 ∈ [1.7, 2.5], so nothing
-/// overflows). Four roundings instead of one on t (|t| ≤ 0.172): ≤ 5e-8 more absolute
-/// error on the result, within the same stated accuracy as [`log2`] (tested).
+/// (log2 a, log2 b). (Once a way to share one division between two logs; [`log2`] needs
+/// none now.)
 #[inline(always)]
 pub fn log2_pair(a: f32, b: f32) -> (f32, f32) {
-    let (ea, ma) = reduce(a);
-    let (eb, mb) = reduce(b);
-    let (na, da) = (ma - 1.0, ma + 1.0);
-    let (nb, db) = (mb - 1.0, mb + 1.0);
-    let r = 1.0 / (da * db);
-    (series(ea, na * db * r), series(eb, nb * da * r))
+    (log2(a), log2(b))
 }
 
-/// (log2 x, 1/y) with one division instead of two, as [`log2_pair`]: t = n · y · r and
-/// 1/y = d · r with r = 1/(d y), d = m + 1 ∈ [1.7, 2.5] (for a normal y ≥ 1.2e-38 and
-/// y ≤ 1e38 nothing under- or overflows). For curves of the form log(…) / L.
+/// (log2 x, 1/y), for curves of the form log(…) / L.
 #[inline(always)]
 pub fn log2_and_recip(x: f32, y: f32) -> (f32, f32) {
-    let (e, m) = reduce(x);
-    let (n, d) = (m - 1.0, m + 1.0);
-    let r = 1.0 / (d * y);
-    (series(e, n * y * r), d * r)
+    (log2(x), 1.0 / y)
 }
 
 /// 2^x (see the module text for accuracy and range).
 #[inline(always)]
+#[allow(clippy::approx_constant)] // 0.693147 is the fitted coefficient, not ln 2 (0.6931472)
 pub fn exp2(x: f32) -> f32 {
     let x = x.clamp(-126.0, 127.0);
     // n = round(x) (half away from zero), written as LLVM lowers `round` with SSE4.1:
@@ -91,16 +87,14 @@ pub fn exp2(x: f32) -> f32 {
     // SAFETY: t is finite and |t| < 128, inside i32's range.
     let ni: i32 = unsafe { t.to_int_unchecked() };
     let n = ni as f32;
-    let f = (x - n) * std::f32::consts::LN_2;
-    // e^f, Taylor to degree 7 (Horner).
-    let p = 1.0 / 5040.0;
-    let p = p * f + 1.0 / 720.0;
-    let p = p * f + 1.0 / 120.0;
-    let p = p * f + 1.0 / 24.0;
-    let p = p * f + 1.0 / 6.0;
-    let p = p * f + 0.5;
-    let p = p * f + 1.0;
-    let p = p * f + 1.0;
+    let f = x - n;
+    // 2^f = 1 + f · r(f) on [−½, ½] (module text).
+    let r = 0.001_326_472;
+    let r = r * f + 0.009_671_513;
+    let r = r * f + 0.055_507_34;
+    let r = r * f + 0.240_222_42;
+    let r = r * f + 0.693_147;
+    let p = r * f + 1.0;
     let scale = f32::from_bits(((ni + 127) as u32) << 23);
     p * scale
 }
@@ -142,7 +136,8 @@ mod tests {
             worst_log = worst_log.max(err);
             x *= 1.000_37;
         }
-        assert!(worst_log <= 3e-7, "log2 error {worst_log}");
+        eprintln!("log2: worst error beyond half an ulp {worst_log:e}");
+        assert!(worst_log <= 1.5e-7, "log2 error {worst_log}");
         // The pair, with partners across the whole range (a prime stride through it).
         let mut worst_pair = 0.0f64;
         let mut x = 1.2e-38f32;
@@ -186,6 +181,7 @@ mod tests {
             worst_exp = worst_exp.max((exp2(y) as f64 / want - 1.0).abs());
             y += 0.000_731;
         }
+        eprintln!("exp2: worst relative error {worst_exp:e}");
         assert!(worst_exp <= 3e-7, "exp2 error {worst_exp}");
         assert_eq!(exp2(-1000.0), f32::MIN_POSITIVE);
         assert!(exp2(1000.0).is_finite());

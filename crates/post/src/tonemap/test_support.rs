@@ -76,3 +76,34 @@ pub fn assert_monotone_within(
         }
     }
 }
+
+/// A 1-row sRGB image of `n` pixels: a grey ramp and three tinted ramps (one channel
+/// dominant each), values spanning 1e-4 … 1e5 relative, interleaved.
+pub fn sweep_image(n: usize) -> Image {
+    let tints = [
+        [1.0f32, 1.0, 1.0],
+        [1.0, 0.3, 0.05],
+        [0.1, 1.0, 0.4],
+        [0.2, 0.25, 1.0],
+    ];
+    let pixels = (0..n)
+        .map(|i| {
+            let v = 10f32.powf(-4.0 + 9.0 * i as f32 / (n - 1) as f32);
+            tints[i % 4].map(|t| t * v)
+        })
+        .collect();
+    Image::new(n, 1, pixels, RgbColorSpace::srgb()).unwrap()
+}
+
+/// Largest difference, in 16-bit sRGB code values (codes of 1/65535), between displayed
+/// (clipped to [0, 1] and sRGB-encoded) linear values `got` and references `want`: what
+/// changes in a 16-bit PNG (less than one code: at most some values at half-code ties
+/// round the other way).
+pub fn max_code_error_16(got: &[[f32; 3]], want: &[[f64; 3]]) -> f64 {
+    let srgb = RgbColorSpace::srgb().transfer;
+    let code = |v: f64| srgb.encode(v.clamp(0.0, 1.0)) * 65535.0;
+    got.iter()
+        .zip(want)
+        .flat_map(|(g, w)| (0..3).map(move |c| (code(g[c] as f64) - code(w[c])).abs()))
+        .fold(0.0, f64::max)
+}
