@@ -150,20 +150,6 @@ impl Lafortune {
             let frame = Frame::from_z(lobe.axis(wo).normalize());
             frame.from_local(sample_power_cosine(u, lobe.exponent))
         };
-        if wi.z <= 0.0 {
-            return None;
-        }
-        let pdf = self.pdf(wo, wi, mode);
-        if pdf.is_nan() || pdf <= 0.0 {
-            return None;
-        }
-        Some(BsdfSample {
-            wi,
-            f: self.eval(wo, wi, mode),
-            pdf,
-            specular: false,
-            transmission: false,
-            eta: 1.0,
-        })
+        BsdfSample::reflection(wi, self.pdf(wo, wi, mode), || self.eval(wo, wi, mode))
     }
 }

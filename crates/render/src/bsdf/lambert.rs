@@ -42,18 +42,7 @@ impl Lambert {
             return None;
         }
         let wi = sample_cosine_hemisphere(u);
-        let pdf = self.pdf(wo, wi, mode);
-        if pdf <= 0.0 {
-            return None;
-        }
-        Some(BsdfSample {
-            wi,
-            f: self.eval(wo, wi, mode),
-            pdf,
-            specular: false,
-            transmission: false,
-            eta: 1.0,
-        })
+        BsdfSample::reflection(wi, self.pdf(wo, wi, mode), || self.eval(wo, wi, mode))
     }
 }
 

@@ -88,6 +88,24 @@ pub struct BsdfSample {
 }
 
 impl BsdfSample {
+    /// A non-specular reflection sample in direction `wi` with solid-angle `pdf`; `None`
+    /// when `wi` is below the surface or the pdf is zero or NaN (the caller's `f` is then
+    /// not evaluated).
+    #[inline]
+    pub fn reflection(wi: Vec3A, pdf: f32, f: impl FnOnce() -> SampledSpectrum) -> Option<Self> {
+        if wi.z <= 0.0 || pdf.is_nan() || pdf <= 0.0 {
+            return None;
+        }
+        Some(BsdfSample {
+            wi,
+            f: f(),
+            pdf,
+            specular: false,
+            transmission: false,
+            eta: 1.0,
+        })
+    }
+
     /// f·|cos θᵢ|/pdf, the throughput factor.
     #[inline]
     pub fn weight(&self) -> SampledSpectrum {

@@ -109,20 +109,6 @@ impl Ward {
             }
             reflect(wo, h)
         };
-        if wi.z <= 0.0 {
-            return None;
-        }
-        let pdf = self.pdf(wo, wi, mode);
-        if pdf.is_nan() || pdf <= 0.0 {
-            return None;
-        }
-        Some(BsdfSample {
-            wi,
-            f: self.eval(wo, wi, mode),
-            pdf,
-            specular: false,
-            transmission: false,
-            eta: 1.0,
-        })
+        BsdfSample::reflection(wi, self.pdf(wo, wi, mode), || self.eval(wo, wi, mode))
     }
 }
