@@ -20,6 +20,7 @@ use glam::{DVec3, Vec2, Vec3A};
 use prism_scene::photometric::{IntensityDistribution, PhotometryType};
 use prism_spectrum::{SampledWavelengths, Spectrum};
 
+use super::point::point_emitter_sample;
 use super::{LightSample, LightSampleContext};
 
 /// The distribution in the luminaire's frame, ready to evaluate.
@@ -235,24 +236,9 @@ impl GoniometricLight {
         _u: Vec2,
         wavelengths: &SampledWavelengths,
     ) -> Option<LightSample> {
-        let to = self.position_m - ctx.p;
-        let d2 = to.length_squared();
-        if d2 <= 0.0 || !d2.is_finite() {
-            return None;
-        }
-        let d = d2.sqrt();
-        let wi = to / d;
-        let cd = self.table_candela(-wi.as_dvec3()) as f32;
-        if cd <= 0.0 {
-            return None;
-        }
-        Some(LightSample {
-            wi,
-            radiance: self.spectrum.eval(wavelengths) * (cd / d2),
-            pdf: 1.0,
-            p_light: self.position_m,
-            distance_m: d,
-            delta: true,
+        point_emitter_sample(ctx, self.position_m, |out| {
+            let cd = self.table_candela(out.as_dvec3()) as f32;
+            (cd > 0.0).then(|| self.spectrum.eval(wavelengths) * cd)
         })
     }
 

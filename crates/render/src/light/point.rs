@@ -2,7 +2,7 @@
 //! irradiance at distance d on a surface facing it is I/d² (inverse-square law).
 
 use glam::{Vec2, Vec3A};
-use prism_spectrum::{SampledWavelengths, Spectrum};
+use prism_spectrum::{SampledSpectrum, SampledWavelengths, Spectrum};
 
 use super::{LightSample, LightSampleContext};
 
@@ -22,19 +22,8 @@ impl PointLight {
         _u: Vec2,
         wavelengths: &SampledWavelengths,
     ) -> Option<LightSample> {
-        let to = self.position_m - ctx.p;
-        let d2 = to.length_squared();
-        if d2 <= 0.0 || !d2.is_finite() {
-            return None;
-        }
-        let d = d2.sqrt();
-        Some(LightSample {
-            wi: to / d,
-            radiance: self.intensity.eval(wavelengths) * (1.0 / d2),
-            pdf: 1.0,
-            p_light: self.position_m,
-            distance_m: d,
-            delta: true,
+        point_emitter_sample(ctx, self.position_m, |_| {
+            Some(self.intensity.eval(wavelengths))
         })
     }
 
@@ -42,6 +31,33 @@ impl PointLight {
     pub fn power_w(&self) -> f64 {
         4.0 * std::f64::consts::PI * integrate_nm(&self.intensity)
     }
+}
+
+/// The light sample of a point emitter at `position_m` seen from `ctx`: `intensity(ω)`
+/// gives I(λ) in W·sr⁻¹·nm⁻¹ along the emitted direction ω (unit, from the light to the
+/// receiver), or `None` where it is zero; the radiance is I/d² (inverse-square law) with
+/// a Dirac pdf of 1. `None` at zero or non-finite distance.
+#[inline]
+pub(crate) fn point_emitter_sample(
+    ctx: &LightSampleContext,
+    position_m: Vec3A,
+    intensity: impl FnOnce(Vec3A) -> Option<SampledSpectrum>,
+) -> Option<LightSample> {
+    let to = position_m - ctx.p;
+    let d2 = to.length_squared();
+    if d2 <= 0.0 || !d2.is_finite() {
+        return None;
+    }
+    let d = d2.sqrt();
+    let wi = to / d;
+    Some(LightSample {
+        wi,
+        radiance: intensity(-wi)? * (1.0 / d2),
+        pdf: 1.0,
+        p_light: position_m,
+        distance_m: d,
+        delta: true,
+    })
 }
 
 /// ∫ S(λ) dλ over 360–830 nm at 1 nm (trapezoid), for light powers.

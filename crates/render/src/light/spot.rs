@@ -15,7 +15,7 @@ use std::f64::consts::PI;
 use glam::{Vec2, Vec3A};
 use prism_spectrum::{SampledWavelengths, Spectrum};
 
-use super::point::integrate_nm;
+use super::point::{integrate_nm, point_emitter_sample};
 use super::{LightSample, LightSampleContext};
 
 #[derive(Clone, Debug, PartialEq)]
@@ -81,24 +81,9 @@ impl SpotLight {
         _u: Vec2,
         wavelengths: &SampledWavelengths,
     ) -> Option<LightSample> {
-        let to = self.position_m - ctx.p;
-        let d2 = to.length_squared();
-        if d2 <= 0.0 || !d2.is_finite() {
-            return None;
-        }
-        let d = d2.sqrt();
-        let wi = to / d;
-        let falloff = self.falloff((-wi).dot(self.axis));
-        if falloff <= 0.0 {
-            return None;
-        }
-        Some(LightSample {
-            wi,
-            radiance: self.intensity.eval(wavelengths) * (falloff / d2),
-            pdf: 1.0,
-            p_light: self.position_m,
-            distance_m: d,
-            delta: true,
+        point_emitter_sample(ctx, self.position_m, |out| {
+            let falloff = self.falloff(out.dot(self.axis));
+            (falloff > 0.0).then(|| self.intensity.eval(wavelengths) * falloff)
         })
     }
 
