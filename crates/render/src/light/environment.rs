@@ -58,6 +58,16 @@ pub fn equirect_direction(uv: Vec2) -> Vec3A {
 /// The image coordinates (u, v) ∈ [0, 1)×[0, 1] of a local unit direction.
 #[inline]
 pub fn equirect_uv(d: Vec3A) -> Vec2 {
+    Vec2::new(
+        azimuth_fraction(d),
+        d.y.clamp(-1.0, 1.0).acos() * (1.0 / PI),
+    )
+}
+
+/// The azimuth of a unit direction about +y as a fraction of a turn in [0, 1), 0 towards
+/// −z and increasing towards +x (the u of the equirectangular and equal-area sphere maps).
+#[inline]
+pub fn azimuth_fraction(d: Vec3A) -> f32 {
     let mut u = d.x.atan2(-d.z) * (0.5 / PI);
     if u < 0.0 {
         u += 1.0;
@@ -65,7 +75,7 @@ pub fn equirect_uv(d: Vec3A) -> Vec2 {
     if u >= 1.0 {
         u = 0.0;
     }
-    Vec2::new(u, d.y.clamp(-1.0, 1.0).acos() * (1.0 / PI))
+    u
 }
 
 /// The rotation (or rotation with mirror) in a scene transform: its linear part divided by

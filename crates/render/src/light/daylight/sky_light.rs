@@ -22,6 +22,7 @@ use std::f32::consts::PI;
 use glam::{Vec2, Vec3A};
 use prism_spectrum::{SampledSpectrum, SampledWavelengths, Spectrum};
 
+use super::super::environment::azimuth_fraction;
 use super::super::piecewise_constant::PiecewiseConstant2D;
 use super::super::scene_sphere::SceneSphere;
 use super::super::{LightSample, LightSampleContext};
@@ -77,14 +78,7 @@ pub fn sphere_direction(uv: Vec2) -> Vec3A {
 /// (u, v) of a unit direction.
 #[inline]
 pub fn sphere_uv(d: Vec3A) -> Vec2 {
-    let mut u = d.x.atan2(-d.z) * (0.5 / PI);
-    if u < 0.0 {
-        u += 1.0;
-    }
-    if u >= 1.0 {
-        u = 0.0;
-    }
-    Vec2::new(u, ((1.0 - d.y) * 0.5).clamp(0.0, 1.0))
+    Vec2::new(azimuth_fraction(d), ((1.0 - d.y) * 0.5).clamp(0.0, 1.0))
 }
 
 impl DaylightSkyLight {
