@@ -2,20 +2,8 @@
 //! of the right size that a `merl` material renders; a wrong material name or an
 //! unwritable output is a clear error.
 
-use std::path::Path;
-use std::process::{Command, Output};
-
-fn prism(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_prism"))
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .args(args)
-        .output()
-        .expect("prism runs")
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
+mod support;
+use support::{prism, s};
 
 #[test]
 fn merl_export_writes_a_table_that_renders() {

@@ -2,12 +2,14 @@
 //! and on a plain Radiance HDR without absolute scale.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
 use prism_post::image::Image;
 use prism_post::io::{read_image, write_image};
 use prism_spectrum::rgb_space::RgbColorSpace;
 use serde_json::Value;
+
+mod support;
+use support::prism;
 
 const OPERATORS: [&str; 15] = [
     "linear",
@@ -26,14 +28,6 @@ const OPERATORS: [&str; 15] = [
     "aces",
     "agx",
 ];
-
-fn prism(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_prism"))
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .args(args)
-        .output()
-        .expect("prism runs")
-}
 
 fn ok(args: &[&str]) -> String {
     let out = prism(args);

@@ -2,27 +2,13 @@
 //! thread counts, output formats and layers, statistics, and error messages.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
 use prism_post::io::exr::read_exr;
 use prism_post::io::spectral_exr::{read_spectral_exr, RADIANCE_UNITS};
 use serde_json::Value;
 
-fn prism(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_prism"))
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .args(args)
-        .output()
-        .expect("prism runs")
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
+mod support;
+use support::{prism, s, stderr};
 
 fn scene_files(dir: &Path, out: &mut Vec<PathBuf>) {
     for entry in std::fs::read_dir(dir).unwrap() {

@@ -1,0 +1,30 @@
+//! Shared by the end-to-end tests that run the `prism` binary: each test crate declares
+//! `mod support;` and uses what it needs.
+#![allow(dead_code)]
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+/// Runs the `prism` binary with `args` from the repository root.
+pub fn prism(args: &[&str]) -> Output {
+    prism_in(Path::new(env!("CARGO_MANIFEST_DIR")), args)
+}
+
+/// Runs the `prism` binary with `args` from `dir`.
+pub fn prism_in(dir: &Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_prism"))
+        .current_dir(dir)
+        .args(args)
+        .output()
+        .expect("prism runs")
+}
+
+/// The standard error of a finished run, as text.
+pub fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// A UTF-8 path as a command-line argument.
+pub fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
