@@ -204,6 +204,17 @@ impl RenderPlan {
                     },
                 );
                 choose(
+                    "thin glazing in shadow rays",
+                    on_off(scene.has_glazing),
+                    if scene.has_glazing {
+                        "a `thin_dielectric` pane is present: shadow rays cross it with its \
+                         transmittance (1 − R)/(1 + R), paths pass it straight as a null event"
+                            .into()
+                    } else {
+                        "no `thin_dielectric` material".into()
+                    },
+                );
+                choose(
                     "Russian roulette",
                     if p.rr_depth < p.max_depth {
                         format!("after {} bounces", p.rr_depth)

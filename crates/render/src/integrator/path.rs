@@ -470,12 +470,26 @@ impl PathTracer {
                     illumination_direct = None;
                 }
             }
-            specular_bounce = bs.specular;
-            prev_bsdf_pdf = bs.pdf;
-            if bs.transmission {
-                eta_scale *= bs.eta * bs.eta;
+            // Straight through thin glazing: a null event (material/glazing.rs), so the MIS
+            // state of the vertex before the pane stays and it is not a bounce.
+            let glazing_pass = bs.transmission
+                && scene.has_glazing
+                && material.thin_glazing(wavelengths).is_some();
+            if glazing_pass {
+                depth -= 1;
+                counters.bounces -= 1;
+                pass_throughs += 1;
+                if pass_throughs > 256 {
+                    break;
+                }
+            } else {
+                specular_bounce = bs.specular;
+                prev_bsdf_pdf = bs.pdf;
+                if bs.transmission {
+                    eta_scale *= bs.eta * bs.eta;
+                }
+                prev_ctx = ctx;
             }
-            prev_ctx = ctx;
             ray = Ray::spawn(vertex.si.p, wi_world.normalize());
             current_differential = None;
             counters.rays += 1;
@@ -546,8 +560,8 @@ impl PathTracer {
             return (zero, zero);
         }
         counters.rays += 1;
-        let transmittance = self.transmittance(scene, vertex.si.p, &ls, counters);
-        if transmittance <= 0.0 {
+        let transmittance = self.transmittance(scene, vertex.si.p, &ls, wavelengths, counters);
+        if transmittance.is_black() {
             return (zero, zero);
         }
         let light_pdf = pmf * ls.pdf;
@@ -557,50 +571,63 @@ impl PathTracer {
             let bsdf_pdf = bsdf.pdf(vertex.wo_local, wi_local, TransportMode::Radiance);
             mis_weight(self.mis, light_pdf, bsdf_pdf)
         };
-        let direct = f * ls.radiance * (w * transmittance / light_pdf);
-        let white = ls.radiance * (white_cos * transmittance / light_pdf);
+        let arriving = ls.radiance * transmittance;
+        let direct = f * arriving * (w / light_pdf);
+        let white = arriving * (white_cos / light_pdf);
         (direct, white)
     }
 
-    /// Fraction of light that reaches `p` from the light sample: 0 or 1, unless the scene
-    /// has opacity masks (the plan's choice, `RenderScene::has_masks`): then each masked
-    /// surface on the way multiplies by 1 − α (exact, no extra noise).
+    /// Fraction of light that reaches `p` from the light sample, per lane: 0 or 1, unless
+    /// the scene has opacity masks or thin glazing (the plan's choices,
+    /// `RenderScene::has_masks`/`has_glazing`): then each masked surface on the way
+    /// multiplies by 1 − α and each pane by its straight-through transmittance
+    /// (material/glazing.rs) — exact, no extra noise.
     #[inline]
     pub(crate) fn transmittance(
         &self,
         scene: &RenderScene,
         p: Vec3A,
         ls: &crate::light::LightSample,
+        wavelengths: &SampledWavelengths,
         counters: &mut PathCounters,
-    ) -> f32 {
+    ) -> SampledSpectrum {
         let mut shadow = if ls.distance_m.is_finite() {
             Ray::spawn_to(p, ls.p_light)
         } else {
             Ray::spawn(p, ls.wi)
         };
-        if !scene.has_masks {
+        let zero = SampledSpectrum::splat(0.0);
+        if !scene.has_masks && !scene.has_glazing {
             return if scene.geometry.occluded(&shadow) {
-                0.0
+                zero
             } else {
-                1.0
+                SampledSpectrum::splat(1.0)
             };
         }
-        let mut transmittance = 1.0f32;
+        let mut transmittance = SampledSpectrum::splat(1.0);
         let offset = shadow.t_min;
         for _ in 0..256 {
             let Some(hit) = scene.geometry.intersect(&shadow) else {
                 return transmittance;
             };
             let si = scene.geometry.shading_interaction(&shadow, &hit);
-            let opacity = scene.material(si.material_id).opacity_at(&si);
-            transmittance *= 1.0 - opacity;
-            if transmittance <= 0.0 {
-                return 0.0;
+            let material = scene.material(si.material_id);
+            // What crosses this surface: the mask's holes (1 − α), plus what a pane lets
+            // through straight of the light that meets it (α · T').
+            let opacity = material.opacity_at(&si);
+            let mut through = SampledSpectrum::splat(1.0 - opacity);
+            if let Some(pane) = material.thin_glazing(wavelengths) {
+                let cos = ls.wi.dot(si.n_shading).abs();
+                through += pane.transmittance(cos) * opacity;
+            }
+            transmittance *= through;
+            if transmittance.is_black() {
+                return zero;
             }
             counters.rays += 1;
-            // Continue past the masked surface, keeping the same end point.
+            // Continue past the surface, keeping the same end point.
             shadow.t_min = hit.t * (1.0 + 1e-5) + offset;
         }
-        0.0
+        zero
     }
 }

@@ -22,6 +22,7 @@
 //! in `bsdf`/`opacity_at`; the `NormalMap` and `BumpMap` wrappers change the hit's shading
 //! normal in `apply_shading_maps`, which the integrator calls before it builds the frame.
 
+mod glazing;
 pub mod ior;
 pub mod library;
 pub mod merl_export;

@@ -51,6 +51,9 @@ pub struct RenderScene {
     pub splat: bool,
     /// Some material has an opacity mask: shadow rays must look through masked surfaces.
     pub has_masks: bool,
+    /// Some material is a thin glazing pane (`thin_dielectric`): shadow rays cross it with
+    /// its transmittance, and paths pass it straight as a null event (material/glazing.rs).
+    pub has_glazing: bool,
     /// Some material reads a texture: hits compute ray differentials, from the camera ray
     /// or (after a bounce) from this camera footprint. `None` when no material is textured.
     pub texture_footprint: Option<crate::texture::CameraFootprint>,
@@ -81,6 +84,7 @@ impl RenderScene {
         let materials = build_materials(scene)?;
         let lights = LightSet::build(scene, &geometry)?;
         let has_masks = materials.iter().any(|m| m.has_mask());
+        let has_glazing = materials.iter().any(|m| m.has_thin_glazing());
         let texture_footprint = if materials.iter().any(|m| m.has_textures()) {
             // A camera without a ray at the film centre (a circular fisheye's corner is
             // never the centre) would leave textures unfiltered: point lookups.
@@ -116,6 +120,7 @@ impl RenderScene {
             materials,
             lights,
             has_masks,
+            has_glazing,
             texture_footprint,
             splat: scene.film.reconstruction == prism_scene::Reconstruction::Splat,
         })

@@ -61,15 +61,15 @@ pub fn sample_illuminance_lx(
             let cos = ls.wi.dot(n);
             if cos > 0.0 && ls.pdf > 0.0 && !ls.radiance.is_black() {
                 counters.rays += 1;
-                let t = tracer.transmittance(scene, p, &ls, counters);
-                if t > 0.0 {
+                let t = tracer.transmittance(scene, p, &ls, &wavelengths, counters);
+                if !t.is_black() {
                     let light_pdf = pmf * ls.pdf;
                     let w = if ls.delta {
                         1.0
                     } else {
                         mis_weight(tracer.mis, light_pdf, cos * FRAC_1_PI)
                     };
-                    let c = ls.radiance * (cos * w * t / (light_pdf * n_light as f32));
+                    let c = ls.radiance * t * (cos * w / (light_pdf * n_light as f32));
                     if c.has_non_finite() {
                         counters.non_finite_contributions += 1;
                     } else {
