@@ -25,42 +25,24 @@
 use glam::{DMat3, DVec3};
 use prism_spectrum::colorimetry::{LAB_EPSILON, LAB_KAPPA};
 
+use super::fast_f64::{atan2_deg, cbrt, exp, sin_small};
+
+/// Pixels per block of the vectorised loops ([`lab_block`], [`delta_e_2000_block`]).
+pub const BLOCK: usize = 64;
+
 /// 25⁷ (Sharma eqs. 4 and 21).
 const POW25_7: f64 = 6_103_515_625.0;
-
-/// Cube root of x ≥ 0 (finite; 0 gives 0). A first guess from the exponent bits (the f64
-/// bit pattern divided by 3, re-biased: ≈ 3 % error), then two steps of Halley's method
-/// y ← y (y³ + 2x) / (2y³ + x), which triples the number of correct digits per step
-/// (3e-2 → 1e-5 → 1e-14), and a Newton step.
-#[inline(always)]
-pub fn cbrt(x: f64) -> f64 {
-    // Guess: bits(x)/3 + B is piecewise linear in log x and off by < 1/32 (the bias of
-    // fdlibm/musl's cbrt, B1 = 715094163 = (1023 − 1023/3 − 0.03306235651) · 2²⁰, placed
-    // in the high word).
-    const B: u64 = 715_094_163 << 32;
-    let x_pos = x.max(f64::MIN_POSITIVE);
-    let mut y = f64::from_bits(x_pos.to_bits() / 3 + B);
-    for _ in 0..2 {
-        let y3 = y * y * y;
-        y *= (y3 + 2.0 * x_pos) / (2.0 * y3 + x_pos);
-    }
-    // Two Halley steps leave up to ~30 ulp (rounding inside the ratio); one Newton step on
-    // the residual, y ← y − (y³ − x) / (3y²), brings it to the rounding of y³.
-    y -= (y * y * y - x_pos) / (3.0 * y * y);
-    if x > 0.0 {
-        y
-    } else {
-        0.0
-    }
-}
 
 /// CIELAB's f(t) (CIE 15:2018 eq. 8.5): ∛t above ε, the linear segment below.
 #[inline(always)]
 fn lab_f(t: f64) -> f64 {
+    // Both branches computed, then selected (vectorisable); cbrt's argument kept > ε.
+    let root = cbrt(t.max(LAB_EPSILON));
+    let linear = (LAB_KAPPA * t + 16.0) / 116.0;
     if t > LAB_EPSILON {
-        cbrt(t)
+        root
     } else {
-        (LAB_KAPPA * t + 16.0) / 116.0
+        linear
     }
 }
 
@@ -95,6 +77,80 @@ impl LabConverter {
     }
 }
 
+/// One block of colours in planes (structure of arrays), the layout the vectorised loops
+/// read: L*, a*, b*, C*ab.
+#[derive(Clone, Copy, Debug)]
+pub struct LabBlock {
+    pub l: [f64; BLOCK],
+    pub a: [f64; BLOCK],
+    pub b: [f64; BLOCK],
+    pub c: [f64; BLOCK],
+}
+
+impl Default for LabBlock {
+    fn default() -> Self {
+        Self {
+            l: [0.0; BLOCK],
+            a: [0.0; BLOCK],
+            b: [0.0; BLOCK],
+            c: [0.0; BLOCK],
+        }
+    }
+}
+
+/// CIELAB (with chroma) of a block of sanitised RGB pixels given as planes.
+#[inline(always)]
+pub fn lab_block(conv: &LabConverter, rgb: &[[f64; BLOCK]; 3], out: &mut LabBlock) {
+    let m = conv.rgb_to_xyz_over_white.to_cols_array();
+    for i in 0..BLOCK {
+        let (r, g, b) = (rgb[0][i], rgb[1][i], rgb[2][i]);
+        // Column-major m: row k is (m[k], m[3 + k], m[6 + k]); the same sums as DMat3 * DVec3.
+        let tx = m[0] * r + m[3] * g + m[6] * b;
+        let ty = m[1] * r + m[4] * g + m[7] * b;
+        let tz = m[2] * r + m[5] * g + m[8] * b;
+        let (fx, fy, fz) = (lab_f(tx), lab_f(ty), lab_f(tz));
+        let (a, bb) = (500.0 * (fx - fy), 200.0 * (fy - fz));
+        out.l[i] = 116.0 * fy - 16.0;
+        out.a[i] = a;
+        out.b[i] = bb;
+        out.c[i] = (a * a + bb * bb).sqrt();
+    }
+}
+
+/// ΔE₀₀ of a block of colour pairs (the first `len` lanes); each lane as
+/// [`delta_e_2000`], the rare reference-implementation lanes (hues exactly 180° apart)
+/// patched after the vectorised loop.
+#[inline(always)]
+pub fn delta_e_2000_block(p: &LabBlock, q: &LabBlock, len: usize, out: &mut [f64; BLOCK]) {
+    let mut fallback = [false; BLOCK];
+    for i in 0..BLOCK {
+        let (de, ok) = delta_e_2000_lane(
+            LabC {
+                l: p.l[i],
+                a: p.a[i],
+                b: p.b[i],
+                c: p.c[i],
+            },
+            LabC {
+                l: q.l[i],
+                a: q.a[i],
+                b: q.b[i],
+                c: q.c[i],
+            },
+        );
+        out[i] = de;
+        fallback[i] = !ok;
+    }
+    for i in 0..len {
+        if fallback[i] {
+            out[i] = prism_spectrum::colorimetry::delta_e_2000(
+                DVec3::new(p.l[i], p.a[i], p.b[i]),
+                DVec3::new(q.l[i], q.a[i], q.b[i]),
+            );
+        }
+    }
+}
+
 /// A colour prepared for CIEDE2000: L*, a*, b* and C*ab = √(a*² + b*²) (computed once for
 /// a reference pixel that is compared many times).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -117,10 +173,11 @@ impl LabC {
     }
 }
 
-/// Outcome of [`delta_e_2000_fast`]: ΔE₀₀, or `None` for hues exactly 180° apart (the caller
-/// uses the reference implementation there).
+/// ΔE₀₀ of one pair without branches (selects only, so that a loop of it vectorises), and
+/// `false` for hues exactly 180° apart, where the value is not CIEDE2000's and the caller
+/// must use the reference implementation.
 #[inline(always)]
-pub fn delta_e_2000_fast(p: LabC, q: LabC) -> Option<f64> {
+pub fn delta_e_2000_lane(p: LabC, q: LabC) -> (f64, bool) {
     // Eqs. 2–7: a′ rescaling and C′.
     let c_bar = 0.5 * (p.c + q.c);
     let c_bar2 = c_bar * c_bar;
@@ -138,9 +195,7 @@ pub fn delta_e_2000_fast(p: LabC, q: LabC) -> Option<f64> {
     let cross = a1 * b2 - b1 * a2;
     let dot = a1 * a2 + b1 * b2;
     let product = c1 * c2;
-    if product != 0.0 && cross == 0.0 && dot < 0.0 {
-        return None;
-    }
+    let ok = !(product != 0.0 && cross == 0.0 && dot < 0.0);
 
     // Eqs. 8–11: ΔL′, ΔC′, ΔH′ (chord form; √(C′₁C′₂) = 0 gives ΔH′ = 0 when a chroma is 0).
     let dl = q.l - p.l;
@@ -159,16 +214,11 @@ pub fn delta_e_2000_fast(p: LabC, q: LabC) -> Option<f64> {
     // Eqs. 12–14: means; h̄′ is the direction of u₁ + u₂ (0° when both chromas are 0).
     let l_bar = 0.5 * (p.l + q.l);
     let cp_bar = 0.5 * (c1 + c2);
-    let (mut wx, wy) = (u1x + u2x, u1y + u2y);
-    if wx == 0.0 && wy == 0.0 {
-        wx = 1.0;
-    }
+    let (wx, wy) = (u1x + u2x, u1y + u2y);
+    let wx = if wx == 0.0 && wy == 0.0 { 1.0 } else { wx };
     let inv_w = 1.0 / (wx * wx + wy * wy).sqrt();
     let (ch, sh) = (wx * inv_w, wy * inv_w);
-    let mut h_bar_deg = wy.atan2(wx).to_degrees();
-    if h_bar_deg < 0.0 {
-        h_bar_deg += 360.0;
-    }
+    let h_bar_deg = atan2_deg(wy, wx);
 
     // Eq. 15: T from cos/sin of h̄′ by the double- and triple-angle identities.
     const COS30: f64 = 0.866_025_403_784_438_6; // cos 30°
@@ -188,7 +238,7 @@ pub fn delta_e_2000_fast(p: LabC, q: LabC) -> Option<f64> {
 
     // Eqs. 16–22.
     let z = (h_bar_deg - 275.0) / 25.0;
-    let d_theta_deg = 30.0 * (-(z * z)).exp();
+    let d_theta_deg = 30.0 * exp(-(z * z));
     let cp_bar2 = cp_bar * cp_bar;
     let cp_bar7 = cp_bar2 * cp_bar2 * cp_bar2 * cp_bar;
     let r_c = 2.0 * (cp_bar7 / (cp_bar7 + POW25_7)).sqrt();
@@ -196,26 +246,28 @@ pub fn delta_e_2000_fast(p: LabC, q: LabC) -> Option<f64> {
     let s_l = 1.0 + 0.015 * l50 / (20.0 + l50).sqrt();
     let s_c = 1.0 + 0.045 * cp_bar;
     let s_h = 1.0 + 0.015 * cp_bar * t;
-    let r_t = -(2.0 * d_theta_deg).to_radians().sin() * r_c;
+    // 2Δθ ≤ 60°: within sin_small's range.
+    let r_t = -sin_small((2.0 * d_theta_deg).to_radians()) * r_c;
 
     // Eq. 23 (kL = kC = kH = 1).
     let tl = dl / s_l;
     let tc = dc / s_c;
     let th = d_big_h / s_h;
-    Some(
+    (
         (tl * tl + tc * tc + th * th + r_t * tc * th)
             .max(0.0)
             .sqrt(),
+        ok,
     )
 }
 
-/// ΔE₀₀ of two prepared colours: [`delta_e_2000_fast`], or the reference implementation
+/// ΔE₀₀ of two prepared colours: [`delta_e_2000_lane`], or the reference implementation
 /// for hues exactly 180° apart.
 #[inline(always)]
 pub fn delta_e_2000(p: LabC, q: LabC) -> f64 {
-    match delta_e_2000_fast(p, q) {
-        Some(de) => de,
-        None => prism_spectrum::colorimetry::delta_e_2000(
+    match delta_e_2000_lane(p, q) {
+        (de, true) => de,
+        _ => prism_spectrum::colorimetry::delta_e_2000(
             DVec3::new(p.l, p.a, p.b),
             DVec3::new(q.l, q.a, q.b),
         ),
@@ -238,26 +290,6 @@ mod tests {
             z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
             ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
         }
-    }
-
-    #[test]
-    fn cbrt_is_within_two_ulp_of_the_library() {
-        let mut worst = 0.0f64;
-        // Log-uniform over the range CIELAB sees (ε … 1e30) plus exact cubes and powers of 2.
-        let mut rng = Rng(7);
-        let mut xs: Vec<f64> = (0..200_000)
-            .map(|_| 10f64.powf(-2.1 + 32.0 * rng.next()))
-            .collect();
-        xs.extend((-20..20).map(|k| 8f64.powi(k)));
-        xs.extend((-60..60).map(|k| 2f64.powi(k)));
-        xs.extend([LAB_EPSILON, 1.0, 27.0, 1e-300, 1e300, f64::MAX]);
-        for x in xs {
-            let (ours, lib) = (cbrt(x), x.cbrt());
-            let ulp = lib * f64::EPSILON;
-            worst = worst.max((ours - lib).abs() / ulp);
-        }
-        assert!(worst <= 2.0, "worst {worst} ulp");
-        assert_eq!(cbrt(0.0), 0.0);
     }
 
     #[test]
@@ -334,6 +366,44 @@ mod tests {
             0.0
         );
         println!("worst |ΔE00 - reference| {worst:.2e}");
+    }
+
+    #[test]
+    fn the_block_form_equals_the_pair_form_lane_by_lane() {
+        // Blocks mixing random pairs, zero chromas and exactly opposite hues (the lanes
+        // patched with the reference implementation), with a short last block.
+        let mut rng = Rng(5);
+        for len in [BLOCK, 17] {
+            let (mut p, mut q) = (LabBlock::default(), LabBlock::default());
+            let mut pairs = Vec::new();
+            for i in 0..BLOCK {
+                let a = [
+                    100.0 * rng.next(),
+                    80.0 * rng.next() - 40.0,
+                    80.0 * rng.next() - 40.0,
+                ];
+                let b = match i % 4 {
+                    0 => [a[0], -a[1], -a[2]],   // opposite hue
+                    1 => [a[0] + 1.0, 0.0, 0.0], // zero chroma
+                    _ => [a[0] + rng.next(), a[1] + rng.next(), a[2] - rng.next()],
+                };
+                for (block, lab) in [(&mut p, a), (&mut q, b)] {
+                    let c = LabC::new(lab);
+                    (block.l[i], block.a[i], block.b[i], block.c[i]) = (c.l, c.a, c.b, c.c);
+                }
+                pairs.push((a, b));
+            }
+            let mut out = [f64::NAN; BLOCK];
+            delta_e_2000_block(&p, &q, len, &mut out);
+            for (i, (a, b)) in pairs.iter().enumerate().take(len) {
+                assert_eq!(
+                    out[i],
+                    delta_e_2000(LabC::new(*a), LabC::new(*b)),
+                    "lane {i}"
+                );
+                check(*a, *b);
+            }
+        }
     }
 
     #[test]

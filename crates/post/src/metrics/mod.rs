@@ -19,6 +19,7 @@
 //! reference formulas to rounding, tested there).
 
 pub mod ciede2000;
+mod fast_f64;
 mod prepared;
 mod ssim;
 
