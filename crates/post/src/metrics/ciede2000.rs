@@ -100,6 +100,8 @@ impl Default for LabBlock {
 }
 
 /// CIELAB (with chroma) of a block of sanitised RGB pixels given as planes.
+// Indexing all planes by one lane index is the form the loop vectoriser recognises.
+#[allow(clippy::needless_range_loop)]
 #[inline(always)]
 pub fn lab_block(conv: &LabConverter, rgb: &[[f64; BLOCK]; 3], out: &mut LabBlock) {
     let m = conv.rgb_to_xyz_over_white.to_cols_array();

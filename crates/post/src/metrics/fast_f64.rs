@@ -106,8 +106,10 @@ pub fn atan2_deg(y: f64, x: f64) -> f64 {
 #[inline(always)]
 pub fn exp(x: f64) -> f64 {
     const MAGIC: f64 = 6_755_399_441_055_744.0; // 1.5 · 2⁵²
-    const LN2_HI: f64 = 6.931_471_803_691_238_164_90e-1;
-    const LN2_LO: f64 = 1.908_214_929_270_587_700_02e-10;
+                                                // fdlibm's split: ln 2 = LN2_HI + LN2_LO, LN2_HI with 32 trailing zero bits so n · LN2_HI
+                                                // is exact for |n| < 2¹¹.
+    const LN2_HI: f64 = f64::from_bits(0x3fe6_2e42_fee0_0000);
+    const LN2_LO: f64 = f64::from_bits(0x3dea_39ef_3579_3c76);
     let x = x.clamp(-700.0, 700.0);
     let k = x * std::f64::consts::LOG2_E + MAGIC;
     let n = k - MAGIC;
