@@ -18,6 +18,7 @@ use std::time::Instant;
 use clap::Args;
 use glam::UVec2;
 use prism_post::io::write_image;
+use prism_post::metrics::PreparedReference;
 use prism_post::Image;
 use prism_render::integrator::DEFAULT_TILE_SIZE_PX;
 use prism_render::{render, RenderScene, RenderSettings, SamplerKind};
@@ -405,6 +406,11 @@ pub fn run(args: &ConvergeArgs) -> Result<(), String> {
         }
     };
 
+    // What every checkpoint compares against, computed once: clean pixels, CIELAB, peaks.
+    let prepare_start = Instant::now();
+    let prepared = PreparedReference::new(&reference);
+    let reference_prepare_s = prepare_start.elapsed().as_secs_f64();
+
     let mut curves = Vec::new();
     let mut methods_json = Vec::new();
     for (index, (method, integrator)) in methods.iter().zip(&integrators).enumerate() {
@@ -417,8 +423,7 @@ pub fn run(args: &ConvergeArgs) -> Result<(), String> {
             spectral_bins: None,
             illumination_aov: false,
         };
-        let run: MethodRun =
-            run_method(&scene, &settings, method.plan, &reference, &budget, &pool)?;
+        let run: MethodRun = run_method(&scene, &settings, method.plan, &prepared, &budget, &pool)?;
         let last = run
             .checkpoints
             .last()
@@ -522,6 +527,9 @@ pub fn run(args: &ConvergeArgs) -> Result<(), String> {
                 "film_copies_wall_s": run.snapshot_wall_s,
                 "metric_cpu_fraction_of_render_cpu": last.cpu_time_s.map(|c| run.metric_cpu_s / c),
                 "film_copies_fraction_of_render_wall": run.snapshot_wall_s / run.render_wall_s,
+                "metric_cpu_per_checkpoint_s": run.metric_cpu_s / run.checkpoints.len() as f64,
+                // Once per run, before the first method (shared by all methods).
+                "reference_prepare_wall_s": reference_prepare_s,
             },
             "stats": {
                 "samples": run.stats.samples,

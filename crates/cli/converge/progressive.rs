@@ -2,8 +2,10 @@
 //!
 //! A method renders in passes; pass k adds the samples [sₖ₋₁, sₖ) of every pixel's sequence
 //! (`render_pass`), so the film after pass k is the film of one render of sₖ samples. After
-//! each pass the render thread only clones the film's sums (a memcpy) and hands the copy
-//! to a metric thread, which normalises it and computes the errors against the reference
+//! each pass the render thread only copies the film's colour sums (a memcpy,
+//! `Film::colour_snapshot`) and hands the copy to a metric thread, which normalises it and
+//! computes the errors against the reference — prepared once (`PreparedReference`: clean
+//! pixels, CIELAB, peaks), so a checkpoint costs one fused pass over the test pixels —
 //! while the next pass renders (issue 6: "checkpoints must not stall the render"). The
 //! metric thread runs its own one-thread rayon pool, so it never queues work on the render
 //! threads.
@@ -18,7 +20,7 @@ use std::sync::mpsc;
 use std::time::Instant;
 
 use prism_bandwidth::SamplePlan;
-use prism_post::metrics::{compare_with, CompareOptions, Comparison};
+use prism_post::metrics::{CompareOptions, Comparison, PreparedReference};
 use prism_post::Image;
 use prism_render::{film_for, render_pass, Film, RenderScene, RenderSettings, RenderStats};
 use prism_spectrum::rgb_space::RgbColorSpace;
@@ -135,11 +137,11 @@ fn thread_cpu_s() -> Option<f64> {
 
 /// The film's image as prism-post sees it (linear Rec.709, like `prism render`'s EXR).
 pub fn film_to_image(film: &Film) -> Result<Image, String> {
-    let image = film.finish();
+    let resolution = film.resolution();
     Image::new(
-        image.width as usize,
-        image.height as usize,
-        image.rgb,
+        resolution.x as usize,
+        resolution.y as usize,
+        film.rgb(),
         RgbColorSpace::srgb(),
     )
     .map_err(|e| e.to_string())
@@ -161,12 +163,13 @@ fn add_stats(a: &mut RenderStats, b: &RenderStats) {
 }
 
 /// Renders `scene` progressively on `pool` and measures the error of every checkpoint
-/// against `reference` on a separate thread.
+/// against `reference` (prepared once for all checkpoints and methods) on a separate
+/// thread.
 pub fn run_method(
     scene: &RenderScene,
     settings: &RenderSettings,
     plan: PlanKind,
-    reference: &Image,
+    reference: &PreparedReference,
     budget: &Budget,
     pool: &rayon::ThreadPool,
 ) -> Result<MethodRun, String> {
@@ -185,7 +188,8 @@ pub fn run_method(
             for (time_s, cpu_time_s, spp, samples, film) in receiver {
                 let comparison = metric_pool.install(|| {
                     let image = film_to_image(&film)?;
-                    compare_with(&image, reference, &CompareOptions { ssim: false })
+                    reference
+                        .compare(&image, &CompareOptions { ssim: false })
                         .map_err(|e| e.to_string())
                 })?;
                 // The pool's worker did the work; the metric thread itself only waited.
@@ -229,7 +233,7 @@ pub fn run_method(
             spp_done = target;
             k += 1;
             let copy_start = Instant::now();
-            let snapshot = film.clone();
+            let snapshot = film.colour_snapshot();
             snapshot_wall_s += copy_start.elapsed().as_secs_f64();
             render_wall_s = start.elapsed().as_secs_f64();
             render_cpu_s = match (cpu_start, process_cpu_s()) {

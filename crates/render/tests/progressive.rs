@@ -82,6 +82,10 @@ fn passes_continuing_the_sequence_equal_one_render_of_the_total() {
                 single.aov("spp.Y").unwrap().values,
                 passes.aov("spp.Y").unwrap().values
             );
+            // What converge's render thread copies at a checkpoint (the colour sums only)
+            // gives the finished image's RGB bit for bit.
+            assert_eq!(film.rgb(), passes.rgb);
+            assert_eq!(film.colour_snapshot().rgb(), passes.rgb);
             // And a pass that repeats samples [0, 8) instead is a different image.
             let mut film = film_for(&scene, &settings);
             for _ in 0..2 {

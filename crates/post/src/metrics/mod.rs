@@ -12,17 +12,23 @@
 //! - ΔE2000: XYZ → CIELAB against the white of the reference's colour space with Y
 //!   normalised so that RGB (1, 1, 1) (Y = 1) is the reference white (L* = 100), i.e.
 //!   display-referred relative colorimetry; mean and 95th percentile (nearest rank).
+//!
+//! All metrics come from one fused pass over the pixels against a [`PreparedReference`]
+//! (the reference's clean pixels, CIELAB and peaks, computed once), with CIELAB and
+//! CIEDE2000 in the arithmetic-heavy form of [`ciede2000`] (equal to prism-spectrum's
+//! reference formulas to rounding, tested there).
 
+pub mod ciede2000;
+mod fast_f64;
+mod prepared;
 mod ssim;
 
-use prism_spectrum::colorimetry::{delta_e_2000, xyz_to_lab};
-use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::error::{PostError, Result};
+use crate::error::Result;
 use crate::image::Image;
-use crate::io::convert_pixels;
-use crate::tonemap::pixels::{sanitise, CHUNK};
+
+pub use prepared::PreparedReference;
 
 /// ε of relMSE.
 pub const RELMSE_EPSILON: f64 = 1e-2;
@@ -52,14 +58,6 @@ pub struct Comparison {
     pub non_finite_pixels: u64,
 }
 
-fn clean(pixels: &[[f32; 3]]) -> (Vec<[f32; 3]>, u64) {
-    let bad = pixels
-        .par_iter()
-        .filter(|p| !p.iter().all(|c| c.is_finite()))
-        .count() as u64;
-    (pixels.par_iter().map(|p| sanitise(*p, 1.0)).collect(), bad)
-}
-
 /// Which of the costlier metrics `compare_with` computes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct CompareOptions {
@@ -80,115 +78,14 @@ pub fn compare(test: &Image, reference: &Image) -> Result<Comparison> {
 }
 
 /// `compare` with a choice of metrics (`ssim` is `None` when not asked for); every metric
-/// it computes is the one `compare` computes, bit for bit.
+/// it computes is the one `compare` computes, bit for bit. To compare many images against
+/// one reference, prepare it once ([`PreparedReference`]): the same code, the same numbers.
 pub fn compare_with(
     test: &Image,
     reference: &Image,
     options: &CompareOptions,
 ) -> Result<Comparison> {
-    if (test.width(), test.height()) != (reference.width(), reference.height()) {
-        return Err(PostError::invalid(format!(
-            "image sizes differ: {}×{} vs reference {}×{}",
-            test.width(),
-            test.height(),
-            reference.width(),
-            reference.height()
-        )));
-    }
-    let mut a = test.pixels().to_vec();
-    convert_pixels(&mut a, &test.color_space, &reference.color_space);
-    let (a, bad_a) = clean(&a);
-    let (b, bad_b) = clean(reference.pixels());
-    let n = a.len() as f64;
-
-    // Squared and relative squared errors, f64 sums per chunk.
-    let (se, rel) = a
-        .par_chunks(CHUNK)
-        .zip(b.par_chunks(CHUNK))
-        .map(|(ca, cb)| {
-            let (mut se, mut rel) = ([0.0f64; 3], [0.0f64; 3]);
-            for (p, q) in ca.iter().zip(cb) {
-                for c in 0..3 {
-                    let d = (p[c] - q[c]) as f64;
-                    let r = q[c] as f64;
-                    se[c] += d * d;
-                    rel[c] += d * d / (r * r + RELMSE_EPSILON);
-                }
-            }
-            (se, rel)
-        })
-        .reduce(
-            || ([0.0; 3], [0.0; 3]),
-            |x, y| {
-                (
-                    [x.0[0] + y.0[0], x.0[1] + y.0[1], x.0[2] + y.0[2]],
-                    [x.1[0] + y.1[0], x.1[1] + y.1[1], x.1[2] + y.1[2]],
-                )
-            },
-        );
-    let mse_c = se.map(|s| s / n);
-    let relmse_c = rel.map(|s| s / n);
-    let peak_c: [f64; 3] =
-        [0, 1, 2].map(|c| b.par_iter().map(|p| p[c] as f64).reduce(|| 0.0, f64::max));
-    let peak = peak_c.iter().cloned().fold(0.0, f64::max);
-    let psnr = |peak: f64, mse: f64| 10.0 * (peak * peak / mse).log10();
-    let mse = mse_c.iter().sum::<f64>() / 3.0;
-
-    let space = &reference.color_space;
-    let w = crate::image::luminance_weights(space);
-    let luminance = |p: &[[f32; 3]]| -> Vec<f32> {
-        p.par_iter()
-            .map(|c| w[0] * c[0] + w[1] * c[1] + w[2] * c[2])
-            .collect()
-    };
-    let ssim = if options.ssim {
-        let (ya, yb) = (luminance(&a), luminance(&b));
-        let y_peak = yb.par_iter().cloned().reduce(|| 0.0, f32::max) as f64;
-        ssim::ssim(
-            &ya,
-            &yb,
-            test.width(),
-            test.height(),
-            if y_peak > 0.0 { y_peak } else { 1.0 },
-        )
-    } else {
-        None
-    };
-
-    let m = space.rgb_to_xyz;
-    let white = space.white_xyz();
-    let lab = |p: [f32; 3]| {
-        let xyz = m * glam::DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64);
-        xyz_to_lab(xyz, white)
-    };
-    let mut de: Vec<f64> = a
-        .par_iter()
-        .zip(b.par_iter())
-        .map(|(p, q)| delta_e_2000(lab(*p), lab(*q)))
-        .collect();
-    let de_mean = de.par_iter().sum::<f64>() / n;
-    let rank = ((0.95 * de.len() as f64).ceil() as usize).clamp(1, de.len()) - 1;
-    let (_, p95, _) = de.select_nth_unstable_by(rank, f64::total_cmp);
-    let de_p95 = *p95;
-
-    Ok(Comparison {
-        width: test.width(),
-        height: test.height(),
-        mse,
-        rmse: mse.sqrt(),
-        relmse: relmse_c.iter().sum::<f64>() / 3.0,
-        psnr_db: psnr(peak, mse),
-        ssim,
-        delta_e2000_mean: de_mean,
-        delta_e2000_p95: de_p95,
-        per_channel: PerChannel {
-            mse: mse_c,
-            rmse: mse_c.map(f64::sqrt),
-            relmse: relmse_c,
-            psnr_db: [0, 1, 2].map(|c| psnr(peak_c[c], mse_c[c])),
-        },
-        non_finite_pixels: bad_a + bad_b,
-    })
+    PreparedReference::new(reference).compare(test, options)
 }
 
 #[cfg(test)]

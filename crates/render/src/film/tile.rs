@@ -66,6 +66,18 @@ pub(crate) struct PixelAccum {
     pub own_weight_sum: f64,
 }
 
+impl PixelAccum {
+    /// Σ wᵢ XYZᵢ / Σ wᵢ (black when no weight landed).
+    #[inline]
+    pub fn mean_xyz(&self) -> DVec3 {
+        if self.weight_sum != 0.0 {
+            self.xyz_sum / self.weight_sum
+        } else {
+            DVec3::ZERO
+        }
+    }
+}
+
 /// AOV sums of one pixel (plain sample means, not filter-weighted, so negative filter
 /// lobes cannot push a depth or normal outside its range).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
