@@ -99,21 +99,40 @@ impl CurveTable {
     /// Replaces every `v[j]` by the tabulated curve at `v[j]`.
     #[inline]
     pub fn eval_slice(&self, v: &mut [f32]) {
+        self.eval_slice_clamped::<false>(v, f32::NEG_INFINITY, f32::INFINITY);
+    }
+
+    /// Replaces every `v[j]` by the tabulated curve at `v[j]` clamped to [lo, hi] (NaN
+    /// to lo), or by 0 where `ZERO_BELOW` and `v[j]` is below lo or NaN: the clamp and the
+    /// select in the same pass as the lookup.
+    #[inline]
+    pub fn eval_slice_clamped<const ZERO_BELOW: bool>(&self, v: &mut [f32], lo: f32, hi: f32) {
         #[cfg(target_arch = "x86_64")]
         if super::simd::has_avx2() {
             // SAFETY: the CPU has AVX2 (checked above).
-            unsafe { self.eval_slice_avx2(v) };
+            unsafe { self.eval_slice_avx2::<ZERO_BELOW>(v, lo, hi) };
             return;
         }
         for x in v {
-            *x = self.eval(*x);
+            *x = self.eval_clamped::<ZERO_BELOW>(*x, lo, hi);
         }
     }
 
-    /// [`Self::eval_slice`] on 8 lanes.
+    /// One element of [`Self::eval_slice_clamped`].
+    #[inline(always)]
+    fn eval_clamped<const ZERO_BELOW: bool>(&self, x: f32, lo: f32, hi: f32) -> f32 {
+        let y = self.eval(x.max(lo).min(hi));
+        if ZERO_BELOW && !(x >= lo) {
+            0.0
+        } else {
+            y
+        }
+    }
+
+    /// [`Self::eval_slice_clamped`] on 8 lanes.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    unsafe fn eval_slice_avx2(&self, v: &mut [f32]) {
+    unsafe fn eval_slice_avx2<const ZERO_BELOW: bool>(&self, v: &mut [f32], lo: f32, hi: f32) {
         use std::arch::x86_64::*;
         let base = self.coeffs.as_ptr() as *const f32;
         let first = _mm256_set1_epi32(self.first as i32);
@@ -121,9 +140,13 @@ impl CurveTable {
         let zero = _mm256_setzero_si256();
         let low_mask = _mm256_set1_epi32(LOW_MASK as i32);
         let t_scale = _mm256_set1_ps(T_SCALE);
+        let (lo_v, hi_v) = (_mm256_set1_ps(lo), _mm256_set1_ps(hi));
         let mut chunks = v.chunks_exact_mut(8);
         for chunk in &mut chunks {
-            let x = _mm256_loadu_ps(chunk.as_ptr());
+            let raw = _mm256_loadu_ps(chunk.as_ptr());
+            // maxps returns its second operand for a NaN first one: NaN → lo, as
+            // f32::max in `eval_clamped`.
+            let x = _mm256_min_ps(_mm256_max_ps(raw, lo_v), hi_v);
             let bits = _mm256_castps_si256(x);
             // Logical shift: negative arguments (sign bit set) land above the last
             // segment and are clamped to it, as in `eval`.
@@ -169,10 +192,15 @@ impl CurveTable {
             let p = _mm256_add_ps(c2, _mm256_mul_ps(t, c3));
             let p = _mm256_add_ps(c1, _mm256_mul_ps(t, p));
             let p = _mm256_add_ps(c0, _mm256_mul_ps(t, p));
+            let p = if ZERO_BELOW {
+                _mm256_and_ps(p, _mm256_cmp_ps::<_CMP_GE_OQ>(raw, lo_v))
+            } else {
+                p
+            };
             _mm256_storeu_ps(chunk.as_mut_ptr(), p);
         }
         for x in chunks.into_remainder() {
-            *x = self.eval(*x);
+            *x = self.eval_clamped::<ZERO_BELOW>(*x, lo, hi);
         }
     }
 }
@@ -291,6 +319,37 @@ mod tests {
             assert!(a.is_finite());
         }
         assert_eq!(v[6], 2.0);
+        // Clamped, and zeroed below lo.
+        let src = [
+            0.5f32,
+            1.0,
+            2.5,
+            9.0,
+            f32::NAN,
+            -1.0,
+            3.0,
+            4.0,
+            0.9,
+            5.0,
+            1.5,
+        ];
+        let (mut c, mut z) = (src, src);
+        table.eval_slice_clamped::<false>(&mut c, 1.0, 4.0);
+        table.eval_slice_clamped::<true>(&mut z, 1.0, 4.0);
+        for (k, x) in src.iter().enumerate() {
+            let want = (x.max(1.0).min(4.0)) as f64;
+            assert!((c[k] as f64 - want).abs() < 1e-6, "{x}: {}", c[k]);
+            let want = if *x >= 1.0 { want } else { 0.0 };
+            assert!((z[k] as f64 - want).abs() < 1e-6, "{x}: {}", z[k]);
+            assert_eq!(
+                c[k].to_bits(),
+                table.eval_clamped::<false>(*x, 1.0, 4.0).to_bits()
+            );
+            assert_eq!(
+                z[k].to_bits(),
+                table.eval_clamped::<true>(*x, 1.0, 4.0).to_bits()
+            );
+        }
         assert!((v[7] - 3.0).abs() < 1e-6);
     }
 }
