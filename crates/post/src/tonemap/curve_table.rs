@@ -122,7 +122,7 @@ impl CurveTable {
     #[inline(always)]
     fn eval_clamped<const ZERO_BELOW: bool>(&self, x: f32, lo: f32, hi: f32) -> f32 {
         let y = self.eval(x.max(lo).min(hi));
-        if ZERO_BELOW && !(x >= lo) {
+        if ZERO_BELOW && (x.is_nan() || x < lo) {
             0.0
         } else {
             y
@@ -216,8 +216,7 @@ fn cubic_through(t: &[f64; 4], y: &[f64; 4]) -> [f64; 4] {
     }
     // p(t) = d0 + (t − t0)(d1 + (t − t1)(d2 + (t − t2) d3)), expanded from the inside.
     let mut c = [d[3], 0.0, 0.0, 0.0]; // coefficients of the running polynomial, low first
-    let mut degree = 0;
-    for k in (0..3).rev() {
+    for (degree, k) in (0..3).rev().enumerate() {
         // c ← c · (t − t_k) + d_k
         let mut next = [0.0; 4];
         for j in 0..=degree {
@@ -226,7 +225,6 @@ fn cubic_through(t: &[f64; 4], y: &[f64; 4]) -> [f64; 4] {
         }
         next[0] += d[k];
         c = next;
-        degree += 1;
     }
     c
 }
@@ -337,7 +335,11 @@ mod tests {
         table.eval_slice_clamped::<false>(&mut c, 1.0, 4.0);
         table.eval_slice_clamped::<true>(&mut z, 1.0, 4.0);
         for (k, x) in src.iter().enumerate() {
-            let want = (x.max(1.0).min(4.0)) as f64;
+            let want = if x.is_nan() {
+                1.0
+            } else {
+                x.clamp(1.0, 4.0) as f64
+            };
             assert!((c[k] as f64 - want).abs() < 1e-6, "{x}: {}", c[k]);
             let want = if *x >= 1.0 { want } else { 0.0 };
             assert!((z[k] as f64 - want).abs() < 1e-6, "{x}: {}", z[k]);
