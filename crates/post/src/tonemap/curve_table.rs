@@ -55,12 +55,22 @@ fn value_of_bits(bits: u64) -> f64 {
 }
 
 impl CurveTable {
-    /// Tabulates `f` over the segments holding `lo ≤ x ≤ hi` (0 ≤ lo ≤ hi, both finite;
-    /// `hi` is clamped to the largest finite f32). `f` is evaluated at four points inside
-    /// each segment (never at its ends), in f64.
+    /// Tabulates `f` over the segments holding `lo ≤ x ≤ hi` (`lo` clamped to
+    /// [0, f32::MAX], NaN to 0; `hi` to [lo, f32::MAX], NaN to lo). `f` is evaluated at
+    /// four points inside each segment (never at its ends), in f64.
     pub fn new(lo: f32, hi: f32, f: impl Fn(f64) -> f64) -> CurveTable {
-        let lo = lo.max(0.0);
-        let hi = hi.clamp(lo, f32::MAX);
+        // NaN, negative or infinite bounds never make the table larger than the whole
+        // non-negative f32 range (2^15 segments, 512 KiB).
+        let lo = if lo.is_nan() {
+            0.0
+        } else {
+            lo.clamp(0.0, f32::MAX)
+        };
+        let hi = if hi.is_nan() {
+            lo
+        } else {
+            hi.clamp(lo, f32::MAX)
+        };
         let first = lo.to_bits() >> LOW_BITS;
         let last = hi.to_bits() >> LOW_BITS;
         // Chebyshev nodes of the first kind on [0, 1].
@@ -301,6 +311,8 @@ mod tests {
         let f = |x: f64| x.sqrt();
         // A single segment and a point.
         check(&CurveTable::new(1.0, 1.01, f), 1.0, 1.01, f, 4e-7);
+        assert_eq!(CurveTable::new(f32::NAN, f32::NAN, f).segments(), 1);
+        assert_eq!(CurveTable::new(3.0, 1.0, f).segments(), 1);
         let t = CurveTable::new(2.0, 2.0, f);
         assert_eq!(t.segments(), 1);
         assert!((t.eval(2.0) as f64 - 2f64.sqrt()).abs() < 3e-7);
