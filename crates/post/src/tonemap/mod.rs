@@ -7,6 +7,7 @@
 mod aces;
 mod agx;
 pub mod bilateral_grid;
+pub(crate) mod curve_table;
 mod drago03;
 mod durand02;
 mod exponential;

@@ -44,7 +44,7 @@ const LANES: usize = 8;
 
 /// Pixels per de-interleaved block inside a task (a multiple of [`LANES`]; five planes of
 /// 1 KiB).
-const BLOCK: usize = 256;
+pub(crate) const BLOCK: usize = 256;
 
 /// A luminance curve L ↦ L_d for [`map_luminance`], given as the ratio L_d / L by which
 /// the pixel's colour is scaled: an operator folds the division by L into its own
