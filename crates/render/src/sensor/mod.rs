@@ -291,7 +291,7 @@ fn measure_point(
         } => {
             let mut done = 0u32;
             // At least two samples per replicate before the first standard error.
-            let mut next = min_samples.max(2 * replicates).min(max_samples);
+            let mut next = min_samples.max(16 * replicates).min(max_samples);
             loop {
                 take(&mut stats, done, next);
                 done = next;

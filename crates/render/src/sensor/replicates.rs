@@ -17,15 +17,17 @@
 //! Why: at a sensor the first dimensions (wavelength, the cosine direction, the first
 //! bounce) carry most of the variance, and stratifying them with a (0, m, 2)-net removes
 //! most of it (docs/lighting.md "Speed": ~4× less variance per sample than independent
-//! samples on the furnished-room benchmark). R = 16 keeps 15 degrees of freedom for the
-//! standard error (a t₁₅ statistic: its z-scores have variance 15/13 ≈ 1.15) while each
-//! replicate still holds enough points to stratify.
+//! samples on the furnished-room benchmark). R = 32 keeps 31 degrees of freedom for the
+//! standard error (a t₃₁ statistic: its z-scores have variance 31/29 ≈ 1.07) while each
+//! replicate still holds enough points to stratify (~150 at 1 % on the benchmark; 16
+//! replicates of twice as many points give ~15 % less variance, 8 of four times ~30 %, at
+//! the price of a noisier standard error).
 
 use crate::sampler::{PixelSampler, SamplerKind};
 
 /// Replicates per point (see the module comment). A point with fewer samples than this
 /// uses one sample per replicate: plain Monte Carlo with s²/n.
-pub const SENSOR_REPLICATES: u32 = 16;
+pub const SENSOR_REPLICATES: u32 = 32;
 
 /// The sampler of replicate `r` of a sensor seeded `sensor_seed`.
 pub fn replicate_sampler(sensor_seed: u64, r: u32) -> PixelSampler {
