@@ -201,6 +201,34 @@ mod tests {
     }
 
     #[test]
+    fn sobol_dimension_limit_keeps_leading_dimensions_and_makes_later_ones_independent() {
+        // 64 samples: a stratified dimension puts exactly one in each 1/64 stratum; with the
+        // limit at 1, dimension 0 still does and dimension 1 (independent) does not.
+        let s = PixelSampler::with_kind(SamplerKind::Sobol, 3);
+        let strata = |dim: usize, limit: u32| {
+            let mut hit = [0u32; 64];
+            for i in 0..64 {
+                let mut st = s.stream(UVec2::new(1, 2), i).with_sobol_dimensions(limit);
+                let v = (0..=dim).map(|_| st.get_1d()).last().unwrap();
+                hit[(v * 64.0) as usize] += 1;
+            }
+            hit.iter().all(|&h| h == 1)
+        };
+        assert!(strata(0, 1) && strata(1, SOBOL_DIMENSIONS));
+        assert!(!strata(1, 1));
+        // The leading dimensions are the unlimited stream's.
+        let mut a = s.stream(UVec2::new(1, 2), 9);
+        let mut b = s.stream(UVec2::new(1, 2), 9).with_sobol_dimensions(3);
+        assert_eq!(a.get_1d(), b.get_1d());
+        assert_eq!(a.get_2d(), b.get_2d());
+        // No effect on an independent stream.
+        let ind = PixelSampler::with_kind(SamplerKind::Independent, 3);
+        let mut c = ind.stream(UVec2::ZERO, 4);
+        let mut d = ind.stream(UVec2::ZERO, 4).with_sobol_dimensions(0);
+        assert!((0..40).all(|_| c.get_1d() == d.get_1d()));
+    }
+
+    #[test]
     fn streams_differ_by_pixel_index_and_seed() {
         for kind in KINDS {
             let v = |seed, px: u32, i| {
