@@ -211,7 +211,7 @@ fn z_scores(json: &str, exact: &dyn Fn(&PointReading) -> f64, seeds: u64) -> Vec
 /// freedom (the s.e. comes from R = 32 replicates): 31/29. Tolerances are 4.5 standard
 /// errors of those two statistics (t_ν: E z⁴ = 3ν²/((ν − 2)(ν − 4)), so
 /// Var z² = E z⁴ − (E z²)²). An s.e. taken as s²/n over the scrambled points, which are not
-/// independent, would be too large (z² ≈ 0.2 on the lit room of the benchmark) and fail.
+/// independent, would be too large (z² ≈ 0.5 on the benchmark's furnished room) and fail.
 fn check_z_scores(z: &[f64], what: &str) {
     let n = z.len() as f64;
     let nu = f64::from(SENSOR_REPLICATES - 1);
