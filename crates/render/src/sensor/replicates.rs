@@ -17,11 +17,11 @@
 //! Why: at a sensor the first dimensions (wavelength, the cosine direction, the first
 //! bounce) carry most of the variance, and stratifying them with a (0, m, 2)-net removes
 //! much of it (docs/lighting.md "Speed": 2× less variance per sample than independent
-//! samples on the furnished-room benchmark with 32 replicates, 5× with one long sequence). R = 32 keeps 31 degrees of freedom for the
-//! standard error (a t₃₁ statistic: its z-scores have variance 31/29 ≈ 1.07) while each
-//! replicate still holds enough points to stratify (~150 at 1 % on the benchmark; 16
-//! replicates of twice as many points give ~15 % less variance, 8 of four times ~35 %, at
-//! the price of a noisier standard error).
+//! samples on the furnished-room benchmark with 32 replicates, 5× with one long sequence).
+//! R = 32 keeps 31 degrees of freedom for the standard error (a t₃₁ statistic: its z-scores
+//! have variance 31/29 ≈ 1.07) while each replicate still holds enough points to stratify
+//! (~300 at 1 % on the benchmark; 16 replicates of twice as many points give ~15 % less
+//! variance, 8 of four times ~35 %, at the price of a noisier standard error).
 
 use crate::sampler::{PixelSampler, SamplerKind};
 
