@@ -34,7 +34,9 @@
 //!
 //! **Pass criterion** (as the published validations of Radiance and Iray): every point within
 //! 5 % of the reference and the mean absolute error within 2 %. Each point is measured to a
-//! relative standard error of 1 %. The last column compares with the reference for a
+//! relative standard error of 0.6 % (at 1 % the noise alone adds ~0.8 % to the mean
+//! absolute error, and the glazed cases, whose systematic polarisation difference is
+//! 1–2 %, then pass or fail by the seed). The last column compares with the reference for a
 //! pane whose two surfaces each reflect R = (R_s + R_p)/2 — what a renderer without
 //! polarisation computes — to show where glazed differences come from.
 
@@ -396,7 +398,7 @@ fn scene_json(case: &Case, sky: Sky) -> String {
             "shapes": [{}],
             "lights": [{}],
             "sensors": [{{"type": "points", "name": "floor", "positions_m": [{}],
-                          "normal": [0, 1, 0], "relative_error": 0.01, "min_samples": 4096,
+                          "normal": [0, 1, 0], "relative_error": 0.006, "min_samples": 4096,
                           "max_samples": 2000000}}]}}"#,
         shapes.join(",\n"),
         sky.json(),

@@ -19,8 +19,10 @@ Run (2 threads each, as the issue asks):
   tools/lighting/.venv/bin/python tools/lighting/bench_sensor_grid.py --grid 100 --threads 2
 The Mitsuba part runs in tools/mitsuba/.venv's Python (a subprocess).
 
-Timings are wall-clock seconds of each program's own run (scene loading included), on the
-same machine in one run. Each program is run to a per-point relative standard error of
+Timings are wall-clock seconds and CPU seconds (user + system, all threads and child
+processes) of each program's own run (scene loading included), on the same machine in one
+run; on a shared machine the CPU times are the steadier comparison. Each program is run to a
+per-point relative standard error of
 --target (default 1 %): Prism by its adaptive sensors; Radiance and Mitsuba by a pilot run
 that measures the per-sample variance and then the sample count that reaches the target
 at the grid's median point (reported), whose run is timed.
@@ -31,6 +33,7 @@ import json
 import math
 import os
 import pathlib
+import resource
 import shutil
 import subprocess
 import sys
@@ -47,6 +50,22 @@ INTENSITY = 10.0  # W/sr/nm, flat spectrum
 LIGHT_RADIUS = 0.02  # Radiance's spheres
 RHO = {"floor": 0.3, "wall": 0.5, "ceiling": 0.7, "furniture": 0.4}
 MAX_DEPTH = 8
+
+
+# ----------------------------------------------------------------------------- timing
+
+
+def timed(args, **kw):
+    """subprocess.run(args, **kw) → (completed, wall seconds, CPU seconds of the child and
+    its waited-for descendants, user + system). CPU time is the fairer measure on a shared
+    machine: other jobs stretch wall time but not (much) the CPU a program needs."""
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    t0 = time.perf_counter()
+    out = subprocess.run(args, **kw)
+    wall = time.perf_counter() - t0
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    return out, wall, cpu
 
 
 # ----------------------------------------------------------------------------- geometry
@@ -186,13 +205,22 @@ def run_prism(work, obj, n, block, threads, target, exe):
     }
     sf = work / "prism_scene.json"
     sf.write_text(json.dumps(scene, indent=1))
-    t0 = time.perf_counter()
-    subprocess.run(
+    _, wall, cpu = timed(
         [str(exe), "render", str(sf), "--sensors-only", "--threads", str(threads), "-o", str(work / "prism.exr")],
         check=True,
         capture_output=True,
     )
-    wall = time.perf_counter() - t0
+    # Start-up CPU (scene loading, BVH): the same scene with one sample per point.
+    one = json.loads(json.dumps(scene))
+    one["sensors"][0] = {k: v for k, v in one["sensors"][0].items() if k not in ("relative_error", "min_samples")}
+    one["sensors"][0]["samples"] = 1
+    sf1 = work / "prism_scene_1.json"
+    sf1.write_text(json.dumps(one))
+    _, _, fixed_cpu = timed(
+        [str(exe), "render", str(sf1), "--sensors-only", "--threads", str(threads), "-o", str(work / "prism1.exr")],
+        check=True,
+        capture_output=True,
+    )
     doc = json.loads((work / "prism.sensors.json").read_text())
     k = doc["lx_per_flat_irradiance"]
     pts = doc["sensors"][0]["points"]
@@ -201,6 +229,8 @@ def run_prism(work, obj, n, block, threads, target, exe):
     return {
         "wall_time_s": wall,
         "fixed_time_s": wall - doc["wall_time_s"],
+        "cpu_time_s": cpu,
+        "fixed_cpu_s": fixed_cpu,
         "measure_time_s": doc["wall_time_s"],
         "samples": doc["samples"],
         "E": e,
@@ -264,25 +294,24 @@ def rtrace(oct_path, points, repeats, threads, seed_offset=0):
     for _ in range(repeats):
         for (x, y, z) in points:
             rows.append("%f %f %f 0 1 0\n" % (x, y + 1e-4, z))
-    t0 = time.perf_counter()
-    out = subprocess.run(args, input="".join(rows).encode(), check=True, capture_output=True, env=env)
-    wall = time.perf_counter() - t0
+    out, wall, cpu = timed(args, input="".join(rows).encode(), check=True, capture_output=True, env=env)
     vals = np.array([float(l.split()[1]) for l in out.stdout.decode().strip().splitlines()])
     vals = vals.reshape(repeats, len(points))
-    return vals.mean(0), vals.std(0, ddof=1) / math.sqrt(repeats), wall
+    return vals.mean(0), vals.std(0, ddof=1) / math.sqrt(repeats), wall, cpu
 
 
 def run_radiance(work, tris, points, threads, target):
     oct_path = build_radiance(work, tris)
     # Pilot on a subset: per-path relative variance at the median point.
     sub = points[:: max(1, len(points) // 200)]
-    m, se, _ = rtrace(oct_path, sub, 64, threads)
+    m, se, _, _ = rtrace(oct_path, sub, 64, threads)
     rel_path_sd = np.median(se * math.sqrt(64) / np.maximum(m, 1e-30))
     repeats = int(math.ceil((rel_path_sd / target) ** 2))
-    mean, se, wall = rtrace(oct_path, points, repeats, threads)
+    mean, se, wall, cpu = rtrace(oct_path, points, repeats, threads)
     # Start-up (octree load): one path at one point.
-    _, _, fixed = rtrace(oct_path, points[:1], 2, threads)
-    return {"wall_time_s": wall, "fixed_time_s": fixed, "paths_per_point": repeats, "E": mean, "se": se}
+    _, _, fixed, fixed_cpu = rtrace(oct_path, points[:1], 2, threads)
+    return {"wall_time_s": wall, "fixed_time_s": fixed, "cpu_time_s": cpu, "fixed_cpu_s": fixed_cpu,
+            "paths_per_point": repeats, "E": mean, "se": se}
 
 
 # ----------------------------------------------------------------------------- Mitsuba
@@ -312,14 +341,18 @@ for i, (name, mat, path) in enumerate(cfg["meshes"]):
 for i, p in enumerate(cfg["lights"]):
     scene["l%d" % i] = {"type": "point", "position": p, "intensity": {"type": "rgb", "value": [cfg["I"]] * 3}}
 t0 = time.perf_counter()
+c0 = time.process_time()
 sc = mi.load_dict(scene)
 load = time.perf_counter() - t0
+load_cpu = time.process_time() - c0
 imgs = []
 for k in range(cfg["repeats"]):
     img = mi.render(sc, spp=cfg["spp"], seed=k + 1)
     imgs.append(np.array(img)[:, :, 1])
 wall = time.perf_counter() - t0
-json.dump({"wall_time_s": wall, "load_time_s": load, "images": [i.tolist() for i in imgs]}, open(sys.argv[3], "w"))
+cpu = time.process_time() - c0
+json.dump({"wall_time_s": wall, "load_time_s": load, "cpu_time_s": cpu, "load_cpu_s": load_cpu,
+           "images": [i.tolist() for i in imgs]}, open(sys.argv[3], "w"))
 '''
 
 
@@ -346,7 +379,7 @@ def mitsuba_render(work, meshes, n, block, spp, repeats, threads, llvm):
     )
     out = json.loads((work / "mi_out.json").read_text())
     imgs = np.array(out["images"])  # repeats × n × n; row 0 is the top of the image
-    return imgs, out["wall_time_s"], out["load_time_s"]
+    return imgs, out["wall_time_s"], out["load_time_s"], out["cpu_time_s"], out["load_cpu_s"]
 
 
 def run_mitsuba(work, obj, n, block, threads, target):
@@ -357,17 +390,20 @@ def run_mitsuba(work, obj, n, block, threads, target):
     # The LLVM (vectorised, JIT) variant when it runs here, else the scalar one.
     llvm = True
     try:
-        imgs, _, _ = mitsuba_render(work, meshes, n, block, 16, 8, threads, llvm)
+        imgs = mitsuba_render(work, meshes, n, block, 16, 8, threads, llvm)[0]
     except subprocess.CalledProcessError:
         llvm = False
-        imgs, _, _ = mitsuba_render(work, meshes, n, block, 16, 8, threads, llvm)
+        imgs = mitsuba_render(work, meshes, n, block, 16, 8, threads, llvm)[0]
     # (Pilot above: per-pixel relative spread of 8 independent 16-spp images.)
     m = imgs.mean(0)
     rel = np.median(imgs.std(0, ddof=1) / np.maximum(m, 1e-30))
     spp_total = int(math.ceil(16 * (rel / target) ** 2))
-    repeats = 4
+    # 16 independent renders: the per-pixel s.e. then has 15 degrees of freedom (with 4, its
+    # median over pixels would read ~11 % low — the median of a χ₃-distributed s.e. — and
+    # the time scaled to the target ~20 % short).
+    repeats = 16
     spp = max(1, int(math.ceil(spp_total / repeats)))
-    imgs, wall, load = mitsuba_render(work, meshes, n, block, spp, repeats, threads, llvm)
+    imgs, wall, load, cpu, load_cpu = mitsuba_render(work, meshes, n, block, spp, repeats, threads, llvm)
     radiance = imgs.mean(0)
     se = imgs.std(0, ddof=1) / math.sqrt(repeats)
     # E = π L / ρ; image row r (top first) looks at z: with up = +Z the top row is z = Z.
@@ -379,7 +415,7 @@ def run_mitsuba(work, obj, n, block, threads, target):
     # and, with the camera looking down −Y with up +Z, x grows to the left).
     E = E[::-1, ::-1].reshape(-1)
     se = se[::-1, ::-1].reshape(-1)
-    return {"wall_time_s": wall, "fixed_time_s": load, "spp": spp * repeats, "variant": "llvm_ad_rgb" if llvm else "scalar_rgb", "E": E, "se": se}
+    return {"wall_time_s": wall, "fixed_time_s": load, "cpu_time_s": cpu, "fixed_cpu_s": load_cpu, "spp": spp * repeats, "variant": "llvm_ad_rgb" if llvm else "scalar_rgb", "E": E, "se": se}
 
 
 # ----------------------------------------------------------------------------- main
@@ -468,12 +504,20 @@ def main():
         med = result[name]["median_relative_se"]
         result[name]["whole_grid_time_s"] = fixed + per_points * scale
         result[name]["whole_grid_time_s_at_target"] = fixed + per_points * scale * (med / args.target) ** 2
+        fixed_cpu = max(0.0, min(r["fixed_cpu_s"], r["cpu_time_s"]))
+        result[name]["whole_grid_cpu_s_at_target"] = (
+            fixed_cpu + (r["cpu_time_s"] - fixed_cpu) * scale * (med / args.target) ** 2
+        )
     for name in runs:
         if name != "prism":
             result[f"prism_vs_{name}"] = agreement(runs["prism"], runs[name])
             result[f"prism_speedup_vs_{name}_at_target"] = (
                 result[name]["whole_grid_time_s_at_target"] / result["prism"]["whole_grid_time_s_at_target"]
             )
+            result[f"prism_cpu_speedup_vs_{name}_at_target"] = (
+                result[name]["whole_grid_cpu_s_at_target"] / result["prism"]["whole_grid_cpu_s_at_target"]
+            )
+    result["load_average_1_5_15_min"] = os.getloadavg()
     print(json.dumps(result, indent=2, default=float))
     if args.keep:
         print(f"kept {work}", file=sys.stderr)

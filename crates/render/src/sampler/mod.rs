@@ -45,6 +45,8 @@ pub struct SampleStream {
     /// The sample index with its bits reversed (Sobol only; unused by independent).
     index_reversed: u32,
     dimension: u32,
+    /// Dimensions drawn from Sobol points (Sobol only); later ones are independent.
+    sobol_dimensions: u32,
     kind: SamplerKind,
 }
 
@@ -76,12 +78,14 @@ impl PixelSampler {
                 key: pixel_key,
                 index_reversed: sample_index.reverse_bits(),
                 dimension: 0,
+                sobol_dimensions: SOBOL_DIMENSIONS,
                 kind: SamplerKind::Sobol,
             },
             SamplerKind::Independent => SampleStream {
                 key: independent::sample_key(pixel_key, sample_index),
                 index_reversed: 0,
                 dimension: 0,
+                sobol_dimensions: 0,
                 kind: SamplerKind::Independent,
             },
         }
@@ -94,6 +98,17 @@ impl PixelSampler {
 pub const SOBOL_DIMENSIONS: u32 = 5 + 3 * 8;
 
 impl SampleStream {
+    /// This stream with Sobol points for its first `dimensions` dimensions only (default
+    /// `SOBOL_DIMENSIONS`) and independent values after: for estimators whose variance sits
+    /// in a few leading dimensions, where a scrambled Sobol value (about four hashes) is
+    /// not worth its cost further on. No effect on an independent stream.
+    pub fn with_sobol_dimensions(mut self, dimensions: u32) -> Self {
+        if self.kind == SamplerKind::Sobol {
+            self.sobol_dimensions = dimensions;
+        }
+        self
+    }
+
     /// Independent value for dimensions past `SOBOL_DIMENSIONS` of a Sobol stream.
     #[inline(always)]
     fn sobol_tail(&self) -> u32 {
@@ -111,7 +126,7 @@ impl SampleStream {
     #[inline]
     pub fn get_1d(&mut self) -> f32 {
         let bits = match self.kind {
-            SamplerKind::Sobol if self.dimension >= SOBOL_DIMENSIONS => self.sobol_tail(),
+            SamplerKind::Sobol if self.dimension >= self.sobol_dimensions => self.sobol_tail(),
             SamplerKind::Sobol => {
                 let h = self.dimension_hash();
                 let index = sobol::shuffle_reversed_index(self.index_reversed, h as u32);
@@ -127,7 +142,7 @@ impl SampleStream {
     #[inline]
     pub fn get_2d(&mut self) -> Vec2 {
         match self.kind {
-            SamplerKind::Sobol if self.dimension + 1 < SOBOL_DIMENSIONS => {
+            SamplerKind::Sobol if self.dimension + 1 < self.sobol_dimensions => {
                 let h = self.dimension_hash();
                 let index = sobol::shuffle_reversed_index(self.index_reversed, h as u32);
                 let seed_y = (mix64(h) >> 32) as u32;
@@ -183,6 +198,34 @@ mod tests {
     fn largest_fraction_maps_below_one() {
         assert!(hash::u32_to_unit_f32(u32::MAX) < 1.0);
         assert_eq!(hash::u32_to_unit_f32(0), 0.0);
+    }
+
+    #[test]
+    fn sobol_dimension_limit_keeps_leading_dimensions_and_makes_later_ones_independent() {
+        // 64 samples: a stratified dimension puts exactly one in each 1/64 stratum; with the
+        // limit at 1, dimension 0 still does and dimension 1 (independent) does not.
+        let s = PixelSampler::with_kind(SamplerKind::Sobol, 3);
+        let strata = |dim: usize, limit: u32| {
+            let mut hit = [0u32; 64];
+            for i in 0..64 {
+                let mut st = s.stream(UVec2::new(1, 2), i).with_sobol_dimensions(limit);
+                let v = (0..=dim).map(|_| st.get_1d()).last().unwrap();
+                hit[(v * 64.0) as usize] += 1;
+            }
+            hit.iter().all(|&h| h == 1)
+        };
+        assert!(strata(0, 1) && strata(1, SOBOL_DIMENSIONS));
+        assert!(!strata(1, 1));
+        // The leading dimensions are the unlimited stream's.
+        let mut a = s.stream(UVec2::new(1, 2), 9);
+        let mut b = s.stream(UVec2::new(1, 2), 9).with_sobol_dimensions(3);
+        assert_eq!(a.get_1d(), b.get_1d());
+        assert_eq!(a.get_2d(), b.get_2d());
+        // No effect on an independent stream.
+        let ind = PixelSampler::with_kind(SamplerKind::Independent, 3);
+        let mut c = ind.stream(UVec2::ZERO, 4);
+        let mut d = ind.stream(UVec2::ZERO, 4).with_sobol_dimensions(0);
+        assert!((0..40).all(|_| c.get_1d() == d.get_1d()));
     }
 
     #[test]

@@ -3,21 +3,27 @@
 //! sample count or until a requested standard error; per sensor the uniformity ratios
 //! E_min/E_avg and E_min/E_max (docs/lighting.md).
 //!
-//! Determinism: sample k of point i of sensor s draws from the independent sampler's
-//! stream (seed, (i, s), k), never from a thread's state, so the readings are the same for
-//! any thread count. The independent sampler (not Sobol) keeps the usual variance
-//! estimate s²/n an honest standard error.
+//! Sampling: randomised quasi-Monte Carlo, the samples of a point split over independent
+//! Owen-scrambled Sobol replicates whose spread gives the standard error (`replicates`).
+//!
+//! Determinism: sample k of replicate r of point i of sensor s draws from the stream
+//! (seed, s, r, (i, s), k), never from a thread's state, so the readings are the same for
+//! any thread count.
 
 mod illuminance;
+mod replicates;
 
 pub use illuminance::sample_illuminance_lx;
+pub use replicates::{
+    replicate_count, replicate_sampler, replicates_for, ReplicateStats, SENSOR_REPLICATES,
+};
 
 use glam::{DVec3, UVec2, Vec3A};
 use prism_scene::{Sensor, SensorSampling};
 use rayon::prelude::*;
 
 use crate::integrator::{Integrator, PathCounters, PathTracer};
-use crate::sampler::{PixelSampler, SamplerKind};
+use crate::sampler::PixelSampler;
 use crate::scene_build::RenderScene;
 
 /// Samples per work item: the unit of parallel work within one point.
@@ -162,6 +168,16 @@ pub fn sensor_light_samples(scene: &RenderScene) -> u32 {
     scene.lights.len().clamp(1, 8) as u32
 }
 
+/// Dimensions of a sensor sample drawn from scrambled Sobol points: the sample's own
+/// (wavelength 1, direction 2, 3 per light sample; `sample_illuminance_lx`) and the first
+/// path vertex's eight (`PathTracer::radiance_from`); the rest are independent. On the
+/// furnished-room benchmark (docs/lighting.md "Speed") the variance per sample is the same
+/// as with the renderer's 29 Sobol dimensions — later dimensions carry little of it — and
+/// each scrambled value costs about four hashes against one.
+pub fn sensor_sobol_dimensions(light_samples: u32) -> u32 {
+    3 + 3 * light_samples.max(1) + 8
+}
+
 /// Deterministic per-sensor seed.
 fn sensor_seed(seed: u64, sensor: usize) -> u64 {
     // SplitMix64 finaliser (Steele et al. 2014).
@@ -171,56 +187,68 @@ fn sensor_seed(seed: u64, sensor: usize) -> u64 {
     z ^ (z >> 31)
 }
 
-/// Samples [start, end) of one point, in parallel chunks merged in a fixed order.
+/// Samples of one point from `from` to `to` in total, spread over the replicates
+/// (`replicates::replicate_count`), in parallel chunks merged in a fixed order.
 #[allow(clippy::too_many_arguments)]
 fn run_samples(
     tracer: &PathTracer,
     scene: &RenderScene,
-    sampler: &PixelSampler,
+    samplers: &[PixelSampler],
     point: UVec2,
     p: Vec3A,
     n: Vec3A,
-    start: u32,
-    end: u32,
-) -> (RunningStats, PathCounters) {
-    let chunks: Vec<(RunningStats, PathCounters)> = (start..end)
-        .step_by(CHUNK_SAMPLES as usize)
-        .collect::<Vec<_>>()
+    from: u32,
+    to: u32,
+    stats: &mut ReplicateStats,
+    counters: &mut PathCounters,
+) {
+    let replicates = samplers.len() as u32;
+    let light_samples = sensor_light_samples(scene);
+    let sobol_dimensions = sensor_sobol_dimensions(light_samples);
+    let mut items = Vec::new();
+    for r in 0..replicates {
+        let start = replicate_count(from, replicates, r);
+        let end = replicate_count(to, replicates, r);
+        let mut c = start;
+        while c < end {
+            items.push((r, c, (c + CHUNK_SAMPLES).min(end)));
+            c += CHUNK_SAMPLES;
+        }
+    }
+    let chunks: Vec<(u32, f64, u64, PathCounters)> = items
         .into_par_iter()
-        .map(|c| {
-            let mut stats = RunningStats::default();
+        .map(|(r, start, end)| {
+            let mut sum = 0.0;
             let mut counters = PathCounters::default();
-            for k in c..(c + CHUNK_SAMPLES).min(end) {
-                let mut stream = sampler.stream(point, k);
-                let e = sample_illuminance_lx(
+            for k in start..end {
+                let mut stream = samplers[r as usize]
+                    .stream(point, k)
+                    .with_sobol_dimensions(sobol_dimensions);
+                sum += sample_illuminance_lx(
                     tracer,
                     scene,
                     p,
                     n,
-                    sensor_light_samples(scene),
+                    light_samples,
                     &mut stream,
                     &mut counters,
                 );
-                stats.push(e);
             }
-            (stats, counters)
+            (r, sum, u64::from(end - start), counters)
         })
         .collect();
-    let mut stats = RunningStats::default();
-    let mut counters = PathCounters::default();
-    for (s, c) in &chunks {
-        stats.merge(s);
+    for (r, sum, count, c) in chunks {
+        stats.add(r, sum, count);
         counters.rays += c.rays;
         counters.non_finite_contributions += c.non_finite_contributions;
     }
-    (stats, counters)
 }
 
 /// Measures one point under `sampling`.
 fn measure_point(
     tracer: &PathTracer,
     scene: &RenderScene,
-    sampler: &PixelSampler,
+    seed: u64,
     index: UVec2,
     position_m: [f64; 3],
     normal: [f64; 3],
@@ -229,12 +257,29 @@ fn measure_point(
     let p = DVec3::from(position_m).as_vec3a();
     let n = DVec3::from(normal).normalize().as_vec3a();
     let mut counters = PathCounters::default();
-    let mut stats = RunningStats::default();
-    let mut take = |stats: &mut RunningStats, start: u32, end: u32| {
-        let (s, c) = run_samples(tracer, scene, sampler, index, p, n, start, end);
-        stats.merge(&s);
-        counters.rays += c.rays;
-        counters.non_finite_contributions += c.non_finite_contributions;
+    // Replicates: as many as the most samples this point may take allows.
+    let most = match sampling {
+        SensorSampling::Fixed { samples } => samples,
+        SensorSampling::Adaptive { max_samples, .. } => max_samples,
+    };
+    let samplers: Vec<PixelSampler> = (0..replicates_for(most))
+        .map(|r| replicate_sampler(seed, r))
+        .collect();
+    let replicates = samplers.len() as u32;
+    let mut stats = ReplicateStats::new(replicates);
+    let mut take = |stats: &mut ReplicateStats, from: u32, to: u32| {
+        run_samples(
+            tracer,
+            scene,
+            &samplers,
+            index,
+            p,
+            n,
+            from,
+            to,
+            stats,
+            &mut counters,
+        );
     };
     match sampling {
         SensorSampling::Fixed { samples } => take(&mut stats, 0, samples),
@@ -245,23 +290,27 @@ fn measure_point(
             max_samples,
         } => {
             let mut done = 0u32;
-            let mut next = min_samples.min(max_samples);
+            // At least two samples per replicate before the first standard error.
+            let mut next = min_samples.max(16 * replicates).min(max_samples);
             loop {
                 take(&mut stats, done, next);
                 done = next;
-                let target = (relative_error * stats.mean.abs()).max(absolute_error_lx);
+                let target = (relative_error * stats.mean().abs()).max(absolute_error_lx);
                 let se = stats.std_error();
                 if se <= target || done >= max_samples {
                     break;
                 }
-                // n · (se / target)² samples reach the target if the variance holds; aim
-                // 10 % beyond, never more than 4× the samples so far in one step.
+                // n · (se / target)² samples reach the target if the variance per sample
+                // holds (scrambled nets do better, so this errs on the safe side); aim 10 %
+                // beyond, never more than 4× the samples so far in one step.
                 let wanted = if target > 0.0 {
                     (done as f64 * (se / target).powi(2) * 1.1).ceil()
                 } else {
                     f64::INFINITY
                 };
-                let wanted = wanted.min(4.0 * done as f64).max(done as f64 + 16.0);
+                let wanted = wanted
+                    .min(4.0 * done as f64)
+                    .max(done as f64 + f64::from(replicates));
                 next = (wanted.min(f64::from(max_samples))) as u32;
             }
         }
@@ -270,9 +319,9 @@ fn measure_point(
         PointReading {
             position_m,
             normal: n.to_array().map(f64::from),
-            illuminance_lx: stats.mean,
+            illuminance_lx: stats.mean(),
             std_error_lx: stats.std_error(),
-            samples: stats.n,
+            samples: stats.samples(),
         },
         counters,
     )
@@ -290,7 +339,7 @@ pub fn measure_sensors(
     let mut readings = Vec::with_capacity(sensors.len());
     let mut stats = SensorStats::default();
     for (s, sensor) in sensors.iter().enumerate() {
-        let sampler = PixelSampler::with_kind(SamplerKind::Independent, sensor_seed(seed, s));
+        let sensor_seed = sensor_seed(seed, s);
         let results: Vec<(PointReading, PathCounters)> = (0..sensor.kind.len())
             .into_par_iter()
             .map(|i| {
@@ -298,7 +347,7 @@ pub fn measure_sensors(
                 let r = measure_point(
                     &tracer,
                     scene,
-                    &sampler,
+                    sensor_seed,
                     UVec2::new(i as u32, s as u32),
                     position_m,
                     normal,

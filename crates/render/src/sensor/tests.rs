@@ -52,6 +52,22 @@ fn point_source_follows_the_cosine_inverse_square_law() {
     assert_eq!(points[3].illuminance_lx, 0.0);
 }
 
+/// Illuminance from the strip of a uniform sky of luminance `l` that shows below the
+/// horizon past the edge of a 1000 m square floor centred under a receiver 0.5 m up facing
+/// `n` (see `uniform_sky_gives_pi_l_…`).
+fn sky_below_floor_edge_lx(l: f64, n: DVec3) -> f64 {
+    let steps = 20_000;
+    let d = std::f64::consts::TAU / steps as f64;
+    (0..steps)
+        .map(|k| {
+            let phi = (k as f64 + 0.5) * d;
+            let (s, c) = phi.sin_cos();
+            let delta = 0.5 * c.abs().max(s.abs()) / 500.0;
+            l * n.normalize().dot(DVec3::new(c, 0.0, s)).max(0.0) * delta * d
+        })
+        .sum::<f64>()
+}
+
 #[test]
 fn uniform_sky_gives_pi_l_and_half_of_it_on_a_vertical_receiver_over_a_black_ground() {
     let l = 1000.0;
@@ -73,10 +89,15 @@ fn uniform_sky_gives_pi_l_and_half_of_it_on_a_vertical_receiver_over_a_black_gro
     ));
     let pts = &floored[0].points;
     check(&pts[0], std::f64::consts::PI * l, "horizontal over ground");
-    // The floor ends 500 m away: seen from 0.5 m up, the missing strip is negligible.
+    // The floor (1000 m square) ends 500–707 m away: seen from 0.5 m up, a strip of sky
+    // below the horizon, δ(φ) = 0.5 m · max(|cos φ|, |sin φ|) / 500 m high at azimuth φ,
+    // is not hidden. It adds L ∫ max(0, n · ω(φ)) δ(φ) dφ (ω horizontal; cos of the
+    // elevation ≈ 1): ≈ 1.8 lx on the vertical receiver, 0.1 % of its reading, which the
+    // sensors now resolve.
+    let strip = |n: DVec3| sky_below_floor_edge_lx(l, n);
     check(
         &pts[1],
-        std::f64::consts::PI * l / 2.0,
+        std::f64::consts::PI * l / 2.0 + strip(DVec3::X),
         "vertical over ground",
     );
     // Facing mostly down: the sky above the floor's horizon, (1 − cos α)/2 of πL with
@@ -86,7 +107,7 @@ fn uniform_sky_gives_pi_l_and_half_of_it_on_a_vertical_receiver_over_a_black_gro
     let sin_beta = -n.y;
     check(
         &pts[2],
-        std::f64::consts::PI * l * (1.0 - sin_beta) / 2.0,
+        std::f64::consts::PI * l * (1.0 - sin_beta) / 2.0 + strip(n),
         "tilted down over ground",
     );
 }
@@ -168,4 +189,162 @@ fn running_stats_merge_like_one_pass() {
         2.0 / 6.0
     );
     assert!(Uniformity::of(std::iter::empty()).is_none());
+}
+
+/// z-scores (reading − exact) / reported s.e. of every point of `json`'s sensors over
+/// `seeds` seeds.
+fn z_scores(json: &str, exact: &dyn Fn(&PointReading) -> f64, seeds: u64) -> Vec<f64> {
+    let (scene, sensors) = scene(json);
+    let mut z = Vec::new();
+    for seed in 0..seeds {
+        let (r, _) = measure_sensors(&scene, &sensors, 1000 + seed, &|_| {});
+        for p in r.iter().flat_map(|s| &s.points) {
+            assert!(p.std_error_lx > 0.0, "{p:?}");
+            z.push((p.illuminance_lx - exact(p)) / p.std_error_lx);
+        }
+    }
+    z
+}
+
+/// The reported standard errors are honest: over many seeds the readings' z-scores against
+/// the exact value have mean 0 and the variance of Student's t with R − 1 = 31 degrees of
+/// freedom (the s.e. comes from R = 32 replicates): 31/29. Tolerances are 4.5 standard
+/// errors of those two statistics (t_ν: E z⁴ = 3ν²/((ν − 2)(ν − 4)), so
+/// Var z² = E z⁴ − (E z²)²). An s.e. taken as s²/n over the scrambled points, which are not
+/// independent, would be too large (z² ≈ 0.5 on the benchmark's furnished room) and fail.
+fn check_z_scores(z: &[f64], what: &str) {
+    let n = z.len() as f64;
+    let nu = f64::from(SENSOR_REPLICATES - 1);
+    let var_t = nu / (nu - 2.0);
+    let fourth = 3.0 * nu * nu / ((nu - 2.0) * (nu - 4.0));
+    let mean = z.iter().sum::<f64>() / n;
+    let mean_sq = z.iter().map(|x| x * x).sum::<f64>() / n;
+    assert!(
+        mean.abs() <= 4.5 * (var_t / n).sqrt(),
+        "{what}: mean z-score {mean} over {n} readings"
+    );
+    let tol = 4.5 * ((fourth - var_t * var_t) / n).sqrt();
+    assert!(
+        (mean_sq - var_t).abs() <= tol,
+        "{what}: mean squared z-score {mean_sq}, expected {var_t} ± {tol} over {n} readings"
+    );
+}
+
+#[test]
+fn standard_errors_are_honest_over_seeds_for_indirect_light() {
+    // The closed emitting sphere (E = π L_e / (1 − ρ), light of every order), 8 receivers,
+    // 32 seeds each: fixed 512 samples (16 per replicate), and adaptively to 1 % (a first
+    // round of 16 per replicate, then more: the stopping rule looks at the s.e. it reports).
+    let (le, rho) = (100.0, 0.5);
+    let exact = std::f64::consts::PI * le / (1.0 - rho);
+    for sampling in [r#""samples": 512"#, r#""relative_error": 0.01"#] {
+        let z = z_scores(
+            &format!(
+                r#"{{"materials": {{"wall": {{"type": "lambert", "reflectance": {rho}}},
+                                  "inside": {{"type": "two_sided", "material": "wall"}}}},
+                    "integrator": {{"type": "path", "max_depth": 40, "rr_depth": 3}},
+                    "shapes": [{{"type": "sphere", "name": "s", "radius_m": 2, "material": "inside"}}],
+                    "lights": [{{"type": "area", "shape": "s", "luminance_cd_m2": {le}, "two_sided": true}}],
+                    "sensors": [{{"type": "grid", "origin_m": [-1, -0.3, -1], "u_m": [2, 0.5, 0],
+                                  "v_m": [0, 0.4, 2], "resolution": [4, 2], "normal": [0.2, 1, -0.3],
+                                  {sampling}}}]}}"#
+            ),
+            &|_| exact,
+            32,
+        );
+        check_z_scores(&z, &format!("furnace, {sampling}"));
+    }
+}
+
+#[test]
+fn standard_errors_are_honest_over_seeds_for_direct_light() {
+    // Point source (inverse-square cosine law; only the wavelengths are random) and a
+    // uniform sky over a black floor (light sampling and cosine sampling combined by MIS).
+    let light = DVec3::new(0.0, 2.0, 0.0);
+    let point = |p: &PointReading| {
+        let to = light - DVec3::from(p.position_m);
+        let d2 = to.length_squared();
+        1000.0 * (to / d2.sqrt()).dot(DVec3::from(p.normal)).max(0.0) / d2
+    };
+    let z = z_scores(
+        r#"{"lights": [{"type": "point", "position_m": [0, 2, 0], "intensity_cd": 1000}],
+            "sensors": [{"type": "points", "positions_m": [[0, 0, 0], [1.5, 0, 0], [0, 0, 3]],
+                         "normals": [[0, 1, 0], [0, 1, 0], [0, 1, -1]], "samples": 64}]}"#,
+        &point,
+        96,
+    );
+    check_z_scores(&z, "point source");
+    let l = 1000.0;
+    let z = z_scores(
+        &format!(
+            r#"{{"materials": {{"black": {{"type": "lambert", "reflectance": 0}}}},
+                "shapes": [{{"type": "rectangle", "size_m": [1000, 1000], "material": "black",
+                            "transform": {{"rotate": {{"axis": [1, 0, 0], "angle_deg": -90}}}}}}],
+                "lights": [{{"type": "sky", "luminance_cd_m2": {l}}}],
+                "sensors": [{{"type": "points", "positions_m": [[0, 0.5, 0], [0, 0.5, 0]],
+                              "normals": [[0, 1, 0], [1, 0, 0]], "samples": 128}}]}}"#
+        ),
+        &|p: &PointReading| {
+            let full = std::f64::consts::PI * l;
+            if p.normal[1] > 0.5 {
+                full
+            } else {
+                full / 2.0 + sky_below_floor_edge_lx(l, DVec3::from(p.normal))
+            }
+        },
+        96,
+    );
+    check_z_scores(&z, "sky over a black floor");
+}
+
+#[test]
+fn scrambled_replicates_beat_independent_samples_on_a_lit_room() {
+    // Why sensors use randomised QMC: in a closed diffuse box lit by a point lamp, the
+    // variance of a 512-sample reading (observed over 64 seeds) is well below that of the
+    // mean of 512 independent samples (their per-sample variance / 512).
+    let json = r#"{"materials": {"w": {"type": "lambert", "reflectance": 0.6},
+                                  "in": {"type": "two_sided", "material": "w"}},
+                   "shapes": [{"type": "cuboid", "size_m": [4, 3, 4], "material": "in",
+                               "transform": {"translate": [0, 1.5, 0]}}],
+                   "lights": [{"type": "point", "position_m": [0.5, 2.7, 0.3], "intensity_cd": 500}],
+                   "sensors": [{"type": "points", "positions_m": [[0.2, 0.01, -0.4]],
+                                "normals": [[0, 1, 0]], "samples": 512}]}"#;
+    let (scene, sensors) = scene(json);
+    let readings: Vec<f64> = (0..64)
+        .map(|seed| measure_sensors(&scene, &sensors, seed, &|_| {}).0[0].points[0].illuminance_lx)
+        .collect();
+    let n = readings.len() as f64;
+    let mean = readings.iter().sum::<f64>() / n;
+    let var_rqmc = readings.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0);
+    // Independent samples at the same point: the per-sample variance / 512.
+    let tracer = sensor_tracer(&scene);
+    let sampler = PixelSampler::with_kind(crate::sampler::SamplerKind::Independent, 5);
+    let mut stats = RunningStats::default();
+    let mut counters = PathCounters::default();
+    let (p, nrm) = (Vec3A::new(0.2, 0.01, -0.4), Vec3A::Y);
+    for k in 0..20_000 {
+        let mut stream = sampler.stream(UVec2::ZERO, k);
+        stats.push(sample_illuminance_lx(
+            &tracer,
+            &scene,
+            p,
+            nrm,
+            sensor_light_samples(&scene),
+            &mut stream,
+            &mut counters,
+        ));
+    }
+    let var_independent = stats.m2 / (stats.n - 1) as f64 / 512.0;
+    // Unbiased: the two means agree within their errors.
+    let se = (var_rqmc / n + stats.std_error().powi(2)).sqrt();
+    assert!(
+        (mean - stats.mean).abs() <= 4.5 * se,
+        "{mean} vs {}",
+        stats.mean
+    );
+    // 64 readings estimate var_rqmc to ±18 % (1σ); ask for at least 1.5× less variance.
+    assert!(
+        var_rqmc * 1.5 < var_independent,
+        "RQMC variance {var_rqmc} vs independent {var_independent}"
+    );
 }
