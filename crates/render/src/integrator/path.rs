@@ -320,16 +320,15 @@ impl PathTracer {
                 }
             }
             let material = scene.material(si.material_id);
-            let u_mask = stream.get_1d();
-            let u_light_choice = stream.get_1d();
-            let u_light = stream.get_2d();
-            let u_lobe = stream.get_1d();
-            let u_bsdf = stream.get_2d();
-            let u_roulette = stream.get_1d();
+            // The vertex's 8 dimensions (module docs): reserved in order, each computed only
+            // when used — the same values as drawing all 8 (`SampleStream::reserve`).
+            let dims = stream.reserve(8);
+            let (d_mask, d_light_choice, d_light, d_lobe, d_bsdf, d_roulette) =
+                (dims, dims + 1, dims + 2, dims + 4, dims + 5, dims + 7);
 
             // Opacity mask: pass straight through with probability 1 − α.
             let opacity = material.opacity_at(&si);
-            if opacity < 1.0 && u_mask >= opacity {
+            if opacity < 1.0 && stream.get_1d_at(d_mask) >= opacity {
                 pass_throughs += 1;
                 if pass_throughs > 256 {
                     break;
@@ -403,7 +402,7 @@ impl PathTracer {
                 let mut white = SampledSpectrum::splat(0.0);
                 for k in 0..n_light {
                     let (uc, ul) = if k == 0 {
-                        (u_light_choice, u_light)
+                        (stream.get_1d_at(d_light_choice), stream.get_2d_at(d_light))
                     } else {
                         (stream.get_1d(), stream.get_2d())
                     };
@@ -442,6 +441,7 @@ impl PathTracer {
             }
 
             // Continue the path by sampling the BSDF.
+            let (u_lobe, u_bsdf) = (stream.get_1d_at(d_lobe), stream.get_2d_at(d_bsdf));
             let Some(bs) = bsdf.sample(vertex.wo_local, u_lobe, u_bsdf, TransportMode::Radiance)
             else {
                 break;
@@ -483,7 +483,7 @@ impl PathTracer {
             // Russian roulette on the radiance-scaled throughput.
             if depth >= self.rr_depth {
                 let q = (1.0 - (beta * eta_scale).max_component()).max(0.0);
-                if u_roulette < q {
+                if stream.get_1d_at(d_roulette) < q {
                     counters.roulette_terminations += 1;
                     break;
                 }
