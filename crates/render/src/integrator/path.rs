@@ -50,7 +50,8 @@ pub struct PathCounters {
 pub struct PathResult {
     /// Radiance arriving at the camera along the ray, W·m⁻²·sr⁻¹·nm⁻¹ per lane.
     pub radiance: SampledSpectrum,
-    /// The first surface hit, when there is one.
+    /// The first surface hit, when there is one (the shading record: `curvature` is left
+    /// at zero; `Geometry::interaction` computes it where it is needed).
     pub first_hit: Option<SurfaceInteraction>,
     /// Radiance a neutral white Lambertian (R = 1) would reflect towards the camera at the
     /// first hit (direct light by light sampling plus the path's indirect estimate), for
@@ -246,8 +247,6 @@ impl PathTracer {
             |o| o.ctx,
         );
         let mut prev_bsdf_pdf = origin.map_or(0.0f32, |o| o.direction_pdf);
-        // Curvature is for the camera's G-buffer; a sensor's first hit needs none.
-        let want_curvature = origin.is_none();
         // Product of η² over refractions: roulette compares radiance, not the 1/η²-scaled
         // throughput (pbrt-v4 §13.4.4 `etaScale`).
         let mut eta_scale = 1.0f32;
@@ -305,12 +304,9 @@ impl PathTracer {
                 }
                 break;
             };
-            // Curvature only at the first hit (the G-buffer's); shading never reads it.
-            let mut si = if first_hit.is_none() && want_curvature {
-                scene.geometry.interaction(&ray, &hit)
-            } else {
-                scene.geometry.shading_interaction(&ray, &hit)
-            };
+            // No curvature: shading never reads it, nor does the film's G-buffer (depth,
+            // normal, albedo); it cost ≈ 1 % of a Cornell box render at every first hit.
+            let mut si = scene.geometry.shading_interaction(&ray, &hit);
             if let Some(footprint) = &scene.texture_footprint {
                 match &current_differential {
                     Some(rd) => si.compute_differentials(rd),
