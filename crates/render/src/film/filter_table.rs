@@ -56,7 +56,7 @@ impl FilterTable {
     #[inline(always)]
     pub fn eval(&self, x_px: f32) -> f32 {
         let a = x_px.abs();
-        if !(a <= self.radius_px) {
+        if a.is_nan() || a > self.radius_px {
             return 0.0;
         }
         let s = a * self.inv_step_per_px;
