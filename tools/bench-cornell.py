@@ -11,7 +11,10 @@ Timing:
 - Mitsuba: `img = mi.render(scene, spp=N, seed=S); dr.eval(img)` alone, in a worker process
   per variant that loaded `mi.cornell_box()` and made one untimed warm-up render (JIT) first;
   the workers stay alive, so rounds alternate Prism / scalar / llvm without reloading.
-Prints JSON: median seconds per renderer, Prism/Mitsuba ratios, RMSE against the reference.
+Also the CPU seconds (user + system, all threads) of the same spans: on a shared, loaded
+machine they are steadier than wall times.
+Prints JSON: median seconds per renderer, Prism/Mitsuba ratios (wall and CPU), RMSE against
+the reference, the load average at the start and the end.
 
 RMSE = sqrt(mean over pixels and R, G, B of (image - reference)^2), also without the pixels
 of the directly visible light (`rmse_excluding_light`), which hold ~75 % of the squared error
@@ -27,6 +30,7 @@ import argparse
 import json
 import os
 import pathlib
+import resource
 import statistics
 import subprocess
 import sys
@@ -94,14 +98,16 @@ def worker(variant, threads):
     for line in sys.stdin:
         spp, seed, out = line.split(maxsplit=2)
         t = time.perf_counter()
+        c = time.process_time()
         img = mi.render(scene, spp=int(spp), seed=int(seed))
         dr.eval(img)
         dr.sync_thread()
         render_s = time.perf_counter() - t
+        cpu_s = time.process_time() - c
         mi.Bitmap(np.array(img, dtype=np.float32), pixel_format=mi.Bitmap.PixelFormat.RGB).write(
             out.strip()
         )
-        print(json.dumps({"render_s": render_s, "file": out.strip()}), flush=True)
+        print(json.dumps({"render_s": render_s, "cpu_s": cpu_s, "file": out.strip()}), flush=True)
 
 
 class Worker:
@@ -146,8 +152,11 @@ def prism_render(prism, scene, spp, threads, seed, out):
     cmd = [str(prism), "render", str(scene), "--spp", str(spp), "--threads", str(threads),
            "--seed", str(seed), "-o", str(out)]
     t = time.perf_counter()
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     p = subprocess.run(cmd, capture_output=True, text=True)
     wall = time.perf_counter() - t
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
     if p.returncode != 0 or not pathlib.Path(out).exists():
         tail = (p.stderr or p.stdout).strip().splitlines()[-5:]
         raise PrismError(
@@ -155,7 +164,7 @@ def prism_render(prism, scene, spp, threads, seed, out):
             "The Cornell box needs Prism's spectral path tracer (integrator `path`, lambert "
             "BSDF, area lights); until it lands only the Mitsuba half of this benchmark runs."
         )
-    return wall
+    return wall, cpu
 
 
 # ----------------------------------------------------------------------------- main
@@ -207,7 +216,9 @@ def main():
         print(f"  {json.dumps(workers[v].info)}", file=sys.stderr, flush=True)
 
     names = (["prism"] if not args.no_prism and prism_error is None else []) + variants
+    load_start = os.getloadavg()[0]
     times = {n: [] for n in names}
+    cpu_times = {n: [] for n in names}
     errors = {n: [] for n in names}
     for r in range(args.rounds):
         seed = args.seed + r
@@ -215,16 +226,18 @@ def main():
         for n in order:
             out = args.out_dir / f"{n}-round{r + 1}.exr"
             if n == "prism":
-                t = prism_render(args.prism, args.scene, args.spp, args.threads, seed, out)
+                t, cpu = prism_render(args.prism, args.scene, args.spp, args.threads, seed, out)
                 target = ref / MITSUBA_FILM_FACTOR
             else:
-                t = workers[n].render(args.spp, seed, out)["render_s"]
+                reply = workers[n].render(args.spp, seed, out)
+                t, cpu = reply["render_s"], reply["cpu_s"]
                 target = ref
+            cpu_times[n].append(cpu)
             img = read_exr(out)
             errors[n].append((rmse(img, target), rmse(img, ref), rmse(img, target, ~light)))
             times[n].append(t)
-            print(f"round {r + 1}: {n} {t:.3f} s, RMSE {errors[n][-1][0]:.5f}", file=sys.stderr,
-                  flush=True)
+            print(f"round {r + 1}: {n} {t:.3f} s ({cpu:.3f} CPU-s), RMSE {errors[n][-1][0]:.5f}",
+                  file=sys.stderr, flush=True)
     for w in workers.values():
         w.close()
 
@@ -246,15 +259,21 @@ def main():
         "timing": {
             "prism": "whole process, start to EXR written",
             "mitsuba": "mi.render + dr.eval only, after a warm-up render",
+            "cpu_s": "user + system CPU seconds of all threads over the same span (Prism: "
+                     "getrusage of the child process; Mitsuba: time.process_time of the worker)",
         },
         "load_average": os.getloadavg()[0],
+        "load_average_start": load_start,
         "renderers": {},
         "ratios_prism_over_mitsuba": {},
+        "cpu_ratios_prism_over_mitsuba": {},
     }
     for n in names:
         entry = {
             "median_s": statistics.median(times[n]),
             "times_s": [round(t, 4) for t in times[n]],
+            "median_cpu_s": statistics.median(cpu_times[n]),
+            "cpu_s": [round(t, 4) for t in cpu_times[n]],
             "rmse": statistics.median(e[0] for e in errors[n]),
             "rmse_excluding_light": statistics.median(e[2] for e in errors[n]),
             "mean_rgb": read_exr(args.out_dir / f"{n}-round1.exr").reshape(-1, 3).mean(0).tolist(),
@@ -272,6 +291,9 @@ def main():
         for v in variants:
             result["ratios_prism_over_mitsuba"][v] = (
                 result["renderers"]["prism"]["median_s"] / result["renderers"][v]["median_s"]
+            )
+            result["cpu_ratios_prism_over_mitsuba"][v] = (
+                result["renderers"]["prism"]["median_cpu_s"] / result["renderers"][v]["median_cpu_s"]
             )
     if prism_error:
         result["prism_error"] = prism_error

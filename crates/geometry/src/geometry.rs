@@ -215,8 +215,10 @@ impl GeometryBuilder {
         };
         let scene = (!leaves.is_empty() && single.is_none())
             .then(|| TriangleBvh::build_with_bounds(&leaves, &leaf_ids, leaf_bounds, quality));
+        let flat_records = self.instances.iter().map(flat_record).collect();
         Geometry {
             meshes,
+            flat_records,
             instances: self.instances,
             scene,
             single,
@@ -294,6 +296,22 @@ fn instance_bounds(inst: &Instance, meshes: &[MeshBvh]) -> Option<(Vec3A, Vec3A)
     Some(inst.to_world.bounds(lo, hi))
 }
 
+/// The shading record of a rectangle instance (`SurfaceInteraction::from_local_with`
+/// without curvature) at its centre: a rectangle's normals and tangents are the same at
+/// every point, so a hit only fills in `p`, `t` and `uv` (see `Geometry::interaction_with`).
+/// `None` for other shapes.
+fn flat_record(inst: &Instance) -> Option<Box<SurfaceInteraction>> {
+    match inst.shape {
+        Shape::Rectangle(r) => Some(Box::new(SurfaceInteraction::from_local_with(
+            &r.local_geometry(Vec3A::ZERO),
+            &inst.to_world,
+            0.0,
+            false,
+        ))),
+        _ => None,
+    }
+}
+
 /// Bounds of a leaf: a triangle's vertices, or the box an instance leaf carries.
 #[inline]
 fn leaf_bounds(p: &[Vec3A; 3], id: Leaf) -> (Vec3A, Vec3A) {
@@ -327,6 +345,10 @@ impl Leaf {
 pub struct Geometry {
     meshes: Vec<MeshBvh>,
     instances: Vec<Instance>,
+    /// Per instance: for a rectangle its constant world-space normals and tangents
+    /// (`flat_record`), which `shading_interaction` copies instead of transforming them per
+    /// hit (the same bits: every field is computed by the same expression).
+    flat_records: Vec<Option<Box<SurfaceInteraction>>>,
     /// One BVH over baked world-space triangles and instance leaves; `None` when the scene
     /// is empty or is a single instance.
     scene: Option<TriangleBvh<Leaf>>,
@@ -494,6 +516,28 @@ impl Geometry {
         let inst = &self.instances[hit.instance_id as usize];
         let (o, d) = object_ray(inst, ray);
         let p_obj = o + hit.t * d;
+        if let (false, Some(record), Shape::Rectangle(r)) = (
+            with_curvature,
+            &self.flat_records[hit.instance_id as usize],
+            inst.shape,
+        ) {
+            // `from_local_with` of the rectangle's local geometry at `p_obj`: only the
+            // position and uv vary over a rectangle.
+            let local = r.local_geometry(p_obj);
+            let mut si = **record;
+            si.p = if inst.to_world.is_identity() {
+                local.p
+            } else {
+                inst.to_world.point(local.p)
+            };
+            si.t = hit.t;
+            si.uv = local.uv;
+            si.primitive_id = 0;
+            si.material_id = inst.material.unwrap_or(NO_MATERIAL);
+            si.object_id = 0;
+            si.instance_id = hit.instance_id;
+            return si;
+        }
         let (local, primitive_id, face_material, object_id) = match inst.shape {
             Shape::Mesh(MeshId(m)) => {
                 let mesh = &self.meshes[m as usize].mesh;

@@ -210,3 +210,80 @@ fn scaled_sphere_instances_give_ellipsoid_and_scaled_curvatures() {
         "k1 along the short axis"
     );
 }
+
+#[test]
+fn rectangle_shading_record_equals_the_transformed_local_geometry_bit_for_bit() {
+    // `shading_interaction` copies a rectangle's constant normals and tangents from a record
+    // made at build time; it must equal `from_local_with` of the hit's local geometry,
+    // field by field, under identity, rotated, scaled and mirrored transforms.
+    use prism_geometry::SurfaceInteraction;
+    let rect = Rectangle {
+        half_width_m: 0.7,
+        half_height_m: 0.4,
+    };
+    let transforms = [
+        Transform::IDENTITY,
+        Transform::rotate(Vec3A::new(1.0, 0.3, -0.2), 1.1)
+            .unwrap()
+            .compose(&Transform::scale(Vec3A::new(0.23, 0.19, 1.0)).unwrap()),
+        Transform::translate(Vec3A::new(0.0, 0.99, 0.01))
+            .compose(&Transform::rotate(Vec3A::X, std::f32::consts::FRAC_PI_2).unwrap())
+            .compose(&Transform::scale(Vec3A::new(-0.5, 0.19, 2.0)).unwrap()),
+    ];
+    let mut rng = Pcg64::seed_from_u64(7);
+    for to_world in transforms {
+        let g = one(Shape::Rectangle(rect), to_world);
+        let mut hits = 0;
+        for _ in 0..2_000 {
+            let target = to_world.point(Vec3A::new(
+                rng.gen_range(-0.8..0.8),
+                rng.gen_range(-0.5..0.5),
+                0.0,
+            ));
+            let o = target
+                + Vec3A::new(
+                    rng.gen_range(-3.0..3.0),
+                    rng.gen_range(-3.0..3.0),
+                    rng.gen_range(-3.0..3.0),
+                );
+            let ray = Ray::infinite(o, (target - o).normalize());
+            let Some(hit) = g.intersect(&ray) else {
+                continue;
+            };
+            hits += 1;
+            let o_obj = to_world.inverse_point(ray.origin);
+            let d_obj = to_world.inverse_vector(ray.direction);
+            let local = rect.local_geometry(o_obj + hit.t * d_obj);
+            let expected = SurfaceInteraction::from_local_with(&local, &to_world, hit.t, false);
+            let got = g.shading_interaction(&ray, &hit);
+            let bits = |v: Vec3A| v.to_array().map(f32::to_bits);
+            assert_eq!(bits(got.p), bits(expected.p));
+            assert_eq!(got.t.to_bits(), expected.t.to_bits());
+            assert_eq!(bits(got.n_geometric), bits(expected.n_geometric));
+            assert_eq!(bits(got.n_shading), bits(expected.n_shading));
+            assert_eq!(
+                got.uv.to_array().map(f32::to_bits),
+                expected.uv.to_array().map(f32::to_bits)
+            );
+            assert_eq!(bits(got.dpdu), bits(expected.dpdu));
+            assert_eq!(bits(got.dpdv), bits(expected.dpdv));
+            assert_eq!(bits(got.dndu), bits(expected.dndu));
+            assert_eq!(bits(got.dndv), bits(expected.dndv));
+            assert_eq!(got.curvature, expected.curvature);
+            assert_eq!(got.differentials, expected.differentials);
+            assert_eq!(
+                (
+                    got.material_id,
+                    got.instance_id,
+                    got.primitive_id,
+                    got.object_id
+                ),
+                (3, 0, 0, 0)
+            );
+            // The full record (with curvature) still comes from the generic path.
+            let full = g.interaction(&ray, &hit);
+            assert_eq!(bits(full.p), bits(got.p));
+        }
+        assert!(hits > 500, "{hits}");
+    }
+}

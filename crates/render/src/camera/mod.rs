@@ -69,6 +69,28 @@ impl Camera {
         }
     }
 
+    /// The ray of `generate_ray` alone (the same bits), without its differentials: for
+    /// renders that never read them (no texture needs a footprint), two camera rays fewer
+    /// per sample.
+    #[inline]
+    pub fn generate_ray_only(&self, film_point_px: Vec2, lens_sample: Vec2) -> Option<Ray> {
+        let (o, d) = match self {
+            Camera::Pinhole(c) => c.camera_ray(film_point_px),
+            Camera::ThinLens(c) => c.camera_ray(film_point_px, lens_sample),
+            Camera::Fisheye(c) => c.camera_ray(film_point_px),
+            Camera::Orthographic(c) => c.camera_ray(film_point_px),
+            Camera::Spherical(c) => c.camera_ray(film_point_px),
+        }?;
+        let t = &self.frame().camera_to_world;
+        Some(Ray::infinite(t.point(o), t.vector(d).normalize()))
+    }
+
+    /// Whether `generate_ray` reads its lens sample (the thin lens only): the driver
+    /// computes those two dimensions only then.
+    pub fn uses_lens_sample(&self) -> bool {
+        matches!(self, Camera::ThinLens(_))
+    }
+
     /// The film point (px) at which `world_point_m` is imaged: the inverse of
     /// `generate_ray` (for the thin lens, through the lens centre: the chief ray). `None`
     /// when the point is behind the camera, outside the field of view or off the film.

@@ -13,6 +13,7 @@
 use glam::Vec2;
 
 use super::filter::Filter;
+use super::filter_table::FilterTable;
 
 /// Cells per pixel of filter radius in the table.
 const CELLS_PER_PX: f32 = 64.0;
@@ -27,6 +28,8 @@ pub struct FilterSampler {
     pdf: Vec<f32>,
     /// CDF at the cell boundaries, cdf[0] = 0, cdf[n] = 1.
     cdf: Vec<f32>,
+    /// f₁ tabulated for splatting films.
+    table: FilterTable,
 }
 
 /// A sampled film offset and its weight f/p.
@@ -60,6 +63,7 @@ impl FilterSampler {
         cdf[n] = 1.0;
         let pdf = values.iter().map(|v| (v / total) as f32).collect();
         Self {
+            table: FilterTable::new(&filter),
             filter,
             radius_px,
             cell_width_px,
@@ -70,6 +74,11 @@ impl FilterSampler {
 
     pub fn filter(&self) -> &Filter {
         &self.filter
+    }
+
+    /// The filter's 1D profile tabulated for splatting.
+    pub(crate) fn table(&self) -> &FilterTable {
+        &self.table
     }
 
     /// Samples one axis: (x, p(x)).

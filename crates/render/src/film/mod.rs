@@ -9,6 +9,7 @@
 
 pub mod filter;
 mod filter_sampler;
+mod filter_table;
 mod image;
 pub mod spectral_bins;
 mod tile;

@@ -9,6 +9,7 @@ use glam::{DVec3, UVec2, Vec2, Vec3A};
 use prism_spectrum::{SampledSpectrum, SampledWavelengths};
 
 use super::filter_sampler::FilterSampler;
+use super::filter_table::FilterTable;
 use super::spectral_bins::SpectralBins;
 use super::xyz::xyz_of_sample;
 use super::AovSelection;
@@ -133,42 +134,44 @@ impl SplatBuffer {
         }
     }
 
-    /// Adds `xyz` at film point `p` to every pixel whose centre is within the radius.
+    /// Adds `xyz` at film point `p` to every pixel whose centre is within the radius, with
+    /// the weights of the tabulated profile (`FilterTable`).
     #[inline]
-    pub fn splat(&mut self, p: Vec2, xyz: DVec3, filter: &super::Filter) {
+    pub fn splat(&mut self, p: Vec2, xyz: DVec3, table: &FilterTable) {
         let r = self.radius_px;
-        let lo = (p - Vec2::splat(0.5 + r))
-            .ceil()
-            .max(self.bounds.min.as_vec2());
-        let hi = (p - Vec2::splat(0.5) + Vec2::splat(r))
-            .floor()
-            .min(self.bounds.max.as_vec2() - Vec2::ONE);
-        if lo.x > hi.x || lo.y > hi.y {
+        // Pixel centres x + ½ within r of p: x from ⌈p − ½ − r⌉ to ⌊p − ½ + r⌋, clipped to
+        // the buffer (integer floor/ceil: `f32::floor` is a library call on baseline x86-64).
+        let (min, max) = (self.bounds.min.as_ivec2(), self.bounds.max.as_ivec2() - 1);
+        let x0 = ceil_i32(p.x - (0.5 + r)).max(min.x);
+        let x1 = floor_i32(p.x - 0.5 + r).min(max.x);
+        let y0 = ceil_i32(p.y - (0.5 + r)).max(min.y);
+        let y1 = floor_i32(p.y - 0.5 + r).min(max.y);
+        if x0 > x1 || y0 > y1 {
             return;
         }
-        // Separable filters (f = f₁(x) f₁(y)): one profile evaluation per row and column.
+        // Separable filters (f = f₁(x) f₁(y)): one profile value per row and column.
         const MAX_TAPS: usize = 16;
-        let (x0, x1, y0, y1) = (lo.x as u32, hi.x as u32, lo.y as u32, hi.y as u32);
         if (x1 - x0) as usize >= MAX_TAPS || (y1 - y0) as usize >= MAX_TAPS {
-            return self.splat_wide(p, xyz, filter, (x0, x1, y0, y1));
+            return self.splat_wide(p, xyz, table, (x0, x1, y0, y1));
         }
         let mut wx = [0.0f32; MAX_TAPS];
-        for (k, x) in (x0..=x1).enumerate() {
-            wx[k] = filter.eval_1d(x as f32 + 0.5 - p.x);
+        let columns = (x1 - x0 + 1) as usize;
+        for (k, w) in wx[..columns].iter_mut().enumerate() {
+            *w = table.eval((x0 + k as i32) as f32 + 0.5 - p.x);
         }
         let width = self.bounds.size().x as usize;
+        let first_column = (x0 - min.x) as usize;
         for y in y0..=y1 {
-            let wy = filter.eval_1d(y as f32 + 0.5 - p.y);
+            let wy = table.eval(y as f32 + 0.5 - p.y);
             if wy == 0.0 {
                 continue;
             }
-            let row = (y - self.bounds.min.y) as usize * width;
-            for (k, x) in (x0..=x1).enumerate() {
-                let w = f64::from(wx[k] * wy);
+            let row = (y - min.y) as usize * width + first_column;
+            for (s, &wxk) in self.sums[row..row + columns].iter_mut().zip(&wx[..columns]) {
+                let w = f64::from(wxk * wy);
                 if w == 0.0 {
                     continue;
                 }
-                let s = &mut self.sums[row + (x - self.bounds.min.x) as usize];
                 s.0 += w * xyz;
                 s.1 += w;
             }
@@ -180,24 +183,39 @@ impl SplatBuffer {
         &mut self,
         p: Vec2,
         xyz: DVec3,
-        filter: &super::Filter,
-        (x0, x1, y0, y1): (u32, u32, u32, u32),
+        table: &FilterTable,
+        (x0, x1, y0, y1): (i32, i32, i32, i32),
     ) {
         let width = self.bounds.size().x as usize;
+        let min = self.bounds.min.as_ivec2();
         for y in y0..=y1 {
+            let wy = table.eval(y as f32 + 0.5 - p.y);
             for x in x0..=x1 {
-                let d = Vec2::new(x as f32 + 0.5, y as f32 + 0.5) - p;
-                let w = f64::from(filter.eval(d));
+                let w = f64::from(table.eval(x as f32 + 0.5 - p.x) * wy);
                 if w == 0.0 {
                     continue;
                 }
-                let i = (y - self.bounds.min.y) as usize * width + (x - self.bounds.min.x) as usize;
+                let i = (y - min.y) as usize * width + (x - min.x) as usize;
                 let s = &mut self.sums[i];
                 s.0 += w * xyz;
                 s.1 += w;
             }
         }
     }
+}
+
+/// ⌊x⌋ for |x| < 2³¹ without a library call (truncation, then one step down for negative
+/// non-integers).
+#[inline(always)]
+fn floor_i32(x: f32) -> i32 {
+    let i = x as i32;
+    i - i32::from((i as f32) > x)
+}
+
+/// ⌈x⌉ for |x| < 2³¹ without a library call.
+#[inline(always)]
+fn ceil_i32(x: f32) -> i32 {
+    -floor_i32(-x)
 }
 
 /// The accumulators of one tile.
@@ -406,7 +424,7 @@ impl FilmTile {
         p.sample_count += 1;
         p.own_weight_sum += w;
         match &mut self.splat {
-            Some(buffer) => buffer.splat(film_point, xyz, self.filter_sampler.filter()),
+            Some(buffer) => buffer.splat(film_point, xyz, self.filter_sampler.table()),
             None => {
                 p.xyz_sum += w * xyz;
                 p.weight_sum += w;

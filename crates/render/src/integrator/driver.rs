@@ -7,7 +7,7 @@
 
 use std::sync::atomic::{AtomicU64, Ordering};
 
-use glam::{DVec3, UVec2};
+use glam::{DVec3, UVec2, Vec2};
 
 use prism_spectrum::{SampledSpectrum, SampledWavelengths};
 
@@ -136,6 +136,7 @@ pub fn render_pass(
     let bounces_total = AtomicU64::new(0);
     let roulette_total = AtomicU64::new(0);
     let non_finite_contributions_total = AtomicU64::new(0);
+    let uses_lens = scene.camera.uses_lens_sample();
     film.render_tiles(settings.tile_size_px, |tile| {
         let (mut rays, mut samples, mut non_finite) = (0u64, 0u64, 0u64);
         let mut counters = PathCounters::default();
@@ -149,26 +150,54 @@ pub fn render_pass(
             for s in first_sample..first_sample.saturating_add(count) {
                 let mut stream = sampler.stream(pixel, s);
                 let (film_point, weight) = tile.sample_film_point(pixel, stream.get_2d());
-                let lens = stream.get_2d();
+                // The lens dimensions are reserved for every camera, computed for the thin
+                // lens only (the others ignore them).
+                let lens_dimension = stream.reserve(2);
+                let lens = if uses_lens {
+                    stream.get_2d_at(lens_dimension)
+                } else {
+                    Vec2::ZERO
+                };
                 match &scene.integrator {
                     Integrator::Path(tracer) => {
                         let mut wavelengths = SampledWavelengths::sample_visible(stream.get_1d());
-                        let (radiance, aov) = match scene.camera.generate_ray(film_point, lens) {
-                            None => (SampledSpectrum::splat(0.0), None),
-                            Some(mut camera_ray) => {
-                                rays += 1;
-                                camera_ray.scale_differentials(differential_scale);
-                                let r = tracer.radiance_with_differentials(
+                        // Ray differentials only feed texture filtering: without textures the
+                        // camera ray alone (same bits) saves two camera rays per sample.
+                        let result = if scene.texture_footprint.is_none() {
+                            scene.camera.generate_ray_only(film_point, lens).map(|ray| {
+                                tracer.radiance(
                                     scene,
-                                    &camera_ray.ray,
-                                    Some(&camera_ray),
-                                    differential_scale,
+                                    &ray,
                                     &mut wavelengths,
                                     &mut stream,
                                     light_samples,
                                     settings.illumination_aov,
                                     &mut counters,
-                                );
+                                )
+                            })
+                        } else {
+                            scene
+                                .camera
+                                .generate_ray(film_point, lens)
+                                .map(|mut camera_ray| {
+                                    camera_ray.scale_differentials(differential_scale);
+                                    tracer.radiance_with_differentials(
+                                        scene,
+                                        &camera_ray.ray,
+                                        Some(&camera_ray),
+                                        differential_scale,
+                                        &mut wavelengths,
+                                        &mut stream,
+                                        light_samples,
+                                        settings.illumination_aov,
+                                        &mut counters,
+                                    )
+                                })
+                        };
+                        let (radiance, aov) = match result {
+                            None => (SampledSpectrum::splat(0.0), None),
+                            Some(r) => {
+                                rays += 1;
                                 if let Some(white) = r.illumination {
                                     tile.add_illumination(pixel, white, &wavelengths);
                                 }

@@ -50,7 +50,8 @@ pub struct PathCounters {
 pub struct PathResult {
     /// Radiance arriving at the camera along the ray, W·m⁻²·sr⁻¹·nm⁻¹ per lane.
     pub radiance: SampledSpectrum,
-    /// The first surface hit, when there is one.
+    /// The first surface hit, when there is one (the shading record: `curvature` is left
+    /// at zero; `Geometry::interaction` computes it where it is needed).
     pub first_hit: Option<SurfaceInteraction>,
     /// Radiance a neutral white Lambertian (R = 1) would reflect towards the camera at the
     /// first hit (direct light by light sampling plus the path's indirect estimate), for
@@ -246,8 +247,6 @@ impl PathTracer {
             |o| o.ctx,
         );
         let mut prev_bsdf_pdf = origin.map_or(0.0f32, |o| o.direction_pdf);
-        // Curvature is for the camera's G-buffer; a sensor's first hit needs none.
-        let want_curvature = origin.is_none();
         // Product of η² over refractions: roulette compares radiance, not the 1/η²-scaled
         // throughput (pbrt-v4 §13.4.4 `etaScale`).
         let mut eta_scale = 1.0f32;
@@ -305,12 +304,9 @@ impl PathTracer {
                 }
                 break;
             };
-            // Curvature only at the first hit (the G-buffer's); shading never reads it.
-            let mut si = if first_hit.is_none() && want_curvature {
-                scene.geometry.interaction(&ray, &hit)
-            } else {
-                scene.geometry.shading_interaction(&ray, &hit)
-            };
+            // No curvature: shading never reads it, nor does the film's G-buffer (depth,
+            // normal, albedo); it cost ≈ 1 % of a Cornell box render at every first hit.
+            let mut si = scene.geometry.shading_interaction(&ray, &hit);
             if let Some(footprint) = &scene.texture_footprint {
                 match &current_differential {
                     Some(rd) => si.compute_differentials(rd),
@@ -320,16 +316,15 @@ impl PathTracer {
                 }
             }
             let material = scene.material(si.material_id);
-            let u_mask = stream.get_1d();
-            let u_light_choice = stream.get_1d();
-            let u_light = stream.get_2d();
-            let u_lobe = stream.get_1d();
-            let u_bsdf = stream.get_2d();
-            let u_roulette = stream.get_1d();
+            // The vertex's 8 dimensions (module docs): reserved in order, each computed only
+            // when used — the same values as drawing all 8 (`SampleStream::reserve`).
+            let dims = stream.reserve(8);
+            let (d_mask, d_light_choice, d_light, d_lobe, d_bsdf, d_roulette) =
+                (dims, dims + 1, dims + 2, dims + 4, dims + 5, dims + 7);
 
             // Opacity mask: pass straight through with probability 1 − α.
             let opacity = material.opacity_at(&si);
-            if opacity < 1.0 && u_mask >= opacity {
+            if opacity < 1.0 && stream.get_1d_at(d_mask) >= opacity {
                 pass_throughs += 1;
                 if pass_throughs > 256 {
                     break;
@@ -403,7 +398,7 @@ impl PathTracer {
                 let mut white = SampledSpectrum::splat(0.0);
                 for k in 0..n_light {
                     let (uc, ul) = if k == 0 {
-                        (u_light_choice, u_light)
+                        (stream.get_1d_at(d_light_choice), stream.get_2d_at(d_light))
                     } else {
                         (stream.get_1d(), stream.get_2d())
                     };
@@ -442,6 +437,7 @@ impl PathTracer {
             }
 
             // Continue the path by sampling the BSDF.
+            let (u_lobe, u_bsdf) = (stream.get_1d_at(d_lobe), stream.get_2d_at(d_bsdf));
             let Some(bs) = bsdf.sample(vertex.wo_local, u_lobe, u_bsdf, TransportMode::Radiance)
             else {
                 break;
@@ -497,7 +493,7 @@ impl PathTracer {
             // Russian roulette on the radiance-scaled throughput.
             if depth >= self.rr_depth {
                 let q = (1.0 - (beta * eta_scale).max_component()).max(0.0);
-                if u_roulette < q {
+                if stream.get_1d_at(d_roulette) < q {
                     counters.roulette_terminations += 1;
                     break;
                 }

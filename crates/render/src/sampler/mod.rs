@@ -92,6 +92,12 @@ impl PixelSampler {
     }
 }
 
+/// The hash of (seed, pixel, dimension) that scrambles one Sobol call.
+#[inline(always)]
+fn dimension_hash(key: u64, dimension: u32) -> u64 {
+    mix64(key ^ u64::from(dimension).wrapping_mul(DIMENSION_SPREAD))
+}
+
 /// Dimensions drawn from Sobol points per camera sample: the path tracer's filter 2, lens
 /// 2, wavelength 1 and 8 per vertex for its first three vertices. Later dimensions are
 /// independent.
@@ -109,54 +115,77 @@ impl SampleStream {
         self
     }
 
-    /// Independent value for dimensions past `SOBOL_DIMENSIONS` of a Sobol stream.
+    /// Dimension `dimension` of this stream as 32 fraction bits: what a `get_1d` call
+    /// reaching that dimension returns, computed without drawing the dimensions before it
+    /// (every value is a function of (seed, pixel, sample index, dimension) alone).
     #[inline(always)]
-    fn sobol_tail(&self) -> u32 {
-        let sample_key = independent::sample_key(self.key, self.index_reversed.reverse_bits());
-        independent::value(sample_key, self.dimension)
-    }
-
-    /// The hash of (seed, pixel, dimension) that scrambles one Sobol call.
-    #[inline(always)]
-    fn dimension_hash(&self) -> u64 {
-        mix64(self.key ^ u64::from(self.dimension).wrapping_mul(DIMENSION_SPREAD))
-    }
-
-    /// The next dimension, uniform in [0, 1).
-    #[inline]
-    pub fn get_1d(&mut self) -> f32 {
-        let bits = match self.kind {
-            SamplerKind::Sobol if self.dimension >= self.sobol_dimensions => self.sobol_tail(),
+    fn bits_1d_at(&self, dimension: u32) -> u32 {
+        match self.kind {
+            SamplerKind::Sobol if dimension >= self.sobol_dimensions => {
+                let sample_key =
+                    independent::sample_key(self.key, self.index_reversed.reverse_bits());
+                independent::value(sample_key, dimension)
+            }
             SamplerKind::Sobol => {
-                let h = self.dimension_hash();
+                let h = dimension_hash(self.key, dimension);
                 let index = sobol::shuffle_reversed_index(self.index_reversed, h as u32);
                 sobol::scrambled_dimension_0(index, (h >> 32) as u32)
             }
-            SamplerKind::Independent => independent::value(self.key, self.dimension),
-        };
-        self.dimension += 1;
-        hash::u32_to_unit_f32(bits)
+            SamplerKind::Independent => independent::value(self.key, dimension),
+        }
     }
 
-    /// The next two dimensions: for Sobol one point of a (0, 2)-sequence.
-    #[inline]
-    pub fn get_2d(&mut self) -> Vec2 {
+    /// The value a `get_1d` call at `dimension` returns (see [`SampleStream::reserve`]).
+    #[inline(always)]
+    pub fn get_1d_at(&self, dimension: u32) -> f32 {
+        hash::u32_to_unit_f32(self.bits_1d_at(dimension))
+    }
+
+    /// The value a `get_2d` call at `dimension` returns (dimensions `dimension` and
+    /// `dimension + 1`; see [`SampleStream::reserve`]).
+    #[inline(always)]
+    pub fn get_2d_at(&self, dimension: u32) -> Vec2 {
         match self.kind {
-            SamplerKind::Sobol if self.dimension + 1 < self.sobol_dimensions => {
-                let h = self.dimension_hash();
+            SamplerKind::Sobol if dimension + 1 < self.sobol_dimensions => {
+                let h = dimension_hash(self.key, dimension);
                 let index = sobol::shuffle_reversed_index(self.index_reversed, h as u32);
                 let seed_y = (mix64(h) >> 32) as u32;
-                self.dimension += 2;
                 Vec2::new(
                     hash::u32_to_unit_f32(sobol::scrambled_dimension_0(index, (h >> 32) as u32)),
                     hash::u32_to_unit_f32(sobol::scrambled_dimension_1(index, seed_y)),
                 )
             }
-            _ => {
-                let x = self.get_1d();
-                Vec2::new(x, self.get_1d())
-            }
+            _ => Vec2::new(self.get_1d_at(dimension), self.get_1d_at(dimension + 1)),
         }
+    }
+
+    /// Skips the next `count` dimensions and returns the first of them: the caller draws
+    /// the ones it needs with `get_1d_at`/`get_2d_at`, getting exactly the values the
+    /// sequential `get_1d`/`get_2d` calls would have returned, and the stream continues
+    /// after them as if all had been drawn. The path tracer reserves a vertex's 8
+    /// dimensions this way and computes only those a hit uses (an opaque surface never
+    /// reads its opacity-mask variate, a path before `rr_depth` never its roulette one).
+    #[inline(always)]
+    pub fn reserve(&mut self, count: u32) -> u32 {
+        let first = self.dimension;
+        self.dimension += count;
+        first
+    }
+
+    /// The next dimension, uniform in [0, 1).
+    #[inline(always)]
+    pub fn get_1d(&mut self) -> f32 {
+        let x = self.get_1d_at(self.dimension);
+        self.dimension += 1;
+        x
+    }
+
+    /// The next two dimensions: for Sobol one point of a (0, 2)-sequence.
+    #[inline(always)]
+    pub fn get_2d(&mut self) -> Vec2 {
+        let p = self.get_2d_at(self.dimension);
+        self.dimension += 2;
+        p
     }
 
     /// Dimensions used so far.
@@ -191,6 +220,68 @@ mod tests {
                 assert!((0.0..1.0).contains(&p.x) && (0.0..1.0).contains(&p.y));
             }
             assert_eq!(a.dimension(), 300);
+        }
+    }
+
+    #[test]
+    fn reserved_dimensions_equal_the_sequential_draws() {
+        // Random access must return the bits of the sequential calls, at every dimension
+        // (Sobol pairs, the Sobol/independent boundary at `SOBOL_DIMENSIONS`, the tail),
+        // and the stream must continue where the sequential one does.
+        for kind in KINDS {
+            let s = PixelSampler::with_kind(kind, 11);
+            for index in [0, 1, 5, 63] {
+                for offset in 0..3 {
+                    let mut sequential = s.stream(UVec2::new(9, 2), index);
+                    let mut reserved = s.stream(UVec2::new(9, 2), index);
+                    for _ in 0..offset {
+                        sequential.get_1d();
+                        reserved.get_1d();
+                    }
+                    for _ in 0..6 {
+                        // One vertex's pattern: 1d, 1d, 2d, 1d, 2d, 1d.
+                        let base = reserved.reserve(8);
+                        let expected = [
+                            sequential.get_1d(),
+                            sequential.get_1d(),
+                            sequential.get_2d().x,
+                            f32::NAN,
+                            sequential.get_1d(),
+                            sequential.get_2d().x,
+                            f32::NAN,
+                            sequential.get_1d(),
+                        ];
+                        let mut again = s.stream(UVec2::new(9, 2), index);
+                        for _ in 0..base {
+                            again.get_1d();
+                        }
+                        let got = [
+                            reserved.get_1d_at(base),
+                            reserved.get_1d_at(base + 1),
+                            reserved.get_2d_at(base + 2).x,
+                            f32::NAN,
+                            reserved.get_1d_at(base + 4),
+                            reserved.get_2d_at(base + 5).x,
+                            f32::NAN,
+                            reserved.get_1d_at(base + 7),
+                        ];
+                        for k in [0, 1, 2, 4, 5, 7] {
+                            assert_eq!(got[k].to_bits(), expected[k].to_bits(), "{kind:?} {k}");
+                        }
+                        assert_eq!(
+                            reserved.get_2d_at(base + 2),
+                            {
+                                again.get_1d();
+                                again.get_1d();
+                                again.get_2d()
+                            },
+                            "{kind:?}"
+                        );
+                        assert_eq!(reserved.dimension(), sequential.dimension());
+                    }
+                    assert_eq!(reserved.get_1d().to_bits(), sequential.get_1d().to_bits());
+                }
+            }
         }
     }
 
