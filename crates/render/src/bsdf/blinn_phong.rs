@@ -18,7 +18,7 @@ use glam::{Vec2, Vec3A};
 use prism_spectrum::SampledSpectrum;
 
 use super::fresnel::reflect;
-use super::phong::diffuse_probability;
+use super::phong::{diffuse_probability, mixture_pdf};
 use super::{BsdfSample, LobeKind, TransportMode};
 use crate::sampling::{power_cosine_pdf, sample_cosine_hemisphere, sample_power_cosine};
 
@@ -73,7 +73,7 @@ impl BlinnPhong {
                 0.0
             }
         });
-        pd * wi.z * std::f32::consts::FRAC_1_PI + (1.0 - pd) * glossy
+        mixture_pdf(pd, wi, glossy)
     }
 
     #[inline]

@@ -24,10 +24,7 @@ impl Lambert {
 
     #[inline]
     pub fn pdf(&self, wo: Vec3A, wi: Vec3A, _mode: TransportMode) -> f32 {
-        if wo.z <= 0.0 || wi.z <= 0.0 {
-            return 0.0;
-        }
-        wi.z * std::f32::consts::FRAC_1_PI
+        cosine_pdf(wo, wi)
     }
 
     #[inline]
@@ -44,6 +41,16 @@ impl Lambert {
         let wi = sample_cosine_hemisphere(u);
         BsdfSample::reflection(wi, self.pdf(wo, wi, mode), || self.eval(wo, wi, mode))
     }
+}
+
+/// Solid-angle pdf of cosine-weighted hemisphere sampling above the surface (0 when either
+/// direction is below): the sampling of every diffuse lobe (Lambert, Oren–Nayar).
+#[inline]
+pub(crate) fn cosine_pdf(wo: Vec3A, wi: Vec3A) -> f32 {
+    if wo.z <= 0.0 || wi.z <= 0.0 {
+        return 0.0;
+    }
+    wi.z * std::f32::consts::FRAC_1_PI
 }
 
 #[cfg(test)]

@@ -109,10 +109,7 @@ impl OrenNayar {
 
     #[inline]
     pub fn pdf(&self, wo: Vec3A, wi: Vec3A, _mode: TransportMode) -> f32 {
-        if wo.z <= 0.0 || wi.z <= 0.0 {
-            return 0.0;
-        }
-        wi.z * std::f32::consts::FRAC_1_PI
+        super::lambert::cosine_pdf(wo, wi)
     }
 
     #[inline]

@@ -46,6 +46,13 @@ pub(crate) fn diffuse_probability(diffuse: SampledSpectrum, glossy: SampledSpect
     }
 }
 
+/// Pdf of a diffuse/glossy mixture: cosine sampling with probability `pd`, the glossy
+/// lobe (solid-angle pdf `glossy`) otherwise.
+#[inline]
+pub(crate) fn mixture_pdf(pd: f32, wi: Vec3A, glossy: f32) -> f32 {
+    pd * wi.z * std::f32::consts::FRAC_1_PI + (1.0 - pd) * glossy
+}
+
 impl Phong {
     #[inline]
     fn mirror(wo: Vec3A) -> Vec3A {
