@@ -393,3 +393,93 @@ fn wb_scene_without_an_illumination_layer_names_the_file_and_the_layer() {
         &["room.exr", "illumination layer is zero"],
     );
 }
+
+#[test]
+fn exposure_auto_brings_an_absolute_render_to_middle_grey() {
+    // A dim absolute-looking image (luminances near 1e-3): linear with EV 0 is black
+    // in 8 bits; `--exposure auto` maps its log-average to 0.18.
+    let input = scratch("dim.exr");
+    let (w, h) = (32usize, 16usize);
+    let pixels: Vec<[f32; 3]> = (0..w * h)
+        .map(|i| {
+            let v = 1e-3 * (1.0 + (i % w) as f32 / w as f32);
+            [v, v, v]
+        })
+        .collect();
+    let ln_mean = pixels.iter().map(|p| f64::from(p[1]).ln()).sum::<f64>() / (w * h) as f64;
+    let expected_ev = (0.18 / ln_mean.exp()).log2();
+    write_image(
+        &input,
+        &Image::new(w, h, pixels, RgbColorSpace::srgb()).unwrap(),
+    )
+    .unwrap();
+    let out = scratch("dim-auto.exr");
+    let report: Value = serde_json::from_str(&ok(&[
+        "tonemap",
+        input.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--op",
+        "linear",
+        "--exposure",
+        "auto",
+        "--json",
+    ]))
+    .unwrap();
+    let ev = report["exposure_ev"].as_f64().unwrap();
+    assert!((ev - expected_ev).abs() < 1e-4, "{ev} vs {expected_ev}");
+    assert_eq!(report["auto_exposure"], Value::Bool(true));
+    let mapped = read_image(&out).unwrap();
+    let ln_mapped = mapped
+        .pixels()
+        .iter()
+        .map(|p| f64::from(p[1]).ln())
+        .sum::<f64>()
+        / (w * h) as f64;
+    assert!((ln_mapped.exp() - 0.18).abs() < 1e-4, "{}", ln_mapped.exp());
+
+    let text = ok(&[
+        "tonemap",
+        input.to_str().unwrap(),
+        "-o",
+        scratch("dim-auto.png").to_str().unwrap(),
+        "--op",
+        "aces",
+        "--exposure",
+        "auto",
+    ]);
+    assert!(text.contains("exposure auto: +"), "{text}");
+
+    fails_with(
+        &[
+            "tonemap",
+            input.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "--op",
+            "linear",
+            "--exposure",
+            "bright",
+        ],
+        &["--exposure bright", "`auto`"],
+    );
+    let black = scratch("black.exr");
+    write_image(
+        &black,
+        &Image::new(4, 4, vec![[0.0; 3]; 16], RgbColorSpace::srgb()).unwrap(),
+    )
+    .unwrap();
+    fails_with(
+        &[
+            "tonemap",
+            black.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "--op",
+            "linear",
+            "--exposure",
+            "auto",
+        ],
+        &["black.exr", "--exposure auto", "black image"],
+    );
+}

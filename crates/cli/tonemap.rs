@@ -35,9 +35,16 @@ pub struct TonemapArgs {
     /// Output primaries: srgb, p3 or rec2020.
     #[arg(long, default_value = "srgb")]
     pub target: String,
-    /// Exposure in stops applied first (input × 2^EV).
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
-    pub exposure: f64,
+    /// Exposure in stops applied first (input × 2^EV), or `auto`: the EV that maps the
+    /// log-average luminance to middle grey 0.18 (for absolute renders with the
+    /// operators that are not scale invariant: linear, aces, agx, …).
+    #[arg(
+        long,
+        default_value = "0",
+        allow_hyphen_values = true,
+        value_name = "EV|auto"
+    )]
+    pub exposure: String,
     /// cd/m² per unit of the input, for the absolute operators when the file has no
     /// `prism:cd_m2_per_unit` header (overrides it when it has).
     #[arg(long, value_name = "CD_M2")]
@@ -66,6 +73,19 @@ fn parse_params(raw: &[String]) -> Result<BTreeMap<String, f64>, String> {
         params.insert(key.trim().to_string(), number);
     }
     Ok(params)
+}
+
+/// `--exposure EV|auto` → (EV, auto).
+fn parse_exposure(raw: &str) -> Result<(f64, bool), String> {
+    if raw.trim().eq_ignore_ascii_case("auto") {
+        return Ok((0.0, true));
+    }
+    match raw.trim().parse::<f64>() {
+        Ok(ev) if ev.is_finite() => Ok((ev, false)),
+        _ => Err(format!(
+            "--exposure {raw}: expected a finite number of stops (e.g. -2.5) or `auto`"
+        )),
+    }
 }
 
 fn print_list(json: bool) -> Result<(), String> {
@@ -98,6 +118,12 @@ fn print_list(json: bool) -> Result<(), String> {
 }
 
 fn print_summary(report: &TonemapFileReport) {
+    if report.auto_exposure {
+        println!(
+            "exposure auto: {:+.2} EV (log-average luminance → 0.18)",
+            report.exposure_ev
+        );
+    }
     println!(
         "wrote {} ({}×{}, {}, {} → {}, {:.2} % of pixels outside the gamut before mapping)",
         report.output,
@@ -127,13 +153,15 @@ pub fn run(args: &TonemapArgs) -> Result<(), String> {
         (Some(i), Some(o), Some(op)) => (i, o, op),
         _ => return Err("tonemap needs IN, -o OUT and --op NAME (or --list)".to_string()),
     };
+    let (exposure_ev, auto_exposure) = parse_exposure(&args.exposure)?;
     let options = TonemapOptions {
         operator: OperatorChoice::parse(op).map_err(|e| format!("--op {op}: {e}"))?,
         params: parse_params(&args.params)?,
         wb: WhiteBalance::parse(&args.wb).map_err(|e| e.to_string())?,
         gamut: GamutMethod::parse(&args.gamut).map_err(|e| e.to_string())?,
         target: GamutTarget::parse(&args.target).map_err(|e| e.to_string())?,
-        exposure_ev: args.exposure,
+        exposure_ev,
+        auto_exposure,
         luminance_scale_cd_m2: args.luminance_scale,
     };
     let report = tonemap_file(input, output, &options).map_err(|e| e.to_string())?;

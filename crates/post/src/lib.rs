@@ -4,6 +4,7 @@
 //! File pipeline (`tonemap_file`): read → exposure → white balance → tone operator →
 //! gamut mapping → display encoding.
 
+pub mod auto_exposure;
 pub mod colour;
 pub mod error;
 pub mod falsecolour;

@@ -17,6 +17,7 @@ use prism_spectrum::AdaptationMethod;
 use rayon::prelude::*;
 use serde::Serialize;
 
+use crate::auto_exposure::auto_exposure_ev;
 use crate::colour::scene_illumination::ILLUMINATION_CHANNELS;
 use crate::colour::{
     apply_white_balance, apply_with_source_white, illumination_white_xyz, map_gamut, GamutMethod,
@@ -76,6 +77,9 @@ pub struct TonemapOptions {
     pub target: GamutTarget,
     /// `--exposure EV`: input × 2^EV before white balance.
     pub exposure_ev: f64,
+    /// `--exposure auto`: `exposure_ev` is replaced by the EV that maps the log-average
+    /// luminance to middle grey ([`auto_exposure_ev`]); the report gives the EV used.
+    pub auto_exposure: bool,
     /// `--luminance-scale CD_M2`: cd/m² per unit, overriding `prism:cd_m2_per_unit`.
     pub luminance_scale_cd_m2: Option<f64>,
 }
@@ -89,6 +93,7 @@ impl Default for TonemapOptions {
             gamut: GamutMethod::Clip,
             target: GamutTarget::Srgb,
             exposure_ev: 0.0,
+            auto_exposure: false,
             luminance_scale_cd_m2: None,
         }
     }
@@ -116,7 +121,9 @@ pub struct TonemapFileReport {
     /// `NAME` or `all`.
     pub operator: &'static str,
     pub params: BTreeMap<String, f64>,
+    /// The exposure applied (computed when `auto_exposure`).
     pub exposure_ev: f64,
+    pub auto_exposure: bool,
     pub luminance_scale_cd_m2: Option<f64>,
     pub white_balance: String,
     /// Estimated scene white (CIE 1931 xy) when white balance ran.
@@ -158,8 +165,18 @@ pub fn tonemap_file(
             options.exposure_ev
         )));
     }
-    if options.exposure_ev != 0.0 {
-        let factor = 2f64.powf(options.exposure_ev) as f32;
+    let exposure_ev = if options.auto_exposure {
+        auto_exposure_ev(&image).ok_or_else(|| {
+            PostError::format(
+                input,
+                "--exposure auto: no pixel has a positive finite luminance (black image)",
+            )
+        })?
+    } else {
+        options.exposure_ev
+    };
+    if exposure_ev != 0.0 {
+        let factor = 2f64.powf(exposure_ev) as f32;
         image
             .pixels_mut()
             .par_iter_mut()
@@ -242,7 +259,8 @@ pub fn tonemap_file(
         height: out.height(),
         operator: options.operator.name(),
         params: options.params.clone(),
-        exposure_ev: options.exposure_ev,
+        exposure_ev,
+        auto_exposure: options.auto_exposure,
         luminance_scale_cd_m2: options.luminance_scale_cd_m2,
         white_balance: options.wb.name(),
         white_balance_source_xy: wb_source_xy,
