@@ -1,16 +1,8 @@
 //! `prism render` with sensors and luminaires: the readings files beside the image, the
 //! false-colour PNGs, and the errors a user sees for a broken photometric file.
 
-use std::path::Path;
-use std::process::{Command, Output};
-
-fn prism(dir: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_prism"))
-        .current_dir(dir)
-        .args(args)
-        .output()
-        .expect("prism runs")
-}
+mod support;
+use support::prism_in as prism;
 
 const IES: &str = "IESNA:LM-63-2002\n[TEST] cli\n[MANUFAC] prism\nTILT=NONE\n1 -1 1 3 1 1 2 0 0 0\n1 1 10\n0 45 90\n0\n600 500 0\n";
 
