@@ -18,7 +18,7 @@ use prism_scene::MisHeuristic;
 use prism_spectrum::{SampledSpectrum, SampledWavelengths};
 
 use crate::bsdf::{Bsdf, TransportMode};
-use crate::light::{LightHit, LightSampleContext};
+use crate::light::{LightHit, LightSampleContext, RadianceCache};
 use crate::sampler::SampleStream;
 use crate::scene_build::RenderScene;
 
@@ -253,6 +253,9 @@ impl PathTracer {
         // Pass-throughs of masked surfaces do not count as bounces; cap them anyway.
         let mut pass_throughs = 0u32;
         let n_light = light_samples.max(1);
+        // The lights' spectra at this path's wavelengths (their values never change along
+        // the path; `terminate_secondary` only zeroes pdfs).
+        let mut le_cache = RadianceCache::new();
 
         // Adds beta·x unless it is NaN/∞ (then counts it: one bad contribution cannot poison
         // a pixel, and the stats say so). `count_incident`: also part of the indirect light
@@ -349,7 +352,13 @@ impl PathTracer {
                     uv: si.uv,
                     distance_m: hit.t,
                 };
-                let le = light.emitted_radiance(&light_hit, -ray.direction, wavelengths);
+                let le = light.emitted_radiance_cached(
+                    l,
+                    &light_hit,
+                    -ray.direction,
+                    wavelengths,
+                    &mut le_cache,
+                );
                 if !le.is_black() {
                     let w = if specular_bounce {
                         1.0
@@ -415,6 +424,7 @@ impl PathTracer {
                         uc,
                         ul,
                         wavelengths,
+                        &mut le_cache,
                         want_illumination && depth == 1,
                         counters,
                     );
@@ -527,6 +537,7 @@ impl PathTracer {
         u_choice: f32,
         u: Vec2,
         wavelengths: &SampledWavelengths,
+        le_cache: &mut RadianceCache,
         want_white: bool,
         counters: &mut PathCounters,
     ) -> (SampledSpectrum, SampledSpectrum) {
@@ -536,7 +547,7 @@ impl PathTracer {
             return (zero, zero);
         };
         let light = lights.light(l);
-        let Some(ls) = light.sample_li(ctx, u, wavelengths) else {
+        let Some(ls) = light.sample_li_cached(l, ctx, u, wavelengths, le_cache) else {
             return (zero, zero);
         };
         if ls.pdf <= 0.0 || ls.radiance.is_black() {

@@ -139,6 +139,18 @@ impl AreaLight {
         u: Vec2,
         wavelengths: &SampledWavelengths,
     ) -> Option<LightSample> {
+        self.sample_li_with(ctx, u, || self.radiance.eval(wavelengths))
+    }
+
+    /// `sample_li` with L(λ) at the path's wavelengths from `radiance` (called only when a
+    /// direction is returned): a path evaluates the spectrum once (`RadianceCache`).
+    #[inline]
+    pub fn sample_li_with(
+        &self,
+        ctx: &LightSampleContext,
+        u: Vec2,
+        radiance: impl FnOnce() -> SampledSpectrum,
+    ) -> Option<LightSample> {
         let s = self.shape.sample(ctx.p, u)?;
         let to = s.p - ctx.p;
         let d = to.length();
@@ -151,7 +163,7 @@ impl AreaLight {
         }
         Some(LightSample {
             wi,
-            radiance: self.radiance.eval(wavelengths),
+            radiance: radiance(),
             pdf: s.pdf,
             p_light: s.p,
             distance_m: d,
@@ -174,8 +186,19 @@ impl AreaLight {
         wo: Vec3A,
         wavelengths: &SampledWavelengths,
     ) -> SampledSpectrum {
+        self.emitted_radiance_with(hit, wo, || self.radiance.eval(wavelengths))
+    }
+
+    /// `emitted_radiance` with L(λ) from `radiance` (see `sample_li_with`).
+    #[inline]
+    pub fn emitted_radiance_with(
+        &self,
+        hit: &LightHit,
+        wo: Vec3A,
+        radiance: impl FnOnce() -> SampledSpectrum,
+    ) -> SampledSpectrum {
         if self.emits_towards(hit.n, wo) {
-            self.radiance.eval(wavelengths)
+            radiance()
         } else {
             SampledSpectrum::splat(0.0)
         }
