@@ -50,13 +50,23 @@ pub struct PathCounters {
 pub struct PathResult {
     /// Radiance arriving at the camera along the ray, W·m⁻²·sr⁻¹·nm⁻¹ per lane.
     pub radiance: SampledSpectrum,
-    /// The first surface hit, when there is one (the shading record: `curvature` is left
-    /// at zero; `Geometry::interaction` computes it where it is needed).
-    pub first_hit: Option<SurfaceInteraction>,
+    /// The first surface hit, when there is one (what the film's surface AOVs record).
+    pub first_hit: Option<FirstHit>,
     /// Radiance a neutral white Lambertian (R = 1) would reflect towards the camera at the
     /// first hit (direct light by light sampling plus the path's indirect estimate), for
     /// scene-based white balance; `None` when the first hit is specular or there is none.
     pub illumination: Option<SampledSpectrum>,
+}
+
+/// What the film's surface AOVs need of a path's first hit: a few fields instead of the
+/// whole `SurfaceInteraction` (≈ 250 bytes, copied into the result of every camera sample).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FirstHit {
+    /// Distance along the camera ray, metres.
+    pub t: f32,
+    /// Shading normal (world, unit), after normal or bump mapping.
+    pub n_shading: Vec3A,
+    pub material_id: u32,
 }
 
 /// Multiple importance sampling weight of a strategy with pdf `a` against one with pdf `b`
@@ -92,8 +102,8 @@ pub struct PathOrigin {
 }
 
 /// A shading point: where the path scatters.
-struct Vertex {
-    si: SurfaceInteraction,
+struct Vertex<'a> {
+    si: &'a SurfaceInteraction,
     frame: Frame,
     wo_local: Vec3A,
     /// The shading normal comes from a normal or bump map: directions whose side of the
@@ -104,7 +114,7 @@ struct Vertex {
     wo_dot_ng: f32,
 }
 
-impl Vertex {
+impl Vertex<'_> {
     /// True when world direction `wi` lies on the side of the geometric surface that the
     /// shading frame's reflection (`wi_local.z · wo_local.z > 0`) or transmission implies.
     #[inline]
@@ -235,7 +245,7 @@ impl PathTracer {
         let mut first_bounce_beta: Option<SampledSpectrum> = None;
         let mut incident_after_first = SampledSpectrum::splat(0.0);
         let mut illumination_direct: Option<SampledSpectrum> = None;
-        let mut first_hit: Option<SurfaceInteraction> = None;
+        let mut first_hit: Option<FirstHit> = None;
         let mut ray = *camera_ray;
         let mut depth = 0u32;
         let mut specular_bounce = origin.is_none();
@@ -340,7 +350,11 @@ impl PathTracer {
                 material.apply_shading_maps(&mut si);
             }
             if first_hit.is_none() {
-                first_hit = Some(si);
+                first_hit = Some(FirstHit {
+                    t: si.t,
+                    n_shading: si.n_shading,
+                    material_id: si.material_id,
+                });
             }
 
             // Emission of a hit area light.
@@ -390,7 +404,7 @@ impl PathTracer {
             let bsdf = material.bsdf(&si, wavelengths);
             let frame = Frame::from_zx(si.n_shading, si.dpdu);
             let vertex = Vertex {
-                si,
+                si: &si,
                 frame,
                 wo_local: frame.to_local(-ray.direction),
                 check_sides: shading_maps,
