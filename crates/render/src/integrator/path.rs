@@ -18,9 +18,10 @@ use prism_scene::MisHeuristic;
 use prism_spectrum::{SampledSpectrum, SampledWavelengths};
 
 use crate::bsdf::{Bsdf, TransportMode};
-use crate::light::{LightHit, LightSampleContext, RadianceCache};
+use crate::light::{LightHit, LightSampleContext};
 use crate::sampler::SampleStream;
 use crate::scene_build::RenderScene;
+use crate::spectrum_cache::SpectrumCache;
 
 /// Parameters of the path tracer.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -265,7 +266,9 @@ impl PathTracer {
         let n_light = light_samples.max(1);
         // The lights' spectra at this path's wavelengths (their values never change along
         // the path; `terminate_secondary` only zeroes pdfs).
-        let mut le_cache = RadianceCache::new();
+        let mut le_cache = SpectrumCache::new();
+        // Constant reflectances at this path's wavelengths, by material id.
+        let mut reflectance_cache = SpectrumCache::new();
 
         // Adds beta·x unless it is NaN/∞ (then counts it: one bad contribution cannot poison
         // a pixel, and the stats say so). `count_incident`: also part of the indirect light
@@ -335,8 +338,13 @@ impl PathTracer {
             let (d_mask, d_light_choice, d_light, d_lobe, d_bsdf, d_roulette) =
                 (dims, dims + 1, dims + 2, dims + 4, dims + 5, dims + 7);
 
-            // Opacity mask: pass straight through with probability 1 − α.
-            let opacity = material.opacity_at(&si);
+            // Opacity mask: pass straight through with probability 1 − α (only scenes with
+            // masks: the per-hit material dispatch is not free).
+            let opacity = if scene.has_masks {
+                material.opacity_at(&si)
+            } else {
+                1.0
+            };
             if opacity < 1.0 && stream.get_1d_at(d_mask) >= opacity {
                 pass_throughs += 1;
                 if pass_throughs > 256 {
@@ -398,10 +406,11 @@ impl PathTracer {
             depth += 1;
             counters.bounces += 1;
 
-            if material.is_dispersive() {
+            if scene.has_dispersion && material.is_dispersive() {
                 wavelengths.terminate_secondary();
             }
-            let bsdf = material.bsdf(&si, wavelengths);
+            let bsdf =
+                material.bsdf_cached(si.material_id, &si, wavelengths, &mut reflectance_cache);
             let frame = Frame::from_zx(si.n_shading, si.dpdu);
             let vertex = Vertex {
                 si: &si,
@@ -551,7 +560,7 @@ impl PathTracer {
         u_choice: f32,
         u: Vec2,
         wavelengths: &SampledWavelengths,
-        le_cache: &mut RadianceCache,
+        le_cache: &mut SpectrumCache,
         want_white: bool,
         counters: &mut PathCounters,
     ) -> (SampledSpectrum, SampledSpectrum) {

@@ -49,6 +49,8 @@ pub use spot::SpotLight;
 use glam::{Vec2, Vec3A};
 use prism_spectrum::{SampledSpectrum, SampledWavelengths};
 
+pub use crate::spectrum_cache::SpectrumCache;
+
 /// Where light arrives: the reference point of `sample_li` / `pdf_li`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LightSampleContext {
@@ -104,53 +106,10 @@ pub enum Light {
     Goniometric(Box<GoniometricLight>),
 }
 
-/// The spectra of a path's lights at its wavelengths, evaluated once per path: an area
-/// light's L(λ) does not depend on the point or direction, and a path's wavelengths keep
-/// their values (terminating the secondaries only zeroes their pdfs), while the Cornell box
-/// path evaluated its light's 477-sample table at every light sample and emission hit
-/// (≈ 90 instructions each, ≈ 4 per camera sample). Four slots, indexed by light index
-/// mod 4 (a direct-mapped cache: scenes with more lights only evaluate more often). Start a
-/// new one for every path (`new`), or after the wavelengths change.
-#[derive(Clone, Copy, Debug)]
-pub struct RadianceCache {
-    slots: [(u32, SampledSpectrum); 4],
-}
-
-impl Default for RadianceCache {
-    fn default() -> Self {
-        Self::new()
-    }
-}
-
-impl RadianceCache {
-    /// An empty cache (no light index is `u32::MAX`: `LightSet` indices are below its
-    /// length).
-    #[inline]
-    pub fn new() -> Self {
-        Self {
-            slots: [(u32::MAX, SampledSpectrum::splat(0.0)); 4],
-        }
-    }
-
-    /// `spectrum` (the spectrum of light `light`) at `wavelengths`.
-    #[inline]
-    fn get(
-        &mut self,
-        light: u32,
-        spectrum: &prism_spectrum::Spectrum,
-        wavelengths: &SampledWavelengths,
-    ) -> SampledSpectrum {
-        let slot = &mut self.slots[(light % 4) as usize];
-        if slot.0 != light {
-            *slot = (light, spectrum.eval(wavelengths));
-        }
-        slot.1
-    }
-}
-
 impl Light {
     /// `sample_li` for light number `index` of the scene's `LightSet`, with its spectrum
-    /// from the path's `cache` where the radiance is uniform (area lights).
+    /// from the path's `cache` (keyed by light index) where the radiance is uniform (area
+    /// lights).
     #[inline]
     pub fn sample_li_cached(
         &self,
@@ -158,7 +117,7 @@ impl Light {
         ctx: &LightSampleContext,
         u: Vec2,
         wavelengths: &SampledWavelengths,
-        cache: &mut RadianceCache,
+        cache: &mut SpectrumCache,
     ) -> Option<LightSample> {
         match self {
             Light::Area(l) => {
@@ -177,12 +136,12 @@ impl Light {
         hit: &LightHit,
         wo: Vec3A,
         wavelengths: &SampledWavelengths,
-        cache: &mut RadianceCache,
+        cache: &mut SpectrumCache,
     ) -> SampledSpectrum {
         match self {
-            Light::Area(l) => l.emitted_radiance_with(hit, wo, || {
-                cache.get(index, &l.radiance, wavelengths)
-            }),
+            Light::Area(l) => {
+                l.emitted_radiance_with(hit, wo, || cache.get(index, &l.radiance, wavelengths))
+            }
             _ => SampledSpectrum::splat(0.0),
         }
     }
