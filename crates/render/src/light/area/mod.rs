@@ -154,7 +154,9 @@ impl AreaLight {
         let s = self.shape.sample(ctx.p, u)?;
         let to = s.p - ctx.p;
         let d = to.length();
-        if !(d > 0.0 && d.is_finite() && s.pdf > 0.0 && s.pdf.is_finite()) {
+        // 0 < x < ∞ is "positive and finite" (false for NaN) in one comparison pair each,
+        // where `is_finite` compiles to integer classification (≈ 20 instructions).
+        if !(d > 0.0 && d < f32::INFINITY && s.pdf > 0.0 && s.pdf < f32::INFINITY) {
             return None;
         }
         let wi = to / d;
