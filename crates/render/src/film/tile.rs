@@ -179,6 +179,14 @@ impl SplatBuffer {
         let value = [xyz.x, xyz.y, xyz.z, 1.0];
         for (y, &wy) in (y0..=y1).zip(&wy[..rows]) {
             let row = (y - min.y) as usize * width + first_column;
+            if let Ok(sums) = <&mut [[f64; 4]; 4]>::try_from(&mut self.sums[row..row + columns]) {
+                // Four columns (every sample of a radius-2 filter not exactly on a pixel
+                // edge): unrolled, the same products in the same order.
+                for (s, &wxk) in sums.iter_mut().zip(&wx[..4]) {
+                    add_scaled(s, f64::from(wxk * wy), &value);
+                }
+                continue;
+            }
             for (s, &wxk) in self.sums[row..row + columns].iter_mut().zip(&wx[..columns]) {
                 add_scaled(s, f64::from(wxk * wy), &value);
             }
