@@ -24,6 +24,7 @@ pub mod sampler;
 pub mod sampling;
 pub mod scene_build;
 pub mod sensor;
+pub mod spectrum_cache;
 pub mod texture;
 
 pub use camera::{

@@ -239,8 +239,8 @@ impl Film {
             let width = self.resolution.x as usize;
             for (k, pixel) in buffer.bounds.pixels().enumerate() {
                 let i = pixel.y as usize * width + pixel.x as usize;
-                let (xyz, w) = buffer.sums[k];
-                self.pixels[i].xyz_sum += xyz;
+                let [x, y, z, w] = buffer.sums[k];
+                self.pixels[i].xyz_sum += DVec3::new(x, y, z);
                 self.pixels[i].weight_sum += w;
             }
         }

@@ -11,7 +11,7 @@ use prism_spectrum::{SampledSpectrum, SampledWavelengths};
 use super::filter_sampler::FilterSampler;
 use super::filter_table::FilterTable;
 use super::spectral_bins::SpectralBins;
-use super::xyz::xyz_of_sample;
+use super::xyz::{xyz_of_sample, XyzWeights};
 use super::AovSelection;
 
 /// A half-open pixel rectangle [min, max).
@@ -116,7 +116,9 @@ impl AovAccum {
 #[derive(Clone, Debug, PartialEq)]
 pub(crate) struct SplatBuffer {
     pub bounds: TileBounds,
-    pub sums: Vec<(DVec3, f64)>,
+    /// Per pixel [Σ f·X, Σ f·Y, Σ f·Z, Σ f]: four f64 in a row, so that one splat tap is
+    /// two packed multiply-adds (SSE2) instead of four scalar ones and a separate weight.
+    pub sums: Vec<[f64; 4]>,
     pub radius_px: f32,
 }
 
@@ -129,7 +131,7 @@ impl SplatBuffer {
         };
         Self {
             bounds,
-            sums: vec![(DVec3::ZERO, 0.0); bounds.pixel_count()],
+            sums: vec![[0.0; 4]; bounds.pixel_count()],
             radius_px,
         }
     }
@@ -154,26 +156,39 @@ impl SplatBuffer {
         if (x1 - x0) as usize >= MAX_TAPS || (y1 - y0) as usize >= MAX_TAPS {
             return self.splat_wide(p, xyz, table, (x0, x1, y0, y1));
         }
+        let (columns, rows) = ((x1 - x0 + 1) as usize, (y1 - y0 + 1) as usize);
+        // Profile values four at a time (`FilterTable::eval4`; a radius-2 filter has four
+        // taps per axis); the lanes past `columns`/`rows` are computed and not used.
         let mut wx = [0.0f32; MAX_TAPS];
-        let columns = (x1 - x0 + 1) as usize;
-        for (k, w) in wx[..columns].iter_mut().enumerate() {
-            *w = table.eval((x0 + k as i32) as f32 + 0.5 - p.x);
+        let mut wy = [0.0f32; MAX_TAPS];
+        for (w, first, p, count) in [(&mut wx, x0, p.x, columns), (&mut wy, y0, p.y, rows)] {
+            for (k, chunk) in w[..count.next_multiple_of(4)]
+                .chunks_exact_mut(4)
+                .enumerate()
+            {
+                let c = first + 4 * k as i32;
+                let x = [c, c + 1, c + 2, c + 3].map(|c| c as f32 + 0.5 - p);
+                chunk.copy_from_slice(&table.eval4(x));
+            }
         }
         let width = self.bounds.size().x as usize;
         let first_column = (x0 - min.x) as usize;
-        for y in y0..=y1 {
-            let wy = table.eval(y as f32 + 0.5 - p.y);
-            if wy == 0.0 {
+        // The weight's own sum rides along as a fourth component of value 1: w · 1 = w
+        // exactly, so the sums are those of separate colour and weight accumulators. A tap
+        // of weight 0 adds ±0 to a sum that starts at +0 — no change — so no test for it.
+        let value = [xyz.x, xyz.y, xyz.z, 1.0];
+        for (y, &wy) in (y0..=y1).zip(&wy[..rows]) {
+            let row = (y - min.y) as usize * width + first_column;
+            if let Ok(sums) = <&mut [[f64; 4]; 4]>::try_from(&mut self.sums[row..row + columns]) {
+                // Four columns (every sample of a radius-2 filter not exactly on a pixel
+                // edge): unrolled, the same products in the same order.
+                for (s, &wxk) in sums.iter_mut().zip(&wx[..4]) {
+                    add_scaled(s, f64::from(wxk * wy), &value);
+                }
                 continue;
             }
-            let row = (y - min.y) as usize * width + first_column;
             for (s, &wxk) in self.sums[row..row + columns].iter_mut().zip(&wx[..columns]) {
-                let w = f64::from(wxk * wy);
-                if w == 0.0 {
-                    continue;
-                }
-                s.0 += w * xyz;
-                s.1 += w;
+                add_scaled(s, f64::from(wxk * wy), &value);
             }
         }
     }
@@ -196,23 +211,54 @@ impl SplatBuffer {
                     continue;
                 }
                 let i = (y - min.y) as usize * width + (x - min.x) as usize;
-                let s = &mut self.sums[i];
-                s.0 += w * xyz;
-                s.1 += w;
+                add_scaled(&mut self.sums[i], w, &[xyz.x, xyz.y, xyz.z, 1.0]);
             }
         }
     }
 }
 
-/// ⌊x⌋ for |x| < 2³¹ without a library call (truncation, then one step down for negative
-/// non-integers).
+/// sum += w · value, lane by lane (a multiply, then an add: the same bits as the scalar
+/// loop). On x86-64 two packed SSE2 multiply-adds — SSE2 is part of the x86-64 baseline, so
+/// no runtime dispatch; left to itself LLVM interleaves two taps and spends more on shuffles
+/// than on the arithmetic.
+#[inline(always)]
+fn add_scaled(sum: &mut [f64; 4], w: f64, value: &[f64; 4]) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{_mm_add_pd, _mm_loadu_pd, _mm_mul_pd, _mm_set1_pd, _mm_storeu_pd};
+        // SAFETY: SSE2 is always present on x86-64; both pointers address four f64 of the
+        // arrays borrowed here (unaligned loads and stores), and `sum` is borrowed uniquely.
+        unsafe {
+            let w = _mm_set1_pd(w);
+            let (s, v) = (sum.as_mut_ptr(), value.as_ptr());
+            let lo = _mm_add_pd(_mm_loadu_pd(s), _mm_mul_pd(w, _mm_loadu_pd(v)));
+            let hi = _mm_add_pd(
+                _mm_loadu_pd(s.add(2)),
+                _mm_mul_pd(w, _mm_loadu_pd(v.add(2))),
+            );
+            _mm_storeu_pd(s, lo);
+            _mm_storeu_pd(s.add(2), hi);
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    for (s, v) in sum.iter_mut().zip(value) {
+        *s += w * v;
+    }
+}
+
+/// ⌊x⌋ for |x| ≤ 2³⁰ without a library call (truncation, then one step down for negative
+/// non-integers); clamped to ±2³⁰ beyond.
 #[inline(always)]
 fn floor_i32(x: f32) -> i32 {
-    let i = x as i32;
+    // Clamped first (NaN becomes −2³⁰: `f32::max` returns the other operand), so that the
+    // conversion needs none of the saturation `as` adds.
+    let x = x.max(-(1 << 30) as f32).min((1 << 30) as f32);
+    // SAFETY: x is finite and within ±2³⁰, inside i32.
+    let i = unsafe { x.to_int_unchecked::<i32>() };
     i - i32::from((i as f32) > x)
 }
 
-/// ⌈x⌉ for |x| < 2³¹ without a library call.
+/// ⌈x⌉ for |x| ≤ 2³⁰ without a library call.
 #[inline(always)]
 fn ceil_i32(x: f32) -> i32 {
     -floor_i32(-x)
@@ -336,6 +382,27 @@ impl FilmTile {
         true
     }
 
+    /// `add_illumination` with the sample's `XyzWeights` (built once per camera sample for
+    /// the beauty and this AOV).
+    #[inline]
+    pub fn add_illumination_with(
+        &mut self,
+        pixel: UVec2,
+        radiance: SampledSpectrum,
+        weights: &XyzWeights,
+    ) -> bool {
+        let Some(i) = self.index(pixel) else {
+            debug_assert!(false, "pixel {pixel} outside tile {:?}", self.bounds);
+            return false;
+        };
+        if let (true, Some(a)) = (self.record_illumination, self.aovs.get_mut(i)) {
+            if !radiance.has_non_finite() {
+                a.illumination_sum += weights.xyz(radiance);
+            }
+        }
+        true
+    }
+
     /// Adds one camera sample whose colour is already CIE 1931 XYZ in the output
     /// normalisation (`xyz::xyz_of_sample`): the diagnostic integrators, whose outputs are
     /// known exactly (a flat spectrum, or an RGB value) and need no wavelength sampling.
@@ -371,6 +438,42 @@ impl FilmTile {
         let finite = !radiance.has_non_finite();
         let xyz = if finite {
             xyz_of_sample(radiance, wavelengths)
+        } else {
+            DVec3::ZERO
+        };
+        if let (Some(bins), true) = (self.spectral_bins, finite && filter_weight.is_finite()) {
+            let n = bins.count() as usize;
+            bins.accumulate(
+                &mut self.spectral[i * n..(i + 1) * n],
+                radiance,
+                wavelengths,
+                f64::from(filter_weight),
+            );
+        }
+        self.add_sample_xyz_at(pixel, film_point, xyz, filter_weight, aov)
+    }
+
+    /// `add_sample_at` with the sample's `XyzWeights` for `wavelengths` (the path tracer
+    /// builds them once per camera sample for the beauty and the illumination AOV).
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    pub fn add_sample_with(
+        &mut self,
+        pixel: UVec2,
+        film_point: Vec2,
+        radiance: SampledSpectrum,
+        wavelengths: &SampledWavelengths,
+        weights: &XyzWeights,
+        filter_weight: f32,
+        aov: Option<&SurfaceAov>,
+    ) -> bool {
+        let Some(i) = self.index(pixel) else {
+            debug_assert!(false, "pixel {pixel} outside tile {:?}", self.bounds);
+            return false;
+        };
+        let finite = !radiance.has_non_finite();
+        let xyz = if finite {
+            weights.xyz(radiance)
         } else {
             DVec3::ZERO
         };

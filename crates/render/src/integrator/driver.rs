@@ -12,6 +12,7 @@ use glam::{DVec3, UVec2, Vec2};
 use prism_spectrum::{SampledSpectrum, SampledWavelengths};
 
 use super::{Integrator, PathCounters};
+use crate::film::xyz::XyzWeights;
 use crate::film::{AovSelection, Film, FilmImage, SpectralBins, SurfaceAov};
 use crate::sampler::{PixelSampler, SamplerKind};
 use crate::scene_build::RenderScene;
@@ -194,12 +195,14 @@ pub fn render_pass(
                                     )
                                 })
                         };
+                        // One colour-matching lookup for the beauty and the illumination AOV.
+                        let xyz_weights = XyzWeights::new(&wavelengths);
                         let (radiance, aov) = match result {
                             None => (SampledSpectrum::splat(0.0), None),
                             Some(r) => {
                                 rays += 1;
                                 if let Some(white) = r.illumination {
-                                    tile.add_illumination(pixel, white, &wavelengths);
+                                    tile.add_illumination_with(pixel, white, &xyz_weights);
                                 }
                                 let aov = r.first_hit.map(|si| SurfaceAov {
                                     depth_m: si.t,
@@ -212,11 +215,12 @@ pub fn render_pass(
                         if radiance.has_non_finite() {
                             non_finite += 1;
                         }
-                        tile.add_sample_at(
+                        tile.add_sample_with(
                             pixel,
                             film_point,
                             radiance,
                             &wavelengths,
+                            &xyz_weights,
                             weight,
                             aov.as_ref(),
                         );

@@ -19,7 +19,7 @@ pub use driver::{
     film_for, render, render_pass, render_plan, total_samples, RenderSettings, RenderStats,
     DEFAULT_TILE_SIZE_PX,
 };
-pub use path::{mis_weight, PathCounters, PathOrigin, PathResult, PathTracer};
+pub use path::{mis_weight, FirstHit, PathCounters, PathOrigin, PathResult, PathTracer};
 
 use glam::DVec3;
 use prism_geometry::{Ray, SurfaceInteraction};

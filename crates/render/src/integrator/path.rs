@@ -21,6 +21,7 @@ use crate::bsdf::{Bsdf, TransportMode};
 use crate::light::{LightHit, LightSampleContext};
 use crate::sampler::SampleStream;
 use crate::scene_build::RenderScene;
+use crate::spectrum_cache::SpectrumCache;
 
 /// Parameters of the path tracer.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -50,13 +51,23 @@ pub struct PathCounters {
 pub struct PathResult {
     /// Radiance arriving at the camera along the ray, W·m⁻²·sr⁻¹·nm⁻¹ per lane.
     pub radiance: SampledSpectrum,
-    /// The first surface hit, when there is one (the shading record: `curvature` is left
-    /// at zero; `Geometry::interaction` computes it where it is needed).
-    pub first_hit: Option<SurfaceInteraction>,
+    /// The first surface hit, when there is one (what the film's surface AOVs record).
+    pub first_hit: Option<FirstHit>,
     /// Radiance a neutral white Lambertian (R = 1) would reflect towards the camera at the
     /// first hit (direct light by light sampling plus the path's indirect estimate), for
     /// scene-based white balance; `None` when the first hit is specular or there is none.
     pub illumination: Option<SampledSpectrum>,
+}
+
+/// What the film's surface AOVs need of a path's first hit: a few fields instead of the
+/// whole `SurfaceInteraction` (≈ 250 bytes, copied into the result of every camera sample).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FirstHit {
+    /// Distance along the camera ray, metres.
+    pub t: f32,
+    /// Shading normal (world, unit), after normal or bump mapping.
+    pub n_shading: Vec3A,
+    pub material_id: u32,
 }
 
 /// Multiple importance sampling weight of a strategy with pdf `a` against one with pdf `b`
@@ -92,8 +103,8 @@ pub struct PathOrigin {
 }
 
 /// A shading point: where the path scatters.
-struct Vertex {
-    si: SurfaceInteraction,
+struct Vertex<'a> {
+    si: &'a SurfaceInteraction,
     frame: Frame,
     wo_local: Vec3A,
     /// The shading normal comes from a normal or bump map: directions whose side of the
@@ -104,7 +115,7 @@ struct Vertex {
     wo_dot_ng: f32,
 }
 
-impl Vertex {
+impl Vertex<'_> {
     /// True when world direction `wi` lies on the side of the geometric surface that the
     /// shading frame's reflection (`wi_local.z · wo_local.z > 0`) or transmission implies.
     #[inline]
@@ -235,7 +246,7 @@ impl PathTracer {
         let mut first_bounce_beta: Option<SampledSpectrum> = None;
         let mut incident_after_first = SampledSpectrum::splat(0.0);
         let mut illumination_direct: Option<SampledSpectrum> = None;
-        let mut first_hit: Option<SurfaceInteraction> = None;
+        let mut first_hit: Option<FirstHit> = None;
         let mut ray = *camera_ray;
         let mut depth = 0u32;
         let mut specular_bounce = origin.is_none();
@@ -253,6 +264,11 @@ impl PathTracer {
         // Pass-throughs of masked surfaces do not count as bounces; cap them anyway.
         let mut pass_throughs = 0u32;
         let n_light = light_samples.max(1);
+        // The lights' spectra at this path's wavelengths (their values never change along
+        // the path; `terminate_secondary` only zeroes pdfs).
+        let mut le_cache = SpectrumCache::new();
+        // Constant reflectances at this path's wavelengths, by material id.
+        let mut reflectance_cache = SpectrumCache::new();
 
         // Adds beta·x unless it is NaN/∞ (then counts it: one bad contribution cannot poison
         // a pixel, and the stats say so). `count_incident`: also part of the indirect light
@@ -322,8 +338,13 @@ impl PathTracer {
             let (d_mask, d_light_choice, d_light, d_lobe, d_bsdf, d_roulette) =
                 (dims, dims + 1, dims + 2, dims + 4, dims + 5, dims + 7);
 
-            // Opacity mask: pass straight through with probability 1 − α.
-            let opacity = material.opacity_at(&si);
+            // Opacity mask: pass straight through with probability 1 − α (only scenes with
+            // masks: the per-hit material dispatch is not free).
+            let opacity = if scene.has_masks {
+                material.opacity_at(&si)
+            } else {
+                1.0
+            };
             if opacity < 1.0 && stream.get_1d_at(d_mask) >= opacity {
                 pass_throughs += 1;
                 if pass_throughs > 256 {
@@ -337,7 +358,11 @@ impl PathTracer {
                 material.apply_shading_maps(&mut si);
             }
             if first_hit.is_none() {
-                first_hit = Some(si);
+                first_hit = Some(FirstHit {
+                    t: si.t,
+                    n_shading: si.n_shading,
+                    material_id: si.material_id,
+                });
             }
 
             // Emission of a hit area light.
@@ -349,7 +374,13 @@ impl PathTracer {
                     uv: si.uv,
                     distance_m: hit.t,
                 };
-                let le = light.emitted_radiance(&light_hit, -ray.direction, wavelengths);
+                let le = light.emitted_radiance_cached(
+                    l,
+                    &light_hit,
+                    -ray.direction,
+                    wavelengths,
+                    &mut le_cache,
+                );
                 if !le.is_black() {
                     let w = if specular_bounce {
                         1.0
@@ -375,13 +406,14 @@ impl PathTracer {
             depth += 1;
             counters.bounces += 1;
 
-            if material.is_dispersive() {
+            if scene.has_dispersion && material.is_dispersive() {
                 wavelengths.terminate_secondary();
             }
-            let bsdf = material.bsdf(&si, wavelengths);
+            let bsdf =
+                material.bsdf_cached(si.material_id, &si, wavelengths, &mut reflectance_cache);
             let frame = Frame::from_zx(si.n_shading, si.dpdu);
             let vertex = Vertex {
-                si,
+                si: &si,
                 frame,
                 wo_local: frame.to_local(-ray.direction),
                 check_sides: shading_maps,
@@ -415,6 +447,7 @@ impl PathTracer {
                         uc,
                         ul,
                         wavelengths,
+                        &mut le_cache,
                         want_illumination && depth == 1,
                         counters,
                     );
@@ -527,6 +560,7 @@ impl PathTracer {
         u_choice: f32,
         u: Vec2,
         wavelengths: &SampledWavelengths,
+        le_cache: &mut SpectrumCache,
         want_white: bool,
         counters: &mut PathCounters,
     ) -> (SampledSpectrum, SampledSpectrum) {
@@ -536,7 +570,7 @@ impl PathTracer {
             return (zero, zero);
         };
         let light = lights.light(l);
-        let Some(ls) = light.sample_li(ctx, u, wavelengths) else {
+        let Some(ls) = light.sample_li_cached(l, ctx, u, wavelengths, le_cache) else {
             return (zero, zero);
         };
         if ls.pdf <= 0.0 || ls.radiance.is_black() {

@@ -49,6 +49,8 @@ pub use spot::SpotLight;
 use glam::{Vec2, Vec3A};
 use prism_spectrum::{SampledSpectrum, SampledWavelengths};
 
+pub use crate::spectrum_cache::SpectrumCache;
+
 /// Where light arrives: the reference point of `sample_li` / `pdf_li`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LightSampleContext {
@@ -105,6 +107,45 @@ pub enum Light {
 }
 
 impl Light {
+    /// `sample_li` for light number `index` of the scene's `LightSet`, with its spectrum
+    /// from the path's `cache` (keyed by light index) where the radiance is uniform (area
+    /// lights).
+    #[inline]
+    pub fn sample_li_cached(
+        &self,
+        index: u32,
+        ctx: &LightSampleContext,
+        u: Vec2,
+        wavelengths: &SampledWavelengths,
+        cache: &mut SpectrumCache,
+    ) -> Option<LightSample> {
+        match self {
+            Light::Area(l) => {
+                l.sample_li_with(ctx, u, || cache.get(index, &l.radiance, wavelengths))
+            }
+            _ => self.sample_li(ctx, u, wavelengths),
+        }
+    }
+
+    /// `emitted_radiance` for light number `index`, with its spectrum from `cache` (see
+    /// `sample_li_cached`).
+    #[inline]
+    pub fn emitted_radiance_cached(
+        &self,
+        index: u32,
+        hit: &LightHit,
+        wo: Vec3A,
+        wavelengths: &SampledWavelengths,
+        cache: &mut SpectrumCache,
+    ) -> SampledSpectrum {
+        match self {
+            Light::Area(l) => {
+                l.emitted_radiance_with(hit, wo, || cache.get(index, &l.radiance, wavelengths))
+            }
+            _ => SampledSpectrum::splat(0.0),
+        }
+    }
+
     /// Samples a direction from `ctx` towards the light.
     #[inline]
     pub fn sample_li(

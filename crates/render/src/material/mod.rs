@@ -164,6 +164,27 @@ impl Material {
         }
     }
 
+    /// `bsdf` of material number `id`, with a constant Lambertian reflectance from the
+    /// path's `cache` (keyed by material id; `crate::spectrum_cache`): the same spectrum,
+    /// evaluated once per path instead of at every hit.
+    #[inline]
+    pub fn bsdf_cached(
+        &self,
+        id: u32,
+        hit: &SurfaceInteraction,
+        wavelengths: &SampledWavelengths,
+        cache: &mut crate::spectrum_cache::SpectrumCache,
+    ) -> Bsdf<'_> {
+        if let Material::Lambert { reflectance } = self {
+            if let Some(constant) = reflectance.constant() {
+                return Bsdf::new(BsdfLobe::Lambert(Lambert {
+                    reflectance: cache.get(id, constant, wavelengths),
+                }));
+            }
+        }
+        self.bsdf(hit, wavelengths)
+    }
+
     /// The BSDF at `hit` for `wavelengths` (textures read the hit's uv and differentials).
     #[inline]
     pub fn bsdf(&self, hit: &SurfaceInteraction, wavelengths: &SampledWavelengths) -> Bsdf<'_> {

@@ -44,6 +44,12 @@ pub struct SampleStream {
     key: u64,
     /// The sample index with its bits reversed (Sobol only; unused by independent).
     index_reversed: u32,
+    /// Key of the independent values: of (seed, pixel, sample index) — the dimensions of
+    /// an independent stream, and those from `sobol_dimensions` on of a Sobol stream.
+    /// Computed once per stream: deriving it in `bits_1d_at` put a bit reversal and a hash
+    /// on every path vertex's draws even for independent streams (LLVM hoists the Sobol
+    /// tail's key computation above the sampler-kind branch).
+    tail_key: u64,
     dimension: u32,
     /// Dimensions drawn from Sobol points (Sobol only); later ones are independent.
     sobol_dimensions: u32,
@@ -77,6 +83,7 @@ impl PixelSampler {
             SamplerKind::Sobol => SampleStream {
                 key: pixel_key,
                 index_reversed: sample_index.reverse_bits(),
+                tail_key: independent::sample_key(pixel_key, sample_index),
                 dimension: 0,
                 sobol_dimensions: SOBOL_DIMENSIONS,
                 kind: SamplerKind::Sobol,
@@ -84,6 +91,7 @@ impl PixelSampler {
             SamplerKind::Independent => SampleStream {
                 key: independent::sample_key(pixel_key, sample_index),
                 index_reversed: 0,
+                tail_key: independent::sample_key(pixel_key, sample_index),
                 dimension: 0,
                 sobol_dimensions: 0,
                 kind: SamplerKind::Independent,
@@ -122,16 +130,14 @@ impl SampleStream {
     fn bits_1d_at(&self, dimension: u32) -> u32 {
         match self.kind {
             SamplerKind::Sobol if dimension >= self.sobol_dimensions => {
-                let sample_key =
-                    independent::sample_key(self.key, self.index_reversed.reverse_bits());
-                independent::value(sample_key, dimension)
+                independent::value(self.tail_key, dimension)
             }
             SamplerKind::Sobol => {
                 let h = dimension_hash(self.key, dimension);
                 let index = sobol::shuffle_reversed_index(self.index_reversed, h as u32);
                 sobol::scrambled_dimension_0(index, (h >> 32) as u32)
             }
-            SamplerKind::Independent => independent::value(self.key, dimension),
+            SamplerKind::Independent => independent::value(self.tail_key, dimension),
         }
     }
 

@@ -54,6 +54,9 @@ pub struct RenderScene {
     /// Some material is a thin glazing pane (`thin_dielectric`): shadow rays cross it with
     /// its transmittance, and paths pass it straight as a null event (material/glazing.rs).
     pub has_glazing: bool,
+    /// Some material has a dispersive index of refraction: a path's hit there keeps only
+    /// its hero wavelength. Lets the path tracer skip the per-hit test.
+    pub has_dispersion: bool,
     /// Some material reads a texture: hits compute ray differentials, from the camera ray
     /// or (after a bounce) from this camera footprint. `None` when no material is textured.
     pub texture_footprint: Option<crate::texture::CameraFootprint>,
@@ -85,6 +88,7 @@ impl RenderScene {
         let lights = LightSet::build(scene, &geometry)?;
         let has_masks = materials.iter().any(|m| m.has_mask());
         let has_glazing = materials.iter().any(|m| m.has_thin_glazing());
+        let has_dispersion = materials.iter().any(|m| m.is_dispersive());
         let texture_footprint = if materials.iter().any(|m| m.has_textures()) {
             // A camera without a ray at the film centre (a circular fisheye's corner is
             // never the centre) would leave textures unfiltered: point lookups.
@@ -121,6 +125,7 @@ impl RenderScene {
             lights,
             has_masks,
             has_glazing,
+            has_dispersion,
             texture_footprint,
             splat: scene.film.reconstruction == prism_scene::Reconstruction::Splat,
         })

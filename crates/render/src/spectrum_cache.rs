@@ -1,0 +1,72 @@
+//! `SpectrumCache`: spectra evaluated once per path at its wavelengths.
+//!
+//! An area light's L(λ) and a constant material reflectance do not depend on the point or
+//! direction, and a path's wavelengths keep their values (terminating the secondaries only
+//! zeroes their pdfs), while the path tracer evaluated them at every light sample, emission
+//! hit and scattering event: for the Cornell box's light a 477-sample table (≈ 90
+//! instructions), for its RGB reflectances the sigmoid polynomial, ≈ 7 evaluations per
+//! camera sample in all.
+
+use prism_spectrum::{SampledSpectrum, SampledWavelengths, Spectrum};
+
+/// Spectra at one path's wavelengths, keyed by a small integer (a light's index in the
+/// `LightSet`, a material id). Four direct-mapped slots (key mod 4): scenes with more keys
+/// only evaluate more often. Start a new one for every path (`new`), or after the
+/// wavelengths change value.
+#[derive(Clone, Copy, Debug)]
+pub struct SpectrumCache {
+    slots: [(u32, SampledSpectrum); 4],
+}
+
+impl Default for SpectrumCache {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl SpectrumCache {
+    /// An empty cache (the key `u32::MAX` is never used: light indices and material ids
+    /// are far below it).
+    #[inline]
+    pub fn new() -> Self {
+        Self {
+            slots: [(u32::MAX, SampledSpectrum::splat(0.0)); 4],
+        }
+    }
+
+    /// `spectrum`, the spectrum of `key`, at `wavelengths`: evaluated on the first request
+    /// for `key` (or after another key took its slot). The caller keeps one key for one
+    /// spectrum and the same wavelength values for the cache's life.
+    #[inline]
+    pub fn get(
+        &mut self,
+        key: u32,
+        spectrum: &Spectrum,
+        wavelengths: &SampledWavelengths,
+    ) -> SampledSpectrum {
+        let slot = &mut self.slots[(key % 4) as usize];
+        if slot.0 != key {
+            *slot = (key, spectrum.eval(wavelengths));
+        }
+        slot.1
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cached_values_are_the_evaluations() {
+        let wl = SampledWavelengths::sample_visible(0.3);
+        let spectra: Vec<Spectrum> = (0..6)
+            .map(|k| Spectrum::piecewise_linear(&[400.0, 700.0], &[k as f64, 2.0]).unwrap())
+            .collect();
+        let mut cache = SpectrumCache::new();
+        // Keys 0 and 4 share a slot: alternating them must still give each its own value.
+        for key in [0u32, 1, 4, 0, 5, 1, 4, 2, 3, 0] {
+            let s = &spectra[key as usize];
+            assert_eq!(cache.get(key, s, &wl), s.eval(&wl), "key {key}");
+        }
+    }
+}
