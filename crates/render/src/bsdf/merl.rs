@@ -747,8 +747,12 @@ impl MerlBrdf {
 
     #[inline]
     fn spectrum(&self, index: usize, lambda_nm: [f32; 4]) -> SampledSpectrum {
-        let b = self.bins[index];
-        sigmoid_spectrum(self.chroma.coefficients(b.chroma), b.scale, lambda_nm)
+        self.bin_spectrum(self.bins[index], lambda_nm)
+    }
+
+    #[inline]
+    fn bin_spectrum(&self, bin: PackedBin, lambda_nm: [f32; 4]) -> SampledSpectrum {
+        sigmoid_spectrum(self.chroma.coefficients(bin.chroma), bin.scale, lambda_nm)
     }
 
     #[inline]
@@ -950,6 +954,8 @@ impl Measured<'_> {
         if wi.z <= 0.0 {
             return None;
         }
+        // The bin first: its load (usually a cache miss) then overlaps the pdf arithmetic.
+        let bin = b.bins[lookup_index(h, wi)];
         // The density of the cell just sampled (no second lookup), plus the cosine part.
         let pdf = (1.0 - COSINE_FRACTION) * b.cell_density(k, i, j, uu, st, cos_oh)
             + COSINE_FRACTION * cosine_pdf(wi);
@@ -958,7 +964,7 @@ impl Measured<'_> {
         }
         Some(BsdfSample {
             wi,
-            f: b.spectrum(lookup_index(h, wi), self.lambda_nm),
+            f: b.bin_spectrum(bin, self.lambda_nm),
             pdf,
             specular: false,
             transmission: false,
