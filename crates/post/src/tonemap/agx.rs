@@ -6,11 +6,16 @@
 //! s(x) = 15.5x⁶ − 40.14x⁵ + 31.96x⁴ − 6.868x³ + 0.4298x² + 0.1191x − 0.00232,
 //! rgb_out = max(M_out · s, 0)^2.2. Works in linear sRGB (Rec.709); other spaces are
 //! converted there and back.
+//!
+//! Evaluation: one pass per pixel in registers (8 lanes with AVX2 + FMA, 16 with AVX-512,
+//! scalar otherwise, all giving the same bits), the two curves as per-mantissa-segment
+//! polynomials whose coefficients sit in registers (see the comment above
+//! [`SEGMENT_BITS`]).
 
 use glam::Mat3;
 
 use super::aces::srgb_matrices;
-use super::curve_table::CurveTable;
+use super::curve_table::{chebyshev_nodes, poly_through};
 use super::pixels::{map_pixels, PixelMap};
 use super::{Context, OperatorInfo, Output};
 
@@ -51,14 +56,13 @@ const OUTSET: [f32; 9] = [
     1.15107367264116,
 ];
 
+/// Coefficients of the AgX contrast polynomial as published, constant first.
+const CONTRAST: [f64; 7] = [-0.00232, 0.1191, 0.4298, -6.868, 31.96, -40.14, 15.5];
+
 /// The polynomial fit of the AgX default contrast curve on [0, 1], in f64 (Horner's rule).
+#[cfg(test)]
 fn contrast_f64(x: f64) -> f64 {
-    let p = 15.5 * x - 40.14;
-    let p = p * x + 31.96;
-    let p = p * x - 6.868;
-    let p = p * x + 0.4298;
-    let p = p * x + 0.1191;
-    p * x - 0.00232
+    CONTRAST.iter().rev().fold(0.0, |p, c| p * x + c)
 }
 
 /// Outset values below 2⁻²⁴ map to 0 instead of y^2.2 ≤ 1.3e-16 (1e-11 of a 16-bit code);
@@ -66,83 +70,466 @@ fn contrast_f64(x: f64) -> f64 {
 const Y_MIN: f32 = 1.0 / 16_777_216.0;
 const Y_MAX: f32 = 2.0;
 
-/// The per-channel curves of the transform, tabulated once (module
-/// [`super::curve_table`]; the closed forms cost a log2 per channel for the encoding and a
-/// log2 and an exp2 per channel for the power, nine transcendental functions per pixel):
-/// s(x) = contrast((log2 x − ev_min) / (ev_max − ev_min)) on [2^ev_min, 2^ev_max]
-/// (18 octaves, 18 KiB) and y ↦ y^2.2 on [2⁻²⁴, 2] (25 octaves, 25 KiB), both from f64.
-struct Tables {
-    encode: CurveTable,
-    power: CurveTable,
-    /// 2^ev_min and 2^ev_max: inset values are clamped to these before the encoding
-    /// table (the log2 clamp of the transform applied to the linear value, so the
-    /// tabulated curve has no kink inside a segment).
+// The per-channel curves are evaluated directly, in registers, as polynomials whose
+// coefficients are picked per mantissa segment (the top SEGMENT_BITS mantissa bits: 8
+// segments per octave, so 8 coefficients per degree fill one AVX register and are looked
+// up with one `vpermps` per coefficient instead of a memory table). Inside a segment
+// m = 1 + (k + t)/8 with t ∈ [0, 1) the remaining 20 mantissa bits, exactly.
+//
+// - Encoding: x − ½ = (log2 v − ev_min)/R − ½ (R = ev_max − ev_min) with v = 2^e · m is
+//   e/R + [(log2 m − ev_min)/R − ½]; the bracket is a quartic in t per segment
+//   (interpolation error |f⁽⁵⁾| h⁵/(5! 2⁹) with f = log2, h = 1/8: ≤ 5e-10 in log2 m,
+//   3e-11 in x), e/R one more fused multiply-add with 1/R split into two f32s. The
+//   published contrast polynomial is then evaluated in u = x − ½ (its coefficients
+//   re-expanded about ½ in f64: Horner's rule on the published ones cancels terms of
+//   size 40 down to values ≤ 1, which cost 0.2 16-bit codes in f32).
+// - Power: y^2.2 with y = 2^e · m is 2^(2.2e) · m^2.2; m^2.2 is a cubic in t per segment
+//   (error |a(a−1)(a−2)(a−3)| h⁴/(4! 2⁷) with a = 2.2: ≤ 3.4e-8 relative), and with
+//   e + 25 = 5q + r (0 ≤ r < 5), 2^(2.2e) = 2^(2e + q − 5) · 2^(r/5): an exponent built in
+//   the bits times one of five constants (another `vpermps`).
+//
+// All coefficients are fitted here, at start-up, by interpolation at Chebyshev nodes in
+// f64 from the formulas, then rounded to f32. Every step is a fused multiply-add, so the
+// scalar path (`f32::mul_add`, used where the CPU lacks AVX2 + FMA and for the last
+// pixels of a block) gives the same bits as the 8-lane one (tested).
+
+/// Mantissa bits that select a segment (8 per octave: one register of coefficients).
+const SEGMENT_BITS: u32 = 3;
+/// Mantissa bits of the position t inside a segment.
+const T_BITS: u32 = 23 - SEGMENT_BITS;
+const T_MASK: u32 = (1 << T_BITS) - 1;
+/// 2^−T_BITS, exact in f32.
+const T_SCALE: f32 = 1.0 / (1u32 << T_BITS) as f32;
+/// Coefficients of the encoding quartic and of the power cubic.
+const ENCODE_TERMS: usize = 5;
+const POWER_TERMS: usize = 4;
+
+/// Per-segment polynomial coefficients: `c[j][k]` multiplies t^j on segment k.
+type SegmentPoly<const N: usize> = [[f32; 8]; N];
+
+/// Fits `f(m)`, m ∈ [1, 2), per segment by interpolation at N Chebyshev nodes of t.
+fn fit_segments<const N: usize>(f: impl Fn(f64) -> f64) -> SegmentPoly<N> {
+    let nodes: [f64; N] = chebyshev_nodes();
+    let mut c = [[0.0f32; 8]; N];
+    #[allow(clippy::needless_range_loop)] // k is the segment and the column of c
+    for k in 0..8 {
+        let y = nodes.map(|t| f(1.0 + (k as f64 + t) / 8.0));
+        for (j, v) in poly_through(&nodes, &y).iter().enumerate() {
+            c[j][k] = *v as f32;
+        }
+    }
+    c
+}
+
+/// The transform's constants, fitted once per process.
+struct Curves {
+    encode: SegmentPoly<ENCODE_TERMS>,
+    /// 1/R as the sum of two f32s.
+    inv_range: (f32, f32),
+    /// The contrast polynomial in u = x − ½, constant first.
+    contrast: [f32; 7],
+    power: SegmentPoly<POWER_TERMS>,
+    /// 2^(r/5) for r = 0…4 (lanes 5–7 unused).
+    fifths: [f32; 8],
+    /// 2^ev_min and 2^ev_max: inset values are clamped to these first (the log2 clamp of
+    /// the transform applied to the linear value).
     x_min: f32,
     x_max: f32,
 }
 
-fn tables() -> &'static Tables {
-    static TABLES: std::sync::OnceLock<Tables> = std::sync::OnceLock::new();
-    TABLES.get_or_init(|| {
+fn curves() -> &'static Curves {
+    static CURVES: std::sync::OnceLock<Curves> = std::sync::OnceLock::new();
+    CURVES.get_or_init(|| {
         let (lo, hi) = (EV_MIN as f64, EV_MAX as f64);
-        let (x_min, x_max) = (lo.exp2() as f32, hi.exp2() as f32);
-        Tables {
-            encode: CurveTable::new(x_min, x_max, |x| contrast_f64((x.log2() - lo) / (hi - lo))),
-            power: CurveTable::new(Y_MIN, Y_MAX, |y| y.powf(2.2)),
-            x_min,
-            x_max,
+        let range = hi - lo;
+        let inv = 1.0 / range;
+        let inv_hi = inv as f32;
+        // Binomial re-expansion: Σ c_k x^k = Σ_j (Σ_{k≥j} C(k, j) c_k ½^(k−j)) u^j.
+        let contrast = std::array::from_fn(|j| {
+            (j..7)
+                .map(|k| {
+                    let binom = (0..j).fold(1.0, |b, i| b * (k - i) as f64 / (i + 1) as f64);
+                    CONTRAST[k] * binom * 0.5f64.powi((k - j) as i32)
+                })
+                .sum::<f64>() as f32
+        });
+        Curves {
+            encode: fit_segments(|m| (m.log2() - lo) / range - 0.5),
+            inv_range: (inv_hi, (inv - inv_hi as f64) as f32),
+            contrast,
+            power: fit_segments(|m| m.powf(2.2)),
+            fifths: std::array::from_fn(|r| {
+                if r < 5 {
+                    2f64.powf(r as f64 / 5.0) as f32
+                } else {
+                    1.0
+                }
+            }),
+            x_min: lo.exp2() as f32,
+            x_max: hi.exp2() as f32,
         }
     })
 }
 
+/// Column-major 3×3 matrix as f32s.
+type Mat = [f32; 9];
+
 struct Map {
-    inset: Mat3,
-    outset: Mat3,
-    from_srgb: Mat3,
-    tables: &'static Tables,
+    inset: Mat,
+    outset: Mat,
+    /// Linear sRGB → the image's space; `None` where that is the identity.
+    from_srgb: Option<Mat>,
+    curves: &'static Curves,
 }
 
-/// `m · (r, g, b)` per pixel on planes (8 pixels per vector; the column-major `Mat3` read
-/// into locals first so the loop keeps them in registers).
+/// `m · (x, y, z)` with fused multiply-adds, in the order the 8-lane path uses.
 #[inline(always)]
-fn mat3_planes(m: Mat3, r: &mut [f32], g: &mut [f32], b: &mut [f32]) {
-    let [m00, m10, m20, m01, m11, m21, m02, m12, m22] = m.to_cols_array();
-    for ((r, g), b) in r.iter_mut().zip(g.iter_mut()).zip(b.iter_mut()) {
-        let (x, y, z) = (*r, *g, *b);
-        *r = m00 * x + m01 * y + m02 * z;
-        *g = m10 * x + m11 * y + m12 * z;
-        *b = m20 * x + m21 * y + m22 * z;
+fn mat3(m: &Mat, x: f32, y: f32, z: f32) -> [f32; 3] {
+    std::array::from_fn(|row| m[6 + row].mul_add(z, m[3 + row].mul_add(y, m[row] * x)))
+}
+
+impl Map {
+    /// The encoding and contrast curve s of one inset value (scalar path).
+    #[inline(always)]
+    fn encode(&self, v: f32) -> f32 {
+        let c = self.curves;
+        // f32::max returns the number for a NaN operand: NaN (from ∞ − ∞ in a wide-gamut
+        // input) encodes as the bottom, as `vmaxps(v, x_min)` does.
+        let v = v.max(c.x_min).min(c.x_max);
+        let bits = v.to_bits();
+        let e = ((bits >> 23) as i32 - 127) as f32;
+        let k = ((bits >> T_BITS) & 7) as usize;
+        let t = (bits & T_MASK) as i32 as f32 * T_SCALE;
+        let p = (0..ENCODE_TERMS - 1)
+            .rev()
+            .fold(c.encode[ENCODE_TERMS - 1][k], |p, j| {
+                p.mul_add(t, c.encode[j][k])
+            });
+        let u = e.mul_add(c.inv_range.0, e.mul_add(c.inv_range.1, p));
+        (0..6)
+            .rev()
+            .fold(c.contrast[6], |p, j| p.mul_add(u, c.contrast[j]))
     }
+
+    /// max(y, 0)^2.2 of one outset value, 0 below [`Y_MIN`] or for NaN (scalar path).
+    #[inline(always)]
+    fn power(&self, y: f32) -> f32 {
+        let c = self.curves;
+        let keep = y >= Y_MIN;
+        // Not `clamp`: NaN goes to Y_MIN here (f32::max), as with vmaxps.
+        #[allow(clippy::manual_clamp)]
+        let bits = y.max(Y_MIN).min(Y_MAX).to_bits();
+        let e = (bits >> 23) as i32 - 127;
+        let (q, r) = split_fifths(e + 25);
+        let k = ((bits >> T_BITS) & 7) as usize;
+        let t = (bits & T_MASK) as i32 as f32 * T_SCALE;
+        let p = (0..POWER_TERMS - 1)
+            .rev()
+            .fold(c.power[POWER_TERMS - 1][k], |p, j| {
+                p.mul_add(t, c.power[j][k])
+            });
+        let scale = f32::from_bits(((2 * e + q - 5 + 127) as u32) << 23) * c.fifths[r as usize];
+        if keep {
+            p * scale
+        } else {
+            0.0
+        }
+    }
+
+    /// One pixel, scalar.
+    #[inline(always)]
+    fn pixel(&self, r: f32, g: f32, b: f32) -> [f32; 3] {
+        let [x, y, z] = mat3(&self.inset, r, g, b).map(|v| self.encode(v));
+        let out = mat3(&self.outset, x, y, z).map(|v| self.power(v));
+        match &self.from_srgb {
+            Some(m) => mat3(m, out[0], out[1], out[2]),
+            None => out,
+        }
+    }
+
+    /// [`PixelMap::map`] on 8 lanes, the same operations in the same order as
+    /// [`Self::pixel`].
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    unsafe fn map_avx2(&self, r: &mut [f32], g: &mut [f32], b: &mut [f32]) {
+        use std::arch::x86_64::*;
+        let n = r.len().min(g.len()).min(b.len());
+        let c = self.curves;
+        let splat = |m: &Mat| m.map(|v| _mm256_set1_ps(v));
+        let (inset, outset) = (splat(&self.inset), splat(&self.outset));
+        let from = self.from_srgb.as_ref().map(splat);
+        // SAFETY (all loads of constants below): each array holds 8 f32s.
+        let load8 = |a: &[f32; 8]| _mm256_loadu_ps(a.as_ptr());
+        let encode: [__m256; ENCODE_TERMS] = std::array::from_fn(|j| load8(&c.encode[j]));
+        let power: [__m256; POWER_TERMS] = std::array::from_fn(|j| load8(&c.power[j]));
+        let contrast = c.contrast.map(|v| _mm256_set1_ps(v));
+        let fifths = load8(&c.fifths);
+        let (inv_hi, inv_lo) = (_mm256_set1_ps(c.inv_range.0), _mm256_set1_ps(c.inv_range.1));
+        let (x_min, x_max) = (_mm256_set1_ps(c.x_min), _mm256_set1_ps(c.x_max));
+        let (y_min, y_max) = (_mm256_set1_ps(Y_MIN), _mm256_set1_ps(Y_MAX));
+        let t_mask = _mm256_set1_epi32(T_MASK as i32);
+        let t_scale = _mm256_set1_ps(T_SCALE);
+        let bias = _mm256_set1_epi32(127);
+        let (i5, i25, i205, i127m5) = (
+            _mm256_set1_epi32(5),
+            _mm256_set1_epi32(25),
+            _mm256_set1_epi32(205),
+            _mm256_set1_epi32(127 - 5),
+        );
+        let mat = |m: &[__m256; 9], x: __m256, y: __m256, z: __m256| -> [__m256; 3] {
+            std::array::from_fn(|row| {
+                _mm256_fmadd_ps(
+                    m[6 + row],
+                    z,
+                    _mm256_fmadd_ps(m[3 + row], y, _mm256_mul_ps(m[row], x)),
+                )
+            })
+        };
+        // t ∈ [0, 1) from the low mantissa bits, exactly.
+        let position = |bits: __m256i| {
+            _mm256_mul_ps(_mm256_cvtepi32_ps(_mm256_and_si256(bits, t_mask)), t_scale)
+        };
+        let encode_curve = |v: __m256| {
+            // maxps returns its second operand when the first is NaN.
+            let v = _mm256_min_ps(_mm256_max_ps(v, x_min), x_max);
+            let bits = _mm256_castps_si256(v);
+            let e = _mm256_cvtepi32_ps(_mm256_sub_epi32(_mm256_srli_epi32::<23>(bits), bias));
+            // vpermps reads the low 3 bits of each index: the segment k.
+            let k = _mm256_srli_epi32::<{ T_BITS as i32 }>(bits);
+            let t = position(bits);
+            let mut p = _mm256_permutevar8x32_ps(encode[ENCODE_TERMS - 1], k);
+            for j in (0..ENCODE_TERMS - 1).rev() {
+                p = _mm256_fmadd_ps(p, t, _mm256_permutevar8x32_ps(encode[j], k));
+            }
+            let u = _mm256_fmadd_ps(e, inv_hi, _mm256_fmadd_ps(e, inv_lo, p));
+            let mut s = contrast[6];
+            for j in (0..6).rev() {
+                s = _mm256_fmadd_ps(s, u, contrast[j]);
+            }
+            s
+        };
+        let power_curve = |y: __m256| {
+            let keep = _mm256_cmp_ps::<_CMP_GE_OQ>(y, y_min);
+            let bits = _mm256_castps_si256(_mm256_min_ps(_mm256_max_ps(y, y_min), y_max));
+            let e = _mm256_sub_epi32(_mm256_srli_epi32::<23>(bits), bias);
+            // e + 25 = 5q + r as in `split_fifths`.
+            let e25 = _mm256_add_epi32(e, i25);
+            let q = _mm256_srli_epi32::<10>(_mm256_mullo_epi32(e25, i205));
+            let r = _mm256_sub_epi32(e25, _mm256_mullo_epi32(q, i5));
+            let k = _mm256_srli_epi32::<{ T_BITS as i32 }>(bits);
+            let t = position(bits);
+            let mut p = _mm256_permutevar8x32_ps(power[POWER_TERMS - 1], k);
+            for j in (0..POWER_TERMS - 1).rev() {
+                p = _mm256_fmadd_ps(p, t, _mm256_permutevar8x32_ps(power[j], k));
+            }
+            let exponent = _mm256_add_epi32(_mm256_add_epi32(_mm256_add_epi32(e, e), q), i127m5);
+            let scale = _mm256_mul_ps(
+                _mm256_castsi256_ps(_mm256_slli_epi32::<23>(exponent)),
+                _mm256_permutevar8x32_ps(fifths, r),
+            );
+            _mm256_and_ps(_mm256_mul_ps(p, scale), keep)
+        };
+        let mut j = 0;
+        while j + 8 <= n {
+            // SAFETY: j + 8 ≤ n ≤ the length of each plane.
+            let (pr, pg, pb) = (
+                r.as_mut_ptr().add(j),
+                g.as_mut_ptr().add(j),
+                b.as_mut_ptr().add(j),
+            );
+            let [x, y, z] = mat(
+                &inset,
+                _mm256_loadu_ps(pr),
+                _mm256_loadu_ps(pg),
+                _mm256_loadu_ps(pb),
+            );
+            let (x, y, z) = (encode_curve(x), encode_curve(y), encode_curve(z));
+            let [x, y, z] = mat(&outset, x, y, z);
+            let (x, y, z) = (power_curve(x), power_curve(y), power_curve(z));
+            let [x, y, z] = match &from {
+                Some(m) => mat(m, x, y, z),
+                None => [x, y, z],
+            };
+            _mm256_storeu_ps(pr, x);
+            _mm256_storeu_ps(pg, y);
+            _mm256_storeu_ps(pb, z);
+            j += 8;
+        }
+        for j in j..n {
+            [r[j], g[j], b[j]] = self.pixel(r[j], g[j], b[j]);
+        }
+    }
+}
+
+/// Whether the CPU has AVX-512 F (16 lanes, two-register permutes, `vgetexpps`).
+#[cfg(target_arch = "x86_64")]
+#[inline]
+fn has_avx512() -> bool {
+    std::arch::is_x86_feature_detected!("avx512f")
+}
+
+impl Map {
+    /// [`PixelMap::map`] on 16 lanes: the same operations in the same order as
+    /// [`Self::pixel`], with three AVX-512 shortcuts that give the same values: the
+    /// exponent by `vgetexpps` (⌊log2 v⌋ of a positive normal v, the integer the scalar
+    /// path extracts), each 8-entry coefficient register repeated in both halves of a
+    /// 16-entry `vpermps` (its index, bits >> 20, then carries the exponent's lowest bit
+    /// above the segment), and 2^(2.2e) read from a 32-entry two-register `vpermt2ps`
+    /// table indexed by the biased exponent (103…128 for y in [2⁻²⁴, 2], distinct modulo
+    /// 32) holding 2^(2e + q − 5) · 2^(r/5) as the scalar path multiplies it (exact:
+    /// scaling by a power of two).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f")]
+    unsafe fn map_avx512(&self, r: &mut [f32], g: &mut [f32], b: &mut [f32]) {
+        use std::arch::x86_64::*;
+        let n = r.len().min(g.len()).min(b.len());
+        let c = self.curves;
+        let splat = |m: &Mat| m.map(|v| _mm512_set1_ps(v));
+        let (inset, outset) = (splat(&self.inset), splat(&self.outset));
+        let from = self.from_srgb.as_ref().map(splat);
+        let twice = |a: &[f32; 8]| {
+            let v: [f32; 16] = std::array::from_fn(|i| a[i % 8]);
+            // SAFETY: v holds 16 f32s.
+            _mm512_loadu_ps(v.as_ptr())
+        };
+        let encode: [__m512; ENCODE_TERMS] = std::array::from_fn(|j| twice(&c.encode[j]));
+        let power: [__m512; POWER_TERMS] = std::array::from_fn(|j| twice(&c.power[j]));
+        let contrast = c.contrast.map(|v| _mm512_set1_ps(v));
+        let scales: [f32; 32] = std::array::from_fn(|i| {
+            let biased = (103..=128).find(|b| b % 32 == i as i32);
+            biased.map_or(0.0, |b| {
+                let e = b - 127;
+                let (q, r) = split_fifths(e + 25);
+                f32::from_bits(((2 * e + q - 5 + 127) as u32) << 23) * c.fifths[r as usize]
+            })
+        });
+        // SAFETY: scales holds 32 f32s.
+        let (scales_lo, scales_hi) = (
+            _mm512_loadu_ps(scales.as_ptr()),
+            _mm512_loadu_ps(scales.as_ptr().add(16)),
+        );
+        let (inv_hi, inv_lo) = (_mm512_set1_ps(c.inv_range.0), _mm512_set1_ps(c.inv_range.1));
+        let (x_min, x_max) = (_mm512_set1_ps(c.x_min), _mm512_set1_ps(c.x_max));
+        let (y_min, y_max) = (_mm512_set1_ps(Y_MIN), _mm512_set1_ps(Y_MAX));
+        let t_mask = _mm512_set1_epi32(T_MASK as i32);
+        let t_scale = _mm512_set1_ps(T_SCALE);
+        let mat = |m: &[__m512; 9], x: __m512, y: __m512, z: __m512| -> [__m512; 3] {
+            std::array::from_fn(|row| {
+                _mm512_fmadd_ps(
+                    m[6 + row],
+                    z,
+                    _mm512_fmadd_ps(m[3 + row], y, _mm512_mul_ps(m[row], x)),
+                )
+            })
+        };
+        let position = |bits: __m512i| {
+            _mm512_mul_ps(_mm512_cvtepi32_ps(_mm512_and_si512(bits, t_mask)), t_scale)
+        };
+        let encode_curve = |v: __m512| {
+            let v = _mm512_min_ps(_mm512_max_ps(v, x_min), x_max);
+            let bits = _mm512_castps_si512(v);
+            let e = _mm512_getexp_ps(v);
+            let k = _mm512_srli_epi32::<{ T_BITS }>(bits);
+            let t = position(bits);
+            let mut p = _mm512_permutexvar_ps(k, encode[ENCODE_TERMS - 1]);
+            for j in (0..ENCODE_TERMS - 1).rev() {
+                p = _mm512_fmadd_ps(p, t, _mm512_permutexvar_ps(k, encode[j]));
+            }
+            let u = _mm512_fmadd_ps(e, inv_hi, _mm512_fmadd_ps(e, inv_lo, p));
+            let mut s = contrast[6];
+            for j in (0..6).rev() {
+                s = _mm512_fmadd_ps(s, u, contrast[j]);
+            }
+            s
+        };
+        let power_curve = |y: __m512| {
+            let keep = _mm512_cmp_ps_mask::<_CMP_GE_OQ>(y, y_min);
+            let bits = _mm512_castps_si512(_mm512_min_ps(_mm512_max_ps(y, y_min), y_max));
+            let k = _mm512_srli_epi32::<{ T_BITS }>(bits);
+            let t = position(bits);
+            let mut p = _mm512_permutexvar_ps(k, power[POWER_TERMS - 1]);
+            for j in (0..POWER_TERMS - 1).rev() {
+                p = _mm512_fmadd_ps(p, t, _mm512_permutexvar_ps(k, power[j]));
+            }
+            let scale = _mm512_permutex2var_ps(scales_lo, _mm512_srli_epi32::<23>(bits), scales_hi);
+            _mm512_maskz_mul_ps(keep, p, scale)
+        };
+        let mut j = 0;
+        while j + 16 <= n {
+            // SAFETY: j + 16 ≤ n ≤ the length of each plane.
+            let (pr, pg, pb) = (
+                r.as_mut_ptr().add(j),
+                g.as_mut_ptr().add(j),
+                b.as_mut_ptr().add(j),
+            );
+            let [x, y, z] = mat(
+                &inset,
+                _mm512_loadu_ps(pr),
+                _mm512_loadu_ps(pg),
+                _mm512_loadu_ps(pb),
+            );
+            let (x, y, z) = (encode_curve(x), encode_curve(y), encode_curve(z));
+            let [x, y, z] = mat(&outset, x, y, z);
+            let (x, y, z) = (power_curve(x), power_curve(y), power_curve(z));
+            let [x, y, z] = match &from {
+                Some(m) => mat(m, x, y, z),
+                None => [x, y, z],
+            };
+            _mm512_storeu_ps(pr, x);
+            _mm512_storeu_ps(pg, y);
+            _mm512_storeu_ps(pb, z);
+            j += 16;
+        }
+        for j in j..n {
+            [r[j], g[j], b[j]] = self.pixel(r[j], g[j], b[j]);
+        }
+    }
+}
+
+/// (q, r) with n = 5q + r, 0 ≤ r < 5, for 0 ≤ n ≤ 26 (q = ⌊205 n / 1024⌋: 205/1024 =
+/// 0.2002 is exact enough below n = 256; checked for every n used).
+#[inline(always)]
+fn split_fifths(n: i32) -> (i32, i32) {
+    let q = (n * 205) >> 10;
+    (q, n - q * 5)
 }
 
 impl PixelMap for Map {
-    /// The transform as passes over the block's planes (inset matrix, clamp + encoding
-    /// table, outset, power table, back to the image's space), each a branch-free loop or
-    /// an 8-lane table loop.
+    /// The whole transform (inset, encoding, contrast, outset, power, back to the image's
+    /// space) per pixel in one pass over the block's planes, in registers.
     #[inline(always)]
     fn map(&self, _start: usize, r: &mut [f32], g: &mut [f32], b: &mut [f32]) {
-        let t = self.tables;
-        let (x_min, x_max) = (t.x_min, t.x_max);
-        mat3_planes(self.inset, r, g, b);
-        // NaN (from ∞ − ∞ in a wide-gamut input) encodes as the bottom, as before.
-        for plane in [&mut *r, &mut *g, &mut *b] {
-            t.encode.eval_slice_clamped::<false>(plane, x_min, x_max);
+        #[cfg(target_arch = "x86_64")]
+        if has_avx512() {
+            // SAFETY: the CPU has AVX-512 F (checked above).
+            unsafe { self.map_avx512(r, g, b) };
+            return;
         }
-        mat3_planes(self.outset, r, g, b);
-        for plane in [&mut *r, &mut *g, &mut *b] {
-            t.power.eval_slice_clamped::<true>(plane, Y_MIN, Y_MAX);
+        #[cfg(target_arch = "x86_64")]
+        if super::simd::has_avx2() {
+            // SAFETY: the CPU has AVX2 and FMA (checked above).
+            unsafe { self.map_avx2(r, g, b) };
+            return;
         }
-        mat3_planes(self.from_srgb, r, g, b);
+        for ((r, g), b) in r.iter_mut().zip(g.iter_mut()).zip(b.iter_mut()) {
+            [*r, *g, *b] = self.pixel(*r, *g, *b);
+        }
     }
+}
+
+/// Whether `m` is the identity to 1e-9 (applying such a matrix would move a channel by
+/// at most 1e-9 of the pixel's largest channel, 1/60 of an f32 rounding step).
+fn is_identity(m: Mat3) -> bool {
+    m.abs_diff_eq(Mat3::IDENTITY, 1e-9)
 }
 
 pub(crate) fn apply(ctx: &Context) -> Output {
     let (to_srgb, from_srgb) = srgb_matrices(&ctx.image.color_space);
     let map = Map {
-        inset: Mat3::from_cols_array(&INSET) * to_srgb,
-        outset: Mat3::from_cols_array(&OUTSET),
-        from_srgb,
-        tables: tables(),
+        inset: (Mat3::from_cols_array(&INSET) * to_srgb).to_cols_array(),
+        outset: OUTSET,
+        from_srgb: (!is_identity(from_srgb)).then(|| from_srgb.to_cols_array()),
+        curves: curves(),
     };
     Output {
         mapped: map_pixels(ctx, ctx.exposure, &map),
@@ -155,6 +542,7 @@ mod tests {
     use super::super::test_support::*;
     use super::super::{ToneOperator, ToneParams};
     use super::*;
+    use prism_spectrum::rgb_space::RgbColorSpace;
 
     #[test]
     fn outset_inverts_inset_and_mid_grey_lands_mid_display() {
@@ -230,9 +618,104 @@ mod tests {
         let want: Vec<[f64; 3]> = img.pixels().iter().map(|p| agx_f64(*p)).collect();
         let err = max_code_error_16(out.pixels(), &want);
         eprintln!("agx: max error {err} 16-bit codes");
-        // Measured 0.012 codes with the curves tabulated from f64 (curve_table: ~1e-7
-        // relative) and the f32 inset/outset sums; the closed forms in f32 (fast log2 and
-        // exp2) measured 0.195, the printed power form 0.43.
+        // Measured 0.0122 codes with the per-segment polynomials in registers (power
+        // ≤ 1.8e-7 relative, encoding ≤ 9.7e-8 absolute: `fifths_split_and_fitted_curves`)
+        // and the f32 inset/outset sums; 0.012 with the memory tables of curve_table
+        // (until 2026-12-01); the closed forms in f32 (fast log2 and exp2) measured 0.195,
+        // the printed power form 0.43.
         assert!(err < 0.03, "{err} 16-bit codes");
+    }
+
+    #[test]
+    fn vector_paths_give_the_scalar_bits() {
+        // Every octave and segment of both curves, NaN, ±∞, negatives, zeros, and a
+        // wide-gamut image (so the matrix back from sRGB runs too).
+        let mut values = vec![0.0f32, -0.0, -1.0, f32::NAN, f32::INFINITY, 1e-30, 3e38];
+        let mut v = 1e-6f32;
+        while v < 1e3 {
+            values.push(v);
+            v *= 1.0137;
+        }
+        for space in [RgbColorSpace::srgb(), RgbColorSpace::rec2020()] {
+            let (to_srgb, from_srgb) = srgb_matrices(&space);
+            let map = Map {
+                inset: (Mat3::from_cols_array(&INSET) * to_srgb).to_cols_array(),
+                outset: OUTSET,
+                from_srgb: (!is_identity(from_srgb)).then(|| from_srgb.to_cols_array()),
+                curves: curves(),
+            };
+            assert_eq!(map.from_srgb.is_none(), space == RgbColorSpace::srgb());
+            let n = values.len();
+            let mut r: Vec<f32> = values.clone();
+            let mut g: Vec<f32> = (0..n).map(|i| values[(i * 7 + 3) % n]).collect();
+            let mut b: Vec<f32> = (0..n).map(|i| values[(i * 13 + 5) % n]).collect();
+            let want: Vec<[f32; 3]> = (0..n).map(|i| map.pixel(r[i], g[i], b[i])).collect();
+            #[allow(clippy::type_complexity)] // (path, r, g, b)
+            let mut paths: Vec<(&str, Vec<f32>, Vec<f32>, Vec<f32>)> = vec![];
+            #[cfg(target_arch = "x86_64")]
+            {
+                if super::super::simd::has_avx2() {
+                    let (mut r, mut g, mut b) = (r.clone(), g.clone(), b.clone());
+                    // SAFETY: the CPU has AVX2 and FMA (checked just above).
+                    unsafe { map.map_avx2(&mut r, &mut g, &mut b) };
+                    paths.push(("avx2", r, g, b));
+                }
+                if has_avx512() {
+                    let (mut r, mut g, mut b) = (r.clone(), g.clone(), b.clone());
+                    // SAFETY: the CPU has AVX-512 F (checked just above).
+                    unsafe { map.map_avx512(&mut r, &mut g, &mut b) };
+                    paths.push(("avx512", r, g, b));
+                }
+            }
+            map.map(0, &mut r, &mut g, &mut b);
+            paths.push(("dispatched", r, g, b));
+            for (name, r, g, b) in &paths {
+                for i in 0..n {
+                    let got = [r[i], g[i], b[i]];
+                    assert_eq!(
+                        got.map(f32::to_bits),
+                        want[i].map(f32::to_bits),
+                        "{name} {i}: {got:?}"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn fifths_split_and_fitted_curves() {
+        for n in 0..=26 {
+            let (q, r) = split_fifths(n);
+            assert_eq!((q, r), (n / 5, n % 5), "{n}");
+        }
+        let map = Map {
+            inset: Mat3::IDENTITY.to_cols_array(),
+            outset: Mat3::IDENTITY.to_cols_array(),
+            from_srgb: None,
+            curves: curves(),
+        };
+        // Power: every octave from 2⁻²⁴ to 2, against f64 (relative error).
+        let mut worst_power = 0.0f64;
+        let mut y = Y_MIN;
+        while y <= Y_MAX {
+            let want = (y as f64).powf(2.2);
+            worst_power = worst_power.max((map.power(y) as f64 / want - 1.0).abs());
+            y *= 1.000_31;
+        }
+        eprintln!("agx power: worst relative error {worst_power:e}");
+        assert!(worst_power < 3e-7, "{worst_power:e}");
+        assert_eq!(map.power(Y_MIN * 0.99), 0.0);
+        assert_eq!(map.power(f32::NAN), 0.0);
+        // Encoding and contrast: absolute error against the published curve in f64.
+        let (lo, hi) = (EV_MIN as f64, EV_MAX as f64);
+        let mut worst_encode = 0.0f64;
+        let mut v = 1e-5f32;
+        while v < 40.0 {
+            let x = ((v as f64).log2().clamp(lo, hi) - lo) / (hi - lo);
+            worst_encode = worst_encode.max((map.encode(v) as f64 - contrast_f64(x)).abs());
+            v *= 1.000_29;
+        }
+        eprintln!("agx encoding: worst absolute error {worst_encode:e}");
+        assert!(worst_encode < 3e-7, "{worst_encode:e}");
     }
 }

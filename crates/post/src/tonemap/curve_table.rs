@@ -73,10 +73,7 @@ impl CurveTable {
         };
         let first = lo.to_bits() >> LOW_BITS;
         let last = hi.to_bits() >> LOW_BITS;
-        // Chebyshev nodes of the first kind on [0, 1].
-        let nodes: [f64; 4] = std::array::from_fn(|k| {
-            0.5 - 0.5 * (std::f64::consts::PI * (2 * k + 1) as f64 / 8.0).cos()
-        });
+        let nodes: [f64; 4] = chebyshev_nodes();
         let coeffs = (first..=last)
             .map(|s| {
                 let a = value_of_bits((s as u64) << LOW_BITS);
@@ -215,20 +212,26 @@ impl CurveTable {
     }
 }
 
-/// Monomial coefficients of the cubic through (t_k, y_k), k = 0..3 (Newton's divided
-/// differences, expanded), in f64.
+/// Monomial coefficients of the cubic through (t_k, y_k), k = 0..3, in f64.
 fn cubic_through(t: &[f64; 4], y: &[f64; 4]) -> [f64; 4] {
+    poly_through(t, y)
+}
+
+/// Monomial coefficients (constant first) of the polynomial of degree N − 1 through
+/// (t_k, y_k), k = 0..N (Newton's divided differences, expanded), in f64.
+pub(crate) fn poly_through<const N: usize>(t: &[f64; N], y: &[f64; N]) -> [f64; N] {
     let mut d = *y;
-    for level in 1..4 {
-        for k in (level..4).rev() {
+    for level in 1..N {
+        for k in (level..N).rev() {
             d[k] = (d[k] - d[k - 1]) / (t[k] - t[k - level]);
         }
     }
-    // p(t) = d0 + (t − t0)(d1 + (t − t1)(d2 + (t − t2) d3)), expanded from the inside.
-    let mut c = [d[3], 0.0, 0.0, 0.0]; // coefficients of the running polynomial, low first
-    for (degree, k) in (0..3).rev().enumerate() {
+    // p(t) = d0 + (t − t0)(d1 + (t − t1)(d2 + …)), expanded from the inside.
+    let mut c = [0.0; N]; // coefficients of the running polynomial, low first
+    c[0] = d[N - 1];
+    for (degree, k) in (0..N - 1).rev().enumerate() {
         // c ← c · (t − t_k) + d_k
-        let mut next = [0.0; 4];
+        let mut next = [0.0; N];
         for j in 0..=degree {
             next[j + 1] += c[j];
             next[j] -= c[j] * t[k];
@@ -237,6 +240,13 @@ fn cubic_through(t: &[f64; 4], y: &[f64; 4]) -> [f64; 4] {
         c = next;
     }
     c
+}
+
+/// The N Chebyshev nodes of the first kind on [0, 1].
+pub(crate) fn chebyshev_nodes<const N: usize>() -> [f64; N] {
+    std::array::from_fn(|k| {
+        0.5 - 0.5 * (std::f64::consts::PI * (2 * k + 1) as f64 / (2 * N) as f64).cos()
+    })
 }
 
 #[cfg(test)]

@@ -18,6 +18,7 @@ mod linear;
 mod logarithmic;
 mod mean_value;
 pub mod pixels;
+mod power_curve;
 mod reinhard02;
 mod reinhard02_local;
 mod schlick94;

@@ -363,6 +363,7 @@ fn map_pixels_chunk<M: PixelMap>(
     let mut g = [0.0f32; BLOCK];
     let mut b = [0.0f32; BLOCK];
     let mut l = [0.0f32; BLOCK];
+    let mut staged = [[0.0f32; 3]; BLOCK];
     let (mut non_finite, mut negative) = (0u64, 0u64);
     for (k, (i, o)) in input.chunks(BLOCK).zip(out.chunks_mut(BLOCK)).enumerate() {
         let n = i.len();
@@ -371,11 +372,64 @@ fn map_pixels_chunk<M: PixelMap>(
         negative += neg as u64;
         f.map(start + k * BLOCK, &mut r[..n], &mut g[..n], &mut b[..n]);
         let clean = |x: f32| if x.is_finite() { x } else { 0.0 };
-        for (j, o) in o.iter_mut().enumerate() {
-            *o = [clean(r[j]), clean(g[j]), clean(b[j])];
+        for (j, s) in staged[..n].iter_mut().enumerate() {
+            *s = [clean(r[j]), clean(g[j]), clean(b[j])];
         }
+        store_block(o, &staged[..n]);
     }
+    store_fence();
     (non_finite, negative)
+}
+
+/// Copies a finished block to the output with non-temporal stores where the CPU has AVX:
+/// the output (100 MB at 4K) is written once and not read again in the pass, so ordinary
+/// stores would first read every cache line of it from memory (read for ownership) and
+/// evict the input from the caches.
+#[inline(always)]
+fn store_block(dst: &mut [[f32; 3]], src: &[[f32; 3]]) {
+    #[cfg(target_arch = "x86_64")]
+    if super::simd::has_avx2() {
+        // SAFETY: the CPU has AVX (implied by AVX2, checked above).
+        unsafe { store_streaming(dst, src) };
+        return;
+    }
+    dst.copy_from_slice(src);
+}
+
+/// Orders a task's non-temporal stores before whatever signals its completion (they are
+/// weakly ordered: another thread could otherwise read the output before it lands).
+#[inline(always)]
+fn store_fence() {
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: sfence is part of SSE, in the x86-64 baseline.
+    unsafe {
+        std::arch::x86_64::_mm_sfence()
+    };
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx")]
+unsafe fn store_streaming(dst: &mut [[f32; 3]], src: &[[f32; 3]]) {
+    use std::arch::x86_64::*;
+    let n = 3 * dst.len().min(src.len());
+    let (d, s) = (dst.as_mut_ptr() as *mut f32, src.as_ptr() as *const f32);
+    // Plain stores up to the first 32-byte boundary (f32s are 4-byte aligned), streaming
+    // 32-byte stores after it, plain stores for the tail.
+    let head = (((32 - (d as usize & 31)) & 31) / 4).min(n);
+    for i in 0..head {
+        // SAFETY: i < n, inside both slices.
+        *d.add(i) = *s.add(i);
+    }
+    let mut i = head;
+    while i + 8 <= n {
+        // SAFETY: i + 8 ≤ n, inside both slices; d + i is 32-byte aligned.
+        _mm256_stream_ps(d.add(i), _mm256_loadu_ps(s.add(i)));
+        i += 8;
+    }
+    for i in i..n {
+        // SAFETY: i < n.
+        *d.add(i) = *s.add(i);
+    }
 }
 
 /// Maps every sanitised pixel through `f` (on de-interleaved planes); non-finite results
