@@ -597,21 +597,62 @@ fn compare_builds(
     scene: &dyn Fn(&mut GeometryBuilder),
     rays: &[(&str, Vec<Ray>)],
 ) -> Value {
-    let build = |flatten: bool| {
+    // The BVH in both builds: this compares flattening alone.
+    let options = |flatten| BuildOptions {
+        quality: BuildQuality::default(),
+        flatten,
+        small_scene_max_leaves: 0,
+    };
+    compare_options(
+        name,
+        scene,
+        rays,
+        [
+            ("unflattened", options(false)),
+            ("flattened", options(true)),
+        ],
+    )
+}
+
+/// The small-scene path (every leaf tested, 8 at a time, no BVH) against the flattened BVH
+/// of the same scene.
+fn compare_small(
+    name: &str,
+    scene: &dyn Fn(&mut GeometryBuilder),
+    rays: &[(&str, Vec<Ray>)],
+) -> Value {
+    let options = |small_scene_max_leaves| BuildOptions {
+        small_scene_max_leaves,
+        ..BuildOptions::default()
+    };
+    compare_options(
+        name,
+        scene,
+        rays,
+        [("bvh", options(0)), ("small", options(usize::MAX))],
+    )
+}
+
+/// Closest-hit and any-hit throughput of the same rays against two builds of a scene
+/// (`[(label, options); 2]`), 1 thread, alternated run by run (best of [`ALTERNATIONS`]
+/// runs each), so that load from other processes affects both alike.
+fn compare_options(
+    name: &str,
+    scene: &dyn Fn(&mut GeometryBuilder),
+    rays: &[(&str, Vec<Ray>)],
+    variants: [(&str, BuildOptions); 2],
+) -> Value {
+    let build = |options: BuildOptions| {
         let mut b = GeometryBuilder::new();
         scene(&mut b);
         let p = POOLS.with(|p| p[1].clone());
         let start = Instant::now();
-        let g = p.install(|| {
-            b.build_with(BuildOptions {
-                quality: BuildQuality::default(),
-                flatten,
-            })
-        });
+        let g = p.install(|| b.build_with(options));
         (g, start.elapsed().as_secs_f64())
     };
-    let (off, off_build_s) = build(false);
-    let (on, on_build_s) = build(true);
+    let [(off_name, off_options), (on_name, on_options)] = variants;
+    let (off, off_build_s) = build(off_options);
+    let (on, on_build_s) = build(on_options);
     let mut sets = Vec::new();
     for (ray_name, rays) in rays {
         let mut best: [[Option<Throughput>; 2]; 2] = Default::default(); // [query][flatten]
@@ -631,7 +672,7 @@ fn compare_builds(
         }
         let [[c_off, c_on], [a_off, a_on]] = best.map(|q| q.map(|t| t.expect("measured")));
         eprintln!(
-            "{name}/{ray_name}: closest {} -> {} ({:.2}x), any hit {} -> {} ({:.2}x), hit fraction {:.3}",
+            "{name}/{ray_name} ({off_name} -> {on_name}): closest {} -> {} ({:.2}x), any hit {} -> {} ({:.2}x), hit fraction {:.3}",
             c_off.show(),
             c_on.show(),
             c_on.rays_per_s / c_off.rays_per_s,
@@ -643,11 +684,11 @@ fn compare_builds(
         sets.push(json!({
             "rays": ray_name,
             "hit_fraction": (c_on.hit_fraction * 1000.0).round() / 1000.0,
-            "closest_unflattened": c_off.json(),
-            "closest_flattened": c_on.json(),
+            format!("closest_{off_name}"): c_off.json(),
+            format!("closest_{on_name}"): c_on.json(),
             "closest_speedup": ((c_on.rays_per_s / c_off.rays_per_s) * 100.0).round() / 100.0,
-            "any_hit_unflattened": a_off.json(),
-            "any_hit_flattened": a_on.json(),
+            format!("any_hit_{off_name}"): a_off.json(),
+            format!("any_hit_{on_name}"): a_on.json(),
             "any_hit_speedup": ((a_on.rays_per_s / a_off.rays_per_s) * 100.0).round() / 100.0,
         }));
     }
@@ -656,8 +697,9 @@ fn compare_builds(
         "instances": on.instances().len(),
         "flattened_triangles": on.flattened_triangle_count(),
         "instance_leaves_flattened": on.instance_leaf_count(),
-        "build_s_unflattened": (off_build_s * 1e4).round() / 1e4,
-        "build_s_flattened": (on_build_s * 1e4).round() / 1e4,
+        "compared": [off_name, on_name],
+        format!("build_s_{off_name}"): (off_build_s * 1e4).round() / 1e4,
+        format!("build_s_{on_name}"): (on_build_s * 1e4).round() / 1e4,
         "threads": 1,
         "ray_sets": sets,
     })
@@ -669,6 +711,13 @@ fn instanced_scenes(filter: &str) -> Vec<Value> {
     let wanted = |name: &str| name.contains(filter);
     if wanted("cornell_box") {
         out.push(compare_builds("cornell_box", &cornell_box, &cornell_rays()));
+    }
+    if wanted("small_cornell_box") {
+        out.push(compare_small(
+            "small_cornell_box",
+            &cornell_box,
+            &cornell_rays(),
+        ));
     }
     if wanted("mixed_650_instances") {
         out.push(compare_builds(
