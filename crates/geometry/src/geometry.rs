@@ -420,6 +420,12 @@ impl Geometry {
         self.instance_leaves
     }
 
+    /// Whether the scene is traced without a BVH, every leaf tested eight at a time (at most
+    /// [`BuildOptions::small_scene_max_leaves`] leaves).
+    pub fn is_small_scene(&self) -> bool {
+        self.small.is_some()
+    }
+
     /// Closest hit of `ray` in `(t_min, t_max)`.
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
         if let Some(small) = &self.small {

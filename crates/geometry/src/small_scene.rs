@@ -964,6 +964,92 @@ fn any_kernel<L: Lanes>(
 mod tests {
     use super::*;
 
+    /// Each lane of the batch tests rounds exactly as the scalar tests it replaces:
+    /// `WatertightRay::intersect` for triangles, `Rectangle::intersect` in the object space
+    /// of `object_ray` for rectangles (same `t` bits, same hit or miss).
+    #[test]
+    fn lanes_round_exactly_as_the_scalar_tests() {
+        use crate::ray::Ray;
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_pcg::Pcg64::seed_from_u64(21);
+        let v = |rng: &mut rand_pcg::Pcg64| {
+            Vec3A::new(
+                rng.gen_range(-1.0..1.0),
+                rng.gen_range(-1.0..1.0),
+                rng.gen_range(-1.0..1.0),
+            )
+        };
+        let tris: Vec<[Vec3A; 3]> = (0..8)
+            .map(|_| [v(&mut rng), v(&mut rng), v(&mut rng)])
+            .collect();
+        let rects: Vec<(Rectangle, Transform)> = (0..8)
+            .map(|i| {
+                let t = Transform::translate(v(&mut rng))
+                    .compose(&Transform::rotate(v(&mut rng), i as f32 + 0.3).unwrap())
+                    .compose(&Transform::scale(Vec3A::new(1.0, 2.0, 0.5)).unwrap());
+                let r = Rectangle {
+                    half_width_m: 0.5,
+                    half_height_m: 0.3,
+                };
+                (r, if i == 2 { Transform::IDENTITY } else { t })
+            })
+            .collect();
+        let mut b = SmallSceneBuilder::new();
+        for (i, &p) in tris.iter().enumerate() {
+            b.triangle(p, 0, i as u32);
+        }
+        for (i, &(r, t)) in rects.iter().enumerate() {
+            b.rectangle(r, t, i as u32);
+        }
+        let s = b.build();
+        let (mut tri_hits, mut rect_hits) = (0, 0);
+        for _ in 0..20_000 {
+            let (o, d) = (2.0 * v(&mut rng), v(&mut rng));
+            let t_max = if rng.gen_bool(0.5) {
+                f32::INFINITY
+            } else {
+                rng.gen_range(0.1..3.0)
+            };
+            let wt = WatertightRay::new(o, d, 1e-3);
+            let r = RayConsts::<Baseline>::new(o, d, &wt, t_max);
+            let (ok, t, b1, b2, zero) = triangle_lanes(&s.triangles[0], &r);
+            let (ok, t, b1, b2) = (ok.bits(), t.store(), b1.store(), b2.store());
+            for (l, p) in tris.iter().enumerate() {
+                if zero & (1 << l) != 0 {
+                    continue;
+                }
+                let h = wt.intersect(p[0], p[1], p[2], t_max);
+                assert_eq!(h.is_some(), ok & (1 << l) != 0, "{o:?} {d:?} lane {l}");
+                if let Some(h) = h {
+                    tri_hits += 1;
+                    assert_eq!(
+                        (h.t.to_bits(), h.b1.to_bits(), h.b2.to_bits()),
+                        (t.0[l].to_bits(), b1.0[l].to_bits(), b2.0[l].to_bits())
+                    );
+                }
+            }
+            let (ok, t) = rectangle_lanes(&s.rectangles[0], &r);
+            let (ok, t) = (ok.bits(), t.store());
+            for (l, (rect, to_world)) in rects.iter().enumerate() {
+                let (oo, od) = if to_world.is_identity() {
+                    (o, d)
+                } else {
+                    (to_world.inverse_point(o), to_world.inverse_vector(d))
+                };
+                let h = rect.intersect(&Ray::new(oo, od, 1e-3, t_max));
+                assert_eq!(h.is_some(), ok & (1 << l) != 0, "{o:?} {d:?} lane {l}");
+                if let Some(h) = h {
+                    rect_hits += 1;
+                    assert_eq!(h.to_bits(), t.0[l].to_bits());
+                }
+            }
+        }
+        assert!(
+            tri_hits > 1000 && rect_hits > 1000,
+            "{tri_hits} {rect_hits}"
+        );
+    }
+
     /// The AVX2 and the baseline kernels give bit-identical answers (when the CPU has AVX2;
     /// otherwise both calls run the baseline).
     #[test]
