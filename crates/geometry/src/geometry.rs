@@ -83,7 +83,7 @@ pub const FLATTEN_SHARED_TRIANGLE_BUDGET: usize = 1 << 20;
 /// Scenes of at most this many leaves (baked triangles + instance leaves) are traced without
 /// a BVH, testing every leaf eight at a time ([`crate::small_scene`]; threshold measured in
 /// docs/geometry.md, "Small scenes without a BVH").
-pub const SMALL_SCENE_MAX_LEAVES: usize = 64;
+pub const SMALL_SCENE_MAX_LEAVES: usize = 128;
 
 /// How [`GeometryBuilder::build_with`] builds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]

@@ -381,7 +381,7 @@ fn small_scene_grazing_rays_match_the_bvh() {
 #[test]
 fn small_scene_threshold_counts_leaves() {
     // 6 rectangles + k cuboids of 12 triangles: small up to the threshold, a BVH above.
-    for k in 0..8 {
+    for k in 0..13 {
         let mut b = GeometryBuilder::new();
         for i in 0..6 {
             b.add_instance(

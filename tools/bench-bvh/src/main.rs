@@ -574,6 +574,39 @@ fn icosphere_scene(b: &mut GeometryBuilder, subdivisions: u32) {
     }
 }
 
+/// The Cornell box's six walls (2 m rectangles and a 0.4 m light) and `cuboids` randomly
+/// placed 0.2–0.6 m cuboids inside (one shared 12-triangle mesh, baked): 6 + 12·`cuboids`
+/// leaves, the sweep that sets `SMALL_SCENE_MAX_LEAVES`.
+fn room_with_cuboids(b: &mut GeometryBuilder, cuboids: usize) {
+    let mut rng = Pcg64::seed_from_u64(12);
+    let quarter = std::f32::consts::FRAC_PI_2;
+    let walls: [(Vec3A, Vec3A, f32); 6] = [
+        (Vec3A::new(0.0, -1.0, 0.0), Vec3A::X, -quarter),
+        (Vec3A::new(0.0, 1.0, 0.0), Vec3A::X, quarter),
+        (Vec3A::new(0.0, 0.0, -1.0), Vec3A::X, 0.0),
+        (Vec3A::new(-1.0, 0.0, 0.0), Vec3A::Y, quarter),
+        (Vec3A::new(1.0, 0.0, 0.0), Vec3A::Y, -quarter),
+        (Vec3A::new(0.0, 0.99, 0.0), Vec3A::X, quarter),
+    ];
+    for (i, (at, axis, angle)) in walls.into_iter().enumerate() {
+        let half = if i == 5 { 0.2 } else { 1.0 };
+        let r = Rectangle {
+            half_width_m: half,
+            half_height_m: half,
+        };
+        let t = Transform::translate(at).compose(&Transform::rotate(axis, angle).expect("axis"));
+        b.add_instance(Shape::Rectangle(r), t, None);
+    }
+    let cube = b.add_mesh(TriangleMesh::cuboid(Vec3A::splat(0.5)));
+    for _ in 0..cuboids {
+        b.add_instance(
+            Shape::Mesh(cube),
+            random_placement(&mut rng, 0.6, 0.4),
+            None,
+        );
+    }
+}
+
 /// Origins uniform in a `spread` cube, uniform directions.
 fn rays_in_cube(spread: f32, seed: u64) -> Vec<Ray> {
     let mut rng = Pcg64::seed_from_u64(seed);
@@ -718,6 +751,16 @@ fn instanced_scenes(filter: &str) -> Vec<Value> {
             &cornell_box,
             &cornell_rays(),
         ));
+    }
+    for cuboids in [1, 2, 3, 4, 5, 6, 8, 10, 14, 18, 22] {
+        let name = format!("small_room_{}_leaves", 6 + 12 * cuboids);
+        if wanted(&name) {
+            out.push(compare_small(
+                &name,
+                &|b| room_with_cuboids(b, cuboids),
+                &[("incoherent", rays_in_cube(0.95, 13))],
+            ));
+        }
     }
     if wanted("mixed_650_instances") {
         out.push(compare_builds(
