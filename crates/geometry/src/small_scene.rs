@@ -876,20 +876,21 @@ fn closest_kernel<L: Lanes>(
             }
         }
     }
+    // Reduction: the smallest `t`, then among lanes at exactly that `t` the lowest key (a
+    // tie needs the loop; one lane is the rule).
+    let bt = best.t.store();
+    let t_best = min_lane(&bt);
     let mut win = extra;
-    let (bt, bk, bb1, bb2) = (
-        best.t.store(),
-        best.key.store(),
-        best.b1.store(),
-        best.b2.store(),
-    );
-    for l in 0..LANES {
-        if bk.0[l] == f32::INFINITY {
-            continue;
-        }
-        let c = (bt.0[l], bk.0[l], bb1.0[l], bb2.0[l]);
-        if win.is_none_or(|(t0, k0, _, _)| c.0 < t0 || (c.0 == t0 && c.1 < k0)) {
-            win = Some(c);
+    let mut at_best = best.t.eq(L::splat(t_best)).bits();
+    if t_best < f32::INFINITY {
+        let (bk, bb1, bb2) = (best.key.store(), best.b1.store(), best.b2.store());
+        while at_best != 0 {
+            let l = at_best.trailing_zeros() as usize;
+            at_best &= at_best - 1;
+            let c = (bt.0[l], bk.0[l], bb1.0[l], bb2.0[l]);
+            if win.is_none_or(|(t0, k0, _, _)| c.0 < t0 || (c.0 == t0 && c.1 < k0)) {
+                win = Some(c);
+            }
         }
     }
     let (t, key, b1, b2) = win?;
