@@ -19,13 +19,14 @@
 
 use glam::Vec3A;
 
-use crate::bvh_build::BuildQuality;
+use crate::bvh_build::{bvh_ray, BuildQuality};
 use crate::disk::Disk;
 use crate::interaction::SurfaceInteraction;
 use crate::mesh::{TriangleMesh, NO_MATERIAL};
 use crate::mesh_bvh::MeshBvh;
 use crate::ray::{Ray, RayDifferential};
 use crate::rectangle::Rectangle;
+use crate::small_scene::{SmallScene, SmallSceneBuilder, NO_PRIMITIVE};
 use crate::sphere::Sphere;
 use crate::transform::Transform;
 use crate::triangle::{TriangleHit, WatertightRay};
@@ -79,6 +80,11 @@ pub const FLATTEN_MAX_SHARED_MESH_TRIANGLES: usize = 4096;
 /// until the budget is spent, the rest stay instanced.
 pub const FLATTEN_SHARED_TRIANGLE_BUDGET: usize = 1 << 20;
 
+/// Scenes of at most this many leaves (baked triangles + instance leaves) are traced without
+/// a BVH, testing every leaf eight at a time ([`crate::small_scene`]; threshold measured in
+/// docs/geometry.md, "Small scenes without a BVH").
+pub const SMALL_SCENE_MAX_LEAVES: usize = 128;
+
 /// How [`GeometryBuilder::build_with`] builds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct BuildOptions {
@@ -89,6 +95,10 @@ pub struct BuildOptions {
     /// instances, the two-level reference the flattened geometry is tested and benchmarked
     /// against.
     pub flatten: bool,
+    /// Scenes of at most this many leaves skip the BVH and test every leaf, eight at a time
+    /// (default [`SMALL_SCENE_MAX_LEAVES`]; 0 always builds the BVH, the reference the small
+    /// path is tested and benchmarked against).
+    pub small_scene_max_leaves: usize,
 }
 
 impl Default for BuildOptions {
@@ -96,6 +106,7 @@ impl Default for BuildOptions {
         Self {
             quality: BuildQuality::default(),
             flatten: true,
+            small_scene_max_leaves: SMALL_SCENE_MAX_LEAVES,
         }
     }
 }
@@ -213,7 +224,11 @@ impl GeometryBuilder {
             [only] if only.is_instance() => Some(only.instance),
             _ => None,
         };
-        let scene = (!leaves.is_empty() && single.is_none())
+        let small = (!leaves.is_empty()
+            && single.is_none()
+            && leaves.len() <= options.small_scene_max_leaves)
+            .then(|| small_scene(&leaves, &leaf_ids, &self.instances));
+        let scene = (!leaves.is_empty() && single.is_none() && small.is_none())
             .then(|| TriangleBvh::build_with_bounds(&leaves, &leaf_ids, leaf_bounds, quality));
         let flat_records = self.instances.iter().map(flat_record).collect();
         Geometry {
@@ -221,6 +236,7 @@ impl GeometryBuilder {
             flat_records,
             instances: self.instances,
             scene,
+            small,
             single,
             triangles,
             instance_leaves,
@@ -312,6 +328,24 @@ fn flat_record(inst: &Instance) -> Option<Box<SurfaceInteraction>> {
     }
 }
 
+/// The leaves of a scene traced without a BVH: baked triangles and rectangles in batches,
+/// other instances (boxes in `leaves`) one by one.
+fn small_scene(leaves: &[[Vec3A; 3]], ids: &[Leaf], instances: &[Instance]) -> SmallScene {
+    let mut b = SmallSceneBuilder::new();
+    for (p, id) in leaves.iter().zip(ids) {
+        if !id.is_instance() {
+            b.triangle(*p, id.instance, id.primitive);
+            continue;
+        }
+        let inst = &instances[id.instance as usize];
+        match inst.shape {
+            Shape::Rectangle(r) => b.rectangle(r, inst.to_world, id.instance),
+            _ => b.other(p[0], p[1], id.instance),
+        }
+    }
+    b.build()
+}
+
 /// Bounds of a leaf: a triangle's vertices, or the box an instance leaf carries.
 #[inline]
 fn leaf_bounds(p: &[Vec3A; 3], id: Leaf) -> (Vec3A, Vec3A) {
@@ -350,8 +384,11 @@ pub struct Geometry {
     /// hit (the same bits: every field is computed by the same expression).
     flat_records: Vec<Option<Box<SurfaceInteraction>>>,
     /// One BVH over baked world-space triangles and instance leaves; `None` when the scene
-    /// is empty or is a single instance.
+    /// is empty, is a single instance or is small.
     scene: Option<TriangleBvh<Leaf>>,
+    /// The leaves of a scene of at most [`BuildOptions::small_scene_max_leaves`], tested
+    /// without a BVH.
+    small: Option<SmallScene>,
     /// The only leaf, an instance, traced without a box test.
     single: Option<u32>,
     triangles: usize,
@@ -383,8 +420,17 @@ impl Geometry {
         self.instance_leaves
     }
 
+    /// Whether the scene is traced without a BVH, every leaf tested eight at a time (at most
+    /// [`BuildOptions::small_scene_max_leaves`] leaves).
+    pub fn is_small_scene(&self) -> bool {
+        self.small.is_some()
+    }
+
     /// Closest hit of `ray` in `(t_min, t_max)`.
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
+        if let Some(small) = &self.small {
+            return self.intersect_small(small, ray);
+        }
         let Some(scene) = &self.scene else {
             return self
                 .single
@@ -415,7 +461,53 @@ impl Geometry {
                 }
             }
         });
-        best_instance.or_else(|| best_triangle.map(|(h, leaf)| self.baked_hit(ray, &h, leaf)))
+        best_instance
+            .or_else(|| best_triangle.map(|(h, leaf)| self.baked_hit(ray, h.t, h.b1, h.b2, leaf)))
+    }
+
+    /// [`Self::intersect`] of a small scene: all triangle and rectangle leaves at once, then
+    /// the other instance leaves one by one against the closest `t` so far.
+    fn intersect_small(&self, small: &SmallScene, ray: &Ray) -> Option<Hit> {
+        let (o, d) = (ray.origin, ray.direction);
+        let wt = WatertightRay::new(o, d, ray.t_min);
+        let candidate = small.closest(o, d, &wt, ray.t_max);
+        let mut t_max = candidate.map_or(ray.t_max, |c| c.t);
+        let mut best_other = None;
+        if !small.others.is_empty() {
+            let inv = bvh_ray(o, d, ray.t_min, ray.t_max).inv_direction;
+            for leaf in &small.others {
+                if slab_hit(leaf.lo, leaf.hi, o, inv, ray.t_min, t_max) {
+                    if let Some(h) = self.intersect_instance(leaf.instance, ray, t_max) {
+                        t_max = h.t;
+                        best_other = Some(h);
+                    }
+                }
+            }
+        }
+        if best_other.is_some() {
+            return best_other;
+        }
+        let c = candidate?;
+        Some(if c.primitive == NO_PRIMITIVE {
+            Hit {
+                t: c.t,
+                instance_id: c.instance,
+                primitive_id: 0,
+                b1: 0.0,
+                b2: 0.0,
+            }
+        } else {
+            self.baked_hit(
+                ray,
+                c.t,
+                c.b1,
+                c.b2,
+                Leaf {
+                    instance: c.instance,
+                    primitive: c.primitive,
+                },
+            )
+        })
     }
 
     /// The [`Hit`] of a baked triangle, with `t`, `b1` and `b2` recomputed by the watertight
@@ -425,13 +517,13 @@ impl Geometry {
     /// should the object-space test round the other way at an edge, the world-space values
     /// are kept.
     #[inline]
-    fn baked_hit(&self, ray: &Ray, h: &TriangleHit, leaf: Leaf) -> Hit {
+    fn baked_hit(&self, ray: &Ray, t: f32, b1: f32, b2: f32, leaf: Leaf) -> Hit {
         let mut hit = Hit {
-            t: h.t,
+            t,
             instance_id: leaf.instance,
             primitive_id: leaf.primitive,
-            b1: h.b1,
-            b2: h.b2,
+            b1,
+            b2,
         };
         let inst = &self.instances[leaf.instance as usize];
         // Identity instances were baked with their own vertex bits: nothing to redo.
@@ -477,6 +569,21 @@ impl Geometry {
     /// Whether anything blocks `ray` in `(t_min, t_max)` — the shadow-ray query; it stops at
     /// the first hit (obvhs `ray_traverse_miss`).
     pub fn occluded(&self, ray: &Ray) -> bool {
+        if let Some(small) = &self.small {
+            let (o, d) = (ray.origin, ray.direction);
+            let wt = WatertightRay::new(o, d, ray.t_min);
+            if small.any(o, d, &wt, ray.t_max) {
+                return true;
+            }
+            if small.others.is_empty() {
+                return false;
+            }
+            let inv = bvh_ray(o, d, ray.t_min, ray.t_max).inv_direction;
+            return small.others.iter().any(|leaf| {
+                slab_hit(leaf.lo, leaf.hi, o, inv, ray.t_min, ray.t_max)
+                    && self.occludes(leaf.instance, ray)
+            });
+        }
         let Some(scene) = &self.scene else {
             return self.single.is_some_and(|i| self.occludes(i, ray));
         };
@@ -570,6 +677,17 @@ impl Geometry {
         si.compute_differentials(ray);
         Some(si)
     }
+}
+
+/// Whether the ray `o + t·d` (`inv` its safe reciprocal direction, `bvh_ray`) enters the
+/// padded box `lo..hi` within `(t_min, t_max)`.
+#[inline]
+fn slab_hit(lo: Vec3A, hi: Vec3A, o: Vec3A, inv: Vec3A, t_min: f32, t_max: f32) -> bool {
+    let t0 = (lo - o) * inv;
+    let t1 = (hi - o) * inv;
+    let near = t0.min(t1).max_element().max(t_min);
+    let far = t0.max(t1).min_element().min(t_max);
+    near <= far
 }
 
 #[inline]

@@ -19,6 +19,7 @@ pub mod obj;
 pub mod ply;
 pub mod ray;
 pub mod rectangle;
+mod small_scene;
 pub mod sphere;
 pub mod transform;
 pub mod triangle;
@@ -32,7 +33,7 @@ pub use error::MeshLoadError;
 pub use frame::Frame;
 pub use geometry::{
     BuildOptions, Geometry, GeometryBuilder, Hit, Instance, MeshId, Shape,
-    FLATTEN_MAX_SHARED_MESH_TRIANGLES, FLATTEN_SHARED_TRIANGLE_BUDGET,
+    FLATTEN_MAX_SHARED_MESH_TRIANGLES, FLATTEN_SHARED_TRIANGLE_BUDGET, SMALL_SCENE_MAX_LEAVES,
 };
 pub use interaction::{Differentials, LocalGeometry, SurfaceInteraction};
 pub use mesh::{TriangleMesh, NO_MATERIAL};

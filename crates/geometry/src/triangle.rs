@@ -21,10 +21,12 @@ use glam::{Mat3A, Vec3A, Vec3Swizzles};
 #[derive(Clone, Copy, Debug)]
 pub struct WatertightRay {
     pub origin: Vec3A,
-    shear_x: Vec3A,
-    shear_y: Vec3A,
-    pick_z: Vec3A,
-    sz: f32,
+    // Read by the many-triangles-at-once test of `crate::small_scene`, which must round
+    // exactly as `intersect` does.
+    pub(crate) shear_x: Vec3A,
+    pub(crate) shear_y: Vec3A,
+    pub(crate) pick_z: Vec3A,
+    pub(crate) sz: f32,
     pub t_min: f32,
 }
 

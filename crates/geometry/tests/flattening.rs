@@ -133,6 +133,7 @@ fn build(b: GeometryBuilder, flatten: bool) -> Geometry {
     b.build_with(BuildOptions {
         quality: BuildQuality::Fast,
         flatten,
+        ..BuildOptions::default()
     })
 }
 

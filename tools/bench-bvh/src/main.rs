@@ -574,6 +574,39 @@ fn icosphere_scene(b: &mut GeometryBuilder, subdivisions: u32) {
     }
 }
 
+/// The Cornell box's six walls (2 m rectangles and a 0.4 m light) and `cuboids` randomly
+/// placed 0.2–0.6 m cuboids inside (one shared 12-triangle mesh, baked): 6 + 12·`cuboids`
+/// leaves, the sweep that sets `SMALL_SCENE_MAX_LEAVES`.
+fn room_with_cuboids(b: &mut GeometryBuilder, cuboids: usize) {
+    let mut rng = Pcg64::seed_from_u64(12);
+    let quarter = std::f32::consts::FRAC_PI_2;
+    let walls: [(Vec3A, Vec3A, f32); 6] = [
+        (Vec3A::new(0.0, -1.0, 0.0), Vec3A::X, -quarter),
+        (Vec3A::new(0.0, 1.0, 0.0), Vec3A::X, quarter),
+        (Vec3A::new(0.0, 0.0, -1.0), Vec3A::X, 0.0),
+        (Vec3A::new(-1.0, 0.0, 0.0), Vec3A::Y, quarter),
+        (Vec3A::new(1.0, 0.0, 0.0), Vec3A::Y, -quarter),
+        (Vec3A::new(0.0, 0.99, 0.0), Vec3A::X, quarter),
+    ];
+    for (i, (at, axis, angle)) in walls.into_iter().enumerate() {
+        let half = if i == 5 { 0.2 } else { 1.0 };
+        let r = Rectangle {
+            half_width_m: half,
+            half_height_m: half,
+        };
+        let t = Transform::translate(at).compose(&Transform::rotate(axis, angle).expect("axis"));
+        b.add_instance(Shape::Rectangle(r), t, None);
+    }
+    let cube = b.add_mesh(TriangleMesh::cuboid(Vec3A::splat(0.5)));
+    for _ in 0..cuboids {
+        b.add_instance(
+            Shape::Mesh(cube),
+            random_placement(&mut rng, 0.6, 0.4),
+            None,
+        );
+    }
+}
+
 /// Origins uniform in a `spread` cube, uniform directions.
 fn rays_in_cube(spread: f32, seed: u64) -> Vec<Ray> {
     let mut rng = Pcg64::seed_from_u64(seed);
@@ -597,21 +630,62 @@ fn compare_builds(
     scene: &dyn Fn(&mut GeometryBuilder),
     rays: &[(&str, Vec<Ray>)],
 ) -> Value {
-    let build = |flatten: bool| {
+    // The BVH in both builds: this compares flattening alone.
+    let options = |flatten| BuildOptions {
+        quality: BuildQuality::default(),
+        flatten,
+        small_scene_max_leaves: 0,
+    };
+    compare_options(
+        name,
+        scene,
+        rays,
+        [
+            ("unflattened", options(false)),
+            ("flattened", options(true)),
+        ],
+    )
+}
+
+/// The small-scene path (every leaf tested, 8 at a time, no BVH) against the flattened BVH
+/// of the same scene.
+fn compare_small(
+    name: &str,
+    scene: &dyn Fn(&mut GeometryBuilder),
+    rays: &[(&str, Vec<Ray>)],
+) -> Value {
+    let options = |small_scene_max_leaves| BuildOptions {
+        small_scene_max_leaves,
+        ..BuildOptions::default()
+    };
+    compare_options(
+        name,
+        scene,
+        rays,
+        [("bvh", options(0)), ("small", options(usize::MAX))],
+    )
+}
+
+/// Closest-hit and any-hit throughput of the same rays against two builds of a scene
+/// (`[(label, options); 2]`), 1 thread, alternated run by run (best of [`ALTERNATIONS`]
+/// runs each), so that load from other processes affects both alike.
+fn compare_options(
+    name: &str,
+    scene: &dyn Fn(&mut GeometryBuilder),
+    rays: &[(&str, Vec<Ray>)],
+    variants: [(&str, BuildOptions); 2],
+) -> Value {
+    let build = |options: BuildOptions| {
         let mut b = GeometryBuilder::new();
         scene(&mut b);
         let p = POOLS.with(|p| p[1].clone());
         let start = Instant::now();
-        let g = p.install(|| {
-            b.build_with(BuildOptions {
-                quality: BuildQuality::default(),
-                flatten,
-            })
-        });
+        let g = p.install(|| b.build_with(options));
         (g, start.elapsed().as_secs_f64())
     };
-    let (off, off_build_s) = build(false);
-    let (on, on_build_s) = build(true);
+    let [(off_name, off_options), (on_name, on_options)] = variants;
+    let (off, off_build_s) = build(off_options);
+    let (on, on_build_s) = build(on_options);
     let mut sets = Vec::new();
     for (ray_name, rays) in rays {
         let mut best: [[Option<Throughput>; 2]; 2] = Default::default(); // [query][flatten]
@@ -631,7 +705,7 @@ fn compare_builds(
         }
         let [[c_off, c_on], [a_off, a_on]] = best.map(|q| q.map(|t| t.expect("measured")));
         eprintln!(
-            "{name}/{ray_name}: closest {} -> {} ({:.2}x), any hit {} -> {} ({:.2}x), hit fraction {:.3}",
+            "{name}/{ray_name} ({off_name} -> {on_name}): closest {} -> {} ({:.2}x), any hit {} -> {} ({:.2}x), hit fraction {:.3}",
             c_off.show(),
             c_on.show(),
             c_on.rays_per_s / c_off.rays_per_s,
@@ -643,11 +717,11 @@ fn compare_builds(
         sets.push(json!({
             "rays": ray_name,
             "hit_fraction": (c_on.hit_fraction * 1000.0).round() / 1000.0,
-            "closest_unflattened": c_off.json(),
-            "closest_flattened": c_on.json(),
+            format!("closest_{off_name}"): c_off.json(),
+            format!("closest_{on_name}"): c_on.json(),
             "closest_speedup": ((c_on.rays_per_s / c_off.rays_per_s) * 100.0).round() / 100.0,
-            "any_hit_unflattened": a_off.json(),
-            "any_hit_flattened": a_on.json(),
+            format!("any_hit_{off_name}"): a_off.json(),
+            format!("any_hit_{on_name}"): a_on.json(),
             "any_hit_speedup": ((a_on.rays_per_s / a_off.rays_per_s) * 100.0).round() / 100.0,
         }));
     }
@@ -656,8 +730,9 @@ fn compare_builds(
         "instances": on.instances().len(),
         "flattened_triangles": on.flattened_triangle_count(),
         "instance_leaves_flattened": on.instance_leaf_count(),
-        "build_s_unflattened": (off_build_s * 1e4).round() / 1e4,
-        "build_s_flattened": (on_build_s * 1e4).round() / 1e4,
+        "compared": [off_name, on_name],
+        format!("build_s_{off_name}"): (off_build_s * 1e4).round() / 1e4,
+        format!("build_s_{on_name}"): (on_build_s * 1e4).round() / 1e4,
         "threads": 1,
         "ray_sets": sets,
     })
@@ -669,6 +744,23 @@ fn instanced_scenes(filter: &str) -> Vec<Value> {
     let wanted = |name: &str| name.contains(filter);
     if wanted("cornell_box") {
         out.push(compare_builds("cornell_box", &cornell_box, &cornell_rays()));
+    }
+    if wanted("small_cornell_box") {
+        out.push(compare_small(
+            "small_cornell_box",
+            &cornell_box,
+            &cornell_rays(),
+        ));
+    }
+    for cuboids in [1, 2, 3, 4, 5, 6, 8, 10, 14, 18, 22] {
+        let name = format!("small_room_{}_leaves", 6 + 12 * cuboids);
+        if wanted(&name) {
+            out.push(compare_small(
+                &name,
+                &|b| room_with_cuboids(b, cuboids),
+                &[("incoherent", rays_in_cube(0.95, 13))],
+            ));
+        }
     }
     if wanted("mixed_650_instances") {
         out.push(compare_builds(
