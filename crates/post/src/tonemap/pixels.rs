@@ -397,7 +397,7 @@ pub(crate) fn map_luminance<C: LuminanceCurve>(
 
 /// One task of [`map_pixels`].
 #[inline(always)]
-fn map_pixels_chunk<M: PixelMap>(
+pub(crate) fn map_pixels_chunk<M: PixelMap>(
     input: &[[f32; 3]],
     out: &mut [[f32; 3]],
     start: usize,
@@ -431,7 +431,7 @@ fn map_pixels_chunk<M: PixelMap>(
 /// stores would first read every cache line of it from memory (read for ownership) and
 /// evict the input from the caches.
 #[inline(always)]
-fn store_block(dst: &mut [[f32; 3]], src: &[[f32; 3]]) {
+pub(crate) fn store_block(dst: &mut [[f32; 3]], src: &[[f32; 3]]) {
     #[cfg(target_arch = "x86_64")]
     if super::simd::has_avx2() {
         // SAFETY: the CPU has AVX (implied by AVX2, checked above).
@@ -444,7 +444,7 @@ fn store_block(dst: &mut [[f32; 3]], src: &[[f32; 3]]) {
 /// Orders a task's non-temporal stores before whatever signals its completion (they are
 /// weakly ordered: another thread could otherwise read the output before it lands).
 #[inline(always)]
-fn store_fence() {
+pub(crate) fn store_fence() {
     #[cfg(target_arch = "x86_64")]
     // SAFETY: sfence is part of SSE, in the x86-64 baseline.
     unsafe {
@@ -486,7 +486,13 @@ pub(crate) fn map_pixels<M: PixelMap>(ctx: &Context, scale: f32, f: &M) -> Mappe
         .par_chunks_mut(CHUNK)
         .zip(image.pixels().par_chunks(CHUNK))
         .enumerate()
-        .map(|(k, (o, i))| avx2!(map_pixels_chunk(i, o, k * CHUNK, scale, f)))
+        .map(|(k, (o, i))| {
+            if super::map512::available() {
+                super::map512::map_pixels_chunk_fast(i, o, k * CHUNK, scale, f)
+            } else {
+                avx2!(map_pixels_chunk(i, o, k * CHUNK, scale, f))
+            }
+        })
         .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
     Mapped {
         pixels,
