@@ -75,23 +75,34 @@ impl RegisterCurve for Curve {
         use std::arch::x86_64::*;
         let (one, rate) = (_mm512_set1_ps(1.0), _mm512_set1_ps(self.rate));
         let x = _mm512_mul_ps(rate, l);
-        let inner = _mm512_sub_ps(one, _mm512_mul_ps(_mm512_set1_ps(0.25), x));
-        let third = _mm512_mul_ps(_mm512_mul_ps(x, _mm512_set1_ps(THIRD)), inner);
-        let half = _mm512_mul_ps(
-            _mm512_mul_ps(_mm512_set1_ps(0.5), x),
-            _mm512_sub_ps(one, third),
-        );
-        let series = _mm512_mul_ps(rate, _mm512_sub_ps(one, half));
-        // exp(−x) = exp2((−x) · log2 e), −x by flipping the sign bit as `-x` does.
-        let minus_x = _mm512_castsi512_ps(_mm512_xor_si512(
-            _mm512_castps_si512(x),
-            _mm512_set1_epi32(i32::MIN),
-        ));
-        let e = map512::exp2_16(_mm512_mul_ps(
-            minus_x,
-            _mm512_set1_ps(std::f32::consts::LOG2_E),
-        ));
         let small = _mm512_cmp_ps_mask::<_CMP_LT_OQ>(x, _mm512_set1_ps(0.01));
+        // Each branch only where some lane selects it (dark and bright pixels come in
+        // runs, so the branches predict well); a lane's value is that of the scalar path
+        // either way, since the blend below only reads the selected side.
+        let series = if small != 0 {
+            let inner = _mm512_sub_ps(one, _mm512_mul_ps(_mm512_set1_ps(0.25), x));
+            let third = _mm512_mul_ps(_mm512_mul_ps(x, _mm512_set1_ps(THIRD)), inner);
+            let half = _mm512_mul_ps(
+                _mm512_mul_ps(_mm512_set1_ps(0.5), x),
+                _mm512_sub_ps(one, third),
+            );
+            _mm512_mul_ps(rate, _mm512_sub_ps(one, half))
+        } else {
+            one
+        };
+        let e = if small != 0xffff {
+            // exp(−x) = exp2((−x) · log2 e), −x by flipping the sign bit as `-x` does.
+            let minus_x = _mm512_castsi512_ps(_mm512_xor_si512(
+                _mm512_castps_si512(x),
+                _mm512_set1_epi32(i32::MIN),
+            ));
+            map512::exp2_16(_mm512_mul_ps(
+                minus_x,
+                _mm512_set1_ps(std::f32::consts::LOG2_E),
+            ))
+        } else {
+            one
+        };
         let numerator = _mm512_mask_blend_ps(small, _mm512_sub_ps(one, e), series);
         let denominator = _mm512_mask_blend_ps(small, l, one);
         _mm512_div_ps(numerator, denominator)
