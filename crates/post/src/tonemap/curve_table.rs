@@ -136,6 +136,62 @@ impl CurveTable {
         }
     }
 
+    /// [`Self::eval`] on 16 lanes with AVX-512F: the same bits (the same operations in the
+    /// same order).
+    ///
+    /// # Safety
+    /// The CPU must have AVX-512F.
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    pub unsafe fn eval16(&self, x: std::arch::x86_64::__m512) -> std::arch::x86_64::__m512 {
+        use std::arch::x86_64::*;
+        let base = self.coeffs.as_ptr() as *const f32;
+        let bits = _mm512_castps_si512(x);
+        // Logical shift: negative arguments land above the last segment, as in `eval`.
+        let s = _mm512_sub_epi32(
+            _mm512_srli_epi32::<{ LOW_BITS }>(bits),
+            _mm512_set1_epi32(self.first as i32),
+        );
+        let s = _mm512_min_epi32(
+            _mm512_max_epi32(s, _mm512_setzero_si512()),
+            _mm512_set1_epi32(self.coeffs.len() as i32 - 1),
+        );
+        // Each lane's four coefficients are one 16-byte load; four rows per register
+        // (lanes j, j + 4, j + 8, j + 12 of register j), then a 4×4 transpose inside
+        // each 128-bit slot turns them into c0..c3 (16 loads and 20 shuffles: measured
+        // cheaper than four 16-lane gathers, as on 8 lanes).
+        let mut idx = [0i32; 16];
+        _mm512_storeu_si512(idx.as_mut_ptr() as *mut _, s);
+        // SAFETY: 0 ≤ idx[k] < coeffs.len() (clamped above), so each row's four floats
+        // lie inside the coefficient table.
+        let row = |k: usize| _mm_loadu_ps(base.add(4 * idx[k] as usize));
+        let reg = |j: usize| {
+            let z = _mm512_castps128_ps512(row(j));
+            let z = _mm512_insertf32x4::<1>(z, row(j + 4));
+            let z = _mm512_insertf32x4::<2>(z, row(j + 8));
+            _mm512_insertf32x4::<3>(z, row(j + 12))
+        };
+        let (r0, r1, r2, r3) = (reg(0), reg(1), reg(2), reg(3));
+        let t0 = _mm512_unpacklo_ps(r0, r1);
+        let t1 = _mm512_unpackhi_ps(r0, r1);
+        let t2 = _mm512_unpacklo_ps(r2, r3);
+        let t3 = _mm512_unpackhi_ps(r2, r3);
+        let lo = |a: __m512, b: __m512| {
+            _mm512_castpd_ps(_mm512_unpacklo_pd(_mm512_castps_pd(a), _mm512_castps_pd(b)))
+        };
+        let hi = |a: __m512, b: __m512| {
+            _mm512_castpd_ps(_mm512_unpackhi_pd(_mm512_castps_pd(a), _mm512_castps_pd(b)))
+        };
+        let c = [lo(t0, t2), hi(t0, t2), lo(t1, t3), hi(t1, t3)];
+        let t = _mm512_mul_ps(
+            _mm512_cvtepi32_ps(_mm512_and_si512(bits, _mm512_set1_epi32(LOW_MASK as i32))),
+            _mm512_set1_ps(T_SCALE),
+        );
+        let p = _mm512_add_ps(c[2], _mm512_mul_ps(t, c[3]));
+        let p = _mm512_add_ps(c[1], _mm512_mul_ps(t, p));
+        _mm512_add_ps(c[0], _mm512_mul_ps(t, p))
+    }
+
     /// [`Self::eval_slice_clamped`] on 8 lanes.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]

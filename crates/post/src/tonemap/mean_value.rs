@@ -3,7 +3,7 @@
 //! histogram is mapped to 0.5"; Wilkie, Rendering lecture notes SS2011, §12.3.1). Values
 //! outside the display range are clipped afterwards.
 
-use super::pixels::{luminance_stats, map_luminance, Scale};
+use super::pixels::{luminance_stats, Scale};
 use super::{Context, OperatorInfo, Output, ParamSpec};
 
 pub(crate) static INFO: OperatorInfo = OperatorInfo {
@@ -28,7 +28,7 @@ pub(crate) fn apply(ctx: &Context) -> Output {
         0.0
     };
     Output {
-        mapped: map_luminance(ctx, ctx.exposure, ctx.weights, &Scale(factor)),
+        mapped: super::map512::map_luminance_fast(ctx, ctx.exposure, ctx.weights, &Scale(factor)),
         values: vec![("mean_luminance", stats.mean), ("scale", factor as f64)],
     }
 }

@@ -16,6 +16,7 @@ mod ferwerda96;
 pub mod gaussian;
 mod linear;
 mod logarithmic;
+mod map512;
 mod mean_value;
 pub mod pixels;
 mod power_curve;

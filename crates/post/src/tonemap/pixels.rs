@@ -39,8 +39,8 @@ pub(crate) fn sanitise(p: [f32; 3], scale: f32) -> [f32; 3] {
     ]
 }
 
-/// Independent accumulators per chunk (8 f32 = one AVX register).
-const LANES: usize = 8;
+/// Independent accumulators per chunk (16 f32 = one AVX-512 register, two AVX ones).
+pub(crate) const LANES: usize = 16;
 
 /// Pixels per de-interleaved block inside a task (a multiple of [`LANES`]; five planes of
 /// 1 KiB).
@@ -148,12 +148,12 @@ pub struct LuminanceStats {
     pub min_positive: f64,
 }
 
-#[derive(Clone, Copy)]
-struct Acc {
-    sum_log: f64,
-    sum: f64,
-    max: f32,
-    min_positive: f32,
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Acc {
+    pub sum_log: f64,
+    pub sum: f64,
+    pub max: f32,
+    pub min_positive: f32,
 }
 
 impl Acc {
@@ -176,7 +176,7 @@ impl Acc {
 
 /// x = 2^e · m, m ∈ [1, 2), for a positive normal (or infinite) f32: (e, m) exactly.
 #[inline(always)]
-fn split_exponent(x: f32) -> (i32, f32) {
+pub(crate) fn split_exponent(x: f32) -> (i32, f32) {
     let bits = x.to_bits();
     (
         (bits >> 23) as i32 - 127,
@@ -184,70 +184,109 @@ fn split_exponent(x: f32) -> (i32, f32) {
     )
 }
 
-/// One task of [`luminance_stats`]: luminance per block into a stack plane, then the sums
-/// in [`LANES`] independent lanes (pixel i of the chunk in lane i mod 8), f64 across lanes.
-///
-/// The log sum uses the exact identity Σ log2 x_i = Σ e_i + log2 Π m_i (x_i = 2^e_i m_i,
-/// m_i ∈ [1, 2)): per lane, the exponents are summed as integers (exactly) and the
-/// mantissas multiplied (at most 32 per block and lane, product < 2^32, each product
-/// rounded to 2⁻²⁴ relative), and [`fast_math::log2`] runs once per block and lane
-/// instead of once per pixel. Error: ≤ 32 · 6e-8 relative on a product, i.e. ≤ 2.8e-6 on
-/// its log2 — 9e-8 per term, below the 3e-7 per term of a log per pixel.
+/// Per-lane accumulators of [`stats_chunk`] (pixel i of the chunk in lane i mod
+/// [`LANES`]).
+#[derive(Clone, Copy)]
+pub(crate) struct StatsLanes {
+    pub sum_log2: [f32; LANES],
+    pub exponents: [i32; LANES],
+    pub sum: [f32; LANES],
+    pub max: [f32; LANES],
+    pub min_positive: [f32; LANES],
+}
+
+impl StatsLanes {
+    pub(crate) const EMPTY: StatsLanes = StatsLanes {
+        sum_log2: [0.0; LANES],
+        exponents: [0; LANES],
+        sum: [0.0; LANES],
+        max: [0.0; LANES],
+        min_positive: [f32::INFINITY; LANES],
+    };
+
+    /// The chunk's totals: f64 sums across lanes, in lane order.
+    pub(crate) fn total(&self) -> Acc {
+        let log2_total = self.exponents.iter().map(|e| *e as f64).sum::<f64>()
+            + self.sum_log2.iter().map(|v| *v as f64).sum::<f64>();
+        Acc {
+            sum_log: log2_total * std::f64::consts::LN_2,
+            sum: self.sum.iter().map(|v| *v as f64).sum(),
+            max: self.max.iter().fold(0.0f32, |a, b| a.max(*b)),
+            min_positive: self
+                .min_positive
+                .iter()
+                .fold(f32::INFINITY, |a, b| a.min(*b)),
+        }
+    }
+}
+
+/// One block (≤ [`BLOCK`] pixels) of [`stats_chunk`]: luminance into a stack plane, then
+/// the lanes' sums; the mantissa product's log2 once per block and lane.
 #[inline(always)]
-fn stats_chunk(chunk: &[[f32; 3]], scale: f32, w: [f32; 3]) -> Acc {
+pub(crate) fn stats_block(lanes: &mut StatsLanes, block: &[[f32; 3]], scale: f32, w: [f32; 3]) {
     let delta = LOG_AVERAGE_DELTA as f32;
-    let mut sum_log2 = [0.0f32; LANES];
-    let mut exponents = [0i32; LANES];
-    let mut sum = [0.0f32; LANES];
-    let mut max = [0.0f32; LANES];
-    let mut min_positive = [f32::INFINITY; LANES];
+    let StatsLanes {
+        sum_log2,
+        exponents,
+        sum,
+        max,
+        min_positive,
+    } = lanes;
     let mut lum = [0.0f32; BLOCK];
-    for block in chunk.chunks(BLOCK) {
-        let lum = &mut lum[..block.len()];
-        for (l, p) in lum.iter_mut().zip(block) {
-            *l = sanitised_luminance(*p, scale, w);
-        }
-        let mut product = [1.0f32; LANES];
-        let mut lanes = lum.chunks_exact(LANES);
-        for group in &mut lanes {
-            for k in 0..LANES {
-                let l = group[k];
-                let (e, m) = split_exponent(delta + l);
-                exponents[k] += e;
-                product[k] *= m;
-                sum[k] += l;
-                max[k] = max[k].max(l);
-                min_positive[k] = if l > 0.0 {
-                    min_positive[k].min(l)
-                } else {
-                    min_positive[k]
-                };
-            }
-        }
-        // Only the image's last block can leave a remainder (BLOCK and CHUNK are
-        // multiples of LANES).
-        for (k, l) in lanes.remainder().iter().enumerate() {
+    let lum = &mut lum[..block.len()];
+    for (l, p) in lum.iter_mut().zip(block) {
+        *l = sanitised_luminance(*p, scale, w);
+    }
+    let mut product = [1.0f32; LANES];
+    let mut groups = lum.chunks_exact(LANES);
+    for group in &mut groups {
+        for k in 0..LANES {
+            let l = group[k];
             let (e, m) = split_exponent(delta + l);
             exponents[k] += e;
             product[k] *= m;
             sum[k] += l;
-            max[k] = max[k].max(*l);
-            if *l > 0.0 {
-                min_positive[k] = min_positive[k].min(*l);
-            }
-        }
-        for k in 0..LANES {
-            sum_log2[k] += fast_math::log2(product[k]);
+            max[k] = max[k].max(l);
+            min_positive[k] = if l > 0.0 {
+                min_positive[k].min(l)
+            } else {
+                min_positive[k]
+            };
         }
     }
-    let log2_total = exponents.iter().map(|e| *e as f64).sum::<f64>()
-        + sum_log2.iter().map(|v| *v as f64).sum::<f64>();
-    Acc {
-        sum_log: log2_total * std::f64::consts::LN_2,
-        sum: sum.iter().map(|v| *v as f64).sum(),
-        max: max.iter().fold(0.0f32, |a, b| a.max(*b)),
-        min_positive: min_positive.iter().fold(f32::INFINITY, |a, b| a.min(*b)),
+    // Only the image's last block can leave a remainder (BLOCK and CHUNK are multiples
+    // of LANES).
+    for (k, l) in groups.remainder().iter().enumerate() {
+        let (e, m) = split_exponent(delta + l);
+        exponents[k] += e;
+        product[k] *= m;
+        sum[k] += l;
+        max[k] = max[k].max(*l);
+        if *l > 0.0 {
+            min_positive[k] = min_positive[k].min(*l);
+        }
     }
+    for k in 0..LANES {
+        sum_log2[k] += fast_math::log2(product[k]);
+    }
+}
+
+/// One task of [`luminance_stats`]: [`stats_block`] per block, in [`LANES`] independent
+/// lanes (pixel i of the chunk in lane i mod 16), f64 across lanes.
+///
+/// The log sum uses the exact identity Σ log2 x_i = Σ e_i + log2 Π m_i (x_i = 2^e_i m_i,
+/// m_i ∈ [1, 2)): per lane, the exponents are summed as integers (exactly) and the
+/// mantissas multiplied (at most 16 per block and lane, product < 2^16, each product
+/// rounded to 2⁻²⁴ relative), and [`fast_math::log2`] runs once per block and lane
+/// instead of once per pixel. Error: ≤ 16 · 6e-8 relative on a product, i.e. ≤ 1.4e-6 on
+/// its log2 — 9e-8 per term, below the 3e-7 per term of a log per pixel.
+#[inline(always)]
+pub(crate) fn stats_chunk(chunk: &[[f32; 3]], scale: f32, w: [f32; 3]) -> Acc {
+    let mut lanes = StatsLanes::EMPTY;
+    for block in chunk.chunks(BLOCK) {
+        stats_block(&mut lanes, block, scale, w);
+    }
+    lanes.total()
 }
 
 /// Statistics of `w · sanitise(p, scale)` over the image in one parallel pass (the log
@@ -261,7 +300,13 @@ pub(crate) fn luminance_stats(image: &Image, scale: f32, w: [f32; 3]) -> Luminan
     let partial: Vec<Acc> = image
         .pixels()
         .par_chunks(CHUNK)
-        .map(|chunk| avx2!(stats_chunk(chunk, scale, w)))
+        .map(|chunk| {
+            if super::map512::available() {
+                super::map512::stats_chunk_fast(chunk, scale, w)
+            } else {
+                avx2!(stats_chunk(chunk, scale, w))
+            }
+        })
         .collect();
     let acc = partial.into_iter().fold(Acc::EMPTY, Acc::merge);
     let n = image.pixels().len() as f64;
@@ -286,7 +331,7 @@ pub(crate) struct Mapped {
 
 /// One task of [`map_luminance`] (pixels `start …` of the image).
 #[inline(always)]
-fn map_luminance_chunk<C: LuminanceCurve>(
+pub(crate) fn map_luminance_chunk<C: LuminanceCurve>(
     input: &[[f32; 3]],
     out: &mut [[f32; 3]],
     start: usize,
@@ -352,7 +397,7 @@ pub(crate) fn map_luminance<C: LuminanceCurve>(
 
 /// One task of [`map_pixels`].
 #[inline(always)]
-fn map_pixels_chunk<M: PixelMap>(
+pub(crate) fn map_pixels_chunk<M: PixelMap>(
     input: &[[f32; 3]],
     out: &mut [[f32; 3]],
     start: usize,
@@ -386,7 +431,7 @@ fn map_pixels_chunk<M: PixelMap>(
 /// stores would first read every cache line of it from memory (read for ownership) and
 /// evict the input from the caches.
 #[inline(always)]
-fn store_block(dst: &mut [[f32; 3]], src: &[[f32; 3]]) {
+pub(crate) fn store_block(dst: &mut [[f32; 3]], src: &[[f32; 3]]) {
     #[cfg(target_arch = "x86_64")]
     if super::simd::has_avx2() {
         // SAFETY: the CPU has AVX (implied by AVX2, checked above).
@@ -399,7 +444,7 @@ fn store_block(dst: &mut [[f32; 3]], src: &[[f32; 3]]) {
 /// Orders a task's non-temporal stores before whatever signals its completion (they are
 /// weakly ordered: another thread could otherwise read the output before it lands).
 #[inline(always)]
-fn store_fence() {
+pub(crate) fn store_fence() {
     #[cfg(target_arch = "x86_64")]
     // SAFETY: sfence is part of SSE, in the x86-64 baseline.
     unsafe {
@@ -441,7 +486,13 @@ pub(crate) fn map_pixels<M: PixelMap>(ctx: &Context, scale: f32, f: &M) -> Mappe
         .par_chunks_mut(CHUNK)
         .zip(image.pixels().par_chunks(CHUNK))
         .enumerate()
-        .map(|(k, (o, i))| avx2!(map_pixels_chunk(i, o, k * CHUNK, scale, f)))
+        .map(|(k, (o, i))| {
+            if super::map512::available() {
+                super::map512::map_pixels_chunk_fast(i, o, k * CHUNK, scale, f)
+            } else {
+                avx2!(map_pixels_chunk(i, o, k * CHUNK, scale, f))
+            }
+        })
         .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
     Mapped {
         pixels,

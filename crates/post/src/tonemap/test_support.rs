@@ -107,3 +107,32 @@ pub fn max_code_error_16(got: &[[f32; 3]], want: &[[f64; 3]]) -> f64 {
         .flat_map(|(g, w)| (0..3).map(move |c| (code(g[c] as f64) - code(w[c])).abs()))
         .fold(0.0, f64::max)
 }
+
+/// 1000 pixels for bit-identity tests of vector paths: greys and colours over 2^-140 …
+/// 2^100 (subnormal to overflowing), plus NaN, ±∞, negative, ±0 components (an odd count,
+/// so every path also meets a partial group).
+pub fn bit_test_image() -> Image {
+    let special = [
+        f32::NAN,
+        f32::INFINITY,
+        f32::NEG_INFINITY,
+        -1.0,
+        -0.0,
+        0.0,
+        f32::MAX,
+        1e-45,
+    ];
+    let pixels: Vec<[f32; 3]> = (0..1000)
+        .map(|i| {
+            let v = 2f32.powf(-140.0 + 240.0 * ((i * 7919) % 1000) as f32 / 1000.0);
+            match i % 13 {
+                0 => [special[i % 8], v, v],
+                1 => [v, special[(i / 13) % 8], 0.5 * v],
+                2 => [v, v, special[(i / 7) % 8]],
+                3 => [v, 0.3 * v, 0.01 * v],
+                _ => [v, v, v],
+            }
+        })
+        .collect();
+    Image::new(1000, 1, pixels, RgbColorSpace::srgb()).unwrap()
+}

@@ -4,7 +4,7 @@
 //! L_d = sf · L_w (cd/m²), shown as L_d / L_dmax. L_wa is the world adaptation luminance,
 //! the log-average of absolute luminance; the display adaptation is L_dmax / 2.
 
-use super::pixels::{luminance_stats, map_luminance, Scale};
+use super::pixels::{luminance_stats, Scale};
 use super::{Context, OperatorInfo, Output, ParamSpec};
 use crate::error::Result;
 
@@ -34,7 +34,7 @@ pub(crate) fn apply(ctx: &Context) -> Result<Output> {
     let sf = scale_factor(stats.log_average, l_dmax);
     let factor = (sf / l_dmax) as f32;
     Ok(Output {
-        mapped: map_luminance(ctx, absolute, ctx.weights, &Scale(factor)),
+        mapped: super::map512::map_luminance_fast(ctx, absolute, ctx.weights, &Scale(factor)),
         values: vec![
             ("world_adaptation_cd_m2", stats.log_average),
             ("scale_factor", sf),

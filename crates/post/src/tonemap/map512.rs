@@ -1,0 +1,632 @@
+//! The luminance mapping pass of [`super::pixels::map_luminance`] written out for AVX-512
+//! (16 pixels per step in registers), for the global operators whose curve has a 16-lane
+//! form ([`RegisterCurve`]: exponential, logarithmic, drago03, reinhard02).
+//!
+//! Why: on the Zen 5 of the fourth pass (docs/post.md) the auto-vectorised pass — pixels
+//! de-interleaved into stack planes, the curve over a plane, interleaved back, written with
+//! ordinary stores — cost 2–3× the copy pass by itself, and compiling those same loops for
+//! AVX-512 measured twice as slow again (the compiler's 16-lane de-interleave of
+//! `[f32; 3]` is poor). Here 16 pixels are three 64-byte loads, de-interleaved with two
+//! `vpermt2ps` per channel, sanitised, mapped through the curve in registers, interleaved
+//! back the same way and written with streaming stores (no read for ownership of the
+//! output).
+//!
+//! Bits: every step is the operation of the scalar path (`load_block` and
+//! `map_luminance_chunk` in [`super::pixels`], and the curve's `ratio`) in the same order,
+//! without fused multiply-adds, so the result is the scalar path's bits (tested for every
+//! curve, on NaN, ±∞, negative, ±0 and subnormal input). The few pixels before the first
+//! 64-byte-aligned output address and after the last whole group of 16 go through the
+//! scalar path itself.
+
+#[cfg(target_arch = "x86_64")]
+use std::arch::x86_64::*;
+
+use rayon::prelude::*;
+
+use super::pixels::{
+    map_luminance, map_luminance_chunk, map_pixels_chunk, stats_block, store_block, store_fence,
+    Acc, LuminanceCurve, Mapped, PixelMap, Scale, StatsLanes, BLOCK, CHUNK, LANES,
+    LOG_AVERAGE_DELTA,
+};
+use super::Context;
+
+/// A [`LuminanceCurve`] with a 16-lane register form.
+pub(crate) trait RegisterCurve: LuminanceCurve {
+    /// [`LuminanceCurve::ratio`] on 16 lanes, lane by lane the same bits. Implementations
+    /// are `#[inline(always)]` and only use AVX-512F intrinsics.
+    ///
+    /// # Safety
+    /// The CPU must have AVX-512F (callers are `#[target_feature(enable = "avx512f")]`).
+    #[cfg(target_arch = "x86_64")]
+    unsafe fn ratio16(&self, l: __m512) -> __m512;
+}
+
+impl RegisterCurve for Scale {
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    unsafe fn ratio16(&self, _l: __m512) -> __m512 {
+        _mm512_set1_ps(self.0)
+    }
+}
+
+/// Whether the AVX-512 pass runs here.
+pub(crate) fn available() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::arch::is_x86_feature_detected!("avx512f")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
+/// [`map_luminance`] (same contract, same bits), on 16 pixels per step with AVX-512 where
+/// the CPU has it.
+pub(crate) fn map_luminance_fast<C: RegisterCurve>(
+    ctx: &Context,
+    scale: f32,
+    w: [f32; 3],
+    curve: &C,
+) -> Mapped {
+    if !available() {
+        return map_luminance(ctx, scale, w, curve);
+    }
+    map_luminance_avx512(ctx, scale, w, curve)
+}
+
+/// The AVX-512 pass (callers check [`available`]).
+pub(crate) fn map_luminance_avx512<C: RegisterCurve>(
+    ctx: &Context,
+    scale: f32,
+    w: [f32; 3],
+    curve: &C,
+) -> Mapped {
+    let image = ctx.image;
+    let mut pixels = ctx.output_buffer(image.pixels().len());
+    let (non_finite, negative) = pixels
+        .par_chunks_mut(CHUNK)
+        .zip(image.pixels().par_chunks(CHUNK))
+        .enumerate()
+        .map(|(k, (o, i))| {
+            #[cfg(target_arch = "x86_64")]
+            {
+                assert!(available());
+                // SAFETY: the CPU has AVX-512F (asserted just above).
+                unsafe { chunk_avx512(i, o, k * CHUNK, scale, w, curve) }
+            }
+            #[cfg(not(target_arch = "x86_64"))]
+            {
+                map_luminance_chunk(i, o, k * CHUNK, scale, w, curve)
+            }
+        })
+        .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
+    Mapped {
+        pixels,
+        non_finite_pixels: non_finite,
+        negative_pixels: negative,
+    }
+}
+
+/// `vpermt2ps` indices that gather channel `ch` of 16 interleaved pixels from the three
+/// registers a, b, c (floats 0–15, 16–31, 32–47): (from a|b, then from that|c).
+#[cfg(target_arch = "x86_64")]
+const fn deinterleave_indices(ch: usize) -> ([i32; 16], [i32; 16]) {
+    let (mut first, mut second) = ([0i32; 16], [0i32; 16]);
+    let mut k = 0;
+    while k < 16 {
+        let f = 3 * k + ch;
+        if f < 32 {
+            first[k] = f as i32;
+            second[k] = k as i32;
+        } else {
+            second[k] = (16 + f - 32) as i32;
+        }
+        k += 1;
+    }
+    (first, second)
+}
+
+/// `vpermt2ps` indices that build output register `reg` (floats 16·reg … 16·reg + 15 of
+/// the interleaved pixels) from the planes r, g (first) and that|b (second).
+#[cfg(target_arch = "x86_64")]
+const fn interleave_indices(reg: usize) -> ([i32; 16], [i32; 16]) {
+    let (mut first, mut second) = ([0i32; 16], [0i32; 16]);
+    let mut j = 0;
+    while j < 16 {
+        let f = 16 * reg + j;
+        let (k, ch) = (f / 3, f % 3);
+        match ch {
+            0 => {
+                first[j] = k as i32;
+                second[j] = j as i32;
+            }
+            1 => {
+                first[j] = (16 + k) as i32;
+                second[j] = j as i32;
+            }
+            _ => second[j] = (16 + k) as i32,
+        }
+        j += 1;
+    }
+    (first, second)
+}
+
+/// Prefetches the three cache lines 16 groups (3 KiB) ahead of `s`.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn prefetch_ahead(s: *const f32) {
+    let p = s.wrapping_add(PREFETCH_FLOATS) as *const i8;
+    _mm_prefetch::<_MM_HINT_T0>(p);
+    _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(64));
+    _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(128));
+}
+
+const PREFETCH_FLOATS: usize = 48 * 16;
+
+/// |x| < ∞ per lane (false for NaN).
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn finite_mask(x: __m512) -> __mmask16 {
+    _mm512_cmp_ps_mask::<_CMP_LT_OQ>(_mm512_abs_ps(x), _mm512_set1_ps(f32::INFINITY))
+}
+
+/// One task of [`map_luminance_avx512`].
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+unsafe fn chunk_avx512<C: RegisterCurve>(
+    input: &[[f32; 3]],
+    out: &mut [[f32; 3]],
+    start: usize,
+    scale: f32,
+    w: [f32; 3],
+    curve: &C,
+) -> (u64, u64) {
+    let n = input.len().min(out.len());
+    // Pixels before the first output pixel on a 64-byte boundary (f32s are 4-byte
+    // aligned and gcd(12, 64) = 4, so one of the first 16 pixels is).
+    let addr = out.as_ptr() as usize;
+    let head = (0..16)
+        .find(|k| (addr + 12 * k).is_multiple_of(64))
+        .unwrap_or(0)
+        .min(n);
+    let groups = (n - head) / 16;
+    let tail = head + 16 * groups;
+    let (mut non_finite, mut negative) =
+        map_luminance_chunk(&input[..head], &mut out[..head], start, scale, w, curve);
+
+    let load_idx = |a: [i32; 16]| _mm512_loadu_si512(a.as_ptr() as *const _);
+    let de = [0, 1, 2].map(|ch| {
+        let (a, b) = deinterleave_indices(ch);
+        (load_idx(a), load_idx(b))
+    });
+    let inter = [0, 1, 2].map(|reg| {
+        let (a, b) = interleave_indices(reg);
+        (load_idx(a), load_idx(b))
+    });
+    let zero = _mm512_setzero_ps();
+    let scale_v = _mm512_set1_ps(scale);
+    let w_v = w.map(|x| _mm512_set1_ps(x));
+    let src = input.as_ptr().add(head) as *const f32;
+    let dst = out.as_mut_ptr().add(head) as *mut f32;
+    for g in 0..groups {
+        // SAFETY: pixels head + 16 g … head + 16 g + 15 lie inside both slices (g <
+        // groups), i.e. floats 48 g … 48 g + 47 from src and dst.
+        let s = src.add(48 * g);
+        prefetch_ahead(s);
+        let v = [
+            _mm512_loadu_ps(s),
+            _mm512_loadu_ps(s.add(16)),
+            _mm512_loadu_ps(s.add(32)),
+        ];
+        let p = de.map(|(i0, i1)| {
+            _mm512_permutex2var_ps(_mm512_permutex2var_ps(v[0], i0, v[1]), i1, v[2])
+        });
+        // load_block: black for a pixel with a non-finite component, negatives to 0
+        // (maxps(x, 0) returns its second operand for NaN and for ±0, as f32::max(x, 0)
+        // compiles), luminance w · c summed left to right.
+        let finite = finite_mask(p[0]) & finite_mask(p[1]) & finite_mask(p[2]);
+        let neg = (_mm512_cmp_ps_mask::<_CMP_LT_OQ>(p[0], zero)
+            | _mm512_cmp_ps_mask::<_CMP_LT_OQ>(p[1], zero)
+            | _mm512_cmp_ps_mask::<_CMP_LT_OQ>(p[2], zero))
+            & finite;
+        non_finite += (!finite).count_ones() as u64;
+        negative += neg.count_ones() as u64;
+        let c =
+            p.map(|x| _mm512_maskz_mov_ps(finite, _mm512_max_ps(_mm512_mul_ps(x, scale_v), zero)));
+        let l = _mm512_add_ps(
+            _mm512_add_ps(_mm512_mul_ps(w_v[0], c[0]), _mm512_mul_ps(w_v[1], c[1])),
+            _mm512_mul_ps(w_v[2], c[2]),
+        );
+        // map_luminance_chunk: the ratio where L > 0 and it is finite, else 0; then
+        // max(c · ratio, 0), black where that overflows.
+        let ld = curve.ratio16(l);
+        let keep = _mm512_cmp_ps_mask::<_CMP_GT_OQ>(l, zero) & finite_mask(ld);
+        let ratio = _mm512_maskz_mov_ps(keep, ld);
+        let o = c.map(|x| _mm512_max_ps(_mm512_mul_ps(x, ratio), zero));
+        let ok = finite_mask(o[0]) & finite_mask(o[1]) & finite_mask(o[2]);
+        let o = o.map(|x| _mm512_maskz_mov_ps(ok, x));
+        let d = dst.add(48 * g);
+        for (reg, (i0, i1)) in inter.iter().enumerate() {
+            let v = _mm512_permutex2var_ps(_mm512_permutex2var_ps(o[0], *i0, o[1]), *i1, o[2]);
+            // SAFETY: d + 16 reg is 64-byte aligned (head chosen so) and inside `out`.
+            _mm512_stream_ps(d.add(16 * reg), v);
+        }
+    }
+    // Streaming stores are weakly ordered: fence them before the task reports done.
+    _mm_sfence();
+    let (nf, neg) = map_luminance_chunk(
+        &input[tail..n],
+        &mut out[tail..n],
+        start + tail,
+        scale,
+        w,
+        curve,
+    );
+    non_finite += nf;
+    negative += neg;
+    (non_finite, negative)
+}
+
+/// One task of [`super::pixels::map_pixels`] with AVX-512F: whole blocks are
+/// de-interleaved into the stack planes and interleaved back in registers (two
+/// `vpermt2ps` per channel and 16 pixels) instead of the compiler's AVX2 shuffles, the
+/// pixel map runs on the planes as before, and the block goes out with streaming stores;
+/// the same operations on every value, so the same bits as
+/// [`super::pixels::map_pixels_chunk`] (which handles a partial last block).
+pub(crate) fn map_pixels_chunk_fast<M: PixelMap>(
+    input: &[[f32; 3]],
+    out: &mut [[f32; 3]],
+    start: usize,
+    scale: f32,
+    f: &M,
+) -> (u64, u64) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        assert!(available());
+        // SAFETY: the CPU has AVX-512F (asserted just above).
+        unsafe { map_pixels_chunk_avx512(input, out, start, scale, f) }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        map_pixels_chunk(input, out, start, scale, f)
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+unsafe fn map_pixels_chunk_avx512<M: PixelMap>(
+    input: &[[f32; 3]],
+    out: &mut [[f32; 3]],
+    start: usize,
+    scale: f32,
+    f: &M,
+) -> (u64, u64) {
+    let load_idx = |a: [i32; 16]| _mm512_loadu_si512(a.as_ptr() as *const _);
+    let de = [0, 1, 2].map(|ch| {
+        let (a, b) = deinterleave_indices(ch);
+        (load_idx(a), load_idx(b))
+    });
+    let inter = [0, 1, 2].map(|reg| {
+        let (a, b) = interleave_indices(reg);
+        (load_idx(a), load_idx(b))
+    });
+    let zero = _mm512_setzero_ps();
+    let scale_v = _mm512_set1_ps(scale);
+    let mut planes = [[0.0f32; BLOCK]; 3];
+    let mut staged = [[0.0f32; 3]; BLOCK];
+    let (mut non_finite, mut negative) = (0u64, 0u64);
+    let n = input.len().min(out.len());
+    let whole = n / BLOCK * BLOCK;
+    for (k, (i, o)) in input[..whole]
+        .chunks_exact(BLOCK)
+        .zip(out[..whole].chunks_exact_mut(BLOCK))
+        .enumerate()
+    {
+        let src = i.as_ptr() as *const f32;
+        for g in 0..BLOCK / 16 {
+            // SAFETY: the block holds BLOCK pixels: floats 48 g … 48 g + 47 lie inside.
+            let s = src.add(48 * g);
+            prefetch_ahead(s);
+            let v = [
+                _mm512_loadu_ps(s),
+                _mm512_loadu_ps(s.add(16)),
+                _mm512_loadu_ps(s.add(32)),
+            ];
+            let p = de.map(|(i0, i1)| {
+                _mm512_permutex2var_ps(_mm512_permutex2var_ps(v[0], i0, v[1]), i1, v[2])
+            });
+            // load_block: black for a non-finite component, negatives clamped to 0.
+            let finite = finite_mask(p[0]) & finite_mask(p[1]) & finite_mask(p[2]);
+            let neg = (_mm512_cmp_ps_mask::<_CMP_LT_OQ>(p[0], zero)
+                | _mm512_cmp_ps_mask::<_CMP_LT_OQ>(p[1], zero)
+                | _mm512_cmp_ps_mask::<_CMP_LT_OQ>(p[2], zero))
+                & finite;
+            non_finite += (!finite).count_ones() as u64;
+            negative += neg.count_ones() as u64;
+            for (plane, x) in planes.iter_mut().zip(p) {
+                let c = _mm512_maskz_mov_ps(finite, _mm512_max_ps(_mm512_mul_ps(x, scale_v), zero));
+                // SAFETY: 16 g + 15 < BLOCK.
+                _mm512_storeu_ps(plane.as_mut_ptr().add(16 * g), c);
+            }
+        }
+        let [r, gp, b] = &mut planes;
+        f.map(start + k * BLOCK, r, gp, b);
+        let dst = staged.as_mut_ptr() as *mut f32;
+        for g in 0..BLOCK / 16 {
+            // Non-finite results become 0, per component.
+            let c = planes.each_ref().map(|plane| {
+                // SAFETY: 16 g + 15 < BLOCK.
+                let x = _mm512_loadu_ps(plane.as_ptr().add(16 * g));
+                _mm512_maskz_mov_ps(finite_mask(x), x)
+            });
+            for (reg, (i0, i1)) in inter.iter().enumerate() {
+                let v = _mm512_permutex2var_ps(_mm512_permutex2var_ps(c[0], *i0, c[1]), *i1, c[2]);
+                // SAFETY: floats 48 g + 16 reg … + 15 lie inside the staged block.
+                _mm512_storeu_ps(dst.add(48 * g + 16 * reg), v);
+            }
+        }
+        store_block(o, &staged);
+    }
+    store_fence();
+    let (nf, neg) = map_pixels_chunk(
+        &input[whole..n],
+        &mut out[whole..n],
+        start + whole,
+        scale,
+        f,
+    );
+    (non_finite + nf, negative + neg)
+}
+
+/// One task of [`super::pixels::luminance_stats`] with AVX-512F: the same accumulators,
+/// lane layout and order of operations as [`super::pixels::stats_chunk`] (so the same
+/// bits), each whole block of 16 groups of 16 pixels de-interleaved and summed in
+/// registers in one pass instead of a luminance plane and a second loop over it.
+pub(crate) fn stats_chunk_fast(chunk: &[[f32; 3]], scale: f32, w: [f32; 3]) -> Acc {
+    #[cfg(target_arch = "x86_64")]
+    {
+        assert!(available());
+        // SAFETY: the CPU has AVX-512F (asserted just above).
+        unsafe { stats_chunk_avx512(chunk, scale, w) }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        super::pixels::stats_chunk(chunk, scale, w)
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+unsafe fn stats_chunk_avx512(chunk: &[[f32; 3]], scale: f32, w: [f32; 3]) -> Acc {
+    const _: () = assert!(LANES == 16 && BLOCK.is_multiple_of(16));
+    let mut lanes = StatsLanes::EMPTY;
+    let load_idx = |a: [i32; 16]| _mm512_loadu_si512(a.as_ptr() as *const _);
+    let de = [0, 1, 2].map(|ch| {
+        let (a, b) = deinterleave_indices(ch);
+        (load_idx(a), load_idx(b))
+    });
+    let zero = _mm512_setzero_ps();
+    let scale_v = _mm512_set1_ps(scale);
+    let w_v = w.map(|x| _mm512_set1_ps(x));
+    let delta = _mm512_set1_ps(LOG_AVERAGE_DELTA as f32);
+    let (mantissa_mask, one_bits) = (
+        _mm512_set1_epi32(0x007f_ffff),
+        _mm512_set1_epi32(0x3f80_0000),
+    );
+    let bias = _mm512_set1_epi32(127);
+    for block in chunk.chunks(BLOCK) {
+        if block.len() < BLOCK {
+            stats_block(&mut lanes, block, scale, w);
+            continue;
+        }
+        let mut exponents = _mm512_loadu_si512(lanes.exponents.as_ptr() as *const _);
+        let mut sum = _mm512_loadu_ps(lanes.sum.as_ptr());
+        let mut max = _mm512_loadu_ps(lanes.max.as_ptr());
+        let mut min_positive = _mm512_loadu_ps(lanes.min_positive.as_ptr());
+        let mut product = _mm512_set1_ps(1.0);
+        let src = block.as_ptr() as *const f32;
+        for g in 0..BLOCK / 16 {
+            // SAFETY: the block holds BLOCK pixels (checked above): floats 48 g …
+            // 48 g + 47 lie inside it.
+            let s = src.add(48 * g);
+            prefetch_ahead(s);
+            let v = [
+                _mm512_loadu_ps(s),
+                _mm512_loadu_ps(s.add(16)),
+                _mm512_loadu_ps(s.add(32)),
+            ];
+            let p = de.map(|(i0, i1)| {
+                _mm512_permutex2var_ps(_mm512_permutex2var_ps(v[0], i0, v[1]), i1, v[2])
+            });
+            // sanitised_luminance: 0 for a pixel with a non-finite component, else
+            // w · max(c · scale, 0) summed left to right.
+            let finite = finite_mask(p[0]) & finite_mask(p[1]) & finite_mask(p[2]);
+            let c = p.map(|x| _mm512_max_ps(_mm512_mul_ps(x, scale_v), zero));
+            let l = _mm512_add_ps(
+                _mm512_add_ps(_mm512_mul_ps(w_v[0], c[0]), _mm512_mul_ps(w_v[1], c[1])),
+                _mm512_mul_ps(w_v[2], c[2]),
+            );
+            let l = _mm512_maskz_mov_ps(finite, l);
+            // split_exponent(δ + L): biased exponent − 127 and the mantissa in [1, 2).
+            let bits = _mm512_castps_si512(_mm512_add_ps(delta, l));
+            exponents = _mm512_add_epi32(
+                exponents,
+                _mm512_sub_epi32(_mm512_srli_epi32::<23>(bits), bias),
+            );
+            let m = _mm512_or_si512(_mm512_and_si512(bits, mantissa_mask), one_bits);
+            product = _mm512_mul_ps(product, _mm512_castsi512_ps(m));
+            sum = _mm512_add_ps(sum, l);
+            max = _mm512_max_ps(max, l);
+            let positive = _mm512_cmp_ps_mask::<_CMP_GT_OQ>(l, zero);
+            min_positive = _mm512_mask_min_ps(min_positive, positive, min_positive, l);
+        }
+        let sum_log2 = _mm512_add_ps(_mm512_loadu_ps(lanes.sum_log2.as_ptr()), log2_16(product));
+        _mm512_storeu_ps(lanes.sum_log2.as_mut_ptr(), sum_log2);
+        _mm512_storeu_si512(lanes.exponents.as_mut_ptr() as *mut _, exponents);
+        _mm512_storeu_ps(lanes.sum.as_mut_ptr(), sum);
+        _mm512_storeu_ps(lanes.max.as_mut_ptr(), max);
+        _mm512_storeu_ps(lanes.min_positive.as_mut_ptr(), min_positive);
+    }
+    lanes.total()
+}
+
+/// [`super::fast_math::exp2`] on 16 lanes, the same operations in the same order.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+#[allow(clippy::excessive_precision, clippy::approx_constant)]
+pub(crate) unsafe fn exp2_16(x: __m512) -> __m512 {
+    // clamp: maxps(lo, x) = lo > x ? lo : x (NaN stays), then the same for hi.
+    let x = _mm512_max_ps(_mm512_set1_ps(-126.0), x);
+    let x = _mm512_min_ps(_mm512_set1_ps(127.0), x);
+    let xi = _mm512_max_ps(x, _mm512_set1_ps(-126.0));
+    let sign = _mm512_and_si512(_mm512_castps_si512(xi), _mm512_set1_epi32(i32::MIN));
+    let half = _mm512_or_si512(_mm512_set1_epi32(0x3eff_ffff), sign);
+    let t = _mm512_add_ps(xi, _mm512_castsi512_ps(half));
+    let ni = _mm512_cvttps_epi32(t);
+    let n = _mm512_cvtepi32_ps(ni);
+    let f = _mm512_sub_ps(x, n);
+    let step = |r: __m512, c: f32| _mm512_add_ps(_mm512_mul_ps(r, f), _mm512_set1_ps(c));
+    let r = _mm512_set1_ps(0.001_326_472);
+    let r = step(r, 0.009_671_513);
+    let r = step(r, 0.055_507_34);
+    let r = step(r, 0.240_222_42);
+    let r = step(r, 0.693_147);
+    let p = step(r, 1.0);
+    let scale = _mm512_slli_epi32::<23>(_mm512_add_epi32(ni, _mm512_set1_epi32(127)));
+    _mm512_mul_ps(p, _mm512_castsi512_ps(scale))
+}
+
+/// [`super::fast_math::log2`] on 16 lanes, the same operations in the same order.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+#[allow(clippy::excessive_precision)]
+pub(crate) unsafe fn log2_16(x: __m512) -> __m512 {
+    let x = _mm512_max_ps(x, _mm512_set1_ps(f32::MIN_POSITIVE));
+    let bits = _mm512_castps_si512(x);
+    let offset = _mm512_sub_epi32(bits, _mm512_set1_epi32(0x3f35_04f3));
+    let e = _mm512_cvtepi32_ps(_mm512_srai_epi32::<23>(offset));
+    let m = _mm512_sub_epi32(
+        bits,
+        _mm512_and_si512(offset, _mm512_set1_epi32(0xff80_0000u32 as i32)),
+    );
+    let u = _mm512_sub_ps(_mm512_castsi512_ps(m), _mm512_set1_ps(1.0));
+    let step = |q: __m512, c: f32| _mm512_add_ps(_mm512_mul_ps(q, u), _mm512_set1_ps(c));
+    let q = _mm512_set1_ps(-0.145_741_06);
+    let q = step(q, 0.236_889_03);
+    let q = step(q, -0.250_069_65);
+    let q = step(q, 0.286_707_67);
+    let q = step(q, -0.360_087_2);
+    let q = step(q, 0.480_939_45);
+    let q = step(q, -0.721_357_17);
+    let q = step(q, 1.442_694_8);
+    _mm512_add_ps(e, _mm512_mul_ps(u, q))
+}
+
+/// Test helper: the AVX-512 pass and the scalar one on the same image give the same bits
+/// and counts (skipped, returning false, on CPUs without AVX-512F).
+#[cfg(test)]
+pub(crate) fn same_bits_as_scalar<C: RegisterCurve>(
+    image: &crate::image::Image,
+    scale: f32,
+    curve: &C,
+) -> bool {
+    if !available() {
+        eprintln!("no AVX-512F: the 16-lane pass is not exercised on this CPU");
+        return false;
+    }
+    let params = super::ToneParams::default();
+    let ctx = Context {
+        image,
+        params: &params,
+        info: &super::linear::INFO,
+        exposure: scale,
+        weights: image.luminance_weights(),
+        buffer: std::sync::Mutex::new(None),
+    };
+    let wide = map_luminance_avx512(&ctx, scale, ctx.weights, curve);
+    let mut scalar = vec![[0f32; 3]; image.pixels().len()];
+    let (nf, neg) = map_luminance_chunk(image.pixels(), &mut scalar, 0, scale, ctx.weights, curve);
+    assert_eq!((wide.non_finite_pixels, wide.negative_pixels), (nf, neg));
+    for (i, (a, b)) in wide.pixels.iter().zip(&scalar).enumerate() {
+        assert_eq!(
+            a.map(f32::to_bits),
+            b.map(f32::to_bits),
+            "pixel {i}: {a:?} vs {b:?} (input {:?})",
+            image.pixels()[i]
+        );
+    }
+    true
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::tonemap::test_support::bit_test_image;
+
+    /// A pixel map that touches every value (and makes some non-finite).
+    struct Probe;
+    impl PixelMap for Probe {
+        #[inline(always)]
+        fn map(&self, start: usize, r: &mut [f32], g: &mut [f32], b: &mut [f32]) {
+            for j in 0..r.len() {
+                let k = (start + j) as f32;
+                (r[j], g[j], b[j]) = (r[j] * 1e30 + k, g[j] - b[j] * 0.5, b[j] / (g[j] - r[j]));
+            }
+        }
+    }
+
+    #[test]
+    fn pixel_pass_gives_the_scalar_bits() {
+        if !available() {
+            eprintln!("no AVX-512F: the 16-lane pixel pass is not exercised on this CPU");
+            return;
+        }
+        let special = bit_test_image();
+        let pixels: Vec<[f32; 3]> = (0..5000)
+            .map(|i| special.pixels()[(i * 7) % 1000])
+            .collect();
+        for scale in [1.0f32, 3e30] {
+            for (k, chunk) in pixels.chunks(CHUNK).enumerate() {
+                let (mut a, mut b) = (vec![[0f32; 3]; chunk.len()], vec![[0f32; 3]; chunk.len()]);
+                let fast = map_pixels_chunk_fast(chunk, &mut a, k * CHUNK, scale, &Probe);
+                let slow = map_pixels_chunk(chunk, &mut b, k * CHUNK, scale, &Probe);
+                assert_eq!(fast, slow);
+                for (i, (x, y)) in a.iter().zip(&b).enumerate() {
+                    assert_eq!(x.map(f32::to_bits), y.map(f32::to_bits), "pixel {i}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn stats_pass_gives_the_scalar_bits() {
+        if !available() {
+            eprintln!("no AVX-512F: the 16-lane statistics pass is not exercised on this CPU");
+            return;
+        }
+        // Whole blocks, a partial block, and the special values of the bit-test image
+        // spread over a chunk and a half.
+        let special = bit_test_image();
+        let pixels: Vec<[f32; 3]> = (0..6000)
+            .map(|i| {
+                let v = (i as f32 * 0.37).sin().abs() * 40.0 + 1e-9 * i as f32;
+                if i % 5 == 0 {
+                    special.pixels()[i % 1000]
+                } else {
+                    [v, 0.5 * v, 2.0 * v]
+                }
+            })
+            .collect();
+        for scale in [1.0f32, 0.25, 3e30] {
+            for chunk in pixels.chunks(CHUNK) {
+                let w = special.luminance_weights();
+                assert_eq!(
+                    stats_chunk_fast(chunk, scale, w),
+                    super::super::pixels::stats_chunk(chunk, scale, w),
+                    "scale {scale}"
+                );
+            }
+        }
+    }
+}
