@@ -26,10 +26,9 @@ use super::curve_table::{chebyshev_nodes, poly_through};
 /// Coefficients per octave (degree 9).
 pub const TERMS: usize = 10;
 const MANTISSA_MASK: u32 = 0x7f_ffff;
-/// The mantissa bits of 1.5: s = (mantissa − HALF) · 2^−23.
-const HALF: i32 = 0x40_0000;
-/// 2^−23, exact in f32.
-const S_SCALE: f32 = 1.0 / (1u32 << 23) as f32;
+/// The bits of 1.0: the mantissa under them is m ∈ [1, 2), and s = m − 1.5 is exact
+/// (both are multiples of 2^−23 and |s| ≤ ½).
+const ONE_BITS: u32 = 0x3f80_0000;
 /// Largest relative error of the fitted polynomials (in f64, before rounding to f32)
 /// accepted.
 pub const MAX_FIT_ERROR: f64 = 1e-7;
@@ -88,7 +87,7 @@ impl OctaveCurve {
     pub fn eval(&self, x: f32) -> f32 {
         let bits = x.max(self.lo).min(self.hi).to_bits();
         let b = ((bits >> 23) & 31) as usize;
-        let s = ((bits & MANTISSA_MASK) as i32 - HALF) as f32 * S_SCALE;
+        let s = f32::from_bits((bits & MANTISSA_MASK) | ONE_BITS) - 1.5;
         let c = &self.coeffs;
         (0..TERMS - 1)
             .rev()
@@ -121,11 +120,13 @@ impl OctaveCurve {
         // vpermt2ps reads the low 5 bits of the index: the biased exponent modulo 32
         // (x > 0 after the clamp, so the sign bit is clear).
         let b = _mm512_srli_epi32::<23>(bits);
-        let m = _mm512_sub_epi32(
-            _mm512_and_si512(bits, _mm512_set1_epi32(MANTISSA_MASK as i32)),
-            _mm512_set1_epi32(HALF),
+        // (bits & MANTISSA_MASK) | ONE_BITS in one vpternlogd (truth table 0xEA: a & b | c).
+        let m = _mm512_ternarylogic_epi32::<0xEA>(
+            bits,
+            _mm512_set1_epi32(MANTISSA_MASK as i32),
+            _mm512_set1_epi32(ONE_BITS as i32),
         );
-        let s = _mm512_mul_ps(_mm512_cvtepi32_ps(m), _mm512_set1_ps(S_SCALE));
+        let s = _mm512_sub_ps(_mm512_castsi512_ps(m), _mm512_set1_ps(1.5));
         // SAFETY: each row holds 32 f32s (two 16-lane loads).
         let coeff = |j: usize| {
             let row = self.coeffs[j].as_ptr();
