@@ -7,6 +7,7 @@
 
 use super::curve_table::CurveTable;
 use super::map512::{self, RegisterCurve};
+use super::octave_curve::OctaveCurve;
 use super::pixels::{luminance_stats, LuminanceCurve};
 use super::{Context, OperatorInfo, Output, ParamSpec};
 
@@ -33,26 +34,46 @@ pub(crate) static INFO: OperatorInfo = OperatorInfo {
     ],
 };
 
-/// Eq. 4 on L_w / L_wa, as the ratio L_d / L, tabulated over the image's luminance range
-/// (module [`super::curve_table`]: the closed form costs three logarithms, a power and a
-/// division per pixel in f32; the table is a 16-byte load and three multiply-adds, and it
-/// is built from the formula in f64, so it is also closer to eq. 4 than the f32 form).
-struct Curve {
-    table: CurveTable,
-}
+/// Eq. 4 on L_w / L_wa, as the ratio L_d / L, approximated over the image's luminance
+/// range from the formula in f64 (the closed form costs three logarithms, a power and a
+/// division per pixel in f32): in registers, one degree-9 polynomial per octave
+/// ([`OctaveCurve`]: ten `vpermt2ps` and nine FMAs per 16 pixels), where the range spans
+/// ≤ 32 binary exponents and the CPU has AVX-512; otherwise the memory table of
+/// [`super::curve_table`] (a 16-byte row per pixel and three multiply-adds).
+/// (Two types, not an enum: the pass is generic over the curve, so each loop is compiled
+/// for one of them and keeps the octave coefficients' loads out of the pixel loop.)
+struct Octaves(OctaveCurve);
 
-impl LuminanceCurve for Curve {
+/// The memory-table form of the curve (see [`Octaves`]).
+struct Table(CurveTable);
+
+impl LuminanceCurve for Octaves {
     #[inline(always)]
     fn ratio(&self, _start: usize, l: &mut [f32]) {
-        self.table.eval_slice(l);
+        self.0.eval_slice(l);
     }
 }
 
-impl RegisterCurve for Curve {
+impl RegisterCurve for Octaves {
     #[cfg(target_arch = "x86_64")]
     #[inline(always)]
     unsafe fn ratio16(&self, l: std::arch::x86_64::__m512) -> std::arch::x86_64::__m512 {
-        self.table.eval16(l)
+        self.0.eval16(l)
+    }
+}
+
+impl LuminanceCurve for Table {
+    #[inline(always)]
+    fn ratio(&self, _start: usize, l: &mut [f32]) {
+        self.0.eval_slice(l);
+    }
+}
+
+impl RegisterCurve for Table {
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    unsafe fn ratio16(&self, l: std::arch::x86_64::__m512) -> std::arch::x86_64::__m512 {
+        self.0.eval16(l)
     }
 }
 
@@ -75,10 +96,14 @@ pub(crate) fn apply(ctx: &Context) -> Output {
             0.0
         }
     };
-    let curve = Curve {
-        table: CurveTable::new(stats.min_positive as f32, stats.max as f32, ratio),
+    let (lo, hi) = (stats.min_positive as f32, stats.max as f32);
+    let mapped = match OctaveCurve::new(lo, hi, ratio) {
+        Some(c) => map512::map_luminance_fast(ctx, ctx.exposure, ctx.weights, &Octaves(c)),
+        None => {
+            let table = Table(CurveTable::new(lo, hi, ratio));
+            map512::map_luminance_fast(ctx, ctx.exposure, ctx.weights, &table)
+        }
     };
-    let mapped = map512::map_luminance_fast(ctx, ctx.exposure, ctx.weights, &curve);
     Output {
         mapped,
         values: vec![
@@ -92,6 +117,7 @@ pub(crate) fn apply(ctx: &Context) -> Output {
 #[cfg(test)]
 mod tests {
     use super::super::curve_table::CurveTable;
+    use super::super::octave_curve::OctaveCurve;
     use super::super::test_support::*;
     use super::super::{ToneOperator, ToneParams};
 
@@ -148,9 +174,12 @@ mod tests {
 
     #[test]
     fn vector_path_gives_the_scalar_bits() {
-        let table = CurveTable::new(1e-3, 1e3, |l| {
-            (1.0 + l).ln() / (l * (2.0 + l.powf(0.23)).ln())
-        });
-        super::super::map512::same_bits_as_scalar(&bit_test_image(), 1.0, &super::Curve { table });
+        let f = |l: f64| (1.0 + l).ln() / (l * (2.0 + l.powf(0.23)).ln());
+        let table = super::Table(CurveTable::new(1e-3, 1e3, f));
+        super::super::map512::same_bits_as_scalar(&bit_test_image(), 1.0, &table);
+        // The register curve (exists only with AVX-512, where the pass runs).
+        if let Some(c) = OctaveCurve::new(1e-3, 1e3, f) {
+            super::super::map512::same_bits_as_scalar(&bit_test_image(), 1.0, &super::Octaves(c));
+        }
     }
 }

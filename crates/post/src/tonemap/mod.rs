@@ -18,6 +18,7 @@ mod linear;
 mod logarithmic;
 mod map512;
 mod mean_value;
+mod octave_curve;
 pub mod pixels;
 mod power_curve;
 mod reinhard02;

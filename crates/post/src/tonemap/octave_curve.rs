@@ -1,0 +1,197 @@
+//! A smooth positive curve f: x ↦ y evaluated in registers with AVX-512, one polynomial
+//! per binary octave of x, for luminance curves that do not split into an exponent
+//! factor and a mantissa factor (drago03's eq. 4; a pure power uses
+//! [`super::power_curve`]): with x = 2^e · (1.5 + s), s ∈ [−½, ½) taken from the 23
+//! mantissa bits, f(x) ≈ Σ_j c_j(e) s^j, where
+//!
+//! - the coefficients c_j(e) of each octave come from a 32-entry table indexed by the
+//!   biased exponent modulo 32 (one two-register `vpermt2ps` per coefficient, no memory
+//!   load per pixel), so the curve's domain [lo, hi] may span at most 32 binary exponents
+//!   ([`OctaveCurve::new`] returns `None` otherwise, and on CPUs without AVX-512, where
+//!   the caller keeps its memory table);
+//! - the polynomial has degree [`TERMS`] − 1 = 9, interpolating f at the Chebyshev nodes
+//!   of the octave in f64. A whole octave is a wide segment (relative width 1, against
+//!   1/64 for [`super::curve_table`]), so the degree is high; centring s on the octave's
+//!   middle keeps the monomial coefficients decreasing (≈ (2/3)^j for a curve like 1/x),
+//!   so Horner's rule in f32 loses little. Measured for eq. 4 (b = 0.85, 34 octaves
+//!   below L_wmax): degree 8 fits to 2.5e-7 relative, degree 9 to 4.2e-8. The fit is
+//!   checked at build time against the formula and refused (`None`) above
+//!   [`MAX_FIT_ERROR`].
+//!
+//! The scalar [`OctaveCurve::eval`] performs the same operations in the same order
+//! (`f32::mul_add` for each fused multiply-add), so both paths give the same bits.
+
+use super::curve_table::{chebyshev_nodes, poly_through};
+
+/// Coefficients per octave (degree 9).
+pub const TERMS: usize = 10;
+const MANTISSA_MASK: u32 = 0x7f_ffff;
+/// The bits of 1.0: the mantissa under them is m ∈ [1, 2), and s = m − 1.5 is exact
+/// (both are multiples of 2^−23 and |s| ≤ ½).
+const ONE_BITS: u32 = 0x3f80_0000;
+/// Largest relative error of the fitted polynomials (in f64, before rounding to f32)
+/// accepted.
+pub const MAX_FIT_ERROR: f64 = 1e-7;
+
+pub(crate) struct OctaveCurve {
+    /// `coeffs[j][b % 32]`: coefficient of s^j on the octave of biased exponent b.
+    coeffs: [[f32; 32]; TERMS],
+    lo: f32,
+    hi: f32,
+}
+
+impl OctaveCurve {
+    /// f(x) for x ∈ [lo, hi] (0 < lo ≤ hi, both normal), arguments clamped to that
+    /// range; `None` where the range spans more than 32 binary exponents, a fit misses
+    /// [`MAX_FIT_ERROR`] or is not finite, or the CPU lacks AVX-512 F.
+    pub fn new(lo: f32, hi: f32, f: impl Fn(f64) -> f64) -> Option<OctaveCurve> {
+        if !(has_avx512() && lo.is_normal() && hi.is_normal() && 0.0 < lo && lo <= hi) {
+            return None;
+        }
+        let (b_lo, b_hi) = ((lo.to_bits() >> 23) as i32, (hi.to_bits() >> 23) as i32);
+        if b_hi - b_lo >= 32 {
+            return None;
+        }
+        let nodes: [f64; TERMS] = chebyshev_nodes::<TERMS>().map(|t| t - 0.5);
+        let mut coeffs = [[0.0f32; 32]; TERMS];
+        for b in b_lo..=b_hi {
+            let scale = 2f64.powi(b - 127);
+            let x = |s: f64| scale * (1.5 + s);
+            let y = nodes.map(|s| f(x(s)));
+            let p = poly_through(&nodes, &y);
+            // The fit in f64 between and beyond the nodes (including both ends).
+            let worst = (0..=64)
+                .map(|i| {
+                    let s = i as f64 / 64.0 - 0.5;
+                    let v = p.iter().rev().fold(0.0, |acc, c| acc * s + c);
+                    (v / f(x(s)) - 1.0).abs()
+                })
+                .fold(0.0, f64::max);
+            // NaN (a non-finite curve) is refused too.
+            if worst.is_nan() || worst > MAX_FIT_ERROR {
+                return None;
+            }
+            for (j, v) in p.iter().enumerate() {
+                let v32 = *v as f32;
+                if !v32.is_finite() {
+                    return None;
+                }
+                coeffs[j][(b % 32) as usize] = v32;
+            }
+        }
+        Some(OctaveCurve { coeffs, lo, hi })
+    }
+
+    /// f(clamp(x, lo, hi)) (NaN → lo), scalar.
+    #[inline(always)]
+    pub fn eval(&self, x: f32) -> f32 {
+        let bits = x.max(self.lo).min(self.hi).to_bits();
+        let b = ((bits >> 23) & 31) as usize;
+        let s = f32::from_bits((bits & MANTISSA_MASK) | ONE_BITS) - 1.5;
+        let c = &self.coeffs;
+        (0..TERMS - 1)
+            .rev()
+            .fold(c[TERMS - 1][b], |p, j| p.mul_add(s, c[j][b]))
+    }
+
+    /// Replaces every `v[j]` by [`Self::eval`]`(v[j])` (scalar: the curve exists only
+    /// where the AVX-512 pass runs, which leaves the scalar path the ends of a plane).
+    #[inline]
+    pub fn eval_slice(&self, v: &mut [f32]) {
+        for x in v {
+            *x = self.eval(*x);
+        }
+    }
+
+    /// [`Self::eval`] on 16 lanes: the same bits.
+    ///
+    /// # Safety
+    /// The CPU must have AVX-512F (which `new` checked).
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    pub unsafe fn eval16(&self, x: std::arch::x86_64::__m512) -> std::arch::x86_64::__m512 {
+        use std::arch::x86_64::*;
+        // maxps returns its second operand when the first is NaN (as f32::max).
+        let x = _mm512_min_ps(
+            _mm512_max_ps(x, _mm512_set1_ps(self.lo)),
+            _mm512_set1_ps(self.hi),
+        );
+        let bits = _mm512_castps_si512(x);
+        // vpermt2ps reads the low 5 bits of the index: the biased exponent modulo 32
+        // (x > 0 after the clamp, so the sign bit is clear).
+        let b = _mm512_srli_epi32::<23>(bits);
+        // (bits & MANTISSA_MASK) | ONE_BITS in one vpternlogd (truth table 0xEA: a & b | c).
+        let m = _mm512_ternarylogic_epi32::<0xEA>(
+            bits,
+            _mm512_set1_epi32(MANTISSA_MASK as i32),
+            _mm512_set1_epi32(ONE_BITS as i32),
+        );
+        let s = _mm512_sub_ps(_mm512_castsi512_ps(m), _mm512_set1_ps(1.5));
+        // SAFETY: each row holds 32 f32s (two 16-lane loads).
+        let coeff = |j: usize| {
+            let row = self.coeffs[j].as_ptr();
+            _mm512_permutex2var_ps(_mm512_loadu_ps(row), b, _mm512_loadu_ps(row.add(16)))
+        };
+        let mut p = coeff(TERMS - 1);
+        for j in (0..TERMS - 1).rev() {
+            p = _mm512_fmadd_ps(p, s, coeff(j));
+        }
+        p
+    }
+}
+
+fn has_avx512() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::arch::is_x86_feature_detected!("avx512f")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn matches_the_curve_and_the_scalar_bits() {
+        let f = |l: f64| (1.0 + l).ln() / (l * (2.0 + 8.0 * (l / 2e5).powf(0.234)).ln());
+        let (lo, hi) = (1.3e-4f32, 2.1e5f32); // 31 binary exponents
+        let Some(curve) = OctaveCurve::new(lo, hi, f) else {
+            assert!(!has_avx512(), "eq. 4-like curve should fit");
+            return;
+        };
+        let mut xs = vec![0.0f32, -1.0, f32::NAN, f32::INFINITY, 1e-30, 1e30, lo, hi];
+        let mut x = lo;
+        while x <= hi {
+            xs.push(x);
+            x *= 1.000_71;
+        }
+        let mut worst = 0.0f64;
+        #[cfg(target_arch = "x86_64")]
+        for chunk in xs.chunks_exact(16) {
+            // SAFETY: `new` returned a curve, so the CPU has AVX-512F.
+            let got: [f32; 16] = unsafe {
+                use std::arch::x86_64::*;
+                let v = curve.eval16(_mm512_loadu_ps(chunk.as_ptr()));
+                std::mem::transmute(v)
+            };
+            for (x, g) in chunk.iter().zip(got) {
+                assert_eq!(g.to_bits(), curve.eval(*x).to_bits(), "x = {x:e}");
+            }
+        }
+        for x in &xs {
+            let got = curve.eval(*x);
+            let xc = if x.is_nan() { lo } else { x.clamp(lo, hi) };
+            worst = worst.max((got as f64 / f(xc as f64) - 1.0).abs());
+        }
+        eprintln!("octave curve: worst relative error {worst:e}");
+        // Fit ≤ 1e-7 plus the f32 roundings of the coefficients and Horner steps.
+        assert!(worst < 5e-7, "{worst:e}");
+        // Refused: more than 32 binary exponents, or a curve no polynomial fits.
+        assert!(OctaveCurve::new(1e-6, 1e6, f).is_none());
+        assert!(OctaveCurve::new(1.0, 2.0, |x| (x - 1.3).abs()).is_none());
+    }
+}
