@@ -361,13 +361,6 @@ impl Map {
     }
 }
 
-/// Whether the CPU has AVX-512 F (16 lanes, two-register permutes, `vgetexpps`).
-#[cfg(target_arch = "x86_64")]
-#[inline]
-fn has_avx512() -> bool {
-    std::arch::is_x86_feature_detected!("avx512f")
-}
-
 impl Map {
     /// [`PixelMap::map`] on 16 lanes: the same operations in the same order as
     /// [`Self::pixel`], with three AVX-512 shortcuts that give the same values: the
@@ -500,7 +493,7 @@ impl PixelMap for Map {
     #[inline(always)]
     fn map(&self, _start: usize, r: &mut [f32], g: &mut [f32], b: &mut [f32]) {
         #[cfg(target_arch = "x86_64")]
-        if has_avx512() {
+        if crate::tonemap::simd::has_avx512() {
             // SAFETY: the CPU has AVX-512 F (checked above).
             unsafe { self.map_avx512(r, g, b) };
             return;
@@ -660,7 +653,7 @@ mod tests {
                     unsafe { map.map_avx2(&mut r, &mut g, &mut b) };
                     paths.push(("avx2", r, g, b));
                 }
-                if has_avx512() {
+                if crate::tonemap::simd::has_avx512() {
                     let (mut r, mut g, mut b) = (r.clone(), g.clone(), b.clone());
                     // SAFETY: the CPU has AVX-512 F (checked just above).
                     unsafe { map.map_avx512(&mut r, &mut g, &mut b) };

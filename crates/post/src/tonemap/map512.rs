@@ -51,14 +51,7 @@ impl RegisterCurve for Scale {
 
 /// Whether the AVX-512 pass runs here.
 pub(crate) fn available() -> bool {
-    #[cfg(target_arch = "x86_64")]
-    {
-        std::arch::is_x86_feature_detected!("avx512f")
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        false
-    }
+    crate::tonemap::simd::has_avx512()
 }
 
 /// [`map_luminance`] (same contract, same bits), on 16 pixels per step with AVX-512 where

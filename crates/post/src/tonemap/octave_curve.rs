@@ -45,7 +45,12 @@ impl OctaveCurve {
     /// range; `None` where the range spans more than 32 binary exponents, a fit misses
     /// [`MAX_FIT_ERROR`] or is not finite, or the CPU lacks AVX-512 F.
     pub fn new(lo: f32, hi: f32, f: impl Fn(f64) -> f64) -> Option<OctaveCurve> {
-        if !(has_avx512() && lo.is_normal() && hi.is_normal() && 0.0 < lo && lo <= hi) {
+        if !(crate::tonemap::simd::has_avx512()
+            && lo.is_normal()
+            && hi.is_normal()
+            && 0.0 < lo
+            && lo <= hi)
+        {
             return None;
         }
         let (b_lo, b_hi) = ((lo.to_bits() >> 23) as i32, (hi.to_bits() >> 23) as i32);
@@ -140,17 +145,6 @@ impl OctaveCurve {
     }
 }
 
-fn has_avx512() -> bool {
-    #[cfg(target_arch = "x86_64")]
-    {
-        std::arch::is_x86_feature_detected!("avx512f")
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        false
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -160,7 +154,10 @@ mod tests {
         let f = |l: f64| (1.0 + l).ln() / (l * (2.0 + 8.0 * (l / 2e5).powf(0.234)).ln());
         let (lo, hi) = (1.3e-4f32, 2.1e5f32); // 31 binary exponents
         let Some(curve) = OctaveCurve::new(lo, hi, f) else {
-            assert!(!has_avx512(), "eq. 4-like curve should fit");
+            assert!(
+                !crate::tonemap::simd::has_avx512(),
+                "eq. 4-like curve should fit"
+            );
             return;
         };
         let mut xs = vec![0.0f32, -1.0, f32::NAN, f32::INFINITY, 1e-30, 1e30, lo, hi];

@@ -40,7 +40,12 @@ impl PowerCurve {
     /// range; `None` where the range spans more than 32 binary exponents, the fit misses
     /// [`MAX_FIT_ERROR`], a scale is not a normal f32, or the CPU lacks AVX-512 F.
     pub fn new(c: f64, a: f64, lo: f32, hi: f32) -> Option<PowerCurve> {
-        if !(has_avx512() && lo.is_normal() && hi.is_normal() && 0.0 < lo && lo <= hi) {
+        if !(crate::tonemap::simd::has_avx512()
+            && lo.is_normal()
+            && hi.is_normal()
+            && 0.0 < lo
+            && lo <= hi)
+        {
             return None;
         }
         let (b_lo, b_hi) = ((lo.to_bits() >> 23) as i32, (hi.to_bits() >> 23) as i32);
@@ -151,24 +156,13 @@ impl PowerCurve {
     }
 }
 
-fn has_avx512() -> bool {
-    #[cfg(target_arch = "x86_64")]
-    {
-        std::arch::is_x86_feature_detected!("avx512f")
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        false
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
 
     #[test]
     fn matches_the_power_and_the_scalar_bits() {
-        if !has_avx512() {
+        if !crate::tonemap::simd::has_avx512() {
             assert!(PowerCurve::new(1.0, 0.5, 1.0, 2.0).is_none());
             return;
         }

@@ -27,6 +27,21 @@ pub fn has_avx2() -> bool {
     }
 }
 
+/// Whether this CPU runs AVX-512 F (16 lanes, two-register permutes), the width of the
+/// register-curve and 16-pixel passes (cached by the standard library after the first
+/// query).
+#[inline]
+pub fn has_avx512() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::arch::is_x86_feature_detected!("avx512f")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
 /// `avx2!(kernel(args…))` (1 to 7 arguments): evaluates `kernel(args…)` compiled for
 /// AVX2 + FMA when the CPU has them, else at the baseline width. `kernel` must be a
 /// function marked `#[inline(always)]`: it is passed as a function item to a local
