@@ -21,7 +21,7 @@
 //! The scalar [`OctaveCurve::eval`] performs the same operations in the same order
 //! (`f32::mul_add` for each fused multiply-add), so both paths give the same bits.
 
-use super::curve_table::{chebyshev_nodes, poly_through};
+use super::curve_table::{chebyshev_nodes, poly_through, register_exponent_range};
 
 /// Coefficients per octave (degree 9).
 pub const TERMS: usize = 10;
@@ -45,18 +45,7 @@ impl OctaveCurve {
     /// range; `None` where the range spans more than 32 binary exponents, a fit misses
     /// [`MAX_FIT_ERROR`] or is not finite, or the CPU lacks AVX-512 F.
     pub fn new(lo: f32, hi: f32, f: impl Fn(f64) -> f64) -> Option<OctaveCurve> {
-        if !(crate::tonemap::simd::has_avx512()
-            && lo.is_normal()
-            && hi.is_normal()
-            && 0.0 < lo
-            && lo <= hi)
-        {
-            return None;
-        }
-        let (b_lo, b_hi) = ((lo.to_bits() >> 23) as i32, (hi.to_bits() >> 23) as i32);
-        if b_hi - b_lo >= 32 {
-            return None;
-        }
+        let (b_lo, b_hi) = register_exponent_range(lo, hi)?;
         let nodes: [f64; TERMS] = chebyshev_nodes::<TERMS>().map(|t| t - 0.5);
         let mut coeffs = [[0.0f32; 32]; TERMS];
         for b in b_lo..=b_hi {

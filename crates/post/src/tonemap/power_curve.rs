@@ -15,7 +15,7 @@
 //! The scalar [`PowerCurve::eval`] performs the same operations in the same order
 //! (`f32::mul_add` for each fused multiply-add), so both paths give the same bits.
 
-use super::curve_table::{chebyshev_nodes, poly_through};
+use super::curve_table::{chebyshev_nodes, poly_through, register_exponent_range};
 
 /// Mantissa bits that select a segment (16 per octave: one AVX-512 register).
 const SEGMENT_BITS: u32 = 4;
@@ -40,18 +40,7 @@ impl PowerCurve {
     /// range; `None` where the range spans more than 32 binary exponents, the fit misses
     /// [`MAX_FIT_ERROR`], a scale is not a normal f32, or the CPU lacks AVX-512 F.
     pub fn new(c: f64, a: f64, lo: f32, hi: f32) -> Option<PowerCurve> {
-        if !(crate::tonemap::simd::has_avx512()
-            && lo.is_normal()
-            && hi.is_normal()
-            && 0.0 < lo
-            && lo <= hi)
-        {
-            return None;
-        }
-        let (b_lo, b_hi) = ((lo.to_bits() >> 23) as i32, (hi.to_bits() >> 23) as i32);
-        if b_hi - b_lo >= 32 {
-            return None;
-        }
+        let (b_lo, b_hi) = register_exponent_range(lo, hi)?;
         let mut scales = [0.0f32; 32];
         for b in b_lo..=b_hi {
             let s = c * (a * (b - 127) as f64).exp2();
