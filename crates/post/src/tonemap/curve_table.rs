@@ -273,7 +273,6 @@ fn cubic_through(t: &[f64; 4], y: &[f64; 4]) -> [f64; 4] {
     poly_through(t, y)
 }
 
-/// Monomial coefficients (constant first) of the polynomial of degree N − 1 through
 /// The biased binary exponents (b_lo, b_hi) of a curve's range [lo, hi] held in AVX-512
 /// registers, one entry per exponent mod 32 (power_curve, octave_curve); `None` where the
 /// CPU lacks AVX-512 F, a bound is not a positive normal f32, lo > hi, or the range spans
@@ -291,6 +290,7 @@ pub(crate) fn register_exponent_range(lo: f32, hi: f32) -> Option<(i32, i32)> {
     (b_hi - b_lo < 32).then_some((b_lo, b_hi))
 }
 
+/// Monomial coefficients (constant first) of the polynomial of degree N − 1 through
 /// (t_k, y_k), k = 0..N (Newton's divided differences, expanded), in f64.
 pub(crate) fn poly_through<const N: usize>(t: &[f64; N], y: &[f64; N]) -> [f64; N] {
     let mut d = *y;
