@@ -370,16 +370,7 @@ impl FilmTile {
         radiance: SampledSpectrum,
         wavelengths: &SampledWavelengths,
     ) -> bool {
-        let Some(i) = self.index(pixel) else {
-            debug_assert!(false, "pixel {pixel} outside tile {:?}", self.bounds);
-            return false;
-        };
-        if let (true, Some(a)) = (self.record_illumination, self.aovs.get_mut(i)) {
-            if !radiance.has_non_finite() {
-                a.illumination_sum += xyz_of_sample(radiance, wavelengths);
-            }
-        }
-        true
+        self.add_illumination_with(pixel, radiance, &XyzWeights::new(wavelengths))
     }
 
     /// `add_illumination` with the sample's `XyzWeights` (built once per camera sample for
