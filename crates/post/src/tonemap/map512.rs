@@ -157,6 +157,32 @@ unsafe fn prefetch_ahead(s: *const f32) {
 
 const PREFETCH_FLOATS: usize = 48 * 16;
 
+/// The `vpermt2ps` index pairs that gather channel 0, 1, 2 of 16 interleaved RGB pixels.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn deinterleave_registers() -> [(__m512i, __m512i); 3] {
+    [0, 1, 2].map(|ch| {
+        let (a, b) = deinterleave_indices(ch);
+        (
+            _mm512_loadu_si512(a.as_ptr() as *const _),
+            _mm512_loadu_si512(b.as_ptr() as *const _),
+        )
+    })
+}
+
+/// The R, G, B planes of the 16 interleaved pixels (48 floats) at `s`: three loads, two
+/// `vpermt2ps` per channel. The caller guarantees the 48 floats are readable.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn load_planes16(s: *const f32, de: &[(__m512i, __m512i); 3]) -> [__m512; 3] {
+    let v = [
+        _mm512_loadu_ps(s),
+        _mm512_loadu_ps(s.add(16)),
+        _mm512_loadu_ps(s.add(32)),
+    ];
+    de.map(|(i0, i1)| _mm512_permutex2var_ps(_mm512_permutex2var_ps(v[0], i0, v[1]), i1, v[2]))
+}
+
 /// |x| < ∞ per lane (false for NaN).
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
@@ -189,10 +215,7 @@ unsafe fn chunk_avx512<C: RegisterCurve>(
         map_luminance_chunk(&input[..head], &mut out[..head], start, scale, w, curve);
 
     let load_idx = |a: [i32; 16]| _mm512_loadu_si512(a.as_ptr() as *const _);
-    let de = [0, 1, 2].map(|ch| {
-        let (a, b) = deinterleave_indices(ch);
-        (load_idx(a), load_idx(b))
-    });
+    let de = deinterleave_registers();
     let inter = [0, 1, 2].map(|reg| {
         let (a, b) = interleave_indices(reg);
         (load_idx(a), load_idx(b))
@@ -207,14 +230,7 @@ unsafe fn chunk_avx512<C: RegisterCurve>(
         // groups), i.e. floats 48 g … 48 g + 47 from src and dst.
         let s = src.add(48 * g);
         prefetch_ahead(s);
-        let v = [
-            _mm512_loadu_ps(s),
-            _mm512_loadu_ps(s.add(16)),
-            _mm512_loadu_ps(s.add(32)),
-        ];
-        let p = de.map(|(i0, i1)| {
-            _mm512_permutex2var_ps(_mm512_permutex2var_ps(v[0], i0, v[1]), i1, v[2])
-        });
+        let p = load_planes16(s, &de);
         // load_block: black for a pixel with a non-finite component, negatives to 0
         // (maxps(x, 0) returns its second operand for NaN and for ±0, as f32::max(x, 0)
         // compiles), luminance w · c summed left to right.
@@ -296,10 +312,7 @@ unsafe fn map_pixels_chunk_avx512<M: PixelMap>(
     f: &M,
 ) -> (u64, u64) {
     let load_idx = |a: [i32; 16]| _mm512_loadu_si512(a.as_ptr() as *const _);
-    let de = [0, 1, 2].map(|ch| {
-        let (a, b) = deinterleave_indices(ch);
-        (load_idx(a), load_idx(b))
-    });
+    let de = deinterleave_registers();
     let inter = [0, 1, 2].map(|reg| {
         let (a, b) = interleave_indices(reg);
         (load_idx(a), load_idx(b))
@@ -321,14 +334,7 @@ unsafe fn map_pixels_chunk_avx512<M: PixelMap>(
             // SAFETY: the block holds BLOCK pixels: floats 48 g … 48 g + 47 lie inside.
             let s = src.add(48 * g);
             prefetch_ahead(s);
-            let v = [
-                _mm512_loadu_ps(s),
-                _mm512_loadu_ps(s.add(16)),
-                _mm512_loadu_ps(s.add(32)),
-            ];
-            let p = de.map(|(i0, i1)| {
-                _mm512_permutex2var_ps(_mm512_permutex2var_ps(v[0], i0, v[1]), i1, v[2])
-            });
+            let p = load_planes16(s, &de);
             // load_block: black for a non-finite component, negatives clamped to 0.
             let finite = finite_mask(p[0]) & finite_mask(p[1]) & finite_mask(p[2]);
             let neg = (_mm512_cmp_ps_mask::<_CMP_LT_OQ>(p[0], zero)
@@ -394,11 +400,7 @@ pub(crate) fn stats_chunk_fast(chunk: &[[f32; 3]], scale: f32, w: [f32; 3]) -> A
 unsafe fn stats_chunk_avx512(chunk: &[[f32; 3]], scale: f32, w: [f32; 3]) -> Acc {
     const _: () = assert!(LANES == 16 && BLOCK.is_multiple_of(16));
     let mut lanes = StatsLanes::EMPTY;
-    let load_idx = |a: [i32; 16]| _mm512_loadu_si512(a.as_ptr() as *const _);
-    let de = [0, 1, 2].map(|ch| {
-        let (a, b) = deinterleave_indices(ch);
-        (load_idx(a), load_idx(b))
-    });
+    let de = deinterleave_registers();
     let zero = _mm512_setzero_ps();
     let scale_v = _mm512_set1_ps(scale);
     let w_v = w.map(|x| _mm512_set1_ps(x));
@@ -424,14 +426,7 @@ unsafe fn stats_chunk_avx512(chunk: &[[f32; 3]], scale: f32, w: [f32; 3]) -> Acc
             // 48 g + 47 lie inside it.
             let s = src.add(48 * g);
             prefetch_ahead(s);
-            let v = [
-                _mm512_loadu_ps(s),
-                _mm512_loadu_ps(s.add(16)),
-                _mm512_loadu_ps(s.add(32)),
-            ];
-            let p = de.map(|(i0, i1)| {
-                _mm512_permutex2var_ps(_mm512_permutex2var_ps(v[0], i0, v[1]), i1, v[2])
-            });
+            let p = load_planes16(s, &de);
             // sanitised_luminance: 0 for a pixel with a non-finite component, else
             // w · max(c · scale, 0) summed left to right.
             let finite = finite_mask(p[0]) & finite_mask(p[1]) & finite_mask(p[2]);
