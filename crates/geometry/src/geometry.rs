@@ -426,6 +426,12 @@ impl Geometry {
         self.small.is_some()
     }
 
+    /// A small scene with leaves other than baked triangles and rectangles (spheres,
+    /// disks, instanced meshes), tested one by one after the batches.
+    pub(crate) fn has_other_small_leaves(&self) -> bool {
+        self.small.as_ref().is_some_and(|s| !s.others.is_empty())
+    }
+
     /// Closest hit of `ray` in `(t_min, t_max)`.
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
         if let Some(small) = &self.small {

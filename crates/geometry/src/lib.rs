@@ -10,6 +10,7 @@ pub mod bvh_build;
 pub mod curvature;
 pub mod disk;
 pub mod error;
+pub mod flat_leaves;
 pub mod frame;
 pub mod geometry;
 pub mod interaction;
@@ -30,6 +31,7 @@ pub use bvh_build::BuildQuality;
 pub use curvature::Curvature;
 pub use disk::Disk;
 pub use error::MeshLoadError;
+pub use flat_leaves::{FlatLeaf, PatchKind};
 pub use frame::Frame;
 pub use geometry::{
     BuildOptions, Geometry, GeometryBuilder, Hit, Instance, MeshId, Shape,

@@ -11,6 +11,7 @@ use glam::{DVec3, UVec2, Vec2};
 
 use prism_spectrum::{SampledSpectrum, SampledWavelengths};
 
+use super::packet::{render_tile as render_packet_tile, TileJob};
 use super::{Integrator, PathCounters};
 use crate::film::xyz::XyzWeights;
 use crate::film::{AovSelection, Film, FilmImage, SpectralBins, SurfaceAov};
@@ -141,7 +142,38 @@ pub fn render_pass(
     film.render_tiles(settings.tile_size_px, |tile| {
         let (mut rays, mut samples, mut non_finite) = (0u64, 0u64, 0u64);
         let mut counters = PathCounters::default();
-        for pixel in tile.bounds().pixels() {
+        // Flat diffuse scenes: many paths at once (`integrator::packet`), for plans of one
+        // light sample per hit.
+        let packet_tracer = match (&scene.integrator, &scene.packet) {
+            (Integrator::Path(tracer), Some(packet))
+                if tile.bounds().pixels().all(|p| plan.light_samples(p) <= 1) =>
+            {
+                Some((tracer, packet))
+            }
+            _ => None,
+        };
+        if let Some((tracer, packet)) = packet_tracer {
+            let job = TileJob {
+                scene,
+                packet,
+                tracer,
+                sampler: &sampler,
+                camera_samples: &|p| plan.camera_samples(p),
+                first_sample,
+                uses_lens,
+                want_illumination: settings.illumination_aov,
+            };
+            let c = render_packet_tile(&job, tile, &mut counters);
+            rays += c.camera_rays;
+            samples += c.samples;
+            non_finite += c.non_finite_samples;
+        }
+        let scalar_pixels = tile
+            .bounds()
+            .pixels()
+            .filter(|_| packet_tracer.is_none())
+            .collect::<Vec<_>>();
+        for pixel in scalar_pixels {
             let light_samples = plan.light_samples(pixel);
             let count = plan.camera_samples(pixel);
             // Several samples share the pixel: each one's differential covers a fraction of

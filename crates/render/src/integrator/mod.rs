@@ -12,6 +12,7 @@ mod ambient_occlusion;
 mod depth;
 mod driver;
 mod normal;
+pub mod packet;
 mod path;
 
 pub use ambient_occlusion::AmbientOcclusion;

@@ -60,6 +60,9 @@ pub struct RenderScene {
     /// Some material reads a texture: hits compute ray differentials, from the camera ray
     /// or (after a bounce) from this camera footprint. `None` when no material is textured.
     pub texture_footprint: Option<crate::texture::CameraFootprint>,
+    /// The scene as flat diffuse patches for the packet tracer (`integrator::packet`), when
+    /// it is one and packet tracing is on (the default).
+    pub packet: Option<crate::integrator::packet::PacketScene>,
 }
 
 impl RenderScene {
@@ -105,7 +108,7 @@ impl RenderScene {
         } else {
             None
         };
-        Ok(Self {
+        let mut built = Self {
             file,
             geometry,
             camera,
@@ -128,7 +131,19 @@ impl RenderScene {
             has_dispersion,
             texture_footprint,
             splat: scene.film.reconstruction == prism_scene::Reconstruction::Splat,
-        })
+            packet: None,
+        };
+        built.set_packet_tracing(true);
+        Ok(built)
+    }
+
+    /// Packet tracing on (where the scene allows it, `PacketScene::new`) or off (every
+    /// path through the scalar tracer; for tests and comparisons).
+    pub fn set_packet_tracing(&mut self, on: bool) {
+        self.packet = None;
+        if on {
+            self.packet = crate::integrator::packet::PacketScene::new(self).ok();
+        }
     }
 
     /// An empty film for this scene recording the surface AOVs (depth, normal, albedo).
