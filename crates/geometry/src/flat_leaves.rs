@@ -131,7 +131,7 @@ mod tests {
             [1.0, 1.0, 1.0],
             [-1.0, 1.0, 1.0],
         ]
-        .map(|v| Vec3A::from_array(v));
+        .map(Vec3A::from_array);
         let idx = vec![
             [0, 2, 1],
             [0, 3, 2],
@@ -163,7 +163,14 @@ mod tests {
             Mat4::from_translation(Vec3::new(0.0, 0.0, -1.0)) * Mat4::from_rotation_x(0.3),
         )
         .unwrap();
-        b.add_instance(Shape::Rectangle(Rectangle { half_width_m: 1.5, half_height_m: 1.0 }), wall, Some(2));
+        b.add_instance(
+            Shape::Rectangle(Rectangle {
+                half_width_m: 1.5,
+                half_height_m: 1.0,
+            }),
+            wall,
+            Some(2),
+        );
         b.build(BuildQuality::Fast)
     }
 
@@ -210,7 +217,10 @@ mod tests {
             Some(0),
         );
         b.add_instance(
-            Shape::Rectangle(Rectangle { half_width_m: 1.0, half_height_m: 1.0 }),
+            Shape::Rectangle(Rectangle {
+                half_width_m: 1.0,
+                half_height_m: 1.0,
+            }),
             Transform::IDENTITY,
             Some(0),
         );
@@ -222,7 +232,10 @@ mod tests {
         let m = b.add_mesh(mesh);
         b.add_instance(Shape::Mesh(m), Transform::IDENTITY, Some(0));
         b.add_instance(
-            Shape::Rectangle(Rectangle { half_width_m: 1.0, half_height_m: 1.0 }),
+            Shape::Rectangle(Rectangle {
+                half_width_m: 1.0,
+                half_height_m: 1.0,
+            }),
             Transform::IDENTITY,
             Some(0),
         );

@@ -128,6 +128,28 @@ impl RenderPlan {
                     "hero + 3 rotated wavelengths per path, visible-importance density".into(),
                     "spectral transport (Wilkie et al. 2014); 4 wavelengths share every ray".into(),
                 );
+                match (
+                    &scene.packet,
+                    crate::integrator::packet::PacketScene::new(scene),
+                ) {
+                    (Some(packet), _) => choose(
+                        "packet tracing",
+                        format!(
+                            "on, {} paths per ray query, {} patches",
+                            crate::integrator::packet::lane_count(),
+                            packet.patch_count()
+                        ),
+                        "flat patches with constant Lambertian materials only: many paths \
+                         share every ray query (same estimator as the scalar tracer)"
+                            .into(),
+                    ),
+                    (None, Ok(_)) => choose(
+                        "packet tracing",
+                        "off".into(),
+                        "switched off for this render".into(),
+                    ),
+                    (None, Err(why)) => choose("packet tracing", "off".into(), why),
+                }
                 let names: Vec<String> = dispersive
                     .iter()
                     .map(|&i| format!("`{}`", scene.material_names[i]))

@@ -21,7 +21,7 @@
 //!
 //! Values lie in [0, 1) with 24 bits, never 1.
 
-mod hash;
+pub(crate) mod hash;
 mod independent;
 mod sobol;
 

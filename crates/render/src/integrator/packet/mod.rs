@@ -49,12 +49,25 @@ struct LeafShading {
     light: Option<u32>,
 }
 
+/// Which lane width runs (tests compare them; renders use `Auto`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(not(test), allow(dead_code))]
+pub(crate) enum Kernel {
+    /// The widest this CPU runs: 16 lanes with AVX-512, else 8 with AVX2, else 8 baseline.
+    Auto,
+    /// 8 lanes with AVX2 where the CPU has it, else baseline.
+    Avx2,
+    /// 8 lanes, baseline instructions (SSE2 on x86-64).
+    Baseline,
+}
+
 /// A scene the packet tracer can render: its patches and their shading.
 #[derive(Clone, Debug)]
 pub struct PacketScene {
     triangles: PatchSet,
     parallelograms: PatchSet,
     leaves: Vec<LeafShading>,
+    kernel: Kernel,
 }
 
 impl PacketScene {
@@ -108,6 +121,7 @@ impl PacketScene {
             triangles: PatchSet::new(&flat, PatchKind::Triangle),
             parallelograms: PatchSet::new(&flat, PatchKind::Parallelogram),
             leaves,
+            kernel: Kernel::Auto,
         })
     }
 
@@ -125,3 +139,6 @@ pub fn lane_count() -> usize {
         8
     }
 }
+
+#[cfg(test)]
+mod tests;

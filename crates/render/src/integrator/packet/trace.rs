@@ -3,14 +3,17 @@
 //! comments explain them), and the two ray queries of each step — the extension ray and
 //! the shadow ray — done for all lanes at once.
 
+// Lanes index several arrays at once: `for l in 0..N` is the clearest form.
+#![allow(clippy::needless_range_loop)]
+
 use glam::{UVec2, Vec2, Vec3A};
 use prism_geometry::Ray;
 use prism_spectrum::{SampledSpectrum, SampledWavelengths};
 
 use super::intersect::{closest, occluded, RayLanes};
-use super::PacketScene;
-use crate::film::FilmTile;
+use super::{Kernel, PacketScene};
 use crate::film::xyz::XyzWeights;
+use crate::film::FilmTile;
 use crate::film::SurfaceAov;
 use crate::integrator::path::{mis_weight, FirstHit, PathCounters, PathTracer};
 use crate::light::{LightHit, LightSampleContext};
@@ -97,7 +100,7 @@ pub(crate) fn has_avx512() -> bool {
     }
 }
 
-fn has_avx2() -> bool {
+pub(crate) fn has_avx2() -> bool {
     #[cfg(target_arch = "x86_64")]
     {
         std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
@@ -117,11 +120,12 @@ pub(crate) fn render_tile(
 ) -> TileCounts {
     #[cfg(target_arch = "x86_64")]
     {
-        if has_avx512() {
+        let kernel = job.packet.kernel;
+        if kernel == Kernel::Auto && has_avx512() {
             // SAFETY: the CPU reports AVX-512 F/DQ/VL/BW (`has_avx512`).
             return unsafe { render_tile_avx512(job, tile, counters) };
         }
-        if has_avx2() {
+        if matches!(kernel, Kernel::Auto | Kernel::Avx2) && has_avx2() {
             // SAFETY: the CPU reports AVX2 and FMA (`has_avx2`).
             return unsafe { render_tile_avx2(job, tile, counters) };
         }
@@ -397,8 +401,13 @@ fn scatter<const N: usize>(
             uv: leaf.uv,
             distance_m: hit_t,
         };
-        let le =
-            light.emitted_radiance_cached(li, &light_hit, -direction, &wavelengths, &mut lane.le_cache);
+        let le = light.emitted_radiance_cached(
+            li,
+            &light_hit,
+            -direction,
+            &wavelengths,
+            &mut lane.le_cache,
+        );
         if !le.is_black() {
             let w = if lane.specular_bounce {
                 1.0
@@ -447,8 +456,7 @@ fn scatter<const N: usize>(
         }
         if let Some((li, pmf)) = lights.sample(uc) {
             let light = lights.light(li);
-            if let Some(ls) =
-                light.sample_li_cached(li, &ctx, ul, &wavelengths, &mut lane.le_cache)
+            if let Some(ls) = light.sample_li_cached(li, &ctx, ul, &wavelengths, &mut lane.le_cache)
             {
                 if ls.pdf > 0.0 && !ls.radiance.is_black() {
                     let wi_local = frame.to_local(ls.wi);
