@@ -39,6 +39,60 @@ pub struct FlatLeaf {
     pub record: SurfaceInteraction,
 }
 
+/// The two triangles of a box face: (index in the leaf list, vertices in face coordinates).
+pub type BoxFace = [(u32, [Vec2; 3]); 2];
+
+/// Object-space bounds of a box mesh and, per triangle, (triangle, face).
+type BoxFaces = (Vec3A, Vec3A, Vec<(usize, usize)>);
+
+/// A mesh instance that is a parallelepiped (an affine image of an axis-aligned box, e.g.
+/// a placed cube): a packet tracer can test it as one box instead of its 12 triangles.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FlatBox {
+    /// World → box space, where the box is [−1, 1]³: rows (x, y, z, offset).
+    pub world_to_box: [[f32; 4]; 3],
+    /// Per face `2·axis + (side > 0)`: its two triangles, each as (index in the leaf list,
+    /// its vertices in the face's coordinates — box space without `axis`, the other two
+    /// axes in increasing order).
+    pub faces: [BoxFace; 6],
+}
+
+/// Whether `mesh` is an axis-aligned box in object space: 12 triangles with every vertex a
+/// corner of the bounds and two triangles in each face plane. Its faces' triangles as
+/// (triangle, face, box-space vertices) when it is.
+fn box_faces(mesh: &crate::mesh::TriangleMesh) -> Option<BoxFaces> {
+    if mesh.triangle_count() != 12 {
+        return None;
+    }
+    let lo = mesh
+        .positions
+        .iter()
+        .fold(Vec3A::INFINITY, |a, &p| a.min(p));
+    let hi = mesh
+        .positions
+        .iter()
+        .fold(Vec3A::NEG_INFINITY, |a, &p| a.max(p));
+    if !(lo.is_finite() && hi.is_finite() && lo.cmplt(hi).all()) {
+        return None;
+    }
+    let corner = |p: Vec3A| (0..3).all(|a| p[a] == lo[a] || p[a] == hi[a]);
+    let mut per_face = [0usize; 6];
+    let mut faces = Vec::with_capacity(12);
+    for (tri, &[a, b, c]) in mesh.indices.iter().enumerate() {
+        let p = [a, b, c].map(|i| mesh.positions[i as usize]);
+        if !p.iter().all(|&q| corner(q)) {
+            return None;
+        }
+        let face = (0..6).find(|&f| {
+            let (axis, bound) = (f / 2, if f % 2 == 1 { hi } else { lo });
+            p.iter().all(|q| q[axis] == bound[axis])
+        })?;
+        per_face[face] += 1;
+        faces.push((tri, face));
+    }
+    per_face.iter().all(|&n| n == 2).then_some((lo, hi, faces))
+}
+
 impl Geometry {
     /// The scene's leaves as flat patches, when it is a small scene made only of baked
     /// triangles of meshes without vertex normals and of rectangles (see module docs).
@@ -105,6 +159,69 @@ impl Geometry {
             }
         }
         Some(leaves)
+    }
+
+    /// The mesh instances among `leaves` (from [`Geometry::flat_leaves`]) that are
+    /// parallelepipeds.
+    pub fn flat_boxes(&self, leaves: &[FlatLeaf]) -> Vec<FlatBox> {
+        let mut boxes = Vec::new();
+        for (i, inst) in self.instances().iter().enumerate() {
+            let Shape::Mesh(id) = inst.shape else {
+                continue;
+            };
+            let mesh = self.mesh(id);
+            let Some((lo, hi, faces)) = box_faces(mesh) else {
+                continue;
+            };
+            let leaf_of = |tri: usize| {
+                leaves.iter().position(|l| {
+                    l.kind == PatchKind::Triangle
+                        && l.record.instance_id == i as u32
+                        && l.record.primitive_id == tri as u32
+                })
+            };
+            let centre = (lo + hi) * 0.5;
+            let half = (hi - lo) * 0.5;
+            let inv = inst.to_world.inverse_matrix();
+            let rows = [inv.row(0), inv.row(1), inv.row(2)];
+            let world_to_box = [0, 1, 2].map(|a| {
+                let r = rows[a];
+                [
+                    r.x / half[a],
+                    r.y / half[a],
+                    r.z / half[a],
+                    (r.w - centre[a]) / half[a],
+                ]
+            });
+            let mut out = [[(u32::MAX, [Vec2::ZERO; 3]); 2]; 6];
+            let mut filled = [0usize; 6];
+            let mut complete = true;
+            for (tri, face) in faces {
+                let Some(leaf) = leaf_of(tri) else {
+                    complete = false;
+                    break;
+                };
+                let (u, v) = match face / 2 {
+                    0 => (1, 2),
+                    1 => (0, 2),
+                    _ => (0, 1),
+                };
+                let vertices = mesh.indices[tri].map(|k| {
+                    let q = (mesh.positions[k as usize] - centre) / half;
+                    Vec2::new(q[u], q[v])
+                });
+                out[face][filled[face]] = (leaf as u32, vertices);
+                filled[face] += 1;
+            }
+            let finite = world_to_box.iter().flatten().all(|x| x.is_finite());
+            if complete && finite {
+                boxes.push(FlatBox {
+                    world_to_box,
+                    faces: out,
+                });
+            }
+        }
+        boxes
     }
 }
 
@@ -206,6 +323,47 @@ mod tests {
             }
         }
         assert!(checked >= 30, "only {checked} probes reached their patch");
+    }
+
+    /// The placed cube is found as a box whose map sends its world corners to ±1 and whose
+    /// faces list its 12 triangles once each.
+    #[test]
+    fn a_placed_cube_is_a_flat_box() {
+        let g = scene();
+        let leaves = g.flat_leaves().unwrap();
+        let boxes = g.flat_boxes(&leaves);
+        assert_eq!(boxes.len(), 1);
+        let b = &boxes[0];
+        let mut seen: Vec<u32> = b.faces.iter().flatten().map(|(leaf, _)| *leaf).collect();
+        seen.sort_unstable();
+        seen.dedup();
+        assert_eq!(seen.len(), 12);
+        for leaf in seen.iter().map(|&i| &leaves[i as usize]) {
+            for p in [leaf.p0, leaf.p0 + leaf.e1, leaf.p0 + leaf.e2] {
+                for row in &b.world_to_box {
+                    let q = row[0] * p.x + row[1] * p.y + row[2] * p.z + row[3];
+                    assert!((q.abs() - 1.0).abs() < 1e-5, "{q}");
+                }
+            }
+        }
+        // A rectangle is not a box; nor is a cube missing a triangle.
+        let mut b = GeometryBuilder::new();
+        let mut open = cube();
+        open.indices.pop();
+        open.material_ids.pop();
+        open.object_ids.pop();
+        let m = b.add_mesh(open);
+        b.add_instance(Shape::Mesh(m), Transform::IDENTITY, Some(0));
+        b.add_instance(
+            Shape::Rectangle(Rectangle {
+                half_width_m: 1.0,
+                half_height_m: 1.0,
+            }),
+            Transform::IDENTITY,
+            Some(0),
+        );
+        let g = b.build(BuildQuality::Fast);
+        assert!(g.flat_boxes(&g.flat_leaves().unwrap()).is_empty());
     }
 
     #[test]

@@ -31,7 +31,7 @@ pub use bvh_build::BuildQuality;
 pub use curvature::Curvature;
 pub use disk::Disk;
 pub use error::MeshLoadError;
-pub use flat_leaves::{FlatLeaf, PatchKind};
+pub use flat_leaves::{BoxFace, FlatBox, FlatLeaf, PatchKind};
 pub use frame::Frame;
 pub use geometry::{
     BuildOptions, Geometry, GeometryBuilder, Hit, Instance, MeshId, Shape,

@@ -135,12 +135,14 @@ impl RenderPlan {
                     (Some(packet), _) => choose(
                         "packet tracing",
                         format!(
-                            "on, {} paths per ray query, {} patches",
+                            "on, {} paths per ray query, {} patches and {} boxes",
                             crate::integrator::packet::lane_count(),
-                            packet.patch_count()
+                            packet.patch_count(),
+                            packet.box_count()
                         ),
                         "flat patches with constant Lambertian materials only: many paths \
-                         share every ray query (same estimator as the scalar tracer)"
+                         share every ray query, cuboid meshes are tested as boxes (same \
+                         estimator as the scalar tracer)"
                             .into(),
                     ),
                     (None, Ok(_)) => choose(

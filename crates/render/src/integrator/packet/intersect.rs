@@ -18,8 +18,9 @@
 // Lanes index several arrays at once: `for l in 0..N` is the clearest form.
 #![allow(clippy::needless_range_loop)]
 
+use glam::Vec2;
 use glam::{Mat3A, Vec3A};
-use prism_geometry::{FlatLeaf, PatchKind};
+use prism_geometry::{BoxFace, FlatBox, FlatLeaf, PatchKind};
 
 /// Relative widening of the barycentric bounds (see the module docs).
 pub(crate) const EDGE_TOLERANCE: f32 = 1e-5;
@@ -42,9 +43,14 @@ pub(crate) struct PatchSet {
 impl PatchSet {
     /// The patches of `kind` among `leaves`; degenerate ones (no area, non-finite) are left
     /// out, as no ray can hit them.
-    pub fn new(leaves: &[FlatLeaf], kind: PatchKind) -> Self {
+    /// Leaves with `skip[i]` set (the triangles of boxes) are left out too.
+    pub fn new(leaves: &[FlatLeaf], kind: PatchKind, skip: &[bool]) -> Self {
         let mut rows = Vec::new();
-        for (i, leaf) in leaves.iter().enumerate().filter(|(_, l)| l.kind == kind) {
+        for (i, leaf) in leaves
+            .iter()
+            .enumerate()
+            .filter(|&(i, l)| l.kind == kind && !skip[i])
+        {
             let n = leaf.e1.cross(leaf.e2);
             let to_world = Mat3A::from_cols(leaf.e1, leaf.e2, n);
             let det = to_world.determinant();
@@ -70,6 +76,120 @@ impl PatchSet {
         }
         Self { rows }
     }
+
+    pub fn len(&self) -> usize {
+        self.rows.len()
+    }
+}
+
+/// Marks a closest hit on box `leaf & !BOX_HIT` (resolved to its triangle by
+/// [`BoxSet::triangle_at`]).
+pub(crate) const BOX_HIT: u32 = 1 << 31;
+
+/// One box: rows of the world → box-space map ([−1, 1]³), one cache line.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(64))]
+struct BoxRow {
+    m: [f32; 12],
+}
+
+/// Parallelepipeds tested as boxes (slab test in box space, Kay & Kajiya 1986) instead of
+/// their 12 triangles: watertight by construction, ≈ 50 operations for all lanes.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct BoxSet {
+    rows: Vec<BoxRow>,
+    faces: Vec<[BoxFace; 6]>,
+}
+
+impl BoxSet {
+    pub fn new(boxes: &[FlatBox]) -> Self {
+        Self {
+            rows: boxes
+                .iter()
+                .map(|b| {
+                    let r = &b.world_to_box;
+                    BoxRow {
+                        m: [
+                            r[0][0], r[0][1], r[0][2], r[0][3], r[1][0], r[1][1], r[1][2], r[1][3],
+                            r[2][0], r[2][1], r[2][2], r[2][3],
+                        ],
+                    }
+                })
+                .collect(),
+            faces: boxes.iter().map(|b| b.faces).collect(),
+        }
+    }
+
+    /// The leaf (triangle) of box `index` at world point `p` on its surface: the face is
+    /// the box-space axis where |q| is largest, the triangle the one of that face's two
+    /// that holds q (2D edge functions).
+    pub fn len(&self) -> usize {
+        self.rows.len()
+    }
+
+    pub fn triangle_at(&self, index: usize, p: Vec3A) -> u32 {
+        let m = &self.rows[index].m;
+        let q = [0, 1, 2]
+            .map(|a| m[4 * a] * p.x + m[4 * a + 1] * p.y + m[4 * a + 2] * p.z + m[4 * a + 3]);
+        let axis = if q[0].abs() >= q[1].abs() && q[0].abs() >= q[2].abs() {
+            0
+        } else if q[1].abs() >= q[2].abs() {
+            1
+        } else {
+            2
+        };
+        let face = 2 * axis + usize::from(q[axis] > 0.0);
+        let (u, v) = match axis {
+            0 => (1, 2),
+            1 => (0, 2),
+            _ => (0, 1),
+        };
+        let x = Vec2::new(q[u], q[v]);
+        let [(first, [a, b, c]), (second, _)] = self.faces[index][face];
+        let edge = |p0: Vec2, p1: Vec2| (p1 - p0).perp_dot(x - p0);
+        let (e0, e1, e2) = (edge(a, b), edge(b, c), edge(c, a));
+        let inside = (e0 >= 0.0 && e1 >= 0.0 && e2 >= 0.0) || (e0 <= 0.0 && e1 <= 0.0 && e2 <= 0.0);
+        if inside {
+            first
+        } else {
+            second
+        }
+    }
+}
+
+/// Slab test of lane `l` against one box: (entry or exit t, its nearest crossing of the
+/// surface in `(t_min, t_max)` exists, the segment `(t_min, t_max)` crosses the surface).
+#[inline(always)]
+fn test_box<const N: usize>(
+    rays: &RayLanes<N>,
+    m: &[f32; 12],
+    t_max: &[f32; N],
+    l: usize,
+) -> (f32, bool, bool) {
+    let (ox, oy, oz) = (rays.o[0][l], rays.o[1][l], rays.o[2][l]);
+    let (dx, dy, dz) = (rays.d[0][l], rays.d[1][l], rays.d[2][l]);
+    let mut near = f32::NEG_INFINITY;
+    let mut far = f32::INFINITY;
+    for a in 0..3 {
+        let r = &m[4 * a..4 * a + 4];
+        let o = r[0] * ox + r[1] * oy + r[2] * oz + r[3];
+        let d = r[0] * dx + r[1] * dy + r[2] * dz;
+        let inv = 1.0 / d;
+        let t0 = (-1.0 - o) * inv;
+        let t1 = (1.0 - o) * inv;
+        near = near.max(t0.min(t1));
+        far = far.min(t0.max(t1));
+    }
+    let (t_min, t_end) = (rays.t_min[l], t_max[l]);
+    let crosses = near <= far;
+    let near_in = (near > t_min) & (near < t_end);
+    let far_in = (far > t_min) & (far < t_end);
+    let t = if near > t_min { near } else { far };
+    (
+        t,
+        crosses & (near_in | (!(near > t_min) & far_in)),
+        crosses & (near_in | far_in),
+    )
 }
 
 /// `N` rays, structure-of-arrays. A lane with `t_min = +∞` is idle: nothing can hit it.
@@ -141,16 +261,20 @@ fn closest_in_set<const N: usize, const PARALLELOGRAM: bool>(
     best_t: &mut [f32; N],
     best_leaf: &mut [u32; N],
 ) {
+    // Local copies, written back once: through the references LLVM keeps them in memory,
+    // and each patch's masked store then stalls the next patch's compare.
+    let (mut t_best, mut leaf_best) = (*best_t, *best_leaf);
     for row in &set.rows {
         // A local, not `row.leaf` in the select: LLVM would select between the two
         // addresses and gather.
         let leaf = row.leaf;
         for l in 0..N {
-            let (t, hit) = test_patch::<N, PARALLELOGRAM>(rays, &row.m, best_t, l);
-            best_t[l] = if hit { t } else { best_t[l] };
-            best_leaf[l] = if hit { leaf } else { best_leaf[l] };
+            let (t, hit) = test_patch::<N, PARALLELOGRAM>(rays, &row.m, &t_best, l);
+            t_best[l] = if hit { t } else { t_best[l] };
+            leaf_best[l] = if hit { leaf } else { leaf_best[l] };
         }
     }
+    (*best_t, *best_leaf) = (t_best, leaf_best);
 }
 
 /// Per lane the closest hit in `(t_min, t_max)`: (t, leaf index), leaf `u32::MAX` for a
@@ -159,13 +283,33 @@ fn closest_in_set<const N: usize, const PARALLELOGRAM: bool>(
 pub(crate) fn closest<const N: usize>(
     triangles: &PatchSet,
     parallelograms: &PatchSet,
+    boxes: &BoxSet,
     rays: &RayLanes<N>,
 ) -> ([f32; N], [u32; N]) {
     let mut best_t = rays.t_max;
     let mut best_leaf = [u32::MAX; N];
     closest_in_set::<N, true>(parallelograms, rays, &mut best_t, &mut best_leaf);
     closest_in_set::<N, false>(triangles, rays, &mut best_t, &mut best_leaf);
-    (best_t, best_leaf)
+    let (mut t_best, mut leaf_best) = (best_t, best_leaf);
+    for (k, row) in boxes.rows.iter().enumerate() {
+        let tag = BOX_HIT | k as u32;
+        for l in 0..N {
+            let (t, hit, _) = test_box(rays, &row.m, &t_best, l);
+            t_best[l] = if hit { t } else { t_best[l] };
+            leaf_best[l] = if hit { tag } else { leaf_best[l] };
+        }
+    }
+    for l in 0..N {
+        if leaf_best[l] != u32::MAX && leaf_best[l] & BOX_HIT != 0 {
+            let p = Vec3A::new(
+                rays.o[0][l] + t_best[l] * rays.d[0][l],
+                rays.o[1][l] + t_best[l] * rays.d[1][l],
+                rays.o[2][l] + t_best[l] * rays.d[2][l],
+            );
+            leaf_best[l] = boxes.triangle_at((leaf_best[l] & !BOX_HIT) as usize, p);
+        }
+    }
+    (t_best, leaf_best)
 }
 
 #[inline(always)]
@@ -174,18 +318,21 @@ fn any_in_set<const N: usize, const PARALLELOGRAM: bool>(
     rays: &RayLanes<N>,
     occluded: &mut [bool; N],
 ) -> bool {
+    let mut blocked = *occluded;
+    let mut all = false;
     for row in &set.rows {
-        let mut all = true;
+        all = true;
         for l in 0..N {
             let (_, hit) = test_patch::<N, PARALLELOGRAM>(rays, &row.m, &rays.t_max, l);
-            occluded[l] |= hit;
-            all &= occluded[l];
+            blocked[l] |= hit;
+            all &= blocked[l];
         }
         if all {
-            return true;
+            break;
         }
     }
-    false
+    *occluded = blocked;
+    all
 }
 
 /// Per lane whether anything lies in `(t_min, t_max)`; idle lanes report `true` (there is
@@ -194,6 +341,7 @@ fn any_in_set<const N: usize, const PARALLELOGRAM: bool>(
 pub(crate) fn occluded<const N: usize>(
     triangles: &PatchSet,
     parallelograms: &PatchSet,
+    boxes: &BoxSet,
     rays: &RayLanes<N>,
 ) -> [bool; N] {
     let mut occluded = [false; N];
@@ -201,7 +349,20 @@ pub(crate) fn occluded<const N: usize>(
         let active = rays.t_min[l] < rays.t_max[l];
         occluded[l] = !active;
     }
-    if !any_in_set::<N, true>(parallelograms, rays, &mut occluded) {
+    // Boxes first: the likeliest blockers of a room's shadow rays.
+    let mut all = false;
+    for row in &boxes.rows {
+        all = true;
+        for l in 0..N {
+            let (_, _, crosses) = test_box(rays, &row.m, &rays.t_max, l);
+            occluded[l] |= crosses;
+            all &= occluded[l];
+        }
+        if all {
+            break;
+        }
+    }
+    if !all && !any_in_set::<N, true>(parallelograms, rays, &mut occluded) {
         any_in_set::<N, false>(triangles, rays, &mut occluded);
     }
     occluded

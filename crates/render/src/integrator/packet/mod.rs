@@ -23,6 +23,7 @@
 //! otherwise); `RenderScene::set_packet_tracing` turns it off (tests, comparisons).
 
 mod intersect;
+mod shade;
 mod trace;
 
 pub(crate) use trace::{render_tile, TileJob};
@@ -30,9 +31,13 @@ pub(crate) use trace::{render_tile, TileJob};
 use glam::{Vec2, Vec3A};
 use prism_geometry::{Frame, PatchKind};
 
-use intersect::PatchSet;
+use intersect::{BoxSet, PatchSet};
+
+use prism_spectrum::Spectrum;
 
 use crate::integrator::Integrator;
+use crate::light::area::{AreaLight, AreaShape};
+use crate::light::Light;
 use crate::material::Material;
 use crate::scene_build::RenderScene;
 
@@ -47,6 +52,19 @@ struct LeafShading {
     material_id: u32,
     /// The area light this patch's instance carries.
     light: Option<u32>,
+}
+
+/// A rectangle emitter as the lanes sample it (`light::area::RectangleEmitter`).
+#[derive(Clone, Debug)]
+struct RectangleLight {
+    /// `to_world`'s linear columns x, y, z and its translation.
+    axes: [Vec3A; 4],
+    half_width_m: f32,
+    half_height_m: f32,
+    normal: Vec3A,
+    inv_area_m2: f32,
+    two_sided: bool,
+    radiance: Spectrum,
 }
 
 /// Which lane width runs (tests compare them; renders use `Auto`).
@@ -66,7 +84,11 @@ pub(crate) enum Kernel {
 pub struct PacketScene {
     triangles: PatchSet,
     parallelograms: PatchSet,
+    boxes: BoxSet,
     leaves: Vec<LeafShading>,
+    /// Per light of the scene's `LightSet`: its rectangle form, or `None` for lights the
+    /// scalar `Light` code samples.
+    lights: Vec<Option<RectangleLight>>,
     kernel: Kernel,
 }
 
@@ -117,17 +139,55 @@ impl PacketScene {
                 light: scene.lights.area_light_of_instance(r.instance_id),
             });
         }
+        let lights = scene
+            .lights
+            .lights()
+            .iter()
+            .map(|light| match light {
+                Light::Area(AreaLight {
+                    shape: AreaShape::Rectangle(r),
+                    radiance,
+                    two_sided,
+                }) if r.area_m2() > 0.0 => {
+                    let m = r.to_world.matrix();
+                    Some(RectangleLight {
+                        axes: [m.x_axis, m.y_axis, m.z_axis, m.w_axis].map(Vec3A::from_vec4),
+                        half_width_m: r.rectangle.half_width_m,
+                        half_height_m: r.rectangle.half_height_m,
+                        normal: r.normal(),
+                        inv_area_m2: 1.0 / r.area_m2() as f32,
+                        two_sided: *two_sided,
+                        radiance: radiance.clone(),
+                    })
+                }
+                _ => None,
+            })
+            .collect();
+        let flat_boxes = scene.geometry.flat_boxes(&flat);
+        let mut in_box = vec![false; flat.len()];
+        for b in &flat_boxes {
+            for &(leaf, _) in b.faces.iter().flatten() {
+                in_box[leaf as usize] = true;
+            }
+        }
         Ok(Self {
-            triangles: PatchSet::new(&flat, PatchKind::Triangle),
-            parallelograms: PatchSet::new(&flat, PatchKind::Parallelogram),
+            triangles: PatchSet::new(&flat, PatchKind::Triangle, &in_box),
+            parallelograms: PatchSet::new(&flat, PatchKind::Parallelogram, &in_box),
+            boxes: BoxSet::new(&flat_boxes),
             leaves,
+            lights,
             kernel: Kernel::Auto,
         })
     }
 
-    /// Number of patches.
+    /// Patches tested one by one (triangles and parallelograms not in a box).
     pub fn patch_count(&self) -> usize {
-        self.leaves.len()
+        self.triangles.len() + self.parallelograms.len()
+    }
+
+    /// Parallelepipeds tested as boxes.
+    pub fn box_count(&self) -> usize {
+        self.boxes.len()
     }
 }
 

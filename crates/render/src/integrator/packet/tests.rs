@@ -155,6 +155,8 @@ fn packet_ray_queries_agree_with_the_scenes_own() {
     use prism_geometry::Ray;
     let scene = cornell(8);
     let packet = scene.packet.as_ref().unwrap();
+    // The two cuboids are tested as boxes, the five walls and the light as patches.
+    assert_eq!((packet.box_count(), packet.patch_count()), (2, 6));
     // A fixed pseudo-random set of rays from points inside the box (hash of the index).
     let unit = |i: u64, k: u64| {
         let h = crate::sampler::hash::mix64(i.wrapping_mul(0x9e37_79b9_7f4a_7c15) ^ k);
@@ -191,8 +193,18 @@ fn packet_ray_queries_agree_with_the_scenes_own() {
             );
             scalar.push((ray, shadow_ray));
         }
-        let (t, leaf) = closest(&packet.triangles, &packet.parallelograms, &rays);
-        let blocked = occluded(&packet.triangles, &packet.parallelograms, &shadow);
+        let (t, leaf) = closest(
+            &packet.triangles,
+            &packet.parallelograms,
+            &packet.boxes,
+            &rays,
+        );
+        let blocked = occluded(
+            &packet.triangles,
+            &packet.parallelograms,
+            &packet.boxes,
+            &shadow,
+        );
         for (l, (ray, shadow_ray)) in scalar.iter().enumerate() {
             total += 1;
             let expected = scene.geometry.intersect(ray);
@@ -232,7 +244,12 @@ fn packet_ray_queries_agree_with_the_scenes_own() {
         let ray = Ray::spawn(o, d);
         let mut rays = RayLanes::<8>::idle();
         rays.set(0, ray.origin, ray.direction, ray.t_min, ray.t_max);
-        let (_, leaf) = closest(&packet.triangles, &packet.parallelograms, &rays);
+        let (_, leaf) = closest(
+            &packet.triangles,
+            &packet.parallelograms,
+            &packet.boxes,
+            &rays,
+        );
         if let (Some(h), Some(s)) = (
             scene.geometry.intersect(&ray),
             packet.leaves.get(leaf[0] as usize),

@@ -11,6 +11,7 @@ use prism_geometry::Ray;
 use prism_spectrum::{SampledSpectrum, SampledWavelengths};
 
 use super::intersect::{closest, occluded, RayLanes};
+use super::shade::{shade, VertexIn, VertexOut, LIGHT_GIVEN, LIGHT_NONE, LIGHT_RECTANGLE};
 use super::{Kernel, PacketScene};
 use crate::film::xyz::XyzWeights;
 use crate::film::FilmTile;
@@ -19,7 +20,6 @@ use crate::integrator::path::{mis_weight, FirstHit, PathCounters, PathTracer};
 use crate::light::{LightHit, LightSampleContext};
 use crate::material::Material;
 use crate::sampler::{PixelSampler, SampleStream};
-use crate::sampling::sample_cosine_hemisphere;
 use crate::scene_build::RenderScene;
 use crate::spectrum_cache::SpectrumCache;
 
@@ -80,6 +80,8 @@ struct Lane {
     prev_bsdf_pdf: f32,
     le_cache: SpectrumCache,
     reflectance_cache: SpectrumCache,
+    /// Geometric normal of the current vertex (for the next emission hit's MIS).
+    n_geometric: Vec3A,
     pending: Option<PendingLight>,
     /// The path ends once its pending light sample is resolved.
     ends: bool,
@@ -195,6 +197,8 @@ fn render_tile_lanes<const N: usize>(
     let mut lanes: [Option<Lane>; N] = [None; N];
     let mut rays = RayLanes::<N>::idle();
     let mut shadow = RayLanes::<N>::idle();
+    let mut vertex = VertexIn::<N>::new();
+    let mut shaded = VertexOut::<N>::new();
     let mut queue_empty = false;
     loop {
         // Fill idle lanes with the tile's next camera samples.
@@ -214,32 +218,56 @@ fn render_tile_lanes<const N: usize>(
         if lanes.iter().all(Option::is_none) {
             break;
         }
-        let (hit_t, hit_leaf) = closest(&packet.triangles, &packet.parallelograms, &rays);
+        let (hit_t, hit_leaf) = closest(
+            &packet.triangles,
+            &packet.parallelograms,
+            &packet.boxes,
+            &rays,
+        );
         for l in 0..N {
             shadow.clear(l);
+            vertex.active[l] = false;
+            if let Some(lane) = &mut lanes[l] {
+                let origin = Vec3A::new(rays.o[0][l], rays.o[1][l], rays.o[2][l]);
+                if !begin_vertex(
+                    job,
+                    lane,
+                    origin,
+                    hit_t[l],
+                    hit_leaf[l],
+                    &mut vertex,
+                    l,
+                    counters,
+                ) {
+                    lane.ends = true;
+                    rays.clear(l);
+                }
+            }
+        }
+        shade(&vertex, job.tracer.mis, &mut shaded);
+        for l in 0..N {
             let Some(lane) = &mut lanes[l] else {
                 continue;
             };
-            let origin = Vec3A::new(rays.o[0][l], rays.o[1][l], rays.o[2][l]);
-            let next = scatter(
-                job,
-                lane,
-                origin,
-                hit_t[l],
-                hit_leaf[l],
-                &mut shadow,
-                l,
-                counters,
-            );
-            match next {
-                Some(ray) => rays.set(l, ray.origin, ray.direction, ray.t_min, ray.t_max),
+            if !vertex.active[l] {
+                continue;
+            }
+            match end_vertex(job, lane, &shaded, &mut shadow, l, counters) {
+                Some((origin, direction, t_min)) => {
+                    rays.set(l, origin, direction, t_min, f32::INFINITY)
+                }
                 None => {
                     lane.ends = true;
                     rays.clear(l);
                 }
             }
         }
-        let blocked = occluded(&packet.triangles, &packet.parallelograms, &shadow);
+        let blocked = occluded(
+            &packet.triangles,
+            &packet.parallelograms,
+            &packet.boxes,
+            &shadow,
+        );
         for l in 0..N {
             let Some(lane) = &mut lanes[l] else {
                 continue;
@@ -311,6 +339,7 @@ fn start_lane(
         prev_bsdf_pdf: 0.0,
         le_cache: SpectrumCache::new(),
         reflectance_cache: SpectrumCache::new(),
+        n_geometric: Vec3A::ZERO,
         pending: None,
         ends: false,
     };
@@ -343,21 +372,22 @@ fn add(lane: &mut Lane, x: SampledSpectrum, count_incident: bool, counters: &mut
     }
 }
 
-/// One path vertex after the closest-hit query: emission, next-event estimation (its
-/// shadow ray into `shadow`, its contribution left pending), BSDF sampling and roulette.
-/// Returns the next ray, or `None` when the path ends after the pending light sample.
+/// A vertex's scalar part before the lanes are shaded together: the escape to infinite
+/// lights, the first-hit record, emission, the depth limit, the vertex's sample dimensions,
+/// the material's and light's spectra and the light choice (as the scalar tracer). Fills
+/// lane `l` of `vertex`; `false` when the path ends here.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn scatter<const N: usize>(
+fn begin_vertex<const N: usize>(
     job: &TileJob,
     lane: &mut Lane,
     origin: Vec3A,
     hit_t: f32,
     hit_leaf: u32,
-    shadow: &mut RayLanes<N>,
+    vertex: &mut VertexIn<N>,
     l: usize,
     counters: &mut PathCounters,
-) -> Option<Ray> {
+) -> bool {
     let scene = job.scene;
     let tracer = job.tracer;
     let lights = &scene.lights;
@@ -380,9 +410,14 @@ fn scatter<const N: usize>(
             let count = lane.depth >= 2;
             add(lane, le * w, count, counters);
         }
-        return None;
+        return false;
     };
-    let p = origin + hit_t * direction;
+    // The same bits as `shade`'s hit point.
+    let p = Vec3A::new(
+        origin.x + hit_t * direction.x,
+        origin.y + hit_t * direction.y,
+        origin.z + hit_t * direction.z,
+    );
     if lane.first_hit.is_none() {
         lane.first_hit = Some(FirstHit {
             t: hit_t,
@@ -421,10 +456,11 @@ fn scatter<const N: usize>(
         }
     }
     if lane.depth == tracer.max_depth {
-        return None;
+        return false;
     }
     lane.depth += 1;
     counters.bounces += 1;
+    lane.n_geometric = leaf.n_geometric;
 
     let Material::Lambert { reflectance } = scene.material(leaf.material_id) else {
         unreachable!("PacketScene::new admits constant Lambertian materials only");
@@ -437,124 +473,149 @@ fn scatter<const N: usize>(
         .get(leaf.material_id, constant, &wavelengths)
         * std::f32::consts::FRAC_1_PI;
     let frame = leaf.frame;
-    let wo_local = frame.to_local(-direction);
-    let ctx = LightSampleContext {
-        p,
-        n: leaf.n_geometric,
+    for a in 0..3 {
+        vertex.o[a][l] = origin[a];
+        vertex.d[a][l] = direction[a];
+        vertex.fx[a][l] = frame.x[a];
+        vertex.fy[a][l] = frame.y[a];
+        vertex.fz[a][l] = frame.z[a];
+    }
+    vertex.t[l] = hit_t;
+    for k in 0..4 {
+        vertex.beta[k][l] = lane.beta[k];
+        vertex.f_lambert[k][l] = f_lambert[k];
+    }
+    let u_bsdf = lane.stream.get_2d_at(d_bsdf);
+    vertex.u_bsdf[0][l] = u_bsdf.x;
+    vertex.u_bsdf[1][l] = u_bsdf.y;
+    vertex.roulette[l] = lane.depth >= tracer.rr_depth;
+    vertex.u_roulette[l] = if vertex.roulette[l] {
+        lane.stream.get_1d_at(d_roulette)
+    } else {
+        1.0
     };
-
-    // Next-event estimation (one light sample: `PacketScene` runs plans of one per hit).
     let record_white = job.want_illumination && lane.depth == 1;
+    vertex.record_white[l] = record_white;
+    vertex.light_kind[l] = LIGHT_NONE;
+
+    // The light choice (one light sample per hit: `PacketScene` runs such plans only).
     if !lights.is_empty() {
+        if record_white {
+            lane.illumination_direct = Some(SampledSpectrum::splat(0.0));
+        }
         let uc = lane
             .stream
             .get_1d_at(d_light_choice)
             .min(1.0 - f32::EPSILON);
         let ul = lane.stream.get_2d_at(d_light);
-        if record_white {
-            lane.illumination_direct = Some(SampledSpectrum::splat(0.0));
-        }
         if let Some((li, pmf)) = lights.sample(uc) {
-            let light = lights.light(li);
-            if let Some(ls) = light.sample_li_cached(li, &ctx, ul, &wavelengths, &mut lane.le_cache)
-            {
-                if ls.pdf > 0.0 && !ls.radiance.is_black() {
-                    let wi_local = frame.to_local(ls.wi);
-                    let upper = wo_local.z > 0.0 && wi_local.z > 0.0;
-                    let f = if upper {
-                        f_lambert
-                    } else {
-                        SampledSpectrum::splat(0.0)
-                    } * wi_local.z.abs();
-                    let white_cos = if record_white {
-                        wi_local.z.max(0.0) * std::f32::consts::FRAC_1_PI
-                    } else {
-                        0.0
+            vertex.pmf[l] = pmf;
+            vertex.u_light[0][l] = ul.x;
+            vertex.u_light[1][l] = ul.y;
+            match &job.packet.lights[li as usize] {
+                Some(rect) => {
+                    let le = lane.le_cache.get(li, &rect.radiance, &wavelengths);
+                    for k in 0..4 {
+                        vertex.le[k][l] = le[k];
+                    }
+                    for a in 0..3 {
+                        vertex.rx[a][l] = rect.axes[0][a];
+                        vertex.ry[a][l] = rect.axes[1][a];
+                        vertex.rz[a][l] = rect.axes[2][a];
+                        vertex.rt[a][l] = rect.axes[3][a];
+                        vertex.rn[a][l] = rect.normal[a];
+                    }
+                    vertex.half_w[l] = rect.half_width_m;
+                    vertex.half_h[l] = rect.half_height_m;
+                    vertex.inv_area[l] = rect.inv_area_m2;
+                    vertex.two_sided[l] = rect.two_sided;
+                    vertex.light_kind[l] = LIGHT_RECTANGLE;
+                }
+                None => {
+                    let ctx = LightSampleContext {
+                        p,
+                        n: leaf.n_geometric,
                     };
-                    if !(f.is_black() && white_cos <= 0.0) {
-                        counters.rays += 1;
-                        let shadow_ray = if ls.distance_m.is_finite() {
-                            Ray::spawn_to(p, ls.p_light)
-                        } else {
-                            Ray::spawn(p, ls.wi)
-                        };
-                        shadow.set(
-                            l,
-                            shadow_ray.origin,
-                            shadow_ray.direction,
-                            shadow_ray.t_min,
-                            shadow_ray.t_max,
-                        );
-                        let light_pdf = pmf * ls.pdf;
-                        let w = if ls.delta {
-                            1.0
-                        } else {
-                            let bsdf_pdf = if upper {
-                                wi_local.z * std::f32::consts::FRAC_1_PI
-                            } else {
-                                0.0
-                            };
-                            mis_weight(tracer.mis, light_pdf, bsdf_pdf)
-                        };
-                        let contribution = lane.beta * (f * ls.radiance * (w / light_pdf));
-                        lane.pending = Some(PendingLight {
-                            contribution,
-                            incident: lane.first_bounce_beta.map(|b1| contribution.safe_div(b1)),
-                            white: ls.radiance * (white_cos / light_pdf),
-                            record_white,
-                        });
+                    let light = lights.light(li);
+                    if let Some(ls) =
+                        light.sample_li_cached(li, &ctx, ul, &wavelengths, &mut lane.le_cache)
+                    {
+                        for k in 0..4 {
+                            vertex.le[k][l] = ls.radiance[k];
+                        }
+                        for a in 0..3 {
+                            vertex.given_p[a][l] = ls.p_light[a];
+                            vertex.given_wi[a][l] = ls.wi[a];
+                        }
+                        vertex.given_pdf[l] = ls.pdf;
+                        vertex.given_distance[l] = ls.distance_m;
+                        vertex.given_delta[l] = ls.delta;
+                        vertex.light_kind[l] = LIGHT_GIVEN;
                     }
                 }
             }
         }
     }
+    vertex.active[l] = true;
+    true
+}
 
-    // Continue by cosine-weighted sampling of the Lambertian lobe (`Lambert::sample`).
-    if wo_local.z <= 0.0 {
+/// A vertex's scalar part after the lanes were shaded: its shadow ray and pending light
+/// contribution, the path's new state, statistics. The next ray (origin, unit direction,
+/// t_min), or `None` when the path ends after the pending light sample.
+#[inline(always)]
+fn end_vertex<const N: usize>(
+    job: &TileJob,
+    lane: &mut Lane,
+    out: &VertexOut<N>,
+    shadow: &mut RayLanes<N>,
+    l: usize,
+    counters: &mut PathCounters,
+) -> Option<(Vec3A, Vec3A, f32)> {
+    let p = Vec3A::new(out.p[0][l], out.p[1][l], out.p[2][l]);
+    let spectrum = |a: &[[f32; N]; 4]| SampledSpectrum::from([a[0][l], a[1][l], a[2][l], a[3][l]]);
+    if out.has_shadow[l] {
+        counters.rays += 1;
+        let d = Vec3A::new(out.shadow_d[0][l], out.shadow_d[1][l], out.shadow_d[2][l]);
+        shadow.set(l, p, d, out.shadow_t_min[l], out.shadow_t_max[l]);
+        let contribution = spectrum(&out.contribution);
+        lane.pending = Some(PendingLight {
+            contribution,
+            incident: lane.first_bounce_beta.map(|b1| contribution.safe_div(b1)),
+            white: spectrum(&out.white),
+            record_white: job.want_illumination && lane.depth == 1,
+        });
+    }
+    if out.weight_non_finite[l] {
+        counters.non_finite_contributions += 1;
+    }
+    let goes_on = out.continues[l] || out.killed_by_roulette[l];
+    if !goes_on {
         return None;
     }
-    let wi = sample_cosine_hemisphere(lane.stream.get_2d_at(d_bsdf));
-    let pdf = if wi.z > 0.0 {
-        wi.z * std::f32::consts::FRAC_1_PI
-    } else {
-        0.0
-    };
-    if wi.z <= 0.0 || pdf.is_nan() || pdf <= 0.0 {
-        return None;
-    }
-    let weight = f_lambert * (wi.z.abs() / pdf);
-    let wi_world = frame.from_local(wi);
-    if weight.is_black() || weight.has_non_finite() {
-        if weight.has_non_finite() {
-            counters.non_finite_contributions += 1;
-        }
-        return None;
-    }
-    lane.beta *= weight;
     if lane.depth == 1 && job.want_illumination {
-        let white_weight = wi.z.max(0.0) * std::f32::consts::FRAC_1_PI / pdf;
+        let white_weight = out.wi_z[l].max(0.0) * std::f32::consts::FRAC_1_PI / out.pdf[l];
         lane.first_bounce_beta = if white_weight <= 0.0 {
             None
         } else {
-            Some(weight * (1.0 / white_weight.max(1e-20)))
+            Some(spectrum(&out.weight) * (1.0 / white_weight.max(1e-20)))
         };
     }
     lane.specular_bounce = false;
-    lane.prev_bsdf_pdf = pdf;
-    lane.prev_ctx = ctx;
-    let ray = Ray::spawn(p, wi_world.normalize());
-    lane.direction = ray.direction;
+    lane.prev_bsdf_pdf = out.pdf[l];
+    lane.prev_ctx = LightSampleContext {
+        p,
+        n: lane.n_geometric,
+    };
     counters.rays += 1;
-
-    if lane.depth >= tracer.rr_depth {
-        let q = (1.0 - lane.beta.max_component()).max(0.0);
-        if lane.stream.get_1d_at(d_roulette) < q {
-            counters.roulette_terminations += 1;
-            return None;
-        }
-        lane.beta *= 1.0 / (1.0 - q);
+    if out.killed_by_roulette[l] {
+        counters.roulette_terminations += 1;
+        return None;
     }
-    Some(ray)
+    lane.beta = spectrum(&out.beta);
+    let direction = Vec3A::new(out.next_d[0][l], out.next_d[1][l], out.next_d[2][l]);
+    lane.direction = direction;
+    Some((p, direction, out.next_t_min[l]))
 }
 
 /// The camera sample's value into the film (the scalar driver's steps after `radiance`).

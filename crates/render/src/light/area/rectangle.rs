@@ -33,6 +33,11 @@ impl RectangleEmitter {
         f64::from(self.area_m2)
     }
 
+    /// The world unit normal (the side a one-sided emitter lights).
+    pub fn normal(&self) -> Vec3A {
+        self.normal
+    }
+
     #[inline]
     pub fn sample(&self, reference: Vec3A, u: Vec2) -> Option<ShapeSample> {
         if self.area_m2 <= 0.0 {
