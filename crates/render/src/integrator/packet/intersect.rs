@@ -184,10 +184,11 @@ fn test_box<const N: usize>(
     let crosses = near <= far;
     let near_in = (near > t_min) & (near < t_end);
     let far_in = (far > t_min) & (far < t_end);
-    let t = if near > t_min { near } else { far };
+    let enters = near > t_min;
+    let t = if enters { near } else { far };
     (
         t,
-        crosses & (near_in | (!(near > t_min) & far_in)),
+        crosses & (near_in | (!enters & far_in)),
         crosses & (near_in | far_in),
     )
 }
