@@ -22,7 +22,7 @@
 //! Values lie in [0, 1) with 24 bits, never 1.
 
 pub(crate) mod hash;
-mod independent;
+pub(crate) mod independent;
 mod sobol;
 
 use glam::{UVec2, Vec2};
@@ -192,6 +192,13 @@ impl SampleStream {
         let p = self.get_2d_at(self.dimension);
         self.dimension += 2;
         p
+    }
+
+    /// The key of an independent stream's values (`independent::value(key, dimension)` is
+    /// `bits` of `get_1d_at(dimension)`), for callers that hash many streams at once; `None`
+    /// for a Sobol stream.
+    pub(crate) fn independent_key(&self) -> Option<u64> {
+        (self.kind == SamplerKind::Independent).then_some(self.tail_key)
     }
 
     /// Dimensions used so far.

@@ -8,17 +8,30 @@ use crate::integrator::{render, RenderSettings, RenderStats};
 use crate::sampler::SamplerKind;
 use crate::FilmImage;
 
-fn cornell(resolution: u32) -> RenderScene {
+fn cornell_with(resolution: u32, extra_light: Option<&str>) -> RenderScene {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
-    let description = prism_scene::load_scene(root.join("scenes/cornell-box.json")).unwrap();
+    let path = root.join("scenes/cornell-box.json");
+    let mut text = std::fs::read_to_string(&path).unwrap();
+    if let Some(light) = extra_light {
+        text = text.replacen("\"lights\": [", &format!("\"lights\": [{light},"), 1);
+    }
+    let description = prism_scene::parse_scene_str(&text, &path).unwrap();
     RenderScene::build(&description, Some(glam::UVec2::splat(resolution))).unwrap()
 }
 
+fn cornell(resolution: u32) -> RenderScene {
+    cornell_with(resolution, None)
+}
+
 fn settings(spp: u32) -> RenderSettings {
+    settings_with(spp, SamplerKind::Independent)
+}
+
+fn settings_with(spp: u32, sampler: SamplerKind) -> RenderSettings {
     RenderSettings {
         spp,
         seed: 7,
-        sampler: SamplerKind::Independent,
+        sampler,
         illumination_aov: true,
         ..RenderSettings::default()
     }
@@ -37,19 +50,42 @@ fn max_relative_difference(a: &[f32], b: &[f32]) -> f64 {
         .fold(0.0, f64::max)
 }
 
-fn render_both(resolution: u32, spp: u32) -> ((FilmImage, RenderStats), (FilmImage, RenderStats)) {
-    let mut scene = cornell(resolution);
-    assert!(scene.packet.is_some(), "the Cornell box qualifies");
-    let packet = render(&scene, &settings(spp), &|_| {});
+fn render_both(
+    mut scene: RenderScene,
+    settings: &RenderSettings,
+) -> ((FilmImage, RenderStats), (FilmImage, RenderStats)) {
+    assert!(scene.packet.is_some(), "the scene qualifies");
+    let packet = render(&scene, settings, &|_| {});
     scene.set_packet_tracing(false);
     assert!(scene.packet.is_none());
-    let scalar = render(&scene, &settings(spp), &|_| {});
+    let scalar = render(&scene, settings, &|_| {});
     (packet, scalar)
 }
 
 #[test]
 fn packet_tracer_gives_the_scalar_tracers_image_sample_for_sample() {
-    let ((packet, ps), (scalar, ss)) = render_both(48, 8);
+    agrees_with_the_scalar_tracer(cornell(48), &settings(8));
+}
+
+/// Sobol streams draw their variates per lane, not hashed for all lanes at once.
+#[test]
+fn packet_tracer_agrees_with_the_sobol_sampler() {
+    agrees_with_the_scalar_tracer(cornell(40), &settings_with(8, SamplerKind::Sobol));
+}
+
+/// A point light besides the rectangle: light choice by power, the point light sampled by
+/// the scalar `Light` code (a delta light, MIS weight 1) and shaded with the lanes.
+#[test]
+fn packet_tracer_agrees_with_a_point_light_beside_the_rectangle() {
+    let point = r#"{"type": "point", "position_m": [0.3, 0.6, 0.2], "power_lm": 40,
+                    "spectrum": {"blackbody_k": 3000}}"#;
+    let scene = cornell_with(40, Some(point));
+    assert_eq!(scene.lights.len(), 2);
+    agrees_with_the_scalar_tracer(scene, &settings(8));
+}
+
+fn agrees_with_the_scalar_tracer(scene: RenderScene, settings: &RenderSettings) {
+    let ((packet, ps), (scalar, ss)) = render_both(scene, settings);
     assert_eq!(ps.samples, ss.samples);
     assert_eq!(ps.non_finite_samples + ps.non_finite_contributions, 0);
     // Rays, bounces and roulette differ only by the few paths that part at an edge.

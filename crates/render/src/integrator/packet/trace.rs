@@ -19,6 +19,8 @@ use crate::film::SurfaceAov;
 use crate::integrator::path::{mis_weight, FirstHit, PathCounters, PathTracer};
 use crate::light::{LightHit, LightSampleContext};
 use crate::material::Material;
+use crate::sampler::hash::u32_to_unit_f32;
+use crate::sampler::independent;
 use crate::sampler::{PixelSampler, SampleStream};
 use crate::scene_build::RenderScene;
 use crate::spectrum_cache::SpectrumCache;
@@ -199,6 +201,7 @@ fn render_tile_lanes<const N: usize>(
     let mut shadow = RayLanes::<N>::idle();
     let mut vertex = VertexIn::<N>::new();
     let mut shaded = VertexOut::<N>::new();
+    let mut variates = Variates::<N>::new();
     let mut queue_empty = false;
     loop {
         // Fill idle lanes with the tile's next camera samples.
@@ -236,12 +239,19 @@ fn render_tile_lanes<const N: usize>(
                     hit_t[l],
                     hit_leaf[l],
                     &mut vertex,
+                    &mut variates,
                     l,
                     counters,
                 ) {
                     lane.ends = true;
                     rays.clear(l);
                 }
+            }
+        }
+        draw_variates(&mut variates);
+        for l in 0..N {
+            if let (Some(lane), true) = (&mut lanes[l], vertex.active[l]) {
+                choose_light(job, lane, &mut vertex, &variates, l);
             }
         }
         shade(&vertex, job.tracer.mis, &mut shaded);
@@ -372,6 +382,134 @@ fn add(lane: &mut Lane, x: SampledSpectrum, count_incident: bool, counters: &mut
     }
 }
 
+/// Offsets of a vertex's variates in its 8 reserved dimensions (`integrator::path` module
+/// docs: mask 0, light choice 1, light position 2–3, lobe 4, direction 5–6, roulette 7).
+const DIM_LIGHT_CHOICE: u32 = 1;
+const DIM_LIGHT: u32 = 2;
+const DIM_BSDF: u32 = 5;
+const DIM_ROULETTE: u32 = 7;
+/// The dimension offset of each entry of `Variates::u`.
+const VARIATE_OFFSETS: [u32; 6] = [
+    DIM_LIGHT_CHOICE,
+    DIM_LIGHT,
+    DIM_LIGHT + 1,
+    DIM_BSDF,
+    DIM_BSDF + 1,
+    DIM_ROULETTE,
+];
+
+/// The variates of one vertex per lane: light choice, light position (2), BSDF direction
+/// (2), roulette — the values `SampleStream::get_1d_at` gives at those dimensions.
+struct Variates<const N: usize> {
+    key: [u64; N],
+    first_dimension: [u32; N],
+    /// Independent stream: `u` is hashed from `key` by `draw_variates`; else drawn already.
+    hashed: [bool; N],
+    u: [[f32; N]; 6],
+}
+
+impl<const N: usize> Variates<N> {
+    fn new() -> Self {
+        Self {
+            key: [0; N],
+            first_dimension: [0; N],
+            hashed: [false; N],
+            u: [[0.0; N]; 6],
+        }
+    }
+}
+
+/// The independent sampler's values (`independent::value`, SplitMix64) for every hashed
+/// lane at once: a loop over lanes of 64-bit multiplies, vector code with AVX-512.
+#[inline(always)]
+fn draw_variates<const N: usize>(v: &mut Variates<N>) {
+    for (k, &offset) in VARIATE_OFFSETS.iter().enumerate() {
+        for l in 0..N {
+            let bits = independent::value(v.key[l], v.first_dimension[l] + offset);
+            let u = u32_to_unit_f32(bits);
+            v.u[k][l] = if v.hashed[l] { u } else { v.u[k][l] };
+        }
+    }
+}
+
+/// A vertex's light choice and, for lights that are not rectangles, its light sample by
+/// the scalar `Light` code (after `draw_variates`).
+#[inline(always)]
+fn choose_light<const N: usize>(
+    job: &TileJob,
+    lane: &mut Lane,
+    vertex: &mut VertexIn<N>,
+    variates: &Variates<N>,
+    l: usize,
+) {
+    let lights = &job.scene.lights;
+    let u = &variates.u;
+    for (k, row) in [(3, 0), (4, 1)] {
+        vertex.u_bsdf[row][l] = u[k][l];
+    }
+    vertex.u_roulette[l] = if vertex.roulette[l] { u[5][l] } else { 1.0 };
+    if lights.is_empty() {
+        return;
+    }
+    let wavelengths = lane.wavelengths;
+    let uc = u[0][l].min(1.0 - f32::EPSILON);
+    let ul = glam::Vec2::new(u[1][l], u[2][l]);
+    let Some((li, pmf)) = lights.sample(uc) else {
+        return;
+    };
+    vertex.pmf[l] = pmf;
+    vertex.u_light[0][l] = ul.x;
+    vertex.u_light[1][l] = ul.y;
+    match &job.packet.lights[li as usize] {
+        Some(rect) => {
+            let le = lane.le_cache.get(li, &rect.radiance, &wavelengths);
+            for k in 0..4 {
+                vertex.le[k][l] = le[k];
+            }
+            for a in 0..3 {
+                vertex.rx[a][l] = rect.axes[0][a];
+                vertex.ry[a][l] = rect.axes[1][a];
+                vertex.rz[a][l] = rect.axes[2][a];
+                vertex.rt[a][l] = rect.axes[3][a];
+                vertex.rn[a][l] = rect.normal[a];
+            }
+            vertex.half_w[l] = rect.half_width_m;
+            vertex.half_h[l] = rect.half_height_m;
+            vertex.inv_area[l] = rect.inv_area_m2;
+            vertex.two_sided[l] = rect.two_sided;
+            vertex.light_kind[l] = LIGHT_RECTANGLE;
+        }
+        None => {
+            let (o, d, t) = (vertex.o, vertex.d, vertex.t[l]);
+            // The same bits as `shade`'s hit point.
+            let p = Vec3A::new(
+                o[0][l] + t * d[0][l],
+                o[1][l] + t * d[1][l],
+                o[2][l] + t * d[2][l],
+            );
+            let ctx = LightSampleContext {
+                p,
+                n: lane.n_geometric,
+            };
+            let light = lights.light(li);
+            if let Some(ls) = light.sample_li_cached(li, &ctx, ul, &wavelengths, &mut lane.le_cache)
+            {
+                for k in 0..4 {
+                    vertex.le[k][l] = ls.radiance[k];
+                }
+                for a in 0..3 {
+                    vertex.given_p[a][l] = ls.p_light[a];
+                    vertex.given_wi[a][l] = ls.wi[a];
+                }
+                vertex.given_pdf[l] = ls.pdf;
+                vertex.given_distance[l] = ls.distance_m;
+                vertex.given_delta[l] = ls.delta;
+                vertex.light_kind[l] = LIGHT_GIVEN;
+            }
+        }
+    }
+}
+
 /// A vertex's scalar part before the lanes are shaded together: the escape to infinite
 /// lights, the first-hit record, emission, the depth limit, the vertex's sample dimensions,
 /// the material's and light's spectra and the light choice (as the scalar tracer). Fills
@@ -385,6 +523,7 @@ fn begin_vertex<const N: usize>(
     hit_t: f32,
     hit_leaf: u32,
     vertex: &mut VertexIn<N>,
+    variates: &mut Variates<N>,
     l: usize,
     counters: &mut PathCounters,
 ) -> bool {
@@ -426,7 +565,12 @@ fn begin_vertex<const N: usize>(
         });
     }
     let dims = lane.stream.reserve(8);
-    let (d_light_choice, d_light, d_bsdf, d_roulette) = (dims + 1, dims + 2, dims + 5, dims + 7);
+    let (d_light_choice, d_light, d_bsdf, d_roulette) = (
+        dims + DIM_LIGHT_CHOICE,
+        dims + DIM_LIGHT,
+        dims + DIM_BSDF,
+        dims + DIM_ROULETTE,
+    );
 
     if let Some(li) = leaf.light {
         let light = lights.light(li);
@@ -485,75 +629,30 @@ fn begin_vertex<const N: usize>(
         vertex.beta[k][l] = lane.beta[k];
         vertex.f_lambert[k][l] = f_lambert[k];
     }
-    let u_bsdf = lane.stream.get_2d_at(d_bsdf);
-    vertex.u_bsdf[0][l] = u_bsdf.x;
-    vertex.u_bsdf[1][l] = u_bsdf.y;
     vertex.roulette[l] = lane.depth >= tracer.rr_depth;
-    vertex.u_roulette[l] = if vertex.roulette[l] {
-        lane.stream.get_1d_at(d_roulette)
-    } else {
-        1.0
-    };
     let record_white = job.want_illumination && lane.depth == 1;
     vertex.record_white[l] = record_white;
     vertex.light_kind[l] = LIGHT_NONE;
-
-    // The light choice (one light sample per hit: `PacketScene` runs such plans only).
-    if !lights.is_empty() {
-        if record_white {
-            lane.illumination_direct = Some(SampledSpectrum::splat(0.0));
+    if !lights.is_empty() && record_white {
+        lane.illumination_direct = Some(SampledSpectrum::splat(0.0));
+    }
+    // The vertex's variates: hashed for all lanes at once (`draw_variates`) for
+    // independent streams, here for the others.
+    variates.first_dimension[l] = dims;
+    match lane.stream.independent_key() {
+        Some(key) => {
+            variates.key[l] = key;
+            variates.hashed[l] = true;
         }
-        let uc = lane
-            .stream
-            .get_1d_at(d_light_choice)
-            .min(1.0 - f32::EPSILON);
-        let ul = lane.stream.get_2d_at(d_light);
-        if let Some((li, pmf)) = lights.sample(uc) {
-            vertex.pmf[l] = pmf;
-            vertex.u_light[0][l] = ul.x;
-            vertex.u_light[1][l] = ul.y;
-            match &job.packet.lights[li as usize] {
-                Some(rect) => {
-                    let le = lane.le_cache.get(li, &rect.radiance, &wavelengths);
-                    for k in 0..4 {
-                        vertex.le[k][l] = le[k];
-                    }
-                    for a in 0..3 {
-                        vertex.rx[a][l] = rect.axes[0][a];
-                        vertex.ry[a][l] = rect.axes[1][a];
-                        vertex.rz[a][l] = rect.axes[2][a];
-                        vertex.rt[a][l] = rect.axes[3][a];
-                        vertex.rn[a][l] = rect.normal[a];
-                    }
-                    vertex.half_w[l] = rect.half_width_m;
-                    vertex.half_h[l] = rect.half_height_m;
-                    vertex.inv_area[l] = rect.inv_area_m2;
-                    vertex.two_sided[l] = rect.two_sided;
-                    vertex.light_kind[l] = LIGHT_RECTANGLE;
-                }
-                None => {
-                    let ctx = LightSampleContext {
-                        p,
-                        n: leaf.n_geometric,
-                    };
-                    let light = lights.light(li);
-                    if let Some(ls) =
-                        light.sample_li_cached(li, &ctx, ul, &wavelengths, &mut lane.le_cache)
-                    {
-                        for k in 0..4 {
-                            vertex.le[k][l] = ls.radiance[k];
-                        }
-                        for a in 0..3 {
-                            vertex.given_p[a][l] = ls.p_light[a];
-                            vertex.given_wi[a][l] = ls.wi[a];
-                        }
-                        vertex.given_pdf[l] = ls.pdf;
-                        vertex.given_distance[l] = ls.distance_m;
-                        vertex.given_delta[l] = ls.delta;
-                        vertex.light_kind[l] = LIGHT_GIVEN;
-                    }
-                }
-            }
+        None => {
+            variates.hashed[l] = false;
+            let u = &mut variates.u;
+            u[0][l] = lane.stream.get_1d_at(d_light_choice);
+            let ul = lane.stream.get_2d_at(d_light);
+            (u[1][l], u[2][l]) = (ul.x, ul.y);
+            let ub = lane.stream.get_2d_at(d_bsdf);
+            (u[3][l], u[4][l]) = (ub.x, ub.y);
+            u[5][l] = lane.stream.get_1d_at(d_roulette);
         }
     }
     vertex.active[l] = true;
