@@ -24,9 +24,8 @@ use std::arch::x86_64::*;
 use rayon::prelude::*;
 
 use super::pixels::{
-    map_luminance, map_luminance_chunk, map_pixels_chunk, stats_block, store_block, store_fence,
-    Acc, LuminanceCurve, Mapped, PixelMap, Scale, StatsLanes, BLOCK, CHUNK, LANES,
-    LOG_AVERAGE_DELTA,
+    map_luminance, map_pixels_chunk, stats_block, store_block, store_fence, Acc, LuminanceCurve,
+    Mapped, PixelMap, Scale, StatsLanes, BLOCK, CHUNK, LANES, LOG_AVERAGE_DELTA,
 };
 use super::Context;
 
@@ -85,12 +84,13 @@ pub(crate) fn map_luminance_avx512<C: RegisterCurve>(
             #[cfg(target_arch = "x86_64")]
             {
                 assert!(available());
-                // SAFETY: the CPU has AVX-512F (asserted just above).
-                unsafe { chunk_avx512(i, o, k * CHUNK, scale, w, curve) }
+                let _ = k; // the register curves do not use the pixel index
+                           // SAFETY: the CPU has AVX-512F (asserted just above).
+                unsafe { chunk_avx512(i, o, scale, w, curve) }
             }
             #[cfg(not(target_arch = "x86_64"))]
             {
-                map_luminance_chunk(i, o, k * CHUNK, scale, w, curve)
+                super::pixels::map_luminance_chunk(i, o, k * CHUNK, scale, w, curve)
             }
         })
         .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
@@ -215,13 +215,81 @@ unsafe fn sanitise16<const SCALED: bool>(
     ([c(p[0]), c(p[1]), c(p[2])], finite, neg)
 }
 
-/// One task of [`map_luminance_avx512`].
+/// G groups of 16 pixels (48 floats each) at `s` through the luminance mapping, as three
+/// interleaved output registers each, with the masks of non-finite and of negative
+/// input pixels. The caller guarantees the 48 G floats are readable.
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f")]
+#[inline(always)]
+unsafe fn luminance_group16<C: RegisterCurve, const G: usize, const SCALED: bool>(
+    curve: &C,
+    w: &[__m512; 3],
+    de: &[(__m512i, __m512i); 3],
+    inter: &[(__m512i, __m512i); 3],
+    scale: __m512,
+    s: *const f32,
+) -> ([[__m512; 3]; G], [__mmask16; G], [__mmask16; G]) {
+    let zero = _mm512_setzero_ps();
+    let (mut c, mut l, mut non_finite, mut neg) = ([[zero; 3]; G], [zero; G], [0; G], [0; G]);
+    for g in 0..G {
+        // load_block: black for a pixel with a non-finite component, negatives to 0,
+        // luminance w · c summed left to right.
+        let (cg, finite, ng) = sanitise16::<SCALED>(load_planes16(s.add(48 * g), de), scale);
+        (c[g], non_finite[g], neg[g]) = (cg, !finite, ng);
+        l[g] = _mm512_add_ps(
+            _mm512_add_ps(_mm512_mul_ps(w[0], cg[0]), _mm512_mul_ps(w[1], cg[1])),
+            _mm512_mul_ps(w[2], cg[2]),
+        );
+    }
+    // The G curve evaluations next to each other (independent chains).
+    let mut ld = [zero; G];
+    for g in 0..G {
+        ld[g] = curve.ratio16(l[g]);
+    }
+    let mut o = [[zero; 3]; G];
+    for g in 0..G {
+        // map_luminance_chunk: the ratio where L > 0 and it is finite, else 0; then
+        // max(c · ratio, 0), black where that overflows.
+        let keep = _mm512_cmp_ps_mask::<_CMP_GT_OQ>(l[g], zero) & finite_mask(ld[g]);
+        let ratio = _mm512_maskz_mov_ps(keep, ld[g]);
+        let x = [0, 1, 2].map(|ch| _mm512_max_ps(_mm512_mul_ps(c[g][ch], ratio), zero));
+        let ok = finite_mask(x[0]) & finite_mask(x[1]) & finite_mask(x[2]);
+        let x = x.map(|v| _mm512_maskz_mov_ps(ok, v));
+        for (reg, (i0, i1)) in inter.iter().enumerate() {
+            o[g][reg] = _mm512_permutex2var_ps(_mm512_permutex2var_ps(x[0], *i0, x[1]), *i1, x[2]);
+        }
+    }
+    (o, non_finite, neg)
+}
+
+/// One task of [`map_luminance_avx512`], without the exposure multiplication where the
+/// scale is 1 (the same bits, see [`sanitise16`]).
+///
+/// # Safety
+/// The CPU must have AVX-512F.
+#[cfg(target_arch = "x86_64")]
 unsafe fn chunk_avx512<C: RegisterCurve>(
     input: &[[f32; 3]],
     out: &mut [[f32; 3]],
-    start: usize,
+    scale: f32,
+    w: [f32; 3],
+    curve: &C,
+) -> (u64, u64) {
+    if scale == 1.0 {
+        luminance_chunk_avx512::<C, false>(input, out, scale, w, curve)
+    } else {
+        luminance_chunk_avx512::<C, true>(input, out, scale, w, curve)
+    }
+}
+
+/// The body of [`chunk_avx512`]: as [`pixels_registers_avx512`], [`STEP_GROUPS`] groups
+/// of 16 pixels per step (their curve evaluations side by side), head and tail pixels
+/// through a zero-padded group (black: counted as neither non-finite nor negative, and
+/// mapped to black), per-lane counts.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+unsafe fn luminance_chunk_avx512<C: RegisterCurve, const SCALED: bool>(
+    input: &[[f32; 3]],
+    out: &mut [[f32; 3]],
     scale: f32,
     w: [f32; 3],
     curve: &C,
@@ -236,70 +304,80 @@ unsafe fn chunk_avx512<C: RegisterCurve>(
         .min(n);
     let groups = (n - head) / 16;
     let tail = head + 16 * groups;
-    let (mut non_finite, mut negative) =
-        map_luminance_chunk(&input[..head], &mut out[..head], start, scale, w, curve);
-
     let load_idx = |a: [i32; 16]| _mm512_loadu_si512(a.as_ptr() as *const _);
     let de = deinterleave_registers();
     let inter = [0, 1, 2].map(|reg| {
         let (a, b) = interleave_indices(reg);
         (load_idx(a), load_idx(b))
     });
-    let zero = _mm512_setzero_ps();
     let scale_v = _mm512_set1_ps(scale);
     let w_v = w.map(|x| _mm512_set1_ps(x));
+    let one = _mm512_set1_epi32(1);
+    let (mut nf_lanes, mut neg_lanes) = (_mm512_setzero_si512(), _mm512_setzero_si512());
+    let partial = |i: &[[f32; 3]], o: &mut [[f32; 3]]| {
+        let mut buf = [[0.0f32; 3]; 16];
+        buf[..i.len()].copy_from_slice(i);
+        // SAFETY: buf holds 48 floats.
+        let ([v], [nf], [neg]) = luminance_group16::<C, 1, SCALED>(
+            curve,
+            &w_v,
+            &de,
+            &inter,
+            scale_v,
+            buf.as_ptr() as *const f32,
+        );
+        let d = buf.as_mut_ptr() as *mut f32;
+        for (reg, v) in v.into_iter().enumerate() {
+            // SAFETY: buf holds 48 floats.
+            _mm512_storeu_ps(d.add(16 * reg), v);
+        }
+        o.copy_from_slice(&buf[..o.len()]);
+        (nf.count_ones() as u64, neg.count_ones() as u64)
+    };
+    let (non_finite, negative) = partial(&input[..head], &mut out[..head]);
     let src = input.as_ptr().add(head) as *const f32;
     let dst = out.as_mut_ptr().add(head) as *mut f32;
-    for g in 0..groups {
-        // SAFETY: pixels head + 16 g … head + 16 g + 15 lie inside both slices (g <
-        // groups), i.e. floats 48 g … 48 g + 47 from src and dst.
+    let mut g = 0;
+    while g < groups {
+        // SAFETY: pixels head + 16 g … head + 16 (g + k) − 1 lie inside both slices for
+        // the k ≤ groups − g groups handled below (floats 48 g … 48 (g + k) − 1 from src
+        // and dst); the prefetches do not fault.
         let s = src.add(48 * g);
-        prefetch_ahead(s);
-        let p = load_planes16(s, &de);
-        // load_block: black for a pixel with a non-finite component, negatives to 0
-        // (maxps(x, 0) returns its second operand for NaN and for ±0, as f32::max(x, 0)
-        // compiles), luminance w · c summed left to right.
-        let finite = finite_mask(p[0]) & finite_mask(p[1]) & finite_mask(p[2]);
-        let neg = (_mm512_cmp_ps_mask::<_CMP_LT_OQ>(p[0], zero)
-            | _mm512_cmp_ps_mask::<_CMP_LT_OQ>(p[1], zero)
-            | _mm512_cmp_ps_mask::<_CMP_LT_OQ>(p[2], zero))
-            & finite;
-        non_finite += (!finite).count_ones() as u64;
-        negative += neg.count_ones() as u64;
-        let c =
-            p.map(|x| _mm512_maskz_mov_ps(finite, _mm512_max_ps(_mm512_mul_ps(x, scale_v), zero)));
-        let l = _mm512_add_ps(
-            _mm512_add_ps(_mm512_mul_ps(w_v[0], c[0]), _mm512_mul_ps(w_v[1], c[1])),
-            _mm512_mul_ps(w_v[2], c[2]),
-        );
-        // map_luminance_chunk: the ratio where L > 0 and it is finite, else 0; then
-        // max(c · ratio, 0), black where that overflows.
-        let ld = curve.ratio16(l);
-        let keep = _mm512_cmp_ps_mask::<_CMP_GT_OQ>(l, zero) & finite_mask(ld);
-        let ratio = _mm512_maskz_mov_ps(keep, ld);
-        let o = c.map(|x| _mm512_max_ps(_mm512_mul_ps(x, ratio), zero));
-        let ok = finite_mask(o[0]) & finite_mask(o[1]) & finite_mask(o[2]);
-        let o = o.map(|x| _mm512_maskz_mov_ps(ok, x));
+        for k in 0..STEP_GROUPS {
+            prefetch_ahead(s.add(48 * k));
+        }
         let d = dst.add(48 * g);
-        for (reg, (i0, i1)) in inter.iter().enumerate() {
-            let v = _mm512_permutex2var_ps(_mm512_permutex2var_ps(o[0], *i0, o[1]), *i1, o[2]);
-            // SAFETY: d + 16 reg is 64-byte aligned (head chosen so) and inside `out`.
-            _mm512_stream_ps(d.add(16 * reg), v);
+        let mut store = |k: usize, v: [__m512; 3], nf: __mmask16, neg: __mmask16| {
+            nf_lanes = _mm512_mask_add_epi32(nf_lanes, nf, nf_lanes, one);
+            neg_lanes = _mm512_mask_add_epi32(neg_lanes, neg, neg_lanes, one);
+            for (reg, v) in v.into_iter().enumerate() {
+                // SAFETY: d + 48 k + 16 reg is 64-byte aligned (head chosen so) and
+                // inside `out`.
+                _mm512_stream_ps(d.add(48 * k + 16 * reg), v);
+            }
+        };
+        if g + STEP_GROUPS <= groups {
+            let (v, nf, neg) =
+                luminance_group16::<C, STEP_GROUPS, SCALED>(curve, &w_v, &de, &inter, scale_v, s);
+            for k in 0..STEP_GROUPS {
+                store(k, v[k], nf[k], neg[k]);
+            }
+            g += STEP_GROUPS;
+        } else {
+            let ([v], [nf], [neg]) =
+                luminance_group16::<C, 1, SCALED>(curve, &w_v, &de, &inter, scale_v, s);
+            store(0, v, nf, neg);
+            g += 1;
         }
     }
     // Streaming stores are weakly ordered: fence them before the task reports done.
     _mm_sfence();
-    let (nf, neg) = map_luminance_chunk(
-        &input[tail..n],
-        &mut out[tail..n],
-        start + tail,
-        scale,
-        w,
-        curve,
-    );
-    non_finite += nf;
-    negative += neg;
-    (non_finite, negative)
+    let (nf, neg) = partial(&input[tail..n], &mut out[tail..n]);
+    let lanes = |v: __m512i| _mm512_reduce_add_epi32(v) as u32 as u64;
+    (
+        non_finite + nf + lanes(nf_lanes),
+        negative + neg + lanes(neg_lanes),
+    )
 }
 /// A [`PixelMap`] with a 16-lane register form, for [`map_pixels_registers`]: the map
 /// runs inside the 16-pixel load/store loop on registers, with its constants loaded once
@@ -775,7 +853,14 @@ pub(crate) fn same_bits_as_scalar<C: RegisterCurve>(
     };
     let wide = map_luminance_avx512(&ctx, scale, ctx.weights, curve);
     let mut scalar = vec![[0f32; 3]; image.pixels().len()];
-    let (nf, neg) = map_luminance_chunk(image.pixels(), &mut scalar, 0, scale, ctx.weights, curve);
+    let (nf, neg) = super::pixels::map_luminance_chunk(
+        image.pixels(),
+        &mut scalar,
+        0,
+        scale,
+        ctx.weights,
+        curve,
+    );
     assert_eq!((wide.non_finite_pixels, wide.negative_pixels), (nf, neg));
     for (i, (a, b)) in wide.pixels.iter().zip(&scalar).enumerate() {
         assert_eq!(
@@ -784,6 +869,44 @@ pub(crate) fn same_bits_as_scalar<C: RegisterCurve>(
             "pixel {i}: {a:?} vs {b:?} (input {:?})",
             image.pixels()[i]
         );
+    }
+    // One task at every output alignment and several lengths (head and tail groups of
+    // 0–15 pixels through the zero-padded group), with and without the exposure multiply.
+    let pixels = image.pixels();
+    let n = pixels.len();
+    let mut fast_buf = vec![[0f32; 3]; n + 16];
+    for scale in [scale, 1.0, 0.37] {
+        for len in [0, 1, 15, 16, 17, 100, n] {
+            for offset in 0..16 {
+                let (input, out) = (&pixels[..len], &mut fast_buf[offset..offset + len]);
+                #[cfg(target_arch = "x86_64")]
+                // SAFETY: the CPU has AVX-512F (checked above).
+                let fast = unsafe { chunk_avx512(input, out, scale, ctx.weights, curve) };
+                #[cfg(not(target_arch = "x86_64"))]
+                let fast =
+                    super::pixels::map_luminance_chunk(input, out, 0, scale, ctx.weights, curve);
+                let slow = super::pixels::map_luminance_chunk(
+                    input,
+                    &mut scalar[..len],
+                    0,
+                    scale,
+                    ctx.weights,
+                    curve,
+                );
+                assert_eq!(fast, slow, "len {len}, offset {offset}");
+                for (i, (a, b)) in fast_buf[offset..offset + len]
+                    .iter()
+                    .zip(&scalar)
+                    .enumerate()
+                {
+                    assert_eq!(
+                        a.map(f32::to_bits),
+                        b.map(f32::to_bits),
+                        "pixel {i} (len {len}, offset {offset}, scale {scale})"
+                    );
+                }
+            }
+        }
     }
     true
 }
