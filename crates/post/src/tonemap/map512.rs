@@ -16,7 +16,14 @@
 //! without fused multiply-adds, so the result is the scalar path's bits (tested for every
 //! curve, on NaN, ±∞, negative, ±0 and subnormal input). The few pixels before the first
 //! 64-byte-aligned output address and after the last whole group of 16 go through the
-//! scalar path itself.
+//! same 16-lane code on a zero-padded group (seventh pass, docs/post.md; the scalar path
+//! itself before). Register curves and maps take no pixel index: the ones written so far
+//! are global (their `ratio` ignores `start`).
+//!
+//! Each step handles several groups of 16 pixels ([`STEP_GROUPS`]) with their curve or
+//! map evaluations written side by side: one group's chain of dependent operations is
+//! long (agx: ≈ 25 operations, ≈ 120 cycles), and one group per step left the passes
+//! latency-bound (seventh pass).
 
 #[cfg(target_arch = "x86_64")]
 use std::arch::x86_64::*;
@@ -84,8 +91,9 @@ pub(crate) fn map_luminance_avx512<C: RegisterCurve>(
             #[cfg(target_arch = "x86_64")]
             {
                 assert!(available());
-                let _ = k; // the register curves do not use the pixel index
-                           // SAFETY: the CPU has AVX-512F (asserted just above).
+                // The register curves take no pixel index.
+                let _ = k;
+                // SAFETY: the CPU has AVX-512F (asserted just above).
                 unsafe { chunk_avx512(i, o, scale, w, curve) }
             }
             #[cfg(not(target_arch = "x86_64"))]
@@ -379,6 +387,7 @@ unsafe fn luminance_chunk_avx512<C: RegisterCurve, const SCALED: bool>(
         negative + neg + lanes(neg_lanes),
     )
 }
+
 /// A [`PixelMap`] with a 16-lane register form, for [`map_pixels_registers`]: the map
 /// runs inside the 16-pixel load/store loop on registers, with its constants loaded once
 /// per task, instead of over stack planes staged through memory (docs/post.md, seventh
@@ -400,8 +409,8 @@ pub(crate) trait RegisterMap: PixelMap {
     #[cfg(target_arch = "x86_64")]
     unsafe fn regs16(&self) -> Self::Regs;
     /// [`PixelMap::map`] on G groups of 16 sanitised pixels (R, G, B planes in
-    /// registers), lane by lane the same bits; the pass hands over two groups at a time
-    /// so that a map can interleave their (independent) dependency chains.
+    /// registers), lane by lane the same bits; the pass hands over [`STEP_GROUPS`] groups
+    /// at a time so that a map can interleave their (independent) dependency chains.
     /// `#[inline(always)]`, AVX-512F intrinsics only.
     ///
     /// # Safety
@@ -432,8 +441,9 @@ pub(crate) fn map_pixels_registers<M: RegisterMap>(ctx: &Context, scale: f32, f:
             #[cfg(target_arch = "x86_64")]
             {
                 assert!(available());
-                let _ = k; // the register maps do not use the pixel index
-                           // SAFETY: the CPU has AVX-512F (asserted just above).
+                // The register maps take no pixel index.
+                let _ = k;
+                // SAFETY: the CPU has AVX-512F (asserted just above).
                 unsafe { pixels_registers_task(i, o, scale, f) }
             }
             #[cfg(not(target_arch = "x86_64"))]
@@ -503,7 +513,9 @@ unsafe fn pixels_registers_task<M: RegisterMap>(
     }
 }
 
-/// Groups of 16 pixels per step of [`pixels_registers_avx512`].
+/// Groups of 16 pixels per step of [`pixels_registers_avx512`] and
+/// [`luminance_chunk_avx512`].
+#[cfg(target_arch = "x86_64")]
 const STEP_GROUPS: usize = 3;
 
 /// One task of [`map_pixels_registers`]. The pixels before the first 64-byte-aligned
