@@ -16,7 +16,8 @@ use glam::Mat3;
 
 use super::aces::srgb_matrices;
 use super::curve_table::{chebyshev_nodes, poly_through};
-use super::pixels::{map_pixels, PixelMap};
+use super::map512::RegisterMap;
+use super::pixels::PixelMap;
 use super::{Context, OperatorInfo, Output};
 
 pub(crate) static INFO: OperatorInfo = OperatorInfo {
@@ -66,54 +67,74 @@ fn contrast_f64(x: f64) -> f64 {
 }
 
 /// Outset values below 2⁻²⁴ map to 0 instead of y^2.2 ≤ 1.3e-16 (1e-11 of a 16-bit code);
-/// the outset never exceeds [`Y_MAX`] (`outset_values_stay_below_y_max`).
+/// the outset never exceeds [`Y_MAX`] (`outset_values_stay_below_y_max`), so the power
+/// curve needs no upper clamp: its exponents run from 2⁻²⁴ to below 2.
 const Y_MIN: f32 = 1.0 / 16_777_216.0;
+#[cfg_attr(not(test), allow(dead_code))] // the bound, checked by that test
 const Y_MAX: f32 = 2.0;
+/// 2⁻²⁵: the AVX-512 power curve clamps to this instead of [`Y_MIN`] and reads a scale of
+/// 0 for its biased exponent (102, free modulo 32 next to 103…128), which zeroes
+/// everything below Y_MIN (NaN included: `vmaxps` returns its second operand) without a
+/// compare and a mask.
+#[cfg(target_arch = "x86_64")]
+const Y_ZERO: f32 = Y_MIN * 0.5;
 
 // The per-channel curves are evaluated directly, in registers, as polynomials whose
 // coefficients are picked per mantissa segment (the top SEGMENT_BITS mantissa bits: 8
 // segments per octave, so 8 coefficients per degree fill one AVX register and are looked
 // up with one `vpermps` per coefficient instead of a memory table). Inside a segment
-// m = 1 + (k + t)/8 with t ∈ [0, 1) the remaining 20 mantissa bits, exactly.
+// m = 1 + (k + t)/8 with t ∈ [0, 1) the remaining 20 mantissa bits, exactly. The
+// polynomials run in the centred variable s = t/8 − 1/16 ∈ [−1/16, 1/16), which is
+// exactly (bits & T_MASK | bits of 1.0) − 1.0625: one `vpternlogd` and a subtraction
+// (Sterbenz: exact), against and, convert and multiply for t.
 //
-// - Encoding: x − ½ = (log2 v − ev_min)/R − ½ (R = ev_max − ev_min) with v = 2^e · m is
-//   e/R + [(log2 m − ev_min)/R − ½]; the bracket is a quartic in t per segment
-//   (interpolation error |f⁽⁵⁾| h⁵/(5! 2⁹) with f = log2, h = 1/8: ≤ 5e-10 in log2 m,
-//   3e-11 in x), e/R one more fused multiply-add with 1/R split into two f32s. The
-//   published contrast polynomial is then evaluated in u = x − ½ (its coefficients
-//   re-expanded about ½ in f64: Horner's rule on the published ones cancels terms of
-//   size 40 down to values ≤ 1, which cost 0.2 16-bit codes in f32).
-// - Power: y^2.2 with y = 2^e · m is 2^(2.2e) · m^2.2; m^2.2 is a cubic in t per segment
+// - Encoding: with R = ev_max − ev_min and v = 2^e · m, the contrast polynomial's
+//   argument is w = R (x − ½) = log2 v − ev_min − R/2 = e + [log2 m − ev_min − R/2]; the
+//   bracket is a quartic in s per segment (interpolation error |f⁽⁵⁾| h⁵/(5! 2⁹) with
+//   f = log2, h = 1/8: ≤ 5e-10), e enters with one addition (|w| ≤ R/2 = 8.25: its
+//   rounding is ≤ 4.8e-7 in w, 2.9e-8 in x, the size of one rounding of x − ½ itself).
+//   The published contrast polynomial is then evaluated in w (its coefficients
+//   re-expanded about x = ½ and scaled by R^−j in f64: Horner's rule on the published
+//   ones cancels terms of size 40 down to values ≤ 1, which cost 0.2 16-bit codes in
+//   f32; the scaling changes no relative rounding).
+// - Power: y^2.2 with y = 2^e · m is 2^(2.2e) · m^2.2; m^2.2 is a cubic in s per segment
 //   (error |a(a−1)(a−2)(a−3)| h⁴/(4! 2⁷) with a = 2.2: ≤ 3.4e-8 relative), and with
 //   e + 25 = 5q + r (0 ≤ r < 5), 2^(2.2e) = 2^(2e + q − 5) · 2^(r/5): an exponent built in
 //   the bits times one of five constants (another `vpermps`).
 //
 // All coefficients are fitted here, at start-up, by interpolation at Chebyshev nodes in
 // f64 from the formulas, then rounded to f32. Every step is a fused multiply-add, so the
-// scalar path (`f32::mul_add`, used where the CPU lacks AVX2 + FMA and for the last
-// pixels of a block) gives the same bits as the 8-lane one (tested).
+// scalar path (`f32::mul_add`, used where the CPU lacks AVX2 + FMA) gives the same bits
+// as the 8- and 16-lane ones (tested).
 
 /// Mantissa bits that select a segment (8 per octave: one register of coefficients).
 const SEGMENT_BITS: u32 = 3;
 /// Mantissa bits of the position t inside a segment.
 const T_BITS: u32 = 23 - SEGMENT_BITS;
 const T_MASK: u32 = (1 << T_BITS) - 1;
-/// 2^−T_BITS, exact in f32.
-const T_SCALE: f32 = 1.0 / (1u32 << T_BITS) as f32;
+/// The bits of 1.0, and the centre of (bits & T_MASK | ONE_BITS) ∈ [1, 1.125).
+const ONE_BITS: u32 = 0x3f80_0000;
+const S_CENTRE: f32 = 1.0625;
 /// Coefficients of the encoding quartic and of the power cubic.
 const ENCODE_TERMS: usize = 5;
 const POWER_TERMS: usize = 4;
 
-/// Per-segment polynomial coefficients: `c[j][k]` multiplies t^j on segment k.
+/// Per-segment polynomial coefficients: `c[j][k]` multiplies s^j on segment k.
 type SegmentPoly<const N: usize> = [[f32; 8]; N];
 
-/// Fits `f(m)`, m ∈ [1, 2), per segment by interpolation at N Chebyshev nodes of t.
+/// s ∈ [−1/16, 1/16) of an f32's low T_BITS mantissa bits, exactly.
+#[inline(always)]
+fn centred_position(bits: u32) -> f32 {
+    f32::from_bits((bits & T_MASK) | ONE_BITS) - S_CENTRE
+}
+
+/// Fits `f(m)`, m ∈ [1, 2), per segment by interpolation at N Chebyshev nodes of s.
 fn fit_segments<const N: usize>(f: impl Fn(f64) -> f64) -> SegmentPoly<N> {
-    let nodes: [f64; N] = chebyshev_nodes();
+    let nodes: [f64; N] = chebyshev_nodes::<N>().map(|t| t / 8.0 - 1.0 / 16.0);
     let mut c = [[0.0f32; 8]; N];
     #[allow(clippy::needless_range_loop)] // k is the segment and the column of c
     for k in 0..8 {
-        let y = nodes.map(|t| f(1.0 + (k as f64 + t) / 8.0));
+        let y = nodes.map(|s| f(1.0 + k as f64 / 8.0 + 1.0 / 16.0 + s));
         for (j, v) in poly_through(&nodes, &y).iter().enumerate() {
             c[j][k] = *v as f32;
         }
@@ -124,9 +145,7 @@ fn fit_segments<const N: usize>(f: impl Fn(f64) -> f64) -> SegmentPoly<N> {
 /// The transform's constants, fitted once per process.
 struct Curves {
     encode: SegmentPoly<ENCODE_TERMS>,
-    /// 1/R as the sum of two f32s.
-    inv_range: (f32, f32),
-    /// The contrast polynomial in u = x − ½, constant first.
+    /// The contrast polynomial in w = R (x − ½), constant first.
     contrast: [f32; 7],
     power: SegmentPoly<POWER_TERMS>,
     /// 2^(r/5) for r = 0…4 (lanes 5–7 unused).
@@ -135,6 +154,13 @@ struct Curves {
     /// the transform applied to the linear value).
     x_min: f32,
     x_max: f32,
+    /// `encode` and `power` with each row repeated in both halves (16-entry `vpermps`).
+    encode16: [[f32; 16]; ENCODE_TERMS],
+    power16: [[f32; 16]; POWER_TERMS],
+    /// 2^(2.2 (b − 127)) as 2^(2e + q − 5) · 2^(r/5) (e = b − 127, e + 25 = 5q + r, as
+    /// the AVX2 path computes it) at index b mod 32 for the biased exponents b = 103…128
+    /// of y ∈ [2⁻²⁴, 2], 0 elsewhere (at 102 in particular: [`Y_ZERO`]).
+    scales: [f32; 32],
 }
 
 fn curves() -> &'static Curves {
@@ -142,29 +168,42 @@ fn curves() -> &'static Curves {
     CURVES.get_or_init(|| {
         let (lo, hi) = (EV_MIN as f64, EV_MAX as f64);
         let range = hi - lo;
-        let inv = 1.0 / range;
-        let inv_hi = inv as f32;
-        // Binomial re-expansion: Σ c_k x^k = Σ_j (Σ_{k≥j} C(k, j) c_k ½^(k−j)) u^j.
+        // Binomial re-expansion: Σ c_k x^k = Σ_j (Σ_{k≥j} C(k, j) c_k ½^(k−j)) u^j, u =
+        // x − ½ = w / R.
         let contrast = std::array::from_fn(|j| {
-            (j..7)
+            let in_u = (j..7)
                 .map(|k| {
                     let binom = (0..j).fold(1.0, |b, i| b * (k - i) as f64 / (i + 1) as f64);
                     CONTRAST[k] * binom * 0.5f64.powi((k - j) as i32)
                 })
-                .sum::<f64>() as f32
+                .sum::<f64>();
+            (in_u / range.powi(j as i32)) as f32
         });
+        let encode: SegmentPoly<ENCODE_TERMS> = fit_segments(|m| m.log2() - lo - range / 2.0);
+        let power: SegmentPoly<POWER_TERMS> = fit_segments(|m| m.powf(2.2));
+        let fifths: [f32; 8] = std::array::from_fn(|r| {
+            if r < 5 {
+                2f64.powf(r as f64 / 5.0) as f32
+            } else {
+                1.0
+            }
+        });
+        let twice = |a: &[f32; 8]| -> [f32; 16] { std::array::from_fn(|i| a[i % 8]) };
         Curves {
-            encode: fit_segments(|m| (m.log2() - lo) / range - 0.5),
-            inv_range: (inv_hi, (inv - inv_hi as f64) as f32),
-            contrast,
-            power: fit_segments(|m| m.powf(2.2)),
-            fifths: std::array::from_fn(|r| {
-                if r < 5 {
-                    2f64.powf(r as f64 / 5.0) as f32
-                } else {
-                    1.0
-                }
+            encode16: encode.each_ref().map(twice),
+            power16: power.each_ref().map(twice),
+            scales: std::array::from_fn(|i| {
+                let biased = (103..=128).find(|b| b % 32 == i as i32);
+                biased.map_or(0.0, |b| {
+                    let e = b - 127;
+                    let (q, r) = split_fifths(e + 25);
+                    f32::from_bits(((2 * e + q - 5 + 127) as u32) << 23) * fifths[r as usize]
+                })
             }),
+            encode,
+            contrast,
+            power,
+            fifths,
             x_min: lo.exp2() as f32,
             x_max: hi.exp2() as f32,
         }
@@ -199,16 +238,16 @@ impl Map {
         let bits = v.to_bits();
         let e = ((bits >> 23) as i32 - 127) as f32;
         let k = ((bits >> T_BITS) & 7) as usize;
-        let t = (bits & T_MASK) as i32 as f32 * T_SCALE;
+        let s = centred_position(bits);
         let p = (0..ENCODE_TERMS - 1)
             .rev()
             .fold(c.encode[ENCODE_TERMS - 1][k], |p, j| {
-                p.mul_add(t, c.encode[j][k])
+                p.mul_add(s, c.encode[j][k])
             });
-        let u = e.mul_add(c.inv_range.0, e.mul_add(c.inv_range.1, p));
+        let w = e + p;
         (0..6)
             .rev()
-            .fold(c.contrast[6], |p, j| p.mul_add(u, c.contrast[j]))
+            .fold(c.contrast[6], |p, j| p.mul_add(w, c.contrast[j]))
     }
 
     /// max(y, 0)^2.2 of one outset value, 0 below [`Y_MIN`] or for NaN (scalar path).
@@ -216,19 +255,16 @@ impl Map {
     fn power(&self, y: f32) -> f32 {
         let c = self.curves;
         let keep = y >= Y_MIN;
-        // Not `clamp`: NaN goes to Y_MIN here (f32::max), as with vmaxps.
-        #[allow(clippy::manual_clamp)]
-        let bits = y.max(Y_MIN).min(Y_MAX).to_bits();
-        let e = (bits >> 23) as i32 - 127;
-        let (q, r) = split_fifths(e + 25);
+        // NaN goes to Y_MIN here (f32::max), as with vmaxps; no upper clamp (Y_MAX).
+        let bits = y.max(Y_MIN).to_bits();
         let k = ((bits >> T_BITS) & 7) as usize;
-        let t = (bits & T_MASK) as i32 as f32 * T_SCALE;
+        let s = centred_position(bits);
         let p = (0..POWER_TERMS - 1)
             .rev()
             .fold(c.power[POWER_TERMS - 1][k], |p, j| {
-                p.mul_add(t, c.power[j][k])
+                p.mul_add(s, c.power[j][k])
             });
-        let scale = f32::from_bits(((2 * e + q - 5 + 127) as u32) << 23) * c.fifths[r as usize];
+        let scale = c.scales[((bits >> 23) & 31) as usize];
         if keep {
             p * scale
         } else {
@@ -264,11 +300,10 @@ impl Map {
         let power: [__m256; POWER_TERMS] = std::array::from_fn(|j| load8(&c.power[j]));
         let contrast = c.contrast.map(|v| _mm256_set1_ps(v));
         let fifths = load8(&c.fifths);
-        let (inv_hi, inv_lo) = (_mm256_set1_ps(c.inv_range.0), _mm256_set1_ps(c.inv_range.1));
         let (x_min, x_max) = (_mm256_set1_ps(c.x_min), _mm256_set1_ps(c.x_max));
-        let (y_min, y_max) = (_mm256_set1_ps(Y_MIN), _mm256_set1_ps(Y_MAX));
+        let y_min = _mm256_set1_ps(Y_MIN);
         let t_mask = _mm256_set1_epi32(T_MASK as i32);
-        let t_scale = _mm256_set1_ps(T_SCALE);
+        let (one_bits, centre) = (_mm256_set1_epi32(ONE_BITS as i32), _mm256_set1_ps(S_CENTRE));
         let bias = _mm256_set1_epi32(127);
         let (i5, i25, i205, i127m5) = (
             _mm256_set1_epi32(5),
@@ -285,9 +320,10 @@ impl Map {
                 )
             })
         };
-        // t ∈ [0, 1) from the low mantissa bits, exactly.
+        // s from the low mantissa bits, exactly (centred_position).
         let position = |bits: __m256i| {
-            _mm256_mul_ps(_mm256_cvtepi32_ps(_mm256_and_si256(bits, t_mask)), t_scale)
+            let m = _mm256_or_si256(_mm256_and_si256(bits, t_mask), one_bits);
+            _mm256_sub_ps(_mm256_castsi256_ps(m), centre)
         };
         let encode_curve = |v: __m256| {
             // maxps returns its second operand when the first is NaN.
@@ -301,16 +337,16 @@ impl Map {
             for j in (0..ENCODE_TERMS - 1).rev() {
                 p = _mm256_fmadd_ps(p, t, _mm256_permutevar8x32_ps(encode[j], k));
             }
-            let u = _mm256_fmadd_ps(e, inv_hi, _mm256_fmadd_ps(e, inv_lo, p));
+            let w = _mm256_add_ps(e, p);
             let mut s = contrast[6];
             for j in (0..6).rev() {
-                s = _mm256_fmadd_ps(s, u, contrast[j]);
+                s = _mm256_fmadd_ps(s, w, contrast[j]);
             }
             s
         };
         let power_curve = |y: __m256| {
             let keep = _mm256_cmp_ps::<_CMP_GE_OQ>(y, y_min);
-            let bits = _mm256_castps_si256(_mm256_min_ps(_mm256_max_ps(y, y_min), y_max));
+            let bits = _mm256_castps_si256(_mm256_max_ps(y, y_min));
             let e = _mm256_sub_epi32(_mm256_srli_epi32::<23>(bits), bias);
             // e + 25 = 5q + r as in `split_fifths`.
             let e25 = _mm256_add_epi32(e, i25);
@@ -362,91 +398,15 @@ impl Map {
 }
 
 impl Map {
-    /// [`PixelMap::map`] on 16 lanes: the same operations in the same order as
-    /// [`Self::pixel`], with three AVX-512 shortcuts that give the same values: the
-    /// exponent by `vgetexpps` (⌊log2 v⌋ of a positive normal v, the integer the scalar
-    /// path extracts), each 8-entry coefficient register repeated in both halves of a
-    /// 16-entry `vpermps` (its index, bits >> 20, then carries the exponent's lowest bit
-    /// above the segment), and 2^(2.2e) read from a 32-entry two-register `vpermt2ps`
-    /// table indexed by the biased exponent (103…128 for y in [2⁻²⁴, 2], distinct modulo
-    /// 32) holding 2^(2e + q − 5) · 2^(r/5) as the scalar path multiplies it (exact:
-    /// scaling by a power of two).
+    /// [`PixelMap::map`] on 16 lanes over planes ([`RegisterMap::map16`] per 16 pixels;
+    /// the tone-mapping pass itself runs the register form directly, this serves
+    /// [`PixelMap::map`] callers).
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512f")]
     unsafe fn map_avx512(&self, r: &mut [f32], g: &mut [f32], b: &mut [f32]) {
         use std::arch::x86_64::*;
         let n = r.len().min(g.len()).min(b.len());
-        let c = self.curves;
-        let splat = |m: &Mat| m.map(|v| _mm512_set1_ps(v));
-        let (inset, outset) = (splat(&self.inset), splat(&self.outset));
-        let from = self.from_srgb.as_ref().map(splat);
-        let twice = |a: &[f32; 8]| {
-            let v: [f32; 16] = std::array::from_fn(|i| a[i % 8]);
-            // SAFETY: v holds 16 f32s.
-            _mm512_loadu_ps(v.as_ptr())
-        };
-        let encode: [__m512; ENCODE_TERMS] = std::array::from_fn(|j| twice(&c.encode[j]));
-        let power: [__m512; POWER_TERMS] = std::array::from_fn(|j| twice(&c.power[j]));
-        let contrast = c.contrast.map(|v| _mm512_set1_ps(v));
-        let scales: [f32; 32] = std::array::from_fn(|i| {
-            let biased = (103..=128).find(|b| b % 32 == i as i32);
-            biased.map_or(0.0, |b| {
-                let e = b - 127;
-                let (q, r) = split_fifths(e + 25);
-                f32::from_bits(((2 * e + q - 5 + 127) as u32) << 23) * c.fifths[r as usize]
-            })
-        });
-        // SAFETY: scales holds 32 f32s.
-        let (scales_lo, scales_hi) = (
-            _mm512_loadu_ps(scales.as_ptr()),
-            _mm512_loadu_ps(scales.as_ptr().add(16)),
-        );
-        let (inv_hi, inv_lo) = (_mm512_set1_ps(c.inv_range.0), _mm512_set1_ps(c.inv_range.1));
-        let (x_min, x_max) = (_mm512_set1_ps(c.x_min), _mm512_set1_ps(c.x_max));
-        let (y_min, y_max) = (_mm512_set1_ps(Y_MIN), _mm512_set1_ps(Y_MAX));
-        let t_mask = _mm512_set1_epi32(T_MASK as i32);
-        let t_scale = _mm512_set1_ps(T_SCALE);
-        let mat = |m: &[__m512; 9], x: __m512, y: __m512, z: __m512| -> [__m512; 3] {
-            std::array::from_fn(|row| {
-                _mm512_fmadd_ps(
-                    m[6 + row],
-                    z,
-                    _mm512_fmadd_ps(m[3 + row], y, _mm512_mul_ps(m[row], x)),
-                )
-            })
-        };
-        let position = |bits: __m512i| {
-            _mm512_mul_ps(_mm512_cvtepi32_ps(_mm512_and_si512(bits, t_mask)), t_scale)
-        };
-        let encode_curve = |v: __m512| {
-            let v = _mm512_min_ps(_mm512_max_ps(v, x_min), x_max);
-            let bits = _mm512_castps_si512(v);
-            let e = _mm512_getexp_ps(v);
-            let k = _mm512_srli_epi32::<{ T_BITS }>(bits);
-            let t = position(bits);
-            let mut p = _mm512_permutexvar_ps(k, encode[ENCODE_TERMS - 1]);
-            for j in (0..ENCODE_TERMS - 1).rev() {
-                p = _mm512_fmadd_ps(p, t, _mm512_permutexvar_ps(k, encode[j]));
-            }
-            let u = _mm512_fmadd_ps(e, inv_hi, _mm512_fmadd_ps(e, inv_lo, p));
-            let mut s = contrast[6];
-            for j in (0..6).rev() {
-                s = _mm512_fmadd_ps(s, u, contrast[j]);
-            }
-            s
-        };
-        let power_curve = |y: __m512| {
-            let keep = _mm512_cmp_ps_mask::<_CMP_GE_OQ>(y, y_min);
-            let bits = _mm512_castps_si512(_mm512_min_ps(_mm512_max_ps(y, y_min), y_max));
-            let k = _mm512_srli_epi32::<{ T_BITS }>(bits);
-            let t = position(bits);
-            let mut p = _mm512_permutexvar_ps(k, power[POWER_TERMS - 1]);
-            for j in (0..POWER_TERMS - 1).rev() {
-                p = _mm512_fmadd_ps(p, t, _mm512_permutexvar_ps(k, power[j]));
-            }
-            let scale = _mm512_permutex2var_ps(scales_lo, _mm512_srli_epi32::<23>(bits), scales_hi);
-            _mm512_maskz_mul_ps(keep, p, scale)
-        };
+        let regs = self.regs16();
         let mut j = 0;
         while j + 16 <= n {
             // SAFETY: j + 16 ≤ n ≤ the length of each plane.
@@ -455,19 +415,14 @@ impl Map {
                 g.as_mut_ptr().add(j),
                 b.as_mut_ptr().add(j),
             );
-            let [x, y, z] = mat(
-                &inset,
-                _mm512_loadu_ps(pr),
-                _mm512_loadu_ps(pg),
-                _mm512_loadu_ps(pb),
+            let [[x, y, z]] = self.map16(
+                &regs,
+                [[
+                    _mm512_loadu_ps(pr),
+                    _mm512_loadu_ps(pg),
+                    _mm512_loadu_ps(pb),
+                ]],
             );
-            let (x, y, z) = (encode_curve(x), encode_curve(y), encode_curve(z));
-            let [x, y, z] = mat(&outset, x, y, z);
-            let (x, y, z) = (power_curve(x), power_curve(y), power_curve(z));
-            let [x, y, z] = match &from {
-                Some(m) => mat(m, x, y, z),
-                None => [x, y, z],
-            };
             _mm512_storeu_ps(pr, x);
             _mm512_storeu_ps(pg, y);
             _mm512_storeu_ps(pb, z);
@@ -475,6 +430,222 @@ impl Map {
         }
         for j in j..n {
             [r[j], g[j], b[j]] = self.pixel(r[j], g[j], b[j]);
+        }
+    }
+}
+
+/// The constants of [`Map`]'s 16-lane form, loaded once per task.
+#[cfg(target_arch = "x86_64")]
+struct Regs16 {
+    inset: [std::arch::x86_64::__m512; 9],
+    outset: [std::arch::x86_64::__m512; 9],
+    from: Option<[std::arch::x86_64::__m512; 9]>,
+    encode: [std::arch::x86_64::__m512; ENCODE_TERMS],
+    power: [std::arch::x86_64::__m512; POWER_TERMS],
+    contrast: [std::arch::x86_64::__m512; 7],
+    scales: [std::arch::x86_64::__m512; 2],
+}
+
+impl RegisterMap for Map {
+    #[cfg(target_arch = "x86_64")]
+    type Regs = Regs16;
+    /// The power curve's input is ≥ Y_ZERO and < Y_MAX (`outset_values_stay_below_y_max`:
+    /// the encoding's clamp and the contrast polynomial bound it), its cubic and scale
+    /// are finite there, and the matrix back from sRGB of such values is finite.
+    const FINITE_OUTPUT: bool = true;
+
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    unsafe fn regs16(&self) -> Regs16 {
+        use std::arch::x86_64::*;
+        let c = self.curves;
+        let splat = |m: &Mat| m.map(|v| _mm512_set1_ps(v));
+        // SAFETY (loads): each array holds 16 f32s.
+        let load = |a: &[f32; 16]| _mm512_loadu_ps(a.as_ptr());
+        Regs16 {
+            inset: splat(&self.inset),
+            outset: splat(&self.outset),
+            from: self.from_srgb.as_ref().map(splat),
+            encode: std::array::from_fn(|j| load(&c.encode16[j])),
+            power: std::array::from_fn(|j| load(&c.power16[j])),
+            contrast: c.contrast.map(|v| _mm512_set1_ps(v)),
+            scales: [
+                _mm512_loadu_ps(c.scales.as_ptr()),
+                _mm512_loadu_ps(c.scales.as_ptr().add(16)),
+            ],
+        }
+    }
+
+    /// [`Map::pixel`] on 16 lanes: the same operations in the same order, with four
+    /// AVX-512 shortcuts that give the same values: the exponent by `vgetexpps` (⌊log2 v⌋
+    /// of a positive normal v, the integer the scalar path extracts), each 8-entry
+    /// coefficient register repeated in both halves of a 16-entry `vpermps` (its index,
+    /// bits >> 20, then carries the exponent's lowest bit above the segment), s by one
+    /// `vpternlogd`, and 2^(2.2e) read from the 32-entry table [`Curves::scales`] with
+    /// one two-register `vpermt2ps` (biased exponents 103…128 are distinct modulo 32),
+    /// whose 0 at exponent 102 ([`Y_ZERO`]) stands for the scalar path's y < Y_MIN test.
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    unsafe fn map16<const G: usize>(
+        &self,
+        k: &Regs16,
+        rgb: [[std::arch::x86_64::__m512; 3]; G],
+    ) -> [[std::arch::x86_64::__m512; 3]; G] {
+        // No closures here: this function has no target features of its own, and a
+        // closure the optimiser does not inline would be compiled without AVX-512 (every
+        // intrinsic a call). The helpers are `#[inline(always)]` functions instead.
+        let mut v = rgb;
+        for x in &mut v {
+            *x = mat16(&k.inset, *x);
+        }
+        encode16(k, self.curves, &mut v);
+        for x in &mut v {
+            *x = mat16(&k.outset, *x);
+        }
+        power16(k, &mut v);
+        if let Some(m) = &k.from {
+            for x in &mut v {
+                *x = mat16(m, *x);
+            }
+        }
+        v
+    }
+}
+
+/// `m · (x, y, z)` on 16 lanes, the operations of [`mat3`].
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn mat16(
+    m: &[std::arch::x86_64::__m512; 9],
+    [x, y, z]: [std::arch::x86_64::__m512; 3],
+) -> [std::arch::x86_64::__m512; 3] {
+    use std::arch::x86_64::*;
+    let mut out = [x; 3];
+    for (row, o) in out.iter_mut().enumerate() {
+        *o = _mm512_fmadd_ps(
+            m[6 + row],
+            z,
+            _mm512_fmadd_ps(m[3 + row], y, _mm512_mul_ps(m[row], x)),
+        );
+    }
+    out
+}
+
+/// [`centred_position`] on 16 lanes: (bits & T_MASK) | ONE_BITS in one `vpternlogd`
+/// (truth table 0xEA: (a & b) | c), then the exact subtraction.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn position16(bits: std::arch::x86_64::__m512i) -> std::arch::x86_64::__m512 {
+    use std::arch::x86_64::*;
+    let m = _mm512_ternarylogic_epi32::<0xEA>(
+        bits,
+        _mm512_set1_epi32(T_MASK as i32),
+        _mm512_set1_epi32(ONE_BITS as i32),
+    );
+    _mm512_sub_ps(_mm512_castsi512_ps(m), _mm512_set1_ps(S_CENTRE))
+}
+
+// The curves below run each step over all 3·G vectors before the next step: the steps
+// of one value form a chain of ~25 dependent operations (≈ 100 cycles), and written
+// value by value the scheduler fills with one chain before it reaches independent work
+// (the pass measured latency-bound: ≈ 150 cycles per 16 pixels for ≈ 45 cycles of
+// issue).
+
+/// [`Map::encode`] on 16 lanes, every vector of `v`.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn encode16<const G: usize>(
+    k: &Regs16,
+    c: &Curves,
+    v: &mut [[std::arch::x86_64::__m512; 3]; G],
+) {
+    use std::arch::x86_64::*;
+    let (x_min, x_max) = (_mm512_set1_ps(c.x_min), _mm512_set1_ps(c.x_max));
+    let zero = _mm512_setzero_ps();
+    let (mut e, mut seg, mut s, mut p) = (
+        [[zero; 3]; G],
+        [[_mm512_setzero_si512(); 3]; G],
+        [[zero; 3]; G],
+        [[zero; 3]; G],
+    );
+    for g in 0..G {
+        for ch in 0..3 {
+            let x = _mm512_min_ps(_mm512_max_ps(v[g][ch], x_min), x_max);
+            let bits = _mm512_castps_si512(x);
+            e[g][ch] = _mm512_getexp_ps(x);
+            seg[g][ch] = _mm512_srli_epi32::<{ T_BITS }>(bits);
+            s[g][ch] = position16(bits);
+            p[g][ch] = _mm512_permutexvar_ps(seg[g][ch], k.encode[ENCODE_TERMS - 1]);
+        }
+    }
+    for j in (0..ENCODE_TERMS - 1).rev() {
+        for g in 0..G {
+            for ch in 0..3 {
+                p[g][ch] = _mm512_fmadd_ps(
+                    p[g][ch],
+                    s[g][ch],
+                    _mm512_permutexvar_ps(seg[g][ch], k.encode[j]),
+                );
+            }
+        }
+    }
+    for g in 0..G {
+        for ch in 0..3 {
+            // w, then the contrast polynomial's top coefficient into v.
+            s[g][ch] = _mm512_add_ps(e[g][ch], p[g][ch]);
+            v[g][ch] = k.contrast[6];
+        }
+    }
+    for j in (0..6).rev() {
+        for g in 0..G {
+            for ch in 0..3 {
+                v[g][ch] = _mm512_fmadd_ps(v[g][ch], s[g][ch], k.contrast[j]);
+            }
+        }
+    }
+}
+
+/// [`Map::power`] on 16 lanes, every vector of `v`.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn power16<const G: usize>(k: &Regs16, v: &mut [[std::arch::x86_64::__m512; 3]; G]) {
+    use std::arch::x86_64::*;
+    let y_zero = _mm512_set1_ps(Y_ZERO);
+    let zero = _mm512_setzero_ps();
+    let (mut bits, mut seg, mut s, mut p) = (
+        [[_mm512_setzero_si512(); 3]; G],
+        [[_mm512_setzero_si512(); 3]; G],
+        [[zero; 3]; G],
+        [[zero; 3]; G],
+    );
+    for g in 0..G {
+        for ch in 0..3 {
+            // Below Y_MIN (and NaN) to Y_ZERO, whose scale is 0.
+            bits[g][ch] = _mm512_castps_si512(_mm512_max_ps(v[g][ch], y_zero));
+            seg[g][ch] = _mm512_srli_epi32::<{ T_BITS }>(bits[g][ch]);
+            s[g][ch] = position16(bits[g][ch]);
+            p[g][ch] = _mm512_permutexvar_ps(seg[g][ch], k.power[POWER_TERMS - 1]);
+        }
+    }
+    for j in (0..POWER_TERMS - 1).rev() {
+        for g in 0..G {
+            for ch in 0..3 {
+                p[g][ch] = _mm512_fmadd_ps(
+                    p[g][ch],
+                    s[g][ch],
+                    _mm512_permutexvar_ps(seg[g][ch], k.power[j]),
+                );
+            }
+        }
+    }
+    for g in 0..G {
+        for ch in 0..3 {
+            let scale = _mm512_permutex2var_ps(
+                k.scales[0],
+                _mm512_srli_epi32::<23>(bits[g][ch]),
+                k.scales[1],
+            );
+            v[g][ch] = _mm512_mul_ps(p[g][ch], scale);
         }
     }
 }
@@ -525,7 +696,7 @@ pub(crate) fn apply(ctx: &Context) -> Output {
         curves: curves(),
     };
     Output {
-        mapped: map_pixels(ctx, ctx.exposure, &map),
+        mapped: super::map512::map_pixels_registers(ctx, ctx.exposure, &map),
         values: vec![],
     }
 }
@@ -611,8 +782,9 @@ mod tests {
         let want: Vec<[f64; 3]> = img.pixels().iter().map(|p| agx_f64(*p)).collect();
         let err = max_code_error_16(out.pixels(), &want);
         eprintln!("agx: max error {err} 16-bit codes");
-        // Measured 0.0122 codes with the per-segment polynomials in registers (power
-        // ≤ 1.8e-7 relative, encoding ≤ 9.7e-8 absolute: `fifths_split_and_fitted_curves`)
+        // Measured 0.0154 codes with the polynomials in s and the contrast in w (power
+        // ≤ 1.95e-7 relative, encoding ≤ 1.39e-7 absolute: `fifths_split_and_fitted_curves`;
+        // seventh pass, docs/post.md), 0.0122 before them with t and u (1.8e-7, 9.7e-8)
         // and the f32 inset/outset sums; 0.012 with the memory tables of curve_table
         // (until 2026-12-01); the closed forms in f32 (fast log2 and exp2) measured 0.195,
         // the printed power form 0.43.
@@ -671,6 +843,32 @@ mod tests {
                         "{name} {i}: {got:?}"
                     );
                 }
+            }
+        }
+    }
+
+    #[test]
+    fn register_pass_gives_the_scalar_bits() {
+        // The whole AVX-512 pass (sanitising, the map in registers with its output
+        // cleaning skipped, zero-padded head and tail groups, the counts) against the
+        // scalar one, on the special values and on every octave of the curves.
+        let special = bit_test_image();
+        let mut pixels = special.pixels().to_vec();
+        let mut v = 1e-7f32;
+        while v < 1e4 {
+            pixels.push([v, 0.37 * v, 2.9 * v]);
+            v *= 1.0093;
+        }
+        for space in [RgbColorSpace::srgb(), RgbColorSpace::rec2020()] {
+            let (to_srgb, from_srgb) = srgb_matrices(&space);
+            let map = Map {
+                inset: (Mat3::from_cols_array(&INSET) * to_srgb).to_cols_array(),
+                outset: OUTSET,
+                from_srgb: (!is_identity(from_srgb)).then(|| from_srgb.to_cols_array()),
+                curves: curves(),
+            };
+            for scale in [1.0f32, 0.37, 3e30] {
+                super::super::map512::register_pass_gives_the_scalar_bits(&pixels, scale, &map);
             }
         }
     }

@@ -16,7 +16,14 @@
 //! without fused multiply-adds, so the result is the scalar path's bits (tested for every
 //! curve, on NaN, ±∞, negative, ±0 and subnormal input). The few pixels before the first
 //! 64-byte-aligned output address and after the last whole group of 16 go through the
-//! scalar path itself.
+//! same 16-lane code on a zero-padded group (seventh pass, docs/post.md; the scalar path
+//! itself before). Register curves and maps take no pixel index: the ones written so far
+//! are global (their `ratio` ignores `start`).
+//!
+//! Each step handles several groups of 16 pixels ([`STEP_GROUPS`]) with their curve or
+//! map evaluations written side by side: one group's chain of dependent operations is
+//! long (agx: ≈ 25 operations, ≈ 120 cycles), and one group per step left the passes
+//! latency-bound (seventh pass).
 
 #[cfg(target_arch = "x86_64")]
 use std::arch::x86_64::*;
@@ -24,9 +31,8 @@ use std::arch::x86_64::*;
 use rayon::prelude::*;
 
 use super::pixels::{
-    map_luminance, map_luminance_chunk, map_pixels_chunk, stats_block, store_block, store_fence,
-    Acc, LuminanceCurve, Mapped, PixelMap, Scale, StatsLanes, BLOCK, CHUNK, LANES,
-    LOG_AVERAGE_DELTA,
+    map_luminance, map_pixels_chunk, stats_block, store_block, store_fence, Acc, LuminanceCurve,
+    Mapped, PixelMap, Scale, StatsLanes, BLOCK, CHUNK, LANES, LOG_AVERAGE_DELTA,
 };
 use super::Context;
 
@@ -85,12 +91,14 @@ pub(crate) fn map_luminance_avx512<C: RegisterCurve>(
             #[cfg(target_arch = "x86_64")]
             {
                 assert!(available());
+                // The register curves take no pixel index.
+                let _ = k;
                 // SAFETY: the CPU has AVX-512F (asserted just above).
-                unsafe { chunk_avx512(i, o, k * CHUNK, scale, w, curve) }
+                unsafe { chunk_avx512(i, o, scale, w, curve) }
             }
             #[cfg(not(target_arch = "x86_64"))]
             {
-                map_luminance_chunk(i, o, k * CHUNK, scale, w, curve)
+                super::pixels::map_luminance_chunk(i, o, k * CHUNK, scale, w, curve)
             }
         })
         .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
@@ -190,13 +198,106 @@ unsafe fn finite_mask(x: __m512) -> __mmask16 {
     _mm512_cmp_ps_mask::<_CMP_LT_OQ>(_mm512_abs_ps(x), _mm512_set1_ps(f32::INFINITY))
 }
 
-/// One task of [`map_luminance_avx512`].
+/// load_block on 16 pixels: `scale · rgb` clamped to ≥ 0 (maxps(x, 0) returns its second
+/// operand for NaN and ±0, as `f32::max(x, 0)` compiles), black for a pixel with a
+/// non-finite component; with the masks of finite pixels and of finite pixels with a
+/// negative component.
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f")]
+#[inline(always)]
+/// `SCALED = false` skips the multiplication, for scale = 1 (x · 1 = x for every finite
+/// x, ±0 and subnormals included, and non-finite pixels become black either way).
+unsafe fn sanitise16<const SCALED: bool>(
+    p: [__m512; 3],
+    scale: __m512,
+) -> ([__m512; 3], __mmask16, __mmask16) {
+    let zero = _mm512_setzero_ps();
+    let finite = finite_mask(p[0]) & finite_mask(p[1]) & finite_mask(p[2]);
+    let neg = (_mm512_cmp_ps_mask::<_CMP_LT_OQ>(p[0], zero)
+        | _mm512_cmp_ps_mask::<_CMP_LT_OQ>(p[1], zero)
+        | _mm512_cmp_ps_mask::<_CMP_LT_OQ>(p[2], zero))
+        & finite;
+    let c = |x: __m512| {
+        let x = if SCALED { _mm512_mul_ps(x, scale) } else { x };
+        _mm512_maskz_mov_ps(finite, _mm512_max_ps(x, zero))
+    };
+    ([c(p[0]), c(p[1]), c(p[2])], finite, neg)
+}
+
+/// G groups of 16 pixels (48 floats each) at `s` through the luminance mapping, as three
+/// interleaved output registers each, with the masks of non-finite and of negative
+/// input pixels. The caller guarantees the 48 G floats are readable.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn luminance_group16<C: RegisterCurve, const G: usize, const SCALED: bool>(
+    curve: &C,
+    w: &[__m512; 3],
+    de: &[(__m512i, __m512i); 3],
+    inter: &[(__m512i, __m512i); 3],
+    scale: __m512,
+    s: *const f32,
+) -> ([[__m512; 3]; G], [__mmask16; G], [__mmask16; G]) {
+    let zero = _mm512_setzero_ps();
+    let (mut c, mut l, mut non_finite, mut neg) = ([[zero; 3]; G], [zero; G], [0; G], [0; G]);
+    for g in 0..G {
+        // load_block: black for a pixel with a non-finite component, negatives to 0,
+        // luminance w · c summed left to right.
+        let (cg, finite, ng) = sanitise16::<SCALED>(load_planes16(s.add(48 * g), de), scale);
+        (c[g], non_finite[g], neg[g]) = (cg, !finite, ng);
+        l[g] = _mm512_add_ps(
+            _mm512_add_ps(_mm512_mul_ps(w[0], cg[0]), _mm512_mul_ps(w[1], cg[1])),
+            _mm512_mul_ps(w[2], cg[2]),
+        );
+    }
+    // The G curve evaluations next to each other (independent chains).
+    let mut ld = [zero; G];
+    for g in 0..G {
+        ld[g] = curve.ratio16(l[g]);
+    }
+    let mut o = [[zero; 3]; G];
+    for g in 0..G {
+        // map_luminance_chunk: the ratio where L > 0 and it is finite, else 0; then
+        // max(c · ratio, 0), black where that overflows.
+        let keep = _mm512_cmp_ps_mask::<_CMP_GT_OQ>(l[g], zero) & finite_mask(ld[g]);
+        let ratio = _mm512_maskz_mov_ps(keep, ld[g]);
+        let x = [0, 1, 2].map(|ch| _mm512_max_ps(_mm512_mul_ps(c[g][ch], ratio), zero));
+        let ok = finite_mask(x[0]) & finite_mask(x[1]) & finite_mask(x[2]);
+        let x = x.map(|v| _mm512_maskz_mov_ps(ok, v));
+        for (reg, (i0, i1)) in inter.iter().enumerate() {
+            o[g][reg] = _mm512_permutex2var_ps(_mm512_permutex2var_ps(x[0], *i0, x[1]), *i1, x[2]);
+        }
+    }
+    (o, non_finite, neg)
+}
+
+/// One task of [`map_luminance_avx512`], without the exposure multiplication where the
+/// scale is 1 (the same bits, see [`sanitise16`]).
+///
+/// # Safety
+/// The CPU must have AVX-512F.
+#[cfg(target_arch = "x86_64")]
 unsafe fn chunk_avx512<C: RegisterCurve>(
     input: &[[f32; 3]],
     out: &mut [[f32; 3]],
-    start: usize,
+    scale: f32,
+    w: [f32; 3],
+    curve: &C,
+) -> (u64, u64) {
+    if scale == 1.0 {
+        luminance_chunk_avx512::<C, false>(input, out, scale, w, curve)
+    } else {
+        luminance_chunk_avx512::<C, true>(input, out, scale, w, curve)
+    }
+}
+
+/// The body of [`chunk_avx512`]: as [`pixels_registers_avx512`], [`STEP_GROUPS`] groups
+/// of 16 pixels per step (their curve evaluations side by side), head and tail pixels
+/// through a zero-padded group (black: counted as neither non-finite nor negative, and
+/// mapped to black), per-lane counts.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+unsafe fn luminance_chunk_avx512<C: RegisterCurve, const SCALED: bool>(
+    input: &[[f32; 3]],
+    out: &mut [[f32; 3]],
     scale: f32,
     w: [f32; 3],
     curve: &C,
@@ -211,70 +312,308 @@ unsafe fn chunk_avx512<C: RegisterCurve>(
         .min(n);
     let groups = (n - head) / 16;
     let tail = head + 16 * groups;
-    let (mut non_finite, mut negative) =
-        map_luminance_chunk(&input[..head], &mut out[..head], start, scale, w, curve);
-
     let load_idx = |a: [i32; 16]| _mm512_loadu_si512(a.as_ptr() as *const _);
     let de = deinterleave_registers();
     let inter = [0, 1, 2].map(|reg| {
         let (a, b) = interleave_indices(reg);
         (load_idx(a), load_idx(b))
     });
-    let zero = _mm512_setzero_ps();
     let scale_v = _mm512_set1_ps(scale);
     let w_v = w.map(|x| _mm512_set1_ps(x));
+    let one = _mm512_set1_epi32(1);
+    let (mut nf_lanes, mut neg_lanes) = (_mm512_setzero_si512(), _mm512_setzero_si512());
+    let partial = |i: &[[f32; 3]], o: &mut [[f32; 3]]| {
+        let mut buf = [[0.0f32; 3]; 16];
+        buf[..i.len()].copy_from_slice(i);
+        // SAFETY: buf holds 48 floats.
+        let ([v], [nf], [neg]) = luminance_group16::<C, 1, SCALED>(
+            curve,
+            &w_v,
+            &de,
+            &inter,
+            scale_v,
+            buf.as_ptr() as *const f32,
+        );
+        let d = buf.as_mut_ptr() as *mut f32;
+        for (reg, v) in v.into_iter().enumerate() {
+            // SAFETY: buf holds 48 floats.
+            _mm512_storeu_ps(d.add(16 * reg), v);
+        }
+        o.copy_from_slice(&buf[..o.len()]);
+        (nf.count_ones() as u64, neg.count_ones() as u64)
+    };
+    let (non_finite, negative) = partial(&input[..head], &mut out[..head]);
     let src = input.as_ptr().add(head) as *const f32;
     let dst = out.as_mut_ptr().add(head) as *mut f32;
-    for g in 0..groups {
-        // SAFETY: pixels head + 16 g … head + 16 g + 15 lie inside both slices (g <
-        // groups), i.e. floats 48 g … 48 g + 47 from src and dst.
+    let mut g = 0;
+    while g < groups {
+        // SAFETY: pixels head + 16 g … head + 16 (g + k) − 1 lie inside both slices for
+        // the k ≤ groups − g groups handled below (floats 48 g … 48 (g + k) − 1 from src
+        // and dst); the prefetches do not fault.
         let s = src.add(48 * g);
-        prefetch_ahead(s);
-        let p = load_planes16(s, &de);
-        // load_block: black for a pixel with a non-finite component, negatives to 0
-        // (maxps(x, 0) returns its second operand for NaN and for ±0, as f32::max(x, 0)
-        // compiles), luminance w · c summed left to right.
-        let finite = finite_mask(p[0]) & finite_mask(p[1]) & finite_mask(p[2]);
-        let neg = (_mm512_cmp_ps_mask::<_CMP_LT_OQ>(p[0], zero)
-            | _mm512_cmp_ps_mask::<_CMP_LT_OQ>(p[1], zero)
-            | _mm512_cmp_ps_mask::<_CMP_LT_OQ>(p[2], zero))
-            & finite;
-        non_finite += (!finite).count_ones() as u64;
-        negative += neg.count_ones() as u64;
-        let c =
-            p.map(|x| _mm512_maskz_mov_ps(finite, _mm512_max_ps(_mm512_mul_ps(x, scale_v), zero)));
-        let l = _mm512_add_ps(
-            _mm512_add_ps(_mm512_mul_ps(w_v[0], c[0]), _mm512_mul_ps(w_v[1], c[1])),
-            _mm512_mul_ps(w_v[2], c[2]),
-        );
-        // map_luminance_chunk: the ratio where L > 0 and it is finite, else 0; then
-        // max(c · ratio, 0), black where that overflows.
-        let ld = curve.ratio16(l);
-        let keep = _mm512_cmp_ps_mask::<_CMP_GT_OQ>(l, zero) & finite_mask(ld);
-        let ratio = _mm512_maskz_mov_ps(keep, ld);
-        let o = c.map(|x| _mm512_max_ps(_mm512_mul_ps(x, ratio), zero));
-        let ok = finite_mask(o[0]) & finite_mask(o[1]) & finite_mask(o[2]);
-        let o = o.map(|x| _mm512_maskz_mov_ps(ok, x));
+        for k in 0..STEP_GROUPS {
+            prefetch_ahead(s.add(48 * k));
+        }
         let d = dst.add(48 * g);
-        for (reg, (i0, i1)) in inter.iter().enumerate() {
-            let v = _mm512_permutex2var_ps(_mm512_permutex2var_ps(o[0], *i0, o[1]), *i1, o[2]);
-            // SAFETY: d + 16 reg is 64-byte aligned (head chosen so) and inside `out`.
-            _mm512_stream_ps(d.add(16 * reg), v);
+        let mut store = |k: usize, v: [__m512; 3], nf: __mmask16, neg: __mmask16| {
+            nf_lanes = _mm512_mask_add_epi32(nf_lanes, nf, nf_lanes, one);
+            neg_lanes = _mm512_mask_add_epi32(neg_lanes, neg, neg_lanes, one);
+            for (reg, v) in v.into_iter().enumerate() {
+                // SAFETY: d + 48 k + 16 reg is 64-byte aligned (head chosen so) and
+                // inside `out`.
+                _mm512_stream_ps(d.add(48 * k + 16 * reg), v);
+            }
+        };
+        if g + STEP_GROUPS <= groups {
+            let (v, nf, neg) =
+                luminance_group16::<C, STEP_GROUPS, SCALED>(curve, &w_v, &de, &inter, scale_v, s);
+            for k in 0..STEP_GROUPS {
+                store(k, v[k], nf[k], neg[k]);
+            }
+            g += STEP_GROUPS;
+        } else {
+            let ([v], [nf], [neg]) =
+                luminance_group16::<C, 1, SCALED>(curve, &w_v, &de, &inter, scale_v, s);
+            store(0, v, nf, neg);
+            g += 1;
         }
     }
     // Streaming stores are weakly ordered: fence them before the task reports done.
     _mm_sfence();
-    let (nf, neg) = map_luminance_chunk(
-        &input[tail..n],
-        &mut out[tail..n],
-        start + tail,
-        scale,
-        w,
-        curve,
-    );
-    non_finite += nf;
-    negative += neg;
-    (non_finite, negative)
+    let (nf, neg) = partial(&input[tail..n], &mut out[tail..n]);
+    let lanes = |v: __m512i| _mm512_reduce_add_epi32(v) as u32 as u64;
+    (
+        non_finite + nf + lanes(nf_lanes),
+        negative + neg + lanes(neg_lanes),
+    )
+}
+
+/// A [`PixelMap`] with a 16-lane register form, for [`map_pixels_registers`]: the map
+/// runs inside the 16-pixel load/store loop on registers, with its constants loaded once
+/// per task, instead of over stack planes staged through memory (docs/post.md, seventh
+/// pass).
+pub(crate) trait RegisterMap: PixelMap {
+    /// The map's constants, held in registers (or wherever the compiler keeps them)
+    /// across a task.
+    #[cfg(target_arch = "x86_64")]
+    type Regs;
+    /// Whether [`Self::map16`] returns only finite values for sanitised input (finite,
+    /// ≥ 0), so that the pass can skip turning non-finite results into 0 (which then
+    /// changes no bits). Implementations that set it say why it holds.
+    const FINITE_OUTPUT: bool = false;
+    /// Loads the constants. Implementations are `#[inline(always)]` and only use
+    /// AVX-512F intrinsics.
+    ///
+    /// # Safety
+    /// The CPU must have AVX-512F (callers are `#[target_feature(enable = "avx512f")]`).
+    #[cfg(target_arch = "x86_64")]
+    unsafe fn regs16(&self) -> Self::Regs;
+    /// [`PixelMap::map`] on G groups of 16 sanitised pixels (R, G, B planes in
+    /// registers), lane by lane the same bits; the pass hands over [`STEP_GROUPS`] groups
+    /// at a time so that a map can interleave their (independent) dependency chains.
+    /// `#[inline(always)]`, AVX-512F intrinsics only.
+    ///
+    /// # Safety
+    /// As [`Self::regs16`]; `regs` comes from `self.regs16()`.
+    #[cfg(target_arch = "x86_64")]
+    unsafe fn map16<const G: usize>(
+        &self,
+        regs: &Self::Regs,
+        rgb: [[__m512; 3]; G],
+    ) -> [[__m512; 3]; G];
+}
+
+/// [`super::pixels::map_pixels`] (same contract, same bits) for a map with a register
+/// form: per 16 pixels three loads, the de-interleave, sanitising, the map, cleaning
+/// (non-finite results to 0), the interleave and three streaming stores, all in
+/// registers. Falls back to `map_pixels` on CPUs without AVX-512F.
+pub(crate) fn map_pixels_registers<M: RegisterMap>(ctx: &Context, scale: f32, f: &M) -> Mapped {
+    if !available() {
+        return super::pixels::map_pixels(ctx, scale, f);
+    }
+    let image = ctx.image;
+    let mut pixels = ctx.output_buffer(image.pixels().len());
+    let (non_finite, negative) = pixels
+        .par_chunks_mut(CHUNK)
+        .zip(image.pixels().par_chunks(CHUNK))
+        .enumerate()
+        .map(|(k, (o, i))| {
+            #[cfg(target_arch = "x86_64")]
+            {
+                assert!(available());
+                // The register maps take no pixel index.
+                let _ = k;
+                // SAFETY: the CPU has AVX-512F (asserted just above).
+                unsafe { pixels_registers_task(i, o, scale, f) }
+            }
+            #[cfg(not(target_arch = "x86_64"))]
+            {
+                map_pixels_chunk(i, o, k * CHUNK, scale, f)
+            }
+        })
+        .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
+    Mapped {
+        pixels,
+        non_finite_pixels: non_finite,
+        negative_pixels: negative,
+    }
+}
+
+/// The G groups of 16 pixels (48 floats each) at `s` through `f`, as three interleaved
+/// output registers each, with the masks of non-finite and of negative input pixels.
+/// The caller guarantees the 48 G floats are readable.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn group16<M: RegisterMap, const G: usize, const SCALED: bool>(
+    f: &M,
+    regs: &M::Regs,
+    de: &[(__m512i, __m512i); 3],
+    inter: &[(__m512i, __m512i); 3],
+    scale: __m512,
+    s: *const f32,
+) -> ([[__m512; 3]; G], [__mmask16; G], [__mmask16; G]) {
+    let zero = _mm512_setzero_ps();
+    let (mut c, mut non_finite, mut neg) = ([[zero; 3]; G], [0; G], [0; G]);
+    for g in 0..G {
+        let (cg, finite, ng) = sanitise16::<SCALED>(load_planes16(s.add(48 * g), de), scale);
+        (c[g], non_finite[g], neg[g]) = (cg, !finite, ng);
+    }
+    let mut o = f.map16(regs, c);
+    if !M::FINITE_OUTPUT {
+        // map_pixels_chunk: non-finite results become 0, per component.
+        for x in o.iter_mut().flatten() {
+            *x = _mm512_maskz_mov_ps(finite_mask(*x), *x);
+        }
+    }
+    for x in &mut o {
+        let p = *x;
+        for (reg, (i0, i1)) in inter.iter().enumerate() {
+            x[reg] = _mm512_permutex2var_ps(_mm512_permutex2var_ps(p[0], *i0, p[1]), *i1, p[2]);
+        }
+    }
+    (o, non_finite, neg)
+}
+
+/// One task of [`map_pixels_registers`], without the exposure multiplication where the
+/// scale is 1 (the default exposure: the same bits, see [`sanitise16`]).
+///
+/// # Safety
+/// The CPU must have AVX-512F.
+#[cfg(target_arch = "x86_64")]
+unsafe fn pixels_registers_task<M: RegisterMap>(
+    input: &[[f32; 3]],
+    out: &mut [[f32; 3]],
+    scale: f32,
+    f: &M,
+) -> (u64, u64) {
+    if scale == 1.0 {
+        pixels_registers_avx512::<M, false>(input, out, scale, f)
+    } else {
+        pixels_registers_avx512::<M, true>(input, out, scale, f)
+    }
+}
+
+/// Groups of 16 pixels per step of [`pixels_registers_avx512`] and
+/// [`luminance_chunk_avx512`].
+#[cfg(target_arch = "x86_64")]
+const STEP_GROUPS: usize = 3;
+
+/// One task of [`map_pixels_registers`]. The pixels before the first 64-byte-aligned
+/// output address and after the last whole group of 16 (fewer than 16 each) go through
+/// the same 16-lane code on a zero-padded copy (zeros count as neither non-finite nor
+/// negative), not the scalar path: a few scalar pixels per task cost more than the rest
+/// of it where `f32::mul_add` is a library call (the baseline build has no FMA).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+unsafe fn pixels_registers_avx512<M: RegisterMap, const SCALED: bool>(
+    input: &[[f32; 3]],
+    out: &mut [[f32; 3]],
+    scale: f32,
+    f: &M,
+) -> (u64, u64) {
+    let n = input.len().min(out.len());
+    // As chunk_avx512: one of the first 16 pixels starts on a 64-byte boundary.
+    let addr = out.as_ptr() as usize;
+    let head = (0..16)
+        .find(|k| (addr + 12 * k).is_multiple_of(64))
+        .unwrap_or(0)
+        .min(n);
+    let groups = (n - head) / 16;
+    let tail = head + 16 * groups;
+    let load_idx = |a: [i32; 16]| _mm512_loadu_si512(a.as_ptr() as *const _);
+    let de = deinterleave_registers();
+    let inter = [0, 1, 2].map(|reg| {
+        let (a, b) = interleave_indices(reg);
+        (load_idx(a), load_idx(b))
+    });
+    let scale_v = _mm512_set1_ps(scale);
+    let regs = f.regs16();
+    // Per-lane counts of non-finite and negative input pixels, added up after the loop
+    // (≤ CHUNK / 16 per lane), instead of two popcounts per group (the baseline build
+    // has no `popcnt`: each is a dozen instructions).
+    let one = _mm512_set1_epi32(1);
+    let (mut nf_lanes, mut neg_lanes) = (_mm512_setzero_si512(), _mm512_setzero_si512());
+    let count = |non_finite: __mmask16, neg: __mmask16| {
+        (non_finite.count_ones() as u64, neg.count_ones() as u64)
+    };
+    // Fewer than 16 pixels through a zero-padded group.
+    let partial = |i: &[[f32; 3]], o: &mut [[f32; 3]]| {
+        let mut buf = [[0.0f32; 3]; 16];
+        buf[..i.len()].copy_from_slice(i);
+        // SAFETY: buf holds 48 floats.
+        let ([v], [nf], [neg]) =
+            group16::<M, 1, SCALED>(f, &regs, &de, &inter, scale_v, buf.as_ptr() as *const f32);
+        let d = buf.as_mut_ptr() as *mut f32;
+        for (reg, v) in v.into_iter().enumerate() {
+            // SAFETY: buf holds 48 floats.
+            _mm512_storeu_ps(d.add(16 * reg), v);
+        }
+        o.copy_from_slice(&buf[..o.len()]);
+        count(nf, neg)
+    };
+    let (non_finite, negative) = partial(&input[..head], &mut out[..head]);
+    let src = input.as_ptr().add(head) as *const f32;
+    let dst = out.as_mut_ptr().add(head) as *mut f32;
+    // Two groups per step (see RegisterMap::map16); an odd last group alone.
+    let mut g = 0;
+    while g < groups {
+        // SAFETY: pixels head + 16 g … head + 16 (g + k) − 1 lie inside both slices for
+        // the k ≤ groups − g groups handled below (floats 48 g … 48 (g + k) − 1 from src
+        // and dst); the prefetches do not fault.
+        let s = src.add(48 * g);
+        for k in 0..STEP_GROUPS {
+            prefetch_ahead(s.add(48 * k));
+        }
+        let d = dst.add(48 * g);
+        let mut store = |k: usize, v: [__m512; 3], nf: __mmask16, neg: __mmask16| {
+            nf_lanes = _mm512_mask_add_epi32(nf_lanes, nf, nf_lanes, one);
+            neg_lanes = _mm512_mask_add_epi32(neg_lanes, neg, neg_lanes, one);
+            for (reg, v) in v.into_iter().enumerate() {
+                // SAFETY: d + 48 k + 16 reg is 64-byte aligned (head chosen so) and
+                // inside `out`.
+                _mm512_stream_ps(d.add(48 * k + 16 * reg), v);
+            }
+        };
+        if g + STEP_GROUPS <= groups {
+            let (v, nf, neg) = group16::<M, STEP_GROUPS, SCALED>(f, &regs, &de, &inter, scale_v, s);
+            for k in 0..STEP_GROUPS {
+                store(k, v[k], nf[k], neg[k]);
+            }
+            g += STEP_GROUPS;
+        } else {
+            let ([v], [nf], [neg]) = group16::<M, 1, SCALED>(f, &regs, &de, &inter, scale_v, s);
+            store(0, v, nf, neg);
+            g += 1;
+        }
+    }
+    // Streaming stores are weakly ordered: fence them before the task reports done.
+    _mm_sfence();
+    let (nf, neg) = partial(&input[tail..n], &mut out[tail..n]);
+    let lanes = |v: __m512i| _mm512_reduce_add_epi32(v) as u32 as u64;
+    (
+        non_finite + nf + lanes(nf_lanes),
+        negative + neg + lanes(neg_lanes),
+    )
 }
 
 /// One task of [`super::pixels::map_pixels`] with AVX-512F: whole blocks are
@@ -317,7 +656,6 @@ unsafe fn map_pixels_chunk_avx512<M: PixelMap>(
         let (a, b) = interleave_indices(reg);
         (load_idx(a), load_idx(b))
     });
-    let zero = _mm512_setzero_ps();
     let scale_v = _mm512_set1_ps(scale);
     let mut planes = [[0.0f32; BLOCK]; 3];
     let mut staged = [[0.0f32; 3]; BLOCK];
@@ -334,17 +672,10 @@ unsafe fn map_pixels_chunk_avx512<M: PixelMap>(
             // SAFETY: the block holds BLOCK pixels: floats 48 g … 48 g + 47 lie inside.
             let s = src.add(48 * g);
             prefetch_ahead(s);
-            let p = load_planes16(s, &de);
-            // load_block: black for a non-finite component, negatives clamped to 0.
-            let finite = finite_mask(p[0]) & finite_mask(p[1]) & finite_mask(p[2]);
-            let neg = (_mm512_cmp_ps_mask::<_CMP_LT_OQ>(p[0], zero)
-                | _mm512_cmp_ps_mask::<_CMP_LT_OQ>(p[1], zero)
-                | _mm512_cmp_ps_mask::<_CMP_LT_OQ>(p[2], zero))
-                & finite;
+            let (c, finite, neg) = sanitise16::<true>(load_planes16(s, &de), scale_v);
             non_finite += (!finite).count_ones() as u64;
             negative += neg.count_ones() as u64;
-            for (plane, x) in planes.iter_mut().zip(p) {
-                let c = _mm512_maskz_mov_ps(finite, _mm512_max_ps(_mm512_mul_ps(x, scale_v), zero));
+            for (plane, c) in planes.iter_mut().zip(c) {
                 // SAFETY: 16 g + 15 < BLOCK.
                 _mm512_storeu_ps(plane.as_mut_ptr().add(16 * g), c);
             }
@@ -534,7 +865,14 @@ pub(crate) fn same_bits_as_scalar<C: RegisterCurve>(
     };
     let wide = map_luminance_avx512(&ctx, scale, ctx.weights, curve);
     let mut scalar = vec![[0f32; 3]; image.pixels().len()];
-    let (nf, neg) = map_luminance_chunk(image.pixels(), &mut scalar, 0, scale, ctx.weights, curve);
+    let (nf, neg) = super::pixels::map_luminance_chunk(
+        image.pixels(),
+        &mut scalar,
+        0,
+        scale,
+        ctx.weights,
+        curve,
+    );
     assert_eq!((wide.non_finite_pixels, wide.negative_pixels), (nf, neg));
     for (i, (a, b)) in wide.pixels.iter().zip(&scalar).enumerate() {
         assert_eq!(
@@ -544,6 +882,84 @@ pub(crate) fn same_bits_as_scalar<C: RegisterCurve>(
             image.pixels()[i]
         );
     }
+    // One task at every output alignment and several lengths (head and tail groups of
+    // 0–15 pixels through the zero-padded group), with and without the exposure multiply.
+    let pixels = image.pixels();
+    let n = pixels.len();
+    let mut fast_buf = vec![[0f32; 3]; n + 16];
+    for scale in [scale, 1.0, 0.37] {
+        for len in [0, 1, 15, 16, 17, 100, n] {
+            for offset in 0..16 {
+                let (input, out) = (&pixels[..len], &mut fast_buf[offset..offset + len]);
+                #[cfg(target_arch = "x86_64")]
+                // SAFETY: the CPU has AVX-512F (checked above).
+                let fast = unsafe { chunk_avx512(input, out, scale, ctx.weights, curve) };
+                #[cfg(not(target_arch = "x86_64"))]
+                let fast =
+                    super::pixels::map_luminance_chunk(input, out, 0, scale, ctx.weights, curve);
+                let slow = super::pixels::map_luminance_chunk(
+                    input,
+                    &mut scalar[..len],
+                    0,
+                    scale,
+                    ctx.weights,
+                    curve,
+                );
+                assert_eq!(fast, slow, "len {len}, offset {offset}");
+                for (i, (a, b)) in fast_buf[offset..offset + len]
+                    .iter()
+                    .zip(&scalar)
+                    .enumerate()
+                {
+                    assert_eq!(
+                        a.map(f32::to_bits),
+                        b.map(f32::to_bits),
+                        "pixel {i} (len {len}, offset {offset}, scale {scale})"
+                    );
+                }
+            }
+        }
+    }
+    true
+}
+
+/// Test helper: the register pass of `f` ([`map_pixels_registers`]'s task) and the scalar
+/// one give the same bits and counts on `pixels`, for every output alignment (so head and
+/// tail groups of 0–15 pixels occur) and for tasks of several lengths (skipped, returning
+/// false, on CPUs without AVX-512F).
+#[cfg(test)]
+pub(crate) fn register_pass_gives_the_scalar_bits<M: RegisterMap>(
+    pixels: &[[f32; 3]],
+    scale: f32,
+    f: &M,
+) -> bool {
+    if !available() {
+        eprintln!("no AVX-512F: the 16-lane register pass is not exercised on this CPU");
+        return false;
+    }
+    let n = pixels.len();
+    let mut fast_buf = vec![[0f32; 3]; n + 16];
+    let mut slow = vec![[0f32; 3]; n];
+    for len in [0, 1, 15, 16, 17, 100, n] {
+        for offset in 0..16 {
+            let (input, out) = (&pixels[..len], &mut fast_buf[offset..offset + len]);
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: the CPU has AVX-512F (checked above).
+            let fast = unsafe { pixels_registers_task(input, out, scale, f) };
+            #[cfg(not(target_arch = "x86_64"))]
+            let fast = map_pixels_chunk(input, out, 0, scale, f);
+            let slow_counts = map_pixels_chunk(input, &mut slow[..len], 0, scale, f);
+            assert_eq!(fast, slow_counts, "len {len}, offset {offset}");
+            for (i, (a, b)) in fast_buf[offset..offset + len].iter().zip(&slow).enumerate() {
+                assert_eq!(
+                    a.map(f32::to_bits),
+                    b.map(f32::to_bits),
+                    "pixel {i} (len {len}, offset {offset}): {a:?} vs {b:?}, input {:?}",
+                    pixels[i]
+                );
+            }
+        }
+    }
     true
 }
 
@@ -551,6 +967,51 @@ pub(crate) fn same_bits_as_scalar<C: RegisterCurve>(
 mod tests {
     use super::*;
     use crate::tonemap::test_support::bit_test_image;
+
+    /// A register map that makes some values non-finite (so the cleaning runs).
+    struct RegisterProbe;
+    impl PixelMap for RegisterProbe {
+        #[inline(always)]
+        fn map(&self, _start: usize, r: &mut [f32], g: &mut [f32], b: &mut [f32]) {
+            for j in 0..r.len() {
+                (r[j], g[j], b[j]) = (r[j] * 1e30 + g[j], g[j] - b[j] * 0.5, b[j] / (g[j] - r[j]));
+            }
+        }
+    }
+    impl RegisterMap for RegisterProbe {
+        #[cfg(target_arch = "x86_64")]
+        type Regs = __m512;
+        #[cfg(target_arch = "x86_64")]
+        #[inline(always)]
+        unsafe fn regs16(&self) -> __m512 {
+            _mm512_set1_ps(0.5)
+        }
+        #[cfg(target_arch = "x86_64")]
+        #[inline(always)]
+        unsafe fn map16<const G: usize>(
+            &self,
+            half: &__m512,
+            rgb: [[__m512; 3]; G],
+        ) -> [[__m512; 3]; G] {
+            let mut out = rgb;
+            for (o, [r, g, b]) in out.iter_mut().zip(rgb) {
+                *o = [
+                    _mm512_add_ps(_mm512_mul_ps(r, _mm512_set1_ps(1e30)), g),
+                    _mm512_sub_ps(g, _mm512_mul_ps(b, *half)),
+                    _mm512_div_ps(b, _mm512_sub_ps(g, r)),
+                ];
+            }
+            out
+        }
+    }
+
+    #[test]
+    fn register_pass_gives_the_scalar_bits_and_counts() {
+        let special = bit_test_image();
+        for scale in [1.0f32, 3e30] {
+            register_pass_gives_the_scalar_bits(special.pixels(), scale, &RegisterProbe);
+        }
+    }
 
     /// A pixel map that touches every value (and makes some non-finite).
     struct Probe;
