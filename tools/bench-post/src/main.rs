@@ -7,7 +7,10 @@
 //!   the median of its own interleaved copy passes (`copy_pass_ms` per operator; the
 //!   top-level `copy_pass_ms` is the median over all of them); `compute_cpu_ms`,
 //!   `copy_pass_cpu_ms` and `ratio_to_copy_cpu` are the same in CPU time of all threads
-//!   (medians), which the shared machine's load does not stretch;
+//!   (medians), which the shared machine's load does not stretch; `ratio_to_copy_min` and
+//!   `ratio_to_copy_cpu_min` divide the fastest operator run by the fastest of its copy
+//!   passes (the least disturbed of each; the copy pass's CPU time is bimodal here, as the
+//!   idle rayon worker's spinning lands in it or not, which the medians can straddle);
 //! - `file_ms`: the whole in-process pipeline `tonemap_file` from a float EXR to a 16-bit
 //!   PNG (read, operator, gamut clip, encode, write), with its stage breakdown, and
 //!   `file_cpu_ms`, its CPU time of all threads (median);
@@ -166,6 +169,9 @@ fn main() {
             times.push(t.elapsed().as_secs_f64() * 1e3);
             times_cpu.push(process_cpu_ms() - cpu);
         }
+        let fastest = |v: &[f64]| v.iter().copied().fold(f64::INFINITY, f64::min);
+        let ratio_min = fastest(&times) / fastest(&copies);
+        let ratio_cpu_min = fastest(&times_cpu) / fastest(&copies_cpu);
         let compute_ms = median(times);
         all_copies.extend(&copies);
         let copy_ms = median(copies);
@@ -185,6 +191,8 @@ fn main() {
                 "compute_cpu_ms": compute_cpu_ms,
                 "copy_pass_cpu_ms": copy_cpu_ms,
                 "ratio_to_copy_cpu": compute_cpu_ms / copy_cpu_ms,
+                "ratio_to_copy_min": ratio_min,
+                "ratio_to_copy_cpu_min": ratio_cpu_min,
                 "file_ms": file_ms,
                 "file_cpu_ms": file_cpu_ms,
                 "file_stages_ms": stages,
