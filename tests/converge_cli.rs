@@ -58,8 +58,8 @@ fn cornell_path_rmse_slope_is_the_monte_carlo_rate_and_chart_and_json_agree() {
         dir.path().join("cornell.json"),
     );
     // CPU time as the clock: the test machine is shared, and other processes stretch wall
-    // time, not the render's CPU time. 1 → 16 spp at 256×256 against Mitsuba 3's 4096-spp
-    // reference (its noise and the two renderers' difference are ≪ the 16-spp error).
+    // time, not the render's CPU time. 1 → 64 spp at 256×256 against Mitsuba 3's 4096-spp
+    // reference (its noise and the two renderers' difference are ≪ the 64-spp error).
     let o = prism(&[
         "converge",
         "scenes/cornell-box.json",
@@ -68,9 +68,9 @@ fn cornell_path_rmse_slope_is_the_monte_carlo_rate_and_chart_and_json_agree() {
         "--method",
         "path",
         "--max-spp",
-        "16",
+        "64",
         "--checkpoints",
-        "5",
+        "7",
         "--clock",
         "cpu",
         "-o",
@@ -91,7 +91,7 @@ fn cornell_path_rmse_slope_is_the_monte_carlo_rate_and_chart_and_json_agree() {
         .collect();
     assert_eq!(
         spp,
-        [1, 2, 4, 8, 16],
+        [1, 2, 4, 8, 16, 32, 64],
         "deterministic schedule under --max-spp"
     );
     // The JSON's slope is the fit of its own checkpoints.
@@ -106,9 +106,21 @@ fn cornell_path_rmse_slope_is_the_monte_carlo_rate_and_chart_and_json_agree() {
         .collect();
     let slope = m["rmse_slope"].as_f64().unwrap();
     assert!((log_log_slope(&points) - slope).abs() < 1e-9);
+    // Error ∝ time^−½ once time ∝ samples: from 8 spp on. Before that, the first pass's
+    // fixed cost (film, threads; tens of ms) is a large part of a checkpoint's time with
+    // the packet path tracer, where one spp of the box costs ≈ 30–50 ms of CPU.
+    let tail: Vec<(f64, f64)> = points
+        .iter()
+        .zip(&spp)
+        .filter(|(_, &n)| n >= 8)
+        .map(|(p, _)| *p)
+        .collect();
+    let tail_slope = log_log_slope(&tail);
+    eprintln!("RMSE slope against CPU time from 8 spp on: {tail_slope:.3} (all: {slope:.3})");
     assert!(
-        (slope + 0.5).abs() <= 0.1,
-        "rmse_slope {slope}: the Monte Carlo rate is −0.5 ± 0.1 ({checkpoints:?})"
+        (tail_slope + 0.5).abs() <= 0.1,
+        "RMSE against CPU time from 8 spp on: slope {tail_slope}, the Monte Carlo rate is \
+         −0.5 ± 0.1 ({checkpoints:?})"
     );
     // Against samples the rate does not depend on the machine at all.
     let per_spp = m["rmse_slope_vs_spp"].as_f64().unwrap();
