@@ -127,6 +127,7 @@ impl BoxSet {
         self.rows.len()
     }
 
+    #[inline(always)]
     pub fn triangle_at(&self, index: usize, p: Vec3A) -> u32 {
         let m = &self.rows[index].m;
         let q = [0, 1, 2]

@@ -202,14 +202,15 @@ fn render_tile_lanes<const N: usize>(
     let mut vertex = VertexIn::<N>::new();
     let mut shaded = VertexOut::<N>::new();
     let mut variates = Variates::<N>::new();
+    let mut starts = Starts::<N>::new();
     let mut queue_empty = false;
     loop {
         // Fill idle lanes with the tile's next camera samples.
         for l in 0..N {
             while lanes[l].is_none() && !queue_empty {
-                match queue.next(job.camera_samples) {
-                    Some((pixel, s)) => {
-                        if let Some((lane, ray)) = start_lane(job, tile, pixel, s, &mut counts) {
+                match starts.next(job, tile, &mut queue) {
+                    Some(start) => {
+                        if let Some((lane, ray)) = start_lane(job, tile, start, &mut counts) {
                             rays.set(l, ray.origin, ray.direction, ray.t_min, ray.t_max);
                             lanes[l] = Some(lane);
                         }
@@ -307,25 +308,89 @@ fn render_tile_lanes<const N: usize>(
     counts
 }
 
-/// Draws the camera sample's film point, lens and wavelengths and its camera ray (the
-/// scalar driver's order of dimensions); a sample without a ray goes to the film at once.
+/// A camera sample's first draws: its stream, film point, lens variate and wavelengths.
+#[derive(Clone, Copy, Debug)]
+struct Start {
+    pixel: UVec2,
+    stream: SampleStream,
+    film_point: Vec2,
+    filter_weight: f32,
+    lens: Vec2,
+    wavelengths: SampledWavelengths,
+}
+
+/// The tile's next camera samples, their first draws made `N` at a time (the scalar
+/// driver's order of dimensions: filter 2, lens 2, wavelength 1), so that the wavelengths
+/// are sampled in one vector loop (`SampledWavelengths::sample_visible_many`).
+struct Starts<const N: usize> {
+    ready: Vec<Start>,
+    next: usize,
+}
+
+impl<const N: usize> Starts<N> {
+    fn new() -> Self {
+        Self {
+            ready: Vec::with_capacity(N),
+            next: 0,
+        }
+    }
+
+    #[inline(always)]
+    fn next(&mut self, job: &TileJob, tile: &FilmTile, queue: &mut SampleQueue) -> Option<Start> {
+        if self.next == self.ready.len() {
+            self.ready.clear();
+            self.next = 0;
+            let mut u = [0.5f32; N];
+            while self.ready.len() < N {
+                let Some((pixel, s)) = queue.next(job.camera_samples) else {
+                    break;
+                };
+                let mut stream = job.sampler.stream(pixel, s);
+                let (film_point, filter_weight) = tile.sample_film_point(pixel, stream.get_2d());
+                let lens_dimension = stream.reserve(2);
+                let lens = if job.uses_lens {
+                    stream.get_2d_at(lens_dimension)
+                } else {
+                    Vec2::ZERO
+                };
+                u[self.ready.len()] = stream.get_1d();
+                self.ready.push(Start {
+                    pixel,
+                    stream,
+                    film_point,
+                    filter_weight,
+                    lens,
+                    wavelengths: SampledWavelengths::new([0.0; 4], SampledSpectrum::splat(0.0)),
+                });
+            }
+            let wavelengths = SampledWavelengths::sample_visible_many(&u);
+            for (start, wl) in self.ready.iter_mut().zip(wavelengths) {
+                start.wavelengths = wl;
+            }
+        }
+        let start = self.ready.get(self.next).copied()?;
+        self.next += 1;
+        Some(start)
+    }
+}
+
+/// A lane for camera sample `start` with its camera ray; a sample without a ray goes to
+/// the film at once.
 #[inline(always)]
 fn start_lane(
     job: &TileJob,
     tile: &mut FilmTile,
-    pixel: UVec2,
-    s: u32,
+    start: Start,
     counts: &mut TileCounts,
 ) -> Option<(Lane, Ray)> {
-    let mut stream = job.sampler.stream(pixel, s);
-    let (film_point, filter_weight) = tile.sample_film_point(pixel, stream.get_2d());
-    let lens_dimension = stream.reserve(2);
-    let lens = if job.uses_lens {
-        stream.get_2d_at(lens_dimension)
-    } else {
-        Vec2::ZERO
-    };
-    let wavelengths = SampledWavelengths::sample_visible(stream.get_1d());
+    let Start {
+        pixel,
+        stream,
+        film_point,
+        filter_weight,
+        lens,
+        wavelengths,
+    } = start;
     let zero = SampledSpectrum::splat(0.0);
     let mut lane = Lane {
         pixel,
