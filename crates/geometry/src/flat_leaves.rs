@@ -266,6 +266,18 @@ mod tests {
         TriangleMesh::new(p.to_vec(), idx)
     }
 
+    /// A 2 m × 2 m rectangle at the origin, material 0.
+    fn add_unit_rectangle(b: &mut GeometryBuilder) {
+        b.add_instance(
+            Shape::Rectangle(Rectangle {
+                half_width_m: 1.0,
+                half_height_m: 1.0,
+            }),
+            Transform::IDENTITY,
+            Some(0),
+        );
+    }
+
     fn scene() -> Geometry {
         let mut b = GeometryBuilder::new();
         let m = b.add_mesh(cube());
@@ -354,14 +366,7 @@ mod tests {
         open.object_ids.pop();
         let m = b.add_mesh(open);
         b.add_instance(Shape::Mesh(m), Transform::IDENTITY, Some(0));
-        b.add_instance(
-            Shape::Rectangle(Rectangle {
-                half_width_m: 1.0,
-                half_height_m: 1.0,
-            }),
-            Transform::IDENTITY,
-            Some(0),
-        );
+        add_unit_rectangle(&mut b);
         let g = b.build(BuildQuality::Fast);
         assert!(g.flat_boxes(&g.flat_leaves().unwrap()).is_empty());
     }
@@ -374,14 +379,7 @@ mod tests {
             Transform::IDENTITY,
             Some(0),
         );
-        b.add_instance(
-            Shape::Rectangle(Rectangle {
-                half_width_m: 1.0,
-                half_height_m: 1.0,
-            }),
-            Transform::IDENTITY,
-            Some(0),
-        );
+        add_unit_rectangle(&mut b);
         assert!(b.build(BuildQuality::Fast).flat_leaves().is_none());
 
         let mut b = GeometryBuilder::new();
@@ -389,14 +387,7 @@ mod tests {
         mesh.normals = Some(mesh.positions.clone());
         let m = b.add_mesh(mesh);
         b.add_instance(Shape::Mesh(m), Transform::IDENTITY, Some(0));
-        b.add_instance(
-            Shape::Rectangle(Rectangle {
-                half_width_m: 1.0,
-                half_height_m: 1.0,
-            }),
-            Transform::IDENTITY,
-            Some(0),
-        );
+        add_unit_rectangle(&mut b);
         assert!(b.build(BuildQuality::Fast).flat_leaves().is_none());
     }
 }
