@@ -23,6 +23,19 @@ fn cornell(resolution: u32) -> RenderScene {
     cornell_with(resolution, None)
 }
 
+/// The Cornell box with parts of its text replaced (camera, film).
+fn cornell_edited(resolution: u32, edits: &[(&str, &str)]) -> RenderScene {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let path = root.join("scenes/cornell-box.json");
+    let mut text = std::fs::read_to_string(&path).unwrap();
+    for (from, to) in edits {
+        assert!(text.contains(from), "{from}");
+        text = text.replacen(from, to, 1);
+    }
+    let description = prism_scene::parse_scene_str(&text, &path).unwrap();
+    RenderScene::build(&description, Some(glam::UVec2::splat(resolution))).unwrap()
+}
+
 fn settings(spp: u32) -> RenderSettings {
     settings_with(spp, SamplerKind::Independent)
 }
@@ -304,4 +317,46 @@ fn packet_ray_queries_agree_with_the_scenes_own() {
         "{mismatched} of {} rays differ",
         total + checked
     );
+}
+
+/// Spectral bins (the predictive users' EXR layout) come from the same film calls: their
+/// planes agree as the XYZ does.
+#[test]
+fn packet_tracer_fills_the_spectral_bins_as_the_scalar_tracer() {
+    let settings = RenderSettings {
+        spectral_bins: Some(crate::film::SpectralBins::new(8).unwrap()),
+        ..settings(4)
+    };
+    let ((packet, _), (scalar, _)) = render_both(cornell(32), &settings);
+    let (a, b) = (packet.spectral.unwrap(), scalar.spectral.unwrap());
+    assert_eq!(a.centres_nm, b.centres_nm);
+    let mean = |v: &[f32]| v.iter().map(|&x| f64::from(x)).sum::<f64>() / v.len() as f64;
+    for (k, (pa, pb)) in a.planes.iter().zip(&b.planes).enumerate() {
+        let rel = (mean(pa) - mean(pb)).abs() / mean(pb);
+        assert!(rel < 1e-3, "bin {k}: means differ by {rel:e}");
+    }
+}
+
+/// A thin-lens camera (the lens dimensions are used) and a film that samples its filter
+/// (each sample to its own pixel with weight f/p) instead of splatting.
+#[test]
+fn packet_tracer_agrees_with_a_thin_lens_and_filter_sampling() {
+    let scene = cornell_edited(
+        40,
+        &[
+            (
+                r#""type": "pinhole","#,
+                r#""type": "thin_lens", "focal_length_mm": 50, "f_number": 2.8, "focus_distance_m": 3.9,"#,
+            ),
+            (
+                r#""reconstruction": "splat""#,
+                r#""reconstruction": "importance""#,
+            ),
+            (r#""fov_deg": 39.3077,"#, ""),
+            (r#""fov_axis": "horizontal","#, ""),
+        ],
+    );
+    assert!(!scene.splat);
+    assert!(scene.camera.uses_lens_sample());
+    agrees_with_the_scalar_tracer(scene, &settings(8));
 }
