@@ -252,7 +252,7 @@ impl SigmoidPolynomial {
     }
 
     /// s(λ) at one wavelength in nm (Horner form in λ − 595 nm, branch-free).
-    #[inline]
+    #[inline(always)]
     pub fn eval(&self, wavelength_nm: f32) -> f32 {
         let [a, b, c] = self.centred;
         let u = wavelength_nm - EVAL_CENTRE_NM;

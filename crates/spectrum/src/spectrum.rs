@@ -193,6 +193,30 @@ impl Spectrum {
         }
     }
 
+    /// `eval` for `N` sets of wavelengths, the same values: for RGB reflectances one loop
+    /// over all `4N` wavelengths, which becomes vector code where the caller is compiled
+    /// for it (the packet path tracer evaluates a batch of camera samples' reflectances at
+    /// once); other kinds one `eval` per set.
+    #[inline(always)]
+    pub fn eval_many<const N: usize>(
+        &self,
+        wavelengths: &[SampledWavelengths; N],
+    ) -> [SampledSpectrum; N] {
+        match self {
+            Spectrum::RgbAlbedo(a) => {
+                let mut value = [[0.0f32; N_SPECTRUM_SAMPLES]; N];
+                for (v, w) in value.iter_mut().zip(wavelengths) {
+                    let lambda = w.lambda();
+                    for i in 0..N_SPECTRUM_SAMPLES {
+                        v[i] = a.polynomial.eval(lambda[i]);
+                    }
+                }
+                value.map(SampledSpectrum::new)
+            }
+            _ => std::array::from_fn(|k| self.eval(&wavelengths[k])),
+        }
+    }
+
     /// Value at one wavelength in f64 (reference integrals, tests, colorimetry).
     pub fn eval_nm(&self, wavelength_nm: f64) -> f64 {
         match self {
@@ -736,6 +760,24 @@ mod tests {
                 Spectrum::rgb_illuminant(RgbGamut::Srgb, [2.0, 1.0, 0.25]).unwrap(),
             ),
         ]
+    }
+
+    /// The batch form gives `eval`'s bits for every kind (RGB reflectances by their own
+    /// loop, the rest through `eval`).
+    #[test]
+    fn eval_many_is_eval_per_set() {
+        let sets: [SampledWavelengths; 5] =
+            std::array::from_fn(|k| SampledWavelengths::sample_visible((k as f32 * 0.377).fract()));
+        for (name, spectrum) in all_kinds() {
+            let many = spectrum.eval_many(&sets);
+            for (k, w) in sets.iter().enumerate() {
+                assert_eq!(
+                    many[k].to_array().map(f32::to_bits),
+                    spectrum.eval(w).to_array().map(f32::to_bits),
+                    "{name}, set {k}"
+                );
+            }
+        }
     }
 
     #[test]

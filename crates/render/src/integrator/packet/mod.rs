@@ -50,9 +50,16 @@ struct LeafShading {
     n_shading: Vec3A,
     uv: Vec2,
     material_id: u32,
+    /// Its reflectance's slot in `PacketScene::reflectances` (evaluated for every camera
+    /// sample up front), or `None` past the first `REFLECTANCE_SLOTS` materials.
+    reflectance_slot: Option<usize>,
     /// The area light this patch's instance carries.
     light: Option<u32>,
 }
+
+/// Materials whose reflectance every camera sample evaluates up front, for 16 samples at
+/// once (`Spectrum::eval_many`); later ones through the per-path cache.
+pub(crate) const REFLECTANCE_SLOTS: usize = 4;
 
 /// A rectangle emitter as the lanes sample it (`light::area::RectangleEmitter`).
 #[derive(Clone, Debug)]
@@ -86,6 +93,8 @@ pub struct PacketScene {
     parallelograms: PatchSet,
     boxes: BoxSet,
     leaves: Vec<LeafShading>,
+    /// The reflectances of the first `REFLECTANCE_SLOTS` materials.
+    reflectances: Vec<Spectrum>,
     /// Per light of the scene's `LightSet`: its rectangle form, or `None` for lights the
     /// scalar `Light` code samples.
     lights: Vec<Option<RectangleLight>>,
@@ -115,13 +124,14 @@ impl PacketScene {
             return Err("the scene has no geometry".into());
         }
         let mut leaves = Vec::with_capacity(flat.len());
+        let mut reflectances: Vec<(u32, Spectrum)> = Vec::new();
         for leaf in &flat {
             let r = &leaf.record;
-            let constant_lambert = matches!(
-                scene.material(r.material_id),
-                Material::Lambert { reflectance } if reflectance.constant().is_some()
-            );
-            if !constant_lambert {
+            let constant = match scene.material(r.material_id) {
+                Material::Lambert { reflectance } => reflectance.constant(),
+                _ => None,
+            };
+            let Some(constant) = constant else {
                 return Err(format!(
                     "material '{}' is not a constant Lambertian",
                     scene
@@ -129,13 +139,22 @@ impl PacketScene {
                         .get(r.material_id as usize)
                         .map_or("default", String::as_str)
                 ));
-            }
+            };
+            let slot = match reflectances.iter().position(|(id, _)| *id == r.material_id) {
+                Some(k) => Some(k),
+                None if reflectances.len() < REFLECTANCE_SLOTS => {
+                    reflectances.push((r.material_id, constant.clone()));
+                    Some(reflectances.len() - 1)
+                }
+                None => None,
+            };
             leaves.push(LeafShading {
                 frame: Frame::from_zx(r.n_shading, r.dpdu),
                 n_geometric: r.n_geometric,
                 n_shading: r.n_shading,
                 uv: r.uv,
                 material_id: r.material_id,
+                reflectance_slot: slot,
                 light: scene.lights.area_light_of_instance(r.instance_id),
             });
         }
@@ -175,6 +194,7 @@ impl PacketScene {
             parallelograms: PatchSet::new(&flat, PatchKind::Parallelogram, &in_box),
             boxes: BoxSet::new(&flat_boxes),
             leaves,
+            reflectances: reflectances.into_iter().map(|(_, s)| s).collect(),
             lights,
             kernel: Kernel::Auto,
         })

@@ -12,7 +12,7 @@ use prism_spectrum::{SampledSpectrum, SampledWavelengths};
 
 use super::intersect::{closest, occluded, RayLanes};
 use super::shade::{shade, VertexIn, VertexOut, LIGHT_GIVEN, LIGHT_NONE, LIGHT_RECTANGLE};
-use super::{Kernel, PacketScene};
+use super::{Kernel, PacketScene, REFLECTANCE_SLOTS};
 use crate::film::xyz::XyzWeights;
 use crate::film::FilmTile;
 use crate::film::SurfaceAov;
@@ -69,6 +69,8 @@ struct Lane {
     filter_weight: f32,
     stream: SampleStream,
     wavelengths: SampledWavelengths,
+    /// `PacketScene::reflectances` at the path's wavelengths.
+    reflectance: [SampledSpectrum; REFLECTANCE_SLOTS],
     radiance: SampledSpectrum,
     beta: SampledSpectrum,
     first_bounce_beta: Option<SampledSpectrum>,
@@ -317,6 +319,8 @@ struct Start {
     filter_weight: f32,
     lens: Vec2,
     wavelengths: SampledWavelengths,
+    /// `PacketScene::reflectances` at the sample's wavelengths.
+    reflectance: [SampledSpectrum; REFLECTANCE_SLOTS],
 }
 
 /// The tile's next camera samples, their first draws made `N` at a time (the scalar
@@ -361,11 +365,18 @@ impl<const N: usize> Starts<N> {
                     filter_weight,
                     lens,
                     wavelengths: SampledWavelengths::new([0.0; 4], SampledSpectrum::splat(0.0)),
+                    reflectance: [SampledSpectrum::splat(0.0); REFLECTANCE_SLOTS],
                 });
             }
             let wavelengths = SampledWavelengths::sample_visible_many(&u);
             for (start, wl) in self.ready.iter_mut().zip(wavelengths) {
                 start.wavelengths = wl;
+            }
+            for (slot, spectrum) in job.packet.reflectances.iter().enumerate() {
+                let values = spectrum.eval_many(&wavelengths);
+                for (start, v) in self.ready.iter_mut().zip(values) {
+                    start.reflectance[slot] = v;
+                }
             }
         }
         let start = self.ready.get(self.next).copied()?;
@@ -392,6 +403,7 @@ fn start_lane(
         filter_weight: start.filter_weight,
         stream: start.stream,
         wavelengths: start.wavelengths,
+        reflectance: start.reflectance,
         radiance: zero,
         beta: SampledSpectrum::splat(1.0),
         first_bounce_beta: None,
@@ -676,10 +688,13 @@ fn begin_vertex<const N: usize>(
     let constant = reflectance
         .constant()
         .expect("PacketScene::new admits constant reflectances only");
-    let f_lambert = lane
-        .reflectance_cache
-        .get(leaf.material_id, constant, &wavelengths)
-        * std::f32::consts::FRAC_1_PI;
+    let reflectance = match leaf.reflectance_slot {
+        Some(slot) => lane.reflectance[slot],
+        None => lane
+            .reflectance_cache
+            .get(leaf.material_id, constant, &wavelengths),
+    };
+    let f_lambert = reflectance * std::f32::consts::FRAC_1_PI;
     let frame = leaf.frame;
     for a in 0..3 {
         vertex.o[a][l] = origin[a];
