@@ -142,7 +142,6 @@ impl Geometry {
                     let local = r.local_geometry(Vec3A::ZERO);
                     let mut record =
                         SurfaceInteraction::from_local_with(&local, &inst.to_world, 0.0, false);
-                    record.uv = Vec2::splat(0.5);
                     record.primitive_id = 0;
                     record.material_id = inst.material.unwrap_or(NO_MATERIAL);
                     record.object_id = 0;

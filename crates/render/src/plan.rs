@@ -128,11 +128,8 @@ impl RenderPlan {
                     "hero + 3 rotated wavelengths per path, visible-importance density".into(),
                     "spectral transport (Wilkie et al. 2014); 4 wavelengths share every ray".into(),
                 );
-                match (
-                    &scene.packet,
-                    crate::integrator::packet::PacketScene::new(scene),
-                ) {
-                    (Some(packet), _) => choose(
+                match &scene.packet {
+                    Some(packet) => choose(
                         "packet tracing",
                         format!(
                             "on, {} paths per ray query, {} patches and {} boxes",
@@ -145,12 +142,15 @@ impl RenderPlan {
                          estimator as the scalar tracer)"
                             .into(),
                     ),
-                    (None, Ok(_)) => choose(
-                        "packet tracing",
-                        "off".into(),
-                        "switched off for this render".into(),
-                    ),
-                    (None, Err(why)) => choose("packet tracing", "off".into(), why),
+                    // Off: ask the scene why (only then is its packet form built again).
+                    None => match crate::integrator::packet::PacketScene::new(scene) {
+                        Ok(_) => choose(
+                            "packet tracing",
+                            "off".into(),
+                            "switched off for this render".into(),
+                        ),
+                        Err(why) => choose("packet tracing", "off".into(), why),
+                    },
                 }
                 let names: Vec<String> = dispersive
                     .iter()

@@ -168,12 +168,8 @@ pub fn render_pass(
             samples += c.samples;
             non_finite += c.non_finite_samples;
         }
-        let scalar_pixels = tile
-            .bounds()
-            .pixels()
-            .filter(|_| packet_tracer.is_none())
-            .collect::<Vec<_>>();
-        for pixel in scalar_pixels {
+        let scalar_pixels = packet_tracer.is_none().then(|| tile.bounds().pixels());
+        for pixel in scalar_pixels.into_iter().flatten() {
             let light_samples = plan.light_samples(pixel);
             let count = plan.camera_samples(pixel);
             // Several samples share the pixel: each one's differential covers a fraction of

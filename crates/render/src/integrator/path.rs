@@ -93,6 +93,32 @@ pub fn mis_weight(heuristic: MisHeuristic, a: f32, b: f32) -> f32 {
     }
 }
 
+/// Adds β·x to `radiance` unless it is NaN/∞ (then counts it: one bad contribution cannot
+/// poison a pixel, and the stats say so). `count_incident`: also part of the indirect light
+/// at the first hit, `incident` (divided by the first bounce's throughput `first`; not
+/// emission met right after the first bounce — the white Lambertian's direct light comes
+/// from light sampling alone). The scalar and the packet tracer both add through here.
+#[inline(always)]
+pub(crate) fn add_contribution(
+    radiance: &mut SampledSpectrum,
+    incident: &mut SampledSpectrum,
+    first: &Option<SampledSpectrum>,
+    beta: SampledSpectrum,
+    x: SampledSpectrum,
+    count_incident: bool,
+    counters: &mut PathCounters,
+) {
+    let c = beta * x;
+    if c.has_non_finite() {
+        counters.non_finite_contributions += 1;
+        return;
+    }
+    *radiance += c;
+    if let (Some(b1), true) = (first, count_incident) {
+        *incident += c.safe_div(*b1);
+    }
+}
+
 /// Where a non-camera path starts: the point that sampled the first direction (with its
 /// geometric normal, for the lights' pdfs) and the solid-angle pdf of that direction.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -270,27 +296,7 @@ impl PathTracer {
         // Constant reflectances at this path's wavelengths, by material id.
         let mut reflectance_cache = SpectrumCache::new();
 
-        // Adds beta·x unless it is NaN/∞ (then counts it: one bad contribution cannot poison
-        // a pixel, and the stats say so). `count_incident`: also part of the indirect light
-        // at the first hit (not emission met right after the first bounce — the white
-        // Lambertian's direct light comes from light sampling alone).
-        let add = |radiance: &mut SampledSpectrum,
-                   incident: &mut SampledSpectrum,
-                   first: &Option<SampledSpectrum>,
-                   beta: SampledSpectrum,
-                   x: SampledSpectrum,
-                   count_incident: bool,
-                   counters: &mut PathCounters| {
-            let c = beta * x;
-            if c.has_non_finite() {
-                counters.non_finite_contributions += 1;
-                return;
-            }
-            *radiance += c;
-            if let (Some(b1), true) = (first, count_incident) {
-                *incident += c.safe_div(*b1);
-            }
-        };
+        let add = add_contribution;
 
         loop {
             let Some(hit) = scene.geometry.intersect(&ray) else {
@@ -301,13 +307,15 @@ impl PathTracer {
                     if le.is_black() {
                         continue;
                     }
-                    let w = if specular_bounce {
-                        1.0
-                    } else {
-                        let light_pdf =
-                            lights.pmf(l) * light.pdf_li(&prev_ctx, ray.direction, None);
-                        mis_weight(self.mis, prev_bsdf_pdf, light_pdf)
-                    };
+                    let w = self.emission_weight(
+                        scene,
+                        l,
+                        specular_bounce,
+                        &prev_ctx,
+                        prev_bsdf_pdf,
+                        ray.direction,
+                        None,
+                    );
                     add(
                         &mut radiance,
                         &mut incident_after_first,
@@ -382,13 +390,15 @@ impl PathTracer {
                     &mut le_cache,
                 );
                 if !le.is_black() {
-                    let w = if specular_bounce {
-                        1.0
-                    } else {
-                        let light_pdf = lights.pmf(l)
-                            * light.pdf_li(&prev_ctx, ray.direction, Some(&light_hit));
-                        mis_weight(self.mis, prev_bsdf_pdf, light_pdf)
-                    };
+                    let w = self.emission_weight(
+                        scene,
+                        l,
+                        specular_bounce,
+                        &prev_ctx,
+                        prev_bsdf_pdf,
+                        ray.direction,
+                        Some(&light_hit),
+                    );
                     add(
                         &mut radiance,
                         &mut incident_after_first,
@@ -545,6 +555,29 @@ impl PathTracer {
             first_hit,
             illumination,
         }
+    }
+
+    /// MIS weight of light `l`'s emission met by a ray along `direction` that BSDF sampling
+    /// at `prev_ctx` produced with `prev_bsdf_pdf` (`hit`: where it met an area light; `None`
+    /// for an infinite light): 1 after a specular bounce or from the camera.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    pub(crate) fn emission_weight(
+        &self,
+        scene: &RenderScene,
+        l: u32,
+        specular_bounce: bool,
+        prev_ctx: &LightSampleContext,
+        prev_bsdf_pdf: f32,
+        direction: Vec3A,
+        hit: Option<&LightHit>,
+    ) -> f32 {
+        if specular_bounce {
+            return 1.0;
+        }
+        let lights = &scene.lights;
+        let light_pdf = lights.pmf(l) * lights.light(l).pdf_li(prev_ctx, direction, hit);
+        mis_weight(self.mis, prev_bsdf_pdf, light_pdf)
     }
 
     /// One light sample at `vertex`, MIS-weighted against BSDF sampling: (contribution for

@@ -70,12 +70,12 @@ pub(crate) struct VertexIn<const N: usize> {
 #[derive(Clone, Copy)]
 pub(crate) struct VertexOut<const N: usize> {
     pub p: [[f32; N]; 3],
-    /// A shadow ray to trace, with the contribution it carries if unblocked.
+    /// A shadow ray to trace, with the light it brings if unblocked (f·L·w/p, before β).
     pub has_shadow: [bool; N],
     pub shadow_d: [[f32; N]; 3],
     pub shadow_t_min: [f32; N],
     pub shadow_t_max: [f32; N],
-    pub contribution: [[f32; N]; 4],
+    pub direct: [[f32; N]; 4],
     pub white: [[f32; N]; 4],
     /// The path goes on along `next_d` (unit) from `p`.
     pub continues: [bool; N],
@@ -137,7 +137,7 @@ impl<const N: usize> VertexOut<N> {
             shadow_d: [z; 3],
             shadow_t_min: z,
             shadow_t_max: z,
-            contribution: [z; 4],
+            direct: [z; 4],
             white: [z; 4],
             continues: [false; N],
             next_d: [z; 3],
@@ -280,7 +280,7 @@ pub(crate) fn shade<const N: usize>(
         let scale = w / light_pdf;
         let white_scale = white_cos / light_pdf;
         for k in 0..4 {
-            out.contribution[k][l] = beta[k] * (f[k] * le[k] * scale);
+            out.direct[k][l] = f[k] * le[k] * scale;
             out.white[k][l] = le[k] * white_scale;
         }
         // `Ray::spawn_to(p, p_light)`, or `Ray::spawn(p, wi)` towards an infinite light.

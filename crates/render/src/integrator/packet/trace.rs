@@ -16,7 +16,7 @@ use super::{Kernel, PacketScene, REFLECTANCE_SLOTS};
 use crate::film::xyz::XyzWeights;
 use crate::film::FilmTile;
 use crate::film::SurfaceAov;
-use crate::integrator::path::{mis_weight, FirstHit, PathCounters, PathTracer};
+use crate::integrator::path::{add_contribution, FirstHit, PathCounters, PathTracer};
 use crate::light::{LightHit, LightSampleContext};
 use crate::material::Material;
 use crate::sampler::hash::u32_to_unit_f32;
@@ -47,18 +47,16 @@ pub(crate) struct TileCounts {
     pub non_finite_samples: u64,
 }
 
-/// A next-event estimate waiting for its shadow ray.
+/// A next-event estimate waiting for its shadow ray, with the path's throughputs as they
+/// were at the vertex (the path has moved on by the time the shadow ray is answered).
 #[derive(Clone, Copy, Debug)]
 struct PendingLight {
-    /// β·f·L·w / p, with β and the first bounce's throughput as they were at the vertex
-    /// (the path has moved on by the time the shadow ray is answered).
-    contribution: SampledSpectrum,
-    /// `contribution` over the first bounce's throughput, when the indirect light at the
-    /// first hit is being recorded (illumination AOV).
-    incident: Option<SampledSpectrum>,
+    /// f·L·w / p, added as β·direct (`path::add_contribution`).
+    direct: SampledSpectrum,
+    beta: SampledSpectrum,
+    first_bounce_beta: Option<SampledSpectrum>,
     /// What a white Lambertian would receive (illumination AOV, depth 1 only).
     white: SampledSpectrum,
-    record_white: bool,
 }
 
 /// One lane's camera sample and path state (the locals of the scalar `trace`).
@@ -287,16 +285,17 @@ fn render_tile_lanes<const N: usize>(
             };
             if let Some(p) = lane.pending.take() {
                 if !blocked[l] {
-                    // The scalar tracer's `add` of the light sample, with the vertex's β.
-                    if p.contribution.has_non_finite() {
-                        counters.non_finite_contributions += 1;
-                    } else {
-                        lane.radiance += p.contribution;
-                        if let Some(incident) = p.incident {
-                            lane.incident_after_first += incident;
-                        }
-                    }
-                    if p.record_white {
+                    add_contribution(
+                        &mut lane.radiance,
+                        &mut lane.incident_after_first,
+                        &p.first_bounce_beta,
+                        p.beta,
+                        p.direct,
+                        true,
+                        counters,
+                    );
+                    // The vertex's depth: it changes only at the next vertex.
+                    if job.want_illumination && lane.depth == 1 {
                         lane.illumination_direct = Some(p.white);
                     }
                 }
@@ -444,18 +443,18 @@ fn start_lane(
     }
 }
 
-/// Adds β·x to the lane's radiance unless it is NaN/∞ (the scalar tracer's `add`).
+/// Adds β·x to the lane's radiance (`path::add_contribution`).
 #[inline(always)]
 fn add(lane: &mut Lane, x: SampledSpectrum, count_incident: bool, counters: &mut PathCounters) {
-    let c = lane.beta * x;
-    if c.has_non_finite() {
-        counters.non_finite_contributions += 1;
-        return;
-    }
-    lane.radiance += c;
-    if let (Some(b1), true) = (lane.first_bounce_beta, count_incident) {
-        lane.incident_after_first += c.safe_div(b1);
-    }
+    add_contribution(
+        &mut lane.radiance,
+        &mut lane.incident_after_first,
+        &lane.first_bounce_beta,
+        lane.beta,
+        x,
+        count_incident,
+        counters,
+    );
 }
 
 /// Offsets of a vertex's variates in its 8 reserved dimensions (`integrator::path` module
@@ -616,12 +615,15 @@ fn begin_vertex<const N: usize>(
             if le.is_black() {
                 continue;
             }
-            let w = if lane.specular_bounce {
-                1.0
-            } else {
-                let light_pdf = lights.pmf(li) * light.pdf_li(&lane.prev_ctx, direction, None);
-                mis_weight(tracer.mis, lane.prev_bsdf_pdf, light_pdf)
-            };
+            let w = tracer.emission_weight(
+                scene,
+                li,
+                lane.specular_bounce,
+                &lane.prev_ctx,
+                lane.prev_bsdf_pdf,
+                direction,
+                None,
+            );
             let count = lane.depth >= 2;
             add(lane, le * w, count, counters);
         }
@@ -664,13 +666,15 @@ fn begin_vertex<const N: usize>(
             &mut lane.le_cache,
         );
         if !le.is_black() {
-            let w = if lane.specular_bounce {
-                1.0
-            } else {
-                let light_pdf =
-                    lights.pmf(li) * light.pdf_li(&lane.prev_ctx, direction, Some(&light_hit));
-                mis_weight(tracer.mis, lane.prev_bsdf_pdf, light_pdf)
-            };
+            let w = tracer.emission_weight(
+                scene,
+                li,
+                lane.specular_bounce,
+                &lane.prev_ctx,
+                lane.prev_bsdf_pdf,
+                direction,
+                Some(&light_hit),
+            );
             let count = lane.depth >= 2;
             add(lane, le * w, count, counters);
         }
@@ -756,12 +760,11 @@ fn end_vertex<const N: usize>(
         counters.rays += 1;
         let d = Vec3A::new(out.shadow_d[0][l], out.shadow_d[1][l], out.shadow_d[2][l]);
         shadow.set(l, p, d, out.shadow_t_min[l], out.shadow_t_max[l]);
-        let contribution = spectrum(&out.contribution);
         lane.pending = Some(PendingLight {
-            contribution,
-            incident: lane.first_bounce_beta.map(|b1| contribution.safe_div(b1)),
+            direct: spectrum(&out.direct),
+            beta: lane.beta,
+            first_bounce_beta: lane.first_bounce_beta,
             white: spectrum(&out.white),
-            record_white: job.want_illumination && lane.depth == 1,
         });
     }
     if out.weight_non_finite[l] {
