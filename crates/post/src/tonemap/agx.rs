@@ -551,6 +551,37 @@ unsafe fn position16(bits: std::arch::x86_64::__m512i) -> std::arch::x86_64::__m
 // (the pass measured latency-bound: ≈ 150 cycles per 16 pixels for ≈ 45 cycles of
 // issue).
 
+/// Per lane the polynomial of its segment `seg` (coefficient j of every segment in
+/// register `coeffs[j]`, picked by `vpermps`) at position `s`, Horner from the top term,
+/// each step over all 3·G vectors (see above).
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn segment_poly16<const G: usize, const T: usize>(
+    seg: &[[std::arch::x86_64::__m512i; 3]; G],
+    s: &[[std::arch::x86_64::__m512; 3]; G],
+    coeffs: &[std::arch::x86_64::__m512; T],
+) -> [[std::arch::x86_64::__m512; 3]; G] {
+    use std::arch::x86_64::*;
+    let mut p = [[_mm512_setzero_ps(); 3]; G];
+    for g in 0..G {
+        for ch in 0..3 {
+            p[g][ch] = _mm512_permutexvar_ps(seg[g][ch], coeffs[T - 1]);
+        }
+    }
+    for j in (0..T - 1).rev() {
+        for g in 0..G {
+            for ch in 0..3 {
+                p[g][ch] = _mm512_fmadd_ps(
+                    p[g][ch],
+                    s[g][ch],
+                    _mm512_permutexvar_ps(seg[g][ch], coeffs[j]),
+                );
+            }
+        }
+    }
+    p
+}
+
 /// [`Map::encode`] on 16 lanes, every vector of `v`.
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
@@ -562,10 +593,9 @@ unsafe fn encode16<const G: usize>(
     use std::arch::x86_64::*;
     let (x_min, x_max) = (_mm512_set1_ps(c.x_min), _mm512_set1_ps(c.x_max));
     let zero = _mm512_setzero_ps();
-    let (mut e, mut seg, mut s, mut p) = (
+    let (mut e, mut seg, mut s) = (
         [[zero; 3]; G],
         [[_mm512_setzero_si512(); 3]; G],
-        [[zero; 3]; G],
         [[zero; 3]; G],
     );
     for g in 0..G {
@@ -575,20 +605,9 @@ unsafe fn encode16<const G: usize>(
             e[g][ch] = _mm512_getexp_ps(x);
             seg[g][ch] = _mm512_srli_epi32::<{ T_BITS }>(bits);
             s[g][ch] = position16(bits);
-            p[g][ch] = _mm512_permutexvar_ps(seg[g][ch], k.encode[ENCODE_TERMS - 1]);
         }
     }
-    for j in (0..ENCODE_TERMS - 1).rev() {
-        for g in 0..G {
-            for ch in 0..3 {
-                p[g][ch] = _mm512_fmadd_ps(
-                    p[g][ch],
-                    s[g][ch],
-                    _mm512_permutexvar_ps(seg[g][ch], k.encode[j]),
-                );
-            }
-        }
-    }
+    let p = segment_poly16(&seg, &s, &k.encode);
     for g in 0..G {
         for ch in 0..3 {
             // w, then the contrast polynomial's top coefficient into v.
@@ -612,10 +631,9 @@ unsafe fn power16<const G: usize>(k: &Regs16, v: &mut [[std::arch::x86_64::__m51
     use std::arch::x86_64::*;
     let y_zero = _mm512_set1_ps(Y_ZERO);
     let zero = _mm512_setzero_ps();
-    let (mut bits, mut seg, mut s, mut p) = (
+    let (mut bits, mut seg, mut s) = (
         [[_mm512_setzero_si512(); 3]; G],
         [[_mm512_setzero_si512(); 3]; G],
-        [[zero; 3]; G],
         [[zero; 3]; G],
     );
     for g in 0..G {
@@ -624,20 +642,9 @@ unsafe fn power16<const G: usize>(k: &Regs16, v: &mut [[std::arch::x86_64::__m51
             bits[g][ch] = _mm512_castps_si512(_mm512_max_ps(v[g][ch], y_zero));
             seg[g][ch] = _mm512_srli_epi32::<{ T_BITS }>(bits[g][ch]);
             s[g][ch] = position16(bits[g][ch]);
-            p[g][ch] = _mm512_permutexvar_ps(seg[g][ch], k.power[POWER_TERMS - 1]);
         }
     }
-    for j in (0..POWER_TERMS - 1).rev() {
-        for g in 0..G {
-            for ch in 0..3 {
-                p[g][ch] = _mm512_fmadd_ps(
-                    p[g][ch],
-                    s[g][ch],
-                    _mm512_permutexvar_ps(seg[g][ch], k.power[j]),
-                );
-            }
-        }
-    }
+    let p = segment_poly16(&seg, &s, &k.power);
     for g in 0..G {
         for ch in 0..3 {
             let scale = _mm512_permutex2var_ps(
