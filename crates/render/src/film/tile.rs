@@ -135,7 +135,7 @@ impl SplatBuffer {
             bounds,
             sums: vec![[0.0; 4]; bounds.pixel_count()],
             radius_px,
-            avx: has_avx(),
+            avx: crate::cpu::has_avx(),
         }
     }
 
@@ -145,7 +145,7 @@ impl SplatBuffer {
     pub fn splat(&mut self, p: Vec2, xyz: DVec3, table: &FilterTable) {
         #[cfg(target_arch = "x86_64")]
         if self.avx {
-            // SAFETY: `avx` is set only when the CPU reports AVX (`has_avx`).
+            // SAFETY: `avx` is set only when the CPU reports AVX (`cpu::has_avx`).
             return unsafe { self.splat_avx(p, xyz, table) };
         }
         self.splat_with::<false>(p, xyz, table)
@@ -279,18 +279,6 @@ fn add_scaled<const AVX: bool>(sum: &mut [f64; 4], w: f64, value: &[f64; 4]) {
     #[cfg(not(target_arch = "x86_64"))]
     for (s, v) in sum.iter_mut().zip(value) {
         *s += w * v;
-    }
-}
-
-/// Whether this CPU runs AVX (cached by the standard library after the first query).
-fn has_avx() -> bool {
-    #[cfg(target_arch = "x86_64")]
-    {
-        std::arch::is_x86_feature_detected!("avx")
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        false
     }
 }
 
@@ -601,7 +589,7 @@ mod tests {
         let mut sse2 = SplatBuffer::new(tile, UVec2::new(64, 64), 2.0);
         sse2.avx = false;
         let mut best = sse2.clone();
-        best.avx = has_avx();
+        best.avx = crate::cpu::has_avx();
         for k in 0..500u32 {
             let f = k as f32;
             let p = Vec2::new(

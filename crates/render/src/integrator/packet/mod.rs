@@ -213,7 +213,7 @@ impl PacketScene {
 
 /// Lanes of the packet on this CPU (16 with AVX-512, else 8).
 pub fn lane_count() -> usize {
-    if trace::has_avx512() {
+    if crate::cpu::has_avx512() {
         16
     } else {
         8

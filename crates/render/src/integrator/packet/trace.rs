@@ -13,6 +13,7 @@ use prism_spectrum::{SampledSpectrum, SampledWavelengths};
 use super::intersect::{closest, occluded, RayLanes};
 use super::shade::{shade, VertexIn, VertexOut, LIGHT_GIVEN, LIGHT_NONE, LIGHT_RECTANGLE};
 use super::{Kernel, PacketScene, REFLECTANCE_SLOTS};
+use crate::cpu::{has_avx2, has_avx512};
 use crate::film::xyz::XyzWeights;
 use crate::film::FilmTile;
 use crate::film::SurfaceAov;
@@ -87,32 +88,6 @@ struct Lane {
     pending: Option<PendingLight>,
     /// The path ends once its pending light sample is resolved.
     ends: bool,
-}
-
-/// Whether this CPU runs the 16-lane AVX-512 kernels.
-pub(crate) fn has_avx512() -> bool {
-    #[cfg(target_arch = "x86_64")]
-    {
-        std::arch::is_x86_feature_detected!("avx512f")
-            && std::arch::is_x86_feature_detected!("avx512dq")
-            && std::arch::is_x86_feature_detected!("avx512vl")
-            && std::arch::is_x86_feature_detected!("avx512bw")
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        false
-    }
-}
-
-pub(crate) fn has_avx2() -> bool {
-    #[cfg(target_arch = "x86_64")]
-    {
-        std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        false
-    }
 }
 
 /// Renders every camera sample of `tile` (pixels in order, samples in order) with the
