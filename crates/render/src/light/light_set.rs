@@ -121,6 +121,17 @@ impl LightSet {
         &self.lights[index as usize]
     }
 
+    /// The running sums of the selection probabilities (`sample` picks the first light
+    /// whose sum exceeds u), for callers that pick for many samples at once.
+    pub(crate) fn selection_cdf(&self) -> &[f32] {
+        &self.cdf
+    }
+
+    /// The selection probabilities, light by light.
+    pub(crate) fn selection_pmf(&self) -> &[f32] {
+        &self.pmf
+    }
+
     /// Picks a light for a light sample: (index, selection probability).
     #[inline]
     pub fn sample(&self, u: f32) -> Option<(u32, f32)> {

@@ -222,12 +222,6 @@ impl<const N: usize> RayLanes<N> {
         self.t_min[lane] = t_min;
         self.t_max[lane] = t_max;
     }
-
-    #[inline]
-    pub fn clear(&mut self, lane: usize) {
-        self.t_min[lane] = f32::INFINITY;
-        self.t_max[lane] = 0.0;
-    }
 }
 
 /// The patch test for lane `l`: (t, hit), hit only inside `(t_min, t_max)`.

@@ -61,6 +61,10 @@ struct LeafShading {
 /// once (`Spectrum::eval_many`); later ones through the per-path cache.
 pub(crate) const REFLECTANCE_SLOTS: usize = 4;
 
+/// Rectangle emitters whose L(λ) every camera sample evaluates up front, as the
+/// reflectances; later ones through the per-path cache.
+pub(crate) const LIGHT_SLOTS: usize = 4;
+
 /// A rectangle emitter as the lanes sample it (`light::area::RectangleEmitter`).
 #[derive(Clone, Debug)]
 struct RectangleLight {
@@ -72,6 +76,8 @@ struct RectangleLight {
     inv_area_m2: f32,
     two_sided: bool,
     radiance: Spectrum,
+    /// Its slot in `PacketScene::light_radiances`, or `None` past the first `LIGHT_SLOTS`.
+    radiance_slot: Option<usize>,
 }
 
 /// Which lane width runs (tests compare them; renders use `Auto`).
@@ -98,6 +104,8 @@ pub struct PacketScene {
     /// Per light of the scene's `LightSet`: its rectangle form, or `None` for lights the
     /// scalar `Light` code samples.
     lights: Vec<Option<RectangleLight>>,
+    /// The radiances of the first `LIGHT_SLOTS` rectangle emitters.
+    light_radiances: Vec<Spectrum>,
     kernel: Kernel,
 }
 
@@ -158,6 +166,7 @@ impl PacketScene {
                 light: scene.lights.area_light_of_instance(r.instance_id),
             });
         }
+        let mut light_radiances = Vec::new();
         let lights = scene
             .lights
             .lights()
@@ -169,6 +178,10 @@ impl PacketScene {
                     two_sided,
                 }) if r.area_m2() > 0.0 => {
                     let m = r.to_world.matrix();
+                    let radiance_slot = (light_radiances.len() < LIGHT_SLOTS).then(|| {
+                        light_radiances.push(radiance.clone());
+                        light_radiances.len() - 1
+                    });
                     Some(RectangleLight {
                         axes: [m.x_axis, m.y_axis, m.z_axis, m.w_axis].map(Vec3A::from_vec4),
                         half_width_m: r.rectangle.half_width_m,
@@ -177,6 +190,7 @@ impl PacketScene {
                         inv_area_m2: 1.0 / r.area_m2() as f32,
                         two_sided: *two_sided,
                         radiance: radiance.clone(),
+                        radiance_slot,
                     })
                 }
                 _ => None,
@@ -196,6 +210,7 @@ impl PacketScene {
             leaves,
             reflectances: reflectances.into_iter().map(|(_, s)| s).collect(),
             lights,
+            light_radiances,
             kernel: Kernel::Auto,
         })
     }

@@ -97,6 +97,55 @@ fn packet_tracer_agrees_with_a_point_light_beside_the_rectangle() {
     agrees_with_the_scalar_tracer(scene, &settings(8));
 }
 
+/// More materials than reflectance slots and more rectangle emitters than light slots
+/// (those through the per-path caches), and a uniform sky that escaping rays see and the
+/// light sampler picks (the scalar `Light` code) — the passes that run lane by lane.
+#[test]
+fn packet_tracer_agrees_past_its_slots_and_with_a_sky() {
+    let mut materials = String::new();
+    let mut lamps = String::new();
+    let mut lights = String::new();
+    for k in 0..6 {
+        let x = -0.75 + 0.3 * k as f32;
+        materials.push_str(&format!(
+            r#""lamp-{k}": {{"type": "lambert", "reflectance": {{"rgb": [0.{k}5, 0.5, 0.3]}}}},"#
+        ));
+        lamps.push_str(&format!(
+            r#"{{"type": "rectangle", "name": "lamp-{k}", "size_m": [0.12, 0.12],
+                 "transform": [{{"rotate": {{"axis": [1, 0, 0], "angle_deg": 90}}}},
+                               {{"translate": [{x}, 0.97, 0.5]}}],
+                 "material": "lamp-{k}"}},"#
+        ));
+        lights.push_str(&format!(
+            r#"{{"type": "area", "shape": "lamp-{k}", "luminance_cd_m2": {}, "two_sided": false,
+                 "spectrum": {{"blackbody_k": {}}}}},"#,
+            1_000_000 + 400_000 * k,
+            2700 + 300 * k
+        ));
+    }
+    lights.push_str(r#"{"type": "sky", "luminance_cd_m2": 300, "spectrum": "D65"},"#);
+    let scene = cornell_edited(
+        40,
+        &[
+            ("\"materials\": {", &format!("\"materials\": {{{materials}")),
+            ("\"shapes\": [", &format!("\"shapes\": [{lamps}")),
+            ("\"lights\": [", &format!("\"lights\": [{lights}")),
+        ],
+    );
+    assert_eq!(scene.lights.len(), 8);
+    let packet = scene.packet.as_ref().expect("the scene qualifies");
+    assert_eq!(packet.reflectances.len(), REFLECTANCE_SLOTS);
+    assert_eq!(packet.light_radiances.len(), LIGHT_SLOTS);
+    assert!(packet.leaves.iter().any(|l| l.reflectance_slot.is_none()));
+    assert!(packet
+        .lights
+        .iter()
+        .flatten()
+        .any(|r| r.radiance_slot.is_none()));
+    assert!(packet.lights.iter().any(Option::is_none), "the sky");
+    agrees_with_the_scalar_tracer(scene, &settings(8));
+}
+
 fn agrees_with_the_scalar_tracer(scene: RenderScene, settings: &RenderSettings) {
     let ((packet, ps), (scalar, ss)) = render_both(scene, settings);
     assert_eq!(ps.samples, ss.samples);

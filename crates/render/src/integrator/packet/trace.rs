@@ -1,7 +1,11 @@
 //! The packet tracer's loop over one film tile: `N` lanes, each following one camera path
 //! of the tile with the scalar tracer's steps (`integrator::path::PathTracer::trace`, whose
-//! comments explain them), and the two ray queries of each step — the extension ray and
-//! the shadow ray — done for all lanes at once.
+//! comments explain them). The paths' state is a structure of arrays (`Paths`), so that
+//! each step — the two ray queries, the vertex's bookkeeping, the light choice, the
+//! shading, the light sample's resolution — is one pass over the lanes that LLVM turns
+//! into vector code; what only some paths meet (an emitter hit, an escape to infinite
+//! lights, a light the scalar `Light` code samples, a Sobol stream's draws, a material past
+//! the reflectance slots) runs lane by lane inside those passes.
 
 // Lanes index several arrays at once: `for l in 0..N` is the clearest form.
 #![allow(clippy::needless_range_loop)]
@@ -12,7 +16,7 @@ use prism_spectrum::{SampledSpectrum, SampledWavelengths};
 
 use super::intersect::{closest, occluded, RayLanes};
 use super::shade::{shade, VertexIn, VertexOut, LIGHT_GIVEN, LIGHT_NONE, LIGHT_RECTANGLE};
-use super::{Kernel, PacketScene, REFLECTANCE_SLOTS};
+use super::{Kernel, PacketScene, LIGHT_SLOTS, REFLECTANCE_SLOTS};
 use crate::cpu::{has_avx2, has_avx512};
 use crate::film::xyz::XyzWeights;
 use crate::film::FilmTile;
@@ -46,48 +50,6 @@ pub(crate) struct TileCounts {
     pub camera_rays: u64,
     pub samples: u64,
     pub non_finite_samples: u64,
-}
-
-/// A next-event estimate waiting for its shadow ray, with the path's throughputs as they
-/// were at the vertex (the path has moved on by the time the shadow ray is answered).
-#[derive(Clone, Copy, Debug)]
-struct PendingLight {
-    /// f·L·w / p, added as β·direct (`path::add_contribution`).
-    direct: SampledSpectrum,
-    beta: SampledSpectrum,
-    first_bounce_beta: Option<SampledSpectrum>,
-    /// What a white Lambertian would receive (illumination AOV, depth 1 only).
-    white: SampledSpectrum,
-}
-
-/// One lane's camera sample and path state (the locals of the scalar `trace`).
-#[derive(Clone, Copy, Debug)]
-struct Lane {
-    pixel: UVec2,
-    film_point: Vec2,
-    filter_weight: f32,
-    stream: SampleStream,
-    wavelengths: SampledWavelengths,
-    /// `PacketScene::reflectances` at the path's wavelengths.
-    reflectance: [SampledSpectrum; REFLECTANCE_SLOTS],
-    radiance: SampledSpectrum,
-    beta: SampledSpectrum,
-    first_bounce_beta: Option<SampledSpectrum>,
-    incident_after_first: SampledSpectrum,
-    illumination_direct: Option<SampledSpectrum>,
-    first_hit: Option<FirstHit>,
-    direction: Vec3A,
-    depth: u32,
-    specular_bounce: bool,
-    prev_ctx: LightSampleContext,
-    prev_bsdf_pdf: f32,
-    le_cache: SpectrumCache,
-    reflectance_cache: SpectrumCache,
-    /// Geometric normal of the current vertex (for the next emission hit's MIS).
-    n_geometric: Vec3A,
-    pending: Option<PendingLight>,
-    /// The path ends once its pending light sample is resolved.
-    ends: bool,
 }
 
 /// Renders every camera sample of `tile` (pixels in order, samples in order) with the
@@ -156,6 +118,174 @@ impl SampleQueue {
     }
 }
 
+/// A lane's camera sample and what only a path's start, its end and the rarer events
+/// touch (the hot path state is in `Paths`).
+#[derive(Clone, Copy, Debug)]
+struct LaneSample {
+    pixel: UVec2,
+    film_point: Vec2,
+    filter_weight: f32,
+    stream: SampleStream,
+    wavelengths: SampledWavelengths,
+    first_hit: Option<FirstHit>,
+    le_cache: SpectrumCache,
+    reflectance_cache: SpectrumCache,
+}
+
+/// The path state of every lane, structure of arrays (the locals of the scalar `trace`):
+/// each step of the loop is one pass over the lanes. Every field is 4 bytes per lane and
+/// the flags live apart (`PathFlags`): LLVM proves arrays of one stride in one object
+/// independent, while mixed strides would need run-time overlap checks, too many of which
+/// make it leave a loop scalar.
+struct Paths<const N: usize> {
+    depth: [u32; N],
+    /// The stream's next dimension (`SampleStream::reserve`, kept here for all lanes).
+    dimension: [u32; N],
+    /// `PacketScene::reflectances` and `PacketScene::light_radiances` at the path's
+    /// wavelengths.
+    reflectance: [[[f32; N]; 4]; REFLECTANCE_SLOTS],
+    light_le: [[[f32; N]; 4]; LIGHT_SLOTS],
+    radiance: [[f32; N]; 4],
+    beta: [[f32; N]; 4],
+    /// β after the first bounce divided by a white Lambertian's (illumination AOV), where
+    /// `PathFlags::has_first_beta`.
+    first_beta: [[f32; N]; 4],
+    incident_after_first: [[f32; N]; 4],
+    illumination_direct: [[f32; N]; 4],
+    prev_p: [[f32; N]; 3],
+    prev_n: [[f32; N]; 3],
+    prev_bsdf_pdf: [f32; N],
+    /// Geometric normal of the current vertex (for the next emission hit's MIS).
+    n_geometric: [[f32; N]; 3],
+    /// A light sample waiting for its shadow ray, as `path::add_contribution`'s terms at
+    /// the vertex's throughputs (the path has moved on when the ray is answered): β·direct
+    /// and its part of the incident light after the first bounce; and what a white
+    /// Lambertian would receive.
+    pending_c: [[f32; N]; 4],
+    pending_incident: [[f32; N]; 4],
+    pending_white: [[f32; N]; 4],
+}
+
+/// The paths' flags (see `Paths`).
+struct PathFlags<const N: usize> {
+    /// The lane follows a path (its `LaneSample` is set).
+    live: [bool; N],
+    /// The path ends once its pending light sample is resolved.
+    ends: [bool; N],
+    has_first_beta: [bool; N],
+    has_illumination: [bool; N],
+    specular_bounce: [bool; N],
+    /// A light sample waits for its shadow ray; whether its incident part counts; whether
+    /// β·direct is non-finite.
+    pending: [bool; N],
+    pending_counts_incident: [bool; N],
+    pending_non_finite: [bool; N],
+}
+
+#[inline(always)]
+fn select(c: bool, a: f32, b: f32) -> f32 {
+    if c {
+        a
+    } else {
+        b
+    }
+}
+
+#[inline(always)]
+fn spectrum_at<const N: usize>(a: &[[f32; N]; 4], l: usize) -> SampledSpectrum {
+    SampledSpectrum::new([a[0][l], a[1][l], a[2][l], a[3][l]])
+}
+
+#[inline(always)]
+fn set_spectrum<const N: usize>(a: &mut [[f32; N]; 4], l: usize, s: SampledSpectrum) {
+    for k in 0..4 {
+        a[k][l] = s[k];
+    }
+}
+
+#[inline(always)]
+fn vec_at<const N: usize>(a: &[[f32; N]; 3], l: usize) -> Vec3A {
+    Vec3A::new(a[0][l], a[1][l], a[2][l])
+}
+
+impl<const N: usize> Paths<N> {
+    fn new() -> Self {
+        let z = [0.0f32; N];
+        Self {
+            depth: [0; N],
+            dimension: [0; N],
+            reflectance: [[z; 4]; REFLECTANCE_SLOTS],
+            light_le: [[z; 4]; LIGHT_SLOTS],
+            radiance: [z; 4],
+            beta: [z; 4],
+            first_beta: [z; 4],
+            incident_after_first: [z; 4],
+            illumination_direct: [z; 4],
+            prev_p: [z; 3],
+            prev_n: [z; 3],
+            prev_bsdf_pdf: z,
+            n_geometric: [z; 3],
+            pending_c: [z; 4],
+            pending_incident: [z; 4],
+            pending_white: [z; 4],
+        }
+    }
+
+    /// Adds β·x to lane `l`'s radiance (`path::add_contribution`).
+    #[inline(always)]
+    fn add(
+        &mut self,
+        flags: &PathFlags<N>,
+        l: usize,
+        x: SampledSpectrum,
+        count_incident: bool,
+        counters: &mut PathCounters,
+    ) {
+        let mut radiance = spectrum_at(&self.radiance, l);
+        let mut incident = spectrum_at(&self.incident_after_first, l);
+        let first = flags.has_first_beta[l].then(|| spectrum_at(&self.first_beta, l));
+        let beta = spectrum_at(&self.beta, l);
+        add_contribution(
+            &mut radiance,
+            &mut incident,
+            &first,
+            beta,
+            x,
+            count_incident,
+            counters,
+        );
+        set_spectrum(&mut self.radiance, l, radiance);
+        set_spectrum(&mut self.incident_after_first, l, incident);
+    }
+
+    /// The previous vertex of lane `l` (for the MIS weight of an emission hit).
+    #[inline(always)]
+    fn prev_ctx(&self, l: usize) -> LightSampleContext {
+        LightSampleContext {
+            p: vec_at(&self.prev_p, l),
+            n: vec_at(&self.prev_n, l),
+        }
+    }
+}
+
+impl<const N: usize> PathFlags<N> {
+    fn new() -> Self {
+        Self {
+            live: [false; N],
+            ends: [false; N],
+            has_first_beta: [false; N],
+            has_illumination: [false; N],
+            specular_bounce: [false; N],
+            pending: [false; N],
+            pending_counts_incident: [false; N],
+            pending_non_finite: [false; N],
+        }
+    }
+}
+
+/// Reflectance slot of a lane whose material has none (`LeafShading::reflectance_slot`).
+const NO_SLOT: u8 = u8::MAX;
+
 #[inline(always)]
 fn render_tile_lanes<const N: usize>(
     job: &TileJob,
@@ -171,30 +301,37 @@ fn render_tile_lanes<const N: usize>(
         end_sample: 0,
         first_sample: job.first_sample,
     };
-    let mut lanes: [Option<Lane>; N] = [None; N];
+    // Separate locals, not one struct: LLVM keeps each one its own object (see `Paths`).
+    let mut samples: [Option<LaneSample>; N] = [None; N];
+    let mut paths = Paths::<N>::new();
+    let mut flags = PathFlags::<N>::new();
     let mut rays = RayLanes::<N>::idle();
     let mut shadow = RayLanes::<N>::idle();
     let mut vertex = VertexIn::<N>::new();
     let mut shaded = VertexOut::<N>::new();
     let mut variates = Variates::<N>::new();
     let mut starts = Starts::<N>::new();
+    // The light whose rectangle fields lane l of `vertex` holds.
+    let mut rectangle_in_lane = [u32::MAX; N];
     let mut queue_empty = false;
     loop {
         // Fill idle lanes with the tile's next camera samples.
         for l in 0..N {
-            while lanes[l].is_none() && !queue_empty {
+            while !flags.live[l] && !queue_empty {
                 match starts.next(job, tile, &mut queue) {
                     Some(start) => {
-                        if let Some(ray) = start_lane(job, tile, start, &mut counts, &mut lanes[l])
-                        {
-                            rays.set(l, ray.origin, ray.direction, ray.t_min, ray.t_max);
-                        }
+                        let Some(ray) = start_lane(job, tile, &start, &mut counts, &mut samples[l])
+                        else {
+                            continue;
+                        };
+                        start_path(&mut paths, &mut flags, &mut variates, l, &start, ray.origin);
+                        rays.set(l, ray.origin, ray.direction, ray.t_min, ray.t_max);
                     }
                     None => queue_empty = true,
                 }
             }
         }
-        if lanes.iter().all(Option::is_none) {
+        if !flags.live.iter().any(|&live| live) {
             break;
         }
         let (hit_t, hit_leaf) = closest(
@@ -203,81 +340,50 @@ fn render_tile_lanes<const N: usize>(
             &packet.boxes,
             &rays,
         );
-        for l in 0..N {
-            shadow.clear(l);
-            vertex.active[l] = false;
-            if let Some(lane) = &mut lanes[l] {
-                let origin = Vec3A::new(rays.o[0][l], rays.o[1][l], rays.o[2][l]);
-                if !begin_vertex(
-                    job,
-                    lane,
-                    origin,
-                    hit_t[l],
-                    hit_leaf[l],
-                    &mut vertex,
-                    &mut variates,
-                    l,
-                    counters,
-                ) {
-                    lane.ends = true;
-                    rays.clear(l);
-                }
-            }
-        }
-        draw_variates(&mut variates);
-        for l in 0..N {
-            if let (Some(lane), true) = (&mut lanes[l], vertex.active[l]) {
-                choose_light(job, lane, &mut vertex, &variates, l);
-            }
-        }
+        begin_vertices(
+            job,
+            &mut paths,
+            &mut flags,
+            &mut samples,
+            &rays,
+            &hit_t,
+            &hit_leaf,
+            &mut vertex,
+            &mut variates,
+            counters,
+        );
+        draw_variates(&mut variates, &vertex, &samples);
+        choose_lights(
+            job,
+            &paths,
+            &mut samples,
+            &mut vertex,
+            &variates,
+            &mut rectangle_in_lane,
+        );
         shade(&vertex, job.tracer.mis, &mut shaded);
-        for l in 0..N {
-            let Some(lane) = &mut lanes[l] else {
-                continue;
-            };
-            if !vertex.active[l] {
-                continue;
-            }
-            match end_vertex(job, lane, &shaded, &mut shadow, l, counters) {
-                Some((origin, direction, t_min)) => {
-                    rays.set(l, origin, direction, t_min, f32::INFINITY)
-                }
-                None => {
-                    lane.ends = true;
-                    rays.clear(l);
-                }
-            }
-        }
+        end_vertices(
+            job,
+            &mut paths,
+            &mut flags,
+            &vertex,
+            &shaded,
+            &mut rays,
+            &mut shadow,
+            counters,
+        );
         let blocked = occluded(
             &packet.triangles,
             &packet.parallelograms,
             &packet.boxes,
             &shadow,
         );
+        resolve_light_samples(job, &mut paths, &mut flags, &blocked, counters);
         for l in 0..N {
-            let Some(lane) = &mut lanes[l] else {
-                continue;
-            };
-            if let Some(p) = lane.pending.take() {
-                if !blocked[l] {
-                    add_contribution(
-                        &mut lane.radiance,
-                        &mut lane.incident_after_first,
-                        &p.first_bounce_beta,
-                        p.beta,
-                        p.direct,
-                        true,
-                        counters,
-                    );
-                    // The vertex's depth: it changes only at the next vertex.
-                    if job.want_illumination && lane.depth == 1 {
-                        lane.illumination_direct = Some(p.white);
-                    }
-                }
-            }
-            if lane.ends {
-                finish_lane(job, tile, lane, &mut counts);
-                lanes[l] = None;
+            if flags.ends[l] {
+                flags.live[l] = false;
+                flags.ends[l] = false;
+                finish_lane(job, tile, &paths, &flags, &mut samples[l], l, &mut counts);
             }
         }
     }
@@ -291,10 +397,12 @@ struct Start {
     stream: SampleStream,
     film_point: Vec2,
     filter_weight: f32,
-    lens: Vec2,
     wavelengths: SampledWavelengths,
-    /// `PacketScene::reflectances` at the sample's wavelengths.
+    /// `PacketScene::reflectances` and `PacketScene::light_radiances` at the sample's
+    /// wavelengths.
     reflectance: [SampledSpectrum; REFLECTANCE_SLOTS],
+    light_le: [SampledSpectrum; LIGHT_SLOTS],
+    lens: Vec2,
 }
 
 /// The tile's next camera samples, their first draws made `N` at a time (the scalar
@@ -319,6 +427,7 @@ impl<const N: usize> Starts<N> {
             self.ready.clear();
             self.next = 0;
             let mut u = [0.5f32; N];
+            let zero = SampledSpectrum::splat(0.0);
             while self.ready.len() < N {
                 let Some((pixel, s)) = queue.next(job.camera_samples) else {
                     break;
@@ -337,9 +446,10 @@ impl<const N: usize> Starts<N> {
                     stream,
                     film_point,
                     filter_weight,
+                    wavelengths: SampledWavelengths::new([0.0; 4], zero),
+                    reflectance: [zero; REFLECTANCE_SLOTS],
+                    light_le: [zero; LIGHT_SLOTS],
                     lens,
-                    wavelengths: SampledWavelengths::new([0.0; 4], SampledSpectrum::splat(0.0)),
-                    reflectance: [SampledSpectrum::splat(0.0); REFLECTANCE_SLOTS],
                 });
             }
             let wavelengths = SampledWavelengths::sample_visible_many(&u);
@@ -352,6 +462,12 @@ impl<const N: usize> Starts<N> {
                     start.reflectance[slot] = v;
                 }
             }
+            for (slot, spectrum) in job.packet.light_radiances.iter().enumerate() {
+                let values = spectrum.eval_many(&wavelengths);
+                for (start, v) in self.ready.iter_mut().zip(values) {
+                    start.light_le[slot] = v;
+                }
+            }
         }
         let start = self.ready.get(self.next).copied()?;
         self.next += 1;
@@ -359,45 +475,26 @@ impl<const N: usize> Starts<N> {
     }
 }
 
-/// Puts camera sample `start` into lane `slot` and returns its camera ray; a sample
-/// without a ray goes to the film at once and leaves the slot empty. (Written in place: a
-/// `Lane` is ≈ 500 bytes, and returning it by value cost two copies per camera sample.)
+/// Camera sample `start`'s record for lane `slot` and its camera ray; a sample without a
+/// ray goes to the film at once and leaves the lane idle (`None`).
 #[inline(always)]
 fn start_lane(
     job: &TileJob,
     tile: &mut FilmTile,
-    start: Start,
+    start: &Start,
     counts: &mut TileCounts,
-    slot: &mut Option<Lane>,
+    slot: &mut Option<LaneSample>,
 ) -> Option<Ray> {
-    let zero = SampledSpectrum::splat(0.0);
-    let lane = slot.insert(Lane {
+    let lane_sample = LaneSample {
         pixel: start.pixel,
         film_point: start.film_point,
         filter_weight: start.filter_weight,
         stream: start.stream,
         wavelengths: start.wavelengths,
-        reflectance: start.reflectance,
-        radiance: zero,
-        beta: SampledSpectrum::splat(1.0),
-        first_bounce_beta: None,
-        incident_after_first: zero,
-        illumination_direct: None,
         first_hit: None,
-        direction: Vec3A::ZERO,
-        depth: 0,
-        specular_bounce: true,
-        prev_ctx: LightSampleContext {
-            p: Vec3A::ZERO,
-            n: Vec3A::ZERO,
-        },
-        prev_bsdf_pdf: 0.0,
         le_cache: SpectrumCache::new(),
         reflectance_cache: SpectrumCache::new(),
-        n_geometric: Vec3A::ZERO,
-        pending: None,
-        ends: false,
-    });
+    };
     match job
         .scene
         .camera
@@ -405,31 +502,55 @@ fn start_lane(
     {
         Some(ray) => {
             counts.camera_rays += 1;
-            lane.prev_ctx.p = ray.origin;
-            lane.direction = ray.direction;
+            *slot = Some(lane_sample);
             Some(ray)
         }
         None => {
             // No camera ray: a black sample with no AOV (the scalar driver's `None` arm).
-            finish_lane(job, tile, lane, counts);
-            *slot = None;
+            let black = SampledSpectrum::splat(0.0);
+            write_sample(job, tile, &lane_sample, black, None, counts);
             None
         }
     }
 }
 
-/// Adds β·x to the lane's radiance (`path::add_contribution`).
+/// Lane `l` starts the path of `start` from the camera ray's origin.
 #[inline(always)]
-fn add(lane: &mut Lane, x: SampledSpectrum, count_incident: bool, counters: &mut PathCounters) {
-    add_contribution(
-        &mut lane.radiance,
-        &mut lane.incident_after_first,
-        &lane.first_bounce_beta,
-        lane.beta,
-        x,
-        count_incident,
-        counters,
-    );
+fn start_path<const N: usize>(
+    paths: &mut Paths<N>,
+    flags: &mut PathFlags<N>,
+    variates: &mut Variates<N>,
+    l: usize,
+    start: &Start,
+    origin: Vec3A,
+) {
+    flags.live[l] = true;
+    flags.ends[l] = false;
+    flags.has_first_beta[l] = false;
+    flags.has_illumination[l] = false;
+    flags.specular_bounce[l] = true;
+    flags.pending[l] = false;
+    paths.depth[l] = 0;
+    paths.dimension[l] = start.stream.dimension();
+    let key = start.stream.independent_key();
+    variates.hashed[l] = key.is_some();
+    variates.key[l] = key.unwrap_or(0);
+    for (slot, r) in start.reflectance.iter().enumerate() {
+        set_spectrum(&mut paths.reflectance[slot], l, *r);
+    }
+    for (slot, le) in start.light_le.iter().enumerate() {
+        set_spectrum(&mut paths.light_le[slot], l, *le);
+    }
+    for k in 0..4 {
+        paths.radiance[k][l] = 0.0;
+        paths.beta[k][l] = 1.0;
+        paths.incident_after_first[k][l] = 0.0;
+    }
+    for a in 0..3 {
+        paths.prev_p[a][l] = origin[a];
+        paths.prev_n[a][l] = 0.0;
+    }
+    paths.prev_bsdf_pdf[l] = 0.0;
 }
 
 /// Offsets of a vertex's variates in its 8 reserved dimensions (`integrator::path` module
@@ -451,9 +572,10 @@ const VARIATE_OFFSETS: [u32; 6] = [
 /// The variates of one vertex per lane: light choice, light position (2), BSDF direction
 /// (2), roulette — the values `SampleStream::get_1d_at` gives at those dimensions.
 struct Variates<const N: usize> {
+    /// The path's independent stream key (`SampleStream::independent_key`), if `hashed`.
     key: [u64; N],
     first_dimension: [u32; N],
-    /// Independent stream: `u` is hashed from `key` by `draw_variates`; else drawn already.
+    /// Independent stream: `u` is hashed from `key`; else drawn from the stream.
     hashed: [bool; N],
     u: [[f32; N]; 6],
 }
@@ -469,340 +591,533 @@ impl<const N: usize> Variates<N> {
     }
 }
 
-/// The independent sampler's values (`independent::value`, SplitMix64) for every hashed
-/// lane at once: a loop over lanes of 64-bit multiplies, vector code with AVX-512.
+/// The vertex's variates (after `begin_vertices`): the independent sampler's values
+/// (`independent::value`, SplitMix64) for all lanes at once — a loop over lanes of 64-bit
+/// multiplies, vector code with AVX-512 — then those of other streams lane by lane.
 #[inline(always)]
-fn draw_variates<const N: usize>(v: &mut Variates<N>) {
+fn draw_variates<const N: usize>(
+    v: &mut Variates<N>,
+    vertex: &VertexIn<N>,
+    samples: &[Option<LaneSample>; N],
+) {
     for (k, &offset) in VARIATE_OFFSETS.iter().enumerate() {
         for l in 0..N {
             let bits = independent::value(v.key[l], v.first_dimension[l] + offset);
-            let u = u32_to_unit_f32(bits);
-            v.u[k][l] = if v.hashed[l] { u } else { v.u[k][l] };
+            v.u[k][l] = u32_to_unit_f32(bits);
         }
+    }
+    for l in 0..N {
+        let (true, false, Some(sample)) = (vertex.active[l], v.hashed[l], &samples[l]) else {
+            continue;
+        };
+        let dims = v.first_dimension[l];
+        let stream = &sample.stream;
+        let u = &mut v.u;
+        u[0][l] = stream.get_1d_at(dims + DIM_LIGHT_CHOICE);
+        let ul = stream.get_2d_at(dims + DIM_LIGHT);
+        (u[1][l], u[2][l]) = (ul.x, ul.y);
+        let ub = stream.get_2d_at(dims + DIM_BSDF);
+        (u[3][l], u[4][l]) = (ub.x, ub.y);
+        u[5][l] = stream.get_1d_at(dims + DIM_ROULETTE);
     }
 }
 
-/// A vertex's light choice and, for lights that are not rectangles, its light sample by
-/// the scalar `Light` code (after `draw_variates`).
-#[inline(always)]
-fn choose_light<const N: usize>(
-    job: &TileJob,
-    lane: &mut Lane,
-    vertex: &mut VertexIn<N>,
-    variates: &Variates<N>,
-    l: usize,
-) {
-    let lights = &job.scene.lights;
-    let u = &variates.u;
-    for (k, row) in [(3, 0), (4, 1)] {
-        vertex.u_bsdf[row][l] = u[k][l];
-    }
-    vertex.u_roulette[l] = if vertex.roulette[l] { u[5][l] } else { 1.0 };
-    if lights.is_empty() {
-        return;
-    }
-    let wavelengths = lane.wavelengths;
-    let uc = u[0][l].min(1.0 - f32::EPSILON);
-    let ul = glam::Vec2::new(u[1][l], u[2][l]);
-    let Some((li, pmf)) = lights.sample(uc) else {
-        return;
-    };
-    vertex.pmf[l] = pmf;
-    vertex.u_light[0][l] = ul.x;
-    vertex.u_light[1][l] = ul.y;
-    match &job.packet.lights[li as usize] {
-        Some(rect) => {
-            let le = lane.le_cache.get(li, &rect.radiance, &wavelengths);
-            for k in 0..4 {
-                vertex.le[k][l] = le[k];
-            }
-            for a in 0..3 {
-                vertex.rx[a][l] = rect.axes[0][a];
-                vertex.ry[a][l] = rect.axes[1][a];
-                vertex.rz[a][l] = rect.axes[2][a];
-                vertex.rt[a][l] = rect.axes[3][a];
-                vertex.rn[a][l] = rect.normal[a];
-            }
-            vertex.half_w[l] = rect.half_width_m;
-            vertex.half_h[l] = rect.half_height_m;
-            vertex.inv_area[l] = rect.inv_area_m2;
-            vertex.two_sided[l] = rect.two_sided;
-            vertex.light_kind[l] = LIGHT_RECTANGLE;
-        }
-        None => {
-            let (o, d, t) = (vertex.o, vertex.d, vertex.t[l]);
-            // The same bits as `shade`'s hit point.
-            let p = Vec3A::new(
-                o[0][l] + t * d[0][l],
-                o[1][l] + t * d[1][l],
-                o[2][l] + t * d[2][l],
-            );
-            let ctx = LightSampleContext {
-                p,
-                n: lane.n_geometric,
-            };
-            let light = lights.light(li);
-            if let Some(ls) = light.sample_li_cached(li, &ctx, ul, &wavelengths, &mut lane.le_cache)
-            {
-                for k in 0..4 {
-                    vertex.le[k][l] = ls.radiance[k];
-                }
-                for a in 0..3 {
-                    vertex.given_p[a][l] = ls.p_light[a];
-                    vertex.given_wi[a][l] = ls.wi[a];
-                }
-                vertex.given_pdf[l] = ls.pdf;
-                vertex.given_distance[l] = ls.distance_m;
-                vertex.given_delta[l] = ls.delta;
-                vertex.light_kind[l] = LIGHT_GIVEN;
-            }
-        }
-    }
-}
-
-/// A vertex's scalar part before the lanes are shaded together: the escape to infinite
-/// lights, the first-hit record, emission, the depth limit, the vertex's sample dimensions,
-/// the material's and light's spectra and the light choice (as the scalar tracer). Fills
-/// lane `l` of `vertex`; `false` when the path ends here.
+/// What each lane's ray found, before the lanes are shaded together (the scalar tracer's
+/// steps): the escape to infinite lights, the first-hit record, emission, the depth
+/// limit, then the vertex's patch, reflectance, sample dimensions and flags into `vertex`.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn begin_vertex<const N: usize>(
+fn begin_vertices<const N: usize>(
     job: &TileJob,
-    lane: &mut Lane,
-    origin: Vec3A,
-    hit_t: f32,
-    hit_leaf: u32,
+    paths: &mut Paths<N>,
+    flags: &mut PathFlags<N>,
+    samples: &mut [Option<LaneSample>; N],
+    rays: &RayLanes<N>,
+    hit_t: &[f32; N],
+    hit_leaf: &[u32; N],
     vertex: &mut VertexIn<N>,
     variates: &mut Variates<N>,
-    l: usize,
     counters: &mut PathCounters,
-) -> bool {
+) {
     let scene = job.scene;
     let tracer = job.tracer;
     let lights = &scene.lights;
-    let direction = lane.direction;
-    let wavelengths = lane.wavelengths;
-    let Some(leaf) = job.packet.leaves.get(hit_leaf as usize) else {
-        // Escaped: infinite lights.
-        for &li in lights.infinite_lights() {
-            let light = lights.light(li);
-            let le = light.infinite_radiance(direction, &wavelengths);
-            if le.is_black() {
-                continue;
+    let leaves = &job.packet.leaves;
+    // Locals, so that the vector passes below read no flag of an object they write.
+    let mut active = [false; N];
+    let mut slot = [NO_SLOT; N];
+    let mut material = [0u32; N];
+    // Lane by lane: the events only some lanes meet, and the patch's constants.
+    for l in 0..N {
+        let (true, Some(sample)) = (flags.live[l], &mut samples[l]) else {
+            continue;
+        };
+        let direction = vec_at(&rays.d, l);
+        let Some(leaf) = leaves.get(hit_leaf[l] as usize) else {
+            escape(job, paths, flags, sample, l, direction, counters);
+            flags.ends[l] = true;
+            continue;
+        };
+        if paths.depth[l] == 0 {
+            sample.first_hit = Some(FirstHit {
+                t: hit_t[l],
+                n_shading: leaf.n_shading,
+                material_id: leaf.material_id,
+            });
+        }
+        if let Some(li) = leaf.light {
+            // The same bits as `shade`'s hit point.
+            let o = vec_at(&rays.o, l);
+            let t = hit_t[l];
+            let light_hit = LightHit {
+                p: Vec3A::new(
+                    o.x + t * direction.x,
+                    o.y + t * direction.y,
+                    o.z + t * direction.z,
+                ),
+                n: leaf.n_geometric,
+                uv: leaf.uv,
+                distance_m: t,
+            };
+            let hit = (li, &light_hit, direction);
+            emission(job, paths, flags, sample, l, hit, counters);
+        }
+        if paths.depth[l] == tracer.max_depth {
+            flags.ends[l] = true;
+            continue;
+        }
+        active[l] = true;
+        let frame = leaf.frame;
+        for a in 0..3 {
+            vertex.fx[a][l] = frame.x[a];
+            vertex.fy[a][l] = frame.y[a];
+            vertex.fz[a][l] = frame.z[a];
+            paths.n_geometric[a][l] = leaf.n_geometric[a];
+        }
+        slot[l] = leaf.reflectance_slot.map_or(NO_SLOT, |s| s as u8);
+        material[l] = leaf.material_id;
+    }
+    // All lanes at once: depth, sample dimensions, the ray, β and R(λ)/π; at the first
+    // bounce the illumination AOV's direct part starts.
+    let want_white = job.want_illumination && !lights.is_empty();
+    let mut bounces = 0u32;
+    for l in 0..N {
+        let depth = paths.depth[l] + active[l] as u32;
+        paths.depth[l] = depth;
+        let clear_white = active[l] && want_white && depth == 1;
+        bounces += active[l] as u32;
+        variates.first_dimension[l] = paths.dimension[l];
+        paths.dimension[l] += if active[l] { 8 } else { 0 };
+        vertex.t[l] = hit_t[l];
+        for a in 0..3 {
+            vertex.o[a][l] = rays.o[a][l];
+            vertex.d[a][l] = rays.d[a][l];
+        }
+        for k in 0..4 {
+            vertex.beta[k][l] = paths.beta[k][l];
+            let mut r = 0.0;
+            for s in 0..REFLECTANCE_SLOTS {
+                r = select(slot[l] == s as u8, paths.reflectance[s][k][l], r);
             }
-            let w = tracer.emission_weight(
-                scene,
-                li,
-                lane.specular_bounce,
-                &lane.prev_ctx,
-                lane.prev_bsdf_pdf,
-                direction,
-                None,
-            );
-            let count = lane.depth >= 2;
-            add(lane, le * w, count, counters);
+            vertex.f_lambert[k][l] = r * std::f32::consts::FRAC_1_PI;
+            let d = paths.illumination_direct[k][l];
+            paths.illumination_direct[k][l] = select(clear_white, 0.0, d);
         }
-        return false;
-    };
-    // The same bits as `shade`'s hit point.
-    let p = Vec3A::new(
-        origin.x + hit_t * direction.x,
-        origin.y + hit_t * direction.y,
-        origin.z + hit_t * direction.z,
-    );
-    if lane.first_hit.is_none() {
-        lane.first_hit = Some(FirstHit {
-            t: hit_t,
-            n_shading: leaf.n_shading,
-            material_id: leaf.material_id,
-        });
     }
-    let dims = lane.stream.reserve(8);
-    let (d_light_choice, d_light, d_bsdf, d_roulette) = (
-        dims + DIM_LIGHT_CHOICE,
-        dims + DIM_LIGHT,
-        dims + DIM_BSDF,
-        dims + DIM_ROULETTE,
-    );
-
-    if let Some(li) = leaf.light {
-        let light = lights.light(li);
-        let light_hit = LightHit {
-            p,
-            n: leaf.n_geometric,
-            uv: leaf.uv,
-            distance_m: hit_t,
+    counters.bounces += bounces as u64;
+    // The vertex's flags.
+    for l in 0..N {
+        let depth = paths.depth[l];
+        vertex.active[l] = active[l];
+        vertex.roulette[l] = depth >= tracer.rr_depth;
+        let record_white = job.want_illumination && depth == 1;
+        vertex.record_white[l] = record_white;
+        vertex.light_kind[l] = LIGHT_NONE;
+        flags.has_illumination[l] |= active[l] && record_white && want_white;
+    }
+    // Lane by lane again where needed: reflectances past the slots.
+    let mut slotless = false;
+    for l in 0..N {
+        slotless |= active[l] & (slot[l] == NO_SLOT);
+    }
+    if !slotless {
+        return;
+    }
+    for l in 0..N {
+        let (true, Some(sample)) = (active[l], &mut samples[l]) else {
+            continue;
         };
-        let le = light.emitted_radiance_cached(
-            li,
-            &light_hit,
-            -direction,
-            &wavelengths,
-            &mut lane.le_cache,
-        );
-        if !le.is_black() {
-            let w = tracer.emission_weight(
-                scene,
-                li,
-                lane.specular_bounce,
-                &lane.prev_ctx,
-                lane.prev_bsdf_pdf,
-                direction,
-                Some(&light_hit),
-            );
-            let count = lane.depth >= 2;
-            add(lane, le * w, count, counters);
+        if slot[l] == NO_SLOT {
+            let Material::Lambert { reflectance } = scene.material(material[l]) else {
+                unreachable!("PacketScene::new admits constant Lambertian materials only");
+            };
+            let constant = reflectance
+                .constant()
+                .expect("PacketScene::new admits constant reflectances only");
+            let r = sample
+                .reflectance_cache
+                .get(material[l], constant, &sample.wavelengths);
+            set_spectrum(&mut vertex.f_lambert, l, r * std::f32::consts::FRAC_1_PI);
         }
     }
-    if lane.depth == tracer.max_depth {
-        return false;
-    }
-    lane.depth += 1;
-    counters.bounces += 1;
-    lane.n_geometric = leaf.n_geometric;
-
-    let Material::Lambert { reflectance } = scene.material(leaf.material_id) else {
-        unreachable!("PacketScene::new admits constant Lambertian materials only");
-    };
-    let constant = reflectance
-        .constant()
-        .expect("PacketScene::new admits constant reflectances only");
-    let reflectance = match leaf.reflectance_slot {
-        Some(slot) => lane.reflectance[slot],
-        None => lane
-            .reflectance_cache
-            .get(leaf.material_id, constant, &wavelengths),
-    };
-    let f_lambert = reflectance * std::f32::consts::FRAC_1_PI;
-    let frame = leaf.frame;
-    for a in 0..3 {
-        vertex.o[a][l] = origin[a];
-        vertex.d[a][l] = direction[a];
-        vertex.fx[a][l] = frame.x[a];
-        vertex.fy[a][l] = frame.y[a];
-        vertex.fz[a][l] = frame.z[a];
-    }
-    vertex.t[l] = hit_t;
-    for k in 0..4 {
-        vertex.beta[k][l] = lane.beta[k];
-        vertex.f_lambert[k][l] = f_lambert[k];
-    }
-    vertex.roulette[l] = lane.depth >= tracer.rr_depth;
-    let record_white = job.want_illumination && lane.depth == 1;
-    vertex.record_white[l] = record_white;
-    vertex.light_kind[l] = LIGHT_NONE;
-    if !lights.is_empty() && record_white {
-        lane.illumination_direct = Some(SampledSpectrum::splat(0.0));
-    }
-    // The vertex's variates: hashed for all lanes at once (`draw_variates`) for
-    // independent streams, here for the others.
-    variates.first_dimension[l] = dims;
-    match lane.stream.independent_key() {
-        Some(key) => {
-            variates.key[l] = key;
-            variates.hashed[l] = true;
-        }
-        None => {
-            variates.hashed[l] = false;
-            let u = &mut variates.u;
-            u[0][l] = lane.stream.get_1d_at(d_light_choice);
-            let ul = lane.stream.get_2d_at(d_light);
-            (u[1][l], u[2][l]) = (ul.x, ul.y);
-            let ub = lane.stream.get_2d_at(d_bsdf);
-            (u[3][l], u[4][l]) = (ub.x, ub.y);
-            u[5][l] = lane.stream.get_1d_at(d_roulette);
-        }
-    }
-    vertex.active[l] = true;
-    true
 }
 
-/// A vertex's scalar part after the lanes were shaded: its shadow ray and pending light
-/// contribution, the path's new state, statistics. The next ray (origin, unit direction,
-/// t_min), or `None` when the path ends after the pending light sample.
+/// A lane's ray escaped: the infinite lights it sees.
 #[inline(always)]
-fn end_vertex<const N: usize>(
+fn escape<const N: usize>(
     job: &TileJob,
-    lane: &mut Lane,
-    out: &VertexOut<N>,
-    shadow: &mut RayLanes<N>,
+    paths: &mut Paths<N>,
+    flags: &PathFlags<N>,
+    sample: &LaneSample,
     l: usize,
+    direction: Vec3A,
     counters: &mut PathCounters,
-) -> Option<(Vec3A, Vec3A, f32)> {
-    let p = Vec3A::new(out.p[0][l], out.p[1][l], out.p[2][l]);
-    let spectrum = |a: &[[f32; N]; 4]| SampledSpectrum::from([a[0][l], a[1][l], a[2][l], a[3][l]]);
-    if out.has_shadow[l] {
-        counters.rays += 1;
-        let d = Vec3A::new(out.shadow_d[0][l], out.shadow_d[1][l], out.shadow_d[2][l]);
-        shadow.set(l, p, d, out.shadow_t_min[l], out.shadow_t_max[l]);
-        lane.pending = Some(PendingLight {
-            direct: spectrum(&out.direct),
-            beta: lane.beta,
-            first_bounce_beta: lane.first_bounce_beta,
-            white: spectrum(&out.white),
-        });
+) {
+    let lights = &job.scene.lights;
+    for &li in lights.infinite_lights() {
+        let light = lights.light(li);
+        let le = light.infinite_radiance(direction, &sample.wavelengths);
+        if le.is_black() {
+            continue;
+        }
+        let w = job.tracer.emission_weight(
+            job.scene,
+            li,
+            flags.specular_bounce[l],
+            &paths.prev_ctx(l),
+            paths.prev_bsdf_pdf[l],
+            direction,
+            None,
+        );
+        let count = paths.depth[l] >= 2;
+        paths.add(flags, l, le * w, count, counters);
     }
-    if out.weight_non_finite[l] {
-        counters.non_finite_contributions += 1;
-    }
-    let goes_on = out.continues[l] || out.killed_by_roulette[l];
-    if !goes_on {
-        return None;
-    }
-    if lane.depth == 1 && job.want_illumination {
-        let white_weight = out.wi_z[l].max(0.0) * std::f32::consts::FRAC_1_PI / out.pdf[l];
-        lane.first_bounce_beta = if white_weight <= 0.0 {
-            None
-        } else {
-            Some(spectrum(&out.weight) * (1.0 / white_weight.max(1e-20)))
-        };
-    }
-    lane.specular_bounce = false;
-    lane.prev_bsdf_pdf = out.pdf[l];
-    lane.prev_ctx = LightSampleContext {
-        p,
-        n: lane.n_geometric,
-    };
-    counters.rays += 1;
-    if out.killed_by_roulette[l] {
-        counters.roulette_terminations += 1;
-        return None;
-    }
-    lane.beta = spectrum(&out.beta);
-    let direction = Vec3A::new(out.next_d[0][l], out.next_d[1][l], out.next_d[2][l]);
-    lane.direction = direction;
-    Some((p, direction, out.next_t_min[l]))
 }
 
-/// The camera sample's value into the film (the scalar driver's steps after `radiance`).
+/// A lane's ray hit emitter `hit.0` at `hit.1` along `hit.2`: its radiance, MIS-weighted
+/// against the light sample.
 #[inline(always)]
-fn finish_lane(job: &TileJob, tile: &mut FilmTile, lane: &mut Lane, counts: &mut TileCounts) {
-    let xyz_weights = XyzWeights::new(&lane.wavelengths);
-    let illumination = lane.illumination_direct.map(|d| {
-        if lane.first_bounce_beta.is_some() {
-            d + lane.incident_after_first
+fn emission<const N: usize>(
+    job: &TileJob,
+    paths: &mut Paths<N>,
+    flags: &PathFlags<N>,
+    sample: &mut LaneSample,
+    l: usize,
+    (li, light_hit, direction): (u32, &LightHit, Vec3A),
+    counters: &mut PathCounters,
+) {
+    let light = job.scene.lights.light(li);
+    let le = light.emitted_radiance_cached(
+        li,
+        light_hit,
+        -direction,
+        &sample.wavelengths,
+        &mut sample.le_cache,
+    );
+    if le.is_black() {
+        return;
+    }
+    let w = job.tracer.emission_weight(
+        job.scene,
+        li,
+        flags.specular_bounce[l],
+        &paths.prev_ctx(l),
+        paths.prev_bsdf_pdf[l],
+        direction,
+        Some(light_hit),
+    );
+    let count = paths.depth[l] >= 2;
+    paths.add(flags, l, le * w, count, counters);
+}
+
+/// Lights with at most this many entries are picked for all lanes in one vector pass.
+const VECTOR_LIGHT_CHOICE_MAX: usize = 16;
+
+/// Each vertex's light choice (`LightSet::sample`), the chosen rectangle's fields and
+/// L(λ), or a light sample by the scalar `Light` code for other lights (after
+/// `draw_variates`). `rectangle_in_lane[l]` names the light whose fields lane `l` of
+/// `vertex` already holds.
+#[inline(always)]
+fn choose_lights<const N: usize>(
+    job: &TileJob,
+    paths: &Paths<N>,
+    samples: &mut [Option<LaneSample>; N],
+    vertex: &mut VertexIn<N>,
+    variates: &Variates<N>,
+    rectangle_in_lane: &mut [u32; N],
+) {
+    let u = &variates.u;
+    let rr_depth = job.tracer.rr_depth;
+    for l in 0..N {
+        vertex.u_bsdf[0][l] = u[3][l];
+        vertex.u_bsdf[1][l] = u[4][l];
+        // `vertex.roulette`, from the depth: this pass writes no flag of `vertex`.
+        vertex.u_roulette[l] = select(paths.depth[l] >= rr_depth, u[5][l], 1.0);
+        vertex.u_light[0][l] = u[1][l];
+        vertex.u_light[1][l] = u[2][l];
+    }
+    let lights = &job.scene.lights;
+    if lights.is_empty() {
+        return;
+    }
+    // `LightSet::sample`: the first light whose running sum exceeds u, i.e. the number of
+    // sums ≤ u (they never decrease).
+    let cdf = lights.selection_cdf();
+    let pmf = lights.selection_pmf();
+    let mut chosen = [0u32; N];
+    let last = cdf.len() as u32 - 1;
+    if cdf.len() <= VECTOR_LIGHT_CHOICE_MAX {
+        for l in 0..N {
+            let uc = u[0][l].min(1.0 - f32::EPSILON);
+            let mut below = 0u32;
+            for &c in cdf {
+                below += (c <= uc) as u32;
+            }
+            chosen[l] = below.min(last);
+        }
+    } else {
+        for l in 0..N {
+            let uc = u[0][l].min(1.0 - f32::EPSILON);
+            chosen[l] = lights.sample(uc).map_or(0, |(i, _)| i);
+        }
+    }
+    for l in 0..N {
+        let (true, Some(sample)) = (vertex.active[l], &mut samples[l]) else {
+            continue;
+        };
+        let li = chosen[l];
+        let p = pmf[li as usize];
+        // `LightSet::sample` picks no light where p is not > 0.
+        if p.is_nan() || p <= 0.0 {
+            continue;
+        }
+        vertex.pmf[l] = p;
+        match &job.packet.lights[li as usize] {
+            Some(rect) => {
+                if rectangle_in_lane[l] != li {
+                    rectangle_in_lane[l] = li;
+                    for a in 0..3 {
+                        vertex.rx[a][l] = rect.axes[0][a];
+                        vertex.ry[a][l] = rect.axes[1][a];
+                        vertex.rz[a][l] = rect.axes[2][a];
+                        vertex.rt[a][l] = rect.axes[3][a];
+                        vertex.rn[a][l] = rect.normal[a];
+                    }
+                    vertex.half_w[l] = rect.half_width_m;
+                    vertex.half_h[l] = rect.half_height_m;
+                    vertex.inv_area[l] = rect.inv_area_m2;
+                    vertex.two_sided[l] = rect.two_sided;
+                }
+                let le = match rect.radiance_slot {
+                    Some(s) => spectrum_at(&paths.light_le[s], l),
+                    None => sample.le_cache.get(li, &rect.radiance, &sample.wavelengths),
+                };
+                set_spectrum(&mut vertex.le, l, le);
+                vertex.light_kind[l] = LIGHT_RECTANGLE;
+            }
+            None => {
+                let (o, d, t) = (vertex.o, vertex.d, vertex.t[l]);
+                // The same bits as `shade`'s hit point.
+                let p = Vec3A::new(
+                    o[0][l] + t * d[0][l],
+                    o[1][l] + t * d[1][l],
+                    o[2][l] + t * d[2][l],
+                );
+                let ctx = LightSampleContext {
+                    p,
+                    n: vec_at(&paths.n_geometric, l),
+                };
+                let ul = Vec2::new(u[1][l], u[2][l]);
+                if let Some(ls) = lights.light(li).sample_li_cached(
+                    li,
+                    &ctx,
+                    ul,
+                    &sample.wavelengths,
+                    &mut sample.le_cache,
+                ) {
+                    set_spectrum(&mut vertex.le, l, ls.radiance);
+                    for a in 0..3 {
+                        vertex.given_p[a][l] = ls.p_light[a];
+                        vertex.given_wi[a][l] = ls.wi[a];
+                    }
+                    vertex.given_pdf[l] = ls.pdf;
+                    vertex.given_distance[l] = ls.distance_m;
+                    vertex.given_delta[l] = ls.delta;
+                    vertex.light_kind[l] = LIGHT_GIVEN;
+                }
+            }
+        }
+    }
+}
+
+/// Each lane's vertex after shading, all lanes at once: its shadow ray and pending light
+/// sample, the path's new state and next ray (or its end), statistics.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn end_vertices<const N: usize>(
+    job: &TileJob,
+    paths: &mut Paths<N>,
+    flags: &mut PathFlags<N>,
+    vertex: &VertexIn<N>,
+    out: &VertexOut<N>,
+    rays: &mut RayLanes<N>,
+    shadow: &mut RayLanes<N>,
+    counters: &mut PathCounters,
+) {
+    let want_illumination = job.want_illumination;
+    let mut rays_traced = 0u32;
+    let mut non_finite = 0u32;
+    let mut roulette = 0u32;
+    for l in 0..N {
+        let has_shadow = out.has_shadow[l];
+        let goes_on = out.continues[l] | out.killed_by_roulette[l];
+        let continues = out.continues[l];
+        let first = want_illumination & goes_on & (paths.depth[l] == 1);
+        let white_weight = out.wi_z[l].max(0.0) * std::f32::consts::FRAC_1_PI / out.pdf[l];
+        let scale = 1.0 / white_weight.max(1e-20);
+        let had_first_beta = flags.has_first_beta[l];
+        // `path::add_contribution`'s terms at this vertex's β.
+        let mut c_non_finite = false;
+        for k in 0..4 {
+            let beta = paths.beta[k][l];
+            let c = beta * out.direct[k][l];
+            c_non_finite |= !c.is_finite();
+            let b1 = paths.first_beta[k][l];
+            paths.pending_c[k][l] = c;
+            // `SampledSpectrum::safe_div`.
+            paths.pending_incident[k][l] = select(b1 != 0.0, c / b1, 0.0);
+            paths.pending_white[k][l] = out.white[k][l];
+            paths.first_beta[k][l] = select(first, out.weight[k][l] * scale, b1);
+            // Stores under a condition, not `select`s of two loads, which LLVM turns into a
+            // load from a selected address that it cannot vectorise.
+            if continues {
+                paths.beta[k][l] = out.beta[k][l];
+            }
+        }
+        flags.pending[l] = has_shadow;
+        flags.pending_non_finite[l] = c_non_finite;
+        flags.pending_counts_incident[l] = had_first_beta;
+        // The scalar tracer keeps no first-bounce β where the weight is ≤ 0 (NaN keeps it).
+        let keeps = white_weight > 0.0 || white_weight.is_nan();
+        flags.has_first_beta[l] = (first & keeps) | (!first & had_first_beta);
+        flags.specular_bounce[l] &= !goes_on;
+        flags.ends[l] |= vertex.active[l] & !continues;
+        if goes_on {
+            paths.prev_bsdf_pdf[l] = out.pdf[l];
+        }
+        for a in 0..3 {
+            let p = out.p[a][l];
+            if goes_on {
+                paths.prev_p[a][l] = p;
+                paths.prev_n[a][l] = paths.n_geometric[a][l];
+            }
+            shadow.o[a][l] = p;
+            shadow.d[a][l] = out.shadow_d[a][l];
+            rays.o[a][l] = p;
+            rays.d[a][l] = out.next_d[a][l];
+        }
+        shadow.t_min[l] = select(has_shadow, out.shadow_t_min[l], f32::INFINITY);
+        shadow.t_max[l] = select(has_shadow, out.shadow_t_max[l], 0.0);
+        rays.t_min[l] = select(continues, out.next_t_min[l], f32::INFINITY);
+        rays.t_max[l] = select(continues, f32::INFINITY, 0.0);
+        rays_traced += has_shadow as u32 + goes_on as u32;
+        non_finite += out.weight_non_finite[l] as u32;
+        roulette += out.killed_by_roulette[l] as u32;
+    }
+    counters.rays += rays_traced as u64;
+    counters.non_finite_contributions += non_finite as u64;
+    counters.roulette_terminations += roulette as u64;
+}
+
+/// The pending light samples whose shadow rays were not blocked, added as
+/// `path::add_contribution` adds them, all lanes at once.
+#[inline(always)]
+fn resolve_light_samples<const N: usize>(
+    job: &TileJob,
+    paths: &mut Paths<N>,
+    flags: &mut PathFlags<N>,
+    blocked: &[bool; N],
+    counters: &mut PathCounters,
+) {
+    let mut non_finite = 0u32;
+    for l in 0..N {
+        let unblocked = flags.pending[l] & !blocked[l];
+        non_finite += (unblocked & flags.pending_non_finite[l]) as u32;
+        let add = unblocked & !flags.pending_non_finite[l];
+        let add_incident = add & flags.pending_counts_incident[l];
+        // The vertex's depth: it changes only at the next vertex.
+        let white = job.want_illumination & unblocked & (paths.depth[l] == 1);
+        flags.has_illumination[l] |= white;
+        flags.pending[l] = false;
+        for k in 0..4 {
+            let r = paths.radiance[k][l];
+            paths.radiance[k][l] = select(add, r + paths.pending_c[k][l], r);
+            let i = paths.incident_after_first[k][l];
+            paths.incident_after_first[k][l] =
+                select(add_incident, i + paths.pending_incident[k][l], i);
+            if white {
+                paths.illumination_direct[k][l] = paths.pending_white[k][l];
+            }
+        }
+    }
+    counters.non_finite_contributions += non_finite as u64;
+}
+
+/// Lane `l`'s camera sample into the film; the lane is idle after.
+#[inline(always)]
+fn finish_lane<const N: usize>(
+    job: &TileJob,
+    tile: &mut FilmTile,
+    paths: &Paths<N>,
+    flags: &PathFlags<N>,
+    sample: &mut Option<LaneSample>,
+    l: usize,
+    counts: &mut TileCounts,
+) {
+    let Some(sample) = sample.take() else {
+        return;
+    };
+    let illumination = flags.has_illumination[l].then(|| {
+        let d = spectrum_at(&paths.illumination_direct, l);
+        if flags.has_first_beta[l] {
+            d + spectrum_at(&paths.incident_after_first, l)
         } else {
             d
         }
     });
+    let radiance = spectrum_at(&paths.radiance, l);
+    write_sample(job, tile, &sample, radiance, illumination, counts);
+}
+
+/// A camera sample's value into the film (the scalar driver's steps after `radiance`).
+#[inline(always)]
+fn write_sample(
+    job: &TileJob,
+    tile: &mut FilmTile,
+    sample: &LaneSample,
+    radiance: SampledSpectrum,
+    illumination: Option<SampledSpectrum>,
+    counts: &mut TileCounts,
+) {
+    let xyz_weights = XyzWeights::new(&sample.wavelengths);
     if let Some(white) = illumination {
-        tile.add_illumination_with(lane.pixel, white, &xyz_weights);
+        tile.add_illumination_with(sample.pixel, white, &xyz_weights);
     }
-    let aov = lane.first_hit.map(|h| SurfaceAov {
+    let aov = sample.first_hit.map(|h| SurfaceAov {
         depth_m: h.t,
         normal: h.n_shading,
         albedo_rgb: job.scene.albedo(h.material_id),
     });
-    if lane.radiance.has_non_finite() {
+    if radiance.has_non_finite() {
         counts.non_finite_samples += 1;
     }
     tile.add_sample_with(
-        lane.pixel,
-        lane.film_point,
-        lane.radiance,
-        &lane.wavelengths,
+        sample.pixel,
+        sample.film_point,
+        radiance,
+        &sample.wavelengths,
         &xyz_weights,
-        lane.filter_weight,
+        sample.filter_weight,
         aov.as_ref(),
     );
     counts.samples += 1;
