@@ -123,6 +123,38 @@ impl FilterTable {
     }
 }
 
+impl FilterTable {
+    /// `eval` at eight points, the table reads as two AVX2 gathers: the same arithmetic
+    /// lane by lane (so the same bits) — a radius-2 splat's four columns and four rows in
+    /// one call, where `eval4`'s sixteen scalar reads cost ≈ 5 % of a Cornell box render.
+    ///
+    /// # Safety
+    /// The CPU must run AVX2 (`cpu::has_avx2`).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx,avx2")]
+    pub unsafe fn eval8_avx2(&self, x_px: [f32; 8]) -> [f32; 8] {
+        use std::arch::x86_64::*;
+        let x = _mm256_loadu_ps(x_px.as_ptr());
+        // As `eval4`: |x|, the lanes inside the support (false for NaN), s clamped to N
+        // (a NaN lane becomes N and is masked out).
+        let a = _mm256_andnot_ps(_mm256_set1_ps(-0.0), x);
+        let inside = _mm256_cmp_ps::<_CMP_LE_OQ>(a, _mm256_set1_ps(self.radius_px));
+        let s = _mm256_min_ps(
+            _mm256_mul_ps(a, _mm256_set1_ps(self.inv_step_per_px)),
+            _mm256_set1_ps(INTERVALS as f32),
+        );
+        let k = _mm256_cvttps_epi32(s);
+        let t = _mm256_sub_ps(s, _mm256_cvtepi32_ps(k));
+        // k ∈ [0, N] in every lane and the table holds N + 2 values: both reads in bounds.
+        let v0 = _mm256_i32gather_ps::<4>(self.values.as_ptr(), k);
+        let v1 = _mm256_i32gather_ps::<4>(self.values.as_ptr().add(1), k);
+        let v = _mm256_add_ps(v0, _mm256_mul_ps(t, _mm256_sub_ps(v1, v0)));
+        let mut out = [0.0f32; 8];
+        _mm256_storeu_ps(out.as_mut_ptr(), _mm256_and_ps(v, inside));
+        out
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -164,6 +196,30 @@ mod tests {
             assert_eq!(table.eval(0.0), filter.eval_1d(0.0));
             assert_eq!(table.eval(r), filter.eval_1d(r));
             assert_eq!(table.eval(-r), filter.eval_1d(r));
+        }
+    }
+
+    #[test]
+    fn eval8_is_eval_in_every_lane() {
+        if !crate::cpu::has_avx2() {
+            return;
+        }
+        for filter in filters() {
+            let table = FilterTable::new(&filter);
+            let r = filter.radius_px();
+            let mut xs: Vec<f32> = (0..=8001)
+                .map(|i| r * (-1.2 + 2.4 * i as f32 / 8001.0))
+                .collect();
+            xs.extend([0.0, -0.0, r, -r, f32::NAN, f32::INFINITY, f32::NEG_INFINITY]);
+            for chunk in xs.chunks(8) {
+                let mut x = [f32::NAN; 8];
+                x[..chunk.len()].copy_from_slice(chunk);
+                // SAFETY: the CPU runs AVX2 (checked above).
+                let got = unsafe { table.eval8_avx2(x) };
+                for (g, &xi) in got.iter().zip(&x) {
+                    assert_eq!(g.to_bits(), table.eval(xi).to_bits(), "{filter:?} at {xi}");
+                }
+            }
         }
     }
 

@@ -136,11 +136,14 @@ impl Film {
     /// The same film recording `selection`. Call before rendering: the AOV sums start at 0.
     pub fn with_aovs(mut self, selection: AovSelection) -> Self {
         self.aov_selection = selection;
-        self.aovs = if selection.any() {
-            vec![AovAccum::default(); self.pixels.len()]
+        if !selection.any() {
+            self.aovs = Vec::new();
+        } else if self.aovs.len() == self.pixels.len() {
+            // Cleared in place: a new buffer of a 256² film is ≈ 6 MB of page faults.
+            self.aovs.fill(AovAccum::default());
         } else {
-            Vec::new()
-        };
+            self.aovs = vec![AovAccum::default(); self.pixels.len()];
+        }
         self
     }
 
