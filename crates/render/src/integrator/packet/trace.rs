@@ -31,7 +31,6 @@ use crate::scene_build::RenderScene;
 use crate::spectrum_cache::SpectrumCache;
 
 /// What the driver passes in and sums up: one tile's work.
-static S4: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
 pub(crate) struct TileJob<'a> {
     pub scene: &'a RenderScene,
     pub packet: &'a PacketScene,
@@ -1112,16 +1111,14 @@ fn write_sample(
     if radiance.has_non_finite() {
         counts.non_finite_samples += 1;
     }
-    if !*S4.get_or_init(|| std::env::var_os("S4_NO_SPLAT").is_some()) {
-        tile.add_sample_with(
-            sample.pixel,
-            sample.film_point,
-            radiance,
-            &sample.wavelengths,
-            &xyz_weights,
-            sample.filter_weight,
-            aov.as_ref(),
-        );
-    }
+    tile.add_sample_with(
+        sample.pixel,
+        sample.film_point,
+        radiance,
+        &sample.wavelengths,
+        &xyz_weights,
+        sample.filter_weight,
+        aov.as_ref(),
+    );
     counts.samples += 1;
 }
