@@ -85,6 +85,28 @@ impl Camera {
         Some(Ray::infinite(t.point(o), t.vector(d).normalize()))
     }
 
+    /// `generate_ray_only` for `N` film points at once, the same rays: the pinhole
+    /// camera's in one vector loop (`PinholeCamera::world_rays_many`), the others' one by
+    /// one.
+    #[inline(always)]
+    pub fn generate_rays_only_many<const N: usize>(
+        &self,
+        film_points_px: &[Vec2; N],
+        lens_samples: &[Vec2; N],
+    ) -> [Option<Ray>; N] {
+        match self {
+            Camera::Pinhole(c) => {
+                let (origin, d) = c.world_rays_many(film_points_px);
+                std::array::from_fn(|k| {
+                    Some(Ray::infinite(origin, Vec3A::new(d[0][k], d[1][k], d[2][k])))
+                })
+            }
+            _ => {
+                std::array::from_fn(|k| self.generate_ray_only(film_points_px[k], lens_samples[k]))
+            }
+        }
+    }
+
     /// Whether `generate_ray` reads its lens sample (the thin lens only): the driver
     /// computes those two dimensions only then.
     pub fn uses_lens_sample(&self) -> bool {

@@ -55,6 +55,37 @@ impl PinholeCamera {
         Some((Vec3A::ZERO, d))
     }
 
+    /// `Camera::generate_ray_only` of `N` film points: the world origin and the unit
+    /// directions (one array per axis). One loop over the points in plain f32
+    /// arithmetic, which LLVM vectorises where the caller is compiled for it; the same
+    /// operations in the same order as glam's `normalize` ((x² + y²) + z², then v / √)
+    /// and `transform_vector3a` ((X·x + Y·y) + Z·z), so the same bits.
+    #[inline(always)]
+    pub(crate) fn world_rays_many<const N: usize>(
+        &self,
+        film_points_px: &[Vec2; N],
+    ) -> (Vec3A, [[f32; N]; 3]) {
+        let to_world = &self.frame.camera_to_world;
+        let m = to_world.matrix();
+        let (x_axis, y_axis, z_axis) = (m.x_axis, m.y_axis, m.z_axis);
+        let centre = self.frame.centre_px();
+        let z = -self.focal_px;
+        let mut world = [[0.0f32; N]; 3];
+        for k in 0..N {
+            let p = film_points_px[k];
+            // `CameraFrame::offset_up_px`.
+            let (x, y) = (p.x - centre.x, centre.y - p.y);
+            let len = ((x * x + y * y) + z * z).sqrt();
+            let (x, y, z) = (x / len, y / len, z / len);
+            let w = [0, 1, 2].map(|a| (x_axis[a] * x + y_axis[a] * y) + z_axis[a] * z);
+            let len = ((w[0] * w[0] + w[1] * w[1]) + w[2] * w[2]).sqrt();
+            for a in 0..3 {
+                world[a][k] = w[a] / len;
+            }
+        }
+        (to_world.point(Vec3A::ZERO), world)
+    }
+
     pub(crate) fn project_camera_space(&self, p: Vec3A) -> Option<Vec2> {
         (p.z < 0.0).then(|| {
             let s = self.focal_px / -p.z;

@@ -390,7 +390,7 @@ fn render_tile_lanes<const N: usize>(
     counts
 }
 
-/// A camera sample's first draws: its stream, film point, lens variate and wavelengths.
+/// A camera sample's first draws: its stream, film point, wavelengths and camera ray.
 #[derive(Clone, Copy, Debug)]
 struct Start {
     pixel: UVec2,
@@ -402,12 +402,14 @@ struct Start {
     /// wavelengths.
     reflectance: [SampledSpectrum; REFLECTANCE_SLOTS],
     light_le: [SampledSpectrum; LIGHT_SLOTS],
-    lens: Vec2,
+    /// The camera ray (`Camera::generate_ray_only`), `None` where the film point has none.
+    ray: Option<Ray>,
 }
 
 /// The tile's next camera samples, their first draws made `N` at a time (the scalar
 /// driver's order of dimensions: filter 2, lens 2, wavelength 1), so that the wavelengths
-/// are sampled in one vector loop (`SampledWavelengths::sample_visible_many`).
+/// are sampled and the camera rays made in vector loops
+/// (`SampledWavelengths::sample_visible_many`, `Camera::generate_rays_only_many`).
 struct Starts<const N: usize> {
     ready: Vec<Start>,
     next: usize,
@@ -427,6 +429,8 @@ impl<const N: usize> Starts<N> {
             self.ready.clear();
             self.next = 0;
             let mut u = [0.5f32; N];
+            let mut film_points = [Vec2::ZERO; N];
+            let mut lens_samples = [Vec2::ZERO; N];
             let zero = SampledSpectrum::splat(0.0);
             while self.ready.len() < N {
                 let Some((pixel, s)) = queue.next(job.camera_samples) else {
@@ -440,7 +444,9 @@ impl<const N: usize> Starts<N> {
                 } else {
                     Vec2::ZERO
                 };
-                u[self.ready.len()] = stream.get_1d();
+                let k = self.ready.len();
+                u[k] = stream.get_1d();
+                (film_points[k], lens_samples[k]) = (film_point, lens);
                 self.ready.push(Start {
                     pixel,
                     stream,
@@ -449,8 +455,13 @@ impl<const N: usize> Starts<N> {
                     wavelengths: SampledWavelengths::new([0.0; 4], zero),
                     reflectance: [zero; REFLECTANCE_SLOTS],
                     light_le: [zero; LIGHT_SLOTS],
-                    lens,
+                    ray: None,
                 });
+            }
+            let camera = &job.scene.camera;
+            let rays = camera.generate_rays_only_many(&film_points, &lens_samples);
+            for (start, ray) in self.ready.iter_mut().zip(rays) {
+                start.ray = ray;
             }
             let wavelengths = SampledWavelengths::sample_visible_many(&u);
             for (start, wl) in self.ready.iter_mut().zip(wavelengths) {
@@ -495,11 +506,7 @@ fn start_lane(
         le_cache: SpectrumCache::new(),
         reflectance_cache: SpectrumCache::new(),
     };
-    match job
-        .scene
-        .camera
-        .generate_ray_only(start.film_point, start.lens)
-    {
+    match start.ray {
         Some(ray) => {
             counts.camera_rays += 1;
             *slot = Some(lane_sample);
