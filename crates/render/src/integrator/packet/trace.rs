@@ -867,10 +867,47 @@ fn choose_lights<const N: usize>(
     if lights.is_empty() {
         return;
     }
-    // `LightSet::sample`: the first light whose running sum exceeds u, i.e. the number of
-    // sums ≤ u (they never decrease).
     let cdf = lights.selection_cdf();
     let pmf = lights.selection_pmf();
+    // One rectangle emitter with its radiance slot (a Cornell box, a room with one
+    // lamp): every lane picks it (`LightSet::sample` of one light) — its fields are
+    // written into the lanes once, its L(λ) and pmf for all lanes in vector passes.
+    if let ([Some(rect)], [p]) = (job.packet.lights.as_slice(), pmf) {
+        if let (Some(0), true) = (rect.radiance_slot, *p > 0.0) {
+            if rectangle_in_lane[0] != 0 {
+                for l in 0..N {
+                    rectangle_in_lane[l] = 0;
+                    for a in 0..3 {
+                        vertex.rx[a][l] = rect.axes[0][a];
+                        vertex.ry[a][l] = rect.axes[1][a];
+                        vertex.rz[a][l] = rect.axes[2][a];
+                        vertex.rt[a][l] = rect.axes[3][a];
+                        vertex.rn[a][l] = rect.normal[a];
+                    }
+                    vertex.half_w[l] = rect.half_width_m;
+                    vertex.half_h[l] = rect.half_height_m;
+                    vertex.inv_area[l] = rect.inv_area_m2;
+                    vertex.two_sided[l] = rect.two_sided;
+                }
+            }
+            for l in 0..N {
+                vertex.pmf[l] = *p;
+                for k in 0..4 {
+                    vertex.le[k][l] = paths.light_le[0][k][l];
+                }
+            }
+            for l in 0..N {
+                vertex.light_kind[l] = if vertex.active[l] {
+                    LIGHT_RECTANGLE
+                } else {
+                    LIGHT_NONE
+                };
+            }
+            return;
+        }
+    }
+    // `LightSet::sample`: the first light whose running sum exceeds u, i.e. the number of
+    // sums ≤ u (they never decrease).
     let mut chosen = [0u32; N];
     let last = cdf.len() as u32 - 1;
     if cdf.len() <= VECTOR_LIGHT_CHOICE_MAX {
