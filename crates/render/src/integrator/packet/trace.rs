@@ -352,7 +352,7 @@ fn render_tile_lanes<const N: usize>(
             &mut variates,
             counters,
         );
-        draw_variates(&mut variates, &vertex, &samples);
+        draw_variates(job, &mut variates, &vertex, &samples);
         choose_lights(
             job,
             &paths,
@@ -600,14 +600,25 @@ impl<const N: usize> Variates<N> {
 
 /// The vertex's variates (after `begin_vertices`): the independent sampler's values
 /// (`independent::value`, SplitMix64) for all lanes at once — a loop over lanes of 64-bit
-/// multiplies, vector code with AVX-512 — then those of other streams lane by lane.
+/// multiplies, vector code with AVX-512 — then those of other streams lane by lane. The
+/// light choice's is skipped where a scene has one light (never read), the roulette's
+/// where no lane has reached `rr_depth` (read only there).
 #[inline(always)]
 fn draw_variates<const N: usize>(
+    job: &TileJob,
     v: &mut Variates<N>,
     vertex: &VertexIn<N>,
     samples: &[Option<LaneSample>; N],
 ) {
+    let mut roulette = false;
+    for l in 0..N {
+        roulette |= vertex.active[l] & vertex.roulette[l];
+    }
+    let needed = [job.scene.lights.len() > 1, true, true, true, true, roulette];
     for (k, &offset) in VARIATE_OFFSETS.iter().enumerate() {
+        if !needed[k] {
+            continue;
+        }
         for l in 0..N {
             let bits = independent::value(v.key[l], v.first_dimension[l] + offset);
             v.u[k][l] = u32_to_unit_f32(bits);
