@@ -152,8 +152,9 @@ impl<const N: usize> VertexOut<N> {
     }
 }
 
+/// `if c { a } else { b }`, a vector select in the lane loops.
 #[inline(always)]
-fn select(c: bool, a: f32, b: f32) -> f32 {
+pub(super) fn select(c: bool, a: f32, b: f32) -> f32 {
     if c {
         a
     } else {

@@ -15,8 +15,8 @@ use prism_geometry::Ray;
 use prism_spectrum::{SampledSpectrum, SampledWavelengths};
 
 use super::intersect::{closest, occluded, RayLanes};
-use super::shade::{shade, VertexIn, VertexOut, LIGHT_GIVEN, LIGHT_NONE, LIGHT_RECTANGLE};
-use super::{Kernel, PacketScene, LIGHT_SLOTS, REFLECTANCE_SLOTS};
+use super::shade::{select, shade, VertexIn, VertexOut, LIGHT_GIVEN, LIGHT_NONE, LIGHT_RECTANGLE};
+use super::{Kernel, PacketScene, RectangleLight, LIGHT_SLOTS, REFLECTANCE_SLOTS};
 use crate::cpu::{has_avx2, has_avx512};
 use crate::film::xyz::XyzWeights;
 use crate::film::FilmTile;
@@ -180,15 +180,6 @@ struct PathFlags<const N: usize> {
     pending: [bool; N],
     pending_counts_incident: [bool; N],
     pending_non_finite: [bool; N],
-}
-
-#[inline(always)]
-fn select(c: bool, a: f32, b: f32) -> f32 {
-    if c {
-        a
-    } else {
-        b
-    }
 }
 
 #[inline(always)]
@@ -848,6 +839,22 @@ fn emission<const N: usize>(
     paths.add(flags, l, le * w, count, counters);
 }
 
+/// Rectangle emitter `rect`'s fields into lane `l` of `vertex`.
+#[inline(always)]
+fn put_rectangle<const N: usize>(vertex: &mut VertexIn<N>, l: usize, rect: &RectangleLight) {
+    for a in 0..3 {
+        vertex.rx[a][l] = rect.axes[0][a];
+        vertex.ry[a][l] = rect.axes[1][a];
+        vertex.rz[a][l] = rect.axes[2][a];
+        vertex.rt[a][l] = rect.axes[3][a];
+        vertex.rn[a][l] = rect.normal[a];
+    }
+    vertex.half_w[l] = rect.half_width_m;
+    vertex.half_h[l] = rect.half_height_m;
+    vertex.inv_area[l] = rect.inv_area_m2;
+    vertex.two_sided[l] = rect.two_sided;
+}
+
 /// Lights with at most this many entries are picked for all lanes in one vector pass.
 const VECTOR_LIGHT_CHOICE_MAX: usize = 16;
 
@@ -888,17 +895,7 @@ fn choose_lights<const N: usize>(
             if rectangle_in_lane[0] != 0 {
                 for l in 0..N {
                     rectangle_in_lane[l] = 0;
-                    for a in 0..3 {
-                        vertex.rx[a][l] = rect.axes[0][a];
-                        vertex.ry[a][l] = rect.axes[1][a];
-                        vertex.rz[a][l] = rect.axes[2][a];
-                        vertex.rt[a][l] = rect.axes[3][a];
-                        vertex.rn[a][l] = rect.normal[a];
-                    }
-                    vertex.half_w[l] = rect.half_width_m;
-                    vertex.half_h[l] = rect.half_height_m;
-                    vertex.inv_area[l] = rect.inv_area_m2;
-                    vertex.two_sided[l] = rect.two_sided;
+                    put_rectangle(vertex, l, rect);
                 }
             }
             for l in 0..N {
@@ -951,17 +948,7 @@ fn choose_lights<const N: usize>(
             Some(rect) => {
                 if rectangle_in_lane[l] != li {
                     rectangle_in_lane[l] = li;
-                    for a in 0..3 {
-                        vertex.rx[a][l] = rect.axes[0][a];
-                        vertex.ry[a][l] = rect.axes[1][a];
-                        vertex.rz[a][l] = rect.axes[2][a];
-                        vertex.rt[a][l] = rect.axes[3][a];
-                        vertex.rn[a][l] = rect.normal[a];
-                    }
-                    vertex.half_w[l] = rect.half_width_m;
-                    vertex.half_h[l] = rect.half_height_m;
-                    vertex.inv_area[l] = rect.inv_area_m2;
-                    vertex.two_sided[l] = rect.two_sided;
+                    put_rectangle(vertex, l, rect);
                 }
                 let le = match rect.radiance_slot {
                     Some(s) => spectrum_at(&paths.light_le[s], l),
