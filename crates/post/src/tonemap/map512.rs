@@ -289,10 +289,109 @@ unsafe fn chunk_avx512<C: RegisterCurve>(
     }
 }
 
-/// The body of [`chunk_avx512`]: as [`pixels_registers_avx512`], [`STEP_GROUPS`] groups
-/// of 16 pixels per step (their curve evaluations side by side), head and tail pixels
-/// through a zero-padded group (black: counted as neither non-finite nor negative, and
-/// mapped to black), per-lane counts.
+/// `vpermt2ps` index pairs, one per channel or output register.
+#[cfg(target_arch = "x86_64")]
+type IndexPairs = [(__m512i, __m512i); 3];
+
+/// The de-interleave and interleave `vpermt2ps` index pairs of the register passes.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn group_indices() -> (IndexPairs, IndexPairs) {
+    let load_idx = |a: [i32; 16]| _mm512_loadu_si512(a.as_ptr() as *const _);
+    let inter = [0, 1, 2].map(|reg| {
+        let (a, b) = interleave_indices(reg);
+        (load_idx(a), load_idx(b))
+    });
+    (deinterleave_registers(), inter)
+}
+
+/// The loop both register passes run over one task's pixels, around `$groups!(G, s)` —
+/// a caller's macro giving the G groups of 16 pixels at `s` as (interleaved output
+/// registers, non-finite masks, negative masks). Pixels before the first output pixel on
+/// a 64-byte boundary (f32s are 4-byte aligned and gcd(12, 64) = 4, so one of the first
+/// 16 is) and after the last whole group go through a zero-padded group (zeros count as
+/// neither non-finite nor negative); [`STEP_GROUPS`] groups per step, prefetched ahead
+/// and stored with streaming stores; the counts kept per lane and added up at the end.
+/// A macro, not a generic function over a kernel trait: the kernels must inline into each
+/// `#[target_feature]` body, and the trait version cost agx half its speed. Evaluates to
+/// the task's (non-finite, negative) pixel counts.
+#[cfg(target_arch = "x86_64")]
+macro_rules! register_pass {
+    ($input:expr, $out:expr, $groups:ident) => {{
+        let (input, out): (&[[f32; 3]], &mut [[f32; 3]]) = ($input, $out);
+        let n = input.len().min(out.len());
+        let addr = out.as_ptr() as usize;
+        let head = (0..16)
+            .find(|k| (addr + 12 * k).is_multiple_of(64))
+            .unwrap_or(0)
+            .min(n);
+        let groups = (n - head) / 16;
+        let tail = head + 16 * groups;
+        // Per-lane counts (≤ CHUNK / 16 per lane) instead of two popcounts per group
+        // (the baseline build has no `popcnt`: each is a dozen instructions).
+        let one = _mm512_set1_epi32(1);
+        let (mut nf_lanes, mut neg_lanes) = (_mm512_setzero_si512(), _mm512_setzero_si512());
+        let partial = |i: &[[f32; 3]], o: &mut [[f32; 3]]| {
+            let mut buf = [[0.0f32; 3]; 16];
+            buf[..i.len()].copy_from_slice(i);
+            // SAFETY: buf holds 48 floats.
+            let ([v], [nf], [neg]) = $groups!(1, buf.as_ptr() as *const f32);
+            let d = buf.as_mut_ptr() as *mut f32;
+            for (reg, v) in v.into_iter().enumerate() {
+                // SAFETY: buf holds 48 floats.
+                _mm512_storeu_ps(d.add(16 * reg), v);
+            }
+            o.copy_from_slice(&buf[..o.len()]);
+            (nf.count_ones() as u64, neg.count_ones() as u64)
+        };
+        let (non_finite, negative) = partial(&input[..head], &mut out[..head]);
+        let src = input.as_ptr().add(head) as *const f32;
+        let dst = out.as_mut_ptr().add(head) as *mut f32;
+        let mut g = 0;
+        while g < groups {
+            // SAFETY: pixels head + 16 g … head + 16 (g + k) − 1 lie inside both slices
+            // for the k ≤ groups − g groups handled below (floats 48 g … 48 (g + k) − 1
+            // from src and dst); the prefetches do not fault.
+            let s = src.add(48 * g);
+            for k in 0..STEP_GROUPS {
+                prefetch_ahead(s.add(48 * k));
+            }
+            let d = dst.add(48 * g);
+            let mut store = |k: usize, v: [__m512; 3], nf: __mmask16, neg: __mmask16| {
+                nf_lanes = _mm512_mask_add_epi32(nf_lanes, nf, nf_lanes, one);
+                neg_lanes = _mm512_mask_add_epi32(neg_lanes, neg, neg_lanes, one);
+                for (reg, v) in v.into_iter().enumerate() {
+                    // SAFETY: d + 48 k + 16 reg is 64-byte aligned (head chosen so) and
+                    // inside `out`.
+                    _mm512_stream_ps(d.add(48 * k + 16 * reg), v);
+                }
+            };
+            if g + STEP_GROUPS <= groups {
+                let (v, nf, neg) = $groups!(STEP_GROUPS, s);
+                for k in 0..STEP_GROUPS {
+                    store(k, v[k], nf[k], neg[k]);
+                }
+                g += STEP_GROUPS;
+            } else {
+                let ([v], [nf], [neg]) = $groups!(1, s);
+                store(0, v, nf, neg);
+                g += 1;
+            }
+        }
+        // Streaming stores are weakly ordered: fence them before the task reports done.
+        _mm_sfence();
+        let (nf, neg) = partial(&input[tail..n], &mut out[tail..n]);
+        let lanes = |v: __m512i| _mm512_reduce_add_epi32(v) as u32 as u64;
+        (
+            non_finite + nf + lanes(nf_lanes),
+            negative + neg + lanes(neg_lanes),
+        )
+    }};
+}
+
+/// The body of [`chunk_avx512`]: [`register_pass!`] around the curve of
+/// [`STEP_GROUPS`] groups of 16 pixels side by side (a zero-padded group is black, and
+/// maps to black).
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f")]
 unsafe fn luminance_chunk_avx512<C: RegisterCurve, const SCALED: bool>(
@@ -302,90 +401,15 @@ unsafe fn luminance_chunk_avx512<C: RegisterCurve, const SCALED: bool>(
     w: [f32; 3],
     curve: &C,
 ) -> (u64, u64) {
-    let n = input.len().min(out.len());
-    // Pixels before the first output pixel on a 64-byte boundary (f32s are 4-byte
-    // aligned and gcd(12, 64) = 4, so one of the first 16 pixels is).
-    let addr = out.as_ptr() as usize;
-    let head = (0..16)
-        .find(|k| (addr + 12 * k).is_multiple_of(64))
-        .unwrap_or(0)
-        .min(n);
-    let groups = (n - head) / 16;
-    let tail = head + 16 * groups;
-    let load_idx = |a: [i32; 16]| _mm512_loadu_si512(a.as_ptr() as *const _);
-    let de = deinterleave_registers();
-    let inter = [0, 1, 2].map(|reg| {
-        let (a, b) = interleave_indices(reg);
-        (load_idx(a), load_idx(b))
-    });
+    let (de, inter) = group_indices();
     let scale_v = _mm512_set1_ps(scale);
     let w_v = w.map(|x| _mm512_set1_ps(x));
-    let one = _mm512_set1_epi32(1);
-    let (mut nf_lanes, mut neg_lanes) = (_mm512_setzero_si512(), _mm512_setzero_si512());
-    let partial = |i: &[[f32; 3]], o: &mut [[f32; 3]]| {
-        let mut buf = [[0.0f32; 3]; 16];
-        buf[..i.len()].copy_from_slice(i);
-        // SAFETY: buf holds 48 floats.
-        let ([v], [nf], [neg]) = luminance_group16::<C, 1, SCALED>(
-            curve,
-            &w_v,
-            &de,
-            &inter,
-            scale_v,
-            buf.as_ptr() as *const f32,
-        );
-        let d = buf.as_mut_ptr() as *mut f32;
-        for (reg, v) in v.into_iter().enumerate() {
-            // SAFETY: buf holds 48 floats.
-            _mm512_storeu_ps(d.add(16 * reg), v);
-        }
-        o.copy_from_slice(&buf[..o.len()]);
-        (nf.count_ones() as u64, neg.count_ones() as u64)
-    };
-    let (non_finite, negative) = partial(&input[..head], &mut out[..head]);
-    let src = input.as_ptr().add(head) as *const f32;
-    let dst = out.as_mut_ptr().add(head) as *mut f32;
-    let mut g = 0;
-    while g < groups {
-        // SAFETY: pixels head + 16 g … head + 16 (g + k) − 1 lie inside both slices for
-        // the k ≤ groups − g groups handled below (floats 48 g … 48 (g + k) − 1 from src
-        // and dst); the prefetches do not fault.
-        let s = src.add(48 * g);
-        for k in 0..STEP_GROUPS {
-            prefetch_ahead(s.add(48 * k));
-        }
-        let d = dst.add(48 * g);
-        let mut store = |k: usize, v: [__m512; 3], nf: __mmask16, neg: __mmask16| {
-            nf_lanes = _mm512_mask_add_epi32(nf_lanes, nf, nf_lanes, one);
-            neg_lanes = _mm512_mask_add_epi32(neg_lanes, neg, neg_lanes, one);
-            for (reg, v) in v.into_iter().enumerate() {
-                // SAFETY: d + 48 k + 16 reg is 64-byte aligned (head chosen so) and
-                // inside `out`.
-                _mm512_stream_ps(d.add(48 * k + 16 * reg), v);
-            }
+    macro_rules! luminance_groups {
+        ($g:expr, $s:expr) => {
+            luminance_group16::<C, { $g }, SCALED>(curve, &w_v, &de, &inter, scale_v, $s)
         };
-        if g + STEP_GROUPS <= groups {
-            let (v, nf, neg) =
-                luminance_group16::<C, STEP_GROUPS, SCALED>(curve, &w_v, &de, &inter, scale_v, s);
-            for k in 0..STEP_GROUPS {
-                store(k, v[k], nf[k], neg[k]);
-            }
-            g += STEP_GROUPS;
-        } else {
-            let ([v], [nf], [neg]) =
-                luminance_group16::<C, 1, SCALED>(curve, &w_v, &de, &inter, scale_v, s);
-            store(0, v, nf, neg);
-            g += 1;
-        }
     }
-    // Streaming stores are weakly ordered: fence them before the task reports done.
-    _mm_sfence();
-    let (nf, neg) = partial(&input[tail..n], &mut out[tail..n]);
-    let lanes = |v: __m512i| _mm512_reduce_add_epi32(v) as u32 as u64;
-    (
-        non_finite + nf + lanes(nf_lanes),
-        negative + neg + lanes(neg_lanes),
-    )
+    register_pass!(input, out, luminance_groups)
 }
 
 /// A [`PixelMap`] with a 16-lane register form, for [`map_pixels_registers`]: the map
@@ -518,11 +542,10 @@ unsafe fn pixels_registers_task<M: RegisterMap>(
 #[cfg(target_arch = "x86_64")]
 const STEP_GROUPS: usize = 3;
 
-/// One task of [`map_pixels_registers`]. The pixels before the first 64-byte-aligned
-/// output address and after the last whole group of 16 (fewer than 16 each) go through
-/// the same 16-lane code on a zero-padded copy (zeros count as neither non-finite nor
-/// negative), not the scalar path: a few scalar pixels per task cost more than the rest
-/// of it where `f32::mul_add` is a library call (the baseline build has no FMA).
+/// One task of [`map_pixels_registers`]: [`register_pass!`] around the map. The head and
+/// tail pixels go through the 16-lane code on a zero-padded copy, not the scalar path: a
+/// few scalar pixels per task cost more than the rest of it where `f32::mul_add` is a
+/// library call (the baseline build has no FMA).
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f")]
 unsafe fn pixels_registers_avx512<M: RegisterMap, const SCALED: bool>(
@@ -531,89 +554,15 @@ unsafe fn pixels_registers_avx512<M: RegisterMap, const SCALED: bool>(
     scale: f32,
     f: &M,
 ) -> (u64, u64) {
-    let n = input.len().min(out.len());
-    // As chunk_avx512: one of the first 16 pixels starts on a 64-byte boundary.
-    let addr = out.as_ptr() as usize;
-    let head = (0..16)
-        .find(|k| (addr + 12 * k).is_multiple_of(64))
-        .unwrap_or(0)
-        .min(n);
-    let groups = (n - head) / 16;
-    let tail = head + 16 * groups;
-    let load_idx = |a: [i32; 16]| _mm512_loadu_si512(a.as_ptr() as *const _);
-    let de = deinterleave_registers();
-    let inter = [0, 1, 2].map(|reg| {
-        let (a, b) = interleave_indices(reg);
-        (load_idx(a), load_idx(b))
-    });
+    let (de, inter) = group_indices();
     let scale_v = _mm512_set1_ps(scale);
     let regs = f.regs16();
-    // Per-lane counts of non-finite and negative input pixels, added up after the loop
-    // (≤ CHUNK / 16 per lane), instead of two popcounts per group (the baseline build
-    // has no `popcnt`: each is a dozen instructions).
-    let one = _mm512_set1_epi32(1);
-    let (mut nf_lanes, mut neg_lanes) = (_mm512_setzero_si512(), _mm512_setzero_si512());
-    let count = |non_finite: __mmask16, neg: __mmask16| {
-        (non_finite.count_ones() as u64, neg.count_ones() as u64)
-    };
-    // Fewer than 16 pixels through a zero-padded group.
-    let partial = |i: &[[f32; 3]], o: &mut [[f32; 3]]| {
-        let mut buf = [[0.0f32; 3]; 16];
-        buf[..i.len()].copy_from_slice(i);
-        // SAFETY: buf holds 48 floats.
-        let ([v], [nf], [neg]) =
-            group16::<M, 1, SCALED>(f, &regs, &de, &inter, scale_v, buf.as_ptr() as *const f32);
-        let d = buf.as_mut_ptr() as *mut f32;
-        for (reg, v) in v.into_iter().enumerate() {
-            // SAFETY: buf holds 48 floats.
-            _mm512_storeu_ps(d.add(16 * reg), v);
-        }
-        o.copy_from_slice(&buf[..o.len()]);
-        count(nf, neg)
-    };
-    let (non_finite, negative) = partial(&input[..head], &mut out[..head]);
-    let src = input.as_ptr().add(head) as *const f32;
-    let dst = out.as_mut_ptr().add(head) as *mut f32;
-    // Two groups per step (see RegisterMap::map16); an odd last group alone.
-    let mut g = 0;
-    while g < groups {
-        // SAFETY: pixels head + 16 g … head + 16 (g + k) − 1 lie inside both slices for
-        // the k ≤ groups − g groups handled below (floats 48 g … 48 (g + k) − 1 from src
-        // and dst); the prefetches do not fault.
-        let s = src.add(48 * g);
-        for k in 0..STEP_GROUPS {
-            prefetch_ahead(s.add(48 * k));
-        }
-        let d = dst.add(48 * g);
-        let mut store = |k: usize, v: [__m512; 3], nf: __mmask16, neg: __mmask16| {
-            nf_lanes = _mm512_mask_add_epi32(nf_lanes, nf, nf_lanes, one);
-            neg_lanes = _mm512_mask_add_epi32(neg_lanes, neg, neg_lanes, one);
-            for (reg, v) in v.into_iter().enumerate() {
-                // SAFETY: d + 48 k + 16 reg is 64-byte aligned (head chosen so) and
-                // inside `out`.
-                _mm512_stream_ps(d.add(48 * k + 16 * reg), v);
-            }
+    macro_rules! map_groups {
+        ($g:expr, $s:expr) => {
+            group16::<M, { $g }, SCALED>(f, &regs, &de, &inter, scale_v, $s)
         };
-        if g + STEP_GROUPS <= groups {
-            let (v, nf, neg) = group16::<M, STEP_GROUPS, SCALED>(f, &regs, &de, &inter, scale_v, s);
-            for k in 0..STEP_GROUPS {
-                store(k, v[k], nf[k], neg[k]);
-            }
-            g += STEP_GROUPS;
-        } else {
-            let ([v], [nf], [neg]) = group16::<M, 1, SCALED>(f, &regs, &de, &inter, scale_v, s);
-            store(0, v, nf, neg);
-            g += 1;
-        }
     }
-    // Streaming stores are weakly ordered: fence them before the task reports done.
-    _mm_sfence();
-    let (nf, neg) = partial(&input[tail..n], &mut out[tail..n]);
-    let lanes = |v: __m512i| _mm512_reduce_add_epi32(v) as u32 as u64;
-    (
-        non_finite + nf + lanes(nf_lanes),
-        negative + neg + lanes(neg_lanes),
-    )
+    register_pass!(input, out, map_groups)
 }
 
 /// One task of [`super::pixels::map_pixels`] with AVX-512F: whole blocks are
