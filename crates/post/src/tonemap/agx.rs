@@ -13,6 +13,7 @@
 //! [`SEGMENT_BITS`]).
 
 use glam::Mat3;
+use prism_spectrum::rgb_space::RgbColorSpace;
 
 use super::aces::srgb_matrices;
 use super::curve_table::{chebyshev_nodes, poly_through};
@@ -228,6 +229,18 @@ fn mat3(m: &Mat, x: f32, y: f32, z: f32) -> [f32; 3] {
 }
 
 impl Map {
+    /// The map for an image in `space`: the inset from it (through linear sRGB), the
+    /// outset, and the way back where `space` is not sRGB.
+    fn for_space(space: &RgbColorSpace) -> Self {
+        let (to_srgb, from_srgb) = srgb_matrices(space);
+        Self {
+            inset: (Mat3::from_cols_array(&INSET) * to_srgb).to_cols_array(),
+            outset: OUTSET,
+            from_srgb: (!is_identity(from_srgb)).then(|| from_srgb.to_cols_array()),
+            curves: curves(),
+        }
+    }
+
     /// The encoding and contrast curve s of one inset value (scalar path).
     #[inline(always)]
     fn encode(&self, v: f32) -> f32 {
@@ -695,13 +708,7 @@ fn is_identity(m: Mat3) -> bool {
 }
 
 pub(crate) fn apply(ctx: &Context) -> Output {
-    let (to_srgb, from_srgb) = srgb_matrices(&ctx.image.color_space);
-    let map = Map {
-        inset: (Mat3::from_cols_array(&INSET) * to_srgb).to_cols_array(),
-        outset: OUTSET,
-        from_srgb: (!is_identity(from_srgb)).then(|| from_srgb.to_cols_array()),
-        curves: curves(),
-    };
+    let map = Map::for_space(&ctx.image.color_space);
     Output {
         mapped: super::map512::map_pixels_registers(ctx, ctx.exposure, &map),
         values: vec![],
@@ -713,7 +720,6 @@ mod tests {
     use super::super::test_support::*;
     use super::super::{ToneOperator, ToneParams};
     use super::*;
-    use prism_spectrum::rgb_space::RgbColorSpace;
 
     #[test]
     fn outset_inverts_inset_and_mid_grey_lands_mid_display() {
@@ -809,13 +815,7 @@ mod tests {
             v *= 1.0137;
         }
         for space in [RgbColorSpace::srgb(), RgbColorSpace::rec2020()] {
-            let (to_srgb, from_srgb) = srgb_matrices(&space);
-            let map = Map {
-                inset: (Mat3::from_cols_array(&INSET) * to_srgb).to_cols_array(),
-                outset: OUTSET,
-                from_srgb: (!is_identity(from_srgb)).then(|| from_srgb.to_cols_array()),
-                curves: curves(),
-            };
+            let map = Map::for_space(&space);
             assert_eq!(map.from_srgb.is_none(), space == RgbColorSpace::srgb());
             let n = values.len();
             let mut r: Vec<f32> = values.clone();
@@ -867,13 +867,7 @@ mod tests {
             v *= 1.0093;
         }
         for space in [RgbColorSpace::srgb(), RgbColorSpace::rec2020()] {
-            let (to_srgb, from_srgb) = srgb_matrices(&space);
-            let map = Map {
-                inset: (Mat3::from_cols_array(&INSET) * to_srgb).to_cols_array(),
-                outset: OUTSET,
-                from_srgb: (!is_identity(from_srgb)).then(|| from_srgb.to_cols_array()),
-                curves: curves(),
-            };
+            let map = Map::for_space(&space);
             for scale in [1.0f32, 0.37, 3e30] {
                 super::super::map512::register_pass_gives_the_scalar_bits(&pixels, scale, &map);
             }
