@@ -28,11 +28,9 @@
 #[cfg(target_arch = "x86_64")]
 use std::arch::x86_64::*;
 
-use rayon::prelude::*;
-
 use super::pixels::{
     map_luminance, map_pixels_chunk, stats_block, store_block, store_fence, Acc, LuminanceCurve,
-    Mapped, PixelMap, Scale, StatsLanes, BLOCK, CHUNK, LANES, LOG_AVERAGE_DELTA,
+    Mapped, PixelMap, Scale, StatsLanes, BLOCK, LANES, LOG_AVERAGE_DELTA,
 };
 use super::Context;
 
@@ -81,32 +79,20 @@ pub(crate) fn map_luminance_avx512<C: RegisterCurve>(
     w: [f32; 3],
     curve: &C,
 ) -> Mapped {
-    let image = ctx.image;
-    let mut pixels = ctx.output_buffer(image.pixels().len());
-    let (non_finite, negative) = pixels
-        .par_chunks_mut(CHUNK)
-        .zip(image.pixels().par_chunks(CHUNK))
-        .enumerate()
-        .map(|(k, (o, i))| {
-            #[cfg(target_arch = "x86_64")]
-            {
-                assert!(available());
-                // The register curves take no pixel index.
-                let _ = k;
-                // SAFETY: the CPU has AVX-512F (asserted just above).
-                unsafe { chunk_avx512(i, o, scale, w, curve) }
-            }
-            #[cfg(not(target_arch = "x86_64"))]
-            {
-                super::pixels::map_luminance_chunk(i, o, k * CHUNK, scale, w, curve)
-            }
-        })
-        .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
-    Mapped {
-        pixels,
-        non_finite_pixels: non_finite,
-        negative_pixels: negative,
-    }
+    super::pixels::map_chunks(ctx, |start, i, o| {
+        #[cfg(target_arch = "x86_64")]
+        {
+            assert!(available());
+            // The register curves take no pixel index.
+            let _ = start;
+            // SAFETY: the CPU has AVX-512F (asserted just above).
+            unsafe { chunk_avx512(i, o, scale, w, curve) }
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        {
+            super::pixels::map_luminance_chunk(i, o, start, scale, w, curve)
+        }
+    })
 }
 
 /// `vpermt2ps` indices that gather channel `ch` of 16 interleaved pixels from the three
@@ -455,32 +441,20 @@ pub(crate) fn map_pixels_registers<M: RegisterMap>(ctx: &Context, scale: f32, f:
     if !available() {
         return super::pixels::map_pixels(ctx, scale, f);
     }
-    let image = ctx.image;
-    let mut pixels = ctx.output_buffer(image.pixels().len());
-    let (non_finite, negative) = pixels
-        .par_chunks_mut(CHUNK)
-        .zip(image.pixels().par_chunks(CHUNK))
-        .enumerate()
-        .map(|(k, (o, i))| {
-            #[cfg(target_arch = "x86_64")]
-            {
-                assert!(available());
-                // The register maps take no pixel index.
-                let _ = k;
-                // SAFETY: the CPU has AVX-512F (asserted just above).
-                unsafe { pixels_registers_task(i, o, scale, f) }
-            }
-            #[cfg(not(target_arch = "x86_64"))]
-            {
-                map_pixels_chunk(i, o, k * CHUNK, scale, f)
-            }
-        })
-        .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
-    Mapped {
-        pixels,
-        non_finite_pixels: non_finite,
-        negative_pixels: negative,
-    }
+    super::pixels::map_chunks(ctx, |start, i, o| {
+        #[cfg(target_arch = "x86_64")]
+        {
+            assert!(available());
+            // The register maps take no pixel index.
+            let _ = start;
+            // SAFETY: the CPU has AVX-512F (asserted just above).
+            unsafe { pixels_registers_task(i, o, scale, f) }
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        {
+            map_pixels_chunk(i, o, start, scale, f)
+        }
+    })
 }
 
 /// The G groups of 16 pixels (48 floats each) at `s` through `f`, as three interleaved
@@ -915,6 +889,7 @@ pub(crate) fn register_pass_gives_the_scalar_bits<M: RegisterMap>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::tonemap::pixels::CHUNK;
     use crate::tonemap::test_support::bit_test_image;
 
     /// A register map that makes some values non-finite (so the cleaning runs).

@@ -370,6 +370,28 @@ pub(crate) fn map_luminance_chunk<C: LuminanceCurve>(
     (non_finite, negative)
 }
 
+/// The image's pixels through `task` in parallel chunks of `CHUNK` pixels — `task(start,
+/// input, output)` with `start` the index of the chunk's first pixel, returning its
+/// (non-finite, negative) input pixel counts — into a new output buffer.
+pub(crate) fn map_chunks(
+    ctx: &Context,
+    task: impl Fn(usize, &[[f32; 3]], &mut [[f32; 3]]) -> (u64, u64) + Sync,
+) -> Mapped {
+    let image = ctx.image;
+    let mut pixels = ctx.output_buffer(image.pixels().len());
+    let (non_finite, negative) = pixels
+        .par_chunks_mut(CHUNK)
+        .zip(image.pixels().par_chunks(CHUNK))
+        .enumerate()
+        .map(|(k, (o, i))| task(k * CHUNK, i, o))
+        .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
+    Mapped {
+        pixels,
+        non_finite_pixels: non_finite,
+        negative_pixels: negative,
+    }
+}
+
 /// Maps every pixel through `curve` on luminance: c_out = c · L_d / L (hue and
 /// saturation kept, Reinhard et al. 2002 §3 "colour scaled by L_d / L_w"); black stays
 /// black and any non-finite result becomes 0. Curves that need the pixel index (local
@@ -380,19 +402,9 @@ pub(crate) fn map_luminance<C: LuminanceCurve>(
     w: [f32; 3],
     curve: &C,
 ) -> Mapped {
-    let image = ctx.image;
-    let mut pixels = ctx.output_buffer(image.pixels().len());
-    let (non_finite, negative) = pixels
-        .par_chunks_mut(CHUNK)
-        .zip(image.pixels().par_chunks(CHUNK))
-        .enumerate()
-        .map(|(k, (o, i))| avx2!(map_luminance_chunk(i, o, k * CHUNK, scale, w, curve)))
-        .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
-    Mapped {
-        pixels,
-        non_finite_pixels: non_finite,
-        negative_pixels: negative,
-    }
+    map_chunks(ctx, |start, i, o| {
+        avx2!(map_luminance_chunk(i, o, start, scale, w, curve))
+    })
 }
 
 /// One task of [`map_pixels`].
@@ -480,25 +492,13 @@ unsafe fn store_streaming(dst: &mut [[f32; 3]], src: &[[f32; 3]]) {
 /// Maps every sanitised pixel through `f` (on de-interleaved planes); non-finite results
 /// become 0.
 pub(crate) fn map_pixels<M: PixelMap>(ctx: &Context, scale: f32, f: &M) -> Mapped {
-    let image = ctx.image;
-    let mut pixels = ctx.output_buffer(image.pixels().len());
-    let (non_finite, negative) = pixels
-        .par_chunks_mut(CHUNK)
-        .zip(image.pixels().par_chunks(CHUNK))
-        .enumerate()
-        .map(|(k, (o, i))| {
-            if super::map512::available() {
-                super::map512::map_pixels_chunk_fast(i, o, k * CHUNK, scale, f)
-            } else {
-                avx2!(map_pixels_chunk(i, o, k * CHUNK, scale, f))
-            }
-        })
-        .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
-    Mapped {
-        pixels,
-        non_finite_pixels: non_finite,
-        negative_pixels: negative,
-    }
+    map_chunks(ctx, |start, i, o| {
+        if super::map512::available() {
+            super::map512::map_pixels_chunk_fast(i, o, start, scale, f)
+        } else {
+            avx2!(map_pixels_chunk(i, o, start, scale, f))
+        }
+    })
 }
 
 #[inline(always)]
