@@ -301,31 +301,26 @@ impl PathTracer {
         loop {
             let Some(hit) = scene.geometry.intersect(&ray) else {
                 // Escaped: infinite lights.
-                for &l in lights.infinite_lights() {
-                    let light = lights.light(l);
-                    let le = light.infinite_radiance(ray.direction, wavelengths);
-                    if le.is_black() {
-                        continue;
-                    }
-                    let w = self.emission_weight(
-                        scene,
-                        l,
-                        specular_bounce,
-                        &prev_ctx,
-                        prev_bsdf_pdf,
-                        ray.direction,
-                        None,
-                    );
-                    add(
-                        &mut radiance,
-                        &mut incident_after_first,
-                        &first_bounce_beta,
-                        beta,
-                        le * w,
-                        depth >= 2,
-                        counters,
-                    );
-                }
+                let (d, prev) = (ray.direction, &prev_ctx);
+                self.escape_terms(
+                    scene,
+                    specular_bounce,
+                    prev,
+                    prev_bsdf_pdf,
+                    d,
+                    wavelengths,
+                    |x| {
+                        add(
+                            &mut radiance,
+                            &mut incident_after_first,
+                            &first_bounce_beta,
+                            beta,
+                            x,
+                            depth >= 2,
+                            counters,
+                        )
+                    },
+                );
                 break;
             };
             // No curvature: shading never reads it, nor does the film's G-buffer (depth,
@@ -375,36 +370,29 @@ impl PathTracer {
 
             // Emission of a hit area light.
             if let Some(l) = lights.area_light_of_instance(hit.instance_id) {
-                let light = lights.light(l);
                 let light_hit = LightHit {
                     p: si.p,
                     n: si.n_geometric,
                     uv: si.uv,
                     distance_m: hit.t,
                 };
-                let le = light.emitted_radiance_cached(
+                if let Some(x) = self.emission_term(
+                    scene,
                     l,
                     &light_hit,
-                    -ray.direction,
+                    specular_bounce,
+                    &prev_ctx,
+                    prev_bsdf_pdf,
+                    ray.direction,
                     wavelengths,
                     &mut le_cache,
-                );
-                if !le.is_black() {
-                    let w = self.emission_weight(
-                        scene,
-                        l,
-                        specular_bounce,
-                        &prev_ctx,
-                        prev_bsdf_pdf,
-                        ray.direction,
-                        Some(&light_hit),
-                    );
+                ) {
                     add(
                         &mut radiance,
                         &mut incident_after_first,
                         &first_bounce_beta,
                         beta,
-                        le * w,
+                        x,
                         depth >= 2,
                         counters,
                     );
@@ -555,6 +543,74 @@ impl PathTracer {
             first_hit,
             illumination,
         }
+    }
+
+    /// What a ray escaping along `direction` brings from the infinite lights: each light's
+    /// radiance, MIS-weighted (`emission_weight`), handed to `add` one by one (each term
+    /// gets its own non-finite check there). Both tracers' escape step.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    pub(crate) fn escape_terms(
+        &self,
+        scene: &RenderScene,
+        specular_bounce: bool,
+        prev_ctx: &LightSampleContext,
+        prev_bsdf_pdf: f32,
+        direction: Vec3A,
+        wavelengths: &SampledWavelengths,
+        mut add: impl FnMut(SampledSpectrum),
+    ) {
+        let lights = &scene.lights;
+        for &l in lights.infinite_lights() {
+            let le = lights.light(l).infinite_radiance(direction, wavelengths);
+            if le.is_black() {
+                continue;
+            }
+            let w = self.emission_weight(
+                scene,
+                l,
+                specular_bounce,
+                prev_ctx,
+                prev_bsdf_pdf,
+                direction,
+                None,
+            );
+            add(le * w);
+        }
+    }
+
+    /// The radiance area light `l` emits back along `direction` at `light_hit`,
+    /// MIS-weighted (`emission_weight`); `None` where it is black. Both tracers' emission
+    /// step.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    pub(crate) fn emission_term(
+        &self,
+        scene: &RenderScene,
+        l: u32,
+        light_hit: &LightHit,
+        specular_bounce: bool,
+        prev_ctx: &LightSampleContext,
+        prev_bsdf_pdf: f32,
+        direction: Vec3A,
+        wavelengths: &SampledWavelengths,
+        le_cache: &mut SpectrumCache,
+    ) -> Option<SampledSpectrum> {
+        let light = scene.lights.light(l);
+        let le = light.emitted_radiance_cached(l, light_hit, -direction, wavelengths, le_cache);
+        if le.is_black() {
+            return None;
+        }
+        let w = self.emission_weight(
+            scene,
+            l,
+            specular_bounce,
+            prev_ctx,
+            prev_bsdf_pdf,
+            direction,
+            Some(light_hit),
+        );
+        Some(le * w)
     }
 
     /// MIS weight of light `l`'s emission met by a ray along `direction` that BSDF sampling

@@ -771,7 +771,7 @@ fn begin_vertices<const N: usize>(
     }
 }
 
-/// A lane's ray escaped: the infinite lights it sees.
+/// A lane's ray escaped: the infinite lights it sees (`PathTracer::escape_terms`).
 #[inline(always)]
 fn escape<const N: usize>(
     job: &TileJob,
@@ -782,29 +782,26 @@ fn escape<const N: usize>(
     direction: Vec3A,
     counters: &mut PathCounters,
 ) {
-    let lights = &job.scene.lights;
-    for &li in lights.infinite_lights() {
-        let light = lights.light(li);
-        let le = light.infinite_radiance(direction, &sample.wavelengths);
-        if le.is_black() {
-            continue;
-        }
-        let w = job.tracer.emission_weight(
-            job.scene,
-            li,
-            flags.specular_bounce[l],
-            &paths.prev_ctx(l),
-            paths.prev_bsdf_pdf[l],
-            direction,
-            None,
-        );
-        let count = paths.depth[l] >= 2;
-        paths.add(flags, l, le * w, count, counters);
-    }
+    let (specular, prev, pdf) = (
+        flags.specular_bounce[l],
+        paths.prev_ctx(l),
+        paths.prev_bsdf_pdf[l],
+    );
+    let count = paths.depth[l] >= 2;
+    let wavelengths = &sample.wavelengths;
+    job.tracer.escape_terms(
+        job.scene,
+        specular,
+        &prev,
+        pdf,
+        direction,
+        wavelengths,
+        |x| paths.add(flags, l, x, count, counters),
+    );
 }
 
 /// A lane's ray hit emitter `hit.0` at `hit.1` along `hit.2`: its radiance, MIS-weighted
-/// against the light sample.
+/// against the light sample (`PathTracer::emission_term`).
 #[inline(always)]
 fn emission<const N: usize>(
     job: &TileJob,
@@ -815,28 +812,20 @@ fn emission<const N: usize>(
     (li, light_hit, direction): (u32, &LightHit, Vec3A),
     counters: &mut PathCounters,
 ) {
-    let light = job.scene.lights.light(li);
-    let le = light.emitted_radiance_cached(
-        li,
-        light_hit,
-        -direction,
-        &sample.wavelengths,
-        &mut sample.le_cache,
-    );
-    if le.is_black() {
-        return;
-    }
-    let w = job.tracer.emission_weight(
+    if let Some(x) = job.tracer.emission_term(
         job.scene,
         li,
+        light_hit,
         flags.specular_bounce[l],
         &paths.prev_ctx(l),
         paths.prev_bsdf_pdf[l],
         direction,
-        Some(light_hit),
-    );
-    let count = paths.depth[l] >= 2;
-    paths.add(flags, l, le * w, count, counters);
+        &sample.wavelengths,
+        &mut sample.le_cache,
+    ) {
+        let count = paths.depth[l] >= 2;
+        paths.add(flags, l, x, count, counters);
+    }
 }
 
 /// Rectangle emitter `rect`'s fields into lane `l` of `vertex`.
