@@ -199,11 +199,9 @@ mod tests {
         }
     }
 
-    #[test]
-    fn eval8_is_eval_in_every_lane() {
-        if !crate::cpu::has_avx2() {
-            return;
-        }
+    /// `eval_w` (a W-wide form of `eval`) gives `eval`'s bits in every lane, for every
+    /// filter: inside, outside, the edge itself, ±0 and non-finite inputs.
+    fn lanes_are_eval<const W: usize>(eval_w: impl Fn(&FilterTable, [f32; W]) -> [f32; W]) {
         for filter in filters() {
             let table = FilterTable::new(&filter);
             let r = filter.radius_px();
@@ -211,11 +209,10 @@ mod tests {
                 .map(|i| r * (-1.2 + 2.4 * i as f32 / 8001.0))
                 .collect();
             xs.extend([0.0, -0.0, r, -r, f32::NAN, f32::INFINITY, f32::NEG_INFINITY]);
-            for chunk in xs.chunks(8) {
-                let mut x = [f32::NAN; 8];
+            for chunk in xs.chunks(W) {
+                let mut x = [f32::NAN; W];
                 x[..chunk.len()].copy_from_slice(chunk);
-                // SAFETY: the CPU runs AVX2 (checked above).
-                let got = unsafe { table.eval8_avx2(x) };
+                let got = eval_w(&table, x);
                 for (g, &xi) in got.iter().zip(&x) {
                     assert_eq!(g.to_bits(), table.eval(xi).to_bits(), "{filter:?} at {xi}");
                 }
@@ -224,29 +221,16 @@ mod tests {
     }
 
     #[test]
-    fn eval4_is_eval_in_every_lane() {
-        for filter in filters() {
-            let table = FilterTable::new(&filter);
-            let r = filter.radius_px();
-            // Inside, outside, the edge itself, ±0 and non-finite inputs.
-            let mut xs: Vec<f32> = (0..=4001)
-                .map(|i| r * (-1.2 + 2.4 * i as f32 / 4001.0))
-                .collect();
-            xs.extend([0.0, -0.0, r, -r, f32::NAN, f32::INFINITY, f32::NEG_INFINITY]);
-            for chunk in xs.chunks(4) {
-                let mut x = [f32::NAN; 4];
-                x[..chunk.len()].copy_from_slice(chunk);
-                let got = table.eval4(x);
-                for lane in 0..4 {
-                    assert_eq!(
-                        got[lane].to_bits(),
-                        table.eval(x[lane]).to_bits(),
-                        "{filter:?} at {}",
-                        x[lane]
-                    );
-                }
-            }
+    fn eval8_is_eval_in_every_lane() {
+        if crate::cpu::has_avx2() {
+            // SAFETY: the CPU runs AVX2 (checked just above).
+            lanes_are_eval::<8>(|t, x| unsafe { t.eval8_avx2(x) });
         }
+    }
+
+    #[test]
+    fn eval4_is_eval_in_every_lane() {
+        lanes_are_eval::<4>(|t, x| t.eval4(x));
     }
 
     #[test]

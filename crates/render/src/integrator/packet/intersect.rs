@@ -120,9 +120,6 @@ impl BoxSet {
         }
     }
 
-    /// The leaf (triangle) of box `index` at world point `p` on its surface: the face is
-    /// the box-space axis where |q| is largest, the triangle the one of that face's two
-    /// that holds q (2D edge functions).
     pub fn len(&self) -> usize {
         self.rows.len()
     }
@@ -200,7 +197,10 @@ impl BoxSet {
         }
     }
 
-    /// `resolve_triangles`' reference, one point at a time.
+    /// The leaf (triangle) of box `index` at world point `p` on its surface: the face is
+    /// the box-space axis where |q| is largest, the triangle the one of that face's two
+    /// that holds q (2D edge functions). `resolve_triangles`' reference, one point at a
+    /// time.
     #[cfg(test)]
     pub fn triangle_at(&self, index: usize, p: Vec3A) -> u32 {
         let m = &self.rows[index].m;
