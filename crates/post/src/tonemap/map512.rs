@@ -154,7 +154,7 @@ const PREFETCH_FLOATS: usize = 48 * 16;
 /// The `vpermt2ps` index pairs that gather channel 0, 1, 2 of 16 interleaved RGB pixels.
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
-unsafe fn deinterleave_registers() -> [(__m512i, __m512i); 3] {
+unsafe fn deinterleave_registers() -> IndexPairs {
     [0, 1, 2].map(|ch| {
         let (a, b) = deinterleave_indices(ch);
         (
@@ -168,13 +168,21 @@ unsafe fn deinterleave_registers() -> [(__m512i, __m512i); 3] {
 /// `vpermt2ps` per channel. The caller guarantees the 48 floats are readable.
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
-unsafe fn load_planes16(s: *const f32, de: &[(__m512i, __m512i); 3]) -> [__m512; 3] {
+unsafe fn load_planes16(s: *const f32, de: &IndexPairs) -> [__m512; 3] {
     let v = [
         _mm512_loadu_ps(s),
         _mm512_loadu_ps(s.add(16)),
         _mm512_loadu_ps(s.add(32)),
     ];
     de.map(|(i0, i1)| _mm512_permutex2var_ps(_mm512_permutex2var_ps(v[0], i0, v[1]), i1, v[2]))
+}
+
+/// Planes R, G, B of 16 pixels permuted into the three registers of 48 interleaved floats
+/// (two `vpermt2ps` each; `load_planes16`'s inverse, `inter` from `interleave_indices`).
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn interleave16(p: [__m512; 3], inter: &IndexPairs) -> [__m512; 3] {
+    inter.map(|(i0, i1)| _mm512_permutex2var_ps(_mm512_permutex2var_ps(p[0], i0, p[1]), i1, p[2]))
 }
 
 /// |x| < ∞ per lane (false for NaN).
@@ -217,8 +225,8 @@ unsafe fn sanitise16<const SCALED: bool>(
 unsafe fn luminance_group16<C: RegisterCurve, const G: usize, const SCALED: bool>(
     curve: &C,
     w: &[__m512; 3],
-    de: &[(__m512i, __m512i); 3],
-    inter: &[(__m512i, __m512i); 3],
+    de: &IndexPairs,
+    inter: &IndexPairs,
     scale: __m512,
     s: *const f32,
 ) -> ([[__m512; 3]; G], [__mmask16; G], [__mmask16; G]) {
@@ -247,10 +255,7 @@ unsafe fn luminance_group16<C: RegisterCurve, const G: usize, const SCALED: bool
         let ratio = _mm512_maskz_mov_ps(keep, ld[g]);
         let x = [0, 1, 2].map(|ch| _mm512_max_ps(_mm512_mul_ps(c[g][ch], ratio), zero));
         let ok = finite_mask(x[0]) & finite_mask(x[1]) & finite_mask(x[2]);
-        let x = x.map(|v| _mm512_maskz_mov_ps(ok, v));
-        for (reg, (i0, i1)) in inter.iter().enumerate() {
-            o[g][reg] = _mm512_permutex2var_ps(_mm512_permutex2var_ps(x[0], *i0, x[1]), *i1, x[2]);
-        }
+        o[g] = interleave16(x.map(|v| _mm512_maskz_mov_ps(ok, v)), inter);
     }
     (o, non_finite, neg)
 }
@@ -465,8 +470,8 @@ pub(crate) fn map_pixels_registers<M: RegisterMap>(ctx: &Context, scale: f32, f:
 unsafe fn group16<M: RegisterMap, const G: usize, const SCALED: bool>(
     f: &M,
     regs: &M::Regs,
-    de: &[(__m512i, __m512i); 3],
-    inter: &[(__m512i, __m512i); 3],
+    de: &IndexPairs,
+    inter: &IndexPairs,
     scale: __m512,
     s: *const f32,
 ) -> ([[__m512; 3]; G], [__mmask16; G], [__mmask16; G]) {
@@ -484,10 +489,7 @@ unsafe fn group16<M: RegisterMap, const G: usize, const SCALED: bool>(
         }
     }
     for x in &mut o {
-        let p = *x;
-        for (reg, (i0, i1)) in inter.iter().enumerate() {
-            x[reg] = _mm512_permutex2var_ps(_mm512_permutex2var_ps(p[0], *i0, p[1]), *i1, p[2]);
-        }
+        *x = interleave16(*x, inter);
     }
     (o, non_finite, neg)
 }
@@ -573,12 +575,7 @@ unsafe fn map_pixels_chunk_avx512<M: PixelMap>(
     scale: f32,
     f: &M,
 ) -> (u64, u64) {
-    let load_idx = |a: [i32; 16]| _mm512_loadu_si512(a.as_ptr() as *const _);
-    let de = deinterleave_registers();
-    let inter = [0, 1, 2].map(|reg| {
-        let (a, b) = interleave_indices(reg);
-        (load_idx(a), load_idx(b))
-    });
+    let (de, inter) = group_indices();
     let scale_v = _mm512_set1_ps(scale);
     let mut planes = [[0.0f32; BLOCK]; 3];
     let mut staged = [[0.0f32; 3]; BLOCK];
@@ -613,8 +610,7 @@ unsafe fn map_pixels_chunk_avx512<M: PixelMap>(
                 let x = _mm512_loadu_ps(plane.as_ptr().add(16 * g));
                 _mm512_maskz_mov_ps(finite_mask(x), x)
             });
-            for (reg, (i0, i1)) in inter.iter().enumerate() {
-                let v = _mm512_permutex2var_ps(_mm512_permutex2var_ps(c[0], *i0, c[1]), *i1, c[2]);
+            for (reg, v) in interleave16(c, &inter).into_iter().enumerate() {
                 // SAFETY: floats 48 g + 16 reg … + 15 lie inside the staged block.
                 _mm512_storeu_ps(dst.add(48 * g + 16 * reg), v);
             }
