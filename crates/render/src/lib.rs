@@ -19,6 +19,7 @@ pub mod film;
 pub mod integrator;
 pub mod light;
 pub mod material;
+pub mod medium;
 pub mod plan;
 pub mod probe;
 pub mod sampler;
@@ -38,8 +39,8 @@ pub use film::{
     SpectralBins, SpectralPlanes, SurfaceAov, TileBounds,
 };
 pub use integrator::{
-    film_for, render, render_pass, render_plan, total_samples, Integrator, RenderSettings,
-    RenderStats,
+    film_for, render, render_pass, render_pass_with, render_plan, total_samples, Estimator,
+    Integrator, RenderError, RenderSettings, RenderStats,
 };
 pub use plan::{PlanChoice, PlanRequest, RenderPlan};
 pub use sampler::{PixelSampler, SampleStream, SamplerKind};

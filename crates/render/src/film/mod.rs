@@ -11,6 +11,7 @@ pub mod filter;
 mod filter_sampler;
 mod filter_table;
 mod image;
+mod light_splats;
 pub mod spectral_bins;
 mod tile;
 pub mod xyz;
@@ -18,6 +19,7 @@ pub mod xyz;
 pub use filter::Filter;
 pub use filter_sampler::{FilterSample, FilterSampler};
 pub use image::{AovPlane, FilmImage, SpectralPlanes};
+pub use light_splats::LightSplats;
 pub use spectral_bins::SpectralBins;
 pub use tile::{FilmTile, SurfaceAov, TileBounds};
 
@@ -28,6 +30,7 @@ use prism_spectrum::rgb_space::RgbColorSpace;
 use rayon::prelude::*;
 
 use crate::error::InvalidParameter;
+use light_splats::LightPlane;
 use tile::{AovAccum, PixelAccum};
 
 /// Which AOVs the film records (`spp.Y` is always recorded).
@@ -86,6 +89,8 @@ pub struct Film {
     spectral: Vec<f64>,
     /// Reconstruct by splatting (see `with_splatting`).
     splat: bool,
+    /// Light-side contributions (`light_splats`), once an estimator splats light paths.
+    light: Option<LightPlane>,
 }
 
 impl Film {
@@ -117,6 +122,7 @@ impl Film {
             spectral_bins: None,
             spectral: Vec::new(),
             splat: false,
+            light: None,
         })
     }
 
@@ -300,6 +306,11 @@ impl Film {
             spectral_bins: None,
             spectral: Vec::new(),
             splat: self.splat,
+            light: self.light.as_ref().map(|l| LightPlane {
+                xyz_sum: l.xyz_sum.clone(),
+                spectral_sum: Vec::new(),
+                paths: l.paths,
+            }),
         }
     }
 
@@ -307,10 +318,54 @@ impl Film {
     /// `finish().rgb`, without the XYZ, luminance, AOV and spectral planes.
     pub fn rgb(&self) -> Vec<[f32; 3]> {
         let xyz_to_rgb = RgbColorSpace::srgb().xyz_to_rgb;
-        self.pixels
-            .iter()
-            .map(|p| (xyz_to_rgb * p.mean_xyz()).as_vec3().to_array())
+        (0..self.pixels.len())
+            .map(|i| (xyz_to_rgb * self.pixel_xyz(i)).as_vec3().to_array())
             .collect()
+    }
+
+    /// Pixel `i`'s XYZ: the mean of its camera samples plus the light-side contributions.
+    #[inline]
+    fn pixel_xyz(&self, i: usize) -> DVec3 {
+        let camera = self.pixels[i].mean_xyz();
+        match &self.light {
+            None => camera,
+            Some(light) => camera + light.xyz(i),
+        }
+    }
+
+    /// An empty splat list for one work item of an estimator that connects light paths to
+    /// the camera; the film starts its light plane (all zero) if it has none.
+    pub fn light_splats(&mut self) -> LightSplats {
+        if self.light.is_none() {
+            self.light = Some(LightPlane::new(self.pixels.len(), self.spectral_bins));
+        }
+        self.empty_light_splats()
+    }
+
+    /// An empty splat list with this film's filter and bins (the light plane must exist:
+    /// `light_splats` first).
+    pub fn empty_light_splats(&self) -> LightSplats {
+        let integral = light_splats::filter_integral_1d(self.filter());
+        LightSplats::new(
+            self.resolution,
+            Arc::clone(&self.filter_sampler),
+            (1.0 / (integral * integral)) as f32,
+            self.spectral_bins,
+        )
+    }
+
+    /// Adds one work item's light splats (call in a fixed work-item order).
+    pub fn merge_light_splats(&mut self, splats: &LightSplats) {
+        let pixels = self.pixels.len();
+        let bins = self.spectral_bins;
+        self.light
+            .get_or_insert_with(|| LightPlane::new(pixels, bins))
+            .merge(splats);
+    }
+
+    /// Light paths whose splats the film holds.
+    pub fn light_paths(&self) -> u64 {
+        self.light.as_ref().map_or(0, |l| l.paths)
     }
 
     /// Normalises the sums into the finished image.
@@ -321,8 +376,8 @@ impl Film {
         let mut rgb = Vec::with_capacity(n);
         let mut y = Vec::with_capacity(n);
         let mut spp = Vec::with_capacity(n);
-        for p in &self.pixels {
-            let v = p.mean_xyz();
+        for (i, p) in self.pixels.iter().enumerate() {
+            let v = self.pixel_xyz(i);
             let c = xyz_to_rgb * v;
             xyz.push(v.as_vec3().to_array());
             rgb.push(c.as_vec3().to_array());
@@ -400,11 +455,16 @@ impl Film {
                     self.pixels
                         .iter()
                         .zip(self.spectral.chunks_exact(n))
-                        .map(|(p, sums)| {
-                            if p.own_weight_sum != 0.0 {
-                                (sums[b] / p.own_weight_sum) as f32
+                        .enumerate()
+                        .map(|(i, (p, sums))| {
+                            let camera = if p.own_weight_sum != 0.0 {
+                                sums[b] / p.own_weight_sum
                             } else {
                                 0.0
+                            };
+                            match &self.light {
+                                None => camera as f32,
+                                Some(l) => (camera + l.spectral(i, b, n)) as f32,
                             }
                         })
                         .collect()

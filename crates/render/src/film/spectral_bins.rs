@@ -85,6 +85,29 @@ impl SpectralBins {
         Some((t as usize).min(self.count as usize - 1))
     }
 
+    /// Calls `share(bin, L̂)` for each lane of one sample that lands in a bin: the lane's
+    /// share of the bin's mean radiance before weighting (what `accumulate` adds times w).
+    #[inline]
+    pub(crate) fn for_each_lane_share(
+        &self,
+        radiance: SampledSpectrum,
+        wavelengths: &SampledWavelengths,
+        mut share: impl FnMut(usize, f64),
+    ) {
+        let pdf = wavelengths.pdf();
+        let scale = 1.0 / (self.width_nm() * prism_spectrum::N_SPECTRUM_SAMPLES as f64);
+        for lane in 0..prism_spectrum::N_SPECTRUM_SAMPLES {
+            let p = f64::from(pdf[lane]);
+            let l = f64::from(radiance[lane]);
+            if p <= 0.0 || l == 0.0 {
+                continue;
+            }
+            if let Some(b) = self.bin_of(wavelengths.wavelength_nm(lane)) {
+                share(b, scale * l / p);
+            }
+        }
+    }
+
     /// Adds w · L̂_b of one sample (see the module documentation) to `sums`, one entry per
     /// bin. Lanes with pdf ≤ 0 or a wavelength outside the range add nothing.
     #[inline]

@@ -1,20 +1,19 @@
-//! Runs an integrator over the film: tiles in parallel on the current rayon pool, every
-//! camera sample seeded by (seed, pixel, sample index) through `PixelSampler`, never by
-//! thread, so the image is bit-identical for any thread count (DESIGN.md "Deterministic").
+//! The driver: runs any `Estimator` over the film — tiles (or tile × sample-range work
+//! items for estimators that splat light paths) in parallel on the current rayon pool,
+//! every camera sample seeded by (seed, pixel, sample index) through `PixelSampler`, never
+//! by thread, and results merged in a fixed order, so the image is bit-identical for any
+//! thread count. It has no case per method: `Integrator` dispatches to the estimators.
 //!
-//! Per camera sample the stream's dimensions are: 2 for the filter offset, 2 for the lens,
-//! then whatever the integrator draws.
+//! The stream's dimensions: `integrator::dimensions`.
 
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::fmt;
 
-use glam::{DVec3, UVec2, Vec2};
+use glam::UVec2;
+use rayon::prelude::*;
 
-use prism_spectrum::{SampledSpectrum, SampledWavelengths};
-
-use super::packet::{render_tile as render_packet_tile, TileJob};
-use super::{Integrator, PathCounters};
-use crate::film::xyz::XyzWeights;
-use crate::film::{AovSelection, Film, FilmImage, SpectralBins, SurfaceAov};
+use super::estimator::{Estimator, Pass, TileWork};
+use super::PathCounters;
+use crate::film::{AovSelection, Film, FilmImage, FilmTile, LightSplats, SpectralBins};
 use crate::sampler::{PixelSampler, SamplerKind};
 use crate::scene_build::RenderScene;
 use prism_bandwidth::{BandwidthError, SamplePlan};
@@ -85,11 +84,63 @@ pub struct RenderStats {
     /// Single light or emission contributions that were NaN/∞ and were dropped before they
     /// reached the film (path tracer).
     pub non_finite_contributions: u64,
+    /// Light paths traced (light tracing, BDPT).
+    pub light_paths: u64,
 }
 
-/// Renders `scene` with the uniform plan (`settings.spp` camera samples and one light
-/// sample per hit everywhere) and returns the finished film with statistics. `progress` is
-/// called after each tile with the number of camera samples that tile took.
+impl RenderStats {
+    /// Adds another item's counts.
+    pub fn add(&mut self, other: &RenderStats) {
+        self.rays_traced += other.rays_traced;
+        self.samples += other.samples;
+        self.non_finite_samples += other.non_finite_samples;
+        self.bounces += other.bounces;
+        self.roulette_terminations += other.roulette_terminations;
+        self.non_finite_contributions += other.non_finite_contributions;
+        self.light_paths += other.light_paths;
+    }
+
+    /// Adds a path tracer's counters.
+    pub fn add_path_counters(&mut self, c: &PathCounters) {
+        self.rays_traced += c.rays;
+        self.bounces += c.bounces;
+        self.roulette_terminations += c.roulette_terminations;
+        self.non_finite_contributions += c.non_finite_contributions;
+    }
+}
+
+/// Why a render pass could not run.
+#[derive(Clone, Debug, PartialEq)]
+pub enum RenderError {
+    /// The sample plan does not fit the film.
+    Plan(BandwidthError),
+    /// The estimator refused the scene (its `prepare` said why).
+    Estimator(String),
+}
+
+impl fmt::Display for RenderError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            RenderError::Plan(e) => write!(f, "{e}"),
+            RenderError::Estimator(message) => f.write_str(message),
+        }
+    }
+}
+
+impl std::error::Error for RenderError {}
+
+impl From<BandwidthError> for RenderError {
+    fn from(e: BandwidthError) -> Self {
+        RenderError::Plan(e)
+    }
+}
+
+/// Renders `scene` with its integrator and the uniform plan (`settings.spp` camera samples
+/// and one light sample per hit everywhere) and returns the finished film with statistics.
+/// `progress` is called after each work item with the number of camera samples it took.
+/// Panics when the scene's estimator refuses the scene, which `RenderScene::build` checks
+/// for every scene it builds (a scene whose integrator was replaced afterwards goes through
+/// `render_plan` or `render_pass`, which return the error).
 pub fn render(
     scene: &RenderScene,
     settings: &RenderSettings,
@@ -97,30 +148,34 @@ pub fn render(
 ) -> (FilmImage, RenderStats) {
     let plan = SamplePlan::uniform(scene.resolution, settings.spp.max(1))
         .expect("the resolution was checked when the camera frame was built");
-    render_plan(scene, settings, &plan, progress).expect("a uniform plan has the film's resolution")
+    match render_plan(scene, settings, &plan, progress) {
+        Ok(result) => result,
+        Err(e) => panic!("render: {e}"),
+    }
 }
 
 /// Renders `scene` executing `plan` (prism-bandwidth): per pixel its camera samples (0 is
 /// allowed: the pixel stays empty, `spp.Y` = 0) and per hit its light samples. Errors when
-/// the plan's resolution is not the film's. `settings.spp` is ignored.
+/// the plan's resolution is not the film's or the estimator refuses the scene.
+/// `settings.spp` is ignored.
 pub fn render_plan(
     scene: &RenderScene,
     settings: &RenderSettings,
     plan: &SamplePlan,
     progress: &(dyn Fn(u64) + Sync),
-) -> Result<(FilmImage, RenderStats), BandwidthError> {
+) -> Result<(FilmImage, RenderStats), RenderError> {
     plan.check_resolution(scene.resolution)?;
     let mut film = film_for(scene, settings);
     let stats = render_pass(scene, settings, plan, &mut film, 0, progress)?;
     Ok((film.finish(), stats))
 }
 
-/// One pass of a progressive render: adds to `film` (from `film_for`) the camera samples
-/// `first_sample .. first_sample + plan.camera_samples(pixel)` of every pixel. Sample
-/// indices continue the same per-pixel sequence (Sobol points, independent hashes), so
-/// passes over [0, a), [a, b), … give the film of one render of b samples, up to the
-/// order of the f64 additions (`prism converge`, tested). Errors when the plan's or the
-/// film's resolution is not the scene's. `settings.spp` is ignored.
+/// One pass of a progressive render with the scene's own integrator: adds to `film` (from
+/// `film_for`) the camera samples `first_sample .. first_sample + plan.camera_samples(pixel)`
+/// of every pixel. Sample indices continue the same per-pixel sequence (Sobol points,
+/// independent hashes), so passes over [0, a), [a, b), … give the film of one render of b
+/// samples, up to the order of the f64 additions (`prism converge`, tested). Errors when
+/// the plan's or the film's resolution is not the scene's. `settings.spp` is ignored.
 pub fn render_pass(
     scene: &RenderScene,
     settings: &RenderSettings,
@@ -128,184 +183,117 @@ pub fn render_pass(
     film: &mut Film,
     first_sample: u32,
     progress: &(dyn Fn(u64) + Sync),
-) -> Result<RenderStats, BandwidthError> {
-    plan.check_resolution(scene.resolution)?;
-    plan.check_resolution(film.resolution())?;
-    let sampler = PixelSampler::with_kind(settings.sampler, settings.seed);
-    let rays_total = AtomicU64::new(0);
-    let samples_total = AtomicU64::new(0);
-    let non_finite_total = AtomicU64::new(0);
-    let bounces_total = AtomicU64::new(0);
-    let roulette_total = AtomicU64::new(0);
-    let non_finite_contributions_total = AtomicU64::new(0);
+) -> Result<RenderStats, RenderError> {
+    let mut estimator = scene.integrator;
+    let pass_index = u32::from(first_sample > 0);
+    render_pass_with(
+        &mut estimator,
+        scene,
+        &Pass {
+            index: pass_index,
+            settings,
+            plan,
+            first_sample,
+        },
+        film,
+        progress,
+    )
+}
+
+/// Work items of estimators that splat are cut to about this many light paths, so that an
+/// item's splat list stays well under a megabyte.
+const LIGHT_PATHS_PER_ITEM: u32 = 4096;
+/// Work items rendered in parallel before their splats are merged in order: bounds the
+/// memory held by finished items.
+const ITEMS_PER_BATCH: usize = 32;
+
+/// One pass of `estimator` over `film` (the driver of every method): `prepare`, then every
+/// work item in parallel on the current rayon pool, merged in a fixed order so the film is
+/// bit-identical for any number of threads.
+pub fn render_pass_with(
+    estimator: &mut (impl Estimator + ?Sized),
+    scene: &RenderScene,
+    pass: &Pass,
+    film: &mut Film,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Result<RenderStats, RenderError> {
+    pass.plan.check_resolution(scene.resolution)?;
+    pass.plan.check_resolution(film.resolution())?;
+    estimator
+        .prepare(scene, pass)
+        .map_err(RenderError::Estimator)?;
+    let estimator = &*estimator;
+    let sampler = PixelSampler::with_kind(pass.settings.sampler, pass.settings.seed);
     let uses_lens = scene.camera.uses_lens_sample();
-    film.render_tiles(settings.tile_size_px, |tile| {
-        let (mut rays, mut samples, mut non_finite) = (0u64, 0u64, 0u64);
-        let mut counters = PathCounters::default();
-        // Flat diffuse scenes: many paths at once (`integrator::packet`), for plans of one
-        // light sample per hit.
-        let packet_tracer = match (&scene.integrator, &scene.packet) {
-            (Integrator::Path(tracer), Some(packet))
-                if tile.bounds().pixels().all(|p| plan.light_samples(p) <= 1) =>
-            {
-                Some((tracer, packet))
-            }
-            _ => None,
-        };
-        if let Some((tracer, packet)) = packet_tracer {
-            let job = TileJob {
-                scene,
-                packet,
-                tracer,
+    let tile_size_px = pass.settings.tile_size_px;
+    let all_samples = pass.first_sample..u32::MAX;
+    if !estimator.splats_light_paths() {
+        // Integer counts: their sum does not depend on the order tiles finish in.
+        let total = std::sync::Mutex::new(RenderStats::default());
+        let no_splats = film.empty_light_splats();
+        film.render_tiles(tile_size_px, |tile| {
+            let work = TileWork {
+                pass,
                 sampler: &sampler,
-                camera_samples: &|p| plan.camera_samples(p),
-                first_sample,
+                sample_indices: all_samples.clone(),
                 uses_lens,
-                want_illumination: settings.illumination_aov,
             };
-            let c = render_packet_tile(&job, tile, &mut counters);
-            rays += c.camera_rays;
-            samples += c.samples;
-            non_finite += c.non_finite_samples;
-        }
-        let scalar_pixels = packet_tracer.is_none().then(|| tile.bounds().pixels());
-        for pixel in scalar_pixels.into_iter().flatten() {
-            let light_samples = plan.light_samples(pixel);
-            let count = plan.camera_samples(pixel);
-            // Several samples share the pixel: each one's differential covers a fraction of
-            // it (pbrt-v4 `GetCameraSample`/`ScaleDifferentials`: max(1/8, 1/√spp)); a
-            // progressive pass scales by its own sample count.
-            let differential_scale = (1.0 / (count.max(1) as f32).sqrt()).max(0.125);
-            for s in first_sample..first_sample.saturating_add(count) {
-                let mut stream = sampler.stream(pixel, s);
-                let (film_point, weight) = tile.sample_film_point(pixel, stream.get_2d());
-                // The lens dimensions are reserved for every camera, computed for the thin
-                // lens only (the others ignore them).
-                let lens_dimension = stream.reserve(2);
-                let lens = if uses_lens {
-                    stream.get_2d_at(lens_dimension)
-                } else {
-                    Vec2::ZERO
-                };
-                match &scene.integrator {
-                    Integrator::Path(tracer) => {
-                        let mut wavelengths = SampledWavelengths::sample_visible(stream.get_1d());
-                        // Ray differentials only feed texture filtering: without textures the
-                        // camera ray alone (same bits) saves two camera rays per sample.
-                        let result = if scene.texture_footprint.is_none() {
-                            scene.camera.generate_ray_only(film_point, lens).map(|ray| {
-                                tracer.radiance(
-                                    scene,
-                                    &ray,
-                                    &mut wavelengths,
-                                    &mut stream,
-                                    light_samples,
-                                    settings.illumination_aov,
-                                    &mut counters,
-                                )
-                            })
-                        } else {
-                            scene
-                                .camera
-                                .generate_ray(film_point, lens)
-                                .map(|mut camera_ray| {
-                                    camera_ray.scale_differentials(differential_scale);
-                                    tracer.radiance_with_differentials(
-                                        scene,
-                                        &camera_ray.ray,
-                                        Some(&camera_ray),
-                                        differential_scale,
-                                        &mut wavelengths,
-                                        &mut stream,
-                                        light_samples,
-                                        settings.illumination_aov,
-                                        &mut counters,
-                                    )
-                                })
-                        };
-                        // One colour-matching lookup for the beauty and the illumination AOV.
-                        let xyz_weights = XyzWeights::new(&wavelengths);
-                        let (radiance, aov) = match result {
-                            None => (SampledSpectrum::splat(0.0), None),
-                            Some(r) => {
-                                rays += 1;
-                                if let Some(white) = r.illumination {
-                                    tile.add_illumination_with(pixel, white, &xyz_weights);
-                                }
-                                let aov = r.first_hit.map(|si| SurfaceAov {
-                                    depth_m: si.t,
-                                    normal: si.n_shading,
-                                    albedo_rgb: scene.albedo(si.material_id),
-                                });
-                                (r.radiance, aov)
-                            }
-                        };
-                        if radiance.has_non_finite() {
-                            non_finite += 1;
-                        }
-                        tile.add_sample_with(
-                            pixel,
-                            film_point,
-                            radiance,
-                            &wavelengths,
-                            &xyz_weights,
-                            weight,
-                            aov.as_ref(),
-                        );
-                    }
-                    diagnostic => {
-                        let (xyz, aov) = match scene.camera.generate_ray(film_point, lens) {
-                            None => (DVec3::ZERO, None),
-                            Some(ray) => {
-                                rays += 1;
-                                match scene.geometry.intersect(&ray.ray) {
-                                    None => (DVec3::ZERO, None),
-                                    Some(h) => {
-                                        let si = scene.geometry.interaction(&ray.ray, &h);
-                                        let xyz = diagnostic.shade(
-                                            scene,
-                                            &ray.ray,
-                                            &si,
-                                            &mut stream,
-                                            &mut rays,
-                                        );
-                                        let aov = SurfaceAov {
-                                            depth_m: h.t,
-                                            normal: si.n_shading,
-                                            albedo_rgb: scene.albedo(si.material_id),
-                                        };
-                                        (xyz, Some(aov))
-                                    }
-                                }
-                            }
-                        };
-                        if !xyz.is_finite() {
-                            non_finite += 1;
-                        }
-                        tile.add_sample_xyz_at(pixel, film_point, xyz, weight, aov.as_ref());
-                    }
-                }
-                samples += 1;
+            let mut splats = no_splats.clone();
+            let stats = estimator.render_tile(scene, &work, tile, &mut splats);
+            debug_assert_eq!(splats.tap_count(), 0, "{} splats", estimator.name());
+            progress(stats.samples);
+            if let Ok(mut t) = total.lock() {
+                t.add(&stats);
             }
+        });
+        return Ok(total.into_inner().unwrap_or_default());
+    }
+    // Light-path estimators: tiles cut into sample ranges of about LIGHT_PATHS_PER_ITEM
+    // camera samples (one light path each).
+    let mut items = Vec::new();
+    for bounds in film.tiles(tile_size_px) {
+        let most = bounds
+            .pixels()
+            .map(|p| pass.plan.camera_samples(p))
+            .max()
+            .unwrap_or(0);
+        let chunk = (LIGHT_PATHS_PER_ITEM / bounds.pixel_count().max(1) as u32).max(1);
+        let mut k = 0u32;
+        while k < most {
+            let end = k.saturating_add(chunk).min(most);
+            let start = pass.first_sample.saturating_add(k);
+            items.push((bounds, start..pass.first_sample.saturating_add(end)));
+            k = end;
         }
-        rays_total.fetch_add(rays + counters.rays, Ordering::Relaxed);
-        samples_total.fetch_add(samples, Ordering::Relaxed);
-        non_finite_total.fetch_add(non_finite, Ordering::Relaxed);
-        bounces_total.fetch_add(counters.bounces, Ordering::Relaxed);
-        roulette_total.fetch_add(counters.roulette_terminations, Ordering::Relaxed);
-        non_finite_contributions_total
-            .fetch_add(counters.non_finite_contributions, Ordering::Relaxed);
-        progress(samples);
-    });
-    let stats = RenderStats {
-        rays_traced: rays_total.into_inner(),
-        samples: samples_total.into_inner(),
-        non_finite_samples: non_finite_total.into_inner(),
-        bounces: bounces_total.into_inner(),
-        roulette_terminations: roulette_total.into_inner(),
-        non_finite_contributions: non_finite_contributions_total.into_inner(),
-    };
-    Ok(stats)
+    }
+    let template = film.light_splats();
+    let mut total = RenderStats::default();
+    for batch in items.chunks(ITEMS_PER_BATCH) {
+        let film_ref = &*film;
+        let template = &template;
+        let results: Vec<(FilmTile, LightSplats, RenderStats)> = batch
+            .par_iter()
+            .map(|(bounds, range)| {
+                let work = TileWork {
+                    pass,
+                    sampler: &sampler,
+                    sample_indices: range.clone(),
+                    uses_lens,
+                };
+                let mut tile = film_ref.new_tile(*bounds);
+                let mut splats = template.clone();
+                let stats = estimator.render_tile(scene, &work, &mut tile, &mut splats);
+                progress(stats.samples);
+                (tile, splats, stats)
+            })
+            .collect();
+        for (tile, splats, stats) in &results {
+            film.merge_tile(tile);
+            film.merge_light_splats(splats);
+            total.add(stats);
+        }
+    }
+    Ok(total)
 }
 
 /// Total camera samples of a render: pixels × spp (for progress bars).

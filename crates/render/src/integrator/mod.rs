@@ -1,30 +1,55 @@
-//! Integrators: what a camera sample computes. This slice has the diagnostic ones —
-//! `depth`, `normal`, `albedo` and `ambient_occlusion` — each in its own file; the path
-//! tracer follows. `render` (in `driver`) runs any of them over the film tile by tile.
+//! Integrators: the rendering methods, each an `Estimator` (`estimator`) that the driver
+//! (`driver`) runs over the film with no case per method. `Integrator` is the closed set
+//! of methods a scene or `--method` can name, dispatched by exhaustive `match`:
+//!
+//! - `path`: unidirectional path tracing with NEE and MIS (`path`, `path_estimator`, and
+//!   the packet tracer `packet` for the scenes its allow-list serves);
+//! - the diagnostic ones — `depth`, `normal`, `albedo`, `ambient_occlusion` — each in its
+//!   own file, sharing one tile loop (`diagnostic`).
+//!
+//! The transport core they share: `PathState` (throughput, MIS state, depth, the
+//! sample-dimension cursor), `ScatterVertex` (a surface or a medium point),
+//! `LaneWavelengths` (sensor vs transport wavelengths), the dimension layout
+//! (`dimensions`) and the camera sample's start (`camera_sample`).
 //!
 //! Diagnostic outputs are known exactly per sample (a flat spectrum or an RGB value), so
 //! they are written to the film as XYZ (`FilmTile::add_sample_xyz`) without sampling
 //! wavelengths: a flat spectrum of value v is v · `flat_spectrum_xyz()` (Y = v exactly),
 //! an RGB colour goes through `rec709_to_xyz` and comes back out of the film unchanged.
 
+#![deny(clippy::wildcard_enum_match_arm)]
+
 mod albedo;
 mod ambient_occlusion;
+mod camera_sample;
 mod depth;
+mod diagnostic;
+pub mod dimensions;
 mod driver;
+mod estimator;
+mod lane_wavelengths;
 mod normal;
 pub mod packet;
 mod path;
+mod path_estimator;
+mod path_state;
+mod scatter_vertex;
 
 pub use ambient_occlusion::AmbientOcclusion;
 pub use driver::{
-    film_for, render, render_pass, render_plan, total_samples, RenderSettings, RenderStats,
-    DEFAULT_TILE_SIZE_PX,
+    film_for, render, render_pass, render_pass_with, render_plan, total_samples, RenderError,
+    RenderSettings, RenderStats, DEFAULT_TILE_SIZE_PX,
 };
-pub use path::{mis_weight, FirstHit, PathCounters, PathOrigin, PathResult, PathTracer};
+pub use estimator::{Estimator, Pass, TileWork};
+pub use lane_wavelengths::LaneWavelengths;
+pub use path::{mis_weight, FirstHit, PathCounters, PathResult, PathTracer};
+pub use path_state::{PathOrigin, PathState, MAX_NULL_EVENTS};
+pub use scatter_vertex::{MediumVertex, ScatterEval, ScatterSample, ScatterVertex, SurfaceVertex};
 
 use glam::DVec3;
 use prism_geometry::{Ray, SurfaceInteraction};
 
+use crate::film::{FilmTile, LightSplats};
 use crate::sampler::SampleStream;
 use crate::scene_build::RenderScene;
 
@@ -97,8 +122,50 @@ impl Integrator {
             Integrator::Normal => normal::shade(hit),
             Integrator::Albedo => albedo::shade(scene, hit),
             Integrator::AmbientOcclusion(ao) => ao.shade(&scene.geometry, ray, hit, stream, rays),
-            // Spectral: the driver calls `PathTracer::radiance` directly.
+            // Spectral: its own estimator (`path_estimator`).
             Integrator::Path(_) => DVec3::ZERO,
+        }
+    }
+}
+
+impl Estimator for Integrator {
+    fn name(&self) -> &'static str {
+        Integrator::name(self)
+    }
+
+    fn prepare(&mut self, scene: &RenderScene, pass: &Pass) -> Result<(), String> {
+        match self {
+            Integrator::Depth
+            | Integrator::Normal
+            | Integrator::Albedo
+            | Integrator::AmbientOcclusion(_) => Ok(()),
+            Integrator::Path(p) => p.prepare(scene, pass),
+        }
+    }
+
+    fn splats_light_paths(&self) -> bool {
+        match self {
+            Integrator::Depth
+            | Integrator::Normal
+            | Integrator::Albedo
+            | Integrator::AmbientOcclusion(_) => false,
+            Integrator::Path(p) => p.splats_light_paths(),
+        }
+    }
+
+    fn render_tile(
+        &self,
+        scene: &RenderScene,
+        work: &TileWork,
+        tile: &mut FilmTile,
+        splats: &mut LightSplats,
+    ) -> RenderStats {
+        match self {
+            Integrator::Depth
+            | Integrator::Normal
+            | Integrator::Albedo
+            | Integrator::AmbientOcclusion(_) => diagnostic::render_tile(self, scene, work, tile),
+            Integrator::Path(p) => p.render_tile(scene, work, tile, splats),
         }
     }
 }

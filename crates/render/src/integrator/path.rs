@@ -6,18 +6,19 @@
 //! `max_depth` counts scattering events: 1 is direct lighting only (pbrt-v4 convention;
 //! Mitsuba 3's `max_depth` is one more, since it counts the camera segment).
 //!
-//! Sample dimensions per camera sample (after the driver's filter 2 + lens 2 + wavelength 1):
-//! per vertex 8 — mask 1, light choice 1, light position 2, BSDF lobe 1, BSDF direction 2,
-//! roulette 1 — drawn in that order whether used or not, so a low-discrepancy sampler's
-//! dimensions mean the same thing in every path; extra light samples (a `SamplePlan` with
-//! more than one light sample per hit) draw 3 more each.
+//! Sample dimensions: `integrator::dimensions` (one `VertexDimensions` block per vertex).
+//! The loop walks `ScatterVertex`es with a `PathState`, so surface and medium vertices take
+//! the same steps.
 
 use glam::{Vec2, Vec3A};
-use prism_geometry::{Frame, Ray, RayDifferential, SurfaceInteraction};
+use prism_geometry::{Ray, RayDifferential};
 use prism_scene::MisHeuristic;
 use prism_spectrum::{SampledSpectrum, SampledWavelengths};
 
-use crate::bsdf::{Bsdf, TransportMode};
+use super::lane_wavelengths::LaneWavelengths;
+use super::path_state::{PathOrigin, PathState};
+use super::scatter_vertex::{ScatterVertex, SurfaceVertex};
+use crate::bsdf::TransportMode;
 use crate::light::{LightHit, LightSampleContext};
 use crate::sampler::SampleStream;
 use crate::scene_build::RenderScene;
@@ -119,42 +120,6 @@ pub(crate) fn add_contribution(
     }
 }
 
-/// Where a non-camera path starts: the point that sampled the first direction (with its
-/// geometric normal, for the lights' pdfs) and the solid-angle pdf of that direction.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct PathOrigin {
-    pub ctx: LightSampleContext,
-    /// Solid-angle pdf with which the first direction was sampled (> 0).
-    pub direction_pdf: f32,
-}
-
-/// A shading point: where the path scatters.
-struct Vertex<'a> {
-    si: &'a SurfaceInteraction,
-    frame: Frame,
-    wo_local: Vec3A,
-    /// The shading normal comes from a normal or bump map: directions whose side of the
-    /// geometric surface disagrees with the BSDF's reflection/transmission are refused
-    /// (see `texture::shading_normal`).
-    check_sides: bool,
-    /// ωo · n_geometric.
-    wo_dot_ng: f32,
-}
-
-impl Vertex<'_> {
-    /// True when world direction `wi` lies on the side of the geometric surface that the
-    /// shading frame's reflection (`wi_local.z · wo_local.z > 0`) or transmission implies.
-    #[inline]
-    fn sides_agree(&self, wi: Vec3A, wi_local: Vec3A) -> bool {
-        if !self.check_sides {
-            return true;
-        }
-        let geometric_reflection = wi.dot(self.si.n_geometric) * self.wo_dot_ng > 0.0;
-        let shading_reflection = wi_local.z * self.wo_local.z > 0.0;
-        geometric_reflection == shading_reflection
-    }
-}
-
 impl PathTracer {
     /// Radiance along `camera_ray` (unit direction) at `wavelengths` (which a dispersive
     /// hit may reduce to the hero); `light_samples` light samples per scattering event.
@@ -165,7 +130,7 @@ impl PathTracer {
         &self,
         scene: &RenderScene,
         camera_ray: &Ray,
-        wavelengths: &mut SampledWavelengths,
+        wavelengths: &mut LaneWavelengths,
         stream: &mut SampleStream,
         light_samples: u32,
         want_illumination: bool,
@@ -197,7 +162,7 @@ impl PathTracer {
         camera_ray: &Ray,
         camera_differential: Option<&RayDifferential>,
         differential_scale: f32,
-        wavelengths: &mut SampledWavelengths,
+        wavelengths: &mut LaneWavelengths,
         stream: &mut SampleStream,
         light_samples: u32,
         want_illumination: bool,
@@ -228,7 +193,7 @@ impl PathTracer {
         scene: &RenderScene,
         camera_ray: &Ray,
         origin: Option<PathOrigin>,
-        wavelengths: &mut SampledWavelengths,
+        wavelengths: &mut LaneWavelengths,
         stream: &mut SampleStream,
         light_samples: u32,
         want_illumination: bool,
@@ -257,7 +222,7 @@ impl PathTracer {
         origin: Option<PathOrigin>,
         camera_differential: Option<&RayDifferential>,
         differential_scale: f32,
-        wavelengths: &mut SampledWavelengths,
+        wavelengths: &mut LaneWavelengths,
         stream: &mut SampleStream,
         light_samples: u32,
         want_illumination: bool,
@@ -266,7 +231,7 @@ impl PathTracer {
         let mut current_differential = camera_differential.copied();
         let lights = &scene.lights;
         let mut radiance = SampledSpectrum::splat(0.0);
-        let mut beta = SampledSpectrum::splat(1.0);
+        let mut path = PathState::new(camera_ray.origin, origin, *stream, *wavelengths);
         // Indirect light arriving at the first hit, for the illumination AOV: contributions
         // after the first bounce divided by the first bounce's throughput factor.
         let mut first_bounce_beta: Option<SampledSpectrum> = None;
@@ -274,21 +239,6 @@ impl PathTracer {
         let mut illumination_direct: Option<SampledSpectrum> = None;
         let mut first_hit: Option<FirstHit> = None;
         let mut ray = *camera_ray;
-        let mut depth = 0u32;
-        let mut specular_bounce = origin.is_none();
-        let mut prev_ctx = origin.map_or(
-            LightSampleContext {
-                p: ray.origin,
-                n: Vec3A::ZERO,
-            },
-            |o| o.ctx,
-        );
-        let mut prev_bsdf_pdf = origin.map_or(0.0f32, |o| o.direction_pdf);
-        // Product of η² over refractions: roulette compares radiance, not the 1/η²-scaled
-        // throughput (pbrt-v4 §13.4.4 `etaScale`).
-        let mut eta_scale = 1.0f32;
-        // Pass-throughs of masked surfaces do not count as bounces; cap them anyway.
-        let mut pass_throughs = 0u32;
         let n_light = light_samples.max(1);
         // The lights' spectra at this path's wavelengths (their values never change along
         // the path; `terminate_secondary` only zeroes pdfs).
@@ -301,22 +251,22 @@ impl PathTracer {
         loop {
             let Some(hit) = scene.geometry.intersect(&ray) else {
                 // Escaped: infinite lights.
-                let (d, prev) = (ray.direction, &prev_ctx);
+                let (d, prev) = (ray.direction, &path.prev_ctx);
                 self.escape_terms(
                     scene,
-                    specular_bounce,
+                    path.specular_bounce,
                     prev,
-                    prev_bsdf_pdf,
+                    path.prev_pdf,
                     d,
-                    wavelengths,
+                    path.wavelengths.transport(),
                     |x| {
                         add(
                             &mut radiance,
                             &mut incident_after_first,
                             &first_bounce_beta,
-                            beta,
+                            path.beta,
                             x,
-                            depth >= 2,
+                            path.depth >= 2,
                             counters,
                         )
                     },
@@ -335,11 +285,9 @@ impl PathTracer {
                 }
             }
             let material = scene.material(si.material_id);
-            // The vertex's 8 dimensions (module docs): reserved in order, each computed only
-            // when used — the same values as drawing all 8 (`SampleStream::reserve`).
-            let dims = stream.reserve(8);
-            let (d_mask, d_light_choice, d_light, d_lobe, d_bsdf, d_roulette) =
-                (dims, dims + 1, dims + 2, dims + 4, dims + 5, dims + 7);
+            // The vertex's block (`dimensions`): reserved in order, each computed only when
+            // used — the same values as drawing all of them (`SampleStream::reserve`).
+            let dims = path.next_vertex_dimensions();
 
             // Opacity mask: pass straight through with probability 1 − α (only scenes with
             // masks: the per-hit material dispatch is not free).
@@ -348,9 +296,8 @@ impl PathTracer {
             } else {
                 1.0
             };
-            if opacity < 1.0 && stream.get_1d_at(d_mask) >= opacity {
-                pass_throughs += 1;
-                if pass_throughs > 256 {
+            if opacity < 1.0 && path.stream.get_1d_at(dims.mask()) >= opacity {
+                if !path.null_event() {
                     break;
                 }
                 ray = Ray::spawn(si.p, ray.direction);
@@ -380,57 +327,55 @@ impl PathTracer {
                     scene,
                     l,
                     &light_hit,
-                    specular_bounce,
-                    &prev_ctx,
-                    prev_bsdf_pdf,
+                    path.specular_bounce,
+                    &path.prev_ctx,
+                    path.prev_pdf,
                     ray.direction,
-                    wavelengths,
+                    path.wavelengths.transport(),
                     &mut le_cache,
                 ) {
                     add(
                         &mut radiance,
                         &mut incident_after_first,
                         &first_bounce_beta,
-                        beta,
+                        path.beta,
                         x,
-                        depth >= 2,
+                        path.depth >= 2,
                         counters,
                     );
                 }
             }
-            if depth == self.max_depth {
+            if path.depth == self.max_depth {
                 break;
             }
-            depth += 1;
+            path.depth += 1;
             counters.bounces += 1;
 
             if scene.has_dispersion && material.is_dispersive() {
-                wavelengths.terminate_secondary();
+                path.wavelengths.terminate_secondary();
             }
-            let bsdf =
-                material.bsdf_cached(si.material_id, &si, wavelengths, &mut reflectance_cache);
-            let frame = Frame::from_zx(si.n_shading, si.dpdu);
-            let vertex = Vertex {
-                si: &si,
-                frame,
-                wo_local: frame.to_local(-ray.direction),
-                check_sides: shading_maps,
-                wo_dot_ng: -ray.direction.dot(si.n_geometric),
-            };
-            let ctx = LightSampleContext {
-                p: si.p,
-                n: si.n_geometric,
-            };
+            let bsdf = material.bsdf_cached(
+                si.material_id,
+                &si,
+                path.wavelengths.transport(),
+                &mut reflectance_cache,
+            );
+            let vertex =
+                ScatterVertex::Surface(SurfaceVertex::new(&si, bsdf, ray.direction, shading_maps));
+            let ctx = vertex.light_context();
 
             // Next-event estimation.
-            if !bsdf.is_specular() && !lights.is_empty() {
+            if !vertex.is_specular() && !lights.is_empty() {
                 let mut direct = SampledSpectrum::splat(0.0);
                 let mut white = SampledSpectrum::splat(0.0);
                 for k in 0..n_light {
                     let (uc, ul) = if k == 0 {
-                        (stream.get_1d_at(d_light_choice), stream.get_2d_at(d_light))
+                        (
+                            path.stream.get_1d_at(dims.light_choice()),
+                            path.stream.get_2d_at(dims.light()),
+                        )
                     } else {
-                        (stream.get_1d(), stream.get_2d())
+                        (path.stream.get_1d(), path.stream.get_2d())
                     };
                     // Stratified light choice: sample k picks from the k-th of n equal
                     // slices of the selection CDF (each is still a sample of the same
@@ -440,13 +385,12 @@ impl PathTracer {
                     let (d, w) = self.sample_light(
                         scene,
                         &vertex,
-                        &bsdf,
                         &ctx,
                         uc,
                         ul,
-                        wavelengths,
+                        path.wavelengths.transport(),
                         &mut le_cache,
-                        want_illumination && depth == 1,
+                        want_illumination && path.depth == 1,
                         counters,
                     );
                     direct += d;
@@ -457,38 +401,37 @@ impl PathTracer {
                     &mut radiance,
                     &mut incident_after_first,
                     &first_bounce_beta,
-                    beta,
+                    path.beta,
                     direct * inv,
                     true,
                     counters,
                 );
-                if want_illumination && depth == 1 {
+                if want_illumination && path.depth == 1 {
                     illumination_direct = Some(white * inv);
                 }
             }
 
             // Continue the path by sampling the BSDF.
-            let (u_lobe, u_bsdf) = (stream.get_1d_at(d_lobe), stream.get_2d_at(d_bsdf));
-            let Some(bs) = bsdf.sample(vertex.wo_local, u_lobe, u_bsdf, TransportMode::Radiance)
-            else {
+            let (u_lobe, u_bsdf) = (
+                path.stream.get_1d_at(dims.lobe()),
+                path.stream.get_2d_at(dims.bsdf()),
+            );
+            let Some(bs) = vertex.sample(u_lobe, u_bsdf, TransportMode::Radiance) else {
                 break;
             };
-            let wi_world = vertex.frame.from_local(bs.wi);
-            if !vertex.sides_agree(wi_world, bs.wi) {
-                break;
-            }
-            let weight = bs.weight();
+            let weight = bs.weight;
             if weight.is_black() || weight.has_non_finite() {
                 if weight.has_non_finite() {
                     counters.non_finite_contributions += 1;
                 }
                 break;
             }
-            beta *= weight;
-            if depth == 1 {
+            path.beta *= weight;
+            if path.depth == 1 {
                 if want_illumination && !bs.specular {
                     // White Lambertian weight of this direction: (cos/π)/pdf.
-                    let white_weight = bs.wi.z.max(0.0) * std::f32::consts::FRAC_1_PI / bs.pdf;
+                    let white_weight =
+                        bs.wi_local.z.max(0.0) * std::f32::consts::FRAC_1_PI / bs.pdf;
                     first_bounce_beta = Some(weight * (1.0 / white_weight.max(1e-20)));
                     if white_weight <= 0.0 {
                         first_bounce_beta = None;
@@ -501,36 +444,30 @@ impl PathTracer {
             // state of the vertex before the pane stays and it is not a bounce.
             let glazing_pass = bs.transmission
                 && scene.has_glazing
-                && material.thin_glazing(wavelengths).is_some();
+                && material
+                    .thin_glazing(path.wavelengths.transport())
+                    .is_some();
             if glazing_pass {
-                depth -= 1;
+                path.depth -= 1;
                 counters.bounces -= 1;
-                pass_throughs += 1;
-                if pass_throughs > 256 {
+                if !path.null_event() {
                     break;
                 }
             } else {
-                specular_bounce = bs.specular;
-                prev_bsdf_pdf = bs.pdf;
-                if bs.transmission {
-                    eta_scale *= bs.eta * bs.eta;
-                }
-                prev_ctx = ctx;
+                path.scattered(ctx, &bs);
             }
-            ray = Ray::spawn(vertex.si.p, wi_world.normalize());
+            ray = Ray::spawn(vertex.p(), bs.wi.normalize());
             current_differential = None;
             counters.rays += 1;
 
-            // Russian roulette on the radiance-scaled throughput.
-            if depth >= self.rr_depth {
-                let q = (1.0 - (beta * eta_scale).max_component()).max(0.0);
-                if stream.get_1d_at(d_roulette) < q {
-                    counters.roulette_terminations += 1;
-                    break;
-                }
-                beta *= 1.0 / (1.0 - q);
+            let stream = path.stream;
+            if path.roulette(self.rr_depth, || stream.get_1d_at(dims.roulette())) {
+                counters.roulette_terminations += 1;
+                break;
             }
         }
+        *stream = path.stream;
+        *wavelengths = path.wavelengths;
         let illumination = illumination_direct.map(|d| {
             if first_bounce_beta.is_some() {
                 d + incident_after_first
@@ -643,8 +580,7 @@ impl PathTracer {
     fn sample_light(
         &self,
         scene: &RenderScene,
-        vertex: &Vertex,
-        bsdf: &Bsdf,
+        vertex: &ScatterVertex,
         ctx: &LightSampleContext,
         u_choice: f32,
         u: Vec2,
@@ -665,13 +601,12 @@ impl PathTracer {
         if ls.pdf <= 0.0 || ls.radiance.is_black() {
             return (zero, zero);
         }
-        let wi_local = vertex.frame.to_local(ls.wi);
-        if !vertex.sides_agree(ls.wi, wi_local) {
+        let Some(eval) = vertex.eval(ls.wi, TransportMode::Radiance) else {
             return (zero, zero);
-        }
-        let f = bsdf.eval(vertex.wo_local, wi_local, TransportMode::Radiance) * wi_local.z.abs();
+        };
+        let f = eval.f_cos;
         let white_cos = if want_white {
-            wi_local.z.max(0.0) * std::f32::consts::FRAC_1_PI
+            eval.wi_local.z.max(0.0) * std::f32::consts::FRAC_1_PI
         } else {
             0.0
         };
@@ -679,7 +614,7 @@ impl PathTracer {
             return (zero, zero);
         }
         counters.rays += 1;
-        let transmittance = self.transmittance(scene, vertex.si.p, &ls, wavelengths, counters);
+        let transmittance = self.transmittance(scene, vertex.p(), &ls, wavelengths, counters);
         if transmittance.is_black() {
             return (zero, zero);
         }
@@ -687,7 +622,7 @@ impl PathTracer {
         let w = if ls.delta {
             1.0
         } else {
-            let bsdf_pdf = bsdf.pdf(vertex.wo_local, wi_local, TransportMode::Radiance);
+            let bsdf_pdf = vertex.pdf(&eval, TransportMode::Radiance);
             mis_weight(self.mis, light_pdf, bsdf_pdf)
         };
         let arriving = ls.radiance * transmittance;

@@ -23,7 +23,7 @@ use prism_geometry::{Frame, Ray};
 use prism_spectrum::{SampledSpectrum, SampledWavelengths};
 
 use crate::film::xyz::{cd_m2_per_unit, xyz_of_sample};
-use crate::integrator::{mis_weight, PathCounters, PathOrigin, PathTracer};
+use crate::integrator::{mis_weight, LaneWavelengths, PathCounters, PathOrigin, PathTracer};
 use crate::light::LightSampleContext;
 use crate::sampler::SampleStream;
 use crate::sampling::sample_cosine_hemisphere;
@@ -42,7 +42,7 @@ pub fn sample_illuminance_lx(
     stream: &mut SampleStream,
     counters: &mut PathCounters,
 ) -> f64 {
-    let mut wavelengths = SampledWavelengths::sample_visible(stream.get_1d());
+    let mut wavelengths = LaneWavelengths::new(SampledWavelengths::sample_visible(stream.get_1d()));
     let u_dir = stream.get_2d();
     let ctx = LightSampleContext { p, n };
     let lights = &scene.lights;
@@ -57,11 +57,14 @@ pub fn sample_illuminance_lx(
         let Some((l, pmf)) = lights.sample(u_choice) else {
             continue;
         };
-        if let Some(ls) = lights.light(l).sample_li(&ctx, u_light, &wavelengths) {
+        if let Some(ls) = lights
+            .light(l)
+            .sample_li(&ctx, u_light, wavelengths.transport())
+        {
             let cos = ls.wi.dot(n);
             if cos > 0.0 && ls.pdf > 0.0 && !ls.radiance.is_black() {
                 counters.rays += 1;
-                let t = tracer.transmittance(scene, p, &ls, &wavelengths, counters);
+                let t = tracer.transmittance(scene, p, &ls, wavelengths.transport(), counters);
                 if !t.is_black() {
                     let light_pdf = pmf * ls.pdf;
                     let w = if ls.delta {
@@ -107,5 +110,5 @@ pub fn sample_illuminance_lx(
         counters.non_finite_contributions += 1;
         return 0.0;
     }
-    xyz_of_sample(e, &wavelengths).y * cd_m2_per_unit()
+    xyz_of_sample(e, wavelengths.sensor()).y * cd_m2_per_unit()
 }

@@ -1,0 +1,213 @@
+//! Light-side contributions: light-path vertices connected to the camera (light tracing,
+//! BDPT's t = 1 strategies) land at a film point anywhere on the film, not at the pixel of
+//! the camera sample being rendered (Veach 1997 §10.2; pbrt-v4 `RGBFilm::AddSplat`).
+//!
+//! Each work item collects its splats in a `LightSplats` list (filter taps already
+//! evaluated, XYZ already converted); the driver merges the lists into the film's
+//! `LightPlane` one after another in work-item order, so the image is bit-identical for any
+//! thread count (floating-point sums in one fixed order) without locks or atomics on the
+//! film.
+//!
+//! Normalisation. A pixel j measures I_j = ∫ f̂(x − c_j) L(x) dx over film points x in px,
+//! with f̂ = f / ∫f the filter normalised to integrate to 1 (the value filter importance
+//! sampling of camera samples converges to). With the camera's importance W_e normalised
+//! to 1 over a film area A (px², `Camera::importance_area_px2`), a light path's
+//! connection C = β · f_s · G · W_e / pdf (W_e included) estimates I_j as
+//! A · f̂(x − c_j) · C per light path; over N light paths the pixel is
+//! Σ A · f̂ · C / N. Estimators splat A · C (`splat`'s `value`), the film keeps Σ f̂ · A · C
+//! and divides by N (`LightPlane::paths`) when it finishes.
+
+use std::sync::Arc;
+
+use glam::{DVec3, UVec2, Vec2};
+use prism_spectrum::{SampledSpectrum, SampledWavelengths};
+
+use super::filter_sampler::FilterSampler;
+use super::spectral_bins::SpectralBins;
+use super::xyz::xyz_of_sample;
+
+/// One bin's share of a splat.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct SpectralTap {
+    pixel: u32,
+    bin: u32,
+    value: f32,
+}
+
+/// The splats of one work item, in the order they were made.
+#[derive(Clone, Debug)]
+pub struct LightSplats {
+    resolution: UVec2,
+    filter: Arc<FilterSampler>,
+    /// 1 / ∫∫ f(x, y) dx dy.
+    inverse_filter_integral: f32,
+    bins: Option<SpectralBins>,
+    /// (pixel index, f̂ · XYZ).
+    taps: Vec<(u32, [f32; 3])>,
+    spectral: Vec<SpectralTap>,
+    /// Light paths traced by the work item.
+    paths: u64,
+}
+
+impl LightSplats {
+    pub(crate) fn new(
+        resolution: UVec2,
+        filter: Arc<FilterSampler>,
+        inverse_filter_integral: f32,
+        bins: Option<SpectralBins>,
+    ) -> Self {
+        Self {
+            resolution,
+            filter,
+            inverse_filter_integral,
+            bins,
+            taps: Vec::new(),
+            spectral: Vec::new(),
+            paths: 0,
+        }
+    }
+
+    /// Counts `n` light paths traced (the normaliser N).
+    #[inline]
+    pub fn count_paths(&mut self, n: u64) {
+        self.paths += n;
+    }
+
+    /// Splats `value` (radiance at `wavelengths`, already multiplied by the importance area
+    /// A; see the module docs) at `film_point_px` into every pixel whose centre is within
+    /// the filter radius. Non-finite values are dropped; returns false for them.
+    pub fn splat(
+        &mut self,
+        film_point_px: Vec2,
+        value: SampledSpectrum,
+        wavelengths: &SampledWavelengths,
+    ) -> bool {
+        if value.has_non_finite() || !film_point_px.is_finite() {
+            return false;
+        }
+        if value.is_black() {
+            return true;
+        }
+        let xyz = xyz_of_sample(value, wavelengths);
+        let table = self.filter.table();
+        let r = self.filter.filter().radius_px();
+        // Pixels whose centre (i + ½) lies within r of the point.
+        let lo = (film_point_px - Vec2::splat(r + 0.5))
+            .ceil()
+            .max(Vec2::ZERO);
+        let hi = (film_point_px + Vec2::splat(r - 0.5))
+            .floor()
+            .min(self.resolution.as_vec2() - Vec2::ONE);
+        if lo.x > hi.x || lo.y > hi.y {
+            return true;
+        }
+        let (x0, x1, y0, y1) = (lo.x as u32, hi.x as u32, lo.y as u32, hi.y as u32);
+        for py in y0..=y1 {
+            let fy = table.eval(py as f32 + 0.5 - film_point_px.y);
+            if fy == 0.0 {
+                continue;
+            }
+            for px in x0..=x1 {
+                let fx = table.eval(px as f32 + 0.5 - film_point_px.x);
+                let w = fx * fy * self.inverse_filter_integral;
+                if w == 0.0 {
+                    continue;
+                }
+                let pixel = py * self.resolution.x + px;
+                let wd = f64::from(w);
+                self.taps.push((
+                    pixel,
+                    [
+                        (xyz.x * wd) as f32,
+                        (xyz.y * wd) as f32,
+                        (xyz.z * wd) as f32,
+                    ],
+                ));
+                if let Some(bins) = self.bins {
+                    bins.for_each_lane_share(value, wavelengths, |bin, share| {
+                        self.spectral.push(SpectralTap {
+                            pixel,
+                            bin: bin as u32,
+                            value: (share * wd) as f32,
+                        });
+                    });
+                }
+            }
+        }
+        true
+    }
+
+    /// Splats made so far (filter taps).
+    pub fn tap_count(&self) -> usize {
+        self.taps.len()
+    }
+}
+
+/// The film's sums of light-side contributions.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub(crate) struct LightPlane {
+    /// Σ f̂ · A · C per pixel, XYZ.
+    pub xyz_sum: Vec<DVec3>,
+    /// Per pixel and bin, pixel-major (empty without bins).
+    pub spectral_sum: Vec<f64>,
+    /// Light paths traced (N).
+    pub paths: u64,
+}
+
+impl LightPlane {
+    pub fn new(pixels: usize, bins: Option<SpectralBins>) -> Self {
+        Self {
+            xyz_sum: vec![DVec3::ZERO; pixels],
+            spectral_sum: bins.map_or(Vec::new(), |b| vec![0.0; pixels * b.count() as usize]),
+            paths: 0,
+        }
+    }
+
+    /// Adds one work item's splats (the driver calls this in work-item order).
+    pub fn merge(&mut self, splats: &LightSplats) {
+        self.paths += splats.paths;
+        for &(pixel, [x, y, z]) in &splats.taps {
+            self.xyz_sum[pixel as usize] += DVec3::new(f64::from(x), f64::from(y), f64::from(z));
+        }
+        if let Some(bins) = splats.bins {
+            let n = bins.count() as usize;
+            for t in &splats.spectral {
+                self.spectral_sum[t.pixel as usize * n + t.bin as usize] += f64::from(t.value);
+            }
+        }
+    }
+
+    /// The light-side XYZ of pixel `i` (Σ / N; zero before any light path).
+    #[inline]
+    pub fn xyz(&self, i: usize) -> DVec3 {
+        if self.paths == 0 {
+            DVec3::ZERO
+        } else {
+            self.xyz_sum[i] / self.paths as f64
+        }
+    }
+
+    /// The light-side mean spectral radiance of pixel `i` in bin `b` of `n`.
+    #[inline]
+    pub fn spectral(&self, i: usize, b: usize, n: usize) -> f64 {
+        if self.paths == 0 || self.spectral_sum.is_empty() {
+            0.0
+        } else {
+            self.spectral_sum[i * n + b] / self.paths as f64
+        }
+    }
+}
+
+/// ∫ f₁(x) dx over [−r, r] of `filter`'s 1-D profile by the composite Simpson rule (the
+/// profiles are smooth inside their support; 4096 intervals put the error far below f32).
+pub(crate) fn filter_integral_1d(filter: &super::Filter) -> f64 {
+    let r = f64::from(filter.radius_px());
+    let n = 4096usize;
+    let h = 2.0 * r / n as f64;
+    let f = |k: usize| f64::from(filter.eval_1d((-r + k as f64 * h) as f32));
+    let mut sum = f(0) + f(n);
+    for k in 1..n {
+        sum += if k % 2 == 1 { 4.0 } else { 2.0 } * f(k);
+    }
+    sum * h / 3.0
+}

@@ -1,0 +1,155 @@
+//! The `path` method as an `Estimator`: each camera sample of a tile through the scalar
+//! path tracer (`path`), or the whole tile through the packet tracer (`packet`) where the
+//! scene is one the packet tracer serves (`RenderScene::packet`, its allow-list) and the
+//! plan takes one light sample per hit.
+
+use prism_spectrum::{SampledSpectrum, SampledWavelengths};
+
+use super::camera_sample::CameraSample;
+use super::driver::RenderStats;
+use super::estimator::{Estimator, Pass, TileWork};
+use super::lane_wavelengths::LaneWavelengths;
+use super::packet::{render_tile as render_packet_tile, TileJob};
+use super::{PathCounters, PathTracer};
+use crate::film::xyz::XyzWeights;
+use crate::film::{FilmTile, LightSplats, SurfaceAov};
+use crate::scene_build::RenderScene;
+
+impl Estimator for PathTracer {
+    fn name(&self) -> &'static str {
+        "path"
+    }
+
+    fn prepare(&mut self, _scene: &RenderScene, _pass: &Pass) -> Result<(), String> {
+        Ok(())
+    }
+
+    fn splats_light_paths(&self) -> bool {
+        false
+    }
+
+    fn render_tile(
+        &self,
+        scene: &RenderScene,
+        work: &TileWork,
+        tile: &mut FilmTile,
+        _splats: &mut LightSplats,
+    ) -> RenderStats {
+        let pass = work.pass;
+        let settings = pass.settings;
+        let mut counters = PathCounters::default();
+        let mut stats = RenderStats::default();
+        // Flat diffuse scenes: many paths at once (`integrator::packet`), for plans of one
+        // light sample per hit.
+        let packet = scene
+            .packet
+            .as_ref()
+            .filter(|_| tile.bounds().pixels().all(|p| work.light_samples(p) <= 1));
+        if let Some(packet) = packet {
+            debug_assert!(tile.bounds().pixels().all(|p| {
+                let own = pass.first_sample..pass.first_sample + pass.plan.camera_samples(p);
+                work.samples_of(p) == own
+            }));
+            let job = TileJob {
+                scene,
+                packet,
+                tracer: self,
+                sampler: work.sampler,
+                camera_samples: &|p| pass.plan.camera_samples(p),
+                first_sample: pass.first_sample,
+                uses_lens: work.uses_lens,
+                want_illumination: settings.illumination_aov,
+            };
+            let c = render_packet_tile(&job, tile, &mut counters);
+            stats.rays_traced += c.camera_rays;
+            stats.samples += c.samples;
+            stats.non_finite_samples += c.non_finite_samples;
+        } else {
+            for pixel in tile.bounds().pixels() {
+                let light_samples = work.light_samples(pixel);
+                let samples = work.samples_of(pixel);
+                // Several samples share the pixel: each one's differential covers a
+                // fraction of it (pbrt-v4 `GetCameraSample`/`ScaleDifferentials`:
+                // max(1/8, 1/√spp)); a progressive pass scales by its own sample count.
+                let count = pass.plan.camera_samples(pixel);
+                let differential_scale = (1.0 / (count.max(1) as f32).sqrt()).max(0.125);
+                for s in samples {
+                    let mut cs = CameraSample::start(tile, work, pixel, s);
+                    let mut wavelengths = LaneWavelengths::new(SampledWavelengths::sample_visible(
+                        cs.stream.get_1d(),
+                    ));
+                    // Ray differentials only feed texture filtering: without textures the
+                    // camera ray alone (same bits) saves two camera rays per sample.
+                    let result = if scene.texture_footprint.is_none() {
+                        scene
+                            .camera
+                            .generate_ray_only(cs.film_point, cs.lens)
+                            .map(|ray| {
+                                self.radiance(
+                                    scene,
+                                    &ray,
+                                    &mut wavelengths,
+                                    &mut cs.stream,
+                                    light_samples,
+                                    settings.illumination_aov,
+                                    &mut counters,
+                                )
+                            })
+                    } else {
+                        scene
+                            .camera
+                            .generate_ray(cs.film_point, cs.lens)
+                            .map(|mut camera_ray| {
+                                camera_ray.scale_differentials(differential_scale);
+                                self.radiance_with_differentials(
+                                    scene,
+                                    &camera_ray.ray,
+                                    Some(&camera_ray),
+                                    differential_scale,
+                                    &mut wavelengths,
+                                    &mut cs.stream,
+                                    light_samples,
+                                    settings.illumination_aov,
+                                    &mut counters,
+                                )
+                            })
+                    };
+                    // One colour-matching lookup for the beauty and the illumination AOV,
+                    // at the wavelengths the film records.
+                    let sensor = wavelengths.sensor();
+                    let xyz_weights = XyzWeights::new(sensor);
+                    let (radiance, aov) = match result {
+                        None => (SampledSpectrum::splat(0.0), None),
+                        Some(r) => {
+                            stats.rays_traced += 1;
+                            if let Some(white) = r.illumination {
+                                tile.add_illumination_with(pixel, white, &xyz_weights);
+                            }
+                            let aov = r.first_hit.map(|si| SurfaceAov {
+                                depth_m: si.t,
+                                normal: si.n_shading,
+                                albedo_rgb: scene.albedo(si.material_id),
+                            });
+                            (r.radiance, aov)
+                        }
+                    };
+                    if radiance.has_non_finite() {
+                        stats.non_finite_samples += 1;
+                    }
+                    tile.add_sample_with(
+                        pixel,
+                        cs.film_point,
+                        radiance,
+                        sensor,
+                        &xyz_weights,
+                        cs.filter_weight,
+                        aov.as_ref(),
+                    );
+                    stats.samples += 1;
+                }
+            }
+        }
+        stats.add_path_counters(&counters);
+        stats
+    }
+}

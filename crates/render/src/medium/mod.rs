@@ -1,0 +1,8 @@
+//! Participating media: what a path meets between surfaces. This slice has the phase
+//! functions that a medium vertex scatters with (`phase`); the media themselves
+//! (homogeneous, grid) and their transmittance follow with the media work. Scenes that
+//! declare media are refused until then (`scene_build`), never rendered as vacuum.
+
+pub mod phase;
+
+pub use phase::{PhaseFunction, PhaseSample};

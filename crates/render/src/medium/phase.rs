@@ -1,0 +1,146 @@
+//! Phase functions p(ωo, ωi) of a medium vertex, in sr⁻¹, both directions pointing away
+//! from the scattering point (pbrt-v4 §11.3 convention: forward scattering is ωi = −ωo).
+//! A phase function is its own pdf when sampled exactly, as both of these are.
+
+use std::f32::consts::PI;
+
+use glam::{Vec2, Vec3A};
+use prism_geometry::Frame;
+
+/// A sampled direction of a phase function.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PhaseSample {
+    /// Unit direction (world).
+    pub wi: Vec3A,
+    /// p(ωo, ωi), sr⁻¹.
+    pub p: f32,
+    /// Solid-angle pdf of `wi`, sr⁻¹ (equal to `p`: exact sampling).
+    pub pdf: f32,
+}
+
+/// The phase functions a medium can have.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum PhaseFunction {
+    /// 1/4π.
+    Isotropic,
+    /// Henyey & Greenstein 1941 with asymmetry g ∈ (−1, 1).
+    HenyeyGreenstein { g: f32 },
+}
+
+/// p_HG(cos θ) = (1 − g²) / (4π (1 + g² + 2g cos θ)^{3/2}) with cos θ = ωo·ωi
+/// (pbrt-v4 eq. 11.12 in the ωo-away convention).
+#[inline]
+fn henyey_greenstein(cos_theta: f32, g: f32) -> f32 {
+    let denom = 1.0 + g * g + 2.0 * g * cos_theta;
+    (1.0 - g * g) / (4.0 * PI * denom * denom.max(1e-12).sqrt())
+}
+
+impl PhaseFunction {
+    /// p(ωo, ωi), sr⁻¹.
+    #[inline]
+    pub fn eval(&self, wo: Vec3A, wi: Vec3A) -> f32 {
+        match *self {
+            PhaseFunction::Isotropic => 1.0 / (4.0 * PI),
+            PhaseFunction::HenyeyGreenstein { g } => henyey_greenstein(wo.dot(wi), g),
+        }
+    }
+
+    /// Solid-angle pdf of `sample` producing `wi` (= `eval`).
+    #[inline]
+    pub fn pdf(&self, wo: Vec3A, wi: Vec3A) -> f32 {
+        self.eval(wo, wi)
+    }
+
+    /// Samples ωi given ωo from `u` ∈ [0, 1)² by inverting the phase function's cdf in
+    /// cos θ (pbrt-v4 §11.3.1 `SampleHenyeyGreenstein`, eq. 11.16).
+    #[inline]
+    pub fn sample(&self, wo: Vec3A, u: Vec2) -> Option<PhaseSample> {
+        let g = match *self {
+            PhaseFunction::Isotropic => 0.0,
+            PhaseFunction::HenyeyGreenstein { g } => g,
+        };
+        // cos θ measured from −ωo (the forward direction).
+        let cos_theta = if g.abs() < 1e-3 {
+            1.0 - 2.0 * u.x
+        } else {
+            let s = (1.0 - g * g) / (1.0 + g - 2.0 * g * u.x);
+            -(1.0 + g * g - s * s) / (2.0 * g)
+        };
+        let cos_theta = cos_theta.clamp(-1.0, 1.0);
+        let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
+        let phi = 2.0 * PI * u.y;
+        let frame = Frame::from_z(-wo);
+        let local = Vec3A::new(sin_theta * phi.cos(), sin_theta * phi.sin(), cos_theta);
+        let wi = frame.from_local(local).normalize();
+        let p = self.eval(wo, wi);
+        (p > 0.0 && p.is_finite()).then_some(PhaseSample { wi, p, pdf: p })
+    }
+
+    /// The mean cosine ⟨cos θ⟩ between the incident propagation direction and ωi.
+    pub fn asymmetry(&self) -> f32 {
+        match *self {
+            PhaseFunction::Isotropic => 0.0,
+            PhaseFunction::HenyeyGreenstein { g } => g,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::chi2::{chi2_test, Chi2Config};
+
+    fn phases() -> [PhaseFunction; 4] {
+        [
+            PhaseFunction::Isotropic,
+            PhaseFunction::HenyeyGreenstein { g: 0.7 },
+            PhaseFunction::HenyeyGreenstein { g: -0.4 },
+            PhaseFunction::HenyeyGreenstein { g: 0.0005 },
+        ]
+    }
+
+    #[test]
+    fn phase_functions_integrate_to_one_and_have_their_mean_cosine() {
+        let wo = Vec3A::new(0.3, -0.5, 0.8).normalize();
+        for phase in phases() {
+            // Midpoint rule over (cos θ, φ) of the sphere.
+            let (n_theta, n_phi) = (2000, 64);
+            let (mut integral, mut mean_cos) = (0.0f64, 0.0f64);
+            let frame = Frame::from_z(-wo);
+            for i in 0..n_theta {
+                let c = -1.0 + (i as f32 + 0.5) * 2.0 / n_theta as f32;
+                let s = (1.0 - c * c).sqrt();
+                for j in 0..n_phi {
+                    let phi = (j as f32 + 0.5) * 2.0 * PI / n_phi as f32;
+                    let wi = frame.from_local(Vec3A::new(s * phi.cos(), s * phi.sin(), c));
+                    let w = phase.eval(wo, wi) as f64
+                        * (2.0 / n_theta as f64)
+                        * (2.0 * std::f64::consts::PI / n_phi as f64);
+                    integral += w;
+                    mean_cos += w * c as f64;
+                }
+            }
+            assert!((integral - 1.0).abs() < 1e-3, "{phase:?}: ∫p = {integral}");
+            assert!(
+                (mean_cos - phase.asymmetry() as f64).abs() < 2e-3,
+                "{phase:?}: <cos> = {mean_cos}"
+            );
+        }
+    }
+
+    #[test]
+    fn sampling_matches_the_phase_function_chi2() {
+        let wo = Vec3A::new(-0.2, 0.9, 0.1).normalize();
+        for phase in phases() {
+            let result = chi2_test(
+                &Chi2Config {
+                    sample_count: 200_000,
+                    ..Chi2Config::default()
+                },
+                |_, u| phase.sample(wo, u).map(|s| s.wi),
+                |wi| phase.pdf(wo, wi) as f64,
+            );
+            assert!(result.passed, "{phase:?}: {result:?}");
+        }
+    }
+}
