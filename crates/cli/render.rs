@@ -24,7 +24,7 @@ use prism_post::Image;
 use prism_render::film::spectral_bins::{MAX_SPECTRAL_BINS, MIN_SPECTRAL_BINS};
 use prism_render::integrator::DEFAULT_TILE_SIZE_PX;
 use prism_render::{
-    render, total_samples, FilmImage, PlanRequest, RenderPlan, RenderScene, RenderSettings,
+    render_plan, total_samples, FilmImage, PlanRequest, RenderPlan, RenderScene, RenderSettings,
     RenderStats, SamplerKind, SpectralBins,
 };
 use prism_spectrum::rgb_space::RgbColorSpace;
@@ -74,6 +74,10 @@ pub struct RenderArgs {
     /// decades below the maximum on a log scale).
     #[arg(long = "false-colour-range", value_parser = crate::falsecolour::parse_range)]
     pub false_colour_range: Option<(f64, f64)>,
+    /// `bdpt` only: write one strategy's image, S,T (S light-subpath and T camera-subpath
+    /// vertices; MIS-weighted) or S,T,unweighted (weight 1), for debugging.
+    #[arg(long = "bdpt-strategy", value_name = "S,T[,unweighted]", value_parser = prism_render::integrator::BdptStrategy::parse)]
+    pub bdpt_strategy: Option<prism_render::integrator::BdptStrategy>,
 }
 
 pub(crate) fn parse_resolution(s: &str) -> Result<UVec2, String> {
@@ -232,15 +236,46 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
             args.scene.display()
         ));
     }
-    let scene = RenderScene::build(&description, args.resolution).map_err(|e| e.to_string())?;
+    let mut scene =
+        RenderScene::build(&description, args.resolution).map_err(|e| e.to_string())?;
+    if let Some(strategy) = args.bdpt_strategy {
+        match &mut scene.integrator {
+            prism_render::Integrator::Bdpt(b) => {
+                if strategy.depth() > b.max_depth {
+                    return Err(format!(
+                        "--bdpt-strategy {},{}: paths of {} scattering events, beyond the \
+                         scene's max_depth {}",
+                        strategy.s,
+                        strategy.t,
+                        strategy.depth(),
+                        b.max_depth
+                    ));
+                }
+                b.strategy = Some(strategy);
+            }
+            other => {
+                return Err(format!(
+                    "--bdpt-strategy needs the `bdpt` integrator; {} renders with `{}` (set \
+                     \"integrator\": {{\"type\": \"bdpt\"}})",
+                    args.scene.display(),
+                    other.name()
+                ))
+            }
+        }
+    }
     let settings = RenderSettings {
         spp: args.spp.unwrap_or(scene.spp),
         seed: args.seed.unwrap_or(scene.seed),
         tile_size_px: DEFAULT_TILE_SIZE_PX,
         // The path tracer's sampler is the scene's choice; every other integrator uses Sobol.
         sampler: match description.integrator {
-            prism_scene::Integrator::Path { sampler, .. } => sampler,
-            _ => SamplerKind::Sobol,
+            prism_scene::Integrator::Path { sampler, .. }
+            | prism_scene::Integrator::Light { sampler, .. }
+            | prism_scene::Integrator::Bdpt { sampler, .. } => sampler,
+            prism_scene::Integrator::Depth
+            | prism_scene::Integrator::Normal
+            | prism_scene::Integrator::Albedo
+            | prism_scene::Integrator::AmbientOcclusion { .. } => SamplerKind::Sobol,
         },
         spectral_bins,
         // Cheap, and what `prism tonemap --wb scene` reads: always in EXR outputs.
@@ -249,11 +284,12 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
     if settings.spp == 0 {
         return Err("--spp must be at least 1".into());
     }
-    if matches!(scene.integrator, prism_render::Integrator::Path(_)) && scene.lights.is_empty() {
+    if scene.integrator.is_spectral() && scene.lights.is_empty() {
         eprintln!(
-            "{}: warning: the scene has no lights: the path tracer's image is black \
+            "{}: warning: the scene has no lights: the {} image is black \
              (add a `lights` entry, or choose a diagnostic `integrator`)",
-            args.scene.display()
+            args.scene.display(),
+            scene.integrator.name()
         );
     }
     if args.explain {
@@ -302,7 +338,11 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
     }
     let bar = progress_bar(total_samples(scene.resolution, settings.spp));
     let start = Instant::now();
-    let (film, stats) = pool.install(|| render(&scene, &settings, &|n| bar.inc(n)));
+    let plan = prism_bandwidth::SamplePlan::uniform(scene.resolution, settings.spp)
+        .map_err(|e| e.to_string())?;
+    let (film, stats) = pool
+        .install(|| render_plan(&scene, &settings, &plan, &|n| bar.inc(n)))
+        .map_err(|e| format!("{}: {e}", args.scene.display()))?;
     let wall_time_s = start.elapsed().as_secs_f64();
     bar.finish_and_clear();
 
@@ -375,6 +415,7 @@ fn write_stats(
         "non_finite_contributions": stats.non_finite_contributions,
         "bounces": stats.bounces,
         "roulette_terminations": stats.roulette_terminations,
+        "light_paths": stats.light_paths,
     });
     let text = serde_json::to_string_pretty(&value).map_err(|e| e.to_string())? + "\n";
     // Atomic like the image: a temporary sibling renamed over the destination.

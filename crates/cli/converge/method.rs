@@ -1,10 +1,11 @@
 //! The method grammar of `prism converge --method`: `INTEGRATOR[+PLAN][:SAMPLER]`.
 //!
-//! - INTEGRATOR: what a camera sample computes — `path` (the spectral path tracer with the
-//!   scene's `max_depth`, `rr_depth` and `mis`, or the defaults when the scene names another
-//!   integrator) or one of the diagnostic integrators (`ambient_occlusion`, `depth`,
-//!   `normal`, `albedo`). `photon` (photon mapping) is a known name that this build does not
-//!   have yet.
+//! - INTEGRATOR: the rendering method — `path` (the spectral path tracer), `light` (light
+//!   tracing) or `bdpt` (bidirectional path tracing), each with the scene's `max_depth`,
+//!   `rr_depth` and (`path`, `bdpt`) `mis` when the scene's integrator is one of these three
+//!   (so one scene compares the methods at equal depth), else the defaults; or one of the
+//!   diagnostic integrators (`ambient_occlusion`, `depth`, `normal`, `albedo`). `photon`
+//!   (photon mapping) is a known name that this build does not have yet.
 //! - PLAN: how samples are distributed over the pixels — `uniform` (the default: the same
 //!   spp everywhere). `predicted` (the bandwidth predictor's per-pixel plan) is known but not
 //!   built yet.
@@ -17,8 +18,10 @@ use prism_render::integrator::AmbientOcclusion;
 use prism_render::{Integrator, SamplerKind};
 
 /// Integrator names: (name, available in this build, what it is).
-pub const INTEGRATORS: [(&str, bool, &str); 6] = [
+pub const INTEGRATORS: [(&str, bool, &str); 8] = [
     ("path", true, "spectral path tracer (NEE + MIS)"),
+    ("light", true, "light tracing (light paths connected to the camera)"),
+    ("bdpt", true, "bidirectional path tracing (MIS over all strategies)"),
     ("ambient_occlusion", true, "diagnostic"),
     ("depth", true, "diagnostic"),
     ("normal", true, "diagnostic"),
@@ -152,7 +155,7 @@ impl Method {
     /// quantity; a run compares one quantity only.
     pub fn quantity(&self) -> &'static str {
         match self.integrator {
-            "path" => "radiance",
+            "path" | "light" | "bdpt" => "radiance",
             other => other,
         }
     }
@@ -160,9 +163,70 @@ impl Method {
     /// The runtime integrator, with the scene's parameters where the scene's own integrator
     /// is of the same kind, else that kind's defaults.
     pub fn integrator(&self, scene: &prism_scene::Integrator) -> Result<Integrator, String> {
+        // The depth, roulette and MIS settings of the scene's spectral method, if it has one.
+        let spectral = match *scene {
+            prism_scene::Integrator::Path {
+                max_depth,
+                mis,
+                rr_depth,
+                ..
+            }
+            | prism_scene::Integrator::Bdpt {
+                max_depth,
+                mis,
+                rr_depth,
+                ..
+            } => Some((max_depth, Some(mis), rr_depth)),
+            prism_scene::Integrator::Light {
+                max_depth,
+                rr_depth,
+                ..
+            } => Some((max_depth, None, rr_depth)),
+            prism_scene::Integrator::Depth
+            | prism_scene::Integrator::Normal
+            | prism_scene::Integrator::Albedo
+            | prism_scene::Integrator::AmbientOcclusion { .. } => None,
+        };
+        let defaults = match prism_scene::Integrator::default() {
+            prism_scene::Integrator::Path {
+                max_depth,
+                mis,
+                rr_depth,
+                ..
+            } => (max_depth, mis, rr_depth),
+            prism_scene::Integrator::Light { .. }
+            | prism_scene::Integrator::Bdpt { .. }
+            | prism_scene::Integrator::Depth
+            | prism_scene::Integrator::Normal
+            | prism_scene::Integrator::Albedo
+            | prism_scene::Integrator::AmbientOcclusion { .. } => {
+                (8, prism_scene::MisHeuristic::Power, 3)
+            }
+        };
+        let (max_depth, mis, rr_depth) = match spectral {
+            Some((d, m, r)) => (d, m.unwrap_or(defaults.1), r),
+            None => defaults,
+        };
+        // The sampler is the method's (`:SAMPLER`); the description's is not read.
+        let sampler = self.sampler;
         let description = match (self.integrator, scene) {
-            ("path", d @ prism_scene::Integrator::Path { .. }) => *d,
-            ("path", _) => prism_scene::Integrator::default(),
+            ("path", _) => prism_scene::Integrator::Path {
+                max_depth,
+                sampler,
+                mis,
+                rr_depth,
+            },
+            ("light", _) => prism_scene::Integrator::Light {
+                max_depth,
+                sampler,
+                rr_depth,
+            },
+            ("bdpt", _) => prism_scene::Integrator::Bdpt {
+                max_depth,
+                sampler,
+                mis,
+                rr_depth,
+            },
             ("ambient_occlusion", d @ prism_scene::Integrator::AmbientOcclusion { .. }) => *d,
             ("ambient_occlusion", _) => {
                 return Ok(Integrator::AmbientOcclusion(AmbientOcclusion::new(

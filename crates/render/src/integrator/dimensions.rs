@@ -90,14 +90,15 @@ impl VertexDimensions {
 }
 
 /// The block that starts a light path: light choice 1, position on the light 2, direction
-/// of emission 2.
+/// of emission 2, and the lens point (2) of light tracing's connection of the light's own
+/// point to the camera.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct LightStartDimensions {
     first: u32,
 }
 
 impl LightStartDimensions {
-    pub const COUNT: u32 = 5;
+    pub const COUNT: u32 = 7;
 
     /// Reserves the block at the stream's cursor.
     #[inline(always)]
@@ -107,8 +108,16 @@ impl LightStartDimensions {
         }
     }
     #[inline(always)]
+    pub fn first(&self) -> u32 {
+        self.first
+    }
+    #[inline(always)]
     pub fn light_choice(&self) -> u32 {
         self.first
+    }
+    #[inline(always)]
+    pub fn lens(&self) -> u32 {
+        self.first + 5
     }
     #[inline(always)]
     pub fn position(&self) -> u32 {

@@ -4,6 +4,9 @@
 //!
 //! - `path`: unidirectional path tracing with NEE and MIS (`path`, `path_estimator`, and
 //!   the packet tracer `packet` for the scenes its allow-list serves);
+//! - `light`: light tracing, every light-path vertex connected to the camera
+//!   (`light_tracer`);
+//! - `bdpt`: bidirectional path tracing with MIS over all strategies (`bdpt`);
 //! - the diagnostic ones — `depth`, `normal`, `albedo`, `ambient_occlusion` — each in its
 //!   own file, sharing one tile loop (`diagnostic`).
 //!
@@ -21,6 +24,7 @@
 
 mod albedo;
 mod ambient_occlusion;
+pub mod bdpt;
 mod camera_sample;
 mod depth;
 mod diagnostic;
@@ -28,6 +32,7 @@ pub mod dimensions;
 mod driver;
 mod estimator;
 mod lane_wavelengths;
+mod light_tracer;
 mod normal;
 pub mod packet;
 mod path;
@@ -36,6 +41,8 @@ mod path_state;
 mod scatter_vertex;
 
 pub use ambient_occlusion::AmbientOcclusion;
+pub use bdpt::{Bdpt, BdptStrategy};
+pub use light_tracer::LightTracer;
 pub use driver::{
     film_for, render, render_pass, render_pass_with, render_plan, total_samples, RenderError,
     RenderSettings, RenderStats, DEFAULT_TILE_SIZE_PX,
@@ -65,6 +72,10 @@ pub enum Integrator {
     AmbientOcclusion(AmbientOcclusion),
     /// The spectral path tracer (NEE + MIS).
     Path(PathTracer),
+    /// Light tracing.
+    Light(LightTracer),
+    /// Bidirectional path tracing.
+    Bdpt(Bdpt),
 }
 
 impl Integrator {
@@ -92,7 +103,57 @@ impl Integrator {
                 rr_depth,
                 mis,
             }),
+            prism_scene::Integrator::Light {
+                max_depth,
+                rr_depth,
+                ..
+            } => Integrator::Light(LightTracer {
+                max_depth: max_depth.max(1),
+                rr_depth,
+            }),
+            prism_scene::Integrator::Bdpt {
+                max_depth,
+                mis,
+                rr_depth,
+                ..
+            } => Integrator::Bdpt(Bdpt {
+                max_depth: max_depth.max(1),
+                rr_depth,
+                mis,
+                strategy: None,
+            }),
         })
+    }
+
+    /// The path tracer that measures illuminance sensors for this method: the method's
+    /// own depth, roulette and MIS settings where it has them (`path`, `light`, `bdpt`
+    /// integrate the same radiance; sensors are points, not pixels, so they are measured
+    /// by path tracing), the default path tracer for the diagnostic integrators.
+    pub fn sensor_tracer(&self) -> PathTracer {
+        match self {
+            Integrator::Path(p) => *p,
+            Integrator::Light(l) => PathTracer {
+                max_depth: l.max_depth,
+                rr_depth: l.rr_depth,
+                mis: prism_scene::MisHeuristic::Power,
+            },
+            Integrator::Bdpt(b) => b.path_tracer(),
+            Integrator::Depth
+            | Integrator::Normal
+            | Integrator::Albedo
+            | Integrator::AmbientOcclusion(_) => PathTracer::default(),
+        }
+    }
+
+    /// True for the methods that estimate radiance (the others are diagnostics).
+    pub fn is_spectral(&self) -> bool {
+        match self {
+            Integrator::Path(_) | Integrator::Light(_) | Integrator::Bdpt(_) => true,
+            Integrator::Depth
+            | Integrator::Normal
+            | Integrator::Albedo
+            | Integrator::AmbientOcclusion(_) => false,
+        }
     }
 
     /// The name used in scene files and statistics.
@@ -103,6 +164,8 @@ impl Integrator {
             Integrator::Albedo => "albedo",
             Integrator::AmbientOcclusion(_) => "ambient_occlusion",
             Integrator::Path(_) => "path",
+            Integrator::Light(_) => "light",
+            Integrator::Bdpt(_) => "bdpt",
         }
     }
 
@@ -122,8 +185,8 @@ impl Integrator {
             Integrator::Normal => normal::shade(hit),
             Integrator::Albedo => albedo::shade(scene, hit),
             Integrator::AmbientOcclusion(ao) => ao.shade(&scene.geometry, ray, hit, stream, rays),
-            // Spectral: its own estimator (`path_estimator`).
-            Integrator::Path(_) => DVec3::ZERO,
+            // Spectral: their own estimators.
+            Integrator::Path(_) | Integrator::Light(_) | Integrator::Bdpt(_) => DVec3::ZERO,
         }
     }
 }
@@ -140,6 +203,8 @@ impl Estimator for Integrator {
             | Integrator::Albedo
             | Integrator::AmbientOcclusion(_) => Ok(()),
             Integrator::Path(p) => p.prepare(scene, pass),
+            Integrator::Light(l) => l.prepare(scene, pass),
+            Integrator::Bdpt(b) => b.prepare(scene, pass),
         }
     }
 
@@ -150,6 +215,8 @@ impl Estimator for Integrator {
             | Integrator::Albedo
             | Integrator::AmbientOcclusion(_) => false,
             Integrator::Path(p) => p.splats_light_paths(),
+            Integrator::Light(l) => l.splats_light_paths(),
+            Integrator::Bdpt(b) => b.splats_light_paths(),
         }
     }
 
@@ -166,6 +233,8 @@ impl Estimator for Integrator {
             | Integrator::Albedo
             | Integrator::AmbientOcclusion(_) => diagnostic::render_tile(self, scene, work, tile),
             Integrator::Path(p) => p.render_tile(scene, work, tile, splats),
+            Integrator::Light(l) => l.render_tile(scene, work, tile, splats),
+            Integrator::Bdpt(b) => b.render_tile(scene, work, tile, splats),
         }
     }
 }

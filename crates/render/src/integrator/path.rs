@@ -34,6 +34,17 @@ pub struct PathTracer {
     pub mis: MisHeuristic,
 }
 
+impl Default for PathTracer {
+    /// The scene format's defaults: max depth 8, roulette from depth 3, power heuristic.
+    fn default() -> Self {
+        Self {
+            max_depth: 8,
+            rr_depth: 3,
+            mis: MisHeuristic::Power,
+        }
+    }
+}
+
 /// Per-sample counters the driver sums into `RenderStats`.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct PathCounters {
@@ -645,11 +656,25 @@ impl PathTracer {
         wavelengths: &SampledWavelengths,
         counters: &mut PathCounters,
     ) -> SampledSpectrum {
-        let mut shadow = if ls.distance_m.is_finite() {
+        let shadow = if ls.distance_m.is_finite() {
             Ray::spawn_to(p, ls.p_light)
         } else {
             Ray::spawn(p, ls.wi)
         };
+        self.segment_transmittance(scene, shadow, ls.wi, wavelengths, counters)
+    }
+
+    /// `transmittance` along the segment `shadow` (its parameter interval bounds it);
+    /// `direction` is its unit direction (panes' transmittance depends on the angle).
+    #[inline]
+    pub(crate) fn segment_transmittance(
+        &self,
+        scene: &RenderScene,
+        mut shadow: Ray,
+        direction: Vec3A,
+        wavelengths: &SampledWavelengths,
+        counters: &mut PathCounters,
+    ) -> SampledSpectrum {
         let zero = SampledSpectrum::splat(0.0);
         if !scene.has_masks && !scene.has_glazing {
             return if scene.geometry.occluded(&shadow) {
@@ -671,7 +696,7 @@ impl PathTracer {
             let opacity = material.opacity_at(&si);
             let mut through = SampledSpectrum::splat(1.0 - opacity);
             if let Some(pane) = material.thin_glazing(wavelengths) {
-                let cos = ls.wi.dot(si.n_shading).abs();
+                let cos = direction.dot(si.n_shading).abs();
                 through += pane.transmittance(cos) * opacity;
             }
             transmittance *= through;

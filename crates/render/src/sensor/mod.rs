@@ -146,20 +146,11 @@ pub struct SensorStats {
     pub non_finite_contributions: u64,
 }
 
-/// The path tracer sensors use: the scene's, or the default one (max depth 8, roulette
-/// from depth 3, power heuristic) when the scene renders with a diagnostic integrator.
+/// The path tracer sensors use: the scene's method's (`Integrator::sensor_tracer`: its
+/// depth, roulette and MIS), or the default one (max depth 8, roulette from depth 3, power
+/// heuristic) when the scene renders with a diagnostic integrator.
 pub fn sensor_tracer(scene: &RenderScene) -> PathTracer {
-    match scene.integrator {
-        Integrator::Path(t) => t,
-        _ => match Integrator::from_description(&prism_scene::Integrator::default()) {
-            Ok(Integrator::Path(t)) => t,
-            _ => PathTracer {
-                max_depth: 8,
-                rr_depth: 3,
-                mis: prism_scene::MisHeuristic::Power,
-            },
-        },
-    }
+    scene.integrator.sensor_tracer()
 }
 
 /// Light samples per vertex for sensors: one per light up to 8 (stratified, so a few

@@ -21,6 +21,7 @@ use crate::cpu::{has_avx2, has_avx512};
 use crate::film::xyz::XyzWeights;
 use crate::film::FilmTile;
 use crate::film::SurfaceAov;
+use crate::integrator::dimensions::{VertexDimensions, LENS_DIMENSIONS};
 use crate::integrator::path::{add_contribution, FirstHit, PathCounters, PathTracer};
 use crate::light::{LightHit, LightSampleContext};
 use crate::material::Material;
@@ -429,7 +430,7 @@ impl<const N: usize> Starts<N> {
                 };
                 let mut stream = job.sampler.stream(pixel, s);
                 let (film_point, filter_weight) = tile.sample_film_point(pixel, stream.get_2d());
-                let lens_dimension = stream.reserve(2);
+                let lens_dimension = stream.reserve(LENS_DIMENSIONS);
                 let lens = if job.uses_lens {
                     stream.get_2d_at(lens_dimension)
                 } else {
@@ -551,20 +552,15 @@ fn start_path<const N: usize>(
     paths.prev_bsdf_pdf[l] = 0.0;
 }
 
-/// Offsets of a vertex's variates in its 8 reserved dimensions (`integrator::path` module
-/// docs: mask 0, light choice 1, light position 2–3, lobe 4, direction 5–6, roulette 7).
-const DIM_LIGHT_CHOICE: u32 = 1;
-const DIM_LIGHT: u32 = 2;
-const DIM_BSDF: u32 = 5;
-const DIM_ROULETTE: u32 = 7;
-/// The dimension offset of each entry of `Variates::u`.
+/// The dimension offset of each entry of `Variates::u` within a vertex's block
+/// (`dimensions::VertexDimensions`).
 const VARIATE_OFFSETS: [u32; 6] = [
-    DIM_LIGHT_CHOICE,
-    DIM_LIGHT,
-    DIM_LIGHT + 1,
-    DIM_BSDF,
-    DIM_BSDF + 1,
-    DIM_ROULETTE,
+    VertexDimensions::LIGHT_CHOICE,
+    VertexDimensions::LIGHT,
+    VertexDimensions::LIGHT + 1,
+    VertexDimensions::BSDF,
+    VertexDimensions::BSDF + 1,
+    VertexDimensions::ROULETTE,
 ];
 
 /// The variates of one vertex per lane: light choice, light position (2), BSDF direction
@@ -619,15 +615,15 @@ fn draw_variates<const N: usize>(
         let (true, false, Some(sample)) = (vertex.active[l], v.hashed[l], &samples[l]) else {
             continue;
         };
-        let dims = v.first_dimension[l];
+        let dims = VertexDimensions::starting_at(v.first_dimension[l]);
         let stream = &sample.stream;
         let u = &mut v.u;
-        u[0][l] = stream.get_1d_at(dims + DIM_LIGHT_CHOICE);
-        let ul = stream.get_2d_at(dims + DIM_LIGHT);
+        u[0][l] = stream.get_1d_at(dims.light_choice());
+        let ul = stream.get_2d_at(dims.light());
         (u[1][l], u[2][l]) = (ul.x, ul.y);
-        let ub = stream.get_2d_at(dims + DIM_BSDF);
+        let ub = stream.get_2d_at(dims.bsdf());
         (u[3][l], u[4][l]) = (ub.x, ub.y);
-        u[5][l] = stream.get_1d_at(dims + DIM_ROULETTE);
+        u[5][l] = stream.get_1d_at(dims.roulette());
     }
 }
 
@@ -716,7 +712,11 @@ fn begin_vertices<const N: usize>(
         let clear_white = active[l] && want_white && depth == 1;
         bounces += active[l] as u32;
         variates.first_dimension[l] = paths.dimension[l];
-        paths.dimension[l] += if active[l] { 8 } else { 0 };
+        paths.dimension[l] += if active[l] {
+            VertexDimensions::COUNT
+        } else {
+            0
+        };
         vertex.t[l] = hit_t[l];
         for a in 0..3 {
             vertex.o[a][l] = rays.o[a][l];
