@@ -5,7 +5,7 @@ use std::f32::consts::PI;
 
 use glam::{Vec2, Vec3A};
 
-use super::{CameraFrame, CameraRay};
+use super::{perspective, CameraFrame, CameraImportance, CameraModel, CameraRay};
 use crate::error::InvalidParameter;
 
 /// A perspective projection through a point. `fov_rad` spans the film **width**.
@@ -36,10 +36,6 @@ impl PinholeCamera {
         })
     }
 
-    pub fn frame(&self) -> &CameraFrame {
-        &self.frame
-    }
-
     pub fn fov_rad(&self) -> f32 {
         self.fov_rad
     }
@@ -47,12 +43,6 @@ impl PinholeCamera {
     /// Image-plane distance in pixels.
     pub fn focal_px(&self) -> f32 {
         self.focal_px
-    }
-
-    pub(crate) fn camera_ray(&self, film_point_px: Vec2) -> Option<CameraRay> {
-        let o = self.frame.offset_up_px(film_point_px);
-        let d = Vec3A::new(o.x, o.y, -self.focal_px).normalize();
-        Some((Vec3A::ZERO, d))
     }
 
     /// `Camera::generate_ray_only` of `N` film points: the world origin and the unit
@@ -85,12 +75,59 @@ impl PinholeCamera {
         }
         (to_world.point(Vec3A::ZERO), world)
     }
+}
 
-    pub(crate) fn project_camera_space(&self, p: Vec3A) -> Option<Vec2> {
+/// Importance with a point lens (area 1) and the image plane at any distance (pbrt-v4
+/// `PerspectiveCamera` with lensRadius 0; `perspective` derives it).
+impl CameraModel for PinholeCamera {
+    fn frame(&self) -> &CameraFrame {
+        &self.frame
+    }
+
+    fn camera_ray(&self, film_point_px: Vec2, _lens_sample: Vec2) -> Option<CameraRay> {
+        let o = self.frame.offset_up_px(film_point_px);
+        let d = Vec3A::new(o.x, o.y, -self.focal_px).normalize();
+        Some((Vec3A::ZERO, d))
+    }
+
+    fn project_camera_space(&self, p: Vec3A) -> Option<Vec2> {
         (p.z < 0.0).then(|| {
             let s = self.focal_px / -p.z;
             self.frame
                 .film_from_offset_up_px(Vec2::new(p.x * s, p.y * s))
         })
+    }
+
+    fn project_jacobian_camera_space(&self, p_m: Vec3A) -> Option<[Vec3A; 2]> {
+        perspective::project_jacobian(self.focal_px, p_m)
+    }
+
+    fn importance_support(&self) -> Result<(), String> {
+        Ok(())
+    }
+
+    fn is_delta_position(&self) -> bool {
+        true
+    }
+
+    fn importance_area_px2(&self) -> f32 {
+        let size = self.frame.size_px();
+        size.x * size.y
+    }
+
+    fn sample_lens_point(&self, _u_lens: Vec2) -> Option<(Vec3A, f32)> {
+        Some((Vec3A::ZERO, 1.0))
+    }
+
+    fn importance_camera_space(
+        &self,
+        _lens_point_m: Vec3A,
+        direction: Vec3A,
+    ) -> Option<CameraImportance> {
+        perspective::importance(&self.frame, self.focal_px, 1.0, 1.0, Vec3A::ZERO, direction)
+    }
+
+    fn pdf_we_camera_space(&self, _lens_point_m: Vec3A, direction: Vec3A) -> Option<(f32, f32)> {
+        perspective::pdf_we(&self.frame, self.focal_px, 1.0, 1.0, Vec3A::ZERO, direction)
     }
 }

@@ -16,7 +16,7 @@
 
 use glam::{Vec2, Vec3A};
 
-use super::{CameraFrame, CameraRay};
+use super::{perspective, CameraFrame, CameraImportance, CameraModel, CameraRay};
 use crate::error::{positive, InvalidParameter};
 use crate::sampling::sample_uniform_disk_concentric;
 
@@ -124,10 +124,6 @@ impl ThinLensCamera {
         })
     }
 
-    pub fn frame(&self) -> &CameraFrame {
-        &self.frame
-    }
-
     pub fn focal_length_m(&self) -> f32 {
         self.focal_length_m
     }
@@ -167,21 +163,14 @@ impl ThinLensCamera {
         Vec3A::new(l.x, l.y, 0.0)
     }
 
-    pub(crate) fn camera_ray(&self, film_point_px: Vec2, lens_sample: Vec2) -> Option<CameraRay> {
-        let o = self.frame.offset_up_px(film_point_px);
-        let scale = self.focus_distance_m / self.focal_px;
-        let focus_point = Vec3A::new(o.x * scale, o.y * scale, -self.focus_distance_m);
-        let lens = self.lens_point_m(lens_sample);
-        Some((lens, (focus_point - lens).normalize()))
-    }
-
-    /// Chief-ray projection (through the lens centre).
-    pub(crate) fn project_camera_space(&self, p: Vec3A) -> Option<Vec2> {
-        (p.z < 0.0).then(|| {
-            let s = self.focal_px / -p.z;
-            self.frame
-                .film_from_offset_up_px(Vec2::new(p.x * s, p.y * s))
-        })
+    /// Aperture area π r² (m²); 1 for a zero aperture, whose lens is a point (pbrt-v4
+    /// `PerspectiveCamera::We`'s `lensArea`).
+    pub fn lens_area_m2(&self) -> f32 {
+        if self.aperture_radius_m > 0.0 {
+            std::f32::consts::PI * self.aperture_radius_m * self.aperture_radius_m
+        } else {
+            1.0
+        }
     }
 
     /// The film point (px) whose ray through the aperture point of `lens_sample` passes
@@ -200,5 +189,78 @@ impl ThinLensCamera {
             .frame
             .film_from_offset_up_px(Vec2::new(focus_point.x * s, focus_point.y * s));
         self.frame.contains(film).then_some(film)
+    }
+}
+
+/// Importance of pbrt-v4's thin lens, W_e = f_px² / (W H · A_lens · cos⁴θ) with the film at
+/// the focus-plane scale (`perspective` derives it for our film parameterisation). The lens
+/// point of `lens_sample` is `lens_point_m`'s concentric map, uniform over the aperture.
+impl CameraModel for ThinLensCamera {
+    fn frame(&self) -> &CameraFrame {
+        &self.frame
+    }
+
+    fn camera_ray(&self, film_point_px: Vec2, lens_sample: Vec2) -> Option<CameraRay> {
+        let o = self.frame.offset_up_px(film_point_px);
+        let scale = self.focus_distance_m / self.focal_px;
+        let focus_point = Vec3A::new(o.x * scale, o.y * scale, -self.focus_distance_m);
+        let lens = self.lens_point_m(lens_sample);
+        Some((lens, (focus_point - lens).normalize()))
+    }
+
+    /// Chief-ray projection (through the lens centre).
+    fn project_camera_space(&self, p: Vec3A) -> Option<Vec2> {
+        (p.z < 0.0).then(|| {
+            let s = self.focal_px / -p.z;
+            self.frame
+                .film_from_offset_up_px(Vec2::new(p.x * s, p.y * s))
+        })
+    }
+
+    fn project_jacobian_camera_space(&self, p_m: Vec3A) -> Option<[Vec3A; 2]> {
+        perspective::project_jacobian(self.focal_px, p_m)
+    }
+
+    fn importance_support(&self) -> Result<(), String> {
+        Ok(())
+    }
+
+    fn is_delta_position(&self) -> bool {
+        self.aperture_radius_m == 0.0
+    }
+
+    fn importance_area_px2(&self) -> f32 {
+        let size = self.frame.size_px();
+        size.x * size.y
+    }
+
+    fn sample_lens_point(&self, u_lens: Vec2) -> Option<(Vec3A, f32)> {
+        Some((self.lens_point_m(u_lens), 1.0 / self.lens_area_m2()))
+    }
+
+    fn importance_camera_space(
+        &self,
+        lens_point_m: Vec3A,
+        direction: Vec3A,
+    ) -> Option<CameraImportance> {
+        perspective::importance(
+            &self.frame,
+            self.focal_px,
+            self.focus_distance_m,
+            self.lens_area_m2(),
+            lens_point_m,
+            direction,
+        )
+    }
+
+    fn pdf_we_camera_space(&self, lens_point_m: Vec3A, direction: Vec3A) -> Option<(f32, f32)> {
+        perspective::pdf_we(
+            &self.frame,
+            self.focal_px,
+            self.focus_distance_m,
+            self.lens_area_m2(),
+            lens_point_m,
+            direction,
+        )
     }
 }
