@@ -30,6 +30,7 @@ pub mod spectrum_cache;
 pub mod texture;
 
 pub use camera::{
+    CameraImportance, CameraModel, CameraWiSample,
     ApertureSpec, Camera, CameraFrame, FisheyeCamera, FisheyeCoverage, FisheyeProjection,
     FocalSpec, OrthographicCamera, PinholeCamera, SphericalCamera, ThinLensCamera,
 };

@@ -252,7 +252,7 @@ impl FisheyeCamera {
             Vec2::ZERO
         };
         let film = self.frame.film_from_offset_up_px(r * azimuth);
-        self.frame.contains(film).then_some((theta, film))
+        self.frame.reaches(film).then_some((theta, film))
     }
 }
 

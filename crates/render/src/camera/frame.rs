@@ -12,6 +12,12 @@ pub struct CameraFrame {
     pub camera_to_world: Transform,
     /// Film width and height in pixels.
     pub resolution: UVec2,
+    /// How far (px) outside the film camera samples' film points reach: the pixel filter's
+    /// radius (a sample is the pixel centre plus a filter offset). Importance and its
+    /// densities (`CameraModel::importance_camera_space`, `pdf_we_camera_space`) are
+    /// defined over the film grown by it, so a light-path connection landing just outside
+    /// still reaches the border pixels' filters, as camera samples do. 0 by default.
+    pub film_margin_px: f32,
 }
 
 const CONTEXT: &str = "camera";
@@ -30,7 +36,26 @@ impl CameraFrame {
         Ok(Self {
             camera_to_world,
             resolution,
+            film_margin_px: 0.0,
         })
+    }
+
+    /// The same frame with camera samples reaching `margin_px` outside the film (the
+    /// filter's radius).
+    pub fn with_film_margin_px(mut self, margin_px: f32) -> Self {
+        self.film_margin_px = margin_px.max(0.0);
+        self
+    }
+
+    /// True when `film_point_px` lies on the film grown by `film_margin_px`: where camera
+    /// samples' film points lie, so where importance is defined.
+    pub fn reaches(&self, film_point_px: Vec2) -> bool {
+        let s = self.size_px();
+        let m = self.film_margin_px;
+        film_point_px.x >= -m
+            && film_point_px.y >= -m
+            && film_point_px.x < s.x + m
+            && film_point_px.y < s.y + m
     }
 
     /// A viewer at `eye_m` looking at `target_m`, `up` giving the image's up direction

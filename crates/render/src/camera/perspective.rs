@@ -31,7 +31,7 @@ fn film_point(
     let on_plane = lens_point_m + direction * ((plane_distance_m + lens_point_m.z) / cos_theta);
     let s = focal_px / plane_distance_m;
     let film = frame.film_from_offset_up_px(Vec2::new(on_plane.x * s, on_plane.y * s));
-    frame.contains(film).then_some((film, cos_theta))
+    frame.reaches(film).then_some((film, cos_theta))
 }
 
 /// W_e = f_px² / (W H · A_lens · cos⁴θ) and the film point (pbrt-v4 `PerspectiveCamera::We`).

@@ -28,11 +28,13 @@ pub fn horizontal_fov_rad(fov_rad: f64, axis: FovAxis, resolution: UVec2) -> f64
     2.0 * ((0.5 * fov_rad).tan() * ratio).atan()
 }
 
-/// Builds the camera of `camera` for a film of `resolution`.
+/// Builds the camera of `camera` for a film of `resolution` whose samples reach
+/// `film_margin_px` outside it (the filter radius; `CameraFrame::film_margin_px`).
 pub fn build_camera(
     file: &std::path::Path,
     camera: &prism_scene::Camera,
     resolution: UVec2,
+    film_margin_px: f32,
 ) -> Result<Camera, SceneBuildError> {
     let err = |place: &str, message: String| SceneBuildError::new(file, place, message);
     let to_world = to_geometry_transform(&camera.transform.matrix).ok_or_else(|| {
@@ -42,7 +44,8 @@ pub fn build_camera(
         )
     })?;
     let frame = CameraFrame::new(to_world, resolution)
-        .map_err(|e| err("film.resolution", e.to_string()))?;
+        .map_err(|e| err("film.resolution", e.to_string()))?
+        .with_film_margin_px(film_margin_px);
     let built = match &camera.kind {
         CameraKind::Pinhole { fov_rad, fov_axis } => {
             let h = horizontal_fov_rad(*fov_rad, *fov_axis, resolution);

@@ -79,9 +79,9 @@ impl RenderScene {
         ));
         let integrator = Integrator::from_description(&scene.integrator)
             .map_err(|message| SceneBuildError::new(&file, "integrator", message))?;
-        let camera = build_camera(&file, &scene.camera, resolution)?;
         let filter = build_filter(&scene.film.filter)
             .map_err(|e| SceneBuildError::new(&file, "film.filter", e.to_string()))?;
+        let camera = build_camera(&file, &scene.camera, resolution, filter.radius_px())?;
         let mut albedo_rgb: Vec<[f32; 3]> = (0..scene.materials.len())
             .map(|i| material_albedo(&scene.materials, i))
             .collect();
