@@ -32,34 +32,9 @@ pub struct RenderProbe<'a> {
     pub seed: u64,
 }
 
-fn bandwidth(spatial: f32, angular: f32) -> Bandwidth {
-    Bandwidth {
-        spatial_cycles_per_m: spatial,
-        angular_cycles_per_rad: angular,
-    }
-}
-
-/// ν_l of a light (see the module docs).
+/// ν_l of a light (see the module docs; the choices live in `light/bandwidth.rs`).
 pub fn light_bandwidth(light: &Light) -> Bandwidth {
-    match light {
-        // A point source: a Dirac in position (its angular distribution is smooth).
-        Light::Point(_) | Light::Spot(_) | Light::Goniometric(_) => bandwidth(0.0, f32::INFINITY),
-        Light::Directional(d) => {
-            if d.one_minus_cos_half_angle > 0.0 {
-                let half = (1.0 - d.one_minus_cos_half_angle).clamp(-1.0, 1.0).acos();
-                bandwidth(0.0, 1.0 / (2.0 * half))
-            } else {
-                bandwidth(0.0, f32::INFINITY)
-            }
-        }
-        Light::Area(a) => bandwidth((1.0 / a.shape.area_m2().sqrt()) as f32, 0.0),
-        Light::Environment(e) => {
-            bandwidth(0.0, e.resolution().0 as f32 / (4.0 * std::f32::consts::PI))
-        }
-        Light::Sky(_) => bandwidth(0.0, 0.0),
-        // The sky's indicatrix exp(d χ) (|d| ≤ 3) varies over about 1/3 rad: ≈ 1.5 cycles/rad.
-        Light::Daylight(_) => bandwidth(0.0, 1.5),
-    }
+    light.bandwidth()
 }
 
 /// ρ of a BSDF (see the module docs).

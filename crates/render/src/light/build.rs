@@ -197,7 +197,9 @@ pub(super) fn build_lights(
                     Strength::LuminousFluxLm(_) => {
                         Target::Photometric(point_intensity_from_flux(value))
                     }
-                    _ => return Err(b.unsupported()),
+                    Strength::LuminanceCdM2(_) | Strength::IlluminanceLx(_) => {
+                        return Err(b.unsupported())
+                    }
                 };
                 Light::Point(PointLight {
                     position_m: vec3(position_m),
@@ -221,7 +223,9 @@ pub(super) fn build_lights(
                                 f64::from(start.cos() as f32),
                             ),
                     ),
-                    _ => return Err(b.unsupported()),
+                    Strength::LuminanceCdM2(_) | Strength::IlluminanceLx(_) => {
+                        return Err(b.unsupported())
+                    }
                 };
                 Light::Spot(SpotLight::new(
                     vec3(position_m),
@@ -238,7 +242,9 @@ pub(super) fn build_lights(
                 let target = match l.strength {
                     Strength::Scale(_) => Target::Scale(value),
                     Strength::IlluminanceLx(_) => Target::Photometric(value),
-                    _ => return Err(b.unsupported()),
+                    Strength::LuminousFluxLm(_)
+                    | Strength::IntensityCd(_)
+                    | Strength::LuminanceCdM2(_) => return Err(b.unsupported()),
                 };
                 Light::Directional(DirectionalLight::new(
                     vec3(direction),
@@ -278,7 +284,9 @@ pub(super) fn build_lights(
                     Strength::LuminousFluxLm(_) => {
                         Target::Photometric(lambertian_luminance_from_flux(value, area, sides))
                     }
-                    _ => return Err(b.unsupported()),
+                    Strength::IntensityCd(_) | Strength::IlluminanceLx(_) => {
+                        return Err(b.unsupported())
+                    }
                 };
                 let light_index = lights.len() as u32;
                 for id in range {
@@ -303,7 +311,10 @@ pub(super) fn build_lights(
             LightKind::Environment { path, transform } => {
                 let scale = match l.strength {
                     Strength::Scale(_) => value as f32,
-                    _ => return Err(b.unsupported()),
+                    Strength::LuminousFluxLm(_)
+                    | Strength::IntensityCd(_)
+                    | Strength::LuminanceCdM2(_)
+                    | Strength::IlluminanceLx(_) => return Err(b.unsupported()),
                 };
                 if !scale.is_finite() {
                     return Err(b.err("scale", format!("{value} is beyond single precision")));
@@ -317,7 +328,9 @@ pub(super) fn build_lights(
                 let target = match l.strength {
                     Strength::Scale(_) => Target::Scale(value),
                     Strength::LuminanceCdM2(_) => Target::Photometric(value),
-                    _ => return Err(b.unsupported()),
+                    Strength::LuminousFluxLm(_)
+                    | Strength::IntensityCd(_)
+                    | Strength::IlluminanceLx(_) => return Err(b.unsupported()),
                 };
                 Light::Sky(UniformSky {
                     radiance: b.absolute(spectrum()?, target)?,

@@ -34,18 +34,25 @@
 //! inside the texel (φ uniform, cos θ uniform between the row's bounds). The density is
 //! P(texel)/ΔΩ: constant over each texel and proportional to its luminance — exactly the
 //! shape of the nearest-texel radiance.
+//!
+//! **Emitted rays.** The same direction sampling, then an origin on the scene disk facing
+//! it (pbrt-v4 §12.5.3 `ImageInfiniteLight::SampleLe`); the radiance and pdf_dir are those
+//! of the texel the direction maps back to, as `pdf_le` finds them. The mean of the power
+//! estimator is π r² Σ_texels ΔΩ ∫ L dλ; `power_w` estimates each texel's ∫ L dλ from its
+//! luminance (exact for grey maps).
 
 use std::f32::consts::PI;
 use std::path::Path;
 
 use glam::{DMat3, DMat4, Mat3A, Vec2, Vec3A};
+use prism_bandwidth::Bandwidth;
 use prism_spectrum::rgb_upsample::{RgbIlluminantSpectrum, SigmoidPolynomial};
 use prism_spectrum::{DenseSpectrum, RgbGamut, SampledSpectrum, SampledWavelengths, Spectrum};
 use rayon::prelude::*;
 
 use super::piecewise_constant::PiecewiseConstant2D;
 use super::scene_sphere::SceneSphere;
-use super::{LightSample, LightSampleContext};
+use super::{LightHit, LightLeSample, LightSample, LightSampleContext, LightSource};
 
 /// The local direction of image coordinates (u, v) (see the module docs).
 #[inline]
@@ -292,13 +299,9 @@ impl EnvironmentLight {
         }
     }
 
+    /// A direction from the texel distribution (world, towards the light) and its texel.
     #[inline]
-    pub fn sample_li(
-        &self,
-        ctx: &LightSampleContext,
-        u: Vec2,
-        wavelengths: &SampledWavelengths,
-    ) -> Option<LightSample> {
+    fn sample_direction(&self, u: Vec2) -> Option<(Vec3A, usize, usize)> {
         let (uv, pdf_uv, [x, y]) = self.distribution.sample(u);
         if pdf_uv.is_nan() || pdf_uv <= 0.0 || x >= self.width || y >= self.height {
             return None;
@@ -310,7 +313,32 @@ impl EnvironmentLight {
         let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
         let (sin_p, cos_p) = (2.0 * PI * uv.x).sin_cos();
         let local = Vec3A::new(sin_p * sin_theta, cos_theta, -cos_p * sin_theta);
-        let wi = (self.to_world * local).normalize();
+        Some(((self.to_world * local).normalize(), x, y))
+    }
+
+    /// The texel a world direction (towards the light) falls in.
+    #[inline]
+    fn texel_of(&self, wi: Vec3A) -> (usize, usize) {
+        self.texel(equirect_uv((self.to_local * wi).normalize()))
+    }
+
+    /// Solid-angle density of `sample_li`'s directions at `wi`.
+    #[inline]
+    pub fn direction_pdf(&self, wi: Vec3A) -> f32 {
+        let (x, y) = self.texel_of(wi);
+        self.texel_pdf(x, y)
+    }
+}
+
+impl LightSource for EnvironmentLight {
+    #[inline]
+    fn sample_li(
+        &self,
+        ctx: &LightSampleContext,
+        u: Vec2,
+        wavelengths: &SampledWavelengths,
+    ) -> Option<LightSample> {
+        let (wi, x, y) = self.sample_direction(u)?;
         let pdf = self.texel_pdf(x, y);
         if !(pdf > 0.0 && pdf.is_finite()) {
             return None;
@@ -326,26 +354,59 @@ impl EnvironmentLight {
     }
 
     #[inline]
-    pub fn pdf_li(&self, wi: Vec3A) -> f32 {
-        let (x, y) = self.texel(equirect_uv((self.to_local * wi).normalize()));
-        self.texel_pdf(x, y)
+    fn pdf_li(&self, _ctx: &LightSampleContext, wi: Vec3A, _hit: Option<&LightHit>) -> f32 {
+        self.direction_pdf(wi)
     }
 
     #[inline]
-    pub fn infinite_radiance(
+    fn emitted_radiance(&self, _: &LightHit, _: Vec3A, _: &SampledWavelengths) -> SampledSpectrum {
+        SampledSpectrum::splat(0.0)
+    }
+
+    #[inline]
+    fn infinite_radiance(
         &self,
         direction: Vec3A,
         wavelengths: &SampledWavelengths,
     ) -> SampledSpectrum {
-        let (x, y) = self.texel(equirect_uv((self.to_local * direction).normalize()));
+        let (x, y) = self.texel_of(direction);
         self.texel_radiance(x, y, wavelengths)
+    }
+
+    fn sample_le(
+        &self,
+        scene: &SceneSphere,
+        u_pos: Vec2,
+        u_dir: Vec2,
+        wavelengths: &SampledWavelengths,
+    ) -> Option<LightLeSample> {
+        let (wi, _, _) = self.sample_direction(u_dir)?;
+        // The texel the direction maps back to (the sampled one but on a texel edge), so
+        // that the sample and `pdf_le` agree.
+        let (x, y) = self.texel_of(wi);
+        scene.emission(
+            wi,
+            u_pos,
+            self.texel_radiance(x, y, wavelengths),
+            self.texel_pdf(x, y),
+        )
+    }
+
+    fn pdf_le(
+        &self,
+        scene: &SceneSphere,
+        _origin: Vec3A,
+        _n: Vec3A,
+        direction: Vec3A,
+    ) -> (f32, f32) {
+        (scene.disk_pdf(), self.direction_pdf(-direction))
     }
 
     /// Φ ≈ π r² · scale · Σ_texels ΔΩ · Y_texel · Σ_λ white(λ) Δλ, W: the flux into a disk
     /// of the scene's radius from the whole map, with each texel's ∫ L dλ estimated as its
     /// luminance Y times that of the white illuminant (exact for grey maps; only used to
     /// choose lights).
-    pub fn power_w(&self, scene_radius_m: f32) -> f64 {
+    fn power_w(&self, scene_radius_m: f32) -> f64 {
         let r = f64::from(scene_radius_m);
         std::f64::consts::PI
             * r
@@ -353,6 +414,20 @@ impl EnvironmentLight {
             * f64::from(self.scale)
             * self.luminance_solid_angle_sr
             * self.white_integral_nm
+    }
+
+    fn bandwidth(&self) -> Bandwidth {
+        super::bandwidth::environment(self)
+    }
+
+    #[inline]
+    fn is_delta(&self) -> bool {
+        false
+    }
+
+    #[inline]
+    fn is_infinite(&self) -> bool {
+        true
     }
 }
 
@@ -410,7 +485,7 @@ mod tests {
             let r = chi2_test_adaptive(
                 &config,
                 |_, u| env.sample_li(&ctx, u, &wl).map(|s| s.wi),
-                |w| f64::from(env.pdf_li(w)),
+                |w| f64::from(env.direction_pdf(w)),
             );
             assert!(r.passed, "{}", r.message);
             assert!((r.pdf_integral - 1.0).abs() < 2e-3, "{}", r.message);
@@ -458,7 +533,7 @@ mod tests {
                 (f64::from(s.pdf) - expected).abs() < 1e-4 * expected,
                 "{x},{y}"
             );
-            assert_eq!(env.pdf_li(s.wi), s.pdf);
+            assert_eq!(env.direction_pdf(s.wi), s.pdf);
             assert_eq!(env.infinite_radiance(s.wi, &wl), s.radiance);
             assert!(x != 9 || y != 6, "sampled the black texel");
         }

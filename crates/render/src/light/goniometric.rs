@@ -13,15 +13,31 @@
 //! Flux Φ = ∮ I_v dω of the interpolated distribution is integrated once at build time
 //! (midpoint rule on a 0.25° × 0.25° grid in (C, γ), or over (H, V) with cos V) and used for
 //! `power_lm` and for light selection.
+//!
+//! Emitted rays: directions from a piecewise-constant table over the equal-area map of the
+//! sphere about the aim, (u, v) = (φ / 2π, (1 − cos γ) / 2) with φ from the length axis
+//! towards the width axis (`EMISSION_NU` × `EMISSION_NV` cells, each holding the largest
+//! candela of its 3 × 3 corner, edge and centre points, and never less than 10⁻³ of the
+//! mean so every direction that might emit can be sampled), uniform in solid angle within
+//! a cell: pdf_dir = pdf(u, v) / 4π (pbrt-v4 §12.2.4 `GoniometricLight::SampleLe` samples
+//! its image the same way).
 
 use std::f64::consts::PI;
 
 use glam::{DVec3, Vec2, Vec3A};
+use prism_bandwidth::Bandwidth;
 use prism_scene::photometric::{IntensityDistribution, PhotometryType};
-use prism_spectrum::{SampledWavelengths, Spectrum};
+use prism_spectrum::{SampledSpectrum, SampledWavelengths, Spectrum};
 
-use super::point::point_emitter_sample;
-use super::{LightSample, LightSampleContext};
+use super::environment::azimuth_fraction;
+use super::piecewise_constant::PiecewiseConstant2D;
+use super::point::{point_emission, point_emitter_sample};
+use super::scene_sphere::SceneSphere;
+use super::{LightHit, LightLeSample, LightSample, LightSampleContext, LightSource};
+
+/// Columns (φ) and rows (cos γ) of the emission table.
+const EMISSION_NU: usize = 64;
+const EMISSION_NV: usize = 64;
 
 /// The distribution in the luminaire's frame, ready to evaluate.
 #[derive(Clone, Debug, PartialEq)]
@@ -190,7 +206,7 @@ impl IntensityTable {
                     }
                 }
             }
-            _ => {
+            PhotometryType::B | PhotometryType::A => {
                 // d = cos V (…) + sin V p: dω = cos V dV dH, H ∈ [−π, π], V ∈ [−π/2, π/2].
                 let (nh, nv) = ((2.0 * PI / step) as usize, (PI / step) as usize);
                 for j in 0..nv {
@@ -219,9 +235,71 @@ pub struct GoniometricLight {
     pub flux_lm: f64,
     /// Radiant power, W (for light selection).
     pub power_w: f64,
+    /// Direction table of `sample_le` (module docs).
+    emission: PiecewiseConstant2D,
+}
+
+/// The luminaire-frame direction (along length, width, aim) of emission-table coordinates.
+#[inline]
+fn emission_local_direction(uv: Vec2) -> Vec3A {
+    let cos_g = (1.0 - 2.0 * uv.y).clamp(-1.0, 1.0);
+    let sin_g = (1.0 - cos_g * cos_g).max(0.0).sqrt();
+    let (sin_p, cos_p) = (2.0 * std::f32::consts::PI * uv.x).sin_cos();
+    Vec3A::new(sin_g * cos_p, sin_g * sin_p, cos_g)
 }
 
 impl GoniometricLight {
+    /// The luminaire at `position_m` with frame `axes` (length, width, aim), its table and
+    /// spectrum; builds the emission table.
+    pub fn new(
+        position_m: Vec3A,
+        axes: [DVec3; 3],
+        table: IntensityTable,
+        spectrum: Spectrum,
+        flux_lm: f64,
+        power_w: f64,
+    ) -> Self {
+        let mut light = Self {
+            position_m,
+            axes,
+            table,
+            spectrum,
+            flux_lm,
+            power_w,
+            emission: PiecewiseConstant2D::new(&[1.0], 1, 1),
+        };
+        // Candela on the (2 NU + 1) × (2 NV + 1) grid of cell corners, edge midpoints and
+        // centres; a cell takes the largest of its nine.
+        let (gu, gv) = (2 * EMISSION_NU + 1, 2 * EMISSION_NV + 1);
+        let mut grid = vec![0.0f64; gu * gv];
+        for j in 0..gv {
+            for i in 0..gu {
+                let uv = Vec2::new(i as f32 / (gu - 1) as f32, j as f32 / (gv - 1) as f32);
+                let d = emission_local_direction(uv).as_dvec3();
+                grid[j * gu + i] = light.table.eval_local(d.x, d.y, d.z).max(0.0);
+            }
+        }
+        let mut values = vec![0.0f32; EMISSION_NU * EMISSION_NV];
+        for y in 0..EMISSION_NV {
+            for x in 0..EMISSION_NU {
+                let mut m = 0.0f64;
+                for j in 0..3 {
+                    for i in 0..3 {
+                        m = m.max(grid[(2 * y + j) * gu + 2 * x + i]);
+                    }
+                }
+                values[y * EMISSION_NU + x] = m as f32;
+            }
+        }
+        let mean = values.iter().map(|&v| f64::from(v)).sum::<f64>() / values.len() as f64;
+        let floor = (1e-3 * mean) as f32;
+        for v in &mut values {
+            *v = v.max(floor);
+        }
+        light.emission = PiecewiseConstant2D::new(&values, EMISSION_NU, EMISSION_NV);
+        light
+    }
+
     /// Candela of the table (before the spectrum's scale) towards world direction `d`
     /// leaving the luminaire.
     pub fn table_candela(&self, d: DVec3) -> f64 {
@@ -229,8 +307,30 @@ impl GoniometricLight {
         self.table.eval_local(d.dot(l), d.dot(w), d.dot(a))
     }
 
+    /// The world direction of emission-table coordinates.
     #[inline]
-    pub fn sample_li(
+    fn emission_direction(&self, uv: Vec2) -> Vec3A {
+        let local = emission_local_direction(uv);
+        let [l, w, a] = self.axes.map(|v| v.as_vec3a());
+        (l * local.x + w * local.y + a * local.z).normalize()
+    }
+
+    /// pdf_dir of `sample_le` along the unit world `direction`: pdf(u, v) / 4π.
+    #[inline]
+    fn direction_pdf(&self, direction: Vec3A) -> f32 {
+        let d = direction.as_dvec3();
+        let [l, w, a] = self.axes;
+        let local = Vec3A::new(d.dot(l) as f32, d.dot(w) as f32, d.dot(a) as f32);
+        // azimuth_fraction measures from −z towards +x; (w, −l) puts φ = 0 on l, φ = ¼ on w.
+        let u = azimuth_fraction(Vec3A::new(local.y, 0.0, -local.x));
+        let v = ((1.0 - local.z) * 0.5).clamp(0.0, 1.0);
+        self.emission.pdf(Vec2::new(u, v)) * (0.25 / std::f32::consts::PI)
+    }
+}
+
+impl LightSource for GoniometricLight {
+    #[inline]
+    fn sample_li(
         &self,
         ctx: &LightSampleContext,
         _u: Vec2,
@@ -242,8 +342,68 @@ impl GoniometricLight {
         })
     }
 
-    pub fn power_w(&self) -> f64 {
+    #[inline]
+    fn pdf_li(&self, _ctx: &LightSampleContext, _wi: Vec3A, _hit: Option<&LightHit>) -> f32 {
+        0.0
+    }
+
+    #[inline]
+    fn emitted_radiance(&self, _: &LightHit, _: Vec3A, _: &SampledWavelengths) -> SampledSpectrum {
+        SampledSpectrum::splat(0.0)
+    }
+
+    #[inline]
+    fn infinite_radiance(&self, _: Vec3A, _: &SampledWavelengths) -> SampledSpectrum {
+        SampledSpectrum::splat(0.0)
+    }
+
+    fn sample_le(
+        &self,
+        _scene: &SceneSphere,
+        _u_pos: Vec2,
+        u_dir: Vec2,
+        wavelengths: &SampledWavelengths,
+    ) -> Option<LightLeSample> {
+        let (uv, pdf_uv, _) = self.emission.sample(u_dir);
+        if !(pdf_uv > 0.0 && pdf_uv.is_finite()) {
+            return None;
+        }
+        let w = self.emission_direction(uv);
+        // The density of the cell the direction maps back to (`pdf_le`'s function).
+        let pdf_dir = self.direction_pdf(w);
+        if !(pdf_dir > 0.0 && pdf_dir.is_finite()) {
+            return None;
+        }
+        let cd = self.table_candela(w.as_dvec3()).max(0.0) as f32;
+        Some(point_emission(
+            self.position_m,
+            w,
+            self.spectrum.eval(wavelengths) * cd,
+            pdf_dir,
+        ))
+    }
+
+    fn pdf_le(&self, _: &SceneSphere, _origin: Vec3A, _n: Vec3A, direction: Vec3A) -> (f32, f32) {
+        (1.0, self.direction_pdf(direction))
+    }
+
+    /// Φ = ∮ I dω from the build-time quadrature of the table, times ∫ s(λ) dλ, W.
+    fn power_w(&self, _scene_radius_m: f32) -> f64 {
         self.power_w
+    }
+
+    fn bandwidth(&self) -> Bandwidth {
+        super::bandwidth::point_like()
+    }
+
+    #[inline]
+    fn is_delta(&self) -> bool {
+        true
+    }
+
+    #[inline]
+    fn is_infinite(&self) -> bool {
+        false
     }
 }
 

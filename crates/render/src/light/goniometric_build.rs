@@ -47,7 +47,9 @@ pub(super) fn build(
     let factor = match strength {
         Strength::Scale(_) => value * tilt,
         Strength::LuminousFluxLm(_) => value / table_flux,
-        _ => return Err(b.unsupported()),
+        Strength::IntensityCd(_) | Strength::LuminanceCdM2(_) | Strength::IlluminanceLx(_) => {
+            return Err(b.unsupported())
+        }
     };
     // s(λ) carries 1 cd per unit: K_m Σ s ȳ Δλ = 1.
     let k = photometric_scale(&spectrum, 1.0).map_err(|e| b.err("spectrum", e))?;
@@ -60,12 +62,12 @@ pub(super) fn build(
     }
     let spectrum = spectrum.scaled(k as f32);
     let power_w = table_flux * integrate_nm(&spectrum);
-    Ok(Light::Goniometric(Box::new(GoniometricLight {
-        position_m: DVec3::from(*position_m).as_vec3a(),
-        axes: [l, w, a],
+    Ok(Light::Goniometric(Box::new(GoniometricLight::new(
+        DVec3::from(*position_m).as_vec3a(),
+        [l, w, a],
         table,
         spectrum,
-        flux_lm: table_flux * factor,
+        table_flux * factor,
         power_w,
-    })))
+    ))))
 }

@@ -100,8 +100,8 @@ impl LightSet {
     }
 
     /// The scene's bounding sphere that the infinite lights use.
-    pub fn scene_sphere(&self) -> SceneSphere {
-        self.scene
+    pub fn scene_sphere(&self) -> &SceneSphere {
+        &self.scene
     }
 
     pub fn len(&self) -> usize {

@@ -1,8 +1,25 @@
-//! Emitters. Every light answers, for a reference point, "sample a direction towards me"
-//! (`sample_li`, with the radiance arriving and the solid-angle pdf) and "how likely would
-//! you have sampled this direction" (`pdf_li`, for MIS against BSDF sampling); lights that
-//! paths can hit (area, environment, sky, a sun of non-zero size) also give the radiance
-//! leaving them (`emitted_radiance` for surfaces, `infinite_radiance` for directions).
+//! Emitters. Every light implements [`LightSource`] (no default methods, so a new light
+//! that misses one does not compile), and [`Light`] forwards each method by an exhaustive
+//! `match`. The contract, in pbrt-v4's terms (§12 `Light`, Veach 1997 ch. 10):
+//! - towards a reference point: `sample_li` (a direction towards the light with the
+//!   radiance arriving and its solid-angle pdf) and `pdf_li` (that pdf for a given
+//!   direction, for MIS against BSDF sampling);
+//! - from the light: `sample_le` (an emitted ray: a point with its area density `pdf_pos`
+//!   and a direction with its solid-angle density `pdf_dir`, for light tracing and BDPT) and
+//!   `pdf_le` (both densities for a given emission). Each pdf is the density the sampler
+//!   really uses; a Dirac (the position of point, spot and goniometric lights, the
+//!   direction of ideal parallel light) has density 1. Infinite lights start their rays on
+//!   the disk of the scene's bounding sphere facing the sampled direction (pdf_pos
+//!   1/(π r²));
+//! - what paths see: `emitted_radiance` at a point of an emitting surface and
+//!   `infinite_radiance` along an escaping direction (zero, explicitly, for lights
+//!   without a surface or without a part at infinity);
+//! - `power_w` (for light selection; infinite lights count the flux through the scene's
+//!   bounding sphere, π r² ∫∫ L dω dλ, so that it is the mean of `sample_le`'s power
+//!   estimator L / (pdf_pos pdf_dir) — exactly for uniform sky and ideal directional
+//!   light, approximately where stated per light), `bandwidth` (for the sample planner),
+//!   `is_delta` and `is_infinite`.
+//!
 //! `LightSet` holds them all, picks one per light sample in proportion to its power, and
 //! maps hit instances to area lights.
 //!
@@ -11,13 +28,16 @@
 //! unit projected solid angle in the same sense pbrt-v4 uses: the contribution of a light
 //! sample is f · |cos θ| · radiance / pdf, with pdf = 1 for a delta light.
 //!
-//! One file per emitter: `point`, `spot`, `directional` (ideal or with an angular
-//! diameter), `area` (sphere, disk, rectangle, triangle meshes), `environment`
-//! (equirectangular map), `sky` (uniform). `build` turns the scene's light descriptions
-//! into them (photometric strengths through `photometry`); docs/lights.md has every
-//! formula.
+//! One file per emitter: `point`, `spot`, `goniometric` (IES/EULUMDAT), `directional`
+//! (ideal or with an angular diameter), `area` (sphere, disk, rectangle, triangle meshes),
+//! `environment` (equirectangular map), `sky` (uniform), `daylight` (CIE, Perez, Preetham).
+//! `build` turns the scene's light descriptions into them (photometric strengths through
+//! `photometry`); docs/lights.md has every formula.
+
+#![deny(clippy::wildcard_enum_match_arm)]
 
 pub mod area;
+mod bandwidth;
 mod build;
 pub mod daylight;
 pub mod directional;
@@ -47,6 +67,8 @@ pub use sky::UniformSky;
 pub use spot::SpotLight;
 
 use glam::{Vec2, Vec3A};
+use prism_bandwidth::Bandwidth;
+use prism_geometry::Ray;
 use prism_spectrum::{SampledSpectrum, SampledWavelengths};
 
 pub use crate::spectrum_cache::SpectrumCache;
@@ -91,6 +113,90 @@ pub struct LightHit {
     pub distance_m: f32,
 }
 
+/// An emitted ray (`sample_le`), in pbrt-v4's conventions (§12.1 `LightLeSample`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LightLeSample {
+    /// Origin on the light (world, m) and unit direction of emission.
+    pub ray: Ray,
+    /// Unit normal of the emitting surface at the origin (area lights), zero for point-like
+    /// lights; for infinite lights the disk normal (= ray direction).
+    pub n: Vec3A,
+    /// pbrt-v4 conventions: area lights L_e(p, ω); point/spot/goniometric the intensity
+    /// I(ω) (W·sr⁻¹·nm⁻¹); infinite lights (environment, skies, sun with a disk) the
+    /// radiance arriving along −ray.direction; ideal directional light the irradiance (as
+    /// its sample_li radiance).
+    pub radiance: SampledSpectrum,
+    /// Area density of the origin, m⁻² (1 for a delta position; 1/(π r²) on the scene disk
+    /// for infinite lights).
+    pub pdf_pos: f32,
+    /// Solid-angle density of the direction, sr⁻¹ (1 for a delta direction: ideal
+    /// directional light).
+    pub pdf_dir: f32,
+}
+
+/// What every emitter answers (see the module docs). No default methods: a new light must
+/// state each answer, zero included.
+pub trait LightSource {
+    /// A direction from `ctx` towards the light, or `None` where the light cannot be
+    /// sampled from there.
+    fn sample_li(
+        &self,
+        ctx: &LightSampleContext,
+        u: Vec2,
+        wavelengths: &SampledWavelengths,
+    ) -> Option<LightSample>;
+
+    /// Solid-angle pdf with which `sample_li` from `ctx` produces `wi`; `hit` is where a ray
+    /// along `wi` met the light's surface (`None` for lights without one). 0 for delta
+    /// lights.
+    fn pdf_li(&self, ctx: &LightSampleContext, wi: Vec3A, hit: Option<&LightHit>) -> f32;
+
+    /// Radiance leaving the light's surface at `hit` towards `wo` (zero without a surface).
+    fn emitted_radiance(
+        &self,
+        hit: &LightHit,
+        wo: Vec3A,
+        wavelengths: &SampledWavelengths,
+    ) -> SampledSpectrum;
+
+    /// Radiance arriving from infinity along `direction` (unit, towards the light; zero for
+    /// lights at finite distance and for ideal parallel light).
+    fn infinite_radiance(
+        &self,
+        direction: Vec3A,
+        wavelengths: &SampledWavelengths,
+    ) -> SampledSpectrum;
+
+    /// An emitted ray from `u_pos` (the origin) and `u_dir` (the direction); `None` only
+    /// where a density would be 0 (the radiance may be zero). `scene` is the bounding
+    /// sphere whose disk infinite lights start from.
+    fn sample_le(
+        &self,
+        scene: &SceneSphere,
+        u_pos: Vec2,
+        u_dir: Vec2,
+        wavelengths: &SampledWavelengths,
+    ) -> Option<LightLeSample>;
+
+    /// (pdf_pos m⁻², pdf_dir sr⁻¹) with which `sample_le` produces an emission from
+    /// `origin` (surface normal `n`, zero if none) along the unit `direction`.
+    fn pdf_le(&self, scene: &SceneSphere, origin: Vec3A, n: Vec3A, direction: Vec3A) -> (f32, f32);
+
+    /// Radiant power in W over 360–830 nm; infinite lights through a sphere of radius
+    /// `scene_radius_m`.
+    fn power_w(&self, scene_radius_m: f32) -> f64;
+
+    /// ν_l for the sample planner (`bandwidth.rs`).
+    fn bandwidth(&self) -> Bandwidth;
+
+    /// Dirac in position or direction: BSDF-sampled rays never hit it.
+    fn is_delta(&self) -> bool;
+
+    /// At infinity: shadow rays go to infinity and the power uses the scene's bounding
+    /// sphere.
+    fn is_infinite(&self) -> bool;
+}
+
 /// One emitter.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Light {
@@ -123,7 +229,13 @@ impl Light {
             Light::Area(l) => {
                 l.sample_li_with(ctx, u, || cache.get(index, &l.radiance, wavelengths))
             }
-            _ => self.sample_li(ctx, u, wavelengths),
+            Light::Point(_)
+            | Light::Spot(_)
+            | Light::Directional(_)
+            | Light::Environment(_)
+            | Light::Sky(_)
+            | Light::Daylight(_)
+            | Light::Goniometric(_) => self.sample_li(ctx, u, wavelengths),
         }
     }
 
@@ -142,7 +254,13 @@ impl Light {
             Light::Area(l) => {
                 l.emitted_radiance_with(hit, wo, || cache.get(index, &l.radiance, wavelengths))
             }
-            _ => SampledSpectrum::splat(0.0),
+            Light::Point(_)
+            | Light::Spot(_)
+            | Light::Directional(_)
+            | Light::Environment(_)
+            | Light::Sky(_)
+            | Light::Daylight(_)
+            | Light::Goniometric(_) => SampledSpectrum::splat(0.0),
         }
     }
 
@@ -173,12 +291,14 @@ impl Light {
     #[inline]
     pub fn pdf_li(&self, ctx: &LightSampleContext, wi: Vec3A, hit: Option<&LightHit>) -> f32 {
         match self {
-            Light::Point(_) | Light::Spot(_) | Light::Goniometric(_) => 0.0,
-            Light::Directional(l) => l.pdf_li(wi),
+            Light::Point(l) => l.pdf_li(ctx, wi, hit),
+            Light::Spot(l) => l.pdf_li(ctx, wi, hit),
+            Light::Directional(l) => l.pdf_li(ctx, wi, hit),
             Light::Area(l) => l.pdf_li(ctx, wi, hit),
-            Light::Environment(l) => l.pdf_li(wi),
-            Light::Sky(l) => l.pdf_li(ctx, wi),
-            Light::Daylight(l) => l.pdf_li(wi),
+            Light::Environment(l) => l.pdf_li(ctx, wi, hit),
+            Light::Sky(l) => l.pdf_li(ctx, wi, hit),
+            Light::Daylight(l) => l.pdf_li(ctx, wi, hit),
+            Light::Goniometric(l) => l.pdf_li(ctx, wi, hit),
         }
     }
 
@@ -193,8 +313,14 @@ impl Light {
         wavelengths: &SampledWavelengths,
     ) -> SampledSpectrum {
         match self {
+            Light::Point(l) => l.emitted_radiance(hit, wo, wavelengths),
+            Light::Spot(l) => l.emitted_radiance(hit, wo, wavelengths),
+            Light::Directional(l) => l.emitted_radiance(hit, wo, wavelengths),
             Light::Area(l) => l.emitted_radiance(hit, wo, wavelengths),
-            _ => SampledSpectrum::splat(0.0),
+            Light::Environment(l) => l.emitted_radiance(hit, wo, wavelengths),
+            Light::Sky(l) => l.emitted_radiance(hit, wo, wavelengths),
+            Light::Daylight(l) => l.emitted_radiance(hit, wo, wavelengths),
+            Light::Goniometric(l) => l.emitted_radiance(hit, wo, wavelengths),
         }
     }
 
@@ -208,22 +334,105 @@ impl Light {
         wavelengths: &SampledWavelengths,
     ) -> SampledSpectrum {
         match self {
+            Light::Point(l) => l.infinite_radiance(direction, wavelengths),
+            Light::Spot(l) => l.infinite_radiance(direction, wavelengths),
             Light::Directional(l) => l.infinite_radiance(direction, wavelengths),
+            Light::Area(l) => l.infinite_radiance(direction, wavelengths),
             Light::Environment(l) => l.infinite_radiance(direction, wavelengths),
-            Light::Sky(l) => l.infinite_radiance(wavelengths),
-            Light::Daylight(l) => l.radiance(direction, wavelengths),
-            _ => SampledSpectrum::splat(0.0),
+            Light::Sky(l) => l.infinite_radiance(direction, wavelengths),
+            Light::Daylight(l) => l.infinite_radiance(direction, wavelengths),
+            Light::Goniometric(l) => l.infinite_radiance(direction, wavelengths),
+        }
+    }
+
+    /// Samples an emitted ray (light tracing, BDPT): the origin from `u_pos`, the
+    /// direction from `u_dir`; `scene` is the bounding sphere infinite lights start from
+    /// (`LightSet::scene_sphere`). See `LightLeSample` for what `radiance` means per kind.
+    #[inline]
+    pub fn sample_le(
+        &self,
+        scene: &SceneSphere,
+        u_pos: Vec2,
+        u_dir: Vec2,
+        wavelengths: &SampledWavelengths,
+    ) -> Option<LightLeSample> {
+        match self {
+            Light::Point(l) => l.sample_le(scene, u_pos, u_dir, wavelengths),
+            Light::Spot(l) => l.sample_le(scene, u_pos, u_dir, wavelengths),
+            Light::Directional(l) => l.sample_le(scene, u_pos, u_dir, wavelengths),
+            Light::Area(l) => l.sample_le(scene, u_pos, u_dir, wavelengths),
+            Light::Environment(l) => l.sample_le(scene, u_pos, u_dir, wavelengths),
+            Light::Sky(l) => l.sample_le(scene, u_pos, u_dir, wavelengths),
+            Light::Daylight(l) => l.sample_le(scene, u_pos, u_dir, wavelengths),
+            Light::Goniometric(l) => l.sample_le(scene, u_pos, u_dir, wavelengths),
+        }
+    }
+
+    /// Densities with which sample_le would produce an emission from `origin` (normal `n`,
+    /// zero if none) along `direction`; for infinite lights `origin` is ignored and pdf_pos
+    /// is the scene disk's 1/(π r²). A Dirac component answers 1 without checking that
+    /// `origin` (`direction`) is the light's own: callers ask about emissions it made.
+    #[inline]
+    pub fn pdf_le(
+        &self,
+        scene: &SceneSphere,
+        origin: Vec3A,
+        n: Vec3A,
+        direction: Vec3A,
+    ) -> (f32, f32) {
+        match self {
+            Light::Point(l) => l.pdf_le(scene, origin, n, direction),
+            Light::Spot(l) => l.pdf_le(scene, origin, n, direction),
+            Light::Directional(l) => l.pdf_le(scene, origin, n, direction),
+            Light::Area(l) => l.pdf_le(scene, origin, n, direction),
+            Light::Environment(l) => l.pdf_le(scene, origin, n, direction),
+            Light::Sky(l) => l.pdf_le(scene, origin, n, direction),
+            Light::Daylight(l) => l.pdf_le(scene, origin, n, direction),
+            Light::Goniometric(l) => l.pdf_le(scene, origin, n, direction),
         }
     }
 
     /// Dirac in position or direction: BSDF-sampled rays never hit it (point, spot,
-    /// directional with angular diameter 0).
+    /// goniometric, directional with angular diameter 0).
     #[inline]
     pub fn is_delta(&self) -> bool {
         match self {
-            Light::Point(_) | Light::Spot(_) | Light::Goniometric(_) => true,
+            Light::Point(l) => l.is_delta(),
+            Light::Spot(l) => l.is_delta(),
             Light::Directional(l) => l.is_delta(),
-            Light::Area(_) | Light::Environment(_) | Light::Sky(_) | Light::Daylight(_) => false,
+            Light::Area(l) => l.is_delta(),
+            Light::Environment(l) => l.is_delta(),
+            Light::Sky(l) => l.is_delta(),
+            Light::Daylight(l) => l.is_delta(),
+            Light::Goniometric(l) => l.is_delta(),
+        }
+    }
+
+    /// Dirac in position: point, spot and goniometric lights (`sample_le`'s pdf_pos is 1).
+    #[inline]
+    pub fn is_delta_position(&self) -> bool {
+        match self {
+            Light::Point(_) | Light::Spot(_) | Light::Goniometric(_) => true,
+            Light::Directional(_)
+            | Light::Area(_)
+            | Light::Environment(_)
+            | Light::Sky(_)
+            | Light::Daylight(_) => false,
+        }
+    }
+
+    /// Dirac in direction: ideal parallel light (`sample_le`'s pdf_dir is 1).
+    #[inline]
+    pub fn is_delta_direction(&self) -> bool {
+        match self {
+            Light::Directional(l) => l.is_delta(),
+            Light::Point(_)
+            | Light::Spot(_)
+            | Light::Goniometric(_)
+            | Light::Area(_)
+            | Light::Environment(_)
+            | Light::Sky(_)
+            | Light::Daylight(_) => false,
         }
     }
 
@@ -232,24 +441,45 @@ impl Light {
     /// see the non-delta ones (`LightSet::infinite_lights`).
     #[inline]
     pub fn is_infinite(&self) -> bool {
-        matches!(
-            self,
-            Light::Directional(_) | Light::Environment(_) | Light::Sky(_) | Light::Daylight(_)
-        )
+        match self {
+            Light::Point(l) => l.is_infinite(),
+            Light::Spot(l) => l.is_infinite(),
+            Light::Directional(l) => l.is_infinite(),
+            Light::Area(l) => l.is_infinite(),
+            Light::Environment(l) => l.is_infinite(),
+            Light::Sky(l) => l.is_infinite(),
+            Light::Daylight(l) => l.is_infinite(),
+            Light::Goniometric(l) => l.is_infinite(),
+        }
     }
 
     /// Radiant power in W (the integral of its spectrum over 360–830 nm), for choosing
     /// lights in proportion to power. Infinite lights use the scene's bounding sphere.
     pub fn power_w(&self, scene_radius_m: f32) -> f64 {
         match self {
-            Light::Point(l) => l.power_w(),
-            Light::Spot(l) => l.power_w(),
+            Light::Point(l) => l.power_w(scene_radius_m),
+            Light::Spot(l) => l.power_w(scene_radius_m),
             Light::Directional(l) => l.power_w(scene_radius_m),
-            Light::Area(l) => l.power_w(),
+            Light::Area(l) => l.power_w(scene_radius_m),
             Light::Environment(l) => l.power_w(scene_radius_m),
             Light::Sky(l) => l.power_w(scene_radius_m),
             Light::Daylight(l) => l.power_w(scene_radius_m),
-            Light::Goniometric(l) => l.power_w(),
+            Light::Goniometric(l) => l.power_w(scene_radius_m),
+        }
+    }
+
+    /// ν_l of the light for the sample planner (Bagher et al. 2013; choices in
+    /// `bandwidth.rs`).
+    pub fn bandwidth(&self) -> Bandwidth {
+        match self {
+            Light::Point(l) => l.bandwidth(),
+            Light::Spot(l) => l.bandwidth(),
+            Light::Directional(l) => l.bandwidth(),
+            Light::Area(l) => l.bandwidth(),
+            Light::Environment(l) => l.bandwidth(),
+            Light::Sky(l) => l.bandwidth(),
+            Light::Daylight(l) => l.bandwidth(),
+            Light::Goniometric(l) => l.bandwidth(),
         }
     }
 }

@@ -1,10 +1,18 @@
 //! An isotropic point light: intensity I(λ) in W·sr⁻¹·nm⁻¹ in every direction; the
-//! irradiance at distance d on a surface facing it is I/d² (inverse-square law).
+//! irradiance at distance d on a surface facing it is I/d² (inverse-square law). Emitted
+//! rays leave it uniformly over the sphere, pdf_dir = 1/4π (pbrt-v4 §12.2.1
+//! `PointLight::SampleLe`).
+
+use std::f32::consts::PI;
 
 use glam::{Vec2, Vec3A};
+use prism_bandwidth::Bandwidth;
+use prism_geometry::Ray;
 use prism_spectrum::{SampledSpectrum, SampledWavelengths, Spectrum};
 
-use super::{LightSample, LightSampleContext};
+use super::scene_sphere::SceneSphere;
+use super::warp::sample_uniform_sphere;
+use super::{LightHit, LightLeSample, LightSample, LightSampleContext, LightSource};
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct PointLight {
@@ -14,9 +22,9 @@ pub struct PointLight {
     pub intensity: Spectrum,
 }
 
-impl PointLight {
+impl LightSource for PointLight {
     #[inline]
-    pub fn sample_li(
+    fn sample_li(
         &self,
         ctx: &LightSampleContext,
         _u: Vec2,
@@ -27,9 +35,77 @@ impl PointLight {
         })
     }
 
+    #[inline]
+    fn pdf_li(&self, _ctx: &LightSampleContext, _wi: Vec3A, _hit: Option<&LightHit>) -> f32 {
+        0.0
+    }
+
+    #[inline]
+    fn emitted_radiance(&self, _: &LightHit, _: Vec3A, _: &SampledWavelengths) -> SampledSpectrum {
+        SampledSpectrum::splat(0.0)
+    }
+
+    #[inline]
+    fn infinite_radiance(&self, _: Vec3A, _: &SampledWavelengths) -> SampledSpectrum {
+        SampledSpectrum::splat(0.0)
+    }
+
+    #[inline]
+    fn sample_le(
+        &self,
+        _scene: &SceneSphere,
+        _u_pos: Vec2,
+        u_dir: Vec2,
+        wavelengths: &SampledWavelengths,
+    ) -> Option<LightLeSample> {
+        Some(point_emission(
+            self.position_m,
+            sample_uniform_sphere(u_dir),
+            self.intensity.eval(wavelengths),
+            1.0 / (4.0 * PI),
+        ))
+    }
+
+    #[inline]
+    fn pdf_le(&self, _: &SceneSphere, _origin: Vec3A, _n: Vec3A, _direction: Vec3A) -> (f32, f32) {
+        (1.0, 1.0 / (4.0 * PI))
+    }
+
     /// Φ = 4π ∫ I(λ) dλ, W.
-    pub fn power_w(&self) -> f64 {
+    fn power_w(&self, _scene_radius_m: f32) -> f64 {
         4.0 * std::f64::consts::PI * integrate_nm(&self.intensity)
+    }
+
+    fn bandwidth(&self) -> Bandwidth {
+        super::bandwidth::point_like()
+    }
+
+    #[inline]
+    fn is_delta(&self) -> bool {
+        true
+    }
+
+    #[inline]
+    fn is_infinite(&self) -> bool {
+        false
+    }
+}
+
+/// The emitted ray of a point emitter (point, spot, goniometric): from `position_m` along
+/// the unit `direction`, with the intensity I(ω) as radiance and pdf_pos = 1 (a Dirac).
+#[inline]
+pub(crate) fn point_emission(
+    position_m: Vec3A,
+    direction: Vec3A,
+    intensity: SampledSpectrum,
+    pdf_dir: f32,
+) -> LightLeSample {
+    LightLeSample {
+        ray: Ray::infinite(position_m, direction),
+        n: Vec3A::ZERO,
+        radiance: intensity,
+        pdf_pos: 1.0,
+        pdf_dir,
     }
 }
 
@@ -77,10 +153,8 @@ mod tests {
     use crate::light::Light;
 
     fn intensity_cd(light: &Light) -> f64 {
-        match light {
-            Light::Point(p) => photometric_sum(|wl| p.intensity.eval(wl)),
-            _ => panic!(),
-        }
+        let Light::Point(p) = light else { panic!() };
+        photometric_sum(|wl| p.intensity.eval(wl))
     }
 
     #[test]

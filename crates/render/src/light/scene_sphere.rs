@@ -1,9 +1,14 @@
 //! The scene's bounding sphere: infinite lights (sun, sky, environment) use its radius for
-//! their power (the flux through a disk of that radius, pbrt-v4 §12.5) and place the
-//! `p_light` of a sample beyond it.
+//! their power (the flux through a disk of that radius, pbrt-v4 §12.5), place the
+//! `p_light` of a sample beyond it, and start emitted rays on the disk of that radius that
+//! faces the emitted direction.
 
-use glam::Vec3A;
-use prism_geometry::{Geometry, Shape};
+use glam::{Vec2, Vec3A};
+use prism_geometry::{Frame, Geometry, Ray, Shape};
+use prism_spectrum::SampledSpectrum;
+
+use super::LightLeSample;
+use crate::sampling::sample_uniform_disk_concentric;
 
 /// A sphere bounding every instance of the scene (world, metres).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -64,6 +69,47 @@ impl SceneSphere {
     pub fn point_beyond(&self, p: Vec3A, wi: Vec3A) -> Vec3A {
         let reach = 2.0 * self.radius_m.max((p - self.center_m).length()).max(1.0);
         p + wi * reach
+    }
+
+    /// Area density of the origins of infinite lights' emitted rays: 1/(π r²) on the disk
+    /// (pbrt-v4 §12.5.1 `UniformInfiniteLight::SampleLe`), 0 for an empty scene.
+    #[inline]
+    pub fn disk_pdf(&self) -> f32 {
+        let pdf = 1.0 / (std::f32::consts::PI * self.radius_m * self.radius_m);
+        if pdf.is_finite() {
+            pdf
+        } else {
+            0.0
+        }
+    }
+
+    /// The emitted ray of an infinite light whose light arrives from the unit direction
+    /// `wi` (towards the light): the origin uniform (concentric map of `u`) on the disk of
+    /// radius r perpendicular to `wi`, centred at centre + r·wi, so every ray along −wi
+    /// that crosses the sphere starts on it (pbrt-v4 §12.5.1). `None` for an empty scene or
+    /// a zero `pdf_dir`.
+    #[inline]
+    pub(crate) fn emission(
+        &self,
+        wi: Vec3A,
+        u: Vec2,
+        radiance: SampledSpectrum,
+        pdf_dir: f32,
+    ) -> Option<LightLeSample> {
+        let pdf_pos = self.disk_pdf();
+        if !(pdf_pos > 0.0 && pdf_dir > 0.0 && pdf_dir < f32::INFINITY) {
+            return None;
+        }
+        let frame = Frame::from_z(wi);
+        let d = sample_uniform_disk_concentric(u);
+        let origin = self.center_m + self.radius_m * (wi + frame.x * d.x + frame.y * d.y);
+        Some(LightLeSample {
+            ray: Ray::infinite(origin, -wi),
+            n: -wi,
+            radiance,
+            pdf_pos,
+            pdf_dir,
+        })
     }
 }
 

@@ -6,17 +6,22 @@
 //! covered (transmission, and normals that face away from the incoming path) and the
 //! estimator L·f·|cos θ|/pdf = 2π L f has no cosine variance. In a medium (n = 0) a
 //! uniform direction on the sphere, density 1/4π.
+//!
+//! Emitted rays: a uniform direction on the sphere (pdf_dir 1/4π), from the scene disk
+//! facing it (pbrt-v4 §12.5.1 `UniformInfiniteLight::SampleLe`); the estimator's mean is
+//! `power_w` exactly.
 
 use std::f32::consts::PI;
 
 use glam::{Vec2, Vec3A};
+use prism_bandwidth::Bandwidth;
 use prism_geometry::Frame;
 use prism_spectrum::{SampledSpectrum, SampledWavelengths, Spectrum};
 
 use super::point::integrate_nm;
 use super::scene_sphere::SceneSphere;
 use super::warp::sample_uniform_sphere;
-use super::{LightSample, LightSampleContext};
+use super::{LightHit, LightLeSample, LightSample, LightSampleContext, LightSource};
 use crate::sampling::sample_cosine_hemisphere;
 
 #[derive(Clone, Debug, PartialEq)]
@@ -32,9 +37,9 @@ fn surface_normal(ctx: &LightSampleContext) -> Option<Vec3A> {
     ctx.n.try_normalize()
 }
 
-impl UniformSky {
+impl LightSource for UniformSky {
     #[inline]
-    pub fn sample_li(
+    fn sample_li(
         &self,
         ctx: &LightSampleContext,
         u: Vec2,
@@ -68,7 +73,7 @@ impl UniformSky {
     }
 
     #[inline]
-    pub fn pdf_li(&self, ctx: &LightSampleContext, wi: Vec3A) -> f32 {
+    fn pdf_li(&self, ctx: &LightSampleContext, wi: Vec3A, _hit: Option<&LightHit>) -> f32 {
         match surface_normal(ctx) {
             Some(n) => wi.dot(n).abs() / (2.0 * PI),
             None => 1.0 / (4.0 * PI),
@@ -76,15 +81,59 @@ impl UniformSky {
     }
 
     #[inline]
-    pub fn infinite_radiance(&self, wavelengths: &SampledWavelengths) -> SampledSpectrum {
+    fn emitted_radiance(&self, _: &LightHit, _: Vec3A, _: &SampledWavelengths) -> SampledSpectrum {
+        SampledSpectrum::splat(0.0)
+    }
+
+    #[inline]
+    fn infinite_radiance(
+        &self,
+        _direction: Vec3A,
+        wavelengths: &SampledWavelengths,
+    ) -> SampledSpectrum {
         self.radiance.eval(wavelengths)
+    }
+
+    fn sample_le(
+        &self,
+        scene: &SceneSphere,
+        u_pos: Vec2,
+        u_dir: Vec2,
+        wavelengths: &SampledWavelengths,
+    ) -> Option<LightLeSample> {
+        let wi = sample_uniform_sphere(u_dir);
+        scene.emission(wi, u_pos, self.radiance.eval(wavelengths), 1.0 / (4.0 * PI))
+    }
+
+    fn pdf_le(
+        &self,
+        scene: &SceneSphere,
+        _origin: Vec3A,
+        _n: Vec3A,
+        _direction: Vec3A,
+    ) -> (f32, f32) {
+        (scene.disk_pdf(), 1.0 / (4.0 * PI))
     }
 
     /// Φ = 4π · π r² ∫ L dλ: the flux the sky sends into a sphere of the scene's radius
     /// (pbrt-v4 `UniformInfiniteLight::Phi`), W.
-    pub fn power_w(&self, scene_radius_m: f32) -> f64 {
+    fn power_w(&self, scene_radius_m: f32) -> f64 {
         let r = f64::from(scene_radius_m);
         4.0 * std::f64::consts::PI * std::f64::consts::PI * r * r * integrate_nm(&self.radiance)
+    }
+
+    fn bandwidth(&self) -> Bandwidth {
+        super::bandwidth::uniform_sky()
+    }
+
+    #[inline]
+    fn is_delta(&self) -> bool {
+        false
+    }
+
+    #[inline]
+    fn is_infinite(&self) -> bool {
+        true
     }
 }
 
@@ -114,7 +163,7 @@ mod tests {
             let r = chi2_test_adaptive(
                 &config,
                 |_, u| sky.sample_li(&ctx, u, &wl).map(|s| s.wi),
-                |w| f64::from(sky.pdf_li(&ctx, w)),
+                |w| f64::from(sky.pdf_li(&ctx, w, None)),
             );
             assert!(r.passed, "n = {n}: {}", r.message);
             assert!(

@@ -9,14 +9,23 @@
 //!
 //! Flux: Φ = ∫ I dω = 2π I₀ [(1 − cos θ_start) + (cos θ_start − cos θ_cone)/2], exact
 //! because ∫₀¹ t²(3 − 2t) dt = ½ (pbrt-v4 `SpotLight::Phi`).
+//!
+//! Emitted rays: directions with density I(ω)/Φ (pbrt-v4 §12.2.2 `SpotLight::SampleLe`):
+//! the inner cone (uniform) or the falloff ring (cos θ by the smoothstep density, φ
+//! uniform), chosen in proportion to their shares of Φ, so pdf_dir = falloff(cos θ) / Ω_f
+//! with Ω_f = Φ / I₀ and I/pdf_dir = I₀ Ω_f for every direction.
 
 use std::f64::consts::PI;
 
 use glam::{Vec2, Vec3A};
-use prism_spectrum::{SampledWavelengths, Spectrum};
+use prism_bandwidth::Bandwidth;
+use prism_geometry::Frame;
+use prism_spectrum::{SampledSpectrum, SampledWavelengths, Spectrum};
 
-use super::point::{integrate_nm, point_emitter_sample};
-use super::{LightSample, LightSampleContext};
+use super::point::{integrate_nm, point_emission, point_emitter_sample};
+use super::scene_sphere::SceneSphere;
+use super::warp::{sample_smoothstep, sample_uniform_cone};
+use super::{LightHit, LightLeSample, LightSample, LightSampleContext, LightSource};
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct SpotLight {
@@ -74,8 +83,40 @@ impl SpotLight {
         solid_angle_of_falloff(f64::from(self.cos_cone), f64::from(self.cos_falloff_start))
     }
 
+    /// A direction in the spot's frame (+Z the axis) with density ∝ falloff(cos θ): the
+    /// inner cone with probability (1 − cos θ_start) / (Ω_f / 2π), else the ring.
     #[inline]
-    pub fn sample_li(
+    fn sample_falloff_local(&self, u: Vec2) -> Vec3A {
+        let inner = 1.0 - self.cos_falloff_start;
+        let ring = 0.5 * (self.cos_falloff_start - self.cos_cone);
+        let p_inner = inner / (inner + ring);
+        if u.x < p_inner {
+            let ux = (u.x / p_inner).min(1.0f32.next_down());
+            return sample_uniform_cone(Vec2::new(ux, u.y), inner);
+        }
+        let ux = ((u.x - p_inner) / (1.0 - p_inner)).clamp(0.0, 1.0);
+        let t = sample_smoothstep(ux);
+        let cos_theta = self.cos_cone + t * (self.cos_falloff_start - self.cos_cone);
+        let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
+        let (sin_phi, cos_phi) = (2.0 * std::f32::consts::PI * u.y).sin_cos();
+        Vec3A::new(sin_theta * cos_phi, sin_theta * sin_phi, cos_theta)
+    }
+
+    /// pdf_dir of `sample_le` along the unit `direction`: falloff(cos θ) / Ω_f.
+    #[inline]
+    fn direction_pdf(&self, direction: Vec3A) -> f32 {
+        let solid_angle = self.falloff_solid_angle_sr() as f32;
+        if solid_angle > 0.0 {
+            self.falloff(direction.dot(self.axis)) / solid_angle
+        } else {
+            0.0
+        }
+    }
+}
+
+impl LightSource for SpotLight {
+    #[inline]
+    fn sample_li(
         &self,
         ctx: &LightSampleContext,
         _u: Vec2,
@@ -87,9 +128,65 @@ impl SpotLight {
         })
     }
 
+    #[inline]
+    fn pdf_li(&self, _ctx: &LightSampleContext, _wi: Vec3A, _hit: Option<&LightHit>) -> f32 {
+        0.0
+    }
+
+    #[inline]
+    fn emitted_radiance(&self, _: &LightHit, _: Vec3A, _: &SampledWavelengths) -> SampledSpectrum {
+        SampledSpectrum::splat(0.0)
+    }
+
+    #[inline]
+    fn infinite_radiance(&self, _: Vec3A, _: &SampledWavelengths) -> SampledSpectrum {
+        SampledSpectrum::splat(0.0)
+    }
+
+    fn sample_le(
+        &self,
+        _scene: &SceneSphere,
+        _u_pos: Vec2,
+        u_dir: Vec2,
+        wavelengths: &SampledWavelengths,
+    ) -> Option<LightLeSample> {
+        let local = self.sample_falloff_local(u_dir);
+        let w = Frame::from_z(self.axis).from_local(local).normalize();
+        // The density of the direction as returned (the same function as `pdf_le`).
+        let falloff = self.falloff(w.dot(self.axis));
+        let pdf_dir = self.direction_pdf(w);
+        if !(pdf_dir > 0.0 && pdf_dir < f32::INFINITY) {
+            return None;
+        }
+        Some(point_emission(
+            self.position_m,
+            w,
+            self.intensity.eval(wavelengths) * falloff,
+            pdf_dir,
+        ))
+    }
+
+    fn pdf_le(&self, _: &SceneSphere, _origin: Vec3A, _n: Vec3A, direction: Vec3A) -> (f32, f32) {
+        (1.0, self.direction_pdf(direction))
+    }
+
     /// Φ = I₀ · 2π [(1 − cos θ_start) + (cos θ_start − cos θ_cone)/2] integrated over λ, W.
-    pub fn power_w(&self) -> f64 {
+    fn power_w(&self, _scene_radius_m: f32) -> f64 {
         integrate_nm(&self.intensity) * self.falloff_solid_angle_sr()
+    }
+
+    fn bandwidth(&self) -> Bandwidth {
+        super::bandwidth::point_like()
+    }
+
+    #[inline]
+    fn is_delta(&self) -> bool {
+        true
+    }
+
+    #[inline]
+    fn is_infinite(&self) -> bool {
+        false
     }
 }
 

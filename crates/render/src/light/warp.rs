@@ -1,6 +1,6 @@
 //! Sample warps of the emitters: uniform directions in a cone and on the sphere, uniform
-//! points in a triangle. Each maps the unit square to its domain with a constant density
-//! (stated per function), so the emitters' pdfs follow in closed form.
+//! points in a triangle, and the smoothstep density of a spot light's falloff ring. Each
+//! states its density, so the emitters' pdfs follow in closed form.
 
 use glam::{Vec2, Vec3A};
 use std::f32::consts::PI;
@@ -41,6 +41,35 @@ pub fn sample_uniform_triangle(u: Vec2) -> [f32; 3] {
         (u.x - b1, b1)
     };
     [b0, b1, 1.0 - b0 - b1]
+}
+
+/// t ∈ [0, 1] with density 2 smoothstep(t) = 2t²(3 − 2t) (pbrt-v4 §A.4.3
+/// `SampleSmoothStep`): the inverse of the CDF F(t) = 2t³ − t⁴ by Newton's method,
+/// safeguarded by bisection, in f64.
+pub fn sample_smoothstep(u: f32) -> f32 {
+    let u = f64::from(u).clamp(0.0, 1.0);
+    let (mut lo, mut hi) = (0.0f64, 1.0f64);
+    // F ≈ 2t³ near 0: a start within a few per cent everywhere but near 1.
+    let mut t = (0.5 * u).cbrt().min(1.0);
+    for _ in 0..40 {
+        let f = t * t * t * (2.0 - t) - u;
+        if f.abs() < 1e-12 {
+            break;
+        }
+        if f < 0.0 {
+            lo = t;
+        } else {
+            hi = t;
+        }
+        let df = t * t * (6.0 - 4.0 * t);
+        let next = t - f / df;
+        t = if df > 0.0 && next > lo && next < hi {
+            next
+        } else {
+            0.5 * (lo + hi)
+        };
+    }
+    t as f32
 }
 
 #[cfg(test)]
@@ -90,6 +119,17 @@ mod tests {
                 let sin_theta = Vec2::new(w.x, w.y).length();
                 assert!(sin_theta <= half_angle.sin() * (1.0 + 1e-5) && w.z > 0.0);
             }
+        }
+    }
+
+    #[test]
+    fn smoothstep_sampling_inverts_its_cdf() {
+        for i in 0..=1000 {
+            let u = i as f32 / 1000.0;
+            let t = f64::from(sample_smoothstep(u));
+            assert!((0.0..=1.0).contains(&t));
+            let cdf = 2.0 * t.powi(3) - t.powi(4);
+            assert!((cdf - f64::from(u)).abs() < 1e-6, "u {u}: t {t}, F {cdf}");
         }
     }
 

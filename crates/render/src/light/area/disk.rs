@@ -49,6 +49,27 @@ impl DiskEmitter {
         })
     }
 
+    /// A point uniform in area (`sample_le`): world position, normal, density 1/A.
+    #[inline]
+    pub fn sample_area(&self, u: Vec2) -> Option<(Vec3A, Vec3A, f32)> {
+        if self.area_m2 <= 0.0 {
+            return None;
+        }
+        let d = sample_uniform_disk_concentric(u) * self.disk.radius_m;
+        let p = self.to_world.point(Vec3A::new(d.x, d.y, 0.0));
+        Some((p, self.normal, 1.0 / self.area_m2))
+    }
+
+    /// Area density of `sample_area`: 1/A (0 without area).
+    #[inline]
+    pub fn pdf_area(&self) -> f32 {
+        if self.area_m2 > 0.0 {
+            1.0 / self.area_m2
+        } else {
+            0.0
+        }
+    }
+
     #[inline]
     pub fn pdf(&self, reference: Vec3A, hit: &LightHit) -> f32 {
         if self.area_m2 <= 0.0 {

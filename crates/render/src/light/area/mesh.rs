@@ -136,11 +136,10 @@ impl MeshEmitter {
         self.mesh.indices.len() * self.instances.len()
     }
 
-    #[inline]
-    pub fn sample(&self, reference: Vec3A, u: Vec2) -> Option<ShapeSample> {
-        if self.area_m2 <= 0.0 {
-            return None;
-        }
+    /// A point uniform in area over every instance: world position and the unit normal
+    /// a hit there reports.
+    #[inline(always)]
+    fn sample_point(&self, u: Vec2) -> Option<(Vec3A, Vec3A)> {
         let (k, _, ux) = self.instance_distribution.sample_discrete(u.x);
         let inst = self.instances.get(k)?;
         let (tri, _, ux) = inst.triangles.sample_discrete(ux);
@@ -162,9 +161,37 @@ impl MeshEmitter {
         if n == Vec3A::ZERO {
             return None;
         }
-        let p = inst.to_world.point(p_local);
+        Some((inst.to_world.point(p_local), n))
+    }
+
+    #[inline]
+    pub fn sample(&self, reference: Vec3A, u: Vec2) -> Option<ShapeSample> {
+        if self.area_m2 <= 0.0 {
+            return None;
+        }
+        let (p, n) = self.sample_point(u)?;
         let pdf = area_to_solid_angle((1.0 / self.area_m2) as f32, reference, p, n);
         Some(ShapeSample { p, n, pdf })
+    }
+
+    /// A point uniform in area (`sample_le`): world position, normal, density 1/A.
+    #[inline]
+    pub fn sample_area(&self, u: Vec2) -> Option<(Vec3A, Vec3A, f32)> {
+        if self.area_m2 <= 0.0 {
+            return None;
+        }
+        let (p, n) = self.sample_point(u)?;
+        Some((p, n, self.pdf_area()))
+    }
+
+    /// Area density of `sample_area`: 1/A (0 without area).
+    #[inline]
+    pub fn pdf_area(&self) -> f32 {
+        if self.area_m2 > 0.0 {
+            (1.0 / self.area_m2) as f32
+        } else {
+            0.0
+        }
     }
 
     #[inline]

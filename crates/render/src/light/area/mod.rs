@@ -18,6 +18,14 @@
 //! Directions towards points that do not emit towards the reference point (the back of a
 //! one-sided emitter) are not sampled (`sample_li` returns `None`) and have density 0 in
 //! `pdf_li`, so the two stay consistent.
+//!
+//! Emitted rays (pbrt-v4 §12.3 `DiffuseAreaLight::SampleLe`): a point by the shape's area
+//! sampling (`AreaShape::sample_area`: uniform in area for disk, rectangle and meshes, and
+//! for spheres the uniform local sphere mapped to the world, so an ellipsoid's density
+//! follows Nanson's stretch), then a cosine-weighted direction about the normal — about
+//! either side with probability ½ each when two-sided: pdf_dir = |cos θ| / π, or
+//! |cos θ| / 2π. The power estimator L |cos θ| / (pdf_pos pdf_dir) then has mean
+//! π A · sides · ∫ L dλ = `power_w`.
 
 mod disk;
 mod mesh;
@@ -29,11 +37,17 @@ pub use mesh::{EmitterMesh, MeshEmitter};
 pub use rectangle::RectangleEmitter;
 pub use sphere::SphereEmitter;
 
+use std::f32::consts::PI;
+
 use glam::{Vec2, Vec3A};
+use prism_bandwidth::Bandwidth;
+use prism_geometry::{Frame, Ray};
 use prism_spectrum::{SampledSpectrum, SampledWavelengths, Spectrum};
 
 use super::point::integrate_nm;
-use super::{LightHit, LightSample, LightSampleContext};
+use super::scene_sphere::SceneSphere;
+use super::{LightHit, LightLeSample, LightSample, LightSampleContext, LightSource};
+use crate::sampling::sample_cosine_hemisphere;
 
 /// A point sampled on a shape as seen from a reference point.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -101,6 +115,29 @@ impl AreaShape {
         }
     }
 
+    /// A point of the shape by its area sampling, without a reference point: (world
+    /// position, unit normal as hits report it, area density m⁻²).
+    #[inline]
+    pub fn sample_area(&self, u: Vec2) -> Option<(Vec3A, Vec3A, f32)> {
+        match self {
+            AreaShape::Sphere(s) => s.sample_area(u),
+            AreaShape::Disk(s) => s.sample_area(u),
+            AreaShape::Rectangle(s) => s.sample_area(u),
+            AreaShape::Mesh(s) => s.sample_area(u),
+        }
+    }
+
+    /// Area density (m⁻²) with which `sample_area` produces `p`, a point of this shape.
+    #[inline]
+    pub fn pdf_area(&self, p: Vec3A) -> f32 {
+        match self {
+            AreaShape::Sphere(s) => s.pdf_area(p),
+            AreaShape::Disk(s) => s.pdf_area(),
+            AreaShape::Rectangle(s) => s.pdf_area(),
+            AreaShape::Mesh(s) => s.pdf_area(),
+        }
+    }
+
     /// World-space surface area, m².
     pub fn area_m2(&self) -> f64 {
         match self {
@@ -134,14 +171,14 @@ impl AreaLight {
         }
     }
 
+    /// Density of `sample_le`'s directions about the normal `n`: |cos θ| / π on the
+    /// emitting side (|cos θ| / 2π on each side when two-sided), 0 elsewhere.
     #[inline]
-    pub fn sample_li(
-        &self,
-        ctx: &LightSampleContext,
-        u: Vec2,
-        wavelengths: &SampledWavelengths,
-    ) -> Option<LightSample> {
-        self.sample_li_with(ctx, u, || self.radiance.eval(wavelengths))
+    fn direction_pdf(&self, n: Vec3A, w: Vec3A) -> f32 {
+        if !self.emits_towards(n, w) {
+            return 0.0;
+        }
+        n.dot(w).abs() / (self.sides() as f32 * PI)
     }
 
     /// `sample_li` with L(λ) at the path's wavelengths from `radiance` (called only when a
@@ -175,24 +212,6 @@ impl AreaLight {
         })
     }
 
-    #[inline]
-    pub fn pdf_li(&self, ctx: &LightSampleContext, wi: Vec3A, hit: Option<&LightHit>) -> f32 {
-        match hit {
-            Some(hit) if self.emits_towards(hit.n, -wi) => self.shape.pdf(ctx.p, hit),
-            _ => 0.0,
-        }
-    }
-
-    #[inline]
-    pub fn emitted_radiance(
-        &self,
-        hit: &LightHit,
-        wo: Vec3A,
-        wavelengths: &SampledWavelengths,
-    ) -> SampledSpectrum {
-        self.emitted_radiance_with(hit, wo, || self.radiance.eval(wavelengths))
-    }
-
     /// `emitted_radiance` with L(λ) from `radiance` (see `sample_li_with`).
     #[inline]
     pub fn emitted_radiance_with(
@@ -216,10 +235,100 @@ impl AreaLight {
             1.0
         }
     }
+}
+
+impl LightSource for AreaLight {
+    #[inline]
+    fn sample_li(
+        &self,
+        ctx: &LightSampleContext,
+        u: Vec2,
+        wavelengths: &SampledWavelengths,
+    ) -> Option<LightSample> {
+        self.sample_li_with(ctx, u, || self.radiance.eval(wavelengths))
+    }
+
+    #[inline]
+    fn pdf_li(&self, ctx: &LightSampleContext, wi: Vec3A, hit: Option<&LightHit>) -> f32 {
+        match hit {
+            Some(hit) if self.emits_towards(hit.n, -wi) => self.shape.pdf(ctx.p, hit),
+            Some(_) | None => 0.0,
+        }
+    }
+
+    #[inline]
+    fn emitted_radiance(
+        &self,
+        hit: &LightHit,
+        wo: Vec3A,
+        wavelengths: &SampledWavelengths,
+    ) -> SampledSpectrum {
+        self.emitted_radiance_with(hit, wo, || self.radiance.eval(wavelengths))
+    }
+
+    #[inline]
+    fn infinite_radiance(&self, _: Vec3A, _: &SampledWavelengths) -> SampledSpectrum {
+        SampledSpectrum::splat(0.0)
+    }
+
+    fn sample_le(
+        &self,
+        _scene: &SceneSphere,
+        u_pos: Vec2,
+        u_dir: Vec2,
+        wavelengths: &SampledWavelengths,
+    ) -> Option<LightLeSample> {
+        let (p, n, pdf_pos) = self.shape.sample_area(u_pos)?;
+        if !(pdf_pos > 0.0 && pdf_pos < f32::INFINITY) {
+            return None;
+        }
+        // Two-sided: u_dir.x picks the side, then is stretched back to [0, 1).
+        let (side, ux) = if !self.two_sided {
+            (n, u_dir.x)
+        } else if u_dir.x < 0.5 {
+            (n, 2.0 * u_dir.x)
+        } else {
+            (-n, 2.0 * u_dir.x - 1.0)
+        };
+        let local = sample_cosine_hemisphere(Vec2::new(ux.min(1.0), u_dir.y));
+        let w = Frame::from_z(side).from_local(local).normalize();
+        let pdf_dir = self.direction_pdf(n, w);
+        if !(pdf_dir > 0.0 && pdf_dir < f32::INFINITY) {
+            return None;
+        }
+        Some(LightLeSample {
+            ray: Ray::spawn(p, w),
+            n,
+            radiance: self.radiance.eval(wavelengths),
+            pdf_pos,
+            pdf_dir,
+        })
+    }
+
+    fn pdf_le(&self, _: &SceneSphere, origin: Vec3A, n: Vec3A, direction: Vec3A) -> (f32, f32) {
+        (
+            self.shape.pdf_area(origin),
+            self.direction_pdf(n, direction),
+        )
+    }
 
     /// Φ = π A · sides · ∫ L dλ (Lambertian emission), W.
-    pub fn power_w(&self) -> f64 {
+    fn power_w(&self, _scene_radius_m: f32) -> f64 {
         std::f64::consts::PI * self.shape.area_m2() * self.sides() * integrate_nm(&self.radiance)
+    }
+
+    fn bandwidth(&self) -> Bandwidth {
+        super::bandwidth::area(self)
+    }
+
+    #[inline]
+    fn is_delta(&self) -> bool {
+        false
+    }
+
+    #[inline]
+    fn is_infinite(&self) -> bool {
+        false
     }
 }
 

@@ -54,6 +54,27 @@ impl RectangleEmitter {
         })
     }
 
+    /// A point uniform in area (`sample_le`): world position, normal, density 1/A.
+    #[inline]
+    pub fn sample_area(&self, u: Vec2) -> Option<(Vec3A, Vec3A, f32)> {
+        if self.area_m2 <= 0.0 {
+            return None;
+        }
+        let (w, h) = (self.rectangle.half_width_m, self.rectangle.half_height_m);
+        let local = Vec3A::new((2.0 * u.x - 1.0) * w, (2.0 * u.y - 1.0) * h, 0.0);
+        Some((self.to_world.point(local), self.normal, 1.0 / self.area_m2))
+    }
+
+    /// Area density of `sample_area`: 1/A (0 without area).
+    #[inline]
+    pub fn pdf_area(&self) -> f32 {
+        if self.area_m2 > 0.0 {
+            1.0 / self.area_m2
+        } else {
+            0.0
+        }
+    }
+
     #[inline]
     pub fn pdf(&self, reference: Vec3A, hit: &LightHit) -> f32 {
         if self.area_m2 <= 0.0 {

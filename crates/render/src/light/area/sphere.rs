@@ -131,6 +131,24 @@ impl SphereEmitter {
         })
     }
 
+    /// A point uniform on the local sphere mapped to the world (`sample_le`): world
+    /// position, unit normal and world area density (Nanson's stretch).
+    #[inline]
+    pub fn sample_area(&self, u: Vec2) -> Option<(Vec3A, Vec3A, f32)> {
+        let n_local = sample_uniform_sphere(u);
+        let p = self.to_world.point(n_local * self.sphere.radius_m);
+        let (n, pdf_area) = self.area_density(n_local)?;
+        Some((p, n, pdf_area))
+    }
+
+    /// Area density of `sample_area` at the world point `p` of the sphere.
+    #[inline]
+    pub fn pdf_area(&self, p: Vec3A) -> f32 {
+        let n_local = self.to_world.inverse_point(p).normalize_or_zero();
+        self.area_density(n_local)
+            .map_or(0.0, |(_, pdf_area)| pdf_area)
+    }
+
     /// World unit normal and world area density at the point of unit local normal
     /// `n_local` under uniform area sampling of the local sphere.
     #[inline]

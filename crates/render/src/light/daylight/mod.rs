@@ -38,7 +38,13 @@ pub const SUN_ANGULAR_DIAMETER_DEG: f64 = 0.533;
 pub fn outdoor_horizontal_illuminance_lx(lights: &super::LightSet) -> Option<f64> {
     let mut skies = (0..lights.len() as u32).filter_map(|i| match lights.light(i) {
         super::Light::Daylight(d) => Some(d.horizontal_illuminance_lx),
-        _ => None,
+        super::Light::Point(_)
+        | super::Light::Spot(_)
+        | super::Light::Directional(_)
+        | super::Light::Area(_)
+        | super::Light::Environment(_)
+        | super::Light::Sky(_)
+        | super::Light::Goniometric(_) => None,
     });
     let first = skies.next()?;
     skies.next().is_none().then_some(first)
@@ -71,7 +77,7 @@ impl SkyShape {
     pub fn chromaticity(&self, cos_z: f64, cos_chi: f64) -> (f64, f64) {
         match self {
             SkyShape::Preetham(s) => s.chromaticity(cos_z, cos_chi),
-            _ => (0.3127, 0.3290),
+            SkyShape::Cie(_) | SkyShape::Perez(_) => (0.3127, 0.3290),
         }
     }
 }

@@ -16,16 +16,23 @@
 //! cell; a direction is uniform in solid angle within the chosen cell. Density:
 //! pdf(ω) = pdf(u, v) / 4π. The radiance itself never comes from the table, so the table's
 //! resolution only changes the variance.
+//!
+//! **Emitted rays.** The same direction sampling, then an origin on the scene disk facing
+//! it (pbrt-v4 §12.5). The mean of the power estimator is π r² ∫∫ L dλ dω, which
+//! `power_w` approximates by the table's luminance times ∫ S dλ of the stated sky
+//! spectrum (exact but for the quadrature where every direction has that spectrum: CIE
+//! and Perez skies over a black ground).
 
 use std::f32::consts::PI;
 
 use glam::{Vec2, Vec3A};
+use prism_bandwidth::Bandwidth;
 use prism_spectrum::{SampledSpectrum, SampledWavelengths, Spectrum};
 
 use super::super::environment::azimuth_fraction;
 use super::super::piecewise_constant::PiecewiseConstant2D;
 use super::super::scene_sphere::SceneSphere;
-use super::super::{LightSample, LightSampleContext};
+use super::super::{LightHit, LightLeSample, LightSample, LightSampleContext, LightSource};
 use super::SkyShape;
 
 /// Table resolution: columns in φ, rows in cos θ (over the whole sphere).
@@ -191,28 +198,37 @@ impl DaylightSkyLight {
 
     /// Density of `sample_li` per steradian at the unit direction `wi`.
     #[inline]
-    pub fn pdf_li(&self, wi: Vec3A) -> f32 {
+    pub fn direction_pdf(&self, wi: Vec3A) -> f32 {
         self.distribution.pdf(sphere_uv(wi)) * (1.0 / (4.0 * PI))
     }
 
+    /// A direction from the table and its density (that of the cell the direction maps
+    /// back to: identical but for rounding on a cell boundary, so that sampling and
+    /// `direction_pdf` always agree).
     #[inline]
-    pub fn sample_li(
-        &self,
-        ctx: &LightSampleContext,
-        u: Vec2,
-        wavelengths: &SampledWavelengths,
-    ) -> Option<LightSample> {
+    fn sample_direction(&self, u: Vec2) -> Option<(Vec3A, f32)> {
         let (uv, pdf_uv, _) = self.distribution.sample(u);
         if !(pdf_uv > 0.0 && pdf_uv.is_finite()) {
             return None;
         }
         let wi = sphere_direction(uv);
-        // The density of the cell the direction maps back to (identical but for rounding
-        // on a cell boundary), so that sample_li and pdf_li always agree.
-        let pdf = self.pdf_li(wi);
+        let pdf = self.direction_pdf(wi);
         if pdf.is_nan() || pdf <= 0.0 {
             return None;
         }
+        Some((wi, pdf))
+    }
+}
+
+impl LightSource for DaylightSkyLight {
+    #[inline]
+    fn sample_li(
+        &self,
+        ctx: &LightSampleContext,
+        u: Vec2,
+        wavelengths: &SampledWavelengths,
+    ) -> Option<LightSample> {
+        let (wi, pdf) = self.sample_direction(u)?;
         Some(LightSample {
             wi,
             radiance: self.radiance(wi, wavelengths),
@@ -223,9 +239,63 @@ impl DaylightSkyLight {
         })
     }
 
+    #[inline]
+    fn pdf_li(&self, _ctx: &LightSampleContext, wi: Vec3A, _hit: Option<&LightHit>) -> f32 {
+        self.direction_pdf(wi)
+    }
+
+    #[inline]
+    fn emitted_radiance(&self, _: &LightHit, _: Vec3A, _: &SampledWavelengths) -> SampledSpectrum {
+        SampledSpectrum::splat(0.0)
+    }
+
+    #[inline]
+    fn infinite_radiance(
+        &self,
+        direction: Vec3A,
+        wavelengths: &SampledWavelengths,
+    ) -> SampledSpectrum {
+        self.radiance(direction, wavelengths)
+    }
+
+    fn sample_le(
+        &self,
+        scene: &SceneSphere,
+        u_pos: Vec2,
+        u_dir: Vec2,
+        wavelengths: &SampledWavelengths,
+    ) -> Option<LightLeSample> {
+        let (wi, pdf) = self.sample_direction(u_dir)?;
+        scene.emission(wi, u_pos, self.radiance(wi, wavelengths), pdf)
+    }
+
+    fn pdf_le(
+        &self,
+        scene: &SceneSphere,
+        _origin: Vec3A,
+        _n: Vec3A,
+        direction: Vec3A,
+    ) -> (f32, f32) {
+        (scene.disk_pdf(), self.direction_pdf(-direction))
+    }
+
     /// Φ ≈ π r² Σ L_v ΔΩ · ∫ S dλ per cd/m², W (only to choose lights).
-    pub fn power_w(&self, scene_radius_m: f32) -> f64 {
+    fn power_w(&self, scene_radius_m: f32) -> f64 {
         let r = f64::from(scene_radius_m);
         std::f64::consts::PI * r * r * self.luminance_solid_angle * self.radiant_per_luminance_nm
+    }
+
+    fn bandwidth(&self) -> Bandwidth {
+        super::super::bandwidth::daylight_sky()
+    }
+
+    #[inline]
+    fn is_delta(&self) -> bool {
+        false
+    }
+
+    #[inline]
+    fn is_infinite(&self) -> bool {
+        true
     }
 }

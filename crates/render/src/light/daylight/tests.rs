@@ -14,7 +14,7 @@ use crate::chi2::chi2_test_adaptive;
 use crate::light::test_support::{
     build_error, build_scene, chi2_config, mean_and_standard_error, photometric_sum,
 };
-use crate::light::{Light, LightSampleContext, LightSet};
+use crate::light::{Light, LightSampleContext, LightSet, LightSource};
 
 fn lights(light_fields: &str) -> LightSet {
     let dir = tempfile::tempdir().unwrap();
@@ -25,10 +25,10 @@ fn lights(light_fields: &str) -> LightSet {
 }
 
 fn daylight(set: &LightSet) -> &DaylightSkyLight {
-    match set.light(0) {
-        Light::Daylight(d) => d,
-        other => panic!("expected a daylight sky, found {other:?}"),
-    }
+    let Light::Daylight(d) = set.light(0) else {
+        panic!("expected a daylight sky, found {:?}", set.light(0))
+    };
+    d
 }
 
 /// Direction of elevation/azimuth in degrees (azimuth from north = −Z towards east = +X).
@@ -433,7 +433,7 @@ fn chi2_daylight_skies() {
             let r = chi2_test_adaptive(
                 &config,
                 |_, u| sky.sample_li(&ctx, u, &wl).map(|s| s.wi),
-                |w| f64::from(sky.pdf_li(w)),
+                |w| f64::from(sky.direction_pdf(w)),
             );
             assert!(r.passed, "{fields}, n = {n}: {}", r.message);
             assert!(
@@ -450,7 +450,7 @@ fn chi2_daylight_skies() {
                 n: Vec3A::Y,
             };
             if let Some(s) = sky.sample_li(&ctx, u, &wl) {
-                assert_eq!(s.pdf, sky.pdf_li(s.wi));
+                assert_eq!(s.pdf, sky.direction_pdf(s.wi));
                 assert!(!s.radiance.has_non_finite());
             }
         }
