@@ -236,8 +236,7 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
             args.scene.display()
         ));
     }
-    let mut scene =
-        RenderScene::build(&description, args.resolution).map_err(|e| e.to_string())?;
+    let mut scene = RenderScene::build(&description, args.resolution).map_err(|e| e.to_string())?;
     if let Some(strategy) = args.bdpt_strategy {
         match &mut scene.integrator {
             prism_render::Integrator::Bdpt(b) => {

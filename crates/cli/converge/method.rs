@@ -20,8 +20,16 @@ use prism_render::{Integrator, SamplerKind};
 /// Integrator names: (name, available in this build, what it is).
 pub const INTEGRATORS: [(&str, bool, &str); 8] = [
     ("path", true, "spectral path tracer (NEE + MIS)"),
-    ("light", true, "light tracing (light paths connected to the camera)"),
-    ("bdpt", true, "bidirectional path tracing (MIS over all strategies)"),
+    (
+        "light",
+        true,
+        "light tracing (light paths connected to the camera)",
+    ),
+    (
+        "bdpt",
+        true,
+        "bidirectional path tracing (MIS over all strategies)",
+    ),
     ("ambient_occlusion", true, "diagnostic"),
     ("depth", true, "diagnostic"),
     ("normal", true, "diagnostic"),

@@ -310,8 +310,7 @@ pub fn run(args: &ConvergeArgs) -> Result<(), String> {
         .iter()
         .map(|m| m.integrator(&description.integrator))
         .collect::<Result<_, _>>()?;
-    if integrators.iter().any(|i| i.is_spectral()) && scene.lights.is_empty()
-    {
+    if integrators.iter().any(|i| i.is_spectral()) && scene.lights.is_empty() {
         return Err(format!(
             "{}: the scene has no lights: every path-traced image is black and there is no \
              error to chart",

@@ -30,9 +30,9 @@ pub mod spectrum_cache;
 pub mod texture;
 
 pub use camera::{
-    CameraImportance, CameraModel, CameraWiSample,
-    ApertureSpec, Camera, CameraFrame, FisheyeCamera, FisheyeCoverage, FisheyeProjection,
-    FocalSpec, OrthographicCamera, PinholeCamera, SphericalCamera, ThinLensCamera,
+    ApertureSpec, Camera, CameraFrame, CameraImportance, CameraModel, CameraWiSample,
+    FisheyeCamera, FisheyeCoverage, FisheyeProjection, FocalSpec, OrthographicCamera,
+    PinholeCamera, SphericalCamera, ThinLensCamera,
 };
 pub use error::InvalidParameter;
 pub use film::{

@@ -4,8 +4,8 @@
 //! converges to the path tracer's image of its path length.
 
 use glam::UVec2;
-use prism_render::integrator::{Bdpt, BdptStrategy, LightTracer};
-use prism_render::{render_plan, Integrator, PathTracer, RenderScene, RenderSettings};
+use prism_render::integrator::{Bdpt, BdptStrategy, LightTracer, PathTracer};
+use prism_render::{render_plan, Integrator, RenderScene, RenderSettings};
 use prism_scene::MisHeuristic;
 
 fn scene(name: &str, resolution: UVec2) -> RenderScene {
@@ -95,8 +95,8 @@ fn non_specular_first_hits(scene: &RenderScene) -> Vec<bool> {
             for j in 0..5 {
                 for i in 0..5 {
                     let offset = glam::Vec2::new(i as f32, j as f32) / 4.0 * 2.0 - 1.0;
-                    let film = glam::Vec2::new(x as f32 + 0.5, y as f32 + 0.5)
-                        + offset * (radius + 0.5);
+                    let film =
+                        glam::Vec2::new(x as f32 + 0.5, y as f32 + 0.5) + offset * (radius + 0.5);
                     let Some(ray) = scene.camera.generate_ray_only(film, glam::Vec2::splat(0.5))
                     else {
                         ok = false;
@@ -145,13 +145,31 @@ fn methods_agree(name: &str, resolution: UVec2, spp: u32, seeds: usize) {
     let mut scene = scene(name, resolution);
     let path = path_of(&scene);
     let seeds: Vec<u64> = (0..seeds as u64).map(|k| 1000 + 17 * k).collect();
+    // The path tracer's own seeds: the methods share sample dimensions (camera sample,
+    // vertex blocks), so equal seeds would correlate their noise and hide a difference.
+    let path_seeds: Vec<u64> = seeds.iter().map(|s| s + 50_000).collect();
     let everywhere = vec![true; (resolution.x * resolution.y) as usize];
     let reachable = non_specular_first_hits(&scene);
-    assert!(reachable.iter().filter(|&&m| m).count() > 16, "{name}: too few pixels");
-    let p_all = channel_means(&mut scene, Integrator::Path(path), spp, &seeds, &everywhere);
+    assert!(
+        reachable.iter().filter(|&&m| m).count() > 16,
+        "{name}: too few pixels"
+    );
+    let p_all = channel_means(
+        &mut scene,
+        Integrator::Path(path),
+        spp,
+        &path_seeds,
+        &everywhere,
+    );
     let b_all = channel_means(&mut scene, bdpt_of(path, None), spp, &seeds, &everywhere);
     assert_agree(&format!("{name}: bdpt vs path"), b_all, p_all);
-    let p_reach = channel_means(&mut scene, Integrator::Path(path), spp, &seeds, &reachable);
+    let p_reach = channel_means(
+        &mut scene,
+        Integrator::Path(path),
+        spp,
+        &path_seeds,
+        &reachable,
+    );
     let l_reach = channel_means(&mut scene, light_of(path), spp, &seeds, &reachable);
     assert_agree(&format!("{name}: light vs path"), l_reach, p_reach);
 }
@@ -210,7 +228,10 @@ fn bdpt_strategy_images_sum_to_the_full_image() {
     }
     let mean = total / (3 * full.len()) as f64;
     eprintln!("strategies' sum vs full image: worst pixel difference {worst:e} (mean {mean})");
-    assert!(worst <= 1e-4 * mean, "worst difference {worst} vs mean pixel {mean}");
+    assert!(
+        worst <= 1e-4 * mean,
+        "worst difference {worst} vs mean pixel {mean}"
+    );
 }
 
 /// Each strategy alone (weight 1) of paths with `depth` scattering events converges to
@@ -229,6 +250,8 @@ fn unweighted_bdpt_strategies_converge_to_the_path_tracers_image_of_their_length
         let per_seed: Vec<[f64; 3]> = seeds
             .iter()
             .map(|&seed| {
+                // Seeds apart from the strategies' (shared sample dimensions).
+                let seed = seed + 50_000;
                 let hi = render_with(&mut scene, Integrator::Path(at(depth)), 64, seed);
                 let lo = if depth == 0 {
                     vec![[0.0; 3]; hi.len()]
@@ -258,7 +281,7 @@ fn unweighted_bdpt_strategies_converge_to_the_path_tracers_image_of_their_length
                 unweighted: true,
             };
             let b = channel_means(
-                &scene,
+                &mut scene,
                 bdpt_of(at(depth), Some(strategy)),
                 64,
                 &seeds,
@@ -280,7 +303,10 @@ fn light_and_bdpt_refuse_cameras_without_importance() {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
     let description = prism_scene::load_scene(root.join("cameras/orthographic.json")).unwrap();
     let mut scene = RenderScene::build(&description, Some(UVec2::new(8, 8))).unwrap();
-    for integrator in [light_of(PathTracer::default()), bdpt_of(PathTracer::default(), None)] {
+    for integrator in [
+        light_of(PathTracer::default()),
+        bdpt_of(PathTracer::default(), None),
+    ] {
         scene.integrator = integrator;
         let plan = prism_bandwidth::SamplePlan::uniform(scene.resolution, 1).unwrap();
         let e = render_plan(&scene, &settings(1, 0), &plan, &|_| {}).unwrap_err();
@@ -310,6 +336,7 @@ fn the_power_and_balance_heuristics_agree() {
     p.mis = MisHeuristic::Power;
     let power = channel_means(&mut scene, bdpt_of(p, None), 16, &seeds, &everywhere);
     p.mis = MisHeuristic::Balance;
-    let balance = channel_means(&mut scene, bdpt_of(p, None), 16, &seeds, &everywhere);
+    let other_seeds: Vec<u64> = seeds.iter().map(|s| s + 50_000).collect();
+    let balance = channel_means(&mut scene, bdpt_of(p, None), 16, &other_seeds, &everywhere);
     assert_agree("bdpt power vs balance", power, balance);
 }

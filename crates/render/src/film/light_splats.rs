@@ -8,9 +8,15 @@
 //! thread count (floating-point sums in one fixed order) without locks or atomics on the
 //! film.
 //!
-//! Normalisation. A pixel j measures I_j = ∫ f̂(x − c_j) L(x) dx over film points x in px,
-//! with f̂ = f / ∫f the filter normalised to integrate to 1 (the value filter importance
-//! sampling of camera samples converges to). With the camera's importance W_e normalised
+//! Normalisation. A pixel j measures I_j = ∫ f̂_j(x) L(x) dx over film points x in px,
+//! with f̂_j the filter around the pixel centre c_j normalised to integrate to 1 over where
+//! camera samples reach — the value the film's camera samples converge to. Filter
+//! importance sampling puts a pixel's samples at c_j plus an offset drawn from the whole
+//! filter, so f̂_j = f(x − c_j) / ∫f (and connections may land up to the filter radius
+//! outside the film, `CameraFrame::film_margin_px`); a splatting film (Mitsuba 3's
+//! `ImageBlock`) draws samples uniformly over the film and divides each pixel by its own
+//! Σ f, so f̂_j = f(x − c_j) / ∫_film f(x − c_j) dx, renormalised at the borders. Both are
+//! separable: one normaliser per column and per row. With the camera's importance W_e normalised
 //! to 1 over a film area A (px², `Camera::importance_area_px2`), a light path's
 //! connection C = β · f_s · G · W_e / pdf (W_e included) estimates I_j as
 //! A · f̂(x − c_j) · C per light path; over N light paths the pixel is
@@ -39,8 +45,9 @@ struct SpectralTap {
 pub struct LightSplats {
     resolution: UVec2,
     filter: Arc<FilterSampler>,
-    /// 1 / ∫∫ f(x, y) dx dy.
-    inverse_filter_integral: f32,
+    /// 1 / ∫ f₁ per film column and per film row (see the module docs).
+    inverse_norm_x: Arc<Vec<f32>>,
+    inverse_norm_y: Arc<Vec<f32>>,
     bins: Option<SpectralBins>,
     /// (pixel index, f̂ · XYZ).
     taps: Vec<(u32, [f32; 3])>,
@@ -53,13 +60,34 @@ impl LightSplats {
     pub(crate) fn new(
         resolution: UVec2,
         filter: Arc<FilterSampler>,
-        inverse_filter_integral: f32,
+        splatting_film: bool,
         bins: Option<SpectralBins>,
     ) -> Self {
+        let f = filter.filter();
+        let full = filter_integral_1d(f, None);
+        let norms = |n: u32| -> Arc<Vec<f32>> {
+            Arc::new(
+                (0..n)
+                    .map(|i| {
+                        let integral = if splatting_film {
+                            filter_integral_1d(f, Some((i as f64 + 0.5, f64::from(n))))
+                        } else {
+                            full
+                        };
+                        if integral > 0.0 {
+                            (1.0 / integral) as f32
+                        } else {
+                            0.0
+                        }
+                    })
+                    .collect(),
+            )
+        };
         Self {
             resolution,
+            inverse_norm_x: norms(resolution.x),
+            inverse_norm_y: norms(resolution.y),
             filter,
-            inverse_filter_integral,
             bins,
             taps: Vec::new(),
             spectral: Vec::new(),
@@ -103,13 +131,14 @@ impl LightSplats {
         }
         let (x0, x1, y0, y1) = (lo.x as u32, hi.x as u32, lo.y as u32, hi.y as u32);
         for py in y0..=y1 {
-            let fy = table.eval(py as f32 + 0.5 - film_point_px.y);
+            let fy =
+                table.eval(py as f32 + 0.5 - film_point_px.y) * self.inverse_norm_y[py as usize];
             if fy == 0.0 {
                 continue;
             }
             for px in x0..=x1 {
                 let fx = table.eval(px as f32 + 0.5 - film_point_px.x);
-                let w = fx * fy * self.inverse_filter_integral;
+                let w = fx * fy * self.inverse_norm_x[px as usize];
                 if w == 0.0 {
                     continue;
                 }
@@ -198,13 +227,22 @@ impl LightPlane {
     }
 }
 
-/// ∫ f₁(x) dx over [−r, r] of `filter`'s 1-D profile by the composite Simpson rule (the
-/// profiles are smooth inside their support; 4096 intervals put the error far below f32).
-pub(crate) fn filter_integral_1d(filter: &super::Filter) -> f64 {
+/// ∫ f₁(x − c) dx of `filter`'s 1-D profile over its support [c − r, c + r], or, with
+/// `Some((c, n))`, over its part inside the film's [0, n], by the composite Simpson rule
+/// (the profiles are smooth inside their support; 4096 intervals put the error far below
+/// f32).
+pub(crate) fn filter_integral_1d(filter: &super::Filter, within: Option<(f64, f64)>) -> f64 {
     let r = f64::from(filter.radius_px());
+    let (lo, hi) = match within {
+        None => (-r, r),
+        Some((c, n)) => ((-c).max(-r), (n - c).min(r)),
+    };
+    if hi <= lo {
+        return 0.0;
+    }
     let n = 4096usize;
-    let h = 2.0 * r / n as f64;
-    let f = |k: usize| f64::from(filter.eval_1d((-r + k as f64 * h) as f32));
+    let h = (hi - lo) / n as f64;
+    let f = |k: usize| f64::from(filter.eval_1d((lo + k as f64 * h) as f32));
     let mut sum = f(0) + f(n);
     for k in 1..n {
         sum += if k % 2 == 1 { 4.0 } else { 2.0 } * f(k);

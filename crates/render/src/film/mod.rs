@@ -345,11 +345,10 @@ impl Film {
     /// An empty splat list with this film's filter and bins (the light plane must exist:
     /// `light_splats` first).
     pub fn empty_light_splats(&self) -> LightSplats {
-        let integral = light_splats::filter_integral_1d(self.filter());
         LightSplats::new(
             self.resolution,
             Arc::clone(&self.filter_sampler),
-            (1.0 / (integral * integral)) as f32,
+            self.splat,
             self.spectral_bins,
         )
     }

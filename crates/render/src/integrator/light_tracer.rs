@@ -77,7 +77,15 @@ impl LightTracer {
         let importance_area = scene.camera.importance_area_px2();
         let tracer = self.path_tracer();
         // The light's own point, seen by the camera.
-        if let Some(c) = self.connect_light_point(scene, &tracer, light_path, state.stream, start, &transport, counters) {
+        if let Some(c) = self.connect_light_point(
+            scene,
+            &tracer,
+            light_path,
+            state.stream,
+            start,
+            &transport,
+            counters,
+        ) {
             let (film_point, value) = c;
             if !splats.splat(film_point, value * importance_area, &sensor) {
                 counters.non_finite_contributions += 1;
@@ -138,7 +146,9 @@ impl LightTracer {
         if light.is_delta_position() || light.is_delta_direction() {
             return None;
         }
-        let cs = scene.camera.sample_wi(v0.p, stream.get_2d_at(start.lens()))?;
+        let cs = scene
+            .camera
+            .sample_wi(v0.p, stream.get_2d_at(start.lens()))?;
         if cs.pdf_per_sr <= 0.0 || cs.importance <= 0.0 {
             return None;
         }
@@ -239,7 +249,14 @@ impl Estimator for LightTracer {
                 if radiance.has_non_finite() {
                     stats.non_finite_samples += 1;
                 }
-                add_camera_sample(tile, pixel, &cs, radiance, wavelengths.sensor(), aov.as_ref());
+                add_camera_sample(
+                    tile,
+                    pixel,
+                    &cs,
+                    radiance,
+                    wavelengths.sensor(),
+                    aov.as_ref(),
+                );
                 splats.count_paths(1);
                 stats.light_paths += 1;
                 stats.samples += 1;

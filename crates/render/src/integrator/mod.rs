@@ -42,13 +42,13 @@ mod scatter_vertex;
 
 pub use ambient_occlusion::AmbientOcclusion;
 pub use bdpt::{Bdpt, BdptStrategy};
-pub use light_tracer::LightTracer;
 pub use driver::{
     film_for, render, render_pass, render_pass_with, render_plan, total_samples, RenderError,
     RenderSettings, RenderStats, DEFAULT_TILE_SIZE_PX,
 };
 pub use estimator::{Estimator, Pass, TileWork};
 pub use lane_wavelengths::LaneWavelengths;
+pub use light_tracer::LightTracer;
 pub use path::{mis_weight, FirstHit, PathCounters, PathResult, PathTracer};
 pub use path_state::{PathOrigin, PathState, MAX_NULL_EVENTS};
 pub use scatter_vertex::{MediumVertex, ScatterEval, ScatterSample, ScatterVertex, SurfaceVertex};

@@ -125,6 +125,7 @@ impl LightSource for DirectionalLight {
                 p_light: self.scene.point_beyond(ctx.p, self.to_light),
                 distance_m: f32::INFINITY,
                 delta: true,
+                n_light: Vec3A::ZERO,
             });
         }
         let local = sample_uniform_cone(u, self.one_minus_cos_half_angle);
@@ -136,6 +137,7 @@ impl LightSource for DirectionalLight {
             p_light: self.scene.point_beyond(ctx.p, wi),
             distance_m: f32::INFINITY,
             delta: false,
+            n_light: Vec3A::ZERO,
         })
     }
 

@@ -350,6 +350,7 @@ impl LightSource for EnvironmentLight {
             p_light: self.scene.point_beyond(ctx.p, wi),
             distance_m: f32::INFINITY,
             delta: false,
+            n_light: Vec3A::ZERO,
         })
     }
 

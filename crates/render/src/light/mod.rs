@@ -99,6 +99,9 @@ pub struct LightSample {
     pub distance_m: f32,
     /// Dirac in direction: BSDF sampling can never hit it (MIS weight 1).
     pub delta: bool,
+    /// Unit normal of the emitting surface at `p_light` (area lights), zero for lights
+    /// without a surface: bidirectional methods convert densities at the light point.
+    pub n_light: Vec3A,
 }
 
 /// A point on an emitting surface that a path hit.

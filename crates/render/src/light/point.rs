@@ -133,6 +133,7 @@ pub(crate) fn point_emitter_sample(
         p_light: position_m,
         distance_m: d,
         delta: true,
+        n_light: Vec3A::ZERO,
     })
 }
 

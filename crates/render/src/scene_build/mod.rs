@@ -81,7 +81,11 @@ impl RenderScene {
             .map_err(|message| SceneBuildError::new(&file, "integrator", message))?;
         let filter = build_filter(&scene.film.filter)
             .map_err(|e| SceneBuildError::new(&file, "film.filter", e.to_string()))?;
-        let camera = build_camera(&file, &scene.camera, resolution, filter.radius_px())?;
+        // Camera samples reach the filter radius outside the film under filter importance
+        // sampling, not on a splatting film (its samples stay on the film).
+        let splatting = scene.film.reconstruction == prism_scene::Reconstruction::Splat;
+        let film_margin_px = if splatting { 0.0 } else { filter.radius_px() };
+        let camera = build_camera(&file, &scene.camera, resolution, film_margin_px)?;
         let mut albedo_rgb: Vec<[f32; 3]> = (0..scene.materials.len())
             .map(|i| material_albedo(&scene.materials, i))
             .collect();

@@ -22,7 +22,7 @@ use glam::{DVec3, UVec2, Vec3A};
 use prism_scene::{Sensor, SensorSampling};
 use rayon::prelude::*;
 
-use crate::integrator::{Integrator, PathCounters, PathTracer};
+use crate::integrator::{PathCounters, PathTracer};
 use crate::sampler::PixelSampler;
 use crate::scene_build::RenderScene;
 

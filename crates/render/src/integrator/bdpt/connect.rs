@@ -60,12 +60,19 @@ fn visibility(
     if len == 0.0 {
         return SampledSpectrum::splat(0.0);
     }
-    tracer.segment_transmittance(scene, Ray::spawn_to(from, to), d / len, wavelengths, counters)
+    tracer.segment_transmittance(
+        scene,
+        Ray::spawn_to(from, to),
+        d / len,
+        wavelengths,
+        counters,
+    )
 }
 
-/// The generalised geometry term G(a ↔ b) with visibility (pbrt-v3 `G`): cosines at
-/// surface vertices (shading normals) over the squared distance.
-fn geometry_term(
+/// The geometry term of a connection between two scattering vertices: visibility over
+/// the squared distance. The cosines of pbrt-v3's `G` are already in each vertex's
+/// `BdptVertex::f` (f·|cos θ| at surfaces; a phase function has none).
+fn inverse_square_with_visibility(
     scene: &RenderScene,
     tracer: &PathTracer,
     a: &BdptVertex,
@@ -73,20 +80,11 @@ fn geometry_term(
     wavelengths: &SampledWavelengths,
     counters: &mut PathCounters,
 ) -> SampledSpectrum {
-    let d = a.p - b.p;
-    let d2 = d.length_squared();
+    let d2 = (a.p - b.p).length_squared();
     if d2 == 0.0 {
         return SampledSpectrum::splat(0.0);
     }
-    let mut g = 1.0 / d2;
-    let w = d * g.sqrt();
-    if a.is_on_surface() {
-        g *= a.n_shading.dot(w).abs();
-    }
-    if b.is_on_surface() {
-        g *= b.n_shading.dot(w).abs();
-    }
-    visibility(scene, tracer, a, b, wavelengths, counters) * g
+    visibility(scene, tracer, a, b, wavelengths, counters) * (1.0 / d2)
 }
 
 /// Strategy (s, t) of the two subpaths, MIS-weighted with `mis` (weight 1 for `None`).
@@ -117,7 +115,12 @@ pub fn connect(
         if !pt.is_light() {
             return None;
         }
-        pt.le(scene, &camera.surfaces, &camera.vertices[t - 2], wavelengths) * pt.beta
+        pt.le(
+            scene,
+            &camera.surfaces,
+            &camera.vertices[t - 2],
+            wavelengths,
+        ) * pt.beta
     } else if t == 1 {
         // Connect a light-path vertex to a point on the lens.
         let qs = &light.vertices[s - 1];
@@ -151,7 +154,8 @@ pub fn connect(
         }
         let (index, pmf) = lights.sample(variates.u_light_choice)?;
         let light_source = lights.light(index);
-        let ls: LightSample = light_source.sample_li(&pt.light_context(), variates.u_light, wavelengths)?;
+        let ls: LightSample =
+            light_source.sample_li(&pt.light_context(), variates.u_light, wavelengths)?;
         if ls.pdf <= 0.0 || ls.radiance.is_black() {
             return None;
         }
@@ -188,7 +192,7 @@ pub fn connect(
         if c.is_black() {
             return None;
         }
-        c * geometry_term(scene, tracer, qs, pt, wavelengths, counters)
+        c * inverse_square_with_visibility(scene, tracer, qs, pt, wavelengths, counters)
     };
     if l.is_black() || l.has_non_finite() {
         if l.has_non_finite() {
@@ -313,7 +317,13 @@ fn mis_weight_in_place(
     // pt−1's density under the light side's sampling (through pt).
     if let Some(pm) = &pt_minus {
         camera.vertices[t - 2].pdf_rev = match &qs {
-            Some(qs) => pt.pdf(scene, &camera.surfaces, Some(qs), pm, TransportMode::Radiance),
+            Some(qs) => pt.pdf(
+                scene,
+                &camera.surfaces,
+                Some(qs),
+                pm,
+                TransportMode::Radiance,
+            ),
             None => pt.pdf_light(scene, pm),
         };
     }
@@ -327,8 +337,13 @@ fn mis_weight_in_place(
             TransportMode::Radiance,
         );
         if let Some(qm) = &qs_minus {
-            light.vertices[s - 2].pdf_rev =
-                qs.pdf(scene, &light.surfaces, Some(&pt), qm, TransportMode::Importance);
+            light.vertices[s - 2].pdf_rev = qs.pdf(
+                scene,
+                &light.surfaces,
+                Some(&pt),
+                qm,
+                TransportMode::Importance,
+            );
         }
     }
     let mut sum_ri = 0.0f32;

@@ -16,11 +16,11 @@
 //! connection there).
 
 mod connect;
-pub(crate) mod vertex;
+pub mod vertex;
 pub(crate) mod walk;
 
-pub use connect::{Connection, ConnectionVariates};
 pub(crate) use connect::connect as connect_strategy;
+pub use connect::{Connection, ConnectionVariates};
 
 use glam::UVec2;
 use prism_scene::MisHeuristic;
@@ -121,9 +121,15 @@ impl Bdpt {
         light_path: &mut Subpath<'s>,
         splats: &mut LightSplats,
         counters: &mut PathCounters,
-    ) -> (SampledSpectrum, SampledWavelengths, Option<SurfaceAov>, bool) {
+    ) -> (
+        SampledSpectrum,
+        SampledWavelengths,
+        Option<SurfaceAov>,
+        bool,
+    ) {
         let zero = SampledSpectrum::splat(0.0);
-        let wavelengths = LaneWavelengths::new(SampledWavelengths::sample_visible(cs.stream.get_1d()));
+        let wavelengths =
+            LaneWavelengths::new(SampledWavelengths::sample_visible(cs.stream.get_1d()));
         let Some(ray) = scene.camera.generate_ray_only(cs.film_point, cs.lens) else {
             return (zero, *wavelengths.sensor(), None, false);
         };

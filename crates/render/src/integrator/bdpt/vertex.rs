@@ -49,7 +49,12 @@ pub struct SurfaceScatter<'a> {
 }
 
 impl<'a> SurfaceScatter<'a> {
-    pub fn new(si: SurfaceInteraction, bsdf: Bsdf<'a>, ray_direction: Vec3A, check_sides: bool) -> Self {
+    pub fn new(
+        si: SurfaceInteraction,
+        bsdf: Bsdf<'a>,
+        ray_direction: Vec3A,
+        check_sides: bool,
+    ) -> Self {
         Self {
             frame: Frame::from_zx(si.n_shading, si.dpdu),
             si,
@@ -102,7 +107,12 @@ impl<'a> Subpath<'a> {
     }
 
     /// Appends a surface vertex.
-    pub fn push_surface(&mut self, scatter: SurfaceScatter<'a>, emitter: u32, beta: SampledSpectrum) {
+    pub fn push_surface(
+        &mut self,
+        scatter: SurfaceScatter<'a>,
+        emitter: u32,
+        beta: SampledSpectrum,
+    ) {
         let si = scatter.si;
         self.vertices.push(BdptVertex {
             kind: VertexKind::Surface {
@@ -241,9 +251,7 @@ impl BdptVertex {
             VertexKind::Medium(_) | VertexKind::Camera => true,
             VertexKind::Light { index } => !lights.light(index).is_delta_direction(),
             VertexKind::InfiniteLight { .. } => false,
-            VertexKind::Surface { scatter, .. } => {
-                !surfaces[scatter as usize].bsdf.is_specular()
-            }
+            VertexKind::Surface { scatter, .. } => !surfaces[scatter as usize].bsdf.is_specular(),
         }
     }
 
@@ -412,9 +420,10 @@ impl BdptVertex {
                 lights.pmf(index) * pdf_pos
             }
             VertexKind::Surface { emitter, .. } if emitter != NO_LIGHT => {
-                let (pdf_pos, _) = lights
-                    .light(emitter)
-                    .pdf_le(sphere, self.p, self.n_geometric, w);
+                let (pdf_pos, _) =
+                    lights
+                        .light(emitter)
+                        .pdf_le(sphere, self.p, self.n_geometric, w);
                 lights.pmf(emitter) * pdf_pos
             }
             VertexKind::Surface { .. } | VertexKind::Camera | VertexKind::Medium(_) => 0.0,
@@ -453,7 +462,9 @@ impl BdptVertex {
                     uv: surfaces[*scatter as usize].si.uv,
                     distance_m: w.length(),
                 };
-                lights.light(*emitter).emitted_radiance(&hit, w, wavelengths)
+                lights
+                    .light(*emitter)
+                    .emitted_radiance(&hit, w, wavelengths)
             }
             VertexKind::Surface { .. }
             | VertexKind::Light { .. }

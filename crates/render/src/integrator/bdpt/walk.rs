@@ -10,7 +10,6 @@
 
 use glam::Vec3A;
 use prism_geometry::Ray;
-use prism_spectrum::SampledSpectrum;
 
 use super::vertex::{infinite_light_density, BdptVertex, Subpath, SurfaceScatter};
 use crate::bsdf::TransportMode;
@@ -121,8 +120,11 @@ pub fn random_walk<'s>(
         let Some(bs) = v.sample(u_lobe, u, mode) else {
             break;
         };
-        let glazing_pass =
-            bs.transmission && scene.has_glazing && material.thin_glazing(path_state.wavelengths.transport()).is_some();
+        let glazing_pass = bs.transmission
+            && scene.has_glazing
+            && material
+                .thin_glazing(path_state.wavelengths.transport())
+                .is_some();
         let correction =
             super::vertex::shading_normal_correction(&scatter.si, scatter.wo, bs.wi, mode);
         let weight = bs.weight * correction;
@@ -226,8 +228,7 @@ pub fn light_subpath<'s>(
     let u_pos = path_state.stream.get_2d_at(start.position());
     let u_dir = path_state.stream.get_2d_at(start.direction());
     let sphere = lights.scene_sphere();
-    let Some(le) = light.sample_le(sphere, u_pos, u_dir, path_state.wavelengths.transport())
-    else {
+    let Some(le) = light.sample_le(sphere, u_pos, u_dir, path_state.wavelengths.transport()) else {
         return;
     };
     if le.pdf_pos <= 0.0 || le.pdf_dir <= 0.0 || le.radiance.is_black() {
@@ -269,9 +270,4 @@ pub fn light_subpath<'s>(
         }
         path.vertices[0].pdf_fwd = infinite_light_density(lights, le.ray.direction);
     }
-}
-
-/// Zero on every lane.
-pub fn black() -> SampledSpectrum {
-    SampledSpectrum::splat(0.0)
 }

@@ -209,6 +209,7 @@ impl AreaLight {
             p_light: s.p,
             distance_m: d,
             delta: false,
+            n_light: s.n,
         })
     }
 

@@ -236,6 +236,7 @@ impl LightSource for DaylightSkyLight {
             p_light: self.scene.point_beyond(ctx.p, wi),
             distance_m: f32::INFINITY,
             delta: false,
+            n_light: Vec3A::ZERO,
         })
     }
 
