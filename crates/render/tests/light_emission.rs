@@ -26,9 +26,9 @@ use prism_render::light::{AreaShape, Light, LightHit, LightSampleContext, LightS
 use prism_render::scene_build::build_geometry_with_instances;
 use prism_spectrum::{SampledSpectrum, SampledWavelengths, Spectrum};
 
-/// χ² tests in this file (22 of directions, 11 of positions): each runs at the Šidák level
+/// χ² tests in this file (23 of directions, 11 of positions): each runs at the Šidák level
 /// that keeps the family-wise rate at 1 %.
-const CHI2_TESTS: usize = 33;
+const CHI2_TESTS: usize = 34;
 
 /// `integration_resolution` sub-cells per bin edge: 8 resolve smooth densities and
 /// outlines (adaptively), an environment map's few bright sun texels (0.7° against 15° bins)
@@ -487,6 +487,7 @@ fn chi2_directions(case: &Case, u_pos: Option<Vec2>, seed: u64) {
             f64::from(light.pdf_le(scene, o, n, w).1)
         },
     );
+    println!("{}: {}", case.name, r.message);
     assert!(r.passed, "{}: {}", case.name, r.message);
     assert!(r.success_fraction > 0.999, "{}: {}", case.name, r.message);
     assert!(
@@ -737,6 +738,7 @@ fn chi2_positions_of_area_lights() {
                 f64::from(pdf_pos) * area_per_st / (4.0 * PI)
             },
         );
+        println!("{}: {}", case.name, r.message);
         assert!(r.passed, "{}: {}", case.name, r.message);
         assert!(
             (r.pdf_integral - 1.0).abs() < 0.01,
@@ -779,6 +781,7 @@ fn chi2_positions_on_the_scene_disk() {
                 f64::from(pdf_pos) * PI * f64::from(r_m * r_m) / (4.0 * PI)
             },
         );
+        println!("{}: {}", case.name, r.message);
         assert!(r.passed, "{}: {}", case.name, r.message);
         assert!(
             (r.pdf_integral - 1.0).abs() < 1e-3,

@@ -36,7 +36,7 @@
 //! shape of the nearest-texel radiance.
 //!
 //! **Emitted rays.** The same direction sampling, then an origin on the scene disk facing
-//! it (pbrt-v4 §12.5.3 `ImageInfiniteLight::SampleLe`); the radiance and pdf_dir are those
+//! it (pbrt-v4 §12.5.2 `ImageInfiniteLight::SampleLe`); the radiance and pdf_dir are those
 //! of the texel the direction maps back to, as `pdf_le` finds them. The mean of the power
 //! estimator is π r² Σ_texels ΔΩ ∫ L dλ; `power_w` estimates each texel's ∫ L dλ from its
 //! luminance (exact for grey maps).

@@ -14,10 +14,11 @@
 //! - what paths see: `emitted_radiance` at a point of an emitting surface and
 //!   `infinite_radiance` along an escaping direction (zero, explicitly, for lights
 //!   without a surface or without a part at infinity);
-//! - `power_w` (for light selection; infinite lights count the flux through the scene's
-//!   bounding sphere, π r² ∫∫ L dω dλ, so that it is the mean of `sample_le`'s power
-//!   estimator L / (pdf_pos pdf_dir) — exactly for uniform sky and ideal directional
-//!   light, approximately where stated per light), `bandwidth` (for the sample planner),
+//! - `power_w` in W over 360–830 nm, for light selection: the mean of `sample_le`'s
+//!   estimator L |cos θ| / (pdf_pos pdf_dir) integrated over λ; infinite lights count the
+//!   flux into the scene's bounding sphere, π r² ∫∫ L dω dλ (π r² ∫ E⊥ dλ for ideal
+//!   parallel light), approximately where a light's docs say so (environment map, daylight
+//!   skies, a directional light's disk); then `bandwidth` (for the sample planner),
 //!   `is_delta` and `is_infinite`.
 //!
 //! `LightSet` holds them all, picks one per light sample in proportion to its power, and
@@ -116,7 +117,7 @@ pub struct LightHit {
     pub distance_m: f32,
 }
 
-/// An emitted ray (`sample_le`), in pbrt-v4's conventions (§12.1 `LightLeSample`).
+/// An emitted ray (`sample_le`), in the conventions of pbrt-v4's `LightLeSample`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LightLeSample {
     /// Origin on the light (world, m) and unit direction of emission.

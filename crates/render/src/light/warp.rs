@@ -43,9 +43,9 @@ pub fn sample_uniform_triangle(u: Vec2) -> [f32; 3] {
     [b0, b1, 1.0 - b0 - b1]
 }
 
-/// t ∈ [0, 1] with density 2 smoothstep(t) = 2t²(3 − 2t) (pbrt-v4 §A.4.3
-/// `SampleSmoothStep`): the inverse of the CDF F(t) = 2t³ − t⁴ by Newton's method,
-/// safeguarded by bisection, in f64.
+/// t ∈ [0, 1] with density 2 smoothstep(t) = 2t²(3 − 2t) (pbrt-v4 `SampleSmoothStep`,
+/// Appendix A): the inverse of the CDF F(t) = 2t³ − t⁴ by Newton's method, safeguarded by
+/// bisection, in f64.
 pub fn sample_smoothstep(u: f32) -> f32 {
     let u = f64::from(u).clamp(0.0, 1.0);
     let (mut lo, mut hi) = (0.0f64, 1.0f64);
