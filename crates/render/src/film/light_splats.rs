@@ -54,6 +54,8 @@ pub struct LightSplats {
     spectral: Vec<SpectralTap>,
     /// Light paths traced by the work item.
     paths: u64,
+    /// Scratch: one splat's column weights.
+    column_weights: Vec<f32>,
 }
 
 impl LightSplats {
@@ -92,6 +94,7 @@ impl LightSplats {
             taps: Vec::new(),
             spectral: Vec::new(),
             paths: 0,
+            column_weights: Vec::new(),
         }
     }
 
@@ -130,15 +133,21 @@ impl LightSplats {
             return true;
         }
         let (x0, x1, y0, y1) = (lo.x as u32, hi.x as u32, lo.y as u32, hi.y as u32);
+        // The column weights once (a radius-2 filter touches up to 5 × 5 pixels).
+        let mut column_weights = std::mem::take(&mut self.column_weights);
+        column_weights.clear();
+        column_weights.extend((x0..=x1).map(|px| {
+            table.eval(px as f32 + 0.5 - film_point_px.x) * self.inverse_norm_x[px as usize]
+        }));
         for py in y0..=y1 {
             let fy =
                 table.eval(py as f32 + 0.5 - film_point_px.y) * self.inverse_norm_y[py as usize];
             if fy == 0.0 {
                 continue;
             }
-            for px in x0..=x1 {
-                let fx = table.eval(px as f32 + 0.5 - film_point_px.x);
-                let w = fx * fy * self.inverse_norm_x[px as usize];
+            for (k, &fx) in column_weights.iter().enumerate() {
+                let px = x0 + k as u32;
+                let w = fx * fy;
                 if w == 0.0 {
                     continue;
                 }
@@ -163,6 +172,7 @@ impl LightSplats {
                 }
             }
         }
+        self.column_weights = column_weights;
         true
     }
 

@@ -92,6 +92,7 @@ impl LightTracer {
             }
         }
         let first_block = start.first() + LightStartDimensions::COUNT;
+        let uses_lens = scene.camera.uses_lens_sample();
         // t = 1 connections sample their camera vertex; the camera subpath is never read.
         let mut no_camera = Subpath::default();
         for s in 2..=light_path.len() {
@@ -101,7 +102,11 @@ impl LightTracer {
             let variates = ConnectionVariates {
                 u_light_choice: 0.0,
                 u_light: glam::Vec2::ZERO,
-                u_lens: state.stream.get_2d_at(block.light()),
+                u_lens: if uses_lens {
+                    state.stream.get_2d_at(block.light())
+                } else {
+                    glam::Vec2::ZERO
+                },
             };
             let Some(c) = super::bdpt::connect_strategy(
                 scene,

@@ -372,7 +372,7 @@ impl PathTracer {
                 &mut reflectance_cache,
             );
             let vertex =
-                ScatterVertex::Surface(SurfaceVertex::new(&si, bsdf, ray.direction, shading_maps));
+                ScatterVertex::Surface(SurfaceVertex::new(&si, &bsdf, ray.direction, shading_maps));
             let ctx = vertex.light_context();
 
             // Next-event estimation.

@@ -20,7 +20,9 @@ use crate::medium::PhaseFunction;
 #[derive(Clone, Copy, Debug)]
 pub struct SurfaceVertex<'a> {
     pub si: &'a SurfaceInteraction,
-    pub bsdf: Bsdf<'a>,
+    /// Borrowed: a `Bsdf` is a few hundred bytes (a mix holds its lobes by value), and
+    /// bidirectional methods view one vertex from several directions.
+    pub bsdf: &'a Bsdf<'a>,
     pub frame: Frame,
     pub wo_local: Vec3A,
     /// The shading normal comes from a normal or bump map: directions whose side of the
@@ -80,7 +82,7 @@ impl<'a> SurfaceVertex<'a> {
     #[inline(always)]
     pub fn new(
         si: &'a SurfaceInteraction,
-        bsdf: Bsdf<'a>,
+        bsdf: &'a Bsdf<'a>,
         ray_direction: Vec3A,
         check_sides: bool,
     ) -> Self {
@@ -168,6 +170,22 @@ impl ScatterVertex<'_> {
         match self {
             ScatterVertex::Surface(s) => s.bsdf.pdf(s.wo_local, eval.wi_local, mode),
             ScatterVertex::Medium(m) => m.phase.pdf(m.wo, eval.wi_local),
+        }
+    }
+
+    /// Solid-angle pdf with which `sample` produces world direction `wi` (0 where a
+    /// shading-normal vertex refuses the direction's side): `pdf` without evaluating f.
+    #[inline(always)]
+    pub fn pdf_toward(&self, wi: Vec3A, mode: TransportMode) -> f32 {
+        match self {
+            ScatterVertex::Surface(s) => {
+                let wi_local = s.frame.to_local(wi);
+                if !s.sides_agree(wi, wi_local) {
+                    return 0.0;
+                }
+                s.bsdf.pdf(s.wo_local, wi_local, mode)
+            }
+            ScatterVertex::Medium(m) => m.phase.pdf(m.wo, wi),
         }
     }
 

@@ -187,6 +187,7 @@ impl Bdpt {
         let mut radiance = zero;
         let (n_camera, n_light) = (camera_path.len(), light_path.len());
         let light_first = start_of_light_vertex_blocks(start);
+        let uses_lens = scene.camera.uses_lens_sample();
         for t in 1..=n_camera {
             for s in 0..=n_light {
                 let depth = s as i64 + t as i64 - 2;
@@ -206,10 +207,24 @@ impl Bdpt {
                 let light_block = VertexDimensions::starting_at(
                     light_first + VertexDimensions::COUNT * (s.max(2) as u32 - 2),
                 );
+                // Only the variates the strategy reads (each is a hash or a Sobol point).
+                let (u_light_choice, u_light) = if s == 1 {
+                    (
+                        cs.stream.get_1d_at(camera_block.light_choice()),
+                        cs.stream.get_2d_at(camera_block.light()),
+                    )
+                } else {
+                    (0.0, glam::Vec2::ZERO)
+                };
+                let u_lens = if t == 1 && uses_lens {
+                    cs.stream.get_2d_at(light_block.light())
+                } else {
+                    glam::Vec2::ZERO
+                };
                 let variates = ConnectionVariates {
-                    u_light_choice: cs.stream.get_1d_at(camera_block.light_choice()),
-                    u_light: cs.stream.get_2d_at(camera_block.light()),
-                    u_lens: cs.stream.get_2d_at(light_block.light()),
+                    u_light_choice,
+                    u_light,
+                    u_lens,
                 };
                 let Some(c) = connect::connect(
                     scene,

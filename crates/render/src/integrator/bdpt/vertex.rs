@@ -70,7 +70,7 @@ impl<'a> SurfaceScatter<'a> {
     pub fn seen_from(&self, wo: Vec3A) -> ScatterVertex<'_> {
         ScatterVertex::Surface(SurfaceVertex {
             si: &self.si,
-            bsdf: self.bsdf,
+            bsdf: &self.bsdf,
             frame: self.frame,
             wo_local: self.frame.to_local(wo),
             check_sides: self.check_sides,
@@ -348,11 +348,9 @@ impl BdptVertex {
                 if arriving.length_squared() == 0.0 {
                     return 0.0;
                 }
-                let v = surfaces[*scatter as usize].seen_from(-arriving.normalize());
-                match v.eval(wn, mode) {
-                    Some(eval) => v.pdf(&eval, mode),
-                    None => 0.0,
-                }
+                surfaces[*scatter as usize]
+                    .seen_from(-arriving.normalize())
+                    .pdf_toward(wn, mode)
             }
             VertexKind::Medium(m) => match prev {
                 Some(prev) if prev.p != self.p => m.phase.pdf((prev.p - self.p).normalize(), wn),

@@ -112,22 +112,32 @@ pub fn random_walk<'s>(
             break;
         }
         counters.bounces += 1;
-        // Sample the next direction at the new vertex.
-        let scatter = path.surfaces[path.surfaces.len() - 1];
-        let v = scatter.scatter_vertex();
-        let u_lobe = path_state.stream.get_1d_at(dims.lobe());
-        let u = path_state.stream.get_2d_at(dims.bsdf());
-        let Some(bs) = v.sample(u_lobe, u, mode) else {
-            break;
+        // Sample the next direction at the new vertex, and the reverse density (sampling
+        // −ωo from ωi there), borrowing its scattering data in place.
+        let (bs, weight, pdf_rev) = {
+            let scatter = &path.surfaces[path.surfaces.len() - 1];
+            let v = scatter.scatter_vertex();
+            let u_lobe = path_state.stream.get_1d_at(dims.lobe());
+            let u = path_state.stream.get_2d_at(dims.bsdf());
+            let Some(bs) = v.sample(u_lobe, u, mode) else {
+                break;
+            };
+            let correction =
+                super::vertex::shading_normal_correction(&scatter.si, scatter.wo, bs.wi, mode);
+            let pdf_rev = if bs.specular {
+                0.0
+            } else {
+                scatter
+                    .seen_from(bs.wi.normalize())
+                    .pdf_toward(-ray.direction, mode)
+            };
+            (bs, bs.weight * correction, pdf_rev)
         };
         let glazing_pass = bs.transmission
             && scene.has_glazing
             && material
                 .thin_glazing(path_state.wavelengths.transport())
                 .is_some();
-        let correction =
-            super::vertex::shading_normal_correction(&scatter.si, scatter.wo, bs.wi, mode);
-        let weight = bs.weight * correction;
         if weight.is_black() || weight.has_non_finite() {
             if weight.has_non_finite() {
                 counters.non_finite_contributions += 1;
@@ -148,19 +158,12 @@ pub fn random_walk<'s>(
             continue;
         }
         let wi = bs.wi.normalize();
-        let (pdf_next, pdf_rev) = if bs.specular {
+        if bs.specular {
             path.vertices[index].delta = true;
-            (0.0, 0.0)
+            pdf_fwd = 0.0;
         } else {
-            // The reverse density: sampling −ωo from ωi at this vertex.
-            let reverse = scatter.seen_from(wi);
-            let pdf_rev = match reverse.eval(-ray.direction, mode) {
-                Some(eval) => reverse.pdf(&eval, mode),
-                None => 0.0,
-            };
-            (bs.pdf, pdf_rev)
-        };
-        pdf_fwd = pdf_next;
+            pdf_fwd = bs.pdf;
+        }
         let prev = path.vertices[prev_index];
         path.vertices[prev_index].pdf_rev = path.vertices[index].convert_density(pdf_rev, &prev);
         ray = Ray::spawn(si.p, wi);
