@@ -1,11 +1,13 @@
 //! A `SceneDescription` (prism-scene) turned into what the integrators need: geometry with
-//! its BVH, the camera, the film and the albedo of every material. What a fast path may
+//! its BVH, the camera, the film and the albedo of every material. What the description
+//! asks for but render does not do yet is refused here (`fields`), and what a fast path may
 //! not support is summed up once as the scene's `SceneFeatures` (`features`).
 
 mod albedo;
 mod camera;
 mod error;
 pub mod features;
+pub mod fields;
 mod filter;
 mod geometry;
 pub mod spectrum;
@@ -82,6 +84,7 @@ impl RenderScene {
         scene: &SceneDescription,
         resolution: Option<UVec2>,
     ) -> Result<Self, SceneBuildError> {
+        fields::refuse_unrendered(scene)?;
         let file = scene.file.clone();
         let resolution = resolution.unwrap_or(UVec2::new(
             scene.film.resolution[0],
