@@ -34,11 +34,12 @@ pub enum SceneFeature {
     DeltaLights,
     NonRectangleAreaLights,
     ThinLensCamera,
+    LightPaths,
 }
 
 impl SceneFeature {
     /// Every feature, in declaration order (bit `i` of `SceneFeatures` is `ALL[i]`).
-    pub const ALL: [SceneFeature; 15] = [
+    pub const ALL: [SceneFeature; 16] = [
         SceneFeature::DiagnosticIntegrator,
         SceneFeature::ParticipatingMedia,
         SceneFeature::OpacityMasks,
@@ -54,6 +55,7 @@ impl SceneFeature {
         SceneFeature::DeltaLights,
         SceneFeature::NonRectangleAreaLights,
         SceneFeature::ThinLensCamera,
+        SceneFeature::LightPaths,
     ];
 
     /// Short name, as `--explain` lists it.
@@ -74,6 +76,7 @@ impl SceneFeature {
             SceneFeature::DeltaLights => "delta lights",
             SceneFeature::NonRectangleAreaLights => "non-rectangle area lights",
             SceneFeature::ThinLensCamera => "thin-lens camera",
+            SceneFeature::LightPaths => "light tracing or BDPT",
         }
     }
 
@@ -135,6 +138,10 @@ impl SceneFeature {
             }
             SceneFeature::ThinLensCamera => {
                 "a thin-lens camera: every camera ray needs a lens sample (depth of field)"
+            }
+            SceneFeature::LightPaths => {
+                "the light tracer or BDPT: paths also start at the lights and are connected \
+                 to the camera, splatted onto the film"
             }
         }
     }
@@ -215,6 +222,7 @@ impl SceneFeatures {
             | Integrator::Normal
             | Integrator::Albedo
             | Integrator::AmbientOcclusion(_) => f.insert(SceneFeature::DiagnosticIntegrator),
+            Integrator::Light(_) | Integrator::Bdpt(_) => f.insert(SceneFeature::LightPaths),
             Integrator::Path(_) => {}
         }
         match camera {

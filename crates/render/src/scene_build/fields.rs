@@ -78,7 +78,10 @@ const INTEGRATORS: &[&str] = &[
     "integrator<albedo>",
     "integrator<ambient_occlusion>",
     "integrator<path>",
+    "integrator<light>",
+    "integrator<bdpt>",
 ];
+const TRANSPORT: &[&str] = &["integrator<path>", "integrator<light>", "integrator<bdpt>"];
 const SHAPES: &[&str] = &[
     "shapes[]<mesh>",
     "shapes[]<sphere>",
@@ -216,13 +219,14 @@ pub const FIELD_USES: &[FieldRow] = &[
         &["max_distance_m", "samples"],
         INTEGRATOR,
     ),
+    read(TRANSPORT, &["max_depth", "rr_depth"], INTEGRATOR),
     read(
-        &["integrator<path>"],
-        &["max_depth", "mis", "rr_depth"],
+        &["integrator<path>", "integrator<bdpt>"],
+        &["mis"],
         INTEGRATOR,
     ),
     read(
-        &["integrator<path>"],
+        TRANSPORT,
         &["sampler"],
         "`prism render`: crates/cli/render.rs run (RenderSettings::sampler)",
     ),

@@ -38,6 +38,7 @@ use super::transform::to_geometry_transform;
 /// change that renders them decides.
 pub const SMALL_SCENE_SUPPORTS: SceneFeatures = SceneFeatures::of(&[
     SceneFeature::DiagnosticIntegrator,
+    SceneFeature::LightPaths,
     SceneFeature::OpacityMasks,
     SceneFeature::ThinGlazing,
     SceneFeature::Dispersion,
