@@ -152,7 +152,21 @@ impl PacketScene {
             let r = &leaf.record;
             let constant = match scene.material(r.material_id) {
                 Material::Lambert { reflectance } => reflectance.constant(),
-                _ => None,
+                Material::Conductor { .. }
+                | Material::Dielectric { .. }
+                | Material::TwoSided { .. }
+                | Material::Mask { .. }
+                | Material::NormalMap { .. }
+                | Material::BumpMap { .. }
+                | Material::OrenNayar { .. }
+                | Material::Phong { .. }
+                | Material::BlinnPhong { .. }
+                | Material::Ward { .. }
+                | Material::Lafortune { .. }
+                | Material::Coated { .. }
+                | Material::ThinDielectric { .. }
+                | Material::Mix { .. }
+                | Material::Measured { .. } => None,
             };
             // Guaranteed by the features (`NonLambertianBsdfs`, `Textures`, …): a guard.
             let Some(constant) = constant else {
@@ -209,7 +223,15 @@ impl PacketScene {
                         radiance_slot,
                     })
                 }
-                _ => None,
+                // Other emitters (and empty rectangles) go through the scalar `Light` code.
+                Light::Area(_)
+                | Light::Point(_)
+                | Light::Spot(_)
+                | Light::Directional(_)
+                | Light::Environment(_)
+                | Light::Sky(_)
+                | Light::Daylight(_)
+                | Light::Goniometric(_) => None,
             })
             .collect();
         let flat_boxes = scene.geometry.flat_boxes(&flat);
