@@ -5,6 +5,10 @@
 //! The integrator follows the same facts at run time (a delta light gets MIS weight 1, a
 //! purely specular BSDF skips light sampling, dispersion keeps only the hero wavelength),
 //! so the plan is a faithful description, not a second code path.
+//!
+//! Each fast path (packet tracing, small-scene intersection) gets a line: on, with why
+//! `used`, or off, with why `not used: …` — the scene's features outside the path's
+//! allow-list, or the limit the scene is past.
 
 use std::fmt;
 
@@ -12,8 +16,9 @@ use glam::{Vec2, Vec3A};
 use prism_geometry::{Curvature, Differentials, SurfaceInteraction};
 use prism_spectrum::SampledWavelengths;
 
+use crate::integrator::packet::PacketScene;
 use crate::integrator::Integrator;
-use crate::scene_build::RenderScene;
+use crate::scene_build::{small_scene_not_used, RenderScene, SceneFeatures};
 
 /// One decision of the plan.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -67,6 +72,18 @@ fn probe_hit() -> SurfaceInteraction {
 
 fn on_off(b: bool) -> String {
     if b { "on" } else { "off" }.to_string()
+}
+
+/// "the scene's features (a, b) are within LIST", or that it has none.
+fn within(features: SceneFeatures, list: &str) -> String {
+    if features.is_empty() {
+        "the scene uses none of the features a fast path may lack".into()
+    } else {
+        format!(
+            "the scene's features ({}) are within {list}",
+            features.names()
+        )
+    }
 }
 
 impl RenderPlan {
@@ -128,30 +145,6 @@ impl RenderPlan {
                     "hero + 3 rotated wavelengths per path, visible-importance density".into(),
                     "spectral transport (Wilkie et al. 2014); 4 wavelengths share every ray".into(),
                 );
-                match &scene.packet {
-                    Some(packet) => choose(
-                        "packet tracing",
-                        format!(
-                            "on, {} paths per ray query, {} patches and {} boxes",
-                            crate::integrator::packet::lane_count(),
-                            packet.patch_count(),
-                            packet.box_count()
-                        ),
-                        "flat patches with constant Lambertian materials only: many paths \
-                         share every ray query, cuboid meshes are tested as boxes (same \
-                         estimator as the scalar tracer)"
-                            .into(),
-                    ),
-                    // Off: ask the scene why (only then is its packet form built again).
-                    None => match crate::integrator::packet::PacketScene::new(scene) {
-                        Ok(_) => choose(
-                            "packet tracing",
-                            "off".into(),
-                            "switched off for this render".into(),
-                        ),
-                        Err(why) => choose("packet tracing", "off".into(), why),
-                    },
-                }
                 let names: Vec<String> = dispersive
                     .iter()
                     .map(|&i| format!("`{}`", scene.material_names[i]))
@@ -259,6 +252,52 @@ impl RenderPlan {
                 "integrator",
                 other.name().to_string(),
                 "a diagnostic integrator: no light transport, lights and BSDFs are unused".into(),
+            ),
+        }
+        match &scene.packet {
+            Some(packet) => choose(
+                "packet tracing",
+                format!(
+                    "on, {} paths per ray query, {} patches and {} boxes",
+                    crate::integrator::packet::lane_count(),
+                    packet.patch_count(),
+                    packet.box_count()
+                ),
+                format!(
+                    "used: {}; flat patches with constant Lambertian materials: many paths \
+                     share every ray query, cuboid meshes are tested as boxes (same estimator \
+                     as the scalar tracer)",
+                    within(scene.features, "PacketScene::SUPPORTS")
+                ),
+            ),
+            // Off: ask the scene why (only then is its packet form built again).
+            None => choose(
+                "packet tracing",
+                "off".into(),
+                match PacketScene::new(scene) {
+                    Ok(_) => "not used: switched off for this render".into(),
+                    Err(why) => format!("not used: {why}"),
+                },
+            ),
+        }
+        match small_scene_not_used(&scene.geometry, scene.features) {
+            None => choose(
+                "small-scene intersection",
+                format!(
+                    "on, {} leaves tested eight at a time without a BVH",
+                    scene.geometry.flattened_triangle_count()
+                        + scene.geometry.instance_leaf_count()
+                ),
+                format!(
+                    "used: {}, and at most {} leaves",
+                    within(scene.features, "SMALL_SCENE_SUPPORTS"),
+                    prism_geometry::SMALL_SCENE_MAX_LEAVES
+                ),
+            ),
+            Some(why) => choose(
+                "small-scene intersection",
+                "off".into(),
+                format!("not used: {why}"),
             ),
         }
         choose(

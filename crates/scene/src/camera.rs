@@ -3,6 +3,7 @@
 //! `look_at`) places it in the world.
 
 use crate::reader::{Obj, Result, V};
+use crate::schema::schema;
 use crate::transform::{parse_transform, Transform};
 
 #[derive(Debug, Clone, PartialEq)]
@@ -131,7 +132,7 @@ fn transform_of(o: &Obj) -> Result<Transform> {
 pub(crate) fn parse_camera(v: &V) -> Result<Camera> {
     match v.tag("camera", &TYPES, Some("pinhole"))? {
         "pinhole" => {
-            let o = v.tagged_object(&["type", "transform", "fov_deg", "fov_axis"])?;
+            let o = v.tagged_object(schema!("camera<pinhole>"))?;
             let fov_rad = perspective_fov(&o)?;
             let fov_axis = match o.one_of_or(
                 "fov_axis",
@@ -149,16 +150,7 @@ pub(crate) fn parse_camera(v: &V) -> Result<Camera> {
             })
         }
         "thin_lens" => {
-            let o = v.tagged_object(&[
-                "type",
-                "transform",
-                "fov_deg",
-                "focal_length_mm",
-                "sensor_width_mm",
-                "f_number",
-                "aperture_radius_m",
-                "focus_distance_m",
-            ])?;
+            let o = v.tagged_object(schema!("camera<thin_lens>"))?;
             let sensor_width_m = o.positive_or("sensor_width_mm", DEFAULT_SENSOR_WIDTH_MM)? * 1e-3;
             let (focal_length_m, fov_rad) = match o.at_most_one(&["focal_length_mm", "fov_deg"])? {
                 Some(("focal_length_mm", f)) => {
@@ -199,7 +191,7 @@ pub(crate) fn parse_camera(v: &V) -> Result<Camera> {
             })
         }
         "fisheye" => {
-            let o = v.tagged_object(&["type", "transform", "projection", "fov_deg", "fit"])?;
+            let o = v.tagged_object(schema!("camera<fisheye>"))?;
             let projection = match o.one_of_or(
                 "projection",
                 "fisheye projection",
@@ -245,7 +237,7 @@ pub(crate) fn parse_camera(v: &V) -> Result<Camera> {
             })
         }
         "orthographic" => {
-            let o = v.tagged_object(&["type", "transform", "width_m"])?;
+            let o = v.tagged_object(schema!("camera<orthographic>"))?;
             Ok(Camera {
                 transform: transform_of(&o)?,
                 kind: CameraKind::Orthographic {
@@ -254,7 +246,7 @@ pub(crate) fn parse_camera(v: &V) -> Result<Camera> {
             })
         }
         _ => {
-            let o = v.tagged_object(&["type", "transform"])?;
+            let o = v.tagged_object(schema!("camera<spherical>"))?;
             Ok(Camera {
                 transform: transform_of(&o)?,
                 kind: CameraKind::Spherical,

@@ -5,6 +5,7 @@
 //! them into emitters; docs/lights.md (Daylight) has the formulas.
 
 use crate::reader::{Obj, Result, V};
+use crate::schema::schema;
 
 /// Which luminance distribution.
 #[derive(Debug, Clone, PartialEq)]
@@ -109,17 +110,6 @@ pub struct DaylightSky {
 
 pub const DAYLIGHT_TYPES: [&str; 3] = ["cie_sky", "perez_sky", "preetham_sky"];
 
-const COMMON: [&str; 8] = [
-    "type",
-    "sun",
-    "sky_cct_k",
-    "sun_cct_k",
-    "ground_albedo",
-    "north_deg",
-    "spectrum",
-    "scale",
-];
-
 fn parse_date_time(v: &V) -> Result<DateTime> {
     let s = v.str()?;
     let bad = || {
@@ -195,13 +185,7 @@ fn parse_date_time(v: &V) -> Result<DateTime> {
 }
 
 fn parse_sun_position(v: &V) -> Result<SunPosition> {
-    let o = v.object(&[
-        "elevation_deg",
-        "azimuth_deg",
-        "date_time",
-        "latitude_deg",
-        "longitude_deg",
-    ])?;
+    let o = v.object(schema!("@sun"))?;
     if let Some(t) = o.get("date_time") {
         for k in ["elevation_deg", "azimuth_deg"] {
             if let Some(x) = o.get(k) {
@@ -246,28 +230,11 @@ fn optional_non_negative(o: &Obj, key: &str) -> Result<Option<f64>> {
 
 /// Parses a `cie_sky`, `perez_sky` or `preetham_sky` light object.
 pub(crate) fn parse_daylight(v: &V, kind: &str) -> Result<DaylightSky> {
-    let extra: &[&str] = match kind {
-        "cie_sky" => &[
-            "sky_type",
-            "zenith_luminance_cd_m2",
-            "diffuse_horizontal_illuminance_lx",
-            "sun_normal_illuminance_lx",
-        ],
-        "perez_sky" => &[
-            "diffuse_horizontal_irradiance_w_m2",
-            "direct_normal_irradiance_w_m2",
-            "dew_point_c",
-            "diffuse_horizontal_illuminance_lx",
-            "direct_normal_illuminance_lx",
-        ],
-        _ => &[
-            "turbidity",
-            "diffuse_horizontal_illuminance_lx",
-            "sun_normal_illuminance_lx",
-        ],
-    };
-    let allowed: Vec<&str> = COMMON.iter().chain(extra).copied().collect();
-    let o = v.object(&allowed)?;
+    let o = v.object(match kind {
+        "cie_sky" => schema!("lights[]<cie_sky>"),
+        "perez_sky" => schema!("lights[]<perez_sky>"),
+        _ => schema!("lights[]<preetham_sky>"),
+    })?;
     for k in ["spectrum", "scale"] {
         if let Some(x) = o.get(k) {
             return Err(x.err(format!(

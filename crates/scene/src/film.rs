@@ -4,6 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use crate::reader::{quoted_list, Result, V};
+use crate::schema::schema;
 
 #[derive(Debug, Clone, PartialEq)]
 pub struct Film {
@@ -90,15 +91,7 @@ impl Default for Film {
 const MAX_EXACT_INTEGER: f64 = 9_007_199_254_740_992.0;
 
 pub(crate) fn parse_film(v: &V, base_dir: &Path) -> Result<Film> {
-    let o = v.object(&[
-        "resolution",
-        "filter",
-        "spp",
-        "seed",
-        "output",
-        "aovs",
-        "reconstruction",
-    ])?;
+    let o = v.object(schema!("film"))?;
     let defaults = Film::default();
     let resolution = match o.get("resolution") {
         None => defaults.resolution,
@@ -189,26 +182,26 @@ fn parse_filter(v: &V) -> Result<PixelFilter> {
     )?;
     Ok(match kind {
         "box" => {
-            let o = v.tagged_object(&["type", "radius_px"])?;
+            let o = v.tagged_object(schema!("film.filter<box>"))?;
             PixelFilter::Box {
                 radius_px: o.positive_or("radius_px", 0.5)?,
             }
         }
         "gaussian" => {
-            let o = v.tagged_object(&["type", "radius_px", "sigma_px"])?;
+            let o = v.tagged_object(schema!("film.filter<gaussian>"))?;
             PixelFilter::Gaussian {
                 radius_px: o.positive_or("radius_px", 1.5)?,
                 sigma_px: o.positive_or("sigma_px", 0.5)?,
             }
         }
         "blackman_harris" => {
-            let o = v.tagged_object(&["type", "radius_px"])?;
+            let o = v.tagged_object(schema!("film.filter<blackman_harris>"))?;
             PixelFilter::BlackmanHarris {
                 radius_px: o.positive_or("radius_px", 2.0)?,
             }
         }
         _ => {
-            let o = v.tagged_object(&["type", "radius_px", "b", "c"])?;
+            let o = v.tagged_object(schema!("film.filter<mitchell>"))?;
             PixelFilter::Mitchell {
                 radius_px: o.positive_or("radius_px", 2.0)?,
                 b: o.f64_or("b", 1.0 / 3.0)?,

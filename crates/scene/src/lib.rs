@@ -15,6 +15,7 @@ pub mod medium;
 pub mod photometric;
 mod reader;
 pub mod scene;
+pub mod schema;
 pub mod sensor;
 pub mod shape;
 pub mod spectrum_ref;

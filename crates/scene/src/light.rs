@@ -9,6 +9,7 @@ use glam::DVec3;
 use crate::daylight::{parse_daylight, DaylightSky};
 use crate::photometric::{load_photometric_file, IntensityDistribution};
 use crate::reader::{quoted_list, suggest, Obj, Result, V};
+use crate::schema::schema;
 use crate::shape::Shape;
 use crate::spectrum_ref::{parse_spectrum, NamedSpectra, SpectrumRef, SpectrumUse};
 use crate::transform::{parse_transform, Transform};
@@ -134,30 +135,15 @@ fn angle_deg(o: &Obj, key: &str, lo: f64, hi: f64, default: f64) -> Result<f64> 
 
 pub(crate) fn parse_light(v: &V, spectra: &NamedSpectra, shapes: &[Shape]) -> Result<Light> {
     let kind = v.tag("light", &LIGHT_TYPES, None)?;
-    let with = |extra: &[&'static str]| -> Vec<&'static str> {
-        ["type", "spectrum", "scale"]
-            .iter()
-            .chain(extra)
-            .copied()
-            .collect()
-    };
     let (o, kind, strength) = match kind {
         "point" => {
-            let o = v.object(&with(&["position_m", "power_lm", "intensity_cd"]))?;
+            let o = v.object(schema!("lights[]<point>"))?;
             let s = strength(&o, &["power_lm", "intensity_cd"])?;
             let position_m = o.vec3_or("position_m", [0.0; 3])?;
             (o, LightKind::Point { position_m }, s)
         }
         "spot" => {
-            let o = v.object(&with(&[
-                "position_m",
-                "direction",
-                "target_m",
-                "cone_angle_deg",
-                "falloff_start_deg",
-                "power_lm",
-                "intensity_cd",
-            ]))?;
+            let o = v.object(schema!("lights[]<spot>"))?;
             let s = strength(&o, &["power_lm", "intensity_cd"])?;
             let position_m = o.vec3_or("position_m", [0.0; 3])?;
             let direction = match o.at_most_one(&["direction", "target_m"])? {
@@ -193,11 +179,7 @@ pub(crate) fn parse_light(v: &V, spectra: &NamedSpectra, shapes: &[Shape]) -> Re
             )
         }
         "directional" => {
-            let o = v.object(&with(&[
-                "direction",
-                "angular_diameter_deg",
-                "illuminance_lx",
-            ]))?;
+            let o = v.object(schema!("lights[]<directional>"))?;
             let s = strength(&o, &["illuminance_lx"])?;
             let direction = match o.get("direction") {
                 None => [0.0, -1.0, 0.0],
@@ -214,12 +196,7 @@ pub(crate) fn parse_light(v: &V, spectra: &NamedSpectra, shapes: &[Shape]) -> Re
             )
         }
         "area" => {
-            let o = v.object(&with(&[
-                "shape",
-                "two_sided",
-                "power_lm",
-                "luminance_cd_m2",
-            ]))?;
+            let o = v.object(schema!("lights[]<area>"))?;
             let s = strength(&o, &["power_lm", "luminance_cd_m2"])?;
             let shape_v = o.req("shape", "the `name` of a shape")?;
             let wanted = shape_v.str()?;
@@ -242,7 +219,7 @@ pub(crate) fn parse_light(v: &V, spectra: &NamedSpectra, shapes: &[Shape]) -> Re
             (o, LightKind::Area { shape, two_sided }, s)
         }
         "environment" => {
-            let o = v.object(&["type", "file", "transform", "scale"])?;
+            let o = v.object(schema!("lights[]<environment>"))?;
             let s = strength(&o, &[])?;
             let path = o
                 .req("file", "an .exr or .hdr environment map")?
@@ -261,13 +238,7 @@ pub(crate) fn parse_light(v: &V, spectra: &NamedSpectra, shapes: &[Shape]) -> Re
             });
         }
         "luminaire" => {
-            let o = v.object(&with(&[
-                "file",
-                "position_m",
-                "aim",
-                "c0_direction",
-                "power_lm",
-            ]))?;
+            let o = v.object(schema!("lights[]<luminaire>"))?;
             let s = strength(&o, &["power_lm"])?;
             let file_v = o.req("file", "an .ies or .ldt photometric file")?;
             let path = file_v.asset("photometric", &["ies", "ldt"])?;
@@ -309,7 +280,7 @@ pub(crate) fn parse_light(v: &V, spectra: &NamedSpectra, shapes: &[Shape]) -> Re
             )
         }
         _ => {
-            let o = v.object(&with(&["luminance_cd_m2"]))?;
+            let o = v.object(schema!("lights[]<sky>"))?;
             let s = strength(&o, &["luminance_cd_m2"])?;
             (o, LightKind::UniformSky, s)
         }

@@ -5,6 +5,7 @@
 //! and dielectric `roughness`, mask `opacity`.
 
 use crate::reader::{quoted_list, suggest, Obj, Result, V};
+use crate::schema::schema;
 use crate::spectrum_ref::{parse_spectrum, NamedSpectra, SpectrumRef, SpectrumUse};
 use crate::texture::{is_texture_ref, parse_spectrum_param, parse_texture_ref};
 use crate::texture::{SpectrumParam, TextureTable};
@@ -311,7 +312,7 @@ fn parse_material(
 ) -> Result<MaterialKind> {
     Ok(match v.tag("material", &TYPES, None)? {
         "lambert" => {
-            let o = v.tagged_object(&["type", "reflectance"])?;
+            let o = v.tagged_object(schema!("materials.*<lambert>"))?;
             MaterialKind::Lambert {
                 reflectance: match o.get("reflectance") {
                     None => SpectrumParam::Spectrum(SpectrumRef::Constant(0.5)),
@@ -322,7 +323,7 @@ fn parse_material(
             }
         }
         "conductor" => {
-            let o = v.tagged_object(&["type", "metal", "eta", "k", "roughness", "distribution"])?;
+            let o = v.tagged_object(schema!("materials.*<conductor>"))?;
             let optics = match (o.get("metal"), o.get("eta"), o.get("k")) {
                 (Some(m), None, None) => ConductorOptics::Named(m.one_of("metal", &METAL_NAMES)?),
                 (None, Some(eta), Some(k)) => ConductorOptics::Spectra {
@@ -346,7 +347,7 @@ fn parse_material(
             }
         }
         "dielectric" => {
-            let o = v.tagged_object(&["type", "ior", "roughness", "distribution"])?;
+            let o = v.tagged_object(schema!("materials.*<dielectric>"))?;
             let ior = match o.get("ior") {
                 None => Ior::Constant(1.5),
                 Some(i) => parse_ior(&i)?,
@@ -361,13 +362,13 @@ fn parse_material(
             }
         }
         "two_sided" => {
-            let o = v.tagged_object(&["type", "material"])?;
+            let o = v.tagged_object(schema!("materials.*<two_sided>"))?;
             MaterialKind::TwoSided {
                 material: material_index(&o.req("material", "a material name")?, names)?,
             }
         }
         "normal_map" => {
-            let o = v.tagged_object(&["type", "material", "texture"])?;
+            let o = v.tagged_object(schema!("materials.*<normal_map>"))?;
             let t = o.req("texture", "a texture name or an image texture object")?;
             MaterialKind::NormalMap {
                 material: material_index(&o.req("material", "a material name")?, names)?,
@@ -375,7 +376,7 @@ fn parse_material(
             }
         }
         "bump_map" => {
-            let o = v.tagged_object(&["type", "material", "texture", "scale_m"])?;
+            let o = v.tagged_object(schema!("materials.*<bump_map>"))?;
             let t = o.req(
                 "texture",
                 "a texture name or texture object (the height field)",
@@ -389,7 +390,7 @@ fn parse_material(
             }
         }
         "mask" => {
-            let o = v.tagged_object(&["type", "material", "opacity"])?;
+            let o = v.tagged_object(schema!("materials.*<mask>"))?;
             let (opacity, opacity_texture) = match o.get("opacity") {
                 Some(a) if is_texture_ref(&a) => {
                     (1.0, Some(parse_texture_ref(&a, spectra, textures)?))
@@ -424,7 +425,11 @@ fn parse_library_material(
 ) -> Result<MaterialKind> {
     Ok(match tag {
         "oren_nayar" | "oren_nayar_qualitative" => {
-            let o = v.tagged_object(&["type", "reflectance", "sigma_deg"])?;
+            let o = v.tagged_object(if tag == "oren_nayar" {
+                schema!("materials.*<oren_nayar>")
+            } else {
+                schema!("materials.*<oren_nayar_qualitative>")
+            })?;
             MaterialKind::OrenNayar {
                 reflectance: reflectance_or(&o, "reflectance", spectra, 0.5)?,
                 sigma_deg: o
@@ -437,7 +442,11 @@ fn parse_library_material(
             }
         }
         "phong" | "blinn_phong" => {
-            let o = v.tagged_object(&["type", "diffuse", "specular", "exponent"])?;
+            let o = v.tagged_object(if tag == "phong" {
+                schema!("materials.*<phong>")
+            } else {
+                schema!("materials.*<blinn_phong>")
+            })?;
             let diffuse = reflectance_or(&o, "diffuse", spectra, 0.5)?;
             let specular = reflectance_or(&o, "specular", spectra, 0.2)?;
             let exponent = o
@@ -458,7 +467,7 @@ fn parse_library_material(
             }
         }
         "ward" => {
-            let o = v.tagged_object(&["type", "diffuse", "specular", "alpha"])?;
+            let o = v.tagged_object(schema!("materials.*<ward>"))?;
             let a = o.req("alpha", "the slope deviation α > 0 or [α_u, α_v]")?;
             let (alpha_u, alpha_v) = if a.f64().is_ok() {
                 let x = a.positive()?;
@@ -483,7 +492,7 @@ fn parse_library_material(
             }
         }
         "lafortune" => {
-            let o = v.tagged_object(&["type", "diffuse", "lobes"])?;
+            let o = v.tagged_object(schema!("materials.*<lafortune>"))?;
             let list = o.req("lobes", "a list of lobes {cx, cy, cz, exponent, albedo}")?;
             let items = list.array()?;
             if items.is_empty() || items.len() > LAFORTUNE_MAX_LOBES {
@@ -494,7 +503,7 @@ fn parse_library_material(
             }
             let mut lobes = Vec::with_capacity(items.len());
             for item in &items {
-                let l = item.object(&["cx", "cy", "cz", "exponent", "albedo"])?;
+                let l = item.object(schema!("materials.*<lafortune>.lobes[]"))?;
                 lobes.push(LafortuneLobe {
                     cx: l.req("cx", "the coefficient C_x")?.f64()?,
                     cy: l.req("cy", "the coefficient C_y")?.f64()?,
@@ -512,7 +521,7 @@ fn parse_library_material(
             }
         }
         "coated" => {
-            let o = v.tagged_object(&["type", "diffuse", "ior", "nonlinear"])?;
+            let o = v.tagged_object(schema!("materials.*<coated>"))?;
             MaterialKind::Coated {
                 diffuse: reflectance_or(&o, "diffuse", spectra, 0.5)?,
                 ior: o.positive_or("ior", 1.5)?,
@@ -520,7 +529,7 @@ fn parse_library_material(
             }
         }
         "thin_dielectric" => {
-            let o = v.tagged_object(&["type", "ior"])?;
+            let o = v.tagged_object(schema!("materials.*<thin_dielectric>"))?;
             MaterialKind::ThinDielectric {
                 ior: match o.get("ior") {
                     None => Ior::Constant(1.5),
@@ -529,7 +538,7 @@ fn parse_library_material(
             }
         }
         "mix" => {
-            let o = v.tagged_object(&["type", "materials", "weight"])?;
+            let o = v.tagged_object(schema!("materials.*<mix>"))?;
             let list = o.req("materials", "two material names [first, second]")?;
             let items = list.array()?;
             if items.len() != 2 {
@@ -549,7 +558,7 @@ fn parse_library_material(
             }
         }
         _ => {
-            let o = v.tagged_object(&["type", "file", "clamp_negative"])?;
+            let o = v.tagged_object(schema!("materials.*<merl>"))?;
             MaterialKind::Merl {
                 file: o
                     .req("file", "a MERL BRDF file (.binary)")?
@@ -564,7 +573,7 @@ fn parse_ior(v: &V) -> Result<Ior> {
     if v.f64().is_ok() {
         return Ok(Ior::Constant(v.positive()?));
     }
-    let o = v.object(&["sellmeier", "cauchy"]).map_err(|e| {
+    let o = v.object(schema!("@ior")).map_err(|e| {
         if !v.is_object() {
             v.type_err("a number, {\"sellmeier\": …} or {\"cauchy\": …}")
         } else {
@@ -573,7 +582,7 @@ fn parse_ior(v: &V) -> Result<Ior> {
     })?;
     match o.at_most_one(&["sellmeier", "cauchy"])? {
         Some(("sellmeier", s)) => {
-            let s = s.object(&["b", "c_um2"])?;
+            let s = s.object(schema!("@ior.sellmeier"))?;
             Ok(Ior::Sellmeier {
                 b: s.req("b", "three coefficients B₁, B₂, B₃")?
                     .numbers::<3>()?,
@@ -583,7 +592,7 @@ fn parse_ior(v: &V) -> Result<Ior> {
             })
         }
         Some((_, c)) => {
-            let c = c.object(&["a", "b_um2"])?;
+            let c = c.object(schema!("@ior.cauchy"))?;
             Ok(Ior::Cauchy {
                 a: c.req("a", "the coefficient A")?.positive()?,
                 b_um2: c.req("b_um2", "the coefficient B in µm²")?.f64()?,

@@ -2,6 +2,7 @@
 //! scattering coefficients and a Henyey–Greenstein phase function.
 
 use crate::reader::{Result, V};
+use crate::schema::schema;
 use crate::spectrum_ref::{parse_spectrum, NamedSpectra, SpectrumRef, SpectrumUse};
 
 #[derive(Debug, Clone, PartialEq)]
@@ -26,7 +27,7 @@ pub(crate) fn parse_media(v: &V, spectra: &NamedSpectra) -> Result<Vec<Medium>> 
     let mut out = Vec::new();
     for (name, entry) in v.map()? {
         entry.tag("medium", &["homogeneous"], Some("homogeneous"))?;
-        let o = entry.object(&["type", "sigma_a_per_m", "sigma_s_per_m", "g"])?;
+        let o = entry.object(schema!("media.*<homogeneous>"))?;
         let coefficient = |key: &str| match o.get(key) {
             None => Ok(SpectrumRef::Constant(0.0)),
             Some(c) => parse_spectrum(&c, spectra, SpectrumUse::NonNegative),

@@ -7,6 +7,7 @@ use prism_spectrum::names::did_you_mean;
 
 use crate::error::{JsonPath, SceneError};
 use crate::json::{Member, Node, Position, Value};
+use crate::schema::ObjectSchema;
 
 pub(crate) type Result<T> = std::result::Result<T, SceneError>;
 
@@ -206,15 +207,16 @@ impl<'a> V<'a> {
         })
     }
 
-    /// An object whose keys must all be in `allowed`.
-    pub fn object(&self, allowed: &[&str]) -> Result<Obj<'a>> {
+    /// An object whose keys must all be keys of `schema` (a row of `schema::SCHEMA`,
+    /// written `schema!("pattern")`).
+    pub fn object(&self, schema: &'static ObjectSchema) -> Result<Obj<'a>> {
         match &self.node.value {
             Value::Object(members) => {
                 let obj = Obj {
                     v: self.clone(),
                     members,
                 };
-                obj.check_fields(allowed)?;
+                obj.check_fields(schema)?;
                 Ok(obj)
             }
             _ => Err(self.type_err("an object")),
@@ -273,13 +275,13 @@ impl<'a> V<'a> {
     }
 
     /// The fields of a tagged value: an object, or nothing for the string shorthand.
-    pub fn tagged_object(&self, allowed: &[&str]) -> Result<Obj<'a>> {
+    pub fn tagged_object(&self, schema: &'static ObjectSchema) -> Result<Obj<'a>> {
         match &self.node.value {
             Value::String(_) => Ok(Obj {
                 v: self.clone(),
                 members: &[],
             }),
-            _ => self.object(allowed),
+            _ => self.object(schema),
         }
     }
 
@@ -324,16 +326,17 @@ pub(crate) struct Obj<'a> {
 }
 
 impl<'a> Obj<'a> {
-    fn check_fields(&self, allowed: &[&str]) -> Result<()> {
+    fn check_fields(&self, schema: &ObjectSchema) -> Result<()> {
         for m in self.members {
-            if !allowed.contains(&m.key.as_str()) {
+            if !schema.accepts(&m.key) {
+                let allowed: Vec<&str> = schema.keys().collect();
                 return Err(self.v.cx.error(
                     m.key_pos,
                     &self.v.path.key(&m.key),
                     format!(
                         "unknown field `{}`, expected one of {}{}",
                         m.key,
-                        quoted_list(allowed),
+                        quoted_list(&allowed),
                         suggest(&m.key, allowed.iter().copied())
                     ),
                 ));

@@ -12,6 +12,7 @@ use crate::light::{parse_light, Light};
 use crate::material::{parse_materials, Material};
 use crate::medium::{parse_media, Medium};
 use crate::reader::{Ctx, Result, V};
+use crate::schema::schema;
 use crate::sensor::{parse_sensors, Sensor};
 use crate::shape::{parse_meshes, parse_shape, MeshAsset, Shape, ShapeContext};
 use crate::spectrum_ref::{parse_spectrum, SpectrumRef, SpectrumUse};
@@ -109,7 +110,7 @@ pub fn parse_scene_str(
 }
 
 fn parse_root(v: &V) -> Result<SceneDescription> {
-    let o = v.object(&TOP_LEVEL_FIELDS)?;
+    let o = v.object(schema!(""))?;
 
     let mut spectra: Vec<(String, SpectrumRef)> = Vec::new();
     if let Some(section) = o.get("spectra") {

@@ -6,6 +6,7 @@
 use glam::DVec3;
 
 use crate::reader::{Obj, Result, V};
+use crate::schema::schema;
 
 /// One entry of `sensors`: a named group of measuring points.
 #[derive(Debug, Clone, PartialEq)]
@@ -165,28 +166,11 @@ fn sampling(o: &Obj) -> Result<SensorSampling> {
     })
 }
 
-const SAMPLING_FIELDS: [&str; 5] = [
-    "samples",
-    "relative_error",
-    "absolute_error_lx",
-    "min_samples",
-    "max_samples",
-];
-
-fn fields(extra: &[&'static str]) -> Vec<&'static str> {
-    ["type", "name"]
-        .iter()
-        .chain(extra)
-        .chain(SAMPLING_FIELDS.iter())
-        .copied()
-        .collect()
-}
-
 fn parse_sensor(v: &V, index: usize) -> Result<Sensor> {
     let kind_name = v.tag("sensor", &SENSOR_TYPES, None)?;
     let (o, kind) = match kind_name {
         "point" => {
-            let o = v.object(&fields(&["position_m", "normal"]))?;
+            let o = v.object(schema!("sensors[]<point>"))?;
             let position_m = o.req("position_m", "[x, y, z] in metres")?.numbers::<3>()?;
             let normal = o.get("normal").map_or(Ok([0.0, 1.0, 0.0]), |n| unit(&n))?;
             (
@@ -198,7 +182,7 @@ fn parse_sensor(v: &V, index: usize) -> Result<Sensor> {
             )
         }
         "points" => {
-            let o = v.object(&fields(&["positions_m", "normal", "normals"]))?;
+            let o = v.object(schema!("sensors[]<points>"))?;
             let list = o.req("positions_m", "an array of [x, y, z] in metres")?;
             let items = list.array()?;
             if items.is_empty() {
@@ -232,7 +216,7 @@ fn parse_sensor(v: &V, index: usize) -> Result<Sensor> {
             )
         }
         _ => {
-            let o = v.object(&fields(&["origin_m", "u_m", "v_m", "resolution", "normal"]))?;
+            let o = v.object(schema!("sensors[]<grid>"))?;
             let origin_m = o
                 .req("origin_m", "the grid's corner [x, y, z] in metres")?
                 .numbers::<3>()?;

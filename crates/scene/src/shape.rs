@@ -5,6 +5,7 @@ use std::path::PathBuf;
 
 use crate::material::material_index;
 use crate::reader::{quoted_list, suggest, Result, V};
+use crate::schema::schema;
 use crate::transform::{parse_transform, Transform};
 
 /// A mesh file to load once and share between the shapes that use it.
@@ -95,7 +96,7 @@ pub(crate) fn parse_meshes(v: &V) -> Result<Vec<MeshAsset>> {
             entry
         } else {
             entry
-                .object(&["file"])?
+                .object(schema!("meshes.*"))?
                 .req("file", "a .obj or .ply file")?
         };
         let (path, format) = parse_mesh_file(&file)?;
@@ -138,25 +139,12 @@ pub(crate) fn named_mesh(v: &V, meshes: &[MeshAsset]) -> Result<usize> {
         .unwrap_or_default())
 }
 
-const COMMON: [&str; 6] = [
-    "type",
-    "name",
-    "transform",
-    "material",
-    "interior_medium",
-    "exterior_medium",
-];
-
-fn fields(extra: &[&'static str]) -> Vec<&'static str> {
-    COMMON.iter().chain(extra).copied().collect()
-}
-
 /// Parses one shape; mesh files named directly on it are appended to `meshes`.
 pub(crate) fn parse_shape(v: &V, cx: &ShapeContext, meshes: &mut Vec<MeshAsset>) -> Result<Shape> {
     let kind = v.tag("shape", &SHAPE_TYPES, None)?;
     let (o, kind) = match kind {
         "mesh" => {
-            let o = v.object(&fields(&["file", "mesh"]))?;
+            let o = v.object(schema!("shapes[]<mesh>"))?;
             let mesh = match o.at_most_one(&["file", "mesh"])? {
                 Some(("file", f)) => {
                     let (path, format) = parse_mesh_file(&f)?;
@@ -177,12 +165,12 @@ pub(crate) fn parse_shape(v: &V, cx: &ShapeContext, meshes: &mut Vec<MeshAsset>)
             (o, ShapeKind::Mesh { mesh })
         }
         "sphere" => {
-            let o = v.object(&fields(&["radius_m"]))?;
+            let o = v.object(schema!("shapes[]<sphere>"))?;
             let radius_m = o.positive_or("radius_m", 1.0)?;
             (o, ShapeKind::Sphere { radius_m })
         }
         "rectangle" => {
-            let o = v.object(&fields(&["size_m"]))?;
+            let o = v.object(schema!("shapes[]<rectangle>"))?;
             let size_m = match o.get("size_m") {
                 None => [1.0, 1.0],
                 Some(s) => positive_numbers::<2>(&s)?,
@@ -190,12 +178,12 @@ pub(crate) fn parse_shape(v: &V, cx: &ShapeContext, meshes: &mut Vec<MeshAsset>)
             (o, ShapeKind::Rectangle { size_m })
         }
         "disk" => {
-            let o = v.object(&fields(&["radius_m"]))?;
+            let o = v.object(schema!("shapes[]<disk>"))?;
             let radius_m = o.positive_or("radius_m", 1.0)?;
             (o, ShapeKind::Disk { radius_m })
         }
         "cuboid" => {
-            let o = v.object(&fields(&["size_m"]))?;
+            let o = v.object(schema!("shapes[]<cuboid>"))?;
             let size_m = match o.get("size_m") {
                 None => [1.0, 1.0, 1.0],
                 Some(s) => positive_numbers::<3>(&s)?,
@@ -203,7 +191,7 @@ pub(crate) fn parse_shape(v: &V, cx: &ShapeContext, meshes: &mut Vec<MeshAsset>)
             (o, ShapeKind::Cuboid { size_m })
         }
         _ => {
-            let o = v.object(&fields(&["mesh", "instances"]))?;
+            let o = v.object(schema!("shapes[]<instances>"))?;
             let mesh = named_mesh(&o.req("mesh", "a name from the `meshes` section")?, meshes)?;
             let list = o.req("instances", "a list of transforms, one per instance")?;
             let transforms = list

@@ -9,6 +9,7 @@ use prism_spectrum::spectrum_file::read_spectral_file;
 use prism_spectrum::Tabulated;
 
 use crate::reader::{quoted_list, suggest, Result, V};
+use crate::schema::schema;
 
 /// A spectrum as the scene gives it; files are already loaded.
 #[derive(Debug, Clone, PartialEq)]
@@ -97,9 +98,13 @@ pub(crate) fn parse_spectrum(
             suggest(s, candidates)
         )));
     }
-    let o = v
-        .object(&["blackbody_k", "rgb", "file", "column"])
-        .map_err(|e| if !v.is_object() { v.type_err(FORMS) } else { e })?;
+    let o = v.object(schema!("@spectrum")).map_err(|e| {
+        if !v.is_object() {
+            v.type_err(FORMS)
+        } else {
+            e
+        }
+    })?;
     match o.at_most_one(&["blackbody_k", "rgb", "file"])? {
         Some(("blackbody_k", t)) => Ok(SpectrumRef::Blackbody {
             temperature_k: t.positive()?,

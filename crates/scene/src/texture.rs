@@ -8,6 +8,7 @@
 use std::path::PathBuf;
 
 use crate::reader::{quoted_list, suggest, Result, V};
+use crate::schema::schema;
 use crate::spectrum_ref::{parse_spectrum, NamedSpectra, SpectrumRef, SpectrumUse};
 
 /// One texture.
@@ -182,7 +183,7 @@ pub(crate) fn parse_texture_ref(
     spectra: &NamedSpectra,
     table: &mut TextureTable,
 ) -> Result<usize> {
-    let o = v.object(&["texture"])?;
+    let o = v.object(schema!("@texture_ref"))?;
     let t = o.req("texture", "a texture name or definition")?;
     if t.str().is_ok() {
         return texture_by_name(&t, table);
@@ -240,29 +241,11 @@ pub(crate) fn parse_texture_definition(
 }
 
 fn parse_texture(v: &V, spectra: &NamedSpectra) -> Result<(TextureKind, UvTransform)> {
-    const UV: [&str; 3] = ["uv_scale", "uv_offset", "uv_rotate_deg"];
-    let with_uv = |fields: &[&'static str]| -> Vec<&'static str> {
-        let mut all = vec!["type"];
-        all.extend_from_slice(fields);
-        all.extend_from_slice(&UV);
-        all
-    };
     let kind = v.tag("texture", &TYPES, None)?;
     let o = match kind {
-        "image" => v.object(&with_uv(&[
-            "file", "encoding", "filter", "wrap", "scale", "channel",
-        ]))?,
-        "checkerboard" => v.object(&with_uv(&["a", "b"]))?,
-        _ => v.object(&with_uv(&[
-            "noise",
-            "space",
-            "frequency",
-            "octaves",
-            "gain",
-            "lacunarity",
-            "a",
-            "b",
-        ]))?,
+        "image" => v.object(schema!("@texture<image>"))?,
+        "checkerboard" => v.object(schema!("@texture<checkerboard>"))?,
+        _ => v.object(schema!("@texture<noise>"))?,
     };
     let uv = {
         let scale = match o.get("uv_scale") {

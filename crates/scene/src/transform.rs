@@ -5,6 +5,7 @@
 use glam::{DMat4, DVec3};
 
 use crate::reader::{Result, V};
+use crate::schema::schema;
 
 /// A local-to-world affine map and its inverse (f64; render may narrow to `Mat4`).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -77,7 +78,7 @@ impl Transform {
     }
 }
 
-const STEPS: [&str; 5] = ["translate", "rotate", "scale", "matrix", "look_at"];
+pub(crate) const STEPS: [&str; 5] = ["translate", "rotate", "scale", "matrix", "look_at"];
 
 /// Parses a transform: a list of steps, or one step on its own.
 pub(crate) fn parse_transform(v: &V) -> Result<Transform> {
@@ -93,7 +94,7 @@ pub(crate) fn parse_transform(v: &V) -> Result<Transform> {
 }
 
 fn parse_step(v: &V) -> Result<Transform> {
-    let o = v.object(&STEPS).map_err(|e| {
+    let o = v.object(schema!("@transform")).map_err(|e| {
         if !v.is_object() && v.array().is_err() {
             v.type_err("a transform step such as {\"translate\": [x, y, z]} or a list of steps")
         } else {
@@ -112,7 +113,7 @@ fn parse_step(v: &V) -> Result<Transform> {
             Ok(Transform::from_matrix(DMat4::from_translation(t.into())).ok_or_else(singular)?)
         }
         "rotate" => {
-            let r = arg.object(&["axis", "angle_deg"])?;
+            let r = arg.object(schema!("@transform.rotate"))?;
             let axis_v = r.req("axis", "an axis such as [0, 1, 0]")?;
             let axis = DVec3::from(axis_v.numbers::<3>()?);
             if axis.length() < 1e-12 {
@@ -151,7 +152,7 @@ fn parse_step(v: &V) -> Result<Transform> {
             Ok(Transform::from_matrix(matrix).ok_or_else(singular)?)
         }
         _ => {
-            let l = arg.object(&["eye", "target", "up"])?;
+            let l = arg.object(schema!("@transform.look_at"))?;
             let eye = DVec3::from(
                 l.req("eye", "a position [x, y, z] in metres")?
                     .numbers::<3>()?,

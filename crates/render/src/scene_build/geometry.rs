@@ -13,18 +13,86 @@
 //! - Instances are added in shape order, so the instances of `shapes[i]` are a contiguous
 //!   range of ids (`build_geometry_with_instances`, `shape_instance_ranges`); area lights
 //!   use it to find the instances of their shape.
+//! - The small-scene intersector (prism-geometry `small_scene`: no BVH, every leaf tested
+//!   eight at a time) is allowed where the scene's features are all in
+//!   [`SMALL_SCENE_SUPPORTS`]; within that, the geometry crate decides by leaf count.
 
 use std::ops::Range;
 use std::path::Path;
 
 use glam::{DMat4, DVec3, Vec3A};
 use prism_geometry::{
-    BuildQuality, Disk, Geometry, GeometryBuilder, MeshId, Rectangle, Shape, Sphere, TriangleMesh,
+    BuildOptions, BuildQuality, Disk, Geometry, GeometryBuilder, MeshId, Rectangle, Shape, Sphere,
+    TriangleMesh, SMALL_SCENE_MAX_LEAVES,
 };
 use prism_scene::{MeshFormat, SceneDescription, ShapeKind};
 
 use super::error::SceneBuildError;
+use super::features::{SceneFeature, SceneFeatures};
 use super::transform::to_geometry_transform;
+
+/// The features the small-scene intersector handles. It only finds the closest surface:
+/// triangles and rectangles in batches, every other leaf (spheres, disks, instanced meshes)
+/// one by one, each with the scene's own exact test, so materials, lights, cameras and
+/// integrators do not concern it. Participating media are left out until they render: the
+/// change that renders them decides.
+pub const SMALL_SCENE_SUPPORTS: SceneFeatures = SceneFeatures::of(&[
+    SceneFeature::DiagnosticIntegrator,
+    SceneFeature::LightPaths,
+    SceneFeature::OpacityMasks,
+    SceneFeature::ThinGlazing,
+    SceneFeature::Dispersion,
+    SceneFeature::Textures,
+    SceneFeature::NonLambertianBsdfs,
+    SceneFeature::TwoSidedMaterials,
+    SceneFeature::ShadingNormalMaps,
+    SceneFeature::VertexNormals,
+    SceneFeature::Quadrics,
+    SceneFeature::InfiniteLights,
+    SceneFeature::DeltaLights,
+    SceneFeature::NonRectangleAreaLights,
+    SceneFeature::ThinLensCamera,
+]);
+
+/// How to build the geometry of a scene with `features`: the default options, without the
+/// small-scene intersector where a feature is outside [`SMALL_SCENE_SUPPORTS`].
+pub(crate) fn build_options(features: SceneFeatures) -> BuildOptions {
+    let options = BuildOptions::from(BuildQuality::default());
+    if features.is_subset_of(SMALL_SCENE_SUPPORTS) {
+        options
+    } else {
+        BuildOptions {
+            small_scene_max_leaves: 0,
+            ..options
+        }
+    }
+}
+
+/// Why `geometry`, built for `features`, is not traced as a small scene; `None` when it is.
+pub fn small_scene_not_used(geometry: &Geometry, features: SceneFeatures) -> Option<String> {
+    let outside = features.outside(SMALL_SCENE_SUPPORTS);
+    if !outside.is_empty() {
+        return Some(outside.names());
+    }
+    if geometry.is_small_scene() {
+        return None;
+    }
+    let leaves = geometry.flattened_triangle_count() + geometry.instance_leaf_count();
+    Some(match leaves {
+        0 => "the scene has no geometry".into(),
+        1 => "a single instance, tested directly".into(),
+        n => format!("{n} leaves, more than the {SMALL_SCENE_MAX_LEAVES} of a small scene"),
+    })
+}
+
+/// The shapes of a scene placed in a builder, before its acceleration structure is built.
+pub(crate) struct PlacedShapes {
+    pub builder: GeometryBuilder,
+    /// Per scene shape, in order, the range of instance ids it was given.
+    pub ranges: Vec<Range<u32>>,
+    /// A mesh that some shape places has vertex normals.
+    pub vertex_normals: bool,
+}
 
 fn load_mesh(asset: &prism_scene::MeshAsset) -> Result<TriangleMesh, String> {
     let mesh = match asset.format {
@@ -67,6 +135,12 @@ pub fn shape_instance_ranges(scene: &SceneDescription) -> Vec<Range<u32>> {
 pub fn build_geometry_with_instances(
     scene: &SceneDescription,
 ) -> Result<(Geometry, Vec<Range<u32>>), SceneBuildError> {
+    let placed = place_shapes(scene)?;
+    Ok((placed.builder.build(BuildQuality::default()), placed.ranges))
+}
+
+/// Loads the meshes of `scene` and places every shape in a `GeometryBuilder`.
+pub(crate) fn place_shapes(scene: &SceneDescription) -> Result<PlacedShapes, SceneBuildError> {
     let file: &Path = &scene.file;
     let mut ranges: Vec<Range<u32>> = Vec::with_capacity(scene.shapes.len());
     let mut instance_count = 0u32;
@@ -74,6 +148,7 @@ pub fn build_geometry_with_instances(
     let mut builder = GeometryBuilder::new();
     let mut mesh_ids: Vec<Option<MeshId>> = vec![None; scene.meshes.len()];
     let mut unit_cube: Option<MeshId> = None;
+    let mut vertex_normals = false;
 
     for (i, shape) in scene.shapes.iter().enumerate() {
         let place = match &shape.name {
@@ -91,6 +166,7 @@ pub fn build_geometry_with_instances(
                 .get(m)
                 .ok_or_else(|| err(format!("mesh index {m} is not in the scene's meshes")))?;
             let mesh = load_mesh(asset).map_err(|e| err(format!("cannot load the mesh: {e}")))?;
+            vertex_normals |= mesh.normals.is_some();
             let id = builder_add_mesh(&mut builder, mesh);
             mesh_ids[m] = Some(id);
             Ok(id)
@@ -126,7 +202,9 @@ pub fn build_geometry_with_instances(
             )),
             ShapeKind::Cuboid { size_m } => {
                 let id = *unit_cube.get_or_insert_with(|| {
-                    builder_add_mesh(&mut builder, TriangleMesh::cuboid(Vec3A::splat(0.5)))
+                    let cube = TriangleMesh::cuboid(Vec3A::splat(0.5));
+                    vertex_normals |= cube.normals.is_some();
+                    builder_add_mesh(&mut builder, cube)
                 });
                 placements.push((Shape::Mesh(id), m * DMat4::from_scale(DVec3::from(*size_m))));
             }
@@ -152,7 +230,11 @@ pub fn build_geometry_with_instances(
         }
         ranges.push(first..instance_count);
     }
-    Ok((builder.build(BuildQuality::default()), ranges))
+    Ok(PlacedShapes {
+        builder,
+        ranges,
+        vertex_normals,
+    })
 }
 
 fn builder_add_mesh(builder: &mut GeometryBuilder, mesh: TriangleMesh) -> MeshId {
@@ -180,5 +262,34 @@ mod tests {
         assert_eq!(ranges, vec![0..1, 1..4, 4..5, 5..6, 6..7]);
         assert_eq!(shape_instance_ranges(&scene), ranges);
         assert_eq!(geometry.instances().len(), 7);
+    }
+
+    #[test]
+    fn a_feature_outside_the_small_scene_list_builds_the_bvh() {
+        let json = r#"{"shapes": [{"type": "rectangle"}, {"type": "sphere"}]}"#;
+        let scene = prism_scene::parse_scene_str(json, "scene.json").unwrap();
+        let quadrics = SceneFeatures::of(&[SceneFeature::Quadrics]);
+        assert_eq!(
+            build_options(quadrics),
+            BuildOptions::from(BuildQuality::default())
+        );
+        let geometry = place_shapes(&scene)
+            .unwrap()
+            .builder
+            .build_with(build_options(quadrics));
+        assert!(geometry.is_small_scene());
+        assert_eq!(small_scene_not_used(&geometry, quadrics), None);
+        // Participating media are outside the list: no small scene, and the reason names them.
+        let fog = SceneFeatures::of(&[SceneFeature::Quadrics, SceneFeature::ParticipatingMedia]);
+        assert_eq!(build_options(fog).small_scene_max_leaves, 0);
+        let geometry = place_shapes(&scene)
+            .unwrap()
+            .builder
+            .build_with(build_options(fog));
+        assert!(!geometry.is_small_scene());
+        assert_eq!(
+            small_scene_not_used(&geometry, fog).as_deref(),
+            Some("participating media")
+        );
     }
 }

@@ -1,9 +1,13 @@
 //! A `SceneDescription` (prism-scene) turned into what the integrators need: geometry with
-//! its BVH, the camera, the film and the albedo of every material.
+//! its BVH, the camera, the film and the albedo of every material. What the description
+//! asks for but render does not do yet is refused here (`fields`), and what a fast path may
+//! not support is summed up once as the scene's `SceneFeatures` (`features`).
 
 mod albedo;
 mod camera;
 mod error;
+pub mod features;
+pub mod fields;
 mod filter;
 mod geometry;
 pub mod spectrum;
@@ -12,8 +16,12 @@ mod transform;
 pub use albedo::{material_albedo, reflectance_rgb, DEFAULT_ALBEDO};
 pub use camera::{build_camera, horizontal_fov_rad};
 pub use error::SceneBuildError;
+pub use features::{SceneFeature, SceneFeatures};
 pub use filter::build_filter;
-pub use geometry::{build_geometry, build_geometry_with_instances, shape_instance_ranges};
+pub use geometry::{
+    build_geometry, build_geometry_with_instances, shape_instance_ranges, small_scene_not_used,
+    SMALL_SCENE_SUPPORTS,
+};
 
 use std::path::PathBuf;
 
@@ -63,6 +71,10 @@ pub struct RenderScene {
     /// The scene as flat diffuse patches for the packet tracer (`integrator::packet`), when
     /// it is one and packet tracing is on (the default).
     pub packet: Option<crate::integrator::packet::PacketScene>,
+    /// What the scene uses that a fast path may not support, computed once here; the
+    /// packet tracer and the small-scene intersector run only where it is within their
+    /// allow-lists (`PacketScene::SUPPORTS`, `SMALL_SCENE_SUPPORTS`).
+    pub features: SceneFeatures,
 }
 
 impl RenderScene {
@@ -72,6 +84,7 @@ impl RenderScene {
         scene: &SceneDescription,
         resolution: Option<UVec2>,
     ) -> Result<Self, SceneBuildError> {
+        fields::refuse_unrendered(scene)?;
         let file = scene.file.clone();
         let resolution = resolution.unwrap_or(UVec2::new(
             scene.film.resolution[0],
@@ -90,8 +103,16 @@ impl RenderScene {
             .map(|i| material_albedo(&scene.materials, i))
             .collect();
         albedo_rgb.push(DEFAULT_ALBEDO);
-        let geometry = build_geometry(scene)?;
+        let placed = geometry::place_shapes(scene)?;
         let materials = build_materials(scene)?;
+        let features = SceneFeatures::of_scene(
+            scene,
+            &integrator,
+            &camera,
+            &materials,
+            placed.vertex_normals,
+        );
+        let geometry = placed.builder.build_with(geometry::build_options(features));
         let lights = LightSet::build(scene, &geometry)?;
         let has_masks = materials.iter().any(|m| m.has_mask());
         let has_glazing = materials.iter().any(|m| m.has_thin_glazing());
@@ -136,6 +157,7 @@ impl RenderScene {
             texture_footprint,
             splat: scene.film.reconstruction == prism_scene::Reconstruction::Splat,
             packet: None,
+            features,
         };
         built.set_packet_tracing(true);
         Ok(built)

@@ -19,8 +19,10 @@
 //! tile runs out; the order of the film's additions stays fixed per tile, so images stay
 //! bit-identical for any thread count.
 //!
-//! The render plan switches it on where the scene allows (`PacketScene::new` says why not
-//! otherwise); `RenderScene::set_packet_tracing` turns it off (tests, comparisons).
+//! The render plan switches it on where the scene allows: its features are within
+//! `PacketScene::SUPPORTS` and its geometry is a small scene of flat patches
+//! (`PacketScene::new` says why not otherwise); `RenderScene::set_packet_tracing` turns it
+//! off (tests, comparisons).
 
 mod intersect;
 mod shade;
@@ -35,11 +37,10 @@ use intersect::{BoxSet, PatchSet};
 
 use prism_spectrum::Spectrum;
 
-use crate::integrator::Integrator;
 use crate::light::area::{AreaLight, AreaShape};
 use crate::light::Light;
 use crate::material::Material;
-use crate::scene_build::RenderScene;
+use crate::scene_build::{small_scene_not_used, RenderScene, SceneFeature, SceneFeatures};
 
 /// What a ray that hits patch `i` finds there (constant over the patch).
 #[derive(Clone, Copy, Debug)]
@@ -110,21 +111,35 @@ pub struct PacketScene {
 }
 
 impl PacketScene {
-    /// The packet form of `scene`, or why it has none (for `--explain`).
+    /// The features the packet tracer handles; a scene with any other runs the scalar
+    /// tracer. It is the path tracer for flat patches (triangles without vertex normals,
+    /// rectangles) with constant Lambertian materials, so every other integrator, shape,
+    /// material and medium is left out. Lights of every kind are in: it samples them with
+    /// the scalar `Light` code (rectangles in lanes) and escapes through
+    /// `PathTracer::escape_terms`; so is the thin lens, whose lens samples it draws.
+    pub const SUPPORTS: SceneFeatures = SceneFeatures::of(&[
+        SceneFeature::InfiniteLights,
+        SceneFeature::DeltaLights,
+        SceneFeature::NonRectangleAreaLights,
+        SceneFeature::ThinLensCamera,
+    ]);
+
+    /// The packet form of `scene`, or why it has none (for `--explain`): the names of its
+    /// features outside [`Self::SUPPORTS`], else the limit it is past (the small-scene
+    /// intersector's, or a mesh kept instanced).
     pub fn new(scene: &RenderScene) -> Result<Self, String> {
-        if !matches!(scene.integrator, Integrator::Path(_)) {
-            return Err("the integrator is not the path tracer".into());
+        let outside = scene.features.outside(Self::SUPPORTS);
+        if !outside.is_empty() {
+            return Err(outside.names());
         }
-        if scene.has_masks || scene.has_glazing || scene.has_dispersion {
-            return Err("a material has an opacity mask, thin glazing or dispersion".into());
-        }
-        if scene.texture_footprint.is_some() {
-            return Err("a material reads a texture".into());
+        // Lanes test every patch of the scene: only a small scene has few enough.
+        if let Some(why) = small_scene_not_used(&scene.geometry, scene.features) {
+            return Err(why);
         }
         let Some(flat) = scene.geometry.flat_leaves() else {
             return Err(
-                "the geometry is not a small scene of flat patches (triangles of meshes \
-                 without vertex normals, rectangles)"
+                "a mesh is kept instanced (shared by several instances and too large to bake \
+                 into world-space patches)"
                     .into(),
             );
         };
@@ -137,8 +152,23 @@ impl PacketScene {
             let r = &leaf.record;
             let constant = match scene.material(r.material_id) {
                 Material::Lambert { reflectance } => reflectance.constant(),
-                _ => None,
+                Material::Conductor { .. }
+                | Material::Dielectric { .. }
+                | Material::TwoSided { .. }
+                | Material::Mask { .. }
+                | Material::NormalMap { .. }
+                | Material::BumpMap { .. }
+                | Material::OrenNayar { .. }
+                | Material::Phong { .. }
+                | Material::BlinnPhong { .. }
+                | Material::Ward { .. }
+                | Material::Lafortune { .. }
+                | Material::Coated { .. }
+                | Material::ThinDielectric { .. }
+                | Material::Mix { .. }
+                | Material::Measured { .. } => None,
             };
+            // Guaranteed by the features (`NonLambertianBsdfs`, `Textures`, …): a guard.
             let Some(constant) = constant else {
                 return Err(format!(
                     "material '{}' is not a constant Lambertian",
@@ -193,7 +223,15 @@ impl PacketScene {
                         radiance_slot,
                     })
                 }
-                _ => None,
+                // Other emitters (and empty rectangles) go through the scalar `Light` code.
+                Light::Area(_)
+                | Light::Point(_)
+                | Light::Spot(_)
+                | Light::Directional(_)
+                | Light::Environment(_)
+                | Light::Sky(_)
+                | Light::Daylight(_)
+                | Light::Goniometric(_) => None,
             })
             .collect();
         let flat_boxes = scene.geometry.flat_boxes(&flat);
