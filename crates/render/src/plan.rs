@@ -248,9 +248,53 @@ impl RenderPlan {
                     },
                 );
             }
-            other => choose(
+            Integrator::Light(l) => {
+                choose(
+                    "integrator",
+                    format!(
+                        "light tracing, max_depth {}, roulette from {}: {} light paths \
+                         ({} spp × {} pixels), each vertex connected to the camera",
+                        l.max_depth,
+                        l.rr_depth,
+                        u64::from(request.spp)
+                            * u64::from(scene.resolution.x)
+                            * u64::from(scene.resolution.y),
+                        request.spp,
+                        u64::from(scene.resolution.x) * u64::from(scene.resolution.y)
+                    ),
+                    "the scene's `integrator` section; pixels that see a specular surface \
+                     first stay black (a light path cannot connect through a Dirac lobe)"
+                        .into(),
+                );
+            }
+            Integrator::Bdpt(b) => {
+                choose(
+                    "integrator",
+                    format!(
+                        "bidirectional path tracing, max_depth {}, MIS {:?} over all \
+                         strategies, roulette from {}{}",
+                        b.max_depth,
+                        b.mis,
+                        b.rr_depth,
+                        match b.strategy {
+                            Some(s) => format!(
+                                "; only strategy ({}, {}){}",
+                                s.s,
+                                s.t,
+                                if s.unweighted { " unweighted" } else { "" }
+                            ),
+                            None => String::new(),
+                        }
+                    ),
+                    "the scene's `integrator` section (and --bdpt-strategy)".into(),
+                );
+            }
+            Integrator::Depth
+            | Integrator::Normal
+            | Integrator::Albedo
+            | Integrator::AmbientOcclusion(_) => choose(
                 "integrator",
-                other.name().to_string(),
+                scene.integrator.name().to_string(),
                 "a diagnostic integrator: no light transport, lights and BSDFs are unused".into(),
             ),
         }

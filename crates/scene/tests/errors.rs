@@ -247,8 +247,8 @@ fn unknown_type_suggests_the_closest_type() {
     assert_eq!(
         e,
         "DIR/scene.json:1:16: integrator: unknown integrator type `ambient_occlusoin`, expected \
-         one of `depth`, `normal`, `albedo`, `ambient_occlusion`, `path` (did you mean \
-         `ambient_occlusion`?)"
+         one of `depth`, `normal`, `albedo`, `ambient_occlusion`, `path`, `light`, `bdpt` \
+         (did you mean `ambient_occlusion`?)"
     );
     let e = dir.error(r#"{"lights": [{"type": "spotlight"}]}"#);
     assert!(e.ends_with("(did you mean `spot`?)"), "{e}");
@@ -346,4 +346,20 @@ fn unreadable_scene_file_names_it() {
         e.starts_with("DIR/nope.json: cannot read the scene file: "),
         "{e}"
     );
+}
+
+#[test]
+fn light_tracing_refuses_mis_and_bdpt_takes_path_keys() {
+    let dir = Dir::new("light-mis");
+    let e = dir.error(r#"{"integrator": {"type": "light", "mis": "power"}}"#);
+    assert!(
+        e.starts_with(
+            "DIR/scene.json:1:41: integrator.mis: `mis` does not apply to the `light` integrator"
+        ),
+        "{e}"
+    );
+    let e = dir.error(r#"{"integrator": {"type": "bdpt", "mis": "powr"}}"#);
+    assert!(e.contains("integrator.mis"), "{e}");
+    let e = dir.error(r#"{"integrator": {"type": "light", "max_depth": 0}}"#);
+    assert!(e.contains("integrator.max_depth"), "{e}");
 }
