@@ -526,7 +526,7 @@ fn oren_nayar_full_model_matches_the_paper_at_known_points() {
     assert!(got > forward);
 }
 
-fn merl_from(bsdf: Bsdf) -> MerlTable {
+pub(super) fn merl_from(bsdf: Bsdf) -> MerlTable {
     MerlTable::from_fn(|th, td, pd| {
         let (wi, wo) = merl_directions(th, td, pd);
         if wi.z <= 0.0 || wo.z <= 0.0 {

@@ -5,9 +5,10 @@
 //! one consistent density). A Dirac sample of lobe j keeps its own weight: f·wⱼ with
 //! discrete probability pⱼ·wⱼ.
 //!
-//! Nested mixes are flattened when the material builds the BSDF (weights multiply), so a
-//! component is never itself a mix; at most `MIX_MAX_COMPONENTS` leaves. Energy and
-//! reciprocity hold when they hold for every component.
+//! Nested mixes are flattened when the material builds the BSDF (weights multiply): a
+//! component is a `LeafLobe`, whose `Mix` variant holds the valueless `NoMix`, so it is
+//! never itself a mix; at most `MIX_MAX_COMPONENTS` leaves. Energy and reciprocity hold
+//! when they hold for every component.
 
 use glam::{Vec2, Vec3A};
 use prism_spectrum::SampledSpectrum;
