@@ -1,7 +1,8 @@
 //! Building the material library of issue 8 (Oren–Nayar, Phong, Blinn–Phong, Ward,
-//! Lafortune, coated, thin dielectric, measured MERL, mix) from scene descriptions, and
-//! turning them into lobes at a hit. Formulas and references: the `bsdf` files and
-//! docs/materials.md.
+//! Lafortune, coated, thin dielectric, measured MERL, mix) from scene descriptions, and the
+//! longer parts of turning them into lobes at a hit (a mix's flattened leaves, a Lafortune
+//! lobe's rows; `Material::lobe` builds the rest). Formulas and references: the `bsdf`
+//! files and docs/materials.md.
 
 use std::sync::Arc;
 
