@@ -21,7 +21,7 @@ use prism_geometry::{Differentials, Frame, SurfaceInteraction};
 use prism_spectrum::colorimetry::sampled_radiance_to_xyz;
 use prism_spectrum::{SampledSpectrum, SampledWavelengths};
 
-use crate::bsdf::{Bsdf, BsdfLobe, TransportMode};
+use crate::bsdf::{Bsdf, Bxdf, TransportMode};
 use crate::light::{Light, LightSampleContext};
 use crate::sampler::{PixelSampler, SamplerKind};
 use crate::scene_build::RenderScene;
@@ -37,59 +37,11 @@ pub fn light_bandwidth(light: &Light) -> Bandwidth {
     light.bandwidth()
 }
 
-/// ρ of a BSDF (see the module docs).
+/// ρ of a BSDF (see the module docs): each lobe's `Bxdf::angular_bandwidth_cycles_per_rad`.
 pub fn material_bandwidth(bsdf: &Bsdf) -> MaterialBandwidth {
-    let angular = match &bsdf.lobe {
-        BsdfLobe::Lambert(_) => 0.0,
-        BsdfLobe::Conductor(c) => {
-            lobe_bandwidth(c.distribution.alpha_x, c.distribution.alpha_y, bsdf)
-        }
-        BsdfLobe::Dielectric(d) => {
-            lobe_bandwidth(d.distribution.alpha_x, d.distribution.alpha_y, bsdf)
-        }
-        _ => library_lobe_bandwidth(&bsdf.lobe),
-    };
     MaterialBandwidth {
-        angular_cycles_per_rad: angular,
+        angular_cycles_per_rad: bsdf.lobe.angular_bandwidth_cycles_per_rad(),
         texture_cycles_per_m: 0.0,
-    }
-}
-
-/// The material library's lobes (issue 8): glossy lobes through an equivalent Beckmann
-/// roughness (a cosine power n ≈ Beckmann α = √(2/(n + 2)), Walter et al. 2007 §5.2),
-/// mirror coats as infinite, a mix as its sharpest component.
-fn library_lobe_bandwidth(lobe: &BsdfLobe) -> f32 {
-    let from_exponent = |n: f32| 1.0 / (2.0 * std::f32::consts::PI * (2.0 / (n + 2.0)).sqrt());
-    let from_alpha = |a: f32| 1.0 / (2.0 * std::f32::consts::PI * a.max(1e-4));
-    match lobe {
-        BsdfLobe::Lambert(_) | BsdfLobe::OrenNayar(_) => 0.0,
-        BsdfLobe::Phong(p) if p.specular.max_component() > 0.0 => from_exponent(p.exponent),
-        BsdfLobe::BlinnPhong(p) if p.specular.max_component() > 0.0 => from_exponent(p.exponent),
-        BsdfLobe::Phong(_) | BsdfLobe::BlinnPhong(_) => 0.0,
-        BsdfLobe::Ward(w) => from_alpha(w.alpha_x.min(w.alpha_y)),
-        BsdfLobe::Lafortune(l) => l.lobes[..l.count]
-            .iter()
-            .filter(|j| j.albedo.max_component() > 0.0)
-            .map(|j| from_exponent(j.exponent))
-            .fold(0.0, f32::max),
-        BsdfLobe::Coated(_) | BsdfLobe::ThinDielectric(_) => f32::INFINITY,
-        BsdfLobe::Measured(m) => from_alpha(m.brdf.equivalent_alpha),
-        BsdfLobe::Mix(m) => m.components[..m.count]
-            .iter()
-            .map(|c| material_bandwidth(&Bsdf::new(c.as_lobe())).angular_cycles_per_rad)
-            .fold(0.0, f32::max),
-        BsdfLobe::Conductor(_) | BsdfLobe::Dielectric(_) => {
-            material_bandwidth(&Bsdf::new(*lobe)).angular_cycles_per_rad
-        }
-    }
-}
-
-fn lobe_bandwidth(alpha_x: f32, alpha_y: f32, bsdf: &Bsdf) -> f32 {
-    if bsdf.is_specular() {
-        f32::INFINITY
-    } else {
-        // The narrower direction of an anisotropic lobe sets the bandwidth.
-        1.0 / (2.0 * std::f32::consts::PI * alpha_x.min(alpha_y).max(1e-4))
     }
 }
 

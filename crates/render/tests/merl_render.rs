@@ -9,7 +9,7 @@ use std::path::Path;
 
 use glam::Vec3A;
 use prism_render::bsdf::{
-    merl_bin_centre, Bsdf, BsdfLobe, Conductor, Measured, MerlBrdf, MerlTable,
+    merl_bin_centre, Bsdf, BsdfLobe, Bxdf, Conductor, Measured, MerlBrdf, MerlTable,
     MicrofacetDistribution, MicrofacetModel, TransportMode,
 };
 use prism_render::material::merl_export::export_material;

@@ -19,7 +19,7 @@ use prism_spectrum::SampledSpectrum;
 
 use super::fresnel::reflect;
 use super::phong::{diffuse_probability, mixture_pdf};
-use super::{BsdfSample, LobeKind, TransportMode};
+use super::{bandwidth_from_exponent, estimate_albedo, BsdfSample, Bxdf, TransportMode};
 use crate::sampling::{power_cosine_pdf, sample_cosine_hemisphere, sample_power_cosine};
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -31,8 +31,6 @@ pub struct BlinnPhong {
     /// Exponent n ≥ 0 of cos θ_h.
     pub exponent: f32,
 }
-
-impl LobeKind for BlinnPhong {}
 
 /// Giesen 2009's exact normalisation of cosⁿθ_h.
 #[inline]
@@ -47,9 +45,11 @@ impl BlinnPhong {
         let len2 = h.length_squared();
         (len2 > 0.0).then(|| h / len2.sqrt())
     }
+}
 
+impl Bxdf for BlinnPhong {
     #[inline]
-    pub fn eval(&self, wo: Vec3A, wi: Vec3A, _mode: TransportMode) -> SampledSpectrum {
+    fn eval(&self, wo: Vec3A, wi: Vec3A, _mode: TransportMode) -> SampledSpectrum {
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return SampledSpectrum::splat(0.0);
         }
@@ -60,7 +60,7 @@ impl BlinnPhong {
     }
 
     #[inline]
-    pub fn pdf(&self, wo: Vec3A, wi: Vec3A, _mode: TransportMode) -> f32 {
+    fn pdf(&self, wo: Vec3A, wi: Vec3A, _mode: TransportMode) -> f32 {
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return 0.0;
         }
@@ -77,13 +77,7 @@ impl BlinnPhong {
     }
 
     #[inline]
-    pub fn sample(
-        &self,
-        wo: Vec3A,
-        u_lobe: f32,
-        u: Vec2,
-        mode: TransportMode,
-    ) -> Option<BsdfSample> {
+    fn sample(&self, wo: Vec3A, u_lobe: f32, u: Vec2, mode: TransportMode) -> Option<BsdfSample> {
         if wo.z <= 0.0 {
             return None;
         }
@@ -98,5 +92,35 @@ impl BlinnPhong {
             reflect(wo, h)
         };
         BsdfSample::reflection(wi, self.pdf(wo, wi, mode), || self.eval(wo, wi, mode))
+    }
+
+    /// No closed form (the lobe is clipped by the horizon away from normal incidence):
+    /// `estimate_albedo`.
+    fn albedo(&self, wo: Vec3A, mode: TransportMode) -> SampledSpectrum {
+        estimate_albedo(self, wo, mode)
+    }
+
+    /// The cosine power's equivalent roughness; 0 without a specular lobe.
+    fn angular_bandwidth_cycles_per_rad(&self) -> f32 {
+        if self.specular.max_component() > 0.0 {
+            bandwidth_from_exponent(self.exponent)
+        } else {
+            0.0
+        }
+    }
+
+    #[inline]
+    fn is_specular(&self) -> bool {
+        false
+    }
+
+    #[inline]
+    fn has_specular(&self) -> bool {
+        false
+    }
+
+    #[inline]
+    fn is_reflection_only(&self) -> bool {
+        true
     }
 }

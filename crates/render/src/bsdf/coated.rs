@@ -27,7 +27,7 @@ use glam::{Vec2, Vec3A};
 use prism_spectrum::SampledSpectrum;
 
 use super::fresnel::fresnel_dielectric;
-use super::{BsdfSample, LobeKind, TransportMode};
+use super::{estimate_albedo, BsdfSample, Bxdf, TransportMode};
 use crate::sampling::sample_cosine_hemisphere;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -40,13 +40,6 @@ pub struct Coated {
     pub fdr_internal: f32,
     /// The geometric series of internal reflections (true) or Mitsuba's linear form.
     pub nonlinear: bool,
-}
-
-impl LobeKind for Coated {
-    #[inline]
-    fn has_specular(&self) -> bool {
-        true
-    }
 }
 
 /// F_dr = ∫ F(μ) 2μ dμ over the inside hemisphere, light inside the coat of index `eta`
@@ -85,9 +78,11 @@ impl Coated {
             self.diffuse / (1.0 - self.fdr_internal)
         }
     }
+}
 
+impl Bxdf for Coated {
     #[inline]
-    pub fn eval(&self, wo: Vec3A, wi: Vec3A, _mode: TransportMode) -> SampledSpectrum {
+    fn eval(&self, wo: Vec3A, wi: Vec3A, _mode: TransportMode) -> SampledSpectrum {
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return SampledSpectrum::splat(0.0);
         }
@@ -98,7 +93,7 @@ impl Coated {
     }
 
     #[inline]
-    pub fn pdf(&self, wo: Vec3A, wi: Vec3A, _mode: TransportMode) -> f32 {
+    fn pdf(&self, wo: Vec3A, wi: Vec3A, _mode: TransportMode) -> f32 {
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return 0.0;
         }
@@ -107,13 +102,7 @@ impl Coated {
     }
 
     #[inline]
-    pub fn sample(
-        &self,
-        wo: Vec3A,
-        u_lobe: f32,
-        u: Vec2,
-        mode: TransportMode,
-    ) -> Option<BsdfSample> {
+    fn sample(&self, wo: Vec3A, u_lobe: f32, u: Vec2, mode: TransportMode) -> Option<BsdfSample> {
         if wo.z <= 0.0 {
             return None;
         }
@@ -132,5 +121,32 @@ impl Coated {
         }
         let wi = sample_cosine_hemisphere(u);
         BsdfSample::reflection(wi, self.pdf(wo, wi, mode), || self.eval(wo, wi, mode))
+    }
+
+    /// The mirror's part is F(θₒ) but the diffuse part needs the coat's external
+    /// hemispherical Fresnel mean, which the lobe does not carry: `estimate_albedo`.
+    fn albedo(&self, wo: Vec3A, mode: TransportMode) -> SampledSpectrum {
+        estimate_albedo(self, wo, mode)
+    }
+
+    /// The smooth coat is a Dirac mirror.
+    fn angular_bandwidth_cycles_per_rad(&self) -> f32 {
+        f32::INFINITY
+    }
+
+    #[inline]
+    fn is_specular(&self) -> bool {
+        false
+    }
+
+    /// The coat's mirror.
+    #[inline]
+    fn has_specular(&self) -> bool {
+        true
+    }
+
+    #[inline]
+    fn is_reflection_only(&self) -> bool {
+        true
     }
 }

@@ -16,7 +16,7 @@ use prism_spectrum::SampledSpectrum;
 
 use super::fresnel::{fresnel_complex_spectrum, reflect};
 use super::microfacet::MicrofacetDistribution;
-use super::{BsdfSample, TransportMode};
+use super::{bandwidth_from_alpha, estimate_albedo, BsdfSample, Bxdf, TransportMode};
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Conductor {
@@ -27,15 +27,9 @@ pub struct Conductor {
     pub distribution: MicrofacetDistribution,
 }
 
-impl Conductor {
-    /// A perfect mirror (no microfacet lobe).
+impl Bxdf for Conductor {
     #[inline]
-    pub fn is_specular(&self) -> bool {
-        self.distribution.effectively_smooth()
-    }
-
-    #[inline]
-    pub fn eval(&self, wo: Vec3A, wi: Vec3A, _mode: TransportMode) -> SampledSpectrum {
+    fn eval(&self, wo: Vec3A, wi: Vec3A, _mode: TransportMode) -> SampledSpectrum {
         if self.is_specular() || wo.z <= 0.0 || wi.z <= 0.0 {
             return SampledSpectrum::zero();
         }
@@ -51,7 +45,7 @@ impl Conductor {
     }
 
     #[inline]
-    pub fn pdf(&self, wo: Vec3A, wi: Vec3A, _mode: TransportMode) -> f32 {
+    fn pdf(&self, wo: Vec3A, wi: Vec3A, _mode: TransportMode) -> f32 {
         if self.is_specular() || wo.z <= 0.0 || wi.z <= 0.0 {
             return 0.0;
         }
@@ -69,13 +63,7 @@ impl Conductor {
     }
 
     #[inline]
-    pub fn sample(
-        &self,
-        wo: Vec3A,
-        _u_lobe: f32,
-        u: Vec2,
-        mode: TransportMode,
-    ) -> Option<BsdfSample> {
+    fn sample(&self, wo: Vec3A, _u_lobe: f32, u: Vec2, mode: TransportMode) -> Option<BsdfSample> {
         if wo.z <= 0.0 {
             return None;
         }
@@ -108,5 +96,43 @@ impl Conductor {
             transmission: false,
             eta: 1.0,
         })
+    }
+
+    /// Smooth: closed form, the Fresnel reflectance F(cos θₒ) of the mirror. Rough: no
+    /// closed form (masking and Fresnel vary over the lobe): `estimate_albedo`.
+    fn albedo(&self, wo: Vec3A, mode: TransportMode) -> SampledSpectrum {
+        if wo.z <= 0.0 {
+            return SampledSpectrum::zero();
+        }
+        if self.is_specular() {
+            return fresnel_complex_spectrum(wo.z, self.eta, self.k);
+        }
+        estimate_albedo(self, wo, mode)
+    }
+
+    /// ∞ for the mirror; else from the narrower of the two roughnesses α (radians of
+    /// slope spread), which sets the anisotropic lobe's sharpest direction.
+    fn angular_bandwidth_cycles_per_rad(&self) -> f32 {
+        if self.is_specular() {
+            f32::INFINITY
+        } else {
+            bandwidth_from_alpha(self.distribution.alpha_x.min(self.distribution.alpha_y))
+        }
+    }
+
+    /// A perfect mirror (no microfacet lobe).
+    #[inline]
+    fn is_specular(&self) -> bool {
+        self.distribution.effectively_smooth()
+    }
+
+    #[inline]
+    fn has_specular(&self) -> bool {
+        self.is_specular()
+    }
+
+    #[inline]
+    fn is_reflection_only(&self) -> bool {
+        true
     }
 }

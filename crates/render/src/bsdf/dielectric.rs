@@ -30,7 +30,9 @@ use prism_spectrum::SampledSpectrum;
 
 use super::fresnel::{fresnel_dielectric, reflect, refract};
 use super::microfacet::MicrofacetDistribution;
-use super::{same_hemisphere, BsdfSample, TransportMode};
+use super::{
+    bandwidth_from_alpha, estimate_albedo, same_hemisphere, BsdfSample, Bxdf, TransportMode,
+};
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Dielectric {
@@ -73,12 +75,6 @@ fn half_vector(wo: Vec3A, wi: Vec3A, eta: f32) -> Option<(Vec3A, f32)> {
 }
 
 impl Dielectric {
-    /// Every lobe is a Dirac delta: smooth, or index-matched (η = 1: straight through).
-    #[inline]
-    pub fn is_specular(&self) -> bool {
-        self.eta[0] == 1.0 || self.distribution.effectively_smooth()
-    }
-
     /// True when every lane has the same η (no dispersion): one evaluation serves all.
     #[inline]
     fn uniform_eta(&self) -> bool {
@@ -107,87 +103,6 @@ impl Dielectric {
             ft /= etap * etap;
         }
         ft
-    }
-
-    #[inline]
-    pub fn eval(&self, wo: Vec3A, wi: Vec3A, mode: TransportMode) -> SampledSpectrum {
-        if self.is_specular() {
-            return SampledSpectrum::zero();
-        }
-        if self.uniform_eta() {
-            SampledSpectrum::splat(self.eval_lane(wo, wi, self.eta[0], mode))
-        } else {
-            SampledSpectrum::from_fn(|l| self.eval_lane(wo, wi, self.eta[l], mode))
-        }
-    }
-
-    /// Density of `sample` (hero lane's η).
-    #[inline]
-    pub fn pdf(&self, wo: Vec3A, wi: Vec3A, _mode: TransportMode) -> f32 {
-        if self.is_specular() {
-            return 0.0;
-        }
-        let eta = self.eta[0];
-        let Some((wm, etap)) = half_vector(wo, wi, eta) else {
-            return 0.0;
-        };
-        let r = fresnel_dielectric(wo.dot(wm), eta);
-        let t = 1.0 - r;
-        let d_vis = self.distribution.d_visible(wo, wm);
-        if wo.z * wi.z > 0.0 {
-            d_vis / (4.0 * wo.dot(wm).abs()) * r
-        } else {
-            let denom = (wi.dot(wm) + wo.dot(wm) / etap).powi(2);
-            if denom == 0.0 {
-                return 0.0;
-            }
-            let dwm_dwi = wi.dot(wm).abs() / denom;
-            d_vis * dwm_dwi * t
-        }
-    }
-
-    #[inline]
-    pub fn sample(
-        &self,
-        wo: Vec3A,
-        u_lobe: f32,
-        u: Vec2,
-        mode: TransportMode,
-    ) -> Option<BsdfSample> {
-        if wo.z == 0.0 {
-            return None;
-        }
-        if self.is_specular() {
-            return self.sample_specular(wo, u_lobe, mode);
-        }
-        let eta = self.eta[0];
-        let wm = self.distribution.sample_wm(wo, u);
-        let r = fresnel_dielectric(wo.dot(wm), eta);
-        let (wi, transmission, etap) = if u_lobe < r {
-            let wi = reflect(wo, wm);
-            if !same_hemisphere(wo, wi) {
-                return None;
-            }
-            (wi, false, 1.0)
-        } else {
-            let (wi, etap) = refract(wo, wm, eta)?;
-            if same_hemisphere(wo, wi) || wi.z == 0.0 {
-                return None;
-            }
-            (wi, true, etap)
-        };
-        let pdf = self.pdf(wo, wi, mode);
-        if pdf.is_nan() || pdf <= 0.0 {
-            return None;
-        }
-        Some(BsdfSample {
-            wi,
-            f: self.eval(wo, wi, mode),
-            pdf,
-            specular: false,
-            transmission,
-            eta: etap,
-        })
     }
 
     /// The smooth interface: reflection with probability F, refraction with 1 − F.
@@ -230,5 +145,128 @@ impl Dielectric {
             transmission: true,
             eta: etap,
         })
+    }
+}
+
+impl Bxdf for Dielectric {
+    #[inline]
+    fn eval(&self, wo: Vec3A, wi: Vec3A, mode: TransportMode) -> SampledSpectrum {
+        if self.is_specular() {
+            return SampledSpectrum::zero();
+        }
+        if self.uniform_eta() {
+            SampledSpectrum::splat(self.eval_lane(wo, wi, self.eta[0], mode))
+        } else {
+            SampledSpectrum::from_fn(|l| self.eval_lane(wo, wi, self.eta[l], mode))
+        }
+    }
+
+    /// Density of `sample` (hero lane's η).
+    #[inline]
+    fn pdf(&self, wo: Vec3A, wi: Vec3A, _mode: TransportMode) -> f32 {
+        if self.is_specular() {
+            return 0.0;
+        }
+        let eta = self.eta[0];
+        let Some((wm, etap)) = half_vector(wo, wi, eta) else {
+            return 0.0;
+        };
+        let r = fresnel_dielectric(wo.dot(wm), eta);
+        let t = 1.0 - r;
+        let d_vis = self.distribution.d_visible(wo, wm);
+        if wo.z * wi.z > 0.0 {
+            d_vis / (4.0 * wo.dot(wm).abs()) * r
+        } else {
+            let denom = (wi.dot(wm) + wo.dot(wm) / etap).powi(2);
+            if denom == 0.0 {
+                return 0.0;
+            }
+            let dwm_dwi = wi.dot(wm).abs() / denom;
+            d_vis * dwm_dwi * t
+        }
+    }
+
+    #[inline]
+    fn sample(&self, wo: Vec3A, u_lobe: f32, u: Vec2, mode: TransportMode) -> Option<BsdfSample> {
+        if wo.z == 0.0 {
+            return None;
+        }
+        if self.is_specular() {
+            return self.sample_specular(wo, u_lobe, mode);
+        }
+        let eta = self.eta[0];
+        let wm = self.distribution.sample_wm(wo, u);
+        let r = fresnel_dielectric(wo.dot(wm), eta);
+        let (wi, transmission, etap) = if u_lobe < r {
+            let wi = reflect(wo, wm);
+            if !same_hemisphere(wo, wi) {
+                return None;
+            }
+            (wi, false, 1.0)
+        } else {
+            let (wi, etap) = refract(wo, wm, eta)?;
+            if same_hemisphere(wo, wi) || wi.z == 0.0 {
+                return None;
+            }
+            (wi, true, etap)
+        };
+        let pdf = self.pdf(wo, wi, mode);
+        if pdf.is_nan() || pdf <= 0.0 {
+            return None;
+        }
+        Some(BsdfSample {
+            wi,
+            f: self.eval(wo, wi, mode),
+            pdf,
+            specular: false,
+            transmission,
+            eta: etap,
+        })
+    }
+
+    /// Smooth: closed form per lane, F + (1 − F)/η'² (the Dirac reflection and refraction;
+    /// no 1/η'² in `Importance` mode, so ρ = 1 there). Rough: `estimate_albedo`.
+    fn albedo(&self, wo: Vec3A, mode: TransportMode) -> SampledSpectrum {
+        if wo.z == 0.0 {
+            return SampledSpectrum::zero();
+        }
+        if !self.is_specular() {
+            return estimate_albedo(self, wo, mode);
+        }
+        SampledSpectrum::from_fn(|l| {
+            let eta_l = self.eta[l];
+            let r = fresnel_dielectric(wo.z, eta_l);
+            let etap_l = if wo.z > 0.0 { eta_l } else { 1.0 / eta_l };
+            match mode {
+                TransportMode::Radiance => r + (1.0 - r) / (etap_l * etap_l),
+                TransportMode::Importance => r + (1.0 - r),
+            }
+        })
+    }
+
+    /// As for `Conductor`: ∞ when Dirac, else from the narrower roughness.
+    fn angular_bandwidth_cycles_per_rad(&self) -> f32 {
+        if self.is_specular() {
+            f32::INFINITY
+        } else {
+            bandwidth_from_alpha(self.distribution.alpha_x.min(self.distribution.alpha_y))
+        }
+    }
+
+    /// Every lobe is a Dirac delta: smooth, or index-matched (η = 1: straight through).
+    #[inline]
+    fn is_specular(&self) -> bool {
+        self.eta[0] == 1.0 || self.distribution.effectively_smooth()
+    }
+
+    #[inline]
+    fn has_specular(&self) -> bool {
+        self.is_specular()
+    }
+
+    /// Reflects and refracts, on both sides.
+    #[inline]
+    fn is_reflection_only(&self) -> bool {
+        false
     }
 }

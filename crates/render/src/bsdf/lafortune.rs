@@ -20,7 +20,7 @@ use glam::{Vec2, Vec3A};
 use prism_geometry::Frame;
 use prism_spectrum::SampledSpectrum;
 
-use super::{BsdfSample, LobeKind, TransportMode};
+use super::{bandwidth_from_exponent, estimate_albedo, BsdfSample, Bxdf, TransportMode};
 use crate::sampling::{power_cosine_pdf, sample_cosine_hemisphere, sample_power_cosine};
 
 /// Most lobes a material may have (the paper fits up to three).
@@ -45,8 +45,6 @@ pub struct Lafortune {
     /// Lobes in use (the first `count` of `lobes`).
     pub count: usize,
 }
-
-impl LobeKind for Lafortune {}
 
 impl LafortuneLobe {
     /// An unused slot.
@@ -84,9 +82,11 @@ impl Lafortune {
         }
         w
     }
+}
 
+impl Bxdf for Lafortune {
     #[inline]
-    pub fn eval(&self, wo: Vec3A, wi: Vec3A, _mode: TransportMode) -> SampledSpectrum {
+    fn eval(&self, wo: Vec3A, wi: Vec3A, _mode: TransportMode) -> SampledSpectrum {
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return SampledSpectrum::splat(0.0);
         }
@@ -101,7 +101,7 @@ impl Lafortune {
     }
 
     #[inline]
-    pub fn pdf(&self, wo: Vec3A, wi: Vec3A, _mode: TransportMode) -> f32 {
+    fn pdf(&self, wo: Vec3A, wi: Vec3A, _mode: TransportMode) -> f32 {
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return 0.0;
         }
@@ -118,13 +118,7 @@ impl Lafortune {
     }
 
     #[inline]
-    pub fn sample(
-        &self,
-        wo: Vec3A,
-        u_lobe: f32,
-        u: Vec2,
-        mode: TransportMode,
-    ) -> Option<BsdfSample> {
+    fn sample(&self, wo: Vec3A, u_lobe: f32, u: Vec2, mode: TransportMode) -> Option<BsdfSample> {
         if wo.z <= 0.0 {
             return None;
         }
@@ -151,5 +145,34 @@ impl Lafortune {
             frame.from_local(sample_power_cosine(u, lobe.exponent))
         };
         BsdfSample::reflection(wi, self.pdf(wo, wi, mode), || self.eval(wo, wi, mode))
+    }
+
+    /// No closed form (the clamped lobes are cut by the horizon): `estimate_albedo`.
+    fn albedo(&self, wo: Vec3A, mode: TransportMode) -> SampledSpectrum {
+        estimate_albedo(self, wo, mode)
+    }
+
+    /// The sharpest lobe in use (non-zero albedo) through its cosine power; 0 with none.
+    fn angular_bandwidth_cycles_per_rad(&self) -> f32 {
+        self.lobes[..self.count]
+            .iter()
+            .filter(|j| j.albedo.max_component() > 0.0)
+            .map(|j| bandwidth_from_exponent(j.exponent))
+            .fold(0.0, f32::max)
+    }
+
+    #[inline]
+    fn is_specular(&self) -> bool {
+        false
+    }
+
+    #[inline]
+    fn has_specular(&self) -> bool {
+        false
+    }
+
+    #[inline]
+    fn is_reflection_only(&self) -> bool {
+        true
     }
 }

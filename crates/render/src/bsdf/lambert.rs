@@ -4,7 +4,7 @@
 use glam::{Vec2, Vec3A};
 use prism_spectrum::SampledSpectrum;
 
-use super::{BsdfSample, TransportMode};
+use super::{BsdfSample, Bxdf, TransportMode};
 use crate::sampling::sample_cosine_hemisphere;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -13,9 +13,9 @@ pub struct Lambert {
     pub reflectance: SampledSpectrum,
 }
 
-impl Lambert {
+impl Bxdf for Lambert {
     #[inline]
-    pub fn eval(&self, wo: Vec3A, wi: Vec3A, _mode: TransportMode) -> SampledSpectrum {
+    fn eval(&self, wo: Vec3A, wi: Vec3A, _mode: TransportMode) -> SampledSpectrum {
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return SampledSpectrum::splat(0.0);
         }
@@ -23,23 +23,42 @@ impl Lambert {
     }
 
     #[inline]
-    pub fn pdf(&self, wo: Vec3A, wi: Vec3A, _mode: TransportMode) -> f32 {
+    fn pdf(&self, wo: Vec3A, wi: Vec3A, _mode: TransportMode) -> f32 {
         cosine_pdf(wo, wi)
     }
 
     #[inline]
-    pub fn sample(
-        &self,
-        wo: Vec3A,
-        _u_lobe: f32,
-        u: Vec2,
-        mode: TransportMode,
-    ) -> Option<BsdfSample> {
+    fn sample(&self, wo: Vec3A, _u_lobe: f32, u: Vec2, mode: TransportMode) -> Option<BsdfSample> {
         if wo.z <= 0.0 {
             return None;
         }
         let wi = sample_cosine_hemisphere(u);
         BsdfSample::reflection(wi, self.pdf(wo, wi, mode), || self.eval(wo, wi, mode))
+    }
+
+    /// Closed form: ∫ R/π cos θᵢ dωᵢ = R above the surface, 0 below.
+    fn albedo(&self, wo: Vec3A, _mode: TransportMode) -> SampledSpectrum {
+        if wo.z <= 0.0 {
+            return SampledSpectrum::zero();
+        }
+        self.reflectance
+    }
+
+    /// A constant lobe has no angular variation.
+    fn angular_bandwidth_cycles_per_rad(&self) -> f32 {
+        0.0
+    }
+
+    fn is_specular(&self) -> bool {
+        false
+    }
+
+    fn has_specular(&self) -> bool {
+        false
+    }
+
+    fn is_reflection_only(&self) -> bool {
+        true
     }
 }
 

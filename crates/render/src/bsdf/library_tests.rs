@@ -133,7 +133,7 @@ fn ggx(alpha: f32) -> Conductor {
     }
 }
 
-fn mix<'a>(parts: &[(MixComponent<'a>, f32)]) -> Bsdf<'a> {
+fn mix<'a>(parts: &[(LeafLobe<'a>, f32)]) -> Bsdf<'a> {
     Bsdf::new(BsdfLobe::Mix(Mix::new(parts).expect("valid mix")))
 }
 
@@ -223,27 +223,27 @@ fn chi2_mix() {
             "lambert + rough GGX".to_string(),
             mix(&[
                 (
-                    MixComponent::Lambert(Lambert {
+                    LeafLobe::Lambert(Lambert {
                         reflectance: s(0.6),
                     }),
                     0.3,
                 ),
-                (MixComponent::Conductor(ggx(0.2)), 0.7),
+                (LeafLobe::Conductor(ggx(0.2)), 0.7),
             ]),
         ),
         (
             "phong + ward + coated".to_string(),
             mix(&[
                 (
-                    MixComponent::from_lobe(phong(0.3, 0.6, 30.0).lobe).unwrap(),
+                    LeafLobe::from_lobe(phong(0.3, 0.6, 30.0).lobe).unwrap(),
                     0.2,
                 ),
                 (
-                    MixComponent::from_lobe(ward(0.2, 0.6, 0.1, 0.3).lobe).unwrap(),
+                    LeafLobe::from_lobe(ward(0.2, 0.6, 0.1, 0.3).lobe).unwrap(),
                     0.5,
                 ),
                 (
-                    MixComponent::from_lobe(coated(0.5, 1.5, true).lobe).unwrap(),
+                    LeafLobe::from_lobe(coated(0.5, 1.5, true).lobe).unwrap(),
                     0.3,
                 ),
             ]),
@@ -366,11 +366,11 @@ fn albedo_of_the_energy_conserving_models_is_at_most_one() {
             "mix".into(),
             mix(&[
                 (
-                    MixComponent::from_lobe(ward(0.0, 1.0, 0.2, 0.2).lobe).unwrap(),
+                    LeafLobe::from_lobe(ward(0.0, 1.0, 0.2, 0.2).lobe).unwrap(),
                     0.5,
                 ),
                 (
-                    MixComponent::from_lobe(coated(1.0, 1.5, true).lobe).unwrap(),
+                    LeafLobe::from_lobe(coated(1.0, 1.5, true).lobe).unwrap(),
                     0.5,
                 ),
             ]),
@@ -438,10 +438,10 @@ fn reciprocity_of_the_library() {
             "mix",
             mix(&[
                 (
-                    MixComponent::from_lobe(phong(0.3, 0.6, 20.0).lobe).unwrap(),
+                    LeafLobe::from_lobe(phong(0.3, 0.6, 20.0).lobe).unwrap(),
                     0.4,
                 ),
-                (MixComponent::Conductor(ggx(0.3)), 0.6),
+                (LeafLobe::Conductor(ggx(0.3)), 0.6),
             ]),
         ),
     ];
@@ -526,7 +526,7 @@ fn oren_nayar_full_model_matches_the_paper_at_known_points() {
     assert!(got > forward);
 }
 
-fn merl_from(bsdf: Bsdf) -> MerlTable {
+pub(super) fn merl_from(bsdf: Bsdf) -> MerlTable {
     MerlTable::from_fn(|th, td, pd| {
         let (wi, wo) = merl_directions(th, td, pd);
         if wi.z <= 0.0 || wo.z <= 0.0 {
@@ -700,12 +700,11 @@ fn chi2_merl() {
             "oren_nayar σ 30° + blinn_phong",
             mix(&[
                 (
-                    MixComponent::from_lobe(oren_nayar(0.5, 30.0, OrenNayarForm::Full).lobe)
-                        .unwrap(),
+                    LeafLobe::from_lobe(oren_nayar(0.5, 30.0, OrenNayarForm::Full).lobe).unwrap(),
                     0.5,
                 ),
                 (
-                    MixComponent::from_lobe(blinn_phong(0.0, 1.0, 60.0).lobe).unwrap(),
+                    LeafLobe::from_lobe(blinn_phong(0.0, 1.0, 60.0).lobe).unwrap(),
                     0.5,
                 ),
             ]),

@@ -52,7 +52,7 @@ use glam::{Vec2, Vec3A};
 use prism_spectrum::{RgbGamut, SampledSpectrum};
 use rayon::prelude::*;
 
-use super::{BsdfSample, LobeKind, TransportMode};
+use super::{bandwidth_from_alpha, estimate_albedo, BsdfSample, Bxdf, TransportMode};
 use crate::sampling::sample_cosine_hemisphere;
 
 /// θ_h bins.
@@ -899,11 +899,9 @@ impl PartialEq for Measured<'_> {
     }
 }
 
-impl LobeKind for Measured<'_> {}
-
-impl Measured<'_> {
+impl Bxdf for Measured<'_> {
     #[inline]
-    pub fn eval(&self, wo: Vec3A, wi: Vec3A, _mode: TransportMode) -> SampledSpectrum {
+    fn eval(&self, wo: Vec3A, wi: Vec3A, _mode: TransportMode) -> SampledSpectrum {
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return SampledSpectrum::zero();
         }
@@ -917,7 +915,7 @@ impl Measured<'_> {
     }
 
     #[inline]
-    pub fn pdf(&self, wo: Vec3A, wi: Vec3A, _mode: TransportMode) -> f32 {
+    fn pdf(&self, wo: Vec3A, wi: Vec3A, _mode: TransportMode) -> f32 {
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return 0.0;
         }
@@ -931,13 +929,7 @@ impl Measured<'_> {
     }
 
     #[inline]
-    pub fn sample(
-        &self,
-        wo: Vec3A,
-        u_lobe: f32,
-        u: Vec2,
-        mode: TransportMode,
-    ) -> Option<BsdfSample> {
+    fn sample(&self, wo: Vec3A, u_lobe: f32, u: Vec2, mode: TransportMode) -> Option<BsdfSample> {
         if wo.z <= 0.0 {
             return None;
         }
@@ -1008,6 +1000,31 @@ impl Measured<'_> {
             transmission: false,
             eta: 1.0,
         })
+    }
+
+    /// No closed form (a table): `estimate_albedo`.
+    fn albedo(&self, wo: Vec3A, mode: TransportMode) -> SampledSpectrum {
+        estimate_albedo(self, wo, mode)
+    }
+
+    /// The table's equivalent microfacet roughness (fitted when it was loaded).
+    fn angular_bandwidth_cycles_per_rad(&self) -> f32 {
+        bandwidth_from_alpha(self.brdf.equivalent_alpha)
+    }
+
+    #[inline]
+    fn is_specular(&self) -> bool {
+        false
+    }
+
+    #[inline]
+    fn has_specular(&self) -> bool {
+        false
+    }
+
+    #[inline]
+    fn is_reflection_only(&self) -> bool {
+        true
     }
 }
 

@@ -5,109 +5,26 @@
 //! one consistent density). A Dirac sample of lobe j keeps its own weight: f·wⱼ with
 //! discrete probability pⱼ·wⱼ.
 //!
-//! Nested mixes are flattened when the material builds the BSDF (weights multiply), so a
-//! component is never itself a mix; at most `MIX_MAX_COMPONENTS` leaves. Energy and
-//! reciprocity hold when they hold for every component.
+//! Nested mixes are flattened when the material builds the BSDF (weights multiply): a
+//! component is a `LeafLobe`, whose `Mix` variant holds the valueless `NoMix`, so it is
+//! never itself a mix; at most `MIX_MAX_COMPONENTS` leaves. Energy and reciprocity hold
+//! when they hold for every component.
 
 use glam::{Vec2, Vec3A};
 use prism_spectrum::SampledSpectrum;
 
-use super::{
-    dispatch_lobe, BlinnPhong, BsdfLobe, BsdfSample, Coated, Conductor, Dielectric, Lafortune,
-    Lambert, LobeKind, Measured, OrenNayar, Phong, ThinDielectric, TransportMode, Ward,
-};
+use super::{BsdfSample, Bxdf, Lambert, LeafLobe, TransportMode};
 
 /// Most leaves a (flattened) mix may have.
 pub const MIX_MAX_COMPONENTS: usize = 4;
 
-/// A lobe inside a mix: every `BsdfLobe` but `Mix`.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum MixComponent<'a> {
-    Lambert(Lambert),
-    Conductor(Conductor),
-    Dielectric(Dielectric),
-    OrenNayar(OrenNayar),
-    Phong(Phong),
-    BlinnPhong(BlinnPhong),
-    Ward(Ward),
-    Lafortune(Lafortune),
-    Coated(Coated),
-    ThinDielectric(ThinDielectric),
-    Measured(Measured<'a>),
-}
-
-impl<'a> MixComponent<'a> {
-    /// The same lobe as a stand-alone `BsdfLobe`.
-    pub fn as_lobe(&self) -> BsdfLobe<'a> {
-        match *self {
-            MixComponent::Lambert(l) => BsdfLobe::Lambert(l),
-            MixComponent::Conductor(l) => BsdfLobe::Conductor(l),
-            MixComponent::Dielectric(l) => BsdfLobe::Dielectric(l),
-            MixComponent::OrenNayar(l) => BsdfLobe::OrenNayar(l),
-            MixComponent::Phong(l) => BsdfLobe::Phong(l),
-            MixComponent::BlinnPhong(l) => BsdfLobe::BlinnPhong(l),
-            MixComponent::Ward(l) => BsdfLobe::Ward(l),
-            MixComponent::Lafortune(l) => BsdfLobe::Lafortune(l),
-            MixComponent::Coated(l) => BsdfLobe::Coated(l),
-            MixComponent::ThinDielectric(l) => BsdfLobe::ThinDielectric(l),
-            MixComponent::Measured(l) => BsdfLobe::Measured(l),
-        }
-    }
-
-    /// A stand-alone lobe as a mix component (`None` for a mix: flatten it instead).
-    pub fn from_lobe(lobe: BsdfLobe<'a>) -> Option<Self> {
-        Some(match lobe {
-            BsdfLobe::Lambert(l) => MixComponent::Lambert(l),
-            BsdfLobe::Conductor(l) => MixComponent::Conductor(l),
-            BsdfLobe::Dielectric(l) => MixComponent::Dielectric(l),
-            BsdfLobe::OrenNayar(l) => MixComponent::OrenNayar(l),
-            BsdfLobe::Phong(l) => MixComponent::Phong(l),
-            BsdfLobe::BlinnPhong(l) => MixComponent::BlinnPhong(l),
-            BsdfLobe::Ward(l) => MixComponent::Ward(l),
-            BsdfLobe::Lafortune(l) => MixComponent::Lafortune(l),
-            BsdfLobe::Coated(l) => MixComponent::Coated(l),
-            BsdfLobe::ThinDielectric(l) => MixComponent::ThinDielectric(l),
-            BsdfLobe::Measured(l) => MixComponent::Measured(l),
-            BsdfLobe::Mix(_) => return None,
-        })
-    }
-
-    #[inline]
-    pub fn eval(&self, wo: Vec3A, wi: Vec3A, mode: TransportMode) -> SampledSpectrum {
-        dispatch_lobe!(MixComponent, self, l => l.eval(wo, wi, mode))
-    }
-    #[inline]
-    pub fn pdf(&self, wo: Vec3A, wi: Vec3A, mode: TransportMode) -> f32 {
-        dispatch_lobe!(MixComponent, self, l => l.pdf(wo, wi, mode))
-    }
-    #[inline]
-    pub fn sample(
-        &self,
-        wo: Vec3A,
-        u_lobe: f32,
-        u: Vec2,
-        mode: TransportMode,
-    ) -> Option<BsdfSample> {
-        dispatch_lobe!(MixComponent, self, l => l.sample(wo, u_lobe, u, mode))
-    }
-    #[inline]
-    pub fn is_specular(&self) -> bool {
-        dispatch_lobe!(MixComponent, self, l => LobeKind::is_specular(l))
-    }
-    #[inline]
-    pub fn has_specular(&self) -> bool {
-        dispatch_lobe!(MixComponent, self, l => l.has_specular())
-    }
-    #[inline]
-    pub fn is_reflection_only(&self) -> bool {
-        dispatch_lobe!(MixComponent, self, l => l.is_reflection_only())
-    }
-}
+/// The former name of a mix leaf, kept for tools/bench-bsdf: the same type as `LeafLobe`.
+pub type MixComponent<'a> = LeafLobe<'a>;
 
 /// The blend: `components[..count]` with `weights[..count]` (each ≥ 0, summing to 1).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Mix<'a> {
-    pub components: [MixComponent<'a>; MIX_MAX_COMPONENTS],
+    pub components: [LeafLobe<'a>; MIX_MAX_COMPONENTS],
     pub weights: [f32; MIX_MAX_COMPONENTS],
     pub count: usize,
 }
@@ -115,7 +32,7 @@ pub struct Mix<'a> {
 impl<'a> Mix<'a> {
     /// A blend of `parts` (weights normalised to sum 1); `None` for no part, more than
     /// `MIX_MAX_COMPONENTS`, or weights that are negative, non-finite or all zero.
-    pub fn new(parts: &[(MixComponent<'a>, f32)]) -> Option<Self> {
+    pub fn new(parts: &[(LeafLobe<'a>, f32)]) -> Option<Self> {
         if parts.is_empty() || parts.len() > MIX_MAX_COMPONENTS {
             return None;
         }
@@ -123,7 +40,7 @@ impl<'a> Mix<'a> {
         if !(total > 0.0 && total.is_finite()) || parts.iter().any(|p| p.1.is_nan() || p.1 < 0.0) {
             return None;
         }
-        let filler = MixComponent::Lambert(Lambert {
+        let filler = LeafLobe::Lambert(Lambert {
             reflectance: SampledSpectrum::zero(),
         });
         let mut components = [filler; MIX_MAX_COMPONENTS];
@@ -140,26 +57,51 @@ impl<'a> Mix<'a> {
     }
 
     #[inline]
-    fn parts(&self) -> impl Iterator<Item = (&MixComponent<'a>, f32)> {
+    fn parts(&self) -> impl Iterator<Item = (&LeafLobe<'a>, f32)> {
         self.components[..self.count]
             .iter()
             .zip(self.weights[..self.count].iter().copied())
     }
+}
 
-    pub fn is_specular(&self) -> bool {
+impl Bxdf for Mix<'_> {
+    /// Exact composition: ρ = Σⱼ wⱼ ρⱼ, since f is linear in the leaves; each ρⱼ is its
+    /// leaf's (closed form or `estimate_albedo`).
+    fn albedo(&self, wo: Vec3A, mode: TransportMode) -> SampledSpectrum {
+        let mut rho = SampledSpectrum::zero();
+        for (c, w) in self.parts() {
+            if w > 0.0 {
+                rho += c.albedo(wo, mode) * w;
+            }
+        }
+        rho
+    }
+
+    /// The sharpest leaf sets the bandwidth.
+    fn angular_bandwidth_cycles_per_rad(&self) -> f32 {
+        self.components[..self.count]
+            .iter()
+            .map(Bxdf::angular_bandwidth_cycles_per_rad)
+            .fold(0.0, f32::max)
+    }
+
+    #[inline]
+    fn is_specular(&self) -> bool {
         self.parts().all(|(c, w)| w == 0.0 || c.is_specular())
     }
 
-    pub fn has_specular(&self) -> bool {
+    #[inline]
+    fn has_specular(&self) -> bool {
         self.parts().any(|(c, w)| w > 0.0 && c.has_specular())
     }
 
-    pub fn is_reflection_only(&self) -> bool {
+    #[inline]
+    fn is_reflection_only(&self) -> bool {
         self.parts().all(|(c, _)| c.is_reflection_only())
     }
 
     #[inline]
-    pub fn eval(&self, wo: Vec3A, wi: Vec3A, mode: TransportMode) -> SampledSpectrum {
+    fn eval(&self, wo: Vec3A, wi: Vec3A, mode: TransportMode) -> SampledSpectrum {
         let mut f = SampledSpectrum::zero();
         for (c, w) in self.parts() {
             if w > 0.0 {
@@ -170,7 +112,7 @@ impl<'a> Mix<'a> {
     }
 
     #[inline]
-    pub fn pdf(&self, wo: Vec3A, wi: Vec3A, mode: TransportMode) -> f32 {
+    fn pdf(&self, wo: Vec3A, wi: Vec3A, mode: TransportMode) -> f32 {
         let mut p = 0.0;
         for (c, w) in self.parts() {
             if w > 0.0 {
@@ -181,13 +123,7 @@ impl<'a> Mix<'a> {
     }
 
     #[inline]
-    pub fn sample(
-        &self,
-        wo: Vec3A,
-        u_lobe: f32,
-        u: Vec2,
-        mode: TransportMode,
-    ) -> Option<BsdfSample> {
+    fn sample(&self, wo: Vec3A, u_lobe: f32, u: Vec2, mode: TransportMode) -> Option<BsdfSample> {
         // Pick component j with probability wⱼ; reuse the variate inside it.
         let mut chosen = self.count - 1;
         let mut start = 0.0;

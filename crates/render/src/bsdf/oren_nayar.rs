@@ -27,7 +27,7 @@
 use glam::{Vec2, Vec3A};
 use prism_spectrum::SampledSpectrum;
 
-use super::{BsdfSample, LobeKind, TransportMode};
+use super::{estimate_albedo, BsdfSample, Bxdf, TransportMode};
 use crate::sampling::sample_cosine_hemisphere;
 
 /// Which of the paper's two forms.
@@ -48,11 +48,9 @@ pub struct OrenNayar {
     pub form: OrenNayarForm,
 }
 
-impl LobeKind for OrenNayar {}
-
-impl OrenNayar {
+impl Bxdf for OrenNayar {
     #[inline]
-    pub fn eval(&self, wo: Vec3A, wi: Vec3A, _mode: TransportMode) -> SampledSpectrum {
+    fn eval(&self, wo: Vec3A, wi: Vec3A, _mode: TransportMode) -> SampledSpectrum {
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return SampledSpectrum::splat(0.0);
         }
@@ -108,22 +106,48 @@ impl OrenNayar {
     }
 
     #[inline]
-    pub fn pdf(&self, wo: Vec3A, wi: Vec3A, _mode: TransportMode) -> f32 {
+    fn pdf(&self, wo: Vec3A, wi: Vec3A, _mode: TransportMode) -> f32 {
         super::lambert::cosine_pdf(wo, wi)
     }
 
     #[inline]
-    pub fn sample(
-        &self,
-        wo: Vec3A,
-        _u_lobe: f32,
-        u: Vec2,
-        mode: TransportMode,
-    ) -> Option<BsdfSample> {
+    fn sample(&self, wo: Vec3A, _u_lobe: f32, u: Vec2, mode: TransportMode) -> Option<BsdfSample> {
         if wo.z <= 0.0 {
             return None;
         }
         let wi = sample_cosine_hemisphere(u);
         BsdfSample::reflection(wi, self.pdf(wo, wi, mode), || self.eval(wo, wi, mode))
+    }
+
+    /// Closed form at σ = 0 (Lambert: ρ); otherwise no closed form for either form
+    /// (eq. 8's coefficients vary with both angles): `estimate_albedo`.
+    fn albedo(&self, wo: Vec3A, mode: TransportMode) -> SampledSpectrum {
+        if wo.z <= 0.0 {
+            return SampledSpectrum::zero();
+        }
+        if self.sigma_rad == 0.0 {
+            return self.reflectance;
+        }
+        estimate_albedo(self, wo, mode)
+    }
+
+    /// A diffuse lobe: no angular detail to resolve.
+    fn angular_bandwidth_cycles_per_rad(&self) -> f32 {
+        0.0
+    }
+
+    #[inline]
+    fn is_specular(&self) -> bool {
+        false
+    }
+
+    #[inline]
+    fn has_specular(&self) -> bool {
+        false
+    }
+
+    #[inline]
+    fn is_reflection_only(&self) -> bool {
+        true
     }
 }

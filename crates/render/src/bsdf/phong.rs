@@ -19,7 +19,7 @@ use glam::{Vec2, Vec3A};
 use prism_geometry::Frame;
 use prism_spectrum::SampledSpectrum;
 
-use super::{BsdfSample, LobeKind, TransportMode};
+use super::{bandwidth_from_exponent, estimate_albedo, BsdfSample, Bxdf, TransportMode};
 use crate::sampling::{power_cosine_pdf, sample_cosine_hemisphere, sample_power_cosine};
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -31,8 +31,6 @@ pub struct Phong {
     /// Phong exponent n ≥ 0.
     pub exponent: f32,
 }
-
-impl LobeKind for Phong {}
 
 /// Probability of sampling the diffuse lobe of a diffuse + glossy pair: the ratio of the
 /// lane means (1 when both are black, so sampling still succeeds).
@@ -58,9 +56,11 @@ impl Phong {
     fn mirror(wo: Vec3A) -> Vec3A {
         Vec3A::new(-wo.x, -wo.y, wo.z)
     }
+}
 
+impl Bxdf for Phong {
     #[inline]
-    pub fn eval(&self, wo: Vec3A, wi: Vec3A, _mode: TransportMode) -> SampledSpectrum {
+    fn eval(&self, wo: Vec3A, wi: Vec3A, _mode: TransportMode) -> SampledSpectrum {
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return SampledSpectrum::splat(0.0);
         }
@@ -77,7 +77,7 @@ impl Phong {
     }
 
     #[inline]
-    pub fn pdf(&self, wo: Vec3A, wi: Vec3A, _mode: TransportMode) -> f32 {
+    fn pdf(&self, wo: Vec3A, wi: Vec3A, _mode: TransportMode) -> f32 {
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return 0.0;
         }
@@ -88,13 +88,7 @@ impl Phong {
     }
 
     #[inline]
-    pub fn sample(
-        &self,
-        wo: Vec3A,
-        u_lobe: f32,
-        u: Vec2,
-        mode: TransportMode,
-    ) -> Option<BsdfSample> {
+    fn sample(&self, wo: Vec3A, u_lobe: f32, u: Vec2, mode: TransportMode) -> Option<BsdfSample> {
         if wo.z <= 0.0 {
             return None;
         }
@@ -106,5 +100,35 @@ impl Phong {
             frame.from_local(sample_power_cosine(u, self.exponent))
         };
         BsdfSample::reflection(wi, self.pdf(wo, wi, mode), || self.eval(wo, wi, mode))
+    }
+
+    /// No closed form (the lobe is clipped by the horizon away from normal incidence):
+    /// `estimate_albedo`.
+    fn albedo(&self, wo: Vec3A, mode: TransportMode) -> SampledSpectrum {
+        estimate_albedo(self, wo, mode)
+    }
+
+    /// The cosine power's equivalent roughness; 0 without a specular lobe.
+    fn angular_bandwidth_cycles_per_rad(&self) -> f32 {
+        if self.specular.max_component() > 0.0 {
+            bandwidth_from_exponent(self.exponent)
+        } else {
+            0.0
+        }
+    }
+
+    #[inline]
+    fn is_specular(&self) -> bool {
+        false
+    }
+
+    #[inline]
+    fn has_specular(&self) -> bool {
+        false
+    }
+
+    #[inline]
+    fn is_reflection_only(&self) -> bool {
+        true
     }
 }

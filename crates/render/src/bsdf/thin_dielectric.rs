@@ -16,23 +16,12 @@ use glam::{Vec2, Vec3A};
 use prism_spectrum::SampledSpectrum;
 
 use super::fresnel::fresnel_dielectric;
-use super::{BsdfSample, LobeKind, TransportMode};
+use super::{BsdfSample, Bxdf, TransportMode};
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ThinDielectric {
     /// Index of refraction of the sheet relative to the surrounding medium, per lane.
     pub eta: SampledSpectrum,
-}
-
-impl LobeKind for ThinDielectric {
-    #[inline]
-    fn is_specular(&self) -> bool {
-        true
-    }
-    #[inline]
-    fn is_reflection_only(&self) -> bool {
-        false
-    }
 }
 
 impl ThinDielectric {
@@ -49,25 +38,21 @@ impl ThinDielectric {
             }
         })
     }
+}
 
+impl Bxdf for ThinDielectric {
     #[inline]
-    pub fn eval(&self, _wo: Vec3A, _wi: Vec3A, _mode: TransportMode) -> SampledSpectrum {
+    fn eval(&self, _wo: Vec3A, _wi: Vec3A, _mode: TransportMode) -> SampledSpectrum {
         SampledSpectrum::zero()
     }
 
     #[inline]
-    pub fn pdf(&self, _wo: Vec3A, _wi: Vec3A, _mode: TransportMode) -> f32 {
+    fn pdf(&self, _wo: Vec3A, _wi: Vec3A, _mode: TransportMode) -> f32 {
         0.0
     }
 
     #[inline]
-    pub fn sample(
-        &self,
-        wo: Vec3A,
-        u_lobe: f32,
-        _u: Vec2,
-        _mode: TransportMode,
-    ) -> Option<BsdfSample> {
+    fn sample(&self, wo: Vec3A, u_lobe: f32, _u: Vec2, _mode: TransportMode) -> Option<BsdfSample> {
         let cos = wo.z.abs();
         if cos == 0.0 {
             return None;
@@ -94,5 +79,35 @@ impl ThinDielectric {
                 eta: 1.0,
             })
         }
+    }
+
+    /// Closed form: R' + T' = 1 per lane (no absorption in the sheet), 0 exactly at grazing
+    /// where `sample` fails.
+    fn albedo(&self, wo: Vec3A, _mode: TransportMode) -> SampledSpectrum {
+        if wo.z == 0.0 {
+            return SampledSpectrum::zero();
+        }
+        SampledSpectrum::splat(1.0)
+    }
+
+    /// Both lobes are Dirac.
+    fn angular_bandwidth_cycles_per_rad(&self) -> f32 {
+        f32::INFINITY
+    }
+
+    #[inline]
+    fn is_specular(&self) -> bool {
+        true
+    }
+
+    #[inline]
+    fn has_specular(&self) -> bool {
+        true
+    }
+
+    /// Transmits straight through.
+    #[inline]
+    fn is_reflection_only(&self) -> bool {
+        false
     }
 }

@@ -25,7 +25,19 @@ impl Material {
             Material::TwoSided { material } | Material::Mask { material, .. } => {
                 material.thin_glazing(wavelengths)
             }
-            _ => None,
+            Material::NormalMap { .. }
+            | Material::BumpMap { .. }
+            | Material::Lambert { .. }
+            | Material::Conductor { .. }
+            | Material::Dielectric { .. }
+            | Material::OrenNayar { .. }
+            | Material::Phong { .. }
+            | Material::BlinnPhong { .. }
+            | Material::Ward { .. }
+            | Material::Lafortune { .. }
+            | Material::Coated { .. }
+            | Material::Mix { .. }
+            | Material::Measured { .. } => None,
         }
     }
 
@@ -36,7 +48,19 @@ impl Material {
             Material::TwoSided { material } | Material::Mask { material, .. } => {
                 material.has_thin_glazing()
             }
-            _ => false,
+            Material::NormalMap { .. }
+            | Material::BumpMap { .. }
+            | Material::Lambert { .. }
+            | Material::Conductor { .. }
+            | Material::Dielectric { .. }
+            | Material::OrenNayar { .. }
+            | Material::Phong { .. }
+            | Material::BlinnPhong { .. }
+            | Material::Ward { .. }
+            | Material::Lafortune { .. }
+            | Material::Coated { .. }
+            | Material::Mix { .. }
+            | Material::Measured { .. } => false,
         }
     }
 }

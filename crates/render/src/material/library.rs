@@ -1,7 +1,8 @@
 //! Building the material library of issue 8 (Oren–Nayar, Phong, Blinn–Phong, Ward,
-//! Lafortune, coated, thin dielectric, measured MERL, mix) from scene descriptions, and
-//! turning them into lobes at a hit. Formulas and references: the `bsdf` files and
-//! docs/materials.md.
+//! Lafortune, coated, thin dielectric, measured MERL, mix) from scene descriptions, and the
+//! longer parts of turning them into lobes at a hit (a mix's flattened leaves, a Lafortune
+//! lobe's rows; `Material::lobe` builds the rest). Formulas and references: the `bsdf`
+//! files and docs/materials.md.
 
 use std::sync::Arc;
 
@@ -12,9 +13,8 @@ use prism_spectrum::{SampledSpectrum, SampledWavelengths, Spectrum};
 
 use super::{Ior, Material};
 use crate::bsdf::{
-    internal_diffuse_reflectance, BlinnPhong, BsdfLobe, Coated, Lafortune, LafortuneLobe, Measured,
-    MerlBrdf, MerlTable, Mix, MixComponent, OrenNayar, OrenNayarForm, Phong, ThinDielectric, Ward,
-    LAFORTUNE_MAX_LOBES, MIX_MAX_COMPONENTS,
+    internal_diffuse_reflectance, BsdfLobe, Lafortune, LafortuneLobe, Lambert, LeafLobe, MerlBrdf,
+    MerlTable, Mix, OrenNayarForm, LAFORTUNE_MAX_LOBES, MIX_MAX_COMPONENTS,
 };
 use crate::scene_build::spectrum::{build_spectrum, SpectrumRole};
 
@@ -146,7 +146,16 @@ pub fn build_library(kind: &MaterialKind) -> Result<Material, FieldError> {
                 brdf: Arc::new(MerlBrdf::new(&table)),
             }
         }
-        other => return Err(("type", format!("not a material-library type: {other:?}"))),
+        MaterialKind::Lambert { .. }
+        | MaterialKind::Conductor { .. }
+        | MaterialKind::Dielectric { .. }
+        | MaterialKind::TwoSided { .. }
+        | MaterialKind::Mix { .. }
+        | MaterialKind::NormalMap { .. }
+        | MaterialKind::BumpMap { .. }
+        | MaterialKind::Mask { .. } => {
+            return Err(("type", format!("not a material-library type: {kind:?}")))
+        }
     })
 }
 
@@ -155,7 +164,21 @@ impl Material {
     pub fn leaf_count(&self) -> usize {
         match self {
             Material::Mix { materials, .. } => materials.iter().map(Material::leaf_count).sum(),
-            _ => 1,
+            Material::Lambert { .. }
+            | Material::Conductor { .. }
+            | Material::Dielectric { .. }
+            | Material::TwoSided { .. }
+            | Material::Mask { .. }
+            | Material::NormalMap { .. }
+            | Material::BumpMap { .. }
+            | Material::OrenNayar { .. }
+            | Material::Phong { .. }
+            | Material::BlinnPhong { .. }
+            | Material::Ward { .. }
+            | Material::Lafortune { .. }
+            | Material::Coated { .. }
+            | Material::ThinDielectric { .. }
+            | Material::Measured { .. } => 1,
         }
     }
 
@@ -165,7 +188,7 @@ impl Material {
         hit: &SurfaceInteraction,
         wavelengths: &SampledWavelengths,
         weight: f32,
-        out: &mut [(MixComponent<'a>, f32); MIX_MAX_COMPONENTS],
+        out: &mut [(LeafLobe<'a>, f32); MIX_MAX_COMPONENTS],
         count: &mut usize,
     ) {
         if let Material::Mix {
@@ -179,113 +202,58 @@ impl Material {
             return;
         }
         if *count < MIX_MAX_COMPONENTS {
-            if let Some(c) = MixComponent::from_lobe(self.bsdf(hit, wavelengths).lobe) {
+            if let Some(c) = LeafLobe::from_lobe(self.bsdf(hit, wavelengths).lobe) {
                 out[*count] = (c, weight);
                 *count += 1;
             }
         }
     }
 
-    /// The lobe of a library material at a hit.
-    pub(super) fn library_lobe(
+    /// The flattened blend of a mix's leaves (`lobe` of `Material::Mix`).
+    pub(super) fn mix_lobe(
         &self,
         hit: &SurfaceInteraction,
         wavelengths: &SampledWavelengths,
     ) -> BsdfLobe<'_> {
-        match self {
-            Material::OrenNayar {
-                reflectance,
-                sigma_rad,
-                form,
-            } => BsdfLobe::OrenNayar(OrenNayar {
-                reflectance: reflectance.eval(wavelengths),
-                sigma_rad: *sigma_rad,
-                form: *form,
+        let filler = (
+            LeafLobe::Lambert(Lambert {
+                reflectance: SampledSpectrum::zero(),
             }),
-            Material::Phong {
-                diffuse,
-                specular,
-                exponent,
-            } => BsdfLobe::Phong(Phong {
-                diffuse: diffuse.eval(wavelengths),
-                specular: specular.eval(wavelengths),
-                exponent: *exponent,
+            0.0,
+        );
+        let mut parts = [filler; MIX_MAX_COMPONENTS];
+        let mut count = 0;
+        self.push_leaves(hit, wavelengths, 1.0, &mut parts, &mut count);
+        match Mix::new(&parts[..count]) {
+            Some(m) => BsdfLobe::Mix(m),
+            // All weights zero cannot happen (they sum to 1); a black lobe if it did.
+            None => BsdfLobe::Lambert(Lambert {
+                reflectance: SampledSpectrum::zero(),
             }),
-            Material::BlinnPhong {
-                diffuse,
-                specular,
-                exponent,
-            } => BsdfLobe::BlinnPhong(BlinnPhong {
-                diffuse: diffuse.eval(wavelengths),
-                specular: specular.eval(wavelengths),
-                exponent: *exponent,
-            }),
-            Material::Ward {
-                diffuse,
-                specular,
-                alpha_x,
-                alpha_y,
-            } => BsdfLobe::Ward(Ward {
-                diffuse: diffuse.eval(wavelengths),
-                specular: specular.eval(wavelengths),
-                alpha_x: *alpha_x,
-                alpha_y: *alpha_y,
-            }),
-            Material::Lafortune { diffuse, lobes } => {
-                let mut l = Lafortune {
-                    diffuse: diffuse.eval(wavelengths),
-                    lobes: [LafortuneLobe::NONE; LAFORTUNE_MAX_LOBES],
-                    count: lobes.len().min(LAFORTUNE_MAX_LOBES),
-                };
-                for (slot, (c, a)) in l.lobes.iter_mut().zip(lobes) {
-                    *slot = LafortuneLobe {
-                        cx: c[0],
-                        cy: c[1],
-                        cz: c[2],
-                        exponent: c[3],
-                        albedo: a.eval(wavelengths),
-                    };
-                }
-                BsdfLobe::Lafortune(l)
-            }
-            Material::Coated {
-                diffuse,
-                eta,
-                fdr_internal,
-                nonlinear,
-            } => BsdfLobe::Coated(Coated {
-                diffuse: diffuse.eval(wavelengths),
-                eta: *eta,
-                fdr_internal: *fdr_internal,
-                nonlinear: *nonlinear,
-            }),
-            Material::ThinDielectric { ior } => BsdfLobe::ThinDielectric(ThinDielectric {
-                eta: ior.eval(wavelengths),
-            }),
-            Material::Measured { brdf } => BsdfLobe::Measured(Measured {
-                brdf,
-                lambda_nm: wavelengths.lambda(),
-            }),
-            Material::Mix { .. } => {
-                let filler = (
-                    MixComponent::Lambert(crate::bsdf::Lambert {
-                        reflectance: SampledSpectrum::zero(),
-                    }),
-                    0.0,
-                );
-                let mut parts = [filler; MIX_MAX_COMPONENTS];
-                let mut count = 0;
-                self.push_leaves(hit, wavelengths, 1.0, &mut parts, &mut count);
-                match Mix::new(&parts[..count]) {
-                    Some(m) => BsdfLobe::Mix(m),
-                    // All weights zero cannot happen (they sum to 1); a black lobe if it did.
-                    None => BsdfLobe::Lambert(crate::bsdf::Lambert {
-                        reflectance: SampledSpectrum::zero(),
-                    }),
-                }
-            }
-            // The core materials are handled by `Material::bsdf` itself.
-            other => other.bsdf(hit, wavelengths).lobe,
         }
     }
+}
+
+/// The Lafortune lobe of `(C_x, C_y, C_z, n)` and albedo rows at `wavelengths` (at most
+/// `LAFORTUNE_MAX_LOBES`; the builder refuses more).
+pub(super) fn lafortune_lobe(
+    diffuse: &Spectrum,
+    lobes: &[([f32; 4], Spectrum)],
+    wavelengths: &SampledWavelengths,
+) -> Lafortune {
+    let mut l = Lafortune {
+        diffuse: diffuse.eval(wavelengths),
+        lobes: [LafortuneLobe::NONE; LAFORTUNE_MAX_LOBES],
+        count: lobes.len().min(LAFORTUNE_MAX_LOBES),
+    };
+    for (slot, (c, a)) in l.lobes.iter_mut().zip(lobes) {
+        *slot = LafortuneLobe {
+            cx: c[0],
+            cy: c[1],
+            cz: c[2],
+            exponent: c[3],
+            albedo: a.eval(wavelengths),
+        };
+    }
+    l
 }
