@@ -10,7 +10,7 @@ pub mod bvh_build;
 pub mod curvature;
 pub mod disk;
 pub mod error;
-pub mod flat_leaves;
+pub mod fast_path;
 pub mod frame;
 pub mod geometry;
 pub mod interaction;
@@ -31,7 +31,6 @@ pub use bvh_build::BuildQuality;
 pub use curvature::Curvature;
 pub use disk::Disk;
 pub use error::MeshLoadError;
-pub use flat_leaves::{BoxFace, FlatBox, FlatLeaf, PatchKind};
 pub use frame::Frame;
 pub use geometry::{
     BuildOptions, Geometry, GeometryBuilder, Hit, Instance, MeshId, Shape,

@@ -24,10 +24,11 @@
 //!
 //! The kernels are `#[inline(always)]` loops over fixed-size lane arrays, compiled once at
 //! the baseline width (SSE2 on x86-64: two 4-wide vectors per batch; whatever the target
-//! offers elsewhere) and once inside a `#[target_feature(enable = "avx2")]` function chosen
-//! at run time (one 8-wide vector), as crates/post/src/tonemap/simd.rs does. Results are
-//! bit-identical on both paths: Rust never contracts `a * b + c` into an FMA, and lanes
-//! are independent.
+//! offers elsewhere) and once inside a `#[target_feature(enable = "avx2")]` function, run
+//! where the ISA the scene was built with allows AVX2 (`prism_cpu::active()` at build,
+//! within `PRISM_SIMD` / `--simd`; one 8-wide vector). Results are bit-identical on both
+//! paths: Rust never contracts `a * b + c` into an FMA, and lanes are independent (tested
+//! for every ISA the machine has).
 //!
 //! Closest hit: the smallest `t` over all lanes; a tie between two leaves at exactly the
 //! same `t` is broken by a fixed order (rectangles before triangles in a lane, then the
@@ -207,7 +208,8 @@ mod x86 {
     pub struct Sse8(__m128, __m128);
 
     /// Eight lanes in one AVX register. Only built inside functions compiled with
-    /// `#[target_feature(enable = "avx2")]`, which are called only when the CPU has AVX2.
+    /// `#[target_feature(enable = "avx2")]`, which are called only when the scene's
+    /// `prism_cpu::Simd` allows AVX2 (so the CPU has it).
     #[derive(Clone, Copy)]
     pub struct Avx8(__m256);
 
@@ -451,8 +453,9 @@ pub(crate) struct SmallScene {
     groups: Vec<BoxGroup>,
     rectangles: Vec<RectangleBatch>,
     pub others: Vec<OtherLeaf>,
-    /// The CPU runs AVX2 (checked once at build).
-    avx2: bool,
+    /// The widest kernels to run (`prism_cpu::active()` at build; the AVX2 ones when it
+    /// allows AVX2).
+    simd: prism_cpu::Simd,
 }
 
 /// What a leaf given to [`SmallSceneBuilder`] is.
@@ -582,20 +585,8 @@ impl SmallSceneBuilder {
             groups,
             rectangles,
             others: self.others,
-            avx2: has_avx2(),
+            simd: prism_cpu::active(),
         }
-    }
-}
-
-/// Whether this CPU runs AVX2 (cached by the standard library after the first query).
-fn has_avx2() -> bool {
-    #[cfg(target_arch = "x86_64")]
-    {
-        std::arch::is_x86_feature_detected!("avx2")
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        false
     }
 }
 
@@ -611,8 +602,8 @@ impl SmallScene {
         t_max: f32,
     ) -> Option<Candidate> {
         #[cfg(target_arch = "x86_64")]
-        if self.avx2 {
-            // SAFETY: `avx2` is set only when the CPU reports AVX2 (`has_avx2`).
+        if self.simd.avx2() {
+            // SAFETY: a `Simd` allows AVX2 only on a CPU that has it.
             return unsafe { closest_avx2(self, origin, direction, wt, t_max) };
         }
         closest_kernel::<Baseline>(self, origin, direction, wt, t_max)
@@ -623,18 +614,18 @@ impl SmallScene {
     #[inline]
     pub fn any(&self, origin: Vec3A, direction: Vec3A, wt: &WatertightRay, t_max: f32) -> bool {
         #[cfg(target_arch = "x86_64")]
-        if self.avx2 {
-            // SAFETY: `avx2` is set only when the CPU reports AVX2 (`has_avx2`).
+        if self.simd.avx2() {
+            // SAFETY: a `Simd` allows AVX2 only on a CPU that has it.
             return unsafe { any_avx2(self, origin, direction, wt, t_max) };
         }
         any_kernel::<Baseline>(self, origin, direction, wt, t_max)
     }
 
-    /// Test with the baseline-width kernels even on an AVX2 CPU (for the tests that check
-    /// both paths agree).
+    /// The same scene with the kernels of `simd` (for the tests that check every ISA's
+    /// kernels agree).
     #[cfg(test)]
-    fn without_avx2(mut self) -> Self {
-        self.avx2 = false;
+    fn with_simd(mut self, simd: prism_cpu::Simd) -> Self {
+        self.simd = simd;
         self
     }
 }
@@ -1051,10 +1042,10 @@ mod tests {
         );
     }
 
-    /// The AVX2 and the baseline kernels give bit-identical answers (when the CPU has AVX2;
-    /// otherwise both calls run the baseline).
+    /// Every ISA's kernels give the baseline kernels' answers bit for bit (each ISA the
+    /// machine runs, `prism_cpu::each_isa`; the others are reported as skipped).
     #[test]
-    fn avx2_and_baseline_kernels_agree_bit_for_bit() {
+    fn every_isa_gives_the_baseline_kernels_bits() {
         use rand::{Rng, SeedableRng};
         let mut rng = rand_pcg::Pcg64::seed_from_u64(7);
         fn v(rng: &mut rand_pcg::Pcg64) -> Vec3A {
@@ -1092,8 +1083,22 @@ mod tests {
                 (if i == 3 { Transform::IDENTITY } else { t }, 0.4)
             })
             .collect();
-        let wide = build(&tris, &rects);
-        let base = build(&tris, &rects).without_avx2();
+        let base = build(&tris, &rects).with_simd(prism_cpu::Simd::SCALAR);
+        let wide: Vec<(prism_cpu::Simd, SmallScene)> = prism_cpu::each_isa()
+            .into_iter()
+            .map(|simd| (simd, build(&tris, &rects).with_simd(simd)))
+            .collect();
+        let key = |c: Option<Candidate>| {
+            c.map(|c| {
+                (
+                    c.t.to_bits(),
+                    c.instance,
+                    c.primitive,
+                    c.b1.to_bits(),
+                    c.b2.to_bits(),
+                )
+            })
+        };
         for _ in 0..20_000 {
             let (o, d) = (2.0 * v(&mut rng), v(&mut rng));
             let wt = WatertightRay::new(o, d, 1e-4);
@@ -1102,28 +1107,14 @@ mod tests {
             } else {
                 rng.gen_range(0.1..3.0)
             };
-            let (a, b) = (
-                wide.closest(o, d, &wt, t_max),
-                base.closest(o, d, &wt, t_max),
-            );
-            assert_eq!(
-                a.map(|c| (
-                    c.t.to_bits(),
-                    c.instance,
-                    c.primitive,
-                    c.b1.to_bits(),
-                    c.b2.to_bits()
-                )),
-                b.map(|c| (
-                    c.t.to_bits(),
-                    c.instance,
-                    c.primitive,
-                    c.b1.to_bits(),
-                    c.b2.to_bits()
-                ))
-            );
-            assert_eq!(wide.any(o, d, &wt, t_max), base.any(o, d, &wt, t_max));
-            assert_eq!(a.is_some(), base.any(o, d, &wt, t_max));
+            let want = base.closest(o, d, &wt, t_max);
+            let want_any = base.any(o, d, &wt, t_max);
+            assert_eq!(want.is_some(), want_any);
+            for (simd, scene) in &wide {
+                let got = scene.closest(o, d, &wt, t_max);
+                assert_eq!(key(got), key(want), "{simd} {o:?} {d:?}");
+                assert_eq!(scene.any(o, d, &wt, t_max), want_any, "{simd} {o:?} {d:?}");
+            }
         }
     }
 }

@@ -1,6 +1,10 @@
+//! Fast path only: the types here serve render's packet tracer (`integrator::packet`) and
+//! nothing else; they are public only because that tracer lives in another crate. They
+//! describe the scene as it is for one tracer's intersection code, and may change with it.
+//!
 //! The leaves of a small scene as flat world-space patches with constant shading records:
 //! what a packet tracer needs to intersect many rays at once without the scene's own
-//! per-ray code (render's `integrator::packet`).
+//! per-ray code.
 //!
 //! A patch is a triangle or a parallelogram `p0 + u·e1 + v·e2`. Its record (normals,
 //! tangent `dpdu`, material, instance, primitive) is the one [`Geometry::shading_interaction`]
@@ -95,7 +99,8 @@ fn box_faces(mesh: &crate::mesh::TriangleMesh) -> Option<BoxFaces> {
 
 impl Geometry {
     /// The scene's leaves as flat patches, when it is a small scene made only of baked
-    /// triangles of meshes without vertex normals and of rectangles (see module docs).
+    /// triangles of meshes without vertex normals and of rectangles (fast path: the
+    /// packet tracer's, see [`crate::fast_path`]).
     pub fn flat_leaves(&self) -> Option<Vec<FlatLeaf>> {
         if !self.is_small_scene() || self.has_other_small_leaves() {
             return None;
@@ -161,7 +166,7 @@ impl Geometry {
     }
 
     /// The mesh instances among `leaves` (from [`Geometry::flat_leaves`]) that are
-    /// parallelepipeds.
+    /// parallelepipeds (fast path: the packet tracer's, see [`crate::fast_path`]).
     pub fn flat_boxes(&self, leaves: &[FlatLeaf]) -> Vec<FlatBox> {
         let mut boxes = Vec::new();
         for (i, inst) in self.instances().iter().enumerate() {
