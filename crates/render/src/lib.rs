@@ -13,7 +13,6 @@
 pub mod bsdf;
 pub mod camera;
 pub mod chi2;
-mod cpu;
 pub mod error;
 pub mod film;
 pub mod integrator;

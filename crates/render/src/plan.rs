@@ -8,7 +8,8 @@
 //!
 //! Each fast path (packet tracing, small-scene intersection) gets a line: on, with why
 //! `used`, or off, with why `not used: …` — the scene's features outside the path's
-//! allow-list, or the limit the scene is past.
+//! allow-list, or the limit the scene is past; and `simd` says which vector kernels they
+//! run and why (`avx2 (PRISM_SIMD=avx2)`).
 
 use std::fmt;
 
@@ -303,7 +304,7 @@ impl RenderPlan {
                 "packet tracing",
                 format!(
                     "on, {} paths per ray query, {} patches and {} boxes",
-                    crate::integrator::packet::lane_count(),
+                    packet.lane_count(),
                     packet.patch_count(),
                     packet.box_count()
                 ),
@@ -344,6 +345,15 @@ impl RenderPlan {
                 format!("not used: {why}"),
             ),
         }
+        // The ISA the fast paths' kernels run, and why (`prism_cpu::choice`).
+        choose(
+            "simd",
+            prism_cpu::choice().to_string(),
+            "the vector kernels of the packet tracer, the film splat and the small-scene \
+             intersector: the widest ISA the CPU runs within PRISM_SIMD or --simd (scalar, \
+             avx2, avx512); images are the same bits at 8 lanes, and within 1e-6 at 16"
+                .into(),
+        );
         choose(
             "spectral output bins",
             match request.spectral_bins {

@@ -535,29 +535,3 @@ fn thin_lens_focal_length_and_fov_specs_agree() {
     }
     let _ = FRAC_PI_2;
 }
-
-#[test]
-fn batched_camera_rays_are_the_single_rays_bit_for_bit() {
-    // The pinhole's batch is its own vector loop (the packet tracer's camera rays); the
-    // others go one by one. Film points off the pixel grid, lens samples varied.
-    for camera in all_cameras() {
-        let points: Vec<Vec2> = grid(23, 17).map(|p| p + Vec2::new(0.37, 0.61)).collect();
-        for chunk in points.chunks_exact(16) {
-            let film: [Vec2; 16] = chunk.try_into().unwrap();
-            let lens: [Vec2; 16] = std::array::from_fn(|k| {
-                Vec2::new((k as f32 * 0.13) % 1.0, (k as f32 * 0.29) % 1.0)
-            });
-            let many = camera.generate_rays_only_many(&film, &lens);
-            for k in 0..16 {
-                let one = camera.generate_ray_only(film[k], lens[k]);
-                let bits = |r: &Option<prism_geometry::Ray>| {
-                    r.map(|r| {
-                        let (o, d) = (r.origin.to_array(), r.direction.to_array());
-                        (o.map(f32::to_bits), d.map(f32::to_bits), r.t_min, r.t_max)
-                    })
-                };
-                assert_eq!(bits(&many[k]), bits(&one), "{camera:?} at {:?}", film[k]);
-            }
-        }
-    }
-}

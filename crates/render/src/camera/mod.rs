@@ -180,9 +180,9 @@ impl Camera {
 
     /// `generate_ray_only` for `N` film points at once, the same rays: the pinhole
     /// camera's in one vector loop (`PinholeCamera::world_rays_many`), the others' one by
-    /// one.
+    /// one. Fast path only: the packet tracer's camera rays.
     #[inline(always)]
-    pub fn generate_rays_only_many<const N: usize>(
+    pub(crate) fn generate_rays_only_many<const N: usize>(
         &self,
         film_points_px: &[Vec2; N],
         lens_samples: &[Vec2; N],
@@ -357,3 +357,6 @@ fn differential(
         ry_direction: t.vector(dy).normalize(),
     })
 }
+
+#[cfg(test)]
+mod tests;

@@ -120,10 +120,10 @@ pub(crate) struct SplatBuffer {
     /// two packed multiply-adds (SSE2) instead of four scalar ones and a separate weight.
     pub sums: Vec<[f64; 4]>,
     pub radius_px: f32,
-    /// The CPU runs AVX: a tap is one 256-bit multiply and add (same bits as SSE2's two).
-    avx: bool,
-    /// The CPU runs AVX2: the filter profile's table reads are gathers too.
-    avx2: bool,
+    /// The widest kernels to run (`prism_cpu::active()` when the tile was made): where it
+    /// allows AVX2, a tap is one 256-bit multiply and add (same bits as SSE2's two) and
+    /// the filter profile's table reads are gathers.
+    simd: prism_cpu::Simd,
 }
 
 impl SplatBuffer {
@@ -137,8 +137,7 @@ impl SplatBuffer {
             bounds,
             sums: vec![[0.0; 4]; bounds.pixel_count()],
             radius_px,
-            avx: crate::cpu::has_avx(),
-            avx2: crate::cpu::has_avx2(),
+            simd: prism_cpu::active(),
         }
     }
 
@@ -147,22 +146,11 @@ impl SplatBuffer {
     #[inline]
     pub fn splat(&mut self, p: Vec2, xyz: DVec3, table: &FilterTable) {
         #[cfg(target_arch = "x86_64")]
-        if self.avx2 {
-            // SAFETY: `avx2` is set only when the CPU reports AVX2 (`cpu::has_avx2`).
+        if self.simd.avx2() {
+            // SAFETY: a `Simd` allows AVX2 (and AVX) only on a CPU that has it.
             return unsafe { self.splat_avx2(p, xyz, table) };
         }
-        #[cfg(target_arch = "x86_64")]
-        if self.avx {
-            // SAFETY: `avx` is set only when the CPU reports AVX (`cpu::has_avx`).
-            return unsafe { self.splat_avx(p, xyz, table) };
-        }
         self.splat_with::<false, false>(p, xyz, table)
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx")]
-    unsafe fn splat_avx(&mut self, p: Vec2, xyz: DVec3, table: &FilterTable) {
-        self.splat_with::<true, false>(p, xyz, table)
     }
 
     #[cfg(target_arch = "x86_64")]
@@ -171,9 +159,9 @@ impl SplatBuffer {
         self.splat_with::<true, true>(p, xyz, table)
     }
 
-    /// `splat`'s body; `AVX`: the taps as 256-bit operations (only inside `splat_avx` and
-    /// `splat_avx2`); `GATHER`: up to 4 × 4 taps' profile values in one
-    /// `FilterTable::eval8_avx2` (only inside `splat_avx2`).
+    /// `splat`'s body; `AVX`: the taps as 256-bit operations, `GATHER`: up to 4 × 4 taps'
+    /// profile values in one `FilterTable::eval8_avx2` (both only inside `splat_avx2`;
+    /// the AVX-only form the AVX CPUs without AVX2 ran is gone with `prism_cpu`'s ladder).
     #[inline(always)]
     fn splat_with<const AVX: bool, const GATHER: bool>(
         &mut self,
@@ -611,10 +599,11 @@ mod tests {
     use super::*;
     use crate::film::Filter;
 
-    /// The AVX taps give the SSE2 taps' bits (one 256-bit multiply and add per tap against
-    /// two 128-bit ones, no fused multiply-add in either), and so do the AVX2 gathers.
+    /// Every ISA's splat gives the SSE2 taps' bits: the AVX taps (one 256-bit multiply and
+    /// add per tap against two 128-bit ones, no fused multiply-add in either) and the
+    /// AVX2 gathers (each ISA the machine runs, `prism_cpu::each_isa`).
     #[test]
-    fn avx_and_sse2_splats_give_the_same_sums() {
+    fn every_isa_splats_the_sse2_sums() {
         // Radius 2 px, σ = ½ px (α = 2 px⁻²): the Cornell box's filter, 4 × 4 taps.
         let filter = Filter::Gaussian(crate::film::filter::GaussianFilter::new(2.0, 2.0).unwrap());
         let table = FilterTable::new(&filter);
@@ -623,11 +612,14 @@ mod tests {
             max: UVec2::new(32, 32),
         };
         let mut sse2 = SplatBuffer::new(tile, UVec2::new(64, 64), 2.0);
-        (sse2.avx, sse2.avx2) = (false, false);
-        let mut avx = sse2.clone();
-        avx.avx = crate::cpu::has_avx();
-        let mut best = avx.clone();
-        best.avx2 = crate::cpu::has_avx2();
+        sse2.simd = prism_cpu::Simd::SCALAR;
+        let mut wide: Vec<SplatBuffer> = prism_cpu::each_isa()
+            .into_iter()
+            .map(|simd| SplatBuffer {
+                simd,
+                ..sse2.clone()
+            })
+            .collect();
         for k in 0..500u32 {
             let f = k as f32;
             let p = Vec2::new(
@@ -636,11 +628,13 @@ mod tests {
             );
             let xyz = DVec3::new(0.1 + f64::from(k % 7), 1.0 / (1.0 + f64::from(k)), 0.25);
             sse2.splat(p, xyz, &table);
-            avx.splat(p, xyz, &table);
-            best.splat(p, xyz, &table);
+            for w in &mut wide {
+                w.splat(p, xyz, &table);
+            }
         }
-        assert_eq!(sse2.sums, avx.sums);
-        assert_eq!(sse2.sums, best.sums);
+        for w in &wide {
+            assert_eq!(sse2.sums, w.sums, "{}", w.simd);
+        }
         assert!(sse2.sums.iter().any(|s| s[3] > 0.0));
     }
 }

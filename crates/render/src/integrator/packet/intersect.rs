@@ -20,7 +20,7 @@
 
 use glam::Vec2;
 use glam::{Mat3A, Vec3A};
-use prism_geometry::{BoxFace, FlatBox, FlatLeaf, PatchKind};
+use prism_geometry::fast_path::{BoxFace, FlatBox, FlatLeaf, PatchKind};
 
 /// Relative widening of the barycentric bounds (see the module docs).
 pub(crate) const EDGE_TOLERANCE: f32 = 1e-5;

@@ -7,8 +7,8 @@
 //! made only of flat patches (triangles of meshes without vertex normals, rectangles) with
 //! constant Lambertian materials — the Cornell box, plain rooms — need none of that
 //! generality: the shading record of a patch is a constant (`FlatLeaf`), the BSDF is
-//! R(λ)/π, and `N` paths can share every ray query (`intersect`), `N` = 16 with AVX-512,
-//! 8 otherwise.
+//! R(λ)/π, and `N` paths can share every ray query (`intersect`), `N` = 16 where the ISA
+//! the scene was built with is AVX-512 (`prism_cpu::active()`), 8 otherwise.
 //!
 //! The estimator is the scalar path tracer's, step for step (`trace`): the same sample
 //! dimensions from the same streams, the same light sampling (the `Light` code itself),
@@ -31,7 +31,8 @@ mod trace;
 pub(crate) use trace::{render_tile, TileJob};
 
 use glam::{Vec2, Vec3A};
-use prism_geometry::{Frame, PatchKind};
+use prism_geometry::fast_path::PatchKind;
+use prism_geometry::Frame;
 
 use intersect::{BoxSet, PatchSet};
 
@@ -81,18 +82,6 @@ struct RectangleLight {
     radiance_slot: Option<usize>,
 }
 
-/// Which lane width runs (tests compare them; renders use `Auto`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[cfg_attr(not(test), allow(dead_code))]
-pub(crate) enum Kernel {
-    /// The widest this CPU runs: 16 lanes with AVX-512, else 8 with AVX2, else 8 baseline.
-    Auto,
-    /// 8 lanes with AVX2 where the CPU has it, else baseline.
-    Avx2,
-    /// 8 lanes, baseline instructions (SSE2 on x86-64).
-    Baseline,
-}
-
 /// A scene the packet tracer can render: its patches and their shading.
 #[derive(Clone, Debug)]
 pub struct PacketScene {
@@ -107,7 +96,10 @@ pub struct PacketScene {
     lights: Vec<Option<RectangleLight>>,
     /// The radiances of the first `LIGHT_SLOTS` rectangle emitters.
     light_radiances: Vec<Spectrum>,
-    kernel: Kernel,
+    /// The kernels that run (`trace::render_tile`): 16 lanes with AVX-512, 8 with AVX2 and
+    /// FMA, 8 baseline (SSE2) for scalar; `prism_cpu::active()` when the scene was built
+    /// (tests set each ISA).
+    simd: prism_cpu::Simd,
 }
 
 impl PacketScene {
@@ -249,7 +241,7 @@ impl PacketScene {
             reflectances: reflectances.into_iter().map(|(_, s)| s).collect(),
             lights,
             light_radiances,
-            kernel: Kernel::Auto,
+            simd: prism_cpu::active(),
         })
     }
 
@@ -262,14 +254,19 @@ impl PacketScene {
     pub fn box_count(&self) -> usize {
         self.boxes.len()
     }
-}
 
-/// Lanes of the packet on this CPU (16 with AVX-512, else 8).
-pub fn lane_count() -> usize {
-    if crate::cpu::has_avx512() {
-        16
-    } else {
-        8
+    /// The ISA its kernels run.
+    pub fn simd(&self) -> prism_cpu::Simd {
+        self.simd
+    }
+
+    /// Paths per ray query: 16 with AVX-512, else 8.
+    pub fn lane_count(&self) -> usize {
+        if self.simd.avx512() {
+            16
+        } else {
+            8
+        }
     }
 }
 

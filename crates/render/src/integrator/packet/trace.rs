@@ -16,8 +16,7 @@ use prism_spectrum::{SampledSpectrum, SampledWavelengths};
 
 use super::intersect::{closest, occluded, RayLanes};
 use super::shade::{select, shade, VertexIn, VertexOut, LIGHT_GIVEN, LIGHT_NONE, LIGHT_RECTANGLE};
-use super::{Kernel, PacketScene, RectangleLight, LIGHT_SLOTS, REFLECTANCE_SLOTS};
-use crate::cpu::{has_avx2, has_avx512};
+use super::{PacketScene, RectangleLight, LIGHT_SLOTS, REFLECTANCE_SLOTS};
 use crate::film::xyz::XyzWeights;
 use crate::film::FilmTile;
 use crate::film::SurfaceAov;
@@ -54,7 +53,8 @@ pub(crate) struct TileCounts {
 }
 
 /// Renders every camera sample of `tile` (pixels in order, samples in order) with the
-/// widest kernels this CPU runs; adds the path counters to `counters`.
+/// kernels of the packet scene's ISA (`PacketScene::simd`); adds the path counters to
+/// `counters`.
 pub(crate) fn render_tile(
     job: &TileJob,
     tile: &mut FilmTile,
@@ -62,13 +62,14 @@ pub(crate) fn render_tile(
 ) -> TileCounts {
     #[cfg(target_arch = "x86_64")]
     {
-        let kernel = job.packet.kernel;
-        if kernel == Kernel::Auto && has_avx512() {
-            // SAFETY: the CPU reports AVX-512 F/DQ/VL/BW (`has_avx512`).
+        let simd = job.packet.simd;
+        if simd.avx512() {
+            // SAFETY: a `Simd` allows AVX-512 F/DQ/VL/BW (with AVX2 and FMA) only on a CPU
+            // that has them.
             return unsafe { render_tile_avx512(job, tile, counters) };
         }
-        if matches!(kernel, Kernel::Auto | Kernel::Avx2) && has_avx2() {
-            // SAFETY: the CPU reports AVX2 and FMA (`has_avx2`).
+        if simd.avx2() {
+            // SAFETY: a `Simd` allows AVX2 and FMA only on a CPU that has them.
             return unsafe { render_tile_avx2(job, tile, counters) };
         }
     }
