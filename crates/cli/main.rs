@@ -8,6 +8,7 @@ mod falsecolour;
 mod merl_export;
 mod render;
 mod sensors;
+mod simd;
 mod tonemap;
 
 use std::process::ExitCode;

@@ -78,6 +78,8 @@ pub struct RenderArgs {
     /// vertices; MIS-weighted) or S,T,unweighted (weight 1), for debugging.
     #[arg(long = "bdpt-strategy", value_name = "S,T[,unweighted]", value_parser = prism_render::integrator::BdptStrategy::parse)]
     pub bdpt_strategy: Option<prism_render::integrator::BdptStrategy>,
+    #[command(flatten)]
+    pub simd: crate::simd::SimdArgs,
 }
 
 pub(crate) fn parse_resolution(s: &str) -> Result<UVec2, String> {
@@ -219,6 +221,7 @@ fn progress_bar(total: u64) -> ProgressBar {
 }
 
 pub fn run(args: &RenderArgs) -> Result<(), String> {
+    args.simd.apply()?;
     let description = prism_scene::load_scene(&args.scene).map_err(|e| e.to_string())?;
     let output = output_path(args, description.film.output.as_deref());
     if !args.explain {
@@ -415,6 +418,8 @@ fn write_stats(
         "bounces": stats.bounces,
         "roulette_terminations": stats.roulette_terminations,
         "light_paths": stats.light_paths,
+        // The fast paths' ISA (`--explain` says why).
+        "simd": prism_cpu::active().isa().name(),
     });
     let text = serde_json::to_string_pretty(&value).map_err(|e| e.to_string())? + "\n";
     // Atomic like the image: a temporary sibling renamed over the destination.

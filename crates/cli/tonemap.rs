@@ -55,6 +55,8 @@ pub struct TonemapArgs {
     /// Print the report (or the --list catalogue) as JSON.
     #[arg(long)]
     pub json: bool,
+    #[command(flatten)]
+    pub simd: crate::simd::SimdArgs,
 }
 
 fn parse_params(raw: &[String]) -> Result<BTreeMap<String, f64>, String> {
@@ -146,6 +148,7 @@ fn print_summary(report: &TonemapFileReport) {
 }
 
 pub fn run(args: &TonemapArgs) -> Result<(), String> {
+    args.simd.apply()?;
     if args.list {
         return print_list(args.json);
     }

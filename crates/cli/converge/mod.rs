@@ -98,6 +98,8 @@ pub struct ConvergeArgs {
     /// Chart title (default: the scene file's name and the resolution).
     #[arg(long)]
     pub title: Option<String>,
+    #[command(flatten)]
+    pub simd: crate::simd::SimdArgs,
 }
 
 /// The time axis of a convergence run.
@@ -274,6 +276,7 @@ fn file_label(method: &Method) -> String {
 }
 
 pub fn run(args: &ConvergeArgs) -> Result<(), String> {
+    args.simd.apply()?;
     let budget = check_arguments(args)?;
     let methods: Vec<Method> = if args.methods.is_empty() {
         vec![Method::parse("path")?]

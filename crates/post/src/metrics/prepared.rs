@@ -18,8 +18,8 @@ use crate::colour::rgb_matrix::same_colorimetry;
 use crate::error::{PostError, Result};
 use crate::image::Image;
 use crate::io::convert_pixels;
+use crate::tonemap::kernels::avx2;
 use crate::tonemap::pixels::{sanitise, CHUNK};
-use crate::tonemap::simd::avx2;
 
 /// The reference side of [`crate::metrics::compare`], computed once.
 #[derive(Debug, Clone)]
@@ -67,6 +67,8 @@ impl PreparedReference {
     /// Prepares `reference` (any size ≥ 1 × 1; its colour space is the comparison's).
     pub fn new(reference: &Image) -> Self {
         let space = reference.color_space.clone();
+        // The ISA of the vector kernels, read once here and carried to the tasks.
+        let simd = prism_cpu::active();
         let lab_converter = LabConverter::new(space.rgb_to_xyz, space.white_xyz());
         let pixels: Vec<[f32; 3]> = reference
             .pixels()
@@ -75,7 +77,7 @@ impl PreparedReference {
             .collect();
         let lab: Vec<LabBlock> = pixels
             .par_chunks(BLOCK)
-            .map(|block| avx2!(reference_block(&lab_converter, block)))
+            .map(|block| avx2!(simd, reference_block(&lab_converter, block)))
             .collect();
         let non_finite = reference.pixels().par_iter().filter(|p| !finite(p)).count() as u64;
         let peak_c = pixels
@@ -129,12 +131,13 @@ impl PreparedReference {
             &converted
         };
         let n = a.len() as f64;
+        let simd = prism_cpu::active();
         let mut de = vec![0.0f64; a.len()];
         let sums = a
             .par_chunks(CHUNK)
             .zip(de.par_chunks_mut(CHUNK))
             .enumerate()
-            .map(|(k, (chunk, out))| avx2!(compare_chunk(self, k * CHUNK, chunk, out)))
+            .map(|(k, (chunk, out))| avx2!(simd, compare_chunk(self, k * CHUNK, chunk, out)))
             .reduce(Sums::default, Sums::add);
 
         let mse_c = sums.se.map(|s| s / n);

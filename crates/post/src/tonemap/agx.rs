@@ -17,9 +17,9 @@ use prism_spectrum::rgb_space::RgbColorSpace;
 
 use super::aces::srgb_matrices;
 use super::curve_table::{chebyshev_nodes, poly_through};
-use super::map512::RegisterMap;
 use super::pixels::PixelMap;
 use super::{Context, OperatorInfo, Output};
+use prism_cpu::Simd;
 
 pub(crate) static INFO: OperatorInfo = OperatorInfo {
     name: "agx",
@@ -70,7 +70,7 @@ fn contrast_f64(x: f64) -> f64 {
 /// Outset values below 2⁻²⁴ map to 0 instead of y^2.2 ≤ 1.3e-16 (1e-11 of a 16-bit code);
 /// the outset never exceeds [`Y_MAX`] (`outset_values_stay_below_y_max`), so the power
 /// curve needs no upper clamp: its exponents run from 2⁻²⁴ to below 2.
-const Y_MIN: f32 = 1.0 / 16_777_216.0;
+pub(super) const Y_MIN: f32 = 1.0 / 16_777_216.0;
 #[cfg_attr(not(test), allow(dead_code))] // the bound, checked by that test
 const Y_MAX: f32 = 2.0;
 /// 2⁻²⁵: the AVX-512 power curve clamps to this instead of [`Y_MIN`] and reads a scale of
@@ -78,7 +78,7 @@ const Y_MAX: f32 = 2.0;
 /// everything below Y_MIN (NaN included: `vmaxps` returns its second operand) without a
 /// compare and a mask.
 #[cfg(target_arch = "x86_64")]
-const Y_ZERO: f32 = Y_MIN * 0.5;
+pub(super) const Y_ZERO: f32 = Y_MIN * 0.5;
 
 // The per-channel curves are evaluated directly, in registers, as polynomials whose
 // coefficients are picked per mantissa segment (the top SEGMENT_BITS mantissa bits: 8
@@ -111,17 +111,17 @@ const Y_ZERO: f32 = Y_MIN * 0.5;
 /// Mantissa bits that select a segment (8 per octave: one register of coefficients).
 const SEGMENT_BITS: u32 = 3;
 /// Mantissa bits of the position t inside a segment.
-const T_BITS: u32 = 23 - SEGMENT_BITS;
-const T_MASK: u32 = (1 << T_BITS) - 1;
+pub(super) const T_BITS: u32 = 23 - SEGMENT_BITS;
+pub(super) const T_MASK: u32 = (1 << T_BITS) - 1;
 /// The bits of 1.0, and the centre of (bits & T_MASK | ONE_BITS) ∈ [1, 1.125).
-const ONE_BITS: u32 = 0x3f80_0000;
-const S_CENTRE: f32 = 1.0625;
+pub(super) const ONE_BITS: u32 = 0x3f80_0000;
+pub(super) const S_CENTRE: f32 = 1.0625;
 /// Coefficients of the encoding quartic and of the power cubic.
-const ENCODE_TERMS: usize = 5;
-const POWER_TERMS: usize = 4;
+pub(super) const ENCODE_TERMS: usize = 5;
+pub(super) const POWER_TERMS: usize = 4;
 
 /// Per-segment polynomial coefficients: `c[j][k]` multiplies s^j on segment k.
-type SegmentPoly<const N: usize> = [[f32; 8]; N];
+pub(super) type SegmentPoly<const N: usize> = [[f32; 8]; N];
 
 /// s ∈ [−1/16, 1/16) of an f32's low T_BITS mantissa bits, exactly.
 #[inline(always)]
@@ -144,24 +144,24 @@ fn fit_segments<const N: usize>(f: impl Fn(f64) -> f64) -> SegmentPoly<N> {
 }
 
 /// The transform's constants, fitted once per process.
-struct Curves {
-    encode: SegmentPoly<ENCODE_TERMS>,
+pub(super) struct Curves {
+    pub(super) encode: SegmentPoly<ENCODE_TERMS>,
     /// The contrast polynomial in w = R (x − ½), constant first.
-    contrast: [f32; 7],
-    power: SegmentPoly<POWER_TERMS>,
+    pub(super) contrast: [f32; 7],
+    pub(super) power: SegmentPoly<POWER_TERMS>,
     /// 2^(r/5) for r = 0…4 (lanes 5–7 unused).
-    fifths: [f32; 8],
+    pub(super) fifths: [f32; 8],
     /// 2^ev_min and 2^ev_max: inset values are clamped to these first (the log2 clamp of
     /// the transform applied to the linear value).
-    x_min: f32,
-    x_max: f32,
+    pub(super) x_min: f32,
+    pub(super) x_max: f32,
     /// `encode` and `power` with each row repeated in both halves (16-entry `vpermps`).
-    encode16: [[f32; 16]; ENCODE_TERMS],
-    power16: [[f32; 16]; POWER_TERMS],
+    pub(super) encode16: [[f32; 16]; ENCODE_TERMS],
+    pub(super) power16: [[f32; 16]; POWER_TERMS],
     /// 2^(2.2 (b − 127)) as 2^(2e + q − 5) · 2^(r/5) (e = b − 127, e + 25 = 5q + r, as
     /// the AVX2 path computes it) at index b mod 32 for the biased exponents b = 103…128
     /// of y ∈ [2⁻²⁴, 2], 0 elsewhere (at 102 in particular: [`Y_ZERO`]).
-    scales: [f32; 32],
+    pub(super) scales: [f32; 32],
 }
 
 fn curves() -> &'static Curves {
@@ -212,14 +212,16 @@ fn curves() -> &'static Curves {
 }
 
 /// Column-major 3×3 matrix as f32s.
-type Mat = [f32; 9];
+pub(super) type Mat = [f32; 9];
 
-struct Map {
-    inset: Mat,
-    outset: Mat,
+pub(super) struct Map {
+    pub(super) inset: Mat,
+    pub(super) outset: Mat,
     /// Linear sRGB → the image's space; `None` where that is the identity.
-    from_srgb: Option<Mat>,
-    curves: &'static Curves,
+    pub(super) from_srgb: Option<Mat>,
+    pub(super) curves: &'static Curves,
+    /// The kernels of [`PixelMap::map`] (the register pass reads the call's own).
+    simd: Simd,
 }
 
 /// `m · (x, y, z)` with fused multiply-adds, in the order the 8-lane path uses.
@@ -230,14 +232,16 @@ fn mat3(m: &Mat, x: f32, y: f32, z: f32) -> [f32; 3] {
 
 impl Map {
     /// The map for an image in `space`: the inset from it (through linear sRGB), the
-    /// outset, and the way back where `space` is not sRGB.
-    fn for_space(space: &RgbColorSpace) -> Self {
+    /// outset, and the way back where `space` is not sRGB; [`PixelMap::map`] runs the
+    /// kernels of `simd`.
+    fn for_space(space: &RgbColorSpace, simd: Simd) -> Self {
         let (to_srgb, from_srgb) = srgb_matrices(space);
         Self {
             inset: (Mat3::from_cols_array(&INSET) * to_srgb).to_cols_array(),
             outset: OUTSET,
             from_srgb: (!is_identity(from_srgb)).then(|| from_srgb.to_cols_array()),
             curves: curves(),
+            simd,
         }
     }
 
@@ -287,385 +291,12 @@ impl Map {
 
     /// One pixel, scalar.
     #[inline(always)]
-    fn pixel(&self, r: f32, g: f32, b: f32) -> [f32; 3] {
+    pub(super) fn pixel(&self, r: f32, g: f32, b: f32) -> [f32; 3] {
         let [x, y, z] = mat3(&self.inset, r, g, b).map(|v| self.encode(v));
         let out = mat3(&self.outset, x, y, z).map(|v| self.power(v));
         match &self.from_srgb {
             Some(m) => mat3(m, out[0], out[1], out[2]),
             None => out,
-        }
-    }
-
-    /// [`PixelMap::map`] on 8 lanes, the same operations in the same order as
-    /// [`Self::pixel`].
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,fma")]
-    unsafe fn map_avx2(&self, r: &mut [f32], g: &mut [f32], b: &mut [f32]) {
-        use std::arch::x86_64::*;
-        let n = r.len().min(g.len()).min(b.len());
-        let c = self.curves;
-        let splat = |m: &Mat| m.map(|v| _mm256_set1_ps(v));
-        let (inset, outset) = (splat(&self.inset), splat(&self.outset));
-        let from = self.from_srgb.as_ref().map(splat);
-        // SAFETY (all loads of constants below): each array holds 8 f32s.
-        let load8 = |a: &[f32; 8]| _mm256_loadu_ps(a.as_ptr());
-        let encode: [__m256; ENCODE_TERMS] = std::array::from_fn(|j| load8(&c.encode[j]));
-        let power: [__m256; POWER_TERMS] = std::array::from_fn(|j| load8(&c.power[j]));
-        let contrast = c.contrast.map(|v| _mm256_set1_ps(v));
-        let fifths = load8(&c.fifths);
-        let (x_min, x_max) = (_mm256_set1_ps(c.x_min), _mm256_set1_ps(c.x_max));
-        let y_min = _mm256_set1_ps(Y_MIN);
-        let t_mask = _mm256_set1_epi32(T_MASK as i32);
-        let (one_bits, centre) = (_mm256_set1_epi32(ONE_BITS as i32), _mm256_set1_ps(S_CENTRE));
-        let bias = _mm256_set1_epi32(127);
-        let (i5, i25, i205, i127m5) = (
-            _mm256_set1_epi32(5),
-            _mm256_set1_epi32(25),
-            _mm256_set1_epi32(205),
-            _mm256_set1_epi32(127 - 5),
-        );
-        let mat = |m: &[__m256; 9], x: __m256, y: __m256, z: __m256| -> [__m256; 3] {
-            std::array::from_fn(|row| {
-                _mm256_fmadd_ps(
-                    m[6 + row],
-                    z,
-                    _mm256_fmadd_ps(m[3 + row], y, _mm256_mul_ps(m[row], x)),
-                )
-            })
-        };
-        // s from the low mantissa bits, exactly (centred_position).
-        let position = |bits: __m256i| {
-            let m = _mm256_or_si256(_mm256_and_si256(bits, t_mask), one_bits);
-            _mm256_sub_ps(_mm256_castsi256_ps(m), centre)
-        };
-        let encode_curve = |v: __m256| {
-            // maxps returns its second operand when the first is NaN.
-            let v = _mm256_min_ps(_mm256_max_ps(v, x_min), x_max);
-            let bits = _mm256_castps_si256(v);
-            let e = _mm256_cvtepi32_ps(_mm256_sub_epi32(_mm256_srli_epi32::<23>(bits), bias));
-            // vpermps reads the low 3 bits of each index: the segment k.
-            let k = _mm256_srli_epi32::<{ T_BITS as i32 }>(bits);
-            let t = position(bits);
-            let mut p = _mm256_permutevar8x32_ps(encode[ENCODE_TERMS - 1], k);
-            for j in (0..ENCODE_TERMS - 1).rev() {
-                p = _mm256_fmadd_ps(p, t, _mm256_permutevar8x32_ps(encode[j], k));
-            }
-            let w = _mm256_add_ps(e, p);
-            let mut s = contrast[6];
-            for j in (0..6).rev() {
-                s = _mm256_fmadd_ps(s, w, contrast[j]);
-            }
-            s
-        };
-        let power_curve = |y: __m256| {
-            let keep = _mm256_cmp_ps::<_CMP_GE_OQ>(y, y_min);
-            let bits = _mm256_castps_si256(_mm256_max_ps(y, y_min));
-            let e = _mm256_sub_epi32(_mm256_srli_epi32::<23>(bits), bias);
-            // e + 25 = 5q + r as in `split_fifths`.
-            let e25 = _mm256_add_epi32(e, i25);
-            let q = _mm256_srli_epi32::<10>(_mm256_mullo_epi32(e25, i205));
-            let r = _mm256_sub_epi32(e25, _mm256_mullo_epi32(q, i5));
-            let k = _mm256_srli_epi32::<{ T_BITS as i32 }>(bits);
-            let t = position(bits);
-            let mut p = _mm256_permutevar8x32_ps(power[POWER_TERMS - 1], k);
-            for j in (0..POWER_TERMS - 1).rev() {
-                p = _mm256_fmadd_ps(p, t, _mm256_permutevar8x32_ps(power[j], k));
-            }
-            let exponent = _mm256_add_epi32(_mm256_add_epi32(_mm256_add_epi32(e, e), q), i127m5);
-            let scale = _mm256_mul_ps(
-                _mm256_castsi256_ps(_mm256_slli_epi32::<23>(exponent)),
-                _mm256_permutevar8x32_ps(fifths, r),
-            );
-            _mm256_and_ps(_mm256_mul_ps(p, scale), keep)
-        };
-        let mut j = 0;
-        while j + 8 <= n {
-            // SAFETY: j + 8 ≤ n ≤ the length of each plane.
-            let (pr, pg, pb) = (
-                r.as_mut_ptr().add(j),
-                g.as_mut_ptr().add(j),
-                b.as_mut_ptr().add(j),
-            );
-            let [x, y, z] = mat(
-                &inset,
-                _mm256_loadu_ps(pr),
-                _mm256_loadu_ps(pg),
-                _mm256_loadu_ps(pb),
-            );
-            let (x, y, z) = (encode_curve(x), encode_curve(y), encode_curve(z));
-            let [x, y, z] = mat(&outset, x, y, z);
-            let (x, y, z) = (power_curve(x), power_curve(y), power_curve(z));
-            let [x, y, z] = match &from {
-                Some(m) => mat(m, x, y, z),
-                None => [x, y, z],
-            };
-            _mm256_storeu_ps(pr, x);
-            _mm256_storeu_ps(pg, y);
-            _mm256_storeu_ps(pb, z);
-            j += 8;
-        }
-        for j in j..n {
-            [r[j], g[j], b[j]] = self.pixel(r[j], g[j], b[j]);
-        }
-    }
-}
-
-impl Map {
-    /// [`PixelMap::map`] on 16 lanes over planes ([`RegisterMap::map16`] per 16 pixels;
-    /// the tone-mapping pass itself runs the register form directly, this serves
-    /// [`PixelMap::map`] callers).
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx512f")]
-    unsafe fn map_avx512(&self, r: &mut [f32], g: &mut [f32], b: &mut [f32]) {
-        use std::arch::x86_64::*;
-        let n = r.len().min(g.len()).min(b.len());
-        let regs = self.regs16();
-        let mut j = 0;
-        while j + 16 <= n {
-            // SAFETY: j + 16 ≤ n ≤ the length of each plane.
-            let (pr, pg, pb) = (
-                r.as_mut_ptr().add(j),
-                g.as_mut_ptr().add(j),
-                b.as_mut_ptr().add(j),
-            );
-            let [[x, y, z]] = self.map16(
-                &regs,
-                [[
-                    _mm512_loadu_ps(pr),
-                    _mm512_loadu_ps(pg),
-                    _mm512_loadu_ps(pb),
-                ]],
-            );
-            _mm512_storeu_ps(pr, x);
-            _mm512_storeu_ps(pg, y);
-            _mm512_storeu_ps(pb, z);
-            j += 16;
-        }
-        for j in j..n {
-            [r[j], g[j], b[j]] = self.pixel(r[j], g[j], b[j]);
-        }
-    }
-}
-
-/// The constants of [`Map`]'s 16-lane form, loaded once per task.
-#[cfg(target_arch = "x86_64")]
-struct Regs16 {
-    inset: [std::arch::x86_64::__m512; 9],
-    outset: [std::arch::x86_64::__m512; 9],
-    from: Option<[std::arch::x86_64::__m512; 9]>,
-    encode: [std::arch::x86_64::__m512; ENCODE_TERMS],
-    power: [std::arch::x86_64::__m512; POWER_TERMS],
-    contrast: [std::arch::x86_64::__m512; 7],
-    scales: [std::arch::x86_64::__m512; 2],
-}
-
-impl RegisterMap for Map {
-    #[cfg(target_arch = "x86_64")]
-    type Regs = Regs16;
-    /// The power curve's input is ≥ Y_ZERO and < Y_MAX (`outset_values_stay_below_y_max`:
-    /// the encoding's clamp and the contrast polynomial bound it), its cubic and scale
-    /// are finite there, and the matrix back from sRGB of such values is finite.
-    const FINITE_OUTPUT: bool = true;
-
-    #[cfg(target_arch = "x86_64")]
-    #[inline(always)]
-    unsafe fn regs16(&self) -> Regs16 {
-        use std::arch::x86_64::*;
-        let c = self.curves;
-        let splat = |m: &Mat| m.map(|v| _mm512_set1_ps(v));
-        // SAFETY (loads): each array holds 16 f32s.
-        let load = |a: &[f32; 16]| _mm512_loadu_ps(a.as_ptr());
-        Regs16 {
-            inset: splat(&self.inset),
-            outset: splat(&self.outset),
-            from: self.from_srgb.as_ref().map(splat),
-            encode: std::array::from_fn(|j| load(&c.encode16[j])),
-            power: std::array::from_fn(|j| load(&c.power16[j])),
-            contrast: c.contrast.map(|v| _mm512_set1_ps(v)),
-            scales: [
-                _mm512_loadu_ps(c.scales.as_ptr()),
-                _mm512_loadu_ps(c.scales.as_ptr().add(16)),
-            ],
-        }
-    }
-
-    /// [`Map::pixel`] on 16 lanes: the same operations in the same order, with four
-    /// AVX-512 shortcuts that give the same values: the exponent by `vgetexpps` (⌊log2 v⌋
-    /// of a positive normal v, the integer the scalar path extracts), each 8-entry
-    /// coefficient register repeated in both halves of a 16-entry `vpermps` (its index,
-    /// bits >> 20, then carries the exponent's lowest bit above the segment), s by one
-    /// `vpternlogd`, and 2^(2.2e) read from the 32-entry table [`Curves::scales`] with
-    /// one two-register `vpermt2ps` (biased exponents 103…128 are distinct modulo 32),
-    /// whose 0 at exponent 102 ([`Y_ZERO`]) stands for the scalar path's y < Y_MIN test.
-    #[cfg(target_arch = "x86_64")]
-    #[inline(always)]
-    unsafe fn map16<const G: usize>(
-        &self,
-        k: &Regs16,
-        rgb: [[std::arch::x86_64::__m512; 3]; G],
-    ) -> [[std::arch::x86_64::__m512; 3]; G] {
-        // No closures here: this function has no target features of its own, and a
-        // closure the optimiser does not inline would be compiled without AVX-512 (every
-        // intrinsic a call). The helpers are `#[inline(always)]` functions instead.
-        let mut v = rgb;
-        for x in &mut v {
-            *x = mat16(&k.inset, *x);
-        }
-        encode16(k, self.curves, &mut v);
-        for x in &mut v {
-            *x = mat16(&k.outset, *x);
-        }
-        power16(k, &mut v);
-        if let Some(m) = &k.from {
-            for x in &mut v {
-                *x = mat16(m, *x);
-            }
-        }
-        v
-    }
-}
-
-/// `m · (x, y, z)` on 16 lanes, the operations of [`mat3`].
-#[cfg(target_arch = "x86_64")]
-#[inline(always)]
-unsafe fn mat16(
-    m: &[std::arch::x86_64::__m512; 9],
-    [x, y, z]: [std::arch::x86_64::__m512; 3],
-) -> [std::arch::x86_64::__m512; 3] {
-    use std::arch::x86_64::*;
-    let mut out = [x; 3];
-    for (row, o) in out.iter_mut().enumerate() {
-        *o = _mm512_fmadd_ps(
-            m[6 + row],
-            z,
-            _mm512_fmadd_ps(m[3 + row], y, _mm512_mul_ps(m[row], x)),
-        );
-    }
-    out
-}
-
-/// [`centred_position`] on 16 lanes: (bits & T_MASK) | ONE_BITS in one `vpternlogd`
-/// (truth table 0xEA: (a & b) | c), then the exact subtraction.
-#[cfg(target_arch = "x86_64")]
-#[inline(always)]
-unsafe fn position16(bits: std::arch::x86_64::__m512i) -> std::arch::x86_64::__m512 {
-    use std::arch::x86_64::*;
-    let m = _mm512_ternarylogic_epi32::<0xEA>(
-        bits,
-        _mm512_set1_epi32(T_MASK as i32),
-        _mm512_set1_epi32(ONE_BITS as i32),
-    );
-    _mm512_sub_ps(_mm512_castsi512_ps(m), _mm512_set1_ps(S_CENTRE))
-}
-
-// The curves below run each step over all 3·G vectors before the next step: the steps
-// of one value form a chain of ~25 dependent operations (≈ 100 cycles), and written
-// value by value the scheduler fills with one chain before it reaches independent work
-// (the pass measured latency-bound: ≈ 150 cycles per 16 pixels for ≈ 45 cycles of
-// issue).
-
-/// Per lane the polynomial of its segment `seg` (coefficient j of every segment in
-/// register `coeffs[j]`, picked by `vpermps`) at position `s`, Horner from the top term,
-/// each step over all 3·G vectors (see above).
-#[cfg(target_arch = "x86_64")]
-#[inline(always)]
-unsafe fn segment_poly16<const G: usize, const T: usize>(
-    seg: &[[std::arch::x86_64::__m512i; 3]; G],
-    s: &[[std::arch::x86_64::__m512; 3]; G],
-    coeffs: &[std::arch::x86_64::__m512; T],
-) -> [[std::arch::x86_64::__m512; 3]; G] {
-    use std::arch::x86_64::*;
-    let mut p = [[_mm512_setzero_ps(); 3]; G];
-    for g in 0..G {
-        for ch in 0..3 {
-            p[g][ch] = _mm512_permutexvar_ps(seg[g][ch], coeffs[T - 1]);
-        }
-    }
-    for j in (0..T - 1).rev() {
-        for g in 0..G {
-            for ch in 0..3 {
-                p[g][ch] = _mm512_fmadd_ps(
-                    p[g][ch],
-                    s[g][ch],
-                    _mm512_permutexvar_ps(seg[g][ch], coeffs[j]),
-                );
-            }
-        }
-    }
-    p
-}
-
-/// [`Map::encode`] on 16 lanes, every vector of `v`.
-#[cfg(target_arch = "x86_64")]
-#[inline(always)]
-unsafe fn encode16<const G: usize>(
-    k: &Regs16,
-    c: &Curves,
-    v: &mut [[std::arch::x86_64::__m512; 3]; G],
-) {
-    use std::arch::x86_64::*;
-    let (x_min, x_max) = (_mm512_set1_ps(c.x_min), _mm512_set1_ps(c.x_max));
-    let zero = _mm512_setzero_ps();
-    let (mut e, mut seg, mut s) = (
-        [[zero; 3]; G],
-        [[_mm512_setzero_si512(); 3]; G],
-        [[zero; 3]; G],
-    );
-    for g in 0..G {
-        for ch in 0..3 {
-            let x = _mm512_min_ps(_mm512_max_ps(v[g][ch], x_min), x_max);
-            let bits = _mm512_castps_si512(x);
-            e[g][ch] = _mm512_getexp_ps(x);
-            seg[g][ch] = _mm512_srli_epi32::<{ T_BITS }>(bits);
-            s[g][ch] = position16(bits);
-        }
-    }
-    let p = segment_poly16(&seg, &s, &k.encode);
-    for g in 0..G {
-        for ch in 0..3 {
-            // w, then the contrast polynomial's top coefficient into v.
-            s[g][ch] = _mm512_add_ps(e[g][ch], p[g][ch]);
-            v[g][ch] = k.contrast[6];
-        }
-    }
-    for j in (0..6).rev() {
-        for g in 0..G {
-            for ch in 0..3 {
-                v[g][ch] = _mm512_fmadd_ps(v[g][ch], s[g][ch], k.contrast[j]);
-            }
-        }
-    }
-}
-
-/// [`Map::power`] on 16 lanes, every vector of `v`.
-#[cfg(target_arch = "x86_64")]
-#[inline(always)]
-unsafe fn power16<const G: usize>(k: &Regs16, v: &mut [[std::arch::x86_64::__m512; 3]; G]) {
-    use std::arch::x86_64::*;
-    let y_zero = _mm512_set1_ps(Y_ZERO);
-    let zero = _mm512_setzero_ps();
-    let (mut bits, mut seg, mut s) = (
-        [[_mm512_setzero_si512(); 3]; G],
-        [[_mm512_setzero_si512(); 3]; G],
-        [[zero; 3]; G],
-    );
-    for g in 0..G {
-        for ch in 0..3 {
-            // Below Y_MIN (and NaN) to Y_ZERO, whose scale is 0.
-            bits[g][ch] = _mm512_castps_si512(_mm512_max_ps(v[g][ch], y_zero));
-            seg[g][ch] = _mm512_srli_epi32::<{ T_BITS }>(bits[g][ch]);
-            s[g][ch] = position16(bits[g][ch]);
-        }
-    }
-    let p = segment_poly16(&seg, &s, &k.power);
-    for g in 0..G {
-        for ch in 0..3 {
-            let scale = _mm512_permutex2var_ps(
-                k.scales[0],
-                _mm512_srli_epi32::<23>(bits[g][ch]),
-                k.scales[1],
-            );
-            v[g][ch] = _mm512_mul_ps(p[g][ch], scale);
         }
     }
 }
@@ -684,14 +315,14 @@ impl PixelMap for Map {
     #[inline(always)]
     fn map(&self, _start: usize, r: &mut [f32], g: &mut [f32], b: &mut [f32]) {
         #[cfg(target_arch = "x86_64")]
-        if crate::tonemap::simd::has_avx512() {
-            // SAFETY: the CPU has AVX-512 F (checked above).
+        if self.simd.avx512() {
+            // SAFETY: a `Simd` allows AVX-512 only on a CPU that has it.
             unsafe { self.map_avx512(r, g, b) };
             return;
         }
         #[cfg(target_arch = "x86_64")]
-        if super::simd::has_avx2() {
-            // SAFETY: the CPU has AVX2 and FMA (checked above).
+        if self.simd.avx2() {
+            // SAFETY: a `Simd` allows AVX2 and FMA only on a CPU that has them.
             unsafe { self.map_avx2(r, g, b) };
             return;
         }
@@ -708,9 +339,9 @@ fn is_identity(m: Mat3) -> bool {
 }
 
 pub(crate) fn apply(ctx: &Context) -> Output {
-    let map = Map::for_space(&ctx.image.color_space);
+    let map = Map::for_space(&ctx.image.color_space, ctx.simd);
     Output {
-        mapped: super::map512::map_pixels_registers(ctx, ctx.exposure, &map),
+        mapped: super::kernels::map_pixels_registers(ctx, ctx.exposure, &map),
         values: vec![],
     }
 }
@@ -814,51 +445,39 @@ mod tests {
             values.push(v);
             v *= 1.0137;
         }
-        for space in [RgbColorSpace::srgb(), RgbColorSpace::rec2020()] {
-            let map = Map::for_space(&space);
+        for (space, simd) in [RgbColorSpace::srgb(), RgbColorSpace::rec2020()]
+            .into_iter()
+            .flat_map(|space| {
+                prism_cpu::each_isa()
+                    .into_iter()
+                    .map(move |s| (space.clone(), s))
+            })
+        {
+            let map = Map::for_space(&space, simd);
             assert_eq!(map.from_srgb.is_none(), space == RgbColorSpace::srgb());
             let n = values.len();
             let mut r: Vec<f32> = values.clone();
             let mut g: Vec<f32> = (0..n).map(|i| values[(i * 7 + 3) % n]).collect();
             let mut b: Vec<f32> = (0..n).map(|i| values[(i * 13 + 5) % n]).collect();
             let want: Vec<[f32; 3]> = (0..n).map(|i| map.pixel(r[i], g[i], b[i])).collect();
-            #[allow(clippy::type_complexity)] // (path, r, g, b)
-            let mut paths: Vec<(&str, Vec<f32>, Vec<f32>, Vec<f32>)> = vec![];
-            #[cfg(target_arch = "x86_64")]
-            {
-                if super::super::simd::has_avx2() {
-                    let (mut r, mut g, mut b) = (r.clone(), g.clone(), b.clone());
-                    // SAFETY: the CPU has AVX2 and FMA (checked just above).
-                    unsafe { map.map_avx2(&mut r, &mut g, &mut b) };
-                    paths.push(("avx2", r, g, b));
-                }
-                if crate::tonemap::simd::has_avx512() {
-                    let (mut r, mut g, mut b) = (r.clone(), g.clone(), b.clone());
-                    // SAFETY: the CPU has AVX-512 F (checked just above).
-                    unsafe { map.map_avx512(&mut r, &mut g, &mut b) };
-                    paths.push(("avx512", r, g, b));
-                }
-            }
+            // `PixelMap::map` at this ISA: the AVX-512 or AVX2 kernel, or `pixel` per pixel.
             map.map(0, &mut r, &mut g, &mut b);
-            paths.push(("dispatched", r, g, b));
-            for (name, r, g, b) in &paths {
-                for i in 0..n {
-                    let got = [r[i], g[i], b[i]];
-                    assert_eq!(
-                        got.map(f32::to_bits),
-                        want[i].map(f32::to_bits),
-                        "{name} {i}: {got:?}"
-                    );
-                }
+            for i in 0..n {
+                let got = [r[i], g[i], b[i]];
+                assert_eq!(
+                    got.map(f32::to_bits),
+                    want[i].map(f32::to_bits),
+                    "{simd} {i}: {got:?}"
+                );
             }
         }
     }
 
     #[test]
     fn register_pass_gives_the_scalar_bits() {
-        // The whole AVX-512 pass (sanitising, the map in registers with its output
-        // cleaning skipped, zero-padded head and tail groups, the counts) against the
-        // scalar one, on the special values and on every octave of the curves.
+        // The whole pass at every ISA (with AVX-512: sanitising, the map in registers with
+        // its output cleaning skipped, zero-padded head and tail groups, the counts)
+        // against the scalar one, on the special values and on every octave of the curves.
         let special = bit_test_image();
         let mut pixels = special.pixels().to_vec();
         let mut v = 1e-7f32;
@@ -867,9 +486,12 @@ mod tests {
             v *= 1.0093;
         }
         for space in [RgbColorSpace::srgb(), RgbColorSpace::rec2020()] {
-            let map = Map::for_space(&space);
             for scale in [1.0f32, 0.37, 3e30] {
-                super::super::map512::register_pass_gives_the_scalar_bits(&pixels, scale, &map);
+                super::super::kernels::tests::register_pass_gives_the_scalar_bits(
+                    &pixels,
+                    scale,
+                    |simd| Map::for_space(&space, simd),
+                );
             }
         }
     }
@@ -885,6 +507,7 @@ mod tests {
             outset: Mat3::IDENTITY.to_cols_array(),
             from_srgb: None,
             curves: curves(),
+            simd: Simd::SCALAR,
         };
         // Power: every octave from 2⁻²⁴ to 2, against f64 (relative error).
         let mut worst_power = 0.0f64;

@@ -16,7 +16,9 @@
 
 use rayon::prelude::*;
 
-use super::simd::avx2;
+use prism_cpu::Simd;
+
+use super::kernels::avx2;
 
 /// Grid nodes of padding on each side of every axis (covers the radius-2 blur and the
 /// trilinear neighbour).
@@ -34,12 +36,14 @@ const GRID_KERNEL: [f32; 5] = [
 /// The bilateral filter of `values` (row-major `width × height`) with spatial σ
 /// `sigma_space_px` (pixels) and range σ `sigma_range` (units of the values), by the
 /// bilateral grid. Returns the filtered plane and the (min, max) of its finite values.
+/// `simd`: the widest kernels to run (`prism_cpu::active()` for the process's choice).
 pub fn bilateral_grid(
     values: &[f32],
     width: usize,
     height: usize,
     sigma_space_px: f32,
     sigma_range: f32,
+    simd: Simd,
 ) -> (Vec<f32>, [f32; 2]) {
     let (lo, hi) = values
         .par_chunks(4096)
@@ -79,7 +83,7 @@ pub fn bilateral_grid(
     let nearest_x: Vec<usize> = fxs.iter().map(|fx| (fx + 0.5) as usize).collect();
 
     // Splat (nearest node), rows in parallel into per-task grids, summed. Per row the z
-    // coordinates are computed first in a vectorisable loop (module simd), then the
+    // coordinates are computed first in a vectorisable loop (`avx2!`), then the
     // scatter runs.
     let grid = values
         .par_chunks(width)
@@ -87,7 +91,7 @@ pub fn bilateral_grid(
         .fold(
             || (vec![[0.0f32; 2]; cells], vec![0.0f32; width]),
             |(mut g, mut fz), (y, row)| {
-                avx2!(z_coordinates(row, &mut fz, lo, sr));
+                avx2!(simd, z_coordinates(row, &mut fz, lo, sr));
                 let ny = (fys[y] + 0.5) as usize;
                 for ((v, fz), nx) in row.iter().zip(&fz).zip(&nearest_x) {
                     if v.is_finite() {
@@ -148,7 +152,7 @@ pub fn bilateral_grid(
         .map_init(
             || vec![0.0f32; width],
             |fz, (y, (o, row))| {
-                avx2!(z_coordinates(row, fz, lo, sr));
+                avx2!(simd, z_coordinates(row, fz, lo, sr));
                 let fy = fys[y];
                 let y0 = fy as usize;
                 let ty = fy - y0 as f32;
@@ -213,7 +217,7 @@ mod tests {
         let v: Vec<f32> = (0..w * h)
             .map(|i| if i % w < 20 { -2.0 } else { 1.0 })
             .collect();
-        let (b, [lo, hi]) = bilateral_grid(&v, w, h, 4.0, 0.4);
+        let (b, [lo, hi]) = bilateral_grid(&v, w, h, 4.0, 0.4, prism_cpu::active());
         for (got, want) in b.iter().zip(&v) {
             assert!((got - want).abs() < 1e-5, "{got} vs {want}");
         }
@@ -228,12 +232,12 @@ mod tests {
                 }
             })
             .collect();
-        let (b, _) = bilateral_grid(&t, w, h, 4.0, 0.4);
+        let (b, _) = bilateral_grid(&t, w, h, 4.0, 0.4, prism_cpu::active());
         assert!(b.iter().all(|x| x.abs() < 0.005), "{:?}", &b[..4]);
         // NaN in → NaN out, and nothing else disturbed.
         let mut n = v.clone();
         n[5] = f32::NAN;
-        let (b, _) = bilateral_grid(&n, w, h, 4.0, 0.4);
+        let (b, _) = bilateral_grid(&n, w, h, 4.0, 0.4, prism_cpu::active());
         assert!(b[5].is_nan() && (b[6] + 2.0).abs() < 1e-5);
     }
 }

@@ -15,7 +15,7 @@
 //! is the f32 rounding of the evaluation (a few 1e-7 relative, tested below).
 //!
 //! The lookup is one 16-byte load per pixel, a transpose and three multiply-adds on 8
-//! lanes (AVX2), against the
+//! lanes (AVX2; the 8- and 16-lane forms are in `kernels/`), against the
 //! 15–25 vector operations of each fast log or exp it replaces (module
 //! [`super::fast_math`]). A table spans the segments from `lo` to `hi` (the curve's
 //! domain, e.g. the image's smallest positive and largest luminance): 64 segments of 16
@@ -28,17 +28,17 @@
 /// Mantissa bits that select the segment inside an octave (64 segments per octave).
 pub const MANTISSA_BITS: u32 = 6;
 /// Low bits that give the position t inside a segment.
-const LOW_BITS: u32 = 23 - MANTISSA_BITS;
-const LOW_MASK: u32 = (1 << LOW_BITS) - 1;
+pub(super) const LOW_BITS: u32 = 23 - MANTISSA_BITS;
+pub(super) const LOW_MASK: u32 = (1 << LOW_BITS) - 1;
 /// 2^−LOW_BITS, exact in f32.
-const T_SCALE: f32 = 1.0 / (1u32 << LOW_BITS) as f32;
+pub(super) const T_SCALE: f32 = 1.0 / (1u32 << LOW_BITS) as f32;
 
 /// A curve tabulated as cubics in t per segment (see the module documentation).
 pub(crate) struct CurveTable {
     /// Segment index (bits >> LOW_BITS) of the first tabulated segment.
-    first: u32,
+    pub(super) first: u32,
     /// c0, c1, c2, c3 of c0 + t (c1 + t (c2 + t c3)) per segment.
-    coeffs: Vec<[f32; 4]>,
+    pub(super) coeffs: Vec<[f32; 4]>,
 }
 
 /// The value of the non-negative f32 whose bits are `bits`, in f64. The upper end of a
@@ -103,20 +103,26 @@ impl CurveTable {
         c[0] + t * (c[1] + t * (c[2] + t * c[3]))
     }
 
-    /// Replaces every `v[j]` by the tabulated curve at `v[j]`.
+    /// Replaces every `v[j]` by the tabulated curve at `v[j]`, with the kernels of `simd`.
     #[inline]
-    pub fn eval_slice(&self, v: &mut [f32]) {
-        self.eval_slice_clamped::<false>(v, f32::NEG_INFINITY, f32::INFINITY);
+    pub fn eval_slice(&self, v: &mut [f32], simd: prism_cpu::Simd) {
+        self.eval_slice_clamped::<false>(v, f32::NEG_INFINITY, f32::INFINITY, simd);
     }
 
     /// Replaces every `v[j]` by the tabulated curve at `v[j]` clamped to [lo, hi] (NaN
     /// to lo), or by 0 where `ZERO_BELOW` and `v[j]` is below lo or NaN: the clamp and the
-    /// select in the same pass as the lookup.
+    /// select in the same pass as the lookup. The AVX2 form (8 lanes) where `simd` allows.
     #[inline]
-    pub fn eval_slice_clamped<const ZERO_BELOW: bool>(&self, v: &mut [f32], lo: f32, hi: f32) {
+    pub fn eval_slice_clamped<const ZERO_BELOW: bool>(
+        &self,
+        v: &mut [f32],
+        lo: f32,
+        hi: f32,
+        simd: prism_cpu::Simd,
+    ) {
         #[cfg(target_arch = "x86_64")]
-        if super::simd::has_avx2() {
-            // SAFETY: the CPU has AVX2 (checked above).
+        if simd.avx2() {
+            // SAFETY: a `Simd` allows AVX2 only on a CPU that has it.
             unsafe { self.eval_slice_avx2::<ZERO_BELOW>(v, lo, hi) };
             return;
         }
@@ -127,143 +133,12 @@ impl CurveTable {
 
     /// One element of [`Self::eval_slice_clamped`].
     #[inline(always)]
-    fn eval_clamped<const ZERO_BELOW: bool>(&self, x: f32, lo: f32, hi: f32) -> f32 {
+    pub(super) fn eval_clamped<const ZERO_BELOW: bool>(&self, x: f32, lo: f32, hi: f32) -> f32 {
         let y = self.eval(x.max(lo).min(hi));
         if ZERO_BELOW && (x.is_nan() || x < lo) {
             0.0
         } else {
             y
-        }
-    }
-
-    /// [`Self::eval`] on 16 lanes with AVX-512F: the same bits (the same operations in the
-    /// same order).
-    ///
-    /// # Safety
-    /// The CPU must have AVX-512F.
-    #[cfg(target_arch = "x86_64")]
-    #[inline(always)]
-    pub unsafe fn eval16(&self, x: std::arch::x86_64::__m512) -> std::arch::x86_64::__m512 {
-        use std::arch::x86_64::*;
-        let base = self.coeffs.as_ptr() as *const f32;
-        let bits = _mm512_castps_si512(x);
-        // Logical shift: negative arguments land above the last segment, as in `eval`.
-        let s = _mm512_sub_epi32(
-            _mm512_srli_epi32::<{ LOW_BITS }>(bits),
-            _mm512_set1_epi32(self.first as i32),
-        );
-        let s = _mm512_min_epi32(
-            _mm512_max_epi32(s, _mm512_setzero_si512()),
-            _mm512_set1_epi32(self.coeffs.len() as i32 - 1),
-        );
-        // Each lane's four coefficients are one 16-byte load; four rows per register
-        // (lanes j, j + 4, j + 8, j + 12 of register j), then a 4×4 transpose inside
-        // each 128-bit slot turns them into c0..c3 (16 loads and 20 shuffles: measured
-        // cheaper than four 16-lane gathers, as on 8 lanes).
-        let mut idx = [0i32; 16];
-        _mm512_storeu_si512(idx.as_mut_ptr() as *mut _, s);
-        // SAFETY: 0 ≤ idx[k] < coeffs.len() (clamped above), so each row's four floats
-        // lie inside the coefficient table.
-        let row = |k: usize| _mm_loadu_ps(base.add(4 * idx[k] as usize));
-        let reg = |j: usize| {
-            let z = _mm512_castps128_ps512(row(j));
-            let z = _mm512_insertf32x4::<1>(z, row(j + 4));
-            let z = _mm512_insertf32x4::<2>(z, row(j + 8));
-            _mm512_insertf32x4::<3>(z, row(j + 12))
-        };
-        let (r0, r1, r2, r3) = (reg(0), reg(1), reg(2), reg(3));
-        let t0 = _mm512_unpacklo_ps(r0, r1);
-        let t1 = _mm512_unpackhi_ps(r0, r1);
-        let t2 = _mm512_unpacklo_ps(r2, r3);
-        let t3 = _mm512_unpackhi_ps(r2, r3);
-        let lo = |a: __m512, b: __m512| {
-            _mm512_castpd_ps(_mm512_unpacklo_pd(_mm512_castps_pd(a), _mm512_castps_pd(b)))
-        };
-        let hi = |a: __m512, b: __m512| {
-            _mm512_castpd_ps(_mm512_unpackhi_pd(_mm512_castps_pd(a), _mm512_castps_pd(b)))
-        };
-        let c = [lo(t0, t2), hi(t0, t2), lo(t1, t3), hi(t1, t3)];
-        let t = _mm512_mul_ps(
-            _mm512_cvtepi32_ps(_mm512_and_si512(bits, _mm512_set1_epi32(LOW_MASK as i32))),
-            _mm512_set1_ps(T_SCALE),
-        );
-        let p = _mm512_add_ps(c[2], _mm512_mul_ps(t, c[3]));
-        let p = _mm512_add_ps(c[1], _mm512_mul_ps(t, p));
-        _mm512_add_ps(c[0], _mm512_mul_ps(t, p))
-    }
-
-    /// [`Self::eval_slice_clamped`] on 8 lanes.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    unsafe fn eval_slice_avx2<const ZERO_BELOW: bool>(&self, v: &mut [f32], lo: f32, hi: f32) {
-        use std::arch::x86_64::*;
-        let base = self.coeffs.as_ptr() as *const f32;
-        let first = _mm256_set1_epi32(self.first as i32);
-        let last = _mm256_set1_epi32(self.coeffs.len() as i32 - 1);
-        let zero = _mm256_setzero_si256();
-        let low_mask = _mm256_set1_epi32(LOW_MASK as i32);
-        let t_scale = _mm256_set1_ps(T_SCALE);
-        let (lo_v, hi_v) = (_mm256_set1_ps(lo), _mm256_set1_ps(hi));
-        let mut chunks = v.chunks_exact_mut(8);
-        for chunk in &mut chunks {
-            let raw = _mm256_loadu_ps(chunk.as_ptr());
-            // maxps returns its second operand for a NaN first one: NaN → lo, as
-            // f32::max in `eval_clamped`.
-            let x = _mm256_min_ps(_mm256_max_ps(raw, lo_v), hi_v);
-            let bits = _mm256_castps_si256(x);
-            // Logical shift: negative arguments (sign bit set) land above the last
-            // segment and are clamped to it, as in `eval`.
-            let s = _mm256_sub_epi32(_mm256_srli_epi32::<{ LOW_BITS as i32 }>(bits), first);
-            let s = _mm256_min_epi32(_mm256_max_epi32(s, zero), last);
-            // Each lane's four coefficients are one 16-byte load; a 4×4 transpose per
-            // 128-bit half turns the eight rows into c0..c3 (eight loads and eight
-            // shuffles: several times cheaper than four 8-lane gathers on Zen 3).
-            let mut idx = [0i32; 8];
-            _mm256_storeu_si256(idx.as_mut_ptr() as *mut __m256i, s);
-            let row = |k: usize| base.add(4 * idx[k] as usize);
-            let pair = |lo: usize, hi: usize| {
-                _mm256_insertf128_ps::<1>(
-                    _mm256_castps128_ps256(_mm_loadu_ps(row(lo))),
-                    _mm_loadu_ps(row(hi)),
-                )
-            };
-            let (r0, r1, r2, r3) = (pair(0, 4), pair(1, 5), pair(2, 6), pair(3, 7));
-            let t0 = _mm256_unpacklo_ps(r0, r1); // a0 b0 a1 b1
-            let t1 = _mm256_unpackhi_ps(r0, r1); // a2 b2 a3 b3
-            let t2 = _mm256_unpacklo_ps(r2, r3); // c0 d0 c1 d1
-            let t3 = _mm256_unpackhi_ps(r2, r3); // c2 d2 c3 d3
-            let c0 = _mm256_castpd_ps(_mm256_unpacklo_pd(
-                _mm256_castps_pd(t0),
-                _mm256_castps_pd(t2),
-            ));
-            let c1 = _mm256_castpd_ps(_mm256_unpackhi_pd(
-                _mm256_castps_pd(t0),
-                _mm256_castps_pd(t2),
-            ));
-            let c2 = _mm256_castpd_ps(_mm256_unpacklo_pd(
-                _mm256_castps_pd(t1),
-                _mm256_castps_pd(t3),
-            ));
-            let c3 = _mm256_castpd_ps(_mm256_unpackhi_pd(
-                _mm256_castps_pd(t1),
-                _mm256_castps_pd(t3),
-            ));
-            let t = _mm256_mul_ps(
-                _mm256_cvtepi32_ps(_mm256_and_si256(bits, low_mask)),
-                t_scale,
-            );
-            let p = _mm256_add_ps(c2, _mm256_mul_ps(t, c3));
-            let p = _mm256_add_ps(c1, _mm256_mul_ps(t, p));
-            let p = _mm256_add_ps(c0, _mm256_mul_ps(t, p));
-            let p = if ZERO_BELOW {
-                _mm256_and_ps(p, _mm256_cmp_ps::<_CMP_GE_OQ>(raw, lo_v))
-            } else {
-                p
-            };
-            _mm256_storeu_ps(chunk.as_mut_ptr(), p);
-        }
-        for x in chunks.into_remainder() {
-            *x = self.eval_clamped::<ZERO_BELOW>(*x, lo, hi);
         }
     }
 }
@@ -274,16 +149,15 @@ fn cubic_through(t: &[f64; 4], y: &[f64; 4]) -> [f64; 4] {
 }
 
 /// The biased binary exponents (b_lo, b_hi) of a curve's range [lo, hi] held in AVX-512
-/// registers, one entry per exponent mod 32 (power_curve, octave_curve); `None` where the
-/// CPU lacks AVX-512 F, a bound is not a positive normal f32, lo > hi, or the range spans
-/// more than 32 exponents (the curve then keeps its memory table).
-pub(crate) fn register_exponent_range(lo: f32, hi: f32) -> Option<(i32, i32)> {
-    if !(crate::tonemap::simd::has_avx512()
-        && lo.is_normal()
-        && hi.is_normal()
-        && 0.0 < lo
-        && lo <= hi)
-    {
+/// registers, one entry per exponent mod 32 (power_curve, octave_curve); `None` where
+/// `simd` does not allow AVX-512, a bound is not a positive normal f32, lo > hi, or the
+/// range spans more than 32 exponents (the curve then keeps its memory table).
+pub(crate) fn register_exponent_range(
+    simd: prism_cpu::Simd,
+    lo: f32,
+    hi: f32,
+) -> Option<(i32, i32)> {
+    if !(simd.avx512() && lo.is_normal() && hi.is_normal() && 0.0 < lo && lo <= hi) {
         return None;
     }
     let (b_lo, b_hi) = ((lo.to_bits() >> 23) as i32, (hi.to_bits() >> 23) as i32);
@@ -326,6 +200,8 @@ pub(crate) fn chebyshev_nodes<const N: usize>() -> [f64; N] {
 mod tests {
     use super::*;
 
+    /// The table against `f`, and every ISA's slice evaluation against the scalar `eval`
+    /// bit for bit (each ISA the machine runs).
     fn check(table: &CurveTable, lo: f64, hi: f64, f: impl Fn(f64) -> f64, max_rel: f64) -> f64 {
         let mut worst = 0.0f64;
         let mut x = lo;
@@ -335,12 +211,19 @@ mod tests {
             x *= 1.000_913;
         }
         xs.push(hi as f32);
-        let mut wide = xs.clone();
-        table.eval_slice(&mut wide);
-        for (x, w) in xs.iter().zip(&wide) {
+        let wide: Vec<(prism_cpu::Simd, Vec<f32>)> = prism_cpu::each_isa()
+            .into_iter()
+            .map(|simd| {
+                let mut v = xs.clone();
+                table.eval_slice(&mut v, simd);
+                (simd, v)
+            })
+            .collect();
+        for (i, x) in xs.iter().enumerate() {
             let got = table.eval(*x);
-            // The AVX2 path and the scalar path give the same bits.
-            assert_eq!(got.to_bits(), w.to_bits(), "x = {x:e}");
+            for (simd, w) in &wide {
+                assert_eq!(got.to_bits(), w[i].to_bits(), "{simd} x = {x:e}");
+            }
             let want = f(*x as f64);
             let rel = (got as f64 - want).abs() / want.abs();
             worst = worst.max(rel);
@@ -404,9 +287,17 @@ mod tests {
     #[test]
     fn arguments_outside_the_domain_are_clamped_to_the_end_segments() {
         let table = CurveTable::new(1.0, 4.0, |x| x);
+        for simd in prism_cpu::each_isa() {
+            clamped_at(&table, simd);
+        }
+    }
+
+    /// `arguments_outside_the_domain_are_clamped_to_the_end_segments` with the kernels of
+    /// `simd`.
+    fn clamped_at(table: &CurveTable, simd: prism_cpu::Simd) {
         let mut v = [0.0f32, -5.0, f32::INFINITY, 1e30, 0.5, 8.0, 2.0, 3.0, -0.0];
         let scalar: Vec<f32> = v.iter().map(|x| table.eval(*x)).collect();
-        table.eval_slice(&mut v);
+        table.eval_slice(&mut v, simd);
         for (a, b) in v.iter().zip(&scalar) {
             assert_eq!(a.to_bits(), b.to_bits());
             assert!(a.is_finite());
@@ -427,8 +318,8 @@ mod tests {
             1.5,
         ];
         let (mut c, mut z) = (src, src);
-        table.eval_slice_clamped::<false>(&mut c, 1.0, 4.0);
-        table.eval_slice_clamped::<true>(&mut z, 1.0, 4.0);
+        table.eval_slice_clamped::<false>(&mut c, 1.0, 4.0, simd);
+        table.eval_slice_clamped::<true>(&mut z, 1.0, 4.0, simd);
         for (k, x) in src.iter().enumerate() {
             let want = if x.is_nan() {
                 1.0

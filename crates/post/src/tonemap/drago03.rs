@@ -6,7 +6,7 @@
 //! brightest pixel maps to 1).
 
 use super::curve_table::CurveTable;
-use super::map512::{self, RegisterCurve};
+use super::kernels;
 use super::octave_curve::OctaveCurve;
 use super::pixels::{luminance_stats, LuminanceCurve};
 use super::{Context, OperatorInfo, Output, ParamSpec};
@@ -38,14 +38,17 @@ pub(crate) static INFO: OperatorInfo = OperatorInfo {
 /// range from the formula in f64 (the closed form costs three logarithms, a power and a
 /// division per pixel in f32): in registers, one degree-9 polynomial per octave
 /// ([`OctaveCurve`]: ten `vpermt2ps` and nine FMAs per 16 pixels), where the range spans
-/// ≤ 32 binary exponents and the CPU has AVX-512; otherwise the memory table of
-/// [`super::curve_table`] (a 16-byte row per pixel and three multiply-adds).
+/// ≤ 32 binary exponents and the ISA is AVX-512; otherwise the memory table of
+/// [`super::curve_table`] (a 16-byte row per pixel and three multiply-adds). The two
+/// approximate eq. 4 to ~1e-7 each, so `PRISM_SIMD` changes drago03's output by that
+/// much (`kernels::tests`).
 /// (Two types, not an enum: the pass is generic over the curve, so each loop is compiled
 /// for one of them and keeps the octave coefficients' loads out of the pixel loop.)
-struct Octaves(OctaveCurve);
+pub(super) struct Octaves(pub(super) OctaveCurve);
 
-/// The memory-table form of the curve (see [`Octaves`]).
-struct Table(CurveTable);
+/// The memory-table form of the curve (see [`Octaves`]), with the ISA its slice lookup
+/// runs.
+pub(super) struct Table(pub(super) CurveTable, pub(super) prism_cpu::Simd);
 
 impl LuminanceCurve for Octaves {
     #[inline(always)]
@@ -54,31 +57,15 @@ impl LuminanceCurve for Octaves {
     }
 }
 
-impl RegisterCurve for Octaves {
-    #[cfg(target_arch = "x86_64")]
-    #[inline(always)]
-    unsafe fn ratio16(&self, l: std::arch::x86_64::__m512) -> std::arch::x86_64::__m512 {
-        self.0.eval16(l)
-    }
-}
-
 impl LuminanceCurve for Table {
     #[inline(always)]
     fn ratio(&self, _start: usize, l: &mut [f32]) {
-        self.0.eval_slice(l);
-    }
-}
-
-impl RegisterCurve for Table {
-    #[cfg(target_arch = "x86_64")]
-    #[inline(always)]
-    unsafe fn ratio16(&self, l: std::arch::x86_64::__m512) -> std::arch::x86_64::__m512 {
-        self.0.eval16(l)
+        self.0.eval_slice(l, self.1);
     }
 }
 
 pub(crate) fn apply(ctx: &Context) -> Output {
-    let stats = luminance_stats(ctx.image, ctx.exposure, ctx.weights);
+    let stats = luminance_stats(ctx, ctx.exposure, ctx.weights);
     let bias = ctx.value("bias");
     let display_max = ctx.value("display_max");
     let l_wa = stats.log_average;
@@ -97,11 +84,11 @@ pub(crate) fn apply(ctx: &Context) -> Output {
         }
     };
     let (lo, hi) = (stats.min_positive as f32, stats.max as f32);
-    let mapped = match OctaveCurve::new(lo, hi, ratio) {
-        Some(c) => map512::map_luminance_fast(ctx, ctx.exposure, ctx.weights, &Octaves(c)),
+    let mapped = match OctaveCurve::new(ctx.simd, lo, hi, ratio) {
+        Some(c) => kernels::map_luminance_fast(ctx, ctx.exposure, ctx.weights, &Octaves(c)),
         None => {
-            let table = Table(CurveTable::new(lo, hi, ratio));
-            map512::map_luminance_fast(ctx, ctx.exposure, ctx.weights, &table)
+            let table = Table(CurveTable::new(lo, hi, ratio), ctx.simd);
+            kernels::map_luminance_fast(ctx, ctx.exposure, ctx.weights, &table)
         }
     };
     Output {
@@ -172,14 +159,19 @@ mod tests {
         assert!(err < 0.015, "{err} 16-bit codes");
     }
 
+    /// Both forms of the curve through every ISA's pass: the table (whose slice lookup
+    /// runs each ISA's kernel) and, made where the machine has AVX-512, the octave
+    /// polynomials.
     #[test]
     fn vector_path_gives_the_scalar_bits() {
+        use super::super::kernels::tests::same_bits_as_scalar;
         let f = |l: f64| (1.0 + l).ln() / (l * (2.0 + l.powf(0.23)).ln());
-        let table = super::Table(CurveTable::new(1e-3, 1e3, f));
-        super::super::map512::same_bits_as_scalar(&bit_test_image(), 1.0, &table);
-        // The register curve (exists only with AVX-512, where the pass runs).
-        if let Some(c) = OctaveCurve::new(1e-3, 1e3, f) {
-            super::super::map512::same_bits_as_scalar(&bit_test_image(), 1.0, &super::Octaves(c));
+        same_bits_as_scalar(&bit_test_image(), 1.0, |simd| {
+            super::Table(CurveTable::new(1e-3, 1e3, f), simd)
+        });
+        if let Some(avx512) = prism_cpu::each_isa().into_iter().find(|s| s.avx512()) {
+            let octaves = || super::Octaves(OctaveCurve::new(avx512, 1e-3, 1e3, f).unwrap());
+            same_bits_as_scalar(&bit_test_image(), 1.0, |_| octaves());
         }
     }
 }

@@ -17,8 +17,8 @@
 
 use super::bilateral_grid::bilateral_grid;
 use super::fast_math;
+use super::kernels::avx2;
 use super::pixels::{luminance_plane, map_luminance, LuminanceCurve, CHUNK};
-use super::simd::avx2;
 use super::{Context, OperatorInfo, Output, ParamSpec};
 use rayon::prelude::*;
 
@@ -86,11 +86,12 @@ pub(crate) fn apply(ctx: &Context) -> Output {
     let contrast = ctx.value("base_contrast");
     let sigma_space_px = (ctx.value("sigma_space") * w.max(h) as f64) as f32;
     let sigma_range = ctx.value("sigma_range") as f32;
-    let mut log_l = luminance_plane(ctx.image, ctx.exposure, ctx.weights);
+    let mut log_l = luminance_plane(ctx, ctx.exposure, ctx.weights);
     log_l
         .par_chunks_mut(CHUNK)
-        .for_each(|c| avx2!(log10_or_nan(c)));
-    let (base, [base_min, base_max]) = bilateral_grid(&log_l, w, h, sigma_space_px, sigma_range);
+        .for_each(|c| avx2!(ctx.simd, log10_or_nan(c)));
+    let (base, [base_min, base_max]) =
+        bilateral_grid(&log_l, w, h, sigma_space_px, sigma_range, ctx.simd);
     drop(log_l);
     let range = (base_max - base_min) as f64;
     let gamma = if range > 0.0 {

@@ -5,7 +5,7 @@
 //! 1 − e^(−q/k) (0.63 by default); compresses bright pixels more than a linear scale.
 
 use super::fast_math;
-use super::map512::{self, RegisterCurve};
+use super::kernels;
 use super::pixels::{luminance_stats, LuminanceCurve};
 use super::{Context, OperatorInfo, Output, ParamSpec};
 
@@ -33,8 +33,8 @@ pub(crate) static INFO: OperatorInfo = OperatorInfo {
 };
 
 /// 1 − e^{−rate · L}.
-struct Curve {
-    rate: f32,
+pub(super) struct Curve {
+    pub(super) rate: f32,
 }
 
 impl LuminanceCurve for Curve {
@@ -65,56 +65,14 @@ impl LuminanceCurve for Curve {
 }
 
 /// 1/3 rounded to f32.
-const THIRD: f32 = 1.0 / 3.0;
-
-impl RegisterCurve for Curve {
-    /// [`LuminanceCurve::ratio`] on 16 lanes (same operations, same order).
-    #[cfg(target_arch = "x86_64")]
-    #[inline(always)]
-    unsafe fn ratio16(&self, l: std::arch::x86_64::__m512) -> std::arch::x86_64::__m512 {
-        use std::arch::x86_64::*;
-        let (one, rate) = (_mm512_set1_ps(1.0), _mm512_set1_ps(self.rate));
-        let x = _mm512_mul_ps(rate, l);
-        let small = _mm512_cmp_ps_mask::<_CMP_LT_OQ>(x, _mm512_set1_ps(0.01));
-        // Each branch only where some lane selects it (dark and bright pixels come in
-        // runs, so the branches predict well); a lane's value is that of the scalar path
-        // either way, since the blend below only reads the selected side.
-        let series = if small != 0 {
-            let inner = _mm512_sub_ps(one, _mm512_mul_ps(_mm512_set1_ps(0.25), x));
-            let third = _mm512_mul_ps(_mm512_mul_ps(x, _mm512_set1_ps(THIRD)), inner);
-            let half = _mm512_mul_ps(
-                _mm512_mul_ps(_mm512_set1_ps(0.5), x),
-                _mm512_sub_ps(one, third),
-            );
-            _mm512_mul_ps(rate, _mm512_sub_ps(one, half))
-        } else {
-            one
-        };
-        let e = if small != 0xffff {
-            // exp(−x) = exp2((−x) · log2 e), −x by flipping the sign bit as `-x` does.
-            let minus_x = _mm512_castsi512_ps(_mm512_xor_si512(
-                _mm512_castps_si512(x),
-                _mm512_set1_epi32(i32::MIN),
-            ));
-            map512::exp2_16(_mm512_mul_ps(
-                minus_x,
-                _mm512_set1_ps(std::f32::consts::LOG2_E),
-            ))
-        } else {
-            one
-        };
-        let numerator = _mm512_mask_blend_ps(small, _mm512_sub_ps(one, e), series);
-        let denominator = _mm512_mask_blend_ps(small, l, one);
-        _mm512_div_ps(numerator, denominator)
-    }
-}
+pub(super) const THIRD: f32 = 1.0 / 3.0;
 
 pub(crate) fn apply(ctx: &Context) -> Output {
-    let stats = luminance_stats(ctx.image, ctx.exposure, ctx.weights);
+    let stats = luminance_stats(ctx, ctx.exposure, ctx.weights);
     let (q, k) = (ctx.value("q"), ctx.value("k"));
     let rate = (q / k / stats.log_average) as f32;
     Output {
-        mapped: map512::map_luminance_fast(ctx, ctx.exposure, ctx.weights, &Curve { rate }),
+        mapped: kernels::map_luminance_fast(ctx, ctx.exposure, ctx.weights, &Curve { rate }),
         values: vec![("log_average", stats.log_average), ("q", q), ("k", k)],
     }
 }
@@ -146,11 +104,9 @@ mod tests {
     fn vector_path_gives_the_scalar_bits() {
         // Rates on both sides of the series/direct switch at x = 0.01 and into exp2's clamp.
         for rate in [0.18f32, 1.0, 7.3, 1e4] {
-            super::super::map512::same_bits_as_scalar(
-                &bit_test_image(),
-                1.0,
-                &super::Curve { rate },
-            );
+            super::super::kernels::tests::same_bits_as_scalar(&bit_test_image(), 1.0, |_| {
+                super::Curve { rate }
+            });
         }
     }
 

@@ -95,7 +95,7 @@ impl PixelMap for Map {
 
 pub(crate) fn apply(ctx: &Context) -> Result<Output> {
     let absolute = ctx.exposure * ctx.absolute_scale()? as f32;
-    let stats = luminance_stats(ctx.image, absolute, ctx.weights);
+    let stats = luminance_stats(ctx, absolute, ctx.weights);
     let l_dmax = ctx.value("display_max");
     let l_wa = ctx
         .param("world_adaptation")

@@ -16,7 +16,9 @@
 
 use rayon::prelude::*;
 
-use super::simd::avx2;
+use prism_cpu::Simd;
+
+use super::kernels::avx2;
 
 /// Below this σ (pixels) the blur is a direct FIR (the recursive filter's q formula is
 /// only fitted for σ ≥ 0.5, and is less accurate than a short FIR below a few pixels).
@@ -30,7 +32,8 @@ const COLUMN_STRIP: usize = 64;
 
 /// Blurs `src` (row-major `width × height`) with a Gaussian of standard deviation
 /// `sigma_px` pixels into `dst`; `scratch` must have the same length (reused across
-/// calls to avoid allocation). σ ≤ 0 copies.
+/// calls to avoid allocation). σ ≤ 0 copies. `simd`: the widest kernels to run
+/// (`prism_cpu::active()` for the process's choice; every ISA gives the same bits).
 pub fn gaussian_blur(
     src: &[f32],
     dst: &mut [f32],
@@ -38,6 +41,7 @@ pub fn gaussian_blur(
     width: usize,
     height: usize,
     sigma_px: f32,
+    simd: Simd,
 ) {
     debug_assert!(src.len() == width * height && dst.len() == src.len());
     debug_assert!(scratch.len() == src.len());
@@ -47,8 +51,8 @@ pub fn gaussian_blur(
     }
     if sigma_px < RECURSIVE_MIN_SIGMA {
         let kernel = sampled_kernel(sigma_px);
-        fir_rows(src, scratch, width, &kernel);
-        fir_columns(scratch, dst, width, height, &kernel);
+        fir_rows(src, scratch, width, &kernel, simd);
+        fir_columns(scratch, dst, width, height, &kernel, simd);
     } else {
         let c = YoungVanVliet::new(sigma_px);
         // Rows in groups of ROW_GROUP, read from src and written to dst, the group's
@@ -56,9 +60,9 @@ pub fn gaussian_blur(
         dst.par_chunks_mut(width * ROW_GROUP)
             .zip(src.par_chunks(width * ROW_GROUP))
             .for_each_init(Vec::new, |lanes, (rows, from)| {
-                avx2!(filter_rows_kernel(&c, from, rows, width, lanes))
+                avx2!(simd, filter_rows_kernel(&c, from, rows, width, lanes))
             });
-        c.filter_columns(dst, width, height);
+        c.filter_columns(dst, width, height, simd);
     }
 }
 
@@ -145,13 +149,13 @@ fn fir_row(i: &[f32], o: &mut [f32], padded: &mut [f32], kernel: &[f32]) {
 }
 
 /// Horizontal FIR, rows in parallel (edge pixels replicated).
-fn fir_rows(src: &[f32], dst: &mut [f32], width: usize, kernel: &[f32]) {
+fn fir_rows(src: &[f32], dst: &mut [f32], width: usize, kernel: &[f32], simd: Simd) {
     let r = kernel.len() / 2;
     dst.par_chunks_mut(width)
         .zip(src.par_chunks(width))
         .for_each_init(
             || vec![0.0f32; width + 2 * r],
-            |padded, (o, i)| avx2!(fir_row(i, o, padded, kernel)),
+            |padded, (o, i)| avx2!(simd, fir_row(i, o, padded, kernel)),
         );
 }
 
@@ -169,10 +173,17 @@ fn fir_column_row(src: &[f32], o: &mut [f32], y: usize, height: usize, kernel: &
     fir_any(&taps[..kernel.len()], kernel, o);
 }
 
-fn fir_columns(src: &[f32], dst: &mut [f32], width: usize, height: usize, kernel: &[f32]) {
+fn fir_columns(
+    src: &[f32],
+    dst: &mut [f32],
+    width: usize,
+    height: usize,
+    kernel: &[f32],
+    simd: Simd,
+) {
     dst.par_chunks_mut(width)
         .enumerate()
-        .for_each(|(y, o)| avx2!(fir_column_row(src, o, y, height, kernel)));
+        .for_each(|(y, o)| avx2!(simd, fir_column_row(src, o, y, height, kernel)));
 }
 
 /// Coefficients of the Young–van Vliet recursive Gaussian, normalised by b0.
@@ -277,8 +288,9 @@ impl YoungVanVliet {
         }
     }
 
-    /// The same recursion down every column, strips of columns in parallel.
-    pub fn filter_columns(&self, plane: &mut [f32], width: usize, height: usize) {
+    /// The same recursion down every column, strips of columns in parallel, with the
+    /// kernels of `simd`.
+    pub fn filter_columns(&self, plane: &mut [f32], width: usize, height: usize, simd: Simd) {
         let strips = width.div_ceil(COLUMN_STRIP);
         let ptr = SharedPlane(plane.as_mut_ptr());
         (0..strips).into_par_iter().for_each(|s| {
@@ -289,7 +301,7 @@ impl YoungVanVliet {
             let row = |y: usize| unsafe {
                 std::slice::from_raw_parts_mut(ptr.get().add(y * width + x0), n)
             };
-            avx2!(columns_strip_kernel(self, row, n, height));
+            avx2!(simd, columns_strip_kernel(self, row, n, height));
         });
     }
 
@@ -366,13 +378,28 @@ impl SharedPlane {
 mod tests {
     use super::*;
 
+    /// The blur of an impulse, the same bits at every ISA the machine runs.
     fn impulse_response(sigma: f32, size: usize) -> Vec<f32> {
         let mut src = vec![0.0; size * size];
         src[(size / 2) * size + size / 2] = 1.0;
-        let mut dst = vec![0.0; src.len()];
         let mut scratch = vec![0.0; src.len()];
-        gaussian_blur(&src, &mut dst, &mut scratch, size, size, sigma);
-        dst
+        let mut want = vec![0.0; src.len()];
+        gaussian_blur(
+            &src,
+            &mut want,
+            &mut scratch,
+            size,
+            size,
+            sigma,
+            Simd::SCALAR,
+        );
+        for simd in prism_cpu::each_isa() {
+            let mut dst = vec![0.0; src.len()];
+            gaussian_blur(&src, &mut dst, &mut scratch, size, size, sigma, simd);
+            let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert!(bits(&dst) == bits(&want), "σ = {sigma}, {simd}");
+        }
+        want
     }
 
     #[test]
@@ -414,7 +441,15 @@ mod tests {
         let src = vec![3.5f32; w * h];
         let (mut dst, mut scratch) = (vec![0.0; w * h], vec![0.0; w * h]);
         for sigma in [0.5f32, 8.0] {
-            gaussian_blur(&src, &mut dst, &mut scratch, w, h, sigma);
+            gaussian_blur(
+                &src,
+                &mut dst,
+                &mut scratch,
+                w,
+                h,
+                sigma,
+                prism_cpu::active(),
+            );
             assert!(dst.iter().all(|v| (v - 3.5).abs() < 1e-4), "σ = {sigma}");
         }
     }

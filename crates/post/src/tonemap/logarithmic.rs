@@ -4,7 +4,7 @@
 //! to 1 when q = k.
 
 use super::fast_math;
-use super::map512::{self, RegisterCurve};
+use super::kernels;
 use super::pixels::{luminance_stats, LuminanceCurve};
 use super::{Context, OperatorInfo, Output, ParamSpec};
 
@@ -32,9 +32,9 @@ pub(crate) static INFO: OperatorInfo = OperatorInfo {
 };
 
 /// ln(1 + q L) / ln(1 + k L_max) (log10 a / log10 b = ln a / ln b).
-struct Curve {
-    q: f32,
-    inv: f32,
+pub(super) struct Curve {
+    pub(super) q: f32,
+    pub(super) inv: f32,
 }
 
 impl LuminanceCurve for Curve {
@@ -50,22 +50,8 @@ impl LuminanceCurve for Curve {
     }
 }
 
-impl RegisterCurve for Curve {
-    /// [`LuminanceCurve::ratio`] on 16 lanes (same operations, same order).
-    #[cfg(target_arch = "x86_64")]
-    #[inline(always)]
-    unsafe fn ratio16(&self, l: std::arch::x86_64::__m512) -> std::arch::x86_64::__m512 {
-        use std::arch::x86_64::*;
-        let one = _mm512_set1_ps(1.0);
-        let inv = _mm512_set1_ps(self.inv * std::f32::consts::LN_2);
-        let log = map512::log2_16(_mm512_add_ps(one, _mm512_mul_ps(_mm512_set1_ps(self.q), l)));
-        let recip = _mm512_div_ps(one, l);
-        _mm512_mul_ps(_mm512_mul_ps(log, inv), recip)
-    }
-}
-
 pub(crate) fn apply(ctx: &Context) -> Output {
-    let stats = luminance_stats(ctx.image, ctx.exposure, ctx.weights);
+    let stats = luminance_stats(ctx, ctx.exposure, ctx.weights);
     let (q, k) = (ctx.value("q"), ctx.value("k"));
     let denominator = (k * stats.max).ln_1p();
     let inv = if denominator > 0.0 {
@@ -75,7 +61,7 @@ pub(crate) fn apply(ctx: &Context) -> Output {
     };
     let q32 = q as f32;
     Output {
-        mapped: map512::map_luminance_fast(ctx, ctx.exposure, ctx.weights, &Curve { q: q32, inv }),
+        mapped: kernels::map_luminance_fast(ctx, ctx.exposure, ctx.weights, &Curve { q: q32, inv }),
         values: vec![("max_luminance", stats.max), ("q", q), ("k", k)],
     }
 }
@@ -104,11 +90,9 @@ mod tests {
     #[test]
     fn vector_path_gives_the_scalar_bits() {
         for (q, inv) in [(1.0f32, 0.2f32), (37.0, 0.05), (1e6, 0.0)] {
-            super::super::map512::same_bits_as_scalar(
-                &bit_test_image(),
-                1.0,
-                &super::Curve { q, inv },
-            );
+            super::super::kernels::tests::same_bits_as_scalar(&bit_test_image(), 1.0, |_| {
+                super::Curve { q, inv }
+            });
         }
     }
 

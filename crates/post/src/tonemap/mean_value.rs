@@ -20,7 +20,7 @@ pub(crate) static INFO: OperatorInfo = OperatorInfo {
 };
 
 pub(crate) fn apply(ctx: &Context) -> Output {
-    let stats = luminance_stats(ctx.image, ctx.exposure, ctx.weights);
+    let stats = luminance_stats(ctx, ctx.exposure, ctx.weights);
     let target = ctx.value("target");
     let factor = if stats.mean > 0.0 {
         (target / stats.mean) as f32
@@ -28,7 +28,7 @@ pub(crate) fn apply(ctx: &Context) -> Output {
         0.0
     };
     Output {
-        mapped: super::map512::map_luminance_fast(ctx, ctx.exposure, ctx.weights, &Scale(factor)),
+        mapped: super::kernels::map_luminance_fast(ctx, ctx.exposure, ctx.weights, &Scale(factor)),
         values: vec![("mean_luminance", stats.mean), ("scale", factor as f64)],
     }
 }

@@ -2,7 +2,9 @@
 //! file with its reference and equations. [`ToneOperator::apply`] maps a linear HDR image to
 //! linear display values (nominally [0, 1]; clipping and gamut mapping come after), never
 //! outputs NaN, ±∞ or negative values, and reports how many input pixels were non-finite or
-//! negative ([`ToneReport`]).
+//! negative ([`ToneReport`]). An operator's file keeps the operator (formula, parameters,
+//! reference, scalar curve); its vector and register forms are in `kernels/`, one file per
+//! ISA family, run at the ISA of `prism_cpu::active()` (`PRISM_SIMD`, `--simd`).
 
 mod aces;
 mod agx;
@@ -14,9 +16,9 @@ mod exponential;
 pub mod fast_math;
 mod ferwerda96;
 pub mod gaussian;
+pub(crate) mod kernels;
 mod linear;
 mod logarithmic;
-mod map512;
 mod mean_value;
 mod octave_curve;
 pub mod pixels;
@@ -24,7 +26,6 @@ mod power_curve;
 mod reinhard02;
 mod reinhard02_local;
 mod schlick94;
-pub(crate) mod simd;
 mod tumblin_rushmeier;
 mod ward94;
 mod ward97_histogram;
@@ -130,6 +131,9 @@ pub(crate) struct Context<'a> {
     pub weights: [f32; 3],
     /// An output buffer to reuse (from [`ToneOperator::apply_into`]).
     pub buffer: std::sync::Mutex<Option<Vec<[f32; 3]>>>,
+    /// The widest kernels to run (module `kernels`): `prism_cpu::active()` when the call
+    /// began, carried to every task.
+    pub simd: prism_cpu::Simd,
 }
 
 impl Context<'_> {
@@ -303,6 +307,17 @@ impl ToneOperator {
         params: &ToneParams,
         buffer: Vec<[f32; 3]>,
     ) -> Result<ToneResult> {
+        self.apply_with(image, params, buffer, prism_cpu::active())
+    }
+
+    /// As [`ToneOperator::apply_into`], with the kernels of `simd` (tests compare ISAs).
+    pub(crate) fn apply_with(
+        self,
+        image: &Image,
+        params: &ToneParams,
+        buffer: Vec<[f32; 3]>,
+        simd: prism_cpu::Simd,
+    ) -> Result<ToneResult> {
         self.validate(params)?;
         let ctx = Context {
             image,
@@ -311,6 +326,7 @@ impl ToneOperator {
             exposure: 2f64.powf(params.exposure_ev) as f32,
             weights: image.luminance_weights(),
             buffer: std::sync::Mutex::new((buffer.capacity() > 0).then_some(buffer)),
+            simd,
         };
         let output = match self {
             ToneOperator::Linear => linear::apply(&ctx),

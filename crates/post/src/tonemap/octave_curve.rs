@@ -7,8 +7,8 @@
 //! - the coefficients c_j(e) of each octave come from a 32-entry table indexed by the
 //!   biased exponent modulo 32 (one two-register `vpermt2ps` per coefficient, no memory
 //!   load per pixel), so the curve's domain [lo, hi] may span at most 32 binary exponents
-//!   ([`OctaveCurve::new`] returns `None` otherwise, and on CPUs without AVX-512, where
-//!   the caller keeps its memory table);
+//!   ([`OctaveCurve::new`] returns `None` otherwise, and where the ISA is not AVX-512,
+//!   where the caller keeps its memory table);
 //! - the polynomial has degree [`TERMS`] − 1 = 9, interpolating f at the Chebyshev nodes
 //!   of the octave in f64. A whole octave is a wide segment (relative width 1, against
 //!   1/64 for [`super::curve_table`]), so the degree is high; centring s on the octave's
@@ -19,33 +19,39 @@
 //!   [`MAX_FIT_ERROR`].
 //!
 //! The scalar [`OctaveCurve::eval`] performs the same operations in the same order
-//! (`f32::mul_add` for each fused multiply-add), so both paths give the same bits.
+//! (`f32::mul_add` for each fused multiply-add) as the 16-lane `eval16` (in
+//! `kernels/avx512.rs`), so both paths give the same bits.
 
 use super::curve_table::{chebyshev_nodes, poly_through, register_exponent_range};
 
 /// Coefficients per octave (degree 9).
 pub const TERMS: usize = 10;
-const MANTISSA_MASK: u32 = 0x7f_ffff;
+pub(super) const MANTISSA_MASK: u32 = 0x7f_ffff;
 /// The bits of 1.0: the mantissa under them is m ∈ [1, 2), and s = m − 1.5 is exact
 /// (both are multiples of 2^−23 and |s| ≤ ½).
-const ONE_BITS: u32 = 0x3f80_0000;
+pub(super) const ONE_BITS: u32 = 0x3f80_0000;
 /// Largest relative error of the fitted polynomials (in f64, before rounding to f32)
 /// accepted.
 pub const MAX_FIT_ERROR: f64 = 1e-7;
 
 pub(crate) struct OctaveCurve {
     /// `coeffs[j][b % 32]`: coefficient of s^j on the octave of biased exponent b.
-    coeffs: [[f32; 32]; TERMS],
-    lo: f32,
-    hi: f32,
+    pub(super) coeffs: [[f32; 32]; TERMS],
+    pub(super) lo: f32,
+    pub(super) hi: f32,
 }
 
 impl OctaveCurve {
     /// f(x) for x ∈ [lo, hi] (0 < lo ≤ hi, both normal), arguments clamped to that
     /// range; `None` where the range spans more than 32 binary exponents, a fit misses
-    /// [`MAX_FIT_ERROR`] or is not finite, or the CPU lacks AVX-512 F.
-    pub fn new(lo: f32, hi: f32, f: impl Fn(f64) -> f64) -> Option<OctaveCurve> {
-        let (b_lo, b_hi) = register_exponent_range(lo, hi)?;
+    /// [`MAX_FIT_ERROR`] or is not finite, or `simd` does not allow AVX-512.
+    pub fn new(
+        simd: prism_cpu::Simd,
+        lo: f32,
+        hi: f32,
+        f: impl Fn(f64) -> f64,
+    ) -> Option<OctaveCurve> {
+        let (b_lo, b_hi) = register_exponent_range(simd, lo, hi)?;
         let nodes: [f64; TERMS] = chebyshev_nodes::<TERMS>().map(|t| t - 0.5);
         let mut coeffs = [[0.0f32; 32]; TERMS];
         for b in b_lo..=b_hi {
@@ -96,88 +102,56 @@ impl OctaveCurve {
             *x = self.eval(*x);
         }
     }
-
-    /// [`Self::eval`] on 16 lanes: the same bits.
-    ///
-    /// # Safety
-    /// The CPU must have AVX-512F (which `new` checked).
-    #[cfg(target_arch = "x86_64")]
-    #[inline(always)]
-    pub unsafe fn eval16(&self, x: std::arch::x86_64::__m512) -> std::arch::x86_64::__m512 {
-        use std::arch::x86_64::*;
-        // maxps returns its second operand when the first is NaN (as f32::max).
-        let x = _mm512_min_ps(
-            _mm512_max_ps(x, _mm512_set1_ps(self.lo)),
-            _mm512_set1_ps(self.hi),
-        );
-        let bits = _mm512_castps_si512(x);
-        // vpermt2ps reads the low 5 bits of the index: the biased exponent modulo 32
-        // (x > 0 after the clamp, so the sign bit is clear).
-        let b = _mm512_srli_epi32::<23>(bits);
-        // (bits & MANTISSA_MASK) | ONE_BITS in one vpternlogd (truth table 0xEA: a & b | c).
-        let m = _mm512_ternarylogic_epi32::<0xEA>(
-            bits,
-            _mm512_set1_epi32(MANTISSA_MASK as i32),
-            _mm512_set1_epi32(ONE_BITS as i32),
-        );
-        let s = _mm512_sub_ps(_mm512_castsi512_ps(m), _mm512_set1_ps(1.5));
-        // SAFETY: each row holds 32 f32s (two 16-lane loads).
-        let coeff = |j: usize| {
-            let row = self.coeffs[j].as_ptr();
-            _mm512_permutex2var_ps(_mm512_loadu_ps(row), b, _mm512_loadu_ps(row.add(16)))
-        };
-        let mut p = coeff(TERMS - 1);
-        for j in (0..TERMS - 1).rev() {
-            p = _mm512_fmadd_ps(p, s, coeff(j));
-        }
-        p
-    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
+    /// The 16-lane `eval16` against the scalar `eval`, bit for bit, and the fit against
+    /// the curve; at the ISAs without AVX-512 the curve is refused (drago03 then keeps its
+    /// memory table).
     #[test]
     fn matches_the_curve_and_the_scalar_bits() {
         let f = |l: f64| (1.0 + l).ln() / (l * (2.0 + 8.0 * (l / 2e5).powf(0.234)).ln());
         let (lo, hi) = (1.3e-4f32, 2.1e5f32); // 31 binary exponents
-        let Some(curve) = OctaveCurve::new(lo, hi, f) else {
-            assert!(
-                !crate::tonemap::simd::has_avx512(),
-                "eq. 4-like curve should fit"
-            );
-            return;
-        };
-        let mut xs = vec![0.0f32, -1.0, f32::NAN, f32::INFINITY, 1e-30, 1e30, lo, hi];
-        let mut x = lo;
-        while x <= hi {
-            xs.push(x);
-            x *= 1.000_71;
-        }
-        let mut worst = 0.0f64;
-        #[cfg(target_arch = "x86_64")]
-        for chunk in xs.chunks_exact(16) {
-            // SAFETY: `new` returned a curve, so the CPU has AVX-512F.
-            let got: [f32; 16] = unsafe {
-                use std::arch::x86_64::*;
-                let v = curve.eval16(_mm512_loadu_ps(chunk.as_ptr()));
-                std::mem::transmute(v)
-            };
-            for (x, g) in chunk.iter().zip(got) {
-                assert_eq!(g.to_bits(), curve.eval(*x).to_bits(), "x = {x:e}");
+        for simd in prism_cpu::each_isa() {
+            let curve = OctaveCurve::new(simd, lo, hi, f);
+            if !simd.avx512() {
+                assert!(curve.is_none(), "{simd}");
+                continue;
             }
+            let curve = curve.expect("eq. 4-like curve should fit");
+            let mut xs = vec![0.0f32, -1.0, f32::NAN, f32::INFINITY, 1e-30, 1e30, lo, hi];
+            let mut x = lo;
+            while x <= hi {
+                xs.push(x);
+                x *= 1.000_71;
+            }
+            #[cfg(target_arch = "x86_64")]
+            for chunk in xs.chunks_exact(16) {
+                // SAFETY: `simd` allows AVX-512, so the CPU has AVX-512F.
+                let got: [f32; 16] = unsafe {
+                    use std::arch::x86_64::*;
+                    let v = curve.eval16(_mm512_loadu_ps(chunk.as_ptr()));
+                    std::mem::transmute(v)
+                };
+                for (x, g) in chunk.iter().zip(got) {
+                    assert_eq!(g.to_bits(), curve.eval(*x).to_bits(), "x = {x:e}");
+                }
+            }
+            let mut worst = 0.0f64;
+            for x in &xs {
+                let got = curve.eval(*x);
+                let xc = if x.is_nan() { lo } else { x.clamp(lo, hi) };
+                worst = worst.max((got as f64 / f(xc as f64) - 1.0).abs());
+            }
+            eprintln!("octave curve: worst relative error {worst:e}");
+            // Fit ≤ 1e-7 plus the f32 roundings of the coefficients and Horner steps.
+            assert!(worst < 5e-7, "{worst:e}");
+            // Refused: more than 32 binary exponents, or a curve no polynomial fits.
+            assert!(OctaveCurve::new(simd, 1e-6, 1e6, f).is_none());
+            assert!(OctaveCurve::new(simd, 1.0, 2.0, |x| (x - 1.3).abs()).is_none());
         }
-        for x in &xs {
-            let got = curve.eval(*x);
-            let xc = if x.is_nan() { lo } else { x.clamp(lo, hi) };
-            worst = worst.max((got as f64 / f(xc as f64) - 1.0).abs());
-        }
-        eprintln!("octave curve: worst relative error {worst:e}");
-        // Fit ≤ 1e-7 plus the f32 roundings of the coefficients and Horner steps.
-        assert!(worst < 5e-7, "{worst:e}");
-        // Refused: more than 32 binary exponents, or a curve no polynomial fits.
-        assert!(OctaveCurve::new(1e-6, 1e6, f).is_none());
-        assert!(OctaveCurve::new(1.0, 2.0, |x| (x - 1.3).abs()).is_none());
     }
 }

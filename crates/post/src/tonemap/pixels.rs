@@ -8,16 +8,18 @@
 //! [`BLOCK`] pixels are de-interleaved into stack planes (R, G, B, L: a few KiB, in L1),
 //! the operator's curve runs over a plane, and the result is interleaved back. Every loop
 //! over a plane is branch-free, so it vectorises, and each task's kernel is compiled twice
-//! (baseline SSE2 and AVX2, chosen at run time: module [`super::simd`]). Operators hand
+//! (baseline SSE2 and AVX2, chosen by the call's ISA, `Context::simd`: module
+//! [`super::kernels`], which also holds the AVX-512 forms of these passes). Operators hand
 //! their curve over as a [`LuminanceCurve`] or [`PixelMap`] whose method is
 //! `#[inline(always)]`, so it is compiled into the vector loop rather than called per pixel.
 
 use rayon::prelude::*;
 
+use prism_cpu::Simd;
+
 use super::fast_math;
-use super::simd::avx2;
+use super::kernels::{self, avx2};
 use super::Context;
-use crate::image::Image;
 
 /// Pixels per rayon task (≈ 48 KiB of RGB f32: big enough to amortise scheduling, small
 /// enough to balance 2–16 threads on a 4K image).
@@ -50,7 +52,7 @@ pub(crate) const BLOCK: usize = 256;
 /// the pixel's colour is scaled: an operator folds the division by L into its own
 /// formula (often removing a division or a power: a division costs as much as a fast
 /// log here). Implementations mark [`Self::ratio`] `#[inline(always)]`, keep its loop
-/// branch-free (module [`super::simd`]) and copy their fields into locals before the loop
+/// branch-free (module [`super::kernels::avx2`]) and copy their fields into locals before the loop
 /// (the compiler cannot tell that `l` does not alias `self`, and would reload the fields
 /// per pixel and keep the loop scalar).
 pub(crate) trait LuminanceCurve: Sync {
@@ -296,17 +298,12 @@ pub(crate) fn stats_chunk(chunk: &[[f32; 3]], scale: f32, w: [f32; 3]) -> Acc {
 ///
 /// Every operator takes this one pass, log-average or not: a variant without the log sum
 /// measured slower (its loop vectorised worse), and the identity makes the log nearly free.
-pub(crate) fn luminance_stats(image: &Image, scale: f32, w: [f32; 3]) -> LuminanceStats {
+pub(crate) fn luminance_stats(ctx: &Context, scale: f32, w: [f32; 3]) -> LuminanceStats {
+    let (image, simd) = (ctx.image, ctx.simd);
     let partial: Vec<Acc> = image
         .pixels()
         .par_chunks(CHUNK)
-        .map(|chunk| {
-            if super::map512::available() {
-                super::map512::stats_chunk_fast(chunk, scale, w)
-            } else {
-                avx2!(stats_chunk(chunk, scale, w))
-            }
-        })
+        .map(|chunk| kernels::stats_task(simd, chunk, scale, w))
         .collect();
     let acc = partial.into_iter().fold(Acc::EMPTY, Acc::merge);
     let n = image.pixels().len() as f64;
@@ -402,12 +399,13 @@ pub(crate) fn map_luminance<C: LuminanceCurve>(
     w: [f32; 3],
     curve: &C,
 ) -> Mapped {
+    let simd = ctx.simd;
     map_chunks(ctx, |start, i, o| {
-        avx2!(map_luminance_chunk(i, o, start, scale, w, curve))
+        avx2!(simd, map_luminance_chunk(i, o, start, scale, w, curve))
     })
 }
 
-/// One task of [`map_pixels`].
+/// One task of [`map_pixels`] (`simd`: for the streaming stores of [`store_block`]).
 #[inline(always)]
 pub(crate) fn map_pixels_chunk<M: PixelMap>(
     input: &[[f32; 3]],
@@ -415,6 +413,7 @@ pub(crate) fn map_pixels_chunk<M: PixelMap>(
     start: usize,
     scale: f32,
     f: &M,
+    simd: Simd,
 ) -> (u64, u64) {
     let mut r = [0.0f32; BLOCK];
     let mut g = [0.0f32; BLOCK];
@@ -432,22 +431,22 @@ pub(crate) fn map_pixels_chunk<M: PixelMap>(
         for (j, s) in staged[..n].iter_mut().enumerate() {
             *s = [clean(r[j]), clean(g[j]), clean(b[j])];
         }
-        store_block(o, &staged[..n]);
+        store_block(o, &staged[..n], simd);
     }
     store_fence();
     (non_finite, negative)
 }
 
-/// Copies a finished block to the output with non-temporal stores where the CPU has AVX:
+/// Copies a finished block to the output with non-temporal stores where `simd` allows AVX:
 /// the output (100 MB at 4K) is written once and not read again in the pass, so ordinary
 /// stores would first read every cache line of it from memory (read for ownership) and
 /// evict the input from the caches.
 #[inline(always)]
-pub(crate) fn store_block(dst: &mut [[f32; 3]], src: &[[f32; 3]]) {
+pub(crate) fn store_block(dst: &mut [[f32; 3]], src: &[[f32; 3]], simd: Simd) {
     #[cfg(target_arch = "x86_64")]
-    if super::simd::has_avx2() {
-        // SAFETY: the CPU has AVX (implied by AVX2, checked above).
-        unsafe { store_streaming(dst, src) };
+    if simd.avx2() {
+        // SAFETY: a `Simd` allows AVX2 (and so AVX) only on a CPU that has it.
+        unsafe { kernels::avx2::store_streaming(dst, src) };
         return;
     }
     dst.copy_from_slice(src);
@@ -464,40 +463,12 @@ pub(crate) fn store_fence() {
     };
 }
 
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx")]
-unsafe fn store_streaming(dst: &mut [[f32; 3]], src: &[[f32; 3]]) {
-    use std::arch::x86_64::*;
-    let n = 3 * dst.len().min(src.len());
-    let (d, s) = (dst.as_mut_ptr() as *mut f32, src.as_ptr() as *const f32);
-    // Plain stores up to the first 32-byte boundary (f32s are 4-byte aligned), streaming
-    // 32-byte stores after it, plain stores for the tail.
-    let head = (((32 - (d as usize & 31)) & 31) / 4).min(n);
-    for i in 0..head {
-        // SAFETY: i < n, inside both slices.
-        *d.add(i) = *s.add(i);
-    }
-    let mut i = head;
-    while i + 8 <= n {
-        // SAFETY: i + 8 ≤ n, inside both slices; d + i is 32-byte aligned.
-        _mm256_stream_ps(d.add(i), _mm256_loadu_ps(s.add(i)));
-        i += 8;
-    }
-    for i in i..n {
-        // SAFETY: i < n.
-        *d.add(i) = *s.add(i);
-    }
-}
-
 /// Maps every sanitised pixel through `f` (on de-interleaved planes); non-finite results
 /// become 0.
 pub(crate) fn map_pixels<M: PixelMap>(ctx: &Context, scale: f32, f: &M) -> Mapped {
+    let simd = ctx.simd;
     map_chunks(ctx, |start, i, o| {
-        if super::map512::available() {
-            super::map512::map_pixels_chunk_fast(i, o, start, scale, f)
-        } else {
-            avx2!(map_pixels_chunk(i, o, start, scale, f))
-        }
+        kernels::pixels_task(simd, i, o, start, scale, f)
     })
 }
 
@@ -509,11 +480,12 @@ fn luminance_chunk(input: &[[f32; 3]], out: &mut [f32], scale: f32, w: [f32; 3])
 }
 
 /// The sanitised luminance plane `w · sanitise(p, scale)` (row-major), for local operators.
-pub(crate) fn luminance_plane(image: &Image, scale: f32, w: [f32; 3]) -> Vec<f32> {
+pub(crate) fn luminance_plane(ctx: &Context, scale: f32, w: [f32; 3]) -> Vec<f32> {
+    let (image, simd) = (ctx.image, ctx.simd);
     let mut plane = vec![0.0f32; image.pixels().len()];
     plane
         .par_chunks_mut(CHUNK)
         .zip(image.pixels().par_chunks(CHUNK))
-        .for_each(|(o, i)| avx2!(luminance_chunk(i, o, scale, w)));
+        .for_each(|(o, i)| avx2!(simd, luminance_chunk(i, o, scale, w)));
     plane
 }

@@ -4,8 +4,8 @@
 //!
 //! - c · 2^(a e) comes from a 32-entry table indexed by the biased exponent modulo 32
 //!   (one two-register `vpermt2ps`), so the curve's domain [lo, hi] may span at most 32
-//!   binary exponents ([`PowerCurve::new`] returns `None` otherwise, and on CPUs without
-//!   AVX-512, where the caller keeps its memory table);
+//!   binary exponents ([`PowerCurve::new`] returns `None` otherwise, and where the ISA is
+//!   not AVX-512, where the caller keeps its memory table);
 //! - m^a is a cubic in t per mantissa segment (the top 4 mantissa bits: 16 segments, one
 //!   16-entry `vpermps` per coefficient; m = 1 + (k + t)/16, t ∈ [0, 1) the low 19 bits),
 //!   interpolating at Chebyshev nodes in f64. Interpolation error ≈ |a(a−1)(a−2)(a−3)|
@@ -13,34 +13,37 @@
 //!   time against the formula and refused (`None`) above [`MAX_FIT_ERROR`].
 //!
 //! The scalar [`PowerCurve::eval`] performs the same operations in the same order
-//! (`f32::mul_add` for each fused multiply-add), so both paths give the same bits.
+//! (`f32::mul_add` for each fused multiply-add) as the 16-lane slice evaluation (in
+//! `kernels/avx512.rs`), so both paths give the same bits.
 
 use super::curve_table::{chebyshev_nodes, poly_through, register_exponent_range};
 
 /// Mantissa bits that select a segment (16 per octave: one AVX-512 register).
 const SEGMENT_BITS: u32 = 4;
-const T_BITS: u32 = 23 - SEGMENT_BITS;
-const T_MASK: u32 = (1 << T_BITS) - 1;
+pub(super) const T_BITS: u32 = 23 - SEGMENT_BITS;
+pub(super) const T_MASK: u32 = (1 << T_BITS) - 1;
 /// 2^−T_BITS, exact in f32.
-const T_SCALE: f32 = 1.0 / (1u32 << T_BITS) as f32;
+pub(super) const T_SCALE: f32 = 1.0 / (1u32 << T_BITS) as f32;
 /// Largest relative error of the fitted cubics (in f64, before rounding to f32) accepted.
 pub const MAX_FIT_ERROR: f64 = 1e-7;
 
 pub(crate) struct PowerCurve {
     /// `coeffs[j][k]`: coefficient of t^j on segment k of m^a.
-    coeffs: [[f32; 16]; 4],
+    pub(super) coeffs: [[f32; 16]; 4],
     /// c · 2^(a (b − 127)) at index b mod 32 for the biased exponents b of [lo, hi].
-    scales: [f32; 32],
-    lo: f32,
-    hi: f32,
+    pub(super) scales: [f32; 32],
+    pub(super) lo: f32,
+    pub(super) hi: f32,
+    /// The ISA it was made for (one that allows AVX-512: `new` refuses the others).
+    simd: prism_cpu::Simd,
 }
 
 impl PowerCurve {
     /// c · x^a for x ∈ [lo, hi] (0 < lo ≤ hi, both normal), arguments clamped to that
     /// range; `None` where the range spans more than 32 binary exponents, the fit misses
-    /// [`MAX_FIT_ERROR`], a scale is not a normal f32, or the CPU lacks AVX-512 F.
-    pub fn new(c: f64, a: f64, lo: f32, hi: f32) -> Option<PowerCurve> {
-        let (b_lo, b_hi) = register_exponent_range(lo, hi)?;
+    /// [`MAX_FIT_ERROR`], a scale is not a normal f32, or `simd` does not allow AVX-512.
+    pub fn new(simd: prism_cpu::Simd, c: f64, a: f64, lo: f32, hi: f32) -> Option<PowerCurve> {
+        let (b_lo, b_hi) = register_exponent_range(simd, lo, hi)?;
         let mut scales = [0.0f32; 32];
         for b in b_lo..=b_hi {
             let s = c * (a * (b - 127) as f64).exp2();
@@ -78,6 +81,7 @@ impl PowerCurve {
             scales,
             lo,
             hi,
+            simd,
         })
     }
 
@@ -95,51 +99,17 @@ impl PowerCurve {
         p * self.scales[((bits >> 23) & 31) as usize]
     }
 
-    /// Replaces every `v[j]` by [`Self::eval`]`(v[j])`.
+    /// Replaces every `v[j]` by [`Self::eval`]`(v[j])`, 16 lanes at a time.
     #[inline]
     pub fn eval_slice(&self, v: &mut [f32]) {
         #[cfg(target_arch = "x86_64")]
-        {
-            // SAFETY: `new` returns a curve only where the CPU has AVX-512 F.
+        if self.simd.avx512() {
+            // SAFETY: a `Simd` allows AVX-512 only on a CPU that has it (and `new` made
+            // this curve only for one that does).
             unsafe { self.eval_slice_avx512(v) };
+            return;
         }
-        #[cfg(not(target_arch = "x86_64"))]
         for x in v {
-            *x = self.eval(*x);
-        }
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx512f")]
-    unsafe fn eval_slice_avx512(&self, v: &mut [f32]) {
-        use std::arch::x86_64::*;
-        // SAFETY (loads): each row holds 16 f32s, `scales` 32.
-        let c: [__m512; 4] = std::array::from_fn(|j| _mm512_loadu_ps(self.coeffs[j].as_ptr()));
-        let s_lo = _mm512_loadu_ps(self.scales.as_ptr());
-        let s_hi = _mm512_loadu_ps(self.scales.as_ptr().add(16));
-        let (lo, hi) = (_mm512_set1_ps(self.lo), _mm512_set1_ps(self.hi));
-        let t_mask = _mm512_set1_epi32(T_MASK as i32);
-        let t_scale = _mm512_set1_ps(T_SCALE);
-        let mut chunks = v.chunks_exact_mut(16);
-        for chunk in &mut chunks {
-            // maxps returns its second operand when the first is NaN (as f32::max).
-            let x = _mm512_min_ps(_mm512_max_ps(_mm512_loadu_ps(chunk.as_ptr()), lo), hi);
-            let bits = _mm512_castps_si512(x);
-            // vpermps reads the low 4 bits of the index (the segment), vpermt2ps the low
-            // 5 (the biased exponent modulo 32).
-            let k = _mm512_srli_epi32::<{ T_BITS }>(bits);
-            let t = _mm512_mul_ps(_mm512_cvtepi32_ps(_mm512_and_si512(bits, t_mask)), t_scale);
-            let p = _mm512_fmadd_ps(
-                _mm512_permutexvar_ps(k, c[3]),
-                t,
-                _mm512_permutexvar_ps(k, c[2]),
-            );
-            let p = _mm512_fmadd_ps(p, t, _mm512_permutexvar_ps(k, c[1]));
-            let p = _mm512_fmadd_ps(p, t, _mm512_permutexvar_ps(k, c[0]));
-            let s = _mm512_permutex2var_ps(s_lo, _mm512_srli_epi32::<23>(bits), s_hi);
-            _mm512_storeu_ps(chunk.as_mut_ptr(), _mm512_mul_ps(p, s));
-        }
-        for x in chunks.into_remainder() {
             *x = self.eval(*x);
         }
     }
@@ -149,12 +119,24 @@ impl PowerCurve {
 mod tests {
     use super::*;
 
+    /// The 16-lane slice evaluation against the scalar `eval`, bit for bit, and the fit
+    /// against the power; at the ISAs without AVX-512 the curve is refused
+    /// (tumblin-rushmeier then keeps its memory table).
     #[test]
     fn matches_the_power_and_the_scalar_bits() {
-        if !crate::tonemap::simd::has_avx512() {
-            assert!(PowerCurve::new(1.0, 0.5, 1.0, 2.0).is_none());
-            return;
+        for simd in prism_cpu::each_isa() {
+            if simd.avx512() {
+                matches_at(simd);
+            } else {
+                assert!(
+                    PowerCurve::new(simd, 1.0, 0.5, 1.0, 2.0).is_none(),
+                    "{simd}"
+                );
+            }
         }
+    }
+
+    fn matches_at(simd: prism_cpu::Simd) {
         for (c, a) in [
             (0.37, -0.72),
             (2.0, 0.45),
@@ -163,7 +145,7 @@ mod tests {
             (1.0, 0.9),
         ] {
             let (lo, hi) = (1.3e-4f32, 2.1e5f32); // 31 binary exponents
-            let curve = PowerCurve::new(c, a, lo, hi).expect("fits");
+            let curve = PowerCurve::new(simd, c, a, lo, hi).expect("fits");
             let mut xs = vec![0.0f32, -1.0, f32::NAN, f32::INFINITY, 1e-30, 1e30, lo, hi];
             let mut x = lo;
             while x <= hi {
@@ -184,7 +166,7 @@ mod tests {
             assert!(worst < 4e-7, "a = {a}: {worst:e}");
         }
         // Refused: more than 32 binary exponents, or a fit off by more than the bound.
-        assert!(PowerCurve::new(1.0, 0.5, 1e-6, 1e6).is_none());
-        assert!(PowerCurve::new(1.0, -3.0, 1.0, 2.0).is_none());
+        assert!(PowerCurve::new(simd, 1.0, 0.5, 1e-6, 1e6).is_none());
+        assert!(PowerCurve::new(simd, 1.0, -3.0, 1.0, 2.0).is_none());
     }
 }

@@ -6,7 +6,7 @@
 //! colour scaled by L_d / L_w. Defaults: key 0.18, L_white = the largest scaled L (so the
 //! brightest pixel maps to 1).
 
-use super::map512::{self, RegisterCurve};
+use super::kernels;
 use super::pixels::{luminance_stats, LuminanceCurve};
 use super::{Context, OperatorInfo, Output, ParamSpec};
 
@@ -35,9 +35,9 @@ pub(crate) static INFO: OperatorInfo = OperatorInfo {
 };
 
 /// Eqs. 2 and 4: L = s · L_w, L_d = L (1 + L / L_white²) / (1 + L).
-struct Curve {
-    s: f32,
-    inv_white2: f32,
+pub(super) struct Curve {
+    pub(super) s: f32,
+    pub(super) inv_white2: f32,
 }
 
 impl LuminanceCurve for Curve {
@@ -52,24 +52,8 @@ impl LuminanceCurve for Curve {
     }
 }
 
-impl RegisterCurve for Curve {
-    /// [`LuminanceCurve::ratio`] on 16 lanes (same operations, same order).
-    #[cfg(target_arch = "x86_64")]
-    #[inline(always)]
-    unsafe fn ratio16(&self, l: std::arch::x86_64::__m512) -> std::arch::x86_64::__m512 {
-        use std::arch::x86_64::*;
-        let (one, s) = (_mm512_set1_ps(1.0), _mm512_set1_ps(self.s));
-        let x = _mm512_mul_ps(s, l);
-        let num = _mm512_mul_ps(
-            s,
-            _mm512_add_ps(one, _mm512_mul_ps(x, _mm512_set1_ps(self.inv_white2))),
-        );
-        _mm512_div_ps(num, _mm512_add_ps(one, x))
-    }
-}
-
 pub(crate) fn apply(ctx: &Context) -> Output {
-    let stats = luminance_stats(ctx.image, ctx.exposure, ctx.weights);
+    let stats = luminance_stats(ctx, ctx.exposure, ctx.weights);
     let key = ctx.value("key");
     let scale = key / stats.log_average;
     let white = ctx.param("white").unwrap_or(stats.max * scale);
@@ -81,7 +65,7 @@ pub(crate) fn apply(ctx: &Context) -> Output {
     };
     let s = scale as f32;
     let mapped =
-        map512::map_luminance_fast(ctx, ctx.exposure, ctx.weights, &Curve { s, inv_white2 });
+        kernels::map_luminance_fast(ctx, ctx.exposure, ctx.weights, &Curve { s, inv_white2 });
     Output {
         mapped,
         values: vec![
@@ -127,11 +111,9 @@ mod tests {
     #[test]
     fn vector_path_gives_the_scalar_bits() {
         for (s, inv_white2) in [(0.18f32, 0.0f32), (2.5, 1e-4), (1e3, 3.0)] {
-            super::super::map512::same_bits_as_scalar(
-                &bit_test_image(),
-                1.0,
-                &super::Curve { s, inv_white2 },
-            );
+            super::super::kernels::tests::same_bits_as_scalar(&bit_test_image(), 1.0, |_| {
+                super::Curve { s, inv_white2 }
+            });
         }
     }
 }

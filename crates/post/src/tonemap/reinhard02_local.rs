@@ -20,8 +20,8 @@
 use rayon::prelude::*;
 
 use super::gaussian::gaussian_blur;
+use super::kernels::avx2;
 use super::pixels::{luminance_plane, luminance_stats, map_luminance, LuminanceCurve, CHUNK};
-use super::simd::avx2;
 use super::{Context, OperatorInfo, Output, ParamSpec};
 
 pub(crate) static INFO: OperatorInfo = OperatorInfo {
@@ -113,19 +113,27 @@ impl LuminanceCurve for Curve<'_> {
 }
 
 pub(crate) fn apply(ctx: &Context) -> Output {
-    let stats = luminance_stats(ctx.image, ctx.exposure, ctx.weights);
+    let stats = luminance_stats(ctx, ctx.exposure, ctx.weights);
     let key = ctx.value("key");
     let phi = ctx.value("phi");
     let epsilon = ctx.value("epsilon") as f32;
     let scales = ctx.value("scales").round().clamp(1.0, 12.0) as usize;
     let key_scale = (key / stats.log_average) as f32;
     let (w, h) = (ctx.image.width(), ctx.image.height());
-    let l = luminance_plane(ctx.image, ctx.exposure * key_scale, ctx.weights);
+    let l = luminance_plane(ctx, ctx.exposure * key_scale, ctx.weights);
     let n = l.len();
     let mut v1 = vec![0.0f32; n];
     let mut v2 = vec![0.0f32; n];
     let mut scratch = vec![0.0f32; n];
-    gaussian_blur(&l, &mut v1, &mut scratch, w, h, centre_sigma_px(1.0));
+    gaussian_blur(
+        &l,
+        &mut v1,
+        &mut scratch,
+        w,
+        h,
+        centre_sigma_px(1.0),
+        ctx.simd,
+    );
     // Selected V_1(s_m); s_0 until a larger scale passes.
     let mut selected = v1.clone();
     let mut active = vec![true; n];
@@ -140,6 +148,7 @@ pub(crate) fn apply(ctx: &Context) -> Output {
             w,
             h,
             centre_sigma_px(s * SCALE_RATIO),
+            ctx.simd,
         );
         let denominator_offset = sharpen / (s * s);
         let still_active: usize = selected
@@ -147,7 +156,10 @@ pub(crate) fn apply(ctx: &Context) -> Output {
             .zip(active.par_chunks_mut(CHUNK))
             .zip(v1.par_chunks(CHUNK).zip(v2.par_chunks(CHUNK)))
             .map(|((sel, act), (a, b))| {
-                avx2!(select_scale(sel, act, a, b, denominator_offset, epsilon))
+                avx2!(
+                    ctx.simd,
+                    select_scale(sel, act, a, b, denominator_offset, epsilon)
+                )
             })
             .sum();
         scales_done += 1;

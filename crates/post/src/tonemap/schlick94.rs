@@ -49,7 +49,7 @@ impl LuminanceCurve for Curve {
 }
 
 pub(crate) fn apply(ctx: &Context) -> Output {
-    let stats = luminance_stats(ctx.image, ctx.exposure, ctx.weights);
+    let stats = luminance_stats(ctx, ctx.exposure, ctx.weights);
     let p = ctx.param("p").unwrap_or_else(|| {
         if stats.min_positive > 0.0 {
             (stats.max / (ctx.value("levels") * stats.min_positive)).max(1.0)

@@ -56,13 +56,14 @@ pub fn gamma(l: f64) -> f64 {
 
 /// L_d = factor · (L / L_wa)^exponent, as the ratio L_d / L = (factor / L_wa) ·
 /// (L / L_wa)^(exponent − 1) = c · L^a over the image's luminance range, from the formula
-/// in f64: evaluated in registers where the CPU and the range allow (module
+/// in f64: evaluated in registers where the ISA (AVX-512) and the range allow (module
 /// [`super::power_curve`]: five permutes and three multiply-adds per 16 pixels), else
 /// tabulated (module [`super::curve_table`]: a 16-byte load and three multiply-adds per
 /// 8 pixels instead of a fast log and exp).
 enum Curve {
     Power(Box<PowerCurve>),
-    Table(CurveTable),
+    /// The table and the ISA its slice lookup runs.
+    Table(CurveTable, prism_cpu::Simd),
 }
 
 impl LuminanceCurve for Curve {
@@ -70,14 +71,14 @@ impl LuminanceCurve for Curve {
     fn ratio(&self, _start: usize, l: &mut [f32]) {
         match self {
             Curve::Power(p) => p.eval_slice(l),
-            Curve::Table(t) => t.eval_slice(l),
+            Curve::Table(t, simd) => t.eval_slice(l, *simd),
         }
     }
 }
 
 pub(crate) fn apply(ctx: &Context) -> Result<Output> {
     let absolute = ctx.exposure * ctx.absolute_scale()? as f32;
-    let stats = luminance_stats(ctx.image, absolute, ctx.weights);
+    let stats = luminance_stats(ctx, absolute, ctx.weights);
     let l_da = ctx.value("display_adaptation");
     let c_max = ctx.value("max_contrast");
     let l_dmax = ctx.value("display_max");
@@ -90,9 +91,9 @@ pub(crate) fn apply(ctx: &Context) -> Result<Output> {
     let ratio = move |l: f64| factor / l_wa * (l / l_wa).powf(exponent - 1.0);
     let (lo, hi) = (stats.min_positive as f32, stats.max as f32);
     let a = exponent - 1.0;
-    let curve = match PowerCurve::new(factor / l_wa * l_wa.powf(-a), a, lo, hi) {
+    let curve = match PowerCurve::new(ctx.simd, factor / l_wa * l_wa.powf(-a), a, lo, hi) {
         Some(p) => Curve::Power(Box::new(p)),
-        None => Curve::Table(CurveTable::new(lo, hi, ratio)),
+        None => Curve::Table(CurveTable::new(lo, hi, ratio), ctx.simd),
     };
     Ok(Output {
         mapped: map_luminance(ctx, absolute, ctx.weights, &curve),
@@ -176,7 +177,14 @@ mod tests {
                 .iter()
                 .filter(|l| **l > 0.0)
                 .fold((f64::INFINITY, 0.0f64), |(a, b), l| (a.min(*l), b.max(*l)));
-            let power = PowerCurve::new(1.0, exponent - 1.0, lo as f32, hi as f32).is_some();
+            let power = PowerCurve::new(
+                prism_cpu::active(),
+                1.0,
+                exponent - 1.0,
+                lo as f32,
+                hi as f32,
+            )
+            .is_some();
             let want: Vec<[f64; 3]> = img
                 .pixels()
                 .iter()

@@ -29,12 +29,12 @@ pub fn scale_factor(l_wa: f64, l_dmax: f64) -> f64 {
 
 pub(crate) fn apply(ctx: &Context) -> Result<Output> {
     let absolute = ctx.exposure * ctx.absolute_scale()? as f32;
-    let stats = luminance_stats(ctx.image, absolute, ctx.weights);
+    let stats = luminance_stats(ctx, absolute, ctx.weights);
     let l_dmax = ctx.value("display_max");
     let sf = scale_factor(stats.log_average, l_dmax);
     let factor = (sf / l_dmax) as f32;
     Ok(Output {
-        mapped: super::map512::map_luminance_fast(ctx, absolute, ctx.weights, &Scale(factor)),
+        mapped: super::kernels::map_luminance_fast(ctx, absolute, ctx.weights, &Scale(factor)),
         values: vec![
             ("world_adaptation_cd_m2", stats.log_average),
             ("scale_factor", sf),

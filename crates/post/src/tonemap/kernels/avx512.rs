@@ -1,6 +1,16 @@
-//! The luminance mapping pass of [`super::pixels::map_luminance`] written out for AVX-512
-//! (16 pixels per step in registers), for the global operators whose curve has a 16-lane
-//! form ([`RegisterCurve`]: exponential, logarithmic, drago03, reinhard02).
+//! The AVX-512 family: kernels in AVX-512F intrinsics (16 f32 lanes), run where the
+//! call's [`prism_cpu::Simd`] allows AVX-512 (`Context::simd`; the dispatch is in
+//! [`super`]). Each is the same operations in the same order as the scalar code it
+//! replaces, without fused multiply-adds where that has none, so it gives the scalar
+//! path's bits (tested for every ISA the machine runs: `kernels::tests` and each
+//! operator's `vector_path_gives_the_scalar_bits`).
+//!
+//! The passes: the luminance mapping pass of [`crate::tonemap::pixels::map_luminance`]
+//! written out for 16 pixels per step in registers, for the global operators whose curve
+//! has a 16-lane form ([`RegisterCurve`]: exponential, logarithmic, drago03, reinhard02,
+//! mean-value, ward94); the pixel pass for maps with a register form ([`RegisterMap`]:
+//! agx); the pixel pass over planes ([`map_pixels_chunk_avx512`]: linear, aces,
+//! ferwerda96) and the statistics pass ([`stats_chunk_avx512`]: every operator).
 //!
 //! Why: on the Zen 5 of the fourth pass (docs/post.md) the auto-vectorised pass — pixels
 //! de-interleaved into stack planes, the curve over a plane, interleaved back, written with
@@ -12,27 +22,32 @@
 //! output).
 //!
 //! Bits: every step is the operation of the scalar path (`load_block` and
-//! `map_luminance_chunk` in [`super::pixels`], and the curve's `ratio`) in the same order,
-//! without fused multiply-adds, so the result is the scalar path's bits (tested for every
-//! curve, on NaN, ±∞, negative, ±0 and subnormal input). The few pixels before the first
-//! 64-byte-aligned output address and after the last whole group of 16 go through the
-//! same 16-lane code on a zero-padded group (seventh pass, docs/post.md; the scalar path
-//! itself before). Register curves and maps take no pixel index: the ones written so far
-//! are global (their `ratio` ignores `start`).
+//! `map_luminance_chunk` in [`crate::tonemap::pixels`], and the curve's `ratio`) in the
+//! same order, so the result is the scalar path's bits (tested for every curve, on NaN,
+//! ±∞, negative, ±0 and subnormal input). The few pixels before the first 64-byte-aligned
+//! output address and after the last whole group of 16 go through the same 16-lane code
+//! on a zero-padded group (seventh pass, docs/post.md; the scalar path itself before).
+//! Register curves and maps take no pixel index: the ones written so far are global
+//! (their `ratio` ignores `start`).
 //!
 //! Each step handles several groups of 16 pixels ([`STEP_GROUPS`]) with their curve or
 //! map evaluations written side by side: one group's chain of dependent operations is
 //! long (agx: ≈ 25 operations, ≈ 120 cycles), and one group per step left the passes
 //! latency-bound (seventh pass).
+//!
+//! After the passes, the operators' register forms, one section per operator file: the
+//! curves' `ratio16`, the curve tables' `eval16`, [`PowerCurve`](crate::tonemap::power_curve::PowerCurve)'s
+//! slice evaluation and agx's `map16`.
 
 #[cfg(target_arch = "x86_64")]
 use std::arch::x86_64::*;
 
-use super::pixels::{
-    map_luminance, map_pixels_chunk, stats_block, store_block, store_fence, Acc, LuminanceCurve,
-    Mapped, PixelMap, Scale, StatsLanes, BLOCK, LANES, LOG_AVERAGE_DELTA,
+#[cfg(target_arch = "x86_64")]
+use crate::tonemap::pixels::{
+    map_pixels_chunk, stats_block, store_block, store_fence, Acc, StatsLanes, BLOCK, LANES,
+    LOG_AVERAGE_DELTA,
 };
-use super::Context;
+use crate::tonemap::pixels::{LuminanceCurve, PixelMap, Scale};
 
 /// A [`LuminanceCurve`] with a 16-lane register form.
 pub(crate) trait RegisterCurve: LuminanceCurve {
@@ -51,48 +66,6 @@ impl RegisterCurve for Scale {
     unsafe fn ratio16(&self, _l: __m512) -> __m512 {
         _mm512_set1_ps(self.0)
     }
-}
-
-/// Whether the AVX-512 pass runs here.
-pub(crate) fn available() -> bool {
-    crate::tonemap::simd::has_avx512()
-}
-
-/// [`map_luminance`] (same contract, same bits), on 16 pixels per step with AVX-512 where
-/// the CPU has it.
-pub(crate) fn map_luminance_fast<C: RegisterCurve>(
-    ctx: &Context,
-    scale: f32,
-    w: [f32; 3],
-    curve: &C,
-) -> Mapped {
-    if !available() {
-        return map_luminance(ctx, scale, w, curve);
-    }
-    map_luminance_avx512(ctx, scale, w, curve)
-}
-
-/// The AVX-512 pass (callers check [`available`]).
-pub(crate) fn map_luminance_avx512<C: RegisterCurve>(
-    ctx: &Context,
-    scale: f32,
-    w: [f32; 3],
-    curve: &C,
-) -> Mapped {
-    super::pixels::map_chunks(ctx, |start, i, o| {
-        #[cfg(target_arch = "x86_64")]
-        {
-            assert!(available());
-            // The register curves take no pixel index.
-            let _ = start;
-            // SAFETY: the CPU has AVX-512F (asserted just above).
-            unsafe { chunk_avx512(i, o, scale, w, curve) }
-        }
-        #[cfg(not(target_arch = "x86_64"))]
-        {
-            super::pixels::map_luminance_chunk(i, o, start, scale, w, curve)
-        }
-    })
 }
 
 /// `vpermt2ps` indices that gather channel `ch` of 16 interleaved pixels from the three
@@ -260,13 +233,13 @@ unsafe fn luminance_group16<C: RegisterCurve, const G: usize, const SCALED: bool
     (o, non_finite, neg)
 }
 
-/// One task of [`map_luminance_avx512`], without the exposure multiplication where the
-/// scale is 1 (the same bits, see [`sanitise16`]).
+/// One task of [`crate::tonemap::kernels::map_luminance_fast`], without the exposure
+/// multiplication where the scale is 1 (the same bits, see [`sanitise16`]).
 ///
 /// # Safety
 /// The CPU must have AVX-512F.
 #[cfg(target_arch = "x86_64")]
-unsafe fn chunk_avx512<C: RegisterCurve>(
+pub(crate) unsafe fn chunk_avx512<C: RegisterCurve>(
     input: &[[f32; 3]],
     out: &mut [[f32; 3]],
     scale: f32,
@@ -403,7 +376,8 @@ unsafe fn luminance_chunk_avx512<C: RegisterCurve, const SCALED: bool>(
     register_pass!(input, out, luminance_groups)
 }
 
-/// A [`PixelMap`] with a 16-lane register form, for [`map_pixels_registers`]: the map
+/// A [`PixelMap`] with a 16-lane register form, for
+/// [`crate::tonemap::kernels::map_pixels_registers`]: the map
 /// runs inside the 16-pixel load/store loop on registers, with its constants loaded once
 /// per task, instead of over stack planes staged through memory (docs/post.md, seventh
 /// pass).
@@ -438,30 +412,6 @@ pub(crate) trait RegisterMap: PixelMap {
     ) -> [[__m512; 3]; G];
 }
 
-/// [`super::pixels::map_pixels`] (same contract, same bits) for a map with a register
-/// form: per 16 pixels three loads, the de-interleave, sanitising, the map, cleaning
-/// (non-finite results to 0), the interleave and three streaming stores, all in
-/// registers. Falls back to `map_pixels` on CPUs without AVX-512F.
-pub(crate) fn map_pixels_registers<M: RegisterMap>(ctx: &Context, scale: f32, f: &M) -> Mapped {
-    if !available() {
-        return super::pixels::map_pixels(ctx, scale, f);
-    }
-    super::pixels::map_chunks(ctx, |start, i, o| {
-        #[cfg(target_arch = "x86_64")]
-        {
-            assert!(available());
-            // The register maps take no pixel index.
-            let _ = start;
-            // SAFETY: the CPU has AVX-512F (asserted just above).
-            unsafe { pixels_registers_task(i, o, scale, f) }
-        }
-        #[cfg(not(target_arch = "x86_64"))]
-        {
-            map_pixels_chunk(i, o, start, scale, f)
-        }
-    })
-}
-
 /// The G groups of 16 pixels (48 floats each) at `s` through `f`, as three interleaved
 /// output registers each, with the masks of non-finite and of negative input pixels.
 /// The caller guarantees the 48 G floats are readable.
@@ -494,13 +444,14 @@ unsafe fn group16<M: RegisterMap, const G: usize, const SCALED: bool>(
     (o, non_finite, neg)
 }
 
-/// One task of [`map_pixels_registers`], without the exposure multiplication where the
-/// scale is 1 (the default exposure: the same bits, see [`sanitise16`]).
+/// One task of [`crate::tonemap::kernels::map_pixels_registers`], without the exposure
+/// multiplication where the scale is 1 (the default exposure: the same bits, see
+/// [`sanitise16`]).
 ///
 /// # Safety
 /// The CPU must have AVX-512F.
 #[cfg(target_arch = "x86_64")]
-unsafe fn pixels_registers_task<M: RegisterMap>(
+pub(crate) unsafe fn pixels_registers_task<M: RegisterMap>(
     input: &[[f32; 3]],
     out: &mut [[f32; 3]],
     scale: f32,
@@ -518,10 +469,10 @@ unsafe fn pixels_registers_task<M: RegisterMap>(
 #[cfg(target_arch = "x86_64")]
 const STEP_GROUPS: usize = 3;
 
-/// One task of [`map_pixels_registers`]: [`register_pass!`] around the map. The head and
-/// tail pixels go through the 16-lane code on a zero-padded copy, not the scalar path: a
-/// few scalar pixels per task cost more than the rest of it where `f32::mul_add` is a
-/// library call (the baseline build has no FMA).
+/// One task of [`crate::tonemap::kernels::map_pixels_registers`]: [`register_pass!`]
+/// around the map. The head and tail pixels go through the 16-lane code on a zero-padded
+/// copy, not the scalar path: a few scalar pixels per task cost more than the rest of it
+/// where `f32::mul_add` is a library call (the baseline build has no FMA).
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f")]
 unsafe fn pixels_registers_avx512<M: RegisterMap, const SCALED: bool>(
@@ -541,39 +492,24 @@ unsafe fn pixels_registers_avx512<M: RegisterMap, const SCALED: bool>(
     register_pass!(input, out, map_groups)
 }
 
-/// One task of [`super::pixels::map_pixels`] with AVX-512F: whole blocks are
+/// One task of [`crate::tonemap::pixels::map_pixels`] with AVX-512F: whole blocks are
 /// de-interleaved into the stack planes and interleaved back in registers (two
 /// `vpermt2ps` per channel and 16 pixels) instead of the compiler's AVX2 shuffles, the
 /// pixel map runs on the planes as before, and the block goes out with streaming stores;
 /// the same operations on every value, so the same bits as
-/// [`super::pixels::map_pixels_chunk`] (which handles a partial last block).
-pub(crate) fn map_pixels_chunk_fast<M: PixelMap>(
-    input: &[[f32; 3]],
-    out: &mut [[f32; 3]],
-    start: usize,
-    scale: f32,
-    f: &M,
-) -> (u64, u64) {
-    #[cfg(target_arch = "x86_64")]
-    {
-        assert!(available());
-        // SAFETY: the CPU has AVX-512F (asserted just above).
-        unsafe { map_pixels_chunk_avx512(input, out, start, scale, f) }
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        map_pixels_chunk(input, out, start, scale, f)
-    }
-}
-
+/// [`crate::tonemap::pixels::map_pixels_chunk`] (which handles a partial last block).
+///
+/// # Safety
+/// The CPU must have AVX-512F: `simd` allows AVX-512.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f")]
-unsafe fn map_pixels_chunk_avx512<M: PixelMap>(
+pub(crate) unsafe fn map_pixels_chunk_avx512<M: PixelMap>(
     input: &[[f32; 3]],
     out: &mut [[f32; 3]],
     start: usize,
     scale: f32,
     f: &M,
+    simd: prism_cpu::Simd,
 ) -> (u64, u64) {
     let (de, inter) = group_indices();
     let scale_v = _mm512_set1_ps(scale);
@@ -615,7 +551,7 @@ unsafe fn map_pixels_chunk_avx512<M: PixelMap>(
                 _mm512_storeu_ps(dst.add(48 * g + 16 * reg), v);
             }
         }
-        store_block(o, &staged);
+        store_block(o, &staged, simd);
     }
     store_fence();
     let (nf, neg) = map_pixels_chunk(
@@ -624,30 +560,22 @@ unsafe fn map_pixels_chunk_avx512<M: PixelMap>(
         start + whole,
         scale,
         f,
+        simd,
     );
     (non_finite + nf, negative + neg)
 }
 
-/// One task of [`super::pixels::luminance_stats`] with AVX-512F: the same accumulators,
-/// lane layout and order of operations as [`super::pixels::stats_chunk`] (so the same
-/// bits), each whole block of 16 groups of 16 pixels de-interleaved and summed in
-/// registers in one pass instead of a luminance plane and a second loop over it.
-pub(crate) fn stats_chunk_fast(chunk: &[[f32; 3]], scale: f32, w: [f32; 3]) -> Acc {
-    #[cfg(target_arch = "x86_64")]
-    {
-        assert!(available());
-        // SAFETY: the CPU has AVX-512F (asserted just above).
-        unsafe { stats_chunk_avx512(chunk, scale, w) }
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        super::pixels::stats_chunk(chunk, scale, w)
-    }
-}
-
+/// One task of [`crate::tonemap::pixels::luminance_stats`] with AVX-512F: the same
+/// accumulators, lane layout and order of operations as
+/// [`crate::tonemap::pixels::stats_chunk`] (so the same bits), each whole block of 16
+/// groups of 16 pixels de-interleaved and summed in registers in one pass instead of a
+/// luminance plane and a second loop over it.
+///
+/// # Safety
+/// The CPU must have AVX-512F.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f")]
-unsafe fn stats_chunk_avx512(chunk: &[[f32; 3]], scale: f32, w: [f32; 3]) -> Acc {
+pub(crate) unsafe fn stats_chunk_avx512(chunk: &[[f32; 3]], scale: f32, w: [f32; 3]) -> Acc {
     const _: () = assert!(LANES == 16 && BLOCK.is_multiple_of(16));
     let mut lanes = StatsLanes::EMPTY;
     let de = deinterleave_registers();
@@ -709,7 +637,7 @@ unsafe fn stats_chunk_avx512(chunk: &[[f32; 3]], scale: f32, w: [f32; 3]) -> Acc
     lanes.total()
 }
 
-/// [`super::fast_math::exp2`] on 16 lanes, the same operations in the same order.
+/// [`crate::tonemap::fast_math::exp2`] on 16 lanes, the same operations in the same order.
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
 #[allow(clippy::excessive_precision, clippy::approx_constant)]
@@ -735,7 +663,7 @@ pub(crate) unsafe fn exp2_16(x: __m512) -> __m512 {
     _mm512_mul_ps(p, _mm512_castsi512_ps(scale))
 }
 
-/// [`super::fast_math::log2`] on 16 lanes, the same operations in the same order.
+/// [`crate::tonemap::fast_math::log2`] on 16 lanes, the same operations in the same order.
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
 #[allow(clippy::excessive_precision)]
@@ -761,240 +689,529 @@ pub(crate) unsafe fn log2_16(x: __m512) -> __m512 {
     _mm512_add_ps(e, _mm512_mul_ps(u, q))
 }
 
-/// Test helper: the AVX-512 pass and the scalar one on the same image give the same bits
-/// and counts (skipped, returning false, on CPUs without AVX-512F).
-#[cfg(test)]
-pub(crate) fn same_bits_as_scalar<C: RegisterCurve>(
-    image: &crate::image::Image,
-    scale: f32,
-    curve: &C,
-) -> bool {
-    if !available() {
-        eprintln!("no AVX-512F: the 16-lane pass is not exercised on this CPU");
-        return false;
+/// The luminance curves' register forms (exponential.rs, logarithmic.rs, reinhard02.rs,
+/// drago03.rs): each [`LuminanceCurve::ratio`] on 16 lanes, the same operations in the
+/// same order.
+mod curves {
+    use super::RegisterCurve;
+    use crate::tonemap::{drago03, exponential, logarithmic, reinhard02};
+
+    impl RegisterCurve for exponential::Curve {
+        /// [`LuminanceCurve::ratio`] on 16 lanes (same operations, same order).
+        #[cfg(target_arch = "x86_64")]
+        #[inline(always)]
+        unsafe fn ratio16(&self, l: std::arch::x86_64::__m512) -> std::arch::x86_64::__m512 {
+            use std::arch::x86_64::*;
+            let (one, rate) = (_mm512_set1_ps(1.0), _mm512_set1_ps(self.rate));
+            let x = _mm512_mul_ps(rate, l);
+            let small = _mm512_cmp_ps_mask::<_CMP_LT_OQ>(x, _mm512_set1_ps(0.01));
+            // Each branch only where some lane selects it (dark and bright pixels come in
+            // runs, so the branches predict well); a lane's value is that of the scalar path
+            // either way, since the blend below only reads the selected side.
+            let series = if small != 0 {
+                let inner = _mm512_sub_ps(one, _mm512_mul_ps(_mm512_set1_ps(0.25), x));
+                let third =
+                    _mm512_mul_ps(_mm512_mul_ps(x, _mm512_set1_ps(exponential::THIRD)), inner);
+                let half = _mm512_mul_ps(
+                    _mm512_mul_ps(_mm512_set1_ps(0.5), x),
+                    _mm512_sub_ps(one, third),
+                );
+                _mm512_mul_ps(rate, _mm512_sub_ps(one, half))
+            } else {
+                one
+            };
+            let e = if small != 0xffff {
+                // exp(−x) = exp2((−x) · log2 e), −x by flipping the sign bit as `-x` does.
+                let minus_x = _mm512_castsi512_ps(_mm512_xor_si512(
+                    _mm512_castps_si512(x),
+                    _mm512_set1_epi32(i32::MIN),
+                ));
+                super::exp2_16(_mm512_mul_ps(
+                    minus_x,
+                    _mm512_set1_ps(std::f32::consts::LOG2_E),
+                ))
+            } else {
+                one
+            };
+            let numerator = _mm512_mask_blend_ps(small, _mm512_sub_ps(one, e), series);
+            let denominator = _mm512_mask_blend_ps(small, l, one);
+            _mm512_div_ps(numerator, denominator)
+        }
     }
-    let params = super::ToneParams::default();
-    let ctx = Context {
-        image,
-        params: &params,
-        info: &super::linear::INFO,
-        exposure: scale,
-        weights: image.luminance_weights(),
-        buffer: std::sync::Mutex::new(None),
+
+    impl RegisterCurve for logarithmic::Curve {
+        /// [`LuminanceCurve::ratio`] on 16 lanes (same operations, same order).
+        #[cfg(target_arch = "x86_64")]
+        #[inline(always)]
+        unsafe fn ratio16(&self, l: std::arch::x86_64::__m512) -> std::arch::x86_64::__m512 {
+            use std::arch::x86_64::*;
+            let one = _mm512_set1_ps(1.0);
+            let inv = _mm512_set1_ps(self.inv * std::f32::consts::LN_2);
+            let log = super::log2_16(_mm512_add_ps(one, _mm512_mul_ps(_mm512_set1_ps(self.q), l)));
+            let recip = _mm512_div_ps(one, l);
+            _mm512_mul_ps(_mm512_mul_ps(log, inv), recip)
+        }
+    }
+
+    impl RegisterCurve for reinhard02::Curve {
+        /// [`LuminanceCurve::ratio`] on 16 lanes (same operations, same order).
+        #[cfg(target_arch = "x86_64")]
+        #[inline(always)]
+        unsafe fn ratio16(&self, l: std::arch::x86_64::__m512) -> std::arch::x86_64::__m512 {
+            use std::arch::x86_64::*;
+            let (one, s) = (_mm512_set1_ps(1.0), _mm512_set1_ps(self.s));
+            let x = _mm512_mul_ps(s, l);
+            let num = _mm512_mul_ps(
+                s,
+                _mm512_add_ps(one, _mm512_mul_ps(x, _mm512_set1_ps(self.inv_white2))),
+            );
+            _mm512_div_ps(num, _mm512_add_ps(one, x))
+        }
+    }
+
+    impl RegisterCurve for drago03::Octaves {
+        #[cfg(target_arch = "x86_64")]
+        #[inline(always)]
+        unsafe fn ratio16(&self, l: std::arch::x86_64::__m512) -> std::arch::x86_64::__m512 {
+            self.0.eval16(l)
+        }
+    }
+
+    impl RegisterCurve for drago03::Table {
+        #[cfg(target_arch = "x86_64")]
+        #[inline(always)]
+        unsafe fn ratio16(&self, l: std::arch::x86_64::__m512) -> std::arch::x86_64::__m512 {
+            self.0.eval16(l)
+        }
+    }
+}
+
+/// curve_table.rs: the memory table's lookup on 16 lanes.
+#[cfg(target_arch = "x86_64")]
+mod curve_table {
+    use crate::tonemap::curve_table::{CurveTable, LOW_BITS, LOW_MASK, T_SCALE};
+
+    impl CurveTable {
+        /// [`Self::eval`] on 16 lanes with AVX-512F: the same bits (the same operations in the
+        /// same order).
+        ///
+        /// # Safety
+        /// The CPU must have AVX-512F.
+        #[cfg(target_arch = "x86_64")]
+        #[inline(always)]
+        pub(crate) unsafe fn eval16(
+            &self,
+            x: std::arch::x86_64::__m512,
+        ) -> std::arch::x86_64::__m512 {
+            use std::arch::x86_64::*;
+            let base = self.coeffs.as_ptr() as *const f32;
+            let bits = _mm512_castps_si512(x);
+            // Logical shift: negative arguments land above the last segment, as in `eval`.
+            let s = _mm512_sub_epi32(
+                _mm512_srli_epi32::<{ LOW_BITS }>(bits),
+                _mm512_set1_epi32(self.first as i32),
+            );
+            let s = _mm512_min_epi32(
+                _mm512_max_epi32(s, _mm512_setzero_si512()),
+                _mm512_set1_epi32(self.coeffs.len() as i32 - 1),
+            );
+            // Each lane's four coefficients are one 16-byte load; four rows per register
+            // (lanes j, j + 4, j + 8, j + 12 of register j), then a 4×4 transpose inside
+            // each 128-bit slot turns them into c0..c3 (16 loads and 20 shuffles: measured
+            // cheaper than four 16-lane gathers, as on 8 lanes).
+            let mut idx = [0i32; 16];
+            _mm512_storeu_si512(idx.as_mut_ptr() as *mut _, s);
+            // SAFETY: 0 ≤ idx[k] < coeffs.len() (clamped above), so each row's four floats
+            // lie inside the coefficient table.
+            let row = |k: usize| _mm_loadu_ps(base.add(4 * idx[k] as usize));
+            let reg = |j: usize| {
+                let z = _mm512_castps128_ps512(row(j));
+                let z = _mm512_insertf32x4::<1>(z, row(j + 4));
+                let z = _mm512_insertf32x4::<2>(z, row(j + 8));
+                _mm512_insertf32x4::<3>(z, row(j + 12))
+            };
+            let (r0, r1, r2, r3) = (reg(0), reg(1), reg(2), reg(3));
+            let t0 = _mm512_unpacklo_ps(r0, r1);
+            let t1 = _mm512_unpackhi_ps(r0, r1);
+            let t2 = _mm512_unpacklo_ps(r2, r3);
+            let t3 = _mm512_unpackhi_ps(r2, r3);
+            let lo = |a: __m512, b: __m512| {
+                _mm512_castpd_ps(_mm512_unpacklo_pd(_mm512_castps_pd(a), _mm512_castps_pd(b)))
+            };
+            let hi = |a: __m512, b: __m512| {
+                _mm512_castpd_ps(_mm512_unpackhi_pd(_mm512_castps_pd(a), _mm512_castps_pd(b)))
+            };
+            let c = [lo(t0, t2), hi(t0, t2), lo(t1, t3), hi(t1, t3)];
+            let t = _mm512_mul_ps(
+                _mm512_cvtepi32_ps(_mm512_and_si512(bits, _mm512_set1_epi32(LOW_MASK as i32))),
+                _mm512_set1_ps(T_SCALE),
+            );
+            let p = _mm512_add_ps(c[2], _mm512_mul_ps(t, c[3]));
+            let p = _mm512_add_ps(c[1], _mm512_mul_ps(t, p));
+            _mm512_add_ps(c[0], _mm512_mul_ps(t, p))
+        }
+    }
+}
+
+/// octave_curve.rs: one polynomial per octave, coefficients from registers.
+#[cfg(target_arch = "x86_64")]
+mod octave_curve {
+    use crate::tonemap::octave_curve::{OctaveCurve, MANTISSA_MASK, ONE_BITS, TERMS};
+
+    impl OctaveCurve {
+        /// [`Self::eval`] on 16 lanes: the same bits.
+        ///
+        /// # Safety
+        /// The CPU must have AVX-512F (which `new` checked).
+        #[cfg(target_arch = "x86_64")]
+        #[inline(always)]
+        pub(crate) unsafe fn eval16(
+            &self,
+            x: std::arch::x86_64::__m512,
+        ) -> std::arch::x86_64::__m512 {
+            use std::arch::x86_64::*;
+            // maxps returns its second operand when the first is NaN (as f32::max).
+            let x = _mm512_min_ps(
+                _mm512_max_ps(x, _mm512_set1_ps(self.lo)),
+                _mm512_set1_ps(self.hi),
+            );
+            let bits = _mm512_castps_si512(x);
+            // vpermt2ps reads the low 5 bits of the index: the biased exponent modulo 32
+            // (x > 0 after the clamp, so the sign bit is clear).
+            let b = _mm512_srli_epi32::<23>(bits);
+            // (bits & MANTISSA_MASK) | ONE_BITS in one vpternlogd (truth table 0xEA: a & b | c).
+            let m = _mm512_ternarylogic_epi32::<0xEA>(
+                bits,
+                _mm512_set1_epi32(MANTISSA_MASK as i32),
+                _mm512_set1_epi32(ONE_BITS as i32),
+            );
+            let s = _mm512_sub_ps(_mm512_castsi512_ps(m), _mm512_set1_ps(1.5));
+            // SAFETY: each row holds 32 f32s (two 16-lane loads).
+            let coeff = |j: usize| {
+                let row = self.coeffs[j].as_ptr();
+                _mm512_permutex2var_ps(_mm512_loadu_ps(row), b, _mm512_loadu_ps(row.add(16)))
+            };
+            let mut p = coeff(TERMS - 1);
+            for j in (0..TERMS - 1).rev() {
+                p = _mm512_fmadd_ps(p, s, coeff(j));
+            }
+            p
+        }
+    }
+}
+
+/// power_curve.rs: c · x^a on 16 lanes.
+#[cfg(target_arch = "x86_64")]
+mod power_curve {
+    use crate::tonemap::power_curve::{PowerCurve, T_BITS, T_MASK, T_SCALE};
+
+    impl PowerCurve {
+        /// [`PowerCurve::eval_slice`] on 16 lanes: the same bits as
+        /// [`PowerCurve::eval`].
+        ///
+        /// # Safety
+        /// The CPU must have AVX-512F.
+        #[target_feature(enable = "avx512f")]
+        pub(crate) unsafe fn eval_slice_avx512(&self, v: &mut [f32]) {
+            use std::arch::x86_64::*;
+            // SAFETY (loads): each row holds 16 f32s, `scales` 32.
+            let c: [__m512; 4] = std::array::from_fn(|j| _mm512_loadu_ps(self.coeffs[j].as_ptr()));
+            let s_lo = _mm512_loadu_ps(self.scales.as_ptr());
+            let s_hi = _mm512_loadu_ps(self.scales.as_ptr().add(16));
+            let (lo, hi) = (_mm512_set1_ps(self.lo), _mm512_set1_ps(self.hi));
+            let t_mask = _mm512_set1_epi32(T_MASK as i32);
+            let t_scale = _mm512_set1_ps(T_SCALE);
+            let mut chunks = v.chunks_exact_mut(16);
+            for chunk in &mut chunks {
+                // maxps returns its second operand when the first is NaN (as f32::max).
+                let x = _mm512_min_ps(_mm512_max_ps(_mm512_loadu_ps(chunk.as_ptr()), lo), hi);
+                let bits = _mm512_castps_si512(x);
+                // vpermps reads the low 4 bits of the index (the segment), vpermt2ps the low
+                // 5 (the biased exponent modulo 32).
+                let k = _mm512_srli_epi32::<{ T_BITS }>(bits);
+                let t = _mm512_mul_ps(_mm512_cvtepi32_ps(_mm512_and_si512(bits, t_mask)), t_scale);
+                let p = _mm512_fmadd_ps(
+                    _mm512_permutexvar_ps(k, c[3]),
+                    t,
+                    _mm512_permutexvar_ps(k, c[2]),
+                );
+                let p = _mm512_fmadd_ps(p, t, _mm512_permutexvar_ps(k, c[1]));
+                let p = _mm512_fmadd_ps(p, t, _mm512_permutexvar_ps(k, c[0]));
+                let s = _mm512_permutex2var_ps(s_lo, _mm512_srli_epi32::<23>(bits), s_hi);
+                _mm512_storeu_ps(chunk.as_mut_ptr(), _mm512_mul_ps(p, s));
+            }
+            for x in chunks.into_remainder() {
+                *x = self.eval(*x);
+            }
+        }
+    }
+}
+
+/// agx.rs: the whole transform on 16 lanes, over planes and in the register pass.
+mod agx {
+    use super::RegisterMap;
+    use crate::tonemap::agx::Map;
+    #[cfg(target_arch = "x86_64")]
+    use crate::tonemap::agx::{
+        Curves, Mat, ENCODE_TERMS, ONE_BITS, POWER_TERMS, S_CENTRE, T_BITS, T_MASK, Y_ZERO,
     };
-    let wide = map_luminance_avx512(&ctx, scale, ctx.weights, curve);
-    let mut scalar = vec![[0f32; 3]; image.pixels().len()];
-    let (nf, neg) = super::pixels::map_luminance_chunk(
-        image.pixels(),
-        &mut scalar,
-        0,
-        scale,
-        ctx.weights,
-        curve,
-    );
-    assert_eq!((wide.non_finite_pixels, wide.negative_pixels), (nf, neg));
-    for (i, (a, b)) in wide.pixels.iter().zip(&scalar).enumerate() {
-        assert_eq!(
-            a.map(f32::to_bits),
-            b.map(f32::to_bits),
-            "pixel {i}: {a:?} vs {b:?} (input {:?})",
-            image.pixels()[i]
-        );
-    }
-    // One task at every output alignment and several lengths (head and tail groups of
-    // 0–15 pixels through the zero-padded group), with and without the exposure multiply.
-    let pixels = image.pixels();
-    let n = pixels.len();
-    let mut fast_buf = vec![[0f32; 3]; n + 16];
-    for scale in [scale, 1.0, 0.37] {
-        for len in [0, 1, 15, 16, 17, 100, n] {
-            for offset in 0..16 {
-                let (input, out) = (&pixels[..len], &mut fast_buf[offset..offset + len]);
-                #[cfg(target_arch = "x86_64")]
-                // SAFETY: the CPU has AVX-512F (checked above).
-                let fast = unsafe { chunk_avx512(input, out, scale, ctx.weights, curve) };
-                #[cfg(not(target_arch = "x86_64"))]
-                let fast =
-                    super::pixels::map_luminance_chunk(input, out, 0, scale, ctx.weights, curve);
-                let slow = super::pixels::map_luminance_chunk(
-                    input,
-                    &mut scalar[..len],
-                    0,
-                    scale,
-                    ctx.weights,
-                    curve,
-                );
-                assert_eq!(fast, slow, "len {len}, offset {offset}");
-                for (i, (a, b)) in fast_buf[offset..offset + len]
-                    .iter()
-                    .zip(&scalar)
-                    .enumerate()
-                {
-                    assert_eq!(
-                        a.map(f32::to_bits),
-                        b.map(f32::to_bits),
-                        "pixel {i} (len {len}, offset {offset}, scale {scale})"
-                    );
-                }
-            }
-        }
-    }
-    true
-}
 
-/// Test helper: the register pass of `f` ([`map_pixels_registers`]'s task) and the scalar
-/// one give the same bits and counts on `pixels`, for every output alignment (so head and
-/// tail groups of 0–15 pixels occur) and for tasks of several lengths (skipped, returning
-/// false, on CPUs without AVX-512F).
-#[cfg(test)]
-pub(crate) fn register_pass_gives_the_scalar_bits<M: RegisterMap>(
-    pixels: &[[f32; 3]],
-    scale: f32,
-    f: &M,
-) -> bool {
-    if !available() {
-        eprintln!("no AVX-512F: the 16-lane register pass is not exercised on this CPU");
-        return false;
-    }
-    let n = pixels.len();
-    let mut fast_buf = vec![[0f32; 3]; n + 16];
-    let mut slow = vec![[0f32; 3]; n];
-    for len in [0, 1, 15, 16, 17, 100, n] {
-        for offset in 0..16 {
-            let (input, out) = (&pixels[..len], &mut fast_buf[offset..offset + len]);
-            #[cfg(target_arch = "x86_64")]
-            // SAFETY: the CPU has AVX-512F (checked above).
-            let fast = unsafe { pixels_registers_task(input, out, scale, f) };
-            #[cfg(not(target_arch = "x86_64"))]
-            let fast = map_pixels_chunk(input, out, 0, scale, f);
-            let slow_counts = map_pixels_chunk(input, &mut slow[..len], 0, scale, f);
-            assert_eq!(fast, slow_counts, "len {len}, offset {offset}");
-            for (i, (a, b)) in fast_buf[offset..offset + len].iter().zip(&slow).enumerate() {
-                assert_eq!(
-                    a.map(f32::to_bits),
-                    b.map(f32::to_bits),
-                    "pixel {i} (len {len}, offset {offset}): {a:?} vs {b:?}, input {:?}",
-                    pixels[i]
-                );
-            }
-        }
-    }
-    true
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::tonemap::pixels::CHUNK;
-    use crate::tonemap::test_support::bit_test_image;
-
-    /// A register map that makes some values non-finite (so the cleaning runs).
-    struct RegisterProbe;
-    impl PixelMap for RegisterProbe {
-        #[inline(always)]
-        fn map(&self, _start: usize, r: &mut [f32], g: &mut [f32], b: &mut [f32]) {
-            for j in 0..r.len() {
-                (r[j], g[j], b[j]) = (r[j] * 1e30 + g[j], g[j] - b[j] * 0.5, b[j] / (g[j] - r[j]));
-            }
-        }
-    }
-    impl RegisterMap for RegisterProbe {
+    impl Map {
+        /// [`PixelMap::map`] on 16 lanes over planes ([`RegisterMap::map16`] per 16 pixels;
+        /// the tone-mapping pass itself runs the register form directly, this serves
+        /// [`PixelMap::map`] callers).
         #[cfg(target_arch = "x86_64")]
-        type Regs = __m512;
+        #[target_feature(enable = "avx512f")]
+        pub(crate) unsafe fn map_avx512(&self, r: &mut [f32], g: &mut [f32], b: &mut [f32]) {
+            use std::arch::x86_64::*;
+            let n = r.len().min(g.len()).min(b.len());
+            let regs = self.regs16();
+            let mut j = 0;
+            while j + 16 <= n {
+                // SAFETY: j + 16 ≤ n ≤ the length of each plane.
+                let (pr, pg, pb) = (
+                    r.as_mut_ptr().add(j),
+                    g.as_mut_ptr().add(j),
+                    b.as_mut_ptr().add(j),
+                );
+                let [[x, y, z]] = self.map16(
+                    &regs,
+                    [[
+                        _mm512_loadu_ps(pr),
+                        _mm512_loadu_ps(pg),
+                        _mm512_loadu_ps(pb),
+                    ]],
+                );
+                _mm512_storeu_ps(pr, x);
+                _mm512_storeu_ps(pg, y);
+                _mm512_storeu_ps(pb, z);
+                j += 16;
+            }
+            for j in j..n {
+                [r[j], g[j], b[j]] = self.pixel(r[j], g[j], b[j]);
+            }
+        }
+    }
+
+    /// The constants of [`Map`]'s 16-lane form, loaded once per task.
+    #[cfg(target_arch = "x86_64")]
+    pub(crate) struct Regs16 {
+        inset: [std::arch::x86_64::__m512; 9],
+        outset: [std::arch::x86_64::__m512; 9],
+        from: Option<[std::arch::x86_64::__m512; 9]>,
+        encode: [std::arch::x86_64::__m512; ENCODE_TERMS],
+        power: [std::arch::x86_64::__m512; POWER_TERMS],
+        contrast: [std::arch::x86_64::__m512; 7],
+        scales: [std::arch::x86_64::__m512; 2],
+    }
+
+    impl RegisterMap for Map {
+        #[cfg(target_arch = "x86_64")]
+        type Regs = Regs16;
+        /// The power curve's input is ≥ Y_ZERO and < Y_MAX (`outset_values_stay_below_y_max`:
+        /// the encoding's clamp and the contrast polynomial bound it), its cubic and scale
+        /// are finite there, and the matrix back from sRGB of such values is finite.
+        const FINITE_OUTPUT: bool = true;
+
         #[cfg(target_arch = "x86_64")]
         #[inline(always)]
-        unsafe fn regs16(&self) -> __m512 {
-            _mm512_set1_ps(0.5)
+        unsafe fn regs16(&self) -> Regs16 {
+            use std::arch::x86_64::*;
+            let c = self.curves;
+            let splat = |m: &Mat| m.map(|v| _mm512_set1_ps(v));
+            // SAFETY (loads): each array holds 16 f32s.
+            let load = |a: &[f32; 16]| _mm512_loadu_ps(a.as_ptr());
+            Regs16 {
+                inset: splat(&self.inset),
+                outset: splat(&self.outset),
+                from: self.from_srgb.as_ref().map(splat),
+                encode: std::array::from_fn(|j| load(&c.encode16[j])),
+                power: std::array::from_fn(|j| load(&c.power16[j])),
+                contrast: c.contrast.map(|v| _mm512_set1_ps(v)),
+                scales: [
+                    _mm512_loadu_ps(c.scales.as_ptr()),
+                    _mm512_loadu_ps(c.scales.as_ptr().add(16)),
+                ],
+            }
         }
+
+        /// [`Map::pixel`] on 16 lanes: the same operations in the same order, with four
+        /// AVX-512 shortcuts that give the same values: the exponent by `vgetexpps` (⌊log2 v⌋
+        /// of a positive normal v, the integer the scalar path extracts), each 8-entry
+        /// coefficient register repeated in both halves of a 16-entry `vpermps` (its index,
+        /// bits >> 20, then carries the exponent's lowest bit above the segment), s by one
+        /// `vpternlogd`, and 2^(2.2e) read from the 32-entry table [`Curves::scales`] with
+        /// one two-register `vpermt2ps` (biased exponents 103…128 are distinct modulo 32),
+        /// whose 0 at exponent 102 ([`Y_ZERO`]) stands for the scalar path's y < Y_MIN test.
         #[cfg(target_arch = "x86_64")]
         #[inline(always)]
         unsafe fn map16<const G: usize>(
             &self,
-            half: &__m512,
-            rgb: [[__m512; 3]; G],
-        ) -> [[__m512; 3]; G] {
-            let mut out = rgb;
-            for (o, [r, g, b]) in out.iter_mut().zip(rgb) {
-                *o = [
-                    _mm512_add_ps(_mm512_mul_ps(r, _mm512_set1_ps(1e30)), g),
-                    _mm512_sub_ps(g, _mm512_mul_ps(b, *half)),
-                    _mm512_div_ps(b, _mm512_sub_ps(g, r)),
-                ];
+            k: &Regs16,
+            rgb: [[std::arch::x86_64::__m512; 3]; G],
+        ) -> [[std::arch::x86_64::__m512; 3]; G] {
+            // No closures here: this function has no target features of its own, and a
+            // closure the optimiser does not inline would be compiled without AVX-512 (every
+            // intrinsic a call). The helpers are `#[inline(always)]` functions instead.
+            let mut v = rgb;
+            for x in &mut v {
+                *x = mat16(&k.inset, *x);
             }
-            out
+            encode16(k, self.curves, &mut v);
+            for x in &mut v {
+                *x = mat16(&k.outset, *x);
+            }
+            power16(k, &mut v);
+            if let Some(m) = &k.from {
+                for x in &mut v {
+                    *x = mat16(m, *x);
+                }
+            }
+            v
         }
     }
 
-    #[test]
-    fn register_pass_gives_the_scalar_bits_and_counts() {
-        let special = bit_test_image();
-        for scale in [1.0f32, 3e30] {
-            register_pass_gives_the_scalar_bits(special.pixels(), scale, &RegisterProbe);
+    /// `m · (x, y, z)` on 16 lanes, the operations of [`mat3`].
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    unsafe fn mat16(
+        m: &[std::arch::x86_64::__m512; 9],
+        [x, y, z]: [std::arch::x86_64::__m512; 3],
+    ) -> [std::arch::x86_64::__m512; 3] {
+        use std::arch::x86_64::*;
+        let mut out = [x; 3];
+        for (row, o) in out.iter_mut().enumerate() {
+            *o = _mm512_fmadd_ps(
+                m[6 + row],
+                z,
+                _mm512_fmadd_ps(m[3 + row], y, _mm512_mul_ps(m[row], x)),
+            );
         }
+        out
     }
 
-    /// A pixel map that touches every value (and makes some non-finite).
-    struct Probe;
-    impl PixelMap for Probe {
-        #[inline(always)]
-        fn map(&self, start: usize, r: &mut [f32], g: &mut [f32], b: &mut [f32]) {
-            for j in 0..r.len() {
-                let k = (start + j) as f32;
-                (r[j], g[j], b[j]) = (r[j] * 1e30 + k, g[j] - b[j] * 0.5, b[j] / (g[j] - r[j]));
+    /// [`centred_position`] on 16 lanes: (bits & T_MASK) | ONE_BITS in one `vpternlogd`
+    /// (truth table 0xEA: (a & b) | c), then the exact subtraction.
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    unsafe fn position16(bits: std::arch::x86_64::__m512i) -> std::arch::x86_64::__m512 {
+        use std::arch::x86_64::*;
+        let m = _mm512_ternarylogic_epi32::<0xEA>(
+            bits,
+            _mm512_set1_epi32(T_MASK as i32),
+            _mm512_set1_epi32(ONE_BITS as i32),
+        );
+        _mm512_sub_ps(_mm512_castsi512_ps(m), _mm512_set1_ps(S_CENTRE))
+    }
+
+    // The curves below run each step over all 3·G vectors before the next step: the steps
+    // of one value form a chain of ~25 dependent operations (≈ 100 cycles), and written
+    // value by value the scheduler fills with one chain before it reaches independent work
+    // (the pass measured latency-bound: ≈ 150 cycles per 16 pixels for ≈ 45 cycles of
+    // issue).
+
+    /// Per lane the polynomial of its segment `seg` (coefficient j of every segment in
+    /// register `coeffs[j]`, picked by `vpermps`) at position `s`, Horner from the top term,
+    /// each step over all 3·G vectors (see above).
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    unsafe fn segment_poly16<const G: usize, const T: usize>(
+        seg: &[[std::arch::x86_64::__m512i; 3]; G],
+        s: &[[std::arch::x86_64::__m512; 3]; G],
+        coeffs: &[std::arch::x86_64::__m512; T],
+    ) -> [[std::arch::x86_64::__m512; 3]; G] {
+        use std::arch::x86_64::*;
+        let mut p = [[_mm512_setzero_ps(); 3]; G];
+        for g in 0..G {
+            for ch in 0..3 {
+                p[g][ch] = _mm512_permutexvar_ps(seg[g][ch], coeffs[T - 1]);
             }
         }
+        for j in (0..T - 1).rev() {
+            for g in 0..G {
+                for ch in 0..3 {
+                    p[g][ch] = _mm512_fmadd_ps(
+                        p[g][ch],
+                        s[g][ch],
+                        _mm512_permutexvar_ps(seg[g][ch], coeffs[j]),
+                    );
+                }
+            }
+        }
+        p
     }
 
-    #[test]
-    fn pixel_pass_gives_the_scalar_bits() {
-        if !available() {
-            eprintln!("no AVX-512F: the 16-lane pixel pass is not exercised on this CPU");
-            return;
+    /// [`Map::encode`] on 16 lanes, every vector of `v`.
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    unsafe fn encode16<const G: usize>(
+        k: &Regs16,
+        c: &Curves,
+        v: &mut [[std::arch::x86_64::__m512; 3]; G],
+    ) {
+        use std::arch::x86_64::*;
+        let (x_min, x_max) = (_mm512_set1_ps(c.x_min), _mm512_set1_ps(c.x_max));
+        let zero = _mm512_setzero_ps();
+        let (mut e, mut seg, mut s) = (
+            [[zero; 3]; G],
+            [[_mm512_setzero_si512(); 3]; G],
+            [[zero; 3]; G],
+        );
+        for g in 0..G {
+            for ch in 0..3 {
+                let x = _mm512_min_ps(_mm512_max_ps(v[g][ch], x_min), x_max);
+                let bits = _mm512_castps_si512(x);
+                e[g][ch] = _mm512_getexp_ps(x);
+                seg[g][ch] = _mm512_srli_epi32::<{ T_BITS }>(bits);
+                s[g][ch] = position16(bits);
+            }
         }
-        let special = bit_test_image();
-        let pixels: Vec<[f32; 3]> = (0..5000)
-            .map(|i| special.pixels()[(i * 7) % 1000])
-            .collect();
-        for scale in [1.0f32, 3e30] {
-            for (k, chunk) in pixels.chunks(CHUNK).enumerate() {
-                let (mut a, mut b) = (vec![[0f32; 3]; chunk.len()], vec![[0f32; 3]; chunk.len()]);
-                let fast = map_pixels_chunk_fast(chunk, &mut a, k * CHUNK, scale, &Probe);
-                let slow = map_pixels_chunk(chunk, &mut b, k * CHUNK, scale, &Probe);
-                assert_eq!(fast, slow);
-                for (i, (x, y)) in a.iter().zip(&b).enumerate() {
-                    assert_eq!(x.map(f32::to_bits), y.map(f32::to_bits), "pixel {i}");
+        let p = segment_poly16(&seg, &s, &k.encode);
+        for g in 0..G {
+            for ch in 0..3 {
+                // w, then the contrast polynomial's top coefficient into v.
+                s[g][ch] = _mm512_add_ps(e[g][ch], p[g][ch]);
+                v[g][ch] = k.contrast[6];
+            }
+        }
+        for j in (0..6).rev() {
+            for g in 0..G {
+                for ch in 0..3 {
+                    v[g][ch] = _mm512_fmadd_ps(v[g][ch], s[g][ch], k.contrast[j]);
                 }
             }
         }
     }
 
-    #[test]
-    fn stats_pass_gives_the_scalar_bits() {
-        if !available() {
-            eprintln!("no AVX-512F: the 16-lane statistics pass is not exercised on this CPU");
-            return;
+    /// [`Map::power`] on 16 lanes, every vector of `v`.
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    unsafe fn power16<const G: usize>(k: &Regs16, v: &mut [[std::arch::x86_64::__m512; 3]; G]) {
+        use std::arch::x86_64::*;
+        let y_zero = _mm512_set1_ps(Y_ZERO);
+        let zero = _mm512_setzero_ps();
+        let (mut bits, mut seg, mut s) = (
+            [[_mm512_setzero_si512(); 3]; G],
+            [[_mm512_setzero_si512(); 3]; G],
+            [[zero; 3]; G],
+        );
+        for g in 0..G {
+            for ch in 0..3 {
+                // Below Y_MIN (and NaN) to Y_ZERO, whose scale is 0.
+                bits[g][ch] = _mm512_castps_si512(_mm512_max_ps(v[g][ch], y_zero));
+                seg[g][ch] = _mm512_srli_epi32::<{ T_BITS }>(bits[g][ch]);
+                s[g][ch] = position16(bits[g][ch]);
+            }
         }
-        // Whole blocks, a partial block, and the special values of the bit-test image
-        // spread over a chunk and a half.
-        let special = bit_test_image();
-        let pixels: Vec<[f32; 3]> = (0..6000)
-            .map(|i| {
-                let v = (i as f32 * 0.37).sin().abs() * 40.0 + 1e-9 * i as f32;
-                if i % 5 == 0 {
-                    special.pixels()[i % 1000]
-                } else {
-                    [v, 0.5 * v, 2.0 * v]
-                }
-            })
-            .collect();
-        for scale in [1.0f32, 0.25, 3e30] {
-            for chunk in pixels.chunks(CHUNK) {
-                let w = special.luminance_weights();
-                assert_eq!(
-                    stats_chunk_fast(chunk, scale, w),
-                    super::super::pixels::stats_chunk(chunk, scale, w),
-                    "scale {scale}"
+        let p = segment_poly16(&seg, &s, &k.power);
+        for g in 0..G {
+            for ch in 0..3 {
+                let scale = _mm512_permutex2var_ps(
+                    k.scales[0],
+                    _mm512_srli_epi32::<23>(bits[g][ch]),
+                    k.scales[1],
                 );
+                v[g][ch] = _mm512_mul_ps(p[g][ch], scale);
             }
         }
     }
