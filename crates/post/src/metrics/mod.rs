@@ -103,6 +103,47 @@ mod tests {
         Image::new(w, h, pixels, RgbColorSpace::srgb()).unwrap()
     }
 
+    /// The fused pass's kernels at every ISA the machine runs (`prism_cpu::each_isa`, which
+    /// reports the others as skipped) give the scalar pass's numbers bit for bit, on an
+    /// image with special values and in another colour space (so the conversion runs). One
+    /// thread, so that the sums are reduced in the same order.
+    #[test]
+    fn every_isa_gives_the_scalar_comparison() {
+        let reference = gradient(67, 31);
+        let mut test = gradient(67, 31);
+        for (i, p) in test.pixels_mut().iter_mut().enumerate() {
+            *p = match i % 11 {
+                0 => [f32::NAN, 0.2, 0.3],
+                1 => [-0.5, f32::INFINITY, 0.1],
+                2 => [0.0; 3],
+                _ => p.map(|c| c * 1.3 + 0.01 * (i % 7) as f32),
+            };
+        }
+        let mut p3 = test.clone();
+        p3.color_space = RgbColorSpace::display_p3();
+        // On the test's thread, so that skipped ISAs are reported under its name.
+        let isas = prism_cpu::each_isa();
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            let options = CompareOptions::default();
+            let at = |simd, test: &Image| {
+                PreparedReference::with_simd(&reference, simd)
+                    .compare(test, &options)
+                    .unwrap()
+            };
+            for test in [&test, &p3] {
+                // Debug prints f64 exactly (shortest round trip), so equal text is equal bits.
+                let scalar = format!("{:?}", at(prism_cpu::Simd::SCALAR, test));
+                for &simd in &isas {
+                    assert_eq!(format!("{:?}", at(simd, test)), scalar, "{simd}");
+                }
+            }
+        });
+    }
+
     #[test]
     fn identical_images_have_zero_error_and_unit_ssim() {
         let a = gradient(32, 24);

@@ -9,6 +9,7 @@
 //! relative squared errors, convert it to CIELAB and take its ΔE₀₀ against the prepared
 //! reference colour — in chunks of [`CHUNK`] pixels, in parallel on the current rayon pool.
 
+use prism_cpu::Simd;
 use prism_spectrum::rgb_space::RgbColorSpace;
 use rayon::prelude::*;
 
@@ -37,6 +38,9 @@ pub struct PreparedReference {
     /// Pixels with a non-finite channel.
     non_finite: u64,
     lab_converter: LabConverter,
+    /// The ISA of the vector kernels (`prism_cpu::active()` when prepared), for the
+    /// preparation and every comparison.
+    simd: Simd,
 }
 
 /// Per-chunk sums of the fused pass.
@@ -66,9 +70,12 @@ fn finite(p: &[f32; 3]) -> bool {
 impl PreparedReference {
     /// Prepares `reference` (any size ≥ 1 × 1; its colour space is the comparison's).
     pub fn new(reference: &Image) -> Self {
+        Self::with_simd(reference, prism_cpu::active())
+    }
+
+    /// As [`Self::new`], with the kernels of `simd` (tests compare ISAs).
+    pub(crate) fn with_simd(reference: &Image, simd: Simd) -> Self {
         let space = reference.color_space.clone();
-        // The ISA of the vector kernels, read once here and carried to the tasks.
-        let simd = prism_cpu::active();
         let lab_converter = LabConverter::new(space.rgb_to_xyz, space.white_xyz());
         let pixels: Vec<[f32; 3]> = reference
             .pixels()
@@ -97,6 +104,7 @@ impl PreparedReference {
             peak_c,
             non_finite,
             lab_converter,
+            simd,
         }
     }
 
@@ -131,14 +139,18 @@ impl PreparedReference {
             &converted
         };
         let n = a.len() as f64;
-        let simd = prism_cpu::active();
+        let simd = self.simd;
         let mut de = vec![0.0f64; a.len()];
         let sums = a
             .par_chunks(CHUNK)
             .zip(de.par_chunks_mut(CHUNK))
             .enumerate()
             .map(|(k, (chunk, out))| avx2!(simd, compare_chunk(self, k * CHUNK, chunk, out)))
-            .reduce(Sums::default, Sums::add);
+            // Collected, then added in order: a rayon reduce would add the chunks in an
+            // order that follows its splitting, and change the last bits between runs.
+            .collect::<Vec<Sums>>()
+            .into_iter()
+            .fold(Sums::default(), Sums::add);
 
         let mse_c = sums.se.map(|s| s / n);
         let relmse_c = sums.rel.map(|s| s / n);

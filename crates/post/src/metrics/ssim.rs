@@ -56,7 +56,7 @@ pub(crate) fn ssim(x: &[f32], y: &[f32], w: usize, h: usize, l: f64) -> Option<f
     let k = kernel();
     // Moments of x − mean(x): variances are shift-invariant, and centring keeps the f32
     // moments E[x²] − μ² from cancelling catastrophically (exact for flat regions).
-    let mean = |v: &[f32]| (v.par_iter().map(|&a| a as f64).sum::<f64>() / v.len() as f64) as f32;
+    let mean = |v: &[f32]| (ordered_sum(v.len(), |i| v[i] as f64) / v.len() as f64) as f32;
     let (mean_x, mean_y) = (mean(x), mean(y));
     let x: Vec<f32> = x.par_iter().map(|a| a - mean_x).collect();
     let y: Vec<f32> = y.par_iter().map(|a| a - mean_y).collect();
@@ -71,19 +71,27 @@ pub(crate) fn ssim(x: &[f32], y: &[f32], w: usize, h: usize, l: f64) -> Option<f
     let xy = blur_valid(&product(x, y), w, h, &k);
     let c1 = (0.01 * l).powi(2);
     let c2 = (0.03 * l).powi(2);
-    let sum: f64 = (0..mu_x.len())
-        .into_par_iter()
-        .map(|i| {
-            let (cx, cy) = (mu_x[i] as f64, mu_y[i] as f64);
-            let sxx = xx[i] as f64 - cx * cx;
-            let syy = yy[i] as f64 - cy * cy;
-            let sxy = xy[i] as f64 - cx * cy;
-            let (mx, my) = (cx + mean_x as f64, cy + mean_y as f64);
-            ((2.0 * mx * my + c1) * (2.0 * sxy + c2))
-                / ((mx * mx + my * my + c1) * (sxx + syy + c2))
-        })
-        .sum();
+    let sum = ordered_sum(mu_x.len(), |i| {
+        let (cx, cy) = (mu_x[i] as f64, mu_y[i] as f64);
+        let sxx = xx[i] as f64 - cx * cx;
+        let syy = yy[i] as f64 - cy * cy;
+        let sxy = xy[i] as f64 - cx * cy;
+        let (mx, my) = (cx + mean_x as f64, cy + mean_y as f64);
+        ((2.0 * mx * my + c1) * (2.0 * sxy + c2)) / ((mx * mx + my * my + c1) * (sxx + syy + c2))
+    });
     Some(sum / mu_x.len() as f64)
+}
+
+/// Σ f(i) for i < n, in parallel but in an order that does not depend on how rayon splits
+/// the work (fixed blocks, their sums added in order), so that a comparison gives the same
+/// bits on every run.
+fn ordered_sum(n: usize, f: impl Fn(usize) -> f64 + Sync) -> f64 {
+    const BLOCK: usize = 4096;
+    let blocks: Vec<f64> = (0..n.div_ceil(BLOCK))
+        .into_par_iter()
+        .map(|b| (b * BLOCK..((b + 1) * BLOCK).min(n)).map(&f).sum())
+        .collect();
+    blocks.iter().sum()
 }
 
 #[cfg(test)]
