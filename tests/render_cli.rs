@@ -8,7 +8,7 @@ use prism_post::io::spectral_exr::{read_spectral_exr, RADIANCE_UNITS};
 use serde_json::Value;
 
 mod support;
-use support::{prism, s, stderr};
+use support::{prism, prism_simd, s, stderr};
 
 fn scene_files(dir: &Path, out: &mut Vec<PathBuf>) {
     for entry in std::fs::read_dir(dir).unwrap() {
@@ -367,4 +367,107 @@ fn explain_prints_the_plan_and_renders_nothing() {
         assert!(text.contains(needle), "missing `{needle}` in:\n{text}");
     }
     assert!(!out.exists(), "--explain must not render");
+}
+
+/// The `simd: <isa> (<why>)` line of `render --explain` with `PRISM_SIMD` set to `env`.
+fn explain_simd_line(env: Option<&str>, extra: &[&str]) -> String {
+    let mut args = vec!["render", "scenes/cornell-box.json", "--explain"];
+    args.extend_from_slice(extra);
+    let o = prism_simd(env, &args);
+    assert!(o.status.success(), "{args:?}: {}", stderr(&o));
+    let text = String::from_utf8_lossy(&o.stdout).into_owned();
+    let lines: Vec<&str> = text.lines().filter(|l| l.starts_with("simd: ")).collect();
+    assert_eq!(lines.len(), 1, "one simd line in:\n{text}");
+    lines[0].to_string()
+}
+
+#[test]
+fn simd_limit_from_the_environment_or_the_flag_is_explained_and_in_the_stats() {
+    use prism_cpu::Isa;
+    // Without a limit: the widest ISA this CPU runs, and why.
+    let best = Isa::detected();
+    let line = explain_simd_line(None, &[]);
+    assert!(line.starts_with(&format!("simd: {best} (")), "{line}");
+    assert_eq!(
+        explain_simd_line(Some("scalar"), &[]),
+        "simd: scalar (PRISM_SIMD=scalar)"
+    );
+    assert_eq!(
+        explain_simd_line(None, &["--simd", "scalar"]),
+        "simd: scalar (--simd scalar)"
+    );
+    assert_eq!(
+        explain_simd_line(Some("avx512"), &["--simd", "scalar"]),
+        "simd: scalar (--simd scalar; PRISM_SIMD=avx512 overridden)"
+    );
+    // Asking for more than the CPU has falls back to what it has and says what it lacks.
+    let line = explain_simd_line(None, &["--simd", "avx512"]);
+    match Isa::Avx512.missing() {
+        None => assert_eq!(line, "simd: avx512 (--simd avx512)"),
+        Some(lacks) => assert_eq!(
+            line,
+            format!("simd: {best} (--simd avx512; the CPU lacks {lacks})")
+        ),
+    }
+
+    let dir = tempfile::tempdir().unwrap();
+    for (env, flag, want) in [
+        (None, None, best.name()),
+        (Some("scalar"), None, "scalar"),
+        (None, Some("scalar"), "scalar"),
+    ] {
+        let (out, stats) = (dir.path().join("c.exr"), dir.path().join("stats.json"));
+        let mut args = vec![
+            "render",
+            "scenes/cornell-box.json",
+            "-o",
+            s(&out),
+            "--resolution",
+            "16x16",
+            "--spp",
+            "1",
+            "--stats-json",
+            s(&stats),
+        ];
+        args.extend(flag.iter().flat_map(|f| ["--simd", f]));
+        let o = prism_simd(env, &args);
+        assert!(o.status.success(), "{args:?}: {}", stderr(&o));
+        let v: Value = serde_json::from_str(&std::fs::read_to_string(&stats).unwrap()).unwrap();
+        assert_eq!(v["simd"], want, "PRISM_SIMD={env:?} --simd {flag:?}");
+    }
+}
+
+#[test]
+fn an_invalid_simd_limit_is_an_error_naming_the_valid_values() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("x.exr");
+    let (out, exr) = (s(&out), "missing.exr");
+    // Every subcommand that runs fast paths checks PRISM_SIMD before any work.
+    for args in [
+        vec!["render", "scenes/cornell-box.json", "-o", out],
+        vec!["converge", "scenes/cornell-box.json", "--max-spp", "1"],
+        vec!["tonemap", exr, "-o", out, "--op", "linear"],
+        vec!["compare", exr, exr],
+    ] {
+        let o = prism_simd(Some("avx3"), &args);
+        assert!(!o.status.success(), "{args:?} should fail");
+        let err = stderr(&o);
+        assert!(
+            err.contains("PRISM_SIMD=avx3: expected scalar, avx2 or avx512"),
+            "{args:?}: {err}"
+        );
+        let mut flagged = args.clone();
+        flagged.extend(["--simd", "sse4"]);
+        let o = prism_simd(None, &flagged);
+        assert!(!o.status.success(), "{flagged:?} should fail");
+        let err = stderr(&o);
+        assert!(
+            err.contains("sse4") && err.contains("expected scalar, avx2 or avx512"),
+            "{flagged:?}: {err}"
+        );
+    }
+    // The flag is for tests and comparisons: hidden from --help.
+    let o = prism(&["render", "--help"]);
+    assert!(o.status.success());
+    assert!(!String::from_utf8_lossy(&o.stdout).contains("--simd"));
 }

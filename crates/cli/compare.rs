@@ -16,6 +16,8 @@ pub struct CompareArgs {
     /// delta_e2000_p95, per_channel) instead of a table.
     #[arg(long)]
     pub json: bool,
+    #[command(flatten)]
+    pub simd: crate::simd::SimdArgs,
 }
 
 fn print_table(c: &Comparison) {
@@ -44,6 +46,7 @@ fn print_table(c: &Comparison) {
 }
 
 pub fn run(args: &CompareArgs) -> Result<(), String> {
+    args.simd.apply()?;
     let comparison = compare_files(&args.test, &args.reference).map_err(|e| e.to_string())?;
     if args.json {
         let text = serde_json::to_string_pretty(&comparison).map_err(|e| e.to_string())?;

@@ -1,5 +1,5 @@
-//! The vector instruction set of the subcommands that render or tone-map: `PRISM_SIMD`
-//! checked at start, and the hidden `--simd scalar|avx2|avx512` (the widest ISA the fast
+//! The vector instruction set of the subcommands that run fast paths (render, converge,
+//! tonemap, compare): `PRISM_SIMD` checked at start, and the hidden `--simd scalar|avx2|avx512` (the widest ISA the fast
 //! paths may use, over `PRISM_SIMD`; for tests and comparisons, so not in `--help`).
 
 use clap::Args;

@@ -148,10 +148,10 @@ fn print_summary(report: &TonemapFileReport) {
 }
 
 pub fn run(args: &TonemapArgs) -> Result<(), String> {
-    args.simd.apply()?;
     if args.list {
         return print_list(args.json);
     }
+    args.simd.apply()?;
     let (input, output, op) = match (&args.input, &args.output, &args.op) {
         (Some(i), Some(o), Some(op)) => (i, o, op),
         _ => return Err("tonemap needs IN, -o OUT and --op NAME (or --list)".to_string()),

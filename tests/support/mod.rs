@@ -19,6 +19,20 @@ pub fn prism_in(dir: &Path, args: &[&str]) -> Output {
         .expect("prism runs")
 }
 
+/// Runs the `prism` binary with `args` from the repository root with `PRISM_SIMD` set to
+/// `simd` (`None`: unset, whatever the test process has).
+pub fn prism_simd(simd: Option<&str>, args: &[&str]) -> Output {
+    let mut command = Command::new(env!("CARGO_BIN_EXE_prism"));
+    command
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .args(args)
+        .env_remove("PRISM_SIMD");
+    if let Some(value) = simd {
+        command.env("PRISM_SIMD", value);
+    }
+    command.output().expect("prism runs")
+}
+
 /// The standard error of a finished run, as text.
 pub fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()

@@ -8,8 +8,8 @@
 //!
 //! Each fast path (packet tracing, small-scene intersection) gets a line: on, with why
 //! `used`, or off, with why `not used: …` — the scene's features outside the path's
-//! allow-list, or the limit the scene is past; and `simd` says which vector kernels they
-//! run and why (`avx2 (PRISM_SIMD=avx2)`).
+//! allow-list, or the limit the scene is past; and the last line, `simd: <isa> (<why>)`,
+//! says which vector kernels they run and why (`simd: avx2 (PRISM_SIMD=avx2)`).
 
 use std::fmt;
 
@@ -36,6 +36,10 @@ pub struct PlanChoice {
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct RenderPlan {
     pub choices: Vec<PlanChoice>,
+    /// The ISA of the vector kernels (packet tracer, film splat, small-scene intersector)
+    /// and why: the widest the CPU runs within `PRISM_SIMD` or `--simd`. Printed last, as
+    /// the line `simd: <isa> (<why>)` (a process setting, not a choice about the scene).
+    pub simd: prism_cpu::Choice,
 }
 
 /// Options that come from the command line rather than the scene.
@@ -345,15 +349,6 @@ impl RenderPlan {
                 format!("not used: {why}"),
             ),
         }
-        // The ISA the fast paths' kernels run, and why (`prism_cpu::choice`).
-        choose(
-            "simd",
-            prism_cpu::choice().to_string(),
-            "the vector kernels of the packet tracer, the film splat and the small-scene \
-             intersector: the widest ISA the CPU runs within PRISM_SIMD or --simd (scalar, \
-             avx2, avx512); images are the same bits at 8 lanes, and within 1e-6 at 16"
-                .into(),
-        );
         choose(
             "spectral output bins",
             match request.spectral_bins {
@@ -375,7 +370,10 @@ impl RenderPlan {
                 "the output format holds no layers".into()
             },
         );
-        Self { choices }
+        Self {
+            choices,
+            simd: prism_cpu::choice(),
+        }
     }
 }
 
@@ -399,6 +397,6 @@ impl fmt::Display for RenderPlan {
                 c.reason
             )?;
         }
-        Ok(())
+        writeln!(f, "simd: {}", self.simd)
     }
 }

@@ -248,6 +248,8 @@ fn every_operator_gives_the_scalar_image_at_every_isa() {
         prism_spectrum::rgb_space::RgbColorSpace::srgb(),
     )
     .unwrap();
+    // On the test's thread, so that skipped ISAs are reported under its name.
+    let isas = prism_cpu::each_isa();
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(1)
         .build()
@@ -266,7 +268,7 @@ fn every_operator_gives_the_scalar_image_at_every_isa() {
                         .image
                 };
                 let scalar = apply(Simd::SCALAR);
-                for simd in prism_cpu::each_isa() {
+                for &simd in &isas {
                     let wide = apply(simd);
                     let bits = |i: &Image| -> Vec<u32> {
                         i.pixels().iter().flatten().map(|v| v.to_bits()).collect()
@@ -294,4 +296,24 @@ fn every_operator_gives_the_scalar_image_at_every_isa() {
             }
         }
     });
+}
+
+/// The octave curve's 16-lane `eval16` gives its scalar `eval`'s bits (the curve exists
+/// only where the ISA allows AVX-512; `each_isa` reports it skipped elsewhere).
+#[test]
+fn octave_curve_eval16_gives_the_scalar_bits() {
+    use crate::tonemap::octave_curve::{tests::eq4_like, OctaveCurve};
+    let (f, lo, hi, xs) = eq4_like();
+    for simd in prism_cpu::each_isa().into_iter().filter(|s| s.avx512()) {
+        let curve = OctaveCurve::new(simd, lo, hi, &f).expect("eq. 4-like curve should fit");
+        #[cfg(target_arch = "x86_64")]
+        for chunk in xs.chunks_exact(16) {
+            // SAFETY: `simd` allows AVX-512, so the CPU has it.
+            let got: [f32; 16] =
+                unsafe { std::mem::transmute(curve.eval16(_mm512_loadu_ps(chunk.as_ptr()))) };
+            for (x, g) in chunk.iter().zip(got) {
+                assert_eq!(g.to_bits(), curve.eval(*x).to_bits(), "x = {x:e}");
+            }
+        }
+    }
 }
