@@ -30,7 +30,7 @@ use prism_spectrum::{SampledSpectrum, SampledWavelengths};
 
 use super::filter_sampler::FilterSampler;
 use super::spectral_bins::SpectralBins;
-use super::xyz::xyz_of_sample;
+use super::xyz::XyzWeights;
 
 /// One bin's share of a splat.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -67,12 +67,15 @@ impl LightSplats {
     ) -> Self {
         let f = filter.filter();
         let full = filter_integral_1d(f, None);
+        let r = f64::from(f.radius_px());
         let norms = |n: u32| -> Arc<Vec<f32>> {
             Arc::new(
                 (0..n)
                     .map(|i| {
-                        let integral = if splatting_film {
-                            filter_integral_1d(f, Some((i as f64 + 0.5, f64::from(n))))
+                        let c = i as f64 + 0.5;
+                        // Only columns within the radius of an edge lose part of the filter.
+                        let integral = if splatting_film && (c < r || c > f64::from(n) - r) {
+                            filter_integral_1d(f, Some((c, f64::from(n))))
                         } else {
                             full
                         };
@@ -113,13 +116,30 @@ impl LightSplats {
         value: SampledSpectrum,
         wavelengths: &SampledWavelengths,
     ) -> bool {
+        self.splat_with(
+            film_point_px,
+            value,
+            wavelengths,
+            &XyzWeights::new(wavelengths),
+        )
+    }
+
+    /// `splat` with the `XyzWeights` of `wavelengths` (built once for all the splats of one
+    /// light path, which share its wavelengths).
+    pub fn splat_with(
+        &mut self,
+        film_point_px: Vec2,
+        value: SampledSpectrum,
+        wavelengths: &SampledWavelengths,
+        weights: &XyzWeights,
+    ) -> bool {
         if value.has_non_finite() || !film_point_px.is_finite() {
             return false;
         }
         if value.is_black() {
             return true;
         }
-        let xyz = xyz_of_sample(value, wavelengths);
+        let xyz = weights.xyz(value);
         let table = self.filter.table();
         let r = self.filter.filter().radius_px();
         // Pixels whose centre (i + ½) lies within r of the point.
@@ -133,35 +153,39 @@ impl LightSplats {
             return true;
         }
         let (x0, x1, y0, y1) = (lo.x as u32, hi.x as u32, lo.y as u32, hi.y as u32);
-        // The column weights once (a radius-2 filter touches up to 5 × 5 pixels).
+        // The column weights once (a radius-2 filter touches up to 5 × 5 pixels), then rows
+        // of taps: f32 products (the sums are f64 in the film).
         let mut column_weights = std::mem::take(&mut self.column_weights);
         column_weights.clear();
         column_weights.extend((x0..=x1).map(|px| {
             table.eval(px as f32 + 0.5 - film_point_px.x) * self.inverse_norm_x[px as usize]
         }));
+        let xyz = [xyz.x as f32, xyz.y as f32, xyz.z as f32];
         for py in y0..=y1 {
             let fy =
                 table.eval(py as f32 + 0.5 - film_point_px.y) * self.inverse_norm_y[py as usize];
             if fy == 0.0 {
                 continue;
             }
+            let row = [xyz[0] * fy, xyz[1] * fy, xyz[2] * fy];
+            let row_start = py * self.resolution.x + x0;
+            self.taps
+                .extend(column_weights.iter().enumerate().map(|(k, &fx)| {
+                    (
+                        row_start + k as u32,
+                        [row[0] * fx, row[1] * fx, row[2] * fx],
+                    )
+                }));
+            let Some(bins) = self.bins else {
+                continue;
+            };
             for (k, &fx) in column_weights.iter().enumerate() {
-                let px = x0 + k as u32;
-                let w = fx * fy;
-                if w == 0.0 {
-                    continue;
-                }
-                let pixel = py * self.resolution.x + px;
-                let wd = f64::from(w);
-                self.taps.push((
-                    pixel,
-                    [
-                        (xyz.x * wd) as f32,
-                        (xyz.y * wd) as f32,
-                        (xyz.z * wd) as f32,
-                    ],
-                ));
-                if let Some(bins) = self.bins {
+                let pixel = row_start + k as u32;
+                {
+                    let wd = f64::from(fx * fy);
+                    if wd == 0.0 {
+                        continue;
+                    }
                     bins.for_each_lane_share(value, wavelengths, |bin, share| {
                         self.spectral.push(SpectralTap {
                             pixel,

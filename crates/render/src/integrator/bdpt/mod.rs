@@ -184,10 +184,13 @@ impl Bdpt {
         });
         let tracer = self.path_tracer();
         let importance_area = scene.camera.importance_area_px2();
+        let xyz_weights = crate::film::xyz::XyzWeights::new(&sensor);
         let mut radiance = zero;
         let (n_camera, n_light) = (camera_path.len(), light_path.len());
         let light_first = start_of_light_vertex_blocks(start);
         let uses_lens = scene.camera.uses_lens_sample();
+        // The lights' spectra at this sample's transport wavelengths (s = 1 connections).
+        let mut le_cache = crate::spectrum_cache::SpectrumCache::new();
         for t in 1..=n_camera {
             for s in 0..=n_light {
                 let depth = s as i64 + t as i64 - 2;
@@ -236,6 +239,7 @@ impl Bdpt {
                     t,
                     &variates,
                     &transport,
+                    &mut le_cache,
                     counters,
                 ) else {
                     continue;
@@ -252,7 +256,12 @@ impl Bdpt {
                 let value = c.unweighted * weight;
                 match c.film_point_px {
                     Some(film_point) => {
-                        if !splats.splat(film_point, value * importance_area, &sensor) {
+                        if !splats.splat_with(
+                            film_point,
+                            value * importance_area,
+                            &sensor,
+                            &xyz_weights,
+                        ) {
                             counters.non_finite_contributions += 1;
                         }
                     }
