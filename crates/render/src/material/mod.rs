@@ -173,7 +173,7 @@ impl Material {
         &self,
         id: u32,
         hit: &SurfaceInteraction,
-        wavelengths: &SampledWavelengths,
+        wavelengths: &impl crate::spectrum_cache::TransportWavelengths,
         cache: &mut crate::spectrum_cache::SpectrumCache,
     ) -> Bsdf<'_> {
         if let Material::Lambert { reflectance } = self {
@@ -183,7 +183,7 @@ impl Material {
                 }));
             }
         }
-        self.bsdf(hit, wavelengths)
+        self.bsdf(hit, wavelengths.transport())
     }
 
     /// The BSDF at `hit` for `wavelengths` (textures read the hit's uv and differentials).
