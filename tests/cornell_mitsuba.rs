@@ -9,7 +9,7 @@
 //! spread of the block differences; the light's blocks excluded, since they are dominated
 //! by the saturated, directly visible emitter).
 
-use prism_post::io::exr::read_exr;
+use prism_image::io::exr::read_exr;
 use prism_render::integrator::{Bdpt, LightTracer};
 use prism_render::{render, Integrator, RenderScene, RenderSettings};
 

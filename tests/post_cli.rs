@@ -3,8 +3,8 @@
 
 use std::path::{Path, PathBuf};
 
-use prism_post::image::Image;
-use prism_post::io::{read_image, write_image};
+use prism_image::image::Image;
+use prism_image::io::{read_image, write_image};
 use prism_spectrum::rgb_space::RgbColorSpace;
 use serde_json::Value;
 

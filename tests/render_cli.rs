@@ -3,8 +3,8 @@
 
 use std::path::{Path, PathBuf};
 
-use prism_post::io::exr::read_exr;
-use prism_post::io::spectral_exr::{read_spectral_exr, RADIANCE_UNITS};
+use prism_image::io::exr::read_exr;
+use prism_image::io::spectral_exr::{read_spectral_exr, RADIANCE_UNITS};
 use serde_json::Value;
 
 mod support;
@@ -70,7 +70,7 @@ fn same_seed_gives_bit_identical_exr_pixels_for_one_and_two_threads() {
         assert!(o.status.success(), "{}", stderr(&o));
         images.push(read_exr(&out).unwrap());
     }
-    let bits = |im: &prism_post::Image| -> Vec<u32> {
+    let bits = |im: &prism_image::Image| -> Vec<u32> {
         let mut v: Vec<u32> = im.pixels().iter().flatten().map(|x| x.to_bits()).collect();
         for l in im.layers() {
             v.extend(l.samples.iter().map(|x| x.to_bits()));
