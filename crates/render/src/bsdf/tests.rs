@@ -6,7 +6,7 @@ use glam::{Vec2, Vec3A};
 use prism_spectrum::SampledSpectrum;
 
 use super::*;
-use crate::chi2::{chi2_test, sidak, Chi2Config, SplitMix64};
+use prism_testkit::chi2::{chi2_test, sidak, Chi2Config, SplitMix64};
 
 /// Incident polar angles of every chi-square family (degrees), at azimuth `PHI_DEG`.
 const THETAS_DEG: [f32; 4] = [0.0, 30.0, 60.0, 85.0];
