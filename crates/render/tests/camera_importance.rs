@@ -669,7 +669,8 @@ fn orthographic_and_spherical_cameras_have_no_importance() {
 #[test]
 fn importance_support_and_lens_kinds() {
     for (name, camera, _) in cameras_with_importance() {
-        assert!(camera.importance_support().is_ok(), "{name}");
+        assert_eq!(camera.importance_support(), Ok(()), "{name}");
+        assert!(camera.importance_area_px2() > 0.0, "{name}");
         assert_eq!(
             camera.is_delta_position(),
             !matches!(camera, Camera::ThinLens(_)),
