@@ -435,10 +435,10 @@ impl LightSource for EnvironmentLight {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::chi2::chi2_test_adaptive;
     use crate::light::test_support::{build_error, build_scene, chi2_config, photometric_sum};
     use crate::light::Light;
     use prism_spectrum::rgb_space::RgbColorSpace;
+    use prism_testkit::chi2::chi2_test_adaptive;
 
     /// A 16 × 8 map: a dim gradient with one bright texel at (x, y) = (4, 3) — u ∈ [¼, 5/16),
     /// just above the horizon towards +X — and a black texel.

@@ -89,7 +89,7 @@ impl PhaseFunction {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::chi2::{chi2_test, Chi2Config};
+    use prism_testkit::chi2::{chi2_test, Chi2Config};
 
     fn phases() -> [PhaseFunction; 4] {
         [
