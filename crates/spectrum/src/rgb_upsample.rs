@@ -102,7 +102,7 @@ impl RgbGamut {
 
     /// The space's white illuminant (D65, or D60 for ACEScg) on the 1 nm grid 360–830 nm,
     /// scaled so that Σ I(λ) ȳ(λ) Δλ = Σ ȳ(λ) Δλ (CIE 1931, Δλ = 1 nm): with the
-    /// DESIGN.md convention Y = ∫L ȳ dλ / ∫ȳ dλ it has luminance Y = 1, as pbrt-v4's
+    /// Prism's convention Y = ∫L ȳ dλ / ∫ȳ dλ it has luminance Y = 1, as pbrt-v4's
     /// normalised standard illuminants do.
     pub fn white_illuminant(self) -> &'static [f32; DENSE_SAMPLE_COUNT] {
         static SRGB: OnceLock<[f32; DENSE_SAMPLE_COUNT]> = OnceLock::new();

@@ -501,7 +501,7 @@ fn illuminant_spectra_emit_their_rgb_with_white_at_unit_luminance() {
         ] {
             let s = RgbIlluminantSpectrum::new(gamut, rgb).unwrap();
             let radiance = sample_dense(|wl| s.eval4(wl));
-            // XYZ = ∫ L x̄ dλ / ∫ ȳ dλ (DESIGN.md), then the space's matrix.
+            // XYZ = ∫ L x̄ dλ / ∫ ȳ dλ (docs/architecture.md), then the space's matrix.
             let xyz = glam::DVec3::new(
                 radiance
                     .iter()

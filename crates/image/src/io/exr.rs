@@ -1,7 +1,7 @@
 //! OpenEXR read/write with the `exr` crate: linear RGB in unprefixed `R`, `G`, `B`
 //! channels, extra layers as prefixed channels (`depth.Z`, `normal.X`, …) in the same
 //! part, the colour space in the standard `chromaticities` attribute and the absolute scale
-//! in the custom attribute `prism:cd_m2_per_unit` (DESIGN.md, "Units and conventions").
+//! in the custom attribute `prism:cd_m2_per_unit` (docs/architecture.md, "Units and conventions").
 
 use std::collections::BTreeMap;
 use std::path::Path;

@@ -8,7 +8,7 @@
 //! Reduction to XYZ: samples are interpolated linearly onto the 1 nm grid of the CIE
 //! observer, zero outside the sampled range, and X = Σ L(λ) x̄(λ) / Σ ȳ(λ) (likewise Y, Z),
 //! so a flat spectrum of 1 over 360–830 nm has Y = 1 (the pbrt-v4 / Mitsuba 3 convention,
-//! DESIGN.md). The absolute scale is then 683.002 lm/W × Σ ȳ(λ) Δλ cd/m² per unit.
+//! docs/architecture.md, "Units and conventions"). The absolute scale is then 683.002 lm/W × Σ ȳ(λ) Δλ cd/m² per unit.
 
 use std::path::Path;
 

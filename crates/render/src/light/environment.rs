@@ -24,7 +24,7 @@
 //! sRGB; negative components clamped to 0) is upsampled once at load time to an RGB
 //! illuminant spectrum (Jakob & Hanika 2019 sigmoid polynomial × the space's white
 //! illuminant, pbrt-v4 `RGBIlluminantSpectrum`, table lookup without refinement): RGB
-//! (1, 1, 1) is the white illuminant at Y = 1 in the output normalisation of DESIGN.md, so
+//! (1, 1, 1) is the white illuminant at Y = 1 in the output normalisation of docs/architecture.md, so
 //! an EXR rendered by Prism used as an environment map gives back its own values. `scale`
 //! multiplies everything.
 //!

@@ -2,7 +2,7 @@
 //! decoders (`prism_image::io::png::read_png_raw` for PNG, `read_image` for EXR/HDR) and
 //! checked for their use.
 //!
-//! Why here and not in prism-scene: DESIGN.md lets prism-scene own asset loading, but its
+//! Why here and not in prism-scene: the founding design let prism-scene own asset loading, but its
 //! arrows say scene uses only geometry and spectrum, and the image decoders live in
 //! prism-image, which render already uses (environment maps load the same way). Parsing
 //! and path resolution (the file must exist) stay in prism-scene; decoding, which depends
