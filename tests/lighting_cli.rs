@@ -51,7 +51,7 @@ fn render_writes_sensor_readings_and_false_colour_beside_the_image() {
     // The 4 × 4 grid at 400 / 4 = 100 px a cell, with the legend beside it.
     let (w, h) = png_size(&dir.path().join("out.floor_plane.falsecolour.png"));
     assert!(h == 400 && w > 400, "{w}×{h}");
-    let image = prism_post::io::exr::read_exr(&dir.path().join("out.exr")).unwrap();
+    let image = prism_image::io::exr::read_exr(&dir.path().join("out.exr")).unwrap();
     assert_eq!((image.width(), image.height()), (16, 12));
 }
 

@@ -44,7 +44,7 @@ fn merl_export_writes_a_table_that_renders() {
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     // The sphere in the middle of the frame reflects the sky: the table is not black.
-    let image = prism_post::io::exr::read_exr(&image).unwrap();
+    let image = prism_image::io::exr::read_exr(&image).unwrap();
     assert_eq!((image.width(), image.height()), (16, 12));
     assert!(image
         .pixels()

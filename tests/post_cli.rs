@@ -506,3 +506,76 @@ fn exposure_auto_brings_an_absolute_render_to_middle_grey() {
         &["black.exr", "--exposure auto", "black image"],
     );
 }
+
+#[test]
+fn cat_chooses_the_adaptation_transform_of_the_white_balance() {
+    use prism_post::colour::white_balance::illuminant_white_xyz_unit_y;
+    use prism_spectrum::adaptation::{adaptation_matrix, AdaptationMethod};
+    // A saturated orange and a grey, well inside [0, 1] after adaptation, under CIE A.
+    let srgb = RgbColorSpace::srgb();
+    let colours = [[0.45f32, 0.22, 0.05], [0.3, 0.3, 0.3]];
+    let pixels: Vec<[f32; 3]> = (0..8).map(|i| colours[i % 2]).collect();
+    let input = scratch("cat_input.exr");
+    write_image(
+        &input,
+        &Image::new(4, 2, pixels, RgbColorSpace::srgb()).unwrap(),
+    )
+    .unwrap();
+    let source = illuminant_white_xyz_unit_y("A").unwrap();
+    let mut orange_by_cat = Vec::new();
+    for (flag, method) in [
+        ("bradford", AdaptationMethod::Bradford),
+        ("cat16", AdaptationMethod::Cat16),
+        ("cat02", AdaptationMethod::Cat02),
+        ("von-kries", AdaptationMethod::VonKries),
+    ] {
+        let output = scratch(&format!("cat_{flag}.exr"));
+        let json: Value = serde_json::from_str(&ok(&[
+            "tonemap",
+            input.to_str().unwrap(),
+            "-o",
+            output.to_str().unwrap(),
+            "--op",
+            "linear",
+            "--wb",
+            "illuminant:A",
+            "--cat",
+            flag,
+            "--json",
+        ]))
+        .unwrap();
+        assert_eq!(json["chromatic_adaptation"], method.name(), "{json}");
+        // Each pixel is M_rgb⁻¹ · CAT(A → D65) · M_rgb · pixel (linear operator, exposure 0).
+        let cat = adaptation_matrix(method, source, srgb.white_xyz());
+        let out = read_image(&output).unwrap();
+        for (i, colour) in colours.iter().enumerate() {
+            let expected =
+                srgb.xyz_to_rgb * (cat * (srgb.rgb_to_xyz * glam::DVec3::from(colour.map(f64::from))));
+            let got = out.pixel(i, 0);
+            for c in 0..3 {
+                assert!(
+                    (f64::from(got[c]) - expected[c]).abs() < 2e-5,
+                    "--cat {flag}, pixel {i}: got {got:?}, expected {expected}"
+                );
+            }
+        }
+        orange_by_cat.push(out.pixel(0, 0));
+    }
+    // The transforms differ on saturated colours (else the flag would be untestable).
+    for other in &orange_by_cat[1..] {
+        let gap = (0..3)
+            .map(|c| (other[c] - orange_by_cat[0][c]).abs())
+            .fold(0.0f32, f32::max);
+        assert!(gap > 1e-3, "{orange_by_cat:?}");
+    }
+}
+
+#[test]
+fn cat_refuses_an_unknown_transform() {
+    fails_with(
+        &[
+            "tonemap", "in.exr", "-o", "out.png", "--op", "linear", "--cat", "sharp",
+        ],
+        &["--cat", "bradford", "cat16", "cat02", "von-kries"],
+    );
+}

@@ -2,7 +2,8 @@
 //! thin wrapper: parse arguments, call these, print the serialisable report.
 //!
 //! `tonemap_file` order: read → exposure (× 2^EV) → white balance
-//! ([`crate::colour::apply_white_balance`], Bradford; for `--wb scene` the white comes from
+//! ([`crate::colour::apply_white_balance`] with the `--cat` transform, Bradford by default;
+//! for `--wb scene` the white comes from
 //! the file's `illumination` layer, [`scene_white_of`]) → tone operator (or, for `--op all`,
 //! the contact sheet of every operator) → gamut mapping into the target
 //! ([`crate::colour::map_gamut`], fraction outside reported) → write. An EXR output holds
@@ -71,6 +72,10 @@ pub struct TonemapOptions {
     pub params: BTreeMap<String, f64>,
     /// `--wb METHOD`.
     pub wb: WhiteBalance,
+    /// `--cat bradford|cat16|cat02|von-kries`: the chromatic adaptation transform white
+    /// balance uses (`AdaptationMethod::None` would make white balance a no-op: the CLI
+    /// does not offer it).
+    pub cat: AdaptationMethod,
     /// `--gamut METHOD`.
     pub gamut: GamutMethod,
     /// `--target srgb|p3|rec2020`: output primaries and, for PNG, transfer function.
@@ -90,6 +95,7 @@ impl Default for TonemapOptions {
             operator: OperatorChoice::One(ToneOperator::Reinhard02),
             params: BTreeMap::new(),
             wb: WhiteBalance::None,
+            cat: AdaptationMethod::Bradford,
             gamut: GamutMethod::Clip,
             target: GamutTarget::Srgb,
             exposure_ev: 0.0,
@@ -126,6 +132,8 @@ pub struct TonemapFileReport {
     pub auto_exposure: bool,
     pub luminance_scale_cd_m2: Option<f64>,
     pub white_balance: String,
+    /// The chromatic adaptation transform of the white balance (`--cat`).
+    pub chromatic_adaptation: &'static str,
     /// Estimated scene white (CIE 1931 xy) when white balance ran.
     pub white_balance_source_xy: Option<[f64; 2]>,
     pub gamut_method: &'static str,
@@ -192,7 +200,7 @@ pub fn tonemap_file(
                 &space,
                 &options.wb,
                 white,
-                AdaptationMethod::Bradford,
+                options.cat,
             );
             Some(report.source_white_xy)
         }
@@ -201,7 +209,7 @@ pub fn tonemap_file(
                 image.pixels_mut(),
                 &space,
                 method,
-                AdaptationMethod::Bradford,
+                options.cat,
             )
             .map_err(|e| ImageError::format(input, e.to_string()))?;
             Some(report.source_white_xy)
@@ -263,6 +271,7 @@ pub fn tonemap_file(
         auto_exposure: options.auto_exposure,
         luminance_scale_cd_m2: options.luminance_scale_cd_m2,
         white_balance: options.wb.name(),
+        chromatic_adaptation: options.cat.name(),
         white_balance_source_xy: wb_source_xy,
         gamut_method: options.gamut.name(),
         target: options.target.name(),
