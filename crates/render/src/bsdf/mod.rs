@@ -1,4 +1,39 @@
 #![deny(clippy::wildcard_enum_match_arm)]
+//! # How to add a BSDF
+//!
+//! A lobe whose parameters are constant spectra and numbers (no texture, no dispersive
+//! index, not a thin pane, not a blend) joins the material library and touches five places;
+//! the compiler points at every arm (all matches are exhaustive):
+//!
+//! 1. **Its own file**, `crates/render/src/bsdf/NAME.rs`: a `Copy` struct of its parameters
+//!    at the path's four wavelengths and `impl Bxdf` (eval, sample, pdf, albedo, angular
+//!    bandwidth, the three kind flags; none has a default), the formulas cited with paper
+//!    and equation numbers, and its tests: χ² of `sample` against `pdf`
+//!    (`prism_render::chi2`), reciprocity, whatever its paper claims.
+//! 2. **The lobe enum**, `crates/render/src/bsdf/mod.rs`: `mod NAME; pub use`, a variant of
+//!    `Lobe`, its arm in `dispatch_lobe!` and in `Lobe::map_mix`; and in
+//!    `bsdf/contract_tests.rs` a representative in `leaves` and the arms the compiler asks
+//!    for (is `albedo` a closed form? does it conserve energy? its bandwidth oracle).
+//! 3. **The library material**, `crates/render/src/material/library.rs`: a `LibraryMaterial`
+//!    variant and one arm in each of `LibraryMaterial::build` (spectra built, physical
+//!    checks that need them), `LibraryMaterial::lobe`, `albedo_rgb` (its albedo AOV colour)
+//!    and a row in `FIELD_USES` (the keys it reads).
+//! 4. **The scene parser**, `crates/scene/src/material.rs`: a `LibraryKind` variant, its tag
+//!    in `TYPES` and its arm in `parse_library_material` (defaults, ranges, errors with the
+//!    JSON path); and its row `materials.*<NAME>` in `crates/scene/src/schema.rs`, the
+//!    parser's table of accepted keys.
+//! 5. **The docs**: `docs/materials.md` (formulas, references, validity, tests) and
+//!    `docs/scene-format.md` (the JSON keys, defaults and ranges). Show it in
+//!    `scenes/material-gallery.json`.
+//!
+//! A BSDF that needs more than the library offers (a texture, a dispersive index, glazing,
+//! composition) is a `SurfaceMaterial` variant instead (`material/surface.rs`) and a
+//! `MaterialKind` one in prism-scene; then every surface-level query asks about it: the
+//! compiler lists them (surface.rs, glazing.rs, `material::build_one`,
+//! `scene_build::features`, `scene_build::albedo`, the packet integrator's allow-list).
+//!
+//! # Conventions
+//!
 //! BSDFs, evaluated in the local shading frame: z is the shading normal, x the tangent
 //! (dP/du, so anisotropic roughness α_u runs along u). Directions point away from the
 //! surface: `wo` towards the viewer (or the previous vertex), `wi` towards the light (or
