@@ -3,8 +3,8 @@
 
 use std::path::{Path, PathBuf};
 
-use prism_post::image::Image;
-use prism_post::io::{read_image, write_image};
+use prism_image::image::Image;
+use prism_image::io::{read_image, write_image};
 use prism_spectrum::rgb_space::RgbColorSpace;
 use serde_json::Value;
 
@@ -118,6 +118,8 @@ fn every_operator_maps_a_render_to_png_and_to_exr_in_unit_range() {
             op,
         ]);
         assert!(std::fs::read(&png).unwrap().starts_with(b"\x89PNG"), "{op}");
+        let mapped = read_image(&png).unwrap();
+        assert_eq!((mapped.width(), mapped.height()), (48, 32), "{op}");
         let exr = scratch(&format!("{op}.exr"));
         let report: Value = serde_json::from_str(&ok(&[
             "tonemap",
@@ -179,7 +181,7 @@ fn absolute_operators_need_a_scale_on_foreign_images() {
             ],
             &["--luminance-scale"],
         );
-        ok(&[
+        let report: Value = serde_json::from_str(&ok(&[
             "tonemap",
             hdr.to_str().unwrap(),
             "-o",
@@ -188,7 +190,28 @@ fn absolute_operators_need_a_scale_on_foreign_images() {
             op,
             "--luminance-scale",
             "179",
-        ]);
+            "--json",
+        ]))
+        .unwrap();
+        assert_eq!(report["operator"], op);
+        assert_eq!(
+            report["luminance_scale_cd_m2"].as_f64(),
+            Some(179.0),
+            "{op}"
+        );
+        assert_eq!(
+            (&report["width"], &report["height"]),
+            (&40.into(), &30.into())
+        );
+        // The image written: full size, and the 200-unit spot (x > 30, y < 5) brighter
+        // than the dimmest corner of the gradient (0.097 units at (0, 29)).
+        let mapped = read_image(&out).unwrap();
+        assert_eq!((mapped.width(), mapped.height()), (40, 30), "{op}");
+        let (spot, dim) = (mapped.pixel(35, 2), mapped.pixel(0, 29));
+        assert!(
+            spot[1] > dim[1] && spot.iter().chain(&dim).all(|c| c.is_finite()),
+            "{op}: spot {spot:?}, dim corner {dim:?}"
+        );
     }
 }
 

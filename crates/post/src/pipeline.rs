@@ -23,12 +23,12 @@ use crate::colour::{
     apply_white_balance, apply_with_source_white, illumination_white_xyz, map_gamut, GamutMethod,
     GamutTarget, SceneWhite, WhiteBalance, ILLUMINATION_LAYER,
 };
-use crate::error::{PostError, Result};
-use crate::image::Image;
-use crate::io::{read_image, write_image};
 use crate::metrics::{compare, Comparison};
 use crate::sheet::{contact_sheet_with_reports, SheetFailure};
 use crate::tonemap::{ToneOperator, ToneParams, ToneReport};
+use prism_image::io::{read_image, write_image};
+use prism_image::Image;
+use prism_image::{ImageError, Result};
 
 /// `--op NAME` or `--op all` (contact sheet).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -160,14 +160,14 @@ pub fn tonemap_file(
 
     let t = Instant::now();
     if !options.exposure_ev.is_finite() {
-        return Err(PostError::invalid(format!(
+        return Err(ImageError::invalid(format!(
             "--exposure {}: expected a finite number of stops",
             options.exposure_ev
         )));
     }
     let exposure_ev = if options.auto_exposure {
         auto_exposure_ev(&image).ok_or_else(|| {
-            PostError::format(
+            ImageError::format(
                 input,
                 "--exposure auto: no pixel has a positive finite luminance (black image)",
             )
@@ -203,7 +203,7 @@ pub fn tonemap_file(
                 method,
                 AdaptationMethod::Bradford,
             )
-            .map_err(|e| PostError::format(input, e.to_string()))?;
+            .map_err(|e| ImageError::format(input, e.to_string()))?;
             Some(report.source_white_xy)
         }
     };
@@ -214,8 +214,8 @@ pub fn tonemap_file(
         luminance_scale_cd_m2: options.luminance_scale_cd_m2,
         values: options.params.clone(),
     };
-    let in_file = |e: PostError| match e {
-        PostError::Invalid(m) => PostError::format(input, m),
+    let in_file = |e: ImageError| match e {
+        ImageError::Invalid(m) => ImageError::format(input, m),
         other => other,
     };
     let t = Instant::now();
@@ -285,7 +285,7 @@ pub fn tonemap_file(
 /// `illumination.X/Y/Z` layer of `image` (read from `path`, which errors name).
 pub fn scene_white_of(image: &Image, path: &Path) -> Result<SceneWhite> {
     let missing = |found: String| {
-        PostError::format(
+        ImageError::format(
             path,
             format!(
                 "`--wb scene` needs the `{ILLUMINATION_LAYER}` layer (channels \
@@ -315,7 +315,7 @@ pub fn scene_white_of(image: &Image, path: &Path) -> Result<SceneWhite> {
         .chunks_exact(k)
         .map(|p| [p[x], p[y], p[z]])
         .collect();
-    illumination_white_xyz(&xyz).map_err(|e| PostError::format(path, e.to_string()))
+    illumination_white_xyz(&xyz).map_err(|e| ImageError::format(path, e.to_string()))
 }
 
 /// Compares the image at `test` with the reference at `reference`; mismatched sizes are an
@@ -324,7 +324,7 @@ pub fn compare_files(test: &Path, reference: &Path) -> Result<Comparison> {
     let a = read_image(test)?;
     let b = read_image(reference)?;
     if (a.width(), a.height()) != (b.width(), b.height()) {
-        return Err(PostError::invalid(format!(
+        return Err(ImageError::invalid(format!(
             "{} is {}×{} but {} is {}×{}: compare needs equal sizes",
             test.display(),
             a.width(),

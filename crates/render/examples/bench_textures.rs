@@ -284,14 +284,14 @@ fn tempfile_dir() -> std::path::PathBuf {
 
 fn write_png(path: &std::path::Path, size: usize, rgb: impl Fn(usize, usize) -> [f32; 3]) {
     let pixels: Vec<[f32; 3]> = (0..size * size).map(|i| rgb(i % size, i / size)).collect();
-    let image = prism_post::Image::new(
+    let image = prism_image::Image::new(
         size,
         size,
         pixels,
         prism_spectrum::rgb_space::RgbColorSpace::srgb(),
     )
     .unwrap();
-    prism_post::io::write_image(path, &image).unwrap();
+    prism_image::io::write_image(path, &image).unwrap();
 }
 
 fn write_noise_png(path: &std::path::Path, size: usize) {
@@ -303,7 +303,7 @@ fn write_noise_png(path: &std::path::Path, size: usize) {
 }
 
 fn write_flatish_normal_png(path: &std::path::Path, size: usize) {
-    // A PNG written through prism-post is sRGB-encoded from these linear values; read
+    // A PNG written through prism-image is sRGB-encoded from these linear values; read
     // back as a normal map it is taken as linear codes, which only changes the bumps.
     write_png(path, size, |x, y| {
         let t = std::f32::consts::TAU * 4.0 / size as f32;

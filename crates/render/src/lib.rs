@@ -12,7 +12,6 @@
 
 pub mod bsdf;
 pub mod camera;
-pub mod chi2;
 mod cpu;
 pub mod error;
 pub mod film;

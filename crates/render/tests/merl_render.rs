@@ -124,14 +124,14 @@ fn write_env(path: &Path) -> f64 {
             pixels.push([v as f32; 3]);
         }
     }
-    let image = prism_post::Image::new(
+    let image = prism_image::Image::new(
         w,
         h,
         pixels,
         prism_spectrum::rgb_space::RgbColorSpace::srgb(),
     )
     .unwrap();
-    prism_post::io::rgbe::write_hdr(path, &image).unwrap();
+    prism_image::io::rgbe::write_hdr(path, &image).unwrap();
     max
 }
 

@@ -435,14 +435,14 @@ fn write_bumpy_normal_map(path: &Path, flat: bool) {
             [0.5 * (n.x + 1.0), 0.5 * (n.y + 1.0), 0.5 * (n.z + 1.0)]
         })
         .collect();
-    let image = prism_post::Image::new(
+    let image = prism_image::Image::new(
         w,
         h,
         pixels,
         prism_spectrum::rgb_space::RgbColorSpace::srgb(),
     )
     .unwrap();
-    prism_post::io::write_image(path, &image).unwrap();
+    prism_image::io::write_image(path, &image).unwrap();
 }
 
 #[test]

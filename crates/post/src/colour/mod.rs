@@ -10,7 +10,6 @@ pub mod cielab_lch;
 pub mod error;
 pub mod gamut;
 pub mod oklab;
-pub mod rgb_matrix;
 pub mod scene_illumination;
 pub mod white_balance;
 

@@ -765,7 +765,7 @@ pub(crate) unsafe fn log2_16(x: __m512) -> __m512 {
 /// and counts (skipped, returning false, on CPUs without AVX-512F).
 #[cfg(test)]
 pub(crate) fn same_bits_as_scalar<C: RegisterCurve>(
-    image: &crate::image::Image,
+    image: &prism_image::Image,
     scale: f32,
     curve: &C,
 ) -> bool {

@@ -17,7 +17,7 @@ use rayon::prelude::*;
 use super::fast_math;
 use super::simd::avx2;
 use super::Context;
-use crate::image::Image;
+use prism_image::Image;
 
 /// Pixels per rayon task (≈ 48 KiB of RGB f32: big enough to amortise scheduling, small
 /// enough to balance 2–16 threads on a 4K image).

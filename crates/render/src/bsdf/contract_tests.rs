@@ -7,7 +7,7 @@ use prism_spectrum::SampledSpectrum;
 
 use super::library_tests::merl_from;
 use super::*;
-use crate::chi2::SplitMix64;
+use prism_testkit::chi2::SplitMix64;
 
 fn s(v: f32) -> SampledSpectrum {
     SampledSpectrum::splat(v)

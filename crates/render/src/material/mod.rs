@@ -115,7 +115,7 @@ impl Material {
         &self,
         id: u32,
         hit: &SurfaceInteraction,
-        wavelengths: &SampledWavelengths,
+        wavelengths: &impl crate::spectrum_cache::TransportWavelengths,
         cache: &mut crate::spectrum_cache::SpectrumCache,
     ) -> Bsdf<'_> {
         if let Material::Surface(SurfaceMaterial::Lambert { reflectance }) = self {
@@ -125,7 +125,7 @@ impl Material {
                 }));
             }
         }
-        self.bsdf(hit, wavelengths)
+        self.bsdf(hit, wavelengths.transport())
     }
 
     /// The BSDF at `hit` for `wavelengths` (textures read the hit's uv and differentials).
