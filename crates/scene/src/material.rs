@@ -6,7 +6,7 @@
 //! `reflectance`, conductor and dielectric `roughness`, mask `opacity`.
 
 use crate::reader::{quoted_list, suggest, Obj, Result, V};
-use crate::schema::schema;
+use crate::schema::{row, schema, ObjectSchema};
 use crate::spectrum_ref::{parse_spectrum, NamedSpectra, SpectrumRef, SpectrumUse};
 use crate::texture::{is_texture_ref, parse_spectrum_param, parse_texture_ref};
 use crate::texture::{SpectrumParam, TextureTable};
@@ -66,7 +66,8 @@ pub enum MaterialKind {
 /// The material library (issue 8 and after): the kinds whose parameters are numbers and
 /// spectra only — no textures, no dispersive index, no material references — so render
 /// builds each into a lobe without any per-kind case outside its library
-/// (`prism_render::material::library`). A new BSDF of that shape is a variant here.
+/// (`prism_render::material::library`). A new BSDF of that shape is a variant here, its
+/// tag in `TYPES`, its arm in `parse_library_material` and its row in `LIBRARY_SCHEMA`.
 #[derive(Debug, Clone, PartialEq)]
 pub enum LibraryKind {
     /// Oren & Nayar 1994 rough diffuse: the full model (C₁, C₂, C₃ and the
@@ -189,6 +190,42 @@ const TYPES: [&str; 17] = [
     "merl",
     "normal_map",
     "bump_map",
+];
+
+/// Rows of `schema::rows()` for the material library's kinds: the keys each accepts
+/// (`parse_library_material` checks them; render's `material::library::FIELD_USES` reads
+/// them).
+pub(crate) const LIBRARY_SCHEMA: &[ObjectSchema] = &[
+    row(
+        "materials.*<oren_nayar>",
+        &[&["type", "reflectance", "sigma_deg"]],
+    ),
+    row(
+        "materials.*<oren_nayar_qualitative>",
+        &[&["type", "reflectance", "sigma_deg"]],
+    ),
+    row(
+        "materials.*<phong>",
+        &[&["type", "diffuse", "specular", "exponent"]],
+    ),
+    row(
+        "materials.*<blinn_phong>",
+        &[&["type", "diffuse", "specular", "exponent"]],
+    ),
+    row(
+        "materials.*<ward>",
+        &[&["type", "diffuse", "specular", "alpha"]],
+    ),
+    row("materials.*<lafortune>", &[&["type", "diffuse", "lobes"]]),
+    row(
+        "materials.*<lafortune>.lobes[]",
+        &[&["cx", "cy", "cz", "exponent", "albedo"]],
+    ),
+    row(
+        "materials.*<coated>",
+        &[&["type", "diffuse", "ior", "nonlinear"]],
+    ),
+    row("materials.*<merl>", &[&["type", "file", "clamp_negative"]]),
 ];
 
 /// Parses the `materials` section: names in file order, references between materials
@@ -567,7 +604,7 @@ fn parse_library_material(tag: &str, v: &V, spectra: &NamedSpectra) -> Result<Li
                 nonlinear: o.bool_or("nonlinear", true)?,
             }
         }
-        _ => {
+        "merl" => {
             let o = v.tagged_object(schema!("materials.*<merl>"))?;
             LibraryKind::Merl {
                 file: o
@@ -576,6 +613,9 @@ fn parse_library_material(tag: &str, v: &V, spectra: &NamedSpectra) -> Result<Li
                 clamp_negative: o.bool_or("clamp_negative", false)?,
             }
         }
+        // `v.tag` accepted only `TYPES`; a tag listed there without an arm here or in
+        // `parse_material` is this file's bug (tests/schema.rs parses every type).
+        other => unreachable!("material type `{other}` is in TYPES but has no parser"),
     })
 }
 

@@ -2,29 +2,31 @@
 //! # How to add a BSDF
 //!
 //! A lobe whose parameters are constant spectra and numbers (no texture, no dispersive
-//! index, not a thin pane, not a blend) joins the material library and touches five places;
-//! the compiler points at every arm (all matches are exhaustive):
+//! index, not a thin pane, not a blend) joins the material library and touches five places,
+//! one file each but the docs (two pages); all matches are exhaustive, so the compiler points
+//! at every arm.
 //!
 //! 1. **Its own file**, `crates/render/src/bsdf/NAME.rs`: a `Copy` struct of its parameters
 //!    at the path's four wavelengths and `impl Bxdf` (eval, sample, pdf, albedo, angular
 //!    bandwidth, the three kind flags; none has a default), the formulas cited with paper
-//!    and equation numbers, and its tests: χ² of `sample` against `pdf`
-//!    (`prism_render::chi2`), reciprocity, whatever its paper claims.
+//!    and equation numbers, and the tests of what its paper claims.
 //! 2. **The lobe enum**, `crates/render/src/bsdf/mod.rs`: `mod NAME; pub use`, a variant of
-//!    `Lobe`, its arm in `dispatch_lobe!` and in `Lobe::map_mix`; and in
-//!    `bsdf/contract_tests.rs` a representative in `leaves` and the arms the compiler asks
-//!    for (is `albedo` a closed form? does it conserve energy? its bandwidth oracle).
+//!    `Lobe`, and its arms in `dispatch_lobe!` and `Lobe::map_mix`.
 //! 3. **The library material**, `crates/render/src/material/library.rs`: a `LibraryMaterial`
 //!    variant and one arm in each of `LibraryMaterial::build` (spectra built, physical
-//!    checks that need them), `LibraryMaterial::lobe`, `albedo_rgb` (its albedo AOV colour)
-//!    and a row in `FIELD_USES` (the keys it reads).
+//!    checks that need them), `LibraryMaterial::lobe` and `albedo_rgb` (its albedo AOV
+//!    colour), and its row in `FIELD_USES` (the keys it reads).
 //! 4. **The scene parser**, `crates/scene/src/material.rs`: a `LibraryKind` variant, its tag
-//!    in `TYPES` and its arm in `parse_library_material` (defaults, ranges, errors with the
-//!    JSON path); and its row `materials.*<NAME>` in `crates/scene/src/schema.rs`, the
-//!    parser's table of accepted keys.
-//! 5. **The docs**: `docs/materials.md` (formulas, references, validity, tests) and
-//!    `docs/scene-format.md` (the JSON keys, defaults and ranges). Show it in
-//!    `scenes/material-gallery.json`.
+//!    in `TYPES`, its arm in `parse_library_material` (defaults, ranges, errors with the JSON
+//!    path) and its row `materials.*<NAME>` in `LIBRARY_SCHEMA` (the keys it accepts).
+//! 5. **The docs**: `docs/materials.md` (a section under "The material library": formulas,
+//!    references, validity) and `docs/scene-format.md` (the JSON keys, defaults and ranges).
+//!
+//! Tests come with the lists, not as a place: in `bsdf/contract_tests.rs` a representative
+//! in `leaves` (χ² of `sample` against `pdf` through `prism_testkit::chi2`, reciprocity,
+//! `albedo` against Monte Carlo) and the arms the compiler asks for (is `albedo` a closed
+//! form? does the model claim albedo ≤ 1? its bandwidth oracle). prism-scene's
+//! tests/schema.rs and render's `scene_build::fields` test pick up the new row by themselves.
 //!
 //! A BSDF that needs more than the library offers (a texture, a dispersive index, glazing,
 //! composition) is a `SurfaceMaterial` variant instead (`material/surface.rs`) and a

@@ -2,7 +2,7 @@
 //! error that refuses it, so that nothing parsed is silently dropped.
 //!
 //! prism-scene lists each kind of object it accepts with its keys (`prism_scene::schema::
-//! SCHEMA`; its parsers can check an object against nothing else). [`field_uses`] is the
+//! rows()`; its parsers can check an object against nothing else). [`field_uses`] is the
 //! other half — [`FIELD_USES`] here, and the material library's rows next to the code that
 //! reads them (`material::library::FIELD_USES`); the test below walks every accepted key
 //! path and fails, naming it, when no row covers it. So a key added to the reader fails
@@ -138,8 +138,8 @@ const TRANSFORM: &str = "prism-scene transform::parse_transform composes the mat
 const MEDIA: &str = "scene_build::fields::refuse_unrendered: participating media are not \
                      rendered yet";
 
-/// Every key path of `prism_scene::schema::SCHEMA`, each in exactly one row.
-/// Every row: [`FIELD_USES`] and the material library's.
+/// Every row: [`FIELD_USES`] and the material library's; together they name every key
+/// path of `prism_scene::schema::rows()`, each in exactly one row.
 pub fn field_uses() -> impl Iterator<Item = &'static FieldRow> {
     FIELD_USES
         .iter()
@@ -537,14 +537,14 @@ pub fn refuse_unrendered(scene: &SceneDescription) -> Result<(), SceneBuildError
 #[cfg(test)]
 mod tests {
     use super::*;
-    use prism_scene::schema::SCHEMA;
+    use prism_scene::schema::rows;
 
     /// The walk over the scene reader's schema: every key path it accepts is in exactly
     /// one row of `field_uses()`, and every row names only accepted key paths.
     #[test]
     fn every_key_the_scene_reader_accepts_is_read_or_refused() {
         let (mut missing, mut twice, mut stale) = (Vec::new(), Vec::new(), Vec::new());
-        for object in SCHEMA {
+        for object in rows() {
             for key in object.keys() {
                 let rows = field_uses()
                     .filter(|r| r.patterns.contains(&object.pattern) && r.keys.contains(&key))
@@ -559,9 +559,7 @@ mod tests {
         for row in field_uses() {
             for pattern in row.patterns {
                 for key in row.keys {
-                    let accepted = SCHEMA
-                        .iter()
-                        .any(|o| o.pattern == *pattern && o.accepts(key));
+                    let accepted = rows().any(|o| o.pattern == *pattern && o.accepts(key));
                     if !accepted {
                         stale.push(format!("{pattern}.{key}"));
                     }
