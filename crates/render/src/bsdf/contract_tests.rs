@@ -167,6 +167,21 @@ fn leaves(brdf: Option<&MerlBrdf>) -> Vec<(&'static str, LeafLobe<'_>)> {
             "thin_dielectric",
             LeafLobe::ThinDielectric(ThinDielectric { eta: s(1.5) }),
         ),
+        // White at the roughest and the smoothest roughness the scene format accepts.
+        (
+            "sheen r 0.1",
+            LeafLobe::Sheen(Sheen {
+                reflectance: s(1.0),
+                roughness: 0.1,
+            }),
+        ),
+        (
+            "sheen r 1",
+            LeafLobe::Sheen(Sheen {
+                reflectance: s(1.0),
+                roughness: 1.0,
+            }),
+        ),
     ];
     if let Some(brdf) = brdf {
         out.push((
@@ -287,7 +302,8 @@ fn closed_form(lobe: &LeafLobe) -> bool {
         | Lobe::Ward(_)
         | Lobe::Lafortune(_)
         | Lobe::Coated(_)
-        | Lobe::Measured(_) => false,
+        | Lobe::Measured(_)
+        | Lobe::Sheen(_) => false,
         Lobe::Mix(never) => match *never {},
     }
 }
@@ -458,7 +474,8 @@ fn albedo_of_the_core_lobes_matches_monte_carlo() {
             | Lobe::Ward(_)
             | Lobe::Lafortune(_)
             | Lobe::Coated(_)
-            | Lobe::Measured(_) => {}
+            | Lobe::Measured(_)
+            | Lobe::Sheen(_) => {}
             Lobe::Mix(never) => match never {},
         }
     }
@@ -472,7 +489,11 @@ fn albedo_of_the_library_lobes_matches_monte_carlo() {
         // Energy conservation is each paper's claim: not Lafortune's (a fit, unnormalised)
         // nor the full Oren–Nayar model's (above 1 near grazing exit, see library_tests).
         let conserving = match leaf {
-            Lobe::Phong(_) | Lobe::BlinnPhong(_) | Lobe::Ward(_) | Lobe::Coated(_) => true,
+            Lobe::Phong(_)
+            | Lobe::BlinnPhong(_)
+            | Lobe::Ward(_)
+            | Lobe::Coated(_)
+            | Lobe::Sheen(_) => true,
             Lobe::OrenNayar(o) => o.form == OrenNayarForm::Qualitative || o.sigma_rad == 0.0,
             Lobe::Lafortune(_) => false,
             Lobe::Lambert(_)
@@ -525,8 +546,8 @@ fn albedo_of_a_measured_table_matches_monte_carlo() {
 }
 
 /// probe.rs's material bandwidth before it moved into the lobes (commit bdf920f), verbatim
-/// but for names and the `MaterialBandwidth` wrapper: the oracle of
-/// `angular_bandwidth_cycles_per_rad`.
+/// but for names and the `MaterialBandwidth` wrapper, plus the arms of lobes added since
+/// (the formula each one's doc states): the oracle of `angular_bandwidth_cycles_per_rad`.
 #[allow(clippy::wildcard_enum_match_arm)]
 fn former_material_bandwidth(bsdf: &Bsdf) -> f32 {
     match &bsdf.lobe {
@@ -557,6 +578,7 @@ fn former_library_lobe_bandwidth(lobe: &BsdfLobe) -> f32 {
             .fold(0.0, f32::max),
         BsdfLobe::Coated(_) | BsdfLobe::ThinDielectric(_) => f32::INFINITY,
         BsdfLobe::Measured(m) => from_alpha(m.brdf.equivalent_alpha),
+        BsdfLobe::Sheen(l) => from_exponent(1.0 / l.roughness),
         BsdfLobe::Mix(m) => m.components[..m.count]
             .iter()
             .map(|c| former_material_bandwidth(&Bsdf::new(c.as_lobe())))
@@ -627,7 +649,7 @@ fn angular_bandwidth_of_every_lobe_is_what_probe_returned_before() {
     }
     eprintln!("angular bandwidth, cycles/rad: {}", report.join("; "));
     // The table covers every variant (a new lobe must join `leaves`).
-    let mut seen = [false; 12];
+    let mut seen = [false; 13];
     for (_, lobe) in &lobes {
         let index = match lobe {
             Lobe::Lambert(_) => 0,
@@ -641,7 +663,8 @@ fn angular_bandwidth_of_every_lobe_is_what_probe_returned_before() {
             Lobe::Coated(_) => 8,
             Lobe::ThinDielectric(_) => 9,
             Lobe::Measured(_) => 10,
-            Lobe::Mix(_) => 11,
+            Lobe::Sheen(_) => 11,
+            Lobe::Mix(_) => 12,
         };
         seen[index] = true;
     }

@@ -1,5 +1,5 @@
 //! The material library (issue 8 and after: Oren–Nayar, Phong, Blinn–Phong, Ward,
-//! Lafortune, coated, measured MERL): the materials whose parameters are constant spectra
+//! Lafortune, coated, measured MERL, sheen): the materials whose parameters are constant spectra
 //! and numbers. Everything render does per library kind is here, one arm each: building it
 //! from the scene (`LibraryMaterial::build`), its lobe at a hit (`LibraryMaterial::lobe`),
 //! its albedo AOV colour (`albedo_rgb`) and the keys it reads (`FIELD_USES`). Formulas and
@@ -13,7 +13,7 @@ use prism_spectrum::{SampledWavelengths, Spectrum};
 
 use crate::bsdf::{
     internal_diffuse_reflectance, BlinnPhong, BsdfLobe, Coated, Lafortune, LafortuneLobe, Measured,
-    MerlBrdf, MerlTable, OrenNayar, OrenNayarForm, Phong, Ward, LAFORTUNE_MAX_LOBES,
+    MerlBrdf, MerlTable, OrenNayar, OrenNayarForm, Phong, Sheen, Ward, LAFORTUNE_MAX_LOBES,
 };
 use crate::scene_build::fields::{read, FieldRow};
 use crate::scene_build::spectrum::{build_spectrum, SpectrumRole};
@@ -90,6 +90,11 @@ pub enum LibraryMaterial {
     },
     /// A measured MERL BRDF, shared by every hit.
     Measured { brdf: Arc<MerlBrdf> },
+    /// Conty Estevez & Kulla 2017 microfacet sheen: colour R, roughness r ∈ [0.1, 1].
+    Sheen {
+        reflectance: Spectrum,
+        roughness: f32,
+    },
 }
 
 impl LibraryMaterial {
@@ -193,6 +198,13 @@ impl LibraryMaterial {
                     brdf: Arc::new(MerlBrdf::new(&table)),
                 }
             }
+            LibraryKind::Sheen {
+                reflectance,
+                roughness,
+            } => LibraryMaterial::Sheen {
+                reflectance: albedo(reflectance, "reflectance")?,
+                roughness: *roughness as f32,
+            },
         })
     }
 
@@ -255,16 +267,26 @@ impl LibraryMaterial {
                 brdf,
                 lambda_nm: wavelengths.lambda(),
             }),
+            LibraryMaterial::Sheen {
+                reflectance,
+                roughness,
+            } => BsdfLobe::Sheen(Sheen {
+                reflectance: reflectance.eval(wavelengths),
+                roughness: *roughness,
+            }),
         }
     }
 }
 
 /// The `albedo` AOV's colour of a library `kind` (`scene_build::material_albedo`): the
 /// diffuse reflectance, plus the specular one where the two share an energy budget; a
-/// measured BRDF (its table is loaded only when rendering) reports the default.
+/// sheen its colour R (the lobe's scale); a measured BRDF (its table is loaded only when
+/// rendering) reports the default.
 pub fn albedo_rgb(kind: &LibraryKind) -> [f32; 3] {
     match kind {
-        LibraryKind::OrenNayar { reflectance, .. } => reflectance_rgb(reflectance),
+        LibraryKind::OrenNayar { reflectance, .. } | LibraryKind::Sheen { reflectance, .. } => {
+            reflectance_rgb(reflectance)
+        }
         LibraryKind::Phong {
             diffuse, specular, ..
         }
@@ -326,6 +348,11 @@ pub const FIELD_USES: &[FieldRow] = &[
         &["materials.*<merl>"],
         &["type", "file", "clamp_negative"],
         "material::LibraryMaterial::build (MerlTable::read)",
+    ),
+    read(
+        &["materials.*<sheen>"],
+        &["type", "reflectance", "roughness"],
+        BUILD,
     ),
 ];
 
