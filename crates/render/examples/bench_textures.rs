@@ -155,9 +155,11 @@ fn main() {
     let description = prism_scene::parse_scene_str(&scene_json, dir.join("s.json")).unwrap();
     let scene = RenderScene::build(&description, None).unwrap();
     let texture = match &scene.materials[0] {
-        prism_render::material::Material::Lambert {
-            reflectance: prism_render::texture::TexturedSpectrum::Texture { texture, .. },
-        } => texture.clone(),
+        prism_render::material::Material::Surface(
+            prism_render::material::SurfaceMaterial::Lambert {
+                reflectance: prism_render::texture::TexturedSpectrum::Texture { texture, .. },
+            },
+        ) => texture.clone(),
         _ => unreachable!(),
     };
     let wavelengths = SampledWavelengths::sample_visible(0.37);

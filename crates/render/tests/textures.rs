@@ -15,7 +15,7 @@ use std::path::Path;
 use std::sync::Arc;
 
 use glam::{Vec2, Vec3A};
-use prism_render::material::Material;
+use prism_render::material::{Material, SurfaceMaterial};
 use prism_render::texture::{TexelValue, Texture, TextureContext, TexturedSpectrum};
 use prism_render::{render, RenderScene, RenderSettings};
 use prism_scene::parse_scene_str;
@@ -53,9 +53,9 @@ fn build(dir: &Path, json: &str) -> Result<RenderScene, String> {
 fn lambert_texture(scene: &RenderScene, index: usize) -> Arc<Texture> {
     fn find(m: &Material) -> Option<Arc<Texture>> {
         match m {
-            Material::Lambert {
+            Material::Surface(SurfaceMaterial::Lambert {
                 reflectance: TexturedSpectrum::Texture { texture, .. },
-            } => Some(texture.clone()),
+            }) => Some(texture.clone()),
             Material::TwoSided { material }
             | Material::Mask { material, .. }
             | Material::NormalMap { material, .. }

@@ -240,7 +240,11 @@ impl LightPlane {
         for r in &splats.records {
             let w = &splats.weights[r.first as usize..(r.first + r.nx + r.ny) as usize];
             let (columns, rows) = w.split_at(r.nx as usize);
-            let xyz = DVec3::new(f64::from(r.xyz[0]), f64::from(r.xyz[1]), f64::from(r.xyz[2]));
+            let xyz = DVec3::new(
+                f64::from(r.xyz[0]),
+                f64::from(r.xyz[1]),
+                f64::from(r.xyz[2]),
+            );
             for (j, &wy) in rows.iter().enumerate() {
                 let row = (r.y0 as usize + j) * width + r.x0 as usize;
                 let xyz_row = xyz * f64::from(wy);
