@@ -180,16 +180,37 @@ fn bad_input_names_the_file_the_line_and_what_was_expected() {
         &["color", "--spectrum", negative.arg()],
         &[&format!("{}:3:", negative.arg()), "non-negative"],
     );
-    // A negative reflectance is data, not an error (colour-science accepts it too) …
-    let out = prism(&[
-        "color",
-        "--spectrum",
-        negative.arg(),
-        "--illuminant",
-        "D65",
-        "--json",
-    ]);
-    assert!(out.status.success());
+    // A negative reflectance is data, not an error (colour-science accepts it too): it is
+    // integrated as given, so every tristimulus value lies below that of the same file
+    // with 0 in its place (x̄, ȳ, z̄ > 0 at 400–410 nm) …
+    let xyz_of = |file: &TempFile| -> Vec<f64> {
+        let out = prism(&[
+            "color",
+            "--spectrum",
+            file.arg(),
+            "--illuminant",
+            "D65",
+            "--json",
+        ]);
+        assert!(
+            out.status.success(),
+            "{}: {}",
+            file.arg(),
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+        floats(&v["XYZ"])
+    };
+    let clipped = TempFile::new("clipped.csv", "wavelength_nm,value\n400,1\n410,0\n");
+    let (with_negative, with_zero) = (xyz_of(&negative), xyz_of(&clipped));
+    assert_eq!(with_negative.len(), 3);
+    assert!(
+        with_negative
+            .iter()
+            .zip(&with_zero)
+            .all(|(n, z)| n.is_finite() && n < z),
+        "XYZ with −0.5 {with_negative:?}, with 0 {with_zero:?}"
+    );
     // … but a negative illuminant is.
     expect_error(
         &[
@@ -246,6 +267,11 @@ fn names_and_aliases_resolve_to_the_same_spectrum() {
     assert!(a.status.success() && b.status.success());
     let a: Value = serde_json::from_slice(&a.stdout).unwrap();
     let b: Value = serde_json::from_slice(&b.stdout).unwrap();
+    let xyz = floats(&a["XYZ"]);
+    assert!(
+        xyz.len() == 3 && xyz.iter().all(|c| c.is_finite() && *c > 0.0),
+        "{xyz:?}"
+    );
     assert_eq!(a["XYZ"], b["XYZ"]);
 }
 

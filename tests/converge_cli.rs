@@ -232,8 +232,8 @@ fn bad_references_and_methods_exit_with_a_clear_message_and_write_nothing() {
         ("tests/fixtures/cct.json", &[], "not a readable image"),
         (
             "tests/fixtures/cornell_mitsuba_reference.exr",
-            &["--resolution", "256x256", "--method", "bdpt"],
-            "unknown integrator `bdpt`; known: INTEGRATOR[+PLAN][:SAMPLER]",
+            &["--resolution", "256x256", "--method", "vcm"],
+            "unknown integrator `vcm`; known: INTEGRATOR[+PLAN][:SAMPLER]",
         ),
         (
             "tests/fixtures/cornell_mitsuba_reference.exr",

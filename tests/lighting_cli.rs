@@ -2,7 +2,7 @@
 //! false-colour PNGs, and the errors a user sees for a broken photometric file.
 
 mod support;
-use support::prism_in as prism;
+use support::{png_size, prism_in as prism};
 
 const IES: &str = "IESNA:LM-63-2002\n[TEST] cli\n[MANUFAC] prism\nTILT=NONE\n1 -1 1 3 1 1 2 0 0 0\n1 1 10\n0 45 90\n0\n600 500 0\n";
 
@@ -48,8 +48,11 @@ fn render_writes_sensor_readings_and_false_colour_beside_the_image() {
     );
     let csv = std::fs::read_to_string(dir.path().join("out.sensors.csv")).unwrap();
     assert_eq!(csv.lines().count(), 1 + 1 + 16);
-    assert!(dir.path().join("out.floor_plane.falsecolour.png").is_file());
-    assert!(dir.path().join("out.exr").is_file());
+    // The 4 × 4 grid at 400 / 4 = 100 px a cell, with the legend beside it.
+    let (w, h) = png_size(&dir.path().join("out.floor_plane.falsecolour.png"));
+    assert!(h == 400 && w > 400, "{w}×{h}");
+    let image = prism_image::io::exr::read_exr(&dir.path().join("out.exr")).unwrap();
+    assert_eq!((image.width(), image.height()), (16, 12));
 }
 
 #[test]

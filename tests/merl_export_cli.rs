@@ -43,7 +43,15 @@ fn merl_export_writes_a_table_that_renders() {
         "2",
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    assert!(image.is_file());
+    // The sphere in the middle of the frame reflects the sky: the table is not black.
+    let image = prism_image::io::exr::read_exr(&image).unwrap();
+    assert_eq!((image.width(), image.height()), (16, 12));
+    assert!(image
+        .pixels()
+        .iter()
+        .all(|p| p.iter().all(|c| c.is_finite() && *c >= 0.0)));
+    let centre = image.pixel(8, 6);
+    assert!(centre.iter().all(|&c| c > 0.0), "{centre:?}");
 
     let o = prism(&[
         "merl-export",

@@ -3,8 +3,8 @@
 
 use std::path::{Path, PathBuf};
 
-use prism_post::image::Image;
-use prism_post::io::{read_image, write_image};
+use prism_image::image::Image;
+use prism_image::io::{read_image, write_image};
 use prism_spectrum::rgb_space::RgbColorSpace;
 use serde_json::Value;
 
@@ -118,6 +118,8 @@ fn every_operator_maps_a_render_to_png_and_to_exr_in_unit_range() {
             op,
         ]);
         assert!(std::fs::read(&png).unwrap().starts_with(b"\x89PNG"), "{op}");
+        let mapped = read_image(&png).unwrap();
+        assert_eq!((mapped.width(), mapped.height()), (48, 32), "{op}");
         let exr = scratch(&format!("{op}.exr"));
         let report: Value = serde_json::from_str(&ok(&[
             "tonemap",
@@ -226,7 +228,7 @@ fn absolute_operators_need_a_scale_on_foreign_images() {
             ],
             &["--luminance-scale"],
         );
-        ok(&[
+        let report: Value = serde_json::from_str(&ok(&[
             "tonemap",
             hdr.to_str().unwrap(),
             "-o",
@@ -235,7 +237,28 @@ fn absolute_operators_need_a_scale_on_foreign_images() {
             op,
             "--luminance-scale",
             "179",
-        ]);
+            "--json",
+        ]))
+        .unwrap();
+        assert_eq!(report["operator"], op);
+        assert_eq!(
+            report["luminance_scale_cd_m2"].as_f64(),
+            Some(179.0),
+            "{op}"
+        );
+        assert_eq!(
+            (&report["width"], &report["height"]),
+            (&40.into(), &30.into())
+        );
+        // The image written: full size, and the 200-unit spot (x > 30, y < 5) brighter
+        // than the dimmest corner of the gradient (0.097 units at (0, 29)).
+        let mapped = read_image(&out).unwrap();
+        assert_eq!((mapped.width(), mapped.height()), (40, 30), "{op}");
+        let (spot, dim) = (mapped.pixel(35, 2), mapped.pixel(0, 29));
+        assert!(
+            spot[1] > dim[1] && spot.iter().chain(&dim).all(|c| c.is_finite()),
+            "{op}: spot {spot:?}, dim corner {dim:?}"
+        );
     }
 }
 
@@ -528,5 +551,78 @@ fn exposure_auto_brings_an_absolute_render_to_middle_grey() {
             "auto",
         ],
         &["black.exr", "--exposure auto", "black image"],
+    );
+}
+
+#[test]
+fn cat_chooses_the_adaptation_transform_of_the_white_balance() {
+    use prism_post::colour::white_balance::illuminant_white_xyz_unit_y;
+    use prism_spectrum::adaptation::{adaptation_matrix, AdaptationMethod};
+    // A saturated orange and a grey, well inside [0, 1] after adaptation, under CIE A.
+    let srgb = RgbColorSpace::srgb();
+    let colours = [[0.45f32, 0.22, 0.05], [0.3, 0.3, 0.3]];
+    let pixels: Vec<[f32; 3]> = (0..8).map(|i| colours[i % 2]).collect();
+    let input = scratch("cat_input.exr");
+    write_image(
+        &input,
+        &Image::new(4, 2, pixels, RgbColorSpace::srgb()).unwrap(),
+    )
+    .unwrap();
+    let source = illuminant_white_xyz_unit_y("A").unwrap();
+    let mut orange_by_cat = Vec::new();
+    for (flag, method) in [
+        ("bradford", AdaptationMethod::Bradford),
+        ("cat16", AdaptationMethod::Cat16),
+        ("cat02", AdaptationMethod::Cat02),
+        ("von-kries", AdaptationMethod::VonKries),
+    ] {
+        let output = scratch(&format!("cat_{flag}.exr"));
+        let json: Value = serde_json::from_str(&ok(&[
+            "tonemap",
+            input.to_str().unwrap(),
+            "-o",
+            output.to_str().unwrap(),
+            "--op",
+            "linear",
+            "--wb",
+            "illuminant:A",
+            "--cat",
+            flag,
+            "--json",
+        ]))
+        .unwrap();
+        assert_eq!(json["chromatic_adaptation"], method.name(), "{json}");
+        // Each pixel is M_rgb⁻¹ · CAT(A → D65) · M_rgb · pixel (linear operator, exposure 0).
+        let cat = adaptation_matrix(method, source, srgb.white_xyz());
+        let out = read_image(&output).unwrap();
+        for (i, colour) in colours.iter().enumerate() {
+            let expected = srgb.xyz_to_rgb
+                * (cat * (srgb.rgb_to_xyz * glam::DVec3::from(colour.map(f64::from))));
+            let got = out.pixel(i, 0);
+            for c in 0..3 {
+                assert!(
+                    (f64::from(got[c]) - expected[c]).abs() < 2e-5,
+                    "--cat {flag}, pixel {i}: got {got:?}, expected {expected}"
+                );
+            }
+        }
+        orange_by_cat.push(out.pixel(0, 0));
+    }
+    // The transforms differ on saturated colours (else the flag would be untestable).
+    for other in &orange_by_cat[1..] {
+        let gap = (0..3)
+            .map(|c| (other[c] - orange_by_cat[0][c]).abs())
+            .fold(0.0f32, f32::max);
+        assert!(gap > 1e-3, "{orange_by_cat:?}");
+    }
+}
+
+#[test]
+fn cat_refuses_an_unknown_transform() {
+    fails_with(
+        &[
+            "tonemap", "in.exr", "-o", "out.png", "--op", "linear", "--cat", "sharp",
+        ],
+        &["--cat", "bradford", "cat16", "cat02", "von-kries"],
     );
 }

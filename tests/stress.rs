@@ -12,7 +12,7 @@
 //!   a sphere light, E = π L sin²α cos θ).
 
 use glam::{UVec2, Vec2};
-use prism_post::Image;
+use prism_image::Image;
 use prism_render::{render, FilmImage, RenderScene, RenderSettings, RenderStats, SamplerKind};
 use prism_spectrum::rgb_space::RgbColorSpace;
 

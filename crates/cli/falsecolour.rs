@@ -5,8 +5,8 @@
 use std::path::{Path, PathBuf};
 
 use clap::ValueEnum;
+use prism_image::io::write_image;
 use prism_post::falsecolour::{false_colour, FalseColourOptions, FalseColourScale};
-use prism_post::io::write_image;
 use prism_render::sensor::SensorReading;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]

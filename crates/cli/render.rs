@@ -17,10 +17,10 @@ use std::time::{Duration, Instant};
 use clap::Args;
 use glam::UVec2;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use prism_post::io::exr::ExrWriteOptions;
-use prism_post::io::spectral_exr::write_exr_with_spectral_bands;
-use prism_post::io::{write_image, ImageFormat};
-use prism_post::Image;
+use prism_image::io::exr::ExrWriteOptions;
+use prism_image::io::spectral_exr::write_exr_with_spectral_bands;
+use prism_image::io::{write_image, ImageFormat};
+use prism_image::Image;
 use prism_render::film::spectral_bins::{MAX_SPECTRAL_BINS, MIN_SPECTRAL_BINS};
 use prism_render::integrator::DEFAULT_TILE_SIZE_PX;
 use prism_render::{

@@ -29,6 +29,10 @@ pub struct TonemapArgs {
     /// the light in the scene, from the `illumination` layer `prism render` writes).
     #[arg(long, default_value = "none")]
     pub wb: String,
+    /// Chromatic adaptation transform of the white balance: bradford, cat16, cat02 or
+    /// von-kries.
+    #[arg(long, value_enum, default_value = "bradford")]
+    pub cat: CatArg,
     /// Gamut mapping: clip, local-lch, local-oklab, global, aces-rgc.
     #[arg(long, default_value = "clip")]
     pub gamut: String,
@@ -147,6 +151,27 @@ fn print_summary(report: &TonemapFileReport) {
     }
 }
 
+/// The adaptation transforms `--cat` offers (all but the identity, which would switch
+/// white balance off: `--wb none` says that).
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+pub enum CatArg {
+    Bradford,
+    Cat16,
+    Cat02,
+    VonKries,
+}
+
+impl From<CatArg> for prism_spectrum::AdaptationMethod {
+    fn from(arg: CatArg) -> Self {
+        match arg {
+            CatArg::Bradford => Self::Bradford,
+            CatArg::Cat16 => Self::Cat16,
+            CatArg::Cat02 => Self::Cat02,
+            CatArg::VonKries => Self::VonKries,
+        }
+    }
+}
+
 pub fn run(args: &TonemapArgs) -> Result<(), String> {
     if args.list {
         return print_list(args.json);
@@ -161,6 +186,7 @@ pub fn run(args: &TonemapArgs) -> Result<(), String> {
         operator: OperatorChoice::parse(op).map_err(|e| format!("--op {op}: {e}"))?,
         params: parse_params(&args.params)?,
         wb: WhiteBalance::parse(&args.wb).map_err(|e| e.to_string())?,
+        cat: args.cat.into(),
         gamut: GamutMethod::parse(&args.gamut).map_err(|e| e.to_string())?,
         target: GamutTarget::parse(&args.target).map_err(|e| e.to_string())?,
         exposure_ev,

@@ -142,6 +142,9 @@ mod tests {
         assert!(e.contains("angular_cycles_per_rad"), "{e}");
         let e = MaterialBandwidth::new(1.0, -2.0).unwrap_err().to_string();
         assert!(e.contains("texture_cycles_per_m"), "{e}");
-        assert!(MaterialBandwidth::new(f32::INFINITY, 0.0).is_ok());
+        // A mirror (+∞ angular bandwidth) without a texture is valid and kept as given.
+        let mirror = MaterialBandwidth::new(f32::INFINITY, 0.0).unwrap();
+        assert!(mirror.angular_cycles_per_rad.is_infinite());
+        assert_eq!(mirror.texture_cycles_per_m, 0.0);
     }
 }

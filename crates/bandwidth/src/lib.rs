@@ -2,7 +2,7 @@
 //! Bagher, Soler, Subr, Belcour & Holzschuch 2013, "Interactive Rendering of Acquired
 //! Materials on Dynamic Geometry Using Frequency Analysis" (IEEE TVCG 19(5)).
 //!
-//! The data flow (DESIGN.md): render fills a [`GBuffer`] from the primary hits; the
+//! The data flow (docs/architecture.md): render fills a [`GBuffer`] from the primary hits; the
 //! predictor reads it, asks render's [`ShadingProbe`] for sampled light directions with
 //! their radiance, BSDF value, distance and bandwidths (Bagher eqs. 4, 5, 9), and returns a
 //! [`SamplePlan`]; render executes the plan. This crate depends only on geometry types

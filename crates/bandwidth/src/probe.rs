@@ -1,6 +1,6 @@
 //! The shading probe: how the predictor asks render, at a G-buffer hit, for the quantities
 //! of Bagher et al. 2013's eqs. 4, 5 and 9 without depending on render (render implements
-//! the trait; DESIGN.md "Core types").
+//! the trait; docs/architecture.md).
 //!
 //! For each of n_b sampled incident directions ω_i at the hit x (Bagher uses n_b = 16):
 //!

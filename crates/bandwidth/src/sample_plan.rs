@@ -1,6 +1,6 @@
 //! The sample plan: how many camera samples each pixel gets and how many light samples
 //! each hit of that pixel takes — what the predictor hands to the integrator (Bagher et al.
-//! 2013: N_p of §2.4 per pixel; DESIGN.md "Uniform plan = same spp everywhere; Predicted
+//! 2013: N_p of §2.4 per pixel; docs/architecture.md: "Uniform plan = same spp everywhere; Predicted
 //! plan = per-pixel spp").
 //!
 //! Light samples are stored **per pixel**: every camera sample of pixel p takes

@@ -277,7 +277,7 @@ mod tests {
     #[test]
     fn unknown_and_unbuilt_names_are_errors_listing_the_known_ones() {
         for (text, says) in [
-            ("bdpt", "unknown integrator `bdpt`"),
+            ("vcm", "unknown integrator `vcm`"),
             (
                 "photon",
                 "`photon` (photon mapping (not built yet)) is not available",
@@ -292,6 +292,38 @@ mod tests {
                 e.contains("path") && e.contains("sobol") && e.contains("uniform"),
                 "{e}"
             );
+        }
+    }
+
+    #[test]
+    fn light_and_bdpt_take_the_scenes_spectral_parameters() {
+        let scene = prism_scene::Integrator::Path {
+            max_depth: 4,
+            sampler: SamplerKind::Sobol,
+            mis: prism_scene::MisHeuristic::Balance,
+            rr_depth: 2,
+        };
+        let m = Method::parse("bdpt:sobol").unwrap();
+        assert_eq!(m.quantity(), "radiance");
+        match m.integrator(&scene).unwrap() {
+            Integrator::Bdpt(b) => assert_eq!(
+                (b.max_depth, b.rr_depth, b.mis),
+                (4, 2, prism_scene::MisHeuristic::Balance)
+            ),
+            other => panic!("{other:?}"),
+        }
+        match Method::parse("light").unwrap().integrator(&scene).unwrap() {
+            Integrator::Light(l) => assert_eq!((l.max_depth, l.rr_depth), (4, 2)),
+            other => panic!("{other:?}"),
+        }
+        // A diagnostic scene integrator: the defaults.
+        match Method::parse("bdpt")
+            .unwrap()
+            .integrator(&prism_scene::Integrator::Depth)
+            .unwrap()
+        {
+            Integrator::Bdpt(b) => assert_eq!((b.max_depth, b.rr_depth), (8, 3)),
+            other => panic!("{other:?}"),
         }
     }
 

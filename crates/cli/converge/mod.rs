@@ -17,9 +17,9 @@ use std::time::Instant;
 
 use clap::Args;
 use glam::UVec2;
-use prism_post::io::write_image;
+use prism_image::io::write_image;
+use prism_image::Image;
 use prism_post::metrics::PreparedReference;
-use prism_post::Image;
 use prism_render::integrator::DEFAULT_TILE_SIZE_PX;
 use prism_render::{render, RenderScene, RenderSettings, SamplerKind};
 use serde_json::{json, Value};

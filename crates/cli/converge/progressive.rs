@@ -20,8 +20,8 @@ use std::sync::mpsc;
 use std::time::Instant;
 
 use prism_bandwidth::SamplePlan;
+use prism_image::Image;
 use prism_post::metrics::{CompareOptions, Comparison, PreparedReference};
-use prism_post::Image;
 use prism_render::{film_for, render_pass, Film, RenderScene, RenderSettings, RenderStats};
 use prism_spectrum::rgb_space::RgbColorSpace;
 

@@ -6,8 +6,8 @@
 use std::path::{Path, PathBuf};
 
 use glam::UVec2;
-use prism_post::io::read_image;
-use prism_post::Image;
+use prism_image::io::read_image;
+use prism_image::Image;
 
 /// Reads the reference at `path` and checks that it is `resolution` pixels.
 pub fn load_reference(path: &Path, resolution: UVec2) -> Result<Image, String> {

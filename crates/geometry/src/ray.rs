@@ -36,7 +36,7 @@ impl Ray {
     }
 
     /// A ray leaving a surface point: `t_min` is offset so the surface it leaves is not hit
-    /// again (the "tmin offset" convention of CRATES.md).
+    /// again (the origin stays on the surface; the offset scales with the coordinates' magnitude).
     pub fn spawn(origin: Vec3A, direction: Vec3A) -> Self {
         Self::new(
             origin,

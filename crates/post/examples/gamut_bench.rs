@@ -1,6 +1,6 @@
 //! Throughput of white balance and every gamut method on 2 Mpixel of random Rec.2020
 //! colours mapped to sRGB; prints one JSON line per method (Mpixel/s) for tools/ to chart.
-//! Run: cargo run --release -p prism-post-colour --example gamut_bench
+//! Run: cargo run --release -p prism-post --example gamut_bench
 
 use std::time::Instant;
 

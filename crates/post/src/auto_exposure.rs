@@ -10,7 +10,7 @@
 
 use rayon::prelude::*;
 
-use crate::image::Image;
+use prism_image::Image;
 
 /// Middle grey that the log-average luminance is mapped to (Reinhard et al. 2002, eq. 2).
 pub const AUTO_EXPOSURE_KEY: f64 = 0.18;

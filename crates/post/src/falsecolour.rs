@@ -6,9 +6,9 @@
 //! colours, interpolated linearly in display space. Values below the range take the first
 //! colour, above it the last; on a log scale values ≤ 0 take the first.
 
-use crate::error::{PostError, Result};
-use crate::image::Image;
 use crate::sheet::font5x7::{draw_text, GLYPH_HEIGHT};
+use prism_image::Image;
+use prism_image::{ImageError, Result};
 use prism_spectrum::rgb_space::RgbColorSpace;
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -107,12 +107,12 @@ pub fn resolve_range(values: &[f32], options: &FalseColourOptions) -> Result<(f6
         }
     };
     if !(lo.is_finite() && hi.is_finite() && hi > lo) {
-        return Err(PostError::Invalid(format!(
+        return Err(ImageError::Invalid(format!(
             "false-colour range [{lo}, {hi}] is empty (every value is the same, or the range is reversed)"
         )));
     }
     if options.scale == FalseColourScale::Log && lo <= 0.0 {
-        return Err(PostError::Invalid(format!(
+        return Err(ImageError::Invalid(format!(
             "a log false-colour scale needs a minimum > 0, found {lo}"
         )));
     }
@@ -128,7 +128,7 @@ pub fn false_colour(
     options: &FalseColourOptions,
 ) -> Result<Image> {
     if values.len() != width * height || width == 0 || height == 0 {
-        return Err(PostError::Invalid(format!(
+        return Err(ImageError::Invalid(format!(
             "false colour: {} values for a {width} × {height} image",
             values.len()
         )));

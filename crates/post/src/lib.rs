@@ -1,18 +1,13 @@
-//! prism-post: the image type, EXR (RGB, AOV layers, spectral layout of Fichet et al. 2021),
-//! Radiance RGBE and PNG I/O, tone operators and image metrics.
+//! prism-post: tone operators, white balance and gamut mapping, image metrics, false colour
+//! and contact sheets, on the image type of prism-image (which also reads and writes the
+//! files, and whose error type these operations return).
 //!
 //! File pipeline (`tonemap_file`): read → exposure → white balance → tone operator →
 //! gamut mapping → display encoding.
 
 pub mod auto_exposure;
 pub mod colour;
-pub mod error;
 pub mod falsecolour;
-pub mod image;
-pub mod io;
-
-pub use error::{PostError, Result};
-pub use image::{AovLayer, Image};
 pub mod metrics;
 pub mod pipeline;
 pub mod sheet;

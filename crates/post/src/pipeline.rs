@@ -2,7 +2,8 @@
 //! thin wrapper: parse arguments, call these, print the serialisable report.
 //!
 //! `tonemap_file` order: read → exposure (× 2^EV) → white balance
-//! ([`crate::colour::apply_white_balance`], Bradford; for `--wb scene` the white comes from
+//! ([`crate::colour::apply_white_balance`] with the `--cat` transform, Bradford by default;
+//! for `--wb scene` the white comes from
 //! the file's `illumination` layer, [`scene_white_of`]) → tone operator (or, for `--op all`,
 //! the contact sheet of every operator) → gamut mapping into the target
 //! ([`crate::colour::map_gamut`], fraction outside reported) → write. An EXR output holds
@@ -23,12 +24,12 @@ use crate::colour::{
     apply_white_balance, apply_with_source_white, illumination_white_xyz, map_gamut, GamutMethod,
     GamutTarget, SceneWhite, WhiteBalance, ILLUMINATION_LAYER,
 };
-use crate::error::{PostError, Result};
-use crate::image::Image;
-use crate::io::{read_image, write_image};
 use crate::metrics::{compare, Comparison};
 use crate::sheet::{contact_sheet_with_reports, SheetFailure};
 use crate::tonemap::{ToneOperator, ToneParams, ToneReport};
+use prism_image::io::{read_image, write_image};
+use prism_image::Image;
+use prism_image::{ImageError, Result};
 
 /// `--op NAME` or `--op all` (contact sheet).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -71,6 +72,10 @@ pub struct TonemapOptions {
     pub params: BTreeMap<String, f64>,
     /// `--wb METHOD`.
     pub wb: WhiteBalance,
+    /// `--cat bradford|cat16|cat02|von-kries`: the chromatic adaptation transform white
+    /// balance uses (`AdaptationMethod::None` would make white balance a no-op: the CLI
+    /// does not offer it).
+    pub cat: AdaptationMethod,
     /// `--gamut METHOD`.
     pub gamut: GamutMethod,
     /// `--target srgb|p3|rec2020`: output primaries and, for PNG, transfer function.
@@ -90,6 +95,7 @@ impl Default for TonemapOptions {
             operator: OperatorChoice::One(ToneOperator::Reinhard02),
             params: BTreeMap::new(),
             wb: WhiteBalance::None,
+            cat: AdaptationMethod::Bradford,
             gamut: GamutMethod::Clip,
             target: GamutTarget::Srgb,
             exposure_ev: 0.0,
@@ -126,6 +132,8 @@ pub struct TonemapFileReport {
     pub auto_exposure: bool,
     pub luminance_scale_cd_m2: Option<f64>,
     pub white_balance: String,
+    /// The chromatic adaptation transform of the white balance (`--cat`).
+    pub chromatic_adaptation: &'static str,
     /// Estimated scene white (CIE 1931 xy) when white balance ran.
     pub white_balance_source_xy: Option<[f64; 2]>,
     pub gamut_method: &'static str,
@@ -160,14 +168,14 @@ pub fn tonemap_file(
 
     let t = Instant::now();
     if !options.exposure_ev.is_finite() {
-        return Err(PostError::invalid(format!(
+        return Err(ImageError::invalid(format!(
             "--exposure {}: expected a finite number of stops",
             options.exposure_ev
         )));
     }
     let exposure_ev = if options.auto_exposure {
         auto_exposure_ev(&image).ok_or_else(|| {
-            PostError::format(
+            ImageError::format(
                 input,
                 "--exposure auto: no pixel has a positive finite luminance (black image)",
             )
@@ -192,18 +200,13 @@ pub fn tonemap_file(
                 &space,
                 &options.wb,
                 white,
-                AdaptationMethod::Bradford,
+                options.cat,
             );
             Some(report.source_white_xy)
         }
         method => {
-            let report = apply_white_balance(
-                image.pixels_mut(),
-                &space,
-                method,
-                AdaptationMethod::Bradford,
-            )
-            .map_err(|e| PostError::format(input, e.to_string()))?;
+            let report = apply_white_balance(image.pixels_mut(), &space, method, options.cat)
+                .map_err(|e| ImageError::format(input, e.to_string()))?;
             Some(report.source_white_xy)
         }
     };
@@ -214,8 +217,8 @@ pub fn tonemap_file(
         luminance_scale_cd_m2: options.luminance_scale_cd_m2,
         values: options.params.clone(),
     };
-    let in_file = |e: PostError| match e {
-        PostError::Invalid(m) => PostError::format(input, m),
+    let in_file = |e: ImageError| match e {
+        ImageError::Invalid(m) => ImageError::format(input, m),
         other => other,
     };
     let t = Instant::now();
@@ -263,6 +266,7 @@ pub fn tonemap_file(
         auto_exposure: options.auto_exposure,
         luminance_scale_cd_m2: options.luminance_scale_cd_m2,
         white_balance: options.wb.name(),
+        chromatic_adaptation: options.cat.name(),
         white_balance_source_xy: wb_source_xy,
         gamut_method: options.gamut.name(),
         target: options.target.name(),
@@ -285,7 +289,7 @@ pub fn tonemap_file(
 /// `illumination.X/Y/Z` layer of `image` (read from `path`, which errors name).
 pub fn scene_white_of(image: &Image, path: &Path) -> Result<SceneWhite> {
     let missing = |found: String| {
-        PostError::format(
+        ImageError::format(
             path,
             format!(
                 "`--wb scene` needs the `{ILLUMINATION_LAYER}` layer (channels \
@@ -315,7 +319,7 @@ pub fn scene_white_of(image: &Image, path: &Path) -> Result<SceneWhite> {
         .chunks_exact(k)
         .map(|p| [p[x], p[y], p[z]])
         .collect();
-    illumination_white_xyz(&xyz).map_err(|e| PostError::format(path, e.to_string()))
+    illumination_white_xyz(&xyz).map_err(|e| ImageError::format(path, e.to_string()))
 }
 
 /// Compares the image at `test` with the reference at `reference`; mismatched sizes are an
@@ -324,7 +328,7 @@ pub fn compare_files(test: &Path, reference: &Path) -> Result<Comparison> {
     let a = read_image(test)?;
     let b = read_image(reference)?;
     if (a.width(), a.height()) != (b.width(), b.height()) {
-        return Err(PostError::invalid(format!(
+        return Err(ImageError::invalid(format!(
             "{} is {}×{} but {} is {}×{}: compare needs equal sizes",
             test.display(),
             a.width(),

@@ -3,11 +3,11 @@
 //! follows the published formula, and the outside fraction is reported correctly.
 
 use glam::DVec3;
+use prism_image::rgb_matrix::rgb_to_rgb_matrix;
 use prism_post::colour::aces_rgc::{aces_rgc_acescg, AcesRgcParameters};
 use prism_post::colour::cielab_lch::{hue_difference_deg, lab_to_lch_deg, CielabConverter};
 use prism_post::colour::gamut::is_inside_unit_cube;
 use prism_post::colour::oklab::OklabConverter;
-use prism_post::colour::rgb_matrix::rgb_to_rgb_matrix;
 use prism_post::colour::{map_gamut, GamutMethod, GamutTarget};
 use prism_spectrum::rgb_space::RgbColorSpace;
 use prism_spectrum::AdaptationMethod;

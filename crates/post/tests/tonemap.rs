@@ -1,7 +1,8 @@
 //! Properties every tone operator shares: finite, non-negative output whatever the input,
 //! problems counted in the report, parameters checked with clear errors.
 
-use prism_post::{Image, ToneOperator, ToneParams};
+use prism_image::Image;
+use prism_post::{ToneOperator, ToneParams};
 use prism_spectrum::rgb_space::RgbColorSpace;
 
 fn troubled_image() -> Image {
@@ -128,7 +129,8 @@ fn absolute_operators_need_a_scale_and_accept_either_source() {
 
 #[test]
 fn tonemap_file_writes_png_and_exr_and_compare_files_reads_them_back() {
-    use prism_post::{compare_files, io, tonemap_file, TonemapOptions};
+    use prism_image::io;
+    use prism_post::{compare_files, tonemap_file, TonemapOptions};
     let dir = std::env::temp_dir().join(format!("prism-post-pipeline-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let input = dir.join("in.exr");
@@ -193,8 +195,9 @@ fn tonemap_file_writes_png_and_exr_and_compare_files_reads_them_back() {
 
 #[test]
 fn tonemap_file_runs_exposure_white_balance_operator_gamut_and_the_contact_sheet() {
+    use prism_image::io;
     use prism_post::colour::{GamutMethod, GamutTarget, WhiteBalance};
-    use prism_post::{io, tonemap_file, OperatorChoice, TonemapOptions};
+    use prism_post::{tonemap_file, OperatorChoice, TonemapOptions};
     let dir = std::env::temp_dir().join(format!("prism-post-sheet-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let input = dir.join("in.exr");

@@ -19,7 +19,8 @@
 //!   `exponentiation_mapping`: no Prism operator with these definitions (Prism's
 //!   `reinhard02` is the 2002 photographic operator, on luminance).
 
-use prism_post::{Image, ToneOperator, ToneParams};
+use prism_image::Image;
+use prism_post::{ToneOperator, ToneParams};
 use prism_spectrum::rgb_space::RgbColorSpace;
 use serde_json::Value;
 

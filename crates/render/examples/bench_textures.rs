@@ -155,9 +155,11 @@ fn main() {
     let description = prism_scene::parse_scene_str(&scene_json, dir.join("s.json")).unwrap();
     let scene = RenderScene::build(&description, None).unwrap();
     let texture = match &scene.materials[0] {
-        prism_render::material::Material::Lambert {
-            reflectance: prism_render::texture::TexturedSpectrum::Texture { texture, .. },
-        } => texture.clone(),
+        prism_render::material::Material::Surface(
+            prism_render::material::SurfaceMaterial::Lambert {
+                reflectance: prism_render::texture::TexturedSpectrum::Texture { texture, .. },
+            },
+        ) => texture.clone(),
         _ => unreachable!(),
     };
     let wavelengths = SampledWavelengths::sample_visible(0.37);
@@ -282,14 +284,14 @@ fn tempfile_dir() -> std::path::PathBuf {
 
 fn write_png(path: &std::path::Path, size: usize, rgb: impl Fn(usize, usize) -> [f32; 3]) {
     let pixels: Vec<[f32; 3]> = (0..size * size).map(|i| rgb(i % size, i / size)).collect();
-    let image = prism_post::Image::new(
+    let image = prism_image::Image::new(
         size,
         size,
         pixels,
         prism_spectrum::rgb_space::RgbColorSpace::srgb(),
     )
     .unwrap();
-    prism_post::io::write_image(path, &image).unwrap();
+    prism_image::io::write_image(path, &image).unwrap();
 }
 
 fn write_noise_png(path: &std::path::Path, size: usize) {
@@ -301,7 +303,7 @@ fn write_noise_png(path: &std::path::Path, size: usize) {
 }
 
 fn write_flatish_normal_png(path: &std::path::Path, size: usize) {
-    // A PNG written through prism-post is sRGB-encoded from these linear values; read
+    // A PNG written through prism-image is sRGB-encoded from these linear values; read
     // back as a normal map it is taken as linear codes, which only changes the bumps.
     write_png(path, size, |x, y| {
         let t = std::f32::consts::TAU * 4.0 / size as f32;

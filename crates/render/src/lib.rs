@@ -3,7 +3,7 @@
 //! the diagnostic integrators, and the `ShadingProbe` the bandwidth predictor uses. Media
 //! follow.
 //!
-//! Conventions (DESIGN.md "Units and conventions"): metres, radians, right-handed with Y up.
+//! Conventions (docs/architecture.md, "Units and conventions"): metres, radians, right-handed with Y up.
 //! Camera space looks down −Z with +X right and +Y up (`prism_geometry::Transform::look_at`).
 //! Film coordinates are in pixels, continuous: (0, 0) is the top-left corner of the top-left
 //! pixel, x grows right and y grows down, pixel (i, j) covers [i, i+1) × [j, j+1) and its
@@ -12,7 +12,6 @@
 
 pub mod bsdf;
 pub mod camera;
-pub mod chi2;
 pub mod error;
 pub mod film;
 pub mod integrator;

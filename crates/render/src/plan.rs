@@ -1,5 +1,5 @@
 //! The render plan: before rendering, look at the scene and switch on only what it uses
-//! ("model no more than a scene needs", DESIGN.md). Each choice records why it was made;
+//! ("model no more than a scene needs", docs/architecture.md). Each choice records why it was made;
 //! `prism render --explain` prints them without rendering.
 //!
 //! The integrator follows the same facts at run time (a delta light gets MIS weight 1, a

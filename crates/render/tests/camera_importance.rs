@@ -22,7 +22,7 @@ use prism_render::camera::{
     ApertureSpec, Camera, CameraFrame, FisheyeCamera, FisheyeCoverage, FisheyeProjection,
     FocalSpec, OrthographicCamera, PinholeCamera, SphericalCamera, ThinLensCamera,
 };
-use prism_render::chi2::{chi2_test_adaptive, sidak, Chi2Config, SplitMix64};
+use prism_testkit::chi2::{chi2_test_adaptive, sidak, Chi2Config, SplitMix64};
 
 const RES: UVec2 = UVec2::new(400, 300);
 
@@ -107,7 +107,7 @@ fn direction(axes: &[DVec3; 3], theta: f64, phi: f64) -> DVec3 {
 /// ∫ g(θ, φ) dω over θ ∈ [0, θ_max], φ ∈ [0, 2π): midpoint rule on n × 2n cells with the
 /// exact ∫ sin θ dθ of each, a cell split in four (up to `depth` times) while the nine
 /// values of its corners, edge midpoints and centre mix zero and non-zero (the film's
-/// outline crosses it), as `prism_render::chi2`'s adaptive bins.
+/// outline crosses it), as `prism_testkit::chi2`'s adaptive bins.
 fn sphere_integral(g: &impl Fn(f64, f64) -> f64, theta_max: f64, n: usize, depth: u32) -> f64 {
     fn cell(g: &impl Fn(f64, f64) -> f64, t0: f64, p0: f64, dt: f64, dp: f64, depth: u32) -> f64 {
         let centre = g(t0 + 0.5 * dt, p0 + 0.5 * dp);
@@ -669,7 +669,8 @@ fn orthographic_and_spherical_cameras_have_no_importance() {
 #[test]
 fn importance_support_and_lens_kinds() {
     for (name, camera, _) in cameras_with_importance() {
-        assert!(camera.importance_support().is_ok(), "{name}");
+        assert_eq!(camera.importance_support(), Ok(()), "{name}");
+        assert!(camera.importance_area_px2() > 0.0, "{name}");
         assert_eq!(
             camera.is_delta_position(),
             !matches!(camera, Camera::ThinLens(_)),

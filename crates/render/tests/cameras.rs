@@ -166,12 +166,17 @@ fn fisheye_fov_limits_are_validated_per_projection() {
     let deg = |d: f32| d.to_radians();
     let make = |p, fov| FisheyeCamera::new(frame(), p, FisheyeCoverage::Circular, fov);
     use FisheyeProjection::*;
-    assert!(make(Orthographic, PI).is_ok());
+    // The largest accepted field of each projection is kept as given.
+    let accepted = |p, fov| {
+        let camera = make(p, fov).unwrap_or_else(|e| panic!("{p:?} at {fov} rad: {e}"));
+        assert_eq!((camera.projection(), camera.fov_rad()), (p, fov));
+    };
+    accepted(Orthographic, PI);
     assert!(make(Orthographic, deg(181.0)).is_err());
-    assert!(make(Stereographic, deg(359.0)).is_ok());
+    accepted(Stereographic, deg(359.0));
     assert!(make(Stereographic, TAU).is_err());
     for p in [Equidistant, Equisolid] {
-        assert!(make(p, TAU).is_ok());
+        accepted(p, TAU);
         assert!(make(p, deg(361.0)).is_err());
     }
     for p in FisheyeProjection::ALL {
@@ -447,7 +452,12 @@ fn constructors_reject_bad_parameters_with_their_names() {
     };
     let mm50 = FocalSpec::FocalLengthMm(50.0);
     let f2 = ApertureSpec::FNumber(2.0);
-    assert!(thin(mm50, f2, 2.0, 36.0).is_ok());
+    // Valid parameters are kept, in metres: f/2 at 50 mm is a 12.5 mm aperture radius.
+    let valid = ThinLensCamera::new(frame(), mm50, f2, 2.0, 36.0).unwrap();
+    assert!((valid.focal_length_m() - 0.05).abs() < 1e-7);
+    assert!((valid.aperture_radius_m() - 0.0125).abs() < 1e-7);
+    assert_eq!(valid.focus_distance_m(), 2.0);
+    assert!((valid.sensor_width_m() - 0.036).abs() < 1e-7);
     assert_eq!(
         thin(mm50, f2, 0.04, 36.0).unwrap_err().parameter,
         "focus_distance_m"
@@ -480,7 +490,10 @@ fn constructors_reject_bad_parameters_with_their_names() {
             .parameter,
         "aperture_radius_m"
     );
-    assert!(thin(mm50, ApertureSpec::RadiusM(0.0), 2.0, 36.0).is_ok());
+    // A zero aperture is a pinhole, not an error.
+    let pinhole = ThinLensCamera::new(frame(), mm50, ApertureSpec::RadiusM(0.0), 2.0, 36.0)
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(pinhole.aperture_radius_m(), 0.0);
 }
 
 #[test]

@@ -142,7 +142,29 @@ fn bdpt_of(p: PathTracer, strategy: Option<BdptStrategy>) -> Integrator {
 }
 
 fn methods_agree(name: &str, resolution: UVec2, spp: u32, seeds: usize) {
-    let mut scene = scene(name, resolution);
+    methods_agree_on(scene(name, resolution), name, spp, seeds);
+}
+
+/// A scene from scenes/, its JSON edited by `edit` (parsed as if it were that file, so
+/// assets resolve), with the path tracer (max depth 5) as its integrator.
+fn edited_scene(
+    name: &str,
+    resolution: UVec2,
+    edit: impl Fn(&mut serde_json::Value),
+) -> RenderScene {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../scenes")
+        .join(name);
+    let mut json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    json["integrator"] = serde_json::json!({"type": "path", "max_depth": 5, "rr_depth": 3});
+    edit(&mut json);
+    let description = prism_scene::parse_scene_str(&json.to_string(), &path).unwrap();
+    RenderScene::build(&description, Some(resolution)).unwrap()
+}
+
+fn methods_agree_on(mut scene: RenderScene, name: &str, spp: u32, seeds: usize) {
+    let resolution = scene.resolution;
     let path = path_of(&scene);
     let seeds: Vec<u64> = (0..seeds as u64).map(|k| 1000 + 17 * k).collect();
     // The path tracer's own seeds: the methods share sample dimensions (camera sample,
@@ -339,4 +361,36 @@ fn the_power_and_balance_heuristics_agree() {
     let other_seeds: Vec<u64> = seeds.iter().map(|s| s + 50_000).collect();
     let balance = channel_means(&mut scene, bdpt_of(p, None), 16, &other_seeds, &everywhere);
     assert_agree("bdpt power vs balance", power, balance);
+}
+
+/// Point, spot, goniometric (IES) and directional lights in the Cornell box (the light
+/// sources a camera path can never hit: bdpt and light reach them only through their
+/// emission sampling and s = 1 connections).
+#[test]
+fn light_bdpt_and_path_agree_with_point_spot_ies_and_directional_lights() {
+    let scene = edited_scene("cornell-box.json", UVec2::new(24, 24), |json| {
+        json["lights"] = serde_json::json!([
+            {"type": "point", "position_m": [0.3, 0.7, 0.2], "power_lm": 60},
+            {"type": "spot", "position_m": [-0.5, 0.9, -0.2], "target_m": [-0.2, -1, 0.1],
+             "cone_angle_deg": 35, "falloff_start_deg": 20, "intensity_cd": 10},
+            {"type": "luminaire", "file": "office/downlight.ies", "position_m": [0.4, 0.95, -0.4],
+             "power_lm": 40},
+            {"type": "directional", "direction": [0.2, -0.3, -1], "illuminance_lx": 40}
+        ]);
+    });
+    methods_agree_on(
+        scene,
+        "cornell box with point, spot, IES and directional lights",
+        16,
+        8,
+    );
+}
+
+/// Light paths connect to the lens of a thin-lens camera and to the point of a fisheye.
+#[test]
+fn light_bdpt_and_path_agree_with_thin_lens_and_fisheye_cameras() {
+    for name in ["cameras/thin-lens.json", "cameras/fisheye-equidistant.json"] {
+        let scene = edited_scene(name, UVec2::new(24, 24), |_| {});
+        methods_agree_on(scene, name, 16, 8);
+    }
 }

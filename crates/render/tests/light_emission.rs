@@ -20,11 +20,11 @@ use std::path::{Path, PathBuf};
 
 use glam::{Mat3A, Vec2, Vec3A};
 use prism_geometry::{Geometry, Shape, Transform};
-use prism_render::chi2::{chi2_test_adaptive, sidak, Chi2Config, SplitMix64};
 use prism_render::light::environment::equirect_direction;
 use prism_render::light::{AreaShape, Light, LightHit, LightSampleContext, LightSet};
 use prism_render::scene_build::build_geometry_with_instances;
 use prism_spectrum::{SampledSpectrum, SampledWavelengths, Spectrum};
+use prism_testkit::chi2::{chi2_test_adaptive, sidak, Chi2Config, SplitMix64};
 
 /// χ² tests in this file (23 of directions, 11 of positions): each runs at the Šidák level
 /// that keeps the family-wise rate at 1 %.

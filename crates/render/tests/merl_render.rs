@@ -13,7 +13,7 @@ use prism_render::bsdf::{
     MicrofacetDistribution, MicrofacetModel, TransportMode,
 };
 use prism_render::material::merl_export::export_material;
-use prism_render::material::Material;
+use prism_render::material::{Material, SurfaceMaterial};
 use prism_render::texture::TexturedSpectrum;
 use prism_render::{render, RenderScene, RenderSettings};
 use prism_scene::parse_scene_str;
@@ -22,12 +22,12 @@ use prism_spectrum::{SampledSpectrum, Spectrum};
 const ALPHA: f32 = 0.3;
 
 fn grey_ggx() -> Material {
-    Material::Conductor {
+    Material::Surface(SurfaceMaterial::Conductor {
         eta: Spectrum::constant(0.2),
         k: Spectrum::constant(3.0),
         distribution: MicrofacetDistribution::new(MicrofacetModel::Ggx, ALPHA, ALPHA),
         roughness_texture: None,
-    }
+    })
 }
 
 fn analytic_ggx() -> Bsdf<'static> {
@@ -124,14 +124,14 @@ fn write_env(path: &Path) -> f64 {
             pixels.push([v as f32; 3]);
         }
     }
-    let image = prism_post::Image::new(
+    let image = prism_image::Image::new(
         w,
         h,
         pixels,
         prism_spectrum::rgb_space::RgbColorSpace::srgb(),
     )
     .unwrap();
-    prism_post::io::rgbe::write_hdr(path, &image).unwrap();
+    prism_image::io::rgbe::write_hdr(path, &image).unwrap();
     max
 }
 
@@ -140,9 +140,9 @@ fn merl_tables_render_like_their_analytic_source() {
     let dir = tempfile::tempdir().unwrap();
     let lambert_path = dir.path().join("lambert.binary");
     let ggx_path = dir.path().join("ggx.binary");
-    export_material(&Material::Lambert {
+    export_material(&Material::Surface(SurfaceMaterial::Lambert {
         reflectance: TexturedSpectrum::Constant(Spectrum::constant(0.5)),
-    })
+    }))
     .write(&lambert_path)
     .unwrap();
     let ggx_table = export_material(&grey_ggx());
@@ -209,9 +209,9 @@ fn merl_tables_render_like_their_analytic_source() {
 fn bad_material_inputs_are_refused_with_their_place() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("short.binary");
-    let table = export_material(&Material::Lambert {
+    let table = export_material(&Material::Surface(SurfaceMaterial::Lambert {
         reflectance: TexturedSpectrum::Constant(Spectrum::constant(0.5)),
-    });
+    }));
     let bytes = table.to_bytes();
     std::fs::write(&path, &bytes[..bytes.len() / 2]).unwrap();
     let json = format!(

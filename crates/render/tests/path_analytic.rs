@@ -1,7 +1,7 @@
 //! The path tracer against closed-form irradiance (issue 4 checks): a point source over a
 //! diffuse plane, E = I cos θ / d², seen through an orthographic camera so every pixel's
 //! radiance is L = (R/π) E (Lambert). Constant spectra give Y = L exactly (the output
-//! normalisation of DESIGN.md), so the only noise is hero-wavelength sampling of Y, and the
+//! normalisation of docs/architecture.md), so the only noise is hero-wavelength sampling of Y, and the
 //! tolerance comes from the pixels' own spread (standard error of the mean over pixels,
 //! plus a per-pixel bound at 6σ).
 

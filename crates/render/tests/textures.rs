@@ -15,7 +15,7 @@ use std::path::Path;
 use std::sync::Arc;
 
 use glam::{Vec2, Vec3A};
-use prism_render::material::Material;
+use prism_render::material::{Material, SurfaceMaterial};
 use prism_render::texture::{TexelValue, Texture, TextureContext, TexturedSpectrum};
 use prism_render::{render, RenderScene, RenderSettings};
 use prism_scene::parse_scene_str;
@@ -53,9 +53,9 @@ fn build(dir: &Path, json: &str) -> Result<RenderScene, String> {
 fn lambert_texture(scene: &RenderScene, index: usize) -> Arc<Texture> {
     fn find(m: &Material) -> Option<Arc<Texture>> {
         match m {
-            Material::Lambert {
+            Material::Surface(SurfaceMaterial::Lambert {
                 reflectance: TexturedSpectrum::Texture { texture, .. },
-            } => Some(texture.clone()),
+            }) => Some(texture.clone()),
             Material::TwoSided { material }
             | Material::Mask { material, .. }
             | Material::NormalMap { material, .. }
@@ -435,14 +435,14 @@ fn write_bumpy_normal_map(path: &Path, flat: bool) {
             [0.5 * (n.x + 1.0), 0.5 * (n.y + 1.0), 0.5 * (n.z + 1.0)]
         })
         .collect();
-    let image = prism_post::Image::new(
+    let image = prism_image::Image::new(
         w,
         h,
         pixels,
         prism_spectrum::rgb_space::RgbColorSpace::srgb(),
     )
     .unwrap();
-    prism_post::io::write_image(path, &image).unwrap();
+    prism_image::io::write_image(path, &image).unwrap();
 }
 
 #[test]

@@ -69,5 +69,8 @@ fn the_position_aov_is_refused_and_the_written_ones_are_not() {
     let json =
         r#"{"film": {"aovs": ["depth", "normal", "albedo"]}, "shapes": [{"type": "rectangle"}]}"#;
     let description = prism_scene::parse_scene_str(json, "scene.json").unwrap();
-    assert!(RenderScene::build(&description, Some(glam::UVec2::new(4, 4))).is_ok());
+    let scene = RenderScene::build(&description, Some(glam::UVec2::new(4, 4)))
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(scene.resolution, glam::UVec2::new(4, 4));
+    assert_eq!(description.film.aovs.len(), 3);
 }

@@ -29,7 +29,7 @@ pub use film::{Aov, Film, PixelFilter, Reconstruction};
 pub use integrator::{Integrator, MisHeuristic, SamplerKind};
 pub use light::{Light, LightKind, Strength};
 pub use material::{
-    ConductorOptics, Ior, LafortuneLobe, Material, MaterialKind, Microfacet, Roughness,
+    ConductorOptics, Ior, LafortuneLobe, LibraryKind, Material, MaterialKind, Microfacet, Roughness,
 };
 pub use medium::{Medium, MediumKind};
 pub use scene::{load_scene, parse_scene_str, SceneDescription};

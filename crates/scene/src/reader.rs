@@ -207,7 +207,7 @@ impl<'a> V<'a> {
         })
     }
 
-    /// An object whose keys must all be keys of `schema` (a row of `schema::SCHEMA`,
+    /// An object whose keys must all be keys of `schema` (a row of `schema::rows()`,
     /// written `schema!("pattern")`).
     pub fn object(&self, schema: &'static ObjectSchema) -> Result<Obj<'a>> {
         match &self.node.value {

@@ -1,10 +1,14 @@
 //! Every kind of JSON object the reader accepts, where it appears and the keys it takes:
-//! the one list of accepted keys. Parsers check an object with `V::object(schema!("…"))`,
-//! which takes a row of this table (found at compile time: an unknown pattern does not
-//! build) and nothing else, so a key added to the format is a key added here.
+//! the one list of accepted keys, [`rows`]. Parsers check an object with
+//! `V::object(schema!("…"))`, which takes one of its rows (found at compile time: an
+//! unknown pattern does not build) and nothing else, so a key added to the format is a key
+//! added to a row. The rows are [`SCHEMA`] here and the material library's
+//! (`material::LIBRARY_SCHEMA`), kept next to the parser of the library kinds so that a new
+//! library BSDF is one place in this crate (as render keeps the library's `FIELD_USES` rows
+//! next to their builder).
 //!
 //! Render keeps the other half (prism-render `scene_build::fields`): what reads each key,
-//! or the error that refuses it; its test walks [`SCHEMA`] and fails on any key path that
+//! or the error that refuses it; its test walks [`rows`] and fails on any key path that
 //! is neither, so a new key cannot be parsed and then silently dropped.
 
 /// One kind of JSON object.
@@ -41,15 +45,20 @@ impl ObjectSchema {
     }
 }
 
+/// Every row: [`SCHEMA`] and the material library's.
+pub fn rows() -> impl Iterator<Item = &'static ObjectSchema> {
+    SCHEMA.iter().chain(crate::material::LIBRARY_SCHEMA)
+}
+
 /// Every key path the reader accepts (`ObjectSchema::key_path` of every key of every row).
 pub fn key_paths() -> Vec<String> {
-    SCHEMA
-        .iter()
+    rows()
         .flat_map(|row| row.keys().map(|k| row.key_path(k)))
         .collect()
 }
 
-const fn row(
+/// A row; rows are made only in [`SCHEMA`] and `material::LIBRARY_SCHEMA`.
+pub(crate) const fn row(
     pattern: &'static str,
     key_groups: &'static [&'static [&'static str]],
 ) -> ObjectSchema {
@@ -91,8 +100,9 @@ const SENSOR_SAMPLING: &[&str] = &[
 const TYPE: &[&str] = &["type"];
 const TEXTURE_UV: &[&str] = &["uv_scale", "uv_offset", "uv_rotate_deg"];
 
-/// The accepted objects. Keys of a row that a parser refuses with a specific message are
-/// still listed (render's table names the parser as what refuses them).
+/// The accepted objects but the material library's (all of them: [`rows`]). Keys of a row
+/// that a parser refuses with a specific message are still listed (render's table names the
+/// parser as what refuses them).
 pub const SCHEMA: &[ObjectSchema] = &[
     row("", &[&crate::scene::TOP_LEVEL_FIELDS]),
     // camera.rs
@@ -266,7 +276,7 @@ pub const SCHEMA: &[ObjectSchema] = &[
             "longitude_deg",
         ]],
     ),
-    // material.rs
+    // material.rs (the library's rows: material::LIBRARY_SCHEMA)
     row("materials.*<lambert>", &[&["type", "reflectance"]]),
     row(
         "materials.*<conductor>",
@@ -286,38 +296,8 @@ pub const SCHEMA: &[ObjectSchema] = &[
         &[&["type", "material", "texture", "scale_m"]],
     ),
     row("materials.*<mask>", &[&["type", "material", "opacity"]]),
-    row(
-        "materials.*<oren_nayar>",
-        &[&["type", "reflectance", "sigma_deg"]],
-    ),
-    row(
-        "materials.*<oren_nayar_qualitative>",
-        &[&["type", "reflectance", "sigma_deg"]],
-    ),
-    row(
-        "materials.*<phong>",
-        &[&["type", "diffuse", "specular", "exponent"]],
-    ),
-    row(
-        "materials.*<blinn_phong>",
-        &[&["type", "diffuse", "specular", "exponent"]],
-    ),
-    row(
-        "materials.*<ward>",
-        &[&["type", "diffuse", "specular", "alpha"]],
-    ),
-    row("materials.*<lafortune>", &[&["type", "diffuse", "lobes"]]),
-    row(
-        "materials.*<lafortune>.lobes[]",
-        &[&["cx", "cy", "cz", "exponent", "albedo"]],
-    ),
-    row(
-        "materials.*<coated>",
-        &[&["type", "diffuse", "ior", "nonlinear"]],
-    ),
     row("materials.*<thin_dielectric>", &[&["type", "ior"]]),
     row("materials.*<mix>", &[&["type", "materials", "weight"]]),
-    row("materials.*<merl>", &[&["type", "file", "clamp_negative"]]),
     row("@ior", &[&["sellmeier", "cauchy"]]),
     row("@ior.sellmeier", &[&["b", "c_um2"]]),
     row("@ior.cauchy", &[&["a", "b_um2"]]),
@@ -394,17 +374,22 @@ const fn same(a: &str, b: &str) -> bool {
 }
 
 /// The row of `pattern`; evaluated at compile time by `schema!`, where a pattern that is
-/// not in [`SCHEMA`] stops the build.
+/// in none of [`rows`]' tables stops the build.
 pub(crate) const fn find(pattern: &str) -> &'static ObjectSchema {
-    let rows: &'static [ObjectSchema] = SCHEMA;
-    let mut i = 0;
-    while i < rows.len() {
-        if same(rows[i].pattern, pattern) {
-            return &rows[i];
+    let tables: [&'static [ObjectSchema]; 2] = [SCHEMA, crate::material::LIBRARY_SCHEMA];
+    let mut t = 0;
+    while t < tables.len() {
+        let rows = tables[t];
+        let mut i = 0;
+        while i < rows.len() {
+            if same(rows[i].pattern, pattern) {
+                return &rows[i];
+            }
+            i += 1;
         }
-        i += 1;
+        t += 1;
     }
-    panic!("no row of prism_scene::schema::SCHEMA has this pattern")
+    panic!("no row of prism_scene::schema::rows() has this pattern")
 }
 
 /// `schema!("shapes[]<sphere>")`: the row of that pattern, checked at compile time.
@@ -421,9 +406,10 @@ mod tests {
 
     #[test]
     fn patterns_are_unique_and_rows_list_each_key_once() {
-        for (i, r) in SCHEMA.iter().enumerate() {
+        let all: Vec<&ObjectSchema> = rows().collect();
+        for (i, r) in all.iter().enumerate() {
             assert!(
-                SCHEMA[..i].iter().all(|s| s.pattern != r.pattern),
+                all[..i].iter().all(|s| s.pattern != r.pattern),
                 "pattern `{}` twice",
                 r.pattern
             );
@@ -438,5 +424,6 @@ mod tests {
             }
         }
         assert_eq!(find("@transform.rotate").pattern, "@transform.rotate");
+        assert_eq!(find("materials.*<ward>").pattern, "materials.*<ward>");
     }
 }

@@ -1,10 +1,10 @@
-//! `prism_scene::schema::SCHEMA` is what the parsers check: for every row, a scene with an
+//! `prism_scene::schema::rows()` is what the parsers check: for every row, a scene with an
 //! unknown key in an object of that kind is refused at that key, with exactly the row's keys
 //! as the expected ones. A row without a scene here fails the test, so a new kind of object
 //! gets one.
 
 use prism_scene::parse_scene_str;
-use prism_scene::schema::{key_paths, SCHEMA};
+use prism_scene::schema::{key_paths, rows};
 
 /// A scene with an object of the row's kind, `$` where the unknown key goes.
 fn scene_with(pattern: &str) -> Option<String> {
@@ -67,7 +67,7 @@ fn scene_with(pattern: &str) -> Option<String> {
 fn every_row_is_the_key_list_its_parser_checks() {
     const UNKNOWN: &str = "zzz_not_a_key";
     let mut failures = Vec::new();
-    for row in SCHEMA {
+    for row in rows() {
         let Some(template) = scene_with(row.pattern) else {
             failures.push(format!("`{}`: no scene in scene_with", row.pattern));
             continue;

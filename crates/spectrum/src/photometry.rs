@@ -35,7 +35,7 @@ pub fn luminous_efficacy_lm_per_w(spectrum: &DenseSpectrum) -> Option<f64> {
 }
 
 /// ∫ ȳ(λ) dλ of `observer` over 360–830 nm on its 1 nm table (Σ ȳ · 1 nm), in nm; ≈ 106.857
-/// for CIE 1931. The normaliser of Prism's output XYZ = ∫ L (x̄, ȳ, z̄) dλ / ∫ ȳ dλ (DESIGN.md).
+/// for CIE 1931. The normaliser of Prism's output XYZ = ∫ L (x̄, ȳ, z̄) dλ / ∫ ȳ dλ (docs/architecture.md).
 pub fn y_bar_integral_nm(observer: Observer) -> f64 {
     cmfs(observer).y_bar.values().iter().sum()
 }

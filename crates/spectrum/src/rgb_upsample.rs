@@ -102,7 +102,7 @@ impl RgbGamut {
 
     /// The space's white illuminant (D65, or D60 for ACEScg) on the 1 nm grid 360–830 nm,
     /// scaled so that Σ I(λ) ȳ(λ) Δλ = Σ ȳ(λ) Δλ (CIE 1931, Δλ = 1 nm): with the
-    /// DESIGN.md convention Y = ∫L ȳ dλ / ∫ȳ dλ it has luminance Y = 1, as pbrt-v4's
+    /// Prism's convention Y = ∫L ȳ dλ / ∫ȳ dλ it has luminance Y = 1, as pbrt-v4's
     /// normalised standard illuminants do.
     pub fn white_illuminant(self) -> &'static [f32; DENSE_SAMPLE_COUNT] {
         static SRGB: OnceLock<[f32; DENSE_SAMPLE_COUNT]> = OnceLock::new();
@@ -1030,8 +1030,11 @@ mod tests {
         assert!(RgbAlbedoSpectrum::new(RgbGamut::Srgb, [f32::NAN, 0.0, 0.0]).is_err());
         assert!(RgbUnboundedSpectrum::new(RgbGamut::Srgb, [-0.1, 0.0, 0.0]).is_err());
         assert!(RgbIlluminantSpectrum::new(RgbGamut::Srgb, [f32::INFINITY, 0.0, 0.0]).is_err());
-        assert!(RgbUnboundedSpectrum::new(RgbGamut::Srgb, [7.0, 0.0, 0.0]).is_ok());
-        assert!(RgbGamut::from_name("ACEScg").is_ok());
+        // Unbounded RGB above 1 is valid, scaled by 2 · max component (pbrt-v4's
+        // RGBUnboundedSpectrum).
+        let bright = RgbUnboundedSpectrum::new(RgbGamut::Srgb, [7.0, 0.0, 0.0]).unwrap();
+        assert_eq!(bright.scale, 14.0);
+        assert_eq!(RgbGamut::from_name("ACEScg"), Ok(RgbGamut::AcesCg));
         assert!(RgbGamut::from_name("p3")
             .unwrap_err()
             .message

@@ -1,14 +1,16 @@
 //! BSDF micro-benchmark (issue 8, "Speed"): nanoseconds per `eval`, `pdf` and `sample` of
-//! every lobe prism-render has — the core ones (Lambert, GGX and Beckmann conductors, rough
-//! and smooth dielectric) and the material library (Oren–Nayar, Phong, Blinn–Phong, Ward,
-//! Lafortune, coated, thin dielectric, mix, MERL) — through the `Bsdf` the integrator
-//! calls, on one thread, over 2¹⁸ precomputed random (ωₒ, ωᵢ, u) inputs (upper
-//! hemisphere, uniform in solid angle: incoherent, so every MERL lookup is a cache miss).
-//! Every spectral lane of f is consumed (summed), as an integrator does; reading one lane
-//! only would let the compiler drop the other three. Each figure is the fastest of 7 passes in thread CPU time (the machine is shared). The MERL table is written from
-//! the GGX α = 0.3 conductor, so `merl_sample_over_ggx_sample` compares equal materials.
-//! `merl_in_cache` repeats the first 2¹² pairs instead (extra information: the bins they
-//! touch stay cached, which separates the lookup's arithmetic from its cache misses).
+//! every lobe prism-render has — the core ones (Lambert, GGX and Beckmann conductors, GGX
+//! and Beckmann rough dielectrics, smooth dielectric) and the material library (Oren–Nayar,
+//! Phong, Blinn–Phong, Ward, Lafortune, coated, thin dielectric, mix, MERL) — through the
+//! `Bsdf` the integrator calls, on one thread, over 2¹⁸ precomputed random (ωₒ, ωᵢ, u)
+//! inputs (upper hemisphere, uniform in solid angle: incoherent, so every MERL lookup is a
+//! cache miss). Every spectral lane of f is consumed (summed), as an integrator does;
+//! reading one lane only would let the compiler drop the other three. Each figure is the
+//! fastest of 7 passes in thread CPU time (the machine is shared). The MERL table is
+//! written from the GGX α = 0.3 conductor, so `merl_sample_over_ggx_sample` compares equal
+//! materials. `merl_in_cache` repeats the first 2¹² pairs instead (extra information: the
+//! bins they touch stay cached, which separates the lookup's arithmetic from its cache
+//! misses).
 //!
 //! Run: `cargo run --release -p bench-bsdf > docs/bench-bsdf-<date>.json`
 
@@ -162,6 +164,14 @@ fn main() {
             BsdfLobe::Dielectric(Dielectric {
                 eta: s(1.5),
                 distribution: MicrofacetDistribution::new(MicrofacetModel::Ggx, 0.3, 0.3),
+            }),
+        ),
+        (
+            "dielectric_beckmann",
+            false,
+            BsdfLobe::Dielectric(Dielectric {
+                eta: s(1.5),
+                distribution: MicrofacetDistribution::new(MicrofacetModel::Beckmann, 0.3, 0.3),
             }),
         ),
         (

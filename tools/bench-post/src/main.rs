@@ -26,7 +26,8 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use prism_post::{tonemap_file, Image, OperatorChoice, ToneOperator, ToneParams, TonemapOptions};
+use prism_image::Image;
+use prism_post::{tonemap_file, OperatorChoice, ToneOperator, ToneParams, TonemapOptions};
 use prism_spectrum::rgb_space::RgbColorSpace;
 use rayon::prelude::*;
 
@@ -89,7 +90,7 @@ fn main() {
         let path = PathBuf::from(args.get(1).unwrap_or_else(|| usage()));
         let n = numbers(&args[2..]);
         let (w, h) = (*n.first().unwrap_or(&3840), *n.get(1).unwrap_or(&2160));
-        if let Err(e) = prism_post::io::write_image(&path, &synthetic(w, h)) {
+        if let Err(e) = prism_image::io::write_image(&path, &synthetic(w, h)) {
             eprintln!("{e}");
             std::process::exit(1);
         }
@@ -140,7 +141,7 @@ fn main() {
     std::fs::create_dir_all(&dir).unwrap();
     let input = given_input.unwrap_or_else(|| dir.join("in.exr"));
     if with_file && !input.exists() {
-        prism_post::io::write_image(&input, &image).unwrap();
+        prism_image::io::write_image(&input, &image).unwrap();
     }
     let file_runs = runs.clamp(1, 3);
 
@@ -222,14 +223,14 @@ fn main() {
 /// (`io::png::write_png`) against the `png` crate's sequential encoder
 /// (`write_png_sequential`), wall and CPU time of all threads (medians), and file bytes.
 fn png_write_times(image: &Image, dir: &Path, runs: usize) -> serde_json::Value {
-    use prism_post::io::png::{write_png, write_png_sequential, PngBitDepth};
+    use prism_image::io::png::{write_png, write_png_sequential, PngBitDepth};
     let mapped = ToneOperator::Reinhard02
         .apply(image, &ToneParams::default())
         .unwrap()
         .image;
     let path = dir.join("write.png");
     let mut result = serde_json::Map::new();
-    type Writer = fn(&Path, &Image, PngBitDepth) -> prism_post::Result<()>;
+    type Writer = fn(&Path, &Image, PngBitDepth) -> prism_image::Result<()>;
     for (name, write) in [
         ("parallel", write_png as Writer),
         ("sequential", write_png_sequential as Writer),

@@ -34,7 +34,7 @@ use crate::colour::aces_rgc::{aces_rgc_acescg, AcesRgcParameters};
 use crate::colour::cielab_lch::{CielabConverter, CIELAB_L_WHITE};
 use crate::colour::error::PostColourError;
 use crate::colour::oklab::OklabConverter;
-use crate::colour::rgb_matrix::{mul, rgb_to_rgb_matrix, same_colorimetry, to_pixel, CHUNK_PIXELS};
+use prism_image::rgb_matrix::{mul, rgb_to_rgb_matrix, same_colorimetry, to_pixel, CHUNK_PIXELS};
 
 /// Bisection stops when the chroma interval is below this, in CIELAB C*ab units
 /// (far below a just-noticeable difference, ΔE*ab ≈ 1).

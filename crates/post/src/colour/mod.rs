@@ -2,7 +2,7 @@
 //! (`&mut [[f32; 3]]` in a given [`RgbColorSpace`](prism_spectrum::rgb_space::RgbColorSpace)),
 //! so that it plugs into any image type.
 //!
-//! Pipeline position (DESIGN.md): white balance ──► gamut mapping ──► tone operator.
+//! Pipeline position (docs/architecture.md, "The data flow"): white balance ──► gamut mapping ──► tone operator.
 //! See docs/gamut-and-white-balance.md for the methods, parameters, references and CLI syntax.
 
 pub mod aces_rgc;
@@ -10,7 +10,6 @@ pub mod cielab_lch;
 pub mod error;
 pub mod gamut;
 pub mod oklab;
-pub mod rgb_matrix;
 pub mod scene_illumination;
 pub mod white_balance;
 

@@ -23,8 +23,8 @@ use prism_spectrum::rgb_space::xy_to_xyz_unit_y;
 use rayon::prelude::*;
 
 use crate::colour::error::PostColourError;
-use crate::colour::rgb_matrix::CHUNK_PIXELS;
 use crate::colour::white_balance::SceneWhite;
+use prism_image::rgb_matrix::CHUNK_PIXELS;
 
 /// The layer's name.
 pub const ILLUMINATION_LAYER: &str = "illumination";

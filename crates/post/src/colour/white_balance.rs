@@ -42,7 +42,7 @@ use prism_spectrum::{adaptation_matrix, AdaptationMethod, Observer};
 use rayon::prelude::*;
 
 use crate::colour::error::PostColourError;
-use crate::colour::rgb_matrix::{apply_rgb_matrix, CHUNK_PIXELS};
+use prism_image::rgb_matrix::{apply_rgb_matrix, CHUNK_PIXELS};
 
 /// Lowest colour temperature accepted by `cct:` in K (the Planckian table's start).
 pub const WB_CCT_MIN_K: f64 = 1000.0;

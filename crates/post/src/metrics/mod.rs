@@ -25,8 +25,8 @@ mod ssim;
 
 use serde::Serialize;
 
-use crate::error::Result;
-use crate::image::Image;
+use prism_image::Image;
+use prism_image::Result;
 
 pub use prepared::PreparedReference;
 

@@ -15,12 +15,12 @@ use rayon::prelude::*;
 
 use super::ciede2000::{delta_e_2000_block, lab_block, LabBlock, LabConverter, BLOCK};
 use super::{ssim, CompareOptions, Comparison, PerChannel, RELMSE_EPSILON};
-use crate::colour::rgb_matrix::same_colorimetry;
-use crate::error::{PostError, Result};
-use crate::image::Image;
-use crate::io::convert_pixels;
 use crate::tonemap::kernels::avx2;
 use crate::tonemap::pixels::{sanitise, CHUNK};
+use prism_image::io::convert_pixels;
+use prism_image::rgb_matrix::same_colorimetry;
+use prism_image::Image;
+use prism_image::{ImageError, Result};
 
 /// The reference side of [`crate::metrics::compare`], computed once.
 #[derive(Debug, Clone)]
@@ -120,7 +120,7 @@ impl PreparedReference {
     /// (which calls this); an error when the sizes differ.
     pub fn compare(&self, test: &Image, options: &CompareOptions) -> Result<Comparison> {
         if (test.width(), test.height()) != (self.width, self.height) {
-            return Err(PostError::invalid(format!(
+            return Err(ImageError::invalid(format!(
                 "image sizes differ: {}×{} vs reference {}×{}",
                 test.width(),
                 test.height(),
@@ -159,7 +159,7 @@ impl PreparedReference {
         let mse = mse_c.iter().sum::<f64>() / 3.0;
 
         let ssim = if options.ssim {
-            let w = crate::image::luminance_weights(&self.color_space);
+            let w = prism_image::image::luminance_weights(&self.color_space);
             let luminance = |p: &[f32; 3]| w[0] * p[0] + w[1] * p[1] + w[2] * p[2];
             let ya: Vec<f32> = a
                 .par_iter()

@@ -16,10 +16,10 @@ use std::collections::BTreeMap;
 use serde::Serialize;
 
 use crate::colour::{map_gamut, GamutMethod, GamutTarget};
-use crate::error::{PostError, Result};
-use crate::image::Image;
 use crate::tonemap::{ToneOperator, ToneParams, ToneReport};
 use font5x7::{draw_text, ADVANCE, GLYPH_HEIGHT};
+use prism_image::Image;
+use prism_image::{ImageError, Result};
 
 /// Largest tile width in pixels (a 4K input gives 960-pixel tiles, factor 4).
 pub const TILE_MAX_WIDTH: usize = 960;
@@ -67,7 +67,7 @@ pub fn contact_sheet_with_reports(
     gamut: GamutMethod,
 ) -> Result<ContactSheet> {
     if operators.is_empty() {
-        return Err(PostError::invalid(
+        return Err(ImageError::invalid(
             "contact sheet: no operators to show".to_string(),
         ));
     }
@@ -77,7 +77,7 @@ pub fn contact_sheet_with_reports(
             .iter()
             .any(|op| op.info().params.iter().any(|p| p.name == name))
         {
-            return Err(PostError::invalid(format!(
+            return Err(ImageError::invalid(format!(
                 "--param {name}: none of the operators on the sheet has this parameter"
             )));
         }
@@ -129,7 +129,7 @@ pub fn contact_sheet_with_reports(
                 buffer = result.image.into_pixels();
                 label
             }
-            Err(PostError::Invalid(message)) => {
+            Err(ImageError::Invalid(message)) => {
                 for y in 0..th {
                     sheet[(y0 + y) * sw + x0..(y0 + y) * sw + x0 + tw].fill(FAILED_TILE);
                 }

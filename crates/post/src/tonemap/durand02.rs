@@ -126,7 +126,7 @@ pub(crate) fn apply(ctx: &Context) -> Output {
 mod tests {
     use super::super::test_support::*;
     use super::super::{ToneOperator, ToneParams};
-    use crate::image::Image;
+    use prism_image::Image;
     use prism_spectrum::rgb_space::RgbColorSpace;
 
     #[test]

@@ -14,7 +14,7 @@
 
 use super::pixels::{luminance_stats, map_pixels, PixelMap};
 use super::{Context, OperatorInfo, Output, ParamSpec};
-use crate::error::Result;
+use prism_image::Result;
 
 pub(crate) static INFO: OperatorInfo = OperatorInfo {
     name: "ferwerda96",

@@ -34,9 +34,9 @@ use std::collections::BTreeMap;
 
 use serde::Serialize;
 
-use crate::error::{PostError, Result};
-use crate::image::Image;
 use pixels::Mapped;
+use prism_image::Image;
+use prism_image::{ImageError, Result};
 
 /// One operator parameter: name, default (`None`: computed from the image) and meaning.
 #[derive(Debug, Clone, Copy, Serialize)]
@@ -174,7 +174,7 @@ impl Context<'_> {
             .luminance_scale_cd_m2
             .or(self.image.cd_m2_per_unit)
             .ok_or_else(|| {
-                PostError::invalid(format!(
+                ImageError::invalid(format!(
                     "operator {} needs absolute luminance: the image has no \
                      prism:cd_m2_per_unit header; give --luminance-scale (cd/m² per unit)",
                     self.info.name
@@ -243,7 +243,7 @@ impl ToneOperator {
             .into_iter()
             .find(|op| op.name().eq_ignore_ascii_case(name))
             .ok_or_else(|| {
-                PostError::invalid(format!(
+                ImageError::invalid(format!(
                     "unknown tone operator '{name}'{}; expected one of: {}",
                     prism_spectrum::names::did_you_mean(name, Self::ALL.iter().map(|o| o.name())),
                     Self::ALL.map(|o| o.name()).join(", ")
@@ -256,14 +256,14 @@ impl ToneOperator {
     pub fn validate(self, params: &ToneParams) -> Result<()> {
         let info = self.info();
         if !params.exposure_ev.is_finite() {
-            return Err(PostError::invalid(format!(
+            return Err(ImageError::invalid(format!(
                 "exposure {} EV: expected a finite number of stops",
                 params.exposure_ev
             )));
         }
         if let Some(s) = params.luminance_scale_cd_m2 {
             if !(s.is_finite() && s > 0.0) {
-                return Err(PostError::invalid(format!(
+                return Err(ImageError::invalid(format!(
                     "luminance scale {s} cd/m² per unit: expected a positive number"
                 )));
             }
@@ -271,7 +271,7 @@ impl ToneOperator {
         for (name, value) in &params.values {
             let Some(spec) = info.params.iter().find(|p| p.name == name) else {
                 let known: Vec<&str> = info.params.iter().map(|p| p.name).collect();
-                return Err(PostError::invalid(format!(
+                return Err(ImageError::invalid(format!(
                     "operator {} has no parameter '{name}'{}; its parameters: {}",
                     info.name,
                     prism_spectrum::names::did_you_mean(name, known.iter().copied()),
@@ -283,7 +283,7 @@ impl ToneOperator {
                 )));
             };
             if !(value.is_finite() && *value >= spec.min && *value <= spec.max) {
-                return Err(PostError::invalid(format!(
+                return Err(ImageError::invalid(format!(
                     "{} {name} = {value}: expected a number in [{}, {}] ({})",
                     info.name, spec.min, spec.max, spec.doc
                 )));

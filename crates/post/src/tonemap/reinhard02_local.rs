@@ -194,7 +194,7 @@ mod tests {
     use super::super::gaussian::sampled_kernel;
     use super::super::test_support::*;
     use super::super::{ToneOperator, ToneParams};
-    use crate::image::Image;
+    use prism_image::Image;
     use prism_spectrum::rgb_space::RgbColorSpace;
 
     /// f64 reference blur: the sampled unit-sum Gaussian, edges replicated.

@@ -3,7 +3,7 @@
 use prism_spectrum::rgb_space::RgbColorSpace;
 
 use super::{ToneOperator, ToneParams};
-use crate::image::Image;
+use prism_image::Image;
 
 /// A 4×1 sRGB image of greys and colours with known luminances.
 pub fn small_image() -> Image {

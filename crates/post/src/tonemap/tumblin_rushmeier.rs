@@ -13,7 +13,7 @@ use super::curve_table::CurveTable;
 use super::pixels::{luminance_stats, map_luminance, LuminanceCurve};
 use super::power_curve::PowerCurve;
 use super::{Context, OperatorInfo, Output, ParamSpec};
-use crate::error::Result;
+use prism_image::Result;
 
 pub(crate) static INFO: OperatorInfo = OperatorInfo {
     name: "tumblin-rushmeier",
@@ -110,7 +110,7 @@ mod tests {
     use super::super::power_curve::PowerCurve;
     use super::super::test_support::*;
     use super::super::{ToneOperator, ToneParams};
-    use crate::image::Image;
+    use prism_image::Image;
 
     #[test]
     fn matches_revised_formula() {

@@ -6,7 +6,7 @@
 
 use super::pixels::{luminance_stats, Scale};
 use super::{Context, OperatorInfo, Output, ParamSpec};
-use crate::error::Result;
+use prism_image::Result;
 
 pub(crate) static INFO: OperatorInfo = OperatorInfo {
     name: "ward94",

@@ -24,7 +24,7 @@ use rayon::prelude::*;
 use super::fast_math;
 use super::pixels::{dot, map_luminance, sanitise, LuminanceCurve};
 use super::{Context, OperatorInfo, Output, ParamSpec};
-use crate::error::Result;
+use prism_image::Result;
 
 pub(crate) static INFO: OperatorInfo = OperatorInfo {
     name: "ward97-histogram",
@@ -180,7 +180,7 @@ pub(crate) fn apply(ctx: &Context) -> Result<Output> {
     let l_dmin = ctx.value("display_min");
     let l_dmax = ctx.value("display_max");
     if l_dmax <= l_dmin {
-        return Err(crate::error::PostError::invalid(format!(
+        return Err(prism_image::ImageError::invalid(format!(
             "ward97-histogram: display_max = {l_dmax} cd/m² must exceed display_min = \
              {l_dmin} cd/m²"
         )));
@@ -258,7 +258,7 @@ mod tests {
     use super::super::test_support::*;
     use super::super::{ToneOperator, ToneParams};
     use super::histogram_ceiling;
-    use crate::image::Image;
+    use prism_image::Image;
     use prism_spectrum::rgb_space::RgbColorSpace;
 
     #[test]

@@ -1,13 +1,16 @@
-//! Tests of the `Bxdf` contract over every lobe: `albedo` against an independent Monte
-//! Carlo estimate of ∫ f |cos θᵢ| dωᵢ, the angular bandwidths against the formulas
-//! probe.rs used before they moved into the lobes, and the size of a `Bsdf`.
+//! Tests of the `Bxdf` contract over every lobe in `leaves`: χ² of `sample` against `pdf`,
+//! reciprocity of reflection, `albedo` against an independent Monte Carlo estimate of
+//! ∫ f |cos θᵢ| dωᵢ (and ≤ 1 where the model claims energy conservation), the angular
+//! bandwidths against the formulas probe.rs used before they moved into the lobes, and the
+//! size of a `Bsdf`. A new lobe is covered once it has a representative in `leaves` and the
+//! arms the compiler asks for.
 
 use glam::{Vec2, Vec3A};
 use prism_spectrum::SampledSpectrum;
 
 use super::library_tests::merl_from;
 use super::*;
-use crate::chi2::SplitMix64;
+use prism_testkit::chi2::{chi2_test, sidak, Chi2Config, SplitMix64};
 
 fn s(v: f32) -> SampledSpectrum {
     SampledSpectrum::splat(v)
@@ -164,6 +167,21 @@ fn leaves(brdf: Option<&MerlBrdf>) -> Vec<(&'static str, LeafLobe<'_>)> {
             "thin_dielectric",
             LeafLobe::ThinDielectric(ThinDielectric { eta: s(1.5) }),
         ),
+        // White at the roughest and the smoothest roughness the scene format accepts.
+        (
+            "sheen r 0.1",
+            LeafLobe::Sheen(Sheen {
+                reflectance: s(1.0),
+                roughness: 0.1,
+            }),
+        ),
+        (
+            "sheen r 1",
+            LeafLobe::Sheen(Sheen {
+                reflectance: s(1.0),
+                roughness: 1.0,
+            }),
+        ),
     ];
     if let Some(brdf) = brdf {
         out.push((
@@ -203,6 +221,74 @@ fn mix_lobe<'a>() -> BsdfLobe<'a> {
     BsdfLobe::Mix(Mix::new(&parts).expect("valid mix"))
 }
 
+/// χ² of every leaf's sampler against its pdf (its non-Dirac samples; a lobe that is only
+/// Dirac has no density to test), at three incident angles, Šidák-corrected to 1 % over
+/// all. The per-family tests (`tests.rs`, `library_tests.rs`) sweep more parameters.
+#[test]
+fn sampling_of_every_leaf_matches_its_pdf() {
+    let thetas_deg = [20.0f32, 60.0, 85.0];
+    let lobes: Vec<_> = leaves(None)
+        .into_iter()
+        .filter(|(_, leaf)| !leaf.is_specular())
+        .collect();
+    let count = lobes.len() * thetas_deg.len();
+    let config = Chi2Config {
+        sample_count: 200_000,
+        significance: sidak(0.01, count),
+        integration_resolution: 32,
+        ..Chi2Config::default()
+    };
+    let (mut failures, mut lowest_p) = (Vec::new(), 1.0f64);
+    for (name, leaf) in &lobes {
+        for theta in thetas_deg {
+            let (wo, mode) = (direction(theta, 30.0), TransportMode::Radiance);
+            let r = chi2_test(
+                &config,
+                |ul, u| {
+                    leaf.sample(wo, ul, u, mode)
+                        .filter(|smp| !smp.specular)
+                        .map(|smp| smp.wi)
+                },
+                |wi| f64::from(leaf.pdf(wo, wi, mode)),
+            );
+            lowest_p = lowest_p.min(r.p_value);
+            if !r.passed {
+                failures.push(format!("{name} θ {theta}°: {}", r.message));
+            }
+        }
+    }
+    eprintln!("{count} χ² tests, lowest p = {lowest_p:.3e}");
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// f(ωₒ, ωᵢ) = f(ωᵢ, ωₒ) for reflection (both directions above the surface) for every
+/// leaf (Helmholtz; refraction's generalised form is tested in `tests.rs`), to f32
+/// rounding.
+#[test]
+fn reflection_of_every_leaf_is_reciprocal() {
+    let mut rng = SplitMix64(21);
+    let mut pick = || {
+        let z = rng.next_f32().max(1e-3);
+        let phi = 2.0 * std::f32::consts::PI * rng.next_f32();
+        let r = (1.0 - z * z).sqrt();
+        Vec3A::new(r * phi.cos(), r * phi.sin(), z)
+    };
+    let mut failures = Vec::new();
+    for (name, leaf) in leaves(None) {
+        for _ in 0..300 {
+            let (wo, wi) = (pick(), pick());
+            let (a, b) = (
+                leaf.eval(wo, wi, TransportMode::Radiance)[0],
+                leaf.eval(wi, wo, TransportMode::Radiance)[0],
+            );
+            if (a - b).abs() > 2e-4 * a.abs().max(b.abs()) + 1e-6 {
+                failures.push(format!("{name}: f({wo}, {wi}) = {a}, swapped {b}"));
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
 /// True where the lobe's `albedo` is a closed form (as each lobe's doc says), so it carries
 /// no estimation error of its own.
 fn closed_form(lobe: &LeafLobe) -> bool {
@@ -216,7 +302,8 @@ fn closed_form(lobe: &LeafLobe) -> bool {
         | Lobe::Ward(_)
         | Lobe::Lafortune(_)
         | Lobe::Coated(_)
-        | Lobe::Measured(_) => false,
+        | Lobe::Measured(_)
+        | Lobe::Sheen(_) => false,
         Lobe::Mix(never) => match *never {},
     }
 }
@@ -387,7 +474,8 @@ fn albedo_of_the_core_lobes_matches_monte_carlo() {
             | Lobe::Ward(_)
             | Lobe::Lafortune(_)
             | Lobe::Coated(_)
-            | Lobe::Measured(_) => {}
+            | Lobe::Measured(_)
+            | Lobe::Sheen(_) => {}
             Lobe::Mix(never) => match never {},
         }
     }
@@ -401,7 +489,11 @@ fn albedo_of_the_library_lobes_matches_monte_carlo() {
         // Energy conservation is each paper's claim: not Lafortune's (a fit, unnormalised)
         // nor the full Oren–Nayar model's (above 1 near grazing exit, see library_tests).
         let conserving = match leaf {
-            Lobe::Phong(_) | Lobe::BlinnPhong(_) | Lobe::Ward(_) | Lobe::Coated(_) => true,
+            Lobe::Phong(_)
+            | Lobe::BlinnPhong(_)
+            | Lobe::Ward(_)
+            | Lobe::Coated(_)
+            | Lobe::Sheen(_) => true,
             Lobe::OrenNayar(o) => o.form == OrenNayarForm::Qualitative || o.sigma_rad == 0.0,
             Lobe::Lafortune(_) => false,
             Lobe::Lambert(_)
@@ -454,8 +546,8 @@ fn albedo_of_a_measured_table_matches_monte_carlo() {
 }
 
 /// probe.rs's material bandwidth before it moved into the lobes (commit bdf920f), verbatim
-/// but for names and the `MaterialBandwidth` wrapper: the oracle of
-/// `angular_bandwidth_cycles_per_rad`.
+/// but for names and the `MaterialBandwidth` wrapper, plus the arms of lobes added since
+/// (the formula each one's doc states): the oracle of `angular_bandwidth_cycles_per_rad`.
 #[allow(clippy::wildcard_enum_match_arm)]
 fn former_material_bandwidth(bsdf: &Bsdf) -> f32 {
     match &bsdf.lobe {
@@ -486,6 +578,7 @@ fn former_library_lobe_bandwidth(lobe: &BsdfLobe) -> f32 {
             .fold(0.0, f32::max),
         BsdfLobe::Coated(_) | BsdfLobe::ThinDielectric(_) => f32::INFINITY,
         BsdfLobe::Measured(m) => from_alpha(m.brdf.equivalent_alpha),
+        BsdfLobe::Sheen(l) => from_exponent(1.0 / l.roughness),
         BsdfLobe::Mix(m) => m.components[..m.count]
             .iter()
             .map(|c| former_material_bandwidth(&Bsdf::new(c.as_lobe())))
@@ -556,7 +649,7 @@ fn angular_bandwidth_of_every_lobe_is_what_probe_returned_before() {
     }
     eprintln!("angular bandwidth, cycles/rad: {}", report.join("; "));
     // The table covers every variant (a new lobe must join `leaves`).
-    let mut seen = [false; 12];
+    let mut seen = [false; 13];
     for (_, lobe) in &lobes {
         let index = match lobe {
             Lobe::Lambert(_) => 0,
@@ -570,7 +663,8 @@ fn angular_bandwidth_of_every_lobe_is_what_probe_returned_before() {
             Lobe::Coated(_) => 8,
             Lobe::ThinDielectric(_) => 9,
             Lobe::Measured(_) => 10,
-            Lobe::Mix(_) => 11,
+            Lobe::Sheen(_) => 11,
+            Lobe::Mix(_) => 12,
         };
         seen[index] = true;
     }

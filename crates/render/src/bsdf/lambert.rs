@@ -75,7 +75,7 @@ pub(crate) fn cosine_pdf(wo: Vec3A, wi: Vec3A) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::chi2::{chi2_test, Chi2Config};
+    use prism_testkit::chi2::{chi2_test, Chi2Config};
 
     #[test]
     fn chi2_lambert() {

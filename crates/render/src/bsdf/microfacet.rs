@@ -334,7 +334,7 @@ pub fn erf_inv(x: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::chi2::{chi2_test, sidak, Chi2Config, SplitMix64};
+    use prism_testkit::chi2::{chi2_test, sidak, Chi2Config, SplitMix64};
 
     fn direction(theta_deg: f32, phi_deg: f32) -> Vec3A {
         let (t, p) = (theta_deg.to_radians(), phi_deg.to_radians());

@@ -6,7 +6,7 @@ use glam::{Vec2, Vec3A};
 use prism_spectrum::SampledSpectrum;
 
 use super::*;
-use crate::chi2::{chi2_test, sidak, Chi2Config, SplitMix64};
+use prism_testkit::chi2::{chi2_test, sidak, Chi2Config, SplitMix64};
 
 /// Incident polar angles of every chi-square family (degrees), at azimuth `PHI_DEG`.
 const THETAS_DEG: [f32; 4] = [0.0, 30.0, 60.0, 85.0];
@@ -487,80 +487,6 @@ fn two_sided_is_ignored_for_dielectrics() {
     b.two_sided = true;
     assert_eq!(b.eval(wo, wi, TransportMode::Radiance), plain);
     assert!(!plain.is_black());
-}
-
-/// CPU time of this thread in ns (Linux `/proc/thread-self/schedstat`, first field), so
-/// that a timing is not inflated by other processes on a shared machine; wall time
-/// elsewhere.
-fn thread_cpu_ns() -> Option<u64> {
-    let text = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
-    text.split_whitespace().next()?.parse().ok()
-}
-
-/// Nanoseconds per call of eval, pdf and sample for the rough lobes (not a pass/fail test:
-/// `cargo test -p prism-render --lib -- --ignored bsdf_timing --nocapture`).
-#[test]
-#[ignore]
-fn bsdf_timing() {
-    use std::hint::black_box;
-    use std::time::Instant;
-    let n = 2_000_000;
-    let dirs = upper_directions(1024, 1);
-    let cases = [
-        ("GGX conductor", conductor(MicrofacetModel::Ggx, 0.3, 0.3)),
-        (
-            "Beckmann conductor",
-            conductor(MicrofacetModel::Beckmann, 0.3, 0.3),
-        ),
-        (
-            "GGX dielectric",
-            dielectric(MicrofacetModel::Ggx, 0.3, 0.3, 1.5),
-        ),
-        (
-            "Beckmann dielectric",
-            dielectric(MicrofacetModel::Beckmann, 0.3, 0.3, 1.5),
-        ),
-    ];
-    let clock = |start: &(Instant, Option<u64>)| -> f64 {
-        match (start.1, thread_cpu_ns()) {
-            (Some(a), Some(b)) => (b - a) as f64 / n as f64,
-            _ => start.0.elapsed().as_nanos() as f64 / n as f64,
-        }
-    };
-    let now = || (Instant::now(), thread_cpu_ns());
-    for (name, b) in cases {
-        let mode = TransportMode::Radiance;
-        let mut acc = 0.0f32;
-        let t = now();
-        for i in 0..n {
-            acc += b.eval(dirs[i & 1023], dirs[(i * 7 + 3) & 1023], mode)[0];
-        }
-        let eval_ns = clock(&t);
-        let t = now();
-        for i in 0..n {
-            acc += b.pdf(dirs[i & 1023], dirs[(i * 7 + 3) & 1023], mode);
-        }
-        let pdf_ns = clock(&t);
-        let mut rng = SplitMix64(2);
-        let t = now();
-        for i in 0..n {
-            let u = Vec2::new(rng.next_f32(), rng.next_f32());
-            if let Some(s) = b.sample(dirs[i & 1023], rng.next_f32(), u, mode) {
-                acc += s.pdf;
-            }
-        }
-        let sample_ns = clock(&t);
-        black_box(acc);
-        let what = if thread_cpu_ns().is_some() {
-            "thread CPU"
-        } else {
-            "wall"
-        };
-        eprintln!(
-            "{name}: eval {eval_ns:.1} ns, pdf {pdf_ns:.1} ns, sample {sample_ns:.1} ns \
-             (sample includes 3 variates and the eval + pdf of its result; {what} time)"
-        );
-    }
 }
 
 #[test]

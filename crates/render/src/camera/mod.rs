@@ -1,5 +1,5 @@
 //! Cameras: pinhole, thin lens, fisheye (four projections), orthographic and spherical
-//! (equirectangular). `Camera` is an enum dispatched by `match` (DESIGN.md "Core types").
+//! (equirectangular). `Camera` is an enum dispatched by `match` (docs/architecture.md, "Deliberate choices").
 //!
 //! Every model works in camera space (−Z forward, +X right, +Y up) and maps continuous film
 //! points in pixels (origin at the top-left corner, y down; see the crate docs) to rays;

@@ -1,4 +1,4 @@
-//! The film's finished output: what prism-post writes to EXR (DESIGN.md "Units and
+//! The film's finished output: what prism-image writes to EXR (docs/architecture.md "Units and
 //! conventions": unprefixed R, G, B linear Rec.709; header `prism:cd_m2_per_unit`; AOV
 //! layers with prefixed channel names).
 

@@ -2,9 +2,10 @@
 //! BDPT's t = 1 strategies) land at a film point anywhere on the film, not at the pixel of
 //! the camera sample being rendered (Veach 1997 §10.2; pbrt-v4 `RGBFilm::AddSplat`).
 //!
-//! Each work item collects its splats in a `LightSplats` list (filter taps already
-//! evaluated, XYZ already converted); the driver merges the lists into the film's
-//! `LightPlane` one after another in work-item order, so the image is bit-identical for any
+//! Each work item collects its splats in a `LightSplats` list (XYZ converted, the filter's
+//! separable weights evaluated: one row and one column of weights per splat, not every tap);
+//! the driver merges the lists into the film's `LightPlane` one after another in work-item
+//! order, so the image is bit-identical for any
 //! thread count (floating-point sums in one fixed order) without locks or atomics on the
 //! film.
 //!
@@ -30,7 +31,19 @@ use prism_spectrum::{SampledSpectrum, SampledWavelengths};
 
 use super::filter_sampler::FilterSampler;
 use super::spectral_bins::SpectralBins;
-use super::xyz::xyz_of_sample;
+use super::xyz::XyzWeights;
+
+/// A splat: its XYZ and the rectangle of pixels its filter reaches.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct SplatRecord {
+    xyz: [f32; 3],
+    x0: u32,
+    y0: u32,
+    nx: u32,
+    ny: u32,
+    /// Index of its first weight in `LightSplats::weights`.
+    first: u32,
+}
 
 /// One bin's share of a splat.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -49,13 +62,13 @@ pub struct LightSplats {
     inverse_norm_x: Arc<Vec<f32>>,
     inverse_norm_y: Arc<Vec<f32>>,
     bins: Option<SpectralBins>,
-    /// (pixel index, f̂ · XYZ).
-    taps: Vec<(u32, [f32; 3])>,
+    /// One record per splat; its weights are `weights[first..first + nx + ny]`.
+    records: Vec<SplatRecord>,
+    /// The splats' column weights then row weights, normalised (f̂ = f_x · f_y).
+    weights: Vec<f32>,
     spectral: Vec<SpectralTap>,
     /// Light paths traced by the work item.
     paths: u64,
-    /// Scratch: one splat's column weights.
-    column_weights: Vec<f32>,
 }
 
 impl LightSplats {
@@ -67,12 +80,15 @@ impl LightSplats {
     ) -> Self {
         let f = filter.filter();
         let full = filter_integral_1d(f, None);
+        let r = f64::from(f.radius_px());
         let norms = |n: u32| -> Arc<Vec<f32>> {
             Arc::new(
                 (0..n)
                     .map(|i| {
-                        let integral = if splatting_film {
-                            filter_integral_1d(f, Some((i as f64 + 0.5, f64::from(n))))
+                        let c = i as f64 + 0.5;
+                        // Only columns within the radius of an edge lose part of the filter.
+                        let integral = if splatting_film && (c < r || c > f64::from(n) - r) {
+                            filter_integral_1d(f, Some((c, f64::from(n))))
                         } else {
                             full
                         };
@@ -91,10 +107,10 @@ impl LightSplats {
             inverse_norm_y: norms(resolution.y),
             filter,
             bins,
-            taps: Vec::new(),
+            records: Vec::new(),
+            weights: Vec::new(),
             spectral: Vec::new(),
             paths: 0,
-            column_weights: Vec::new(),
         }
     }
 
@@ -113,13 +129,30 @@ impl LightSplats {
         value: SampledSpectrum,
         wavelengths: &SampledWavelengths,
     ) -> bool {
+        self.splat_with(
+            film_point_px,
+            value,
+            wavelengths,
+            &XyzWeights::new(wavelengths),
+        )
+    }
+
+    /// `splat` with the `XyzWeights` of `wavelengths` (built once for all the splats of one
+    /// light path, which share its wavelengths).
+    pub fn splat_with(
+        &mut self,
+        film_point_px: Vec2,
+        value: SampledSpectrum,
+        wavelengths: &SampledWavelengths,
+        weights: &XyzWeights,
+    ) -> bool {
         if value.has_non_finite() || !film_point_px.is_finite() {
             return false;
         }
         if value.is_black() {
             return true;
         }
-        let xyz = xyz_of_sample(value, wavelengths);
+        let xyz = weights.xyz(value);
         let table = self.filter.table();
         let r = self.filter.filter().radius_px();
         // Pixels whose centre (i + ½) lies within r of the point.
@@ -133,37 +166,36 @@ impl LightSplats {
             return true;
         }
         let (x0, x1, y0, y1) = (lo.x as u32, hi.x as u32, lo.y as u32, hi.y as u32);
-        // The column weights once (a radius-2 filter touches up to 5 × 5 pixels).
-        let mut column_weights = std::mem::take(&mut self.column_weights);
-        column_weights.clear();
-        column_weights.extend((x0..=x1).map(|px| {
+        // The separable weights: columns then rows (a radius-2 filter touches up to 5 × 5
+        // pixels; the film multiplies them out when it merges).
+        let first = self.weights.len() as u32;
+        self.weights.extend((x0..=x1).map(|px| {
             table.eval(px as f32 + 0.5 - film_point_px.x) * self.inverse_norm_x[px as usize]
         }));
-        for py in y0..=y1 {
-            let fy =
-                table.eval(py as f32 + 0.5 - film_point_px.y) * self.inverse_norm_y[py as usize];
-            if fy == 0.0 {
-                continue;
-            }
-            for (k, &fx) in column_weights.iter().enumerate() {
-                let px = x0 + k as u32;
-                let w = fx * fy;
-                if w == 0.0 {
-                    continue;
-                }
-                let pixel = py * self.resolution.x + px;
-                let wd = f64::from(w);
-                self.taps.push((
-                    pixel,
-                    [
-                        (xyz.x * wd) as f32,
-                        (xyz.y * wd) as f32,
-                        (xyz.z * wd) as f32,
-                    ],
-                ));
-                if let Some(bins) = self.bins {
+        self.weights.extend((y0..=y1).map(|py| {
+            table.eval(py as f32 + 0.5 - film_point_px.y) * self.inverse_norm_y[py as usize]
+        }));
+        let (nx, ny) = (x1 - x0 + 1, y1 - y0 + 1);
+        self.records.push(SplatRecord {
+            xyz: [xyz.x as f32, xyz.y as f32, xyz.z as f32],
+            x0,
+            y0,
+            nx,
+            ny,
+            first,
+        });
+        if let Some(bins) = self.bins {
+            let w = &self.weights[first as usize..];
+            for j in 0..ny {
+                for i in 0..nx {
+                    let wd = f64::from(w[i as usize] * w[(nx + j) as usize]);
+                    if wd == 0.0 {
+                        continue;
+                    }
+                    let pixel = (y0 + j) * self.resolution.x + x0 + i;
+                    let spectral = &mut self.spectral;
                     bins.for_each_lane_share(value, wavelengths, |bin, share| {
-                        self.spectral.push(SpectralTap {
+                        spectral.push(SpectralTap {
                             pixel,
                             bin: bin as u32,
                             value: (share * wd) as f32,
@@ -172,13 +204,12 @@ impl LightSplats {
                 }
             }
         }
-        self.column_weights = column_weights;
         true
     }
 
-    /// Splats made so far (filter taps).
-    pub fn tap_count(&self) -> usize {
-        self.taps.len()
+    /// Splats made so far.
+    pub fn splat_count(&self) -> usize {
+        self.records.len()
     }
 }
 
@@ -205,8 +236,22 @@ impl LightPlane {
     /// Adds one work item's splats (the driver calls this in work-item order).
     pub fn merge(&mut self, splats: &LightSplats) {
         self.paths += splats.paths;
-        for &(pixel, [x, y, z]) in &splats.taps {
-            self.xyz_sum[pixel as usize] += DVec3::new(f64::from(x), f64::from(y), f64::from(z));
+        let width = splats.resolution.x as usize;
+        for r in &splats.records {
+            let w = &splats.weights[r.first as usize..(r.first + r.nx + r.ny) as usize];
+            let (columns, rows) = w.split_at(r.nx as usize);
+            let xyz = DVec3::new(
+                f64::from(r.xyz[0]),
+                f64::from(r.xyz[1]),
+                f64::from(r.xyz[2]),
+            );
+            for (j, &wy) in rows.iter().enumerate() {
+                let row = (r.y0 as usize + j) * width + r.x0 as usize;
+                let xyz_row = xyz * f64::from(wy);
+                for (i, &wx) in columns.iter().enumerate() {
+                    self.xyz_sum[row + i] += xyz_row * f64::from(wx);
+                }
+            }
         }
         if let Some(bins) = splats.bins {
             let n = bins.count() as usize;

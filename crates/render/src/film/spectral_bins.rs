@@ -144,7 +144,15 @@ mod tests {
             assert_eq!(e.parameter, "spectral_bins");
             assert!(e.to_string().contains("1..=471"), "{e}");
         }
-        assert!(SpectralBins::new(1).is_ok() && SpectralBins::new(471).is_ok());
+        // The limits: one bin over 360–830 nm, and 471 bins of 470/471 nm.
+        let one = SpectralBins::new(1).unwrap();
+        assert_eq!(
+            (one.count(), one.width_nm(), one.centre_nm(0)),
+            (1, 470.0, 595.0)
+        );
+        let finest = SpectralBins::new(471).unwrap();
+        assert_eq!(finest.count(), 471);
+        assert!((finest.width_nm() - 470.0 / 471.0).abs() < 1e-12);
     }
 
     #[test]

@@ -1,4 +1,4 @@
-//! Spectral samples → CIE 1931 XYZ in the output normalisation of DESIGN.md: XYZ =
+//! Spectral samples → CIE 1931 XYZ in the output normalisation of docs/architecture.md ("Units and conventions"): XYZ =
 //! ∫ L(λ) (x̄, ȳ, z̄)(λ) dλ / ∫ ȳ dλ, so a flat spectral radiance of 1 gives Y = 1 (the
 //! pbrt-v4 `SampledSpectrum::ToXYZ` / Mitsuba 3 convention), and Y · `cd_m2_per_unit()` is
 //! the luminance in cd/m² (683.002 lm/W · ∫ L ȳ dλ).

@@ -240,7 +240,7 @@ pub fn render_pass_with(
             };
             let mut splats = no_splats.clone();
             let stats = estimator.render_tile(scene, &work, tile, &mut splats);
-            debug_assert_eq!(splats.tap_count(), 0, "{} splats", estimator.name());
+            debug_assert_eq!(splats.splat_count(), 0, "{} splats", estimator.name());
             progress(stats.samples);
             if let Ok(mut t) = total.lock() {
                 t.add(&stats);

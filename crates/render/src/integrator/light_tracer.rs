@@ -75,6 +75,7 @@ impl LightTracer {
         let sensor = *state.wavelengths.sensor();
         let transport = *state.wavelengths.transport();
         let importance_area = scene.camera.importance_area_px2();
+        let xyz_weights = crate::film::xyz::XyzWeights::new(&sensor);
         let tracer = self.path_tracer();
         // The light's own point, seen by the camera.
         if let Some(c) = self.connect_light_point(
@@ -87,12 +88,14 @@ impl LightTracer {
             counters,
         ) {
             let (film_point, value) = c;
-            if !splats.splat(film_point, value * importance_area, &sensor) {
+            if !splats.splat_with(film_point, value * importance_area, &sensor, &xyz_weights) {
                 counters.non_finite_contributions += 1;
             }
         }
         let first_block = start.first() + LightStartDimensions::COUNT;
         let uses_lens = scene.camera.uses_lens_sample();
+        // Not read: t = 1 connections sample no light.
+        let mut le_cache = crate::spectrum_cache::SpectrumCache::new();
         // t = 1 connections sample their camera vertex; the camera subpath is never read.
         let mut no_camera = Subpath::default();
         for s in 2..=light_path.len() {
@@ -118,12 +121,18 @@ impl LightTracer {
                 1,
                 &variates,
                 &transport,
+                &mut le_cache,
                 counters,
             ) else {
                 continue;
             };
             if let Some(film_point) = c.film_point_px {
-                if !splats.splat(film_point, c.unweighted * importance_area, &sensor) {
+                if !splats.splat_with(
+                    film_point,
+                    c.unweighted * importance_area,
+                    &sensor,
+                    &xyz_weights,
+                ) {
                     counters.non_finite_contributions += 1;
                 }
             }

@@ -22,7 +22,7 @@ use crate::bsdf::TransportMode;
 use crate::light::{LightHit, LightSampleContext};
 use crate::sampler::SampleStream;
 use crate::scene_build::RenderScene;
-use crate::spectrum_cache::SpectrumCache;
+use crate::spectrum_cache::{SpectrumCache, TransportWavelengths};
 
 /// Parameters of the path tracer.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -342,7 +342,7 @@ impl PathTracer {
                     &path.prev_ctx,
                     path.prev_pdf,
                     ray.direction,
-                    path.wavelengths.transport(),
+                    &path.wavelengths,
                     &mut le_cache,
                 ) {
                     add(
@@ -368,7 +368,7 @@ impl PathTracer {
             let bsdf = material.bsdf_cached(
                 si.material_id,
                 &si,
-                path.wavelengths.transport(),
+                &path.wavelengths,
                 &mut reflectance_cache,
             );
             let vertex =
@@ -399,7 +399,7 @@ impl PathTracer {
                         &ctx,
                         uc,
                         ul,
-                        path.wavelengths.transport(),
+                        &path.wavelengths,
                         &mut le_cache,
                         want_illumination && path.depth == 1,
                         counters,
@@ -541,7 +541,7 @@ impl PathTracer {
         prev_ctx: &LightSampleContext,
         prev_bsdf_pdf: f32,
         direction: Vec3A,
-        wavelengths: &SampledWavelengths,
+        wavelengths: &impl TransportWavelengths,
         le_cache: &mut SpectrumCache,
     ) -> Option<SampledSpectrum> {
         let light = scene.lights.light(l);
@@ -595,7 +595,7 @@ impl PathTracer {
         ctx: &LightSampleContext,
         u_choice: f32,
         u: Vec2,
-        wavelengths: &SampledWavelengths,
+        wavelengths: &LaneWavelengths,
         le_cache: &mut SpectrumCache,
         want_white: bool,
         counters: &mut PathCounters,
@@ -625,7 +625,8 @@ impl PathTracer {
             return (zero, zero);
         }
         counters.rays += 1;
-        let transmittance = self.transmittance(scene, vertex.p(), &ls, wavelengths, counters);
+        let transmittance =
+            self.transmittance(scene, vertex.p(), &ls, wavelengths.transport(), counters);
         if transmittance.is_black() {
             return (zero, zero);
         }

@@ -1,5 +1,5 @@
 //! An environment map: radiance from every direction read from an equirectangular
-//! (latitude–longitude) RGB image (.exr or .hdr, read by prism-post).
+//! (latitude–longitude) RGB image (.exr or .hdr, read by prism-image).
 //!
 //! **Mapping** (Mitsuba 3 `envmap` orientation). In the light's local frame, image
 //! coordinates (u, v) ∈ [0, 1)², u across from the left edge, v down from the top row, are
@@ -24,7 +24,7 @@
 //! sRGB; negative components clamped to 0) is upsampled once at load time to an RGB
 //! illuminant spectrum (Jakob & Hanika 2019 sigmoid polynomial × the space's white
 //! illuminant, pbrt-v4 `RGBIlluminantSpectrum`, table lookup without refinement): RGB
-//! (1, 1, 1) is the white illuminant at Y = 1 in the output normalisation of DESIGN.md, so
+//! (1, 1, 1) is the white illuminant at Y = 1 in the output normalisation of docs/architecture.md, so
 //! an EXR rendered by Prism used as an environment map gives back its own values. `scale`
 //! multiplies everything.
 //!
@@ -219,7 +219,7 @@ impl EnvironmentLight {
         })
     }
 
-    /// Reads an .exr/.hdr file with prism-post (`prism_post::io::read_image`); errors name
+    /// Reads an .exr/.hdr file with prism-image (`prism_image::io::read_image`); errors name
     /// the file.
     pub fn load(
         path: &Path,
@@ -227,7 +227,7 @@ impl EnvironmentLight {
         scale: f32,
         scene: SceneSphere,
     ) -> Result<Self, String> {
-        let image = prism_post::io::read_image(path).map_err(|e| e.to_string())?;
+        let image = prism_image::io::read_image(path).map_err(|e| e.to_string())?;
         let space = &image.color_space;
         let close =
             |a: &[f64; 2], b: &[f64; 2]| (a[0] - b[0]).abs().max((a[1] - b[1]).abs()) < 5e-4;
@@ -245,7 +245,7 @@ impl EnvironmentLight {
             None => {
                 let from = image.color_space.clone();
                 let mut pixels = image.into_pixels();
-                prism_post::io::convert_pixels(&mut pixels, &from, &RgbGamut::Srgb.color_space());
+                prism_image::io::convert_pixels(&mut pixels, &from, &RgbGamut::Srgb.color_space());
                 (RgbGamut::Srgb, pixels)
             }
         };
@@ -435,10 +435,10 @@ impl LightSource for EnvironmentLight {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::chi2::chi2_test_adaptive;
     use crate::light::test_support::{build_error, build_scene, chi2_config, photometric_sum};
     use crate::light::Light;
     use prism_spectrum::rgb_space::RgbColorSpace;
+    use prism_testkit::chi2::chi2_test_adaptive;
 
     /// A 16 × 8 map: a dim gradient with one bright texel at (x, y) = (4, 3) — u ∈ [¼, 5/16),
     /// just above the horizon towards +X — and a black texel.
@@ -588,9 +588,9 @@ mod tests {
         let pixels = synthetic_pixels();
         for ext in ["exr", "hdr"] {
             let image =
-                prism_post::Image::new(16, 8, pixels.clone(), RgbColorSpace::srgb()).unwrap();
+                prism_image::Image::new(16, 8, pixels.clone(), RgbColorSpace::srgb()).unwrap();
             let path = dir.path().join(format!("sky.{ext}"));
-            prism_post::io::write_image(&path, &image).unwrap();
+            prism_image::io::write_image(&path, &image).unwrap();
             let json = format!(
                 r#"{{"lights": [{{"type": "environment", "file": "sky.{ext}", "scale": 2,
                     "transform": {{"rotate": {{"axis": [0, 1, 0], "angle_deg": 90}}}}}}]}}"#
@@ -633,8 +633,8 @@ mod tests {
         assert!(e.contains("text.exr"), "{e}");
         let mut pixels = synthetic_pixels();
         pixels[20] = [f32::NAN, 0.0, 0.0];
-        let image = prism_post::Image::new(16, 8, pixels, RgbColorSpace::srgb()).unwrap();
-        prism_post::io::write_image(&dir.path().join("nan.exr"), &image).unwrap();
+        let image = prism_image::Image::new(16, 8, pixels, RgbColorSpace::srgb()).unwrap();
+        prism_image::io::write_image(&dir.path().join("nan.exr"), &image).unwrap();
         let e = build_error(
             dir.path(),
             r#"{"lights": [{"type": "environment", "file": "nan.exr"}]}"#,

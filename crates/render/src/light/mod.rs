@@ -72,7 +72,7 @@ use prism_bandwidth::Bandwidth;
 use prism_geometry::Ray;
 use prism_spectrum::{SampledSpectrum, SampledWavelengths};
 
-pub use crate::spectrum_cache::SpectrumCache;
+pub use crate::spectrum_cache::{SpectrumCache, TransportWavelengths};
 
 /// Where light arrives: the reference point of `sample_li` / `pdf_li`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -226,7 +226,7 @@ impl Light {
         index: u32,
         ctx: &LightSampleContext,
         u: Vec2,
-        wavelengths: &SampledWavelengths,
+        wavelengths: &impl TransportWavelengths,
         cache: &mut SpectrumCache,
     ) -> Option<LightSample> {
         match self {
@@ -239,7 +239,7 @@ impl Light {
             | Light::Environment(_)
             | Light::Sky(_)
             | Light::Daylight(_)
-            | Light::Goniometric(_) => self.sample_li(ctx, u, wavelengths),
+            | Light::Goniometric(_) => self.sample_li(ctx, u, wavelengths.transport()),
         }
     }
 
@@ -251,7 +251,7 @@ impl Light {
         index: u32,
         hit: &LightHit,
         wo: Vec3A,
-        wavelengths: &SampledWavelengths,
+        wavelengths: &impl TransportWavelengths,
         cache: &mut SpectrumCache,
     ) -> SampledSpectrum {
         match self {

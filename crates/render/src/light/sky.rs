@@ -141,10 +141,10 @@ impl LightSource for UniformSky {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::chi2::chi2_test_adaptive;
     use crate::light::test_support::{
         build_scene, chi2_config, mean_and_standard_error, photometric_sum,
     };
+    use prism_testkit::chi2::chi2_test_adaptive;
 
     #[test]
     fn chi2_sky() {

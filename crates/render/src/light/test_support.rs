@@ -11,8 +11,8 @@ use prism_spectrum::data::cmfs;
 use prism_spectrum::{Observer, SampledSpectrum, SampledWavelengths};
 
 use super::{Light, LightHit, LightSampleContext, LightSet};
-use crate::chi2::{chi2_test_adaptive, Chi2Config, Chi2Result};
 use crate::scene_build::{build_geometry_with_instances, SceneBuildError};
+use prism_testkit::chi2::{chi2_test_adaptive, Chi2Config, Chi2Result};
 
 /// Geometry and lights of a scene given as JSON, as if it were the file `dir/scene.json`.
 pub fn build_scene(dir: &Path, json: &str) -> Result<(Geometry, LightSet), SceneBuildError> {
@@ -111,7 +111,7 @@ pub fn photometric_sum(mut f: impl FnMut(&SampledWavelengths) -> SampledSpectrum
 
 /// Mean and standard error of `n` values of `f(u₁, u₂)` with fixed-seed variates.
 pub fn mean_and_standard_error(n: usize, seed: u64, mut f: impl FnMut(Vec2) -> f64) -> (f64, f64) {
-    let mut rng = crate::chi2::SplitMix64(seed);
+    let mut rng = prism_testkit::chi2::SplitMix64(seed);
     let (mut sum, mut sum2) = (0.0f64, 0.0f64);
     for _ in 0..n {
         let v = f(Vec2::new(rng.next_f32(), rng.next_f32()));
@@ -147,7 +147,7 @@ pub fn chi2_config(tests: usize, seed: u64) -> Chi2Config {
         theta_bins: 12,
         sample_count: 400_000,
         integration_resolution: 8,
-        significance: crate::chi2::sidak(0.01, tests),
+        significance: prism_testkit::chi2::sidak(0.01, tests),
         seed,
         ..Chi2Config::default()
     }

@@ -75,7 +75,7 @@ pub fn sample_smoothstep(u: f32) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::chi2::{chi2_test, chi2_test_adaptive, Chi2Config};
+    use prism_testkit::chi2::{chi2_test, chi2_test_adaptive, Chi2Config};
 
     fn config() -> Chi2Config {
         Chi2Config {

@@ -10,7 +10,7 @@
 
 use prism_spectrum::{SampledSpectrum, SampledWavelengths};
 
-use super::Material;
+use super::{Material, SurfaceMaterial};
 use crate::bsdf::ThinDielectric;
 
 impl Material {
@@ -19,48 +19,52 @@ impl Material {
     #[inline]
     pub fn thin_glazing(&self, wavelengths: &SampledWavelengths) -> Option<ThinDielectric> {
         match self {
-            Material::ThinDielectric { ior } => Some(ThinDielectric {
-                eta: ior.eval(wavelengths),
-            }),
+            Material::Surface(surface) => surface.thin_glazing(wavelengths),
             Material::TwoSided { material } | Material::Mask { material, .. } => {
                 material.thin_glazing(wavelengths)
             }
-            Material::NormalMap { .. }
-            | Material::BumpMap { .. }
-            | Material::Lambert { .. }
-            | Material::Conductor { .. }
-            | Material::Dielectric { .. }
-            | Material::OrenNayar { .. }
-            | Material::Phong { .. }
-            | Material::BlinnPhong { .. }
-            | Material::Ward { .. }
-            | Material::Lafortune { .. }
-            | Material::Coated { .. }
-            | Material::Mix { .. }
-            | Material::Measured { .. } => None,
+            Material::NormalMap { .. } | Material::BumpMap { .. } => None,
         }
     }
 
     /// True when some hit may be a thin glazing pane (see `thin_glazing`).
     pub fn has_thin_glazing(&self) -> bool {
         match self {
-            Material::ThinDielectric { .. } => true,
+            Material::Surface(surface) => surface.is_thin_glazing(),
             Material::TwoSided { material } | Material::Mask { material, .. } => {
                 material.has_thin_glazing()
             }
-            Material::NormalMap { .. }
-            | Material::BumpMap { .. }
-            | Material::Lambert { .. }
-            | Material::Conductor { .. }
-            | Material::Dielectric { .. }
-            | Material::OrenNayar { .. }
-            | Material::Phong { .. }
-            | Material::BlinnPhong { .. }
-            | Material::Ward { .. }
-            | Material::Lafortune { .. }
-            | Material::Coated { .. }
-            | Material::Mix { .. }
-            | Material::Measured { .. } => false,
+            Material::NormalMap { .. } | Material::BumpMap { .. } => false,
+        }
+    }
+}
+
+impl SurfaceMaterial {
+    /// The pane when this surface is a thin dielectric sheet (a sheet inside a mix is an
+    /// ordinary lobe: the mix may scatter where the pane would pass).
+    #[inline]
+    pub fn thin_glazing(&self, wavelengths: &SampledWavelengths) -> Option<ThinDielectric> {
+        match self {
+            SurfaceMaterial::ThinDielectric { ior } => Some(ThinDielectric {
+                eta: ior.eval(wavelengths),
+            }),
+            SurfaceMaterial::Lambert { .. }
+            | SurfaceMaterial::Conductor { .. }
+            | SurfaceMaterial::Dielectric { .. }
+            | SurfaceMaterial::Mix { .. }
+            | SurfaceMaterial::Library(_) => None,
+        }
+    }
+
+    /// True when this surface is a thin glazing pane (see `thin_glazing`).
+    pub fn is_thin_glazing(&self) -> bool {
+        match self {
+            SurfaceMaterial::ThinDielectric { .. } => true,
+            SurfaceMaterial::Lambert { .. }
+            | SurfaceMaterial::Conductor { .. }
+            | SurfaceMaterial::Dielectric { .. }
+            | SurfaceMaterial::Mix { .. }
+            | SurfaceMaterial::Library(_) => false,
         }
     }
 }

@@ -3,6 +3,8 @@
 //! (homogeneous, grid) and their transmittance follow with the media work. Scenes that
 //! declare media are refused until then (`scene_build`), never rendered as vacuum.
 
+#![deny(clippy::wildcard_enum_match_arm)]
+
 pub mod phase;
 
 pub use phase::{PhaseFunction, PhaseSample};

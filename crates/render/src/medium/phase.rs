@@ -59,7 +59,8 @@ impl PhaseFunction {
             PhaseFunction::Isotropic => 0.0,
             PhaseFunction::HenyeyGreenstein { g } => g,
         };
-        // cos θ measured from −ωo (the forward direction).
+        // cos θ between ωo and ωi (pbrt-v4's form: forward scattering, g > 0, puts ωi near
+        // −ωo, cos θ near −1).
         let cos_theta = if g.abs() < 1e-3 {
             1.0 - 2.0 * u.x
         } else {
@@ -69,7 +70,7 @@ impl PhaseFunction {
         let cos_theta = cos_theta.clamp(-1.0, 1.0);
         let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
         let phi = 2.0 * PI * u.y;
-        let frame = Frame::from_z(-wo);
+        let frame = Frame::from_z(wo);
         let local = Vec3A::new(sin_theta * phi.cos(), sin_theta * phi.sin(), cos_theta);
         let wi = frame.from_local(local).normalize();
         let p = self.eval(wo, wi);
@@ -88,7 +89,7 @@ impl PhaseFunction {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::chi2::{chi2_test, Chi2Config};
+    use prism_testkit::chi2::{chi2_test, Chi2Config};
 
     fn phases() -> [PhaseFunction; 4] {
         [

@@ -1,6 +1,6 @@
 //! Deterministic per-pixel samplers: every value is a function of (seed, pixel, sample
 //! index, dimension) only, so a pixel's samples never depend on which thread or tile draws
-//! them (DESIGN.md "Deterministic").
+//! them: images are the same for any thread count.
 //!
 //! Two kinds (`prism_scene::SamplerKind`, the scene's `integrator.sampler`):
 //!

@@ -11,7 +11,8 @@
 //! transmits all light); a conductor given by η, k spectra has its normal-incidence Fresnel
 //! reflectance F₀ = ((η−1)² + k²)/((η+1)² + k²) (Born & Wolf §14.2), and so has a named
 //! metal, from the η, k tables render ships (`material::metal_optics`, spectra/metals/);
-//! `two_sided` and `mask` take their inner material's albedo.
+//! `two_sided` and `mask` take their inner material's albedo, a mix blends its two; the
+//! material library's kinds answer in `material::library::albedo_rgb`.
 
 use prism_scene::{ConductorOptics, Material, MaterialKind, SpectrumRef};
 use prism_spectrum::colorimetry::reflectance_to_xyz;
@@ -96,26 +97,8 @@ fn albedo_at_depth(materials: &[Material], index: usize, depth: usize) -> [f32; 
         | MaterialKind::BumpMap { material, .. } => {
             albedo_at_depth(materials, *material, depth + 1)
         }
-        // The material library (issue 8): the diffuse reflectance, plus the specular one
-        // where the two share an energy budget; a mix blends its materials' albedos; a
-        // measured BRDF (its table is loaded only when rendering) reports the default.
-        MaterialKind::OrenNayar { reflectance, .. } => reflectance_rgb(reflectance),
-        MaterialKind::Phong {
-            diffuse, specular, ..
-        }
-        | MaterialKind::BlinnPhong {
-            diffuse, specular, ..
-        }
-        | MaterialKind::Ward {
-            diffuse, specular, ..
-        } => {
-            let (d, s) = (reflectance_rgb(diffuse), reflectance_rgb(specular));
-            [d[0] + s[0], d[1] + s[1], d[2] + s[2]]
-        }
-        MaterialKind::Lafortune { diffuse, .. } | MaterialKind::Coated { diffuse, .. } => {
-            reflectance_rgb(diffuse)
-        }
         MaterialKind::ThinDielectric { .. } => [1.0; 3],
+        MaterialKind::Library(kind) => crate::material::library::albedo_rgb(kind),
         MaterialKind::Mix {
             materials: [a, b],
             weight,
@@ -127,7 +110,6 @@ fn albedo_at_depth(materials: &[Material], index: usize, depth: usize) -> [f32; 
             let w = *weight as f32;
             [0, 1, 2].map(|c| (1.0 - w) * a[c] + w * b[c])
         }
-        MaterialKind::Merl { .. } => DEFAULT_ALBEDO,
     }
 }
 

@@ -12,7 +12,7 @@ use prism_scene::{LightKind, SceneDescription, ShapeKind};
 
 use crate::camera::Camera;
 use crate::integrator::Integrator;
-use crate::material::Material;
+use crate::material::{Material, SurfaceMaterial};
 
 /// One thing a scene may use that a fast path may not handle. Append new variants last,
 /// and to `ALL`.
@@ -294,35 +294,10 @@ impl SceneFeatures {
     }
 }
 
-/// The features of material `m` and of the materials it wraps or mixes.
+/// The features of material `m` and of the materials it wraps.
 fn material_features(m: &Material, f: &mut SceneFeatures) {
     match m {
-        Material::Lambert { reflectance } => {
-            if reflectance.constant().is_none() {
-                f.insert(SceneFeature::Textures);
-            }
-        }
-        Material::Conductor {
-            roughness_texture, ..
-        } => {
-            f.insert(SceneFeature::NonLambertianBsdfs);
-            if roughness_texture.is_some() {
-                f.insert(SceneFeature::Textures);
-            }
-        }
-        Material::Dielectric {
-            ior,
-            roughness_texture,
-            ..
-        } => {
-            f.insert(SceneFeature::NonLambertianBsdfs);
-            if ior.is_dispersive() {
-                f.insert(SceneFeature::Dispersion);
-            }
-            if roughness_texture.is_some() {
-                f.insert(SceneFeature::Textures);
-            }
-        }
+        Material::Surface(surface) => surface_features(surface, f),
         Material::TwoSided { material } => {
             f.insert(SceneFeature::TwoSidedMaterials);
             material_features(material, f);
@@ -343,23 +318,49 @@ fn material_features(m: &Material, f: &mut SceneFeatures) {
             f.insert(SceneFeature::Textures);
             material_features(material, f);
         }
-        Material::ThinDielectric { .. } => {
+    }
+}
+
+/// The features of surface `s` and of the surfaces it mixes.
+fn surface_features(s: &SurfaceMaterial, f: &mut SceneFeatures) {
+    match s {
+        SurfaceMaterial::Lambert { reflectance } => {
+            if reflectance.constant().is_none() {
+                f.insert(SceneFeature::Textures);
+            }
+        }
+        SurfaceMaterial::Conductor {
+            roughness_texture, ..
+        } => {
+            f.insert(SceneFeature::NonLambertianBsdfs);
+            if roughness_texture.is_some() {
+                f.insert(SceneFeature::Textures);
+            }
+        }
+        SurfaceMaterial::Dielectric {
+            ior,
+            roughness_texture,
+            ..
+        } => {
+            f.insert(SceneFeature::NonLambertianBsdfs);
+            if ior.is_dispersive() {
+                f.insert(SceneFeature::Dispersion);
+            }
+            if roughness_texture.is_some() {
+                f.insert(SceneFeature::Textures);
+            }
+        }
+        SurfaceMaterial::ThinDielectric { .. } => {
             f.insert(SceneFeature::NonLambertianBsdfs);
             f.insert(SceneFeature::ThinGlazing);
         }
-        Material::Mix { materials, .. } => {
+        SurfaceMaterial::Mix { materials, .. } => {
             f.insert(SceneFeature::NonLambertianBsdfs);
             for inner in materials.iter() {
-                material_features(inner, f);
+                surface_features(inner, f);
             }
         }
-        Material::OrenNayar { .. }
-        | Material::Phong { .. }
-        | Material::BlinnPhong { .. }
-        | Material::Ward { .. }
-        | Material::Lafortune { .. }
-        | Material::Coated { .. }
-        | Material::Measured { .. } => f.insert(SceneFeature::NonLambertianBsdfs),
+        SurfaceMaterial::Library(_) => f.insert(SceneFeature::NonLambertianBsdfs),
     }
 }
 

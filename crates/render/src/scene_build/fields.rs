@@ -2,11 +2,12 @@
 //! error that refuses it, so that nothing parsed is silently dropped.
 //!
 //! prism-scene lists each kind of object it accepts with its keys (`prism_scene::schema::
-//! SCHEMA`; its parsers can check an object against nothing else). [`FIELD_USES`] is the
-//! other half; the test below walks every accepted key path and fails, naming it, when no
-//! row of `FIELD_USES` covers it. So a key added to the reader fails that test until
-//! someone wires it into render here (naming the code that reads it) or refuses it in
-//! [`refuse_unrendered`].
+//! rows()`; its parsers can check an object against nothing else). [`field_uses`] is the
+//! other half — [`FIELD_USES`] here, and the material library's rows next to the code that
+//! reads them (`material::library::FIELD_USES`); the test below walks every accepted key
+//! path and fails, naming it, when no row covers it. So a key added to the reader fails
+//! that test until someone wires it into render (naming the code that reads it) or refuses
+//! it in [`refuse_unrendered`].
 //!
 //! Refusals live here, in one place: when participating media render, delete their
 //! check in `refuse_unrendered` and turn their rows into `Read`.
@@ -35,7 +36,7 @@ pub struct FieldRow {
     pub use_: FieldUse,
 }
 
-const fn read(
+pub(crate) const fn read(
     patterns: &'static [&'static str],
     keys: &'static [&'static str],
     by: &'static str,
@@ -104,6 +105,7 @@ const DAYLIGHT: &[&str] = &[
     "lights[]<perez_sky>",
     "lights[]<preetham_sky>",
 ];
+/// The material types `build_one` reads; the library's are in `material::library::FIELD_USES`.
 const MATERIALS: &[&str] = &[
     "materials.*<lambert>",
     "materials.*<conductor>",
@@ -112,16 +114,8 @@ const MATERIALS: &[&str] = &[
     "materials.*<normal_map>",
     "materials.*<bump_map>",
     "materials.*<mask>",
-    "materials.*<oren_nayar>",
-    "materials.*<oren_nayar_qualitative>",
-    "materials.*<phong>",
-    "materials.*<blinn_phong>",
-    "materials.*<ward>",
-    "materials.*<lafortune>",
-    "materials.*<coated>",
     "materials.*<thin_dielectric>",
     "materials.*<mix>",
-    "materials.*<merl>",
 ];
 const SENSORS: &[&str] = &["sensors[]<point>", "sensors[]<points>", "sensors[]<grid>"];
 const TEXTURES: &[&str] = &[
@@ -137,7 +131,6 @@ const BUILD_GEOMETRY: &str = "scene_build::geometry::place_shapes";
 const BUILD_LIGHTS: &str = "light::build::build_lights";
 const BUILD_DAYLIGHT: &str = "light::daylight::build_daylight";
 const BUILD_MATERIAL: &str = "material::build_materials (build_one)";
-const BUILD_LIBRARY: &str = "material::library::build_library";
 const SENSOR: &str = "sensor::measure_sensors (`prism render`)";
 const LOAD_TEXTURE: &str = "texture::build_textures, texture::load";
 const TRANSFORM: &str = "prism-scene transform::parse_transform composes the matrix that \
@@ -145,7 +138,14 @@ const TRANSFORM: &str = "prism-scene transform::parse_transform composes the mat
 const MEDIA: &str = "scene_build::fields::refuse_unrendered: participating media are not \
                      rendered yet";
 
-/// Every key path of `prism_scene::schema::SCHEMA`, each in exactly one row.
+/// Every row: [`FIELD_USES`] and the material library's; together they name every key
+/// path of `prism_scene::schema::rows()`, each in exactly one row.
+pub fn field_uses() -> impl Iterator<Item = &'static FieldRow> {
+    FIELD_USES
+        .iter()
+        .chain(crate::material::library::FIELD_USES)
+}
+
 pub const FIELD_USES: &[FieldRow] = &[
     // The top level.
     read(&[""], &["camera"], BUILD_CAMERA),
@@ -400,49 +400,11 @@ pub const FIELD_USES: &[FieldRow] = &[
     ),
     read(&["materials.*<bump_map>"], &["scale_m"], BUILD_MATERIAL),
     read(&["materials.*<mask>"], &["opacity"], BUILD_MATERIAL),
-    read(
-        &[
-            "materials.*<oren_nayar>",
-            "materials.*<oren_nayar_qualitative>",
-        ],
-        &["reflectance", "sigma_deg"],
-        BUILD_LIBRARY,
-    ),
-    read(
-        &["materials.*<phong>", "materials.*<blinn_phong>"],
-        &["diffuse", "specular", "exponent"],
-        BUILD_LIBRARY,
-    ),
-    read(
-        &["materials.*<ward>"],
-        &["diffuse", "specular", "alpha"],
-        BUILD_LIBRARY,
-    ),
-    read(
-        &["materials.*<lafortune>"],
-        &["diffuse", "lobes"],
-        BUILD_LIBRARY,
-    ),
-    read(
-        &["materials.*<lafortune>.lobes[]"],
-        &["cx", "cy", "cz", "exponent", "albedo"],
-        BUILD_LIBRARY,
-    ),
-    read(
-        &["materials.*<coated>"],
-        &["diffuse", "ior", "nonlinear"],
-        BUILD_LIBRARY,
-    ),
-    read(&["materials.*<thin_dielectric>"], &["ior"], BUILD_LIBRARY),
+    read(&["materials.*<thin_dielectric>"], &["ior"], BUILD_MATERIAL),
     read(
         &["materials.*<mix>"],
         &["materials", "weight"],
         BUILD_MATERIAL,
-    ),
-    read(
-        &["materials.*<merl>"],
-        &["file", "clamp_negative"],
-        "material::library::build_library (MerlTable::read)",
     ),
     read(
         &["@ior"],
@@ -575,17 +537,16 @@ pub fn refuse_unrendered(scene: &SceneDescription) -> Result<(), SceneBuildError
 #[cfg(test)]
 mod tests {
     use super::*;
-    use prism_scene::schema::SCHEMA;
+    use prism_scene::schema::rows;
 
     /// The walk over the scene reader's schema: every key path it accepts is in exactly
-    /// one row of `FIELD_USES`, and every row names only accepted key paths.
+    /// one row of `field_uses()`, and every row names only accepted key paths.
     #[test]
     fn every_key_the_scene_reader_accepts_is_read_or_refused() {
         let (mut missing, mut twice, mut stale) = (Vec::new(), Vec::new(), Vec::new());
-        for object in SCHEMA {
+        for object in rows() {
             for key in object.keys() {
-                let rows = FIELD_USES
-                    .iter()
+                let rows = field_uses()
                     .filter(|r| r.patterns.contains(&object.pattern) && r.keys.contains(&key))
                     .count();
                 match rows {
@@ -595,12 +556,10 @@ mod tests {
                 }
             }
         }
-        for row in FIELD_USES {
+        for row in field_uses() {
             for pattern in row.patterns {
                 for key in row.keys {
-                    let accepted = SCHEMA
-                        .iter()
-                        .any(|o| o.pattern == *pattern && o.accepts(key));
+                    let accepted = rows().any(|o| o.pattern == *pattern && o.accepts(key));
                     if !accepted {
                         stale.push(format!("{pattern}.{key}"));
                     }
@@ -610,13 +569,13 @@ mod tests {
         assert!(
             missing.is_empty(),
             "the scene reader accepts {missing:?}, which render neither reads nor refuses: \
-             add each to scene_build::fields::FIELD_USES with the code that reads it, or \
-             refuse it in refuse_unrendered"
+             add each to scene_build::fields::FIELD_USES (material::library::FIELD_USES for a \
+             library material) with the code that reads it, or refuse it in refuse_unrendered"
         );
-        assert!(twice.is_empty(), "in two rows of FIELD_USES: {twice:?}");
+        assert!(twice.is_empty(), "in two rows of field_uses(): {twice:?}");
         assert!(
             stale.is_empty(),
-            "FIELD_USES names key paths the scene reader does not accept: {stale:?}"
+            "field_uses() names key paths the scene reader does not accept: {stale:?}"
         );
     }
 }

@@ -1,10 +1,10 @@
-//! Building textures from the scene description: images are read through prism-post's
-//! decoders (`prism_post::io::png::read_png_raw` for PNG, `read_image` for EXR/HDR) and
+//! Building textures from the scene description: images are read through prism-image's
+//! decoders (`prism_image::io::png::read_png_raw` for PNG, `read_image` for EXR/HDR) and
 //! checked for their use.
 //!
-//! Why here and not in prism-scene: DESIGN.md lets prism-scene own asset loading, but its
+//! Why here and not in prism-scene: the founding design let prism-scene own asset loading, but its
 //! arrows say scene uses only geometry and spectrum, and the image decoders live in
-//! prism-post, which render already uses (environment maps load the same way). Parsing
+//! prism-image, which render already uses (environment maps load the same way). Parsing
 //! and path resolution (the file must exist) stay in prism-scene; decoding, which depends
 //! on how a texture is used (sRGB vs linear normal maps, albedo bounds, channel needs), is
 //! done here, once per (texture, use).
@@ -299,7 +299,7 @@ fn decode(
         .is_some_and(|e| e.eq_ignore_ascii_case("png"));
     let srgb_target = RgbGamut::Srgb.color_space();
     let (w, h, mut texels, channels, space) = if is_png {
-        let raw = prism_post::io::png::read_png_raw(path).map_err(|e| e.to_string())?;
+        let raw = prism_image::io::png::read_png_raw(path).map_err(|e| e.to_string())?;
         let linear = match encoding {
             ImageEncoding::Linear => true,
             ImageEncoding::Srgb => false,
@@ -333,7 +333,7 @@ fn decode(
             .collect();
         (raw.width, raw.height, texels, n, raw.space)
     } else {
-        let image = prism_post::io::read_image(path).map_err(|e| e.to_string())?;
+        let image = prism_image::io::read_image(path).map_err(|e| e.to_string())?;
         let (w, h) = (image.width(), image.height());
         let alpha = image
             .layer("")
@@ -352,7 +352,7 @@ fn decode(
     // Colour in Rec.709 primaries (not for normal maps: their components are a vector).
     if purpose != TexturePurpose::NormalMap && !same_primaries(&space, &srgb_target) {
         let mut rgb: Vec<[f32; 3]> = texels.iter().map(|t| [t[0], t[1], t[2]]).collect();
-        prism_post::io::convert_pixels(&mut rgb, &space, &srgb_target);
+        prism_image::io::convert_pixels(&mut rgb, &space, &srgb_target);
         for (t, c) in texels.iter_mut().zip(rgb) {
             t[..3].copy_from_slice(&c);
         }

@@ -6,7 +6,7 @@
 //! Every lookup goes through a [`TextureContext`] (position, uv and their screen-space
 //! derivatives, from `SurfaceInteraction::differentials`). A texture's uv transform maps
 //! uv → st before the lookup, with the derivatives transformed alike (pbrt-v4
-//! `UVMapping`). Images are read when the scene is built (`load`), through prism-post's
+//! `UVMapping`). Images are read when the scene is built (`load`), through prism-image's
 //! decoders, and validated for their use there.
 
 pub mod checkerboard;

@@ -11,9 +11,9 @@
 
 use std::path::Path;
 
-use prism_post::io::read_image;
+use prism_image::io::read_image;
+use prism_image::Image;
 use prism_post::metrics::{compare_with, CompareOptions, PreparedReference};
-use prism_post::Image;
 
 fn thread_cpu_ms() -> f64 {
     #[cfg(unix)]

@@ -9,10 +9,10 @@ use std::arch::x86_64::*;
 use prism_cpu::Simd;
 
 use super::*;
-use crate::image::Image;
 use crate::tonemap::pixels::{map_pixels_chunk, stats_chunk, CHUNK};
 use crate::tonemap::test_support::{bit_test_image, sweep_image};
 use crate::tonemap::{ToneOperator, ToneParams};
+use prism_image::Image;
 
 /// The luminance pass at every ISA gives the scalar pass's bits and counts on `image`:
 /// the whole pass ([`map_luminance_fast`]), and single tasks ([`luminance_task`]) at every

@@ -13,6 +13,7 @@ use crate::bsdf::TransportMode;
 use crate::integrator::{PathCounters, PathTracer};
 use crate::light::LightSample;
 use crate::scene_build::RenderScene;
+use crate::spectrum_cache::SpectrumCache;
 
 /// The contribution of one strategy: radiance (camera side) or a splat at a film point
 /// (t = 1), with its MIS weight applied and its weight for diagnostics.
@@ -100,6 +101,7 @@ pub fn connect(
     t: usize,
     variates: &ConnectionVariates,
     wavelengths: &SampledWavelengths,
+    le_cache: &mut SpectrumCache,
     counters: &mut PathCounters,
 ) -> Option<Connection> {
     let lights = &scene.lights;
@@ -154,8 +156,13 @@ pub fn connect(
         }
         let (index, pmf) = lights.sample(variates.u_light_choice)?;
         let light_source = lights.light(index);
-        let ls: LightSample =
-            light_source.sample_li(&pt.light_context(), variates.u_light, wavelengths)?;
+        let ls: LightSample = light_source.sample_li_cached(
+            index,
+            &pt.light_context(),
+            variates.u_light,
+            wavelengths,
+            le_cache,
+        )?;
         if ls.pdf <= 0.0 || ls.radiance.is_black() {
             return None;
         }
@@ -220,22 +227,11 @@ fn remap0(x: f32) -> f32 {
     }
 }
 
-/// The vertex fields `mis_weight` overwrites, to put back afterwards (pbrt-v3's
-/// `ScopedAssignment`s).
-#[derive(Clone, Copy)]
-struct Saved {
-    camera_first: BdptVertex,
-    light_first: Option<BdptVertex>,
-    camera_end: BdptVertex,
-    camera_before_end: Option<BdptVertex>,
-    light_end: Option<BdptVertex>,
-    light_before_end: Option<BdptVertex>,
-}
-
 /// The MIS weight of strategy (s, t) (pbrt-v3 §16.3.4): the densities of the connection's
 /// vertices under the other strategies are filled in, then the ratios r_i = p_i / p_s
 /// accumulate outwards along both subpaths; w = 1 / (1 + Σ r_i^β) with β = 1 (balance) or
-/// 2 (power, Veach 1997 eq. 9.13). The subpaths are restored before it returns.
+/// 2 (power, Veach 1997 eq. 9.13). The subpaths are restored before it returns: only the
+/// fields it overwrites are saved (pbrt-v3's `ScopedAssignment`s), a vertex is ~160 bytes.
 fn mis_weight(
     scene: &RenderScene,
     mis: MisHeuristic,
@@ -248,34 +244,45 @@ fn mis_weight(
     if s + t == 2 {
         return 1.0;
     }
-    let saved = Saved {
-        camera_first: camera.vertices[0],
-        light_first: light.vertices.first().copied(),
-        camera_end: camera.vertices[t - 1],
-        camera_before_end: (t > 1).then(|| camera.vertices[t - 2]),
-        light_end: (s > 0).then(|| light.vertices[s - 1]),
-        light_before_end: (s > 1).then(|| light.vertices[s - 2]),
-    };
-    if s == 1 {
+    // (pdf_rev, delta) of the camera's last two and the light's last two vertices.
+    let field = |v: &BdptVertex| (v.pdf_rev, v.delta);
+    let camera_end = field(&camera.vertices[t - 1]);
+    let camera_before_end = (t > 1).then(|| field(&camera.vertices[t - 2]));
+    let light_end = (s > 0).then(|| field(&light.vertices[s - 1]));
+    let light_before_end = (s > 1).then(|| field(&light.vertices[s - 2]));
+    // The strategy's own sampled vertex replaces the subpath's first.
+    let replaced = if s == 1 {
+        let first = light.vertices[0];
         light.vertices[0] = sampled.expect("s = 1 samples a light vertex");
+        Some((true, first))
     } else if t == 1 {
+        let first = camera.vertices[0];
         camera.vertices[0] = sampled.expect("t = 1 samples a camera vertex");
-    }
+        Some((false, first))
+    } else {
+        None
+    };
     let w = mis_weight_in_place(scene, mis, light, camera, s, t);
-    // Put back what was overwritten (innermost first, so that index 0 ends as it was).
-    if let Some(v) = saved.light_before_end {
-        light.vertices[s - 2] = v;
+    match replaced {
+        Some((true, first)) => light.vertices[0] = first,
+        Some((false, first)) => camera.vertices[0] = first,
+        None => {}
     }
-    if let Some(v) = saved.light_end {
-        light.vertices[s - 1] = v;
+    let put = |v: &mut BdptVertex, (pdf_rev, delta): (f32, bool)| {
+        v.pdf_rev = pdf_rev;
+        v.delta = delta;
+    };
+    // The saved fields are the original vertices' (saved before the replacement), so
+    // putting them back is right for a restored index 0 too.
+    put(&mut camera.vertices[t - 1], camera_end);
+    if let Some(f) = camera_before_end {
+        put(&mut camera.vertices[t - 2], f);
     }
-    if let Some(v) = saved.camera_before_end {
-        camera.vertices[t - 2] = v;
+    if let Some(f) = light_end {
+        put(&mut light.vertices[s - 1], f);
     }
-    camera.vertices[t - 1] = saved.camera_end;
-    camera.vertices[0] = saved.camera_first;
-    if let Some(v) = saved.light_first {
-        light.vertices[0] = v;
+    if let Some(f) = light_before_end {
+        put(&mut light.vertices[s - 2], f);
     }
     w
 }

@@ -22,7 +22,7 @@ pub(crate) mod walk;
 pub(crate) use connect::connect as connect_strategy;
 pub use connect::{Connection, ConnectionVariates};
 
-use glam::UVec2;
+use glam::{UVec2, Vec3A};
 use prism_scene::MisHeuristic;
 use prism_spectrum::{SampledSpectrum, SampledWavelengths};
 
@@ -130,32 +130,44 @@ impl Bdpt {
         let zero = SampledSpectrum::splat(0.0);
         let wavelengths =
             LaneWavelengths::new(SampledWavelengths::sample_visible(cs.stream.get_1d()));
-        let Some(ray) = scene.camera.generate_ray_only(cs.film_point, cs.lens) else {
-            return (zero, *wavelengths.sensor(), None, false);
-        };
-        let pdf_dir = scene
-            .camera
-            .pdf_we(&ray)
-            .map_or(0.0, |(_, pdf_dir)| pdf_dir);
         debug_assert_eq!(cs.stream.dimension(), CAMERA_SAMPLE_DIMENSIONS);
-        let mut camera_state = PathState::new(ray.origin, None, cs.stream, wavelengths);
-        walk::camera_subpath(
-            scene,
-            &ray,
-            pdf_dir,
-            self.max_depth,
-            self.rr_depth,
-            &mut camera_state,
-            camera_path,
-            counters,
-        );
+        let camera_ray = scene.camera.generate_ray_only(cs.film_point, cs.lens);
+        let mut camera_state = PathState::new(Vec3A::ZERO, None, cs.stream, wavelengths);
+        match &camera_ray {
+            Some(ray) => {
+                let pdf_dir = scene.camera.pdf_we(ray).map_or(0.0, |(_, pdf_dir)| pdf_dir);
+                walk::camera_subpath(
+                    scene,
+                    ray,
+                    pdf_dir,
+                    self.max_depth,
+                    self.rr_depth,
+                    &mut camera_state,
+                    camera_path,
+                    counters,
+                );
+            }
+            None => {
+                // A film point without a ray (outside a circular fisheye's image circle):
+                // no camera subpath, but the light subpath is traced all the same — its
+                // t = 1 connections land anywhere on the film, and the film divides the
+                // splats by every camera sample's light path.
+                camera_path.clear();
+                camera_path.vertices.push(vertex::BdptVertex::camera(
+                    scene.camera.frame().camera_to_world.point(Vec3A::ZERO),
+                    scene.camera.forward(),
+                    SampledSpectrum::splat(1.0),
+                ));
+            }
+        }
+        let ray_origin = camera_path.vertices[0].p;
         // The light subpath's dimensions start at a fixed place (module docs).
         let mut light_stream = cs.stream;
         let first = bdpt_light_subpath_first_dimension(self.max_depth);
         light_stream.reserve(first - light_stream.dimension());
         let start = LightStartDimensions::reserve(&mut light_stream);
         let mut light_state =
-            PathState::new(ray.origin, None, light_stream, camera_state.wavelengths);
+            PathState::new(ray_origin, None, light_stream, camera_state.wavelengths);
         walk::light_subpath(
             scene,
             start,
@@ -172,7 +184,7 @@ impl Bdpt {
             VertexKind::Surface { scatter, .. } => {
                 let si = &camera_path.surfaces[scatter as usize].si;
                 Some(SurfaceAov {
-                    depth_m: (si.p - ray.origin).length(),
+                    depth_m: (si.p - ray_origin).length(),
                     normal: si.n_shading,
                     albedo_rgb: scene.albedo(si.material_id),
                 })
@@ -184,10 +196,13 @@ impl Bdpt {
         });
         let tracer = self.path_tracer();
         let importance_area = scene.camera.importance_area_px2();
+        let xyz_weights = crate::film::xyz::XyzWeights::new(&sensor);
         let mut radiance = zero;
         let (n_camera, n_light) = (camera_path.len(), light_path.len());
         let light_first = start_of_light_vertex_blocks(start);
         let uses_lens = scene.camera.uses_lens_sample();
+        // The lights' spectra at this sample's transport wavelengths (s = 1 connections).
+        let mut le_cache = crate::spectrum_cache::SpectrumCache::new();
         for t in 1..=n_camera {
             for s in 0..=n_light {
                 let depth = s as i64 + t as i64 - 2;
@@ -236,6 +251,7 @@ impl Bdpt {
                     t,
                     &variates,
                     &transport,
+                    &mut le_cache,
                     counters,
                 ) else {
                     continue;
@@ -252,7 +268,12 @@ impl Bdpt {
                 let value = c.unweighted * weight;
                 match c.film_point_px {
                     Some(film_point) => {
-                        if !splats.splat(film_point, value * importance_area, &sensor) {
+                        if !splats.splat_with(
+                            film_point,
+                            value * importance_area,
+                            &sensor,
+                            &xyz_weights,
+                        ) {
                             counters.non_finite_contributions += 1;
                         }
                     }
@@ -260,7 +281,7 @@ impl Bdpt {
                 }
             }
         }
-        (radiance, sensor, aov, true)
+        (radiance, sensor, aov, camera_ray.is_some())
     }
 }
 

@@ -46,6 +46,10 @@ pub struct SurfaceScatter<'a> {
     /// Unit direction back along the arriving ray (world).
     pub wo: Vec3A,
     pub check_sides: bool,
+    /// `wo` in the shading frame and ωo·n_geometric, computed once (every connection views
+    /// the vertex from `wo`).
+    wo_local: Vec3A,
+    wo_dot_ng: f32,
 }
 
 impl<'a> SurfaceScatter<'a> {
@@ -55,11 +59,15 @@ impl<'a> SurfaceScatter<'a> {
         ray_direction: Vec3A,
         check_sides: bool,
     ) -> Self {
+        let frame = Frame::from_zx(si.n_shading, si.dpdu);
+        let wo = -ray_direction;
         Self {
-            frame: Frame::from_zx(si.n_shading, si.dpdu),
+            frame,
+            wo_local: frame.to_local(wo),
+            wo_dot_ng: wo.dot(si.n_geometric),
             si,
             bsdf,
-            wo: -ray_direction,
+            wo,
             check_sides,
         }
     }
@@ -81,7 +89,14 @@ impl<'a> SurfaceScatter<'a> {
     /// The vertex seen from the direction it was reached from.
     #[inline]
     pub fn scatter_vertex(&self) -> ScatterVertex<'_> {
-        self.seen_from(self.wo)
+        ScatterVertex::Surface(SurfaceVertex {
+            si: &self.si,
+            bsdf: &self.bsdf,
+            frame: self.frame,
+            wo_local: self.wo_local,
+            check_sides: self.check_sides,
+            wo_dot_ng: self.wo_dot_ng,
+        })
     }
 }
 
@@ -307,11 +322,7 @@ impl BdptVertex {
         if d2 == 0.0 {
             return 0.0;
         }
-        let mut pdf = pdf / d2;
-        if next.is_on_surface() {
-            pdf *= next.n_geometric.dot(w / d2.sqrt()).abs();
-        }
-        pdf
+        convert_with(pdf, d2, w / d2.sqrt(), next)
     }
 
     /// Area density with which this vertex's subpath samples `next` given `prev` (pbrt-v3
@@ -326,10 +337,11 @@ impl BdptVertex {
         mode: TransportMode,
     ) -> f32 {
         let w = next.p - self.p;
-        if w.length_squared() == 0.0 {
+        let d2 = w.length_squared();
+        if d2 == 0.0 {
             return 0.0;
         }
-        let wn = w.normalize();
+        let wn = w * (1.0 / d2.sqrt());
         let pdf = match &self.kind {
             VertexKind::Light { .. } | VertexKind::InfiniteLight { .. } => {
                 return self.pdf_light(scene, next);
@@ -357,7 +369,11 @@ impl BdptVertex {
                 Some(_) | None => 0.0,
             },
         };
-        self.convert_density(pdf, next)
+        if next.is_infinite_light() {
+            pdf
+        } else {
+            convert_with(pdf, d2, wn, next)
+        }
     }
 
     /// Density with which this light vertex emits towards `v`, per unit area at `v` (per
@@ -478,6 +494,17 @@ impl BdptVertex {
             n: self.n_geometric,
         }
     }
+}
+
+/// A solid-angle density along unit `w` over squared distance `d2` as an area density at
+/// `next` (pbrt-v3 `ConvertDensity`'s arithmetic).
+#[inline(always)]
+fn convert_with(pdf: f32, d2: f32, w: Vec3A, next: &BdptVertex) -> f32 {
+    let mut pdf = pdf / d2;
+    if next.is_on_surface() {
+        pdf *= next.n_geometric.dot(w).abs();
+    }
+    pdf
 }
 
 /// Σ over the infinite lights of pmf(l) · pdf_li(−w): the density with which a light

@@ -90,7 +90,7 @@ pub fn random_walk<'s>(
         let bsdf = material.bsdf_cached(
             si.material_id,
             &si,
-            path_state.wavelengths.transport(),
+            &path_state.wavelengths,
             &mut reflectance_cache,
         );
         let emitter = scene

@@ -40,7 +40,7 @@ use prism_spectrum::Spectrum;
 
 use crate::light::area::{AreaLight, AreaShape};
 use crate::light::Light;
-use crate::material::Material;
+use crate::material::{Material, SurfaceMaterial};
 use crate::scene_build::{small_scene_not_used, RenderScene, SceneFeature, SceneFeatures};
 
 /// What a ray that hits patch `i` finds there (constant over the patch).
@@ -143,22 +143,20 @@ impl PacketScene {
         for leaf in &flat {
             let r = &leaf.record;
             let constant = match scene.material(r.material_id) {
-                Material::Lambert { reflectance } => reflectance.constant(),
-                Material::Conductor { .. }
-                | Material::Dielectric { .. }
+                Material::Surface(SurfaceMaterial::Lambert { reflectance }) => {
+                    reflectance.constant()
+                }
+                Material::Surface(
+                    SurfaceMaterial::Conductor { .. }
+                    | SurfaceMaterial::Dielectric { .. }
+                    | SurfaceMaterial::ThinDielectric { .. }
+                    | SurfaceMaterial::Mix { .. }
+                    | SurfaceMaterial::Library(_),
+                )
                 | Material::TwoSided { .. }
                 | Material::Mask { .. }
                 | Material::NormalMap { .. }
-                | Material::BumpMap { .. }
-                | Material::OrenNayar { .. }
-                | Material::Phong { .. }
-                | Material::BlinnPhong { .. }
-                | Material::Ward { .. }
-                | Material::Lafortune { .. }
-                | Material::Coated { .. }
-                | Material::ThinDielectric { .. }
-                | Material::Mix { .. }
-                | Material::Measured { .. } => None,
+                | Material::BumpMap { .. } => None,
             };
             // Guaranteed by the features (`NonLambertianBsdfs`, `Textures`, …): a guard.
             let Some(constant) = constant else {

@@ -23,7 +23,7 @@ use crate::film::SurfaceAov;
 use crate::integrator::dimensions::{VertexDimensions, LENS_DIMENSIONS};
 use crate::integrator::path::{add_contribution, FirstHit, PathCounters, PathTracer};
 use crate::light::{LightHit, LightSampleContext};
-use crate::material::Material;
+use crate::material::{Material, SurfaceMaterial};
 use crate::sampler::hash::u32_to_unit_f32;
 use crate::sampler::independent;
 use crate::sampler::{PixelSampler, SampleStream};
@@ -758,7 +758,9 @@ fn begin_vertices<const N: usize>(
             continue;
         };
         if slot[l] == NO_SLOT {
-            let Material::Lambert { reflectance } = scene.material(material[l]) else {
+            let Material::Surface(SurfaceMaterial::Lambert { reflectance }) =
+                scene.material(material[l])
+            else {
                 unreachable!("PacketScene::new admits constant Lambertian materials only");
             };
             let constant = reflectance

@@ -10,11 +10,11 @@ use prism_spectrum::{Observer, SampledSpectrum, SampledWavelengths};
 
 use super::sun_position::solar_angles;
 use super::*;
-use crate::chi2::chi2_test_adaptive;
 use crate::light::test_support::{
     build_error, build_scene, chi2_config, mean_and_standard_error, photometric_sum,
 };
 use crate::light::{Light, LightSampleContext, LightSet, LightSource};
+use prism_testkit::chi2::chi2_test_adaptive;
 
 fn lights(light_fields: &str) -> LightSet {
     let dir = tempfile::tempdir().unwrap();

@@ -2,16 +2,16 @@
 
 use std::path::PathBuf;
 
-use prism_post::io::exr::{read_exr, write_exr, ExrCompression, ExrSampleType, ExrWriteOptions};
-use prism_post::io::png::{read_png, write_png, PngBitDepth};
-use prism_post::io::rgbe::{decode_rgbe, encode_rgbe, read_hdr, write_hdr};
-use prism_post::io::spectral_exr::{
+use prism_image::io::exr::{read_exr, write_exr, ExrCompression, ExrSampleType, ExrWriteOptions};
+use prism_image::io::png::{read_png, write_png, PngBitDepth};
+use prism_image::io::rgbe::{decode_rgbe, encode_rgbe, read_hdr, write_hdr};
+use prism_image::io::spectral_exr::{
     emissive_channel_name, parse_spectral_channel, read_spectral_exr,
     write_exr_with_spectral_bands, write_spectral_exr, SpectralChannelKind, SpectralImage,
     EMISSIVE_UNITS_ATTRIBUTE, RADIANCE_UNITS, VERSION_ATTRIBUTE,
 };
-use prism_post::io::{read_image, write_image};
-use prism_post::Image;
+use prism_image::io::{read_image, write_image};
+use prism_image::Image;
 use prism_spectrum::rgb_space::RgbColorSpace;
 use prism_spectrum::Observer;
 
@@ -244,7 +244,7 @@ fn decode_png(
 
 #[test]
 fn parallel_png_writer_decodes_to_the_sequential_writers_samples() {
-    use prism_post::io::png::write_png_sequential;
+    use prism_image::io::png::write_png_sequential;
     // Odd sizes, 1×1, one strip, many strips (641×413 at 16 bits: 68 rows per strip),
     // rows longer than a strip (50 000 px), and a 1-pixel-wide column of several strips.
     for (w, h) in [
@@ -299,7 +299,7 @@ fn parallel_png_writer_decodes_to_the_sequential_writers_samples() {
 
 #[test]
 fn parallel_png_writer_keeps_file_sizes_of_smooth_images() {
-    use prism_post::io::png::write_png_sequential;
+    use prism_image::io::png::write_png_sequential;
     // A smooth HDR gradient with texture (deflate shrinks it): same filter and encoder,
     // so the sizes differ only by the strips' 53-byte table headers and 4–5 byte flushes.
     let (w, h) = (1000, 300);

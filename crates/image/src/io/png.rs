@@ -15,7 +15,7 @@ use rayon::prelude::*;
 use super::quantise::Quantiser;
 use super::zlib_strips;
 use super::{color_space_from_chromaticities, write_stream_atomically};
-use crate::error::{PostError, Result};
+use crate::error::{ImageError, Result};
 use crate::image::Image;
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -40,7 +40,7 @@ const STRIP_BYTES: usize = 1 << 18;
 pub fn write_png(path: &Path, image: &Image, depth: PngBitDepth) -> Result<()> {
     let (w, h) = (image.width(), image.height());
     if w > u32::MAX as usize || h > u32::MAX as usize {
-        return Err(PostError::invalid(format!(
+        return Err(ImageError::invalid(format!(
             "{}: {w}×{h} is too large for PNG",
             path.display()
         )));
@@ -85,7 +85,7 @@ pub fn write_png(path: &Path, image: &Image, depth: PngBitDepth) -> Result<()> {
             zlib_strips::store_strip(&filtered)
         })
         .collect::<std::io::Result<Vec<_>>>()
-        .map_err(|e| PostError::io(path, "compress", e))?;
+        .map_err(|e| ImageError::io(path, "compress", e))?;
     let Some(pieces) = zlib_strips::join(strips) else {
         return write_png_sequential(path, image, depth);
     };
@@ -220,16 +220,16 @@ pub struct RawPng {
 
 /// Reads a PNG's encoded samples (see [`RawPng`]).
 pub fn read_png_raw(path: &Path) -> Result<RawPng> {
-    let file = File::open(path).map_err(|e| PostError::io(path, "open", e))?;
+    let file = File::open(path).map_err(|e| ImageError::io(path, "open", e))?;
     let mut decoder = Decoder::new(BufReader::new(file));
     decoder.set_transformations(Transformations::EXPAND);
     let mut reader = decoder
         .read_info()
-        .map_err(|e| PostError::format(path, format!("not a readable PNG file: {e}")))?;
+        .map_err(|e| ImageError::format(path, format!("not a readable PNG file: {e}")))?;
     let mut buffer = vec![0u8; reader.output_buffer_size()];
     let info = reader
         .next_frame(&mut buffer)
-        .map_err(|e| PostError::format(path, format!("PNG image data is unreadable: {e}")))?;
+        .map_err(|e| ImageError::format(path, format!("PNG image data is unreadable: {e}")))?;
     let (w, h) = (info.width as usize, info.height as usize);
     let channels = match info.color_type {
         ColorType::Grayscale => 1,
@@ -237,7 +237,7 @@ pub fn read_png_raw(path: &Path) -> Result<RawPng> {
         ColorType::Rgb => 3,
         ColorType::Rgba => 4,
         ColorType::Indexed => {
-            return Err(PostError::format(
+            return Err(ImageError::format(
                 path,
                 "palette PNG was not expanded to RGB",
             ))

@@ -10,7 +10,8 @@
 //! `sample_count` but land in no bin: `pdf` must then integrate to the probability of a
 //! successful continuous sample, which is exactly what a correct `pdf` does.
 //!
-//! Public (not test-only) so every crate's tests — the material library's too — reuse it.
+//! Lives in the dev-only prism-testkit so every crate's tests reuse it while statrs stays
+//! out of the renderer's dependencies.
 
 use glam::{Vec2, Vec3A};
 use statrs::distribution::{ChiSquared, ContinuousCDF};
@@ -49,6 +50,15 @@ impl Default for Chi2Config {
 /// `test_count` independent tests (Šidák 1967).
 pub fn sidak(alpha: f64, test_count: usize) -> f64 {
     1.0 - (1.0 - alpha).powf(1.0 / test_count.max(1) as f64)
+}
+
+/// P(X ≥ `statistic`) for X ~ χ² with `degrees_of_freedom` (the p-value of Pearson's
+/// statistic); 0 for a non-finite statistic or zero degrees of freedom.
+pub fn chi2_p_value(statistic: f64, degrees_of_freedom: usize) -> f64 {
+    match ChiSquared::new(degrees_of_freedom as f64) {
+        Ok(d) if statistic.is_finite() => 1.0 - d.cdf(statistic),
+        _ => 0.0,
+    }
 }
 
 /// What a test found.
@@ -318,10 +328,7 @@ fn run(
         statistic = f64::INFINITY;
     }
     let dof = bins.saturating_sub(1).max(1);
-    let p_value = match ChiSquared::new(dof as f64) {
-        Ok(d) if statistic.is_finite() => 1.0 - d.cdf(statistic),
-        _ => 0.0,
-    };
+    let p_value = chi2_p_value(statistic, dof);
     let passed = p_value >= config.significance;
     let message = format!(
         "χ² = {statistic:.2} with {dof} dof, p = {p_value:.3e} (reject below {:.3e}); \
@@ -342,7 +349,14 @@ fn run(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sampling::sample_cosine_hemisphere;
+
+    /// Cosine-weighted hemisphere (Malley's method on the uniform disk, pbrt-v4 §A.5.3):
+    /// z = √(1 − u₀), so p(ω) = cos θ / π. Local because this crate depends on no renderer.
+    fn sample_cosine_hemisphere(u: Vec2) -> Vec3A {
+        let r = u.x.sqrt();
+        let phi = 2.0 * std::f32::consts::PI * u.y;
+        Vec3A::new(r * phi.cos(), r * phi.sin(), (1.0 - u.x).max(0.0).sqrt())
+    }
 
     fn config() -> Chi2Config {
         Chi2Config {
@@ -416,6 +430,15 @@ mod tests {
         let r = chi2_test_adaptive(&config(), sample, pdf);
         assert!(r.passed, "{}", r.message);
         assert!((r.pdf_integral - 1.0).abs() < 1e-3, "{}", r.message);
+    }
+
+    #[test]
+    fn p_values_match_the_chi_square_table() {
+        // Upper 5 % points of χ² (Abramowitz & Stegun Table 26.8): 3.841 (1 dof), 18.307 (10).
+        assert!((chi2_p_value(3.841_459, 1) - 0.05).abs() < 1e-6);
+        assert!((chi2_p_value(18.307_04, 10) - 0.05).abs() < 1e-6);
+        assert_eq!(chi2_p_value(f64::INFINITY, 3), 0.0);
+        assert_eq!(chi2_p_value(1.0, 0), 0.0);
     }
 
     #[test]

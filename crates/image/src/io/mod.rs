@@ -16,7 +16,7 @@ use std::path::{Path, PathBuf};
 
 use prism_spectrum::rgb_space::RgbColorSpace;
 
-use crate::error::{PostError, Result};
+use crate::error::{ImageError, Result};
 use crate::image::Image;
 
 /// File formats, chosen from the file extension.
@@ -38,7 +38,7 @@ impl ImageFormat {
             Some("exr") => Ok(ImageFormat::Exr),
             Some("hdr") | Some("pic") | Some("rgbe") => Ok(ImageFormat::Hdr),
             Some("png") => Ok(ImageFormat::Png),
-            _ => Err(PostError::format(
+            _ => Err(ImageError::format(
                 path,
                 "unknown image extension: expected .exr, .hdr (Radiance RGBE) or .png",
             )),
@@ -81,7 +81,7 @@ fn temp_sibling(path: &Path) -> PathBuf {
 pub(crate) fn write_atomically(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
     let tmp = temp_sibling(path);
     let result = write(&tmp).and_then(|()| {
-        std::fs::rename(&tmp, path).map_err(|e| PostError::io(path, "rename the finished file", e))
+        std::fs::rename(&tmp, path).map_err(|e| ImageError::io(path, "rename the finished file", e))
     });
     if result.is_err() {
         let _ = std::fs::remove_file(&tmp);
@@ -95,11 +95,11 @@ pub(crate) fn write_stream_atomically(
     write: impl FnOnce(&mut BufWriter<File>) -> std::io::Result<()>,
 ) -> Result<()> {
     write_atomically(path, |tmp| {
-        let file = File::create(tmp).map_err(|e| PostError::io(path, "create", e))?;
+        let file = File::create(tmp).map_err(|e| ImageError::io(path, "create", e))?;
         let mut out = BufWriter::new(file);
         write(&mut out)
             .and_then(|()| out.flush())
-            .map_err(|e| PostError::io(path, "write", e))
+            .map_err(|e| ImageError::io(path, "write", e))
     })
 }
 
@@ -138,10 +138,10 @@ pub fn convert_pixels(pixels: &mut [[f32; 3]], from: &RgbColorSpace, to: &RgbCol
     if from.primaries_xy == to.primaries_xy && from.white_xy == to.white_xy {
         return;
     }
-    let m = crate::colour::rgb_matrix::rgb_to_rgb_matrix(
+    let m = crate::rgb_matrix::rgb_to_rgb_matrix(
         from,
         to,
         prism_spectrum::adaptation::AdaptationMethod::None,
     );
-    crate::colour::rgb_matrix::apply_rgb_matrix(pixels, m);
+    crate::rgb_matrix::apply_rgb_matrix(pixels, m);
 }

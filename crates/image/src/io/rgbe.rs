@@ -18,7 +18,7 @@ use prism_spectrum::rgb_space::RgbColorSpace;
 use rayon::prelude::*;
 
 use super::{color_space_from_chromaticities, write_stream_atomically};
-use crate::error::{PostError, Result};
+use crate::error::{ImageError, Result};
 use crate::image::Image;
 
 /// Largest header we read before deciding the file is not Radiance.
@@ -63,7 +63,7 @@ struct Header {
 }
 
 fn read_header(path: &Path, input: &mut impl BufRead) -> Result<Header> {
-    let bad = |m: String| PostError::format(path, m);
+    let bad = |m: String| ImageError::format(path, m);
     let mut total = 0usize;
     let mut line = String::new();
     let mut next_line = |line: &mut String| -> Result<bool> {
@@ -73,7 +73,7 @@ fn read_header(path: &Path, input: &mut impl BufRead) -> Result<Header> {
             .by_ref()
             .take((MAX_HEADER_BYTES - total.min(MAX_HEADER_BYTES)) as u64)
             .read_until(b'\n', &mut bytes)
-            .map_err(|e| PostError::io(path, "read", e))?;
+            .map_err(|e| ImageError::io(path, "read", e))?;
         total += n;
         if n == 0 || !bytes.ends_with(b"\n") {
             return Ok(false);
@@ -242,14 +242,14 @@ fn read_scanline(input: &mut impl Read, out: &mut [[u8; 4]]) -> std::io::Result<
 /// Reads a Radiance picture: pixels divided by the product of its `EXPOSURE=` lines, XYZE
 /// pictures converted to linear sRGB, colour space from `PRIMARIES=` (else sRGB).
 pub fn read_hdr(path: &Path) -> Result<Image> {
-    let file = File::open(path).map_err(|e| PostError::io(path, "open", e))?;
+    let file = File::open(path).map_err(|e| ImageError::io(path, "open", e))?;
     let mut input = BufReader::new(file);
     let header = read_header(path, &mut input)?;
     let (w, h) = (header.width, header.height);
     let mut rgbe = vec![[0u8; 4]; w * h];
     for (y, row) in rgbe.chunks_mut(w).enumerate() {
         read_scanline(&mut input, row).map_err(|e| {
-            PostError::format(path, format!("scanline {y} of {h} is unreadable: {e}"))
+            ImageError::format(path, format!("scanline {y} of {h} is unreadable: {e}"))
         })?;
     }
     let scale = (1.0 / header.exposure) as f32;
@@ -359,6 +359,7 @@ pub fn write_hdr(path: &Path, image: &Image) -> Result<()> {
         s.white_xy[0],
         s.white_xy[1]
     );
+    // SOFTWARE keeps the name this writer had in prism-post, so files stay byte-identical.
     write_stream_atomically(path, |out| {
         write!(
             out,

@@ -1,7 +1,7 @@
 //! OpenEXR read/write with the `exr` crate: linear RGB in unprefixed `R`, `G`, `B`
 //! channels, extra layers as prefixed channels (`depth.Z`, `normal.X`, …) in the same
 //! part, the colour space in the standard `chromaticities` attribute and the absolute scale
-//! in the custom attribute `prism:cd_m2_per_unit` (DESIGN.md, "Units and conventions").
+//! in the custom attribute `prism:cd_m2_per_unit` (docs/architecture.md, "Units and conventions").
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -15,7 +15,7 @@ use prism_spectrum::rgb_space::RgbColorSpace;
 use rayon::prelude::*;
 
 use super::{color_space_from_chromaticities, spectral_exr, write_atomically};
-use crate::error::{PostError, Result};
+use crate::error::{ImageError, Result};
 use crate::image::Image;
 
 /// Header attribute holding cd/m² per unit of relative luminance Y.
@@ -63,10 +63,10 @@ pub(crate) struct ExrChannels {
     pub attributes: BTreeMap<String, AttributeValue>,
 }
 
-fn exr_error(path: &Path, action: &'static str, e: ::exr::error::Error) -> PostError {
+fn exr_error(path: &Path, action: &'static str, e: ::exr::error::Error) -> ImageError {
     match e {
-        ::exr::error::Error::Io(io) => PostError::io(path, action, io),
-        other => PostError::format(path, format!("not a readable OpenEXR file: {other}")),
+        ::exr::error::Error::Io(io) => ImageError::io(path, action, io),
+        other => ImageError::format(path, format!("not a readable OpenEXR file: {other}")),
     }
 }
 
@@ -83,13 +83,13 @@ pub(crate) fn read_exr_channels(path: &Path) -> Result<ExrChannels> {
     let first = image
         .layer_data
         .first()
-        .ok_or_else(|| PostError::format(path, "the file holds no image part"))?;
+        .ok_or_else(|| ImageError::format(path, "the file holds no image part"))?;
     let (width, height) = (first.size.0, first.size.1);
     let mut channels = Vec::new();
     let mut attributes = BTreeMap::new();
     for layer in image.layer_data {
         if (layer.size.0, layer.size.1) != (width, height) {
-            return Err(PostError::format(
+            return Err(ImageError::format(
                 path,
                 format!(
                     "parts differ in size ({}×{} and {}×{}): expected every part the same size",
@@ -152,7 +152,7 @@ pub fn read_exr(path: &Path) -> Result<Image> {
     if let Some(rgb) = super::exr_rgb::read_rgb_exr(path) {
         let space = space_of(&rgb.chromaticities);
         let mut image = Image::new(rgb.width, rgb.height, rgb.pixels, space)
-            .map_err(|e| PostError::format(path, e.to_string()))?;
+            .map_err(|e| ImageError::format(path, e.to_string()))?;
         apply_attributes(path, &mut image, &rgb.attributes)?;
         return Ok(image);
     }
@@ -174,7 +174,7 @@ pub fn read_exr(path: &Path) -> Result<Image> {
                 .to_rgb_image(prism_spectrum::Observer::Cie1931, &RgbColorSpace::srgb());
         }
         let names: Vec<&str> = data.channels.iter().map(|(n, _)| n.as_str()).collect();
-        return Err(PostError::format(
+        return Err(ImageError::format(
             path,
             format!(
                 "expected channels R, G, B (or Y, or spectral S0.<λ>nm), found: {}",
@@ -201,7 +201,7 @@ pub fn read_exr(path: &Path) -> Result<Image> {
         });
     let space = space_of(&data.chromaticities);
     let mut image = Image::new(data.width, data.height, pixels, space)
-        .map_err(|e| PostError::format(path, e.to_string()))?;
+        .map_err(|e| ImageError::format(path, e.to_string()))?;
 
     // Extra layers, grouped by the prefix before the last '.', in file order.
     let mut groups: Vec<(String, Vec<(String, usize)>)> = Vec::new();
@@ -234,7 +234,7 @@ pub fn read_exr(path: &Path) -> Result<Image> {
         let names: Vec<&str> = list.iter().map(|(c, _)| c.as_str()).collect();
         image
             .set_layer(&layer, &names, samples)
-            .map_err(|e| PostError::format(path, e.to_string()))?;
+            .map_err(|e| ImageError::format(path, e.to_string()))?;
     }
 
     apply_attributes(path, &mut image, &data.attributes)?;
@@ -270,7 +270,7 @@ fn apply_attributes(
             }
             (CD_M2_PER_UNIT_ATTRIBUTE, AttributeValue::F64(v)) => image.cd_m2_per_unit = Some(*v),
             (CD_M2_PER_UNIT_ATTRIBUTE, _) => {
-                return Err(PostError::format(
+                return Err(ImageError::format(
                     path,
                     format!("attribute {CD_M2_PER_UNIT_ATTRIBUTE} must be a float or double"),
                 ))
@@ -283,7 +283,7 @@ fn apply_attributes(
     }
     if let Some(scale) = image.cd_m2_per_unit {
         if !(scale.is_finite() && scale > 0.0) {
-            return Err(PostError::format(
+            return Err(ImageError::format(
                 path,
                 format!("{CD_M2_PER_UNIT_ATTRIBUTE} = {scale}: expected a positive finite number"),
             ));
@@ -328,7 +328,7 @@ pub(crate) fn encoding(options: &ExrWriteOptions) -> Encoding {
 
 pub(crate) fn text(path: &Path, s: &str) -> Result<Text> {
     Text::new_or_none(s).ok_or_else(|| {
-        PostError::format(
+        ImageError::format(
             path,
             format!("cannot store '{s}' in an EXR header: expected non-empty Latin-1 text"),
         )

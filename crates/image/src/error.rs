@@ -1,12 +1,12 @@
-//! The one error type of prism-post: every failure names the file (when there is one) and
-//! what was expected.
+//! The one error type of prism-image, also returned by prism-post's tone operators and
+//! metrics: every failure names the file (when there is one) and what was expected.
 
 use std::fmt;
 use std::path::{Path, PathBuf};
 
 /// Errors from image I/O, tone operators and metrics.
 #[derive(Debug)]
-pub enum PostError {
+pub enum ImageError {
     /// The operating system refused to open, read, write or rename a file.
     Io {
         path: PathBuf,
@@ -19,16 +19,16 @@ pub enum PostError {
     Invalid(String),
 }
 
-impl PostError {
+impl ImageError {
     pub fn format(path: &Path, message: impl Into<String>) -> Self {
-        PostError::Format {
+        ImageError::Format {
             path: path.to_path_buf(),
             message: message.into(),
         }
     }
 
     pub fn io(path: &Path, action: &'static str, source: std::io::Error) -> Self {
-        PostError::Io {
+        ImageError::Io {
             path: path.to_path_buf(),
             action,
             source,
@@ -36,31 +36,31 @@ impl PostError {
     }
 
     pub fn invalid(message: impl Into<String>) -> Self {
-        PostError::Invalid(message.into())
+        ImageError::Invalid(message.into())
     }
 }
 
-impl fmt::Display for PostError {
+impl fmt::Display for ImageError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            PostError::Io {
+            ImageError::Io {
                 path,
                 action,
                 source,
             } => write!(f, "{}: cannot {action}: {source}", path.display()),
-            PostError::Format { path, message } => write!(f, "{}: {message}", path.display()),
-            PostError::Invalid(message) => f.write_str(message),
+            ImageError::Format { path, message } => write!(f, "{}: {message}", path.display()),
+            ImageError::Invalid(message) => f.write_str(message),
         }
     }
 }
 
-impl std::error::Error for PostError {
+impl std::error::Error for ImageError {
     fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
         match self {
-            PostError::Io { source, .. } => Some(source),
+            ImageError::Io { source, .. } => Some(source),
             _ => None,
         }
     }
 }
 
-pub type Result<T, E = PostError> = std::result::Result<T, E>;
+pub type Result<T, E = ImageError> = std::result::Result<T, E>;

@@ -8,7 +8,7 @@
 //! Reduction to XYZ: samples are interpolated linearly onto the 1 nm grid of the CIE
 //! observer, zero outside the sampled range, and X = Σ L(λ) x̄(λ) / Σ ȳ(λ) (likewise Y, Z),
 //! so a flat spectrum of 1 over 360–830 nm has Y = 1 (the pbrt-v4 / Mitsuba 3 convention,
-//! DESIGN.md). The absolute scale is then 683.002 lm/W × Σ ȳ(λ) Δλ cd/m² per unit.
+//! docs/architecture.md, "Units and conventions"). The absolute scale is then 683.002 lm/W × Σ ȳ(λ) Δλ cd/m² per unit.
 
 use std::path::Path;
 
@@ -24,7 +24,7 @@ use super::exr::{
     chromaticities_of, flat_samples, image_channels, read_exr_channels, text, write_exr_channels,
     ExrChannels, ExrWriteOptions,
 };
-use crate::error::{PostError, Result};
+use crate::error::{ImageError, Result};
 use crate::image::Image;
 
 pub const VERSION_ATTRIBUTE: &str = "spectralLayoutVersion";
@@ -134,18 +134,18 @@ impl SpectralImage {
         samples: Vec<f32>,
     ) -> Result<Self> {
         if wavelengths_nm.len() < 2 {
-            return Err(PostError::invalid(format!(
+            return Err(ImageError::invalid(format!(
                 "a spectral image needs at least 2 bands to interpolate, got {}",
                 wavelengths_nm.len()
             )));
         }
         if !wavelengths_nm.windows(2).all(|w| w[0] < w[1]) || wavelengths_nm[0] <= 0.0 {
-            return Err(PostError::invalid(
+            return Err(ImageError::invalid(
                 "spectral band wavelengths must be positive and strictly increasing",
             ));
         }
         if width == 0 || height == 0 || samples.len() != width * height * wavelengths_nm.len() {
-            return Err(PostError::invalid(format!(
+            return Err(ImageError::invalid(format!(
                 "a {width}×{height} spectral image with {} bands needs {} samples, got {}",
                 wavelengths_nm.len(),
                 width * height * wavelengths_nm.len(),
@@ -238,7 +238,7 @@ pub(crate) fn spectral_from_channels(path: &Path, data: &ExrChannels) -> Result<
         })
         .collect();
     if bands.is_empty() {
-        return Err(PostError::format(
+        return Err(ImageError::format(
             path,
             "expected emissive spectral channels S0.<wavelength>nm (Fichet et al. 2021 layout); \
              reflective (T.*) images are not supported",
@@ -246,7 +246,7 @@ pub(crate) fn spectral_from_channels(path: &Path, data: &ExrChannels) -> Result<
     }
     bands.sort_by(|a, b| a.0.total_cmp(&b.0));
     if let Some(w) = bands.windows(2).find(|w| w[0].0 == w[1].0) {
-        return Err(PostError::format(
+        return Err(ImageError::format(
             path,
             format!(
                 "two spectral channels at {} nm: expected one per wavelength",
@@ -266,7 +266,7 @@ pub(crate) fn spectral_from_channels(path: &Path, data: &ExrChannels) -> Result<
     }
     let wavelengths = bands.iter().map(|b| b.0).collect();
     let mut image = SpectralImage::new(data.width, data.height, wavelengths, samples)
-        .map_err(|e| PostError::format(path, e.to_string()))?;
+        .map_err(|e| ImageError::format(path, e.to_string()))?;
     if let Some(AttributeValue::Text(units)) = data.attributes.get(EMISSIVE_UNITS_ATTRIBUTE) {
         image.emissive_units = units.to_string();
     }
@@ -344,19 +344,19 @@ pub fn write_exr_with_spectral_bands(
 ) -> Result<()> {
     let pixels = image.width() * image.height();
     if wavelengths_nm.is_empty() || planes.len() != wavelengths_nm.len() {
-        return Err(PostError::invalid(format!(
+        return Err(ImageError::invalid(format!(
             "spectral bands: {} wavelengths and {} planes; expected the same number, at least 1",
             wavelengths_nm.len(),
             planes.len()
         )));
     }
     if !(wavelengths_nm[0] > 0.0 && wavelengths_nm.windows(2).all(|w| w[0] < w[1])) {
-        return Err(PostError::invalid(
+        return Err(ImageError::invalid(
             "spectral band wavelengths must be positive and strictly increasing",
         ));
     }
     if let Some((k, p)) = planes.iter().enumerate().find(|(_, p)| p.len() != pixels) {
-        return Err(PostError::invalid(format!(
+        return Err(ImageError::invalid(format!(
             "spectral band {k} ({} nm) has {} values; a {}×{} image needs {pixels}",
             wavelengths_nm[k],
             p.len(),

@@ -1,5 +1,6 @@
-//! The image that post-processing works on: linear RGB in a named colour space, optional
-//! absolute scale (cd/m² per unit), named extra layers (AOVs) and free-form metadata.
+//! The image that rendering writes and post-processing works on: linear RGB in a named
+//! colour space, optional absolute scale (cd/m² per unit), named extra layers (AOVs) and
+//! free-form metadata.
 //!
 //! Pixels are stored interleaved (`[f32; 3]` per pixel, row-major, top row first): every
 //! per-pixel operation reads one contiguous stream, which rayon splits by rows, so 4K
@@ -9,7 +10,7 @@ use std::collections::BTreeMap;
 
 use prism_spectrum::rgb_space::RgbColorSpace;
 
-use crate::error::{PostError, Result};
+use crate::error::{ImageError, Result};
 
 /// A named extra layer (AOV) such as `depth` (channel `Z`) or `normal` (`X`, `Y`, `Z`);
 /// samples are interleaved by pixel, `channels.len()` values per pixel.
@@ -45,12 +46,12 @@ impl Image {
         color_space: RgbColorSpace,
     ) -> Result<Self> {
         if width == 0 || height == 0 {
-            return Err(PostError::invalid(format!(
+            return Err(ImageError::invalid(format!(
                 "image size {width}×{height}: width and height must be at least 1"
             )));
         }
         if pixels.len() != width * height {
-            return Err(PostError::invalid(format!(
+            return Err(ImageError::invalid(format!(
                 "image of {width}×{height} needs {} pixels, got {}",
                 width * height,
                 pixels.len()
@@ -122,7 +123,7 @@ impl Image {
     /// holds unprefixed channels other than R, G, B (an alpha `A`, a bare `Z`).
     pub fn set_layer(&mut self, name: &str, channels: &[&str], samples: Vec<f32>) -> Result<()> {
         if name.contains('.') || channels.is_empty() {
-            return Err(PostError::invalid(format!(
+            return Err(ImageError::invalid(format!(
                 "layer name '{name}' must not contain '.' and needs at least one channel"
             )));
         }
@@ -131,14 +132,14 @@ impl Image {
             .iter()
             .find(|c| c.is_empty() || c.contains('.') || reserved(c))
         {
-            return Err(PostError::invalid(format!(
+            return Err(ImageError::invalid(format!(
                 "layer '{name}': channel name '{c}' must be non-empty, without '.', and not an \
                  unprefixed R, G or B"
             )));
         }
         let expected = self.width * self.height * channels.len();
         if samples.len() != expected {
-            return Err(PostError::invalid(format!(
+            return Err(ImageError::invalid(format!(
                 "layer '{name}' of a {}×{} image with {} channels needs {expected} samples, got {}",
                 self.width,
                 self.height,
