@@ -205,13 +205,8 @@ pub fn tonemap_file(
             Some(report.source_white_xy)
         }
         method => {
-            let report = apply_white_balance(
-                image.pixels_mut(),
-                &space,
-                method,
-                options.cat,
-            )
-            .map_err(|e| ImageError::format(input, e.to_string()))?;
+            let report = apply_white_balance(image.pixels_mut(), &space, method, options.cat)
+                .map_err(|e| ImageError::format(input, e.to_string()))?;
             Some(report.source_white_xy)
         }
     };
