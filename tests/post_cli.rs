@@ -558,9 +558,10 @@ fn exposure_auto_brings_an_absolute_render_to_middle_grey() {
 fn cat_chooses_the_adaptation_transform_of_the_white_balance() {
     use prism_post::colour::white_balance::illuminant_white_xyz_unit_y;
     use prism_spectrum::adaptation::{adaptation_matrix, AdaptationMethod};
-    // A saturated orange and a grey, well inside [0, 1] after adaptation, under CIE A.
+    // A saturated orange and a grey under CIE A, both inside [0, 1] after adaptation (the
+    // grey turns blue: it was neutral for D65, not for A).
     let srgb = RgbColorSpace::srgb();
-    let colours = [[0.45f32, 0.22, 0.05], [0.3, 0.3, 0.3]];
+    let colours = [[0.45f32, 0.22, 0.05], [0.2, 0.2, 0.2]];
     let pixels: Vec<[f32; 3]> = (0..8).map(|i| colours[i % 2]).collect();
     let input = scratch("cat_input.exr");
     write_image(

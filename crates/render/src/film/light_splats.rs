@@ -114,6 +114,23 @@ impl LightSplats {
         }
     }
 
+    /// A list for estimators that do not splat (`Estimator::splats_light_paths` false): it
+    /// skips the per-column and per-row normalisation `new` computes, and refuses every
+    /// splat (`splat_with` returns false).
+    pub(crate) fn unused(resolution: UVec2, filter: Arc<FilterSampler>) -> Self {
+        Self {
+            resolution,
+            inverse_norm_x: Arc::new(Vec::new()),
+            inverse_norm_y: Arc::new(Vec::new()),
+            filter,
+            bins: None,
+            records: Vec::new(),
+            weights: Vec::new(),
+            spectral: Vec::new(),
+            paths: 0,
+        }
+    }
+
     /// Counts `n` light paths traced (the normaliser N).
     #[inline]
     pub fn count_paths(&mut self, n: u64) {
@@ -146,7 +163,7 @@ impl LightSplats {
         wavelengths: &SampledWavelengths,
         weights: &XyzWeights,
     ) -> bool {
-        if value.has_non_finite() || !film_point_px.is_finite() {
+        if value.has_non_finite() || !film_point_px.is_finite() || self.inverse_norm_x.is_empty() {
             return false;
         }
         if value.is_black() {

@@ -353,6 +353,12 @@ impl Film {
         )
     }
 
+    /// A splat list for estimators that do not splat: no normalisation computed, every
+    /// splat refused.
+    pub fn unused_light_splats(&self) -> LightSplats {
+        LightSplats::unused(self.resolution, Arc::clone(&self.filter_sampler))
+    }
+
     /// Adds one work item's light splats (call in a fixed work-item order).
     pub fn merge_light_splats(&mut self, splats: &LightSplats) {
         let pixels = self.pixels.len();

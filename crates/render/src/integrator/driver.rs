@@ -230,7 +230,7 @@ pub fn render_pass_with(
     if !estimator.splats_light_paths() {
         // Integer counts: their sum does not depend on the order tiles finish in.
         let total = std::sync::Mutex::new(RenderStats::default());
-        let no_splats = film.empty_light_splats();
+        let no_splats = film.unused_light_splats();
         film.render_tiles(tile_size_px, |tile| {
             let work = TileWork {
                 pass,
