@@ -182,7 +182,8 @@ def main():
     ap.add_argument("--reference", type=pathlib.Path, default=REFERENCE)
     ap.add_argument("--out-dir", type=pathlib.Path, default=ROOT / "target" / "bench-cornell")
     ap.add_argument("--no-prism", action="store_true", help="benchmark Mitsuba only")
-    ap.add_argument("--json", type=pathlib.Path, help="also write the JSON here")
+    ap.add_argument("--json", type=pathlib.Path,
+                    help="also write the JSON here (tools/bench-results/bench-cornell.json keeps the latest run)")
     ap.add_argument("--worker", help=argparse.SUPPRESS)
     args = ap.parse_args()
     if args.worker:

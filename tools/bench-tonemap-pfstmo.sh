@@ -11,6 +11,7 @@
 #   PFS_RUNS (default RUNS) repeats of each pfstmo pipeline (durand02 takes ~1 min).
 #   --with-prism also runs `bench-post` (compute + in-process tonemap_file) first and nests
 #   its JSON under "prism", so both sides share the machine state.
+# The latest run is kept as tools/bench-results/bench-tonemap-pfstmo.json (redirect stdout).
 set -euo pipefail
 RUNS=${1:-3}
 PFS_RUNS=${PFS_RUNS:-$RUNS}

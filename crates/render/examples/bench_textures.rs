@@ -1,7 +1,8 @@
 //! Texture speed: ns per lookup (nearest, bilinear, trilinear, trilinear + RGB → spectrum,
 //! checkerboard, fBm) on one thread, and the render-time overhead of textures on a small
 //! scene (the same scene with constant materials vs image textures + a normal map).
-//! Prints JSON (docs/bench-textures-*.json):
+//! Prints JSON, and writes it to OUT.json if given (the latest run is kept as
+//! tools/bench-results/bench-textures.json):
 //!
 //!     cargo run -p prism-render --example bench_textures -- [OUT.json]
 //!

@@ -12,7 +12,8 @@
 //! bins they touch stay cached, which separates the lookup's arithmetic from its cache
 //! misses).
 //!
-//! Run: `cargo run --release -p bench-bsdf > docs/bench-bsdf-<date>.json`
+//! Run: `cargo run --release -p bench-bsdf > tools/bench-results/bench-bsdf.json` (the latest
+//! run is kept there; git keeps the earlier ones)
 
 use std::hint::black_box;
 use std::time::Instant;

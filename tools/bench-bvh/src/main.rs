@@ -7,7 +7,8 @@
 //! the same rays against the flattened geometry (the default build) and against the
 //! unflattened two-level geometry (`BuildOptions { flatten: false }`), alternating the two.
 //!
-//! Run: `cargo run --release -p bench-bvh` (numbers recorded in docs/geometry.md);
+//! Run: `cargo run --release -p bench-bvh > tools/bench-results/bench-bvh.json` (numbers in
+//! docs/geometry.md);
 //! `cargo run --release -p bench-bvh -- --instanced-only [--scene NAME_PART]` runs only the
 //! instanced scenes (those whose name contains `NAME_PART`).
 

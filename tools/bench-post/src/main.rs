@@ -17,8 +17,9 @@
 //! - `png_write`: the 16-bit PNG write alone, parallel writer against the `png` crate's
 //!   sequential encoder (wall, CPU of all threads, bytes).
 //!
-//! Prints one JSON object. `bench-post --write-input PATH [WIDTH HEIGHT]` only writes the
-//! synthetic image as a float EXR (for peers: tools/bench-tonemap-pfstmo.sh).
+//! Prints one JSON object (the latest full run is kept as
+//! tools/bench-results/bench-post-4k.json). `bench-post --write-input PATH [WIDTH HEIGHT]`
+//! only writes the synthetic image as a float EXR (for peers: tools/bench-tonemap-pfstmo.sh).
 //! `--ops NAME,NAME` limits the run to those operators; `--no-file` skips `file_ms`
 //! (for profiling one operator's compute); `--input PATH.exr` times `file_ms` on that
 //! file instead of writing the synthetic image first (for profiling the file pipeline).

@@ -1,7 +1,7 @@
 //! `cargo run --release -p bench-spectrum`: nanoseconds per 4-wavelength `Spectrum::eval`
 //! for every spectrum kind, per hero-wavelength sample, and per spectrum → XYZ of a 1 nm
-//! table, and per RGB → coefficients conversion. Prints one JSON object for tools/ to chart;
-//! docs/spectrum-benchmark.md explains the fields.
+//! table, and per RGB → coefficients conversion. Prints one JSON object (kept as
+//! tools/bench-results/bench-spectrum.json); docs/colour.md, "Speed", explains the fields.
 
 use std::hint::black_box;
 use std::time::Instant;
