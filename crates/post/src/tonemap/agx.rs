@@ -428,7 +428,7 @@ mod tests {
         eprintln!("agx: max error {err} 16-bit codes");
         // Measured 0.0154 codes with the polynomials in s and the contrast in w (power
         // ≤ 1.95e-7 relative, encoding ≤ 1.39e-7 absolute: `fifths_split_and_fitted_curves`;
-        // seventh pass, docs/post.md), 0.0122 before them with t and u (1.8e-7, 9.7e-8)
+        // seventh pass, docs/history/post-speed.md), 0.0122 before them with t and u (1.8e-7, 9.7e-8)
         // and the f32 inset/outset sums; 0.012 with the memory tables of curve_table
         // (until 2026-12-01); the closed forms in f32 (fast log2 and exp2) measured 0.195,
         // the printed power form 0.43.

@@ -3,7 +3,7 @@
 //! vectorise, and cost 5–20 ns each, several times the memory time of a pixel.
 //!
 //! Both are polynomials without a division (a vector division costs as much as the rest
-//! of a log on the CPUs measured, docs/post.md), near-minimax polynomials fitted by
+//! of a log on the CPUs measured, docs/history/post-speed.md), near-minimax polynomials fitted by
 //! tools/bench-post/fit_fast_math.py (Lawson's reweighted least squares on Chebyshev
 //! nodes, coefficients rounded to f32) and evaluated by Horner's rule:
 //!
@@ -21,7 +21,7 @@
 //! (Until 2026-11-22 log2 used the atanh series in t = (m − 1)/(m + 1), one division per
 //! log, and exp2 a degree-7 Taylor series. The polynomials are as accurate or better;
 //! on the shared benchmark machine drago03 and tumblin-rushmeier measured the same speed
-//! within noise, agx (9 logs/exps per pixel) 5–10 % faster: docs/post.md.)
+//! within noise, agx (9 logs/exps per pixel) 5–10 % faster: docs/history/post-speed.md.)
 //!
 //! With both, powf(x, y) = exp2(y log2 x) has relative error ≈ ln 2 · |y log2 x| · 2e-7 +
 //! 3e-7: 1e-5 for |y log2 x| ≤ 60, i.e. far below one 16-bit display code (1.5e-5).

@@ -12,7 +12,7 @@
 //! agx); the pixel pass over planes ([`map_pixels_chunk_avx512`]: linear, aces,
 //! ferwerda96) and the statistics pass ([`stats_chunk_avx512`]: every operator).
 //!
-//! Why: on the Zen 5 of the fourth pass (docs/post.md) the auto-vectorised pass — pixels
+//! Why: on the Zen 5 of the fourth pass (docs/history/post-speed.md) the auto-vectorised pass — pixels
 //! de-interleaved into stack planes, the curve over a plane, interleaved back, written with
 //! ordinary stores — cost 2–3× the copy pass by itself, and compiling those same loops for
 //! AVX-512 measured twice as slow again (the compiler's 16-lane de-interleave of
@@ -26,7 +26,7 @@
 //! same order, so the result is the scalar path's bits (tested for every curve, on NaN,
 //! ±∞, negative, ±0 and subnormal input). The few pixels before the first 64-byte-aligned
 //! output address and after the last whole group of 16 go through the same 16-lane code
-//! on a zero-padded group (seventh pass, docs/post.md; the scalar path itself before).
+//! on a zero-padded group (seventh pass, docs/history/post-speed.md; the scalar path itself before).
 //! Register curves and maps take no pixel index: the ones written so far are global
 //! (their `ratio` ignores `start`).
 //!
@@ -379,7 +379,7 @@ unsafe fn luminance_chunk_avx512<C: RegisterCurve, const SCALED: bool>(
 /// A [`PixelMap`] with a 16-lane register form, for
 /// [`crate::tonemap::kernels::map_pixels_registers`]: the map
 /// runs inside the 16-pixel load/store loop on registers, with its constants loaded once
-/// per task, instead of over stack planes staged through memory (docs/post.md, seventh
+/// per task, instead of over stack planes staged through memory (docs/history/post-speed.md, seventh
 /// pass).
 pub(crate) trait RegisterMap: PixelMap {
     /// The map's constants, held in registers (or wherever the compiler keeps them)
