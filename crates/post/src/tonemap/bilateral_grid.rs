@@ -24,6 +24,10 @@ use super::kernels::avx2;
 /// trilinear neighbour).
 const PAD: usize = 3;
 
+/// Row bands the splat is cut into at most (work for up to this many threads; their grids
+/// are summed in band order, whatever the thread count).
+const SPLAT_BANDS: usize = 16;
+
 /// Unit-σ (in grid nodes) Gaussian, radius 2, normalised: exp(−k²/2) for k = −2 … 2.
 const GRID_KERNEL: [f32; 5] = [
     0.054_488_685,
@@ -82,17 +86,24 @@ pub fn bilateral_grid(
     let fys: Vec<f32> = (0..height).map(|y| coord(0, y, lo).1).collect();
     let nearest_x: Vec<usize> = fxs.iter().map(|fx| (fx + 0.5) as usize).collect();
 
-    // Splat (nearest node), rows in parallel into per-task grids, summed. Per row the z
-    // coordinates are computed first in a vectorisable loop (`avx2!`), then the
-    // scatter runs.
-    let grid = values
-        .par_chunks(width)
+    // Splat (nearest node): bands of rows in parallel, each into its own grid, then the
+    // band grids summed in band order — a fixed order, so the f32 sums (and the image) do
+    // not depend on the thread count or on how rayon splits the work. Per row the z
+    // coordinates are computed first in a vectorisable loop (`avx2!`), then the scatter
+    // runs.
+    // Fewer bands when the grid is large against the image (a small σ_s): the band grids
+    // then hold at most about as many cells as the image has pixels.
+    let bands = (values.len() / cells.max(1)).clamp(1, SPLAT_BANDS);
+    let band_rows = height.div_ceil(bands).max(1);
+    let band_grids: Vec<Vec<[f32; 2]>> = values
+        .par_chunks(width * band_rows)
         .enumerate()
-        .fold(
-            || (vec![[0.0f32; 2]; cells], vec![0.0f32; width]),
-            |(mut g, mut fz), (y, row)| {
+        .map(|(band, rows)| {
+            let mut g = vec![[0.0f32; 2]; cells];
+            let mut fz = vec![0.0f32; width];
+            for (r, row) in rows.chunks(width).enumerate() {
                 avx2!(simd, z_coordinates(row, &mut fz, lo, sr));
-                let ny = (fys[y] + 0.5) as usize;
+                let ny = (fys[band * band_rows + r] + 0.5) as usize;
                 for ((v, fz), nx) in row.iter().zip(&fz).zip(&nearest_x) {
                     if v.is_finite() {
                         let cell = &mut g[index(*nx, ny, (fz + 0.5) as usize)];
@@ -100,23 +111,19 @@ pub fn bilateral_grid(
                         cell[1] += 1.0;
                     }
                 }
-                (g, fz)
-            },
-        )
-        .map(|(g, _)| g)
-        .reduce(
-            || vec![[0.0f32; 2]; cells],
-            |mut a, b| {
-                a.iter_mut().zip(&b).for_each(|(a, b)| {
-                    a[0] += b[0];
-                    a[1] += b[1];
-                });
-                a
-            },
-        );
+            }
+            g
+        })
+        .collect();
+    let mut grid = vec![[0.0f32; 2]; cells];
+    for band in &band_grids {
+        grid.iter_mut().zip(band).for_each(|(a, b)| {
+            a[0] += b[0];
+            a[1] += b[1];
+        });
+    }
 
     // Separable blur along x, y, z (the grid is small: serial).
-    let mut grid = grid;
     let mut tmp = vec![[0.0f32; 2]; cells];
     for (stride, len) in [(1, gx), (gx, gy), (gx * gy, gz)] {
         for (i, out) in tmp.iter_mut().enumerate() {
@@ -208,6 +215,34 @@ fn z_coordinates(row: &[f32], fz: &mut [f32], lo: f32, sr: f32) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_filtered_plane_is_the_same_bits_for_any_thread_count() {
+        // A noisy plane whose splat sums round differently in different orders.
+        let (w, h) = (203, 157);
+        let v: Vec<f32> = (0..w * h)
+            .map(|i| ((i as f32 * 0.618_034).fract() * 7.3).sin() * 3.0 + (i % w) as f32 * 0.01)
+            .collect();
+        let run = |threads: usize| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+                .install(|| bilateral_grid(&v, w, h, 6.0, 0.35, prism_cpu::active()))
+        };
+        let one = run(1);
+        for threads in [2, 3, 5, 8] {
+            let other = run(threads);
+            assert!(
+                one.0
+                    .iter()
+                    .zip(&other.0)
+                    .all(|(a, b)| a.to_bits() == b.to_bits()),
+                "{threads} threads"
+            );
+            assert_eq!(one.1, other.1);
+        }
+    }
 
     #[test]
     fn keeps_edges_far_apart_in_range_and_smooths_within_a_region() {
