@@ -10,6 +10,9 @@ pub struct SpectrumFileError {
     pub path: PathBuf,
     /// 1-based line number, when the problem is on one line.
     pub line: Option<usize>,
+    /// 1-based column (in characters, a tab counting one) of the offending field, for
+    /// formats whose fields are positional (BFC-450 matrices).
+    pub column: Option<usize>,
     /// What was wrong and what was expected.
     pub message: String,
 }
@@ -19,6 +22,22 @@ impl SpectrumFileError {
         Self {
             path: path.into(),
             line,
+            column: None,
+            message: message.into(),
+        }
+    }
+
+    /// An error at `line`:`column` (both 1-based).
+    pub fn at(
+        path: impl Into<PathBuf>,
+        line: usize,
+        column: usize,
+        message: impl Into<String>,
+    ) -> Self {
+        Self {
+            path: path.into(),
+            line: Some(line),
+            column: Some(column),
             message: message.into(),
         }
     }
@@ -26,9 +45,17 @@ impl SpectrumFileError {
 
 impl fmt::Display for SpectrumFileError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self.line {
-            Some(line) => write!(f, "{}:{}: {}", self.path.display(), line, self.message),
-            None => write!(f, "{}: {}", self.path.display(), self.message),
+        match (self.line, self.column) {
+            (Some(line), Some(column)) => write!(
+                f,
+                "{}:{}:{}: {}",
+                self.path.display(),
+                line,
+                column,
+                self.message
+            ),
+            (Some(line), None) => write!(f, "{}:{}: {}", self.path.display(), line, self.message),
+            (None, _) => write!(f, "{}: {}", self.path.display(), self.message),
         }
     }
 }

@@ -5,6 +5,7 @@
 //! Units: wavelengths in nm, spectral radiance in W·m⁻²·sr⁻¹·nm⁻¹, luminance in cd/m².
 
 pub mod adaptation;
+pub mod bfc;
 pub mod blackbody;
 pub mod cct;
 pub mod colorimetry;
@@ -25,6 +26,7 @@ pub mod spectrum_file;
 pub mod table;
 
 pub use adaptation::{adaptation_matrix, AdaptationMethod};
+pub use bfc::{load_bfc, parse_bfc, BfcData, NegativesPolicy};
 pub use cct::{cct_to_uv_ohno2013, uv_to_cct_ohno2013, xyz_to_cct_ohno2013, CctDuv};
 pub use constants::*;
 pub use data::Observer;

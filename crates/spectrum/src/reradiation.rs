@@ -13,6 +13,10 @@
 //! row CDF at the nodes is linear in the row interpolation weight, so per-row cumulative
 //! integrals are precomputed once) and the position inside it by inverting the CDF of a
 //! linear density (a quadratic, solved in its cancellation-free form).
+//!
+//! Measured matrices carry noise around zero; `from_dense_signed` keeps it. Evaluation and
+//! `row_integral` keep the sign, while sampling draws ∝ the bilinear interpolation of |M| at
+//! the nodes (≥ |M| and non-zero wherever M is), so M/pdf stays a valid, signed weight.
 
 use std::fmt;
 
@@ -111,6 +115,14 @@ pub struct ReradiationMatrix {
     /// Per row, ∫ from the first emission node to node `column` of the row (trapezoids,
     /// exact for the piecewise-linear row), `cumulative[row * emission.count + column]`.
     cumulative: Box<[f64]>,
+    /// |M| at the nodes: the sampling density is bilinear in these (equal to `values` for a
+    /// non-negative matrix). For a signed matrix it bounds |M| from above and is non-zero
+    /// wherever M is, so M/pdf is a valid signed weight.
+    magnitudes: Box<[f32]>,
+    /// As `cumulative`, of the magnitudes.
+    magnitude_cumulative: Box<[f64]>,
+    /// Whether some node is negative (only `from_dense_signed` allows it).
+    signed: bool,
 }
 
 impl ReradiationMatrix {
@@ -120,6 +132,25 @@ impl ReradiationMatrix {
         excitation: WavelengthGrid,
         emission: WavelengthGrid,
         values: Vec<f32>,
+    ) -> Result<Self, ReradiationError> {
+        Self::build(excitation, emission, values, false)
+    }
+
+    /// As `from_dense`, but entries may be negative (measured matrices carry noise around
+    /// zero): evaluation and the integrals keep the sign, sampling draws ∝ |M| at the nodes.
+    pub fn from_dense_signed(
+        excitation: WavelengthGrid,
+        emission: WavelengthGrid,
+        values: Vec<f32>,
+    ) -> Result<Self, ReradiationError> {
+        Self::build(excitation, emission, values, true)
+    }
+
+    fn build(
+        excitation: WavelengthGrid,
+        emission: WavelengthGrid,
+        values: Vec<f32>,
+        allow_negative: bool,
     ) -> Result<Self, ReradiationError> {
         let expected = excitation.count * emission.count;
         if values.len() != expected {
@@ -131,10 +162,15 @@ impl ReradiationMatrix {
             )));
         }
         for (index, &v) in values.iter().enumerate() {
-            if !(v.is_finite() && v >= 0.0) {
+            if !(v.is_finite() && (allow_negative || v >= 0.0)) {
                 let (row, column) = (index / emission.count, index % emission.count);
+                let rule = if allow_negative {
+                    "finite"
+                } else {
+                    "finite and non-negative"
+                };
                 return Err(ReradiationError::new(format!(
-                    "re-radiation matrix entry at excitation row {} ({} nm), emission column {} ({} nm) is {v}: entries must be finite and non-negative",
+                    "re-radiation matrix entry at excitation row {} ({} nm), emission column {} ({} nm) is {v}: entries must be {rule}",
                     row + 1,
                     excitation.wavelength_nm(row),
                     column + 1,
@@ -142,24 +178,28 @@ impl ReradiationMatrix {
                 )));
             }
         }
-        let step = emission.step_nm as f64;
-        let mut cumulative = vec![0.0f64; expected];
-        for (row_values, row_cumulative) in values
-            .chunks_exact(emission.count)
-            .zip(cumulative.chunks_exact_mut(emission.count))
-        {
-            let mut sum = 0.0;
-            for column in 1..emission.count {
-                sum += 0.5 * step * (row_values[column - 1] as f64 + row_values[column] as f64);
-                row_cumulative[column] = sum;
-            }
-        }
+        let signed = values.iter().any(|&v| v < 0.0);
+        let magnitudes: Box<[f32]> = values.iter().map(|v| v.abs()).collect();
+        let cumulative = row_cumulative(&values, emission);
+        let magnitude_cumulative = if signed {
+            row_cumulative(&magnitudes, emission)
+        } else {
+            cumulative.clone()
+        };
         Ok(Self {
             excitation,
             emission,
             values: values.into_boxed_slice(),
-            cumulative: cumulative.into_boxed_slice(),
+            cumulative,
+            magnitudes,
+            magnitude_cumulative,
+            signed,
         })
+    }
+
+    /// Whether some entry is negative (a signed matrix from `from_dense_signed`).
+    pub fn is_signed(&self) -> bool {
+        self.signed
     }
 
     /// From rows as any parser produces them: exactly `excitation.count()` rows of
@@ -315,56 +355,135 @@ impl ReradiationMatrix {
         self.check_energy_conservation(1e-4).is_ok()
     }
 
-    /// Draws λ_out with density ∝ M(λ_in, ·) from `u` ∈ [0, 1). Returns the wavelength in
-    /// nm and its density in nm⁻¹, or `None` when λ_in is outside the excitation grid or
-    /// nothing is re-radiated there.
+    /// ∫ |M|(λ_in, λ_out) dλ_out with |M| bilinear in the node magnitudes: the row's
+    /// sampling mass (equal to `row_integral` for a non-negative matrix).
+    pub fn row_magnitude_integral(&self, excitation_nm: f32) -> f32 {
+        self.row_magnitude_integral_f64(excitation_nm) as f32
+    }
+
+    fn row_magnitude_integral_f64(&self, excitation_nm: f32) -> f64 {
+        match self.excitation.locate(excitation_nm) {
+            Some((row, s)) => self.magnitude_cumulative_at(row, s, self.emission.count - 1),
+            None => 0.0,
+        }
+    }
+
+    #[inline]
+    fn magnitude_cumulative_at(&self, row: usize, s: f64, column: usize) -> f64 {
+        let n = self.emission.count;
+        (1.0 - s) * self.magnitude_cumulative[row * n + column]
+            + s * self.magnitude_cumulative[(row + 1) * n + column]
+    }
+
+    /// The sampling density's unnormalised value: bilinear in the node magnitudes.
+    fn eval_magnitude_f64(&self, excitation_nm: f32, emission_nm: f32) -> f64 {
+        let (Some((row, s)), Some((column, t))) = (
+            self.excitation.locate(excitation_nm),
+            self.emission.locate(emission_nm),
+        ) else {
+            return 0.0;
+        };
+        let n = self.emission.count;
+        let node = |c: usize| {
+            (1.0 - s) * self.magnitudes[row * n + c] as f64
+                + s * self.magnitudes[(row + 1) * n + c] as f64
+        };
+        let (a, b) = (node(column), node(column + 1));
+        a + t * (b - a)
+    }
+
+    /// Draws λ_out with density ∝ M(λ_in, ·) (∝ |M| at the nodes, bilinear, for a signed
+    /// matrix) from `u` ∈ [0, 1). Returns the wavelength in nm and its density in nm⁻¹, or
+    /// `None` when λ_in is outside the excitation grid or nothing is re-radiated there.
     pub fn sample_emission(&self, excitation_nm: f32, u: f32) -> Option<(f32, f32)> {
         let (row, s) = self.excitation.locate(excitation_nm)?;
         let n = self.emission.count;
-        let total = self.cumulative_at(row, s, n - 1);
-        if !(total > 0.0 && total.is_finite()) {
-            return None;
-        }
-        // Keep the target strictly below the total so the chosen segment has mass.
-        let target = (u.clamp(0.0, 1.0) as f64 * total).min(total * (1.0 - f64::EPSILON));
-        // Binary search for the first node whose cumulative integral exceeds the target
-        // (node n − 1 does, its integral being the total); the segment ends there.
-        let (mut low, mut high) = (1, n - 1);
-        while low < high {
-            let mid = (low + high) / 2;
-            if self.cumulative_at(row, s, mid) > target {
-                high = mid;
-            } else {
-                low = mid + 1;
-            }
-        }
-        let column = low - 1;
-        let step = self.emission.step_nm as f64;
-        let a = self.row_node(row, s, column);
-        let b = self.row_node(row, s, column + 1);
-        // Solve step·(a x + (b − a) x²/2) = d for x ∈ [0, 1]: x = 2d' / (a + √(a² + 2(b − a)d'))
-        // with d' = d / step, stable for every sign of b − a.
-        let d = (target - self.cumulative_at(row, s, column)) / step;
-        let denominator = a + (a * a + 2.0 * (b - a) * d).max(0.0).sqrt();
-        let x = if denominator > 0.0 {
-            (2.0 * d / denominator).clamp(0.0, 1.0)
-        } else {
-            0.5
+        let node = |c: usize| {
+            (1.0 - s) * self.magnitudes[row * n + c] as f64
+                + s * self.magnitudes[(row + 1) * n + c] as f64
         };
-        let emission_nm = self.emission.start_nm as f64 + (column as f64 + x) * step;
-        let pdf = (a + x * (b - a)) / total;
-        Some((emission_nm as f32, pdf as f32))
+        sample_piecewise_linear(
+            &self.emission,
+            node,
+            |c| self.magnitude_cumulative_at(row, s, c),
+            u,
+        )
     }
 
     /// Density of `sample_emission` at λ_out given λ_in, in nm⁻¹.
     pub fn pdf_emission(&self, excitation_nm: f32, emission_nm: f32) -> f32 {
-        let total = self.row_integral_f64(excitation_nm);
+        let total = self.row_magnitude_integral_f64(excitation_nm);
         if total > 0.0 {
-            (self.eval_f64(excitation_nm, emission_nm) / total) as f32
+            (self.eval_magnitude_f64(excitation_nm, emission_nm) / total) as f32
         } else {
             0.0
         }
     }
+}
+
+/// Per row of a row-major `grid`-wide table, ∫ from the first node to each node
+/// (trapezoids, exact for the piecewise-linear row).
+fn row_cumulative(values: &[f32], grid: WavelengthGrid) -> Box<[f64]> {
+    let step = grid.step_nm as f64;
+    let mut cumulative = vec![0.0f64; values.len()];
+    for (row_values, row_cumulative) in values
+        .chunks_exact(grid.count)
+        .zip(cumulative.chunks_exact_mut(grid.count))
+    {
+        let mut sum = 0.0;
+        for column in 1..grid.count {
+            sum += 0.5 * step * (row_values[column - 1] as f64 + row_values[column] as f64);
+            row_cumulative[column] = sum;
+        }
+    }
+    cumulative.into_boxed_slice()
+}
+
+/// Draws x on `grid` with density ∝ the piecewise-linear function with node values
+/// `node(k)` ≥ 0 and cumulative integrals `cumulative(k)` (from node 0 to node k), from
+/// `u` ∈ [0, 1): the segment by binary search on the cumulative integrals, the position
+/// inside by inverting the linear density's CDF. Returns x in nm and its density in nm⁻¹;
+/// `None` when the function has no mass.
+fn sample_piecewise_linear(
+    grid: &WavelengthGrid,
+    node: impl Fn(usize) -> f64,
+    cumulative: impl Fn(usize) -> f64,
+    u: f32,
+) -> Option<(f32, f32)> {
+    let n = grid.count;
+    let total = cumulative(n - 1);
+    if !(total > 0.0 && total.is_finite()) {
+        return None;
+    }
+    // Keep the target strictly below the total so the chosen segment has mass.
+    let target = (u.clamp(0.0, 1.0) as f64 * total).min(total * (1.0 - f64::EPSILON));
+    // Binary search for the first node whose cumulative integral exceeds the target
+    // (node n − 1 does, its integral being the total); the segment ends there.
+    let (mut low, mut high) = (1, n - 1);
+    while low < high {
+        let mid = (low + high) / 2;
+        if cumulative(mid) > target {
+            high = mid;
+        } else {
+            low = mid + 1;
+        }
+    }
+    let segment = low - 1;
+    let step = grid.step_nm as f64;
+    let a = node(segment);
+    let b = node(segment + 1);
+    // Solve step·(a x + (b − a) x²/2) = d for x ∈ [0, 1]: x = 2d' / (a + √(a² + 2(b − a)d'))
+    // with d' = d / step, stable for every sign of b − a.
+    let d = (target - cumulative(segment)) / step;
+    let denominator = a + (a * a + 2.0 * (b - a) * d).max(0.0).sqrt();
+    let x = if denominator > 0.0 {
+        (2.0 * d / denominator).clamp(0.0, 1.0)
+    } else {
+        0.5
+    };
+    let wavelength_nm = grid.start_nm as f64 + (segment as f64 + x) * step;
+    let pdf = (a + x * (b - a)) / total;
+    Some((wavelength_nm as f32, pdf as f32))
 }
 
 #[cfg(test)]
@@ -547,6 +666,39 @@ mod tests {
         // A zero row samples nothing.
         assert_eq!(ok.sample_emission(350.0, 0.5), None);
         assert_eq!(ok.pdf_emission(350.0, 410.0), 0.0);
+    }
+
+    #[test]
+    fn signed_matrices_keep_the_sign_and_sample_the_magnitude() {
+        let excitation = WavelengthGrid::new(300.0, 50.0, 2).unwrap();
+        let emission = WavelengthGrid::new(400.0, 10.0, 3).unwrap();
+        let values = vec![0.02f32, -0.01, 0.03, 0.0, 0.0, 0.0];
+        assert!(ReradiationMatrix::from_dense(excitation, emission, values.clone()).is_err());
+        let m = ReradiationMatrix::from_dense_signed(excitation, emission, values).unwrap();
+        assert!(m.is_signed());
+        assert_eq!(m.eval(300.0, 410.0), -0.01);
+        // Signed: 10 nm × (0.005 + 0.01) = 0.15; magnitudes: 10 nm × (0.015 + 0.02) = 0.35.
+        assert!((m.row_integral(300.0) - 0.15).abs() < 1e-7);
+        assert!((m.row_magnitude_integral(300.0) - 0.35).abs() < 1e-7);
+        assert!((m.pdf_emission(300.0, 410.0) - 0.01 / 0.35).abs() < 1e-6);
+        assert!((m.pdf_emission(300.0, 405.0) - 0.015 / 0.35).abs() < 1e-6);
+        // Every draw has positive density, and the signed weights M/pdf average to ∫M.
+        let mut rng = SplitMix64(7);
+        let n = 200_000;
+        let mut sum = 0.0f64;
+        for _ in 0..n {
+            let (l_out, pdf) = m.sample_emission(300.0, rng.next_f32()).unwrap();
+            assert!(pdf > 0.0);
+            sum += m.eval(300.0, l_out) as f64 / pdf as f64;
+        }
+        assert!((sum / n as f64 - 0.15).abs() < 3e-3, "{}", sum / n as f64);
+        let e = ReradiationMatrix::from_dense_signed(
+            excitation,
+            emission,
+            vec![f32::INFINITY, 0.0, 0.0, 0.0, 0.0, 0.0],
+        )
+        .unwrap_err();
+        assert!(e.message.contains("must be finite"), "{e}");
     }
 
     #[test]
