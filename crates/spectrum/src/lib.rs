@@ -12,6 +12,7 @@ pub mod colorimetry;
 pub mod constants;
 pub mod data;
 pub mod daylight;
+pub mod dye;
 pub mod embedded_files;
 pub mod error;
 pub mod names;
@@ -30,6 +31,7 @@ pub use bfc::{load_bfc, parse_bfc, BfcData, NegativesPolicy};
 pub use cct::{cct_to_uv_ohno2013, uv_to_cct_ohno2013, xyz_to_cct_ohno2013, CctDuv};
 pub use constants::*;
 pub use data::Observer;
+pub use dye::{Dye, EmissionUnits};
 pub use error::SpectrumFileError;
 pub use reradiation::{ReradiationError, ReradiationMatrix, WavelengthGrid};
 pub use rgb_upsample::{
