@@ -12,7 +12,8 @@
 //! M(λ_in, ·), which is piecewise linear in λ_out: a segment is picked by its integral (the
 //! row CDF at the nodes is linear in the row interpolation weight, so per-row cumulative
 //! integrals are precomputed once) and the position inside it by inverting the CDF of a
-//! linear density (a quadratic, solved in its cancellation-free form).
+//! linear density (a quadratic, solved in its cancellation-free form). Excitation sampling
+//! (λ_in ∝ M(·, λ_out), for camera paths) is the same on per-column cumulative integrals.
 //!
 //! Measured matrices carry noise around zero; `from_dense_signed` keeps it. Evaluation and
 //! `row_integral` keep the sign, while sampling draws ∝ the bilinear interpolation of |M| at
@@ -121,6 +122,12 @@ pub struct ReradiationMatrix {
     magnitudes: Box<[f32]>,
     /// As `cumulative`, of the magnitudes.
     magnitude_cumulative: Box<[f64]>,
+    /// Per emission column, ∫ from the first excitation node to node `row` of the column's
+    /// magnitudes, `column_cumulative[column * excitation.count + row]`: the per-column CDFs
+    /// of `sample_excitation`.
+    column_cumulative: Box<[f64]>,
+    /// Per emission column, ∫ M dλ_in over the whole excitation grid (signed).
+    column_totals: Box<[f64]>,
     /// Whether some node is negative (only `from_dense_signed` allows it).
     signed: bool,
 }
@@ -186,6 +193,18 @@ impl ReradiationMatrix {
         } else {
             cumulative.clone()
         };
+        let transpose = |table: &[f32]| -> Vec<f32> {
+            (0..emission.count)
+                .flat_map(|column| {
+                    (0..excitation.count).map(move |row| table[row * emission.count + column])
+                })
+                .collect()
+        };
+        let column_cumulative = row_cumulative(&transpose(&magnitudes), excitation);
+        let column_totals = row_cumulative(&transpose(&values), excitation)
+            .chunks_exact(excitation.count)
+            .map(|c| c[excitation.count - 1])
+            .collect();
         Ok(Self {
             excitation,
             emission,
@@ -193,6 +212,8 @@ impl ReradiationMatrix {
             cumulative,
             magnitudes,
             magnitude_cumulative,
+            column_cumulative,
+            column_totals,
             signed,
         })
     }
@@ -421,6 +442,68 @@ impl ReradiationMatrix {
     }
 }
 
+impl ReradiationMatrix {
+    /// c(λ_out) = ∫ M(λ_in, λ_out) dλ_in: how much an emission wavelength gathers from all
+    /// excitations (zero outside the emission grid).
+    pub fn column_integral(&self, emission_nm: f32) -> f32 {
+        match self.emission.locate(emission_nm) {
+            Some((column, t)) => {
+                ((1.0 - t) * self.column_totals[column] + t * self.column_totals[column + 1]) as f32
+            }
+            None => 0.0,
+        }
+    }
+
+    /// ∫ |M|(λ_in, λ_out) dλ_in with |M| bilinear in the node magnitudes: the column's
+    /// sampling mass (equal to `column_integral` for a non-negative matrix).
+    pub fn column_magnitude_integral(&self, emission_nm: f32) -> f32 {
+        self.column_magnitude_integral_f64(emission_nm) as f32
+    }
+
+    fn column_magnitude_integral_f64(&self, emission_nm: f32) -> f64 {
+        match self.emission.locate(emission_nm) {
+            Some((column, t)) => self.column_cumulative_at(column, t, self.excitation.count - 1),
+            None => 0.0,
+        }
+    }
+
+    #[inline]
+    fn column_cumulative_at(&self, column: usize, t: f64, row: usize) -> f64 {
+        let n = self.excitation.count;
+        (1.0 - t) * self.column_cumulative[column * n + row]
+            + t * self.column_cumulative[(column + 1) * n + row]
+    }
+
+    /// Draws λ_in with density ∝ M(·, λ_out) (∝ |M| at the nodes, bilinear, for a signed
+    /// matrix) from `u` ∈ [0, 1): for camera paths, which meet the emission wavelength first
+    /// and ask which excitation fed it. Returns the wavelength in nm and its density in
+    /// nm⁻¹, or `None` when λ_out is outside the emission grid or nothing re-radiates there.
+    pub fn sample_excitation(&self, emission_nm: f32, u: f32) -> Option<(f32, f32)> {
+        let (column, t) = self.emission.locate(emission_nm)?;
+        let m = self.emission.count;
+        let node = |row: usize| {
+            (1.0 - t) * self.magnitudes[row * m + column] as f64
+                + t * self.magnitudes[row * m + column + 1] as f64
+        };
+        sample_piecewise_linear(
+            &self.excitation,
+            node,
+            |row| self.column_cumulative_at(column, t, row),
+            u,
+        )
+    }
+
+    /// Density of `sample_excitation` at λ_in given λ_out, in nm⁻¹.
+    pub fn pdf_excitation(&self, emission_nm: f32, excitation_nm: f32) -> f32 {
+        let total = self.column_magnitude_integral_f64(emission_nm);
+        if total > 0.0 {
+            (self.eval_magnitude_f64(excitation_nm, emission_nm) / total) as f32
+        } else {
+            0.0
+        }
+    }
+}
+
 /// Per row of a row-major `grid`-wide table, ∫ from the first node to each node
 /// (trapezoids, exact for the piecewise-linear row).
 fn row_cumulative(values: &[f32], grid: WavelengthGrid) -> Box<[f64]> {
@@ -489,18 +572,7 @@ fn sample_piecewise_linear(
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// SplitMix64 (Steele et al. 2014) for deterministic tests.
-    struct SplitMix64(u64);
-    impl SplitMix64 {
-        fn next_f32(&mut self) -> f32 {
-            self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-            let mut z = self.0;
-            z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-            z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-            ((z ^ (z >> 31)) >> 40) as f32 * (1.0 / (1u64 << 24) as f32)
-        }
-    }
+    use prism_testkit::chi2::{chi2_p_value, sidak, SplitMix64};
 
     /// A small fluorescent-like matrix: excitation 300–500 nm (5 rows), emission 400–780 nm
     /// (20 columns), Stokes-shifted Gaussian-ish emission with exact zeros below λ_in and in
@@ -518,9 +590,37 @@ mod tests {
         .unwrap()
     }
 
-    fn chi_square_quantile(dof: f64, z: f64) -> f64 {
-        let a = 2.0 / (9.0 * dof);
-        dof * (1.0 - a + z * a.sqrt()).powi(3)
+    /// Pearson's statistic of `histogram` against `expected` counts (bins expecting nothing
+    /// must be empty) and its p-value.
+    fn pearson(histogram: &[u64], expected: &[f64]) -> (f64, usize, f64) {
+        let (mut chi2, mut bins) = (0.0, 0usize);
+        for (bin, (&observed, &expected)) in histogram.iter().zip(expected).enumerate() {
+            if expected < 1e-9 {
+                assert_eq!(observed, 0, "samples in empty bin {bin}");
+                continue;
+            }
+            chi2 += (observed as f64 - expected).powi(2) / expected;
+            bins += 1;
+        }
+        let dof = bins - 1;
+        (chi2, dof, chi2_p_value(chi2, dof))
+    }
+
+    /// Simpson's rule on `n` (even) steps over [a, b].
+    fn simpson(a: f64, b: f64, n: usize, f: impl Fn(f64) -> f64) -> f64 {
+        let h = (b - a) / n as f64;
+        let mut sum = 0.0;
+        for i in 0..=n {
+            let w = if i == 0 || i == n {
+                1.0
+            } else if i % 2 == 1 {
+                4.0
+            } else {
+                2.0
+            };
+            sum += w * f(a + i as f64 * h);
+        }
+        sum * h / 3.0
     }
 
     #[test]
@@ -601,19 +701,203 @@ mod tests {
                 assert!(pdf > 0.0, "sampled a zero-density wavelength {l_out} nm");
                 histogram[(((l_out - 400.0) / 4.0) as usize).min(BINS - 1)] += 1;
             }
-            let (mut chi2, mut dof) = (0.0, -1.0);
-            for (bin, &observed) in histogram.iter().enumerate() {
-                let mid = 400.0 + 4.0 * bin as f32 + 2.0;
-                let expected = m.pdf_emission(l_in, mid) as f64 * 4.0 * samples as f64;
-                if expected < 1e-9 {
-                    assert_eq!(observed, 0, "{l_in} nm: samples in empty bin {bin}");
-                    continue;
-                }
-                chi2 += (observed as f64 - expected).powi(2) / expected;
-                dof += 1.0;
+            let expected: Vec<f64> = (0..BINS)
+                .map(|bin| {
+                    let mid = 400.0 + 4.0 * bin as f32 + 2.0;
+                    m.pdf_emission(l_in, mid) as f64 * 4.0 * samples as f64
+                })
+                .collect();
+            let (chi2, dof, p) = pearson(&histogram, &expected);
+            assert!(
+                p >= sidak(0.01, 3),
+                "{l_in} nm: χ² = {chi2} ({dof} dof), p = {p}"
+            );
+        }
+    }
+
+    #[test]
+    fn sampled_excitation_matches_its_pdf_chi_square() {
+        let m = test_matrix();
+        let samples = 1_000_000;
+        // 2.5 nm bins over 300–500 nm: aligned with the 50 nm excitation nodes, so the pdf
+        // is linear in each bin and the midpoint rule gives the expected count exactly.
+        const BINS: usize = 80;
+        let cases = [(460.0f32, 1u64), (517.0, 2), (700.0, 3), (780.0, 4)];
+        for (l_out, seed) in cases {
+            let mut rng = SplitMix64(seed);
+            let mut histogram = [0u64; BINS];
+            for _ in 0..samples {
+                let (l_in, pdf) = m.sample_excitation(l_out, rng.next_f32()).unwrap();
+                assert!((300.0..=500.0).contains(&l_in));
+                let expected_pdf = m.pdf_excitation(l_out, l_in);
+                assert!(
+                    (pdf - expected_pdf).abs() <= 1e-4 * expected_pdf + 1e-7,
+                    "pdf {pdf} vs {expected_pdf} at {l_in} nm"
+                );
+                assert!(pdf > 0.0, "sampled a zero-density wavelength {l_in} nm");
+                histogram[(((l_in - 300.0) / 2.5) as usize).min(BINS - 1)] += 1;
             }
-            let limit = chi_square_quantile(dof, 3.090_232_306);
-            assert!(chi2 < limit, "{l_in} nm: χ² = {chi2} ≥ {limit} ({dof} dof)");
+            let expected: Vec<f64> = (0..BINS)
+                .map(|bin| {
+                    let mid = 300.0 + 2.5 * bin as f32 + 1.25;
+                    m.pdf_excitation(l_out, mid) as f64 * 2.5 * samples as f64
+                })
+                .collect();
+            let (chi2, dof, p) = pearson(&histogram, &expected);
+            assert!(
+                p >= sidak(0.01, cases.len()),
+                "{l_out} nm: χ² = {chi2} ({dof} dof), p = {p}"
+            );
+        }
+        // A wrong pdf fails: the histogram of 517 nm against the column at 460 nm.
+        let mut rng = SplitMix64(9);
+        let mut histogram = [0u64; BINS];
+        for _ in 0..samples {
+            let (l_in, _) = m.sample_excitation(517.0, rng.next_f32()).unwrap();
+            histogram[(((l_in - 300.0) / 2.5) as usize).min(BINS - 1)] += 1;
+        }
+        let expected: Vec<f64> = (0..BINS)
+            .map(|bin| {
+                let mid = 300.0 + 2.5 * bin as f32 + 1.25;
+                m.pdf_excitation(460.0, mid) as f64 * 2.5 * samples as f64
+            })
+            .collect();
+        let chi2: f64 = histogram
+            .iter()
+            .zip(&expected)
+            .filter(|(_, &e)| e > 0.0)
+            .map(|(&o, &e)| (o as f64 - e).powi(2) / e)
+            .sum();
+        assert!(chi2 > 1e4, "{chi2}");
+    }
+
+    #[test]
+    fn excitation_pdf_integrates_to_one_and_column_integral_is_the_gathered_fraction() {
+        let m = test_matrix();
+        // λ_out on nodes, between nodes, at the grid's ends.
+        for l_out in [400.0f32, 433.3, 517.0, 560.0, 700.0, 780.0] {
+            // 0.25 nm Simpson steps: 200 per 50 nm segment, exact for the linear pieces.
+            let pdf_integral = simpson(300.0, 500.0, 800, |l| {
+                m.pdf_excitation(l_out, l as f32) as f64
+            });
+            let m_integral = simpson(300.0, 500.0, 800, |l| m.eval(l as f32, l_out) as f64);
+            assert!(
+                (pdf_integral - 1.0).abs() < 1e-5,
+                "{l_out} nm: ∫pdf = {pdf_integral}"
+            );
+            assert!(
+                (m_integral / m.column_integral(l_out) as f64 - 1.0).abs() < 1e-5,
+                "{l_out} nm: {m_integral} vs {}",
+                m.column_integral(l_out)
+            );
+            assert_eq!(m.column_integral(l_out), m.column_magnitude_integral(l_out));
+        }
+        // The gap at 600–640 nm gathers nothing; outside the emission grid is empty too.
+        assert_eq!(m.column_integral(620.0), 0.0);
+        assert_eq!(m.sample_excitation(620.0, 0.5), None);
+        assert_eq!(m.pdf_excitation(620.0, 400.0), 0.0);
+        assert_eq!(m.sample_excitation(399.0, 0.5), None);
+        assert_eq!(m.sample_excitation(f32::NAN, 0.5), None);
+    }
+
+    /// A signed variant of `test_matrix`: noise of ±0.0004 on every node.
+    fn signed_test_matrix() -> ReradiationMatrix {
+        let m = test_matrix();
+        let mut values = Vec::new();
+        for row in 0..5 {
+            for column in 0..20 {
+                let noise = if (row + column) % 3 == 0 { -4e-4 } else { 4e-4 };
+                values.push(m.node(row, column) + noise);
+            }
+        }
+        ReradiationMatrix::from_dense_signed(*m.excitation(), *m.emission(), values).unwrap()
+    }
+
+    /// Row and column estimators of ∫∫ f(λi) M(λi, λo) g(λo) dλi dλo against quadrature,
+    /// each within 4 standard errors (issue 21's test 1).
+    fn check_row_and_column_estimators(m: &ReradiationMatrix) {
+        let f = |l: f64| 1.0 + 0.5 * (l / 37.0).sin();
+        let g = |l: f64| 0.5 + (l - 400.0) / 380.0;
+        let (ex_lo, ex_hi, em_lo, em_hi) = (300.0, 500.0, 400.0, 780.0);
+        // Nested Simpson on steps that divide the node spacings (50 and 20 nm).
+        let exact = simpson(ex_lo, ex_hi, 400, |li| {
+            f(li)
+                * simpson(em_lo, em_hi, 380, |lo| {
+                    m.eval(li as f32, lo as f32) as f64 * g(lo)
+                })
+        });
+        let n = 400_000;
+        let estimate = |mut draw: Box<dyn FnMut(&mut SplitMix64) -> f64>, seed: u64| {
+            let mut rng = SplitMix64(seed);
+            let (mut sum, mut sum2) = (0.0, 0.0);
+            for _ in 0..n {
+                let x = draw(&mut rng);
+                sum += x;
+                sum2 += x * x;
+            }
+            let mean = sum / n as f64;
+            let standard_error = ((sum2 / n as f64 - mean * mean) / n as f64).sqrt();
+            (mean, standard_error)
+        };
+        // Row: λi uniform, λo ∝ M(λi, ·).
+        let row = estimate(
+            Box::new(|rng: &mut SplitMix64| {
+                let li = ex_lo + (ex_hi - ex_lo) * rng.next_f32() as f64;
+                match m.sample_emission(li as f32, rng.next_f32()) {
+                    Some((lo, pdf)) => {
+                        f(li) * m.eval(li as f32, lo) as f64 * g(lo as f64) * (ex_hi - ex_lo)
+                            / pdf as f64
+                    }
+                    None => 0.0,
+                }
+            }),
+            11,
+        );
+        // Column: λo uniform, λi ∝ M(·, λo).
+        let column = estimate(
+            Box::new(|rng: &mut SplitMix64| {
+                let lo = em_lo + (em_hi - em_lo) * rng.next_f32() as f64;
+                match m.sample_excitation(lo as f32, rng.next_f32()) {
+                    Some((li, pdf)) => {
+                        f(li as f64) * m.eval(li, lo as f32) as f64 * g(lo) * (em_hi - em_lo)
+                            / pdf as f64
+                    }
+                    None => 0.0,
+                }
+            }),
+            12,
+        );
+        for (name, (mean, standard_error)) in [("row", row), ("column", column)] {
+            assert!(
+                (mean - exact).abs() <= 4.0 * standard_error + 1e-6 * exact.abs(),
+                "{name}: {mean} ± {standard_error} vs quadrature {exact}"
+            );
+        }
+    }
+
+    #[test]
+    fn row_and_column_estimators_agree_with_quadrature() {
+        check_row_and_column_estimators(&test_matrix());
+    }
+
+    #[test]
+    fn signed_matrices_sample_columns_by_magnitude() {
+        let m = signed_test_matrix();
+        assert!(m.is_signed());
+        check_row_and_column_estimators(&m);
+        // The column pdf is the magnitude's: it integrates to 1 and never vanishes where M
+        // does not.
+        for l_out in [400.0f32, 517.0, 620.0] {
+            let pdf_integral = simpson(300.0, 500.0, 800, |l| {
+                m.pdf_excitation(l_out, l as f32) as f64
+            });
+            assert!((pdf_integral - 1.0).abs() < 1e-5, "{pdf_integral}");
+            assert!(m.column_magnitude_integral(l_out) > m.column_integral(l_out).abs());
+        }
+        let mut rng = SplitMix64(5);
+        for _ in 0..10_000 {
+            let (_, pdf) = m.sample_excitation(620.0, rng.next_f32()).unwrap();
+            assert!(pdf > 0.0);
         }
     }
 
