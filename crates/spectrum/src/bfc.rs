@@ -12,8 +12,8 @@
 //! EOD
 //! ```
 //!
-//! Lines end in LF or CRLF; fields are separated by tabs or spaces (runs of them, trailing
-//! ones ignored). Values are bispectral radiance factors per band D(λ_in, λ_out): the
+//! Lines end in LF or CRLF (a leading byte-order mark is skipped); fields are separated by
+//! tabs or spaces (runs of them, trailing ones ignored). Values are bispectral radiance factors per band D(λ_in, λ_out): the
 //! diagonal (λ_in = λ_out) is the reflected radiance factor R(λ), an off-diagonal entry
 //! divided by the excitation band width (the excitation step, nm) is the Donaldson matrix
 //! M(λ_in, λ_out) in nm⁻¹, so Σ_μ D(μ, λ)·S(μ) ≈ ∫ M(λ_in, λ)·S(λ_in) dλ_in. Every emission
@@ -84,6 +84,22 @@ pub struct NegativesReport {
     pub total: usize,
     /// The most negative entry, when there is one.
     pub worst: Option<BfcEntry>,
+}
+
+/// One line for the user (`prism color` and `--explain` print the policy): "2 of 75 entries
+/// are negative, the most negative -0.03 at excitation 330 nm, emission 420 nm (line 8,
+/// column 23)", or "no negative entries".
+impl std::fmt::Display for NegativesReport {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self.worst {
+            None => f.write_str("no negative entries"),
+            Some(w) => write!(
+                f,
+                "{} of {} entries are negative, the most negative {} at excitation {} nm, emission {} nm (line {}, column {})",
+                self.count, self.total, w.value, w.excitation_nm, w.emission_nm, w.line, w.column
+            ),
+        }
+    }
 }
 
 /// A BFC-450 file as R(λ) and a Donaldson matrix.
@@ -174,6 +190,8 @@ pub fn parse_bfc(
 ) -> Result<BfcData, SpectrumFileError> {
     let err =
         |line: usize, column: usize, msg: String| SpectrumFileError::at(path, line, column, msg);
+    // Windows tools may prefix a byte-order mark.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let end_of_file_line = text.lines().count() + 1;
     let mut lines = text.lines().enumerate().filter_map(|(index, raw)| {
         let (fields, end_column) = split_fields(raw);
@@ -187,25 +205,20 @@ pub fn parse_bfc(
             }),
         }
     });
-    let number = |field: Field, what: &str| -> Result<f64, SpectrumFileError> {
+    let number = |line: usize, field: Field, what: &str| -> Result<f64, SpectrumFileError> {
         match field.text.parse::<f64>() {
             Ok(v) if v.is_finite() => Ok(v),
             Ok(_) => Err(err(
-                0,
+                line,
                 field.column,
                 format!("expected a finite number ({what}), found `{}`", field.text),
             )),
             Err(_) => Err(err(
-                0,
+                line,
                 field.column,
                 format!("expected a number ({what}), found `{}`", field.text),
             )),
         }
-    };
-    // `number` does not know the line; this puts it in.
-    let on_line = |line: &Line, e: SpectrumFileError| SpectrumFileError {
-        line: Some(line.number),
-        ..e
     };
 
     // First line: VEC_01.
@@ -287,7 +300,7 @@ pub fn parse_bfc(
     ];
     let mut h = [0.0f64; 6];
     for (k, value) in h.iter_mut().enumerate() {
-        *value = number(header.fields[k], names[k]).map_err(|e| on_line(&header, e))?;
+        *value = number(header.number, header.fields[k], names[k])?;
     }
     let [em_first, em_last, em_step, ex_count, ex_first, ex_step] = h;
     let hcol = |k: usize| header.fields[k].column;
@@ -385,7 +398,7 @@ pub fn parse_bfc(
         .map_err(|(c, m)| err(rc.number, c, m))?;
     for k in 0..ex_count {
         let field = rc.fields[k + 1];
-        let value = number(field, "excitation wavelength in nm").map_err(|e| on_line(&rc, e))?;
+        let value = number(rc.number, field, "excitation wavelength in nm")?;
         let expected = ex_first + k as f64 * ex_step;
         if (value - expected).abs() > 1e-3 {
             return Err(err(
@@ -418,8 +431,7 @@ pub fn parse_bfc(
                 format!("expected {em_count} emission rows ({em_first}–{em_last} nm), found {e} before `EOD`"),
             ));
         }
-        let value =
-            number(row.fields[0], "emission wavelength in nm").map_err(|x| on_line(&row, x))?;
+        let value = number(row.number, row.fields[0], "emission wavelength in nm")?;
         if (value - expected_nm).abs() > 1e-3 {
             return Err(err(
                 row.number,
@@ -441,7 +453,7 @@ pub fn parse_bfc(
                 "radiance factor for excitation {} nm",
                 ex_first + x as f64 * ex_step
             );
-            let v = number(field, &what).map_err(|e| on_line(&row, e))?;
+            let v = number(row.number, field, &what)?;
             radiance_factors.push(v);
             positions.push((row.number, field.column));
         }
@@ -661,6 +673,38 @@ mod tests {
         let text = variant.join("\r\n") + "\r\n";
         let data = parse_bfc(&text, Path::new(PATH), NegativesPolicy::Clamp).unwrap();
         assert_eq!(data, reference);
+        let with_bom = format!("\u{feff}{text}");
+        let data = parse_bfc(&with_bom, Path::new(PATH), NegativesPolicy::Clamp).unwrap();
+        assert_eq!(data, reference);
+    }
+
+    #[test]
+    fn positions_count_lines_and_characters_in_crlf_files_with_mixed_separators() {
+        // Line 9 (after a comment and a blank line) reads `  410 \t 0.02\t\t0.x2 …`: the bad
+        // token starts at character 15, a tab counting one.
+        let mut l = lines();
+        l.insert(5, "; comment".into());
+        l.insert(6, String::new());
+        l[8] = format!(
+            "  410 \t 0.02\t\t0.x2\t{}",
+            l[8].splitn(4, '\t').nth(3).unwrap()
+        );
+        let text = l.join("\r\n") + "\r\n";
+        let e = parse_bfc(&text, Path::new(PATH), NegativesPolicy::Clamp).unwrap_err();
+        assert_eq!((e.line, e.column), (Some(9), Some(15)), "{e}");
+        assert!(
+            e.message.contains(
+                "expected a number (radiance factor for excitation 310 nm), found `0.x2`"
+            ),
+            "{e}"
+        );
+        // The end of the file is the line after the last CRLF-terminated one.
+        let mut l = lines();
+        l.insert(5, "; comment".into());
+        l.pop();
+        let text = l.join("\r\n") + "\r\n";
+        let e = parse_bfc(&text, Path::new(PATH), NegativesPolicy::Clamp).unwrap_err();
+        assert_eq!(e.line, Some(l.len() + 1), "{e}");
     }
 
     #[test]
@@ -885,6 +929,17 @@ mod tests {
         assert!((kept.matrix.eval(300.0, 410.0) + 0.001).abs() < 1e-9);
         assert_eq!(kept.negatives, clamped.negatives);
 
+        assert_eq!(
+            clamped.negatives.to_string(),
+            format!(
+                "2 of 75 entries are negative, the most negative -0.03 at excitation 330 nm, emission 420 nm (line 8, column {})",
+                column_of(&l[7], "-0.03")
+            )
+        );
+        assert_eq!(
+            parse(&lines()).unwrap().negatives.to_string(),
+            "no negative entries"
+        );
         let e = parse_bfc(&text, Path::new(PATH), NegativesPolicy::Error).unwrap_err();
         assert_eq!(
             (e.line, e.column),
