@@ -10,9 +10,10 @@
 //!
 //! What exists now: the types ([`GBuffer`], [`GBufferHit`], [`SamplePlan`] with
 //! [`SamplePlan::uniform`] as the default plan, [`Bandwidth`], [`MaterialBandwidth`],
-//! [`LightSample`], [`ShadingProbe`]) and a closed-form [`MockProbe`] for tests; the
-//! transport operators of Fig. 4 with eq. 3's reflection and eq. 4's one-bounce bandwidth
-//! ([`operators`], [`Bounce`]). The rest of the predictor (per-pixel bandwidth and variance,
+//! [`LightSample`], [`ShadingProbe`]) and a closed-form [`MockProbe`] for tests; the local
+//! bandwidth of a 2-D signal by a Haar pyramid ([`local_bandwidth`], [`LocalBandwidth`],
+//! eq. 7 with a measured deviation in the level choice); the transport operators of Fig. 4
+//! with eq. 3's reflection and eq. 4's one-bounce bandwidth ([`operators`], [`Bounce`]). The rest of the predictor (per-pixel bandwidth and variance,
 //! the bandwidth pyramid, variance → samples) comes next; see docs/bandwidth.md.
 //!
 //! Units: metres, radians, frequencies in cycles per metre and cycles per radian
@@ -22,6 +23,7 @@
 pub mod bandwidth;
 pub mod error;
 pub mod gbuffer;
+pub mod local_bandwidth;
 pub mod mock_probe;
 pub mod operators;
 pub mod probe;
@@ -30,6 +32,7 @@ pub mod sample_plan;
 pub use bandwidth::{Bandwidth, MaterialBandwidth};
 pub use error::BandwidthError;
 pub use gbuffer::{GBuffer, GBufferHit};
+pub use local_bandwidth::{Boundary, LocalBandwidth};
 pub use mock_probe::MockProbe;
 pub use operators::Bounce;
 pub use probe::{LightSample, ShadingProbe};
