@@ -24,7 +24,9 @@
 //! bandwidth of the finest wavelet (two texels, +1 and −1), Δ the texel size in units of the
 //! signal's coordinate (metres per texel for a texture or an area light, radians per texel
 //! for an angular map): ν is in cycles per that unit (cycles/m, cycles/rad; `bandwidth`
-//! module).
+//! module). Where Δ varies over the map (a lat-long environment map, whose Δ per texel is
+//! the largest singular value of the mapping's Jacobian), pass Δ = 1 and divide each
+//! texel's cycles/texel by its own Δ.
 //!
 //! Borders and sizes: any width and height; no power of two is needed because the pyramid
 //! is undecimated. Only wavelets lying inside the image count (no extension: with the
