@@ -51,6 +51,13 @@ impl Bandwidth {
         angular_cycles_per_rad: 0.0,
     };
 
+    /// A point or spot light: a delta in space, unbounded spatial spectrum and no angular
+    /// variation, ν_l = [∞, 0] (Bagher eq. 4's ν_l for delta local lights).
+    pub const POINT_LIGHT: Bandwidth = Bandwidth {
+        spatial_cycles_per_m: f32::INFINITY,
+        angular_cycles_per_rad: 0.0,
+    };
+
     /// ν = [spatial, angular]; both ≥ 0 (+∞ allowed).
     pub fn new(
         spatial_cycles_per_m: f32,

@@ -10,9 +10,11 @@
 //!
 //! What exists now: the types ([`GBuffer`], [`GBufferHit`], [`SamplePlan`] with
 //! [`SamplePlan::uniform`] as the default plan, [`Bandwidth`], [`MaterialBandwidth`],
-//! [`LightSample`], [`ShadingProbe`]) and a closed-form [`MockProbe`] for tests. The
-//! predictor itself (transport operators of eq. 3, per-pixel bandwidth and variance, the
-//! bandwidth pyramid, variance → samples) comes next; see docs/bandwidth.md.
+//! [`LightSample`], [`ShadingProbe`]) and a closed-form [`MockProbe`] for tests; the local
+//! bandwidth of a 2-D signal by a Haar pyramid ([`local_bandwidth`], [`LocalBandwidth`],
+//! eq. 7 with a measured deviation in the level choice); the transport operators of Fig. 4
+//! with eq. 3's reflection and eq. 4's one-bounce bandwidth ([`operators`], [`Bounce`]). The rest of the predictor (per-pixel bandwidth and variance,
+//! the bandwidth pyramid, variance → samples) comes next; see docs/bandwidth.md.
 //!
 //! Units: metres, radians, frequencies in cycles per metre and cycles per radian
 //! (`bandwidth` module), radiance and BSDF values as Y in Prism's output normalisation
@@ -21,13 +23,17 @@
 pub mod bandwidth;
 pub mod error;
 pub mod gbuffer;
+pub mod local_bandwidth;
 pub mod mock_probe;
+pub mod operators;
 pub mod probe;
 pub mod sample_plan;
 
 pub use bandwidth::{Bandwidth, MaterialBandwidth};
 pub use error::BandwidthError;
 pub use gbuffer::{GBuffer, GBufferHit};
+pub use local_bandwidth::{Boundary, LocalBandwidth};
 pub use mock_probe::MockProbe;
+pub use operators::Bounce;
 pub use probe::{LightSample, ShadingProbe};
 pub use sample_plan::{SamplePlan, DEFAULT_LIGHT_SAMPLES};
