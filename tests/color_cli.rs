@@ -291,3 +291,185 @@ fn blackbody_spectra_have_their_own_temperature_as_cct() {
         &["blackbody:<temperature in K>"],
     );
 }
+
+/// Issue 21 test 7: a synthetic optically brightened white against band sums done
+/// independently (tools/export_bispectral_fixture.py, standard-library Python on spectra/).
+#[test]
+fn bispectral_matches_the_independent_band_sums() {
+    let fixture = fixture("bispectral_cli.json");
+    let bfc = fixture["bfc"].as_str().unwrap();
+    let mut args = vec!["color", "--json", "--bispectral", bfc];
+    args.extend(
+        fixture["args"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|a| a.as_str().unwrap()),
+    );
+    let out = prism(&args);
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let ours: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(ours["negatives"]["policy"], "clamp");
+    assert_eq!(ours["negatives"]["count"], 0);
+    let relative = |e: f64| 1e-6 * e.abs();
+    let want_all = fixture["illuminants"].as_array().unwrap();
+    let ours_all = ours["illuminants"].as_array().unwrap();
+    assert_eq!(ours_all.len(), want_all.len());
+    for (o, w) in ours_all.iter().zip(want_all) {
+        let name = w["illuminant"].as_str().unwrap();
+        assert_eq!(o["illuminant"], w["illuminant"]);
+        let what = |key: &str| format!("{name} {key}");
+        assert_close(
+            &what("white"),
+            &floats(&o["white_XYZ"]),
+            &floats(&w["white_XYZ"]),
+            relative,
+        );
+        for part in ["reflected", "total"] {
+            assert_close(
+                &what(&format!("{part} XYZ")),
+                &floats(&o[part]["XYZ"]),
+                &floats(&w[part]["XYZ"]),
+                relative,
+            );
+            assert_close(
+                &what(&format!("{part} xy")),
+                &floats(&o[part]["xy"]),
+                &floats(&w[part]["xy"]),
+                |_| 1e-8,
+            );
+            assert_close(
+                &what(&format!("{part} Lab")),
+                &floats(&o[part]["Lab"]),
+                &floats(&w[part]["Lab"]),
+                |_| 1e-6,
+            );
+        }
+        let bands =
+            |v: &Value| -> Vec<f64> { v.as_array().unwrap().iter().flat_map(floats).collect() };
+        assert_close(
+            &what("beta_t"),
+            &bands(&o["beta_t"]),
+            &bands(&w["beta_t"]),
+            |e| 1e-6 * e.abs().max(1e-3),
+        );
+        for key in ["beta_t_peak", "beta_l_peak"] {
+            assert_close(&what(key), &floats(&o[key]), &floats(&w[key]), |e| {
+                1e-6 * e.abs()
+            });
+        }
+    }
+    // The accepted check: βT changes with the illuminant (the UV-rich D65 excites more).
+    let peak = |i: usize| floats(&ours_all[i]["beta_t_peak"])[1];
+    assert!(
+        peak(0) > peak(1) + 0.1,
+        "βT peaks {} vs {}",
+        peak(0),
+        peak(1)
+    );
+    let (o, w) = (&ours["whiteness"], &fixture["whiteness"]);
+    for key in ["W", "T_W"] {
+        assert_close(
+            key,
+            &[o[key].as_f64().unwrap()],
+            &[w[key].as_f64().unwrap()],
+            |_| 1e-6,
+        );
+    }
+    assert_eq!(o["valid"], w["valid"]);
+    assert_eq!(o["valid"], true);
+}
+
+#[test]
+fn bispectral_text_prints_both_illuminants_the_policy_and_whiteness() {
+    let fixture = fixture("bispectral_cli.json");
+    let bfc = fixture["bfc"].as_str().unwrap();
+    let out = prism(&["color", "--bispectral", bfc, "--compare-illuminant", "A"]);
+    assert!(out.status.success());
+    let text = String::from_utf8(out.stdout).unwrap();
+    for label in [
+        "negatives    clamp (no negative entries)",
+        "illuminant D65",
+        "illuminant A",
+        "reflected (R alone)",
+        "total (R + fluorescence)",
+        "βT peak D65",
+        "βT peak A",
+        "βL peak",
+        "whiteness",
+        "T_W",
+    ] {
+        assert!(text.contains(label), "`{label}` not in:\n{text}");
+    }
+}
+
+/// A 3 × 3 file (400–420 nm) with one negative off-diagonal entry on line 7, column 10.
+const SMALL_BFC_WITH_NEGATIVE: &str = "VEC_01\t9\nBFC-450 Matrix File\n400 420 10 3 400 10\nr:c: 400 410 420\n400\t0.9\t0\t0\n410\t0.01\t0.9\t0\n420\t0.02\t-0.003\t0.9\nEOD\n";
+
+#[test]
+fn bispectral_bad_input_and_negatives() {
+    let fixture_bfc = "tests/fixtures/bispectral-synthetic.bfc";
+    expect_error(
+        &["color", "--bispectral", fixture_bfc, "--spectrum", "D65"],
+        &["--spectrum", "cannot be used with"],
+    );
+    expect_error(&["color"], &["--spectrum", "--bispectral"]);
+    expect_error(
+        &["color", "--spectrum", "D65", "--compare-illuminant", "A"],
+        &["--bispectral only"],
+    );
+    expect_error(
+        &["color", "--spectrum", "D65", "--negatives", "keep"],
+        &["--bispectral only"],
+    );
+    let malformed = TempFile::new(
+        "malformed.bfc",
+        &SMALL_BFC_WITH_NEGATIVE.replace("0.01\t0.9", "0.01\tx9"),
+    );
+    expect_error(
+        &["color", "--bispectral", malformed.arg()],
+        &[&format!("{}:6:10:", malformed.arg()), "expected a number"],
+    );
+    let negative = TempFile::new("negative.bfc", SMALL_BFC_WITH_NEGATIVE);
+    expect_error(
+        &[
+            "color",
+            "--bispectral",
+            negative.arg(),
+            "--negatives",
+            "error",
+        ],
+        &[&format!("{}:7:10:", negative.arg()), "negative", "-0.003"],
+    );
+    // clamp (the default) reports the count and the worst entry, in text and JSON.
+    let out = prism(&["color", "--bispectral", negative.arg()]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(
+        text.contains("clamp (1 of 9 entries are negative, the most negative -0.003 at excitation 410 nm, emission 420 nm (line 7, column 10): set to 0)"),
+        "{text}"
+    );
+    let out = prism(&[
+        "color",
+        "--bispectral",
+        negative.arg(),
+        "--negatives",
+        "keep",
+        "--json",
+    ]);
+    assert!(out.status.success());
+    let ours: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let negatives = &ours["negatives"];
+    assert_eq!(negatives["policy"], "keep");
+    assert_eq!(negatives["count"], 1);
+    assert_eq!(negatives["worst"]["emission_nm"], 420.0);
+    assert_eq!(negatives["worst"]["excitation_nm"], 410.0);
+}

@@ -1,11 +1,12 @@
 //! `prism color`: colorimetry of one spectrum, scriptable (`--json`) and checked against
 //! colour-science (tests/fixtures/color_cli.json).
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
-use clap::{Args, ValueEnum};
+use clap::{ArgGroup, Args, ValueEnum};
 use glam::DVec3;
 use prism_spectrum::adaptation::{adaptation_matrix, AdaptationMethod};
+use prism_spectrum::bfc::NegativesPolicy;
 use prism_spectrum::cct::{blackbody_dense, xyz_to_cct_ohno2013};
 use prism_spectrum::colorimetry::{
     emission_to_xyz_cd_per_m2, illuminant_white_xyz, reflectance_to_xyz, xyz_to_lab, xyz_to_xy,
@@ -58,18 +59,53 @@ impl From<AdaptArg> for AdaptationMethod {
     }
 }
 
+/// The `--negatives` policy for bispectral files.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum NegativesArg {
+    /// Set negative entries to 0 and report their count and the most negative one.
+    Clamp,
+    /// Keep the signed matrix.
+    Keep,
+    /// Refuse a file with negative entries.
+    Error,
+}
+
+impl From<NegativesArg> for NegativesPolicy {
+    fn from(arg: NegativesArg) -> Self {
+        match arg {
+            NegativesArg::Clamp => NegativesPolicy::Clamp,
+            NegativesArg::Keep => NegativesPolicy::Keep,
+            NegativesArg::Error => NegativesPolicy::Error,
+        }
+    }
+}
+
 #[derive(Args, Debug)]
+#[command(group(ArgGroup::new("input").required(true).args(["spectrum", "bispectral"])))]
 pub struct ColorArgs {
     /// Spectrum: a CSV file (`wavelength_nm,value`), a file stem under spectra/ (e.g. D65, F11,
     /// LED-B3), a ColorChecker patch (e.g. `colorchecker:dark skin`) or a blackbody's absolute
     /// spectral radiance (e.g. `blackbody:5000` in K).
     #[arg(long, value_name = "FILE.csv|NAME")]
-    pub spectrum: String,
+    pub spectrum: Option<String>,
+    /// A fluorescent sample: a Labsphere BFC-450 bispectral matrix file; prints the reflected
+    /// and total colour, βT and CIE whiteness (docs/colour.md "prism color --bispectral").
+    #[arg(long, value_name = "FILE.BFC")]
+    pub bispectral: Option<PathBuf>,
     /// Treat the spectrum as a reflectance under this illuminant (CIE name or CSV file);
     /// XYZ is then normalised so a perfect reflector has Y = 100. Without it the spectrum is
-    /// spectral radiance in W·m⁻²·sr⁻¹·nm⁻¹ and Y is luminance in cd/m².
+    /// spectral radiance in W·m⁻²·sr⁻¹·nm⁻¹ and Y is luminance in cd/m². With --bispectral
+    /// it defaults to D65.
     #[arg(long, value_name = "NAME|FILE.csv")]
     pub illuminant: Option<String>,
+    /// With --bispectral: a second illuminant, reported alongside (βT changes with the
+    /// illuminant, R does not).
+    #[arg(long, value_name = "NAME|FILE.csv")]
+    pub compare_illuminant: Option<String>,
+    /// With --bispectral: what to do with negative matrix entries (measurement noise);
+    /// default clamp.
+    #[arg(long, value_enum)]
+    pub negatives: Option<NegativesArg>,
     /// Colour-matching functions for XYZ, xy and Lab (CCT and sRGB always use CIE 1931).
     #[arg(long, value_enum, default_value = "cie1931")]
     pub observer: ObserverArg,
@@ -107,6 +143,10 @@ fn looks_like_path(text: &str) -> bool {
 }
 
 /// Resolves `FILE.csv|NAME|colorchecker:PATCH` to a table and a label for the report.
+pub(crate) fn resolve_illuminant(spec: &str, flag: &str) -> Result<(Tabulated, String), String> {
+    resolve_spectrum(spec, Role::Illuminant, flag)
+}
+
 fn resolve_spectrum(spec: &str, role: Role, flag: &str) -> Result<(Tabulated, String), String> {
     let lower = spec.to_lowercase();
     if let Some(patch) = lower.strip_prefix(COLORCHECKER_PREFIX) {
@@ -194,14 +234,13 @@ fn chromaticity(xyz: DVec3) -> Option<[f64; 2]> {
     xyz_to_xy(xyz).map(|xy| xy.to_array())
 }
 
-fn compute(args: &ColorArgs) -> Result<ColorReport, String> {
+fn compute(args: &ColorArgs, spectrum: &str) -> Result<ColorReport, String> {
     let observer = Observer::from(args.observer);
     let srgb = RgbColorSpace::srgb();
     let (report_xyz, xyz_1931, lab, linear_srgb, illuminant_label, spectrum_label);
     match &args.illuminant {
         Some(illuminant_spec) => {
-            let (spectrum, label) =
-                resolve_spectrum(&args.spectrum, Role::Reflectance, "--spectrum")?;
+            let (spectrum, label) = resolve_spectrum(spectrum, Role::Reflectance, "--spectrum")?;
             let (illuminant, illum_label) =
                 resolve_spectrum(illuminant_spec, Role::Illuminant, "--illuminant")?;
             let reflectance = spectrum.to_dense();
@@ -222,7 +261,7 @@ fn compute(args: &ColorArgs) -> Result<ColorReport, String> {
             spectrum_label = label;
         }
         None => {
-            let (spectrum, label) = resolve_spectrum(&args.spectrum, Role::Emission, "--spectrum")?;
+            let (spectrum, label) = resolve_spectrum(spectrum, Role::Emission, "--spectrum")?;
             let radiance = spectrum.to_dense();
             report_xyz = emission_to_xyz_cd_per_m2(&radiance, observer);
             xyz_1931 = emission_to_xyz_cd_per_m2(&radiance, Observer::Cie1931);
@@ -302,7 +341,23 @@ fn print_table(r: &ColorReport) {
 }
 
 pub fn run(args: &ColorArgs) -> Result<(), String> {
-    let report = compute(args)?;
+    // clap's "input" group requires exactly one of --spectrum and --bispectral.
+    let spectrum = match (&args.spectrum, &args.bispectral) {
+        (Some(spectrum), None) => spectrum,
+        (None, Some(path)) => return crate::bispectral::run(args, path),
+        (Some(_), Some(_)) | (None, None) => {
+            return Err("give exactly one of --spectrum and --bispectral".into())
+        }
+    };
+    // Checked here rather than by clap's `requires`, which does not fire for a member of
+    // the "input" group.
+    if args.compare_illuminant.is_some() || args.negatives.is_some() {
+        return Err(
+            "--compare-illuminant and --negatives apply to --bispectral only, not to --spectrum"
+                .into(),
+        );
+    }
+    let report = compute(args, spectrum)?;
     if args.json {
         println!("{}", to_json(&report));
     } else {

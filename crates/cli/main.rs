@@ -1,5 +1,6 @@
 //! The `prism` command: spectral rendering, colorimetry and tone reproduction.
 
+mod bispectral;
 mod color;
 mod compare;
 mod converge;
@@ -28,7 +29,8 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Colorimetry of a spectrum: XYZ, xy, CCT/Duv, CIELAB and sRGB, as colour-science computes them.
+    /// Colorimetry of a spectrum: XYZ, xy, CCT/Duv, CIELAB and sRGB, as colour-science computes them;
+    /// of a fluorescent sample (--bispectral): reflected and total colour, βT, CIE whiteness.
     Color(color::ColorArgs),
     /// Error metrics of an image against a reference: MSE, RMSE, relMSE, PSNR, SSIM, ΔE2000.
     Compare(compare::CompareArgs),
