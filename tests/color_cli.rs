@@ -28,7 +28,7 @@ fn assert_close(what: &str, ours: &[f64], expected: &[f64], tol: impl Fn(f64) ->
     for (o, e) in ours.iter().zip(expected) {
         assert!(
             (o - e).abs() <= tol(*e),
-            "{what}: ours {ours:?}, colour-science {expected:?}"
+            "{what}: ours {ours:?}, fixture {expected:?}"
         );
     }
 }
