@@ -191,21 +191,7 @@ mod tests {
     /// Simpson over the emission range on 0.5 nm steps: 10 per 5 nm node segment, so every
     /// Simpson pair lies inside a segment and is exact for the quadratic M(λi, ·)·λo.
     fn integrate_emission(f: impl Fn(f64) -> f64) -> f64 {
-        let (a, b) = (360.0, 830.0);
-        let n = 940;
-        let h = (b - a) / n as f64;
-        let mut sum = 0.0;
-        for i in 0..=n {
-            let w = if i == 0 || i == n {
-                1.0
-            } else if i % 2 == 1 {
-                4.0
-            } else {
-                2.0
-            };
-            sum += w * f(a + i as f64 * h);
-        }
-        sum * h / 3.0
+        crate::test_quadrature::simpson(360.0, 830.0, 940, f)
     }
 
     #[test]

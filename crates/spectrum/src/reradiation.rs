@@ -606,22 +606,7 @@ mod tests {
         (chi2, dof, chi2_p_value(chi2, dof))
     }
 
-    /// Simpson's rule on `n` (even) steps over [a, b].
-    fn simpson(a: f64, b: f64, n: usize, f: impl Fn(f64) -> f64) -> f64 {
-        let h = (b - a) / n as f64;
-        let mut sum = 0.0;
-        for i in 0..=n {
-            let w = if i == 0 || i == n {
-                1.0
-            } else if i % 2 == 1 {
-                4.0
-            } else {
-                2.0
-            };
-            sum += w * f(a + i as f64 * h);
-        }
-        sum * h / 3.0
-    }
+    use crate::test_quadrature::simpson;
 
     #[test]
     fn eval_matches_the_grid_at_nodes_and_is_zero_outside() {
