@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Writes docs/methods.md: for the Cornell box (against Mitsuba 3's reference) and every
 stress scene in scenes/stress/, runs `prism converge` with each method, commits the chart
-(PNG) and JSON under docs/methods/, and tabulates per method the time to reach relMSE 1e-2
+(PNG) under docs/methods/ and its JSON under tools/bench-results/methods/, and tabulates per method the time to reach relMSE 1e-2
 (or the error when the budget ran out), the fitted slopes and a one-line verdict.
 
 Refresh it whenever an integrator changes:
@@ -203,7 +203,7 @@ def main():
     ap.add_argument("--scenes", nargs="*", default=None, help="subset of stress scene names")
     ap.add_argument("--skip-cornell", action="store_true")
     ap.add_argument("--no-run", action="store_true",
-                    help="rebuild docs/methods.md from the JSON already in docs/methods/ "
+                    help="rebuild docs/methods.md from the JSON already in tools/bench-results/methods/ "
                          "(pass the options of the run that made them)")
     args = ap.parse_args()
     prism = args.prism
@@ -215,8 +215,9 @@ def main():
     if prism is None:
         sys.exit("build prism first (cargo build --release)")
     methods = args.method or ["path", "path:sobol", "light", "bdpt"]
-    out_dir = os.path.join(ROOT, "docs", "methods")
-    os.makedirs(out_dir, exist_ok=True)
+    for out_dir in (os.path.join(ROOT, "docs", "methods"),
+                    os.path.join(ROOT, "tools", "bench-results", "methods")):
+        os.makedirs(out_dir, exist_ok=True)
     clock_key = "cpu_time_s" if args.clock == "cpu" else "time_s"
 
     jobs = []
@@ -238,7 +239,7 @@ def main():
     comparisons = []
     for name, scene, ref_args, what in jobs:
         chart = f"docs/methods/{name}.png"
-        data_path = f"docs/methods/{name}.json"
+        data_path = f"tools/bench-results/methods/{name}.json"
         cmd = [prism, "converge", scene, *ref_args, "--budget-s", str(args.budget_s),
                "--checkpoints", str(args.checkpoints), "--clock", args.clock,
                "-o", chart, "--json", data_path]
@@ -277,7 +278,8 @@ integrator changes (command below). Each scene is rendered progressively by
 [`prism converge`](converge.md) with every method; each row gives the time to reach
 relMSE {TARGET_RELMSE:g} (interpolated between checkpoints; when the budget ran out first,
 the time the fitted power law predicts), the error at the end of the budget, the fitted
-log–log slopes (Monte Carlo rate: RMSE −0.5, relMSE −1), and a verdict.
+log–log slopes (Monte Carlo rate: RMSE −0.5, relMSE −1), and a verdict. Every checkpoint of
+every run is in `tools/bench-results/methods/<scene>.json`.
 
 **This run:** budget {args.budget_s:g} s per method ({clock_text}){cap_text}, {args.checkpoints}
 checkpoints, stress-scene references at {args.reference_spp} spp, methods

@@ -2,7 +2,10 @@
 
 /// Composite Simpson's rule on `n` (even) steps over [a, b].
 pub(crate) fn simpson(a: f64, b: f64, n: usize, f: impl Fn(f64) -> f64) -> f64 {
-    debug_assert!(n.is_multiple_of(2), "Simpson's rule needs an even number of steps");
+    debug_assert!(
+        n.is_multiple_of(2),
+        "Simpson's rule needs an even number of steps"
+    );
     let h = (b - a) / n as f64;
     let mut sum = 0.0;
     for i in 0..=n {
