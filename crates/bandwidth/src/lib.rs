@@ -28,6 +28,8 @@ pub mod mock_probe;
 pub mod operators;
 pub mod probe;
 pub mod sample_plan;
+#[cfg(test)]
+mod test_rng;
 
 pub use bandwidth::{Bandwidth, MaterialBandwidth};
 pub use error::BandwidthError;

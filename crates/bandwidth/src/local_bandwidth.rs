@@ -263,16 +263,7 @@ fn sliding_max(input: &[f32], window: usize, out: &mut [f32]) {
 mod tests {
     use super::*;
 
-    /// xorshift32 → [0, 1).
-    struct Rng(u32);
-    impl Rng {
-        fn next(&mut self) -> f32 {
-            self.0 ^= self.0 << 13;
-            self.0 ^= self.0 >> 17;
-            self.0 ^= self.0 << 5;
-            (self.0 >> 8) as f32 / (1u32 << 24) as f32
-        }
-    }
+    use crate::test_rng::Rng;
 
     fn image(resolution: UVec2, f: impl Fn(f32, f32) -> f32) -> Vec<f32> {
         let mut v = Vec::with_capacity((resolution.x * resolution.y) as usize);

@@ -270,19 +270,7 @@ impl Bounce {
 mod tests {
     use super::*;
 
-    /// xorshift32 → [0, 1): deterministic test values.
-    struct Rng(u32);
-    impl Rng {
-        fn next(&mut self) -> f32 {
-            self.0 ^= self.0 << 13;
-            self.0 ^= self.0 >> 17;
-            self.0 ^= self.0 << 5;
-            (self.0 >> 8) as f32 / (1u32 << 24) as f32
-        }
-        fn range(&mut self, lo: f32, hi: f32) -> f32 {
-            lo + (hi - lo) * self.next()
-        }
-    }
+    use crate::test_rng::Rng;
 
     fn nu(s: f32, a: f32) -> Bandwidth {
         Bandwidth::new(s, a).unwrap()

@@ -13,6 +13,7 @@
 pub mod bsdf;
 pub mod camera;
 pub mod error;
+pub mod file_error;
 pub mod film;
 pub mod integrator;
 pub mod light;

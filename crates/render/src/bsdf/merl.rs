@@ -81,37 +81,7 @@ const SAMPLE_V: usize = 64;
 const COSINE_FRACTION: f32 = 0.1;
 
 /// What went wrong reading or writing a MERL file.
-#[derive(Debug, Clone, PartialEq)]
-pub struct MerlError {
-    /// The file, when there is one.
-    pub path: Option<PathBuf>,
-    pub message: String,
-}
-
-impl MerlError {
-    fn new(message: impl Into<String>) -> Self {
-        Self {
-            path: None,
-            message: message.into(),
-        }
-    }
-
-    fn at(mut self, path: &Path) -> Self {
-        self.path = Some(path.to_path_buf());
-        self
-    }
-}
-
-impl fmt::Display for MerlError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match &self.path {
-            Some(p) => write!(f, "{}: {}", p.display(), self.message),
-            None => f.write_str(&self.message),
-        }
-    }
-}
-
-impl std::error::Error for MerlError {}
+pub type MerlError = crate::file_error::FileError;
 
 /// (i_h, i_d, i_φ) of a flat index.
 pub fn merl_bin(index: usize) -> (usize, usize, usize) {

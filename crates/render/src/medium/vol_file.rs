@@ -14,8 +14,7 @@
 //! A density is finite and ≥ 0, so NaN, infinite or negative voxels are errors naming the
 //! voxel, never clamped: a broken file would otherwise render as a plausible medium.
 
-use std::fmt;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use glam::Vec3;
 
@@ -25,36 +24,7 @@ const ENCODING_FLOAT32: i32 = 1;
 const HEADER_BYTES: usize = 48;
 
 /// A `.vol` file that cannot be read, with the file's name when there is one.
-#[derive(Clone, Debug, PartialEq)]
-pub struct VolError {
-    pub path: Option<PathBuf>,
-    pub message: String,
-}
-
-impl VolError {
-    fn new(message: impl Into<String>) -> Self {
-        Self {
-            path: None,
-            message: message.into(),
-        }
-    }
-
-    fn at(mut self, path: &Path) -> Self {
-        self.path = Some(path.to_path_buf());
-        self
-    }
-}
-
-impl fmt::Display for VolError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match &self.path {
-            Some(p) => write!(f, "{}: {}", p.display(), self.message),
-            None => f.write_str(&self.message),
-        }
-    }
-}
-
-impl std::error::Error for VolError {}
+pub type VolError = crate::file_error::FileError;
 
 /// A scalar voxel grid with the bounding box the file gives it.
 #[derive(Clone, Debug, PartialEq)]
