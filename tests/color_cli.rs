@@ -15,6 +15,17 @@ fn fixture(name: &str) -> Value {
     serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
 }
 
+/// Runs `prism` with `args`, which must succeed, and parses its JSON output.
+fn json_of(args: &[&str]) -> Value {
+    let out = prism(args);
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
 fn floats(v: &Value) -> Vec<f64> {
     v.as_array()
         .unwrap()
@@ -47,13 +58,7 @@ fn color_json_matches_colour_science() {
                 .iter()
                 .map(|a| a.as_str().unwrap()),
         );
-        let out = prism(&args);
-        assert!(
-            out.status.success(),
-            "{args:?}: {}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        let ours: Value = serde_json::from_slice(&out.stdout).unwrap();
+        let ours = json_of(&args);
         let want = &case["expected"];
         let what = |key: &str| format!("{args:?} {key}");
         // Issue contract: XYZ to 1e-6 relative; CCT to 0.5 K.
@@ -279,9 +284,7 @@ fn names_and_aliases_resolve_to_the_same_spectrum() {
 fn blackbody_spectra_have_their_own_temperature_as_cct() {
     for temperature_k in [1500.0, 2856.0, 6500.0, 20000.0] {
         let spec = format!("blackbody:{temperature_k}");
-        let out = prism(&["color", "--spectrum", &spec, "--json"]);
-        assert!(out.status.success());
-        let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+        let v = json_of(&["color", "--spectrum", &spec, "--json"]);
         let cct = v["CCT_K"].as_f64().unwrap();
         assert!((cct - temperature_k).abs() < 0.5, "{spec}: CCT {cct}");
         assert!(v["Duv"].as_f64().unwrap().abs() < 1e-5);
@@ -306,13 +309,7 @@ fn bispectral_matches_the_independent_band_sums() {
             .iter()
             .map(|a| a.as_str().unwrap()),
     );
-    let out = prism(&args);
-    assert!(
-        out.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let ours: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let ours = json_of(&args);
     assert_eq!(ours["negatives"]["policy"], "clamp");
     assert_eq!(ours["negatives"]["count"], 0);
     let relative = |e: f64| 1e-6 * e.abs();
@@ -457,7 +454,7 @@ fn bispectral_bad_input_and_negatives() {
         text.contains("clamp (1 of 9 entries are negative, the most negative -0.003 at excitation 410 nm, emission 420 nm (line 7, column 10): set to 0)"),
         "{text}"
     );
-    let out = prism(&[
+    let ours = json_of(&[
         "color",
         "--bispectral",
         negative.arg(),
@@ -465,8 +462,6 @@ fn bispectral_bad_input_and_negatives() {
         "keep",
         "--json",
     ]);
-    assert!(out.status.success());
-    let ours: Value = serde_json::from_slice(&out.stdout).unwrap();
     let negatives = &ours["negatives"];
     assert_eq!(negatives["policy"], "keep");
     assert_eq!(negatives["count"], 1);
