@@ -11,31 +11,43 @@
 //! What exists now: the types ([`GBuffer`], [`GBufferHit`], [`SamplePlan`] with
 //! [`SamplePlan::uniform`] as the default plan, [`Bandwidth`], [`MaterialBandwidth`],
 //! [`LightSample`], [`ShadingProbe`]) and a closed-form [`MockProbe`] for tests; the local
-//! bandwidth of a 2-D signal by a Haar pyramid ([`local_bandwidth`], [`LocalBandwidth`],
-//! eq. 7 with a measured deviation in the level choice); the transport operators of Fig. 4
-//! with eq. 3's reflection and eq. 4's one-bounce bandwidth ([`operators`], [`Bounce`]). The rest of the predictor (per-pixel bandwidth and variance,
-//! the bandwidth pyramid, variance → samples) comes next; see docs/bandwidth.md.
+//! bandwidth of a 2-D signal by a Haar pyramid ([`local_bandwidth`], eq. 7 with a measured
+//! deviation in the level choice); the transport operators of Fig. 4 ([`operators`], eqs. 3
+//! and 4); the per-pixel prediction ([`pixel_prediction`], eqs. 5, 6, 9); the bandwidth
+//! buffer ([`bandwidth_buffer`], eq. 11 and its pyramid); the allocation of camera samples
+//! ([`allocation`]) and the adaptive-sampling baseline ([`adaptive_error`]). The renderer
+//! side (G-buffer pass, probe bandwidths, executing the plan) is docs/bandwidth.md's last
+//! section.
 //!
 //! Units: metres, radians, frequencies in cycles per metre and cycles per radian
 //! (`bandwidth` module), radiance and BSDF values as Y in Prism's output normalisation
 //! (`probe` module).
 
+pub mod adaptive_error;
+pub mod allocation;
 pub mod bandwidth;
+pub mod bandwidth_buffer;
 pub mod error;
 pub mod gbuffer;
 pub mod local_bandwidth;
 pub mod mock_probe;
 pub mod operators;
+pub mod pixel_prediction;
 pub mod probe;
 pub mod sample_plan;
+mod stochastic_rounding;
 #[cfg(test)]
 mod test_rng;
 
+pub use adaptive_error::{adaptive_error, adaptive_pass_counts};
+pub use allocation::{allocate, Allocated, Allocation, AllocationInputs, AllocationSettings};
 pub use bandwidth::{Bandwidth, MaterialBandwidth};
+pub use bandwidth_buffer::{shading_level, BandwidthBuffer, BandwidthLevel};
 pub use error::BandwidthError;
 pub use gbuffer::{GBuffer, GBufferHit};
 pub use local_bandwidth::{Boundary, LocalBandwidth};
 pub use mock_probe::MockProbe;
 pub use operators::Bounce;
+pub use pixel_prediction::{predict_pixel, PixelFootprint, PixelPrediction, VarianceBandwidth};
 pub use probe::{LightSample, ShadingProbe};
 pub use sample_plan::{SamplePlan, DEFAULT_LIGHT_SAMPLES};

@@ -1,0 +1,284 @@
+//! From the bandwidth buffer to camera samples per pixel: N_p = budget · a_p / mean(a),
+//! a_p = f + (1 − f) · s_p / mean(s), with a floor f for the light the predictor does not
+//! see (indirect light) and at least 4^−level samples where eq. 11 asks for sub-pixel
+//! anti-aliasing (level < 0).
+//!
+//! s_p is the pixel's predicted relative standard deviation √V̂_p / √(L̂_p² + 0.01): the
+//! allocation that minimises the image's relMSE gives each pixel samples ∝ σ_p / L_p (a
+//! pixel's relMSE term is σ_p² / (N_p L_p²); with Σ N_p fixed, Lagrange gives N_p ∝ σ_p/L_p).
+//! The paper keeps the variance itself constant (N_p ∝ V̂_p, Bagher et al. 2013 after eq. 9),
+//! which is [`Allocation::Variance`]. The 0.01 keeps black pixels finite.
+
+use glam::UVec2;
+
+use crate::error::{pixel_count, BandwidthError};
+use crate::sample_plan::SamplePlan;
+use crate::stochastic_rounding::round_stochastic;
+
+/// What s_p measures.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Allocation {
+    /// s_p = √V̂_p / √(L̂_p² + 0.01): equal relative error (`--plan-allocation relative`).
+    RelativeError,
+    /// s_p = V̂_p: the paper's constant variance (`--plan-allocation variance`).
+    Variance,
+}
+
+/// The allocation's parameters.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AllocationSettings {
+    /// The mean camera samples per pixel (`--spp`).
+    pub mean_spp: f64,
+    /// f in [0, 1]: the share of the budget spread uniformly (`--plan-floor`, default 0.25).
+    pub floor: f64,
+    pub allocation: Allocation,
+    /// Seeds the stochastic rounding of the counts.
+    pub seed: u64,
+}
+
+/// The default floor: a quarter of the budget is spent uniformly, because indirect light,
+/// which the probe does not see, still needs samples everywhere.
+pub const DEFAULT_FLOOR: f64 = 0.25;
+
+/// The per-pixel inputs, row-major, as long as the image.
+#[derive(Clone, Copy, Debug)]
+pub struct AllocationInputs<'a> {
+    /// V̂_p (eq. 9).
+    pub variance: &'a [f32],
+    /// L̂_p.
+    pub mean_y: &'a [f32],
+    /// Eq. 11's level per pixel (negative: sub-pixel anti-aliasing).
+    pub shading_level: &'a [i32],
+}
+
+/// The plan and the relative sample density a_p / mean(a) (expected N_p / budget) that
+/// splatting reconstruction divides each sample's weight by.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Allocated {
+    pub plan: SamplePlan,
+    pub relative_density: Vec<f32>,
+}
+
+/// s_p of one pixel.
+fn shape(allocation: Allocation, variance: f32, mean_y: f32) -> f64 {
+    let v = f64::from(variance.max(0.0));
+    match allocation {
+        Allocation::RelativeError => v.sqrt() / (f64::from(mean_y).powi(2) + 0.01).sqrt(),
+        Allocation::Variance => v,
+    }
+}
+
+/// Camera samples per pixel for the whole image.
+pub fn allocate(
+    resolution: UVec2,
+    inputs: AllocationInputs<'_>,
+    settings: AllocationSettings,
+) -> Result<Allocated, BandwidthError> {
+    let n = pixel_count("sample allocation", resolution)?;
+    for (what, len) in [
+        ("sample allocation variance", inputs.variance.len()),
+        ("sample allocation mean", inputs.mean_y.len()),
+        (
+            "sample allocation shading level",
+            inputs.shading_level.len(),
+        ),
+    ] {
+        if len != n {
+            return Err(BandwidthError::LengthMismatch {
+                what,
+                resolution,
+                found: len,
+            });
+        }
+    }
+    if !(settings.mean_spp > 0.0 && settings.mean_spp.is_finite()) {
+        return Err(BandwidthError::invalid(
+            "sample allocation",
+            "mean_spp",
+            settings.mean_spp,
+            "finite, > 0",
+        ));
+    }
+    if !(0.0..=1.0).contains(&settings.floor) {
+        return Err(BandwidthError::invalid(
+            "sample allocation",
+            "floor",
+            settings.floor,
+            "in [0, 1]",
+        ));
+    }
+    let s: Vec<f64> = (0..n)
+        .map(|i| shape(settings.allocation, inputs.variance[i], inputs.mean_y[i]))
+        .map(|s| if s.is_finite() { s } else { 0.0 })
+        .collect();
+    let mean_s = s.iter().sum::<f64>() / n as f64;
+    // a_p; with nothing predicted anywhere (mean(s) = 0) the plan is uniform.
+    let a: Vec<f64> = s
+        .iter()
+        .map(|&s_p| {
+            if mean_s > 0.0 {
+                settings.floor + (1.0 - settings.floor) * s_p / mean_s
+            } else {
+                1.0
+            }
+        })
+        .collect();
+    let minimum: Vec<f64> = inputs
+        .shading_level
+        .iter()
+        .map(|&level| if level < 0 { 4f64.powi(-level) } else { 0.0 })
+        .collect();
+    let expected = fill_with_minimums(&a, &minimum, settings.mean_spp * n as f64);
+    let camera_samples: Vec<u32> = expected
+        .iter()
+        .enumerate()
+        .map(|(i, &x)| round_stochastic(x, settings.seed, i as u64))
+        .collect();
+    let plan = SamplePlan::from_counts(
+        resolution,
+        camera_samples,
+        vec![crate::sample_plan::DEFAULT_LIGHT_SAMPLES; n],
+    )?;
+    let relative_density = expected
+        .iter()
+        .map(|&x| (x / settings.mean_spp) as f32)
+        .collect();
+    Ok(Allocated {
+        plan,
+        relative_density,
+    })
+}
+
+/// x_p = k·a_p with the total `budget`, except that no pixel gets less than its minimum:
+/// pixels held at their minimum leave the rest a smaller budget, so k is solved again over
+/// the free pixels until no free pixel falls below its minimum (at most n rounds; a few in
+/// practice). A budget below Σ minimum gives every pixel its minimum.
+fn fill_with_minimums(a: &[f64], minimum: &[f64], budget: f64) -> Vec<f64> {
+    let mut held = vec![false; a.len()];
+    loop {
+        let held_total: f64 = (0..a.len()).filter(|&i| held[i]).map(|i| minimum[i]).sum();
+        let free_a: f64 = (0..a.len()).filter(|&i| !held[i]).map(|i| a[i]).sum();
+        let k = if free_a > 0.0 {
+            ((budget - held_total) / free_a).max(0.0)
+        } else {
+            0.0
+        };
+        let mut changed = false;
+        for i in 0..a.len() {
+            if !held[i] && k * a[i] < minimum[i] {
+                held[i] = true;
+                changed = true;
+            }
+        }
+        if !changed {
+            return (0..a.len())
+                .map(|i| if held[i] { minimum[i] } else { k * a[i] })
+                .collect();
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn settings(allocation: Allocation) -> AllocationSettings {
+        AllocationSettings {
+            mean_spp: 16.0,
+            floor: DEFAULT_FLOOR,
+            allocation,
+            seed: 5,
+        }
+    }
+
+    #[test]
+    fn samples_follow_the_predicted_relative_error_above_the_floor() {
+        // Pixel 0: σ/L = 1; pixel 1: σ/L = 3; pixels 2, 3: nothing predicted.
+        let variance = [1.0, 9.0, 0.0, 0.0];
+        let mean = [((1.0f64 - 0.01).sqrt()) as f32; 4];
+        let levels = [0; 4];
+        let inputs = AllocationInputs {
+            variance: &variance,
+            mean_y: &mean,
+            shading_level: &levels,
+        };
+        let out = allocate(
+            UVec2::new(2, 2),
+            inputs,
+            settings(Allocation::RelativeError),
+        )
+        .unwrap();
+        // s = [1, 3, 0, 0], mean 1; a = 0.25 + 0.75 s = [1, 2.5, 0.25, 0.25], mean 1.
+        let expected = [1.0, 2.5, 0.25, 0.25];
+        for (d, e) in out.relative_density.iter().zip(expected) {
+            assert!((d - e).abs() < 1e-5, "{:?}", out.relative_density);
+        }
+        assert_eq!(out.plan.camera_samples(UVec2::new(0, 0)), 16);
+        assert_eq!(out.plan.camera_samples(UVec2::new(1, 0)), 40);
+        assert_eq!(out.plan.camera_samples(UVec2::new(0, 1)), 4);
+        assert_eq!(out.plan.total_camera_samples(), 64);
+    }
+
+    #[test]
+    fn the_papers_allocation_is_proportional_to_the_variance() {
+        let variance = [1.0, 9.0];
+        let inputs = AllocationInputs {
+            variance: &variance,
+            mean_y: &[0.0, 100.0],
+            shading_level: &[0, 0],
+        };
+        let mut s = settings(Allocation::Variance);
+        s.floor = 0.0;
+        let out = allocate(UVec2::new(2, 1), inputs, s).unwrap();
+        assert!((out.relative_density[1] / out.relative_density[0] - 9.0).abs() < 1e-5);
+    }
+
+    #[test]
+    fn anti_aliased_levels_get_their_minimum_and_the_rest_keeps_the_budget() {
+        // Level −2 wants 16 samples although nothing is predicted there.
+        let inputs = AllocationInputs {
+            variance: &[0.0, 4.0, 4.0, 4.0],
+            mean_y: &[1.0; 4],
+            shading_level: &[-2, 0, 0, 0],
+        };
+        let mut s = settings(Allocation::RelativeError);
+        s.mean_spp = 8.0;
+        let out = allocate(UVec2::new(4, 1), inputs, s).unwrap();
+        assert_eq!(out.plan.camera_samples(UVec2::new(0, 0)), 16);
+        let rest: f32 = out.relative_density[1..].iter().sum::<f32>() * 8.0;
+        assert!((rest - 16.0).abs() < 1e-4, "{rest}");
+        // Budget below the minimums: every pixel at its minimum.
+        let tight = AllocationInputs {
+            variance: &[0.0; 2],
+            mean_y: &[1.0; 2],
+            shading_level: &[-1, -1],
+        };
+        s.mean_spp = 1.0;
+        let out = allocate(UVec2::new(2, 1), tight, s).unwrap();
+        assert_eq!(out.plan.total_camera_samples(), 8);
+    }
+
+    #[test]
+    fn nothing_predicted_is_uniform_and_bad_settings_are_errors() {
+        let inputs = AllocationInputs {
+            variance: &[0.0; 6],
+            mean_y: &[0.5; 6],
+            shading_level: &[3; 6],
+        };
+        let out = allocate(
+            UVec2::new(3, 2),
+            inputs,
+            settings(Allocation::RelativeError),
+        )
+        .unwrap();
+        assert_eq!(out.plan, SamplePlan::uniform(UVec2::new(3, 2), 16).unwrap());
+        let mut bad = settings(Allocation::RelativeError);
+        bad.floor = 1.5;
+        let e = allocate(UVec2::new(3, 2), inputs, bad).unwrap_err();
+        assert!(e.to_string().contains("floor"), "{e}");
+        bad.floor = 0.25;
+        bad.mean_spp = 0.0;
+        assert!(allocate(UVec2::new(3, 2), inputs, bad).is_err());
+        assert!(allocate(UVec2::new(2, 2), inputs, settings(Allocation::Variance)).is_err());
+    }
+}

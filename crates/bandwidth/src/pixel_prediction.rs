@@ -1,0 +1,371 @@
+//! What the predictor says of one pixel from its G-buffer hit and the probe's n_b light
+//! samples (Bagher et al. 2013 §2.2 and §2.4): the image-space bandwidth ν (eq. 5), the
+//! sampling rate b_p (eq. 6), the variance of the shading integrand V̂_p (eq. 9) and the
+//! mean shading value L̂_p (the estimate the relative-error allocation divides by).
+
+use crate::bandwidth::Bandwidth;
+use crate::error::BandwidthError;
+use crate::gbuffer::GBufferHit;
+use crate::operators::{bound, normal_curvature, transport, Bounce};
+use crate::probe::LightSample;
+
+/// The largest b_p the bandwidth buffer stores, cycles per pixel: eq. 11 clamps the level to
+/// −2 (4×4 samples per pixel, ⌊log2(1/(2·2))⌋ = −2), so a higher rate (+∞ from a hard edge
+/// or a point light seen in a mirror) says nothing more.
+pub const MAX_IMAGE_BANDWIDTH_CYCLES_PER_PX: f32 = 2.0;
+
+/// Which angular bandwidth of sample i eq. 9 weights: the test of V̂ against a
+/// measured variance keeps the one that ranks pixels better.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum VarianceBandwidth {
+    /// ν_a of the light field arriving at x (|T_d| ν_l): how fast the incident radiance
+    /// changes over the directions the shading integral sweeps. The default.
+    Incident,
+    /// ν_a of eq. 4's one-bounce bandwidth at the eye, as the paper's eq. 9 writes it.
+    OneBounce,
+}
+
+/// The predictor's numbers for one pixel.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PixelPrediction {
+    /// ν = [ν_s, ν_a] at the eye (eq. 5): cycles/m, cycles/rad; +∞ = not band-limited.
+    pub bandwidth: Bandwidth,
+    /// b_p (eq. 6), cycles per pixel, at most [`MAX_IMAGE_BANDWIDTH_CYCLES_PER_PX`].
+    pub image_bandwidth_cycles_per_px: f32,
+    /// V̂_p (eq. 9), in Y² (the probe's units squared); 0 where only delta lights shine.
+    pub variance: f32,
+    /// L̂_p: the mean of the n_b samples' weights λᵢ/pᵢ, Y.
+    pub mean_y: f32,
+}
+
+/// How the pixel maps angles to pixels and how many samples the probe was asked for.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PixelFootprint {
+    /// Radians per pixel at this pixel: eq. 6's max(f_x/W, f_y/H) for a pinhole; a fisheye
+    /// passes the largest singular value of its projection's Jacobian here.
+    pub rad_per_px: f32,
+    /// n_b: the samples requested (samples the probe could not take count as zero).
+    pub probe_samples: u32,
+}
+
+/// ν^i of eq. 4 for one sample, or `None` for a sample that lights nothing (below the
+/// horizon, zero weight) and so does not enter eq. 5.
+fn one_bounce(hit: &GBufferHit, sample: &LightSample) -> Result<Option<Bandwidth>, BandwidthError> {
+    let cos_theta_x = hit.cos_theta_view();
+    if !(sample.cos_theta_i > 0.0 && cos_theta_x > 0.0) {
+        return Ok(None);
+    }
+    let bounce = Bounce {
+        curvature_per_m: normal_curvature(&hit.curvature(), sample.direction),
+        cos_theta_i: sample.cos_theta_i.min(1.0),
+        cos_theta_x: cos_theta_x.min(1.0),
+        material: sample.material_bandwidth,
+    };
+    bounce
+        .one_bounce(sample.light_bandwidth, sample.distance_m, hit.depth_m())
+        .map(Some)
+}
+
+/// ν_a of the light field arriving at x: |T_d| ν_l (a distant light arrives unchanged).
+fn incident_angular(sample: &LightSample) -> f32 {
+    if sample.distance_m.is_finite() {
+        bound(transport(sample.distance_m), sample.light_bandwidth).angular_cycles_per_rad
+    } else {
+        sample.light_bandwidth.angular_cycles_per_rad
+    }
+}
+
+/// Σ wᵢ xᵢ / Σ wᵢ with 0·∞ = 0 (a sample of zero weight does not make ν infinite).
+fn weighted_mean(pairs: impl Iterator<Item = (f32, f32)>) -> f32 {
+    let (mut sum, mut weight) = (0.0f64, 0.0f64);
+    for (w, x) in pairs {
+        if w > 0.0 {
+            sum += f64::from(w) * f64::from(x);
+            weight += f64::from(w);
+        }
+    }
+    if weight > 0.0 {
+        (sum / weight) as f32
+    } else {
+        0.0
+    }
+}
+
+/// Eqs. 5, 6 and 9 at one pixel from the probe's samples at its hit.
+pub fn predict_pixel(
+    hit: &GBufferHit,
+    samples: &[LightSample],
+    footprint: PixelFootprint,
+    variance_bandwidth: VarianceBandwidth,
+) -> Result<PixelPrediction, BandwidthError> {
+    if !(footprint.rad_per_px > 0.0 && footprint.rad_per_px.is_finite()) {
+        return Err(BandwidthError::invalid(
+            "pixel prediction",
+            "rad_per_px",
+            footprint.rad_per_px,
+            "finite, > 0",
+        ));
+    }
+    let n_b = footprint.probe_samples.max(samples.len() as u32);
+    if n_b == 0 {
+        return Ok(PixelPrediction::default());
+    }
+    let mut per_sample = Vec::with_capacity(samples.len());
+    for sample in samples {
+        per_sample.push((sample, one_bounce(hit, sample)?));
+    }
+    // Eq. 5: λᵢ = Lᵢ ρ cos θᵢ, here the estimator's weight λᵢ/pᵢ (the issue's `weight_y`):
+    // with importance-sampled directions the plain λᵢ would over-count where pᵢ is high.
+    let lit = || {
+        per_sample
+            .iter()
+            .filter_map(|(s, nu)| nu.map(|nu| (s.weight_y(), nu)))
+    };
+    let bandwidth = Bandwidth {
+        spatial_cycles_per_m: weighted_mean(lit().map(|(w, nu)| (w, nu.spatial_cycles_per_m))),
+        angular_cycles_per_rad: weighted_mean(lit().map(|(w, nu)| (w, nu.angular_cycles_per_rad))),
+    };
+    // Eq. 6; NaN cannot arise (ν_a ≥ 0, rad_per_px finite > 0), ∞ is clamped.
+    let image_bandwidth_cycles_per_px = (bandwidth.angular_cycles_per_rad * footprint.rad_per_px)
+        .min(MAX_IMAGE_BANDWIDTH_CYCLES_PER_PX);
+    // Eq. 9 as a Monte Carlo mean over the probe's directions: (2π/n_b) Σ (ν_a + ν_ρa) χᵢ²/pᵢ.
+    // A delta light is one direction, so it adds no variance to the shading integral.
+    let mut variance_sum = 0.0f64;
+    for (sample, nu) in &per_sample {
+        let Some(nu) = nu else { continue };
+        if sample.is_delta() {
+            continue;
+        }
+        let nu_a = match variance_bandwidth {
+            VarianceBandwidth::Incident => incident_angular(sample),
+            VarianceBandwidth::OneBounce => nu.angular_cycles_per_rad,
+        };
+        let chi = sample.chi_y();
+        let term = (nu_a + sample.material_bandwidth.angular_cycles_per_rad) * chi * chi;
+        if term > 0.0 {
+            variance_sum += f64::from(term) / f64::from(sample.pdf_per_sr);
+        }
+    }
+    let variance = (std::f64::consts::TAU * variance_sum / f64::from(n_b)) as f32;
+    let mean_y =
+        (samples.iter().map(|s| f64::from(s.weight_y())).sum::<f64>() / f64::from(n_b)) as f32;
+    Ok(PixelPrediction {
+        bandwidth,
+        image_bandwidth_cycles_per_px,
+        variance,
+        mean_y,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bandwidth::MaterialBandwidth;
+    use glam::Vec3A;
+    use prism_geometry::Curvature;
+
+    fn plane_hit(depth_m: f32) -> GBufferHit {
+        GBufferHit::new(
+            Vec3A::new(0.0, 0.0, 0.0),
+            depth_m,
+            Vec3A::Z,
+            Curvature::default(),
+            Vec3A::Z,
+            0,
+        )
+        .unwrap()
+    }
+
+    fn sample(light: Bandwidth, rho: f32, radiance_y: f32, pdf: f32, d: f32) -> LightSample {
+        let cos = 0.8f32;
+        LightSample {
+            direction: Vec3A::new((1.0 - cos * cos).sqrt(), 0.0, cos),
+            radiance_y,
+            pdf_per_sr: pdf,
+            bsdf_cos_per_sr: cos / std::f32::consts::PI,
+            cos_theta_i: cos,
+            distance_m: d,
+            light_bandwidth: light,
+            material_bandwidth: MaterialBandwidth::new(rho, 0.0).unwrap(),
+        }
+    }
+
+    const FOOTPRINT: PixelFootprint = PixelFootprint {
+        rad_per_px: 0.01,
+        probe_samples: 16,
+    };
+
+    #[test]
+    fn equal_bandwidths_average_to_themselves_and_b_p_is_nu_a_times_the_footprint() {
+        let light = Bandwidth::distant_light(3.0).unwrap();
+        let samples: Vec<_> = (0..4)
+            .map(|k| sample(light, 5.0, 1.0 + k as f32, 0.5, f32::INFINITY))
+            .collect();
+        let p = predict_pixel(
+            &plane_hit(2.0),
+            &samples,
+            FOOTPRINT,
+            VarianceBandwidth::Incident,
+        )
+        .unwrap();
+        let single = one_bounce(&plane_hit(2.0), &samples[0]).unwrap().unwrap();
+        assert!((p.bandwidth.angular_cycles_per_rad - single.angular_cycles_per_rad).abs() < 1e-4);
+        assert!(
+            (p.image_bandwidth_cycles_per_px - single.angular_cycles_per_rad * 0.01).abs() < 1e-6
+        );
+    }
+
+    #[test]
+    fn eq5_gives_more_credit_to_brighter_paths() {
+        let low = Bandwidth::distant_light(1.0).unwrap();
+        let high = Bandwidth::distant_light(10.0).unwrap();
+        let hit = plane_hit(1.0);
+        let nu = |a: LightSample, b: LightSample| {
+            predict_pixel(&hit, &[a, b], FOOTPRINT, VarianceBandwidth::Incident)
+                .unwrap()
+                .bandwidth
+                .angular_cycles_per_rad
+        };
+        let bright_high = nu(
+            sample(low, 20.0, 1.0, 1.0, f32::INFINITY),
+            sample(high, 20.0, 9.0, 1.0, f32::INFINITY),
+        );
+        let bright_low = nu(
+            sample(low, 20.0, 9.0, 1.0, f32::INFINITY),
+            sample(high, 20.0, 1.0, 1.0, f32::INFINITY),
+        );
+        assert!(bright_high > bright_low, "{bright_high} vs {bright_low}");
+    }
+
+    #[test]
+    fn lambert_plane_under_a_uniform_sky_is_smooth_and_a_point_light_on_it_too() {
+        // Lambert: ρ = 0 kills ν_a (the operators' test), so b_p = 0 and eq. 11's level is
+        // the coarsest; a uniform sky has ν_a = 0, so V̂ = 0 too.
+        let sky = sample(Bandwidth::ZERO, 0.0, 1.0, 0.5, f32::INFINITY);
+        let p = predict_pixel(
+            &plane_hit(3.0),
+            &[sky; 16],
+            FOOTPRINT,
+            VarianceBandwidth::Incident,
+        )
+        .unwrap();
+        assert_eq!(p.image_bandwidth_cycles_per_px, 0.0);
+        assert_eq!(p.variance, 0.0);
+        assert!((p.mean_y - 1.0 * (0.8 / std::f32::consts::PI) / 0.5).abs() < 1e-5);
+        let point = sample(Bandwidth::POINT_LIGHT, 0.0, 1.0, 0.0, 2.0);
+        let p = predict_pixel(
+            &plane_hit(3.0),
+            &[point],
+            FOOTPRINT,
+            VarianceBandwidth::Incident,
+        )
+        .unwrap();
+        assert_eq!(p.bandwidth, Bandwidth::ZERO);
+        assert_eq!(p.variance, 0.0, "a delta light is one direction");
+    }
+
+    #[test]
+    fn eq9_grows_with_the_incident_and_material_bandwidths_and_with_chi_squared() {
+        let hit = plane_hit(1.0);
+        let v = |nu_l: f32, rho: f32, radiance: f32| {
+            let s = sample(
+                Bandwidth::distant_light(nu_l).unwrap(),
+                rho,
+                radiance,
+                0.25,
+                f32::INFINITY,
+            );
+            predict_pixel(&hit, &[s; 16], FOOTPRINT, VarianceBandwidth::Incident)
+                .unwrap()
+                .variance
+        };
+        let base = v(2.0, 3.0, 1.0);
+        // (ν_a + ν_ρa) χ²/p · 2π: every factor exactly.
+        let chi = 1.0 * (0.8 / std::f32::consts::PI) / 0.8;
+        let expected = std::f32::consts::TAU * 5.0 * chi * chi / 0.25;
+        assert!(
+            (base - expected).abs() < 1e-4 * expected,
+            "{base} vs {expected}"
+        );
+        assert!((v(4.0, 6.0, 1.0) - 2.0 * base).abs() < 1e-4 * base);
+        assert!((v(2.0, 3.0, 3.0) - 9.0 * base).abs() < 1e-3 * base);
+    }
+
+    #[test]
+    fn mirror_sphere_centre_matches_the_closed_form() {
+        // The test a: b_p = ν_env (1 + 2 d′ c) · footprint at the centre of a mirror
+        // sphere of curvature c seen from d′ (θ_i = θ_x = 0).
+        let (radius_m, d_eye_m, nu_env) = (0.5f32, 3.0f32, 4.0f32);
+        let curvature = Curvature {
+            k1: 1.0 / radius_m,
+            k2: 1.0 / radius_m,
+            dir1: Vec3A::X,
+            dir2: Vec3A::Y,
+        };
+        let hit = GBufferHit::new(Vec3A::ZERO, d_eye_m, Vec3A::Z, curvature, Vec3A::Z, 0).unwrap();
+        let mirror = LightSample {
+            direction: Vec3A::Z,
+            radiance_y: 1.0,
+            pdf_per_sr: 1.0,
+            bsdf_cos_per_sr: 1.0,
+            cos_theta_i: 1.0,
+            distance_m: f32::INFINITY,
+            light_bandwidth: Bandwidth::distant_light(nu_env).unwrap(),
+            material_bandwidth: MaterialBandwidth::new(f32::INFINITY, 0.0).unwrap(),
+        };
+        let footprint = PixelFootprint {
+            rad_per_px: 1e-3,
+            probe_samples: 1,
+        };
+        let p = predict_pixel(&hit, &[mirror], footprint, VarianceBandwidth::Incident).unwrap();
+        let expected = nu_env * (1.0 + 2.0 * d_eye_m / radius_m) * 1e-3;
+        assert!(
+            (p.image_bandwidth_cycles_per_px - expected).abs() < 1e-6,
+            "{} vs {expected}",
+            p.image_bandwidth_cycles_per_px
+        );
+    }
+
+    #[test]
+    fn failed_probe_samples_count_as_zero_in_the_means() {
+        let s = sample(Bandwidth::ZERO, 0.0, 1.0, 0.5, f32::INFINITY);
+        let all = predict_pixel(
+            &plane_hit(1.0),
+            &[s; 16],
+            FOOTPRINT,
+            VarianceBandwidth::Incident,
+        )
+        .unwrap();
+        let half = predict_pixel(
+            &plane_hit(1.0),
+            &[s; 8],
+            FOOTPRINT,
+            VarianceBandwidth::Incident,
+        )
+        .unwrap();
+        assert!((half.mean_y - 0.5 * all.mean_y).abs() < 1e-6);
+    }
+
+    #[test]
+    fn an_unbounded_bandwidth_is_clamped_and_a_bad_footprint_is_an_error() {
+        // A mirror (ρ = ∞) reflecting a point light: ν_a = ∞ at the eye.
+        let s = sample(Bandwidth::POINT_LIGHT, f32::INFINITY, 1.0, 0.0, 1.0);
+        let p = predict_pixel(
+            &plane_hit(1.0),
+            &[s],
+            FOOTPRINT,
+            VarianceBandwidth::OneBounce,
+        )
+        .unwrap();
+        assert_eq!(
+            p.image_bandwidth_cycles_per_px,
+            MAX_IMAGE_BANDWIDTH_CYCLES_PER_PX
+        );
+        let bad = PixelFootprint {
+            rad_per_px: 0.0,
+            probe_samples: 16,
+        };
+        let e = predict_pixel(&plane_hit(1.0), &[s], bad, VarianceBandwidth::Incident).unwrap_err();
+        assert!(e.to_string().contains("rad_per_px"), "{e}");
+    }
+}
