@@ -30,6 +30,8 @@ use prism_render::{
 use prism_spectrum::rgb_space::RgbColorSpace;
 use serde_json::json;
 
+use crate::plan_args::PlanArg;
+
 #[derive(Args, Debug)]
 pub struct RenderArgs {
     /// The scene file (JSON, docs/scene-format.md).
@@ -78,6 +80,8 @@ pub struct RenderArgs {
     /// vertices; MIS-weighted) or S,T,unweighted (weight 1), for debugging.
     #[arg(long = "bdpt-strategy", value_name = "S,T[,unweighted]", value_parser = prism_render::integrator::BdptStrategy::parse)]
     pub bdpt_strategy: Option<prism_render::integrator::BdptStrategy>,
+    #[command(flatten)]
+    pub plan: crate::plan_args::PlanArgs,
     #[command(flatten)]
     pub simd: crate::simd::SimdArgs,
 }
@@ -222,6 +226,7 @@ fn progress_bar(total: u64) -> ProgressBar {
 
 pub fn run(args: &RenderArgs) -> Result<(), String> {
     args.simd.apply()?;
+    args.plan.check()?;
     let description = prism_scene::load_scene(&args.scene).map_err(|e| e.to_string())?;
     let output = output_path(args, description.film.output.as_deref());
     if !args.explain {
@@ -303,6 +308,7 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
                 SamplerKind::Sobol => "Owen-scrambled Sobol",
                 SamplerKind::Independent => "independent",
             },
+            sample_plan: args.plan.kind(),
         };
         print!("{}", RenderPlan::new(&scene, &request));
         return Ok(());
@@ -338,15 +344,54 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
             &output,
         );
     }
+    if args.plan.plan != PlanArg::Uniform
+        && !matches!(scene.integrator, prism_render::Integrator::Path(_))
+    {
+        return Err(format!(
+            "--plan {}: per-pixel sample plans are for the `path` integrator; {} renders \
+             with `{}`",
+            args.plan.plan.name(),
+            args.scene.display(),
+            scene.integrator.name()
+        ));
+    }
     let bar = progress_bar(total_samples(scene.resolution, settings.spp));
     let start = Instant::now();
-    let plan = prism_bandwidth::SamplePlan::uniform(scene.resolution, settings.spp)
-        .map_err(|e| e.to_string())?;
-    let (film, stats) = pool
-        .install(|| render_plan(&scene, &settings, &plan, &|n| bar.inc(n)))
-        .map_err(|e| format!("{}: {e}", args.scene.display()))?;
+    let (mut film, stats) = match args.plan.plan {
+        PlanArg::Uniform => {
+            let plan = prism_bandwidth::SamplePlan::uniform(scene.resolution, settings.spp)
+                .map_err(|e| e.to_string())?;
+            pool.install(|| render_plan(&scene, &settings, &plan, &|n| bar.inc(n)))
+        }
+        PlanArg::Predicted => {
+            let predictor = args.plan.predictor(settings.spp, settings.seed);
+            let prediction = pool
+                .install(|| prism_render::predictor::predict(&scene, &predictor, settings.seed))
+                .map_err(|e| format!("{}: {e}", args.scene.display()))?;
+            pool.install(|| {
+                render_plan(&scene, &settings, &prediction.allocated.plan, &|n| {
+                    bar.inc(n)
+                })
+            })
+            .map(|(mut film, stats)| {
+                film.aovs.extend(prediction.aov_planes());
+                (film, stats)
+            })
+        }
+        PlanArg::Adaptive => pool.install(|| {
+            prism_render::adaptive::render_adaptive(&scene, &settings, settings.spp, &|n| {
+                bar.inc(n)
+            })
+        }),
+    }
+    .map_err(|e| format!("{}: {e}", args.scene.display()))?;
     let wall_time_s = start.elapsed().as_secs_f64();
     bar.finish_and_clear();
+    if !matches!(ImageFormat::from_path(&output), Ok(ImageFormat::Exr)) {
+        // Only EXR holds layers; the plan's are extra.
+        film.aovs
+            .retain(|a| !a.name.starts_with("bandwidth.") && !a.name.starts_with("plan."));
+    }
 
     let image = to_image(&film)?;
     match &film.spectral {

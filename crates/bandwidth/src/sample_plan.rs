@@ -12,6 +12,10 @@
 //! A pixel may get 0 camera samples: a predicted plan leaves pixels whose value the
 //! reconstruction step up-samples from their neighbours (Bagher §3.2); the film then
 //! records `spp.Y` = 0 for them.
+//!
+//! A pass of a progressive render with a non-uniform plan continues each pixel's own
+//! sequence: `first_samples` (default 0 everywhere) says where pixel p's samples of this
+//! plan start, so passes [0, n₁(p)), [n₁(p), n₂(p)), … equal one render of n₂(p) samples.
 
 use glam::UVec2;
 
@@ -26,6 +30,8 @@ pub struct SamplePlan {
     resolution: UVec2,
     camera_samples: Vec<u32>,
     light_samples: Vec<u32>,
+    /// Per pixel, the index of its first sample; `None`: 0 everywhere.
+    first_samples: Option<Vec<u32>>,
 }
 
 impl SamplePlan {
@@ -37,6 +43,7 @@ impl SamplePlan {
             resolution,
             camera_samples: vec![spp; n],
             light_samples: vec![DEFAULT_LIGHT_SAMPLES; n],
+            first_samples: None,
         })
     }
 
@@ -63,7 +70,37 @@ impl SamplePlan {
             resolution,
             camera_samples,
             light_samples,
+            first_samples: None,
         })
+    }
+
+    /// The same plan with pixel p's samples starting at `first_samples[p]` (row-major).
+    pub fn with_first_samples(mut self, first_samples: Vec<u32>) -> Result<Self, BandwidthError> {
+        if first_samples.len() != self.camera_samples.len() {
+            return Err(BandwidthError::LengthMismatch {
+                what: "sample plan first samples",
+                resolution: self.resolution,
+                found: first_samples.len(),
+            });
+        }
+        self.first_samples = Some(first_samples);
+        Ok(self)
+    }
+
+    /// The index of pixel p's first sample in this plan (0 unless `with_first_samples`).
+    #[inline]
+    pub fn first_sample(&self, pixel: UVec2) -> u32 {
+        match &self.first_samples {
+            None => 0,
+            Some(first) => {
+                pixel_index("sample plan", pixel, self.resolution).map_or(0, |i| first[i])
+            }
+        }
+    }
+
+    /// True when some pixel's samples start at its own index (`with_first_samples`).
+    pub fn has_per_pixel_first_samples(&self) -> bool {
+        self.first_samples.is_some()
     }
 
     /// The same plan with `light_samples` per hit in every pixel.
@@ -152,6 +189,11 @@ mod tests {
         assert!(plan.set(UVec2::new(0, 2), 1, 1).is_err());
         let plan = plan.with_uniform_light_samples(3);
         assert_eq!(plan.light_samples(UVec2::new(1, 0)), 3);
+        assert_eq!(plan.first_sample(UVec2::new(1, 1)), 0);
+        assert!(!plan.has_per_pixel_first_samples());
+        let plan = plan.with_first_samples(vec![0, 5, 6, 7]).unwrap();
+        assert_eq!(plan.first_sample(UVec2::new(1, 0)), 5);
+        assert!(plan.clone().with_first_samples(vec![1]).is_err());
     }
 
     #[test]

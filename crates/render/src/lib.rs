@@ -10,6 +10,7 @@
 //! centre is (i + ½, j + ½) (pbrt-v4 §5.4 "Film and imaging", discrete vs continuous pixel
 //! coordinates, §8.1.4).
 
+pub mod adaptive;
 pub mod bsdf;
 pub mod camera;
 pub mod error;
@@ -20,6 +21,7 @@ pub mod light;
 pub mod material;
 pub mod medium;
 pub mod plan;
+pub mod predictor;
 pub mod probe;
 pub mod sampler;
 pub mod sampling;
@@ -42,6 +44,6 @@ pub use integrator::{
     film_for, render, render_pass, render_pass_with, render_plan, total_samples, Estimator,
     Integrator, RenderError, RenderSettings, RenderStats,
 };
-pub use plan::{PlanChoice, PlanRequest, RenderPlan};
+pub use plan::{PlanChoice, PlanRequest, RenderPlan, SamplePlanKind};
 pub use sampler::{PixelSampler, SampleStream, SamplerKind};
 pub use scene_build::{RenderScene, SceneBuildError};

@@ -52,6 +52,25 @@ pub struct PlanRequest {
     pub aov_output: bool,
     /// The sampler's name.
     pub sampler: &'static str,
+    /// How camera samples are spread over the pixels (`--plan`).
+    pub sample_plan: SamplePlanKind,
+}
+
+/// `--plan`: how camera samples are spread over the pixels.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum SamplePlanKind {
+    /// The same spp everywhere.
+    #[default]
+    Uniform,
+    /// The bandwidth predictor's plan (`predictor`): n_b probe samples per pixel, the floor
+    /// in thousandths of the budget, the allocation rule.
+    Predicted {
+        probe_samples: u32,
+        floor_per_mille: u32,
+        allocation: prism_bandwidth::Allocation,
+    },
+    /// Variance-driven passes (`adaptive`).
+    Adaptive,
 }
 
 /// A neutral hit for asking a material which lobes it has.
@@ -88,6 +107,44 @@ fn within(features: SceneFeatures, list: &str) -> String {
             "the scene's features ({}) are within {list}",
             features.names()
         )
+    }
+}
+
+/// The sample plan's name and what it switches on, for the `sampler` line.
+fn sample_plan_text(kind: SamplePlanKind) -> (&'static str, String) {
+    match kind {
+        SamplePlanKind::Uniform => (
+            "uniform",
+            "no predicted plan was asked for: every pixel gets the same samples".into(),
+        ),
+        SamplePlanKind::Predicted {
+            probe_samples,
+            floor_per_mille,
+            allocation,
+        } => (
+            "predicted",
+            format!(
+                "--plan predicted: a G-buffer of pixel-centre hits, {probe_samples} probe light \
+                 samples per pixel, bandwidth by Bagher et al. 2013 eqs. 4-6, variance by eq. 9, \
+                 levels by eq. 11; {:.1} % of the budget uniform (indirect light is not \
+                 predicted), the rest {}",
+                f64::from(floor_per_mille) / 10.0,
+                match allocation {
+                    prism_bandwidth::Allocation::RelativeError => {
+                        "in proportion to the predicted relative error"
+                    }
+                    prism_bandwidth::Allocation::Variance => {
+                        "in proportion to the predicted variance (the paper's rule)"
+                    }
+                }
+            ),
+        ),
+        SamplePlanKind::Adaptive => (
+            "adaptive",
+            "--plan adaptive: 4 spp everywhere, then passes spread by the error of a \
+             half-sample image (Cycles' adaptive sampling)"
+                .into(),
+        ),
     }
 }
 
@@ -137,13 +194,14 @@ impl RenderPlan {
                     ),
                     "the scene's `integrator` section (default `path`)".into(),
                 );
+                let (plan_name, plan_reason) = sample_plan_text(request.sample_plan);
                 choose(
                     "sampler",
                     format!(
-                        "{}, {} spp, uniform sample plan",
+                        "{}, {} spp (mean), {plan_name} sample plan",
                         request.sampler, request.spp
                     ),
-                    "no predicted plan was asked for: every pixel gets the same samples".into(),
+                    plan_reason,
                 );
                 choose(
                     "wavelengths",

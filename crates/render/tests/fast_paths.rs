@@ -90,6 +90,7 @@ fn plan_text(scene: &RenderScene) -> String {
         spectral_bins: None,
         aov_output: false,
         sampler: "independent",
+        sample_plan: Default::default(),
     };
     RenderPlan::new(scene, &request).to_string()
 }

@@ -120,3 +120,84 @@ fn a_pass_rejects_a_film_of_another_resolution() {
     let e = render_pass(&scene, &settings, &plan, &mut film, 0, &|_| {}).unwrap_err();
     assert!(e.to_string().contains("20×14"), "{e}");
 }
+
+/// A plan whose pixels start at their own sample index (`SamplePlan::with_first_samples`,
+/// what predicted and adaptive plans need): passes of per-pixel counts equal one render of
+/// the summed counts, through the packet tracer and the scalar one; two films holding
+/// different samples merge into that render too (`Film::merge_film`).
+#[test]
+fn per_pixel_passes_equal_one_render_of_the_summed_counts() {
+    let mut scene = scene("importance");
+    let n = (scene.resolution.x * scene.resolution.y) as usize;
+    let first: Vec<u32> = (0..n).map(|i| (i % 5) as u32).collect();
+    let second: Vec<u32> = (0..n).map(|i| ((i * 7) % 4) as u32).collect();
+    let total: Vec<u32> = first.iter().zip(&second).map(|(a, b)| a + b).collect();
+    for packet in [true, false] {
+        scene.set_packet_tracing(packet);
+        let settings = RenderSettings {
+            seed: 3,
+            sampler: SamplerKind::Sobol,
+            ..RenderSettings::default()
+        };
+        let plan_of = |counts: &[u32]| {
+            SamplePlan::from_counts(scene.resolution, counts.to_vec(), vec![1; n]).unwrap()
+        };
+        let (single, _) =
+            prism_render::render_plan(&scene, &settings, &plan_of(&total), &|_| {}).unwrap();
+        let mut film = film_for(&scene, &settings);
+        render_pass(&scene, &settings, &plan_of(&first), &mut film, 0, &|_| {}).unwrap();
+        let continued = plan_of(&second).with_first_samples(first.clone()).unwrap();
+        render_pass(&scene, &settings, &continued, &mut film, 0, &|_| {}).unwrap();
+        let passes = film.finish();
+        let d = max_relative_difference(&single, &passes);
+        assert!(d < 1e-5, "packet {packet}: max rel. difference {d}");
+        assert_eq!(
+            single.aov("spp.Y").unwrap().values,
+            passes.aov("spp.Y").unwrap().values
+        );
+        // The second pass in a film of its own, merged afterwards.
+        let mut a = film_for(&scene, &settings);
+        render_pass(&scene, &settings, &plan_of(&first), &mut a, 0, &|_| {}).unwrap();
+        let mut b = film_for(&scene, &settings);
+        render_pass(&scene, &settings, &continued, &mut b, 0, &|_| {}).unwrap();
+        a.merge_film(&b).unwrap();
+        let d = max_relative_difference(&single, &a.finish());
+        assert!(d < 1e-5, "merged films, packet {packet}: {d}");
+        // Without the first samples the second pass repeats the first's samples.
+        let mut repeat = film_for(&scene, &settings);
+        render_pass(&scene, &settings, &plan_of(&first), &mut repeat, 0, &|_| {}).unwrap();
+        render_pass(
+            &scene,
+            &settings,
+            &plan_of(&second),
+            &mut repeat,
+            0,
+            &|_| {},
+        )
+        .unwrap();
+        assert!(max_relative_difference(&single, &repeat.finish()) > 1e-3);
+    }
+}
+
+/// Adaptive sampling spends the budget (up to the rounding of its last pass) and records
+/// how many samples each pixel got; the pixels did not all get the same.
+#[test]
+fn adaptive_render_spends_the_budget_unevenly() {
+    let scene = scene("importance");
+    let n = (scene.resolution.x * scene.resolution.y) as f64;
+    let settings = RenderSettings {
+        seed: 3,
+        ..RenderSettings::default()
+    };
+    let (image, stats) =
+        prism_render::adaptive::render_adaptive(&scene, &settings, 32, &|_| {}).unwrap();
+    let spp = &image.aov("plan.spp").unwrap().values;
+    let total: f64 = spp.iter().map(|&s| f64::from(s)).sum();
+    assert_eq!(total as u64, stats.samples);
+    assert!((total / n - 32.0).abs() < 0.5, "mean spp {}", total / n);
+    assert_eq!(spp, &image.aov("spp.Y").unwrap().values);
+    let (lo, hi) = spp
+        .iter()
+        .fold((f32::MAX, 0.0f32), |(l, h), &s| (l.min(s), h.max(s)));
+    assert!(lo >= 4.0 && hi > 2.0 * lo, "spp from {lo} to {hi}");
+}

@@ -270,6 +270,31 @@ impl Film {
         }
     }
 
+    /// Adds the sums of `other`, a film of the same resolution, filter, AOVs and bins that
+    /// recorded other samples of the same render (adaptive sampling keeps half its samples
+    /// in a second film to estimate the error, then merges the two). Camera-side sums only:
+    /// `None` (nothing merged) when either film holds light-path splats or the films differ.
+    pub fn merge_film(&mut self, other: &Film) -> Option<()> {
+        if self.resolution != other.resolution
+            || self.aov_selection != other.aov_selection
+            || self.spectral_bins != other.spectral_bins
+            || self.light.is_some()
+            || other.light.is_some()
+        {
+            return None;
+        }
+        for (dst, src) in self.pixels.iter_mut().zip(&other.pixels) {
+            dst.merge(src);
+        }
+        for (dst, src) in self.aovs.iter_mut().zip(&other.aovs) {
+            dst.merge(src);
+        }
+        for (dst, src) in self.spectral.iter_mut().zip(&other.spectral) {
+            *dst += src;
+        }
+        Some(())
+    }
+
     /// Renders every tile with `render_tile` on the current rayon pool (a
     /// `ThreadPool::install` around the call picks the pool) and merges the tiles
     /// in row-major order. `render_tile` must seed its samples per pixel (e.g. with

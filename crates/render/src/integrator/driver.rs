@@ -219,6 +219,14 @@ pub fn render_pass_with(
 ) -> Result<RenderStats, RenderError> {
     pass.plan.check_resolution(scene.resolution)?;
     pass.plan.check_resolution(film.resolution())?;
+    if estimator.splats_light_paths() && pass.plan.has_per_pixel_first_samples() {
+        // Their work items are sample ranges shared by a whole tile.
+        return Err(RenderError::Estimator(format!(
+            "{} takes the same samples in every pixel: a plan whose pixels start their \
+             samples at different indices (a predicted or adaptive plan) is for `path`",
+            estimator.name()
+        )));
+    }
     estimator
         .prepare(scene, pass)
         .map_err(RenderError::Estimator)?;

@@ -27,7 +27,8 @@ pub struct Pass<'a> {
     pub settings: &'a RenderSettings,
     /// Camera samples per pixel (and light samples per hit).
     pub plan: &'a SamplePlan,
-    /// Sample index of each pixel's first sample in this pass.
+    /// Sample index of each pixel's first sample in this pass (plus the plan's own
+    /// per-pixel start, `SamplePlan::first_sample`).
     pub first_sample: u32,
 }
 
@@ -47,7 +48,7 @@ impl TileWork<'_> {
     /// The sample indices pixel `pixel` renders in this item.
     #[inline]
     pub fn samples_of(&self, pixel: UVec2) -> Range<u32> {
-        let first = self.pass.first_sample;
+        let first = self.pass.first_sample + self.pass.plan.first_sample(pixel);
         let own_end = first.saturating_add(self.pass.plan.camera_samples(pixel));
         let start = first.max(self.sample_indices.start);
         let end = own_end.min(self.sample_indices.end);

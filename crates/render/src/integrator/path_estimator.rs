@@ -47,7 +47,8 @@ impl Estimator for PathTracer {
             .filter(|_| tile.bounds().pixels().all(|p| work.light_samples(p) <= 1));
         if let Some(packet) = packet {
             debug_assert!(tile.bounds().pixels().all(|p| {
-                let own = pass.first_sample..pass.first_sample + pass.plan.camera_samples(p);
+                let first = pass.first_sample + pass.plan.first_sample(p);
+                let own = first..first + pass.plan.camera_samples(p);
                 work.samples_of(p) == own
             }));
             let job = TileJob {
@@ -56,7 +57,7 @@ impl Estimator for PathTracer {
                 tracer: self,
                 sampler: work.sampler,
                 camera_samples: &|p| pass.plan.camera_samples(p),
-                first_sample: pass.first_sample,
+                first_sample: &|p| pass.first_sample + pass.plan.first_sample(p),
                 uses_lens: work.uses_lens,
                 want_illumination: settings.illumination_aov,
             };

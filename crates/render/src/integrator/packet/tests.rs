@@ -251,6 +251,7 @@ fn plan_says_why_a_scene_has_no_packet_tracer() {
         spectral_bins: None,
         aov_output: true,
         sampler: "independent",
+        sample_plan: Default::default(),
     };
     let plan = crate::plan::RenderPlan::new(&cornell, &request);
     let choice = plan

@@ -38,7 +38,8 @@ pub(crate) struct TileJob<'a> {
     pub sampler: &'a PixelSampler,
     /// Camera samples per pixel of the tile (from the `SamplePlan`).
     pub camera_samples: &'a dyn Fn(UVec2) -> u32,
-    pub first_sample: u32,
+    /// Index of each pixel's first sample in this pass.
+    pub first_sample: &'a dyn Fn(UVec2) -> u32,
     pub uses_lens: bool,
     pub want_illumination: bool,
 }
@@ -102,17 +103,20 @@ struct SampleQueue {
     next_pixel: usize,
     next_sample: u32,
     end_sample: u32,
-    first_sample: u32,
 }
 
 impl SampleQueue {
     /// The next (pixel, sample index), pixels in order and each one's samples in order.
-    fn next(&mut self, camera_samples: &dyn Fn(UVec2) -> u32) -> Option<(UVec2, u32)> {
+    fn next(
+        &mut self,
+        camera_samples: &dyn Fn(UVec2) -> u32,
+        first_sample: &dyn Fn(UVec2) -> u32,
+    ) -> Option<(UVec2, u32)> {
         while self.next_sample >= self.end_sample {
             let &pixel = self.pixels.get(self.next_pixel)?;
             self.next_pixel += 1;
-            self.next_sample = self.first_sample;
-            self.end_sample = self.first_sample.saturating_add(camera_samples(pixel));
+            self.next_sample = first_sample(pixel);
+            self.end_sample = self.next_sample.saturating_add(camera_samples(pixel));
         }
         let s = self.next_sample;
         self.next_sample += 1;
@@ -292,7 +296,6 @@ fn render_tile_lanes<const N: usize>(
         next_pixel: 0,
         next_sample: 0,
         end_sample: 0,
-        first_sample: job.first_sample,
     };
     // Separate locals, not one struct: LLVM keeps each one its own object (see `Paths`).
     let mut samples: [Option<LaneSample>; N] = [None; N];
@@ -426,7 +429,7 @@ impl<const N: usize> Starts<N> {
             let mut lens_samples = [Vec2::ZERO; N];
             let zero = SampledSpectrum::splat(0.0);
             while self.ready.len() < N {
-                let Some((pixel, s)) = queue.next(job.camera_samples) else {
+                let Some((pixel, s)) = queue.next(job.camera_samples, job.first_sample) else {
                     break;
                 };
                 let mut stream = job.sampler.stream(pixel, s);

@@ -1,0 +1,113 @@
+//! `--plan` and its options (`prism render`): how camera samples are spread over the pixels
+//! (docs/bandwidth.md).
+
+use clap::{Args, ValueEnum};
+use prism_bandwidth::allocation::DEFAULT_FLOOR;
+use prism_bandwidth::{Allocation, AllocationSettings, VarianceBandwidth};
+use prism_render::predictor::{PredictorSettings, DEFAULT_PROBE_SAMPLES};
+use prism_render::SamplePlanKind;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum PlanArg {
+    /// The same spp in every pixel.
+    Uniform,
+    /// The bandwidth predictor's per-pixel plan (Bagher et al. 2013).
+    Predicted,
+    /// Variance-driven passes after 4 spp (Cycles' adaptive sampling).
+    Adaptive,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum AllocationArg {
+    /// Samples ∝ predicted relative error √V̂/L̂ (minimises relMSE).
+    Relative,
+    /// Samples ∝ predicted variance V̂ (the paper's rule).
+    Variance,
+}
+
+#[derive(Clone, Debug, Args)]
+pub struct PlanArgs {
+    /// How camera samples are spread over the pixels; `--spp` is the mean.
+    #[arg(long, value_enum, default_value = "uniform")]
+    pub plan: PlanArg,
+    /// `--plan predicted`: probe light samples per pixel (n_b).
+    #[arg(long = "plan-nb", value_name = "N", default_value_t = DEFAULT_PROBE_SAMPLES)]
+    pub plan_nb: u32,
+    /// `--plan predicted`: share of the budget spread uniformly, in [0, 1].
+    #[arg(long = "plan-floor", value_name = "F", default_value_t = DEFAULT_FLOOR)]
+    pub plan_floor: f64,
+    /// `--plan predicted`: what the samples follow.
+    #[arg(long = "plan-allocation", value_enum, default_value = "relative")]
+    pub plan_allocation: AllocationArg,
+}
+
+impl PlanArg {
+    /// The name as on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            PlanArg::Uniform => "uniform",
+            PlanArg::Predicted => "predicted",
+            PlanArg::Adaptive => "adaptive",
+        }
+    }
+}
+
+impl PlanArgs {
+    fn allocation(&self) -> Allocation {
+        match self.plan_allocation {
+            AllocationArg::Relative => Allocation::RelativeError,
+            AllocationArg::Variance => Allocation::Variance,
+        }
+    }
+
+    /// The checked options; errors name the flag.
+    pub fn check(&self) -> Result<(), String> {
+        let predictor_flags_given = self.plan_nb != DEFAULT_PROBE_SAMPLES
+            || self.plan_floor != DEFAULT_FLOOR
+            || self.plan_allocation != AllocationArg::Relative;
+        if self.plan != PlanArg::Predicted && predictor_flags_given {
+            return Err(
+                "--plan-nb, --plan-floor and --plan-allocation set up the predictor: add \
+                 --plan predicted"
+                    .into(),
+            );
+        }
+        if self.plan_nb == 0 {
+            return Err("--plan-nb must be at least 1".into());
+        }
+        if !(0.0..=1.0).contains(&self.plan_floor) {
+            return Err(format!(
+                "--plan-floor {}: expected a share of the budget in [0, 1]",
+                self.plan_floor
+            ));
+        }
+        Ok(())
+    }
+
+    /// What `--explain` reports.
+    pub fn kind(&self) -> SamplePlanKind {
+        match self.plan {
+            PlanArg::Uniform => SamplePlanKind::Uniform,
+            PlanArg::Predicted => SamplePlanKind::Predicted {
+                probe_samples: self.plan_nb,
+                floor_per_mille: (self.plan_floor * 1000.0).round() as u32,
+                allocation: self.allocation(),
+            },
+            PlanArg::Adaptive => SamplePlanKind::Adaptive,
+        }
+    }
+
+    /// The predictor's settings for a render of `mean_spp` with `seed`.
+    pub fn predictor(&self, mean_spp: u32, seed: u64) -> PredictorSettings {
+        PredictorSettings {
+            probe_samples: self.plan_nb,
+            allocation: AllocationSettings {
+                mean_spp: f64::from(mean_spp),
+                floor: self.plan_floor,
+                allocation: self.allocation(),
+                seed,
+            },
+            variance_bandwidth: VarianceBandwidth::Incident,
+        }
+    }
+}

@@ -1,0 +1,219 @@
+//! The predicted sample plan (Bagher et al. 2013 §2, §3.1; docs/bandwidth.md): a G-buffer of
+//! pixel-centre hits, the shading probe's n_b light samples at each, eqs. 5, 6 and 9 per
+//! pixel (prism-bandwidth's `predict_pixel`), eq. 11's levels and the allocation of camera
+//! samples. Runs once before the first pass; its per-pixel numbers become the EXR layers
+//! `bandwidth.S`, `bandwidth.A`, `bandwidth.B`, `plan.level`, `plan.variance`, `plan.spp`.
+//!
+//! Eq. 6 needs radians per pixel: it is measured from the camera itself, as the larger angle
+//! between a pixel's centre ray and those of its right and lower neighbours, so a fisheye
+//! or a wide pinhole gets its own footprint at every pixel, not f/W.
+
+use glam::{UVec2, Vec2};
+use prism_bandwidth::{
+    allocate, predict_pixel, Allocated, AllocationInputs, AllocationSettings, BandwidthBuffer,
+    GBufferHit, LightSample, PixelFootprint, PixelPrediction, ShadingProbe, VarianceBandwidth,
+};
+use rayon::prelude::*;
+
+use crate::film::AovPlane;
+use crate::probe::RenderProbe;
+use crate::scene_build::RenderScene;
+
+/// n_b: probe samples per pixel (Bagher: 16 suffice, Fig. 13).
+pub const DEFAULT_PROBE_SAMPLES: u32 = 16;
+
+/// What the predictor is asked.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PredictorSettings {
+    /// n_b (`--plan-nb`).
+    pub probe_samples: u32,
+    pub allocation: AllocationSettings,
+    pub variance_bandwidth: VarianceBandwidth,
+}
+
+/// The predictor's answer for a whole image.
+#[derive(Clone, Debug)]
+pub struct Prediction {
+    pub resolution: UVec2,
+    /// Per pixel, row-major; the default (all zero) where the centre ray hits nothing.
+    pub pixels: Vec<PixelPrediction>,
+    pub buffer: BandwidthBuffer,
+    pub allocated: Allocated,
+}
+
+/// Why the predictor cannot plan a scene.
+fn unsupported(why: &str) -> String {
+    format!("the bandwidth predictor cannot plan this scene: {why}")
+}
+
+/// Radians between the centre ray of `pixel` and those of its right and lower neighbours
+/// (the larger), or `None` where a ray is missing (outside a fisheye's image circle).
+fn angular_footprint(scene: &RenderScene, pixel: UVec2) -> Option<f32> {
+    let centre = |dx: f32, dy: f32| {
+        let p = Vec2::new(pixel.x as f32 + 0.5 + dx, pixel.y as f32 + 0.5 + dy);
+        scene
+            .camera
+            .generate_ray_only(p, Vec2::splat(0.5))
+            .map(|r| r.direction)
+    };
+    let d = centre(0.0, 0.0)?;
+    // Towards the image's inside at its last column and row.
+    let sx = if pixel.x + 1 < scene.resolution.x {
+        1.0
+    } else {
+        -1.0
+    };
+    let sy = if pixel.y + 1 < scene.resolution.y {
+        1.0
+    } else {
+        -1.0
+    };
+    let angle = |e: glam::Vec3A| d.dot(e).clamp(-1.0, 1.0).acos();
+    let ax = centre(sx, 0.0).map(angle).unwrap_or(0.0);
+    let ay = centre(0.0, sy).map(angle).unwrap_or(0.0);
+    Some(ax.max(ay))
+}
+
+/// The G-buffer hit of `pixel`'s centre ray (with curvature, which shading skips).
+fn centre_hit(scene: &RenderScene, pixel: UVec2) -> Option<GBufferHit> {
+    let film_point = Vec2::new(pixel.x as f32 + 0.5, pixel.y as f32 + 0.5);
+    let ray = scene
+        .camera
+        .generate_ray_only(film_point, Vec2::splat(0.5))?;
+    let hit = scene.geometry.intersect(&ray)?;
+    let si = scene.geometry.interaction(&ray, &hit);
+    let view = -ray.direction;
+    // The side the camera sees: eq. 3's cosines are of that side.
+    let normal = if si.n_shading.dot(view) < 0.0 {
+        -si.n_shading
+    } else {
+        si.n_shading
+    };
+    GBufferHit::new(
+        si.p,
+        hit.t,
+        normal.normalize(),
+        si.curvature,
+        view,
+        si.material_id,
+    )
+    .ok()
+}
+
+/// Runs the predictor over every pixel of `scene` (in parallel on the current rayon pool).
+pub fn predict(
+    scene: &RenderScene,
+    settings: &PredictorSettings,
+    seed: u64,
+) -> Result<Prediction, String> {
+    if settings.probe_samples == 0 {
+        return Err("--plan-nb must be at least 1".into());
+    }
+    let resolution = scene.resolution;
+    let probe = RenderProbe { scene, seed };
+    // Infinite lights seen directly: the background's own angular bandwidth.
+    let background_nu_a = scene
+        .lights
+        .lights()
+        .iter()
+        .filter(|l| l.is_infinite())
+        .map(|l| l.bandwidth().angular_cycles_per_rad)
+        .fold(0.0f32, f32::max);
+    let rows: Vec<Vec<(PixelPrediction, f32)>> = (0..resolution.y)
+        .into_par_iter()
+        .map(|y| {
+            let mut samples: Vec<LightSample> = Vec::new();
+            (0..resolution.x)
+                .map(|x| {
+                    let pixel = UVec2::new(x, y);
+                    let Some(rad_per_px) = angular_footprint(scene, pixel).filter(|a| *a > 0.0)
+                    else {
+                        return Ok((PixelPrediction::default(), 0.0));
+                    };
+                    let footprint = PixelFootprint {
+                        rad_per_px,
+                        probe_samples: settings.probe_samples,
+                    };
+                    match centre_hit(scene, pixel) {
+                        Some(hit) => {
+                            probe.sample_lights(pixel, &hit, settings.probe_samples, &mut samples);
+                            let p = predict_pixel(
+                                &hit,
+                                &samples,
+                                footprint,
+                                settings.variance_bandwidth,
+                            )
+                            .map_err(|e| e.to_string())?;
+                            let c = hit.curvature();
+                            Ok((p, c.k1.abs().max(c.k2.abs())))
+                        }
+                        None => Ok((
+                            PixelPrediction {
+                                image_bandwidth_cycles_per_px: (background_nu_a * rad_per_px)
+                                    .min(prism_bandwidth::pixel_prediction::MAX_IMAGE_BANDWIDTH_CYCLES_PER_PX),
+                                ..PixelPrediction::default()
+                            },
+                            0.0,
+                        )),
+                    }
+                })
+                .collect::<Result<Vec<_>, String>>()
+        })
+        .collect::<Result<Vec<_>, String>>()?;
+    let (pixels, curvature): (Vec<PixelPrediction>, Vec<f32>) = rows.into_iter().flatten().unzip();
+    let b: Vec<f32> = pixels
+        .iter()
+        .map(|p| p.image_bandwidth_cycles_per_px)
+        .collect();
+    let variance: Vec<f32> = pixels.iter().map(|p| p.variance).collect();
+    let mean_y: Vec<f32> = pixels.iter().map(|p| p.mean_y).collect();
+    let buffer = BandwidthBuffer::new(resolution, &b, &variance, &curvature)
+        .map_err(|e| unsupported(&e.to_string()))?;
+    let levels = &buffer.levels()[0].shading_level;
+    let allocated = allocate(
+        resolution,
+        AllocationInputs {
+            variance: &variance,
+            mean_y: &mean_y,
+            shading_level: levels,
+        },
+        settings.allocation,
+    )
+    .map_err(|e| e.to_string())?;
+    Ok(Prediction {
+        resolution,
+        pixels,
+        buffer,
+        allocated,
+    })
+}
+
+impl Prediction {
+    /// The EXR layers of the prediction (docs/bandwidth.md): ν_s (cycles/m), ν_a
+    /// (cycles/rad), b_p (cycles/px), eq. 11's level, V̂_p and the planned camera samples.
+    pub fn aov_planes(&self) -> Vec<AovPlane> {
+        let plane = |name: &str, f: &dyn Fn(usize) -> f32| AovPlane {
+            name: name.to_string(),
+            values: (0..self.pixels.len()).map(f).collect(),
+        };
+        let plan = &self.allocated.plan;
+        let w = self.resolution.x as usize;
+        let levels = &self.buffer.levels()[0].shading_level;
+        vec![
+            plane("bandwidth.S", &|i| {
+                self.pixels[i].bandwidth.spatial_cycles_per_m
+            }),
+            plane("bandwidth.A", &|i| {
+                self.pixels[i].bandwidth.angular_cycles_per_rad
+            }),
+            plane("bandwidth.B", &|i| {
+                self.pixels[i].image_bandwidth_cycles_per_px
+            }),
+            plane("plan.level", &|i| levels[i] as f32),
+            plane("plan.variance", &|i| self.pixels[i].variance),
+            plane("plan.spp", &|i| {
+                plan.camera_samples(UVec2::new((i % w) as u32, (i / w) as u32)) as f32
+            }),
+        ]
+    }
+}
