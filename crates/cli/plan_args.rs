@@ -25,6 +25,16 @@ pub enum AllocationArg {
     Variance,
 }
 
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum VarianceArg {
+    /// Eq. 9 with the angular bandwidth of the light arriving at the hit.
+    Eq9,
+    /// Eq. 9 with eq. 4's one-bounce angular bandwidth at the eye, as the paper writes it.
+    Eq9OneBounce,
+    /// The sample variance of the probe's own weights (not the paper).
+    Measured,
+}
+
 #[derive(Clone, Debug, Args)]
 pub struct PlanArgs {
     /// How camera samples are spread over the pixels; `--spp` is the mean.
@@ -39,6 +49,9 @@ pub struct PlanArgs {
     /// `--plan predicted`: what the samples follow.
     #[arg(long = "plan-allocation", value_enum, default_value = "relative")]
     pub plan_allocation: AllocationArg,
+    /// `--plan predicted`: how V̂_p is predicted.
+    #[arg(long = "plan-variance", value_enum, default_value = "eq9")]
+    pub plan_variance: VarianceArg,
 }
 
 impl PlanArg {
@@ -64,10 +77,12 @@ impl PlanArgs {
     pub fn check(&self) -> Result<(), String> {
         let predictor_flags_given = self.plan_nb != DEFAULT_PROBE_SAMPLES
             || self.plan_floor != DEFAULT_FLOOR
-            || self.plan_allocation != AllocationArg::Relative;
+            || self.plan_allocation != AllocationArg::Relative
+            || self.plan_variance != VarianceArg::Eq9;
         if self.plan != PlanArg::Predicted && predictor_flags_given {
             return Err(
-                "--plan-nb, --plan-floor and --plan-allocation set up the predictor: add \
+                "--plan-nb, --plan-floor, --plan-allocation and --plan-variance set up the \
+                 predictor: add \
                  --plan predicted"
                     .into(),
             );
@@ -107,7 +122,11 @@ impl PlanArgs {
                 allocation: self.allocation(),
                 seed,
             },
-            variance_bandwidth: VarianceBandwidth::Incident,
+            variance_bandwidth: match self.plan_variance {
+                VarianceArg::Eq9 => VarianceBandwidth::Incident,
+                VarianceArg::Eq9OneBounce => VarianceBandwidth::OneBounce,
+                VarianceArg::Measured => VarianceBandwidth::Measured,
+            },
         }
     }
 }

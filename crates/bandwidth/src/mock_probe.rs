@@ -57,6 +57,7 @@ impl ShadingProbe for MockProbe {
             distance_m,
             light_bandwidth: self.light_bandwidth,
             material_bandwidth: self.material_bandwidth,
+            lane_variance: 0.0,
         };
         out.extend(std::iter::repeat_n(sample, count as usize));
     }

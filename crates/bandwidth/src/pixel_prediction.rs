@@ -23,6 +23,10 @@ pub enum VarianceBandwidth {
     Incident,
     /// ν_a of eq. 4's one-bounce bandwidth at the eye, as the paper's eq. 9 writes it.
     OneBounce,
+    /// Not eq. 9: the sample variance of the probe's own weights (an unbiased estimate of
+    /// the per-sample variance of the direct-light estimator, in Y², on the same scale as
+    /// the colour noise of pixels that see the lights directly).
+    Measured,
 }
 
 /// The predictor's numbers for one pixel.
@@ -32,7 +36,8 @@ pub struct PixelPrediction {
     pub bandwidth: Bandwidth,
     /// b_p (eq. 6), cycles per pixel, at most [`MAX_IMAGE_BANDWIDTH_CYCLES_PER_PX`].
     pub image_bandwidth_cycles_per_px: f32,
-    /// V̂_p (eq. 9), in Y² (the probe's units squared); 0 where only delta lights shine.
+    /// V̂_p: eq. 9 plus the samples' mean lane variance (colour noise of hero-wavelength
+    /// sampling), in Y² (the probe's units squared).
     pub variance: f32,
     /// L̂_p: the mean of the n_b samples' weights λᵢ/pᵢ, Y.
     pub mean_y: f32,
@@ -131,22 +136,46 @@ pub fn predict_pixel(
     // Eq. 9 as a Monte Carlo mean over the probe's directions: (2π/n_b) Σ (ν_a + ν_ρa) χᵢ²/pᵢ.
     // A delta light is one direction, so it adds no variance to the shading integral.
     let mut variance_sum = 0.0f64;
-    for (sample, nu) in &per_sample {
-        let Some(nu) = nu else { continue };
-        if sample.is_delta() {
-            continue;
+    match variance_bandwidth {
+        VarianceBandwidth::Incident | VarianceBandwidth::OneBounce => {
+            for (sample, nu) in &per_sample {
+                let Some(nu) = nu else { continue };
+                if sample.is_delta() {
+                    continue;
+                }
+                let nu_a = match variance_bandwidth {
+                    VarianceBandwidth::Incident => incident_angular(sample),
+                    VarianceBandwidth::OneBounce | VarianceBandwidth::Measured => {
+                        nu.angular_cycles_per_rad
+                    }
+                };
+                let chi = sample.chi_y();
+                let term = (nu_a + sample.material_bandwidth.angular_cycles_per_rad) * chi * chi;
+                if term > 0.0 {
+                    variance_sum += f64::from(term) / f64::from(sample.pdf_per_sr);
+                }
+            }
+            variance_sum *= std::f64::consts::TAU;
         }
-        let nu_a = match variance_bandwidth {
-            VarianceBandwidth::Incident => incident_angular(sample),
-            VarianceBandwidth::OneBounce => nu.angular_cycles_per_rad,
-        };
-        let chi = sample.chi_y();
-        let term = (nu_a + sample.material_bandwidth.angular_cycles_per_rad) * chi * chi;
-        if term > 0.0 {
-            variance_sum += f64::from(term) / f64::from(sample.pdf_per_sr);
+        VarianceBandwidth::Measured => {
+            // Σ (wᵢ − mean)² over all n_b draws (missing ones are zeros) · n_b / (n_b − 1),
+            // so that the division by n_b below leaves the unbiased sample variance.
+            let mean = samples.iter().map(|s| f64::from(s.weight_y())).sum::<f64>()
+                / f64::from(n_b);
+            let present: f64 = samples
+                .iter()
+                .map(|s| (f64::from(s.weight_y()) - mean).powi(2))
+                .sum();
+            let missing = f64::from(n_b - samples.len() as u32) * mean * mean;
+            if n_b > 1 {
+                variance_sum = (present + missing) * f64::from(n_b) / f64::from(n_b - 1);
+            }
         }
     }
-    let variance = (std::f64::consts::TAU * variance_sum / f64::from(n_b)) as f32;
+    // Colour noise (beyond the paper; the "spectral" term): the lanes' variance,
+    // averaged over the n_b samples like the weights.
+    let lane_variance_sum: f64 = samples.iter().map(|s| f64::from(s.lane_variance)).sum();
+    let variance = ((variance_sum + lane_variance_sum) / f64::from(n_b)) as f32;
     let mean_y =
         (samples.iter().map(|s| f64::from(s.weight_y())).sum::<f64>() / f64::from(n_b)) as f32;
     Ok(PixelPrediction {
@@ -187,6 +216,7 @@ mod tests {
             distance_m: d,
             light_bandwidth: light,
             material_bandwidth: MaterialBandwidth::new(rho, 0.0).unwrap(),
+            lane_variance: 0.0,
         }
     }
 
@@ -312,6 +342,7 @@ mod tests {
             distance_m: f32::INFINITY,
             light_bandwidth: Bandwidth::distant_light(nu_env).unwrap(),
             material_bandwidth: MaterialBandwidth::new(f32::INFINITY, 0.0).unwrap(),
+            lane_variance: 0.0,
         };
         let footprint = PixelFootprint {
             rad_per_px: 1e-3,
@@ -324,6 +355,23 @@ mod tests {
             "{} vs {expected}",
             p.image_bandwidth_cycles_per_px
         );
+    }
+
+    #[test]
+    fn lane_variance_adds_to_the_predicted_variance() {
+        let flat = sample(Bandwidth::ZERO, 0.0, 1.0, 0.5, f32::INFINITY);
+        let spiky = LightSample {
+            lane_variance: 2.0,
+            ..flat
+        };
+        let v = |s: LightSample, n: usize| {
+            predict_pixel(&plane_hit(1.0), &vec![s; n], FOOTPRINT, VarianceBandwidth::Incident)
+                .unwrap()
+                .variance
+        };
+        assert_eq!(v(flat, 16), 0.0);
+        assert!((v(spiky, 16) - 2.0).abs() < 1e-6);
+        assert!((v(spiky, 8) - 1.0).abs() < 1e-6, "missing samples count as 0");
     }
 
     #[test]

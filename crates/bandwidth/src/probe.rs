@@ -52,6 +52,11 @@ pub struct LightSample {
     pub light_bandwidth: Bandwidth,
     /// ρ and t of the material at the hit for (ω_i, ω_o) (eq. 3's B_{t,ρ}, eq. 9's ν_ρa).
     pub material_bandwidth: MaterialBandwidth,
+    /// The colour noise of this sample's weight that luminance bandwidth misses: the
+    /// variance of its hero-wavelength XYZ estimate over the sample's wavelength lanes
+    /// (X, Y and Z variances summed), in the weight's units squared. 0 for a probe that
+    /// does not measure it, or a flat spectrum.
+    pub lane_variance: f32,
 }
 
 impl LightSample {

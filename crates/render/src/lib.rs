@@ -12,6 +12,7 @@
 
 pub mod adaptive;
 pub mod bsdf;
+pub mod bsdf_angular_table;
 pub mod camera;
 pub mod error;
 pub mod file_error;

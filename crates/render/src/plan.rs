@@ -74,7 +74,7 @@ pub enum SamplePlanKind {
 }
 
 /// A neutral hit for asking a material which lobes it has.
-fn probe_hit() -> SurfaceInteraction {
+pub(crate) fn probe_hit() -> SurfaceInteraction {
     SurfaceInteraction {
         p: Vec3A::ZERO,
         t: 1.0,

@@ -8,11 +8,15 @@
 //! between a pixel's centre ray and those of its right and lower neighbours, so a fisheye
 //! or a wide pinhole gets its own footprint at every pixel, not f/W.
 
-use glam::{UVec2, Vec2};
+use glam::{DVec3, UVec2, Vec2, Vec3A};
+use prism_bandwidth::pixel_prediction::MAX_IMAGE_BANDWIDTH_CYCLES_PER_PX;
 use prism_bandwidth::{
-    allocate, predict_pixel, Allocated, AllocationInputs, AllocationSettings, BandwidthBuffer,
-    GBufferHit, LightSample, PixelFootprint, PixelPrediction, ShadingProbe, VarianceBandwidth,
+    allocate, predict_pixel, Allocated, AllocationInputs, AllocationSettings, Bandwidth,
+    BandwidthBuffer, GBufferHit, LightSample, PixelFootprint, PixelPrediction, ShadingProbe,
+    VarianceBandwidth,
 };
+use prism_spectrum::colorimetry::sampled_radiance_to_xyz;
+use prism_spectrum::{SampledSpectrum, SampledWavelengths};
 use rayon::prelude::*;
 
 use crate::film::AovPlane;
@@ -74,13 +78,24 @@ fn angular_footprint(scene: &RenderScene, pixel: UVec2) -> Option<f32> {
     Some(ax.max(ay))
 }
 
-/// The G-buffer hit of `pixel`'s centre ray (with curvature, which shading skips).
-fn centre_hit(scene: &RenderScene, pixel: UVec2) -> Option<GBufferHit> {
+/// What `pixel`'s centre ray meets.
+enum CentreRay {
+    /// A surface: its G-buffer hit (with curvature, which shading skips).
+    Hit(GBufferHit),
+    /// Nothing: the ray leaves the scene in this direction (world, unit).
+    Escapes(Vec3A),
+    /// No ray (outside a fisheye's image circle) or a degenerate hit.
+    None,
+}
+
+fn centre_ray(scene: &RenderScene, pixel: UVec2) -> CentreRay {
     let film_point = Vec2::new(pixel.x as f32 + 0.5, pixel.y as f32 + 0.5);
-    let ray = scene
-        .camera
-        .generate_ray_only(film_point, Vec2::splat(0.5))?;
-    let hit = scene.geometry.intersect(&ray)?;
+    let Some(ray) = scene.camera.generate_ray_only(film_point, Vec2::splat(0.5)) else {
+        return CentreRay::None;
+    };
+    let Some(hit) = scene.geometry.intersect(&ray) else {
+        return CentreRay::Escapes(ray.direction);
+    };
     let si = scene.geometry.interaction(&ray, &hit);
     let view = -ray.direction;
     // The side the camera sees: eq. 3's cosines are of that side.
@@ -89,15 +104,61 @@ fn centre_hit(scene: &RenderScene, pixel: UVec2) -> Option<GBufferHit> {
     } else {
         si.n_shading
     };
-    GBufferHit::new(
+    match GBufferHit::new(
         si.p,
         hit.t,
         normal.normalize(),
         si.curvature,
         view,
         si.material_id,
-    )
-    .ok()
+    ) {
+        Ok(hit) => CentreRay::Hit(hit),
+        Err(_) => CentreRay::None,
+    }
+}
+
+/// A pixel that sees the infinite lights directly: its noise is colour noise alone (the
+/// hero wavelengths' estimate of the radiance along the ray, sampled `count` times with
+/// stratified hero wavelengths) plus the anti-aliasing of the lights' own detail (b_p).
+fn escaping_pixel(
+    scene: &RenderScene,
+    direction: Vec3A,
+    count: u32,
+    background_nu_a: f32,
+    rad_per_px: f32,
+) -> PixelPrediction {
+    let lights = &scene.lights;
+    let estimates: Vec<DVec3> = (0..count)
+        .map(|k| {
+            let wavelengths = SampledWavelengths::sample_visible((k as f32 + 0.5) / count as f32);
+            let mut radiance = SampledSpectrum::splat(0.0);
+            for &l in lights.infinite_lights() {
+                radiance += lights.light(l).infinite_radiance(direction, &wavelengths);
+            }
+            sampled_radiance_to_xyz(radiance, &wavelengths)
+        })
+        .collect();
+    let n = f64::from(count.max(1));
+    let mean = estimates.iter().copied().sum::<DVec3>() / n;
+    let variance = if count > 1 {
+        estimates
+            .iter()
+            .map(|x| (*x - mean).length_squared())
+            .sum::<f64>()
+            / (n - 1.0)
+    } else {
+        0.0
+    };
+    PixelPrediction {
+        bandwidth: Bandwidth {
+            spatial_cycles_per_m: 0.0,
+            angular_cycles_per_rad: background_nu_a,
+        },
+        image_bandwidth_cycles_per_px: (background_nu_a * rad_per_px)
+            .min(MAX_IMAGE_BANDWIDTH_CYCLES_PER_PX),
+        variance: variance as f32,
+        mean_y: mean.y as f32,
+    }
 }
 
 /// Runs the predictor over every pixel of `scene` (in parallel on the current rayon pool).
@@ -110,7 +171,7 @@ pub fn predict(
         return Err("--plan-nb must be at least 1".into());
     }
     let resolution = scene.resolution;
-    let probe = RenderProbe { scene, seed };
+    let probe = RenderProbe::new(scene, seed).with_bandwidth_tables()?;
     // Infinite lights seen directly: the background's own angular bandwidth.
     let background_nu_a = scene
         .lights
@@ -134,8 +195,8 @@ pub fn predict(
                         rad_per_px,
                         probe_samples: settings.probe_samples,
                     };
-                    match centre_hit(scene, pixel) {
-                        Some(hit) => {
+                    match centre_ray(scene, pixel) {
+                        CentreRay::Hit(hit) => {
                             probe.sample_lights(pixel, &hit, settings.probe_samples, &mut samples);
                             let p = predict_pixel(
                                 &hit,
@@ -147,14 +208,17 @@ pub fn predict(
                             let c = hit.curvature();
                             Ok((p, c.k1.abs().max(c.k2.abs())))
                         }
-                        None => Ok((
-                            PixelPrediction {
-                                image_bandwidth_cycles_per_px: (background_nu_a * rad_per_px)
-                                    .min(prism_bandwidth::pixel_prediction::MAX_IMAGE_BANDWIDTH_CYCLES_PER_PX),
-                                ..PixelPrediction::default()
-                            },
+                        CentreRay::Escapes(direction) => Ok((
+                            escaping_pixel(
+                                scene,
+                                direction,
+                                settings.probe_samples,
+                                background_nu_a,
+                                rad_per_px,
+                            ),
                             0.0,
                         )),
+                        CentreRay::None => Ok((PixelPrediction::default(), 0.0)),
                     }
                 })
                 .collect::<Result<Vec<_>, String>>()

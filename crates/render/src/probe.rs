@@ -7,22 +7,31 @@
 //! estimated from one set of hero wavelengths per sample. Occlusion is ignored, as in
 //! Bagher's eq. 1.
 //!
-//! Bandwidths (cycles per metre / per radian), stated choices:
-//! - point, spot, ideal directional light: a Dirac in angle, ν_a = ∞, ν_s = 0;
-//! - area light of area A: a box of width √A in space, ν_s = 1/√A, ν_a = 0 (Lambertian);
-//! - sun of angular diameter α: ν_a = 1/α; uniform sky: 0;
-//! - environment map W texels wide: its Nyquist rate, ν_a = W / 4π (W/2 cycles per 2π);
-//! - Lambert: ρ = 0; microfacet lobe of roughness α (radians of slope spread): a lobe of
-//!   angular standard deviation ≈ α has spectrum width 1/(2πα); Dirac lobes: ∞.
+//! Bandwidths (cycles per metre / per radian): each light's `Light::bandwidth`
+//! (light/bandwidth.rs), except environment maps, which answer per direction from eq. 7's
+//! map when the probe is given one (`with_environment_bandwidths`); the material's ρ from
+//! its lobe (`Bxdf::angular_bandwidth_cycles_per_rad`).
+//!
+//! The samples alternate between the path tracer's two strategies, light sampling and BSDF
+//! sampling, and each sample's pdf is the mixture's (½ p_light + ½ p_bsdf), so eq. 9's
+//! χᵢ²/pᵢ is the variance of the estimator the render runs (a glossy lobe that light
+//! sampling rarely hits shows its variance through the BSDF samples). A BSDF sample that
+//! meets an area light (occlusion counts here) or escapes to the infinite lights is one
+//! sample per emitter. At a Dirac-only lobe (a mirror, smooth glass) every sample is a
+//! BSDF sample, a delta: one direction, no shading variance, the bandwidth of the light it
+//! sees. Delta lights and Dirac lobes report pdf 0 and fold their selection probability
+//! into their weight.
 
 use glam::{UVec2, Vec2, Vec3A};
 use prism_bandwidth::{Bandwidth, GBufferHit, LightSample, MaterialBandwidth, ShadingProbe};
-use prism_geometry::{Differentials, Frame, SurfaceInteraction};
+use prism_geometry::{Differentials, Frame, Ray, SurfaceInteraction};
 use prism_spectrum::colorimetry::sampled_radiance_to_xyz;
 use prism_spectrum::{SampledSpectrum, SampledWavelengths};
 
 use crate::bsdf::{Bsdf, Bxdf, TransportMode};
-use crate::light::{Light, LightSampleContext};
+use crate::bsdf_angular_table::MaterialAngularBandwidth;
+use crate::light::environment_bandwidth::EnvironmentBandwidth;
+use crate::light::{Light, LightHit, LightSampleContext};
 use crate::sampler::{PixelSampler, SamplerKind};
 use crate::scene_build::RenderScene;
 
@@ -30,6 +39,103 @@ use crate::scene_build::RenderScene;
 pub struct RenderProbe<'a> {
     pub scene: &'a RenderScene,
     pub seed: u64,
+    /// Per light (the scene's order): eq. 7's map for environment lights, else `None`.
+    pub environment_bandwidths: Vec<Option<EnvironmentBandwidth>>,
+    /// Per material (`material_id` order): its angular bandwidth table; empty: each lobe's
+    /// closed form.
+    pub material_tables: Vec<MaterialAngularBandwidth>,
+}
+
+impl<'a> RenderProbe<'a> {
+    /// A probe with each light's single bandwidth (`Light::bandwidth`).
+    pub fn new(scene: &'a RenderScene, seed: u64) -> Self {
+        Self {
+            scene,
+            seed,
+            environment_bandwidths: Vec::new(),
+            material_tables: Vec::new(),
+        }
+    }
+
+    /// The same probe with eq. 7's per-direction map for every environment light and the
+    /// angular bandwidth table of every material the scene's shapes use (others get a
+    /// constant), what the predictor runs with.
+    pub fn with_bandwidth_tables(mut self) -> Result<Self, String> {
+        let mut used = vec![false; self.scene.materials.len()];
+        for inst in self.scene.geometry.instances() {
+            let id = inst.material.map_or(used.len() - 1, |m| m as usize);
+            if let Some(u) = used.get_mut(id) {
+                *u = true;
+            }
+        }
+        self.material_tables = self
+            .scene
+            .materials
+            .iter()
+            .zip(&used)
+            .map(|(m, &used)| {
+                if used {
+                    MaterialAngularBandwidth::build(m)
+                } else {
+                    MaterialAngularBandwidth::Constant(0.0)
+                }
+            })
+            .collect();
+        self.environment_bandwidths = self
+            .scene
+            .lights
+            .lights()
+            .iter()
+            .map(|l| match l {
+                Light::Environment(e) => EnvironmentBandwidth::new(e).map(Some),
+                Light::Point(_)
+                | Light::Spot(_)
+                | Light::Directional(_)
+                | Light::Area(_)
+                | Light::Sky(_)
+                | Light::Daylight(_)
+                | Light::Goniometric(_) => Ok(None),
+            })
+            .collect::<Result<_, _>>()?;
+        Ok(self)
+    }
+
+    /// ρ and t of the material `material_id` for light from `wi_local` seen from
+    /// `wo_local`.
+    fn material_bandwidth_at(
+        &self,
+        material_id: u32,
+        bsdf: &Bsdf,
+        wi_local: Vec3A,
+        wo_local: Vec3A,
+    ) -> MaterialBandwidth {
+        let closed_form = material_bandwidth(bsdf);
+        // `NO_MATERIAL` (and any id past the end) is the default material, the last.
+        let index = (material_id as usize).min(self.material_tables.len().saturating_sub(1));
+        match self.material_tables.get(index) {
+            Some(table) => MaterialBandwidth {
+                angular_cycles_per_rad: table.at(
+                    wi_local,
+                    wo_local,
+                    closed_form.angular_cycles_per_rad,
+                ),
+                ..closed_form
+            },
+            None => closed_form,
+        }
+    }
+
+    /// ν_l of light `index` towards `wi`.
+    fn light_bandwidth_towards(&self, index: usize, wi: Vec3A) -> Bandwidth {
+        let light = &self.scene.lights.lights()[index];
+        match (light, self.environment_bandwidths.get(index)) {
+            (Light::Environment(e), Some(Some(map))) => Bandwidth {
+                spatial_cycles_per_m: 0.0,
+                angular_cycles_per_rad: map.at(e, wi),
+            },
+            _ => light.bandwidth(),
+        }
+    }
 }
 
 /// ν_l of a light (see the module docs; the choices live in `light/bandwidth.rs`).
@@ -51,10 +157,33 @@ fn luminance_y(s: SampledSpectrum, wavelengths: &SampledWavelengths) -> f32 {
 }
 
 /// The ȳ-weighted mean of a BSDF value over the lanes (a white Lambertian gives 1/π).
-fn reflectance_y(f: SampledSpectrum, wavelengths: &SampledWavelengths) -> f32 {
+pub(crate) fn reflectance_y(f: SampledSpectrum, wavelengths: &SampledWavelengths) -> f32 {
     let ones = luminance_y(SampledSpectrum::splat(1.0), wavelengths);
     if ones > 0.0 {
         luminance_y(f, wavelengths) / ones
+    } else {
+        0.0
+    }
+}
+
+/// The variance of the hero-wavelength XYZ estimate of `weight` over its lanes (X, Y, Z
+/// summed): each lane alone is an unbiased single-wavelength estimate, the hero estimate is
+/// their mean, so its variance is the lanes' sample variance / 4. Spiky spectra (F11,
+/// narrow LEDs) give much, flat ones none.
+pub(crate) fn lane_variance(weight: SampledSpectrum, wavelengths: &SampledWavelengths) -> f32 {
+    let lanes = prism_spectrum::N_SPECTRUM_SAMPLES;
+    let per_lane: Vec<glam::DVec3> = (0..lanes)
+        .map(|j| {
+            let mut only = [0.0f32; prism_spectrum::N_SPECTRUM_SAMPLES];
+            only[j] = weight[j];
+            sampled_radiance_to_xyz(SampledSpectrum::new(only), wavelengths) * lanes as f64
+        })
+        .collect();
+    let mean = per_lane.iter().copied().sum::<glam::DVec3>() / lanes as f64;
+    let sum_sq: f64 = per_lane.iter().map(|x| (*x - mean).length_squared()).sum();
+    let variance = sum_sq / ((lanes - 1) * lanes) as f64;
+    if variance.is_finite() {
+        variance as f32
     } else {
         0.0
     }
@@ -79,6 +208,71 @@ fn hit_interaction(hit: &GBufferHit) -> SurfaceInteraction {
         material_id: hit.material_id(),
         object_id: 0,
         instance_id: 0,
+    }
+}
+
+/// One probe sample's strategy: the path tracer's two (light sampling and BSDF sampling),
+/// drawn in turn so that eq. 9's pᵢ is the density of the estimator the render uses.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum ProbeStrategy {
+    Light,
+    Bsdf,
+}
+
+impl RenderProbe<'_> {
+    /// Light sampling's solid-angle density towards `wi` (all lights, with their pmf).
+    fn light_pdf(&self, ctx: &LightSampleContext, wi: Vec3A, hit: Option<(u32, &LightHit)>) -> f32 {
+        let lights = &self.scene.lights;
+        let mut pdf = 0.0;
+        for (index, light) in lights.lights().iter().enumerate() {
+            let light_hit = match hit {
+                Some((l, h)) if l as usize == index => Some(h),
+                Some(_) => None,
+                None => None,
+            };
+            let on_this_light = light.is_infinite() || light_hit.is_some();
+            if on_this_light && !light.is_delta() {
+                pdf += lights.pmf(index as u32) * light.pdf_li(ctx, wi, light_hit);
+            }
+        }
+        pdf
+    }
+
+    /// What a BSDF-sampled direction from `si` meets: the area light it hits (occlusion
+    /// by other surfaces counts here, as the render's BSDF samples see it), else every
+    /// infinite light along it. Per emitter: (light index, radiance, distance, its hit).
+    fn emitters_along(
+        &self,
+        si: &SurfaceInteraction,
+        wi: Vec3A,
+        wavelengths: &SampledWavelengths,
+    ) -> Vec<(u32, SampledSpectrum, f32, Option<LightHit>)> {
+        let lights = &self.scene.lights;
+        let ray = Ray::spawn(si.p, wi);
+        match self.scene.geometry.intersect(&ray) {
+            Some(hit) => {
+                let Some(l) = lights.area_light_of_instance(hit.instance_id) else {
+                    return Vec::new();
+                };
+                let hit_si = self.scene.geometry.shading_interaction(&ray, &hit);
+                let light_hit = LightHit {
+                    p: hit_si.p,
+                    n: hit_si.n_geometric,
+                    uv: hit_si.uv,
+                    distance_m: hit.t,
+                };
+                let le = lights.light(l).emitted_radiance(&light_hit, -wi, wavelengths);
+                vec![(l, le, hit.t, Some(light_hit))]
+            }
+            None => lights
+                .infinite_lights()
+                .iter()
+                .map(|&l| {
+                    let le = lights.light(l).infinite_radiance(wi, wavelengths);
+                    (l, le, f32::INFINITY, None)
+                })
+                .collect(),
+        }
     }
 }
 
@@ -108,26 +302,120 @@ impl ShadingProbe for RenderProbe<'_> {
             let mut stream = sampler.stream(pixel, k);
             let wavelengths = SampledWavelengths::sample_visible(stream.get_1d());
             let bsdf = material.bsdf(&si, &wavelengths);
-            let Some((l, pmf)) = lights.sample(stream.get_1d()) else {
-                continue;
+            // A Dirac-only lobe: light sampling cannot reach it, BSDF sampling alone does.
+            let strategy = if bsdf.is_specular() || k % 2 == 1 {
+                ProbeStrategy::Bsdf
+            } else {
+                ProbeStrategy::Light
             };
-            let light = lights.light(l);
-            let Some(ls) = light.sample_li(&ctx, stream.get_2d(), &wavelengths) else {
-                continue;
+            // The share of samples each strategy takes (the mixture's weights).
+            let (light_share, bsdf_share) = if bsdf.is_specular() {
+                (0.0, 1.0)
+            } else {
+                (0.5, 0.5)
             };
-            let wi_local = frame.to_local(ls.wi);
-            let cos = wi_local.z.abs();
-            let f = bsdf.eval(wo_local, wi_local, TransportMode::Radiance) * cos;
-            out.push(LightSample {
-                direction: ls.wi,
-                radiance_y: luminance_y(ls.radiance, &wavelengths),
-                pdf_per_sr: if ls.delta { 0.0 } else { pmf * ls.pdf },
-                bsdf_cos_per_sr: reflectance_y(f, &wavelengths),
-                cos_theta_i: cos,
-                distance_m: ls.distance_m,
-                light_bandwidth: light_bandwidth(light),
-                material_bandwidth: material_bandwidth(&bsdf),
-            });
+            match strategy {
+                ProbeStrategy::Light => {
+                    let Some((l, pmf)) = lights.sample(stream.get_1d()) else {
+                        continue;
+                    };
+                    let light = lights.light(l);
+                    let Some(ls) = light.sample_li(&ctx, stream.get_2d(), &wavelengths) else {
+                        continue;
+                    };
+                    let wi_local = frame.to_local(ls.wi);
+                    let cos = wi_local.z.abs();
+                    let f = bsdf.eval(wo_local, wi_local, TransportMode::Radiance) * cos;
+                    let mut radiance_y = luminance_y(ls.radiance, &wavelengths);
+                    let pdf_per_sr = if ls.delta {
+                        // One direction: the estimator's weight divides by the selection.
+                        radiance_y /= light_share * pmf;
+                        0.0
+                    } else {
+                        light_share * pmf * ls.pdf
+                            + bsdf_share * bsdf.pdf(wo_local, wi_local, TransportMode::Radiance)
+                    };
+                    let divisor = if ls.delta { light_share * pmf } else { pdf_per_sr };
+                    let lanes = lane_variance(ls.radiance * f * (1.0 / divisor), &wavelengths);
+                    out.push(LightSample {
+                        direction: ls.wi,
+                        radiance_y,
+                        pdf_per_sr,
+                        bsdf_cos_per_sr: reflectance_y(f, &wavelengths),
+                        cos_theta_i: cos,
+                        distance_m: ls.distance_m,
+                        light_bandwidth: self.light_bandwidth_towards(l as usize, ls.wi),
+                        material_bandwidth: self.material_bandwidth_at(
+                            hit.material_id(),
+                            &bsdf,
+                            wi_local,
+                            wo_local,
+                        ),
+                        lane_variance: lanes,
+                    });
+                }
+                ProbeStrategy::Bsdf => {
+                    let Some(bs) = bsdf.sample(
+                        wo_local,
+                        stream.get_1d(),
+                        stream.get_2d(),
+                        TransportMode::Radiance,
+                    ) else {
+                        continue;
+                    };
+                    if !(bs.pdf > 0.0) {
+                        continue;
+                    }
+                    let cos = bs.wi.z.abs();
+                    let wi = frame.from_local(bs.wi);
+                    for (l, le, distance_m, light_hit) in self.emitters_along(&si, wi, &wavelengths)
+                    {
+                        let radiance_y = luminance_y(le, &wavelengths);
+                        if !(radiance_y > 0.0) {
+                            continue;
+                        }
+                        let (pdf_per_sr, bsdf_cos_per_sr) = if bs.specular {
+                            // A Dirac lobe: one direction, weight f cos / (share · P(lobe)).
+                            (
+                                0.0,
+                                reflectance_y(bs.f * (cos / (bsdf_share * bs.pdf)), &wavelengths),
+                            )
+                        } else {
+                            let light_pdf = self.light_pdf(
+                                &ctx,
+                                wi,
+                                light_hit.as_ref().map(|h| (l, h)),
+                            );
+                            (
+                                bsdf_share * bs.pdf + light_share * light_pdf,
+                                reflectance_y(bs.f * cos, &wavelengths),
+                            )
+                        };
+                        let divisor = if bs.specular {
+                            bsdf_share * bs.pdf
+                        } else {
+                            pdf_per_sr
+                        };
+                        let lanes = lane_variance(le * bs.f * (cos / divisor), &wavelengths);
+                        out.push(LightSample {
+                            direction: wi,
+                            radiance_y,
+                            pdf_per_sr,
+                            bsdf_cos_per_sr,
+                            cos_theta_i: cos,
+                            distance_m,
+                            light_bandwidth: self.light_bandwidth_towards(l as usize, wi),
+                            material_bandwidth: self.material_bandwidth_at(
+                                hit.material_id(),
+                                &bsdf,
+                                bs.wi,
+                                wo_local,
+                            ),
+                            lane_variance: lanes,
+                        });
+                    }
+                }
+            }
         }
     }
 }
@@ -144,10 +432,7 @@ mod tests {
             "shapes": [{"type": "sphere", "material": "white"}],
             "lights": [{"type": "point", "position_m": [0, 3, 0], "spectrum": 1.0, "scale": 2.0}]}"#;
         let scene = RenderScene::build(&parse_scene_str(json, "t.json").unwrap(), None).unwrap();
-        let probe = RenderProbe {
-            scene: &scene,
-            seed: 1,
-        };
+        let probe = RenderProbe::new(&scene, 1);
         let hit = GBufferHit::new(
             Vec3A::new(0.0, 1.0, 0.0),
             2.0,
@@ -159,19 +444,21 @@ mod tests {
         .unwrap();
         let mut out = Vec::new();
         probe.sample_lights(UVec2::new(3, 4), &hit, 64, &mut out);
-        assert_eq!(out.len(), 64);
+        // Every other sample is a BSDF sample, which never finds a point light.
+        assert_eq!(out.len(), 32);
         let values: Vec<f64> = out.iter().map(|s| f64::from(s.radiance_y)).collect();
-        let mean_radiance = values.iter().sum::<f64>() / 64.0;
+        let mean_radiance = values.iter().sum::<f64>() / 32.0;
         let sd = (values
             .iter()
             .map(|v| (v - mean_radiance).powi(2))
             .sum::<f64>()
-            / 63.0)
+            / 31.0)
             .sqrt();
-        // I/d² = 2/4 at the hit; Y of a flat spectrum is exact in expectation: 5 standard
+        // I/d² = 2/4 at the hit, divided by the light strategy's share ½ (the sample's
+        // weight in the mixture); Y of a flat spectrum is exact in expectation: 5 standard
         // errors of the hero-wavelength estimate.
         assert!(
-            (mean_radiance - 0.5).abs() < 5.0 * sd / 8.0,
+            (mean_radiance - 1.0).abs() < 5.0 * sd / 32f64.sqrt(),
             "{mean_radiance} (sd {sd})"
         );
         for s in &out {
@@ -179,11 +466,54 @@ mod tests {
             assert!((s.bsdf_cos_per_sr - 1.0 / std::f32::consts::PI).abs() < 1e-4);
             assert!((s.distance_m - 2.0).abs() < 1e-5);
             assert_eq!(s.material_bandwidth.angular_cycles_per_rad, 0.0);
-            assert!(s.light_bandwidth.angular_cycles_per_rad.is_infinite());
+            assert_eq!(s.light_bandwidth, Bandwidth::POINT_LIGHT);
         }
         // Deterministic per pixel.
         let mut again = Vec::new();
         probe.sample_lights(UVec2::new(3, 4), &hit, 64, &mut again);
         assert_eq!(out, again);
+    }
+
+    /// The mixture's weights are an unbiased estimate of the reflected radiance: a
+    /// Lambertian plane (a = 0.6) under a uniform sky of radiance 1 reflects 0.6; a glossy
+    /// aluminium lobe reflects its directional albedo (between 0.3 and 1).
+    #[test]
+    fn mixture_weights_estimate_the_reflected_radiance() {
+        for (material, expected) in [
+            (r#"{"type": "lambert", "reflectance": 0.6}"#, Some(0.6)),
+            (r#"{"type": "conductor", "metal": "Al", "roughness": 0.2}"#, None),
+        ] {
+            let json = format!(
+                r#"{{"materials": {{"m": {material}}},
+                "shapes": [{{"type": "rectangle", "size_m": [1, 1], "material": "m"}}],
+                "lights": [{{"type": "sky", "spectrum": 1.0}}]}}"#
+            );
+            let scene =
+                RenderScene::build(&parse_scene_str(&json, "t.json").unwrap(), None).unwrap();
+            let probe = RenderProbe::new(&scene, 7);
+            let view = Vec3A::new(0.3, 0.0, 1.0).normalize();
+            let hit =
+                GBufferHit::new(Vec3A::ZERO, 2.0, Vec3A::Z, Curvature::default(), view, 0).unwrap();
+            let n = 4096u32;
+            let mut out = Vec::new();
+            let (mut sum, mut sum_sq) = (0.0, 0.0);
+            for pixel in 0..n / 16 {
+                probe.sample_lights(UVec2::new(pixel, 0), &hit, 16, &mut out);
+                // The probe alternates strategies; each sample's weight is the mixture's.
+                for s in &out {
+                    let w = f64::from(s.weight_y());
+                    sum += w;
+                    sum_sq += w * w;
+                }
+            }
+            // All samples of both strategies together (n of them) estimate the integral.
+            let mean = sum / f64::from(n);
+            let sd = (sum_sq / f64::from(n) - mean * mean).max(0.0).sqrt();
+            let tolerance = 4.0 * sd / f64::from(n).sqrt() + 1e-3;
+            match expected {
+                Some(e) => assert!((mean - e).abs() < tolerance, "{material}: {mean} vs {e}"),
+                None => assert!(mean > 0.3 && mean < 1.0, "{material}: {mean}"),
+            }
+        }
     }
 }

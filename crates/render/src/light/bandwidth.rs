@@ -1,11 +1,12 @@
 //! ν_l of each kind of light, the light's part of the shading bandwidth that the sample
 //! planner predicts (Bagher et al. 2013, eqs. 4, 5, 9; `probe.rs` hands it to
 //! prism-bandwidth). Cycles per metre (spatial) and per radian (angular), stated choices:
-//! - point, spot, goniometric, ideal directional light: a Dirac in angle, ν_a = ∞, ν_s = 0
-//!   (their angular distributions are smooth; the Dirac is the position or direction);
+//! - point, spot, goniometric: a Dirac in position, ν_l = [∞, 0] (their angular
+//!   distributions are smooth); an ideal directional light: a Dirac in direction, [0, ∞];
 //! - area light of area A: a box of width √A in space, ν_s = 1/√A, ν_a = 0 (Lambertian);
 //! - sun of angular diameter 2α: ν_a = 1/(2α); uniform sky: 0;
-//! - environment map W texels wide: its Nyquist rate, ν_a = W / 4π (W/2 cycles per 2π);
+//! - environment map W texels wide: its Nyquist rate, ν_a = W / 4π (W/2 cycles per 2π), as a
+//!   whole; per direction the predictor uses eq. 7's map (`environment_bandwidth.rs`);
 //! - daylight sky: the indicatrix exp(d χ) (|d| ≤ 3) varies over about 1/3 rad, ≈ 1.5
 //!   cycles/rad.
 
@@ -20,9 +21,9 @@ fn bandwidth(spatial: f32, angular: f32) -> Bandwidth {
     }
 }
 
-/// Point, spot and goniometric lights: a Dirac in position.
+/// Point, spot and goniometric lights: a Dirac in position (Bagher Fig. 4: ν_l = [∞, 0]).
 pub(super) fn point_like() -> Bandwidth {
-    bandwidth(0.0, f32::INFINITY)
+    Bandwidth::POINT_LIGHT
 }
 
 pub(super) fn directional(d: &DirectionalLight) -> Bandwidth {

@@ -257,6 +257,25 @@ impl EnvironmentLight {
         (self.width, self.height)
     }
 
+    /// Luminance of every texel (row-major, top row first) in the map's own units (Y of the
+    /// RGB pixels, before `scale`): what the sampling distribution was built from.
+    pub fn luminance_texels(&self) -> Vec<f32> {
+        let mut out = Vec::with_capacity(self.width * self.height);
+        for y in 0..self.height {
+            let d_omega = self.texel_solid_angle(y);
+            for x in 0..self.width {
+                let v = self.distribution.value(x, y);
+                out.push(if d_omega > 0.0 { v / d_omega } else { 0.0 });
+            }
+        }
+        out
+    }
+
+    /// Local image coordinates in [0, 1)² of a world direction (towards the light).
+    pub fn local_uv(&self, wi: Vec3A) -> Vec2 {
+        equirect_uv((self.to_local * wi).normalize())
+    }
+
     /// Texel (column, row) of local image coordinates.
     #[inline]
     fn texel(&self, uv: Vec2) -> (usize, usize) {

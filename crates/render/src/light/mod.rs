@@ -43,6 +43,7 @@ mod build;
 pub mod daylight;
 pub mod directional;
 pub mod environment;
+pub mod environment_bandwidth;
 pub mod goniometric;
 mod goniometric_build;
 mod light_set;

@@ -169,6 +169,12 @@ impl PiecewiseConstant2D {
         self.marginal.integral()
     }
 
+    /// The value of cell (u, v) as given (negative and non-finite ones as 0).
+    #[inline]
+    pub fn value(&self, u: usize, v: usize) -> f32 {
+        self.conditional.get(v).map_or(0.0, |c| c.func(u))
+    }
+
     /// (u, v), their joint density and the cell (column, row).
     #[inline]
     pub fn sample(&self, u: Vec2) -> (Vec2, f32, [usize; 2]) {

@@ -1,0 +1,236 @@
+//! ρ of a material per pair of directions: the BSDF angular bandwidth tables of Bagher et al.
+//! 2013 §2.3 ("Reflectance (angular)"). For 16×16 incident directions the lobe
+//! f(ωᵢ, ·) is taken over the outgoing hemisphere at 64×64 (θ_o linear over [0, π/2), φ_o
+//! over [0, 2π)), reduced by eq. 7 (prism-bandwidth's `LocalBandwidth`) to cycles per
+//! texel, divided by the texel's angular size (the larger of Δθ and sin θ_o Δφ, the map's
+//! Jacobian) and max-filtered to 16×16 (a coarse cell keeps its sharpest texel: §2.3 scales
+//! high-resolution slices down so that the resolution does not cap the bandwidth).
+//!
+//! Built once per material, only when the predictor runs. A Lambertian lobe (ρ = 0) and a
+//! purely specular one (ρ = ∞) need no table; lobes with a Dirac part (a smooth coat) and
+//! directions through the surface keep the lobe's own closed-form value
+//! (`Bxdf::angular_bandwidth_cycles_per_rad`).
+
+use glam::{UVec2, Vec3A};
+use prism_bandwidth::local_bandwidth::{Boundary, LocalBandwidth};
+use prism_spectrum::SampledWavelengths;
+use rayon::prelude::*;
+
+use crate::bsdf::{Bsdf, Bxdf, TransportMode};
+use crate::material::Material;
+use crate::plan::probe_hit;
+use crate::probe::reflectance_y;
+
+/// Incident and outgoing cells per axis (θ, φ) of a table.
+pub const TABLE_CELLS: usize = 16;
+/// Texels per axis of one lobe slice before max-filtering.
+pub const SLICE_TEXELS: usize = 64;
+
+/// The direction at the centre of cell (iθ, iφ) of an `n`×`n` hemisphere grid.
+fn cell_direction(i_theta: usize, i_phi: usize, n: usize) -> Vec3A {
+    let theta = std::f32::consts::FRAC_PI_2 * (i_theta as f32 + 0.5) / n as f32;
+    let phi = std::f32::consts::TAU * (i_phi as f32 + 0.5) / n as f32;
+    Vec3A::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos())
+}
+
+/// The cell of a local direction (z up) in an `n`×`n` hemisphere grid; `None` below.
+fn cell_of(w: Vec3A, n: usize) -> Option<(usize, usize)> {
+    if w.z <= 0.0 {
+        return None;
+    }
+    let theta = w.z.clamp(0.0, 1.0).acos();
+    let phi = w.y.atan2(w.x).rem_euclid(std::f32::consts::TAU);
+    let i_theta = ((theta / std::f32::consts::FRAC_PI_2 * n as f32) as usize).min(n - 1);
+    let i_phi = ((phi / std::f32::consts::TAU * n as f32) as usize).min(n - 1);
+    Some((i_theta, i_phi))
+}
+
+/// A material's angular bandwidth, cycles/rad.
+#[derive(Clone, Debug, PartialEq)]
+pub enum MaterialAngularBandwidth {
+    /// The same everywhere: 0 (Lambert), ∞ (Dirac lobes), or the closed form of a lobe
+    /// the table cannot hold.
+    Constant(f32),
+    /// ρ per (incident cell, outgoing cell), `TABLE_CELLS`⁴ values, incident-major.
+    Table(Vec<f32>),
+}
+
+impl MaterialAngularBandwidth {
+    /// The table of `material` at a neutral hit (its textures at uv = (0.5, 0.5)).
+    pub fn build(material: &Material) -> Self {
+        let hit = probe_hit();
+        let wavelengths = SampledWavelengths::sample_visible(0.5);
+        let bsdf = material.bsdf(&hit, &wavelengths);
+        let closed_form = bsdf.lobe.angular_bandwidth_cycles_per_rad();
+        if bsdf.is_specular() || bsdf.has_specular() || closed_form == 0.0 {
+            return Self::Constant(closed_form);
+        }
+        let slices: Vec<Vec<f32>> = (0..TABLE_CELLS * TABLE_CELLS)
+            .into_par_iter()
+            .map(|i| {
+                let wi = cell_direction(i / TABLE_CELLS, i % TABLE_CELLS, TABLE_CELLS);
+                slice_bandwidth(&bsdf, wi, &wavelengths)
+            })
+            .collect();
+        Self::Table(slices.concat())
+    }
+
+    /// ρ for light from `wi_local` seen from `wo_local` (shading frame, z = normal).
+    pub fn at(&self, wi_local: Vec3A, wo_local: Vec3A, fallback: f32) -> f32 {
+        match self {
+            Self::Constant(v) => *v,
+            Self::Table(table) => {
+                // Reciprocity: either side may be "incident"; a direction through the
+                // surface has no table.
+                match (cell_of(wi_local, TABLE_CELLS), cell_of(wo_local, TABLE_CELLS)) {
+                    (Some((it, ip)), Some((ot, op))) => {
+                        let n = TABLE_CELLS;
+                        table[((it * n + ip) * n + ot) * n + op]
+                    }
+                    _ => fallback,
+                }
+            }
+        }
+    }
+}
+
+/// One incident direction's 16×16 outgoing bandwidths (row = θ_o, column = φ_o).
+fn slice_bandwidth(bsdf: &Bsdf, wi: Vec3A, wavelengths: &SampledWavelengths) -> Vec<f32> {
+    let n = SLICE_TEXELS;
+    let values: Vec<f32> = (0..n * n)
+        .map(|k| {
+            let wo = cell_direction(k / n, k % n, n);
+            reflectance_y(bsdf.eval(wo, wi, TransportMode::Radiance), wavelengths)
+        })
+        .collect();
+    let Ok(local) = LocalBandwidth::estimate(
+        &values,
+        UVec2::new(n as u32, n as u32),
+        1.0,
+        Boundary::InsideOnly,
+    ) else {
+        return vec![bsdf.lobe.angular_bandwidth_cycles_per_rad(); TABLE_CELLS * TABLE_CELLS];
+    };
+    let d_theta = std::f32::consts::FRAC_PI_2 / n as f32;
+    let d_phi = std::f32::consts::TAU / n as f32;
+    let per_texel = local.cycles_per_unit();
+    let mut out = vec![0.0f32; TABLE_CELLS * TABLE_CELLS];
+    let block = n / TABLE_CELLS;
+    for k in 0..n * n {
+        let (row, column) = (k / n, k % n);
+        let theta = (row as f32 + 0.5) * d_theta;
+        let rad_per_texel = d_theta.max(theta.sin() * d_phi);
+        let cell = (row / block) * TABLE_CELLS + column / block;
+        out[cell] = out[cell].max(per_texel[k] / rad_per_texel);
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use prism_scene::parse_scene_str;
+
+    use crate::scene_build::RenderScene;
+
+    fn material(json_material: &str) -> MaterialAngularBandwidth {
+        let json = format!(
+            r#"{{"materials": {{"m": {json_material}}},
+                "shapes": [{{"type": "sphere", "material": "m"}}]}}"#
+        );
+        let scene = RenderScene::build(&parse_scene_str(&json, "t.json").unwrap(), None).unwrap();
+        MaterialAngularBandwidth::build(scene.material(0))
+    }
+
+    /// ρ for light at normal incidence seen along the mirror direction (the peak).
+    fn at_peak(m: &MaterialAngularBandwidth) -> f32 {
+        let w = cell_direction(0, 0, TABLE_CELLS);
+        m.at(w, Vec3A::new(-w.x, -w.y, w.z), f32::NAN)
+    }
+
+    #[test]
+    fn lambert_and_mirror_need_no_table() {
+        assert_eq!(
+            material(r#"{"type": "lambert", "reflectance": 0.5}"#),
+            MaterialAngularBandwidth::Constant(0.0)
+        );
+        assert_eq!(
+            material(r#"{"type": "conductor", "metal": "Ag", "roughness": 0}"#),
+            MaterialAngularBandwidth::Constant(f32::INFINITY)
+        );
+    }
+
+    /// The 95 %-energy radius (cycles/rad) of the 2-D DFT of the lobe at normal incidence,
+    /// sampled on a 64×64 grid of tangent-plane angles 2.5/α·… wide: the reference of test c.
+    fn lobe_fft_bandwidth(json_material: &str, half_width_rad: f32) -> f32 {
+        let json = format!(
+            r#"{{"materials": {{"m": {json_material}}},
+                "shapes": [{{"type": "sphere", "material": "m"}}]}}"#
+        );
+        let scene = RenderScene::build(&parse_scene_str(&json, "t.json").unwrap(), None).unwrap();
+        let wavelengths = SampledWavelengths::sample_visible(0.5);
+        let bsdf = scene.material(0).bsdf(&probe_hit(), &wavelengths);
+        let n = 64usize;
+        let step = 2.0 * half_width_rad / n as f32;
+        let values: Vec<f64> = (0..n * n)
+            .map(|k| {
+                let (ax, ay) = (
+                    ((k % n) as f32 + 0.5) * step - half_width_rad,
+                    ((k / n) as f32 + 0.5) * step - half_width_rad,
+                );
+                let wo = Vec3A::new(ax.sin(), ay.sin(), 1.0).normalize();
+                f64::from(reflectance_y(
+                    bsdf.eval(wo, Vec3A::Z, TransportMode::Radiance),
+                    &wavelengths,
+                ))
+            })
+            .collect();
+        // Power spectrum by a direct DFT, then the radius holding 95 % of the energy
+        // (the DC term included, as for a lobe's spectrum).
+        let mut power = Vec::with_capacity(n * n);
+        for fy in 0..n {
+            for fx in 0..n {
+                let (mut re, mut im) = (0.0f64, 0.0f64);
+                for (k, v) in values.iter().enumerate() {
+                    let phase = std::f64::consts::TAU
+                        * ((fx * (k % n)) as f64 + (fy * (k / n)) as f64)
+                        / n as f64;
+                    re += v * phase.cos();
+                    im -= v * phase.sin();
+                }
+                let signed = |f: usize| if f > n / 2 { f as f64 - n as f64 } else { f as f64 };
+                let radius = (signed(fx).powi(2) + signed(fy).powi(2)).sqrt();
+                power.push((radius, re * re + im * im));
+            }
+        }
+        power.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let total: f64 = power.iter().map(|p| p.1).sum();
+        let mut running = 0.0;
+        for (radius, p) in &power {
+            running += p;
+            if running >= 0.95 * total {
+                return (*radius / (n as f64 * f64::from(step))) as f32;
+            }
+        }
+        f32::NAN
+    }
+
+    #[test]
+    fn ggx_tables_are_sharper_for_smoother_lobes_and_near_the_lobes_fft() {
+        let mut previous = f32::INFINITY;
+        for alpha in [0.05f32, 0.1, 0.3] {
+            let json = format!(r#"{{"type": "conductor", "metal": "Al", "roughness": {alpha}}}"#);
+            let m = material(&json);
+            assert!(matches!(m, MaterialAngularBandwidth::Table(_)));
+            let rho = at_peak(&m);
+            assert!(rho < previous, "α {alpha}: ρ {rho} not below {previous}");
+            previous = rho;
+            let reference = lobe_fft_bandwidth(&json, (8.0 * alpha).min(1.2));
+            eprintln!("α {alpha}: table ρ {rho:.3} cycles/rad, lobe FFT {reference:.3}");
+            assert!(
+                rho > 0.5 * reference && rho < 2.0 * reference,
+                "α {alpha}: ρ {rho} vs the lobe's FFT {reference}"
+            );
+        }
+    }
+}
