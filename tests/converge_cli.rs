@@ -237,8 +237,8 @@ fn bad_references_and_methods_exit_with_a_clear_message_and_write_nothing() {
         ),
         (
             "tests/fixtures/cornell_mitsuba_reference.exr",
-            &["--resolution", "256x256", "--method", "path+predicted"],
-            "the sample plan `predicted`",
+            &["--resolution", "256x256", "--method", "light+adaptive"],
+            "the sample plan `adaptive` is for `path`, not `light`",
         ),
     ];
     for (reference, extra, says) in cases {

@@ -40,7 +40,11 @@ fn predicted_and_adaptive_plans_write_their_layers_and_keep_the_budget() {
         let planned = image.layer("plan").expect("plan layer");
         assert!(planned.channels.iter().any(|c| c == "spp"), "{plan}");
         if plan == "predicted" {
-            let mut channels = image.layer("bandwidth").expect("bandwidth layer").channels.clone();
+            let mut channels = image
+                .layer("bandwidth")
+                .expect("bandwidth layer")
+                .channels
+                .clone();
             channels.sort();
             assert_eq!(channels, ["A", "B", "S"]);
             let mut channels = planned.channels.clone();
@@ -61,8 +65,14 @@ fn plan_flags_are_checked() {
     let out = dir.path().join("x.exr");
     for (flags, expected) in [
         (vec!["--plan-nb", "4"], "add --plan predicted"),
-        (vec!["--plan", "predicted", "--plan-floor", "1.5"], "--plan-floor 1.5"),
-        (vec!["--plan", "predicted", "--plan-nb", "0"], "--plan-nb must be at least 1"),
+        (
+            vec!["--plan", "predicted", "--plan-floor", "1.5"],
+            "--plan-floor 1.5",
+        ),
+        (
+            vec!["--plan", "predicted", "--plan-nb", "0"],
+            "--plan-nb must be at least 1",
+        ),
     ] {
         let o = render(&flags, &out);
         assert!(!o.status.success(), "{flags:?}");
@@ -102,5 +112,8 @@ fn explain_names_the_plan() {
     let text = String::from_utf8_lossy(&o.stdout);
     assert!(text.contains("predicted sample plan"), "{text}");
     assert!(text.contains("16 probe light samples"), "{text}");
-    assert!(text.contains("predicted variance (the paper's rule)"), "{text}");
+    assert!(
+        text.contains("predicted variance (the paper's rule)"),
+        "{text}"
+    );
 }

@@ -149,6 +149,20 @@ pub fn allocate(
     })
 }
 
+impl Allocated {
+    /// Camera samples per pixel for a render of `mean_spp` on average with this plan's
+    /// densities: ⌊x⌋ or ⌈x⌉ of x = density·mean_spp, rounded stochastically per
+    /// (seed, pixel) with the same variate at every `mean_spp`, so the counts never
+    /// decrease as `mean_spp` grows (progressive passes add the difference).
+    pub fn cumulative_counts(&self, mean_spp: f64, seed: u64) -> Vec<u32> {
+        self.relative_density
+            .iter()
+            .enumerate()
+            .map(|(i, &d)| round_stochastic(f64::from(d) * mean_spp, seed, i as u64))
+            .collect()
+    }
+}
+
 /// x_p = k·a_p with the total `budget`, except that no pixel gets less than its minimum:
 /// pixels held at their minimum leave the rest a smaller budget, so k is solved again over
 /// the free pixels until no free pixel falls below its minimum (at most n rounds; a few in
@@ -256,6 +270,32 @@ mod tests {
         s.mean_spp = 1.0;
         let out = allocate(UVec2::new(2, 1), tight, s).unwrap();
         assert_eq!(out.plan.total_camera_samples(), 8);
+    }
+
+    #[test]
+    fn cumulative_counts_never_decrease() {
+        let inputs = AllocationInputs {
+            variance: &[0.3, 4.0, 0.0, 1.0, 2.5, 0.1],
+            mean_y: &[1.0; 6],
+            shading_level: &[0; 6],
+        };
+        let out = allocate(
+            UVec2::new(3, 2),
+            inputs,
+            settings(Allocation::RelativeError),
+        )
+        .unwrap();
+        let mut previous = vec![0u32; 6];
+        for spp in 1..200 {
+            let counts = out.cumulative_counts(f64::from(spp) * 0.37, 3);
+            assert!(counts.iter().zip(&previous).all(|(c, p)| c >= p), "{spp}");
+            previous = counts;
+        }
+        let total: u32 = previous.iter().sum();
+        assert!(
+            (f64::from(total) - 199.0 * 0.37 * 6.0).abs() < 6.0,
+            "{total}"
+        );
     }
 
     #[test]

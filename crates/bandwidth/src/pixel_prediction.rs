@@ -160,8 +160,8 @@ pub fn predict_pixel(
         VarianceBandwidth::Measured => {
             // Σ (wᵢ − mean)² over all n_b draws (missing ones are zeros) · n_b / (n_b − 1),
             // so that the division by n_b below leaves the unbiased sample variance.
-            let mean = samples.iter().map(|s| f64::from(s.weight_y())).sum::<f64>()
-                / f64::from(n_b);
+            let mean =
+                samples.iter().map(|s| f64::from(s.weight_y())).sum::<f64>() / f64::from(n_b);
             let present: f64 = samples
                 .iter()
                 .map(|s| (f64::from(s.weight_y()) - mean).powi(2))
@@ -365,13 +365,21 @@ mod tests {
             ..flat
         };
         let v = |s: LightSample, n: usize| {
-            predict_pixel(&plane_hit(1.0), &vec![s; n], FOOTPRINT, VarianceBandwidth::Incident)
-                .unwrap()
-                .variance
+            predict_pixel(
+                &plane_hit(1.0),
+                &vec![s; n],
+                FOOTPRINT,
+                VarianceBandwidth::Incident,
+            )
+            .unwrap()
+            .variance
         };
         assert_eq!(v(flat, 16), 0.0);
         assert!((v(spiky, 16) - 2.0).abs() < 1e-6);
-        assert!((v(spiky, 8) - 1.0).abs() < 1e-6, "missing samples count as 0");
+        assert!(
+            (v(spiky, 8) - 1.0).abs() < 1e-6,
+            "missing samples count as 0"
+        );
     }
 
     #[test]

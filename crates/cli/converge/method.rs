@@ -7,8 +7,9 @@
 //!   diagnostic integrators (`ambient_occlusion`, `depth`, `normal`, `albedo`). `photon`
 //!   (photon mapping) is a known name that this build does not have yet.
 //! - PLAN: how samples are distributed over the pixels — `uniform` (the default: the same
-//!   spp everywhere). `predicted` (the bandwidth predictor's per-pixel plan) is known but not
-//!   built yet.
+//!   spp everywhere), `predicted` (the bandwidth predictor's per-pixel plan, computed once
+//!   before the first pass with `prism render --plan predicted`'s defaults) or `adaptive`
+//!   (variance-driven passes after 4 spp). The last two are for `path` only.
 //! - SAMPLER: `independent` (the default, so that `path` is plain Monte Carlo with the
 //!   −0.5 RMSE rate) or `sobol` (Owen-scrambled Sobol, Burley 2020).
 //!
@@ -38,12 +39,13 @@ pub const INTEGRATORS: [(&str, bool, &str); 8] = [
 ];
 
 /// Sample plans: (name, available, what it is).
-pub const PLANS: [(&str, bool, &str); 2] = [
+pub const PLANS: [(&str, bool, &str); 3] = [
     ("uniform", true, "same spp in every pixel"),
+    ("predicted", true, "bandwidth predictor's per-pixel plan"),
     (
-        "predicted",
-        false,
-        "bandwidth predictor's per-pixel plan (not built yet)",
+        "adaptive",
+        true,
+        "variance-driven passes after 4 spp (Cycles' adaptive sampling)",
     ),
 ];
 
@@ -57,12 +59,16 @@ pub const SAMPLERS: [(&str, &str); 2] = [
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum PlanKind {
     Uniform,
+    Predicted,
+    Adaptive,
 }
 
 impl PlanKind {
     pub fn name(&self) -> &'static str {
         match self {
             PlanKind::Uniform => "uniform",
+            PlanKind::Predicted => "predicted",
+            PlanKind::Adaptive => "adaptive",
         }
     }
 }
@@ -92,11 +98,16 @@ pub fn known_methods() -> String {
         } else {
             format!("{n} (not built yet)")
         })),
-        list(PLANS.iter().map(|(n, ok, _)| if *ok {
-            format!("{n} (default)")
-        } else {
-            format!("{n} (not built yet)")
-        })),
+        list(
+            PLANS
+                .iter()
+                .enumerate()
+                .map(|(i, (n, ok, _))| match (i, ok) {
+                    (_, false) => format!("{n} (not built yet)"),
+                    (0, true) => format!("{n} (default)"),
+                    (_, true) => (*n).to_string(),
+                })
+        ),
         list(SAMPLERS.iter().enumerate().map(|(i, (n, _))| if i == 0 {
             format!("{n} (default)")
         } else {
@@ -128,6 +139,8 @@ impl Method {
         };
         let plan = match plan {
             None | Some("uniform") => PlanKind::Uniform,
+            Some("predicted") => PlanKind::Predicted,
+            Some("adaptive") => PlanKind::Adaptive,
             Some(p) => match PLANS.iter().find(|(n, _, _)| *n == p) {
                 Some((n, _, what)) => {
                     return Err(bad(format!(
@@ -142,6 +155,12 @@ impl Method {
             Some("sobol") => SamplerKind::Sobol,
             Some(s) => return Err(bad(format!("unknown sampler `{s}`"))),
         };
+        if plan != PlanKind::Uniform && integrator != "path" {
+            return Err(bad(format!(
+                "the sample plan `{}` is for `path`, not `{integrator}`",
+                plan.name()
+            )));
+        }
         Ok(Self {
             label: text.to_string(),
             integrator,
@@ -282,8 +301,11 @@ mod tests {
                 "photon",
                 "`photon` (photon mapping (not built yet)) is not available",
             ),
-            ("path+predicted", "sample plan `predicted`"),
-            ("path+adaptive", "unknown sample plan `adaptive`"),
+            (
+                "bdpt+predicted",
+                "the sample plan `predicted` is for `path`, not `bdpt`",
+            ),
+            ("path+oracle", "unknown sample plan `oracle`"),
             ("path:halton", "unknown sampler `halton`"),
         ] {
             let e = Method::parse(text).unwrap_err();

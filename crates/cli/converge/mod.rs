@@ -9,6 +9,7 @@
 mod chart;
 mod fit;
 mod method;
+mod pass_planner;
 mod progressive;
 mod reference;
 
@@ -53,7 +54,8 @@ pub struct ConvergeArgs {
     pub reference_spp: u32,
     /// A method, INTEGRATOR[+PLAN][:SAMPLER] (repeat for several; default `path`, the path
     /// tracer with the uniform plan and the independent sampler). Integrators: path,
-    /// ambient_occlusion, depth, normal, albedo; plans: uniform; samplers: independent, sobol.
+    /// ambient_occlusion, depth, normal, albedo; plans: uniform, predicted, adaptive (path
+    /// only); samplers: independent, sobol.
     #[arg(long = "method", value_name = "METHOD")]
     pub methods: Vec<String>,
     /// Time budget per method, seconds, on the --clock (wall or render CPU time; default 10

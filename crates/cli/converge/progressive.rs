@@ -19,13 +19,14 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::mpsc;
 use std::time::Instant;
 
-use prism_bandwidth::SamplePlan;
 use prism_image::Image;
 use prism_post::metrics::{CompareOptions, Comparison, PreparedReference};
-use prism_render::{film_for, render_pass, Film, RenderScene, RenderSettings, RenderStats};
+use prism_render::adaptive::ADAPTIVE_FIRST_PASS_SPP;
+use prism_render::{Film, RenderScene, RenderSettings, RenderStats};
 use prism_spectrum::rgb_space::RgbColorSpace;
 
 use super::method::PlanKind;
+use super::pass_planner::PassPlanner;
 
 /// How long a method may render.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -147,12 +148,6 @@ pub fn film_to_image(film: &Film) -> Result<Image, String> {
     .map_err(|e| e.to_string())
 }
 
-fn plan_for_pass(kind: PlanKind, scene: &RenderScene, spp: u32) -> Result<SamplePlan, String> {
-    match kind {
-        PlanKind::Uniform => SamplePlan::uniform(scene.resolution, spp).map_err(|e| e.to_string()),
-    }
-}
-
 fn add_stats(a: &mut RenderStats, b: &RenderStats) {
     a.rays_traced += b.rays_traced;
     a.samples += b.samples;
@@ -213,7 +208,8 @@ pub fn run_method(
 
         let cpu_start = process_cpu_s();
         let start = Instant::now();
-        let mut film = film_for(scene, settings);
+        // A predicted plan's predictor runs here: its time is the method's.
+        let mut planner = pool.install(|| PassPlanner::new(plan, scene, settings))?;
         let mut stats = RenderStats::default();
         let mut spp_done = 0u32;
         let mut k = 0u32;
@@ -225,15 +221,13 @@ pub fn run_method(
             _ => start.elapsed().as_secs_f64(),
         };
         while let Some(target) = next_target(k, spp_done, elapsed(render_cpu_s), budget) {
-            let pass = plan_for_pass(plan, scene, target - spp_done)?;
-            let pass_stats = pool
-                .install(|| render_pass(scene, settings, &pass, &mut film, spp_done, &|_| {}))
-                .map_err(|e| e.to_string())?;
+            let pass_stats =
+                pool.install(|| planner.render_pass(scene, settings, spp_done, target))?;
             add_stats(&mut stats, &pass_stats);
             spp_done = target;
             k += 1;
             let copy_start = Instant::now();
-            let snapshot = film.colour_snapshot();
+            let snapshot = planner.snapshot();
             snapshot_wall_s += copy_start.elapsed().as_secs_f64();
             render_wall_s = start.elapsed().as_secs_f64();
             render_cpu_s = match (cpu_start, process_cpu_s()) {
@@ -270,7 +264,7 @@ pub fn run_method(
             stats,
             render_wall_s,
             cpu_s,
-            film,
+            film: planner.into_film(),
             metric_cpu_s: metric_cpu_ns.load(Ordering::Relaxed) as f64 * 1e-9,
             snapshot_wall_s,
         })
@@ -288,10 +282,25 @@ pub fn run_plain(
 ) -> Result<(f64, Option<f64>), String> {
     let cpu_start = process_cpu_s();
     let start = Instant::now();
-    let mut film = film_for(scene, settings);
-    let pass = plan_for_pass(plan, scene, spp)?;
-    pool.install(|| render_pass(scene, settings, &pass, &mut film, 0, &|_| {}))
-        .map_err(|e| e.to_string())?;
+    pool.install(|| -> Result<(), String> {
+        let mut planner = PassPlanner::new(plan, scene, settings)?;
+        // Adaptive sampling needs its error passes; the others render in one pass.
+        match plan {
+            PlanKind::Adaptive => {
+                let mut done = 0;
+                for target in [ADAPTIVE_FIRST_PASS_SPP.min(spp), spp] {
+                    if target > done {
+                        planner.render_pass(scene, settings, done, target)?;
+                        done = target;
+                    }
+                }
+            }
+            PlanKind::Uniform | PlanKind::Predicted => {
+                planner.render_pass(scene, settings, 0, spp)?;
+            }
+        }
+        Ok(())
+    })?;
     let wall = start.elapsed().as_secs_f64();
     let cpu = match (cpu_start, process_cpu_s()) {
         (Some(a), Some(b)) => Some(b - a),

@@ -30,7 +30,11 @@ pub const SLICE_TEXELS: usize = 64;
 fn cell_direction(i_theta: usize, i_phi: usize, n: usize) -> Vec3A {
     let theta = std::f32::consts::FRAC_PI_2 * (i_theta as f32 + 0.5) / n as f32;
     let phi = std::f32::consts::TAU * (i_phi as f32 + 0.5) / n as f32;
-    Vec3A::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos())
+    Vec3A::new(
+        theta.sin() * phi.cos(),
+        theta.sin() * phi.sin(),
+        theta.cos(),
+    )
 }
 
 /// The cell of a local direction (z up) in an `n`×`n` hemisphere grid; `None` below.
@@ -82,7 +86,10 @@ impl MaterialAngularBandwidth {
             Self::Table(table) => {
                 // Reciprocity: either side may be "incident"; a direction through the
                 // surface has no table.
-                match (cell_of(wi_local, TABLE_CELLS), cell_of(wo_local, TABLE_CELLS)) {
+                match (
+                    cell_of(wi_local, TABLE_CELLS),
+                    cell_of(wo_local, TABLE_CELLS),
+                ) {
                     (Some((it, ip)), Some((ot, op))) => {
                         let n = TABLE_CELLS;
                         table[((it * n + ip) * n + ot) * n + op]
@@ -116,12 +123,12 @@ fn slice_bandwidth(bsdf: &Bsdf, wi: Vec3A, wavelengths: &SampledWavelengths) -> 
     let per_texel = local.cycles_per_unit();
     let mut out = vec![0.0f32; TABLE_CELLS * TABLE_CELLS];
     let block = n / TABLE_CELLS;
-    for k in 0..n * n {
+    for (k, texel) in per_texel.iter().enumerate() {
         let (row, column) = (k / n, k % n);
         let theta = (row as f32 + 0.5) * d_theta;
         let rad_per_texel = d_theta.max(theta.sin() * d_phi);
         let cell = (row / block) * TABLE_CELLS + column / block;
-        out[cell] = out[cell].max(per_texel[k] / rad_per_texel);
+        out[cell] = out[cell].max(texel / rad_per_texel);
     }
     out
 }
@@ -198,7 +205,13 @@ mod tests {
                     re += v * phase.cos();
                     im -= v * phase.sin();
                 }
-                let signed = |f: usize| if f > n / 2 { f as f64 - n as f64 } else { f as f64 };
+                let signed = |f: usize| {
+                    if f > n / 2 {
+                        f as f64 - n as f64
+                    } else {
+                        f as f64
+                    }
+                };
                 let radius = (signed(fx).powi(2) + signed(fy).powi(2)).sqrt();
                 power.push((radius, re * re + im * im));
             }

@@ -261,7 +261,9 @@ impl RenderProbe<'_> {
                     uv: hit_si.uv,
                     distance_m: hit.t,
                 };
-                let le = lights.light(l).emitted_radiance(&light_hit, -wi, wavelengths);
+                let le = lights
+                    .light(l)
+                    .emitted_radiance(&light_hit, -wi, wavelengths);
                 vec![(l, le, hit.t, Some(light_hit))]
             }
             None => lights
@@ -335,7 +337,11 @@ impl ShadingProbe for RenderProbe<'_> {
                         light_share * pmf * ls.pdf
                             + bsdf_share * bsdf.pdf(wo_local, wi_local, TransportMode::Radiance)
                     };
-                    let divisor = if ls.delta { light_share * pmf } else { pdf_per_sr };
+                    let divisor = if ls.delta {
+                        light_share * pmf
+                    } else {
+                        pdf_per_sr
+                    };
                     let lanes = lane_variance(ls.radiance * f * (1.0 / divisor), &wavelengths);
                     out.push(LightSample {
                         direction: ls.wi,
@@ -363,7 +369,7 @@ impl ShadingProbe for RenderProbe<'_> {
                     ) else {
                         continue;
                     };
-                    if !(bs.pdf > 0.0) {
+                    if bs.pdf.is_nan() || bs.pdf <= 0.0 {
                         continue;
                     }
                     let cos = bs.wi.z.abs();
@@ -371,7 +377,7 @@ impl ShadingProbe for RenderProbe<'_> {
                     for (l, le, distance_m, light_hit) in self.emitters_along(&si, wi, &wavelengths)
                     {
                         let radiance_y = luminance_y(le, &wavelengths);
-                        if !(radiance_y > 0.0) {
+                        if radiance_y.is_nan() || radiance_y <= 0.0 {
                             continue;
                         }
                         let (pdf_per_sr, bsdf_cos_per_sr) = if bs.specular {
@@ -381,11 +387,8 @@ impl ShadingProbe for RenderProbe<'_> {
                                 reflectance_y(bs.f * (cos / (bsdf_share * bs.pdf)), &wavelengths),
                             )
                         } else {
-                            let light_pdf = self.light_pdf(
-                                &ctx,
-                                wi,
-                                light_hit.as_ref().map(|h| (l, h)),
-                            );
+                            let light_pdf =
+                                self.light_pdf(&ctx, wi, light_hit.as_ref().map(|h| (l, h)));
                             (
                                 bsdf_share * bs.pdf + light_share * light_pdf,
                                 reflectance_y(bs.f * cos, &wavelengths),
@@ -481,7 +484,10 @@ mod tests {
     fn mixture_weights_estimate_the_reflected_radiance() {
         for (material, expected) in [
             (r#"{"type": "lambert", "reflectance": 0.6}"#, Some(0.6)),
-            (r#"{"type": "conductor", "metal": "Al", "roughness": 0.2}"#, None),
+            (
+                r#"{"type": "conductor", "metal": "Al", "roughness": 0.2}"#,
+                None,
+            ),
         ] {
             let json = format!(
                 r#"{{"materials": {{"m": {material}}},
