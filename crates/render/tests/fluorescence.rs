@@ -43,7 +43,36 @@ impl Data {
         }
         std::fs::write(dir.path().join("dye-abs.csv"), abs).unwrap();
         std::fs::write(dir.path().join("dye-em.csv"), em).unwrap();
-        write_band_bfc(&dir.path().join("band.bfc"), 0.5, 0.4);
+        write_band_bfc(
+            &dir.path().join("band.bfc"),
+            0.5,
+            0.4,
+            (400, 450),
+            (560, 610),
+        );
+        write_band_bfc(&dir.path().join("uv.bfc"), 0.5, 0.4, (300, 340), (500, 550));
+        // band.bfc with a negative patch D = −0.01 (measurement noise, exaggerated) from
+        // 470–490 nm into 600–620 nm.
+        let band = std::fs::read_to_string(dir.path().join("band.bfc")).unwrap();
+        let signed: Vec<String> = band
+            .split("\r\n")
+            .map(|line| {
+                let fields: Vec<&str> = line.split('\t').collect();
+                match fields[0].parse::<i32>() {
+                    Ok(out) if (600..=620).contains(&out) && fields.len() == 55 => {
+                        let mut f: Vec<String> = fields.iter().map(|s| s.to_string()).collect();
+                        for x in 0..54 {
+                            if (470..=490).contains(&(300 + 10 * x)) {
+                                f[x as usize + 1] = "-0.01".into();
+                            }
+                        }
+                        f.join("\t")
+                    }
+                    _ => line.to_string(),
+                }
+            })
+            .collect();
+        std::fs::write(dir.path().join("signed.bfc"), signed.join("\r\n")).unwrap();
         Self { dir }
     }
 
@@ -53,10 +82,11 @@ impl Data {
 }
 
 /// A BFC-450 file, excitation 300–830 nm and emission 360–830 nm every 10 nm: R = `r` on
-/// the diagonal, and M = k/50 nm⁻¹ (D = M·10 nm per band) at the nodes from band A =
-/// 400–450 nm into band B = 560–610 nm, 0 at the other nodes (bilinear in between, so the
-/// bands have 10 nm ramps: A reaches 390–460 nm, B 550–620 nm, still disjoint).
-fn write_band_bfc(path: &Path, r: f64, k: f64) {
+/// the diagonal, and M = k/50 nm⁻¹ (D = M·10 nm per band) at the nodes from band `a` (nm)
+/// into band `b`, 0 at the other nodes (bilinear in between, so the bands have 10 nm
+/// ramps: `band.bfc`'s A = 400–450 nm reaches 390–460 nm, its B = 560–610 nm 550–620 nm,
+/// still disjoint).
+fn write_band_bfc(path: &Path, r: f64, k: f64, a: (i32, i32), b: (i32, i32)) {
     let mut text = String::from("VEC_01\t1\r\nBFC-450 Matrix File\r\n; synthetic band matrix\r\n");
     text += "360\t830\t10\t54\t300\t10\r\nr:c:";
     for x in 0..54 {
@@ -70,7 +100,7 @@ fn write_band_bfc(path: &Path, r: f64, k: f64) {
             let ex = 300 + 10 * x;
             let d = if ex == out {
                 r
-            } else if (400..=450).contains(&ex) && (560..=610).contains(&out) {
+            } else if (a.0..=a.1).contains(&ex) && (b.0..=b.1).contains(&out) {
                 k / 50.0 * 10.0
             } else {
                 0.0
@@ -227,6 +257,100 @@ fn one_bounce_under_a_uniform_sky_matches_the_bilinear_model() {
             "{total:?} {reflected:?}"
         );
     }
+}
+
+/// Lights excite down to 300 nm where their spectrum is defined there: a surface excited
+/// only at 300–350 nm glows under a D65 sky (CIE table from 300 nm) as the quadrature says,
+/// and not at all under an RGB-given sky (0 below 360 nm, as `--explain` says).
+#[test]
+fn ultraviolet_excitation_comes_from_lights_defined_below_360_nm() {
+    let data = Data::new();
+    let m = load_bfc(Path::new(&data.path("uv.bfc")), NegativesPolicy::Clamp)
+        .unwrap()
+        .matrix;
+    let scene = |sky: &str| {
+        format!(
+            r#"{{
+          "camera": {{"type": "orthographic", "width_m": 0.5,
+                      "transform": {{"look_at": {{"eye": [0, 1, 0], "target": [0, 0, 0], "up": [0, 0, -1]}}}}}},
+          "film": {{"resolution": [16, 16], "filter": {{"type": "box", "radius_px": 0.5}}}},
+          "integrator": {{"type": "path", "max_depth": 1}},
+          "reradiation": {{"uv": {{"bfc": "{bfc}"}}}},
+          "materials": {{"card": {{"type": "fluorescent", "reradiation": "uv"}}}},
+          "shapes": [{{"type": "rectangle", "size_m": [1000, 1000], "material": "card",
+              "transform": {{"rotate": {{"axis": [1, 0, 0], "angle_deg": -90}}}}}}],
+          "lights": [{{"type": "sky", "spectrum": {sky}, "scale": 0.01}}]
+        }}"#,
+            bfc = data.path("uv.bfc")
+        )
+    };
+    let d65 = illuminant("D65").unwrap();
+    let s = |l: f64| 0.01 * d65.eval(l);
+    let expected = film_xyz(|l| 0.5 * s(l) + gathered(&m, &s, l));
+    let reflected = film_xyz(|l| 0.5 * s(l));
+    assert!(expected[1] - reflected[1] > 0.05 * expected[1]);
+    let image = mean_and_se(&render_scene(&build(&scene(r#""D65""#)), 256, 21));
+    for (c, (mean, se)) in image.into_iter().enumerate() {
+        assert_close(&format!("D65 UV-excited {c}"), mean, se, expected[c], 2e-4);
+    }
+    // White RGB sky: only the reflected part, exactly (no lane can gather anything).
+    let image = render_scene(&build(&scene(r#"{"rgb": [1, 1, 1]}"#)), 64, 22);
+    let r_only = render_scene(
+        &build(&scene(r#"{"rgb": [1, 1, 1]}"#).replace(
+            r#""card": {"type": "fluorescent", "reradiation": "uv"}"#,
+            r#""card": {"type": "lambert", "reflectance": 0.5}"#,
+        )),
+        64,
+        22,
+    );
+    let (a, b) = (mean_and_se(&image), mean_and_se(&r_only));
+    for c in 0..3 {
+        let diff = a[c].0 - b[c].0;
+        let se = (a[c].1.powi(2) + b[c].1.powi(2)).sqrt();
+        eprintln!("RGB sky, fluorescent part {c}: {diff:.2e} (se {se:.1e})");
+        assert!(
+            diff.abs() < 4.0 * se + 1e-6,
+            "channel {c}: {diff} (se {se})"
+        );
+    }
+}
+
+/// `negatives: keep` renders the signed matrix (λ_in ∝ |M|, the sign in the weight),
+/// `clamp` the clamped one: each matches the quadrature of its own matrix, and they differ.
+#[test]
+fn kept_negatives_render_the_signed_matrix_and_clamped_ones_the_clamped() {
+    let data = Data::new();
+    let path = data.path("signed.bfc");
+    let mut results = Vec::new();
+    for (policy, seed) in [("keep", 31u64), ("clamp", 32)] {
+        let m = load_bfc(Path::new(&path), NegativesPolicy::parse(policy).unwrap())
+            .unwrap()
+            .matrix;
+        assert_eq!(m.is_signed(), policy == "keep");
+        let json = format!(
+            r#"{{
+          "camera": {{"type": "orthographic", "width_m": 0.5,
+                      "transform": {{"look_at": {{"eye": [0, 1, 0], "target": [0, 0, 0], "up": [0, 0, -1]}}}}}},
+          "film": {{"resolution": [16, 16], "filter": {{"type": "box", "radius_px": 0.5}}}},
+          "integrator": {{"type": "path", "max_depth": 1}},
+          "reradiation": {{"x": {{"bfc": "{path}", "negatives": "{policy}"}}}},
+          "materials": {{"card": {{"type": "fluorescent", "reradiation": "x"}}}},
+          "shapes": [{{"type": "rectangle", "size_m": [1000, 1000], "material": "card",
+              "transform": {{"rotate": {{"axis": [1, 0, 0], "angle_deg": -90}}}}}}],
+          "lights": [{{"type": "sky", "spectrum": "D65", "scale": 0.01}}]
+        }}"#
+        );
+        let d65 = illuminant("D65").unwrap();
+        let s = |l: f64| 0.01 * d65.eval(l);
+        let expected = film_xyz(|l| 0.5 * s(l) + gathered(&m, &s, l));
+        let image = mean_and_se(&render_scene(&build(&json), 256, seed));
+        for (c, (mean, se)) in image.into_iter().enumerate() {
+            assert_close(&format!("{policy} {c}"), mean, se, expected[c], 2e-4);
+        }
+        results.push(expected);
+    }
+    // The negative patch takes light from 600–620 nm: X (red) drops when it is kept.
+    assert!(results[0][0] < results[1][0] - 1e-3, "{results:?}");
 }
 
 fn furnace_scene(data: &Data, le: f64, lanes: &str) -> String {
