@@ -426,9 +426,9 @@ fn reradiation_reason(scene: &RenderScene, lanes: prism_scene::FluorescenceLanes
     };
     format!(
         "{} shift lanes to excitation wavelengths down to 300 nm; {lanes}. Lights excite \
-         below 360 nm where their spectrum reaches: CIE illuminant tables, blackbodies and \
-         spectrum files do; RGB-given emitters, daylight skies and environment maps give 0 \
-         there",
+         below 360 nm where their spectrum reaches: CIE illuminant tables, blackbodies, \
+         spectrum files and daylight skies and suns do; RGB-given emitters and environment \
+         maps give 0 there",
         materials.join(", ")
     )
 }
