@@ -433,6 +433,20 @@ fn packet_light_tracer_and_bdpt_refuse_reradiation_and_path_renders_it() {
          but the packet tracer evaluates reflectances once per camera sample"
     );
     assert!(scene.packet.is_none());
+    // `--explain` prints the refusal and the re-radiation line (material, entry, lanes).
+    let request = prism_render::PlanRequest {
+        spp: 1,
+        spectral_bins: None,
+        aov_output: false,
+        sampler: "independent",
+    };
+    let plan = prism_render::RenderPlan::new(&scene, &request).to_string();
+    assert!(plan.contains(&format!("not used: {why}")), "{plan}");
+    assert!(
+        plan.contains("re-radiation (fluorescence)") && plan.contains("on, lanes: all"),
+        "{plan}"
+    );
+    assert!(plan.contains("`card` (dye `dye`)"), "{plan}");
     scene.resolution = UVec2::new(4, 4);
     let image = render_scene(&scene, 4, 1);
     assert!(image.y.iter().all(|y| y.is_finite() && *y > 0.0));

@@ -379,16 +379,13 @@ impl PathTracer {
                 &path.wavelengths,
                 &mut reflectance_cache,
             );
-            if let (Some(d), Some(f)) = (reradiation_dims, material.fluorescent()) {
-                let lanes = &mut path.wavelengths;
-                fluorescent_vertex::scatter(
-                    self.fluorescence_lanes,
-                    f,
-                    &mut bsdf,
-                    lanes,
-                    &path.stream,
-                    d,
-                );
+            // Re-radiation (fluorescent_vertex.rs): asked only in scenes that have it.
+            if let Some(d) = reradiation_dims {
+                if let Some(f) = material.fluorescent() {
+                    let lanes = &mut path.wavelengths;
+                    let mode = self.fluorescence_lanes;
+                    fluorescent_vertex::scatter(mode, f, &mut bsdf, lanes, &path.stream, d);
+                }
             }
             let vertex =
                 ScatterVertex::Surface(SurfaceVertex::new(&si, &bsdf, ray.direction, shading_maps));
