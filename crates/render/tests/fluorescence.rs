@@ -52,7 +52,7 @@ impl Data {
         );
         write_band_bfc(&dir.path().join("uv.bfc"), 0.5, 0.4, (300, 340), (500, 550));
         // band.bfc with a negative patch D = −0.01 (measurement noise, exaggerated) from
-        // 470–490 nm into 600–620 nm.
+        // 470–490 nm into 600–620 nm, and a negative diagonal R(700 nm) = −0.02.
         let band = std::fs::read_to_string(dir.path().join("band.bfc")).unwrap();
         let signed: Vec<String> = band
             .split("\r\n")
@@ -66,6 +66,11 @@ impl Data {
                                 f[x as usize + 1] = "-0.01".into();
                             }
                         }
+                        f.join("\t")
+                    }
+                    Ok(700) if fields.len() == 55 => {
+                        let mut f: Vec<String> = fields.iter().map(|s| s.to_string()).collect();
+                        f[41] = "-0.02".into();
                         f.join("\t")
                     }
                     _ => line.to_string(),
@@ -315,18 +320,19 @@ fn ultraviolet_excitation_comes_from_lights_defined_below_360_nm() {
     }
 }
 
-/// `negatives: keep` renders the signed matrix (λ_in ∝ |M|, the sign in the weight),
-/// `clamp` the clamped one: each matches the quadrature of its own matrix, and they differ.
+/// `negatives: keep` renders the signed matrix and diagonal (λ_in ∝ |M|, the choice by |R|
+/// and ∫|M|, the sign in the weight), `clamp` the clamped ones: each matches the quadrature
+/// of its own R and M, and they differ.
 #[test]
 fn kept_negatives_render_the_signed_matrix_and_clamped_ones_the_clamped() {
     let data = Data::new();
     let path = data.path("signed.bfc");
     let mut results = Vec::new();
     for (policy, seed) in [("keep", 31u64), ("clamp", 32)] {
-        let m = load_bfc(Path::new(&path), NegativesPolicy::parse(policy).unwrap())
-            .unwrap()
-            .matrix;
+        let data = load_bfc(Path::new(&path), NegativesPolicy::parse(policy).unwrap()).unwrap();
+        let (m, r) = (data.matrix, data.reflectance);
         assert_eq!(m.is_signed(), policy == "keep");
+        assert_eq!(r.eval(700.0), if policy == "keep" { -0.02 } else { 0.0 });
         let json = format!(
             r#"{{
           "camera": {{"type": "orthographic", "width_m": 0.5,
@@ -342,7 +348,7 @@ fn kept_negatives_render_the_signed_matrix_and_clamped_ones_the_clamped() {
         );
         let d65 = illuminant("D65").unwrap();
         let s = |l: f64| 0.01 * d65.eval(l);
-        let expected = film_xyz(|l| 0.5 * s(l) + gathered(&m, &s, l));
+        let expected = film_xyz(|l| r.eval(l) * s(l) + gathered(&m, &s, l));
         let image = mean_and_se(&render_scene(&build(&json), 256, seed));
         for (c, (mean, se)) in image.into_iter().enumerate() {
             assert_close(&format!("{policy} {c}"), mean, se, expected[c], 2e-4);
