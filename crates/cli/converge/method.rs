@@ -236,12 +236,27 @@ impl Method {
         };
         // The sampler is the method's (`:SAMPLER`); the description's is not read.
         let sampler = self.sampler;
+        // The lane mode of re-radiation is the scene's when it renders with `path`.
+        let fluorescence_lanes = match *scene {
+            prism_scene::Integrator::Path {
+                fluorescence_lanes, ..
+            } => fluorescence_lanes,
+            prism_scene::Integrator::Light { .. }
+            | prism_scene::Integrator::Bdpt { .. }
+            | prism_scene::Integrator::Depth
+            | prism_scene::Integrator::Normal
+            | prism_scene::Integrator::Albedo
+            | prism_scene::Integrator::AmbientOcclusion { .. } => {
+                prism_scene::FluorescenceLanes::default()
+            }
+        };
         let description = match (self.integrator, scene) {
             ("path", _) => prism_scene::Integrator::Path {
                 max_depth,
                 sampler,
                 mis,
                 rr_depth,
+                fluorescence_lanes,
             },
             ("light", _) => prism_scene::Integrator::Light {
                 max_depth,
@@ -324,6 +339,7 @@ mod tests {
             sampler: SamplerKind::Sobol,
             mis: prism_scene::MisHeuristic::Balance,
             rr_depth: 2,
+            fluorescence_lanes: prism_scene::FluorescenceLanes::All,
         };
         let m = Method::parse("bdpt:sobol").unwrap();
         assert_eq!(m.quantity(), "radiance");
@@ -356,6 +372,7 @@ mod tests {
             sampler: SamplerKind::Sobol,
             mis: prism_scene::MisHeuristic::Balance,
             rr_depth: 2,
+            fluorescence_lanes: prism_scene::FluorescenceLanes::All,
         };
         let m = Method::parse("path").unwrap();
         match m.integrator(&scene).unwrap() {

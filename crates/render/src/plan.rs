@@ -227,6 +227,15 @@ impl RenderPlan {
                         )
                     },
                 );
+                choose(
+                    "re-radiation (fluorescence)",
+                    if scene.has_reradiation {
+                        format!("on, lanes: {}", lanes_name(p.fluorescence_lanes))
+                    } else {
+                        "off".into()
+                    },
+                    reradiation_reason(scene, p.fluorescence_lanes),
+                );
                 let nee = !lights.is_empty() && any_non_specular;
                 choose(
                     "light sampling (next-event estimation)",
@@ -433,6 +442,53 @@ impl RenderPlan {
             simd: prism_cpu::choice(),
         }
     }
+}
+
+fn lanes_name(lanes: prism_scene::FluorescenceLanes) -> &'static str {
+    match lanes {
+        prism_scene::FluorescenceLanes::All => "all",
+        prism_scene::FluorescenceLanes::Hero => "hero",
+    }
+}
+
+/// Why re-radiation is on or off: the fluorescent materials with their entries (and, for BFC
+/// files, the negatives policy and what it did: clamping moves XYZ), the lane mode and how
+/// far down the lights excite.
+fn reradiation_reason(scene: &RenderScene, lanes: prism_scene::FluorescenceLanes) -> String {
+    let materials: Vec<String> = scene
+        .materials
+        .iter()
+        .zip(&scene.material_names)
+        .filter_map(|(m, name)| {
+            let f = m.fluorescent()?;
+            Some(match &f.negatives {
+                Some((policy, report)) => format!(
+                    "`{name}` (BFC `{}`, negatives {}: {report})",
+                    f.reradiation,
+                    policy.name()
+                ),
+                None => format!("`{name}` (dye `{}`)", f.reradiation),
+            })
+        })
+        .collect();
+    if materials.is_empty() {
+        return "no `fluorescent` material".into();
+    }
+    let lanes = match lanes {
+        prism_scene::FluorescenceLanes::All => {
+            "each lane reflects or re-radiates on its own and keeps going"
+        }
+        prism_scene::FluorescenceLanes::Hero => {
+            "secondary lanes end where a lane re-radiates (fluorescence_lanes hero)"
+        }
+    };
+    format!(
+        "{} shift lanes to excitation wavelengths down to 300 nm; {lanes}. Lights excite \
+         below 360 nm where their spectrum reaches: CIE illuminant tables, blackbodies, \
+         spectrum files and daylight skies and suns do; RGB-given emitters and environment \
+         maps give 0 there",
+        materials.join(", ")
+    )
 }
 
 impl fmt::Display for RenderPlan {

@@ -26,6 +26,7 @@ const DECISIONS: &[(&str, bool, bool, &[SceneFeature])] = {
         ("cameras/thin-lens.json", false, true, &[DiagnosticIntegrator, NonLambertianBsdfs, Quadrics, ThinLensCamera]),
         ("cornell-box.json", true, true, &[]),
         ("daylight-room.json", false, true, &[ThinGlazing, NonLambertianBsdfs, InfiniteLights]),
+        ("fluorescence.json", false, true, &[DeltaLights, Reradiation]),
         ("glossy-env.json", false, true, &[Dispersion, NonLambertianBsdfs, Quadrics, InfiniteLights]),
         ("material-gallery.json", false, true, &[ThinGlazing, NonLambertianBsdfs, Quadrics, InfiniteLights]),
         ("merl/sources.json", false, true, &[NonLambertianBsdfs, Quadrics]),

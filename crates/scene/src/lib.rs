@@ -14,6 +14,7 @@ pub mod material;
 pub mod medium;
 pub mod photometric;
 mod reader;
+pub mod reradiation;
 pub mod scene;
 pub mod schema;
 pub mod sensor;
@@ -26,12 +27,13 @@ pub use camera::{Camera, CameraKind, FisheyeFit, FisheyeProjection, FovAxis};
 pub use daylight::{DateTime, DaylightSky, SkyModel, SkyNormalisation, SunPosition};
 pub use error::{JsonPath, PathSegment, Position, SceneError};
 pub use film::{Aov, Film, PixelFilter, Reconstruction};
-pub use integrator::{Integrator, MisHeuristic, SamplerKind};
+pub use integrator::{FluorescenceLanes, Integrator, MisHeuristic, SamplerKind};
 pub use light::{Light, LightKind, Strength};
 pub use material::{
     ConductorOptics, Ior, LafortuneLobe, LibraryKind, Material, MaterialKind, Microfacet, Roughness,
 };
 pub use medium::{Medium, MediumKind};
+pub use reradiation::{Reradiation, ReradiationKind};
 pub use scene::{load_scene, parse_scene_str, SceneDescription};
 pub use sensor::{Sensor, SensorKind, SensorSampling};
 pub use shape::{MeshAsset, MeshFormat, Shape, ShapeKind};

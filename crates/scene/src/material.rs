@@ -6,6 +6,7 @@
 //! `reflectance`, conductor and dielectric `roughness`, mask `opacity`.
 
 use crate::reader::{quoted_list, suggest, Obj, Result, V};
+use crate::reradiation::Reradiation;
 use crate::schema::{row, schema, ObjectSchema};
 use crate::spectrum_ref::{parse_spectrum, NamedSpectra, SpectrumRef, SpectrumUse};
 use crate::texture::{is_texture_ref, parse_spectrum_param, parse_texture_ref};
@@ -61,6 +62,13 @@ pub enum MaterialKind {
     Mix { materials: [usize; 2], weight: f64 },
     /// A material of the library: parameters that are numbers and spectra only.
     Library(LibraryKind),
+    /// Lambertian with re-radiation (fluorescence): R(λ)/π plus M(λ_in, λ_out)/π, M from
+    /// the `reradiation` entry (index into `SceneDescription::reradiation`). `reflectance`
+    /// is `None` for a BFC entry (its diagonal is R) and for a dye without one (R = 1 − a).
+    Fluorescent {
+        reradiation: usize,
+        reflectance: Option<SpectrumRef>,
+    },
 }
 
 /// The material library (issue 8 and after): the kinds whose parameters are numbers and
@@ -178,7 +186,7 @@ pub enum Ior {
     },
 }
 
-const TYPES: [&str; 18] = [
+const TYPES: [&str; 19] = [
     "lambert",
     "conductor",
     "dielectric",
@@ -197,6 +205,7 @@ const TYPES: [&str; 18] = [
     "normal_map",
     "bump_map",
     "sheen",
+    "fluorescent",
 ];
 
 /// Rows of `schema::rows()` for the material library's kinds: the keys each accepts
@@ -245,14 +254,28 @@ pub(crate) fn parse_materials(
     v: &V,
     spectra: &NamedSpectra,
     textures: &mut TextureTable,
+    reradiation: &[Reradiation],
 ) -> Result<Vec<Material>> {
     let entries = v.map()?;
     let names: Vec<&str> = entries.iter().map(|(n, _)| *n).collect();
+    let fluorescent: Vec<&str> = entries
+        .iter()
+        .filter(|(_, e)| {
+            e.member("type")
+                .is_some_and(|t| t.str() == Ok("fluorescent"))
+        })
+        .map(|(n, _)| *n)
+        .collect();
+    let cx = MaterialContext {
+        names: &names,
+        fluorescent: &fluorescent,
+        reradiation,
+    };
     let mut materials = Vec::with_capacity(entries.len());
     for (name, entry) in &entries {
         materials.push(Material {
             name: name.to_string(),
-            kind: parse_material(entry, spectra, &names, textures)?,
+            kind: parse_material(entry, spectra, &cx, textures)?,
         });
     }
     // Wrappers reference one material, mixes two: refuse any cycle (depth-first search
@@ -292,7 +315,8 @@ fn references(kind: &MaterialKind) -> Vec<usize> {
         | MaterialKind::Conductor { .. }
         | MaterialKind::Dielectric { .. }
         | MaterialKind::ThinDielectric { .. }
-        | MaterialKind::Library(_) => Vec::new(),
+        | MaterialKind::Library(_)
+        | MaterialKind::Fluorescent { .. } => Vec::new(),
     }
 }
 
@@ -367,13 +391,39 @@ fn roughness_and_distribution(
     Ok((roughness, distribution, roughness_texture))
 }
 
+/// What a material may refer to besides spectra and textures.
+struct MaterialContext<'a> {
+    /// Every material name, in file order.
+    names: &'a [&'a str],
+    /// The names of the `fluorescent` materials.
+    fluorescent: &'a [&'a str],
+    reradiation: &'a [Reradiation],
+}
+
 fn parse_material(
     v: &V,
     spectra: &NamedSpectra,
-    names: &[&str],
+    cx: &MaterialContext,
     textures: &mut TextureTable,
 ) -> Result<MaterialKind> {
+    let names = cx.names;
     Ok(match v.tag("material", &TYPES, None)? {
+        "fluorescent" => parse_fluorescent(v, spectra, cx.reradiation)?,
+        "coated" => {
+            // The coat's base is a spectrum; naming a fluorescent material there asks for
+            // re-radiation under a coat, which the coated lobe cannot carry.
+            if let Some(d) = v.member("diffuse") {
+                if let Ok(base) = d.str() {
+                    if cx.fluorescent.contains(&base) {
+                        return Err(d.err(format!(
+                            "`coated` over a fluorescent base (`{base}`) is not supported yet: \
+                             the coat's lobe evaluates its base at one wavelength per lane"
+                        )));
+                    }
+                }
+            }
+            MaterialKind::Library(parse_library_material("coated", v, spectra)?)
+        }
         "lambert" => {
             let o = v.tagged_object(schema!("materials.*<lambert>"))?;
             MaterialKind::Lambert {
@@ -497,6 +547,48 @@ fn parse_material(
             }
         }
         other => MaterialKind::Library(parse_library_material(other, v, spectra)?),
+    })
+}
+
+/// `{"type": "fluorescent", "reradiation": NAME, "reflectance": …}`.
+fn parse_fluorescent(
+    v: &V,
+    spectra: &NamedSpectra,
+    reradiation: &[Reradiation],
+) -> Result<MaterialKind> {
+    let o = v.tagged_object(schema!("materials.*<fluorescent>"))?;
+    let known: Vec<&str> = reradiation.iter().map(|r| r.name.as_str()).collect();
+    let r = o.req(
+        "reradiation",
+        "the name of an entry of the top-level `reradiation` section (its Donaldson matrix)",
+    )?;
+    let wanted = r.str()?;
+    let index = known.iter().position(|n| *n == wanted).ok_or_else(|| {
+        let defined = if known.is_empty() {
+            "the scene has no `reradiation` section".to_string()
+        } else {
+            format!("defined: {}", quoted_list(&known))
+        };
+        r.err(format!(
+            "unknown reradiation `{wanted}` ({defined}){}",
+            suggest(wanted, known.iter().copied())
+        ))
+    })?;
+    let reflectance = match o.get("reflectance") {
+        None => None,
+        Some(refl) => {
+            if reradiation[index].has_own_reflectance() {
+                return Err(refl.err(format!(
+                    "reradiation `{wanted}` is a BFC file, whose diagonal is the reflectance \
+                     R(λ): remove `reflectance`"
+                )));
+            }
+            Some(parse_spectrum(&refl, spectra, SpectrumUse::Reflectance)?)
+        }
+    };
+    Ok(MaterialKind::Fluorescent {
+        reradiation: index,
+        reflectance,
     })
 }
 

@@ -1,5 +1,5 @@
 //! The whole scene: the top-level object and the order its sections are resolved in
-//! (spectra → media → materials → meshes → shapes → lights; camera, film, integrator).
+//! (spectra → media → reradiation → materials → meshes → shapes → lights; camera, film, integrator).
 
 use std::path::{Path, PathBuf};
 
@@ -12,6 +12,7 @@ use crate::light::{parse_light, Light};
 use crate::material::{parse_materials, Material};
 use crate::medium::{parse_media, Medium};
 use crate::reader::{Ctx, Result, V};
+use crate::reradiation::{parse_reradiation, Reradiation};
 use crate::schema::schema;
 use crate::sensor::{parse_sensors, Sensor};
 use crate::shape::{parse_meshes, parse_shape, MeshAsset, Shape, ShapeContext};
@@ -40,9 +41,11 @@ pub struct SceneDescription {
     /// The `textures` section, then textures defined inline in materials (materials refer
     /// to them by index).
     pub textures: Vec<Texture>,
+    /// The `reradiation` section (fluorescent materials refer to it by index).
+    pub reradiation: Vec<Reradiation>,
 }
 
-pub const TOP_LEVEL_FIELDS: [&str; 12] = [
+pub const TOP_LEVEL_FIELDS: [&str; 13] = [
     "camera",
     "film",
     "integrator",
@@ -54,6 +57,7 @@ pub const TOP_LEVEL_FIELDS: [&str; 12] = [
     "media",
     "sensors",
     "textures",
+    "reradiation",
     "$schema",
 ];
 
@@ -127,8 +131,11 @@ fn parse_root(v: &V) -> Result<SceneDescription> {
         Some(t) => parse_textures(&t, &spectra)?,
         None => TextureTable::default(),
     };
+    let reradiation = o
+        .get("reradiation")
+        .map_or(Ok(Vec::new()), |r| parse_reradiation(&r))?;
     let materials = o.get("materials").map_or(Ok(Vec::new()), |m| {
-        parse_materials(&m, &spectra, &mut textures)
+        parse_materials(&m, &spectra, &mut textures, &reradiation)
     })?;
     let mut meshes = o
         .get("meshes")
@@ -185,5 +192,6 @@ fn parse_root(v: &V) -> Result<SceneDescription> {
         media,
         sensors,
         textures: textures.textures,
+        reradiation,
     })
 }

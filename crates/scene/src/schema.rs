@@ -159,7 +159,14 @@ pub const SCHEMA: &[ObjectSchema] = &[
     ),
     row(
         "integrator<path>",
-        &[&["type", "max_depth", "sampler", "mis", "rr_depth"]],
+        &[&[
+            "type",
+            "max_depth",
+            "sampler",
+            "mis",
+            "rr_depth",
+            "fluorescence_lanes",
+        ]],
     ),
     // `mis` is refused before the keys are checked: light tracing has one strategy.
     row(
@@ -169,6 +176,23 @@ pub const SCHEMA: &[ObjectSchema] = &[
     row(
         "integrator<bdpt>",
         &[&["type", "max_depth", "sampler", "mis", "rr_depth"]],
+    ),
+    // reradiation.rs: the entries have no `type`; `<bfc>` and `<dye>` name the two forms,
+    // told apart by the `bfc` and `absorption`/`emission` keys.
+    row("reradiation.*<bfc>", &[&["bfc", "negatives"]]),
+    row(
+        "reradiation.*<dye>",
+        &[&[
+            "absorption",
+            "emission",
+            "quantum_yield",
+            "peak_absorptance",
+        ]],
+    ),
+    // material.rs (the kinds outside the library: `material::LIBRARY_SCHEMA` has those)
+    row(
+        "materials.*<fluorescent>",
+        &[&["type", "reradiation", "reflectance"]],
     ),
     // medium.rs
     row(

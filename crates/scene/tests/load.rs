@@ -170,7 +170,8 @@ fn every_field_kind_comes_through() {
             max_depth: 5,
             sampler: SamplerKind::Independent,
             mis: MisHeuristic::Balance,
-            rr_depth: 2
+            rr_depth: 2,
+            fluorescence_lanes: prism_scene::FluorescenceLanes::All,
         }
     );
 

@@ -48,6 +48,9 @@ fn scene_with(pattern: &str) -> Option<String> {
             r#"{"materials": {"x": {"type": "dielectric", "ior": {"cauchy": {$}}}}}"#.into()
         }
         "@spectrum" => r#"{"spectra": {"s": {$}}}"#.into(),
+        // Re-radiation entries have no `type`: the form is told by `bfc` or `absorption`.
+        "reradiation.*<bfc>" => r#"{"reradiation": {"r": {"bfc": "r.bfc", $}}}"#.into(),
+        "reradiation.*<dye>" => r#"{"reradiation": {"r": {"absorption": "a.csv", $}}}"#.into(),
         "@texture_ref" => r#"{"materials": {"x": {"type": "lambert",
                               "reflectance": {"texture": "t", $}}}}"#
             .into(),

@@ -89,6 +89,35 @@ impl VertexDimensions {
     }
 }
 
+/// Two more dimensions per vertex in scenes with re-radiation (`RenderScene::
+/// has_reradiation`), right after the vertex's block: the lanes' choice between reflection
+/// and re-radiation, and the excitation wavelength (integrator/fluorescent_vertex.rs).
+/// Other scenes do not reserve them, so their dimensions (and images) are unchanged.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ReradiationDimensions {
+    first: u32,
+}
+
+impl ReradiationDimensions {
+    pub const COUNT: u32 = 2;
+
+    /// Reserves the pair at the stream's cursor.
+    #[inline(always)]
+    pub fn reserve(stream: &mut SampleStream) -> Self {
+        Self {
+            first: stream.reserve(Self::COUNT),
+        }
+    }
+    #[inline(always)]
+    pub fn choice(&self) -> u32 {
+        self.first
+    }
+    #[inline(always)]
+    pub fn excitation(&self) -> u32 {
+        self.first + 1
+    }
+}
+
 /// The block that starts a light path: light choice 1, position on the light 2, direction
 /// of emission 2, and the lens point (2) of light tracing's connection of the light's own
 /// point to the camera.

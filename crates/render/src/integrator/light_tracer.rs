@@ -43,6 +43,8 @@ impl LightTracer {
             max_depth: self.max_depth,
             rr_depth: self.rr_depth,
             mis: prism_scene::MisHeuristic::Power,
+            // Light paths refuse re-radiation (`prepare`); sensors path-trace with all lanes.
+            fluorescence_lanes: prism_scene::FluorescenceLanes::All,
         }
     }
 
@@ -195,6 +197,7 @@ impl Estimator for LightTracer {
     }
 
     fn prepare(&mut self, scene: &RenderScene, _pass: &Pass) -> Result<(), String> {
+        scene.refuse_reradiation("light")?;
         scene
             .camera
             .importance_support()

@@ -31,6 +31,7 @@ mod diagnostic;
 pub mod dimensions;
 mod driver;
 mod estimator;
+mod fluorescent_vertex;
 mod lane_wavelengths;
 mod light_tracer;
 mod normal;
@@ -97,11 +98,13 @@ impl Integrator {
                 max_depth,
                 mis,
                 rr_depth,
+                fluorescence_lanes,
                 ..
             } => Integrator::Path(PathTracer {
                 max_depth: max_depth.max(1),
                 rr_depth,
                 mis,
+                fluorescence_lanes,
             }),
             prism_scene::Integrator::Light {
                 max_depth,
@@ -136,6 +139,7 @@ impl Integrator {
                 max_depth: l.max_depth,
                 rr_depth: l.rr_depth,
                 mis: prism_scene::MisHeuristic::Power,
+                fluorescence_lanes: prism_scene::FluorescenceLanes::All,
             },
             Integrator::Bdpt(b) => b.path_tracer(),
             Integrator::Depth

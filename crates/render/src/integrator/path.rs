@@ -12,9 +12,11 @@
 
 use glam::{Vec2, Vec3A};
 use prism_geometry::{Ray, RayDifferential};
-use prism_scene::MisHeuristic;
+use prism_scene::{FluorescenceLanes, MisHeuristic};
 use prism_spectrum::{SampledSpectrum, SampledWavelengths};
 
+use super::dimensions::ReradiationDimensions;
+use super::fluorescent_vertex;
 use super::lane_wavelengths::LaneWavelengths;
 use super::path_state::{PathOrigin, PathState};
 use super::scatter_vertex::{ScatterVertex, SurfaceVertex};
@@ -32,6 +34,8 @@ pub struct PathTracer {
     /// Russian roulette starts after this many scattering events.
     pub rr_depth: u32,
     pub mis: MisHeuristic,
+    /// What the lanes do at a fluorescent vertex (integrator/fluorescent_vertex.rs).
+    pub fluorescence_lanes: FluorescenceLanes,
 }
 
 impl Default for PathTracer {
@@ -41,6 +45,7 @@ impl Default for PathTracer {
             max_depth: 8,
             rr_depth: 3,
             mis: MisHeuristic::Power,
+            fluorescence_lanes: FluorescenceLanes::All,
         }
     }
 }
@@ -299,6 +304,9 @@ impl PathTracer {
             // The vertex's block (`dimensions`): reserved in order, each computed only when
             // used — the same values as drawing all of them (`SampleStream::reserve`).
             let dims = path.next_vertex_dimensions();
+            let reradiation_dims = scene
+                .has_reradiation
+                .then(|| ReradiationDimensions::reserve(&mut path.stream));
 
             // Opacity mask: pass straight through with probability 1 − α (only scenes with
             // masks: the per-hit material dispatch is not free).
@@ -365,12 +373,20 @@ impl PathTracer {
             if scene.has_dispersion && material.is_dispersive() {
                 path.wavelengths.terminate_secondary();
             }
-            let bsdf = material.bsdf_cached(
+            let mut bsdf = material.bsdf_cached(
                 si.material_id,
                 &si,
                 &path.wavelengths,
                 &mut reflectance_cache,
             );
+            // Re-radiation (fluorescent_vertex.rs): asked only in scenes that have it.
+            if let Some(d) = reradiation_dims {
+                if let Some(f) = material.fluorescent() {
+                    let lanes = &mut path.wavelengths;
+                    let mode = self.fluorescence_lanes;
+                    fluorescent_vertex::scatter(mode, f, &mut bsdf, lanes, &path.stream, d);
+                }
+            }
             let vertex =
                 ScatterVertex::Surface(SurfaceVertex::new(&si, &bsdf, ray.direction, shading_maps));
             let ctx = vertex.light_context();

@@ -113,7 +113,8 @@ impl PathState {
         if self.depth < rr_depth {
             return false;
         }
-        let q = (1.0 - (self.beta * self.eta_scale).max_component()).max(0.0);
+        // |β|: re-radiation with a signed matrix (`negatives: keep`) makes lanes negative.
+        let q = (1.0 - (self.beta * self.eta_scale).map(f32::abs).max_component()).max(0.0);
         if u() < q {
             return true;
         }

@@ -338,7 +338,10 @@ pub(super) fn build_lights(
                 })
             }
             LightKind::Daylight(desc) => {
-                let built = build_daylight(desc, scene_sphere).map_err(|e| b.err("", e))?;
+                // Daylight reaches below 360 nm only where something is excited there.
+                let ultraviolet = !scene.reradiation.is_empty();
+                let built =
+                    build_daylight(desc, scene_sphere, ultraviolet).map_err(|e| b.err("", e))?;
                 extra = built.sun.map(Light::Directional);
                 Light::Daylight(Box::new(built.sky))
             }

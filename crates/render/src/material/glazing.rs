@@ -52,7 +52,8 @@ impl SurfaceMaterial {
             | SurfaceMaterial::Conductor { .. }
             | SurfaceMaterial::Dielectric { .. }
             | SurfaceMaterial::Mix { .. }
-            | SurfaceMaterial::Library(_) => None,
+            | SurfaceMaterial::Library(_)
+            | SurfaceMaterial::Fluorescent(_) => None,
         }
     }
 
@@ -64,7 +65,8 @@ impl SurfaceMaterial {
             | SurfaceMaterial::Conductor { .. }
             | SurfaceMaterial::Dielectric { .. }
             | SurfaceMaterial::Mix { .. }
-            | SurfaceMaterial::Library(_) => false,
+            | SurfaceMaterial::Library(_)
+            | SurfaceMaterial::Fluorescent(_) => false,
         }
     }
 }

@@ -32,6 +32,7 @@
 //! in `bsdf`/`opacity_at`; the `NormalMap` and `BumpMap` wrappers change the hit's shading
 //! normal in `apply_shading_maps`, which the integrator calls before it builds the frame.
 
+pub mod fluorescent;
 mod glazing;
 pub mod ior;
 pub mod library;
@@ -59,6 +60,7 @@ use crate::texture::{
     build_textures, FloatTexture, RgbUse, Texture, TexturePurpose, TextureSet, TexturedSpectrum,
 };
 
+pub use fluorescent::FluorescentSurface;
 pub use ior::Ior;
 pub use library::LibraryMaterial;
 pub use metals::{metal_optics, MetalOptics};
@@ -246,6 +248,27 @@ impl Material {
         }
     }
 
+    /// The re-radiating surface under the wrappers, if this is a `fluorescent` material
+    /// (mixes of one are refused when the scene is built).
+    #[inline]
+    pub fn fluorescent(&self) -> Option<&FluorescentSurface> {
+        match self {
+            Material::Surface(SurfaceMaterial::Fluorescent(f)) => Some(f),
+            Material::Surface(
+                SurfaceMaterial::Lambert { .. }
+                | SurfaceMaterial::Conductor { .. }
+                | SurfaceMaterial::Dielectric { .. }
+                | SurfaceMaterial::ThinDielectric { .. }
+                | SurfaceMaterial::Mix { .. }
+                | SurfaceMaterial::Library(_),
+            ) => None,
+            Material::TwoSided { material }
+            | Material::Mask { material, .. }
+            | Material::NormalMap { material, .. }
+            | Material::BumpMap { material, .. } => material.fluorescent(),
+        }
+    }
+
     /// True when the material's BSDF depends on wavelength through its index of refraction
     /// (dispersion): the integrator keeps only the hero wavelength after such a hit.
     #[inline]
@@ -391,8 +414,23 @@ fn build_one(
         MaterialKind::Library(kind) => Material::Surface(SurfaceMaterial::Library(
             LibraryMaterial::build(kind).map_err(|(f, e)| err(f, e))?,
         )),
+        MaterialKind::Fluorescent {
+            reradiation,
+            reflectance,
+        } => Material::Surface(SurfaceMaterial::Fluorescent(Arc::new(
+            FluorescentSurface::build(scene, *reradiation, reflectance.as_ref())
+                .map_err(|(f, e)| err(f, e))?,
+        ))),
         MaterialKind::Mix { materials, weight } => {
             let mut build = |k: usize| match build_one(scene, materials[k], depth + 1, textures)? {
+                Material::Surface(SurfaceMaterial::Fluorescent(_)) => Err(err(
+                    "materials",
+                    format!(
+                        "`{}` is fluorescent: a mix of a fluorescent material is not supported \
+                         yet (a mix blends lobes at one wavelength per lane)",
+                        scene.materials[materials[k]].name
+                    ),
+                )),
                 Material::Surface(surface) => Ok(surface),
                 Material::TwoSided { .. }
                 | Material::Mask { .. }

@@ -9,6 +9,9 @@
 use prism_geometry::SurfaceInteraction;
 use prism_spectrum::{SampledSpectrum, SampledWavelengths, Spectrum};
 
+use std::sync::Arc;
+
+use super::fluorescent::FluorescentSurface;
 use super::library::LibraryMaterial;
 use super::{Ior, MixWeight};
 use crate::bsdf::{
@@ -52,6 +55,9 @@ pub enum SurfaceMaterial {
     },
     /// A material of the library (library.rs): constant parameters, one lobe.
     Library(LibraryMaterial),
+    /// Lambertian with re-radiation (fluorescent.rs): its lobe is the reflected part
+    /// R(λ)/π; the path tracer adds M through `Material::fluorescent`.
+    Fluorescent(Arc<FluorescentSurface>),
 }
 
 impl From<SurfaceMaterial> for super::Material {
@@ -102,7 +108,8 @@ impl SurfaceMaterial {
             )),
             SurfaceMaterial::ThinDielectric { .. }
             | SurfaceMaterial::Mix { .. }
-            | SurfaceMaterial::Library(_) => self.other_lobe(hit, wavelengths),
+            | SurfaceMaterial::Library(_)
+            | SurfaceMaterial::Fluorescent(_) => self.other_lobe(hit, wavelengths),
         }
     }
 
@@ -119,6 +126,9 @@ impl SurfaceMaterial {
             }),
             SurfaceMaterial::Mix { .. } => self.mix_lobe(hit, wavelengths),
             SurfaceMaterial::Library(library) => library.lobe(wavelengths),
+            SurfaceMaterial::Fluorescent(f) => BsdfLobe::Lambert(Lambert {
+                reflectance: f.reflectance.eval(wavelengths),
+            }),
             SurfaceMaterial::Lambert { .. }
             | SurfaceMaterial::Conductor { .. }
             | SurfaceMaterial::Dielectric { .. } => self.lobe(hit, wavelengths),
@@ -138,7 +148,8 @@ impl SurfaceMaterial {
             SurfaceMaterial::Lambert { .. }
             | SurfaceMaterial::Conductor { .. }
             | SurfaceMaterial::ThinDielectric { .. }
-            | SurfaceMaterial::Library(_) => false,
+            | SurfaceMaterial::Library(_)
+            | SurfaceMaterial::Fluorescent(_) => false,
         }
     }
 
@@ -155,7 +166,9 @@ impl SurfaceMaterial {
             SurfaceMaterial::Mix { materials, .. } => {
                 materials.iter().any(SurfaceMaterial::has_textures)
             }
-            SurfaceMaterial::ThinDielectric { .. } | SurfaceMaterial::Library(_) => false,
+            SurfaceMaterial::ThinDielectric { .. }
+            | SurfaceMaterial::Library(_)
+            | SurfaceMaterial::Fluorescent(_) => false,
         }
     }
 
@@ -169,7 +182,8 @@ impl SurfaceMaterial {
             | SurfaceMaterial::Conductor { .. }
             | SurfaceMaterial::Dielectric { .. }
             | SurfaceMaterial::ThinDielectric { .. }
-            | SurfaceMaterial::Library(_) => 1,
+            | SurfaceMaterial::Library(_)
+            | SurfaceMaterial::Fluorescent(_) => 1,
         }
     }
 

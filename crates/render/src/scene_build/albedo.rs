@@ -99,6 +99,15 @@ fn albedo_at_depth(materials: &[Material], index: usize, depth: usize) -> [f32; 
         }
         MaterialKind::ThinDielectric { .. } => [1.0; 3],
         MaterialKind::Library(kind) => crate::material::library::albedo_rgb(kind),
+        // The reflected part only (the re-radiated part depends on the light); a BFC's or
+        // dye's own R is not at hand here.
+        MaterialKind::Fluorescent {
+            reflectance: Some(reflectance),
+            ..
+        } => reflectance_rgb(reflectance),
+        MaterialKind::Fluorescent {
+            reflectance: None, ..
+        } => DEFAULT_ALBEDO,
         MaterialKind::Mix {
             materials: [a, b],
             weight,

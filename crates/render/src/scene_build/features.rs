@@ -35,11 +35,12 @@ pub enum SceneFeature {
     NonRectangleAreaLights,
     ThinLensCamera,
     LightPaths,
+    Reradiation,
 }
 
 impl SceneFeature {
     /// Every feature, in declaration order (bit `i` of `SceneFeatures` is `ALL[i]`).
-    pub const ALL: [SceneFeature; 16] = [
+    pub const ALL: [SceneFeature; 17] = [
         SceneFeature::DiagnosticIntegrator,
         SceneFeature::ParticipatingMedia,
         SceneFeature::OpacityMasks,
@@ -56,6 +57,7 @@ impl SceneFeature {
         SceneFeature::NonRectangleAreaLights,
         SceneFeature::ThinLensCamera,
         SceneFeature::LightPaths,
+        SceneFeature::Reradiation,
     ];
 
     /// Short name, as `--explain` lists it.
@@ -77,6 +79,7 @@ impl SceneFeature {
             SceneFeature::NonRectangleAreaLights => "non-rectangle area lights",
             SceneFeature::ThinLensCamera => "thin-lens camera",
             SceneFeature::LightPaths => "light tracing or BDPT",
+            SceneFeature::Reradiation => "re-radiation (fluorescence)",
         }
     }
 
@@ -142,6 +145,10 @@ impl SceneFeature {
             SceneFeature::LightPaths => {
                 "the light tracer or BDPT: paths also start at the lights and are connected \
                  to the camera, splatted onto the film"
+            }
+            SceneFeature::Reradiation => {
+                "a `fluorescent` material: a lane absorbs at one wavelength and re-emits at \
+                 another, so spectra are evaluated again along the path"
             }
         }
     }
@@ -361,6 +368,7 @@ fn surface_features(s: &SurfaceMaterial, f: &mut SceneFeatures) {
             }
         }
         SurfaceMaterial::Library(_) => f.insert(SceneFeature::NonLambertianBsdfs),
+        SurfaceMaterial::Fluorescent(_) => f.insert(SceneFeature::Reradiation),
     }
 }
 

@@ -116,6 +116,7 @@ const MATERIALS: &[&str] = &[
     "materials.*<mask>",
     "materials.*<thin_dielectric>",
     "materials.*<mix>",
+    "materials.*<fluorescent>",
 ];
 const SENSORS: &[&str] = &["sensors[]<point>", "sensors[]<points>", "sensors[]<grid>"];
 const TEXTURES: &[&str] = &[
@@ -133,6 +134,8 @@ const BUILD_DAYLIGHT: &str = "light::daylight::build_daylight";
 const BUILD_MATERIAL: &str = "material::build_materials (build_one)";
 const SENSOR: &str = "sensor::measure_sensors (`prism render`)";
 const LOAD_TEXTURE: &str = "texture::build_textures, texture::load";
+const BUILD_FLUORESCENT: &str = "material::fluorescent::FluorescentSurface::build (the \
+     matrix and R that prism-scene reradiation::parse_reradiation loaded)";
 const TRANSFORM: &str = "prism-scene transform::parse_transform composes the matrix that \
                          scene_build::transform::to_geometry_transform reads";
 const MEDIA: &str = "scene_build::fields::refuse_unrendered: participating media are not \
@@ -164,6 +167,22 @@ pub const FIELD_USES: &[FieldRow] = &[
     refused(&[""], &["media"], MEDIA),
     read(&[""], &["sensors"], SENSOR),
     read(&[""], &["textures"], LOAD_TEXTURE),
+    read(&[""], &["reradiation"], BUILD_FLUORESCENT),
+    read(
+        &["reradiation.*<bfc>"],
+        &["bfc", "negatives"],
+        BUILD_FLUORESCENT,
+    ),
+    read(
+        &["reradiation.*<dye>"],
+        &[
+            "absorption",
+            "emission",
+            "quantum_yield",
+            "peak_absorptance",
+        ],
+        BUILD_FLUORESCENT,
+    ),
     FieldRow {
         patterns: &[""],
         keys: &["$schema"],
@@ -224,6 +243,11 @@ pub const FIELD_USES: &[FieldRow] = &[
         &["integrator<path>", "integrator<bdpt>"],
         &["mis"],
         INTEGRATOR,
+    ),
+    read(
+        &["integrator<path>"],
+        &["fluorescence_lanes"],
+        "Integrator::from_description (PathTracer::fluorescence_lanes)",
     ),
     read(
         TRANSPORT,
@@ -373,6 +397,11 @@ pub const FIELD_USES: &[FieldRow] = &[
     // materials
     read(MATERIALS, &["type"], BUILD_MATERIAL),
     read(&["materials.*<lambert>"], &["reflectance"], BUILD_MATERIAL),
+    read(
+        &["materials.*<fluorescent>"],
+        &["reradiation", "reflectance"],
+        BUILD_FLUORESCENT,
+    ),
     read(
         &["materials.*<conductor>"],
         &["metal", "eta", "k", "roughness", "distribution"],

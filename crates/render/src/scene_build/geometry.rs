@@ -45,6 +45,8 @@ pub const SMALL_SCENE_SUPPORTS: SceneFeatures = SceneFeatures::of(&[
     SceneFeature::Textures,
     SceneFeature::NonLambertianBsdfs,
     SceneFeature::TwoSidedMaterials,
+    // Materials do not concern it: re-radiation changes wavelengths, not intersections.
+    SceneFeature::Reradiation,
     SceneFeature::ShadingNormalMaps,
     SceneFeature::VertexNormals,
     SceneFeature::Quadrics,

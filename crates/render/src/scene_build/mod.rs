@@ -65,6 +65,9 @@ pub struct RenderScene {
     /// Some material has a dispersive index of refraction: a path's hit there keeps only
     /// its hero wavelength. Lets the path tracer skip the per-hit test.
     pub has_dispersion: bool,
+    /// Some material re-radiates (`fluorescent`): path vertices reserve the two
+    /// re-radiation dimensions (`ReradiationDimensions`) and ask `Material::fluorescent`.
+    pub has_reradiation: bool,
     /// Some material reads a texture: hits compute ray differentials, from the camera ray
     /// or (after a bounce) from this camera footprint. `None` when no material is textured.
     pub texture_footprint: Option<crate::texture::CameraFootprint>,
@@ -117,6 +120,7 @@ impl RenderScene {
         let has_masks = materials.iter().any(|m| m.has_mask());
         let has_glazing = materials.iter().any(|m| m.has_thin_glazing());
         let has_dispersion = materials.iter().any(|m| m.is_dispersive());
+        let has_reradiation = materials.iter().any(|m| m.fluorescent().is_some());
         let texture_footprint = if materials.iter().any(|m| m.has_textures()) {
             // A camera without a ray at the film centre (a circular fisheye's corner is
             // never the centre) would leave textures unfiltered: point lookups.
@@ -154,6 +158,7 @@ impl RenderScene {
             has_masks,
             has_glazing,
             has_dispersion,
+            has_reradiation,
             texture_footprint,
             splat: scene.film.reconstruction == prism_scene::Reconstruction::Splat,
             packet: None,
@@ -169,6 +174,27 @@ impl RenderScene {
         self.packet = None;
         if on {
             self.packet = crate::integrator::packet::PacketScene::new(self).ok();
+        }
+    }
+
+    /// The name of the first material that re-radiates (fluorescence), if any.
+    pub fn reradiating_material(&self) -> Option<&str> {
+        self.materials
+            .iter()
+            .position(|m| m.fluorescent().is_some())
+            .map(|i| self.material_names[i].as_str())
+    }
+
+    /// An error for estimators that carry one wavelength set along a path (`method`: the
+    /// light tracer, BDPT) when some material re-radiates.
+    pub fn refuse_reradiation(&self, method: &str) -> Result<(), String> {
+        match self.reradiating_material() {
+            None => Ok(()),
+            Some(name) => Err(format!(
+                "{}: materials.{name}: material '{name}' re-radiates (fluorescence): `{method}` \
+                 carries one wavelength set along its light paths and cannot shift it; use path",
+                self.file.display()
+            )),
         }
     }
 

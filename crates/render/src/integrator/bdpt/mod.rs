@@ -107,6 +107,8 @@ impl Bdpt {
             max_depth: self.max_depth,
             rr_depth: self.rr_depth,
             mis: self.mis,
+            // Light paths refuse re-radiation (`prepare`); sensors path-trace with all lanes.
+            fluorescence_lanes: prism_scene::FluorescenceLanes::All,
         }
     }
 
@@ -296,6 +298,7 @@ impl Estimator for Bdpt {
     }
 
     fn prepare(&mut self, scene: &RenderScene, _pass: &Pass) -> Result<(), String> {
+        scene.refuse_reradiation("bdpt")?;
         scene
             .camera
             .importance_support()

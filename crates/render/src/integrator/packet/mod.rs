@@ -120,6 +120,12 @@ impl PacketScene {
     /// features outside [`Self::SUPPORTS`], else the limit it is past (the small-scene
     /// intersector's, or a mesh kept instanced).
     pub fn new(scene: &RenderScene) -> Result<Self, String> {
+        if let Some(name) = scene.reradiating_material() {
+            return Err(format!(
+                "material '{name}' re-radiates (fluorescence): lanes change wavelength along a \
+                 path, but the packet tracer evaluates reflectances once per camera sample"
+            ));
+        }
         let outside = scene.features.outside(Self::SUPPORTS);
         if !outside.is_empty() {
             return Err(outside.names());
@@ -151,7 +157,8 @@ impl PacketScene {
                     | SurfaceMaterial::Dielectric { .. }
                     | SurfaceMaterial::ThinDielectric { .. }
                     | SurfaceMaterial::Mix { .. }
-                    | SurfaceMaterial::Library(_),
+                    | SurfaceMaterial::Library(_)
+                    | SurfaceMaterial::Fluorescent(_),
                 )
                 | Material::TwoSided { .. }
                 | Material::Mask { .. }

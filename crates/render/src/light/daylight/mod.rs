@@ -16,7 +16,7 @@ pub mod sun_position;
 
 use glam::Vec3A;
 use prism_scene::{DaylightSky, SkyModel, SkyNormalisation, SunPosition};
-use prism_spectrum::daylight::{daylight_basis, daylight_spectrum};
+use prism_spectrum::daylight::{daylight_basis, daylight_m1_m2, daylight_spectrum, daylight_xy};
 use prism_spectrum::{DenseSpectrum, Spectrum};
 
 use self::cie_sky::CieSky;
@@ -124,18 +124,54 @@ pub struct BuiltDaylight {
     pub sun_azimuth_deg: f64,
 }
 
-/// A D-series spectrum of CCT `cct_k` scaled to unit photometric value.
-fn unit_daylight(cct_k: f64) -> Result<Spectrum, String> {
-    let s = Spectrum::from_dense(&daylight_spectrum(cct_k)?).map_err(|e| e.to_string())?;
+/// A D-series spectrum of CCT `cct_k` scaled to unit photometric value; with
+/// `ultraviolet`, continued below 360 nm (`with_ultraviolet`).
+fn unit_daylight(cct_k: f64, ultraviolet: bool) -> Result<Spectrum, String> {
+    let dense = daylight_spectrum(cct_k)?;
+    let s = Spectrum::from_dense(&dense).map_err(|e| e.to_string())?;
     let k = photometric_scale(&s, 1.0)?;
+    if ultraviolet {
+        let (x, y) = daylight_xy(cct_k)?;
+        let (m1, m2) = daylight_m1_m2(x, y);
+        return with_ultraviolet(&dense, [1.0, m1, m2], k);
+    }
     Ok(s.scaled(k as f32))
+}
+
+/// `k`·`dense` over 360–830 nm continued below 360 nm by k·Σ cᵢSᵢ of the daylight basis
+/// tables, which start at 300 nm: the daylight that excites fluorescent materials there
+/// (the dense grid stops at 360 nm). Used only in scenes with re-radiation, so other scenes
+/// keep their dense spectra (and images) exactly.
+fn with_ultraviolet(dense: &DenseSpectrum, c: [f64; 3], k: f64) -> Result<Spectrum, String> {
+    let basis = prism_spectrum::data::embedded_file("cie-daylight-basis")
+        .expect("the daylight basis is embedded");
+    let mut wavelengths_nm = Vec::new();
+    let mut values = Vec::new();
+    for (row, &nm) in basis.wavelengths_nm.iter().enumerate() {
+        if nm >= 360.0 {
+            break;
+        }
+        wavelengths_nm.push(nm);
+        values.push(k * (0..3).map(|i| c[i] * basis.columns[i][row]).sum::<f64>());
+    }
+    for (i, v) in dense.values().iter().enumerate() {
+        wavelengths_nm.push(DenseSpectrum::wavelength_nm(i));
+        values.push(k * v);
+    }
+    Spectrum::piecewise_linear(&wavelengths_nm, &values).map_err(|e| e.to_string())
 }
 
 /// The quadrature resolution of normalisations and ground illuminance.
 const QUADRATURE_N: usize = 384;
 
 /// Builds the sky (and sun) of `desc`; errors are plain messages (the caller adds the place).
-pub fn build_daylight(desc: &DaylightSky, scene: SceneSphere) -> Result<BuiltDaylight, String> {
+/// `ultraviolet`: the sky's and the sun's spectra reach down to 300 nm (scenes with
+/// re-radiation, whose lanes may be excited there); otherwise they stop at 360 nm.
+pub fn build_daylight(
+    desc: &DaylightSky,
+    scene: SceneSphere,
+    ultraviolet: bool,
+) -> Result<BuiltDaylight, String> {
     let (elevation_deg, azimuth_deg) = match desc.sun_position {
         SunPosition::Angles {
             elevation_rad,
@@ -160,8 +196,8 @@ pub fn build_daylight(desc: &DaylightSky, scene: SceneSphere) -> Result<BuiltDay
         SunPosition::Time { date_time, .. } => Some(date_time.day_of_year()),
         SunPosition::Angles { .. } => None,
     };
-    let sky_unit = unit_daylight(desc.sky_cct_k)?;
-    let sun_unit = unit_daylight(desc.sun_cct_k)?;
+    let sky_unit = unit_daylight(desc.sky_cct_k, ultraviolet)?;
+    let sun_unit = unit_daylight(desc.sun_cct_k, ultraviolet)?;
     let radiant_per_luminance_nm = integrate_nm(&sky_unit);
     let needs_sun_up = |model: &str| -> Result<(), String> {
         if elevation_deg <= 0.0 {
@@ -242,9 +278,17 @@ pub fn build_daylight(desc: &DaylightSky, scene: SceneSphere) -> Result<BuiltDay
                 }
             };
             let b = daylight_basis();
-            let basis =
+            let basis = if ultraviolet {
+                let unit = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+                let mut out = Vec::with_capacity(3);
+                for (s, c) in b.s.iter().zip(unit) {
+                    out.push(with_ultraviolet(s, c, 1.0)?);
+                }
+                [out[0].clone(), out[1].clone(), out[2].clone()]
+            } else {
                 b.s.clone()
-                    .map(|s| Spectrum::from_dense(&s).expect("the daylight basis is finite"));
+                    .map(|s| Spectrum::from_dense(&s).expect("the daylight basis is finite"))
+            };
             (
                 shape,
                 scale,

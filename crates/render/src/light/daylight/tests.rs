@@ -592,3 +592,59 @@ fn sensors_measure_sky_and_sun_by_quadrature() {
         assert!(p.std_error_lx < 0.02 * exact, "{}", p.std_error_lx);
     }
 }
+
+/// In scenes with re-radiation the sky and the sun reach down to 300 nm (the daylight
+/// basis tables start there), with the same values over 360–830 nm; elsewhere they stop at
+/// 360 nm as before.
+#[test]
+fn daylight_reaches_the_ultraviolet_only_where_something_fluoresces() {
+    for model in [
+        r#""type": "cie_sky", "sky_type": 12, "zenith_luminance_cd_m2": 5000"#,
+        r#""type": "preetham_sky", "turbidity": 3"#,
+    ] {
+        let json = format!(
+            r#"{{"lights": [{{{model}, "sun_normal_illuminance_lx": 80000,
+                "sun": {{"elevation_deg": 40, "azimuth_deg": 180}}}}]}}"#
+        );
+        let description = prism_scene::parse_scene_str(&json, "sky.json").unwrap();
+        let prism_scene::LightKind::Daylight(desc) = &description.lights[0].kind else {
+            panic!("expected a daylight sky");
+        };
+        let scene = SceneSphere {
+            center_m: Vec3A::ZERO,
+            radius_m: 1.0,
+        };
+        let plain = build_daylight(desc, scene, false).unwrap();
+        let uv = build_daylight(desc, scene, true).unwrap();
+        let up = Vec3A::new(0.0, 1.0, 0.0);
+        let at = |lambda: f32| {
+            SampledWavelengths::new([lambda, lambda + 1.0, lambda + 2.0, lambda + 3.0], {
+                SampledSpectrum::splat(1.0)
+            })
+        };
+        let (ultraviolet, visible) = (at(320.0), at(550.0));
+        assert!(plain.sky.radiance(up, &ultraviolet).is_black(), "{model}");
+        assert!(
+            uv.sky.radiance(up, &ultraviolet).min_component() > 0.0,
+            "{model}"
+        );
+        let (a, b) = (
+            plain.sky.radiance(up, &visible),
+            uv.sky.radiance(up, &visible),
+        );
+        for lane in 0..4 {
+            assert!(
+                (a[lane] - b[lane]).abs() <= 1e-5 * a[lane],
+                "{model}: {a:?} {b:?}"
+            );
+        }
+        let (sun, sun_uv) = (plain.sun.unwrap(), uv.sun.unwrap());
+        assert!(sun.irradiance.eval_nm(320.0) == 0.0);
+        assert!(sun_uv.irradiance.eval_nm(320.0) > 0.0);
+        let (a, b) = (
+            sun.irradiance.eval_nm(550.5),
+            sun_uv.irradiance.eval_nm(550.5),
+        );
+        assert!((a - b).abs() <= 1e-5 * a, "{model}: sun {a} vs {b}");
+    }
+}
