@@ -445,6 +445,7 @@ fn packet_light_tracer_and_bdpt_refuse_reradiation_and_path_renders_it() {
         spectral_bins: None,
         aov_output: false,
         sampler: "independent",
+        sample_plan: Default::default(),
     };
     let plan = prism_render::RenderPlan::new(&scene, &request).to_string();
     assert!(plan.contains(&format!("not used: {why}")), "{plan}");
