@@ -223,6 +223,15 @@ impl Method {
                 sampler,
                 mis,
                 rr_depth,
+                spectral_mis: match *scene {
+                    prism_scene::Integrator::Path { spectral_mis, .. } => spectral_mis,
+                    prism_scene::Integrator::Light { .. }
+                    | prism_scene::Integrator::Bdpt { .. }
+                    | prism_scene::Integrator::Depth
+                    | prism_scene::Integrator::Normal
+                    | prism_scene::Integrator::Albedo
+                    | prism_scene::Integrator::AmbientOcclusion { .. } => true,
+                },
             },
             ("light", _) => prism_scene::Integrator::Light {
                 max_depth,
@@ -302,6 +311,7 @@ mod tests {
             sampler: SamplerKind::Sobol,
             mis: prism_scene::MisHeuristic::Balance,
             rr_depth: 2,
+            spectral_mis: true,
         };
         let m = Method::parse("bdpt:sobol").unwrap();
         assert_eq!(m.quantity(), "radiance");
@@ -334,6 +344,7 @@ mod tests {
             sampler: SamplerKind::Sobol,
             mis: prism_scene::MisHeuristic::Balance,
             rr_depth: 2,
+            spectral_mis: true,
         };
         let m = Method::parse("path").unwrap();
         match m.integrator(&scene).unwrap() {

@@ -61,6 +61,9 @@ pub enum MaterialKind {
     Mix { materials: [usize; 2], weight: f64 },
     /// A material of the library: parameters that are numbers and spectra only.
     Library(LibraryKind),
+    /// Scatters nothing: the boundary of a medium (Mitsuba's `null` BSDF). Crossing it is
+    /// not a scattering event.
+    Interface,
 }
 
 /// The material library (issue 8 and after): the kinds whose parameters are numbers and
@@ -178,7 +181,7 @@ pub enum Ior {
     },
 }
 
-const TYPES: [&str; 18] = [
+const TYPES: [&str; 19] = [
     "lambert",
     "conductor",
     "dielectric",
@@ -197,6 +200,7 @@ const TYPES: [&str; 18] = [
     "normal_map",
     "bump_map",
     "sheen",
+    "interface",
 ];
 
 /// Rows of `schema::rows()` for the material library's kinds: the keys each accepts
@@ -292,6 +296,7 @@ fn references(kind: &MaterialKind) -> Vec<usize> {
         | MaterialKind::Conductor { .. }
         | MaterialKind::Dielectric { .. }
         | MaterialKind::ThinDielectric { .. }
+        | MaterialKind::Interface
         | MaterialKind::Library(_) => Vec::new(),
     }
 }
@@ -466,6 +471,10 @@ fn parse_material(
                 opacity,
                 opacity_texture,
             }
+        }
+        "interface" => {
+            v.tagged_object(schema!("materials.*<interface>"))?;
+            MaterialKind::Interface
         }
         "thin_dielectric" => {
             let o = v.tagged_object(schema!("materials.*<thin_dielectric>"))?;

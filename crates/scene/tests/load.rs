@@ -170,7 +170,8 @@ fn every_field_kind_comes_through() {
             max_depth: 5,
             sampler: SamplerKind::Independent,
             mis: MisHeuristic::Balance,
-            rr_depth: 2
+            rr_depth: 2,
+            spectral_mis: true
         }
     );
 
@@ -211,14 +212,11 @@ fn every_field_kind_comes_through() {
 
     // Media.
     assert_eq!(s.media.len(), 1);
-    assert_eq!(
-        s.media[0].kind,
-        MediumKind::Homogeneous {
-            sigma_a_per_m: SpectrumRef::Constant(0.01),
-            sigma_s_per_m: SpectrumRef::Constant(0.25),
-            g: 0.3
-        }
-    );
+    assert_eq!(s.media[0].kind, MediumKind::Homogeneous);
+    assert_eq!(s.media[0].sigma_a_per_m, SpectrumRef::Constant(0.01));
+    assert_eq!(s.media[0].sigma_s_per_m, SpectrumRef::Constant(0.25));
+    assert_eq!(s.media[0].phase, Phase::HenyeyGreenstein { g: 0.3 });
+    assert_eq!(s.media[0].emission, None);
 
     // Materials.
     let m: Vec<&str> = s.materials.iter().map(|m| m.name.as_str()).collect();

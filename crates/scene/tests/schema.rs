@@ -48,6 +48,9 @@ fn scene_with(pattern: &str) -> Option<String> {
             r#"{"materials": {"x": {"type": "dielectric", "ior": {"cauchy": {$}}}}}"#.into()
         }
         "@spectrum" => r#"{"spectra": {"s": {$}}}"#.into(),
+        "@phase<isotropic>" | "@phase<rayleigh>" | "@phase<hg>" | "@phase<tabulated>" => {
+            format!(r#"{{"media": {{"m": {{"phase": {{"type": "{kind}", $}}}}}}}}"#)
+        }
         "@texture_ref" => r#"{"materials": {"x": {"type": "lambert",
                               "reflectance": {"texture": "t", $}}}}"#
             .into(),

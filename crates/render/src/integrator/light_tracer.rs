@@ -43,6 +43,7 @@ impl LightTracer {
             max_depth: self.max_depth,
             rr_depth: self.rr_depth,
             mis: prism_scene::MisHeuristic::Power,
+            spectral_mis: true,
         }
     }
 
@@ -195,6 +196,9 @@ impl Estimator for LightTracer {
     }
 
     fn prepare(&mut self, scene: &RenderScene, _pass: &Pass) -> Result<(), String> {
+        if let Some(media) = &scene.media {
+            return Err(crate::integrator::media_refusal("light", &media.names));
+        }
         scene
             .camera
             .importance_support()

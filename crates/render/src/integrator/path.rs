@@ -32,6 +32,8 @@ pub struct PathTracer {
     /// Russian roulette starts after this many scattering events.
     pub rr_depth: u32,
     pub mis: MisHeuristic,
+    /// Spectral MIS of distance samples in media (`medium_transport`).
+    pub spectral_mis: bool,
 }
 
 impl Default for PathTracer {
@@ -41,6 +43,7 @@ impl Default for PathTracer {
             max_depth: 8,
             rr_depth: 3,
             mis: MisHeuristic::Power,
+            spectral_mis: true,
         }
     }
 }
@@ -239,6 +242,20 @@ impl PathTracer {
         want_illumination: bool,
         counters: &mut PathCounters,
     ) -> PathResult {
+        if let Some(media) = &scene.media {
+            return self.trace_volumetric(
+                scene,
+                media,
+                camera_ray,
+                origin,
+                camera_differential,
+                differential_scale,
+                wavelengths,
+                stream,
+                light_samples,
+                counters,
+            );
+        }
         let mut current_differential = camera_differential.copied();
         let lights = &scene.lights;
         let mut radiance = SampledSpectrum::splat(0.0);

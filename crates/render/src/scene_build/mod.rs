@@ -10,6 +10,7 @@ pub mod features;
 pub mod fields;
 mod filter;
 mod geometry;
+pub mod media;
 pub mod spectrum;
 mod transform;
 
@@ -75,6 +76,9 @@ pub struct RenderScene {
     /// packet tracer and the small-scene intersector run only where it is within their
     /// allow-lists (`PacketScene::SUPPORTS`, `SMALL_SCENE_SUPPORTS`).
     pub features: SceneFeatures,
+    /// The scene's participating media (`None` when it declares none): `path` then walks
+    /// its paths through `integrator::medium_transport`.
+    pub media: Option<media::MediaScene>,
 }
 
 impl RenderScene {
@@ -112,7 +116,14 @@ impl RenderScene {
             &materials,
             placed.vertex_normals,
         );
+        let ranges = placed.ranges.clone();
         let geometry = placed.builder.build_with(geometry::build_options(features));
+        let media = media::build_media(scene, &ranges, &geometry, &camera, resolution)?;
+        if let Some(m) = &media {
+            integrator
+                .refuse_media(&m.names)
+                .map_err(|message| SceneBuildError::new(&file, "integrator", message))?;
+        }
         let lights = LightSet::build(scene, &geometry)?;
         let has_masks = materials.iter().any(|m| m.has_mask());
         let has_glazing = materials.iter().any(|m| m.has_thin_glazing());
@@ -158,6 +169,7 @@ impl RenderScene {
             splat: scene.film.reconstruction == prism_scene::Reconstruction::Splat,
             packet: None,
             features,
+            media,
         };
         built.set_packet_tracing(true);
         Ok(built)

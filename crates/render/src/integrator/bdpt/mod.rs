@@ -107,6 +107,7 @@ impl Bdpt {
             max_depth: self.max_depth,
             rr_depth: self.rr_depth,
             mis: self.mis,
+            spectral_mis: true,
         }
     }
 
@@ -296,6 +297,9 @@ impl Estimator for Bdpt {
     }
 
     fn prepare(&mut self, scene: &RenderScene, _pass: &Pass) -> Result<(), String> {
+        if let Some(media) = &scene.media {
+            return Err(crate::integrator::media_refusal("bdpt", &media.names));
+        }
         scene
             .camera
             .importance_support()

@@ -120,6 +120,12 @@ impl PacketScene {
     /// features outside [`Self::SUPPORTS`], else the limit it is past (the small-scene
     /// intersector's, or a mesh kept instanced).
     pub fn new(scene: &RenderScene) -> Result<Self, String> {
+        if let Some(media) = &scene.media {
+            return Err(format!(
+                "the scene has participating media ({}): the packet tracer samples no media",
+                media.names.join(", ")
+            ));
+        }
         let outside = scene.features.outside(Self::SUPPORTS);
         if !outside.is_empty() {
             return Err(outside.names());
