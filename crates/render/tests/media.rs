@@ -162,7 +162,9 @@ fn beer_lambert_through_an_absorbing_slab() {
     let points = [(360.0, 0.5), (550.0, 1.5), (830.0, 3.0)];
     let (csv, sigma_a) = spectrum_csv(&points);
     dir.write("sigma_a.csv", csv.as_bytes());
-    let integrator = r#"{"type": "path", "max_depth": 2}"#;
+    // max_depth 1: the two interface crossings are not bounces (pbrt-v3 #69), so the
+    // emitter behind them is still reached.
+    let integrator = r#"{"type": "path", "max_depth": 1}"#;
     let (z0, z1) = (-0.5 * SLAB_D_M as f32, 0.5 * SLAB_D_M as f32);
     dir.write(
         "constant.vol",
@@ -208,6 +210,30 @@ fn beer_lambert_through_an_absorbing_slab() {
         let expected = y_weighted(|wl| LE * (-sigma_a(wl) * depth_m).exp());
         assert_close(what, &image, expected, 1e-3);
     }
+}
+
+/// An emissive absorbing slab (σa spectral, emission Le_m) in front of a black wall:
+/// L = Le_m·(1 − e^(−σa·d)).
+#[test]
+fn an_emissive_slab_glows_with_its_closed_form() {
+    let dir = Dir::new("emissive");
+    let points = [(360.0, 0.5), (550.0, 1.5), (830.0, 3.0)];
+    let (csv, sigma_a) = spectrum_csv(&points);
+    dir.write("sigma_a.csv", csv.as_bytes());
+    let le_m = 3.0;
+    let lit = slab_scene(
+        &format!(r#""slab": {{"sigma_a_per_m": "sigma_a.csv", "emission": {le_m}}}"#),
+        r#"{"type": "path", "max_depth": 4}"#,
+    );
+    // The wall behind stays black: no light.
+    let json = lit.replace(
+        r#""lights": [{"type": "area", "shape": "emitter", "spectrum": 1, "scale": 2}]"#,
+        r#""lights": []"#,
+    );
+    assert_ne!(json, lit);
+    let image = render_scene(&dir.scene(&json), 256, 6);
+    let expected = y_weighted(|wl| le_m * (1.0 - (-sigma_a(wl) * SLAB_D_M).exp()));
+    assert_close("emissive slab", &image, expected, 1e-3);
 }
 
 /// Single scattering of an isotropic point light of intensity I along a camera ray:
@@ -432,11 +458,74 @@ fn media_errors_name_the_entry() {
         "DIR/scene.json: camera.medium: the camera is in `fog` but sits outside shapes[0] \
          (`ball`), the first medium boundary along its view axis, where the medium is vacuum"
     );
+    // Sensors are not measured in media yet.
+    let e = dir.build_error(
+        r#"{"media": {"fog": {}}, "sensors": [{"type": "point", "name": "s", "position_m": [0, 0, 0], "normal": [0, 1, 0]}]}"#,
+    );
+    assert_eq!(
+        e,
+        "DIR/scene.json: sensors[0]: illuminance sensors are not measured in scenes with \
+         participating media yet"
+    );
     // A bad .vol names the file and what is wrong.
     dir.write("bad.vol", b"VOX\x03");
     let e = dir.build_error(r#"{"media": {"s": {"type": "grid", "density": "bad.vol"}}}"#);
     assert!(
         e.starts_with("DIR/scene.json: media.s.density: DIR/bad.vol:"),
         "{e}"
+    );
+}
+
+/// `--explain` lists each medium (σt range, spectral MIS, grid size), says why packets are
+/// off, and warns of a point light inside a closed dielectric (a volumetric caustic).
+#[test]
+fn the_plan_lists_media_and_warns_of_volumetric_caustics() {
+    let dir = Dir::new("plan");
+    dir.write(
+        "grid.vol",
+        &vol_bytes([2, 3, 4], [-1.0; 3], [1.0; 3], &[0.5; 24]),
+    );
+    let scene = dir.scene(
+        r#"{
+  "world_medium": "fog",
+  "media": {"fog": {"sigma_a_per_m": 0.1, "sigma_s_per_m": {"rgb": [0.2, 0.4, 0.9]}},
+            "smoke": {"type": "grid", "density": "grid.vol", "sigma_s_per_m": 2}},
+  "materials": {"glass": {"type": "dielectric", "ior": 1.5}},
+  "shapes": [{"type": "sphere", "radius_m": 0.3, "material": "glass"}],
+  "lights": [{"type": "point", "position_m": [0, 0, 0]}]
+}"#,
+    );
+    let plan = prism_render::RenderPlan::new(&scene, &prism_render::PlanRequest::default());
+    let line = |feature: &str| -> Vec<String> {
+        plan.choices
+            .iter()
+            .filter(|c| c.feature == feature)
+            .map(|c| format!("{} | {}", c.setting, c.reason))
+            .collect()
+    };
+    let media = line("medium");
+    assert_eq!(media.len(), 2, "{media:?}");
+    assert!(
+        media[0].starts_with("`fog`: homogeneous, σt "),
+        "{}",
+        media[0]
+    );
+    assert!(media[0].contains("chromatic σt"), "{}", media[0]);
+    assert!(
+        media[1].starts_with("`smoke`: grid, σt 2.0000–2.0000 m⁻¹ over 360–830 nm, 2×3×4 voxels"),
+        "{}",
+        media[1]
+    );
+    assert!(media[1].contains("grey σt"), "{}", media[1]);
+    let caustic = line("volumetric caustic");
+    assert_eq!(caustic.len(), 1, "{caustic:?}");
+    assert!(caustic[0].starts_with(
+        "warning: the point light at [0.0, 0.0, 0.0] m is inside a closed dielectric"
+    ));
+    assert!(caustic[0].ends_with("volumetric caustic: use photon_progressive"));
+    let packet = line("packet tracing");
+    assert_eq!(
+        packet,
+        vec!["off | not used: the scene has participating media (fog, smoke): the packet tracer samples no media"]
     );
 }

@@ -125,6 +125,14 @@ pub(crate) fn build_media(
         return Ok(None);
     }
     let file = &scene.file;
+    if !scene.sensors.is_empty() {
+        // Their estimator samples lights at the sensor point as in vacuum.
+        return Err(SceneBuildError::new(
+            file,
+            "sensors[0]",
+            "illuminance sensors are not measured in scenes with participating media yet",
+        ));
+    }
     let mut media = Vec::with_capacity(scene.media.len());
     for m in &scene.media {
         let place = |key: &str| format!("media.{}{key}", m.name);
