@@ -418,9 +418,9 @@ fn light_bdpt_and_packets_refuse_media() {
         );
     }
     let scene = dir.scene(&slab_scene(media, r#"{"type": "path"}"#));
-    let why = prism_render::integrator::packet::PacketScene::new(&scene)
-        .err()
-        .expect("the packet tracer refuses media");
+    let Err(why) = prism_render::integrator::packet::PacketScene::new(&scene) else {
+        panic!("the packet tracer took a scene with media");
+    };
     assert_eq!(
         why,
         "the scene has participating media (slab): the packet tracer samples no media"

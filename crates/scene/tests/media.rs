@@ -171,7 +171,7 @@ fn bad_media_are_refused_at_their_json_path() {
     for (scene, expected) in cases {
         let e = dir.error(scene);
         // Drop "DIR/scene.json:line:col: ".
-        let message = e.splitn(2, ": ").nth(1).unwrap_or(&e);
+        let message = e.split_once(": ").map_or(e.as_str(), |(_, m)| m);
         if !message.starts_with(expected) {
             failures.push(format!(
                 "{scene}\n  got:      {message}\n  expected: {expected}…"
