@@ -280,8 +280,8 @@ fn airlight_sun(sigma_s: f64, sigma_t: f64, intensity: f64, d: f64, gamma: f64, 
 }
 
 /// Test 2: airlight of an isotropic point light in `world_medium`, `max_depth` 1, with the
-/// isotropic (against quadrature and Sun et al. 2005) and a Henyey–Greenstein phase
-/// function (quadrature of the single-scattering integral).
+/// isotropic phase function (against quadrature and Sun et al. 2005) and, by quadrature of
+/// the single-scattering integral, Henyey–Greenstein, Rayleigh and a tabulated one.
 #[test]
 fn airlight_of_a_point_light() {
     let dir = Dir::new("airlight");
@@ -302,12 +302,42 @@ fn airlight_of_a_point_light() {
     let hg = |c: f64| {
         (1.0 - g * g) / (4.0 * std::f64::consts::PI * (1.0 + g * g - 2.0 * g * c).powf(1.5))
     };
+    let rayleigh = |c: f64| 3.0 / (16.0 * std::f64::consts::PI) * (1.0 + c * c);
+    // A forward-peaked table, linear between its rows, normalised to ∫ p dω = 1.
+    let rows = [
+        (-1.0, 1.0),
+        (-0.5, 1.0),
+        (0.0, 2.0),
+        (0.5, 4.0),
+        (1.0, 10.0),
+    ];
+    let csv: String = rows.iter().map(|(c, v)| format!("{c},{v}\n")).collect();
+    dir.write("phase.csv", csv.as_bytes());
+    let area: f64 = rows
+        .windows(2)
+        .map(|w| 0.5 * (w[0].1 + w[1].1) * (w[1].0 - w[0].0))
+        .sum();
+    let table = |c: f64| {
+        let w = rows.windows(2).find(|w| c <= w[1].0).unwrap_or(&rows[3..5]);
+        let t = (c - w[0].0) / (w[1].0 - w[0].0);
+        (w[0].1 + t * (w[1].1 - w[0].1)) / (2.0 * std::f64::consts::PI * area)
+    };
     for (what, phase, expected) in [
         ("isotropic", r#""isotropic""#.to_string(), sun),
         (
             "hg 0.6",
             format!(r#"{{"type": "hg", "g": {g}}}"#),
             single_scattering(sigma_s, sigma_t, intensity, light, hg),
+        ),
+        (
+            "rayleigh",
+            r#""rayleigh""#.to_string(),
+            single_scattering(sigma_s, sigma_t, intensity, light, rayleigh),
+        ),
+        (
+            "tabulated",
+            r#"{"type": "tabulated", "file": "phase.csv"}"#.to_string(),
+            single_scattering(sigma_s, sigma_t, intensity, light, table),
         ),
     ] {
         let json = format!(
