@@ -488,6 +488,18 @@ fn media_errors_name_the_entry() {
         "DIR/scene.json: camera.medium: the camera is in `fog` but sits outside shapes[0] \
          (`ball`), the first medium boundary along its view axis, where the medium is vacuum"
     );
+    // A light that says vacuum but sits inside the fog sphere below it.
+    let e = dir.build_error(
+        r#"{"media": {"fog": {}},
+            "camera": {"transform": {"look_at": {"eye": [0, 0, 5], "target": [0, 0, 0], "up": [0, 1, 0]}}},
+            "shapes": [{"type": "sphere", "name": "ball", "interior_medium": "fog"}],
+            "lights": [{"type": "point", "position_m": [0, 0.5, 0]}]}"#,
+    );
+    assert_eq!(
+        e,
+        "DIR/scene.json: lights[0].medium: the light is in vacuum but sits inside shapes[0] \
+         (`ball`), the first medium boundary straight below it, where the medium is `fog`"
+    );
     // Sensors are not measured in media yet.
     let e = dir.build_error(
         r#"{"media": {"fog": {}}, "sensors": [{"type": "point", "name": "s", "position_m": [0, 0, 0], "normal": [0, 1, 0]}]}"#,

@@ -260,8 +260,23 @@ fn check_closed(scene: &SceneDescription, shape_index: usize) -> Result<(), Scen
     Ok(())
 }
 
-/// The camera's medium (`camera.medium`, else `world_medium`) must be the one on the
-/// camera's side of the first medium boundary along the view axis.
+/// Where a declared medium is checked: the first medium boundary along a ray from the
+/// camera or a light must have that medium on the ray's side.
+struct MediumClaim<'a> {
+    ray: Ray,
+    declared: Option<u32>,
+    /// The JSON path of the claim (`camera.medium`, `lights[2].medium`).
+    place: String,
+    /// "the camera", "the light".
+    who: &'a str,
+    /// "along its view axis", "straight below it".
+    along: &'a str,
+}
+
+/// The camera's medium (`camera.medium`, else `world_medium`) and each point, spot and
+/// goniometric light's (`medium`, else `world_medium`) must be the one on their side of
+/// the first medium boundary along the view axis (a light: along its beam axis or aim, or
+/// straight down).
 fn check_camera_medium(
     scene: &SceneDescription,
     media: &MediaScene,
@@ -271,19 +286,77 @@ fn check_camera_medium(
     resolution: glam::UVec2,
 ) -> Result<(), SceneBuildError> {
     let centre = Vec2::new(resolution.x as f32, resolution.y as f32) * 0.5;
-    let Some(mut ray) = camera.generate_ray_only(centre, Vec2::splat(0.5)) else {
-        return Ok(());
-    };
+    if let Some(ray) = camera.generate_ray_only(centre, Vec2::splat(0.5)) {
+        check_claim(
+            scene,
+            media,
+            ranges,
+            geometry,
+            &MediumClaim {
+                ray,
+                declared: media.camera,
+                place: "camera.medium".into(),
+                who: "the camera",
+                along: "along its view axis",
+            },
+        )?;
+    }
+    for (i, light) in scene.lights.iter().enumerate() {
+        let down = [0.0, -1.0, 0.0];
+        let (position, direction, along) = match &light.kind {
+            prism_scene::LightKind::Point { position_m } => {
+                (position_m, &down, "straight below it")
+            }
+            prism_scene::LightKind::Spot {
+                position_m,
+                direction,
+                ..
+            } => (position_m, direction, "along its beam axis"),
+            prism_scene::LightKind::Luminaire {
+                position_m, aim, ..
+            } => (position_m, aim, "along its aim"),
+            prism_scene::LightKind::Directional { .. }
+            | prism_scene::LightKind::Area { .. }
+            | prism_scene::LightKind::Environment { .. }
+            | prism_scene::LightKind::UniformSky
+            | prism_scene::LightKind::Daylight(_) => continue,
+        };
+        let to_vec = |v: &[f64; 3]| glam::Vec3A::new(v[0] as f32, v[1] as f32, v[2] as f32);
+        check_claim(
+            scene,
+            media,
+            ranges,
+            geometry,
+            &MediumClaim {
+                ray: Ray::infinite(to_vec(position), to_vec(direction).normalize()),
+                declared: media.light_media.get(i).copied().flatten(),
+                place: format!("lights[{i}].medium"),
+                who: "the light",
+                along,
+            },
+        )?;
+    }
+    Ok(())
+}
+
+fn check_claim(
+    scene: &SceneDescription,
+    media: &MediaScene,
+    ranges: &[Range<u32>],
+    geometry: &Geometry,
+    claim: &MediumClaim,
+) -> Result<(), SceneBuildError> {
+    let mut ray = claim.ray;
     for _ in 0..1024 {
         let Some(hit) = geometry.intersect(&ray) else {
             return Ok(());
         };
         let si = geometry.shading_interaction(&ray, &hit);
         if let Some(b) = media.boundary(hit.instance_id) {
-            // The camera's side is the one the ray arrives from.
+            // The claimant's side is the one the ray arrives from.
             let facing = -ray.direction;
             let expected = b.medium_towards(facing, si.n_geometric);
-            if expected == media.camera {
+            if expected == claim.declared {
                 return Ok(());
             }
             let shape = ranges
@@ -305,11 +378,13 @@ fn check_camera_medium(
             };
             return Err(SceneBuildError::new(
                 &scene.file,
-                "camera.medium",
+                claim.place.clone(),
                 format!(
-                    "the camera is in {} but sits {side} {shape_name}, the first medium \
-                     boundary along its view axis, where the medium is {}",
-                    name(media.camera),
+                    "{} is in {} but sits {side} {shape_name}, the first medium boundary {}, \
+                     where the medium is {}",
+                    claim.who,
+                    name(claim.declared),
+                    claim.along,
                     name(expected)
                 ),
             ));
