@@ -304,6 +304,19 @@ impl RenderPlan {
             ),
         }
         if let Some(media) = &scene.media {
+            if let Integrator::Path(p) = &scene.integrator {
+                choose(
+                    "medium transport",
+                    format!(
+                        "null-scattering delta tracking, spectral MIS {}, light and BSDF \
+                         samples weighted by the balance heuristic",
+                        on_off(p.spectral_mis)
+                    ),
+                    "the scene has participating media: `path` follows pbrt-v4's \
+                     VolPathIntegrator (rescaled path probabilities; docs/media.md)"
+                        .into(),
+                );
+            }
             for (name, medium) in media.names.iter().zip(&media.media) {
                 let (setting, reason) = describe_medium(name, medium);
                 choose("medium", setting, reason);

@@ -559,6 +559,14 @@ fn the_plan_lists_media_and_warns_of_volumetric_caustics() {
         media[1]
     );
     assert!(media[1].contains("grey σt"), "{}", media[1]);
+    assert_eq!(
+        line("medium transport"),
+        vec![
+            "null-scattering delta tracking, spectral MIS on, light and BSDF samples weighted \
+             by the balance heuristic | the scene has participating media: `path` follows \
+             pbrt-v4's VolPathIntegrator (rescaled path probabilities; docs/media.md)"
+        ]
+    );
     let caustic = line("volumetric caustic");
     assert_eq!(caustic.len(), 1, "{caustic:?}");
     assert!(caustic[0].starts_with(
