@@ -579,3 +579,39 @@ fn the_plan_lists_media_and_warns_of_volumetric_caustics() {
         vec!["off | not used: the scene has participating media (fog, smoke): the packet tracer samples no media"]
     );
 }
+
+/// Boundaries that disagree with the medium a ray arrives in are counted (and `prism
+/// render` warns); consistent ones are not.
+#[test]
+fn inconsistent_boundaries_are_counted() {
+    let dir = Dir::new("mismatch");
+    let scene = |inner_exterior: &str| {
+        format!(
+            r#"{{
+  "media": {{"fog": {{"sigma_s_per_m": 0.1}}, "smoke": {{"sigma_s_per_m": 0.2}}}},
+  "camera": {{"transform": {{"look_at": {{"eye": [0, 0, 5], "target": [0, 0, 0], "up": [0, 1, 0]}}}}}},
+  "film": {{"resolution": [8, 8]}},
+  "materials": {{"b": {{"type": "interface"}}}},
+  "shapes": [
+    {{"type": "sphere", "radius_m": 2, "material": "b", "interior_medium": "fog"}},
+    {{"type": "sphere", "radius_m": 1, "material": "b", "interior_medium": "smoke",
+      "exterior_medium": "{inner_exterior}"}}
+  ],
+  "lights": [{{"type": "point", "position_m": [0, 3, 3]}}]
+}}"#
+        )
+    };
+    let settings = RenderSettings {
+        spp: 4,
+        seed: 1,
+        ..RenderSettings::default()
+    };
+    let consistent = render(&dir.scene(&scene("fog")), &settings, &|_| {}).1;
+    assert_eq!(consistent.medium_mismatches, 0);
+    let nested_wrong = render(&dir.scene(&scene("smoke")), &settings, &|_| {}).1;
+    assert!(
+        nested_wrong.medium_mismatches > 0,
+        "{}",
+        nested_wrong.medium_mismatches
+    );
+}

@@ -363,6 +363,12 @@ impl PathTracer {
                 break;
             };
             let mut si = scene.geometry.shading_interaction(&ray, &hit);
+            // The boundary's own word for the side the ray arrives from.
+            if let Some(b) = media.boundary(hit.instance_id) {
+                if b.medium_towards(-ray.direction, si.n_geometric) != medium {
+                    counters.medium_mismatches += 1;
+                }
+            }
             // A medium boundary that scatters nothing: cross it, not a bounce.
             if media.is_interface(si.material_id) {
                 medium =

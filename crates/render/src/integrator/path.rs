@@ -59,6 +59,9 @@ pub struct PathCounters {
     pub roulette_terminations: u64,
     /// Light-sample or emission contributions that were NaN or infinite (dropped).
     pub non_finite_contributions: u64,
+    /// Medium boundaries met from a medium other than the one they declare on that side
+    /// (scenes with media: overlapping or inconsistent `interior_medium`/`exterior_medium`).
+    pub medium_mismatches: u64,
 }
 
 /// What one camera path returns.
