@@ -428,6 +428,15 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
     if let Some(path) = &args.stats_json {
         write_stats(path, &scene, &settings, threads, wall_time_s, &stats)?;
     }
+    if stats.medium_mismatches > 0 {
+        eprintln!(
+            "{}: warning: paths met a medium boundary {} times from a medium other than the \
+             one it declares on that side: check the shapes' interior_medium and \
+             exterior_medium (overlapping or nested boundaries must agree)",
+            args.scene.display(),
+            stats.medium_mismatches
+        );
+    }
     eprintln!(
         "wrote {} ({}×{}, {} spp, {:.2} s, {:.3} M rays/s)",
         output.display(),
@@ -463,6 +472,7 @@ fn write_stats(
         "bounces": stats.bounces,
         "roulette_terminations": stats.roulette_terminations,
         "light_paths": stats.light_paths,
+        "medium_mismatches": stats.medium_mismatches,
         // The fast paths' ISA (`--explain` says why).
         "simd": prism_cpu::active().isa().name(),
     });

@@ -257,6 +257,15 @@ impl Method {
                 mis,
                 rr_depth,
                 fluorescence_lanes,
+                spectral_mis: match *scene {
+                    prism_scene::Integrator::Path { spectral_mis, .. } => spectral_mis,
+                    prism_scene::Integrator::Light { .. }
+                    | prism_scene::Integrator::Bdpt { .. }
+                    | prism_scene::Integrator::Depth
+                    | prism_scene::Integrator::Normal
+                    | prism_scene::Integrator::Albedo
+                    | prism_scene::Integrator::AmbientOcclusion { .. } => true,
+                },
             },
             ("light", _) => prism_scene::Integrator::Light {
                 max_depth,
@@ -340,6 +349,7 @@ mod tests {
             mis: prism_scene::MisHeuristic::Balance,
             rr_depth: 2,
             fluorescence_lanes: prism_scene::FluorescenceLanes::All,
+            spectral_mis: true,
         };
         let m = Method::parse("bdpt:sobol").unwrap();
         assert_eq!(m.quantity(), "radiance");
@@ -373,6 +383,7 @@ mod tests {
             mis: prism_scene::MisHeuristic::Balance,
             rr_depth: 2,
             fluorescence_lanes: prism_scene::FluorescenceLanes::All,
+            spectral_mis: true,
         };
         let m = Method::parse("path").unwrap();
         match m.integrator(&scene).unwrap() {

@@ -370,6 +370,36 @@ impl RenderPlan {
                 "a diagnostic integrator: no light transport, lights and BSDFs are unused".into(),
             ),
         }
+        if let Some(media) = &scene.media {
+            if let Integrator::Path(p) = &scene.integrator {
+                choose(
+                    "medium transport",
+                    format!(
+                        "null-scattering delta tracking, spectral MIS {}, light and BSDF \
+                         samples weighted by the balance heuristic",
+                        on_off(p.spectral_mis)
+                    ),
+                    "the scene has participating media: `path` follows pbrt-v4's \
+                     VolPathIntegrator (rescaled path probabilities; docs/media.md)"
+                        .into(),
+                );
+            }
+            for (name, medium) in media.names.iter().zip(&media.media) {
+                let (setting, reason) = describe_medium(name, medium);
+                choose("medium", setting, reason);
+            }
+            for (position, what) in lights_in_closed_dielectrics(scene) {
+                choose(
+                    "volumetric caustic",
+                    format!("warning: the {what} at {position:?} m is inside a closed dielectric"),
+                    "path cannot sample light that reaches a medium only through specular \
+                     surfaces (its light sample is blocked, its BSDF sample never hits a \
+                     point): the glow around it will be missing. volumetric caustic: use \
+                     photon_progressive"
+                        .into(),
+                );
+            }
+        }
         match &scene.packet {
             Some(packet) => choose(
                 "packet tracing",
@@ -489,6 +519,85 @@ fn reradiation_reason(scene: &RenderScene, lanes: prism_scene::FluorescenceLanes
          maps give 0 there",
         materials.join(", ")
     )
+}
+
+/// The `medium` line of one medium: its type, σt range over 360–830 nm and grid size; why
+/// spectral MIS matters (a chromatic σt) or not.
+fn describe_medium(name: &str, medium: &crate::medium::Medium) -> (String, String) {
+    let optics = medium.optics();
+    let (lo, hi) = crate::scene_build::media::coefficient_range(&optics.sigma_a, &optics.sigma_s);
+    let grid = match medium {
+        crate::medium::Medium::Homogeneous(_) => String::new(),
+        crate::medium::Medium::Grid(g) => {
+            let [x, y, z] = g.density.resolution();
+            format!(
+                ", {x}×{y}×{z} voxels (max density {}), 16³ majorant cells",
+                g.density.max_density()
+            )
+        }
+    };
+    let chromatic = hi > lo * (1.0 + 1e-4);
+    let setting = format!(
+        "`{name}`: {}, σt {lo:.4}–{hi:.4} m⁻¹ over 360–830 nm{grid}{}",
+        medium.kind_name(),
+        if optics.emission.is_some() {
+            ", emissive"
+        } else {
+            ""
+        }
+    );
+    let reason = if chromatic {
+        "chromatic σt: free flights are sampled at the hero wavelength and spectral MIS \
+         weights the four wavelengths (pbrt-v4 rescaled probabilities)"
+            .to_string()
+    } else {
+        "grey σt: every wavelength samples the same free flights".to_string()
+    };
+    (setting, reason)
+}
+
+/// Point, spot and goniometric lights enclosed by a dielectric: rays from the light
+/// along the six axes all first meet a dielectric surface from its inside.
+fn lights_in_closed_dielectrics(scene: &RenderScene) -> Vec<([f32; 3], &'static str)> {
+    use crate::light::Light;
+    use crate::material::{Material, SurfaceMaterial};
+    let mut out = Vec::new();
+    for light in scene.lights.lights() {
+        let (position, what) = match light {
+            Light::Point(l) => (l.position_m, "point light"),
+            Light::Spot(l) => (l.position_m, "spot light"),
+            Light::Goniometric(l) => (l.position_m, "luminaire"),
+            Light::Directional(_)
+            | Light::Area(_)
+            | Light::Environment(_)
+            | Light::Sky(_)
+            | Light::Daylight(_) => continue,
+        };
+        let enclosed = [
+            Vec3A::X,
+            Vec3A::NEG_X,
+            Vec3A::Y,
+            Vec3A::NEG_Y,
+            Vec3A::Z,
+            Vec3A::NEG_Z,
+        ]
+        .iter()
+        .all(|&d| {
+            let ray = prism_geometry::Ray::infinite(position, d);
+            scene.geometry.intersect(&ray).is_some_and(|hit| {
+                let si = scene.geometry.shading_interaction(&ray, &hit);
+                let dielectric = matches!(
+                    scene.material(si.material_id),
+                    Material::Surface(SurfaceMaterial::Dielectric { .. })
+                );
+                dielectric && d.dot(si.n_geometric) > 0.0
+            })
+        });
+        if enclosed {
+            out.push((position.to_array(), what));
+        }
+    }
+    out
 }
 
 impl fmt::Display for RenderPlan {

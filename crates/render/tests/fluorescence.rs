@@ -516,6 +516,19 @@ fn bad_inputs_are_errors_that_name_their_place() {
             with(
                 &data,
                 DYE,
+                r#"{"m": {"type": "fluorescent", "reradiation": "dye"}}"#,
+            )
+            .replacen(
+                "\"reradiation\":",
+                r#""media": {"fog": {"sigma_s_per_m": 0.1}}, "world_medium": "fog", "reradiation":"#,
+                1,
+            ),
+            &["materials.m", "participating media (fog)", "not rendered together"],
+        ),
+        (
+            with(
+                &data,
+                DYE,
                 r#"{"m": {"type": "fluorescent", "reradiation": "dey"}}"#,
             ),
             &[

@@ -3,9 +3,6 @@
 
 use prism_render::RenderScene;
 
-const FOG: &str = r#""media": {"fog": {"type": "homogeneous", "sigma_a_per_m": 0.01,
-                                        "sigma_s_per_m": 0.1, "g": 0.2}}"#;
-
 /// `RenderScene::build`'s error for the scene `json`, read as `scene.json`.
 fn build_error(json: &str) -> String {
     let description = prism_scene::parse_scene_str(json, "scene.json").unwrap();
@@ -13,49 +10,6 @@ fn build_error(json: &str) -> String {
         Ok(_) => panic!("built a scene that should be refused: {json}"),
         Err(e) => e.to_string(),
     }
-}
-
-#[test]
-fn a_fog_medium_is_refused_where_it_is_defined() {
-    let json = format!(r#"{{{FOG}, "shapes": [{{"type": "rectangle"}}]}}"#);
-    assert_eq!(
-        build_error(&json),
-        "scene.json: media.fog: participating media are not rendered yet"
-    );
-    // Names that are not plain keys are written as the reader writes them.
-    let json = r#"{"media": {"thick fog": {"sigma_s_per_m": 1}}}"#;
-    assert_eq!(
-        build_error(json),
-        "scene.json: media[\"thick fog\"]: participating media are not rendered yet"
-    );
-}
-
-#[test]
-fn a_shape_in_a_medium_is_refused_at_the_shape() {
-    let shapes = |medium: &str| {
-        format!(
-            r#"{{{FOG}, "shapes": [{{"type": "rectangle"}}, {{"type": "cuboid"}}, {{"type": "disk"}},
-                {{"type": "sphere", "radius_m": 0.5, {medium}: "fog"}}]}}"#
-        )
-    };
-    assert_eq!(
-        build_error(&shapes(r#""interior_medium""#)),
-        "scene.json: shapes[3].interior_medium: participating media are not rendered yet"
-    );
-    assert_eq!(
-        build_error(&shapes(r#""exterior_medium""#)),
-        "scene.json: shapes[3].exterior_medium: participating media are not rendered yet"
-    );
-}
-
-/// The format has no camera (or world) medium: the reader refuses the key, so a camera in
-/// fog cannot be written and then dropped.
-#[test]
-fn a_camera_medium_is_not_a_key_of_the_format() {
-    let json = format!(r#"{{{FOG}, "camera": {{"type": "pinhole", "medium": "fog"}}}}"#);
-    let e = prism_scene::parse_scene_str(&json, "scene.json").unwrap_err();
-    assert_eq!(e.path.to_string(), "camera.medium");
-    assert!(e.message.starts_with("unknown field `medium`"), "{e}");
 }
 
 #[test]

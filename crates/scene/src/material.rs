@@ -69,6 +69,9 @@ pub enum MaterialKind {
         reradiation: usize,
         reflectance: Option<SpectrumRef>,
     },
+    /// Scatters nothing: the boundary of a medium (Mitsuba's `null` BSDF). Crossing it is
+    /// not a scattering event.
+    Interface,
 }
 
 /// The material library (issue 8 and after): the kinds whose parameters are numbers and
@@ -186,7 +189,7 @@ pub enum Ior {
     },
 }
 
-const TYPES: [&str; 19] = [
+const TYPES: [&str; 20] = [
     "lambert",
     "conductor",
     "dielectric",
@@ -206,6 +209,7 @@ const TYPES: [&str; 19] = [
     "bump_map",
     "sheen",
     "fluorescent",
+    "interface",
 ];
 
 /// Rows of `schema::rows()` for the material library's kinds: the keys each accepts
@@ -316,7 +320,8 @@ fn references(kind: &MaterialKind) -> Vec<usize> {
         | MaterialKind::Dielectric { .. }
         | MaterialKind::ThinDielectric { .. }
         | MaterialKind::Library(_)
-        | MaterialKind::Fluorescent { .. } => Vec::new(),
+        | MaterialKind::Fluorescent { .. }
+        | MaterialKind::Interface => Vec::new(),
     }
 }
 
@@ -516,6 +521,10 @@ fn parse_material(
                 opacity,
                 opacity_texture,
             }
+        }
+        "interface" => {
+            v.tagged_object(schema!("materials.*<interface>"))?;
+            MaterialKind::Interface
         }
         "thin_dielectric" => {
             let o = v.tagged_object(schema!("materials.*<thin_dielectric>"))?;

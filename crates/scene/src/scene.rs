@@ -10,7 +10,7 @@ use crate::integrator::{parse_integrator, Integrator};
 use crate::json::{self, Position};
 use crate::light::{parse_light, Light};
 use crate::material::{parse_materials, Material};
-use crate::medium::{parse_media, Medium};
+use crate::medium::{medium_index, parse_media, Medium};
 use crate::reader::{Ctx, Result, V};
 use crate::reradiation::{parse_reradiation, Reradiation};
 use crate::schema::schema;
@@ -36,6 +36,13 @@ pub struct SceneDescription {
     pub shapes: Vec<Shape>,
     pub lights: Vec<Light>,
     pub media: Vec<Medium>,
+    /// The medium that fills space outside all shapes (`world_medium`): the default of
+    /// shapes' `exterior_medium`, of the camera and of the lights. `None`: vacuum.
+    pub world_medium: Option<usize>,
+    /// The medium the camera sits in (`camera.medium`, else `world_medium`).
+    pub camera_medium: Option<usize>,
+    /// Per light, the medium it sits in (its `medium`, else `world_medium`).
+    pub light_media: Vec<Option<usize>>,
     /// Illuminance sensors (`sensors`), measured by `prism render` beside the image.
     pub sensors: Vec<Sensor>,
     /// The `textures` section, then textures defined inline in materials (materials refer
@@ -45,7 +52,7 @@ pub struct SceneDescription {
     pub reradiation: Vec<Reradiation>,
 }
 
-pub const TOP_LEVEL_FIELDS: [&str; 13] = [
+pub const TOP_LEVEL_FIELDS: [&str; 14] = [
     "camera",
     "film",
     "integrator",
@@ -55,6 +62,7 @@ pub const TOP_LEVEL_FIELDS: [&str; 13] = [
     "shapes",
     "lights",
     "media",
+    "world_medium",
     "sensors",
     "textures",
     "reradiation",
@@ -161,12 +169,31 @@ fn parse_root(v: &V) -> Result<SceneDescription> {
             shapes.push(shape);
         }
     }
+    let world_medium = o
+        .get("world_medium")
+        .map(|m| medium_index(&m, &medium_names))
+        .transpose()?;
+    // A shape's unnamed side outside it is the world medium.
+    for shape in &mut shapes {
+        if shape.interior_medium.is_some() && shape.exterior_medium.is_none() {
+            shape.exterior_medium = world_medium;
+        }
+    }
     let mut lights = Vec::new();
+    let mut light_media = Vec::new();
     if let Some(list) = o.get("lights") {
         for item in list.array()? {
             lights.push(parse_light(&item, &spectra, &shapes)?);
+            light_media.push(match item.member("medium") {
+                Some(m) => Some(medium_index(&m, &medium_names)?),
+                None => world_medium,
+            });
         }
     }
+    let camera_medium = match o.get("camera").and_then(|c| c.member("medium")) {
+        Some(m) => Some(medium_index(&m, &medium_names)?),
+        None => world_medium,
+    };
     let camera = o
         .get("camera")
         .map_or(Ok(Camera::default()), |c| parse_camera(&c))?;
@@ -190,6 +217,9 @@ fn parse_root(v: &V) -> Result<SceneDescription> {
         shapes,
         lights,
         media,
+        world_medium,
+        camera_medium,
+        light_media,
         sensors,
         textures: textures.textures,
         reradiation,

@@ -76,7 +76,7 @@ const SHAPE: &[&str] = &[
     "interior_medium",
     "exterior_medium",
 ];
-const LIGHT: &[&str] = &["type", "spectrum", "scale"];
+const LIGHT: &[&str] = &["type", "spectrum", "scale", "medium"];
 /// `spectrum` and `scale` are accepted only to be refused with the reason (the sky model
 /// sets both; `daylight::parse_daylight`).
 const DAYLIGHT: &[&str] = &[
@@ -88,6 +88,7 @@ const DAYLIGHT: &[&str] = &[
     "north_deg",
     "spectrum",
     "scale",
+    "medium",
 ];
 const SENSOR: &[&str] = &["type", "name"];
 const SENSOR_SAMPLING: &[&str] = &[
@@ -98,6 +99,15 @@ const SENSOR_SAMPLING: &[&str] = &[
     "max_samples",
 ];
 const TYPE: &[&str] = &["type"];
+/// Keys of every medium type; `g` is the old spelling of `{"type": "hg", "g": …}`.
+const MEDIUM: &[&str] = &[
+    "type",
+    "sigma_a_per_m",
+    "sigma_s_per_m",
+    "emission",
+    "phase",
+    "g",
+];
 const TEXTURE_UV: &[&str] = &["uv_scale", "uv_offset", "uv_rotate_deg"];
 
 /// The accepted objects but the material library's (all of them: [`rows`]). Keys of a row
@@ -108,13 +118,14 @@ pub const SCHEMA: &[ObjectSchema] = &[
     // camera.rs
     row(
         "camera<pinhole>",
-        &[&["type", "transform", "fov_deg", "fov_axis"]],
+        &[&["type", "transform", "medium", "fov_deg", "fov_axis"]],
     ),
     row(
         "camera<thin_lens>",
         &[&[
             "type",
             "transform",
+            "medium",
             "fov_deg",
             "focal_length_mm",
             "sensor_width_mm",
@@ -125,10 +136,20 @@ pub const SCHEMA: &[ObjectSchema] = &[
     ),
     row(
         "camera<fisheye>",
-        &[&["type", "transform", "projection", "fov_deg", "fit"]],
+        &[&[
+            "type",
+            "transform",
+            "medium",
+            "projection",
+            "fov_deg",
+            "fit",
+        ]],
     ),
-    row("camera<orthographic>", &[&["type", "transform", "width_m"]]),
-    row("camera<spherical>", &[&["type", "transform"]]),
+    row(
+        "camera<orthographic>",
+        &[&["type", "transform", "medium", "width_m"]],
+    ),
+    row("camera<spherical>", &[&["type", "transform", "medium"]]),
     // film.rs
     row(
         "film",
@@ -166,6 +187,7 @@ pub const SCHEMA: &[ObjectSchema] = &[
             "mis",
             "rr_depth",
             "fluorescence_lanes",
+            "spectral_mis",
         ]],
     ),
     // `mis` is refused before the keys are checked: light tracing has one strategy.
@@ -195,10 +217,12 @@ pub const SCHEMA: &[ObjectSchema] = &[
         &[&["type", "reradiation", "reflectance"]],
     ),
     // medium.rs
-    row(
-        "media.*<homogeneous>",
-        &[&["type", "sigma_a_per_m", "sigma_s_per_m", "g"]],
-    ),
+    row("media.*<homogeneous>", &[MEDIUM]),
+    row("media.*<grid>", &[MEDIUM, &["density", "bounds_m"]]),
+    row("@phase<isotropic>", &[TYPE]),
+    row("@phase<rayleigh>", &[TYPE]),
+    row("@phase<hg>", &[&["type", "g"]]),
+    row("@phase<tabulated>", &[&["type", "file"]]),
     // shape.rs
     row("meshes.*", &[&["file"]]),
     row("shapes[]<mesh>", &[SHAPE, &["file", "mesh"]]),
@@ -243,7 +267,7 @@ pub const SCHEMA: &[ObjectSchema] = &[
     ),
     row(
         "lights[]<environment>",
-        &[&["type", "file", "transform", "scale"]],
+        &[&["type", "file", "transform", "scale", "medium"]],
     ),
     row("lights[]<sky>", &[LIGHT, &["luminance_cd_m2"]]),
     row(
@@ -322,6 +346,7 @@ pub const SCHEMA: &[ObjectSchema] = &[
     row("materials.*<mask>", &[&["type", "material", "opacity"]]),
     row("materials.*<thin_dielectric>", &[&["type", "ior"]]),
     row("materials.*<mix>", &[&["type", "materials", "weight"]]),
+    row("materials.*<interface>", &[TYPE]),
     row("@ior", &[&["sellmeier", "cauchy"]]),
     row("@ior.sellmeier", &[&["b", "c_um2"]]),
     row("@ior.cauchy", &[&["a", "b_um2"]]),

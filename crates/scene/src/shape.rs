@@ -115,7 +115,7 @@ pub(crate) struct ShapeContext<'a> {
     pub media: &'a [&'a str],
 }
 
-fn named_index(v: &V, what: &str, section: &str, names: &[&str]) -> Result<usize> {
+pub(crate) fn named_index(v: &V, what: &str, section: &str, names: &[&str]) -> Result<usize> {
     let wanted = v.str()?;
     names.iter().position(|n| *n == wanted).ok_or_else(|| {
         let known = if names.is_empty() {
@@ -205,6 +205,17 @@ pub(crate) fn parse_shape(v: &V, cx: &ShapeContext, meshes: &mut Vec<MeshAsset>)
             (o, ShapeKind::Instances { mesh, transforms })
         }
     };
+    // A medium inside needs an inside: flat shapes have none (meshes are checked for
+    // boundary edges when render loads them).
+    if let (Some(m), ShapeKind::Rectangle { .. } | ShapeKind::Disk { .. }) =
+        (o.get("interior_medium"), &kind)
+    {
+        return Err(m.err(
+            "a rectangle or disk is open (it encloses no volume), so it has no interior \
+             medium: give a closed shape (sphere, cuboid, closed mesh) or only \
+             `exterior_medium`",
+        ));
+    }
     Ok(Shape {
         name: o
             .get("name")

@@ -172,6 +172,7 @@ fn every_field_kind_comes_through() {
             mis: MisHeuristic::Balance,
             rr_depth: 2,
             fluorescence_lanes: prism_scene::FluorescenceLanes::All,
+            spectral_mis: true,
         }
     );
 
@@ -212,14 +213,11 @@ fn every_field_kind_comes_through() {
 
     // Media.
     assert_eq!(s.media.len(), 1);
-    assert_eq!(
-        s.media[0].kind,
-        MediumKind::Homogeneous {
-            sigma_a_per_m: SpectrumRef::Constant(0.01),
-            sigma_s_per_m: SpectrumRef::Constant(0.25),
-            g: 0.3
-        }
-    );
+    assert_eq!(s.media[0].kind, MediumKind::Homogeneous);
+    assert_eq!(s.media[0].sigma_a_per_m, SpectrumRef::Constant(0.01));
+    assert_eq!(s.media[0].sigma_s_per_m, SpectrumRef::Constant(0.25));
+    assert_eq!(s.media[0].phase, Phase::HenyeyGreenstein { g: 0.3 });
+    assert_eq!(s.media[0].emission, None);
 
     // Materials.
     let m: Vec<&str> = s.materials.iter().map(|m| m.name.as_str()).collect();

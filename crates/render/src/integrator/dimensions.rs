@@ -118,6 +118,35 @@ impl ReradiationDimensions {
     }
 }
 
+/// The block a path segment through a medium reserves before its vertex's block, in
+/// scenes with media only (so media-free scenes keep their layout, and their images):
+/// the first free-flight distance 0, and 1 whose 64-bit hash (`SampleStream::seed_at`)
+/// seeds the generator of the segment's further collisions and of the following vertex's
+/// shadow rays (ratio tracking): their count is unbounded.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct MediumDimensions {
+    first: u32,
+}
+
+impl MediumDimensions {
+    pub const COUNT: u32 = 2;
+
+    #[inline(always)]
+    pub fn reserve(stream: &mut SampleStream) -> Self {
+        Self {
+            first: stream.reserve(Self::COUNT),
+        }
+    }
+    #[inline(always)]
+    pub fn distance(&self) -> u32 {
+        self.first
+    }
+    #[inline(always)]
+    pub fn generator(&self) -> u32 {
+        self.first + 1
+    }
+}
+
 /// The block that starts a light path: light choice 1, position on the light 2, direction
 /// of emission 2, and the lens point (2) of light tracing's connection of the light's own
 /// point to the camera.

@@ -86,6 +86,9 @@ pub struct RenderStats {
     pub non_finite_contributions: u64,
     /// Light paths traced (light tracing, BDPT).
     pub light_paths: u64,
+    /// Medium boundaries a path met from a medium other than the one declared on that side
+    /// (`PathCounters::medium_mismatches`).
+    pub medium_mismatches: u64,
 }
 
 impl RenderStats {
@@ -98,6 +101,7 @@ impl RenderStats {
         self.roulette_terminations += other.roulette_terminations;
         self.non_finite_contributions += other.non_finite_contributions;
         self.light_paths += other.light_paths;
+        self.medium_mismatches += other.medium_mismatches;
     }
 
     /// Adds a path tracer's counters.
@@ -106,6 +110,7 @@ impl RenderStats {
         self.bounces += c.bounces;
         self.roulette_terminations += c.roulette_terminations;
         self.non_finite_contributions += c.non_finite_contributions;
+        self.medium_mismatches += c.medium_mismatches;
     }
 }
 

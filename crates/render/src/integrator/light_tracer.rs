@@ -45,6 +45,7 @@ impl LightTracer {
             mis: prism_scene::MisHeuristic::Power,
             // Light paths refuse re-radiation (`prepare`); sensors path-trace with all lanes.
             fluorescence_lanes: prism_scene::FluorescenceLanes::All,
+            spectral_mis: true,
         }
     }
 
@@ -198,6 +199,9 @@ impl Estimator for LightTracer {
 
     fn prepare(&mut self, scene: &RenderScene, _pass: &Pass) -> Result<(), String> {
         scene.refuse_reradiation("light")?;
+        if let Some(media) = &scene.media {
+            return Err(crate::integrator::media_refusal("light", &media.names));
+        }
         scene
             .camera
             .importance_support()

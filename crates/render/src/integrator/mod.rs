@@ -34,6 +34,7 @@ mod estimator;
 mod fluorescent_vertex;
 mod lane_wavelengths;
 mod light_tracer;
+mod medium_transport;
 mod normal;
 pub mod packet;
 mod path;
@@ -99,12 +100,14 @@ impl Integrator {
                 mis,
                 rr_depth,
                 fluorescence_lanes,
+                spectral_mis,
                 ..
             } => Integrator::Path(PathTracer {
                 max_depth: max_depth.max(1),
                 rr_depth,
                 mis,
                 fluorescence_lanes,
+                spectral_mis,
             }),
             prism_scene::Integrator::Light {
                 max_depth,
@@ -140,6 +143,7 @@ impl Integrator {
                 rr_depth: l.rr_depth,
                 mis: prism_scene::MisHeuristic::Power,
                 fluorescence_lanes: prism_scene::FluorescenceLanes::All,
+                spectral_mis: true,
             },
             Integrator::Bdpt(b) => b.path_tracer(),
             Integrator::Depth
@@ -157,6 +161,21 @@ impl Integrator {
             | Integrator::Normal
             | Integrator::Albedo
             | Integrator::AmbientOcclusion(_) => false,
+        }
+    }
+
+    /// Err with the reason when this method cannot render a scene with the media `names`
+    /// (the light-path methods sample no media yet: rendering them as vacuum would be
+    /// silently wrong). Diagnostic integrators look at surfaces only, so media do not
+    /// concern them.
+    pub fn refuse_media(&self, names: &[String]) -> Result<(), String> {
+        match self {
+            Integrator::Light(_) | Integrator::Bdpt(_) => Err(media_refusal(self.name(), names)),
+            Integrator::Path(_)
+            | Integrator::Depth
+            | Integrator::Normal
+            | Integrator::Albedo
+            | Integrator::AmbientOcclusion(_) => Ok(()),
         }
     }
 
@@ -241,4 +260,13 @@ impl Estimator for Integrator {
             Integrator::Bdpt(b) => b.render_tile(scene, work, tile, splats),
         }
     }
+}
+
+/// Why light-path method `method` refuses a scene with the media `names`.
+pub(crate) fn media_refusal(method: &str, names: &[String]) -> String {
+    let listed: Vec<String> = names.iter().map(|n| format!("`{n}`")).collect();
+    format!(
+        "`{method}` samples no participating media yet (the scene has {}): use `path`",
+        listed.join(", ")
+    )
 }

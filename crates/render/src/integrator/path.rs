@@ -36,6 +36,8 @@ pub struct PathTracer {
     pub mis: MisHeuristic,
     /// What the lanes do at a fluorescent vertex (integrator/fluorescent_vertex.rs).
     pub fluorescence_lanes: FluorescenceLanes,
+    /// Spectral MIS of distance samples in media (`medium_transport`).
+    pub spectral_mis: bool,
 }
 
 impl Default for PathTracer {
@@ -46,6 +48,7 @@ impl Default for PathTracer {
             rr_depth: 3,
             mis: MisHeuristic::Power,
             fluorescence_lanes: FluorescenceLanes::All,
+            spectral_mis: true,
         }
     }
 }
@@ -61,6 +64,9 @@ pub struct PathCounters {
     pub roulette_terminations: u64,
     /// Light-sample or emission contributions that were NaN or infinite (dropped).
     pub non_finite_contributions: u64,
+    /// Medium boundaries met from a medium other than the one they declare on that side
+    /// (scenes with media: overlapping or inconsistent `interior_medium`/`exterior_medium`).
+    pub medium_mismatches: u64,
 }
 
 /// What one camera path returns.
@@ -244,6 +250,20 @@ impl PathTracer {
         want_illumination: bool,
         counters: &mut PathCounters,
     ) -> PathResult {
+        if let Some(media) = &scene.media {
+            return self.trace_volumetric(
+                scene,
+                media,
+                camera_ray,
+                origin,
+                camera_differential,
+                differential_scale,
+                wavelengths,
+                stream,
+                light_samples,
+                counters,
+            );
+        }
         let mut current_differential = camera_differential.copied();
         let lights = &scene.lights;
         let mut radiance = SampledSpectrum::splat(0.0);

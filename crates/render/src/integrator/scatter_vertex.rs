@@ -35,19 +35,20 @@ pub struct SurfaceVertex<'a> {
 
 /// A medium vertex: a point and the medium's phase function there.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct MediumVertex {
+pub struct MediumVertex<'a> {
     /// Position, metres (world).
     pub p: Vec3A,
     /// Unit direction back along the arriving ray.
     pub wo: Vec3A,
-    pub phase: PhaseFunction,
+    /// The medium's (a table is shared, not copied).
+    pub phase: &'a PhaseFunction,
 }
 
 /// Where a path scatters.
 #[derive(Clone, Copy, Debug)]
 pub enum ScatterVertex<'a> {
     Surface(SurfaceVertex<'a>),
-    Medium(MediumVertex),
+    Medium(MediumVertex<'a>),
 }
 
 /// The scattering function towards a direction: f·|cos θi| (surface) or p (medium), with

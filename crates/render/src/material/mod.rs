@@ -406,6 +406,14 @@ fn build_one(
                 .map(|t| scalar_texture(textures, t, 0.0, 1.0, &place, "roughness"))
                 .transpose()?,
         }),
+        // Scatters nothing: a mask of coverage 0 is exactly that for every estimator (paths
+        // pass it as a null event, not a bounce; shadow rays cross it), and the medium
+        // transport reads the interface from `MediaScene::is_interface`.
+        MaterialKind::Interface => Material::Mask {
+            material: Box::new(Material::default_material()),
+            opacity: 0.0,
+            opacity_texture: None,
+        },
         MaterialKind::ThinDielectric { ior } => {
             Material::Surface(SurfaceMaterial::ThinDielectric {
                 ior: Ior::from_scene(ior).map_err(|e| err("ior", e))?,

@@ -148,6 +148,11 @@ impl DensityGrid {
         self.majorants[(cell[2] * m + cell[1]) * m + cell[0]]
     }
 
+    /// Voxels along x, y, z.
+    pub fn resolution(&self) -> [usize; 3] {
+        self.resolution
+    }
+
     /// The largest density anywhere (the max voxel).
     pub fn max_density(&self) -> f32 {
         self.values.iter().copied().fold(0.0, f32::max)

@@ -3,6 +3,7 @@
 //! A phase function is its own pdf when sampled exactly, as all of these are.
 
 use std::f32::consts::PI;
+use std::sync::Arc;
 
 use glam::{Vec2, Vec3A};
 use prism_geometry::Frame;
@@ -18,8 +19,9 @@ pub struct PhaseSample {
     pub pdf: f32,
 }
 
-/// The phase functions a medium can have.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// The phase functions a medium can have. Not `Copy` (a table is shared): medium vertices
+/// borrow it from their medium.
+#[derive(Clone, Debug, PartialEq)]
 pub enum PhaseFunction {
     /// 1/4π.
     Isotropic,
@@ -28,6 +30,9 @@ pub enum PhaseFunction {
     /// Rayleigh scattering by particles much smaller than the wavelength (air molecules):
     /// 3/(16π) (1 + cos²θ), symmetric, so its mean cosine is 0.
     Rayleigh,
+    /// A table over the scattering angle's cosine (a Mie or Cornette–Shanks table),
+    /// normalised, sampled by inversion (`tabulated_phase`).
+    Tabulated(Arc<super::tabulated_phase::TabulatedPhase>),
 }
 
 /// p_HG(cos θ) = (1 − g²) / (4π (1 + g² + 2g cos θ)^{3/2}) with cos θ = ωo·ωi
@@ -61,10 +66,12 @@ impl PhaseFunction {
     /// p(ωo, ωi), sr⁻¹.
     #[inline]
     pub fn eval(&self, wo: Vec3A, wi: Vec3A) -> f32 {
-        match *self {
+        match self {
             PhaseFunction::Isotropic => 1.0 / (4.0 * PI),
-            PhaseFunction::HenyeyGreenstein { g } => henyey_greenstein(wo.dot(wi), g),
+            PhaseFunction::HenyeyGreenstein { g } => henyey_greenstein(wo.dot(wi), *g),
             PhaseFunction::Rayleigh => rayleigh(wo.dot(wi)),
+            // The table is over the scattering cosine, −ωo·ωi in this convention.
+            PhaseFunction::Tabulated(t) => t.eval(-wo.dot(wi)),
         }
     }
 
@@ -80,14 +87,16 @@ impl PhaseFunction {
     pub fn sample(&self, wo: Vec3A, u: Vec2) -> Option<PhaseSample> {
         // cos θ between ωo and ωi (pbrt-v4's form: forward scattering, g > 0, puts ωi near
         // −ωo, cos θ near −1).
-        let cos_theta = match *self {
+        let cos_theta = match self {
             PhaseFunction::Isotropic => 1.0 - 2.0 * u.x,
             PhaseFunction::HenyeyGreenstein { g } if g.abs() < 1e-3 => 1.0 - 2.0 * u.x,
             PhaseFunction::HenyeyGreenstein { g } => {
+                let g = *g;
                 let s = (1.0 - g * g) / (1.0 + g - 2.0 * g * u.x);
                 -(1.0 + g * g - s * s) / (2.0 * g)
             }
             PhaseFunction::Rayleigh => sample_rayleigh_cos_theta(u.x),
+            PhaseFunction::Tabulated(t) => -t.sample_cos_theta(u.x),
         };
         let cos_theta = cos_theta.clamp(-1.0, 1.0);
         let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
@@ -101,10 +110,11 @@ impl PhaseFunction {
 
     /// The mean cosine ⟨cos θ⟩ between the incident propagation direction and ωi.
     pub fn asymmetry(&self) -> f32 {
-        match *self {
+        match self {
             PhaseFunction::Isotropic => 0.0,
-            PhaseFunction::HenyeyGreenstein { g } => g,
+            PhaseFunction::HenyeyGreenstein { g } => *g,
             PhaseFunction::Rayleigh => 0.0,
+            PhaseFunction::Tabulated(t) => t.mean_cosine(),
         }
     }
 }
@@ -116,8 +126,22 @@ mod tests {
 
     /// Issue 20 test 6 asks for HG at g −0.9, 0, 0.5, 0.95 and Rayleigh; the others cover
     /// the small-|g| branch and both signs.
-    fn phases() -> [PhaseFunction; 9] {
+    fn phases() -> [PhaseFunction; 11] {
+        // A forward-peaked table (steep, so the inversion's quadratic branch is exercised)
+        // and a backward one with a flat piece.
+        let forward = crate::medium::tabulated_phase::TabulatedPhase::new(
+            &[-1.0, -0.5, 0.0, 0.5, 0.9, 1.0],
+            &[0.2, 0.3, 0.5, 1.0, 6.0, 20.0],
+        )
+        .unwrap();
+        let backward = crate::medium::tabulated_phase::TabulatedPhase::new(
+            &[-1.0, -0.2, 0.3, 1.0],
+            &[3.0, 1.0, 1.0, 0.0],
+        )
+        .unwrap();
         [
+            PhaseFunction::Tabulated(Arc::new(forward)),
+            PhaseFunction::Tabulated(Arc::new(backward)),
             PhaseFunction::Isotropic,
             PhaseFunction::HenyeyGreenstein { g: -0.9 },
             PhaseFunction::HenyeyGreenstein { g: 0.0 },

@@ -201,6 +201,14 @@ impl SampleStream {
         (self.kind == SamplerKind::Independent).then_some(self.tail_key)
     }
 
+    /// A 64-bit hash of (seed, pixel, sample index, `dimension`): the seed of a
+    /// generator for an unbounded number of variates that one reserved dimension stands
+    /// for (a medium segment's collisions, `integrator::medium_transport`).
+    #[inline]
+    pub fn seed_at(&self, dimension: u32) -> u64 {
+        mix64(self.tail_key ^ u64::from(dimension).wrapping_mul(DIMENSION_SPREAD))
+    }
+
     /// Dimensions used so far.
     pub fn dimension(&self) -> u32 {
         self.dimension

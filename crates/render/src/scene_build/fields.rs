@@ -9,8 +9,7 @@
 //! that test until someone wires it into render (naming the code that reads it) or refuses
 //! it in [`refuse_unrendered`].
 //!
-//! Refusals live here, in one place: when participating media render, delete their
-//! check in `refuse_unrendered` and turn their rows into `Read`.
+//! Refusals live here, in one place.
 
 use prism_scene::{Aov, JsonPath, SceneDescription};
 
@@ -138,8 +137,10 @@ const BUILD_FLUORESCENT: &str = "material::fluorescent::FluorescentSurface::buil
      matrix and R that prism-scene reradiation::parse_reradiation loaded)";
 const TRANSFORM: &str = "prism-scene transform::parse_transform composes the matrix that \
                          scene_build::transform::to_geometry_transform reads";
-const MEDIA: &str = "scene_build::fields::refuse_unrendered: participating media are not \
-                     rendered yet";
+const BUILD_MEDIA: &str = "scene_build::media::build_media";
+const CAMERAS_AND_LIGHTS_MEDIUM: &str = "prism-scene scene::parse_root (SceneDescription::\
+                                         camera_medium, light_media), read by \
+                                         scene_build::media::build_media";
 
 /// Every row: [`FIELD_USES`] and the material library's; together they name every key
 /// path of `prism_scene::schema::rows()`, each in exactly one row.
@@ -164,7 +165,7 @@ pub const FIELD_USES: &[FieldRow] = &[
     read(&[""], &["meshes"], BUILD_GEOMETRY),
     read(&[""], &["shapes"], BUILD_GEOMETRY),
     read(&[""], &["lights"], BUILD_LIGHTS),
-    refused(&[""], &["media"], MEDIA),
+    read(&[""], &["media", "world_medium"], BUILD_MEDIA),
     read(&[""], &["sensors"], SENSOR),
     read(&[""], &["textures"], LOAD_TEXTURE),
     read(&[""], &["reradiation"], BUILD_FLUORESCENT),
@@ -190,6 +191,7 @@ pub const FIELD_USES: &[FieldRow] = &[
     },
     // camera
     read(CAMERAS, &["type", "transform"], BUILD_CAMERA),
+    read(CAMERAS, &["medium"], CAMERAS_AND_LIGHTS_MEDIUM),
     read(&["camera<pinhole>"], &["fov_deg", "fov_axis"], BUILD_CAMERA),
     read(
         &["camera<thin_lens>"],
@@ -254,11 +256,40 @@ pub const FIELD_USES: &[FieldRow] = &[
         &["sampler"],
         "`prism render`: crates/cli/render.rs run (RenderSettings::sampler)",
     ),
+    read(
+        &["integrator<path>"],
+        &["spectral_mis"],
+        "Integrator::from_description (PathTracer::spectral_mis)",
+    ),
     // media
-    refused(
-        &["media.*<homogeneous>"],
-        &["type", "sigma_a_per_m", "sigma_s_per_m", "g"],
-        MEDIA,
+    read(
+        &["media.*<homogeneous>", "media.*<grid>"],
+        &[
+            "type",
+            "sigma_a_per_m",
+            "sigma_s_per_m",
+            "emission",
+            "phase",
+            "g",
+        ],
+        BUILD_MEDIA,
+    ),
+    read(&["media.*<grid>"], &["density", "bounds_m"], BUILD_MEDIA),
+    read(
+        &[
+            "@phase<isotropic>",
+            "@phase<rayleigh>",
+            "@phase<hg>",
+            "@phase<tabulated>",
+        ],
+        &["type"],
+        BUILD_MEDIA,
+    ),
+    read(&["@phase<hg>"], &["g"], BUILD_MEDIA),
+    read(
+        &["@phase<tabulated>"],
+        &["file"],
+        "prism-scene medium::read_phase_table, then scene_build::media::build_media",
     ),
     // meshes and shapes
     read(&["meshes.*"], &["file"], BUILD_GEOMETRY),
@@ -269,7 +300,7 @@ pub const FIELD_USES: &[FieldRow] = &[
         "prism-scene light::parse_light (an area light names its shape) and \
          scene_build::geometry (error places)",
     ),
-    refused(SHAPES, &["interior_medium", "exterior_medium"], MEDIA),
+    read(SHAPES, &["interior_medium", "exterior_medium"], BUILD_MEDIA),
     read(&["shapes[]<mesh>"], &["file", "mesh"], BUILD_GEOMETRY),
     read(
         &["shapes[]<sphere>", "shapes[]<disk>"],
@@ -291,6 +322,22 @@ pub const FIELD_USES: &[FieldRow] = &[
         SPECTRAL_LIGHTS,
         &["type", "spectrum", "scale"],
         BUILD_LIGHTS,
+    ),
+    read(
+        &[
+            "lights[]<point>",
+            "lights[]<spot>",
+            "lights[]<directional>",
+            "lights[]<area>",
+            "lights[]<sky>",
+            "lights[]<luminaire>",
+            "lights[]<environment>",
+            "lights[]<cie_sky>",
+            "lights[]<perez_sky>",
+            "lights[]<preetham_sky>",
+        ],
+        &["medium"],
+        CAMERAS_AND_LIGHTS_MEDIUM,
     ),
     read(
         &["lights[]<point>"],
@@ -431,6 +478,12 @@ pub const FIELD_USES: &[FieldRow] = &[
     read(&["materials.*<mask>"], &["opacity"], BUILD_MATERIAL),
     read(&["materials.*<thin_dielectric>"], &["ior"], BUILD_MATERIAL),
     read(
+        &["materials.*<interface>"],
+        &["type"],
+        "material::build_materials (a mask of opacity 0) and scene_build::media::build_media \
+         (MediaScene::interface_material)",
+    ),
+    read(
         &["materials.*<mix>"],
         &["materials", "weight"],
         BUILD_MATERIAL,
@@ -523,31 +576,11 @@ pub const FIELD_USES: &[FieldRow] = &[
 ];
 
 /// Refuses what the scene reader accepts but render does not do yet, with the file and the
-/// JSON path: participating media (`media.NAME`, `shapes[i].interior_medium`,
-/// `shapes[i].exterior_medium`) and the `position` AOV (`film.aovs[i]`). A shape that uses
-/// a medium is named before the medium itself.
+/// JSON path: the `position` AOV (`film.aovs[i]`).
 pub fn refuse_unrendered(scene: &SceneDescription) -> Result<(), SceneBuildError> {
     let refuse = |path: JsonPath, message: &str| {
         Err(SceneBuildError::new(&scene.file, path.to_string(), message))
     };
-    const MEDIA_NOT_RENDERED: &str = "participating media are not rendered yet";
-    for (i, shape) in scene.shapes.iter().enumerate() {
-        for (key, medium) in [
-            ("interior_medium", shape.interior_medium),
-            ("exterior_medium", shape.exterior_medium),
-        ] {
-            if medium.is_some() {
-                let path = JsonPath::default().key("shapes").index(i).key(key);
-                return refuse(path, MEDIA_NOT_RENDERED);
-            }
-        }
-    }
-    if let Some(medium) = scene.media.first() {
-        return refuse(
-            JsonPath::default().key("media").key(&medium.name),
-            MEDIA_NOT_RENDERED,
-        );
-    }
     for (i, aov) in scene.film.aovs.iter().enumerate() {
         match aov {
             Aov::Depth | Aov::Normal | Aov::Albedo => {}

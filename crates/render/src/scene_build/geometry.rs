@@ -96,7 +96,7 @@ pub(crate) struct PlacedShapes {
     pub vertex_normals: bool,
 }
 
-fn load_mesh(asset: &prism_scene::MeshAsset) -> Result<TriangleMesh, String> {
+pub(crate) fn load_mesh(asset: &prism_scene::MeshAsset) -> Result<TriangleMesh, String> {
     let mesh = match asset.format {
         MeshFormat::Obj => prism_geometry::load_obj(&asset.path),
         MeshFormat::Ply => prism_geometry::load_ply(&asset.path),

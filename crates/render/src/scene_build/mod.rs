@@ -10,6 +10,7 @@ pub mod features;
 pub mod fields;
 mod filter;
 mod geometry;
+pub mod media;
 pub mod spectrum;
 mod transform;
 
@@ -78,6 +79,9 @@ pub struct RenderScene {
     /// packet tracer and the small-scene intersector run only where it is within their
     /// allow-lists (`PacketScene::SUPPORTS`, `SMALL_SCENE_SUPPORTS`).
     pub features: SceneFeatures,
+    /// The scene's participating media (`None` when it declares none): `path` then walks
+    /// its paths through `integrator::medium_transport`.
+    pub media: Option<media::MediaScene>,
 }
 
 impl RenderScene {
@@ -115,12 +119,36 @@ impl RenderScene {
             &materials,
             placed.vertex_normals,
         );
+        let ranges = placed.ranges.clone();
         let geometry = placed.builder.build_with(geometry::build_options(features));
+        let media = media::build_media(scene, &ranges, &geometry, &camera, resolution)?;
+        if let Some(m) = &media {
+            integrator
+                .refuse_media(&m.names)
+                .map_err(|message| SceneBuildError::new(&file, "integrator", message))?;
+        }
         let lights = LightSet::build(scene, &geometry)?;
         let has_masks = materials.iter().any(|m| m.has_mask());
         let has_glazing = materials.iter().any(|m| m.has_thin_glazing());
         let has_dispersion = materials.iter().any(|m| m.is_dispersive());
         let has_reradiation = materials.iter().any(|m| m.fluorescent().is_some());
+        if let (Some(m), Some(i)) = (
+            &media,
+            materials.iter().position(|m| m.fluorescent().is_some()),
+        ) {
+            // The volumetric loop (integrator/medium_transport.rs) has no fluorescent vertex.
+            let name = &scene.materials[i].name;
+            return Err(SceneBuildError::new(
+                &file,
+                &format!("materials.{name}"),
+                format!(
+                    "material '{name}' re-radiates (fluorescence) in a scene with participating \
+                     media ({}): fluorescence is not rendered together with media yet; remove \
+                     the media or the re-radiation",
+                    m.names.join(", ")
+                ),
+            ));
+        }
         let texture_footprint = if materials.iter().any(|m| m.has_textures()) {
             // A camera without a ray at the film centre (a circular fisheye's corner is
             // never the centre) would leave textures unfiltered: point lookups.
@@ -163,6 +191,7 @@ impl RenderScene {
             splat: scene.film.reconstruction == prism_scene::Reconstruction::Splat,
             packet: None,
             features,
+            media,
         };
         built.set_packet_tracing(true);
         Ok(built)

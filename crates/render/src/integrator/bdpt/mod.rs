@@ -109,6 +109,7 @@ impl Bdpt {
             mis: self.mis,
             // Light paths refuse re-radiation (`prepare`); sensors path-trace with all lanes.
             fluorescence_lanes: prism_scene::FluorescenceLanes::All,
+            spectral_mis: true,
         }
     }
 
@@ -299,6 +300,9 @@ impl Estimator for Bdpt {
 
     fn prepare(&mut self, scene: &RenderScene, _pass: &Pass) -> Result<(), String> {
         scene.refuse_reradiation("bdpt")?;
+        if let Some(media) = &scene.media {
+            return Err(crate::integrator::media_refusal("bdpt", &media.names));
+        }
         scene
             .camera
             .importance_support()

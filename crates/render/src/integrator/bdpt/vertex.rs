@@ -34,7 +34,7 @@ pub enum VertexKind {
         emitter: u32,
     },
     /// A medium point.
-    Medium(MediumVertex),
+    Medium(MediumVertex<'static>),
 }
 
 /// A surface vertex's scattering data (the heavy part: the hit and its BSDF).

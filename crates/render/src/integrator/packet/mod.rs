@@ -126,6 +126,12 @@ impl PacketScene {
                  path, but the packet tracer evaluates reflectances once per camera sample"
             ));
         }
+        if let Some(media) = &scene.media {
+            return Err(format!(
+                "the scene has participating media ({}): the packet tracer samples no media",
+                media.names.join(", ")
+            ));
+        }
         let outside = scene.features.outside(Self::SUPPORTS);
         if !outside.is_empty() {
             return Err(outside.names());
