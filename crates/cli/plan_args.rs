@@ -35,6 +35,12 @@ pub enum VarianceArg {
     Measured,
 }
 
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum OnOff {
+    On,
+    Off,
+}
+
 #[derive(Clone, Debug, Args)]
 pub struct PlanArgs {
     /// How camera samples are spread over the pixels; `--spp` is the mean.
@@ -49,6 +55,10 @@ pub struct PlanArgs {
     /// `--plan predicted`: what the samples follow.
     #[arg(long = "plan-allocation", value_enum, default_value = "relative")]
     pub plan_allocation: AllocationArg,
+    /// `--plan predicted`: shadow edges from the probe's shadow rays (`off`: the paper,
+    /// which ignores visibility).
+    #[arg(long = "plan-visibility", value_enum, default_value = "on")]
+    pub plan_visibility: OnOff,
     /// `--plan predicted`: how V̂_p is predicted.
     #[arg(long = "plan-variance", value_enum, default_value = "eq9")]
     pub plan_variance: VarianceArg,
@@ -78,11 +88,12 @@ impl PlanArgs {
         let predictor_flags_given = self.plan_nb != DEFAULT_PROBE_SAMPLES
             || self.plan_floor != DEFAULT_FLOOR
             || self.plan_allocation != AllocationArg::Relative
-            || self.plan_variance != VarianceArg::Eq9;
+            || self.plan_variance != VarianceArg::Eq9
+            || self.plan_visibility != OnOff::On;
         if self.plan != PlanArg::Predicted && predictor_flags_given {
             return Err(
-                "--plan-nb, --plan-floor, --plan-allocation and --plan-variance set up the \
-                 predictor: add \
+                "--plan-nb, --plan-floor, --plan-allocation, --plan-variance and \
+                 --plan-visibility set up the predictor: add \
                  --plan predicted"
                     .into(),
             );
@@ -127,6 +138,7 @@ impl PlanArgs {
                 VarianceArg::Eq9OneBounce => VarianceBandwidth::OneBounce,
                 VarianceArg::Measured => VarianceBandwidth::Measured,
             },
+            visibility: self.plan_visibility == OnOff::On,
         }
     }
 }

@@ -1,7 +1,7 @@
 //! From the bandwidth buffer to camera samples per pixel: N_p = budget · a_p / mean(a),
 //! a_p = f + (1 − f) · s_p / mean(s), with a floor f for the light the predictor does not
 //! see (indirect light) and at least 4^−level samples where eq. 11 asks for sub-pixel
-//! anti-aliasing (level < 0).
+//! anti-aliasing (level < 0), as far as the budget allows.
 //!
 //! s_p is the pixel's predicted relative standard deviation √V̂_p / √(L̂_p² + 0.01): the
 //! allocation that minimises the image's relMSE gives each pixel samples ∝ σ_p / L_p (a
@@ -166,8 +166,17 @@ impl Allocated {
 /// x_p = k·a_p with the total `budget`, except that no pixel gets less than its minimum:
 /// pixels held at their minimum leave the rest a smaller budget, so k is solved again over
 /// the free pixels until no free pixel falls below its minimum (at most n rounds; a few in
-/// practice). A budget below Σ minimum gives every pixel its minimum.
+/// practice). Minimums that alone exceed the budget are scaled down to fit it: the budget
+/// is the user's (`--spp` is the mean), the minimums a preference.
 fn fill_with_minimums(a: &[f64], minimum: &[f64], budget: f64) -> Vec<f64> {
+    let total_minimum: f64 = minimum.iter().sum();
+    let scaled: Vec<f64>;
+    let minimum = if total_minimum > budget {
+        scaled = minimum.iter().map(|m| m * budget / total_minimum).collect();
+        &scaled[..]
+    } else {
+        minimum
+    };
     let mut held = vec![false; a.len()];
     loop {
         let held_total: f64 = (0..a.len()).filter(|&i| held[i]).map(|i| minimum[i]).sum();
@@ -261,15 +270,16 @@ mod tests {
         assert_eq!(out.plan.camera_samples(UVec2::new(0, 0)), 16);
         let rest: f32 = out.relative_density[1..].iter().sum::<f32>() * 8.0;
         assert!((rest - 16.0).abs() < 1e-4, "{rest}");
-        // Budget below the minimums: every pixel at its minimum.
+        // Minimums above the budget are scaled to fit it: 4 + 16 wanted, 10 spent.
         let tight = AllocationInputs {
             variance: &[0.0; 2],
             mean_y: &[1.0; 2],
-            shading_level: &[-1, -1],
+            shading_level: &[-1, -2],
         };
-        s.mean_spp = 1.0;
+        s.mean_spp = 5.0;
         let out = allocate(UVec2::new(2, 1), tight, s).unwrap();
-        assert_eq!(out.plan.total_camera_samples(), 8);
+        assert_eq!(out.plan.total_camera_samples(), 10);
+        assert_eq!(out.plan.camera_samples(UVec2::new(0, 0)), 2);
     }
 
     #[test]

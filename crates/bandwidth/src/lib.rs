@@ -38,6 +38,7 @@ pub mod sample_plan;
 mod stochastic_rounding;
 #[cfg(test)]
 mod test_rng;
+pub mod visibility;
 
 pub use adaptive_error::{adaptive_error, adaptive_pass_counts};
 pub use allocation::{allocate, Allocated, Allocation, AllocationInputs, AllocationSettings};
@@ -51,3 +52,4 @@ pub use operators::Bounce;
 pub use pixel_prediction::{predict_pixel, PixelFootprint, PixelPrediction, VarianceBandwidth};
 pub use probe::{LightSample, ShadingProbe};
 pub use sample_plan::{SamplePlan, DEFAULT_LIGHT_SAMPLES};
+pub use visibility::{Visibility, VisibilitySummary};

@@ -12,6 +12,7 @@ use glam::{UVec2, Vec3A};
 use crate::bandwidth::{Bandwidth, MaterialBandwidth};
 use crate::gbuffer::GBufferHit;
 use crate::probe::{LightSample, ShadingProbe};
+use crate::visibility::Visibility;
 
 /// A point light over Lambertian surfaces (see the module documentation).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -58,6 +59,7 @@ impl ShadingProbe for MockProbe {
             light_bandwidth: self.light_bandwidth,
             material_bandwidth: self.material_bandwidth,
             lane_variance: 0.0,
+            visibility: Visibility::Unknown,
         };
         out.extend(std::iter::repeat_n(sample, count as usize));
     }

@@ -8,6 +8,7 @@ use crate::error::BandwidthError;
 use crate::gbuffer::GBufferHit;
 use crate::operators::{bound, normal_curvature, transport, Bounce};
 use crate::probe::LightSample;
+use crate::visibility::{penumbra_bandwidth, Visibility, VisibilitySummary};
 
 /// The largest b_p the bandwidth buffer stores, cycles per pixel: eq. 11 clamps the level to
 /// −2 (4×4 samples per pixel, ⌊log2(1/(2·2))⌋ = −2), so a higher rate (+∞ from a hard edge
@@ -41,6 +42,8 @@ pub struct PixelPrediction {
     pub variance: f32,
     /// L̂_p: the mean of the n_b samples' weights λᵢ/pᵢ, Y.
     pub mean_y: f32,
+    /// The shadow rays' outcomes (`visibility` module).
+    pub visibility: VisibilitySummary,
 }
 
 /// How the pixel maps angles to pixels and how many samples the probe was asked for.
@@ -178,11 +181,32 @@ pub fn predict_pixel(
     let variance = ((variance_sum + lane_variance_sum) / f64::from(n_b)) as f32;
     let mean_y =
         (samples.iter().map(|s| f64::from(s.weight_y())).sum::<f64>() / f64::from(n_b)) as f32;
+    let mut visibility = VisibilitySummary::default();
+    for sample in samples {
+        match sample.visibility {
+            Visibility::Unknown => {}
+            Visibility::Visible => {
+                visibility.traced += 1;
+                visibility.visible += 1;
+            }
+            Visibility::Blocked { blocker_distance_m } => {
+                visibility.traced += 1;
+                visibility.penumbra_cycles_per_m =
+                    visibility.penumbra_cycles_per_m.max(penumbra_bandwidth(
+                        sample.light_bandwidth,
+                        sample.is_delta(),
+                        sample.distance_m,
+                        blocker_distance_m,
+                    ));
+            }
+        }
+    }
     Ok(PixelPrediction {
         bandwidth,
         image_bandwidth_cycles_per_px,
         variance,
         mean_y,
+        visibility,
     })
 }
 
@@ -217,6 +241,7 @@ mod tests {
             light_bandwidth: light,
             material_bandwidth: MaterialBandwidth::new(rho, 0.0).unwrap(),
             lane_variance: 0.0,
+            visibility: Visibility::Unknown,
         }
     }
 
@@ -343,6 +368,7 @@ mod tests {
             light_bandwidth: Bandwidth::distant_light(nu_env).unwrap(),
             material_bandwidth: MaterialBandwidth::new(f32::INFINITY, 0.0).unwrap(),
             lane_variance: 0.0,
+            visibility: Visibility::Unknown,
         };
         let footprint = PixelFootprint {
             rad_per_px: 1e-3,

@@ -25,6 +25,7 @@ use glam::{UVec2, Vec3A};
 
 use crate::bandwidth::{Bandwidth, MaterialBandwidth};
 use crate::gbuffer::GBufferHit;
+use crate::visibility::Visibility;
 
 /// One sampled incident direction at a G-buffer hit.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -57,6 +58,8 @@ pub struct LightSample {
     /// (X, Y and Z variances summed), in the weight's units squared. 0 for a probe that
     /// does not measure it, or a flat spectrum.
     pub lane_variance: f32,
+    /// What the sample's shadow ray met (`Unknown` where the probe does not trace it).
+    pub visibility: Visibility,
 }
 
 impl LightSample {

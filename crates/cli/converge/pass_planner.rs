@@ -52,6 +52,7 @@ impl PassPlanner {
                         seed: settings.seed,
                     },
                     variance_bandwidth: prism_bandwidth::VarianceBandwidth::Incident,
+                    visibility: true,
                 };
                 Some(predict(scene, &predictor, settings.seed)?.allocated)
             }

@@ -13,7 +13,7 @@ use prism_bandwidth::pixel_prediction::MAX_IMAGE_BANDWIDTH_CYCLES_PER_PX;
 use prism_bandwidth::{
     allocate, predict_pixel, Allocated, AllocationInputs, AllocationSettings, Bandwidth,
     BandwidthBuffer, GBufferHit, LightSample, PixelFootprint, PixelPrediction, ShadingProbe,
-    VarianceBandwidth,
+    VarianceBandwidth, VisibilitySummary,
 };
 use prism_spectrum::colorimetry::sampled_radiance_to_xyz;
 use prism_spectrum::{SampledSpectrum, SampledWavelengths};
@@ -33,6 +33,8 @@ pub struct PredictorSettings {
     pub probe_samples: u32,
     pub allocation: AllocationSettings,
     pub variance_bandwidth: VarianceBandwidth,
+    /// Shadow edges from the probe's shadow rays (`--plan-visibility`; off = the paper).
+    pub visibility: bool,
 }
 
 /// The predictor's answer for a whole image.
@@ -158,6 +160,62 @@ fn escaping_pixel(
             .min(MAX_IMAGE_BANDWIDTH_CYCLES_PER_PX),
         variance: variance as f32,
         mean_y: mean.y as f32,
+        visibility: VisibilitySummary::default(),
+    }
+}
+
+/// Where a hit pixel's image bandwidth comes from, for the visibility pass: the eye
+/// distance d′ (m), cos θ_x and the pixel's radians per pixel.
+#[derive(Clone, Copy, Debug, Default)]
+struct EyeGeometry {
+    depth_m: f32,
+    cos_theta_x: f32,
+    rad_per_px: f32,
+}
+
+/// Two visible shares this far apart put a shadow boundary between two pixels.
+const SHADOW_EDGE_SHARE_STEP: f32 = 0.25;
+
+/// Shadow edges (`prism_bandwidth::visibility`): a pixel whose shadow rays disagree, or
+/// whose visible share differs from a 4-neighbour's by `SHADOW_EDGE_SHARE_STEP` or more,
+/// gets the penumbra's spatial bandwidth (its own or, when all its light samples were
+/// visible, its neighbours'), carried to the eye like a texture's (P_x then T_d′).
+fn add_shadow_edges(
+    resolution: UVec2,
+    pixels: &mut [PixelPrediction],
+    eye: &[Option<EyeGeometry>],
+) {
+    let (w, h) = (resolution.x as usize, resolution.y as usize);
+    let before: Vec<VisibilitySummary> = pixels.iter().map(|p| p.visibility).collect();
+    for i in 0..w * h {
+        let Some(eye) = eye[i] else { continue };
+        let (x, y) = (i % w, i / w);
+        let own = before[i];
+        let mut edge = own.disagrees();
+        let mut penumbra = own.penumbra_cycles_per_m;
+        let neighbours = [
+            (x > 0).then(|| i - 1),
+            (x + 1 < w).then(|| i + 1),
+            (y > 0).then(|| i - w),
+            (y + 1 < h).then(|| i + w),
+        ];
+        for n in neighbours.into_iter().flatten() {
+            if let (Some(a), Some(b)) = (own.visible_share(), before[n].visible_share()) {
+                if (a - b).abs() >= SHADOW_EDGE_SHARE_STEP {
+                    edge = true;
+                    penumbra = penumbra.max(before[n].penumbra_cycles_per_m);
+                }
+            }
+        }
+        if !edge || penumbra <= 0.0 || eye.cos_theta_x <= 0.0 {
+            continue;
+        }
+        let p = &mut pixels[i];
+        let spatial = penumbra / eye.cos_theta_x;
+        p.bandwidth.spatial_cycles_per_m += spatial;
+        p.bandwidth.angular_cycles_per_rad += eye.depth_m * spatial;
+        p.image_bandwidth_cycles_per_px = (p.bandwidth.angular_cycles_per_rad * eye.rad_per_px)
+            .min(MAX_IMAGE_BANDWIDTH_CYCLES_PER_PX);
     }
 }
 
@@ -171,7 +229,8 @@ pub fn predict(
         return Err("--plan-nb must be at least 1".into());
     }
     let resolution = scene.resolution;
-    let probe = RenderProbe::new(scene, seed).with_bandwidth_tables()?;
+    let mut probe = RenderProbe::new(scene, seed).with_bandwidth_tables()?;
+    probe.trace_visibility = settings.visibility;
     // Infinite lights seen directly: the background's own angular bandwidth.
     let background_nu_a = scene
         .lights
@@ -180,7 +239,8 @@ pub fn predict(
         .filter(|l| l.is_infinite())
         .map(|l| l.bandwidth().angular_cycles_per_rad)
         .fold(0.0f32, f32::max);
-    let rows: Vec<Vec<(PixelPrediction, f32)>> = (0..resolution.y)
+    type PixelRow = Vec<(PixelPrediction, f32, Option<EyeGeometry>)>;
+    let rows: Vec<PixelRow> = (0..resolution.y)
         .into_par_iter()
         .map(|y| {
             let mut samples: Vec<LightSample> = Vec::new();
@@ -189,7 +249,7 @@ pub fn predict(
                     let pixel = UVec2::new(x, y);
                     let Some(rad_per_px) = angular_footprint(scene, pixel).filter(|a| *a > 0.0)
                     else {
-                        return Ok((PixelPrediction::default(), 0.0));
+                        return Ok((PixelPrediction::default(), 0.0, None));
                     };
                     let footprint = PixelFootprint {
                         rad_per_px,
@@ -206,7 +266,12 @@ pub fn predict(
                             )
                             .map_err(|e| e.to_string())?;
                             let c = hit.curvature();
-                            Ok((p, c.k1.abs().max(c.k2.abs())))
+                            let eye = EyeGeometry {
+                                depth_m: hit.depth_m(),
+                                cos_theta_x: hit.cos_theta_view(),
+                                rad_per_px,
+                            };
+                            Ok((p, c.k1.abs().max(c.k2.abs()), Some(eye)))
                         }
                         CentreRay::Escapes(direction) => Ok((
                             escaping_pixel(
@@ -217,14 +282,25 @@ pub fn predict(
                                 rad_per_px,
                             ),
                             0.0,
+                            None,
                         )),
-                        CentreRay::None => Ok((PixelPrediction::default(), 0.0)),
+                        CentreRay::None => Ok((PixelPrediction::default(), 0.0, None)),
                     }
                 })
                 .collect::<Result<Vec<_>, String>>()
         })
         .collect::<Result<Vec<_>, String>>()?;
-    let (pixels, curvature): (Vec<PixelPrediction>, Vec<f32>) = rows.into_iter().flatten().unzip();
+    let mut pixels = Vec::new();
+    let mut curvature = Vec::new();
+    let mut eye = Vec::new();
+    for (p, c, e) in rows.into_iter().flatten() {
+        pixels.push(p);
+        curvature.push(c);
+        eye.push(e);
+    }
+    if settings.visibility {
+        add_shadow_edges(resolution, &mut pixels, &eye);
+    }
     let b: Vec<f32> = pixels
         .iter()
         .map(|p| p.image_bandwidth_cycles_per_px)

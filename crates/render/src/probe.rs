@@ -23,7 +23,9 @@
 //! into their weight.
 
 use glam::{UVec2, Vec2, Vec3A};
-use prism_bandwidth::{Bandwidth, GBufferHit, LightSample, MaterialBandwidth, ShadingProbe};
+use prism_bandwidth::{
+    Bandwidth, GBufferHit, LightSample, MaterialBandwidth, ShadingProbe, Visibility,
+};
 use prism_geometry::{Differentials, Frame, Ray, SurfaceInteraction};
 use prism_spectrum::colorimetry::sampled_radiance_to_xyz;
 use prism_spectrum::{SampledSpectrum, SampledWavelengths};
@@ -44,6 +46,8 @@ pub struct RenderProbe<'a> {
     /// Per material (`material_id` order): its angular bandwidth table; empty: each lobe's
     /// closed form.
     pub material_tables: Vec<MaterialAngularBandwidth>,
+    /// Trace the light samples' shadow rays (`Visibility`; the paper ignores visibility).
+    pub trace_visibility: bool,
 }
 
 impl<'a> RenderProbe<'a> {
@@ -54,6 +58,7 @@ impl<'a> RenderProbe<'a> {
             seed,
             environment_bandwidths: Vec::new(),
             material_tables: Vec::new(),
+            trace_visibility: false,
         }
     }
 
@@ -238,6 +243,24 @@ impl RenderProbe<'_> {
         pdf
     }
 
+    /// What the shadow ray of light sample `ls` from `si` meets.
+    fn shadow_ray(&self, si: &SurfaceInteraction, ls: &crate::light::LightSample) -> Visibility {
+        let (ray, metres_per_t) = if ls.distance_m.is_finite() {
+            (
+                Ray::spawn_to(si.p, ls.p_light),
+                (ls.p_light - si.p).length(),
+            )
+        } else {
+            (Ray::spawn(si.p, ls.wi), 1.0)
+        };
+        match self.scene.geometry.intersect(&ray) {
+            None => Visibility::Visible,
+            Some(hit) => Visibility::Blocked {
+                blocker_distance_m: hit.t * metres_per_t,
+            },
+        }
+    }
+
     /// What a BSDF-sampled direction from `si` meets: the area light it hits (occlusion
     /// by other surfaces counts here, as the render's BSDF samples see it), else every
     /// infinite light along it. Per emitter: (light index, radiance, distance, its hit).
@@ -343,6 +366,11 @@ impl ShadingProbe for RenderProbe<'_> {
                         pdf_per_sr
                     };
                     let lanes = lane_variance(ls.radiance * f * (1.0 / divisor), &wavelengths);
+                    let visibility = if self.trace_visibility {
+                        self.shadow_ray(&si, &ls)
+                    } else {
+                        Visibility::Unknown
+                    };
                     out.push(LightSample {
                         direction: ls.wi,
                         radiance_y,
@@ -358,6 +386,7 @@ impl ShadingProbe for RenderProbe<'_> {
                             wo_local,
                         ),
                         lane_variance: lanes,
+                        visibility,
                     });
                 }
                 ProbeStrategy::Bsdf => {
@@ -415,6 +444,7 @@ impl ShadingProbe for RenderProbe<'_> {
                                 wo_local,
                             ),
                             lane_variance: lanes,
+                            visibility: Visibility::Unknown,
                         });
                     }
                 }

@@ -140,7 +140,7 @@ impl RenderScene {
             let name = &scene.materials[i].name;
             return Err(SceneBuildError::new(
                 &file,
-                &format!("materials.{name}"),
+                format!("materials.{name}"),
                 format!(
                     "material '{name}' re-radiates (fluorescence) in a scene with participating \
                      media ({}): fluorescence is not rendered together with media yet; remove \

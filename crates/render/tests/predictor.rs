@@ -1,0 +1,99 @@
+//! The bandwidth predictor on scenes whose answer is known (issue 19, test f): a Lambertian
+//! plane under a uniform sky is smooth everywhere (b_p < 0.05 cycles/px); the edge of a
+//! hard shadow (a point light and a box) is sharp (b_p ≥ 0.25) along the edge and nowhere
+//! else on the floor; `--plan-visibility off` (the paper, which ignores visibility) misses
+//! it. And the plan keeps its budget.
+
+use prism_bandwidth::{Allocation, AllocationSettings, VarianceBandwidth};
+use prism_render::predictor::{predict, Prediction, PredictorSettings};
+use prism_render::RenderScene;
+use prism_scene::parse_scene_str;
+
+fn build(json: &str) -> RenderScene {
+    RenderScene::build(&parse_scene_str(json, "predictor.json").unwrap(), None).unwrap()
+}
+
+fn run(scene: &RenderScene, visibility: bool) -> Prediction {
+    let settings = PredictorSettings {
+        probe_samples: 16,
+        allocation: AllocationSettings {
+            mean_spp: 16.0,
+            floor: 0.25,
+            allocation: Allocation::RelativeError,
+            seed: 1,
+        },
+        variance_bandwidth: VarianceBandwidth::Incident,
+        visibility,
+    };
+    predict(scene, &settings, 1).unwrap()
+}
+
+const CAMERA: &str = r#""camera": {"type": "pinhole", "fov_deg": 40,
+    "transform": {"look_at": {"eye": [0, 4, 0.01], "target": [0, 0, 0], "up": [0, 0, -1]}}},
+    "film": {"resolution": [48, 48]}"#;
+
+#[test]
+fn a_lambertian_plane_under_a_uniform_sky_is_smooth() {
+    let scene = build(&format!(
+        r#"{{{CAMERA},
+        "materials": {{"white": {{"type": "lambert", "reflectance": 0.7}}}},
+        "shapes": [{{"type": "rectangle", "size_m": [20, 20], "material": "white",
+            "transform": {{"rotate": {{"axis": [1, 0, 0], "angle_deg": -90}}}}}}],
+        "lights": [{{"type": "sky", "spectrum": 1.0}}]}}"#
+    ));
+    let p = run(&scene, true);
+    let worst = p
+        .pixels
+        .iter()
+        .map(|x| x.image_bandwidth_cycles_per_px)
+        .fold(0.0f32, f32::max);
+    eprintln!("Lambertian plane under a uniform sky: b_p at most {worst}");
+    assert!(worst < 0.05, "b_p up to {worst}");
+    let total = p.allocated.plan.total_camera_samples() as f64;
+    assert!((total / (48.0 * 48.0) - 16.0).abs() < 0.5, "{total}");
+}
+
+#[test]
+fn a_hard_shadow_edge_is_sharp_and_only_visibility_sees_it() {
+    let scene = build(&format!(
+        r#"{{{CAMERA},
+        "materials": {{"white": {{"type": "lambert", "reflectance": 0.7}}}},
+        "shapes": [
+          {{"type": "rectangle", "size_m": [20, 20], "material": "white",
+            "transform": {{"rotate": {{"axis": [1, 0, 0], "angle_deg": -90}}}}}},
+          {{"type": "cuboid", "size_m": [0.8, 0.1, 0.8], "material": "white",
+            "transform": {{"translate": [0.3, 0.5, 0]}}}}],
+        "lights": [{{"type": "point", "position_m": [0.3, 2.5, 0], "spectrum": 1.0, "scale": 10}}]}}"#
+    ));
+    let with = run(&scene, true);
+    // The pixels that see a surface lit by the light (floor and box top).
+    let lit: Vec<usize> = (0..48 * 48)
+        .filter(|&i| with.pixels[i].visibility.traced > 0)
+        .collect();
+    assert!(lit.len() > 48 * 40, "{} lit pixels", lit.len());
+    let floor_pixels = |p: &Prediction| {
+        lit.iter()
+            .map(|&i| p.pixels[i].image_bandwidth_cycles_per_px)
+            .collect::<Vec<f32>>()
+    };
+    let sharp = floor_pixels(&with).iter().filter(|&&b| b >= 0.25).count();
+    let smooth = floor_pixels(&with).iter().filter(|&&b| b < 0.05).count();
+    // The shadow's outline is ≈ 4 × 10 pixels long at this size; most of the floor is
+    // smooth (a point light on a Lambertian plane: ν = 0).
+    assert!(sharp >= 20, "{sharp} sharp pixels");
+    assert!(smooth > 48 * 48 / 2, "{smooth} smooth pixels");
+    let without = run(&scene, false);
+    let sharp_without = floor_pixels(&without)
+        .iter()
+        .filter(|&&b| b >= 0.25)
+        .count();
+    eprintln!(
+        "{} lit pixels: {sharp} sharp and {smooth} smooth with visibility, {sharp_without} sharp \
+         without",
+        lit.len()
+    );
+    assert!(
+        sharp_without < sharp / 4,
+        "the paper's predictor (no visibility) sees {sharp_without} sharp pixels"
+    );
+}
