@@ -12,7 +12,7 @@ import struct
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 OUT = os.path.join(ROOT, "scenes", "stress", "media", "smoke.vol")
-RES = (24, 32, 24)  # x, y, z voxels: small enough to commit (55 KiB)
+RES = (24, 32, 24)  # x, y, z voxels: small enough to commit (72 KiB)
 BOUNDS = ((-0.5, 0.0, -0.5), (0.5, 1.4, 0.5))  # metres, the file's own box
 
 
