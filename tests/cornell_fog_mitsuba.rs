@@ -37,7 +37,8 @@ fn render_fog(scene: &RenderScene, seed: u64) -> FilmImage {
     assert_eq!(stats.non_finite_samples, 0);
     assert_eq!(stats.non_finite_contributions, 0);
     // The fog box is closed and unnested, yet 2–11 paths in 10⁶ meet it from the side
-    // they are not in (seeds 1–8, 64 spp, 2026-12-02): a rare leak, under investigation.
+    // they are not in (seeds 1–8, 64 spp, 2026-12-02): rays entering near a cube edge
+    // (docs/mitsuba.md, "The Cornell box in fog").
     // Tolerated here, bounded 10× above the worst seed so that a systematic one fails.
     assert!(
         stats.medium_mismatches * 10_000 < stats.samples,
