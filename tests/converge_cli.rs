@@ -221,7 +221,7 @@ fn bad_references_and_methods_exit_with_a_clear_message_and_write_nothing() {
     std::fs::create_dir(&out).unwrap();
     let not_image = dir.path().join("notes.exr");
     std::fs::write(&not_image, "these are notes, not pixels").unwrap();
-    let cases: [(&str, &[&str], &str); 6] = [
+    let cases: [(&str, &[&str], &str); 8] = [
         (
             "tests/fixtures/cornell_mitsuba_reference.exr",
             &[],
@@ -239,6 +239,23 @@ fn bad_references_and_methods_exit_with_a_clear_message_and_write_nothing() {
             "tests/fixtures/cornell_mitsuba_reference.exr",
             &["--resolution", "256x256", "--method", "light+adaptive"],
             "the sample plan `adaptive` is for `path`, not `light`",
+        ),
+        (
+            "tests/fixtures/cornell_mitsuba_reference.exr",
+            &["--resolution", "256x256", "--method", "path+oracle"],
+            "path+oracle needs --oracle-variance FILE.exr",
+        ),
+        (
+            "tests/fixtures/cornell_mitsuba_reference.exr",
+            &[
+                "--resolution",
+                "256x256",
+                "--method",
+                "path+oracle",
+                "--oracle-variance",
+                "tests/fixtures/cornell_mitsuba_reference.exr",
+            ],
+            "no `variance.Y` layer",
         ),
     ];
     for (reference, extra, says) in cases {
@@ -273,5 +290,54 @@ fn bad_references_and_methods_exit_with_a_clear_message_and_write_nothing() {
             .filter(|n| n.contains("reference"))
             .collect();
         assert!(beside.is_empty(), "no reference was rendered: {beside:?}");
+    }
+}
+
+/// The per-pixel plans run end to end: `path+predicted`, `path+adaptive` and `path+oracle`
+/// (fed the `variance.Y` layer of a `prism render` EXR) reach the same final spp as
+/// `path` and are in the JSON.
+#[test]
+fn per_pixel_plans_converge_side_by_side() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = small_scene(dir.path(), "small.json", 0.6);
+    let reference = dir.path().join("reference.exr");
+    let o = prism(&["render", s(&scene), "-o", s(&reference), "--spp", "64"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let json = dir.path().join("data.json");
+    let o = prism(&[
+        "converge",
+        s(&scene),
+        "--reference",
+        s(&reference),
+        "--oracle-variance",
+        s(&reference),
+        "--method",
+        "path",
+        "--method",
+        "path+predicted",
+        "--method",
+        "path+adaptive",
+        "--method",
+        "path+oracle",
+        "--max-spp",
+        "16",
+        "--checkpoints",
+        "4",
+        "--seed",
+        "3",
+        "-o",
+        s(&dir.path().join("chart.png")),
+        "--json",
+        s(&json),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let data: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let methods = data["methods"].as_array().unwrap();
+    assert_eq!(methods.len(), 4);
+    for (m, plan) in methods.iter().zip(["uniform", "predicted", "adaptive", "oracle"]) {
+        assert_eq!(m["plan"], plan, "{m}");
+        let last = m["checkpoints"].as_array().unwrap().last().unwrap().clone();
+        assert_eq!(last["spp"], 16, "{plan}: {last}");
     }
 }

@@ -287,6 +287,8 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
         spectral_bins,
         // Cheap, and what `prism tonemap --wb scene` reads: always in EXR outputs.
         illumination_aov: matches!(ImageFormat::from_path(&output), Ok(ImageFormat::Exr)),
+        // What a sample plan can be judged by (`path+oracle`); EXR only, as cheap.
+        variance_aov: matches!(ImageFormat::from_path(&output), Ok(ImageFormat::Exr)),
     };
     if settings.spp == 0 {
         return Err("--spp must be at least 1".into());

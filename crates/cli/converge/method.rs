@@ -9,7 +9,9 @@
 //! - PLAN: how samples are distributed over the pixels — `uniform` (the default: the same
 //!   spp everywhere), `predicted` (the bandwidth predictor's per-pixel plan, computed once
 //!   before the first pass with `prism render --plan predicted`'s defaults) or `adaptive`
-//!   (variance-driven passes after 4 spp). The last two are for `path` only.
+//!   (variance-driven passes after 4 spp) or `oracle` (the predicted plan's allocation fed
+//!   with a measured `variance.Y`, `--oracle-variance`: the best a predictor could do).
+//!   All but `uniform` are for `path` only.
 //! - SAMPLER: `independent` (the default, so that `path` is plain Monte Carlo with the
 //!   −0.5 RMSE rate) or `sobol` (Owen-scrambled Sobol, Burley 2020).
 //!
@@ -39,13 +41,18 @@ pub const INTEGRATORS: [(&str, bool, &str); 8] = [
 ];
 
 /// Sample plans: (name, available, what it is).
-pub const PLANS: [(&str, bool, &str); 3] = [
+pub const PLANS: [(&str, bool, &str); 4] = [
     ("uniform", true, "same spp in every pixel"),
     ("predicted", true, "bandwidth predictor's per-pixel plan"),
     (
         "adaptive",
         true,
         "variance-driven passes after 4 spp (Cycles' adaptive sampling)",
+    ),
+    (
+        "oracle",
+        true,
+        "the allocation from a measured variance.Y (--oracle-variance FILE.exr): the ceiling",
     ),
 ];
 
@@ -61,6 +68,7 @@ pub enum PlanKind {
     Uniform,
     Predicted,
     Adaptive,
+    Oracle,
 }
 
 impl PlanKind {
@@ -69,6 +77,7 @@ impl PlanKind {
             PlanKind::Uniform => "uniform",
             PlanKind::Predicted => "predicted",
             PlanKind::Adaptive => "adaptive",
+            PlanKind::Oracle => "oracle",
         }
     }
 }
@@ -141,6 +150,7 @@ impl Method {
             None | Some("uniform") => PlanKind::Uniform,
             Some("predicted") => PlanKind::Predicted,
             Some("adaptive") => PlanKind::Adaptive,
+            Some("oracle") => PlanKind::Oracle,
             Some(p) => match PLANS.iter().find(|(n, _, _)| *n == p) {
                 Some((n, _, what)) => {
                     return Err(bad(format!(
@@ -329,7 +339,7 @@ mod tests {
                 "bdpt+predicted",
                 "the sample plan `predicted` is for `path`, not `bdpt`",
             ),
-            ("path+oracle", "unknown sample plan `oracle`"),
+            ("path+hier", "unknown sample plan `hier`"),
             ("path:halton", "unknown sampler `halton`"),
         ] {
             let e = Method::parse(text).unwrap_err();

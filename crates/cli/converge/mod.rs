@@ -92,6 +92,10 @@ pub struct ConvergeArgs {
     /// (`<n>-<method>.exr`), e.g. to check the numbers with `prism compare`.
     #[arg(long = "save-final", value_name = "DIR")]
     pub save_final: Option<PathBuf>,
+    /// For `path+oracle`: an EXR with a `variance.Y` layer (what `prism render -o X.exr`
+    /// writes, best from many samples) whose measured variance sets the oracle's plan.
+    #[arg(long = "oracle-variance", value_name = "FILE.exr")]
+    pub oracle_variance: Option<PathBuf>,
     /// The time axis of the chart and fits: `wall` (elapsed time, the default) or `cpu`
     /// (CPU time of the render threads, which other processes on a shared machine do not
     /// stretch). Both are in the JSON either way.
@@ -381,6 +385,7 @@ pub fn run(args: &ConvergeArgs) -> Result<(), String> {
                         sampler: SamplerKind::Sobol,
                         spectral_bins: None,
                         illumination_aov: false,
+                        variance_aov: false,
                     };
                     let start = Instant::now();
                     let (film, _) = pool.install(|| render(&scene, &settings, &|_| {}));
@@ -412,6 +417,19 @@ pub fn run(args: &ConvergeArgs) -> Result<(), String> {
     let prepared = PreparedReference::new(&reference);
     let reference_prepare_s = prepare_start.elapsed().as_secs_f64();
 
+    let wants_oracle = methods.iter().any(|m| m.plan == method::PlanKind::Oracle);
+    let oracle = match (&args.oracle_variance, wants_oracle) {
+        (Some(path), true) => Some(pass_planner::oracle_allocation(
+            path,
+            scene.resolution,
+            seed,
+        )?),
+        (None, true) => return Err("--method path+oracle needs --oracle-variance FILE.exr".into()),
+        (Some(_), false) => {
+            return Err("--oracle-variance is for a `path+oracle` method; none was given".into())
+        }
+        (None, false) => None,
+    };
     let mut curves = Vec::new();
     let mut methods_json = Vec::new();
     for (index, (method, integrator)) in methods.iter().zip(&integrators).enumerate() {
@@ -423,8 +441,17 @@ pub fn run(args: &ConvergeArgs) -> Result<(), String> {
             sampler: method.sampler,
             spectral_bins: None,
             illumination_aov: false,
+            variance_aov: false,
         };
-        let run: MethodRun = run_method(&scene, &settings, method.plan, &prepared, &budget, &pool)?;
+        let run: MethodRun = run_method(
+            &scene,
+            &settings,
+            method.plan,
+            &prepared,
+            &budget,
+            &pool,
+            oracle.as_ref(),
+        )?;
         let last = run
             .checkpoints
             .last()
@@ -443,8 +470,14 @@ pub fn run(args: &ConvergeArgs) -> Result<(), String> {
         );
         let time_to_target = first_crossing(&series(1), TARGET_RELMSE);
         let overhead = if args.overhead {
-            let (plain_wall, plain_cpu) =
-                run_plain(&scene, &settings, method.plan, last.spp, &pool)?;
+            let (plain_wall, plain_cpu) = run_plain(
+                &scene,
+                &settings,
+                method.plan,
+                last.spp,
+                &pool,
+                oracle.as_ref(),
+            )?;
             let wall_fraction = run.render_wall_s / plain_wall - 1.0;
             let cpu_fraction = match (run.cpu_s, plain_cpu) {
                 (Some(a), Some(b)) => Some(a / b - 1.0),

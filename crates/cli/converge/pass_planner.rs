@@ -39,6 +39,7 @@ impl PassPlanner {
         kind: PlanKind,
         scene: &RenderScene,
         settings: &RenderSettings,
+        oracle: Option<&Allocated>,
     ) -> Result<Self, String> {
         let n = (scene.resolution.x * scene.resolution.y) as usize;
         let allocated = match kind {
@@ -56,6 +57,11 @@ impl PassPlanner {
                 };
                 Some(predict(scene, &predictor, settings.seed)?.allocated)
             }
+            PlanKind::Oracle => Some(
+                oracle
+                    .ok_or("path+oracle needs --oracle-variance FILE.exr")?
+                    .clone(),
+            ),
             PlanKind::Uniform | PlanKind::Adaptive => None,
         };
         Ok(Self {
@@ -65,7 +71,7 @@ impl PassPlanner {
             film: film_for(scene, settings),
             half: match kind {
                 PlanKind::Adaptive => Some(film_for(scene, settings)),
-                PlanKind::Uniform | PlanKind::Predicted => None,
+                PlanKind::Uniform | PlanKind::Predicted | PlanKind::Oracle => None,
             },
             allocated,
             seed: settings.seed,
@@ -90,13 +96,15 @@ impl PassPlanner {
                 return render_pass(scene, settings, &plan, &mut self.film, spp_done, &|_| {})
                     .map_err(|e| e.to_string());
             }
-            (PlanKind::Predicted, Some(allocated)) => allocated
+            (PlanKind::Predicted | PlanKind::Oracle, Some(allocated)) => allocated
                 .cumulative_counts(f64::from(target), self.seed)
                 .iter()
                 .zip(&self.done)
                 .map(|(c, d)| c.saturating_sub(*d))
                 .collect(),
-            (PlanKind::Predicted, None) => unreachable!("the predicted plan is made in `new`"),
+            (PlanKind::Predicted | PlanKind::Oracle, None) => {
+                unreachable!("the predicted and oracle plans are made in `new`")
+            }
             (PlanKind::Adaptive, _) if spp_done < ADAPTIVE_FIRST_PASS_SPP => vec![pass; n],
             (PlanKind::Adaptive, _) => {
                 let half = self.half.as_ref().expect("adaptive keeps two films");
@@ -160,4 +168,58 @@ impl PassPlanner {
         }
         self.film
     }
+}
+
+/// The oracle's allocation: the predicted plan's rule (relative error, the default floor)
+/// fed with a measured per-sample variance and mean (`variance.Y` and Y of an EXR that
+/// `prism render` wrote), so its gain over `uniform` is the most a predictor can reach.
+pub fn oracle_allocation(
+    path: &std::path::Path,
+    resolution: UVec2,
+    seed: u64,
+) -> Result<Allocated, String> {
+    let image = prism_image::io::exr::read_exr(path)
+        .map_err(|e| format!("--oracle-variance {}: {e}", path.display()))?;
+    if (image.width() as u32, image.height() as u32) != (resolution.x, resolution.y) {
+        return Err(format!(
+            "--oracle-variance {}: {}×{} pixels, the render is {}×{}",
+            path.display(),
+            image.width(),
+            image.height(),
+            resolution.x,
+            resolution.y
+        ));
+    }
+    let layer = image
+        .layer("variance")
+        .filter(|l| l.channels.len() == 1 && l.channels[0] == "Y")
+        .ok_or_else(|| {
+            format!(
+                "--oracle-variance {}: no `variance.Y` layer (write one with `prism render \
+                 SCENE -o FILE.exr`)",
+                path.display()
+            )
+        })?;
+    // Y of linear Rec.709 RGB: the film's XYZ Y, the variance's units.
+    let mean_y: Vec<f32> = image
+        .pixels()
+        .iter()
+        .map(|p| 0.212_639 * p[0] + 0.715_169 * p[1] + 0.072_192 * p[2])
+        .collect();
+    let levels = vec![0; mean_y.len()];
+    prism_bandwidth::allocate(
+        resolution,
+        prism_bandwidth::AllocationInputs {
+            variance: &layer.samples,
+            mean_y: &mean_y,
+            shading_level: &levels,
+        },
+        prism_bandwidth::AllocationSettings {
+            mean_spp: PREDICTED_PLAN_SPP,
+            floor: prism_bandwidth::allocation::DEFAULT_FLOOR,
+            allocation: prism_bandwidth::Allocation::RelativeError,
+            seed,
+        },
+    )
+    .map_err(|e| e.to_string())
 }

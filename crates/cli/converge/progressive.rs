@@ -19,6 +19,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::mpsc;
 use std::time::Instant;
 
+use prism_bandwidth::Allocated;
 use prism_image::Image;
 use prism_post::metrics::{CompareOptions, Comparison, PreparedReference};
 use prism_render::adaptive::ADAPTIVE_FIRST_PASS_SPP;
@@ -167,6 +168,7 @@ pub fn run_method(
     reference: &PreparedReference,
     budget: &Budget,
     pool: &rayon::ThreadPool,
+    oracle: Option<&Allocated>,
 ) -> Result<MethodRun, String> {
     let (sender, receiver) = mpsc::channel::<(f64, Option<f64>, u32, u64, Film)>();
     // CPU time the metric thread has spent, ns (subtracted from the process's CPU time).
@@ -209,7 +211,7 @@ pub fn run_method(
         let cpu_start = process_cpu_s();
         let start = Instant::now();
         // A predicted plan's predictor runs here: its time is the method's.
-        let mut planner = pool.install(|| PassPlanner::new(plan, scene, settings))?;
+        let mut planner = pool.install(|| PassPlanner::new(plan, scene, settings, oracle))?;
         let mut stats = RenderStats::default();
         let mut spp_done = 0u32;
         let mut k = 0u32;
@@ -279,11 +281,12 @@ pub fn run_plain(
     plan: PlanKind,
     spp: u32,
     pool: &rayon::ThreadPool,
+    oracle: Option<&Allocated>,
 ) -> Result<(f64, Option<f64>), String> {
     let cpu_start = process_cpu_s();
     let start = Instant::now();
     pool.install(|| -> Result<(), String> {
-        let mut planner = PassPlanner::new(plan, scene, settings)?;
+        let mut planner = PassPlanner::new(plan, scene, settings, oracle)?;
         // Adaptive sampling needs its error passes; the others render in one pass.
         match plan {
             PlanKind::Adaptive => {
@@ -295,7 +298,7 @@ pub fn run_plain(
                     }
                 }
             }
-            PlanKind::Uniform | PlanKind::Predicted => {
+            PlanKind::Uniform | PlanKind::Predicted | PlanKind::Oracle => {
                 planner.render_pass(scene, settings, 0, spp)?;
             }
         }

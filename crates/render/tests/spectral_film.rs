@@ -170,6 +170,45 @@ fn illumination_aov_is_the_plain_mean_of_its_xyz_over_all_samples_of_the_pixel()
     assert!(image.aov("depth.Z").is_none());
 }
 
+/// `variance.Y` is the unbiased sample variance of the samples' Y (the film's XYZ of each
+/// sample, unweighted), 0 where a pixel has fewer than two samples.
+#[test]
+fn variance_aov_is_the_sample_variance_of_the_samples_luminance() {
+    let res = UVec2::new(2, 1);
+    let selection = AovSelection {
+        variance: true,
+        ..AovSelection::NONE
+    };
+    let mut film = Film::new(res, Filter::default(), selection).unwrap();
+    let pixel = UVec2::new(1, 0);
+    let mut ys = Vec::new();
+    film.render_tiles(4, |tile| {
+        for i in 0..6 {
+            let wl = SampledWavelengths::sample_visible((i as f32 + 0.5) / 6.0);
+            let l = SampledSpectrum::splat(1.0 + i as f32);
+            tile.add_sample(pixel, l, &wl, 1.0, None);
+        }
+        tile.add_sample(
+            UVec2::ZERO,
+            SampledSpectrum::splat(3.0),
+            &SampledWavelengths::sample_visible(0.5),
+            1.0,
+            None,
+        );
+    });
+    for i in 0..6 {
+        let wl = SampledWavelengths::sample_visible((i as f32 + 0.5) / 6.0);
+        ys.push(xyz_of_sample(SampledSpectrum::splat(1.0 + i as f32), &wl)[1]);
+    }
+    let mean = ys.iter().sum::<f64>() / 6.0;
+    let want = ys.iter().map(|y| (y - mean).powi(2)).sum::<f64>() / 5.0;
+    let image = film.finish();
+    let plane = &image.aov("variance.Y").expect("variance.Y").values;
+    let got = f64::from(plane[image.index(pixel.x, pixel.y)]);
+    assert!((got - want).abs() < 1e-6 * want, "{got} vs {want}");
+    assert_eq!(plane[0], 0.0, "one sample: no variance");
+}
+
 #[test]
 fn illumination_is_not_recorded_unless_selected() {
     let mut film = Film::new(UVec2::new(2, 2), Filter::default(), AovSelection::SURFACE).unwrap();

@@ -47,6 +47,10 @@ pub struct AovSelection {
     /// (`FilmTile::add_illumination`; misses count 0). For scene-based white balance
     /// (`prism tonemap --wb scene`).
     pub illumination: bool,
+    /// `variance.Y`: the sample variance (n − 1) of the camera samples' Y (beauty
+    /// normalisation, unweighted) per pixel, 0 below two samples: the measured variance a
+    /// sample plan can be judged by (`path+oracle`, docs/bandwidth.md).
+    pub variance: bool,
 }
 
 impl AovSelection {
@@ -55,6 +59,7 @@ impl AovSelection {
         normal: false,
         albedo: false,
         illumination: false,
+        variance: false,
     };
     /// The first-hit surface AOVs: depth, normal, albedo.
     pub const SURFACE: AovSelection = AovSelection {
@@ -62,6 +67,7 @@ impl AovSelection {
         normal: true,
         albedo: true,
         illumination: false,
+        variance: false,
     };
     /// Every AOV.
     pub const ALL: AovSelection = AovSelection {
@@ -69,10 +75,11 @@ impl AovSelection {
         normal: true,
         albedo: true,
         illumination: true,
+        variance: true,
     };
 
     pub fn any(&self) -> bool {
-        self.depth || self.normal || self.albedo || self.illumination
+        self.depth || self.normal || self.albedo || self.illumination || self.variance
     }
 }
 
@@ -476,6 +483,25 @@ impl Film {
                     |a| a.illumination_sum,
                     ["illumination.X", "illumination.Y", "illumination.Z"],
                 ));
+            }
+            if sel.variance {
+                let values = self
+                    .aovs
+                    .iter()
+                    .zip(&self.pixels)
+                    .map(|(a, p)| {
+                        let n = f64::from(p.sample_count);
+                        if n >= 2.0 {
+                            ((a.y_sq_sum - a.y_sum * a.y_sum / n) / (n - 1.0)).max(0.0) as f32
+                        } else {
+                            0.0
+                        }
+                    })
+                    .collect();
+                aovs.push(AovPlane {
+                    name: "variance.Y".into(),
+                    values,
+                });
             }
         }
         let spectral = self.spectral_bins.map(|bins| {

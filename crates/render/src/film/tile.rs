@@ -89,6 +89,10 @@ pub(crate) struct AovAccum {
     pub albedo_sum: DVec3,
     /// Σ XYZ of the illumination spectra (`FilmTile::add_illumination`).
     pub illumination_sum: DVec3,
+    /// Σ Y and Σ Y² of the camera samples (`AovSelection::variance`; f64 sums of values of
+    /// order 1 over at most millions of samples keep ~10 significant digits).
+    pub y_sum: f64,
+    pub y_sq_sum: f64,
 }
 
 impl PixelAccum {
@@ -107,6 +111,8 @@ impl AovAccum {
         self.normal_sum += other.normal_sum;
         self.albedo_sum += other.albedo_sum;
         self.illumination_sum += other.illumination_sum;
+        self.y_sum += other.y_sum;
+        self.y_sq_sum += other.y_sq_sum;
     }
 }
 
@@ -337,6 +343,8 @@ pub struct FilmTile {
     spectral_bins: Option<SpectralBins>,
     /// Whether `add_illumination` records anything.
     record_illumination: bool,
+    /// Whether samples add to the `variance.Y` sums.
+    record_variance: bool,
     filter_sampler: Arc<FilterSampler>,
     /// `Some` when the film splats (then `sample_film_point` jitters within the pixel and
     /// colour goes here instead of into the own pixel's sums).
@@ -362,6 +370,7 @@ impl FilmTile {
             spectral: spectral_bins.map_or_else(Vec::new, |b| vec![0.0; n * b.count() as usize]),
             spectral_bins,
             record_illumination: aov_selection.illumination,
+            record_variance: aov_selection.variance,
             filter_sampler,
             splat: None,
         }
@@ -582,6 +591,12 @@ impl FilmTile {
             None => {
                 p.xyz_sum += w * xyz;
                 p.weight_sum += w;
+            }
+        }
+        if self.record_variance {
+            if let Some(a) = self.aovs.get_mut(i) {
+                a.y_sum += xyz.y;
+                a.y_sq_sum += xyz.y * xyz.y;
             }
         }
         if let (Some(a), Some(hit)) = (self.aovs.get_mut(i), aov) {

@@ -35,10 +35,12 @@ pub struct RenderSettings {
     pub spectral_bins: Option<SpectralBins>,
     /// Record the `illumination.X/Y/Z` AOV (filled by `FilmTile::add_illumination`).
     pub illumination_aov: bool,
+    /// Record the `variance.Y` AOV (`AovSelection::variance`).
+    pub variance_aov: bool,
 }
 
 impl Default for RenderSettings {
-    /// 16 spp, seed 0, 16-pixel tiles, Sobol, no spectral bins, no illumination AOV.
+    /// 16 spp, seed 0, 16-pixel tiles, Sobol, no spectral bins, no illumination or variance AOV.
     fn default() -> Self {
         Self {
             spp: 16,
@@ -47,6 +49,7 @@ impl Default for RenderSettings {
             sampler: SamplerKind::Sobol,
             spectral_bins: None,
             illumination_aov: false,
+            variance_aov: false,
         }
     }
 }
@@ -55,10 +58,12 @@ impl Default for RenderSettings {
 /// `render_plan` renders into, and what `render_pass` accumulates pass after pass.
 pub fn film_for(scene: &RenderScene, settings: &RenderSettings) -> Film {
     let mut film = scene.new_film();
-    if settings.illumination_aov {
+    if settings.illumination_aov || settings.variance_aov {
+        let selection = film.aov_selection();
         let aovs = AovSelection {
-            illumination: true,
-            ..film.aov_selection()
+            illumination: selection.illumination || settings.illumination_aov,
+            variance: selection.variance || settings.variance_aov,
+            ..selection
         };
         film = film.with_aovs(aovs);
     }
