@@ -335,7 +335,10 @@ fn per_pixel_plans_converge_side_by_side() {
         serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
     let methods = data["methods"].as_array().unwrap();
     assert_eq!(methods.len(), 4);
-    for (m, plan) in methods.iter().zip(["uniform", "predicted", "adaptive", "oracle"]) {
+    for (m, plan) in methods
+        .iter()
+        .zip(["uniform", "predicted", "adaptive", "oracle"])
+    {
         assert_eq!(m["plan"], plan, "{m}");
         let last = m["checkpoints"].as_array().unwrap().last().unwrap().clone();
         assert_eq!(last["spp"], 16, "{plan}: {last}");

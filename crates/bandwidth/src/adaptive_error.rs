@@ -6,7 +6,7 @@
 
 use glam::UVec2;
 
-use crate::error::{pixel_count, BandwidthError};
+use crate::error::{check_lengths, pixel_count, BandwidthError};
 use crate::stochastic_rounding::round_stochastic;
 
 /// The image mean (per channel, averaged over R, G, B) the error is measured at, so that its
@@ -24,18 +24,14 @@ pub fn adaptive_error(
     half_rgb: &[[f32; 3]],
 ) -> Result<Vec<f32>, BandwidthError> {
     let n = pixel_count("adaptive error", resolution)?;
-    for (what, len) in [
-        ("adaptive error full image", full_rgb.len()),
-        ("adaptive error half image", half_rgb.len()),
-    ] {
-        if len != n {
-            return Err(BandwidthError::LengthMismatch {
-                what,
-                resolution,
-                found: len,
-            });
-        }
-    }
+    check_lengths(
+        resolution,
+        n,
+        &[
+            ("adaptive error full image", full_rgb.len()),
+            ("adaptive error half image", half_rgb.len()),
+        ],
+    )?;
     let mean = full_rgb
         .iter()
         .map(|p| p.iter().map(|&c| f64::from(c)).sum::<f64>() / 3.0)

@@ -11,7 +11,7 @@
 
 use glam::UVec2;
 
-use crate::error::{pixel_count, BandwidthError};
+use crate::error::{check_lengths, pixel_count, BandwidthError};
 use crate::sample_plan::SamplePlan;
 use crate::stochastic_rounding::round_stochastic;
 
@@ -75,22 +75,18 @@ pub fn allocate(
     settings: AllocationSettings,
 ) -> Result<Allocated, BandwidthError> {
     let n = pixel_count("sample allocation", resolution)?;
-    for (what, len) in [
-        ("sample allocation variance", inputs.variance.len()),
-        ("sample allocation mean", inputs.mean_y.len()),
-        (
-            "sample allocation shading level",
-            inputs.shading_level.len(),
-        ),
-    ] {
-        if len != n {
-            return Err(BandwidthError::LengthMismatch {
-                what,
-                resolution,
-                found: len,
-            });
-        }
-    }
+    check_lengths(
+        resolution,
+        n,
+        &[
+            ("sample allocation variance", inputs.variance.len()),
+            ("sample allocation mean", inputs.mean_y.len()),
+            (
+                "sample allocation shading level",
+                inputs.shading_level.len(),
+            ),
+        ],
+    )?;
     if !(settings.mean_spp > 0.0 && settings.mean_spp.is_finite()) {
         return Err(BandwidthError::invalid(
             "sample allocation",

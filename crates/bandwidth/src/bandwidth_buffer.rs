@@ -5,7 +5,7 @@
 
 use glam::UVec2;
 
-use crate::error::{pixel_count, pixel_index, BandwidthError};
+use crate::error::{check_lengths, pixel_count, pixel_index, BandwidthError};
 
 /// The finest level eq. 11 may ask for: −2 = 4×4 samples per pixel (anti-aliasing of edges
 /// and highlights narrower than a pixel). Negative levels are sub-pixel sampling.
@@ -82,19 +82,15 @@ impl BandwidthBuffer {
         curvature_per_m: &[f32],
     ) -> Result<Self, BandwidthError> {
         let n = pixel_count("bandwidth buffer", resolution)?;
-        for (what, len) in [
-            ("bandwidth buffer b_p", image_bandwidth_cycles_per_px.len()),
-            ("bandwidth buffer variance", variance.len()),
-            ("bandwidth buffer curvature", curvature_per_m.len()),
-        ] {
-            if len != n {
-                return Err(BandwidthError::LengthMismatch {
-                    what,
-                    resolution,
-                    found: len,
-                });
-            }
-        }
+        check_lengths(
+            resolution,
+            n,
+            &[
+                ("bandwidth buffer b_p", image_bandwidth_cycles_per_px.len()),
+                ("bandwidth buffer variance", variance.len()),
+                ("bandwidth buffer curvature", curvature_per_m.len()),
+            ],
+        )?;
         let mut levels = vec![BandwidthLevel {
             resolution,
             shading_level: image_bandwidth_cycles_per_px

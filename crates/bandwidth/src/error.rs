@@ -128,6 +128,23 @@ pub(crate) fn pixel_index(
 }
 
 /// Width × height of a resolution that must be at least 1×1.
+/// Every per-pixel list (name, length) is as long as the image (`n` pixels), else the
+/// first that is not, by name.
+pub(crate) fn check_lengths(
+    resolution: UVec2,
+    n: usize,
+    lists: &[(&'static str, usize)],
+) -> Result<(), BandwidthError> {
+    match lists.iter().find(|(_, len)| *len != n) {
+        Some(&(what, found)) => Err(BandwidthError::LengthMismatch {
+            what,
+            resolution,
+            found,
+        }),
+        None => Ok(()),
+    }
+}
+
 pub(crate) fn pixel_count(what: &'static str, resolution: UVec2) -> Result<usize, BandwidthError> {
     if resolution.x == 0 || resolution.y == 0 {
         return Err(BandwidthError::ZeroResolution { what });
