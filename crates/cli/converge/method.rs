@@ -1,4 +1,4 @@
-//! The method grammar of `prism converge --method`: `INTEGRATOR[+PLAN][:SAMPLER]`.
+//! The method grammar of `prism converge --method`: `INTEGRATOR[+PLAN][:SAMPLER][,lanes=L]`.
 //!
 //! - INTEGRATOR: the rendering method — `path` (the spectral path tracer), `light` (light
 //!   tracing) or `bdpt` (bidirectional path tracing), each with the scene's `max_depth`,
@@ -14,6 +14,9 @@
 //!   All but `uniform` are for `path` only.
 //! - SAMPLER: `independent` (the default, so that `path` is plain Monte Carlo with the
 //!   −0.5 RMSE rate) or `sobol` (Owen-scrambled Sobol, Burley 2020).
+//!
+//! - `,lanes=all|hero` (`path` only): the re-radiation lane mode (`fluorescence_lanes`) instead
+//!   of the scene's, so one run charts both modes of a fluorescent scene.
 //!
 //! Unknown or unavailable names are errors that list what is known.
 
@@ -91,6 +94,8 @@ pub struct Method {
     pub integrator: &'static str,
     pub plan: PlanKind,
     pub sampler: SamplerKind,
+    /// `,lanes=…`: the lane mode of re-radiation; `None`: the scene's.
+    pub lanes: Option<prism_scene::FluorescenceLanes>,
 }
 
 fn list(names: impl Iterator<Item = String>) -> String {
@@ -100,8 +105,8 @@ fn list(names: impl Iterator<Item = String>) -> String {
 /// The grammar and every known name, for error messages.
 pub fn known_methods() -> String {
     format!(
-        "INTEGRATOR[+PLAN][:SAMPLER] with INTEGRATOR one of {}; PLAN one of {}; SAMPLER one of \
-         {} (e.g. `path`, `path+uniform:sobol`)",
+        "INTEGRATOR[+PLAN][:SAMPLER][,lanes=all|hero] with INTEGRATOR one of {}; PLAN one of {}; \
+         SAMPLER one of {} (e.g. `path`, `path+uniform:sobol`, `path,lanes=hero`)",
         list(INTEGRATORS.iter().map(|(n, ok, _)| if *ok {
             (*n).to_string()
         } else {
@@ -126,12 +131,22 @@ pub fn known_methods() -> String {
 }
 
 impl Method {
-    /// Parses `INTEGRATOR[+PLAN][:SAMPLER]` (see the module documentation).
+    /// Parses `INTEGRATOR[+PLAN][:SAMPLER][,lanes=L]` (see the module documentation).
     pub fn parse(text: &str) -> Result<Self, String> {
         let bad = |what: String| format!("--method `{text}`: {what}; known: {}", known_methods());
-        let (head, sampler) = match text.split_once(':') {
-            Some((h, s)) => (h, Some(s)),
+        let (method, option) = match text.split_once(',') {
+            Some((m, o)) => (m, Some(o)),
             None => (text, None),
+        };
+        let lanes = match option {
+            None => None,
+            Some("lanes=all") => Some(prism_scene::FluorescenceLanes::All),
+            Some("lanes=hero") => Some(prism_scene::FluorescenceLanes::Hero),
+            Some(o) => return Err(bad(format!("unknown option `{o}`"))),
+        };
+        let (head, sampler) = match method.split_once(':') {
+            Some((h, s)) => (h, Some(s)),
+            None => (method, None),
         };
         let (integrator, plan) = match head.split_once('+') {
             Some((i, p)) => (i, Some(p)),
@@ -165,6 +180,11 @@ impl Method {
             Some("sobol") => SamplerKind::Sobol,
             Some(s) => return Err(bad(format!("unknown sampler `{s}`"))),
         };
+        if lanes.is_some() && integrator != "path" {
+            return Err(bad(format!(
+                "`lanes` is the re-radiation mode of `path`, not of `{integrator}`"
+            )));
+        }
         if plan != PlanKind::Uniform && integrator != "path" {
             return Err(bad(format!(
                 "the sample plan `{}` is for `path`, not `{integrator}`",
@@ -176,6 +196,7 @@ impl Method {
             integrator,
             plan,
             sampler,
+            lanes,
         })
     }
 
@@ -185,7 +206,12 @@ impl Method {
             SamplerKind::Independent => "independent",
             SamplerKind::Sobol => "sobol",
         };
-        format!("{}+{}:{sampler}", self.integrator, self.plan.name())
+        let lanes = match self.lanes {
+            None => "",
+            Some(prism_scene::FluorescenceLanes::All) => ",lanes=all",
+            Some(prism_scene::FluorescenceLanes::Hero) => ",lanes=hero",
+        };
+        format!("{}+{}:{sampler}{lanes}", self.integrator, self.plan.name())
     }
 
     /// Whether the method estimates radiance (the path family) rather than a diagnostic
@@ -246,7 +272,8 @@ impl Method {
         };
         // The sampler is the method's (`:SAMPLER`); the description's is not read.
         let sampler = self.sampler;
-        // The lane mode of re-radiation is the scene's when it renders with `path`.
+        // The lane mode of re-radiation: the method's, else the scene's when it renders
+        // with `path`.
         let fluorescence_lanes = match *scene {
             prism_scene::Integrator::Path {
                 fluorescence_lanes, ..
@@ -260,6 +287,7 @@ impl Method {
                 prism_scene::FluorescenceLanes::default()
             }
         };
+        let fluorescence_lanes = self.lanes.unwrap_or(fluorescence_lanes);
         let description = match (self.integrator, scene) {
             ("path", _) => prism_scene::Integrator::Path {
                 max_depth,
@@ -340,6 +368,11 @@ mod tests {
                 "the sample plan `predicted` is for `path`, not `bdpt`",
             ),
             ("path+hier", "unknown sample plan `hier`"),
+            ("path,lanes=some", "unknown option `lanes=some`"),
+            (
+                "bdpt,lanes=hero",
+                "`lanes` is the re-radiation mode of `path`",
+            ),
             ("path:halton", "unknown sampler `halton`"),
         ] {
             let e = Method::parse(text).unwrap_err();
