@@ -746,12 +746,13 @@ fn ink_medium(data: &Data, sigma_a: &str, sigma_s: f64) -> String {
 
 /// Issue 21 test 4: L(λo) = ∫dλi E·M(λi, λo)/4π ∫₀ᵈ e^(−σt(λi)z)·e^(−σt(λo)(d−z)/μ) dz/μ,
 /// the inner integral exact, the outer by Simpson on 0.25 nm steps over 300–830 nm; σt =
-/// σa + σf, M and σf the ones the scene built (the dye's 5 nm nodes, linear between).
-fn ink_expected_xyz(scene_json: &str, sigma_a: &dyn Fn(f64) -> f64) -> [f64; 3] {
+/// σa + σf, M and σf the ones the scene built (the dye's 5 nm nodes, linear between), all
+/// times `density`.
+fn ink_expected_xyz(scene_json: &str, sigma_a: &dyn Fn(f64) -> f64, density: f64) -> [f64; 3] {
     let description = parse_scene_str(scene_json, "test.json").unwrap();
     let f = description.media[0].fluorescence.as_ref().unwrap();
-    let peak = f.peak_absorption_per_m;
-    let sigma_t = |l: f64| sigma_a(l) + peak * f.dye.absorptance(l);
+    let peak = density * f.peak_absorption_per_m;
+    let sigma_t = |l: f64| density * sigma_a(l) + peak * f.dye.absorptance(l);
     let mu = INK_VIEW_DEG.to_radians().cos();
     let d = INK_D_M;
     let depth_integral = |a: f64, b: f64| {
@@ -823,7 +824,7 @@ fn one_reemission_in_a_fluorophore_slab_matches_the_closed_form() {
             &ink_medium(&data, sigma_a, 0.0),
             &format!(r#"{{"type": "path", "max_depth": 1, "spectral_mis": {mis}}}"#),
         );
-        let expected = ink_expected_xyz(&json, f);
+        let expected = ink_expected_xyz(&json, f, 1.0);
         let image = mean_and_se(&render_scene(&build(&json), 4096, seed));
         for c in 0..3 {
             let (mean, se) = image[c];
@@ -933,4 +934,48 @@ fn bad_fluorescence_keys_are_errors_that_name_their_place() {
             assert!(e.contains(needle), "`{needle}` not in: {e}");
         }
     }
+}
+
+/// A grid medium scales the fluorophore's σf and M by its density as it does σa: test 4
+/// through a constant grid of density 0.6 (the majorant cells bound it exactly).
+#[test]
+fn a_fluorescent_grid_scales_the_fluorophore_by_its_density() {
+    let data = Data::new();
+    let density = 0.6f32;
+    let half = 0.5 * INK_D_M as f32;
+    // A Mitsuba .vol (version 3, float32, 1 channel), 2×2×2 voxels of `density`.
+    let mut vol = b"VOL".to_vec();
+    vol.push(3);
+    vol.extend_from_slice(&1i32.to_le_bytes());
+    for r in [2i32, 2, 2] {
+        vol.extend_from_slice(&r.to_le_bytes());
+    }
+    vol.extend_from_slice(&1i32.to_le_bytes());
+    for x in [-3.0f32, -3.0, -half, 3.0, 3.0, half] {
+        vol.extend_from_slice(&x.to_le_bytes());
+    }
+    for _ in 0..8 {
+        vol.extend_from_slice(&density.to_le_bytes());
+    }
+    std::fs::write(data.dir.path().join("ink.vol"), vol).unwrap();
+    let medium = ink_medium(&data, "0.3", 0.0).replacen(
+        "{",
+        &format!(
+            r#"{{"type": "grid", "density": "{}", "#,
+            data.path("ink.vol")
+        ),
+        1,
+    );
+    let json = ink_scene(&medium, r#"{"type": "path", "max_depth": 1}"#);
+    let expected = ink_expected_xyz(&json, &|_| 0.3, f64::from(density));
+    let image = mean_and_se(&render_scene(&build(&json), 2048, 51));
+    for (c, &(mean, se)) in image.iter().enumerate() {
+        assert_close(&format!("grid {c}"), mean, se, expected[c], 2e-3);
+    }
+    // Density 1 would glow differently: the test tells the two apart.
+    let unscaled = ink_expected_xyz(&json, &|_| 0.3, 1.0);
+    assert!(
+        (unscaled[1] - expected[1]).abs() > 10.0 * image[1].1,
+        "{unscaled:?}"
+    );
 }
