@@ -979,3 +979,19 @@ fn a_fluorescent_grid_scales_the_fluorophore_by_its_density() {
         "{unscaled:?}"
     );
 }
+
+/// `fluorescence_lanes: hero` in a fluorescent medium (the secondary lanes end where any
+/// lane re-emits) estimates the same as `all`: test 4's closed form.
+#[test]
+fn hero_lanes_in_a_fluorescent_medium_match_the_closed_form() {
+    let data = Data::new();
+    let json = ink_scene(
+        &ink_medium(&data, "0.3", 0.0),
+        r#"{"type": "path", "max_depth": 1, "fluorescence_lanes": "hero"}"#,
+    );
+    let expected = ink_expected_xyz(&json, &|_| 0.3, 1.0);
+    let image = mean_and_se(&render_scene(&build(&json), 4096, 61));
+    for (c, &(mean, se)) in image.iter().enumerate() {
+        assert_close(&format!("hero lanes {c}"), mean, se, expected[c], 2e-3);
+    }
+}

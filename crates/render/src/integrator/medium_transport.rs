@@ -12,7 +12,8 @@
 //!   their lane average, the one-sample balance heuristic over the four wavelengths and
 //!   the two strategies (dividing by the hero's pdf alone made Mitsuba 2's `volpath`
 //!   noisy in chromatic media, mitsuba2 #323). `spectral_mis: false` divides by the hero's
-//!   alone (a debug switch).
+//!   alone (a debug switch), as does every contribution once the secondary lanes have
+//!   ended (`spectral_mis_now`).
 //! - **Next-event estimation** from surface and medium vertices; shadow rays estimate
 //!   transmittance by ratio tracking and cross `interface` surfaces (and masks and thin
 //!   panes, as in vacuum); any other surface blocks them.
@@ -250,7 +251,6 @@ impl PathTracer {
         light_samples: u32,
         counters: &mut PathCounters,
     ) -> PathResult {
-        let spectral = self.spectral_mis;
         let mode = self.fluorescence_lanes;
         let lights = &scene.lights;
         let mut current_differential = camera_differential.copied();
@@ -274,6 +274,7 @@ impl PathTracer {
         let isotropic = PhaseFunction::Isotropic;
 
         loop {
+            let spectral = self.spectral_mis_now(&path.wavelengths);
             let hit = scene.geometry.intersect(&ray);
             let md = MediumDimensions::reserve(&mut path.stream);
             let mut rng = MediumRng::new(path.stream.seed_at(md.generator()));
@@ -439,6 +440,7 @@ impl PathTracer {
                     ray = Ray::infinite(p, ps.wi);
                     current_differential = None;
                     counters.rays += 1;
+                    let spectral = self.spectral_mis_now(&path.wavelengths);
                     if self.volumetric_roulette(&mut path, r_u, dims.roulette(), spectral) {
                         counters.roulette_terminations += 1;
                         break;
@@ -620,6 +622,7 @@ impl PathTracer {
             ray = Ray::spawn(vertex.p(), wi);
             current_differential = None;
             counters.rays += 1;
+            let spectral = self.spectral_mis_now(&path.wavelengths);
             if self.volumetric_roulette(&mut path, r_u, dims.roulette(), spectral) {
                 counters.roulette_terminations += 1;
                 break;
@@ -633,6 +636,15 @@ impl PathTracer {
             // The white-Lambertian illumination AOV is not estimated in media.
             illumination: None,
         }
+    }
+
+    /// Spectral MIS while every lane lives. Once the secondary lanes end (a dispersive
+    /// surface, or re-emission under `fluorescence_lanes: hero`) only the hero's estimate
+    /// is kept, counted four times by its quartered pdf, so it must divide by the hero's
+    /// own pdf: averaging in the dead lanes' pdfs biased it (+23 % in the fluorophore slab).
+    #[inline]
+    fn spectral_mis_now(&self, lanes: &LaneWavelengths) -> bool {
+        self.spectral_mis && !lanes.sensor().secondary_terminated()
     }
 
     /// Russian roulette on β/⟨r_u⟩ (pbrt-v4 `VolPathIntegrator`), from `rr_depth` on.
@@ -771,7 +783,7 @@ impl PathTracer {
         let light_pdf = pmf * ls.pdf;
         let r_l = tr.r_l * r_p * light_pdf;
         let r_u = tr.r_u * r_p * scatter_pdf;
-        let spectral = self.spectral_mis;
+        let spectral = self.spectral_mis_now(wavelengths);
         let denom = if ls.delta {
             average(r_l, spectral)
         } else {
