@@ -995,3 +995,31 @@ fn hero_lanes_in_a_fluorescent_medium_match_the_closed_form() {
         assert_close(&format!("hero lanes {c}"), mean, se, expected[c], 2e-3);
     }
 }
+
+/// `--explain` names a fluorescent medium, and its σt range includes the dye's σf (4 m⁻¹
+/// at the 420 nm peak, over σa 0.3).
+#[test]
+fn the_plan_names_a_fluorescent_medium() {
+    let data = Data::new();
+    let json = ink_scene(
+        &ink_medium(&data, "0.3", 0.0),
+        r#"{"type": "path", "max_depth": 1}"#,
+    );
+    let scene = build(&json);
+    let plan = prism_render::RenderPlan::new(&scene, &prism_render::PlanRequest::default());
+    let media: Vec<String> = plan
+        .choices
+        .iter()
+        .filter(|c| c.feature == "medium")
+        .map(|c| format!("{} | {}", c.setting, c.reason))
+        .collect();
+    assert_eq!(media.len(), 1, "{media:?}");
+    assert!(
+        media[0].starts_with(
+            "`ink`: homogeneous, σt 0.3000–4.3000 m⁻¹ over 360–830 nm, fluorescent (re-emits"
+        ),
+        "{}",
+        media[0]
+    );
+    assert!(media[0].contains("chromatic σt"), "{}", media[0]);
+}

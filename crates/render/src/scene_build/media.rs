@@ -426,8 +426,9 @@ fn check_claim(
     Ok(())
 }
 
-/// σt at 360, 365, …, 830 nm of `spectrum` sums: the (min, max) of `a + b` over that grid.
-pub fn coefficient_range(a: &Spectrum, b: &Spectrum) -> (f32, f32) {
+/// σt at 360, 365, …, 830 nm as the sum of `terms` (σa, σs and a fluorophore's σf): the
+/// (min, max) of the sum over that grid.
+pub fn coefficient_range(terms: &[&Spectrum]) -> (f32, f32) {
     let mut range = (f32::INFINITY, f32::NEG_INFINITY);
     for k in 0..=94 {
         let wl = 360.0 + 5.0 * k as f32;
@@ -435,7 +436,7 @@ pub fn coefficient_range(a: &Spectrum, b: &Spectrum) -> (f32, f32) {
             [wl; 4],
             prism_spectrum::SampledSpectrum::splat(1.0),
         );
-        let v = a.eval(&w)[0] + b.eval(&w)[0];
+        let v: f32 = terms.iter().map(|t| t.eval(&w)[0]).sum();
         range = (range.0.min(v), range.1.max(v));
     }
     range
