@@ -525,7 +525,11 @@ fn reradiation_reason(scene: &RenderScene, lanes: prism_scene::FluorescenceLanes
 /// spectral MIS matters (a chromatic σt) or not.
 fn describe_medium(name: &str, medium: &crate::medium::Medium) -> (String, String) {
     let optics = medium.optics();
-    let (lo, hi) = crate::scene_build::media::coefficient_range(&optics.sigma_a, &optics.sigma_s);
+    let mut terms = vec![&optics.sigma_a, &optics.sigma_s];
+    if let Some(f) = &optics.fluorescence {
+        terms.push(&f.sigma_f);
+    }
+    let (lo, hi) = crate::scene_build::media::coefficient_range(&terms);
     let grid = match medium {
         crate::medium::Medium::Homogeneous(_) => String::new(),
         crate::medium::Medium::Grid(g) => {
@@ -538,10 +542,16 @@ fn describe_medium(name: &str, medium: &crate::medium::Medium) -> (String, Strin
     };
     let chromatic = hi > lo * (1.0 + 1e-4);
     let setting = format!(
-        "`{name}`: {}, σt {lo:.4}–{hi:.4} m⁻¹ over 360–830 nm{grid}{}",
+        "`{name}`: {}, σt {lo:.4}–{hi:.4} m⁻¹ over 360–830 nm{grid}{}{}",
         medium.kind_name(),
         if optics.emission.is_some() {
             ", emissive"
+        } else {
+            ""
+        },
+        if optics.fluorescence.is_some() {
+            ", fluorescent (re-emits what its dye absorbs: lanes shift to excitation \
+             wavelengths down to 300 nm)"
         } else {
             ""
         }

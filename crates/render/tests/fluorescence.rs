@@ -6,7 +6,10 @@
 //!   outside B, (Le + c(λ)·Le/(1 − r))/(1 − r) in B, c(λ) = ∫M(λi, λ)dλi;
 //! - `fluorescence_lanes` `all` and `hero` estimate the same image;
 //! - the packet tracer, the light tracer and BDPT refuse re-radiation, and every bad input
-//!   of the scene format is an error naming its place.
+//!   of the scene format is an error naming its place;
+//! - media: a fluorescent surface in a clear medium as in vacuum; one re-emission in a
+//!   fluorophore slab under a directional light (issue 21 test 4), also with a spectral σt
+//!   and spectral MIS on and off; errors of the `fluorescence` key.
 //!
 //! Standard errors are over pixels (each pixel an independent estimate); the stated floors
 //! cover the 1 nm quadrature of the CMFs.
@@ -516,19 +519,6 @@ fn bad_inputs_are_errors_that_name_their_place() {
             with(
                 &data,
                 DYE,
-                r#"{"m": {"type": "fluorescent", "reradiation": "dye"}}"#,
-            )
-            .replacen(
-                "\"reradiation\":",
-                r#""media": {"fog": {"sigma_s_per_m": 0.1}}, "world_medium": "fog", "reradiation":"#,
-                1,
-            ),
-            &["materials.m", "participating media (fog)", "not rendered together"],
-        ),
-        (
-            with(
-                &data,
-                DYE,
                 r#"{"m": {"type": "fluorescent", "reradiation": "dey"}}"#,
             ),
             &[
@@ -679,4 +669,357 @@ fn bad_inputs_are_errors_that_name_their_place() {
         let d = parse_scene_str(&json, "ok.json").unwrap();
         RenderScene::build(&d, None).unwrap();
     }
+}
+
+/// A fluorescent surface renders through the volumetric loop (a scene with a medium, here
+/// a clear one the camera and the sky sit in) with the same closed form as in vacuum.
+#[test]
+fn a_fluorescent_surface_in_a_medium_scene_matches_the_bilinear_model() {
+    let data = Data::new();
+    let vacuum = sky_scene(&data, "card", "D65", 0.01, "all");
+    let json = vacuum.replacen(
+        r#""reradiation":"#,
+        r#""media": {"air": {"sigma_s_per_m": 0}}, "world_medium": "air", "reradiation":"#,
+        1,
+    );
+    assert_ne!(json, vacuum);
+    let description = parse_scene_str(&json, "test.json").unwrap();
+    let m = description.reradiation[0].matrix().clone();
+    let scene = build(&json);
+    assert!(scene.media.is_some());
+    let table = illuminant("D65").unwrap();
+    let s = |l: f64| 0.01 * table.eval(l);
+    let total = film_xyz(|l| 0.4 * s(l) + gathered(&m, &s, l));
+    let image = mean_and_se(&render_scene(&scene, 512, 21));
+    for c in 0..3 {
+        let (mean, se) = image[c];
+        assert_close(&format!("in a medium {c}"), mean, se, total[c], 2e-4);
+    }
+}
+
+/// Thickness of the fluorophore slab, m; the camera's angle to its normal (μ = cos).
+const INK_D_M: f64 = 0.5;
+const INK_VIEW_DEG: f64 = 30.0;
+/// The directional light's irradiance, W·m⁻²·nm⁻¹ at every wavelength.
+const INK_E: f64 = 2.0;
+
+/// A slab (z in ±INK_D_M/2, an `interface` cuboid) of medium `ink` = `medium` under a
+/// directional light travelling −z, seen from below at INK_VIEW_DEG by an orthographic
+/// camera (nothing behind the slab: all it sees is what the slab re-emits).
+fn ink_scene(medium: &str, integrator: &str) -> String {
+    let (s, c) = INK_VIEW_DEG.to_radians().sin_cos();
+    format!(
+        r#"{{
+      "camera": {{"type": "orthographic", "width_m": 0.2,
+                  "transform": {{"look_at": {{"eye": [0, {ey}, {ez}], "target": [0, 0, 0], "up": [0, 1, 0]}}}}}},
+      "film": {{"resolution": [16, 16], "filter": {{"type": "box", "radius_px": 0.5}}}},
+      "integrator": {integrator},
+      "media": {{"ink": {medium}}},
+      "materials": {{"boundary": {{"type": "interface"}}}},
+      "shapes": [{{"type": "cuboid", "size_m": [6, 6, {INK_D_M}], "material": "boundary",
+                   "interior_medium": "ink"}}],
+      "lights": [{{"type": "directional", "direction": [0, 0, -1], "spectrum": 1, "scale": {INK_E}}}]
+    }}"#,
+        ey = -2.0 * s,
+        ez = -2.0 * c,
+    )
+}
+
+/// The fluorophore: absorption 4·gauss(420 nm, 35 nm) m⁻¹ over 300–560 nm, `dye-em.csv`'s
+/// emission, Φ = 0.9; `sigma_a`: the medium's own σa.
+fn ink_medium(data: &Data, sigma_a: &str, sigma_s: f64) -> String {
+    let gaussian = |l: f64| (-(l - 420.0f64).powi(2) / (2.0 * 35.0 * 35.0)).exp();
+    let mut abs = String::from("wavelength_nm,sigma_per_m\n");
+    for k in 0..=52 {
+        let l = 300.0 + 5.0 * k as f64;
+        abs += &format!("{l},{}\n", 4.0 * gaussian(l));
+    }
+    std::fs::write(data.dir.path().join("ink-abs.csv"), abs).unwrap();
+    format!(
+        r#"{{"sigma_a_per_m": {sigma_a}, "sigma_s_per_m": {sigma_s},
+            "fluorescence": {{"absorption_per_m": "{abs}", "emission": "{em}",
+                              "quantum_yield": 0.9}}}}"#,
+        abs = data.path("ink-abs.csv"),
+        em = data.path("dye-em.csv"),
+    )
+}
+
+/// Issue 21 test 4: L(λo) = ∫dλi E·M(λi, λo)/4π ∫₀ᵈ e^(−σt(λi)z)·e^(−σt(λo)(d−z)/μ) dz/μ,
+/// the inner integral exact, the outer by Simpson on 0.25 nm steps over 300–830 nm; σt =
+/// σa + σf, M and σf the ones the scene built (the dye's 5 nm nodes, linear between), all
+/// times `density`.
+fn ink_expected_xyz(scene_json: &str, sigma_a: &dyn Fn(f64) -> f64, density: f64) -> [f64; 3] {
+    let description = parse_scene_str(scene_json, "test.json").unwrap();
+    let f = description.media[0].fluorescence.as_ref().unwrap();
+    let peak = density * f.peak_absorption_per_m;
+    let sigma_t = |l: f64| density * sigma_a(l) + peak * f.dye.absorptance(l);
+    let mu = INK_VIEW_DEG.to_radians().cos();
+    let d = INK_D_M;
+    let depth_integral = |a: f64, b: f64| {
+        // ∫₀ᵈ e^(−a z − b (d − z)/μ) dz / μ
+        let k = a - b / mu;
+        let inner = if k.abs() < 1e-9 {
+            d
+        } else {
+            (1.0 - (-k * d).exp()) / k
+        };
+        (-b * d / mu).exp() * inner / mu
+    };
+    let n = 2120;
+    let h = 530.0 / n as f64;
+    film_xyz(|lo| {
+        let mut sum = 0.0;
+        for i in 0..=n {
+            let w = if i == 0 || i == n {
+                1.0
+            } else if i % 2 == 1 {
+                4.0
+            } else {
+                2.0
+            };
+            let li = 300.0 + i as f64 * h;
+            let m = peak * f64::from(f.dye.matrix().eval(li as f32, lo as f32));
+            if m > 0.0 {
+                sum += w * m * depth_integral(sigma_t(li), sigma_t(lo));
+            }
+        }
+        INK_E * sum * h / 3.0 / (4.0 * std::f64::consts::PI)
+    })
+}
+
+/// (what, the medium's σa in the scene, σa(λ), spectral MIS, seed).
+type InkCase<'a> = (&'a str, &'a str, &'a dyn Fn(f64) -> f64, bool, u64);
+
+#[test]
+fn one_reemission_in_a_fluorophore_slab_matches_the_closed_form() {
+    let data = Data::new();
+    // A spectral σa of the medium itself, 0.2 m⁻¹ at 300 nm rising to 1.2 at 830 nm.
+    std::fs::write(
+        data.dir.path().join("sigma-a.csv"),
+        "wavelength_nm,value\n300,0.2\n830,1.2\n",
+    )
+    .unwrap();
+    let spectral = |l: f64| 0.2 + (l - 300.0) / 530.0;
+    let sigma_a_file = format!("\"{}\"", data.path("sigma-a.csv"));
+    let cases: [InkCase; 3] = [
+        ("σa = 0", "0", &|_| 0.0, true, 131),
+        (
+            "spectral σt, spectral MIS",
+            &sigma_a_file,
+            &spectral,
+            true,
+            132,
+        ),
+        (
+            "spectral σt, hero pdf only",
+            &sigma_a_file,
+            &spectral,
+            false,
+            133,
+        ),
+    ];
+    let mut means = Vec::new();
+    for (what, sigma_a, f, mis, seed) in cases {
+        let json = ink_scene(
+            &ink_medium(&data, sigma_a, 0.0),
+            &format!(r#"{{"type": "path", "max_depth": 1, "spectral_mis": {mis}}}"#),
+        );
+        let expected = ink_expected_xyz(&json, f, 1.0);
+        let image = mean_and_se(&render_scene(&build(&json), 4096, seed));
+        for c in 0..3 {
+            let (mean, se) = image[c];
+            assert_close(&format!("{what} {c}"), mean, se, expected[c], 2e-3);
+        }
+        assert!(expected[1] > 1e-3, "the slab glows: {expected:?}");
+        means.push(image);
+    }
+    // The two estimators of the spectral case agree with each other too.
+    for (c, (&(a, sa), &(b, sb))) in means[1].iter().zip(&means[2]).enumerate() {
+        assert_close(
+            &format!("spectral MIS on vs off {c}"),
+            a,
+            (sa * sa + sb * sb).sqrt(),
+            b,
+            2e-3,
+        );
+    }
+}
+
+/// After re-emission the lanes travel at their excitation wavelengths, where the medium's
+/// σt differs: with scattering and more bounces (no closed form), spectral MIS on and off
+/// estimate the same image.
+#[test]
+fn spectral_mis_after_a_shift_keeps_the_mean() {
+    let data = Data::new();
+    std::fs::write(
+        data.dir.path().join("sigma-a.csv"),
+        "wavelength_nm,value\n300,0.2\n830,1.2\n",
+    )
+    .unwrap();
+    let sigma_a = format!("\"{}\"", data.path("sigma-a.csv"));
+    let mut results = Vec::new();
+    for (mis, seed) in [(true, 41u64), (false, 42)] {
+        let json = ink_scene(
+            &ink_medium(&data, &sigma_a, 1.5),
+            &format!(r#"{{"type": "path", "max_depth": 6, "spectral_mis": {mis}}}"#),
+        );
+        results.push(mean_and_se(&render_scene(&build(&json), 1024, seed)));
+    }
+    for (c, (&(a, sa), &(b, sb))) in results[0].iter().zip(&results[1]).enumerate() {
+        assert_close(
+            &format!("max_depth 6, on vs off {c}"),
+            a,
+            (sa * sa + sb * sb).sqrt(),
+            b,
+            2e-3,
+        );
+    }
+    assert!(results[0][1].0 > 1e-3, "{results:?}");
+}
+
+#[test]
+fn bad_fluorescence_keys_are_errors_that_name_their_place() {
+    let data = Data::new();
+    let dir = data.dir.path();
+    std::fs::write(
+        dir.join("plain-em.csv"),
+        "wavelength_nm,value\n450,0\n500,1\n600,0\n",
+    )
+    .unwrap();
+    std::fs::write(dir.join("zero.csv"), "wavelength_nm,sigma\n400,0\n500,0\n").unwrap();
+    let medium = |fluorescence: &str| {
+        let json = format!(
+            r#"{{"media": {{"ink": {{"sigma_s_per_m": 1, "fluorescence": {fluorescence}}}}},
+                "world_medium": "ink"}}"#
+        );
+        json.replace("ABS", &data.path("dye-abs.csv"))
+            .replace("EM", &data.path("dye-em.csv"))
+            .replace("PLAIN", &data.path("plain-em.csv"))
+            .replace("ZERO", &data.path("zero.csv"))
+    };
+    let cases: Vec<(String, &[&str])> = vec![
+        (
+            medium(
+                r#"{"absorption_per_m": "ABS", "emission": "EM", "quantum_yield": 0.9, "yield": 1}"#,
+            ),
+            &["media.ink.fluorescence", "yield"],
+        ),
+        (
+            medium(r#"{"emission": "EM", "quantum_yield": 0.9}"#),
+            &["media.ink.fluorescence", "absorption_per_m"],
+        ),
+        (
+            medium(r#"{"absorption_per_m": "ABS", "emission": "EM", "quantum_yield": 1.5}"#),
+            &["media.ink.fluorescence.quantum_yield", "1.5"],
+        ),
+        (
+            medium(r#"{"absorption_per_m": "ABS", "emission": "PLAIN", "quantum_yield": 0.9}"#),
+            &["media.ink.fluorescence.emission", "`photons`", "`energy`"],
+        ),
+        (
+            medium(r#"{"absorption_per_m": "ZERO", "emission": "EM", "quantum_yield": 0.9}"#),
+            &["media.ink.fluorescence", "zero"],
+        ),
+        (
+            medium(
+                r#"{"absorption_per_m": "missing.csv", "emission": "EM", "quantum_yield": 0.9}"#,
+            ),
+            &["media.ink.fluorescence.absorption_per_m", "not found"],
+        ),
+        (medium(r#""dye""#), &["media.ink.fluorescence"]),
+    ];
+    for (json, needles) in &cases {
+        let e = error_of(json);
+        for needle in needles.iter() {
+            assert!(e.contains(needle), "`{needle}` not in: {e}");
+        }
+    }
+}
+
+/// A grid medium scales the fluorophore's σf and M by its density as it does σa: test 4
+/// through a constant grid of density 0.6 (the majorant cells bound it exactly).
+#[test]
+fn a_fluorescent_grid_scales_the_fluorophore_by_its_density() {
+    let data = Data::new();
+    let density = 0.6f32;
+    let half = 0.5 * INK_D_M as f32;
+    // A Mitsuba .vol (version 3, float32, 1 channel), 2×2×2 voxels of `density`.
+    let mut vol = b"VOL".to_vec();
+    vol.push(3);
+    vol.extend_from_slice(&1i32.to_le_bytes());
+    for r in [2i32, 2, 2] {
+        vol.extend_from_slice(&r.to_le_bytes());
+    }
+    vol.extend_from_slice(&1i32.to_le_bytes());
+    for x in [-3.0f32, -3.0, -half, 3.0, 3.0, half] {
+        vol.extend_from_slice(&x.to_le_bytes());
+    }
+    for _ in 0..8 {
+        vol.extend_from_slice(&density.to_le_bytes());
+    }
+    std::fs::write(data.dir.path().join("ink.vol"), vol).unwrap();
+    let medium = ink_medium(&data, "0.3", 0.0).replacen(
+        "{",
+        &format!(
+            r#"{{"type": "grid", "density": "{}", "#,
+            data.path("ink.vol")
+        ),
+        1,
+    );
+    let json = ink_scene(&medium, r#"{"type": "path", "max_depth": 1}"#);
+    let expected = ink_expected_xyz(&json, &|_| 0.3, f64::from(density));
+    let image = mean_and_se(&render_scene(&build(&json), 2048, 51));
+    for (c, &(mean, se)) in image.iter().enumerate() {
+        assert_close(&format!("grid {c}"), mean, se, expected[c], 2e-3);
+    }
+    // Density 1 would glow differently: the test tells the two apart.
+    let unscaled = ink_expected_xyz(&json, &|_| 0.3, 1.0);
+    assert!(
+        (unscaled[1] - expected[1]).abs() > 10.0 * image[1].1,
+        "{unscaled:?}"
+    );
+}
+
+/// `fluorescence_lanes: hero` in a fluorescent medium (the secondary lanes end where any
+/// lane re-emits) estimates the same as `all`: test 4's closed form.
+#[test]
+fn hero_lanes_in_a_fluorescent_medium_match_the_closed_form() {
+    let data = Data::new();
+    let json = ink_scene(
+        &ink_medium(&data, "0.3", 0.0),
+        r#"{"type": "path", "max_depth": 1, "fluorescence_lanes": "hero"}"#,
+    );
+    let expected = ink_expected_xyz(&json, &|_| 0.3, 1.0);
+    let image = mean_and_se(&render_scene(&build(&json), 4096, 61));
+    for (c, &(mean, se)) in image.iter().enumerate() {
+        assert_close(&format!("hero lanes {c}"), mean, se, expected[c], 2e-3);
+    }
+}
+
+/// `--explain` names a fluorescent medium, and its σt range includes the dye's σf (4 m⁻¹
+/// at the 420 nm peak, over σa 0.3).
+#[test]
+fn the_plan_names_a_fluorescent_medium() {
+    let data = Data::new();
+    let json = ink_scene(
+        &ink_medium(&data, "0.3", 0.0),
+        r#"{"type": "path", "max_depth": 1}"#,
+    );
+    let scene = build(&json);
+    let plan = prism_render::RenderPlan::new(&scene, &prism_render::PlanRequest::default());
+    let media: Vec<String> = plan
+        .choices
+        .iter()
+        .filter(|c| c.feature == "medium")
+        .map(|c| format!("{} | {}", c.setting, c.reason))
+        .collect();
+    assert_eq!(media.len(), 1, "{media:?}");
+    assert!(
+        media[0].starts_with(
+            "`ink`: homogeneous, σt 0.3000–4.3000 m⁻¹ over 360–830 nm, fluorescent (re-emits"
+        ),
+        "{}",
+        media[0]
+    );
+    assert!(media[0].contains("chromatic σt"), "{}", media[0]);
 }

@@ -615,3 +615,47 @@ fn inconsistent_boundaries_are_counted() {
         nested_wrong.medium_mismatches
     );
 }
+
+/// A dispersive glass ball (Cauchy flint) holding a chromatic scattering medium in front of
+/// an emitter: the glass ends the secondary lanes at the first hit, and from then on only
+/// the hero's estimate counts, so spectral MIS on must divide by the hero's pdf as off does
+/// (the lane average biased it): the two agree.
+#[test]
+fn after_dispersion_spectral_mis_on_and_off_agree() {
+    let dir = Dir::new("dispersion");
+    let csv = "wavelength_nm,value\n360,2\n489,2\n490,6\n589,6\n590,9\n830,9\n";
+    dir.write("bands.csv", csv.as_bytes());
+    let mut results = Vec::new();
+    for (on, seed) in [(true, 7u64), (false, 8)] {
+        let json = format!(
+            r#"{{
+  "camera": {{"type": "orthographic", "width_m": 0.4,
+              "transform": {{"look_at": {{"eye": [0, 0, 2], "target": [0, 0, 0], "up": [0, 1, 0]}}}}}},
+  "film": {{"resolution": [16, 16], "filter": {{"type": "box", "radius_px": 0.5}}}},
+  "integrator": {{"type": "path", "max_depth": 16, "spectral_mis": {on}}},
+  "media": {{"fog": {{"sigma_s_per_m": "bands.csv", "phase": {{"type": "hg", "g": 0.5}}}}}},
+  "materials": {{"flint": {{"type": "dielectric", "ior": {{"cauchy": {{"a": 1.67, "b_um2": 0.0074}}}}}},
+                 "black": {{"type": "lambert", "reflectance": 0}}}},
+  "shapes": [
+    {{"type": "sphere", "radius_m": 0.5, "material": "flint", "interior_medium": "fog"}},
+    {{"type": "rectangle", "name": "emitter", "size_m": [6, 6], "material": "black",
+      "transform": {{"translate": [0, 0, -1]}}}}
+  ],
+  "lights": [{{"type": "area", "shape": "emitter", "spectrum": 1, "scale": {LE}}}]
+}}"#
+        );
+        let image = render_scene(&dir.scene(&json), 1024, seed);
+        results.push(mean_and_se(&image));
+    }
+    let ((mean_on, se_on), (mean_off, se_off)) = (results[0], results[1]);
+    eprintln!("dispersion: on {mean_on:.5} ± {se_on:.2e}, off {mean_off:.5} ± {se_off:.2e}");
+    let se = (se_on * se_on + se_off * se_off).sqrt();
+    assert!(
+        (mean_on - mean_off).abs() <= 4.0 * se + 1e-3 * mean_off,
+        "means differ: on {mean_on}, off {mean_off} (s.e. {se})"
+    );
+    assert!(
+        mean_off > 0.1 * LE,
+        "the emitter shows through the ball: {mean_off}"
+    );
+}

@@ -32,7 +32,7 @@ pub use light::{Light, LightKind, Strength};
 pub use material::{
     ConductorOptics, Ior, LafortuneLobe, LibraryKind, Material, MaterialKind, Microfacet, Roughness,
 };
-pub use medium::{Medium, MediumKind, Phase, MEDIUM_TYPES, PHASE_TYPES};
+pub use medium::{Medium, MediumFluorescence, MediumKind, Phase, MEDIUM_TYPES, PHASE_TYPES};
 pub use reradiation::{Reradiation, ReradiationKind};
 pub use scene::{load_scene, parse_scene_str, SceneDescription};
 pub use sensor::{Sensor, SensorKind, SensorSampling};

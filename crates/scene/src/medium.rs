@@ -1,8 +1,11 @@
 //! Participating media: homogeneous, or a density grid (Mitsuba `.vol`) scaling the
 //! coefficients; absorption and scattering coefficients as spectra, an optional emission
-//! and a phase function (isotropic, Henyey–Greenstein, Rayleigh or a table).
+//! and a phase function (isotropic, Henyey–Greenstein, Rayleigh or a table); optionally a
+//! dissolved fluorophore (`fluorescence`) that re-emits what it absorbs.
 
 use std::path::PathBuf;
+
+use prism_spectrum::{Dye, EmissionUnits};
 
 use crate::reader::{Result, V};
 use crate::schema::schema;
@@ -20,6 +23,27 @@ pub struct Medium {
     /// (pbrt-v4 `Le`), so emitted power scales with the density. `None`: not emissive.
     pub emission: Option<SpectrumRef>,
     pub phase: Phase,
+    /// A dissolved fluorophore: its absorption adds to σₐ, and what it absorbs is re-emitted
+    /// isotropically. `None`: the medium does not fluoresce.
+    pub fluorescence: Option<MediumFluorescence>,
+}
+
+/// `"fluorescence": {"absorption_per_m": CSV, "emission": CSV, "quantum_yield": Φ}`: the
+/// dye model of `reradiation` entries (prism-spectrum `dye.rs`) with an absorption
+/// coefficient in m⁻¹ instead of an absorptance. The medium's re-radiation matrix is
+/// M(λi, λo) = σf(λi)·Φ·(λi/λo)·e(λo)/∫e (m⁻¹·nm⁻¹, photon-count e; energy e as there).
+#[derive(Debug, Clone, PartialEq)]
+pub struct MediumFluorescence {
+    pub absorption: PathBuf,
+    pub emission: PathBuf,
+    pub units: EmissionUnits,
+    pub quantum_yield: f64,
+    /// The absorption coefficient's largest value on the dye's 5 nm excitation grid, m⁻¹.
+    pub peak_absorption_per_m: f64,
+    /// The dye at peak absorptance 1 (absorptance σf/peak): the medium's M is
+    /// `peak_absorption_per_m` times its matrix, σf is `peak_absorption_per_m` times its
+    /// absorptance.
+    pub dye: Dye,
 }
 
 #[derive(Debug, Clone, PartialEq)]
@@ -92,9 +116,59 @@ pub(crate) fn parse_media(v: &V, spectra: &NamedSpectra) -> Result<Vec<Medium>> 
                 .map(|e| parse_spectrum(&e, spectra, SpectrumUse::NonNegative))
                 .transpose()?,
             phase,
+            fluorescence: o
+                .get("fluorescence")
+                .map(|f| parse_fluorescence(&f))
+                .transpose()?,
         });
     }
     Ok(out)
+}
+
+fn parse_fluorescence(v: &V) -> Result<MediumFluorescence> {
+    use crate::reradiation::{emission_units, grid_of, read_columns};
+    let o = v.object(schema!("media.*.fluorescence"))?;
+    let absorption_v = o.req(
+        "absorption_per_m",
+        "the fluorophore's absorption coefficient in m⁻¹ (CSV)",
+    )?;
+    let emission_v = o.req(
+        "emission",
+        "the fluorophore's emission spectrum (CSV with a `photons` or `energy` column)",
+    )?;
+    let absorption = absorption_v.asset("absorption spectrum", &["csv", "txt"])?;
+    let emission = emission_v.asset("emission spectrum", &["csv", "txt"])?;
+    let quantum_yield = o
+        .req("quantum_yield", "the quantum yield Φ in [0, 1]")?
+        .in_range(0.0, 1.0)?;
+    let a = read_columns(&absorption_v, &absorption)?;
+    let e = read_columns(&emission_v, &emission)?;
+    let units = emission_units(&emission_v, &emission, &e)?;
+    let excitation = grid_of(&absorption_v, &absorption, &a, "absorption")?;
+    let emission_grid = grid_of(&emission_v, &emission, &e, "emission")?;
+    let (a_table, e_table) = (a.table(0), e.table(0));
+    // Dye::new scales the absorption to its largest grid node: the same nodes here.
+    let peak_absorption_per_m = (0..excitation.count())
+        .map(|k| a_table.eval(f64::from(excitation.wavelength_nm(k))))
+        .fold(0.0, f64::max);
+    let dye = Dye::new(
+        |nm| a_table.eval(nm),
+        |nm| e_table.eval(nm),
+        units,
+        quantum_yield,
+        1.0,
+        excitation,
+        emission_grid,
+    )
+    .map_err(|err| v.err(err.message))?;
+    Ok(MediumFluorescence {
+        absorption,
+        emission,
+        units,
+        quantum_yield,
+        peak_absorption_per_m,
+        dye,
+    })
 }
 
 fn hg_g(v: &V) -> Result<f64> {

@@ -132,7 +132,7 @@ pub(crate) fn parse_reradiation(v: &V) -> Result<Vec<Reradiation>> {
     Ok(out)
 }
 
-fn read_columns(v: &V, path: &Path) -> Result<SpectralColumns> {
+pub(crate) fn read_columns(v: &V, path: &Path) -> Result<SpectralColumns> {
     let columns = read_spectral_file(path).map_err(|e| v.err(e.to_string()))?;
     if columns.columns.len() != 1 {
         return Err(v.err(format!(
@@ -149,7 +149,11 @@ fn read_columns(v: &V, path: &Path) -> Result<SpectralColumns> {
 
 /// The emission CSV's header names its column `photons` (photon counts per nm) or
 /// `energy` (radiant energy per nm): the two differ by a factor λ, so it must say.
-fn emission_units(v: &V, path: &Path, columns: &SpectralColumns) -> Result<EmissionUnits> {
+pub(crate) fn emission_units(
+    v: &V,
+    path: &Path,
+    columns: &SpectralColumns,
+) -> Result<EmissionUnits> {
     match columns.names[0].to_ascii_lowercase().as_str() {
         "photons" => Ok(EmissionUnits::Photons),
         "energy" => Ok(EmissionUnits::Energy),
@@ -163,7 +167,12 @@ fn emission_units(v: &V, path: &Path, columns: &SpectralColumns) -> Result<Emiss
 }
 
 /// The 5 nm grid inside the file's wavelength range, which must lie in 300–830 nm.
-fn grid_of(v: &V, path: &Path, columns: &SpectralColumns, what: &str) -> Result<WavelengthGrid> {
+pub(crate) fn grid_of(
+    v: &V,
+    path: &Path,
+    columns: &SpectralColumns,
+    what: &str,
+) -> Result<WavelengthGrid> {
     let (low, high) = EXCITATION_RANGE_NM;
     let first = columns.wavelengths_nm[0];
     let last = *columns.wavelengths_nm.last().expect("parser gives ≥ 1 row");

@@ -107,6 +107,7 @@ const MEDIUM: &[&str] = &[
     "emission",
     "phase",
     "g",
+    "fluorescence",
 ];
 const TEXTURE_UV: &[&str] = &["uv_scale", "uv_offset", "uv_rotate_deg"];
 
@@ -219,6 +220,10 @@ pub const SCHEMA: &[ObjectSchema] = &[
     // medium.rs
     row("media.*<homogeneous>", &[MEDIUM]),
     row("media.*<grid>", &[MEDIUM, &["density", "bounds_m"]]),
+    row(
+        "media.*.fluorescence",
+        &[&["absorption_per_m", "emission", "quantum_yield"]],
+    ),
     row("@phase<isotropic>", &[TYPE]),
     row("@phase<rayleigh>", &[TYPE]),
     row("@phase<hg>", &[&["type", "g"]]),

@@ -180,3 +180,31 @@ fn bad_media_are_refused_at_their_json_path() {
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
+
+/// `fluorescence` (issue 21): the dye model with an absorption coefficient; the peak is the
+/// largest value on the 5 nm excitation grid, and the stored dye has peak absorptance 1.
+#[test]
+fn a_fluorescent_medium_parses_its_dye() {
+    let dir = Dir::new("media-fluorescence");
+    dir.write(
+        "abs.csv",
+        "wavelength_nm,sigma\n380,0\n400,2\n420,6\n440,1\n460,0\n",
+    );
+    dir.write(
+        "em.csv",
+        "wavelength_nm,energy\n480,0\n520,1\n560,0.5\n600,0\n",
+    );
+    let s = dir
+        .load(
+            r#"{"media": {"ink": {"type": "homogeneous", "sigma_s_per_m": 5,
+                "fluorescence": {"absorption_per_m": "abs.csv", "emission": "em.csv",
+                                 "quantum_yield": 0.9}}}}"#,
+        )
+        .unwrap();
+    let f = s.media[0].fluorescence.as_ref().unwrap();
+    assert_eq!(f.peak_absorption_per_m, 6.0);
+    assert_eq!(f.units, prism_spectrum::EmissionUnits::Energy);
+    assert_eq!(f.quantum_yield, 0.9);
+    assert!((f.dye.absorptance(420.0) - 1.0).abs() < 1e-12);
+    assert!((f.dye.absorptance(400.0) - 2.0 / 6.0).abs() < 1e-12);
+}

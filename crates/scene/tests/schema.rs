@@ -51,6 +51,7 @@ fn scene_with(pattern: &str) -> Option<String> {
         // Re-radiation entries have no `type`: the form is told by `bfc` or `absorption`.
         "reradiation.*<bfc>" => r#"{"reradiation": {"r": {"bfc": "r.bfc", $}}}"#.into(),
         "reradiation.*<dye>" => r#"{"reradiation": {"r": {"absorption": "a.csv", $}}}"#.into(),
+        "media.*.fluorescence" => r#"{"media": {"m": {"fluorescence": {$}}}}"#.into(),
         "@phase<isotropic>" | "@phase<rayleigh>" | "@phase<hg>" | "@phase<tabulated>" => {
             format!(r#"{{"media": {{"m": {{"phase": {{"type": "{kind}", $}}}}}}}}"#)
         }

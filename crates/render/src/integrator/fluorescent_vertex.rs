@@ -35,7 +35,7 @@ use crate::sampler::SampleStream;
 /// `u` rotated by lane `lane` (the hero-wavelength rotation, Wilkie et al. 2014), so the
 /// four lanes' choices are stratified against each other.
 #[inline]
-fn rotated(u: f32, lane: usize) -> f32 {
+pub(crate) fn rotated(u: f32, lane: usize) -> f32 {
     let x = u + lane as f32 / N_SPECTRUM_SAMPLES as f32;
     if x >= 1.0 {
         x - 1.0

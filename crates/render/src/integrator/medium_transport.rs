@@ -12,32 +12,44 @@
 //!   their lane average, the one-sample balance heuristic over the four wavelengths and
 //!   the two strategies (dividing by the hero's pdf alone made Mitsuba 2's `volpath`
 //!   noisy in chromatic media, mitsuba2 #323). `spectral_mis: false` divides by the hero's
-//!   alone (a debug switch).
+//!   alone (a debug switch), as does every contribution once the secondary lanes have
+//!   ended (`spectral_mis_now`).
 //! - **Next-event estimation** from surface and medium vertices; shadow rays estimate
 //!   transmittance by ratio tracking and cross `interface` surfaces (and masks and thin
 //!   panes, as in vacuum); any other surface blocks them.
 //! - **Interfaces** (`material: interface`) scatter nothing: crossing one changes the
 //!   ray's medium and is not a bounce (pbrt-v3 #69).
 //! - **Emissive media** add σa·Le at every collision (pbrt-v4).
+//! - **Fluorescent media** (a `Fluorophore`, issue 21): at each collision, with
+//!   probability q = c_max/(σ_maj + c_max) the path continues as the fluorescent source
+//!   (isotropic, each lane's λi drawn ∝ M(·, λo) at its transport wavelength, weight
+//!   M/(σ_maj·q·p), the lane's transport moved to λi), else as usual with weight 1/(1 − q).
+//!   q and the majorant (`OpticsAtLanes::fluorescent_majorant`) are the same for every
+//!   lane, so no lane's source or null continuation is out of the hero's reach. Fluorescent
+//!   surfaces scatter as in vacuum (`fluorescent_vertex`).
 //!
 //! Light and BSDF sampling are weighted by the balance heuristic here (it is what the
 //! rescaled probabilities express), whatever `mis` says.
 //!
 //! Sample dimensions: every segment reserves a `MediumDimensions` block, then each vertex
-//! (surface or medium) its `VertexDimensions` block. Scenes without media never come here.
+//! (surface or medium) its `VertexDimensions` block, and a surface vertex in a scene with
+//! re-radiation its `ReradiationDimensions`. A fluorophore's choices draw from the
+//! segment's generator. Scenes without media never come here.
 
 use glam::{Vec2, Vec3A};
 use prism_geometry::{Ray, RayDifferential};
-use prism_spectrum::{SampledSpectrum, SampledWavelengths};
+use prism_scene::FluorescenceLanes;
+use prism_spectrum::{SampledSpectrum, SampledWavelengths, N_SPECTRUM_SAMPLES};
 
-use super::dimensions::MediumDimensions;
+use super::dimensions::{MediumDimensions, ReradiationDimensions};
+use super::fluorescent_vertex;
 use super::lane_wavelengths::LaneWavelengths;
 use super::path::{FirstHit, PathCounters, PathResult, PathTracer};
 use super::path_state::{PathOrigin, PathState};
 use super::scatter_vertex::{MediumVertex, ScatterVertex, SurfaceVertex};
 use crate::bsdf::TransportMode;
 use crate::light::LightHit;
-use crate::medium::{Medium, OpticsAtLanes};
+use crate::medium::{Fluorophore, Medium, OpticsAtLanes, PhaseFunction};
 use crate::sampler::SampleStream;
 use crate::scene_build::media::MediaScene;
 use crate::scene_build::RenderScene;
@@ -74,6 +86,8 @@ pub struct Collision {
     pub sigma_s: SampledSpectrum,
     pub emission: SampledSpectrum,
     pub sigma_maj: SampledSpectrum,
+    /// The density at `p` (1 in a homogeneous medium).
+    pub density: f32,
     /// Majorant transmittance since the previous collision (or the segment's start).
     pub t_maj: SampledSpectrum,
 }
@@ -93,7 +107,7 @@ pub fn sample_t_maj(
 ) -> SampledSpectrum {
     let mut t_maj = SampledSpectrum::splat(1.0);
     for stretch in medium.stretches(ray) {
-        let sigma_maj = optics.sigma_t * stretch.density_bound;
+        let sigma_maj = optics.sigma_maj * stretch.density_bound;
         let span = |a: f32, b: f32| {
             let dt = b - a;
             if dt.is_finite() {
@@ -121,6 +135,7 @@ pub fn sample_t_maj(
                     sigma_s: optics.sigma_s * density,
                     emission: optics.emission,
                     sigma_maj,
+                    density,
                     t_maj,
                 };
                 if !callback(&c, rng) {
@@ -173,6 +188,51 @@ enum SegmentEnd {
     Terminated,
     /// Real scattering at this point.
     Scattered(Vec3A),
+    /// The fluorophore re-emits here: the lanes' new transport wavelengths (`None`: the
+    /// lane carries nothing on).
+    Fluoresced(Vec3A, [Option<f32>; N_SPECTRUM_SAMPLES]),
+}
+
+/// Per-lane weights of re-emission by fluorophore `f` (density `density`) at a collision,
+/// times the source's isotropic phase over its pdf (1), and the lanes' excitation
+/// wavelengths: each lane draws λi ∝ M(·, λo) at its own transport wavelength λo (`u`
+/// rotated per lane, as at fluorescent surfaces), weight M(λi, λo)·density/p(λi). `Hero`
+/// keeps only the hero lane when any lane shifts.
+fn fluoresce(
+    f: &Fluorophore,
+    lanes: &LaneWavelengths,
+    density: f32,
+    u: f32,
+    mode: FluorescenceLanes,
+) -> (SampledSpectrum, [Option<f32>; N_SPECTRUM_SAMPLES]) {
+    let mut weight = SampledSpectrum::splat(0.0);
+    let mut shifted = [None; N_SPECTRUM_SAMPLES];
+    let live = lanes.sensor().pdf();
+    let lambda_out = lanes.transport().lambda();
+    for lane in 0..N_SPECTRUM_SAMPLES {
+        if live[lane] == 0.0 {
+            continue;
+        }
+        let u_lane = fluorescent_vertex::rotated(u, lane);
+        let Some((lambda_in_nm, pdf)) = f.matrix.sample_excitation(lambda_out[lane], u_lane) else {
+            continue;
+        };
+        if pdf > 0.0 {
+            weight[lane] = f.matrix.eval(lambda_in_nm, lambda_out[lane]) * density / pdf;
+            shifted[lane] = Some(lambda_in_nm);
+        }
+    }
+    match mode {
+        FluorescenceLanes::All => {}
+        FluorescenceLanes::Hero => {
+            if shifted.iter().any(Option::is_some) {
+                for lane in 1..N_SPECTRUM_SAMPLES {
+                    weight[lane] = 0.0;
+                }
+            }
+        }
+    }
+    (weight, shifted)
 }
 
 impl PathTracer {
@@ -191,7 +251,7 @@ impl PathTracer {
         light_samples: u32,
         counters: &mut PathCounters,
     ) -> PathResult {
-        let spectral = self.spectral_mis;
+        let mode = self.fluorescence_lanes;
         let lights = &scene.lights;
         let mut current_differential = camera_differential.copied();
         let mut radiance = SampledSpectrum::splat(0.0);
@@ -210,14 +270,20 @@ impl PathTracer {
         let n_light = light_samples.max(1);
         let mut le_cache = SpectrumCache::new();
         let mut reflectance_cache = SpectrumCache::new();
+        // The phase function of re-emission by a medium's fluorophore.
+        let isotropic = PhaseFunction::Isotropic;
 
         loop {
+            let spectral = self.spectral_mis_now(&path.wavelengths);
             let hit = scene.geometry.intersect(&ray);
             let md = MediumDimensions::reserve(&mut path.stream);
             let mut rng = MediumRng::new(path.stream.seed_at(md.generator()));
             if let Some(m) = medium {
                 let med = media.medium(m);
-                let optics = med.optics().at(path.wavelengths.transport());
+                let optics = med
+                    .optics()
+                    .at(path.wavelengths.transport())
+                    .fluorescent_majorant(path.depth < self.max_depth);
                 let segment = Ray::new(
                     ray.origin,
                     ray.direction,
@@ -227,6 +293,8 @@ impl PathTracer {
                 let mut end = SegmentEnd::Passed;
                 let (mut beta, max_depth) = (path.beta, self.max_depth);
                 let mut depth = path.depth;
+                let fluorophore = med.optics().fluorescence.as_ref();
+                let lanes = &path.wavelengths;
                 let u0 = path.stream.get_1d_at(md.distance());
                 let t_maj = sample_t_maj(med, &optics, &segment, u0, &mut rng, |c, rng| {
                     // Emission (pbrt-v4: σa·Le, weighted over the lanes' distance pdfs).
@@ -240,6 +308,32 @@ impl PathTracer {
                                 beta_e * c.sigma_a * c.emission / average(r_e, spectral),
                                 counters,
                             );
+                        }
+                    }
+                    // A fluorophore's source term, chosen with probability q (one value for
+                    // all lanes, so their MIS ratios keep it out); the rest of the collision
+                    // estimator is weighted by 1/(1 − q).
+                    if let (Some(f), true) = (fluorophore, depth < max_depth) {
+                        let c_max = optics.sigma_fl.max_component() * c.density;
+                        // (c_max > 0 implies the shared majorant: depth only grows here.)
+                        if c_max > 0.0 {
+                            let q = c_max / (c.sigma_maj[0] + c_max);
+                            if rng.uniform() < q {
+                                depth += 1;
+                                let (w, shifted) =
+                                    fluoresce(f, lanes, c.density, rng.uniform(), mode);
+                                let pdf = c.t_maj[0] * c.sigma_maj[0] * q;
+                                beta *= c.t_maj * w / pdf;
+                                r_u *= c.t_maj * c.sigma_maj * q / pdf;
+                                end = if beta.is_black() || r_u.is_black() {
+                                    SegmentEnd::Terminated
+                                } else {
+                                    SegmentEnd::Fluoresced(c.p, shifted)
+                                };
+                                return false;
+                            }
+                            beta *= 1.0 / (1.0 - q);
+                            r_l *= 1.0 / (1.0 - q);
                         }
                     }
                     let p_absorb = c.sigma_a[0] / c.sigma_maj[0];
@@ -282,53 +376,19 @@ impl PathTracer {
                     true
                 });
                 path.beta = beta;
-                match end {
+                let scattered = match end {
                     SegmentEnd::Terminated => break,
-                    SegmentEnd::Scattered(p) => {
-                        path.depth = depth;
-                        counters.bounces += 1;
-                        let phase = &med.optics().phase;
-                        let vertex = ScatterVertex::Medium(MediumVertex {
-                            p,
-                            wo: -ray.direction,
-                            phase,
-                        });
-                        let dims = path.next_vertex_dimensions();
-                        if !lights.is_empty() {
-                            let direct = self.sample_lights_volumetric(
-                                scene,
-                                media,
-                                &vertex,
-                                medium,
-                                None,
-                                &dims,
-                                n_light,
-                                &mut path,
-                                r_u,
-                                &mut rng,
-                                &mut le_cache,
-                                counters,
-                            );
-                            add(&mut radiance, path.beta * direct, counters);
+                    SegmentEnd::Scattered(p) => Some((p, &med.optics().phase)),
+                    SegmentEnd::Fluoresced(p, shifted) => {
+                        for (lane, lambda_in_nm) in shifted.iter().enumerate() {
+                            if let Some(lambda_in_nm) = lambda_in_nm {
+                                path.wavelengths.shift_transport(lane, *lambda_in_nm);
+                            }
                         }
-                        let Some(ps) = vertex.sample(
-                            0.0,
-                            path.stream.get_2d_at(dims.bsdf()),
-                            TransportMode::Radiance,
-                        ) else {
-                            break;
-                        };
-                        path.beta *= ps.weight;
-                        r_l = r_u / ps.pdf;
-                        path.scattered(vertex.light_context(), &ps);
-                        ray = Ray::infinite(p, ps.wi);
-                        current_differential = None;
-                        counters.rays += 1;
-                        if self.volumetric_roulette(&mut path, r_u, dims.roulette(), spectral) {
-                            counters.roulette_terminations += 1;
-                            break;
+                        if mode == FluorescenceLanes::Hero && shifted.iter().any(Option::is_some) {
+                            path.wavelengths.terminate_secondary();
                         }
-                        continue;
+                        Some((p, &isotropic))
                     }
                     SegmentEnd::Passed => {
                         let scale = t_maj / t_maj[0];
@@ -338,7 +398,54 @@ impl PathTracer {
                         if path.beta.is_black() || path.beta.has_non_finite() {
                             break;
                         }
+                        None
                     }
+                };
+                if let Some((p, phase)) = scattered {
+                    path.depth = depth;
+                    counters.bounces += 1;
+                    let vertex = ScatterVertex::Medium(MediumVertex {
+                        p,
+                        wo: -ray.direction,
+                        phase,
+                    });
+                    let dims = path.next_vertex_dimensions();
+                    if !lights.is_empty() {
+                        let direct = self.sample_lights_volumetric(
+                            scene,
+                            media,
+                            &vertex,
+                            medium,
+                            None,
+                            &dims,
+                            n_light,
+                            &mut path,
+                            r_u,
+                            &mut rng,
+                            &mut le_cache,
+                            counters,
+                        );
+                        add(&mut radiance, path.beta * direct, counters);
+                    }
+                    let Some(ps) = vertex.sample(
+                        0.0,
+                        path.stream.get_2d_at(dims.bsdf()),
+                        TransportMode::Radiance,
+                    ) else {
+                        break;
+                    };
+                    path.beta *= ps.weight;
+                    r_l = r_u / ps.pdf;
+                    path.scattered(vertex.light_context(), &ps);
+                    ray = Ray::infinite(p, ps.wi);
+                    current_differential = None;
+                    counters.rays += 1;
+                    let spectral = self.spectral_mis_now(&path.wavelengths);
+                    if self.volumetric_roulette(&mut path, r_u, dims.roulette(), spectral) {
+                        counters.roulette_terminations += 1;
+                        break;
+                    }
+                    continue;
                 }
             }
 
@@ -389,6 +496,9 @@ impl PathTracer {
             }
             let material = scene.material(si.material_id);
             let dims = path.next_vertex_dimensions();
+            let reradiation_dims = scene
+                .has_reradiation
+                .then(|| ReradiationDimensions::reserve(&mut path.stream));
             let opacity = if scene.has_masks {
                 material.opacity_at(&si)
             } else {
@@ -448,12 +558,17 @@ impl PathTracer {
             if scene.has_dispersion && material.is_dispersive() {
                 path.wavelengths.terminate_secondary();
             }
-            let bsdf = material.bsdf_cached(
+            let mut bsdf = material.bsdf_cached(
                 si.material_id,
                 &si,
                 &path.wavelengths,
                 &mut reflectance_cache,
             );
+            // A fluorescent surface (fluorescent_vertex.rs), as in vacuum.
+            if let (Some(d), Some(f)) = (reradiation_dims, material.fluorescent()) {
+                let lanes = &mut path.wavelengths;
+                fluorescent_vertex::scatter(mode, f, &mut bsdf, lanes, &path.stream, d);
+            }
             let vertex =
                 ScatterVertex::Surface(SurfaceVertex::new(&si, &bsdf, ray.direction, shading_maps));
             if !vertex.is_specular() && !lights.is_empty() {
@@ -507,6 +622,7 @@ impl PathTracer {
             ray = Ray::spawn(vertex.p(), wi);
             current_differential = None;
             counters.rays += 1;
+            let spectral = self.spectral_mis_now(&path.wavelengths);
             if self.volumetric_roulette(&mut path, r_u, dims.roulette(), spectral) {
                 counters.roulette_terminations += 1;
                 break;
@@ -520,6 +636,15 @@ impl PathTracer {
             // The white-Lambertian illumination AOV is not estimated in media.
             illumination: None,
         }
+    }
+
+    /// Spectral MIS while every lane lives. Once the secondary lanes end (a dispersive
+    /// surface, or re-emission under `fluorescence_lanes: hero`) only the hero's estimate
+    /// is kept, counted four times by its quartered pdf, so it must divide by the hero's
+    /// own pdf: averaging in the dead lanes' pdfs biased it (+23 % in the fluorophore slab).
+    #[inline]
+    fn spectral_mis_now(&self, lanes: &LaneWavelengths) -> bool {
+        self.spectral_mis && !lanes.sensor().secondary_terminated()
     }
 
     /// Russian roulette on β/⟨r_u⟩ (pbrt-v4 `VolPathIntegrator`), from `rr_depth` on.
@@ -585,6 +710,7 @@ impl PathTracer {
                 uc,
                 ul,
                 &path.wavelengths,
+                path.depth < self.max_depth,
                 r_p,
                 rng,
                 le_cache,
@@ -608,6 +734,7 @@ impl PathTracer {
         u_choice: f32,
         u: Vec2,
         wavelengths: &LaneWavelengths,
+        may_scatter: bool,
         r_p: SampledSpectrum,
         rng: &mut MediumRng,
         le_cache: &mut SpectrumCache,
@@ -647,6 +774,7 @@ impl PathTracer {
             &ls,
             start_medium,
             wavelengths.transport(),
+            may_scatter,
             rng,
             counters,
         ) else {
@@ -655,7 +783,7 @@ impl PathTracer {
         let light_pdf = pmf * ls.pdf;
         let r_l = tr.r_l * r_p * light_pdf;
         let r_u = tr.r_u * r_p * scatter_pdf;
-        let spectral = self.spectral_mis;
+        let spectral = self.spectral_mis_now(wavelengths);
         let denom = if ls.delta {
             average(r_l, spectral)
         } else {
@@ -668,7 +796,8 @@ impl PathTracer {
     }
 }
 
-/// Transmittance from `p` to the light sample `ls` leaving in `medium`: ratio tracking
+/// Transmittance from `p` to the light sample `ls` leaving in `medium` (`may_scatter`: the
+/// path may scatter again, `OpticsAtLanes::fluorescent_majorant`): ratio tracking
 /// through each medium on the way (pbrt-v4 `SampleLd`), across `interface` surfaces,
 /// masks' holes and thin panes; `None` where something opaque blocks it or the estimate
 /// is 0.
@@ -680,6 +809,7 @@ fn shadow_transmittance(
     ls: &crate::light::LightSample,
     mut medium: Option<u32>,
     wavelengths: &SampledWavelengths,
+    may_scatter: bool,
     rng: &mut MediumRng,
     counters: &mut PathCounters,
 ) -> Option<ShadowTransmittance> {
@@ -723,7 +853,12 @@ fn shadow_transmittance(
                 t_end * length,
             );
             let med = media.medium(m);
-            let optics = med.optics().at(wavelengths);
+            // The majorant of the path's own next segment, so both strategies of the MIS
+            // weigh the same null collisions.
+            let optics = med
+                .optics()
+                .at(wavelengths)
+                .fluorescent_majorant(may_scatter);
             let u = rng.uniform();
             let t_maj = sample_t_maj(med, &optics, &segment, u, rng, |c, rng| {
                 let sigma_n = (c.sigma_maj - c.sigma_a - c.sigma_s).clamp_zero();
@@ -775,6 +910,7 @@ mod tests {
                 sigma_s: Spectrum::constant(sigma_t),
                 emission: None,
                 phase: PhaseFunction::Isotropic,
+                fluorescence: None,
             },
         })
     }
@@ -801,6 +937,7 @@ mod tests {
                 sigma_s: Spectrum::constant(0.0),
                 emission: None,
                 phase: PhaseFunction::Isotropic,
+                fluorescence: None,
             },
             density: grid,
         });

@@ -1,11 +1,11 @@
 //! The media a scene holds: what a path meets between surfaces (pbrt-v4 §11.4 `Medium`).
 //! Every medium scales one set of optical properties (`MediumOptics`) by a density: 1
 //! everywhere (homogeneous) or a grid's. Transport asks a medium for two things: the
-//! majorant stretches of a ray (density bound × σt) and the density at a point.
+//! majorant stretches of a ray (density bound × σ_maj) and the density at a point.
 
 use glam::Vec3A;
 use prism_geometry::Ray;
-use prism_spectrum::{SampledSpectrum, SampledWavelengths, Spectrum};
+use prism_spectrum::{ReradiationMatrix, SampledSpectrum, SampledWavelengths, Spectrum};
 
 use super::{GridMedium, HomogeneousMedium, MajorantIter, PhaseFunction};
 
@@ -19,6 +19,19 @@ pub struct MediumOptics {
     /// Emitted radiance Le; the source term is σa·Le (pbrt-v4 `MediumProperties::Le`).
     pub emission: Option<Spectrum>,
     pub phase: PhaseFunction,
+    /// A dissolved fluorophore (`None`: the medium does not fluoresce).
+    pub fluorescence: Option<Fluorophore>,
+}
+
+/// A fluorophore in a medium: its absorption σf adds to σa, and what it absorbs at λi is
+/// re-emitted isotropically at λo with the medium's re-radiation matrix.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Fluorophore {
+    /// σf, m⁻¹ (per unit density).
+    pub sigma_f: Spectrum,
+    /// M(λi, λo), m⁻¹·nm⁻¹ (per unit density): the source term at λo is
+    /// ∫ M(λi, λo) ∫ L(λi, ω) dω/4π dλi.
+    pub matrix: ReradiationMatrix,
 }
 
 /// `MediumOptics` at a path's four wavelengths.
@@ -30,22 +43,54 @@ pub struct OpticsAtLanes {
     pub sigma_t: SampledSpectrum,
     /// Le (0 where the medium does not emit).
     pub emission: SampledSpectrum,
+    /// c(λ) = ∫ M(λi, λ) dλi, the fluorophore's re-emission coefficient at each lane's
+    /// wavelength (0 without a fluorophore).
+    pub sigma_fl: SampledSpectrum,
+    /// The majorant per unit density: σt, or `fluorescent_majorant`'s.
+    pub sigma_maj: SampledSpectrum,
+}
+
+impl OpticsAtLanes {
+    /// Where a fluorophore may re-emit (some lane's c > 0) on a segment that may still
+    /// scatter: one majorant for every lane, max σt + max c, so the hero collides wherever
+    /// any lane re-emits and keeps null collisions for the lanes that pass
+    /// (integrator::medium_transport). Elsewhere σt stays the majorant, so a segment that
+    /// cannot re-emit never walks null collisions (an unbounded one would not end).
+    #[inline]
+    pub fn fluorescent_majorant(mut self, may_scatter: bool) -> Self {
+        let c_max = self.sigma_fl.max_component();
+        if may_scatter && c_max > 0.0 {
+            self.sigma_maj = SampledSpectrum::splat(self.sigma_t.max_component() + c_max);
+        }
+        self
+    }
 }
 
 impl MediumOptics {
     /// The coefficients at `wavelengths`.
     #[inline]
     pub fn at(&self, wavelengths: &SampledWavelengths) -> OpticsAtLanes {
-        let sigma_a = self.sigma_a.eval(wavelengths);
+        let mut sigma_a = self.sigma_a.eval(wavelengths);
         let sigma_s = self.sigma_s.eval(wavelengths);
+        let mut sigma_fl = SampledSpectrum::splat(0.0);
+        if let Some(f) = &self.fluorescence {
+            sigma_a += f.sigma_f.eval(wavelengths);
+            let lambda = wavelengths.lambda();
+            for (lane, &nm) in lambda.iter().enumerate() {
+                sigma_fl[lane] = f.matrix.column_integral(nm);
+            }
+        }
+        let sigma_t = sigma_a + sigma_s;
         OpticsAtLanes {
             sigma_a,
             sigma_s,
-            sigma_t: sigma_a + sigma_s,
+            sigma_t,
             emission: self
                 .emission
                 .as_ref()
                 .map_or(SampledSpectrum::splat(0.0), |e| e.eval(wavelengths)),
+            sigma_fl,
+            sigma_maj: sigma_t,
         }
     }
 }

@@ -17,7 +17,7 @@ pub mod vol_file;
 pub use density_grid::{DensityGrid, MajorantIter, MajorantSegment, MAJORANT_RES};
 pub use grid::GridMedium;
 pub use homogeneous::HomogeneousMedium;
-pub use media::{DensityStretch, Medium, MediumOptics, OpticsAtLanes, Stretches};
+pub use media::{DensityStretch, Fluorophore, Medium, MediumOptics, OpticsAtLanes, Stretches};
 pub use phase::{PhaseFunction, PhaseSample};
 pub use tabulated_phase::TabulatedPhase;
 pub use vol_file::{VolError, VolGrid};

@@ -271,8 +271,15 @@ pub const FIELD_USES: &[FieldRow] = &[
             "emission",
             "phase",
             "g",
+            "fluorescence",
         ],
         BUILD_MEDIA,
+    ),
+    read(
+        &["media.*.fluorescence"],
+        &["absorption_per_m", "emission", "quantum_yield"],
+        "prism-scene medium::parse_fluorescence, then scene_build::media::build_media \
+         (integrator::medium_transport re-emits what it absorbs)",
     ),
     read(&["media.*<grid>"], &["density", "bounds_m"], BUILD_MEDIA),
     read(

@@ -12,13 +12,13 @@ use std::sync::Arc;
 use glam::{Vec2, Vec3};
 use prism_geometry::{Geometry, Ray};
 use prism_scene::{MaterialKind, MediumKind, Phase, SceneDescription, ShapeKind};
-use prism_spectrum::Spectrum;
+use prism_spectrum::{ReradiationMatrix, Spectrum};
 
 use super::error::SceneBuildError;
 use super::spectrum::{build_spectrum, SpectrumRole};
 use crate::camera::Camera;
 use crate::medium::{
-    DensityGrid, GridMedium, HomogeneousMedium, Medium, MediumOptics, PhaseFunction,
+    DensityGrid, Fluorophore, GridMedium, HomogeneousMedium, Medium, MediumOptics, PhaseFunction,
     TabulatedPhase, VolGrid,
 };
 
@@ -112,6 +112,32 @@ fn build_phase(phase: &Phase) -> Result<PhaseFunction, String> {
     })
 }
 
+/// σf and M of a medium's fluorophore: the dye at peak absorptance 1 scaled by the peak
+/// absorption coefficient (both linear between the 5 nm excitation nodes, so σf(λi) is
+/// what row λi of M re-emits from).
+fn build_fluorophore(f: &prism_scene::MediumFluorescence) -> Result<Fluorophore, String> {
+    let peak = f.peak_absorption_per_m;
+    let matrix = f.dye.matrix();
+    let (ex, em) = (*matrix.excitation(), *matrix.emission());
+    let mut values = Vec::with_capacity(ex.count() * em.count());
+    for row in 0..ex.count() {
+        for column in 0..em.count() {
+            values.push((f64::from(matrix.node(row, column)) * peak) as f32);
+        }
+    }
+    let nodes_nm: Vec<f64> = (0..ex.count())
+        .map(|k| f64::from(ex.wavelength_nm(k)))
+        .collect();
+    let sigma_f: Vec<f64> = nodes_nm
+        .iter()
+        .map(|&nm| f.dye.absorptance(nm) * peak)
+        .collect();
+    Ok(Fluorophore {
+        sigma_f: Spectrum::piecewise_linear(&nodes_nm, &sigma_f).map_err(|e| e.to_string())?,
+        matrix: ReradiationMatrix::from_dense(ex, em, values).map_err(|e| e.message)?,
+    })
+}
+
 /// The media of `scene` (`None` when it declares none). `ranges`: each shape's instance
 /// ids; `geometry` and `camera` for the camera-medium check.
 pub(crate) fn build_media(
@@ -149,6 +175,12 @@ pub(crate) fn build_media(
                 .transpose()?,
             phase: build_phase(&m.phase)
                 .map_err(|e| SceneBuildError::new(file, place(".phase"), e))?,
+            fluorescence: m
+                .fluorescence
+                .as_ref()
+                .map(build_fluorophore)
+                .transpose()
+                .map_err(|e| SceneBuildError::new(file, place(".fluorescence"), e))?,
         };
         media.push(match &m.kind {
             MediumKind::Homogeneous => Medium::Homogeneous(HomogeneousMedium { optics }),
@@ -394,8 +426,9 @@ fn check_claim(
     Ok(())
 }
 
-/// σt at 360, 365, …, 830 nm of `spectrum` sums: the (min, max) of `a + b` over that grid.
-pub fn coefficient_range(a: &Spectrum, b: &Spectrum) -> (f32, f32) {
+/// σt at 360, 365, …, 830 nm as the sum of `terms` (σa, σs and a fluorophore's σf): the
+/// (min, max) of the sum over that grid.
+pub fn coefficient_range(terms: &[&Spectrum]) -> (f32, f32) {
     let mut range = (f32::INFINITY, f32::NEG_INFINITY);
     for k in 0..=94 {
         let wl = 360.0 + 5.0 * k as f32;
@@ -403,7 +436,7 @@ pub fn coefficient_range(a: &Spectrum, b: &Spectrum) -> (f32, f32) {
             [wl; 4],
             prism_spectrum::SampledSpectrum::splat(1.0),
         );
-        let v = a.eval(&w)[0] + b.eval(&w)[0];
+        let v: f32 = terms.iter().map(|t| t.eval(&w)[0]).sum();
         range = (range.0.min(v), range.1.max(v));
     }
     range

@@ -132,23 +132,6 @@ impl RenderScene {
         let has_glazing = materials.iter().any(|m| m.has_thin_glazing());
         let has_dispersion = materials.iter().any(|m| m.is_dispersive());
         let has_reradiation = materials.iter().any(|m| m.fluorescent().is_some());
-        if let (Some(m), Some(i)) = (
-            &media,
-            materials.iter().position(|m| m.fluorescent().is_some()),
-        ) {
-            // The volumetric loop (integrator/medium_transport.rs) has no fluorescent vertex.
-            let name = &scene.materials[i].name;
-            return Err(SceneBuildError::new(
-                &file,
-                format!("materials.{name}"),
-                format!(
-                    "material '{name}' re-radiates (fluorescence) in a scene with participating \
-                     media ({}): fluorescence is not rendered together with media yet; remove \
-                     the media or the re-radiation",
-                    m.names.join(", ")
-                ),
-            ));
-        }
         let texture_footprint = if materials.iter().any(|m| m.has_textures()) {
             // A camera without a ray at the film centre (a circular fisheye's corner is
             // never the centre) would leave textures unfiltered: point lookups.
