@@ -20,6 +20,7 @@
 
 pub mod ciede2000;
 mod fast_f64;
+pub mod flip;
 mod prepared;
 mod ssim;
 
