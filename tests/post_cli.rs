@@ -626,3 +626,59 @@ fn cat_refuses_an_unknown_transform() {
         &["--cat", "bradford", "cat16", "cat02", "von-kries"],
     );
 }
+
+/// FLIP in `prism compare`: the keys, zero for an image against itself, the negative
+/// samples HDR-FLIP clamps, the viewing condition, the error map (magma + legend, written
+/// atomically) and the refused viewing conditions.
+#[test]
+fn compare_reports_flip_and_writes_its_error_map() {
+    let a = scratch("flip-a.exr");
+    plain_hdr(&a);
+    let reference = read_image(&a).unwrap();
+    let mut pixels = reference.pixels().to_vec();
+    for (i, p) in pixels.iter_mut().enumerate() {
+        *p = p.map(|v| v * (1.0 + 0.3 * ((i * 7919 % 13) as f32 / 13.0 - 0.5)));
+    }
+    pixels[5] = [-0.5, 0.1, -0.25];
+    let b = scratch("flip-b.exr");
+    write_image(&b, &reference.with_pixels(pixels).unwrap()).unwrap();
+    let (a, b) = (a.to_str().unwrap(), b.to_str().unwrap());
+    let json = |args: &[&str]| -> Value { serde_json::from_str(&ok(args)).unwrap() };
+
+    let same = json(&["compare", a, a, "--json"]);
+    for key in [
+        "ldr_flip_mean",
+        "hdr_flip_mean",
+        "ldr_flip_p95",
+        "hdr_flip_p95",
+    ] {
+        assert_eq!(same[key].as_f64(), Some(0.0), "{key}: {same}");
+    }
+    let diff = json(&["compare", b, a, "--json"]);
+    let ldr = diff["ldr_flip_mean"].as_f64().unwrap();
+    assert!(ldr > 0.0 && diff["hdr_flip_mean"].as_f64().unwrap() > 0.0);
+    assert!(diff["hdr_flip_p95"].as_f64().unwrap() >= diff["hdr_flip_mean"].as_f64().unwrap());
+    assert_eq!(diff["hdr_flip_negative_samples"], 2);
+    assert!(diff["hdr_flip_exposures"]["count"].as_u64().unwrap() >= 2);
+    // A farther viewer (fewer pixels per degree) blurs more: a different score.
+    let far = json(&["compare", b, a, "--json", "--ppd", "20"]);
+    assert_eq!(far["flip_ppd"], 20.0);
+    assert_ne!(far["ldr_flip_mean"].as_f64().unwrap(), ldr);
+
+    let map = scratch("flip-map.png");
+    let table = ok(&["compare", b, a, "--error-map", map.to_str().unwrap()]);
+    assert!(table.contains("HDR-FLIP mean") && table.contains("negative samples"));
+    let img = read_image(&map).unwrap();
+    // 40 × 30 map, a 150-px legend, at least 220 px tall.
+    assert_eq!((img.width(), img.height()), (190, 220));
+    let leftovers: Vec<_> = std::fs::read_dir(map.parent().unwrap())
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .filter(|e| e.file_name().to_string_lossy().ends_with(".tmp"))
+        .collect();
+    assert!(leftovers.is_empty(), "{leftovers:?}");
+
+    for ppd in ["0", "-3"] {
+        fails_with(&["compare", b, a, "--ppd", ppd], &["pixels per degree"]);
+    }
+}

@@ -24,7 +24,7 @@ use crate::colour::{
     apply_white_balance, apply_with_source_white, illumination_white_xyz, map_gamut, GamutMethod,
     GamutTarget, SceneWhite, WhiteBalance, ILLUMINATION_LAYER,
 };
-use crate::metrics::{compare, Comparison};
+use crate::metrics::{CompareOptions, Comparison, FlipMaps, PreparedReference};
 use crate::sheet::{contact_sheet_with_reports, SheetFailure};
 use crate::tonemap::{ToneOperator, ToneParams, ToneReport};
 use prism_image::io::{read_image, write_image};
@@ -325,6 +325,15 @@ pub fn scene_white_of(image: &Image, path: &Path) -> Result<SceneWhite> {
 /// Compares the image at `test` with the reference at `reference`; mismatched sizes are an
 /// error naming both files.
 pub fn compare_files(test: &Path, reference: &Path) -> Result<Comparison> {
+    compare_files_with(test, reference, &CompareOptions::default()).map(|(c, _)| c)
+}
+
+/// [`compare_files`] with a choice of metrics, and the FLIP maps when FLIP is asked for.
+pub fn compare_files_with(
+    test: &Path,
+    reference: &Path,
+    options: &CompareOptions,
+) -> Result<(Comparison, Option<FlipMaps>)> {
     let a = read_image(test)?;
     let b = read_image(reference)?;
     if (a.width(), a.height()) != (b.width(), b.height()) {
@@ -338,5 +347,5 @@ pub fn compare_files(test: &Path, reference: &Path) -> Result<Comparison> {
             b.height()
         )));
     }
-    compare(&a, &b)
+    PreparedReference::new(&b).compare_with_maps(&a, options)
 }

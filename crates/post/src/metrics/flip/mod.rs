@@ -19,7 +19,8 @@ mod colour;
 pub mod exposure;
 mod kernels;
 
-use prism_image::{ImageError, Result};
+use crate::falsecolour::{false_colour, FalseColourOptions, FalseColourScale, Palette};
+use prism_image::{Image, ImageError, Result};
 
 pub use exposure::ExposureRange;
 use kernels::Kernels;
@@ -47,6 +48,25 @@ impl FlipMap {
         let rank = ((0.95 * v.len() as f64).ceil() as usize).clamp(1, v.len()) - 1;
         let (_, p, _) = v.select_nth_unstable_by(rank, f32::total_cmp);
         f64::from(*p)
+    }
+}
+
+impl FlipMap {
+    /// The map in magma over [0, 1] (FLIP's own presentation), one pixel per value, with
+    /// a legend titled `title`.
+    pub fn to_image(&self, title: &str) -> Result<Image> {
+        false_colour(
+            &self.values,
+            self.width,
+            self.height,
+            &FalseColourOptions {
+                scale: FalseColourScale::Linear,
+                range: Some((0.0, 1.0)),
+                unit: title.into(),
+                cell_px: 1,
+                palette: Palette::Magma,
+            },
+        )
     }
 }
 
@@ -178,6 +198,12 @@ mod tests {
         assert!(0.0 < small.mean() && small.mean() < large.mean());
         assert!(large.values.iter().all(|v| (0.0..=1.0).contains(v)));
         assert!(large.p95() >= large.mean());
+        let img = large.to_image("LDR-FLIP").unwrap();
+        assert_eq!(
+            img.pixel(0, 0),
+            Palette::Magma.colour(f64::from(large.values[0]))
+        );
+        assert!(img.width() > 40 && img.height() >= 30);
     }
 
     #[test]
