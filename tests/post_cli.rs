@@ -682,3 +682,41 @@ fn compare_reports_flip_and_writes_its_error_map() {
         fails_with(&["compare", b, a, "--ppd", ppd], &["pixels per degree"]);
     }
 }
+
+/// `--tmqi`: a tone-mapped PNG against its HDR source gives the three keys in [0, 1];
+/// two LDR images, or the pair the wrong way round, and mismatched sizes are errors.
+#[test]
+fn compare_tmqi_scores_a_tone_mapped_png_and_refuses_other_pairings() {
+    let (w, h) = (192usize, 180usize);
+    let pixels = (0..w * h)
+        .map(|i| {
+            let (x, y) = ((i % w) as f32, (i / w) as f32);
+            let t = (x / 3.0).sin() * (y / 5.0).cos() + (x / 17.0 + y / 23.0).sin();
+            let v = (2.0 + t).exp2() * (1.0 + x / 8.0);
+            [v, 0.8 * v, 0.6 * v]
+        })
+        .collect();
+    let hdr = scratch("tmqi.exr");
+    write_image(
+        &hdr,
+        &Image::new(w, h, pixels, RgbColorSpace::srgb()).unwrap(),
+    )
+    .unwrap();
+    let ldr = scratch("tmqi-reinhard02.png");
+    let (hdr, ldr) = (hdr.to_str().unwrap(), ldr.to_str().unwrap());
+    ok(&["tonemap", hdr, "-o", ldr, "--op", "reinhard02"]);
+    let t: Value = serde_json::from_str(&ok(&["compare", ldr, hdr, "--tmqi", "--json"])).unwrap();
+    for key in ["tmqi", "tmqi_structural_fidelity", "tmqi_naturalness"] {
+        let v = t[key].as_f64().unwrap();
+        assert!(v > 0.0 && v <= 1.0, "{key} = {v}: {t}");
+    }
+    assert!(ok(&["compare", ldr, hdr, "--tmqi"]).contains("structural fidelity S"));
+    fails_with(&["compare", ldr, ldr, "--tmqi"], &["--tmqi", "PNG", "EXR"]);
+    fails_with(&["compare", hdr, ldr, "--tmqi"], &["--tmqi"]);
+    let small = scratch("tmqi-small.hdr");
+    plain_hdr(&small);
+    fails_with(
+        &["compare", ldr, small.to_str().unwrap(), "--tmqi"],
+        &["192×180", "40×30"],
+    );
+}

@@ -1,13 +1,15 @@
 //! `prism compare A B [--json] [--ppd X] [--error-map OUT.png]`: error metrics of image A
-//! against the reference B, FLIP included (docs/post.md).
+//! against the reference B, FLIP included; `prism compare LDR.png HDR.exr --tmqi`: TMQI of
+//! a tone-mapped image against its HDR source (docs/post.md).
 
 use std::path::{Path, PathBuf};
 
 use clap::{Args, ValueEnum};
 use prism_image::io::{write_image, ImageFormat};
 use prism_post::metrics::flip::DEFAULT_PPD;
+use prism_post::metrics::tmqi::Tmqi;
 use prism_post::metrics::{CompareOptions, Comparison, FlipMaps};
-use prism_post::pipeline::compare_files_with;
+use prism_post::pipeline::{compare_files_with, tmqi_files};
 
 /// Which FLIP map `--error-map` writes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -39,6 +41,11 @@ pub struct CompareArgs {
     /// LDR-FLIP for two PNGs.
     #[arg(long, value_enum, requires = "error_map")]
     pub error_map_kind: Option<ErrorMapKind>,
+    /// TMQI (Yeganeh & Wang 2013) of A, a tone-mapped PNG, against B, its HDR source (EXR
+    /// or HDR), instead of the error metrics: tmqi, tmqi_structural_fidelity,
+    /// tmqi_naturalness.
+    #[arg(long, conflicts_with_all = ["error_map", "error_map_kind"])]
+    pub tmqi: bool,
     #[command(flatten)]
     pub simd: crate::simd::SimdArgs,
 }
@@ -111,8 +118,34 @@ fn write_error_map(args: &CompareArgs, out: &Path, maps: &FlipMaps) -> Result<()
     write_image(out, &image).map_err(|e| e.to_string())
 }
 
+fn print_tmqi(t: &Tmqi) {
+    println!("{:<26}{:>10.6}", "TMQI", t.tmqi);
+    println!(
+        "{:<26}{:>10.6}",
+        "structural fidelity S", t.tmqi_structural_fidelity
+    );
+    println!("{:<26}{:>10.6}", "naturalness N", t.tmqi_naturalness);
+    let s = t.tmqi_structural_per_scale;
+    println!(
+        "{:<26}{:.4} {:.4} {:.4} {:.4} {:.4}",
+        "S per scale (fine→coarse)", s[0], s[1], s[2], s[3], s[4]
+    );
+}
+
 pub fn run(args: &CompareArgs) -> Result<(), String> {
     args.simd.apply()?;
+    if args.tmqi {
+        let t = tmqi_files(&args.test, &args.reference).map_err(|e| e.to_string())?;
+        if args.json {
+            println!(
+                "{}",
+                serde_json::to_string_pretty(&t).map_err(|e| e.to_string())?
+            );
+        } else {
+            print_tmqi(&t);
+        }
+        return Ok(());
+    }
     let options = CompareOptions {
         flip_ppd: Some(args.ppd),
         ..CompareOptions::default()

@@ -27,6 +27,7 @@ mod fast_f64;
 pub mod flip;
 mod prepared;
 mod ssim;
+pub mod tmqi;
 
 use serde::Serialize;
 
