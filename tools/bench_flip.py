@@ -73,10 +73,10 @@ def main():
         return sorted(times)[mid], sorted(cpus)[mid], result
 
     ref_clip, test_clip = np.clip(reference, 0, 1), np.clip(test, 0, 1)
-    ldr_s, ldr_cpu, (_, ldr_mean, _) = timed(
+    ldr_s, ldr_cpu, (ldr_map, ldr_mean, _) = timed(
         lambda: flip_evaluator.evaluate(ref_clip, test_clip, "LDR", inputsRGB=False, applyMagma=False)
     )
-    hdr_s, hdr_cpu, (_, hdr_mean, params) = timed(
+    hdr_s, hdr_cpu, (hdr_map, hdr_mean, params) = timed(
         lambda: flip_evaluator.evaluate(reference, test, "HDR", inputsRGB=False, applyMagma=False)
     )
     result = {
@@ -99,6 +99,9 @@ def main():
             "ldr_mean": float(ldr_mean),
             "hdr_mean": float(hdr_mean),
             "hdr_exposures": int(params["numExposures"]),
+            # The tool's own mean against the mean of its map summed in float64.
+            "ldr_map_mean_f64": float(np.mean(ldr_map, dtype=np.float64)),
+            "hdr_map_mean_f64": float(np.mean(hdr_map, dtype=np.float64)),
         },
         "ratio_reference_over_prism": {
             "ldr_wall": ldr_s / prism["ldr_wall_s"],
@@ -109,6 +112,12 @@ def main():
         "mean_relative_difference": {
             "ldr": abs(prism["ldr_mean"] - ldr_mean) / ldr_mean,
             "hdr": abs(prism["hdr_mean"] - hdr_mean) / hdr_mean,
+        },
+        "mean_relative_difference_to_map_mean_f64": {
+            "ldr": abs(prism["ldr_mean"] - float(np.mean(ldr_map, dtype=np.float64)))
+            / ldr_mean,
+            "hdr": abs(prism["hdr_mean"] - float(np.mean(hdr_map, dtype=np.float64)))
+            / hdr_mean,
         },
     }
     OUT.write_text(json.dumps(result, indent=2) + "\n")

@@ -237,17 +237,21 @@ impl PreparedReference {
     /// LDR-FLIP and HDR-FLIP of `test` (in the reference's colour space) on Rec.709.
     fn flip(&self, test: &[[f32; 3]], ppd: f64) -> Result<(FlipSummary, FlipMaps)> {
         let rec709 = RgbColorSpace::srgb();
-        let (test, reference) = if same_colorimetry(&self.color_space, &rec709) {
-            (test.to_vec(), self.pixels.clone())
-        } else {
-            let (mut t, mut r) = (test.to_vec(), self.pixels.clone());
-            convert_pixels(&mut t, &self.color_space, &rec709);
-            convert_pixels(&mut r, &self.color_space, &rec709);
-            (t, r)
-        };
+        // Copies only when the reference space is not Rec.709.
+        let converted;
+        let (test, reference): (&[[f32; 3]], &[[f32; 3]]) =
+            if same_colorimetry(&self.color_space, &rec709) {
+                (test, &self.pixels)
+            } else {
+                let (mut t, mut r) = (test.to_vec(), self.pixels.clone());
+                convert_pixels(&mut t, &self.color_space, &rec709);
+                convert_pixels(&mut r, &self.color_space, &rec709);
+                converted = (t, r);
+                (&converted.0, &converted.1)
+            };
         let (w, h) = (self.width, self.height);
-        let ldr = flip::ldr_flip(&test, &reference, w, h, ppd)?;
-        let hdr = flip::hdr_flip(&test, &reference, w, h, ppd)?;
+        let ldr = flip::ldr_flip(test, reference, w, h, ppd)?;
+        let hdr = flip::hdr_flip(test, reference, w, h, ppd)?;
         let summary = FlipSummary {
             flip_ppd: ppd,
             ldr_flip_mean: ldr.mean(),

@@ -77,13 +77,15 @@ fn band_side(
     for j in 0..band_h {
         let sy = (y0 + j).saturating_sub(halo).min(h - 1);
         let row = &image[sy * w..(sy + 1) * w];
-        for (i, pi) in (0..w + 2 * halo).enumerate() {
-            let sx = pi.saturating_sub(halo).min(w - 1);
-            let c = rgb_to_ycxcz(transform(row[sx]));
-            pad[0][i] = c[0];
-            pad[1][i] = c[1];
-            pad[2][i] = c[2];
-            pad[3][i] = ycxcz_grey(c[0]);
+        let [pad_y, pad_cx, pad_cz, pad_grey] = &mut pad;
+        let pads = pad_y
+            .iter_mut()
+            .zip(pad_cx.iter_mut())
+            .zip(pad_cz.iter_mut().zip(pad_grey.iter_mut()));
+        for (i, ((y, cx), (cz, grey))) in pads.enumerate() {
+            let sx = i.saturating_sub(halo).min(w - 1);
+            [*y, *cx, *cz] = rgb_to_ycxcz(transform(row[sx]));
+            *grey = ycxcz_grey(*y);
         }
         let [py, pcx, pcz1, pcz2, pg, pd1, pd2] = &mut planes;
         let r = j * w..(j + 1) * w;
@@ -118,9 +120,12 @@ fn band_side(
         correlate_column(pg, centre, &k.d1, &mut t[1]);
         correlate_column(pd2, centre, &k.gauss, &mut t[2]);
         correlate_column(pg, centre, &k.d2, &mut t[3]);
-        for x in 0..w {
-            side.edge[i * w + x] = t[0][x].hypot(t[1][x]);
-            side.point[i * w + x] = t[2][x].hypot(t[3][x]);
+        let row = i * w..(i + 1) * w;
+        let outs = side.edge[row.clone()].iter_mut().zip(&mut side.point[row]);
+        let ins = t[0].iter().zip(&t[1]).zip(t[2].iter().zip(&t[3]));
+        for ((edge, point), ((ex, ey), (px, py))) in outs.zip(ins) {
+            *edge = ex.hypot(*ey);
+            *point = px.hypot(*py);
         }
     }
     side

@@ -38,9 +38,8 @@ impl ExposureRange {
     /// The reference implementation's automatic range for `reference` (linear Rec.709,
     /// non-negative): c_start from its largest luminance, c_stop from its median (the
     /// element at rank ⌊n/2⌋ in ascending order).
-    pub fn automatic(reference: &[[f32; 3]]) -> Self {
+    pub fn automatic(reference: impl Iterator<Item = [f32; 3]>) -> Self {
         let mut y: Vec<f32> = reference
-            .iter()
             .map(|p| LUMINANCE[0] * p[0] + LUMINANCE[1] * p[1] + LUMINANCE[2] * p[2])
             .collect();
         let max = y.iter().cloned().fold(0.0f32, f32::max);
@@ -87,13 +86,13 @@ mod tests {
         assert!((f64::from(aces(x as f32)) - TARGET).abs() < 1e-5);
         // Luminances 1, 2, 3, 4: max 4, median (rank 2) 3.
         let px: Vec<[f32; 3]> = (1..=4).map(|v| [v as f32; 3]).collect();
-        let r = ExposureRange::automatic(&px);
+        let r = ExposureRange::automatic(px.into_iter());
         assert!((r.start_stops - (x / 4.0).log2()).abs() < 1e-5);
         assert!((r.stop_stops - (x / 3.0).log2()).abs() < 1e-5);
         assert_eq!(r.count, 2);
         assert!((r.stops(1) - r.stop_stops).abs() < 1e-12);
         // A black image stays finite: both ends at the 2⁻²³ floor.
-        let black = ExposureRange::automatic(&[[0.0; 3]; 4]);
+        let black = ExposureRange::automatic([[0.0; 3]; 4].into_iter());
         assert!(black.start_stops.is_finite() && black.count == 2);
     }
 }

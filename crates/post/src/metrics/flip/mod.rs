@@ -152,8 +152,7 @@ pub fn hdr_flip(
         .filter(|v| **v < 0.0)
         .count() as u64;
     let clean = |p: [f32; 3]| finite_or_black(p).map(|v| v.max(0.0));
-    let clean_reference: Vec<[f32; 3]> = reference.iter().map(|&p| clean(p)).collect();
-    let exposures = ExposureRange::automatic(&clean_reference);
+    let exposures = ExposureRange::automatic(reference.iter().map(|&p| clean(p)));
     let kernels = Kernels::new(ppd);
     let mut values = vec![0.0f32; w * h];
     for i in 0..exposures.count {
