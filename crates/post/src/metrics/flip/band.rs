@@ -124,8 +124,9 @@ fn band_side(
         let outs = side.edge[row.clone()].iter_mut().zip(&mut side.point[row]);
         let ins = t[0].iter().zip(&t[1]).zip(t[2].iter().zip(&t[3]));
         for ((edge, point), ((ex, ey), (px, py))) in outs.zip(ins) {
-            *edge = ex.hypot(*ey);
-            *point = px.hypot(*py);
+            // Filter responses are O(1): plain sqrt, not hypot.
+            *edge = (ex * ex + ey * ey).sqrt();
+            *point = (px * px + py * py).sqrt();
         }
     }
     side
