@@ -126,7 +126,10 @@ mod tests {
         let mut t = 0.008_856f32;
         while t < 1e4 {
             let (fast, libm) = (cbrt_positive(t), t.cbrt());
-            assert!((fast - libm).abs() <= 2.0 * f32::EPSILON * libm, "{t}: {fast} {libm}");
+            assert!(
+                (fast - libm).abs() <= 2.0 * f32::EPSILON * libm,
+                "{t}: {fast} {libm}"
+            );
             t *= 1.013;
         }
     }

@@ -23,9 +23,6 @@ const TARGET: f64 = 0.85;
 /// guard for black images, f32 epsilon (2⁻²³; measured: a median of 0 gives its c_stop).
 const MIN_LUMINANCE: f64 = f32::EPSILON as f64;
 
-/// Rec.709 luminance weights.
-const LUMINANCE: [f32; 3] = [0.2126, 0.7152, 0.0722];
-
 /// The exposures HDR-FLIP evaluates at (exposure factors 2^c).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct ExposureRange {
@@ -39,15 +36,20 @@ impl ExposureRange {
     /// non-negative): c_start from its largest luminance, c_stop from its median (the
     /// element at rank ⌊n/2⌋ in ascending order).
     pub fn automatic(reference: impl Iterator<Item = [f32; 3]>) -> Self {
-        let mut y: Vec<f32> = reference
-            .map(|p| LUMINANCE[0] * p[0] + LUMINANCE[1] * p[1] + LUMINANCE[2] * p[2])
+        // Rec.709 luminance in f64: a sum near f32::MAX must not round to ∞ (c_start = −∞,
+        // endless exposures).
+        let mut y: Vec<f64> = reference
+            .map(|p| {
+                let p = p.map(f64::from);
+                0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]
+            })
             .collect();
-        let max = y.iter().cloned().fold(0.0f32, f32::max);
+        let max = y.iter().cloned().fold(0.0f64, f64::max);
         let mid = y.len() / 2;
-        let (_, median, _) = y.select_nth_unstable_by(mid, f32::total_cmp);
+        let (_, median, _) = y.select_nth_unstable_by(mid, f64::total_cmp);
         let x = aces_inverse(TARGET);
-        let start = (x / f64::from(max).max(MIN_LUMINANCE)).log2();
-        let stop = (x / f64::from(*median).max(MIN_LUMINANCE)).log2();
+        let start = (x / max.max(MIN_LUMINANCE)).log2();
+        let stop = (x / median.max(MIN_LUMINANCE)).log2();
         let count = ((stop - start).ceil() as usize).max(2);
         Self {
             start_stops: start,
@@ -65,6 +67,11 @@ impl ExposureRange {
 /// The ACES fit clamped to [0, 1].
 pub(super) fn aces(x: f32) -> f32 {
     let x2 = x * x;
+    if !x2.is_finite() {
+        // x² overflows (x > 1.8e19) where the curve has long reached its limit k0/k3 > 1:
+        // white, not inf/inf = NaN.
+        return 1.0;
+    }
     ((K[0] * x2 + K[1] * x + K[2]) / (K[3] * x2 + K[4] * x + K[5])).clamp(0.0, 1.0)
 }
 
@@ -93,6 +100,10 @@ mod tests {
         assert!((r.stops(1) - r.stop_stops).abs() < 1e-12);
         // A black image stays finite: both ends at the 2⁻²³ floor.
         let black = ExposureRange::automatic([[0.0; 3]; 4].into_iter());
+        assert_eq!((aces(1e20), aces(f32::MAX), aces(0.0)), (1.0, 1.0, 0.0));
+        // Luminance of f32::MAX white is finite in f64: a bounded exposure count.
+        let huge = ExposureRange::automatic([[f32::MAX; 3], [1.0; 3]].into_iter());
+        assert!(huge.start_stops.is_finite() && huge.count < 200, "{huge:?}");
         assert!(black.start_stops.is_finite() && black.count == 2);
     }
 }

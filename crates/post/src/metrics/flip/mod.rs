@@ -219,4 +219,21 @@ mod tests {
         }
         assert!(ldr_flip(&a, &a, 16, 11, DEFAULT_PPD).is_err());
     }
+
+    /// Highlights near the f32 limit (and a 1×1 image, smaller than every filter) give
+    /// finite maps in [0, 1].
+    #[test]
+    fn extreme_highlights_and_tiny_images_stay_finite() {
+        let mut a = gradient(16, 12, 4.0);
+        a[40] = [3e38, 1e30, 1e25];
+        let mut b = a.clone();
+        b[41] = [1e30; 3];
+        let r = hdr_flip(&b, &a, 16, 12, DEFAULT_PPD).unwrap();
+        assert!(
+            r.map.values.iter().all(|v| (0.0..=1.0).contains(v)),
+            "{r:?}"
+        );
+        let one = hdr_flip(&[[2.0; 3]], &[[1.0; 3]], 1, 1, DEFAULT_PPD).unwrap();
+        assert!(one.map.values[0] > 0.0 && one.map.values[0] <= 1.0);
+    }
 }
