@@ -626,3 +626,97 @@ fn cat_refuses_an_unknown_transform() {
         &["--cat", "bradford", "cat16", "cat02", "von-kries"],
     );
 }
+
+/// FLIP in `prism compare`: the keys, zero for an image against itself, the negative
+/// samples HDR-FLIP clamps, the viewing condition, the error map (magma + legend, written
+/// atomically) and the refused viewing conditions.
+#[test]
+fn compare_reports_flip_and_writes_its_error_map() {
+    let a = scratch("flip-a.exr");
+    plain_hdr(&a);
+    let reference = read_image(&a).unwrap();
+    let mut pixels = reference.pixels().to_vec();
+    for (i, p) in pixels.iter_mut().enumerate() {
+        *p = p.map(|v| v * (1.0 + 0.3 * ((i * 7919 % 13) as f32 / 13.0 - 0.5)));
+    }
+    pixels[5] = [-0.5, 0.1, -0.25];
+    let b = scratch("flip-b.exr");
+    write_image(&b, &reference.with_pixels(pixels).unwrap()).unwrap();
+    let (a, b) = (a.to_str().unwrap(), b.to_str().unwrap());
+    let json = |args: &[&str]| -> Value { serde_json::from_str(&ok(args)).unwrap() };
+
+    let same = json(&["compare", a, a, "--json"]);
+    for key in [
+        "ldr_flip_mean",
+        "hdr_flip_mean",
+        "ldr_flip_p95",
+        "hdr_flip_p95",
+    ] {
+        assert_eq!(same[key].as_f64(), Some(0.0), "{key}: {same}");
+    }
+    let diff = json(&["compare", b, a, "--json"]);
+    let ldr = diff["ldr_flip_mean"].as_f64().unwrap();
+    assert!(ldr > 0.0 && diff["hdr_flip_mean"].as_f64().unwrap() > 0.0);
+    assert!(diff["hdr_flip_p95"].as_f64().unwrap() >= diff["hdr_flip_mean"].as_f64().unwrap());
+    assert_eq!(diff["hdr_flip_negative_samples"], 2);
+    assert!(diff["hdr_flip_exposures"]["count"].as_u64().unwrap() >= 2);
+    // A farther viewer (fewer pixels per degree) blurs more: a different score.
+    let far = json(&["compare", b, a, "--json", "--ppd", "20"]);
+    assert_eq!(far["flip_ppd"], 20.0);
+    assert_ne!(far["ldr_flip_mean"].as_f64().unwrap(), ldr);
+
+    let map = scratch("flip-map.png");
+    let table = ok(&["compare", b, a, "--error-map", map.to_str().unwrap()]);
+    assert!(table.contains("HDR-FLIP mean") && table.contains("negative samples"));
+    let img = read_image(&map).unwrap();
+    // 40 × 30 map, a 150-px legend, at least 220 px tall.
+    assert_eq!((img.width(), img.height()), (190, 220));
+    let leftovers: Vec<_> = std::fs::read_dir(map.parent().unwrap())
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .filter(|e| e.file_name().to_string_lossy().ends_with(".tmp"))
+        .collect();
+    assert!(leftovers.is_empty(), "{leftovers:?}");
+
+    for ppd in ["0", "-3"] {
+        fails_with(&["compare", b, a, "--ppd", ppd], &["pixels per degree"]);
+    }
+}
+
+/// `--tmqi`: a tone-mapped PNG against its HDR source gives the three keys in [0, 1];
+/// two LDR images, or the pair the wrong way round, and mismatched sizes are errors.
+#[test]
+fn compare_tmqi_scores_a_tone_mapped_png_and_refuses_other_pairings() {
+    let (w, h) = (192usize, 180usize);
+    let pixels = (0..w * h)
+        .map(|i| {
+            let (x, y) = ((i % w) as f32, (i / w) as f32);
+            let t = (x / 3.0).sin() * (y / 5.0).cos() + (x / 17.0 + y / 23.0).sin();
+            let v = (2.0 + t).exp2() * (1.0 + x / 8.0);
+            [v, 0.8 * v, 0.6 * v]
+        })
+        .collect();
+    let hdr = scratch("tmqi.exr");
+    write_image(
+        &hdr,
+        &Image::new(w, h, pixels, RgbColorSpace::srgb()).unwrap(),
+    )
+    .unwrap();
+    let ldr = scratch("tmqi-reinhard02.png");
+    let (hdr, ldr) = (hdr.to_str().unwrap(), ldr.to_str().unwrap());
+    ok(&["tonemap", hdr, "-o", ldr, "--op", "reinhard02"]);
+    let t: Value = serde_json::from_str(&ok(&["compare", ldr, hdr, "--tmqi", "--json"])).unwrap();
+    for key in ["tmqi", "tmqi_structural_fidelity", "tmqi_naturalness"] {
+        let v = t[key].as_f64().unwrap();
+        assert!(v > 0.0 && v <= 1.0, "{key} = {v}: {t}");
+    }
+    assert!(ok(&["compare", ldr, hdr, "--tmqi"]).contains("structural fidelity S"));
+    fails_with(&["compare", ldr, ldr, "--tmqi"], &["--tmqi", "PNG", "EXR"]);
+    fails_with(&["compare", hdr, ldr, "--tmqi"], &["--tmqi"]);
+    let small = scratch("tmqi-small.hdr");
+    plain_hdr(&small);
+    fails_with(
+        &["compare", ldr, small.to_str().unwrap(), "--tmqi"],
+        &["192×180", "40×30"],
+    );
+}

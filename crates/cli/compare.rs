@@ -1,21 +1,51 @@
-//! `prism compare A B [--json]`: error metrics of image A against the reference B.
+//! `prism compare A B [--json] [--ppd X] [--error-map OUT.png]`: error metrics of image A
+//! against the reference B, FLIP included; `prism compare LDR.png HDR.exr --tmqi`: TMQI of
+//! a tone-mapped image against its HDR source (docs/post.md).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
-use clap::Args;
-use prism_post::metrics::Comparison;
-use prism_post::pipeline::compare_files;
+use clap::{Args, ValueEnum};
+use prism_image::io::{write_image, ImageFormat};
+use prism_post::metrics::flip::DEFAULT_PPD;
+use prism_post::metrics::tmqi::Tmqi;
+use prism_post::metrics::{CompareOptions, Comparison, FlipMaps};
+use prism_post::pipeline::{compare_files_with, tmqi_files};
+
+/// Which FLIP map `--error-map` writes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum ErrorMapKind {
+    Ldr,
+    Hdr,
+}
 
 #[derive(Args, Debug)]
 pub struct CompareArgs {
     /// The image under test (EXR, HDR or PNG).
     pub test: PathBuf,
-    /// The reference image (same size); relMSE, PSNR peak and ΔE2000 white come from it.
+    /// The reference image (same size); relMSE, PSNR peak, ΔE2000 white and HDR-FLIP's
+    /// exposure range come from it.
     pub reference: PathBuf,
     /// Print one JSON object (mse, rmse, relmse, psnr_db, ssim, delta_e2000_mean,
-    /// delta_e2000_p95, per_channel) instead of a table.
+    /// delta_e2000_p95, per_channel, ldr_flip_mean, ldr_flip_p95, hdr_flip_mean,
+    /// hdr_flip_p95, …) instead of a table.
     #[arg(long)]
     pub json: bool,
+    /// FLIP's viewing condition in pixels per degree (default: flip-evaluator's, a 0.7 m
+    /// wide 3840-pixel display at 0.7 m, 67.02).
+    #[arg(long, default_value_t = DEFAULT_PPD, allow_negative_numbers = true)]
+    pub ppd: f64,
+    /// Write the FLIP error map in magma with a legend (PNG).
+    #[arg(long, value_name = "OUT.png")]
+    pub error_map: Option<PathBuf>,
+    /// The map `--error-map` writes: default HDR-FLIP when either input is EXR or HDR,
+    /// LDR-FLIP for two PNGs.
+    #[arg(long, value_enum, requires = "error_map")]
+    pub error_map_kind: Option<ErrorMapKind>,
+    /// TMQI (Yeganeh & Wang 2013) of A, a tone-mapped PNG, against B, its HDR source (EXR
+    /// or HDR), instead of the error metrics: tmqi, tmqi_structural_fidelity,
+    /// tmqi_naturalness.
+    #[arg(long, conflicts_with_all = ["error_map", "error_map_kind"])]
+    pub tmqi: bool,
     #[command(flatten)]
     pub simd: crate::simd::SimdArgs,
 }
@@ -35,6 +65,25 @@ fn print_table(c: &Comparison) {
     }
     println!("{:<18}{:>14.4}", "ΔE2000 mean", c.delta_e2000_mean);
     println!("{:<18}{:>14.4}", "ΔE2000 p95", c.delta_e2000_p95);
+    if let Some(f) = &c.flip {
+        println!("{:<18}{:>14.6}", "LDR-FLIP mean", f.ldr_flip_mean);
+        println!("{:<18}{:>14.6}", "LDR-FLIP p95", f.ldr_flip_p95);
+        println!("{:<18}{:>14.6}", "HDR-FLIP mean", f.hdr_flip_mean);
+        println!("{:<18}{:>14.6}", "HDR-FLIP p95", f.hdr_flip_p95);
+        let e = &f.hdr_flip_exposures;
+        println!(
+            "{:<18}{:>14}",
+            "HDR-FLIP stops",
+            format!("{:.2} … {:.2} ({})", e.start_stops, e.stop_stops, e.count)
+        );
+        println!("{:<18}{:>14.2}", "FLIP px/degree", f.flip_ppd);
+        if f.hdr_flip_negative_samples > 0 {
+            println!(
+                "{:<18}{:>14}",
+                "negative samples", f.hdr_flip_negative_samples
+            );
+        }
+    }
     println!("{:<18}{:>14}{:>14}{:>14}", "per channel", "R", "G", "B");
     row3("  MSE", c.per_channel.mse);
     row3("  RMSE", c.per_channel.rmse);
@@ -45,9 +94,67 @@ fn print_table(c: &Comparison) {
     }
 }
 
+fn is_hdr(path: &Path) -> bool {
+    match ImageFormat::from_path(path) {
+        Ok(ImageFormat::Exr | ImageFormat::Hdr) => true,
+        Ok(ImageFormat::Png) | Err(_) => false,
+    }
+}
+
+fn write_error_map(args: &CompareArgs, out: &Path, maps: &FlipMaps) -> Result<(), String> {
+    let kind = args
+        .error_map_kind
+        .unwrap_or(if is_hdr(&args.test) || is_hdr(&args.reference) {
+            ErrorMapKind::Hdr
+        } else {
+            ErrorMapKind::Ldr
+        });
+    let (map, title) = match kind {
+        ErrorMapKind::Ldr => (&maps.ldr, "LDR-FLIP"),
+        ErrorMapKind::Hdr => (&maps.hdr, "HDR-FLIP"),
+    };
+    let image = map.to_image(title).map_err(|e| e.to_string())?;
+    // write_image writes a temporary sibling and renames it (atomic).
+    write_image(out, &image).map_err(|e| e.to_string())
+}
+
+fn print_tmqi(t: &Tmqi) {
+    println!("{:<26}{:>10.6}", "TMQI", t.tmqi);
+    println!(
+        "{:<26}{:>10.6}",
+        "structural fidelity S", t.tmqi_structural_fidelity
+    );
+    println!("{:<26}{:>10.6}", "naturalness N", t.tmqi_naturalness);
+    let s = t.tmqi_structural_per_scale;
+    println!(
+        "{:<26}{:.4} {:.4} {:.4} {:.4} {:.4}",
+        "S per scale (fine→coarse)", s[0], s[1], s[2], s[3], s[4]
+    );
+}
+
 pub fn run(args: &CompareArgs) -> Result<(), String> {
     args.simd.apply()?;
-    let comparison = compare_files(&args.test, &args.reference).map_err(|e| e.to_string())?;
+    if args.tmqi {
+        let t = tmqi_files(&args.test, &args.reference).map_err(|e| e.to_string())?;
+        if args.json {
+            println!(
+                "{}",
+                serde_json::to_string_pretty(&t).map_err(|e| e.to_string())?
+            );
+        } else {
+            print_tmqi(&t);
+        }
+        return Ok(());
+    }
+    let options = CompareOptions {
+        flip_ppd: Some(args.ppd),
+        ..CompareOptions::default()
+    };
+    let (comparison, maps) =
+        compare_files_with(&args.test, &args.reference, &options).map_err(|e| e.to_string())?;
+    if let (Some(out), Some(maps)) = (&args.error_map, &maps) {
+        write_error_map(args, out, maps)?;
+    }
     if args.json {
         let text = serde_json::to_string_pretty(&comparison).map_err(|e| e.to_string())?;
         println!("{text}");

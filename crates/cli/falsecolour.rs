@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use clap::ValueEnum;
 use prism_image::io::write_image;
-use prism_post::falsecolour::{false_colour, FalseColourOptions, FalseColourScale};
+use prism_post::falsecolour::{false_colour, FalseColourOptions, FalseColourScale, Palette};
 use prism_render::sensor::SensorReading;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -51,6 +51,7 @@ fn options(
         range,
         unit: unit.into(),
         cell_px,
+        palette: Palette::Lighting,
     }
 }
 

@@ -186,7 +186,15 @@ pub fn run_method(
                 let comparison = metric_pool.install(|| {
                     let image = film_to_image(&film)?;
                     reference
-                        .compare(&image, &CompareOptions { ssim: false })
+                        .compare(
+                            &image,
+                            // FLIP is not a convergence metric here: it would cost the
+                            // render more time than every other metric together.
+                            &CompareOptions {
+                                ssim: false,
+                                flip_ppd: None,
+                            },
+                        )
                         .map_err(|e| e.to_string())
                 })?;
                 // The pool's worker did the work; the metric thread itself only waited.

@@ -15,7 +15,8 @@ pub mod tonemap;
 
 pub use metrics::{compare, compare_with, CompareOptions, Comparison};
 pub use pipeline::{
-    compare_files, tonemap_file, OperatorChoice, TonemapFileReport, TonemapOptions, TonemapTimings,
+    compare_files, compare_files_with, tmqi_files, tonemap_file, OperatorChoice, TonemapFileReport,
+    TonemapOptions, TonemapTimings,
 };
 pub use sheet::{contact_sheet, contact_sheet_with_reports, ContactSheet};
 pub use tonemap::{ToneOperator, ToneParams, ToneReport, ToneResult};

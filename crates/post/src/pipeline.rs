@@ -24,10 +24,11 @@ use crate::colour::{
     apply_white_balance, apply_with_source_white, illumination_white_xyz, map_gamut, GamutMethod,
     GamutTarget, SceneWhite, WhiteBalance, ILLUMINATION_LAYER,
 };
-use crate::metrics::{compare, Comparison};
+use crate::metrics::tmqi::{tmqi_images, Tmqi};
+use crate::metrics::{CompareOptions, Comparison, FlipMaps, PreparedReference};
 use crate::sheet::{contact_sheet_with_reports, SheetFailure};
 use crate::tonemap::{ToneOperator, ToneParams, ToneReport};
-use prism_image::io::{read_image, write_image};
+use prism_image::io::{read_image, write_image, ImageFormat};
 use prism_image::Image;
 use prism_image::{ImageError, Result};
 
@@ -325,6 +326,38 @@ pub fn scene_white_of(image: &Image, path: &Path) -> Result<SceneWhite> {
 /// Compares the image at `test` with the reference at `reference`; mismatched sizes are an
 /// error naming both files.
 pub fn compare_files(test: &Path, reference: &Path) -> Result<Comparison> {
+    compare_files_with(test, reference, &CompareOptions::default()).map(|(c, _)| c)
+}
+
+/// TMQI of the tone-mapped image at `ldr` (PNG) against its HDR source at `hdr` (EXR or
+/// Radiance HDR); any other pairing is an error naming the files.
+pub fn tmqi_files(ldr: &Path, hdr: &Path) -> Result<Tmqi> {
+    let (ldr_format, hdr_format) = (ImageFormat::from_path(ldr)?, ImageFormat::from_path(hdr)?);
+    let ldr_ok = match ldr_format {
+        ImageFormat::Png => true,
+        ImageFormat::Exr | ImageFormat::Hdr => false,
+    };
+    let hdr_ok = match hdr_format {
+        ImageFormat::Exr | ImageFormat::Hdr => true,
+        ImageFormat::Png => false,
+    };
+    if !(ldr_ok && hdr_ok) {
+        return Err(ImageError::invalid(format!(
+            "--tmqi compares a tone-mapped LDR image (PNG) with its HDR source (EXR or HDR): \
+             got {} and {}",
+            ldr.display(),
+            hdr.display()
+        )));
+    }
+    tmqi_images(&read_image(ldr)?, &read_image(hdr)?)
+}
+
+/// [`compare_files`] with a choice of metrics, and the FLIP maps when FLIP is asked for.
+pub fn compare_files_with(
+    test: &Path,
+    reference: &Path,
+    options: &CompareOptions,
+) -> Result<(Comparison, Option<FlipMaps>)> {
     let a = read_image(test)?;
     let b = read_image(reference)?;
     if (a.width(), a.height()) != (b.width(), b.height()) {
@@ -338,5 +371,5 @@ pub fn compare_files(test: &Path, reference: &Path) -> Result<Comparison> {
             b.height()
         )));
     }
-    compare(&a, &b)
+    PreparedReference::new(&b).compare_with_maps(&a, options)
 }

@@ -11,7 +11,11 @@
 //!   largest Y (see [`ssim`]); null for images smaller than 11×11;
 //! - ΔE2000: XYZ → CIELAB against the white of the reference's colour space with Y
 //!   normalised so that RGB (1, 1, 1) (Y = 1) is the reference white (L* = 100), i.e.
-//!   display-referred relative colorimetry; mean and 95th percentile (nearest rank).
+//!   display-referred relative colorimetry; mean and 95th percentile (nearest rank);
+//! - FLIP ([`flip`]): LDR-FLIP and HDR-FLIP means and 95th percentiles (nearest rank) at a
+//!   viewing condition in pixels per degree, both images in linear Rec.709 (converted
+//!   when the reference is in another space); LDR clips to [0, 1], HDR clamps negative
+//!   samples to 0 and counts them.
 //!
 //! All metrics come from one fused pass over the pixels against a [`PreparedReference`]
 //! (the reference's clean pixels, CIELAB and peaks, computed once), with CIELAB and
@@ -20,14 +24,17 @@
 
 pub mod ciede2000;
 mod fast_f64;
+pub mod flip;
 mod prepared;
 mod ssim;
+pub mod tmqi;
 
 use serde::Serialize;
 
 use prism_image::Image;
 use prism_image::Result;
 
+pub use flip::{ExposureRange, FlipMap};
 pub use prepared::PreparedReference;
 
 /// ε of relMSE.
@@ -56,19 +63,52 @@ pub struct Comparison {
     pub delta_e2000_p95: f64,
     pub per_channel: PerChannel,
     pub non_finite_pixels: u64,
+    /// FLIP, when asked for: its keys at the top level of the JSON object.
+    #[serde(flatten)]
+    pub flip: Option<FlipSummary>,
+}
+
+/// LDR-FLIP and HDR-FLIP of a comparison.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FlipSummary {
+    /// The viewing condition, pixels per degree.
+    pub flip_ppd: f64,
+    pub ldr_flip_mean: f64,
+    pub ldr_flip_p95: f64,
+    pub hdr_flip_mean: f64,
+    pub hdr_flip_p95: f64,
+    /// The exposures HDR-FLIP took the maximum over (from the reference).
+    pub hdr_flip_exposures: ExposureRange,
+    /// Samples below 0 (either image, as read or after conversion to Rec.709) that
+    /// HDR-FLIP clamped to 0.
+    pub hdr_flip_negative_samples: u64,
+}
+
+/// The per-pixel FLIP maps behind a [`FlipSummary`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct FlipMaps {
+    pub ldr: FlipMap,
+    pub hdr: FlipMap,
 }
 
 /// Which of the costlier metrics `compare_with` computes.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CompareOptions {
     /// SSIM (an 11×11 window per pixel: the costliest metric). `prism converge` leaves it
     /// out of its checkpoints so that the metric thread steals less time from the render.
     pub ssim: bool,
+    /// LDR-FLIP and HDR-FLIP at this many pixels per degree (`None`: not computed; a
+    /// 4K pair costs about as much as the other metrics together, times HDR-FLIP's
+    /// exposure count).
+    pub flip_ppd: Option<f64>,
 }
 
 impl Default for CompareOptions {
     fn default() -> Self {
-        Self { ssim: true }
+        Self {
+            ssim: true,
+            flip_ppd: Some(flip::DEFAULT_PPD),
+        }
     }
 }
 
@@ -91,6 +131,7 @@ pub fn compare_with(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use prism_image::io::convert_pixels;
     use prism_spectrum::rgb_space::RgbColorSpace;
 
     fn gradient(w: usize, h: usize) -> Image {
@@ -153,6 +194,37 @@ mod tests {
         assert_eq!(c.delta_e2000_mean, 0.0);
         assert!(c.psnr_db.is_infinite());
         assert!((c.ssim.unwrap() - 1.0).abs() < 1e-6);
+        let flip = c.flip.unwrap();
+        assert_eq!((flip.ldr_flip_mean, flip.hdr_flip_p95), (0.0, 0.0));
+    }
+
+    /// FLIP runs on Rec.709: a P3 test against its sRGB conversion scores 0 (to rounding),
+    /// and the JSON carries the keys at the top level.
+    #[test]
+    fn flip_converts_to_rec709_and_serialises_flat() {
+        let b = gradient(24, 16);
+        let mut p3 = b.clone();
+        convert_pixels(
+            p3.pixels_mut(),
+            &RgbColorSpace::srgb(),
+            &RgbColorSpace::display_p3(),
+        );
+        p3.color_space = RgbColorSpace::display_p3();
+        let c = compare(&p3, &b).unwrap();
+        let flip = c.flip.clone().unwrap();
+        assert!(
+            flip.ldr_flip_mean < 1e-3 && flip.hdr_flip_mean < 1e-3,
+            "{flip:?}"
+        );
+        let json = serde_json::to_value(&c).unwrap();
+        for key in [
+            "ldr_flip_mean",
+            "hdr_flip_mean",
+            "ldr_flip_p95",
+            "hdr_flip_p95",
+        ] {
+            assert!(json[key].is_number(), "{key}: {json}");
+        }
     }
 
     #[test]
@@ -201,9 +273,24 @@ mod tests {
             .with_pixels(b.pixels().iter().map(|p| p.map(|c| c * 1.1)).collect())
             .unwrap();
         let full = compare(&a, &b).unwrap();
-        let lean = compare_with(&a, &b, &CompareOptions { ssim: false }).unwrap();
-        assert!(full.ssim.is_some());
-        assert_eq!(lean, Comparison { ssim: None, ..full });
+        let lean = compare_with(
+            &a,
+            &b,
+            &CompareOptions {
+                ssim: false,
+                flip_ppd: None,
+            },
+        )
+        .unwrap();
+        assert!(full.ssim.is_some() && full.flip.is_some());
+        assert_eq!(
+            lean,
+            Comparison {
+                ssim: None,
+                flip: None,
+                ..full
+            }
+        );
     }
 
     #[test]

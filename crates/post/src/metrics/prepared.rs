@@ -14,7 +14,9 @@ use prism_spectrum::rgb_space::RgbColorSpace;
 use rayon::prelude::*;
 
 use super::ciede2000::{delta_e_2000_block, lab_block, LabBlock, LabConverter, BLOCK};
-use super::{ssim, CompareOptions, Comparison, PerChannel, RELMSE_EPSILON};
+use super::{
+    flip, ssim, CompareOptions, Comparison, FlipMaps, FlipSummary, PerChannel, RELMSE_EPSILON,
+};
 use crate::tonemap::kernels::avx2;
 use crate::tonemap::pixels::{sanitise, CHUNK};
 use prism_image::io::convert_pixels;
@@ -37,6 +39,8 @@ pub struct PreparedReference {
     peak_c: [f64; 3],
     /// Pixels with a non-finite channel.
     non_finite: u64,
+    /// Finite samples < 0 (HDR-FLIP's count).
+    negative_samples: u64,
     lab_converter: LabConverter,
     /// The ISA of the vector kernels (`prism_cpu::active()` when prepared), for the
     /// preparation and every comparison.
@@ -87,6 +91,11 @@ impl PreparedReference {
             .map(|block| avx2!(simd, reference_block(&lab_converter, block)))
             .collect();
         let non_finite = reference.pixels().par_iter().filter(|p| !finite(p)).count() as u64;
+        let negative_samples = reference
+            .pixels()
+            .par_iter()
+            .map(|p| p.iter().filter(|v| **v < 0.0).count() as u64)
+            .sum();
         let peak_c = pixels
             .par_chunks(CHUNK)
             .map(|chunk| {
@@ -103,6 +112,7 @@ impl PreparedReference {
             lab,
             peak_c,
             non_finite,
+            negative_samples,
             lab_converter,
             simd,
         }
@@ -119,6 +129,18 @@ impl PreparedReference {
     /// Compares `test` against the prepared reference: exactly [`crate::metrics::compare_with`]
     /// (which calls this); an error when the sizes differ.
     pub fn compare(&self, test: &Image, options: &CompareOptions) -> Result<Comparison> {
+        self.compare_with_maps(test, options).map(|(c, _)| c)
+    }
+
+    /// [`Self::compare`] and, when FLIP is asked for, its per-pixel maps.
+    pub fn compare_with_maps(
+        &self,
+        test: &Image,
+        options: &CompareOptions,
+    ) -> Result<(Comparison, Option<FlipMaps>)> {
+        if let Some(ppd) = options.flip_ppd {
+            flip::check_ppd(ppd)?;
+        }
         if (test.width(), test.height()) != (self.width, self.height) {
             return Err(ImageError::invalid(format!(
                 "image sizes differ: {}×{} vs reference {}×{}",
@@ -182,7 +204,15 @@ impl PreparedReference {
         let (_, p95, _) = de.select_nth_unstable_by(rank, f64::total_cmp);
         let de_p95 = *p95;
 
-        Ok(Comparison {
+        let (flip, maps) = match options.flip_ppd {
+            Some(ppd) => {
+                let (summary, maps) = self.flip(a, ppd)?;
+                (Some(summary), Some(maps))
+            }
+            None => (None, None),
+        };
+
+        let comparison = Comparison {
             width: self.width,
             height: self.height,
             mse,
@@ -199,7 +229,39 @@ impl PreparedReference {
                 psnr_db: [0, 1, 2].map(|c| psnr(self.peak_c[c], mse_c[c])),
             },
             non_finite_pixels: sums.non_finite + self.non_finite,
-        })
+            flip,
+        };
+        Ok((comparison, maps))
+    }
+
+    /// LDR-FLIP and HDR-FLIP of `test` (in the reference's colour space) on Rec.709.
+    fn flip(&self, test: &[[f32; 3]], ppd: f64) -> Result<(FlipSummary, FlipMaps)> {
+        let rec709 = RgbColorSpace::srgb();
+        // Copies only when the reference space is not Rec.709.
+        let converted;
+        let (test, reference): (&[[f32; 3]], &[[f32; 3]]) =
+            if same_colorimetry(&self.color_space, &rec709) {
+                (test, &self.pixels)
+            } else {
+                let (mut t, mut r) = (test.to_vec(), self.pixels.clone());
+                convert_pixels(&mut t, &self.color_space, &rec709);
+                convert_pixels(&mut r, &self.color_space, &rec709);
+                converted = (t, r);
+                (&converted.0, &converted.1)
+            };
+        let (w, h) = (self.width, self.height);
+        let ldr = flip::ldr_flip(test, reference, w, h, ppd)?;
+        let hdr = flip::hdr_flip(test, reference, w, h, ppd)?;
+        let summary = FlipSummary {
+            flip_ppd: ppd,
+            ldr_flip_mean: ldr.mean(),
+            ldr_flip_p95: ldr.p95(),
+            hdr_flip_mean: hdr.map.mean(),
+            hdr_flip_p95: hdr.map.p95(),
+            hdr_flip_exposures: hdr.exposures,
+            hdr_flip_negative_samples: hdr.negative_samples + self.negative_samples,
+        };
+        Ok((summary, FlipMaps { ldr, hdr: hdr.map }))
     }
 }
 
@@ -302,7 +364,13 @@ mod tests {
         // 150 × 40 = 6000 pixels: one full chunk, a partial one, a short last block.
         let (test, reference) = pair(150, 40);
         let got = PreparedReference::new(&reference)
-            .compare(&test, &CompareOptions { ssim: false })
+            .compare(
+                &test,
+                &CompareOptions {
+                    ssim: false,
+                    flip_ppd: None,
+                },
+            )
             .unwrap();
         // The formulas of the module documentation, evaluated directly in f64 with
         // prism-spectrum's reference CIELAB and CIEDE2000.
@@ -348,7 +416,8 @@ mod tests {
     fn one_preparation_serves_many_comparisons_with_compare_s_numbers() {
         let (test, reference) = pair(64, 33);
         let prepared = PreparedReference::new(&reference);
-        let options = CompareOptions { ssim: true };
+        // FLIP included: prepared or not, the same numbers.
+        let options = CompareOptions::default();
         let first = prepared.compare(&test, &options).unwrap();
         assert_eq!(prepared.compare(&test, &options).unwrap(), first);
         assert_eq!(compare_with(&test, &reference, &options).unwrap(), first);

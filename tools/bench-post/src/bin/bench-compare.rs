@@ -80,7 +80,10 @@ fn main() {
         .num_threads(1)
         .build()
         .unwrap();
-    let options = CompareOptions { ssim: false };
+    let options = CompareOptions {
+        ssim: false,
+        flip_ppd: None,
+    };
     let (mut prep, mut cmp, mut full, mut sse) = (vec![], vec![], vec![], vec![]);
     let mut last = None;
     pool.install(|| {

@@ -2,9 +2,13 @@
 //! with a legend: a colour bar and labelled ticks in the quantity's unit, on a linear or a
 //! logarithmic scale — the lighting engineer's view of a result (Radiance's `falsecolor`).
 //!
-//! The ramp runs dark blue → blue → cyan → green → yellow → red through six sRGB control
-//! colours, interpolated linearly in display space. Values below the range take the first
-//! colour, above it the last; on a log scale values ≤ 0 take the first.
+//! Two palettes ([`Palette`]): the lighting ramp, dark blue → blue → cyan → green → yellow →
+//! red through six sRGB control colours interpolated linearly in display space; and
+//! matplotlib's magma (256 entries, nearest), the colour map FLIP error maps are shown in.
+//! Values below the range take the first colour, above it the last; on a log scale values
+//! ≤ 0 take the first.
+
+mod magma;
 
 use crate::sheet::font5x7::{draw_text, GLYPH_HEIGHT};
 use prism_image::Image;
@@ -17,6 +21,33 @@ pub enum FalseColourScale {
     Log,
 }
 
+/// The colour ramp of a false-colour image.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Palette {
+    /// Radiance-style blue → red (lighting quantities).
+    Lighting,
+    /// matplotlib's magma, black → purple → orange → pale yellow (FLIP error maps).
+    Magma,
+}
+
+impl Palette {
+    /// The palette's linear-RGB colour at t ∈ [0, 1] (NaN → t = 0).
+    pub fn colour(self, t: f64) -> [f32; 3] {
+        match self {
+            Palette::Lighting => ramp(t),
+            Palette::Magma => {
+                let t = if t.is_finite() {
+                    t.clamp(0.0, 1.0)
+                } else {
+                    0.0
+                };
+                // Nearest entry, as FLIP indexes its table (round(255 t)).
+                magma::MAGMA_SRGB[(t * 255.0).round() as usize].map(srgb_decode)
+            }
+        }
+    }
+}
+
 #[derive(Debug, Clone, PartialEq)]
 pub struct FalseColourOptions {
     pub scale: FalseColourScale,
@@ -27,6 +58,7 @@ pub struct FalseColourOptions {
     pub unit: String,
     /// Each input value becomes a block of `cell_px × cell_px` pixels.
     pub cell_px: usize,
+    pub palette: Palette,
 }
 
 /// sRGB display colours of the ramp at t = 0, 0.2, …, 1.
@@ -145,7 +177,7 @@ pub fn false_colour(
     for y in 0..ih {
         for x in 0..iw {
             let v = f64::from(values[(y / cell) * width + x / cell]);
-            px[y * out_w + x] = ramp(position(v, options.scale, range));
+            px[y * out_w + x] = options.palette.colour(position(v, options.scale, range));
         }
     }
     // Colour bar: top = max.
@@ -153,7 +185,7 @@ pub fn false_colour(
     for y in 0..bar_h {
         let t = 1.0 - y as f64 / (bar_h - 1).max(1) as f64;
         for x in 0..bar_w {
-            px[(bar_top + y) * out_w + bar_x + x] = ramp(t);
+            px[(bar_top + y) * out_w + bar_x + x] = options.palette.colour(t);
         }
     }
     draw_text(&mut px, out_w, (iw + 8, 6), &options.unit, 2, text);
@@ -191,6 +223,7 @@ mod tests {
             range: None,
             unit: "lx".into(),
             cell_px: 4,
+            palette: Palette::Lighting,
         }
     }
 
@@ -218,6 +251,22 @@ mod tests {
         assert_eq!(format_value(1234.5), "1234");
         assert_eq!(format_value(0.03125), "0.0312");
         assert_eq!(format_value(250_000.0), "2.5e5");
+    }
+
+    #[test]
+    fn magma_runs_black_to_pale_yellow() {
+        let (lo, hi) = (Palette::Magma.colour(0.0), Palette::Magma.colour(1.0));
+        assert!(lo.iter().all(|c| *c < 0.01), "{lo:?}");
+        assert!(
+            hi[0] > 0.9 && hi[1] > 0.9 && hi[2] > 0.5 && hi[2] < hi[1],
+            "{hi:?}"
+        );
+        assert_eq!(Palette::Magma.colour(f64::NAN), lo);
+        let mut o = options(FalseColourScale::Linear);
+        o.palette = Palette::Magma;
+        o.range = Some((0.0, 1.0));
+        let img = false_colour(&[0.0, 1.0], 2, 1, &o).unwrap();
+        assert_eq!((img.pixel(0, 0), img.pixel(7, 0)), (lo, hi));
     }
 
     #[test]
