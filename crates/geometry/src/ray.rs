@@ -46,6 +46,18 @@ impl Ray {
         )
     }
 
+    /// A ray leaving a surface point through or off the surface: the origin moves off the
+    /// surface along the normal `n` (to the side `direction` goes to) and `t_min` is 0
+    /// (pbrt-v4 `OffsetRayOrigin`). Unlike `spawn`, whose `t_min` skips the first
+    /// 2·10⁻⁵·(1 + |p|∞) of the ray, this still finds a surface the ray meets right away:
+    /// an adjacent face of a box entered next to its edge, which a path tracking media must
+    /// not miss (it would leave the box still marked as inside).
+    pub fn spawn_off_surface(origin: Vec3A, n: Vec3A, direction: Vec3A) -> Self {
+        let offset = SPAWN_T_MIN_REL * (1.0 + origin.abs().max_element());
+        let side = if n.dot(direction) >= 0.0 { 1.0 } else { -1.0 };
+        Self::new(origin + n * (offset * side), direction, 0.0, f32::INFINITY)
+    }
+
     /// A shadow ray from `from` to `to`, stopping short of `to` by the same relative offset.
     pub fn spawn_to(from: Vec3A, to: Vec3A) -> Self {
         let d = to - from;

@@ -480,7 +480,7 @@ impl PathTracer {
             if media.is_interface(si.material_id) {
                 medium =
                     media.after_surface(medium, hit.instance_id, ray.direction, si.n_geometric);
-                ray = Ray::spawn(si.p, ray.direction);
+                ray = Ray::spawn_off_surface(si.p, si.n_geometric, ray.direction);
                 if !path.null_event() {
                     break;
                 }
@@ -510,7 +510,7 @@ impl PathTracer {
                 if !path.null_event() {
                     break;
                 }
-                ray = Ray::spawn(si.p, ray.direction);
+                ray = Ray::spawn_off_surface(si.p, si.n_geometric, ray.direction);
                 continue;
             }
             let shading_maps = material.has_shading_maps();
@@ -619,7 +619,7 @@ impl PathTracer {
             }
             let wi = bs.wi.normalize();
             medium = media.after_surface(medium, hit.instance_id, wi, si.n_geometric);
-            ray = Ray::spawn(vertex.p(), wi);
+            ray = Ray::spawn_off_surface(vertex.p(), si.n_geometric, wi);
             current_differential = None;
             counters.rays += 1;
             let spectral = self.spectral_mis_now(&path.wavelengths);
