@@ -14,6 +14,7 @@
 //! Standard errors are over pixels (each pixel an independent estimate); the stated floors
 //! cover the 1 nm quadrature of the CMFs.
 
+use prism_testkit::quadrature::simpson;
 use std::path::Path;
 
 use glam::UVec2;
@@ -173,21 +174,9 @@ fn film_xyz(radiance: impl Fn(f64) -> f64) -> [f64; 3] {
 /// ∫ M(λi, λo)·S(λi) dλi by Simpson on 0.25 nm steps over 300–830 nm (exact per linear
 /// piece of M up to the illuminant's 5 nm kinks).
 fn gathered(m: &ReradiationMatrix, s: &impl Fn(f64) -> f64, lambda_out_nm: f64) -> f64 {
-    let n = 2120;
-    let h = 530.0 / n as f64;
-    let mut sum = 0.0;
-    for i in 0..=n {
-        let w = if i == 0 || i == n {
-            1.0
-        } else if i % 2 == 1 {
-            4.0
-        } else {
-            2.0
-        };
-        let l = 300.0 + i as f64 * h;
-        sum += w * m.eval(l as f32, lambda_out_nm as f32) as f64 * s(l);
-    }
-    sum * h / 3.0
+    simpson(300.0, 830.0, 2120, |l| {
+        f64::from(m.eval(l as f32, lambda_out_nm as f32)) * s(l)
+    })
 }
 
 fn assert_close(what: &str, mean: f64, se: f64, expected: f64, floor: f64) {
@@ -765,25 +754,16 @@ fn ink_expected_xyz(scene_json: &str, sigma_a: &dyn Fn(f64) -> f64, density: f64
         };
         (-b * d / mu).exp() * inner / mu
     };
-    let n = 2120;
-    let h = 530.0 / n as f64;
     film_xyz(|lo| {
-        let mut sum = 0.0;
-        for i in 0..=n {
-            let w = if i == 0 || i == n {
-                1.0
-            } else if i % 2 == 1 {
-                4.0
-            } else {
-                2.0
-            };
-            let li = 300.0 + i as f64 * h;
+        let sum = simpson(300.0, 830.0, 2120, |li| {
             let m = peak * f64::from(f.dye.matrix().eval(li as f32, lo as f32));
             if m > 0.0 {
-                sum += w * m * depth_integral(sigma_t(li), sigma_t(lo));
+                m * depth_integral(sigma_t(li), sigma_t(lo))
+            } else {
+                0.0
             }
-        }
-        INK_E * sum * h / 3.0 / (4.0 * std::f64::consts::PI)
+        });
+        INK_E * sum / (4.0 * std::f64::consts::PI)
     })
 }
 

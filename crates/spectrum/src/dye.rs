@@ -191,7 +191,7 @@ mod tests {
     /// Simpson over the emission range on 0.5 nm steps: 10 per 5 nm node segment, so every
     /// Simpson pair lies inside a segment and is exact for the quadratic M(λi, ·)·λo.
     fn integrate_emission(f: impl Fn(f64) -> f64) -> f64 {
-        crate::test_quadrature::simpson(360.0, 830.0, 940, f)
+        prism_testkit::quadrature::simpson(360.0, 830.0, 940, f)
     }
 
     #[test]

@@ -25,8 +25,6 @@ pub mod sampled_wavelengths;
 pub mod spectrum;
 pub mod spectrum_file;
 pub mod table;
-#[cfg(test)]
-mod test_quadrature;
 
 pub use adaptation::{adaptation_matrix, AdaptationMethod};
 pub use bfc::{load_bfc, parse_bfc, BfcData, NegativesPolicy};

@@ -606,7 +606,7 @@ mod tests {
         (chi2, dof, chi2_p_value(chi2, dof))
     }
 
-    use crate::test_quadrature::simpson;
+    use prism_testkit::quadrature::simpson;
 
     #[test]
     fn eval_matches_the_grid_at_nodes_and_is_zero_outside() {

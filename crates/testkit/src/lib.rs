@@ -1,8 +1,10 @@
 //! Test-only helpers shared by the Prism crates' tests (a `[dev-dependencies]` entry, never
 //! a normal dependency): the chi-square goodness-of-fit harness of direction samplers
-//! ([`chi2`]) and its deterministic variates ([`chi2::SplitMix64`]).
+//! ([`chi2`]) and its deterministic variates ([`chi2::SplitMix64`]); Simpson's rule for
+//! closed-form references ([`quadrature`]).
 //!
 //! Generic over closures, so it depends on no prism crate and every crate — prism-render's
 //! own unit tests included — can dev-depend on it without a cycle.
 
 pub mod chi2;
+pub mod quadrature;
