@@ -6,10 +6,10 @@
 //! (`prism_render::adaptive` is the same method for `prism render`).
 
 use glam::UVec2;
-use prism_bandwidth::{adaptive_error, adaptive_pass_counts, Allocated, SamplePlan};
-use prism_render::adaptive::ADAPTIVE_FIRST_PASS_SPP;
-use prism_render::predictor::{predict, PredictorSettings, DEFAULT_PROBE_SAMPLES};
-use prism_render::{film_for, render_pass, Film, RenderScene, RenderSettings, RenderStats};
+use prism_bandwidth::{adaptive_pass_counts, Allocated};
+use prism_render::adaptive::{PerPixelPasses, ADAPTIVE_FIRST_PASS_SPP};
+use prism_render::predictor::{predict, PredictorSettings};
+use prism_render::{Film, RenderScene, RenderSettings, RenderStats};
 
 use super::method::PlanKind;
 
@@ -20,16 +20,10 @@ const PREDICTED_PLAN_SPP: f64 = 64.0;
 /// A method's films and the state its plan carries between passes.
 pub struct PassPlanner {
     kind: PlanKind,
-    resolution: UVec2,
-    /// Samples each pixel has so far.
-    done: Vec<u32>,
-    /// The film every method has; for `adaptive`, half of each pass's samples.
-    pub film: Film,
-    /// `adaptive`: the other half.
-    half: Option<Film>,
+    passes: PerPixelPasses,
     allocated: Option<Allocated>,
     seed: u64,
-    passes: u32,
+    pass_count: u32,
 }
 
 impl PassPlanner {
@@ -41,20 +35,9 @@ impl PassPlanner {
         settings: &RenderSettings,
         oracle: Option<&Allocated>,
     ) -> Result<Self, String> {
-        let n = (scene.resolution.x * scene.resolution.y) as usize;
         let allocated = match kind {
             PlanKind::Predicted => {
-                let predictor = PredictorSettings {
-                    probe_samples: DEFAULT_PROBE_SAMPLES,
-                    allocation: prism_bandwidth::AllocationSettings {
-                        mean_spp: PREDICTED_PLAN_SPP,
-                        floor: prism_bandwidth::allocation::DEFAULT_FLOOR,
-                        allocation: prism_bandwidth::Allocation::RelativeError,
-                        seed: settings.seed,
-                    },
-                    variance_bandwidth: prism_bandwidth::VarianceBandwidth::Incident,
-                    visibility: true,
-                };
+                let predictor = PredictorSettings::defaults(PREDICTED_PLAN_SPP, settings.seed);
                 Some(predict(scene, &predictor, settings.seed)?.allocated)
             }
             PlanKind::Oracle => Some(
@@ -66,16 +49,10 @@ impl PassPlanner {
         };
         Ok(Self {
             kind,
-            resolution: scene.resolution,
-            done: vec![0; n],
-            film: film_for(scene, settings),
-            half: match kind {
-                PlanKind::Adaptive => Some(film_for(scene, settings)),
-                PlanKind::Uniform | PlanKind::Predicted | PlanKind::Oracle => None,
-            },
+            passes: PerPixelPasses::new(scene, settings, kind == PlanKind::Adaptive),
             allocated,
             seed: settings.seed,
-            passes: 0,
+            pass_count: 0,
         })
     }
 
@@ -87,19 +64,14 @@ impl PassPlanner {
         spp_done: u32,
         target: u32,
     ) -> Result<RenderStats, String> {
-        let n = self.done.len();
+        let n = self.passes.done().len();
         let pass = target - spp_done;
         let counts: Vec<u32> = match (self.kind, &self.allocated) {
-            (PlanKind::Uniform, _) => {
-                let plan = SamplePlan::uniform(self.resolution, pass).map_err(|e| e.to_string())?;
-                self.passes += 1;
-                return render_pass(scene, settings, &plan, &mut self.film, spp_done, &|_| {})
-                    .map_err(|e| e.to_string());
-            }
+            (PlanKind::Uniform, _) => vec![pass; n],
             (PlanKind::Predicted | PlanKind::Oracle, Some(allocated)) => allocated
                 .cumulative_counts(f64::from(target), self.seed)
                 .iter()
-                .zip(&self.done)
+                .zip(self.passes.done())
                 .map(|(c, d)| c.saturating_sub(*d))
                 .collect(),
             (PlanKind::Predicted | PlanKind::Oracle, None) => {
@@ -107,66 +79,33 @@ impl PassPlanner {
             }
             (PlanKind::Adaptive, _) if spp_done < ADAPTIVE_FIRST_PASS_SPP => vec![pass; n],
             (PlanKind::Adaptive, _) => {
-                let half = self.half.as_ref().expect("adaptive keeps two films");
-                let errors = adaptive_error(self.resolution, &self.snapshot().rgb(), &half.rgb())
+                let errors = self
+                    .passes
+                    .adaptive_error(scene.resolution)
+                    .expect("adaptive passes are split")
                     .map_err(|e| e.to_string())?;
-                adaptive_pass_counts(&errors, u64::from(pass) * n as u64, self.seed, self.passes)
+                adaptive_pass_counts(
+                    &errors,
+                    u64::from(pass) * n as u64,
+                    self.seed,
+                    self.pass_count,
+                )
             }
         };
-        self.passes += 1;
-        let mut stats = RenderStats::default();
-        // `adaptive`: the first ⌈c/2⌉ of a pixel's pass into `half`, the rest into `film`.
-        let (first_part, second_part): (Vec<u32>, Vec<u32>) = match self.half {
-            Some(_) => counts.iter().map(|c| (c.div_ceil(2), c / 2)).unzip(),
-            None => (counts.clone(), vec![0; n]),
-        };
-        let second_start: Vec<u32> = self
-            .done
-            .iter()
-            .zip(&first_part)
-            .map(|(d, a)| d + a)
-            .collect();
-        let parts = [
-            (first_part, self.done.clone(), true),
-            (second_part, second_start, false),
-        ];
-        for (count, start, first) in parts {
-            if count.iter().all(|&c| c == 0) {
-                continue;
-            }
-            let plan = SamplePlan::from_counts(self.resolution, count, vec![1; n])
-                .and_then(|p| p.with_first_samples(start))
-                .map_err(|e| e.to_string())?;
-            let film = match (&mut self.half, first) {
-                (Some(half), true) => half,
-                _ => &mut self.film,
-            };
-            let s =
-                render_pass(scene, settings, &plan, film, 0, &|_| {}).map_err(|e| e.to_string())?;
-            stats.add(&s);
-        }
-        for (d, c) in self.done.iter_mut().zip(&counts) {
-            *d += c;
-        }
-        Ok(stats)
+        self.pass_count += 1;
+        self.passes
+            .render(scene, settings, &counts, &|_| {})
+            .map_err(|e| e.to_string())
     }
 
-    /// The colour sums of every sample so far (both films for `adaptive`).
+    /// The colour sums of every sample so far.
     pub fn snapshot(&self) -> Film {
-        let mut out = self.film.colour_snapshot();
-        if let Some(half) = &self.half {
-            out.merge_film(&half.colour_snapshot())
-                .expect("two films of one render");
-        }
-        out
+        self.passes.snapshot()
     }
 
-    /// The finished film (both halves merged for `adaptive`).
-    pub fn into_film(mut self) -> Film {
-        if let Some(half) = &self.half {
-            self.film.merge_film(half).expect("two films of one render");
-        }
-        self.film
+    /// The finished film.
+    pub fn into_film(self) -> Film {
+        self.passes.into_film()
     }
 }
 
@@ -200,11 +139,12 @@ pub fn oracle_allocation(
                 path.display()
             )
         })?;
-    // Y of linear Rec.709 RGB: the film's XYZ Y, the variance's units.
+    // Y of the image's RGB: the film's XYZ Y, the variance's units.
+    let rgb_to_xyz = image.color_space.rgb_to_xyz;
     let mean_y: Vec<f32> = image
         .pixels()
         .iter()
-        .map(|p| 0.212_639 * p[0] + 0.715_169 * p[1] + 0.072_192 * p[2])
+        .map(|&p| (rgb_to_xyz * glam::Vec3::from(p).as_dvec3()).y as f32)
         .collect();
     let levels = vec![0; mean_y.len()];
     prism_bandwidth::allocate(
@@ -214,12 +154,7 @@ pub fn oracle_allocation(
             mean_y: &mean_y,
             shading_level: &levels,
         },
-        prism_bandwidth::AllocationSettings {
-            mean_spp: PREDICTED_PLAN_SPP,
-            floor: prism_bandwidth::allocation::DEFAULT_FLOOR,
-            allocation: prism_bandwidth::Allocation::RelativeError,
-            seed,
-        },
+        PredictorSettings::defaults(PREDICTED_PLAN_SPP, seed).allocation,
     )
     .map_err(|e| e.to_string())
 }

@@ -6,9 +6,10 @@
 //! (prism-bandwidth's `adaptive_error`). After a uniform first pass of 4 spp, each pass
 //! spends what a uniform pass would, spread ∝ that error.
 
+use glam::UVec2;
 use prism_bandwidth::{adaptive_error, adaptive_pass_counts, SamplePlan};
 
-use crate::film::{AovPlane, FilmImage};
+use crate::film::{AovPlane, Film, FilmImage};
 use crate::scene_build::RenderScene;
 use crate::{film_for, render_pass, RenderError, RenderSettings, RenderStats};
 
@@ -19,6 +20,95 @@ pub const ADAPTIVE_FIRST_PASS_SPP: u32 = 4;
 /// map is refreshed often enough to follow the noise while a pass's overhead (one error
 /// map, O(pixels)) stays negligible.
 pub const ADAPTIVE_PASSES: u32 = 8;
+
+/// A render whose passes give each pixel its own count of samples, each pixel continuing
+/// its own sample sequence (`SamplePlan::with_first_samples`), so the passes add up to one
+/// render of the summed counts. Split (adaptive sampling): the first ⌈c/2⌉ of a pixel's c
+/// samples in a pass go to film A, the rest to film B, and |I − A| (I = A + B) estimates
+/// the error. Used by `render_adaptive` and by `prism converge`'s per-pixel plans.
+pub struct PerPixelPasses {
+    done: Vec<u32>,
+    /// Film B (or the only film when not split).
+    film: Film,
+    /// Film A, when split.
+    half: Option<Film>,
+}
+
+impl PerPixelPasses {
+    pub fn new(scene: &RenderScene, settings: &RenderSettings, split: bool) -> Self {
+        let n = scene.resolution.x as usize * scene.resolution.y as usize;
+        Self {
+            done: vec![0; n],
+            film: film_for(scene, settings),
+            half: split.then(|| film_for(scene, settings)),
+        }
+    }
+
+    /// Samples each pixel has so far (row-major).
+    pub fn done(&self) -> &[u32] {
+        &self.done
+    }
+
+    /// Renders `counts[p]` more samples of every pixel p.
+    pub fn render(
+        &mut self,
+        scene: &RenderScene,
+        settings: &RenderSettings,
+        counts: &[u32],
+        progress: &(dyn Fn(u64) + Sync),
+    ) -> Result<RenderStats, RenderError> {
+        let n = self.done.len();
+        let (to_half, to_film): (Vec<u32>, Vec<u32>) = match self.half {
+            Some(_) => counts.iter().map(|c| (c.div_ceil(2), c / 2)).unzip(),
+            None => (vec![0; n], counts.to_vec()),
+        };
+        let film_start: Vec<u32> = self.done.iter().zip(&to_half).map(|(d, a)| d + a).collect();
+        let mut stats = RenderStats::default();
+        for (count, start, into_half) in [
+            (to_half, self.done.clone(), true),
+            (to_film, film_start, false),
+        ] {
+            if count.iter().all(|&c| c == 0) {
+                continue;
+            }
+            let plan = SamplePlan::from_counts(scene.resolution, count, vec![1; n])?
+                .with_first_samples(start)?;
+            let film = match (&mut self.half, into_half) {
+                (Some(half), true) => half,
+                _ => &mut self.film,
+            };
+            stats.add(&render_pass(scene, settings, &plan, film, 0, progress)?);
+        }
+        for (d, c) in self.done.iter_mut().zip(counts) {
+            *d += c;
+        }
+        Ok(stats)
+    }
+
+    /// The colour sums of every sample so far (both films when split).
+    pub fn snapshot(&self) -> Film {
+        let mut out = self.film.colour_snapshot();
+        if let Some(half) = &self.half {
+            out.merge_film(&half.colour_snapshot())
+                .expect("two films of one render");
+        }
+        out
+    }
+
+    /// Per-pixel error of the image so far (`adaptive_error`; `None` unless split).
+    pub fn adaptive_error(&self, resolution: UVec2) -> Option<Result<Vec<f32>, RenderError>> {
+        let half = self.half.as_ref()?;
+        Some(adaptive_error(resolution, &self.snapshot().rgb(), &half.rgb()).map_err(Into::into))
+    }
+
+    /// The finished film (both films merged when split).
+    pub fn into_film(mut self) -> Film {
+        if let Some(half) = &self.half {
+            self.film.merge_film(half).expect("two films of one render");
+        }
+        self.film
+    }
+}
 
 /// Renders `scene` with a mean of `mean_spp` camera samples per pixel placed adaptively;
 /// returns the film (with a `plan.spp` layer: the samples each pixel got) and statistics.
@@ -31,9 +121,7 @@ pub fn render_adaptive(
     let resolution = scene.resolution;
     let n = resolution.x as usize * resolution.y as usize;
     let budget = u64::from(mean_spp.max(1)) * n as u64;
-    let mut film_a = film_for(scene, settings);
-    let mut film_b = film_for(scene, settings);
-    let mut done = vec![0u32; n];
+    let mut passes = PerPixelPasses::new(scene, settings, true);
     let mut stats = RenderStats::default();
     let first = ADAPTIVE_FIRST_PASS_SPP.min(mean_spp.max(1));
     let mut counts = vec![first; n];
@@ -41,40 +129,24 @@ pub fn render_adaptive(
     let mut spent = 0u64;
     let mut pass = 0u32;
     loop {
-        // A: the first ⌈c/2⌉ samples of each pixel's pass, B: the rest.
-        let half_a: Vec<u32> = counts.iter().map(|c| c.div_ceil(2)).collect();
-        let half_b: Vec<u32> = counts.iter().zip(&half_a).map(|(c, a)| c - a).collect();
-        let start_b: Vec<u32> = done.iter().zip(&half_a).map(|(d, a)| d + a).collect();
-        for (film, count, start) in [
-            (&mut film_a, half_a, done.clone()),
-            (&mut film_b, half_b, start_b),
-        ] {
-            let plan = SamplePlan::from_counts(resolution, count, vec![1; n])?
-                .with_first_samples(start)?;
-            let s = render_pass(scene, settings, &plan, film, 0, progress)?;
-            stats.add(&s);
-        }
-        for (d, c) in done.iter_mut().zip(&counts) {
-            *d += c;
-        }
+        stats.add(&passes.render(scene, settings, &counts, progress)?);
         spent += counts.iter().map(|&c| u64::from(c)).sum::<u64>();
         // The pass count bounds the loop when stochastic rounding leaves the last few
         // samples of the budget unspent.
         if spent >= budget || pass_total == 0 || pass >= 2 * ADAPTIVE_PASSES {
             break;
         }
-        let mut full = film_a.colour_snapshot();
-        full.merge_film(&film_b.colour_snapshot())
-            .expect("two films of one render");
-        let errors = adaptive_error(resolution, &full.rgb(), &film_a.rgb())?;
+        let errors = passes
+            .adaptive_error(resolution)
+            .expect("the passes are split")?;
         counts = adaptive_pass_counts(&errors, pass_total.min(budget - spent), settings.seed, pass);
         pass += 1;
     }
-    film_a.merge_film(&film_b).expect("two films of one render");
-    let mut image = film_a.finish();
+    let done: Vec<f32> = passes.done().iter().map(|&d| d as f32).collect();
+    let mut image = passes.into_film().finish();
     image.aovs.push(AovPlane {
         name: "plan.spp".into(),
-        values: done.iter().map(|&d| d as f32).collect(),
+        values: done,
     });
     Ok((image, stats))
 }

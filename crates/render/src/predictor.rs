@@ -37,6 +37,25 @@ pub struct PredictorSettings {
     pub visibility: bool,
 }
 
+impl PredictorSettings {
+    /// `prism render --plan predicted`'s defaults for a mean of `mean_spp`: n_b = 16, a
+    /// quarter of the budget uniform, the relative-error allocation, eq. 9 with the
+    /// incident bandwidth, shadow edges on.
+    pub fn defaults(mean_spp: f64, seed: u64) -> Self {
+        Self {
+            probe_samples: DEFAULT_PROBE_SAMPLES,
+            allocation: AllocationSettings {
+                mean_spp,
+                floor: prism_bandwidth::allocation::DEFAULT_FLOOR,
+                allocation: prism_bandwidth::Allocation::RelativeError,
+                seed,
+            },
+            variance_bandwidth: VarianceBandwidth::Incident,
+            visibility: true,
+        }
+    }
+}
+
 /// The predictor's answer for a whole image.
 #[derive(Clone, Debug)]
 pub struct Prediction {

@@ -177,13 +177,11 @@ pub(crate) fn reflectance_y(f: SampledSpectrum, wavelengths: &SampledWavelengths
 /// narrow LEDs) give much, flat ones none.
 pub(crate) fn lane_variance(weight: SampledSpectrum, wavelengths: &SampledWavelengths) -> f32 {
     let lanes = prism_spectrum::N_SPECTRUM_SAMPLES;
-    let per_lane: Vec<glam::DVec3> = (0..lanes)
-        .map(|j| {
-            let mut only = [0.0f32; prism_spectrum::N_SPECTRUM_SAMPLES];
-            only[j] = weight[j];
-            sampled_radiance_to_xyz(SampledSpectrum::new(only), wavelengths) * lanes as f64
-        })
-        .collect();
+    let per_lane: [glam::DVec3; prism_spectrum::N_SPECTRUM_SAMPLES] = std::array::from_fn(|j| {
+        let mut only = [0.0f32; prism_spectrum::N_SPECTRUM_SAMPLES];
+        only[j] = weight[j];
+        sampled_radiance_to_xyz(SampledSpectrum::new(only), wavelengths) * lanes as f64
+    });
     let mean = per_lane.iter().copied().sum::<glam::DVec3>() / lanes as f64;
     let sum_sq: f64 = per_lane.iter().map(|x| (*x - mean).length_squared()).sum();
     let variance = sum_sq / ((lanes - 1) * lanes) as f64;

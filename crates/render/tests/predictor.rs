@@ -4,7 +4,6 @@
 //! else on the floor; `--plan-visibility off` (the paper, which ignores visibility) misses
 //! it. And the plan keeps its budget.
 
-use prism_bandwidth::{Allocation, AllocationSettings, VarianceBandwidth};
 use prism_render::predictor::{predict, Prediction, PredictorSettings};
 use prism_render::RenderScene;
 use prism_scene::parse_scene_str;
@@ -15,15 +14,8 @@ fn build(json: &str) -> RenderScene {
 
 fn run(scene: &RenderScene, visibility: bool) -> Prediction {
     let settings = PredictorSettings {
-        probe_samples: 16,
-        allocation: AllocationSettings {
-            mean_spp: 16.0,
-            floor: 0.25,
-            allocation: Allocation::RelativeError,
-            seed: 1,
-        },
-        variance_bandwidth: VarianceBandwidth::Incident,
         visibility,
+        ..PredictorSettings::defaults(16.0, 1)
     };
     predict(scene, &settings, 1).unwrap()
 }
