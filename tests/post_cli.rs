@@ -685,8 +685,9 @@ fn compare_reports_flip_and_writes_its_error_map() {
 
 /// `--tmqi`: a tone-mapped PNG against its HDR source gives the three keys in [0, 1];
 /// two LDR images, or the pair the wrong way round, and mismatched sizes are errors.
-#[test]
-fn compare_tmqi_scores_a_tone_mapped_png_and_refuses_other_pairings() {
+/// A 192×180 HDR image with texture at several scales and about 9 stops of range, large
+/// enough for TMQI's 5 scales.
+fn tmqi_hdr(name: &str) -> PathBuf {
     let (w, h) = (192usize, 180usize);
     let pixels = (0..w * h)
         .map(|i| {
@@ -696,12 +697,92 @@ fn compare_tmqi_scores_a_tone_mapped_png_and_refuses_other_pairings() {
             [v, 0.8 * v, 0.6 * v]
         })
         .collect();
-    let hdr = scratch("tmqi.exr");
+    let hdr = scratch(name);
     write_image(
         &hdr,
         &Image::new(w, h, pixels, RgbColorSpace::srgb()).unwrap(),
     )
     .unwrap();
+    hdr
+}
+
+#[test]
+fn contact_sheet_scores_every_tile_with_tmqi_and_sorts_on_request() {
+    let hdr = tmqi_hdr("score.exr");
+    let sheet = scratch("score-sheet.png");
+    let (hdr, sheet) = (hdr.to_str().unwrap(), sheet.to_str().unwrap());
+    let sheet_args = [
+        "tonemap", hdr, "-o", sheet, "--op", "all", "--score", "tmqi",
+    ];
+    let report: Value = serde_json::from_str(&ok(&[
+        &sheet_args[..],
+        &["--sort", "score", "--luminance-scale", "100", "--json"],
+    ]
+    .concat()))
+    .unwrap();
+    assert_eq!(report["score"], "tmqi");
+    let scores = report["scores"].as_array().unwrap();
+    assert_eq!(scores.len(), report["tone"].as_array().unwrap().len());
+    let tmqi: Vec<f64> = scores.iter().map(|s| s["tmqi"].as_f64().unwrap()).collect();
+    assert!(tmqi.iter().all(|t| *t > 0.0 && *t <= 1.0), "{tmqi:?}");
+    assert!(
+        tmqi.windows(2).all(|p| p[0] >= p[1]),
+        "not best first: {tmqi:?}"
+    );
+    // The sheet scores the full-resolution output: a single-operator PNG of the same
+    // operator scores the same, up to the PNG's 8-bit quantisation.
+    for entry in [&scores[0], scores.last().unwrap()] {
+        let op = entry["operator"].as_str().unwrap();
+        let png = scratch(&format!("score-{op}.png"));
+        let png = png.to_str().unwrap();
+        let one: Value = serde_json::from_str(&ok(&[
+            "tonemap",
+            hdr,
+            "-o",
+            png,
+            "--op",
+            op,
+            "--score",
+            "tmqi",
+            "--luminance-scale",
+            "100",
+            "--json",
+        ]))
+        .unwrap();
+        assert_eq!(one["scores"][0]["tmqi"], entry["tmqi"], "{op}");
+        let read: Value =
+            serde_json::from_str(&ok(&["compare", png, hdr, "--tmqi", "--json"])).unwrap();
+        let (a, b) = (
+            entry["tmqi"].as_f64().unwrap(),
+            read["tmqi"].as_f64().unwrap(),
+        );
+        assert!((a - b).abs() < 5e-3, "{op}: sheet {a}, PNG {b}");
+    }
+    // Catalogue order without --sort; the table under the text output.
+    let text = ok(&sheet_args);
+    assert!(text.contains("TMQI") && text.contains("linear"), "{text}");
+    fails_with(
+        &[
+            "tonemap", hdr, "-o", sheet, "--op", "all", "--sort", "score",
+        ],
+        &["--sort score", "--score tmqi"],
+    );
+    let small = scratch("score-small.hdr");
+    plain_hdr(&small);
+    fails_with(
+        &[
+            &sheet_args[..1],
+            &[small.to_str().unwrap()],
+            &sheet_args[2..],
+        ]
+        .concat(),
+        &["176", "40×30"],
+    );
+}
+
+#[test]
+fn compare_tmqi_scores_a_tone_mapped_png_and_refuses_other_pairings() {
+    let hdr = tmqi_hdr("tmqi.exr");
     let ldr = scratch("tmqi-reinhard02.png");
     let (hdr, ldr) = (hdr.to_str().unwrap(), ldr.to_str().unwrap());
     ok(&["tonemap", hdr, "-o", ldr, "--op", "reinhard02"]);

@@ -7,6 +7,7 @@ use std::path::PathBuf;
 use clap::Args;
 use prism_post::colour::{GamutMethod, GamutTarget, WhiteBalance};
 use prism_post::pipeline::{tonemap_file, OperatorChoice, TonemapFileReport, TonemapOptions};
+use prism_post::sheet::{SheetScore, TileOrder};
 use prism_post::tonemap::ToneOperator;
 
 #[derive(Args, Debug)]
@@ -53,6 +54,15 @@ pub struct TonemapArgs {
     /// `prism:cd_m2_per_unit` header (overrides it when it has).
     #[arg(long, value_name = "CD_M2")]
     pub luminance_scale: Option<f64>,
+    /// Score the output against the input it was made from: `tmqi` (Yeganeh & Wang 2013:
+    /// structural fidelity S, naturalness N). With `--op all` each tile is scored at full
+    /// resolution and its score printed under it. Needs an image of at least 176×176 px.
+    #[arg(long, value_enum)]
+    pub score: Option<ScoreArg>,
+    /// Tile order of `--op all`: `catalogue` (the `--list` order) or `score` (best first,
+    /// unscored tiles last; needs `--score`).
+    #[arg(long, value_enum, default_value = "catalogue")]
+    pub sort: SortArg,
     /// List every operator with its parameters, defaults and reference.
     #[arg(long)]
     pub list: bool,
@@ -149,6 +159,39 @@ fn print_summary(report: &TonemapFileReport) {
     for failure in &report.failures {
         println!("note: no tile for {failure:?}");
     }
+    if !report.scores.is_empty() {
+        println!("{:<20}{:>8}{:>8}{:>8}", "operator", "TMQI", "S", "N");
+        for score in &report.scores {
+            println!(
+                "{:<20}{:>8.4}{:>8.4}{:>8.4}",
+                score.operator,
+                score.tmqi.tmqi,
+                score.tmqi.tmqi_structural_fidelity,
+                score.tmqi.tmqi_naturalness
+            );
+        }
+    }
+}
+
+/// The scores `--score` offers.
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+pub enum ScoreArg {
+    Tmqi,
+}
+
+impl From<ScoreArg> for SheetScore {
+    fn from(arg: ScoreArg) -> Self {
+        match arg {
+            ScoreArg::Tmqi => Self::Tmqi,
+        }
+    }
+}
+
+/// The tile orders `--sort` offers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum SortArg {
+    Catalogue,
+    Score,
 }
 
 /// The adaptation transforms `--cat` offers (all but the identity, which would switch
@@ -182,6 +225,13 @@ pub fn run(args: &TonemapArgs) -> Result<(), String> {
         _ => return Err("tonemap needs IN, -o OUT and --op NAME (or --list)".to_string()),
     };
     let (exposure_ev, auto_exposure) = parse_exposure(&args.exposure)?;
+    let order = match (args.sort, args.score) {
+        (SortArg::Catalogue, _) => TileOrder::Catalogue,
+        (SortArg::Score, Some(_)) => TileOrder::ScoreDescending,
+        (SortArg::Score, None) => {
+            return Err("--sort score needs a score: add --score tmqi".to_string())
+        }
+    };
     let options = TonemapOptions {
         operator: OperatorChoice::parse(op).map_err(|e| format!("--op {op}: {e}"))?,
         params: parse_params(&args.params)?,
@@ -192,6 +242,8 @@ pub fn run(args: &TonemapArgs) -> Result<(), String> {
         exposure_ev,
         auto_exposure,
         luminance_scale_cd_m2: args.luminance_scale,
+        score: args.score.map(SheetScore::from),
+        order,
     };
     let report = tonemap_file(input, output, &options).map_err(|e| e.to_string())?;
     if args.json {

@@ -24,9 +24,11 @@ use crate::colour::{
     apply_white_balance, apply_with_source_white, illumination_white_xyz, map_gamut, GamutMethod,
     GamutTarget, SceneWhite, WhiteBalance, ILLUMINATION_LAYER,
 };
-use crate::metrics::tmqi::{tmqi_images, Tmqi};
+use crate::metrics::tmqi::{check_size, tmqi_images, Tmqi};
 use crate::metrics::{CompareOptions, Comparison, FlipMaps, PreparedReference};
-use crate::sheet::{contact_sheet_with_reports, SheetFailure};
+use crate::sheet::{
+    contact_sheet_scored, score_tmqi, SheetFailure, SheetOptions, SheetScore, TileOrder, TileScore,
+};
 use crate::tonemap::{ToneOperator, ToneParams, ToneReport};
 use prism_image::io::{read_image, write_image, ImageFormat};
 use prism_image::Image;
@@ -88,6 +90,11 @@ pub struct TonemapOptions {
     pub auto_exposure: bool,
     /// `--luminance-scale CD_M2`: cd/m² per unit, overriding `prism:cd_m2_per_unit`.
     pub luminance_scale_cd_m2: Option<f64>,
+    /// `--score tmqi`: score the output (each tile of a sheet) against the HDR input as the
+    /// operators see it (after exposure and white balance).
+    pub score: Option<SheetScore>,
+    /// `--sort score`: the sheet's tiles best first.
+    pub order: TileOrder,
 }
 
 impl Default for TonemapOptions {
@@ -102,6 +109,8 @@ impl Default for TonemapOptions {
             exposure_ev: 0.0,
             auto_exposure: false,
             luminance_scale_cd_m2: None,
+            score: None,
+            order: TileOrder::Catalogue,
         }
     }
 }
@@ -145,6 +154,9 @@ pub struct TonemapFileReport {
     pub failures: Vec<SheetFailure>,
     /// Input pixels with a NaN/∞ component (reported, mapped as black).
     pub non_finite_pixels: u64,
+    /// `--score`: which score, and one entry per scored operator in the sheet's tile order.
+    pub score: Option<SheetScore>,
+    pub scores: Vec<TileScore>,
     /// Fraction of pixels outside the target gamut before gamut mapping.
     pub gamut_fraction_outside: f64,
     pub timings: TonemapTimings,
@@ -223,25 +235,39 @@ pub fn tonemap_file(
         other => other,
     };
     let t = Instant::now();
-    let (mut out, tone, failures, sheet_outside) = match options.operator {
+    let sheet_options = SheetOptions {
+        target: options.target,
+        gamut: options.gamut,
+        score: options.score,
+        order: options.order,
+    };
+    let (mut out, tone, failures, sheet_outside, scores) = match options.operator {
         OperatorChoice::One(op) => {
+            match options.score {
+                Some(SheetScore::Tmqi) => {
+                    check_size(image.width(), image.height()).map_err(in_file)?
+                }
+                None => {}
+            }
             let result = op.apply(&image, &params).map_err(in_file)?;
-            (result.image, vec![result.report], Vec::new(), None)
+            let scores = match options.score {
+                Some(SheetScore::Tmqi) => vec![TileScore {
+                    operator: op.name(),
+                    tmqi: score_tmqi(&result.image, &image, &sheet_options).map_err(in_file)?,
+                }],
+                None => Vec::new(),
+            };
+            (result.image, vec![result.report], Vec::new(), None, scores)
         }
         OperatorChoice::All => {
-            let sheet = contact_sheet_with_reports(
-                &image,
-                &ToneOperator::ALL,
-                &params,
-                options.target,
-                options.gamut,
-            )
-            .map_err(in_file)?;
+            let sheet = contact_sheet_scored(&image, &ToneOperator::ALL, &params, &sheet_options)
+                .map_err(in_file)?;
             (
                 sheet.image,
                 sheet.reports,
                 sheet.failures,
                 Some(sheet.gamut_fraction_outside),
+                sheet.scores,
             )
         }
     };
@@ -273,6 +299,8 @@ pub fn tonemap_file(
         target: options.target.name(),
         non_finite_pixels: tone.first().map_or(0, |r| r.non_finite_pixels),
         tone,
+        score: options.score,
+        scores,
         failures,
         gamut_fraction_outside: sheet_outside.unwrap_or(gamut.fraction_outside),
         timings: TonemapTimings {

@@ -88,6 +88,16 @@ pub fn tmqi_images(ldr: &Image, hdr: &Image) -> Result<Tmqi> {
     tmqi(&ldr_y, &hdr_y, ldr.width(), ldr.height())
 }
 
+/// An error unless a `w × h` image is large enough for TMQI's 5 scales.
+pub fn check_size(w: usize, h: usize) -> Result<()> {
+    if w < MIN_SIDE_PX || h < MIN_SIDE_PX {
+        return Err(ImageError::invalid(format!(
+            "TMQI's 5 scales need images of at least {MIN_SIDE_PX}×{MIN_SIDE_PX} px, got {w}×{h}"
+        )));
+    }
+    Ok(())
+}
+
 /// TMQI of an LDR image's luminance in code values (0–255) against its HDR source's
 /// linear luminance, both `w × h` row-major.
 pub fn tmqi(ldr_y: &[f64], hdr_y: &[f64], w: usize, h: usize) -> Result<Tmqi> {
@@ -98,11 +108,7 @@ pub fn tmqi(ldr_y: &[f64], hdr_y: &[f64], w: usize, h: usize) -> Result<Tmqi> {
             hdr_y.len()
         )));
     }
-    if w < MIN_SIDE_PX || h < MIN_SIDE_PX {
-        return Err(ImageError::invalid(format!(
-            "TMQI's 5 scales need images of at least {MIN_SIDE_PX}×{MIN_SIDE_PX} px, got {w}×{h}"
-        )));
-    }
+    check_size(w, h)?;
     let (lo, hi) = hdr_y
         .iter()
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| {

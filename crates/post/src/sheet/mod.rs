@@ -16,6 +16,7 @@ use std::collections::BTreeMap;
 use serde::Serialize;
 
 use crate::colour::{map_gamut, GamutMethod, GamutTarget};
+use crate::metrics::tmqi::{self, tmqi_images, Tmqi};
 use crate::tonemap::{ToneOperator, ToneParams, ToneReport};
 use font5x7::{draw_text, ADVANCE, GLYPH_HEIGHT};
 use prism_image::Image;
@@ -37,6 +38,49 @@ pub struct SheetFailure {
     pub error: String,
 }
 
+/// What `--score` measures on each tile.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum SheetScore {
+    /// TMQI (Yeganeh & Wang 2013) of the operator's full-resolution output, gamut-mapped
+    /// into the target, against the HDR image the operators were given.
+    Tmqi,
+}
+
+impl SheetScore {
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Tmqi => "tmqi",
+        }
+    }
+}
+
+/// The order of the tiles.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TileOrder {
+    /// The order of the operator list ([`ToneOperator::ALL`] for `--op all`).
+    Catalogue,
+    /// Best score first; tiles without a score last, in catalogue order.
+    ScoreDescending,
+}
+
+/// How a sheet is mapped, scored and ordered.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SheetOptions {
+    pub target: GamutTarget,
+    pub gamut: GamutMethod,
+    pub score: Option<SheetScore>,
+    pub order: TileOrder,
+}
+
+/// One operator's score (`--score tmqi`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct TileScore {
+    pub operator: &'static str,
+    #[serde(flatten)]
+    pub tmqi: Tmqi,
+}
+
 /// A contact sheet with what each operator reported.
 #[derive(Debug, Clone)]
 pub struct ContactSheet {
@@ -45,6 +89,16 @@ pub struct ContactSheet {
     pub failures: Vec<SheetFailure>,
     /// Fraction of tile pixels outside the target gamut before mapping.
     pub gamut_fraction_outside: f64,
+    /// One per scored tile, in the sheet's tile order (empty without a score).
+    pub scores: Vec<TileScore>,
+}
+
+/// One labelled tile before placement.
+struct Tile {
+    /// `None` for an operator that failed (a grey tile).
+    pixels: Option<Vec<[f32; 3]>>,
+    label: String,
+    score: Option<TileScore>,
 }
 
 /// One tile per operator, labelled, gamut-clipped into `target` (see the module text).
@@ -66,6 +120,28 @@ pub fn contact_sheet_with_reports(
     target: GamutTarget,
     gamut: GamutMethod,
 ) -> Result<ContactSheet> {
+    contact_sheet_scored(
+        image,
+        operators,
+        params,
+        &SheetOptions {
+            target,
+            gamut,
+            score: None,
+            order: TileOrder::Catalogue,
+        },
+    )
+}
+
+/// [`contact_sheet_with_reports`] with an optional score under each tile and a tile order.
+/// TMQI needs an image of at least [`tmqi::MIN_SIDE_PX`] on each side: smaller ones are
+/// an error before any operator runs.
+pub fn contact_sheet_scored(
+    image: &Image,
+    operators: &[ToneOperator],
+    params: &ToneParams,
+    options: &SheetOptions,
+) -> Result<ContactSheet> {
     if operators.is_empty() {
         return Err(ImageError::invalid(
             "contact sheet: no operators to show".to_string(),
@@ -82,25 +158,21 @@ pub fn contact_sheet_with_reports(
             )));
         }
     }
+    match options.score {
+        Some(SheetScore::Tmqi) => tmqi::check_size(image.width(), image.height())?,
+        None => {}
+    }
     let factor = image.width().div_ceil(TILE_MAX_WIDTH).max(1);
     let (tw, th) = (
         image.width().div_ceil(factor),
         image.height().div_ceil(factor),
     );
-    let scale = if tw >= 480 { 2 } else { 1 };
-    let label_h = GLYPH_HEIGHT * scale + 2 * scale;
-    let cols = (operators.len() as f64).sqrt().ceil() as usize;
-    let rows = operators.len().div_ceil(cols);
-    let (sw, sh) = (
-        cols * (tw + GAP_PX) + GAP_PX,
-        rows * (th + label_h + GAP_PX) + GAP_PX,
-    );
-    let mut sheet = vec![BACKGROUND; sw * sh];
     let mut reports = Vec::new();
     let mut failures = Vec::new();
     let (mut outside, mut counted) = (0usize, 0usize);
     let mut buffer = Vec::new();
-    for (k, op) in operators.iter().enumerate() {
+    let mut tiles = Vec::with_capacity(operators.len());
+    for op in operators {
         let own = ToneParams {
             values: params
                 .values
@@ -110,29 +182,34 @@ pub fn contact_sheet_with_reports(
                 .collect(),
             ..params.clone()
         };
-        let (x0, y0) = (
-            GAP_PX + (k % cols) * (tw + GAP_PX),
-            GAP_PX + (k / cols) * (th + label_h + GAP_PX),
-        );
-        let label = match op.apply_into(image, &own, std::mem::take(&mut buffer)) {
+        let tile = match op.apply_into(image, &own, std::mem::take(&mut buffer)) {
             Ok(result) => {
-                let mut tile = downsample(&result.image, factor, tw, th);
-                let g = map_gamut(&mut tile, &result.image.color_space, target, gamut);
+                let score = match options.score {
+                    Some(SheetScore::Tmqi) => Some(TileScore {
+                        operator: op.name(),
+                        tmqi: score_tmqi(&result.image, image, options)?,
+                    }),
+                    None => None,
+                };
+                let mut pixels = downsample(&result.image, factor, tw, th);
+                let g = map_gamut(
+                    &mut pixels,
+                    &result.image.color_space,
+                    options.target,
+                    options.gamut,
+                );
                 outside += g.pixels_outside;
                 counted += g.pixel_count;
-                for y in 0..th {
-                    let row = &tile[y * tw..(y + 1) * tw];
-                    sheet[(y0 + y) * sw + x0..(y0 + y) * sw + x0 + tw].copy_from_slice(row);
-                }
                 let label = label_for(*op, &own.values, &result.report.values);
                 reports.push(result.report);
                 buffer = result.image.into_pixels();
-                label
+                Tile {
+                    pixels: Some(pixels),
+                    label,
+                    score,
+                }
             }
             Err(ImageError::Invalid(message)) => {
-                for y in 0..th {
-                    sheet[(y0 + y) * sw + x0..(y0 + y) * sw + x0 + tw].fill(FAILED_TILE);
-                }
                 let short = if op.info().absolute {
                     "needs --luminance-scale"
                 } else {
@@ -142,15 +219,73 @@ pub fn contact_sheet_with_reports(
                     operator: op.name(),
                     error: message,
                 });
-                format!("{}: {short}", op.name())
+                Tile {
+                    pixels: None,
+                    label: format!("{}: {short}", op.name()),
+                    score: None,
+                }
             }
             Err(other) => return Err(other),
         };
-        let max_chars = (tw / (ADVANCE * scale)).max(1);
-        let text: String = label.chars().take(max_chars).collect();
-        draw_text(&mut sheet, sw, (x0, y0 + th + scale), &text, scale, TEXT);
+        tiles.push(tile);
     }
-    let mut out = Image::new(sw, sh, sheet, target.space())?;
+    match options.order {
+        TileOrder::Catalogue => {}
+        // Stable: ties and unscored tiles keep the catalogue order.
+        TileOrder::ScoreDescending => tiles.sort_by(|a, b| {
+            let key = |t: &Tile| t.score.as_ref().map(|s| s.tmqi.tmqi);
+            match (key(a), key(b)) {
+                (Some(x), Some(y)) => y.total_cmp(&x),
+                (Some(_), None) => std::cmp::Ordering::Less,
+                (None, Some(_)) => std::cmp::Ordering::Greater,
+                (None, None) => std::cmp::Ordering::Equal,
+            }
+        }),
+    }
+
+    let scale = if tw >= 480 { 2 } else { 1 };
+    let lines = if options.score.is_some() { 2 } else { 1 };
+    let line_h = GLYPH_HEIGHT * scale + 2 * scale;
+    let label_h = lines * line_h;
+    let cols = (operators.len() as f64).sqrt().ceil() as usize;
+    let rows = operators.len().div_ceil(cols);
+    let (sw, sh) = (
+        cols * (tw + GAP_PX) + GAP_PX,
+        rows * (th + label_h + GAP_PX) + GAP_PX,
+    );
+    let mut sheet = vec![BACKGROUND; sw * sh];
+    let max_chars = (tw / (ADVANCE * scale)).max(1);
+    for (k, tile) in tiles.iter().enumerate() {
+        let (x0, y0) = (
+            GAP_PX + (k % cols) * (tw + GAP_PX),
+            GAP_PX + (k / cols) * (th + label_h + GAP_PX),
+        );
+        for y in 0..th {
+            let row = &mut sheet[(y0 + y) * sw + x0..(y0 + y) * sw + x0 + tw];
+            match &tile.pixels {
+                Some(pixels) => row.copy_from_slice(&pixels[y * tw..(y + 1) * tw]),
+                None => row.fill(FAILED_TILE),
+            }
+        }
+        let text: String = tile.label.chars().take(max_chars).collect();
+        draw_text(&mut sheet, sw, (x0, y0 + th + scale), &text, scale, TEXT);
+        if let Some(score) = &tile.score {
+            let text = format!(
+                "TMQI {:.3} S {:.3} N {:.3}",
+                score.tmqi.tmqi, score.tmqi.tmqi_structural_fidelity, score.tmqi.tmqi_naturalness
+            );
+            let text: String = text.chars().take(max_chars).collect();
+            draw_text(
+                &mut sheet,
+                sw,
+                (x0, y0 + th + line_h + scale),
+                &text,
+                scale,
+                TEXT,
+            );
+        }
+    }
+    let mut out = Image::new(sw, sh, sheet, options.target.space())?;
     out.metadata
         .insert("prism:contact_sheet".into(), operators.len().to_string());
     Ok(ContactSheet {
@@ -162,7 +297,27 @@ pub fn contact_sheet_with_reports(
         } else {
             0.0
         },
+        scores: tiles.into_iter().filter_map(|t| t.score).collect(),
     })
+}
+
+/// TMQI of an operator's full-resolution output, gamut-mapped into the target as a
+/// single-operator `prism tonemap` would write it, against the operators' input.
+pub fn score_tmqi(tone_mapped: &Image, hdr: &Image, options: &SheetOptions) -> Result<Tmqi> {
+    let mut pixels = tone_mapped.pixels().to_vec();
+    map_gamut(
+        &mut pixels,
+        &tone_mapped.color_space,
+        options.target,
+        options.gamut,
+    );
+    let ldr = Image::new(
+        tone_mapped.width(),
+        tone_mapped.height(),
+        pixels,
+        options.target.space(),
+    )?;
+    tmqi_images(&ldr, hdr)
 }
 
 /// `name k=v …`: each parameter's given value, else the value the operator resolved (in
