@@ -344,3 +344,67 @@ fn per_pixel_plans_converge_side_by_side() {
         assert_eq!(last["spp"], 16, "{plan}: {last}");
     }
 }
+
+/// `--report` writes one self-contained page: the chart inlined, the methods table with
+/// each method's last checkpoint (the numbers of `--json`), and per method a viewer of its
+/// image against the reference with three error maps. The light-path estimators (bdpt)
+/// run through converge's planner too (pixels that share a start are one ordinary pass).
+#[test]
+fn report_holds_the_chart_the_table_and_every_method_s_images() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = small_scene(dir.path(), "small.json", 0.6);
+    let reference = dir.path().join("reference.exr");
+    let o = prism(&["render", s(&scene), "-o", s(&reference), "--spp", "64"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (json, html) = (dir.path().join("data.json"), dir.path().join("study.html"));
+    let o = prism(&[
+        "converge",
+        s(&scene),
+        "--reference",
+        s(&reference),
+        "--method",
+        "path",
+        "--method",
+        "bdpt",
+        "--max-spp",
+        "8",
+        "--checkpoints",
+        "3",
+        "--json",
+        s(&json),
+        "--report",
+        s(&html),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let page = support::html_report::check_report(&std::fs::read_to_string(&html).unwrap());
+    assert_eq!(page.inline_svgs, 1, "the chart");
+    assert_eq!((page.viewers, page.exposure_controls), (2, 2));
+    // Per method: A and B as RGBE pairs (4 PNGs of 24×16), HDR-FLIP, LDR-FLIP, ΔE2000.
+    assert_eq!(page.images.len(), 2 * 7, "{:?}", page.images);
+    assert_eq!(page.images.iter().filter(|s| **s == (24, 16)).count(), 8);
+    let data = read_json(&json);
+    let table = &page.tables[0];
+    assert_eq!(table[0][0], "method");
+    for (row, method) in table[1..].iter().zip(data["methods"].as_array().unwrap()) {
+        assert_eq!(row[0], method["method"].as_str().unwrap());
+        assert_eq!(row[1], method["final"]["spp"].to_string());
+        let relmse: f64 = row[4].parse().unwrap();
+        let want = method["final"]["relmse"].as_f64().unwrap();
+        assert!((relmse - want).abs() <= 1e-4 * want, "{relmse} vs {want}");
+    }
+    // Checked before anything renders.
+    let o = prism(&[
+        "converge",
+        s(&scene),
+        "--reference",
+        s(&reference),
+        "--report",
+        s(&dir.path().join("study.txt")),
+    ]);
+    assert!(!o.status.success());
+    assert!(
+        stderr(&o).contains("expected an .html file name"),
+        "{}",
+        stderr(&o)
+    );
+}

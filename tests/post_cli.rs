@@ -801,3 +801,92 @@ fn compare_tmqi_scores_a_tone_mapped_png_and_refuses_other_pairings() {
         &["192×180", "40×30"],
     );
 }
+
+/// `compare --report` writes one self-contained page whose table carries `--json`'s
+/// numbers: for two EXRs a viewer with an exposure control, the A and B images as RGBE
+/// pairs and the HDR-FLIP, LDR-FLIP and ΔE2000 maps; for two PNGs no exposure control and
+/// no HDR-FLIP map. Bad report paths are refused before the comparison.
+#[test]
+fn compare_report_is_one_self_contained_page() {
+    let a = rendered_exr();
+    let b = scratch("room-16spp.exr");
+    ok(&[
+        "render",
+        "scenes/cameras/pinhole.json",
+        "--resolution",
+        "48x32",
+        "--spp",
+        "16",
+        "-o",
+        b.to_str().unwrap(),
+    ]);
+    let html = scratch("report.html");
+    let (a, b, html_s) = (
+        a.to_str().unwrap(),
+        b.to_str().unwrap(),
+        html.to_str().unwrap(),
+    );
+    let json: Value =
+        serde_json::from_str(&ok(&["compare", a, b, "--report", html_s, "--json"])).unwrap();
+    let page = support::html_report::check_report(&std::fs::read_to_string(&html).unwrap());
+    assert_eq!((page.viewers, page.exposure_controls), (1, 1));
+    assert_eq!(page.images.len(), 7, "{:?}", page.images);
+    assert_eq!(page.images.iter().filter(|s| **s == (48, 32)).count(), 4);
+    let table: std::collections::HashMap<&str, &str> = page.tables[0]
+        .iter()
+        .map(|row| (row[0].as_str(), row[1].as_str()))
+        .collect();
+    for (name, key) in [
+        ("relMSE", "relmse"),
+        ("ΔE2000 mean", "delta_e2000_mean"),
+        ("LDR-FLIP mean", "ldr_flip_mean"),
+        ("HDR-FLIP mean", "hdr_flip_mean"),
+    ] {
+        let shown: f64 = table[name].parse().unwrap();
+        let want = json[key].as_f64().unwrap();
+        assert!(
+            (shown - want).abs() <= 1e-5 * want.abs().max(1.0),
+            "{name}: {shown} vs {want}"
+        );
+    }
+
+    let (pa, pb) = (scratch("report-a.png"), scratch("report-b.png"));
+    for (exr, png) in [(a, &pa), (b, &pb)] {
+        ok(&[
+            "tonemap",
+            exr,
+            "-o",
+            png.to_str().unwrap(),
+            "--op",
+            "reinhard02",
+        ]);
+    }
+    ok(&[
+        "compare",
+        pa.to_str().unwrap(),
+        pb.to_str().unwrap(),
+        "--report",
+        html_s,
+    ]);
+    let page = support::html_report::check_report(&std::fs::read_to_string(&html).unwrap());
+    assert_eq!((page.viewers, page.exposure_controls), (1, 0));
+    assert_eq!(
+        page.images.len(),
+        4,
+        "A, B, LDR-FLIP, ΔE2000: {:?}",
+        page.images
+    );
+
+    fails_with(
+        &["compare", a, b, "--report", "report.txt"],
+        &["--report", ".html"],
+    );
+    fails_with(
+        &["compare", a, b, "--report", "/no/such/dir/r.html"],
+        &["/no/such/dir", "does not exist"],
+    );
+    fails_with(
+        &["compare", a, b, "--tmqi", "--report", html_s],
+        &["--report"],
+    );
+}

@@ -9,7 +9,7 @@ use prism_image::io::{write_image, ImageFormat};
 use prism_post::metrics::flip::DEFAULT_PPD;
 use prism_post::metrics::tmqi::Tmqi;
 use prism_post::metrics::{CompareOptions, Comparison, FlipMaps};
-use prism_post::pipeline::{compare_files_with, tmqi_files};
+use prism_post::pipeline::{compare_files_report, compare_files_with, tmqi_files};
 
 /// Which FLIP map `--error-map` writes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -41,10 +41,15 @@ pub struct CompareArgs {
     /// LDR-FLIP for two PNGs.
     #[arg(long, value_enum, requires = "error_map")]
     pub error_map_kind: Option<ErrorMapKind>,
+    /// Write a self-contained HTML page (images embedded, no network): A and B in a
+    /// viewer that flips, splits and zooms (with an exposure control for EXR/HDR), the
+    /// FLIP and ΔE2000 maps with legends, and the metric table.
+    #[arg(long, value_name = "OUT.html")]
+    pub report: Option<PathBuf>,
     /// TMQI (Yeganeh & Wang 2013) of A, a tone-mapped PNG, against B, its HDR source (EXR
     /// or HDR), instead of the error metrics: tmqi, tmqi_structural_fidelity,
     /// tmqi_naturalness.
-    #[arg(long, conflicts_with_all = ["error_map", "error_map_kind"])]
+    #[arg(long, conflicts_with_all = ["error_map", "error_map_kind", "report"])]
     pub tmqi: bool,
     #[command(flatten)]
     pub simd: crate::simd::SimdArgs,
@@ -118,6 +123,33 @@ fn write_error_map(args: &CompareArgs, out: &Path, maps: &FlipMaps) -> Result<()
     write_image(out, &image).map_err(|e| e.to_string())
 }
 
+/// `--report` must name an `.html` file in an existing directory: checked before the
+/// comparison runs.
+pub fn check_report_path(path: &Path) -> Result<(), String> {
+    let html = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("html") || e.eq_ignore_ascii_case("htm"));
+    if !html {
+        return Err(format!(
+            "--report {}: expected an .html file name",
+            path.display()
+        ));
+    }
+    let parent = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    if !parent.is_dir() {
+        return Err(format!(
+            "--report {}: the directory {} does not exist",
+            path.display(),
+            parent.display()
+        ));
+    }
+    Ok(())
+}
+
 fn print_tmqi(t: &Tmqi) {
     println!("{:<26}{:>10.6}", "TMQI", t.tmqi);
     println!(
@@ -150,10 +182,19 @@ pub fn run(args: &CompareArgs) -> Result<(), String> {
         flip_ppd: Some(args.ppd),
         ..CompareOptions::default()
     };
-    let (comparison, maps) =
-        compare_files_with(&args.test, &args.reference, &options).map_err(|e| e.to_string())?;
-    if let (Some(out), Some(maps)) = (&args.error_map, &maps) {
+    if let Some(report) = &args.report {
+        check_report_path(report)?;
+    }
+    let (comparison, maps) = match &args.report {
+        Some(report) => compare_files_report(&args.test, &args.reference, &options, report),
+        None => compare_files_with(&args.test, &args.reference, &options),
+    }
+    .map_err(|e| e.to_string())?;
+    if let (Some(out), Some(maps)) = (&args.error_map, &maps.flip) {
         write_error_map(args, out, maps)?;
+    }
+    if let Some(report) = &args.report {
+        eprintln!("wrote {}", report.display());
     }
     if args.json {
         let text = serde_json::to_string_pretty(&comparison).map_err(|e| e.to_string())?;

@@ -2,6 +2,8 @@
 //! `mod support;` and uses what it needs.
 #![allow(dead_code)]
 
+pub mod html_report;
+
 use std::path::Path;
 use std::process::{Command, Output};
 

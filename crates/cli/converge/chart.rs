@@ -199,6 +199,18 @@ where
     root.present().map_err(err)
 }
 
+/// The chart as SVG text (what `-o CHART.svg` writes; the HTML report inlines it).
+pub fn chart_svg(title: &str, x_axis: &str, curves: &[Curve]) -> Result<String, String> {
+    register_font()?;
+    let (w, h) = CHART_SIZE_PX;
+    let mut text = String::new();
+    {
+        let root = SVGBackend::with_string(&mut text, (w, h)).into_drawing_area();
+        draw(&root, title, x_axis, curves)?;
+    }
+    Ok(text)
+}
+
 /// Draws the chart to `path` (.png or .svg) atomically.
 pub fn write_chart(path: &Path, title: &str, x_axis: &str, curves: &[Curve]) -> Result<(), String> {
     register_font()?;
@@ -208,14 +220,7 @@ pub fn write_chart(path: &Path, title: &str, x_axis: &str, curves: &[Curve]) -> 
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase);
     let bytes = match ext.as_deref() {
-        Some("svg") => {
-            let mut text = String::new();
-            {
-                let root = SVGBackend::with_string(&mut text, (w, h)).into_drawing_area();
-                draw(&root, title, x_axis, curves)?;
-            }
-            text.into_bytes()
-        }
+        Some("svg") => chart_svg(title, x_axis, curves)?.into_bytes(),
         Some("png") => {
             let mut rgb = vec![0u8; w as usize * h as usize * 3];
             {

@@ -12,6 +12,7 @@ mod method;
 mod pass_planner;
 mod progressive;
 mod reference;
+mod report;
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -90,6 +91,11 @@ pub struct ConvergeArgs {
     pub overhead: bool,
     /// Write each method's last checkpoint image as EXR into this directory
     /// (`<n>-<method>.exr`), e.g. to check the numbers with `prism compare`.
+    /// Write the study as one self-contained HTML page (images embedded): the chart, the
+    /// methods' last checkpoints in a table, and each method's last image against the
+    /// reference in a viewer with its FLIP and ΔE2000 maps.
+    #[arg(long, value_name = "OUT.html")]
+    pub report: Option<PathBuf>,
     #[arg(long = "save-final", value_name = "DIR")]
     pub save_final: Option<PathBuf>,
     /// For `path+oracle`: an EXR with a `variance.Y` layer (what `prism render -o X.exr`
@@ -172,8 +178,13 @@ fn check_parent(what: &str, path: &Path) -> Result<(), String> {
 }
 
 fn check_arguments(args: &ConvergeArgs) -> Result<Budget, String> {
-    if args.outputs.is_empty() && args.json.is_none() {
-        return Err("nothing to write: give a chart with -o CHART.png|svg and/or --json".into());
+    if args.outputs.is_empty() && args.json.is_none() && args.report.is_none() {
+        return Err(
+            "nothing to write: give a chart with -o CHART.png|svg, --json and/or --report".into(),
+        );
+    }
+    if let Some(r) = &args.report {
+        crate::compare::check_report_path(r)?;
     }
     for o in &args.outputs {
         let ext = o
@@ -432,6 +443,7 @@ pub fn run(args: &ConvergeArgs) -> Result<(), String> {
     };
     let mut curves = Vec::new();
     let mut methods_json = Vec::new();
+    let mut report_entries = Vec::new();
     for (index, (method, integrator)) in methods.iter().zip(&integrators).enumerate() {
         scene.integrator = *integrator;
         let settings = RenderSettings {
@@ -509,6 +521,17 @@ pub fn run(args: &ConvergeArgs) -> Result<(), String> {
         if let Some(dir) = &args.save_final {
             let path = dir.join(format!("{index}-{}.exr", file_label(method)));
             write_image(&path, &film_to_image(&run.film)?).map_err(|e| e.to_string())?;
+        }
+        if args.report.is_some() {
+            report_entries.push(report::MethodEntry::new(
+                &method.label,
+                last.spp,
+                args.clock.of(last),
+                fits[1].map(|f| f.slope),
+                time_to_target,
+                &film_to_image(&run.film)?,
+                &prepared,
+            )?);
         }
         let slope_text = |f: &Option<PowerFit>| {
             f.as_ref()
@@ -612,6 +635,34 @@ pub fn run(args: &ConvergeArgs) -> Result<(), String> {
     for o in &args.outputs {
         chart::write_chart(o, &title, args.clock.axis(), &curves)?;
         eprintln!("wrote {}", o.display());
+    }
+    if let Some(path) = &args.report {
+        let intro = format!(
+            "{} at {}×{} px against a {} reference. Budget per method: {} ({}). The \
+             table and the images are each method's last checkpoint; the viewer shows it \
+             (A, left) against the reference (B, right).",
+            args.scene.display(),
+            resolution.x,
+            resolution.y,
+            reference_json["source"].as_str().unwrap_or("given"),
+            match (budget.time_s.is_finite(), budget.max_spp) {
+                (true, Some(spp)) => format!("{} s or {spp} spp", budget.time_s),
+                (true, None) => format!("{} s", budget.time_s),
+                (false, Some(spp)) => format!("{spp} spp"),
+                (false, None) => "none".into(),
+            },
+            args.clock.axis(),
+        );
+        let page = report::converge_page(
+            &title,
+            intro,
+            chart::chart_svg(&title, args.clock.axis(), &curves)?,
+            &reference,
+            prism_post::auto_exposure::auto_exposure_ev(&reference).unwrap_or(0.0),
+            std::mem::take(&mut report_entries),
+        )?;
+        prism_post::report::write_report(path, &page).map_err(|e| e.to_string())?;
+        eprintln!("wrote {}", path.display());
     }
     if let Some(path) = &args.json {
         let value = json!({

@@ -193,6 +193,7 @@ pub fn run_method(
                             &CompareOptions {
                                 ssim: false,
                                 flip_ppd: None,
+                                delta_e2000_map: false,
                             },
                         )
                         .map_err(|e| e.to_string())

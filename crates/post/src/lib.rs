@@ -10,6 +10,7 @@ pub mod colour;
 pub mod falsecolour;
 pub mod metrics;
 pub mod pipeline;
+pub mod report;
 pub mod sheet;
 pub mod tonemap;
 

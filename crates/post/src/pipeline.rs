@@ -25,7 +25,9 @@ use crate::colour::{
     GamutTarget, SceneWhite, WhiteBalance, ILLUMINATION_LAYER,
 };
 use crate::metrics::tmqi::{check_size, tmqi_images, Tmqi};
-use crate::metrics::{CompareOptions, Comparison, FlipMaps, PreparedReference};
+use crate::metrics::{CompareOptions, Comparison, ErrorMaps, PreparedReference};
+use crate::report::compare_page::{compare_page, CompareInput};
+use crate::report::write_report;
 use crate::sheet::{
     contact_sheet_scored, score_tmqi, SheetFailure, SheetOptions, SheetScore, TileOrder, TileScore,
 };
@@ -380,12 +382,66 @@ pub fn tmqi_files(ldr: &Path, hdr: &Path) -> Result<Tmqi> {
     tmqi_images(&read_image(ldr)?, &read_image(hdr)?)
 }
 
-/// [`compare_files`] with a choice of metrics, and the FLIP maps when FLIP is asked for.
+/// [`compare_files`] with a choice of metrics, and the maps asked for.
 pub fn compare_files_with(
     test: &Path,
     reference: &Path,
     options: &CompareOptions,
-) -> Result<(Comparison, Option<FlipMaps>)> {
+) -> Result<(Comparison, ErrorMaps)> {
+    let (a, b) = read_pair(test, reference)?;
+    PreparedReference::new(&b).compare_with_maps(&a, options)
+}
+
+/// [`compare_files_with`] (FLIP and the ΔE2000 map always computed) that also writes the
+/// HTML report of the comparison to `report` (report/compare_page.rs), atomically. EXR and
+/// HDR inputs are shown scene-referred (with an exposure control), PNGs as they are.
+pub fn compare_files_report(
+    test: &Path,
+    reference: &Path,
+    options: &CompareOptions,
+    report: &Path,
+) -> Result<(Comparison, ErrorMaps)> {
+    let (a, b) = read_pair(test, reference)?;
+    let options = CompareOptions {
+        flip_ppd: Some(
+            options
+                .flip_ppd
+                .unwrap_or(crate::metrics::flip::DEFAULT_PPD),
+        ),
+        delta_e2000_map: true,
+        ..*options
+    };
+    let (comparison, maps) = PreparedReference::new(&b).compare_with_maps(&a, &options)?;
+    let scene_referred = |path: &Path| match ImageFormat::from_path(path) {
+        Ok(ImageFormat::Exr | ImageFormat::Hdr) => true,
+        Ok(ImageFormat::Png) | Err(_) => false,
+    };
+    let label = |path: &Path| {
+        path.file_name().map_or_else(
+            || path.display().to_string(),
+            |n| n.to_string_lossy().into_owned(),
+        )
+    };
+    let page = compare_page(
+        &CompareInput {
+            label: label(test),
+            image: &a,
+            scene_referred: scene_referred(test),
+        },
+        &CompareInput {
+            label: label(reference),
+            image: &b,
+            scene_referred: scene_referred(reference),
+        },
+        &comparison,
+        &maps,
+    )?;
+    write_report(report, &page)?;
+    Ok((comparison, maps))
+}
+
+/// The images at `test` and `reference`; an error naming both when their sizes differ.
+pub fn read_pair(test: &Path, reference: &Path) -> Result<(Image, Image)> {
     let a = read_image(test)?;
     let b = read_image(reference)?;
     if (a.width(), a.height()) != (b.width(), b.height()) {
@@ -399,5 +455,5 @@ pub fn compare_files_with(
             b.height()
         )));
     }
-    PreparedReference::new(&b).compare_with_maps(&a, options)
+    Ok((a, b))
 }

@@ -103,6 +103,12 @@ pub(crate) fn write_stream_atomically(
     })
 }
 
+/// Writes `bytes` to `path` atomically (a temporary sibling, then a rename): readers see
+/// the old file or the whole new one, never a part.
+pub fn write_bytes_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
+    write_stream_atomically(path, |out| out.write_all(bytes))
+}
+
 /// The built-in colour space whose primaries and white match `primaries_xy`/`white_xy`
 /// within 5e-4 (the precision files usually print), else a linear space built from them.
 pub fn color_space_from_chromaticities(

@@ -91,6 +91,15 @@ pub struct FlipMaps {
     pub hdr: FlipMap,
 }
 
+/// The per-pixel maps behind a [`Comparison`], as far as they were asked for.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct ErrorMaps {
+    /// LDR-FLIP and HDR-FLIP (with [`CompareOptions::flip_ppd`]).
+    pub flip: Option<FlipMaps>,
+    /// ΔE2000 per pixel, row-major (with [`CompareOptions::delta_e2000_map`]).
+    pub delta_e2000: Option<Vec<f32>>,
+}
+
 /// Which of the costlier metrics `compare_with` computes.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CompareOptions {
@@ -101,6 +110,9 @@ pub struct CompareOptions {
     /// 4K pair costs about as much as the other metrics together, times HDR-FLIP's
     /// exposure count).
     pub flip_ppd: Option<f64>,
+    /// Keep the per-pixel ΔE2000 map ([`ErrorMaps::delta_e2000`]; 4 bytes per pixel more):
+    /// the HTML report shows it.
+    pub delta_e2000_map: bool,
 }
 
 impl Default for CompareOptions {
@@ -108,6 +120,7 @@ impl Default for CompareOptions {
         Self {
             ssim: true,
             flip_ppd: Some(flip::DEFAULT_PPD),
+            delta_e2000_map: false,
         }
     }
 }
@@ -279,6 +292,7 @@ mod tests {
             &CompareOptions {
                 ssim: false,
                 flip_ppd: None,
+                delta_e2000_map: false,
             },
         )
         .unwrap();

@@ -15,7 +15,8 @@ use rayon::prelude::*;
 
 use super::ciede2000::{delta_e_2000_block, lab_block, LabBlock, LabConverter, BLOCK};
 use super::{
-    flip, ssim, CompareOptions, Comparison, FlipMaps, FlipSummary, PerChannel, RELMSE_EPSILON,
+    flip, ssim, CompareOptions, Comparison, ErrorMaps, FlipMaps, FlipSummary, PerChannel,
+    RELMSE_EPSILON,
 };
 use crate::tonemap::kernels::avx2;
 use crate::tonemap::pixels::{sanitise, CHUNK};
@@ -132,12 +133,12 @@ impl PreparedReference {
         self.compare_with_maps(test, options).map(|(c, _)| c)
     }
 
-    /// [`Self::compare`] and, when FLIP is asked for, its per-pixel maps.
+    /// [`Self::compare`] and the per-pixel maps asked for (FLIP's, ΔE2000's).
     pub fn compare_with_maps(
         &self,
         test: &Image,
         options: &CompareOptions,
-    ) -> Result<(Comparison, Option<FlipMaps>)> {
+    ) -> Result<(Comparison, ErrorMaps)> {
         if let Some(ppd) = options.flip_ppd {
             flip::check_ppd(ppd)?;
         }
@@ -200,6 +201,10 @@ impl PreparedReference {
             None
         };
 
+        // Before the selection below reorders `de`.
+        let delta_e2000_map = options
+            .delta_e2000_map
+            .then(|| de.par_iter().map(|&d| d as f32).collect::<Vec<f32>>());
         let rank = ((0.95 * de.len() as f64).ceil() as usize).clamp(1, de.len()) - 1;
         let (_, p95, _) = de.select_nth_unstable_by(rank, f64::total_cmp);
         let de_p95 = *p95;
@@ -231,7 +236,13 @@ impl PreparedReference {
             non_finite_pixels: sums.non_finite + self.non_finite,
             flip,
         };
-        Ok((comparison, maps))
+        Ok((
+            comparison,
+            ErrorMaps {
+                flip: maps,
+                delta_e2000: delta_e2000_map,
+            },
+        ))
     }
 
     /// LDR-FLIP and HDR-FLIP of `test` (in the reference's colour space) on Rec.709.
@@ -369,6 +380,7 @@ mod tests {
                 &CompareOptions {
                     ssim: false,
                     flip_ppd: None,
+                    delta_e2000_map: false,
                 },
             )
             .unwrap();

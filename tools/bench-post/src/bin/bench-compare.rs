@@ -83,6 +83,7 @@ fn main() {
     let options = CompareOptions {
         ssim: false,
         flip_ppd: None,
+        delta_e2000_map: false,
     };
     let (mut prep, mut cmp, mut full, mut sse) = (vec![], vec![], vec![], vec![]);
     let mut last = None;
