@@ -342,6 +342,29 @@ fn per_pixel_plans_converge_side_by_side() {
         assert_eq!(m["plan"], plan, "{m}");
         let last = m["checkpoints"].as_array().unwrap().last().unwrap().clone();
         assert_eq!(last["spp"], 16, "{plan}: {last}");
+        // The predictor's CPU time, tables apart, only where it ran.
+        for key in ["tables_cpu_s", "predict_cpu_s"] {
+            match plan {
+                "predicted" => assert!(m[key].as_f64().unwrap() > 0.0, "{key}: {m}"),
+                _ => assert!(m[key].is_null(), "{plan} {key}"),
+            }
+        }
+        // Ratios against the first method, at its checkpoints inside this one's range.
+        match plan {
+            "uniform" => assert!(m.get("ratios").is_none()),
+            _ => {
+                let r = &m["ratios"];
+                assert_eq!(r["against"], "path");
+                assert_eq!(r["time_to_relmse"].as_array().unwrap().len(), 3);
+                for row in r["relmse_at_equal_time"].as_array().unwrap() {
+                    let (a, t) = (
+                        row["against"].as_f64().unwrap(),
+                        row["this"].as_f64().unwrap(),
+                    );
+                    assert!((row["ratio"].as_f64().unwrap() - a / t).abs() <= 1e-12 * a / t);
+                }
+            }
+        }
     }
 }
 

@@ -11,6 +11,7 @@ mod fit;
 mod method;
 mod pass_planner;
 mod progressive;
+mod ratios;
 mod reference;
 mod report;
 
@@ -576,6 +577,14 @@ pub fn run(args: &ConvergeArgs) -> Result<(), String> {
             },
             "legend": legend,
             "time_to_relmse_target_s": time_to_target,
+            "tables_cpu_s": run.predictor_cpu.map(|p| p.tables_cpu_s),
+            "predict_cpu_s": run.predictor_cpu.map(|p| p.predict_cpu_s),
+            // The issue's budget for the predictor: its CPU time (tables apart) as a share
+            // of the method's time to the relMSE target, on the CPU clock only.
+            "predict_cpu_fraction_of_time_to_target": match (run.predictor_cpu, time_to_target, args.clock) {
+                (Some(p), Some(t), Clock::Cpu) if t > 0.0 => Some(p.predict_cpu_s / t),
+                _ => None,
+            },
             "final": checkpoint_json(last),
             "render_wall_s": run.render_wall_s,
             "cpu_s": run.cpu_s,
@@ -615,6 +624,15 @@ pub fn run(args: &ConvergeArgs) -> Result<(), String> {
                  --reference-spp)",
                 method.label, last.spp, args.reference_spp
             );
+        }
+    }
+    // Each method against the first, on the run's clock (relMSE).
+    let relmse_series =
+        |c: &Curve| -> Vec<(f64, f64)> { c.points.iter().map(|p| (p.0, p.1[1])).collect() };
+    if let Some((first, rest)) = curves.split_first() {
+        let against = relmse_series(first);
+        for (json, curve) in methods_json.iter_mut().skip(1).zip(rest) {
+            json["ratios"] = ratios::ratios(&first.label, &against, &relmse_series(curve));
         }
     }
     let title = args.title.clone().unwrap_or_else(|| {

@@ -8,10 +8,20 @@
 use glam::UVec2;
 use prism_bandwidth::{adaptive_pass_counts, Allocated};
 use prism_render::adaptive::{PerPixelPasses, ADAPTIVE_FIRST_PASS_SPP};
-use prism_render::predictor::{predict, PredictorSettings};
+use prism_render::predictor::{predict_with_probe, PredictorSettings};
+use prism_render::probe::RenderProbe;
 use prism_render::{Film, RenderScene, RenderSettings, RenderStats};
 
 use super::method::PlanKind;
+use super::progressive::process_cpu_s;
+
+/// Process CPU time the predictor took (`predicted` plans), s: its BSDF and environment
+/// tables apart from the per-pixel prediction (the "tables apart, cached").
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PredictorCpu {
+    pub tables_cpu_s: f64,
+    pub predict_cpu_s: f64,
+}
 
 /// The mean spp the predicted plan's densities are computed for (its anti-aliasing
 /// minimums depend on the budget; the densities are then scaled to each checkpoint).
@@ -22,6 +32,8 @@ pub struct PassPlanner {
     kind: PlanKind,
     passes: PerPixelPasses,
     allocated: Option<Allocated>,
+    /// `None` unless the plan is `predicted` and the platform has a process clock.
+    pub predictor_cpu: Option<PredictorCpu>,
     seed: u64,
     pass_count: u32,
 }
@@ -35,10 +47,22 @@ impl PassPlanner {
         settings: &RenderSettings,
         oracle: Option<&Allocated>,
     ) -> Result<Self, String> {
+        let mut predictor_cpu = None;
         let allocated = match kind {
             PlanKind::Predicted => {
                 let predictor = PredictorSettings::defaults(PREDICTED_PLAN_SPP, settings.seed);
-                Some(predict(scene, &predictor, settings.seed)?.allocated)
+                let start = process_cpu_s();
+                let probe = RenderProbe::new(scene, settings.seed).with_bandwidth_tables()?;
+                let tables_done = process_cpu_s();
+                let prediction = predict_with_probe(scene, &predictor, probe)?;
+                predictor_cpu = match (start, tables_done, process_cpu_s()) {
+                    (Some(a), Some(b), Some(c)) => Some(PredictorCpu {
+                        tables_cpu_s: b - a,
+                        predict_cpu_s: c - b,
+                    }),
+                    _ => None,
+                };
+                Some(prediction.allocated)
             }
             PlanKind::Oracle => Some(
                 oracle
@@ -51,6 +75,7 @@ impl PassPlanner {
             kind,
             passes: PerPixelPasses::new(scene, settings, kind == PlanKind::Adaptive),
             allocated,
+            predictor_cpu,
             seed: settings.seed,
             pass_count: 0,
         })

@@ -100,6 +100,8 @@ pub struct MethodRun {
     pub metric_cpu_s: f64,
     /// Wall time the render thread spent copying the film at checkpoints, s.
     pub snapshot_wall_s: f64,
+    /// The predictor's CPU time (`predicted` plans; inside the method's clock).
+    pub predictor_cpu: Option<super::pass_planner::PredictorCpu>,
 }
 
 #[cfg(unix)]
@@ -270,11 +272,13 @@ pub fn run_method(
             (Some(a), Some(b)) => Some(b - a),
             _ => None,
         };
+        let predictor_cpu = planner.predictor_cpu;
         Ok(MethodRun {
             checkpoints,
             stats,
             render_wall_s,
             cpu_s,
+            predictor_cpu,
             film: planner.into_film(),
             metric_cpu_s: metric_cpu_ns.load(Ordering::Relaxed) as f64 * 1e-9,
             snapshot_wall_s,

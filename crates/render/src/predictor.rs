@@ -244,11 +244,24 @@ pub fn predict(
     settings: &PredictorSettings,
     seed: u64,
 ) -> Result<Prediction, String> {
+    predict_with_probe(
+        scene,
+        settings,
+        RenderProbe::new(scene, seed).with_bandwidth_tables()?,
+    )
+}
+
+/// [`predict`] with a probe whose BSDF and environment tables are built already (so that
+/// a caller can time the tables apart from the per-pixel prediction).
+pub fn predict_with_probe<'a>(
+    scene: &'a RenderScene,
+    settings: &PredictorSettings,
+    mut probe: RenderProbe<'a>,
+) -> Result<Prediction, String> {
     if settings.probe_samples == 0 {
         return Err("--plan-nb must be at least 1".into());
     }
     let resolution = scene.resolution;
-    let mut probe = RenderProbe::new(scene, seed).with_bandwidth_tables()?;
     probe.trace_visibility = settings.visibility;
     // Infinite lights seen directly: the background's own angular bandwidth.
     let background_nu_a = scene
