@@ -70,8 +70,66 @@ fn exr_error(path: &Path, action: &'static str, e: ::exr::error::Error) -> Image
     }
 }
 
+/// The most decoded sample bytes an EXR file may need unless
+/// [`set_exr_decode_limit_bytes`] says otherwise (16 GiB: a 16384² image with 16 float
+/// channels).
+pub const DEFAULT_EXR_DECODE_LIMIT_BYTES: u64 = 16 << 30;
+
+static EXR_DECODE_LIMIT_BYTES: std::sync::atomic::AtomicU64 =
+    std::sync::atomic::AtomicU64::new(DEFAULT_EXR_DECODE_LIMIT_BYTES);
+
+/// Sets the most decoded sample bytes an EXR file may need (the CLI passes its memory
+/// limit; the fuzz tests a small one). Files whose headers declare more are refused
+/// before any pixel is allocated.
+pub fn set_exr_decode_limit_bytes(bytes: u64) {
+    EXR_DECODE_LIMIT_BYTES.store(bytes, std::sync::atomic::Ordering::Relaxed);
+}
+
+/// The current limit ([`set_exr_decode_limit_bytes`]).
+pub fn exr_decode_limit_bytes() -> u64 {
+    EXR_DECODE_LIMIT_BYTES.load(std::sync::atomic::Ordering::Relaxed)
+}
+
+/// Reads the headers and refuses a file whose parts would need more sample memory than
+/// the limit (a corrupt or hostile data window would otherwise be allocated as it is).
+fn check_declared_size(path: &Path) -> Result<()> {
+    let meta = ::exr::meta::MetaData::read_from_file(path, false)
+        .map_err(|e| exr_error(path, "read the header of", e))?;
+    let mut bytes: u128 = 0;
+    for header in &meta.headers {
+        let (w, h) = (header.layer_size.0 as u128, header.layer_size.1 as u128);
+        let per_pixel: u128 = header
+            .channels
+            .list
+            .iter()
+            .map(|c| c.sample_type.bytes_per_sample() as u128)
+            .sum();
+        bytes += w * h * per_pixel;
+    }
+    let limit = exr_decode_limit_bytes();
+    if bytes > u128::from(limit) {
+        let first = meta
+            .headers
+            .first()
+            .map_or((0, 0), |h| (h.layer_size.0, h.layer_size.1));
+        return Err(ImageError::format(
+            path,
+            format!(
+                "the header declares {} bytes of samples ({}×{} in the first of {} parts): \
+                 more than the {limit}-byte limit for decoding an EXR (--max-memory)",
+                bytes,
+                first.0,
+                first.1,
+                meta.headers.len()
+            ),
+        ));
+    }
+    Ok(())
+}
+
 /// Reads every channel of every part of an EXR file (largest resolution level, flat data).
 pub(crate) fn read_exr_channels(path: &Path) -> Result<ExrChannels> {
+    check_declared_size(path)?;
     let image = ::exr::prelude::read()
         .no_deep_data()
         .largest_resolution_level()

@@ -73,6 +73,10 @@ pub(crate) fn read_rgb_exr(path: &Path) -> Option<RgbExr> {
     if width == 0 || height == 0 || band_rows == 0 {
         return None;
     }
+    // Above the decode limit: the general reader refuses the file with a message.
+    if (width as u128) * (height as u128) * 12 > u128::from(super::exr::exr_decode_limit_bytes()) {
+        return None;
+    }
     let top = header.own_attributes.layer_position.1 as i64;
 
     // Chunks in file order, each put in its band; a band whose chunks have all arrived
