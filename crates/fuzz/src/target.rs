@@ -240,15 +240,39 @@ fn built_in_seeds(target: Target) -> Vec<Vec<u8>> {
             seeds.push(merl);
         }
         Target::SpectrumCsv => seeds.push(b"wavelength_nm,value\n380,0.1\n780,0.9\n".to_vec()),
-        Target::Bfc
-        | Target::Ies
-        | Target::Vol
-        | Target::Exr
-        | Target::SpectralExr
-        | Target::Rgbe
-        | Target::Png => {}
+        Target::SpectralExr => seeds.extend(spectral_exr_seed()),
+        Target::Bfc | Target::Ies | Target::Vol | Target::Exr | Target::Rgbe | Target::Png => {}
     }
     seeds
+}
+
+/// A 4×3 spectral EXR of 8 bands, written by Prism's own writer (uncompressed, so that
+/// mutations reach the samples).
+fn spectral_exr_seed() -> Option<Vec<u8>> {
+    use prism_image::io::exr::{ExrCompression, ExrWriteOptions};
+    use prism_image::io::spectral_exr::{write_spectral_exr, SpectralImage};
+    let (width, height, bands) = (4, 3, 8);
+    let image = SpectralImage {
+        width,
+        height,
+        wavelengths_nm: (0..bands).map(|b| 400.0 + 40.0 * b as f64).collect(),
+        samples: (0..width * height * bands)
+            .map(|i| 0.01 * i as f32)
+            .collect(),
+        emissive_units: "W.m^-2.sr^-1".into(),
+    };
+    let dir = std::env::temp_dir().join(format!("prism-fuzz-seed-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).ok()?;
+    let path = dir.join("seed.exr");
+    let options = ExrWriteOptions {
+        compression: ExrCompression::None,
+        ..ExrWriteOptions::default()
+    };
+    let bytes = write_spectral_exr(&path, &image, &options)
+        .ok()
+        .and_then(|()| std::fs::read(&path).ok());
+    let _ = std::fs::remove_dir_all(&dir);
+    bytes
 }
 
 /// A rotationally symmetric EULUMDAT file (5 γ angles, one C plane).
