@@ -69,7 +69,14 @@ fn fuzz(target: Target) {
     };
     // What a user's --max-memory does for decoders: files declaring more are refused.
     prism_image::io::exr::set_exr_decode_limit_bytes(ALLOCATION_LIMIT_BYTES as u64 / 4);
-    let dir = tempfile::tempdir().unwrap();
+    // Each input is a file: in memory where the system has a RAM file system.
+    let shm = Path::new("/dev/shm");
+    let dir = if shm.is_dir() {
+        tempfile::tempdir_in(shm)
+    } else {
+        tempfile::tempdir()
+    }
+    .unwrap();
     // Panics are caught and reported per input; the default hook would print each one.
     let hook = std::panic::take_hook();
     std::panic::set_hook(Box::new(|_| {}));

@@ -1,0 +1,115 @@
+#!/usr/bin/env python3
+"""The bandwidth predictor's benchmark (docs/bandwidth.md): one `prism converge --clock cpu`
+run per scene with path, path+adaptive and path+predicted on one sampler, and the numbers
+the predictor issue asks for, from each run's `ratios` block:
+
+- time to relMSE 1e-2: path ÷ path+predicted (speed-up; > 1 means the predictor helps);
+- relMSE at equal CPU time: path+adaptive ÷ path+predicted at each of path's checkpoints
+  from 4 spp on (> 1 means the predictor beats the variance-driven adaptive sampler);
+- predict_cpu_s and its share of path+predicted's time to relMSE 1e-2.
+
+    cargo build --release
+    python3 tools/bench_bandwidth.py [--budget-s 20] [--reference-spp 2048] [--scenes a,b]
+
+The MERL tables of scenes/bandwidth/fig9-spheres.json are written first by
+`prism merl-export` from scenes/bandwidth/merl-sources.json when missing (33 MB each, not
+committed). Writes tools/bench-results/bandwidth.json (per-scene converge JSON inside).
+"""
+
+import argparse
+import json
+import os
+import platform
+import subprocess
+import sys
+import tempfile
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+PRISM = os.path.join(ROOT, "target", "release", "prism")
+SCENES = {
+    "fig9-spheres": ("scenes/bandwidth/fig9-spheres.json", None),
+    "fig17-curved-area": ("scenes/bandwidth/fig17-curved-area.json", None),
+    "glossy-env": ("scenes/glossy-env.json", "160x90"),
+}
+MERL = ["gold-ggx", "sharp-copper", "rough-nickel"]
+METHODS = ["path", "path+adaptive", "path+predicted"]
+
+
+def ensure_merl():
+    for name in MERL:
+        out = os.path.join(ROOT, "scenes", "merl", f"{name}.binary")
+        if not os.path.exists(out):
+            subprocess.run([PRISM, "merl-export", "scenes/bandwidth/merl-sources.json",
+                            "--material", name, "-o", out], cwd=ROOT, check=True)
+
+
+def summarise(data):
+    methods = {m["method"]: m for m in data["methods"]}
+    predicted, adaptive = methods["path+predicted"], methods["path+adaptive"]
+    time_to = {row["relmse"]: row for row in predicted["ratios"]["time_to_relmse"]}
+    ahead = {row["time_s"]: row["ratio"] for row in predicted["ratios"]["relmse_at_equal_time"]}
+    path_checkpoints = {c["time_s"] if data["clock"] == "wall" else c["cpu_time_s"]: c["spp"]
+                        for c in methods["path"]["checkpoints"]}
+    adaptive_vs_predicted = []
+    for row in adaptive["ratios"]["relmse_at_equal_time"]:
+        t = row["time_s"]
+        if t in ahead and path_checkpoints.get(t, 0) >= 4:
+            # (path ÷ predicted) ÷ (path ÷ adaptive) = adaptive ÷ predicted.
+            adaptive_vs_predicted.append({"time_s": t, "path_spp": path_checkpoints[t],
+                                          "ratio": ahead[t] / row["ratio"]})
+    return {
+        "time_to_relmse_1e-2_path_over_predicted": time_to[0.01]["speedup"],
+        "time_to_relmse_1e-2_s": {"path": time_to[0.01]["against_s"],
+                                  "path+predicted": time_to[0.01]["this_s"]},
+        "relmse_adaptive_over_predicted_at_equal_cpu": adaptive_vs_predicted,
+        "predict_cpu_s": predicted["predict_cpu_s"],
+        "tables_cpu_s": predicted["tables_cpu_s"],
+        "predict_cpu_fraction_of_time_to_target":
+            predicted["predict_cpu_fraction_of_time_to_target"],
+        "final_relmse": {m: methods[m]["final"]["relmse"] for m in METHODS},
+    }
+
+
+def main():
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--budget-s", type=float, default=20.0)
+    parser.add_argument("--reference-spp", type=int, default=2048)
+    parser.add_argument("--scenes", default=",".join(SCENES))
+    parser.add_argument("--no-file", action="store_true")
+    opts = parser.parse_args()
+    ensure_merl()
+    work = tempfile.mkdtemp(prefix="prism-bandwidth-")
+    results = {}
+    for name in opts.scenes.split(","):
+        scene, resolution = SCENES[name]
+        out = os.path.join(work, f"{name}.json")
+        command = [PRISM, "converge", scene, "--clock", "cpu", "--budget-s",
+                   str(opts.budget_s), "--reference-spp", str(opts.reference_spp),
+                   "--seed", "1", "--json", out]
+        for m in METHODS:
+            command += ["--method", m]
+        if resolution:
+            command += ["--resolution", resolution]
+        subprocess.run(command, cwd=ROOT, check=True)
+        with open(out) as f:
+            data = json.load(f)
+        results[name] = {"command": " ".join(command[1:]), "summary": summarise(data),
+                         "converge": data}
+        print(name, json.dumps(results[name]["summary"], indent=2), flush=True)
+    result = {
+        "command": "python3 tools/bench_bandwidth.py " + " ".join(sys.argv[1:]),
+        "machine": {"platform": platform.platform(), "cpus": os.cpu_count(),
+                    "load_average_1min_at_end": os.getloadavg()[0]},
+        "scenes": results,
+    }
+    if not opts.no_file:
+        path = os.path.join(ROOT, "tools", "bench-results", "bandwidth.json")
+        with open(path + ".tmp", "w") as f:
+            json.dump(result, f, indent=2)
+            f.write("\n")
+        os.replace(path + ".tmp", path)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
