@@ -194,10 +194,10 @@ pub fn render_pass(
     first_sample: u32,
     progress: &(dyn Fn(u64) + Sync),
 ) -> Result<RenderStats, RenderError> {
-    let mut estimator = scene.integrator;
+    let mut estimator = scene.integrator.estimator();
     let pass_index = u32::from(first_sample > 0);
     render_pass_with(
-        &mut estimator,
+        estimator.as_mut(),
         scene,
         &Pass {
             index: pass_index,
@@ -237,10 +237,75 @@ pub fn render_pass_with(
             estimator.name()
         )));
     }
+    if let Some(per_prepare) = estimator.sample_indices_per_prepare() {
+        return render_in_sample_steps(estimator, scene, pass, film, progress, per_prepare);
+    }
     estimator
         .prepare(scene, pass)
         .map_err(RenderError::Estimator)?;
-    let estimator = &*estimator;
+    run_prepared(&*estimator, scene, pass, film, progress)
+}
+
+/// `render_pass_with` for an estimator that prepares every `per_prepare` sample indices:
+/// the pass cut into passes of at most that many indices, `prepare` before each. The
+/// pixels' sample ranges must start at the same index.
+fn render_in_sample_steps(
+    estimator: &mut (impl Estimator + ?Sized),
+    scene: &RenderScene,
+    pass: &Pass,
+    film: &mut Film,
+    progress: &(dyn Fn(u64) + Sync),
+    per_prepare: u32,
+) -> Result<RenderStats, RenderError> {
+    let resolution = pass.plan.resolution();
+    let pixels =
+        || (0..resolution.y).flat_map(move |y| (0..resolution.x).map(move |x| UVec2::new(x, y)));
+    let first = pass.plan.first_sample(UVec2::ZERO);
+    if pixels().any(|p| pass.plan.first_sample(p) != first) {
+        return Err(RenderError::Estimator(format!(
+            "{} renders one pass per sample index, the same in every pixel: a plan whose \
+             pixels start their samples at different indices (a predicted or adaptive plan) \
+             is for `path`",
+            estimator.name()
+        )));
+    }
+    let counts: Vec<u32> = pixels().map(|p| pass.plan.camera_samples(p)).collect();
+    let light: Vec<u32> = pixels().map(|p| pass.plan.light_samples(p)).collect();
+    let most = counts.iter().copied().max().unwrap_or(0);
+    let n = counts.len();
+    let step = per_prepare.max(1);
+    let mut total = RenderStats::default();
+    let mut k = 0u32;
+    while k < most {
+        let sub_counts: Vec<u32> = counts
+            .iter()
+            .map(|c| c.saturating_sub(k).min(step))
+            .collect();
+        let plan = SamplePlan::from_counts(resolution, sub_counts, light.clone())?
+            .with_first_samples(vec![first + k; n])?;
+        let sub = Pass {
+            index: pass.index + k,
+            settings: pass.settings,
+            plan: &plan,
+            first_sample: pass.first_sample,
+        };
+        estimator
+            .prepare(scene, &sub)
+            .map_err(RenderError::Estimator)?;
+        total.add(&run_prepared(&*estimator, scene, &sub, film, progress)?);
+        k += step;
+    }
+    Ok(total)
+}
+
+/// Every work item of a prepared pass, in parallel, merged in a fixed order.
+fn run_prepared(
+    estimator: &(impl Estimator + ?Sized),
+    scene: &RenderScene,
+    pass: &Pass,
+    film: &mut Film,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Result<RenderStats, RenderError> {
     let sampler = PixelSampler::with_kind(pass.settings.sampler, pass.settings.seed);
     let uses_lens = scene.camera.uses_lens_sample();
     let tile_size_px = pass.settings.tile_size_px;
