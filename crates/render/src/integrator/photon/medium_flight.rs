@@ -1,13 +1,10 @@
-//! What the photon integrators do in media without spectral MIS: one grey majorant per
-//! stretch, σ̄ = max over the lanes of σt × the stretch's density bound, so every lane's
-//! null coefficient σ̄ − σt(λ) is ≥ 0 (Kutz et al. 2017, "Spectral and decomposition
-//! tracking", §4: the maximum majorant).
+//! What the photon integrators do in media. Camera segments and shadow rays estimate
+//! transmittance only: one grey majorant per stretch, σ̄ = max over the lanes of σt × the
+//! stretch's density bound, so every lane's ratio-tracking weight 1 − σt(λ)/σ̄ is ≥ 0
+//! (Kutz et al. 2017, "Spectral and decomposition tracking", §4: the maximum majorant).
 //!
-//! - `photon_flight`: a photon's free flight by delta tracking; the collision's kind is
-//!   chosen with the lanes' average probabilities (σs, σa, σn averaged over the lanes,
-//!   divided by σ̄: they sum to 1) and each lane weighted by its own coefficient over that
-//!   average — unbiased per lane wherever the average is positive, which it is wherever
-//!   any lane's coefficient is.
+//! - `photon_flight`: a photon's free flight by delta tracking at the hero's majorant with
+//!   spectral MIS (as `path`, below).
 //! - `Transmittance`: T(0, t) along a camera segment for every t at once — closed form in a
 //!   homogeneous medium, else ratio tracking's running product (Novák et al. 2014: the
 //!   product up to t is an unbiased estimate of T(0, t) for every t).
@@ -18,7 +15,7 @@ use glam::Vec3A;
 use prism_geometry::Ray;
 use prism_spectrum::{SampledSpectrum, SampledWavelengths};
 
-use crate::integrator::medium_transport::MediumRng;
+use crate::integrator::medium_transport::{sample_t_maj, MediumRng};
 use crate::integrator::PathCounters;
 use crate::medium::{Medium, OpticsAtLanes};
 use crate::scene_build::media::MediaScene;
@@ -26,54 +23,68 @@ use crate::scene_build::RenderScene;
 
 /// How a photon's flight through a medium segment ended.
 pub enum Flight {
-    /// It reached the segment's end; β holds the null collisions' weights.
+    /// It reached the segment's end.
     Passed,
     Absorbed,
     /// Real scattering at this point.
     Scattered(Vec3A),
 }
 
-/// Delta tracking of a photon along `ray` (unit direction, over [t_min, t_max]).
+/// Delta tracking of a photon along `ray` (unit direction, over [t_min, t_max]) at the
+/// hero lane's majorant, as `path` samples its distances (pbrt-v4 `SampleT_maj`): the hero
+/// decides absorption, scattering or a null collision; β takes every lane's
+/// f/p_hero and `r_u` every lane's p_lane/p_hero (pbrt-v4's rescaled probabilities), so
+/// the flux a photon stores is β/⟨r_u⟩, the balance heuristic over the four wavelengths
+/// (weighting each lane by its own coefficient over the hero's made its flux a product of
+/// ratios that explodes over many scatterings in a chromatic medium).
 pub fn photon_flight(
     medium: &Medium,
     optics: &OpticsAtLanes,
     ray: &Ray,
     beta: &mut SampledSpectrum,
+    r_u: &mut SampledSpectrum,
     rng: &mut MediumRng,
 ) -> Flight {
-    let sigma_t_max = optics.sigma_t.max_component();
-    for stretch in medium.stretches(ray) {
-        let sigma_bar = sigma_t_max * stretch.density_bound;
-        if sigma_bar <= 0.0 {
-            continue;
+    let mut end = Flight::Passed;
+    let u = rng.uniform();
+    let (mut b, mut r) = (*beta, *r_u);
+    let t_maj = sample_t_maj(medium, optics, ray, u, rng, |c, rng| {
+        let u_mode = rng.uniform();
+        let p_absorb = c.sigma_a[0] / c.sigma_maj[0];
+        let p_scatter = c.sigma_s[0] / c.sigma_maj[0];
+        if u_mode < p_absorb {
+            end = Flight::Absorbed;
+            return false;
         }
-        let mut t = stretch.t_min;
-        loop {
-            t -= (1.0 - rng.uniform()).ln() / sigma_bar;
-            if t >= stretch.t_max {
-                break;
-            }
-            let p = ray.origin + ray.direction * t;
-            let density = medium.density(p);
-            let sigma_s = optics.sigma_s * density;
-            let sigma_a = optics.sigma_a * density;
-            let sigma_n = (SampledSpectrum::splat(sigma_bar) - sigma_s - sigma_a).clamp_zero();
-            let (s, a, n) = (sigma_s.average(), sigma_a.average(), sigma_n.average());
-            let u = rng.uniform() * (s + a + n);
-            if u < s {
-                *beta *= sigma_s * (1.0 / s);
-                return Flight::Scattered(p);
-            }
-            if u < s + a {
-                return Flight::Absorbed;
-            }
-            if n <= 0.0 {
-                return Flight::Absorbed;
-            }
-            *beta *= sigma_n * (1.0 / n);
+        if u_mode < p_absorb + p_scatter {
+            let pdf = c.t_maj[0] * c.sigma_s[0];
+            b *= c.t_maj * c.sigma_s / pdf;
+            r *= c.t_maj * c.sigma_s / pdf;
+            end = Flight::Scattered(c.p);
+            return false;
         }
+        let sigma_n = (c.sigma_maj - c.sigma_a - c.sigma_s).clamp_zero();
+        let pdf = c.t_maj[0] * sigma_n[0];
+        if pdf <= 0.0 {
+            end = Flight::Absorbed;
+            return false;
+        }
+        b *= c.t_maj * sigma_n / pdf;
+        r *= c.t_maj * sigma_n / pdf;
+        if b.is_black() {
+            end = Flight::Absorbed;
+            return false;
+        }
+        true
+    });
+    if let Flight::Passed = end {
+        let scale = t_maj / t_maj[0];
+        b *= scale;
+        r *= scale;
     }
-    Flight::Passed
+    *beta = b;
+    *r_u = r;
+    end
 }
 
 /// T(0, t) along one camera segment.

@@ -102,11 +102,14 @@ fn u2(rng: &mut MediumRng) -> Vec2 {
     Vec2::new(rng.uniform(), rng.uniform())
 }
 
-/// The flux a photon deposits: β, with lanes 1–3 zeroed once they have ended.
+/// The flux a photon deposits: β/⟨r_u⟩ (spectral MIS of its distance samples; the hero's
+/// r_u alone once lanes 1–3 have ended, as `path`), with lanes 1–3 zeroed then.
+#[allow(clippy::too_many_arguments)]
 fn stored(
     p: glam::Vec3A,
     direction: glam::Vec3A,
     beta: SampledSpectrum,
+    r_u: SampledSpectrum,
     lanes: &LaneWavelengths,
     depth: u32,
     radius_m: f32,
@@ -115,11 +118,20 @@ fn stored(
     Photon {
         p: p.to_array(),
         direction: direction.to_array(),
-        beta: beta.values,
+        beta: (beta * (1.0 / average_r(r_u, lanes))).values,
         radius_m,
         depth: depth.min(255) as u8,
         hero_only: lanes.sensor().secondary_terminated(),
         medium: medium.map_or(u16::MAX, |m| m.min(u32::from(u16::MAX - 1)) as u16),
+    }
+}
+
+/// ⟨r_u⟩ over the live lanes.
+fn average_r(r_u: SampledSpectrum, lanes: &LaneWavelengths) -> f32 {
+    if lanes.sensor().secondary_terminated() {
+        r_u[0]
+    } else {
+        r_u.average()
     }
 }
 
@@ -152,6 +164,7 @@ fn trace_photon(
         le.n.dot(le.ray.direction).abs()
     };
     let mut beta = le.radiance * (cos / (pmf * le.pdf_pos * le.pdf_dir * count as f32));
+    let mut r_u = SampledSpectrum::splat(1.0);
     let mut ray = le.ray;
     let media = scene.media.as_ref();
     let mut medium = media.and_then(|m| {
@@ -176,7 +189,7 @@ fn trace_photon(
                 0.0,
                 hit.map_or(f32::INFINITY, |h| h.t),
             );
-            match photon_flight(med, &optics, &segment, &mut beta, rng) {
+            match photon_flight(med, &optics, &segment, &mut beta, &mut r_u, rng) {
                 Flight::Passed => {}
                 Flight::Absorbed => return,
                 Flight::Scattered(p) => {
@@ -188,6 +201,7 @@ fn trace_photon(
                         p,
                         ray.direction,
                         beta,
+                        r_u,
                         &lanes,
                         depth,
                         radius_m,
@@ -265,6 +279,7 @@ fn trace_photon(
                     si.p,
                     ray.direction,
                     beta,
+                    r_u,
                     &lanes,
                     depth,
                     radius_m,
@@ -299,10 +314,11 @@ fn trace_photon(
                 had_specular = true;
             }
         }
-        let before = beta.max_component();
+        let r = average_r(r_u, &lanes);
+        let before = beta.max_component() / r;
         let after = beta * bs.weight;
         // Roulette by the throughput's ratio (pbrt-v4 SPPM): a photon keeps its flux.
-        let q = (1.0 - after.max_component() / before.max(1e-30)).max(0.0);
+        let q = (1.0 - after.max_component() / r / before.max(1e-30)).max(0.0);
         if q > 0.0 {
             if rng.uniform() < q {
                 return;
