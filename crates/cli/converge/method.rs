@@ -478,4 +478,28 @@ mod tests {
             other => panic!("{other:?}"),
         }
     }
+
+    #[test]
+    fn photon_methods_take_the_scene_depth_and_the_photon_defaults() {
+        let scene = prism_scene::Integrator::Path {
+            max_depth: 5,
+            sampler: SamplerKind::Sobol,
+            mis: prism_scene::MisHeuristic::Power,
+            rr_depth: 2,
+            fluorescence_lanes: prism_scene::FluorescenceLanes::All,
+            spectral_mis: true,
+        };
+        for (name, progressive) in [("photon", false), ("photon_progressive", true)] {
+            let m = Method::parse(name).unwrap();
+            assert_eq!(m.quantity(), "radiance");
+            match m.integrator(&scene).unwrap() {
+                Integrator::Photon(p) => {
+                    assert_eq!((p.max_depth, p.rr_depth), (5, 2));
+                    assert_eq!(p.photons_per_pass, None);
+                    assert_eq!(p.is_progressive(), progressive);
+                }
+                other => panic!("{other:?}"),
+            }
+        }
+    }
 }
