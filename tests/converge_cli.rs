@@ -347,7 +347,9 @@ fn per_pixel_plans_converge_side_by_side() {
 
 /// `--method photon_progressive` and `--method photon` run on a scene written for `path`
 /// (every photon parameter has a default): the progressive method's error falls from the
-/// first checkpoint to the last.
+/// first checkpoint to the last. `light` runs beside them: converge's uniform passes give
+/// every pixel the same first sample index, which the splatting methods take as a moved
+/// uniform plan.
 #[test]
 fn photon_methods_run_on_a_path_scene() {
     let dir = tempfile::tempdir().unwrap();
@@ -362,6 +364,8 @@ fn photon_methods_run_on_a_path_scene() {
         "photon_progressive",
         "--method",
         "photon",
+        "--method",
+        "light",
         "--max-spp",
         "16",
         "--checkpoints",
@@ -376,6 +380,7 @@ fn photon_methods_run_on_a_path_scene() {
         "photon_progressive+uniform:independent"
     );
     assert_eq!(v["methods"][1]["canonical"], "photon+uniform:independent");
+    assert_eq!(v["methods"][2]["canonical"], "light+uniform:independent");
     let checkpoints = v["methods"][0]["checkpoints"].as_array().unwrap();
     let relmse: Vec<f64> = checkpoints
         .iter()

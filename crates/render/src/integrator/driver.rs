@@ -230,12 +230,23 @@ pub fn render_pass_with(
     pass.plan.check_resolution(scene.resolution)?;
     pass.plan.check_resolution(film.resolution())?;
     if estimator.splats_light_paths() && pass.plan.has_per_pixel_first_samples() {
-        // Their work items are sample ranges shared by a whole tile.
-        return Err(RenderError::Estimator(format!(
-            "{} takes the same samples in every pixel: a plan whose pixels start their \
-             samples at different indices (a predicted or adaptive plan) is for `path`",
-            estimator.name()
-        )));
+        // Their work items are sample ranges shared by a whole tile: a plan whose pixels
+        // all start at one index (`prism converge`'s uniform passes) is the uniform plan
+        // moved by that index; any other is refused.
+        let Some(first) = uniform_first_sample(pass.plan) else {
+            return Err(RenderError::Estimator(format!(
+                "{} takes the same samples in every pixel: a plan whose pixels start their \
+                 samples at different indices (a predicted or adaptive plan) is for `path`",
+                estimator.name()
+            )));
+        };
+        let plan = plan_counts(pass.plan)?;
+        let moved = Pass {
+            first_sample: pass.first_sample + first,
+            plan: &plan,
+            ..*pass
+        };
+        return render_pass_with(estimator, scene, &moved, film, progress);
     }
     if let Some(per_prepare) = estimator.sample_indices_per_prepare() {
         return render_in_sample_steps(estimator, scene, pass, film, progress, per_prepare);
@@ -258,19 +269,20 @@ fn render_in_sample_steps(
     per_prepare: u32,
 ) -> Result<RenderStats, RenderError> {
     let resolution = pass.plan.resolution();
-    let pixels =
-        || (0..resolution.y).flat_map(move |y| (0..resolution.x).map(move |x| UVec2::new(x, y)));
-    let first = pass.plan.first_sample(UVec2::ZERO);
-    if pixels().any(|p| pass.plan.first_sample(p) != first) {
+    let Some(first) = uniform_first_sample(pass.plan) else {
         return Err(RenderError::Estimator(format!(
             "{} renders one pass per sample index, the same in every pixel: a plan whose \
              pixels start their samples at different indices (a predicted or adaptive plan) \
              is for `path`",
             estimator.name()
         )));
-    }
-    let counts: Vec<u32> = pixels().map(|p| pass.plan.camera_samples(p)).collect();
-    let light: Vec<u32> = pixels().map(|p| pass.plan.light_samples(p)).collect();
+    };
+    let counts: Vec<u32> = pixels_of(resolution)
+        .map(|p| pass.plan.camera_samples(p))
+        .collect();
+    let light: Vec<u32> = pixels_of(resolution)
+        .map(|p| pass.plan.light_samples(p))
+        .collect();
     let most = counts.iter().copied().max().unwrap_or(0);
     let n = counts.len();
     let step = per_prepare.max(1);
@@ -296,6 +308,31 @@ fn render_in_sample_steps(
         k += step;
     }
     Ok(total)
+}
+
+/// The pixels of a `resolution` film, row-major (the plans' order).
+fn pixels_of(resolution: UVec2) -> impl Iterator<Item = UVec2> {
+    (0..resolution.y).flat_map(move |y| (0..resolution.x).map(move |x| UVec2::new(x, y)))
+}
+
+/// The index every pixel of `plan` starts at, if they all start at one.
+fn uniform_first_sample(plan: &SamplePlan) -> Option<u32> {
+    let first = plan.first_sample(UVec2::ZERO);
+    pixels_of(plan.resolution())
+        .all(|p| plan.first_sample(p) == first)
+        .then_some(first)
+}
+
+/// `plan`'s counts without its per-pixel first samples.
+fn plan_counts(plan: &SamplePlan) -> Result<SamplePlan, RenderError> {
+    let resolution = plan.resolution();
+    let counts = pixels_of(resolution)
+        .map(|p| plan.camera_samples(p))
+        .collect();
+    let light = pixels_of(resolution)
+        .map(|p| plan.light_samples(p))
+        .collect();
+    Ok(SamplePlan::from_counts(resolution, counts, light)?)
 }
 
 /// Every work item of a prepared pass, in parallel, merged in a fixed order.

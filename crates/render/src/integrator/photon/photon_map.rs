@@ -227,7 +227,9 @@ impl PhotonTree {
         if self.nodes.is_empty() || t1 <= t0 {
             return;
         }
-        let inv = Vec3A::ONE / d;
+        // A zero component gets a huge finite reciprocal: 0 · ∞ would be NaN in the slab
+        // test at a node face through the origin.
+        let inv = Vec3A::select(d.cmpeq(Vec3A::ZERO), Vec3A::splat(f32::MAX), Vec3A::ONE / d);
         let mut stack = [0u32; 64];
         let mut top = 1usize;
         while top > 0 {
@@ -238,7 +240,7 @@ impl PhotonTree {
             let tb = (node.hi - o) * inv;
             let near = ta.min(tb).max_element().max(t0);
             let far = ta.max(tb).min_element().min(t1);
-            if near > far || far.is_nan() {
+            if near > far {
                 continue;
             }
             if node.leaf {
