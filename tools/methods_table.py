@@ -353,7 +353,9 @@ were the point, photon rows. `photon_progressive` and `photon` (photon mapping, 
 per pixel per pass, default radius; [rendering.md](rendering.md#photon-mapping)) run on the
 scenes they were built for: caustic-glass-sphere, dispersion-prism, spot-fog-glass. Their
 references are still `path`'s own render, so where `path` fails the reference's own noise
-bounds every method's error. The bandwidth predictor's plan (`path+predicted`) will get rows
+bounds every method's error. The photon speed target (spot-fog-glass at 128², against
+`photon_progressive`'s own reference, `tools/photon_speed.py`) is in
+[rendering.md](rendering.md#photon-mapping). The bandwidth predictor's plan (`path+predicted`) will get rows
 here when it exists.
 
 {{bdpt_summary}}
