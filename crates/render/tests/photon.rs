@@ -272,8 +272,8 @@ fn caustic_under_a_glass_sphere_converges() {
     );
 }
 
-/// A photon integrator refuses a scene without lights, and a photon storage estimate
-/// above the memory limit, naming the count, the estimate and the limit.
+/// A photon integrator refuses a scene without lights, an emissive medium, and a photon
+/// storage estimate above the memory limit, naming the count, the estimate and the limit.
 #[test]
 fn refusals_name_the_reason() {
     let dir = Dir::new("refusals");
@@ -285,6 +285,21 @@ fn refusals_name_the_reason() {
         e,
         "DIR/scene.json: integrator: `photon` shoots photons from the lights, and the scene \
          has none (add a `lights` entry)"
+    );
+    // An emissive medium: photons leave lights only.
+    let e = dir.build_error(
+        r#"{"integrator": {"type": "photon_progressive"},
+            "world_medium": "glow",
+            "media": {"glow": {"sigma_a_per_m": 0.1, "emission": 1}},
+            "shapes": [{"type": "sphere", "radius_m": 1}],
+            "lights": [{"type": "point", "position_m": [0, 3, 0]}]}"#,
+    );
+    assert!(
+        e.starts_with(
+            "DIR/scene.json: media.glow: medium 'glow' emits light (`emission`): \
+             `photon_progressive` shoots photons from lights only"
+        ),
+        "{e}"
     );
     let mut scene = dir.scene(
         r#"{"integrator": {"type": "photon_progressive", "photons_per_pass": 100000},
