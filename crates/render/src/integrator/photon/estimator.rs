@@ -34,6 +34,8 @@ pub struct PhotonEstimator {
     iteration: Option<u32>,
     /// The pass's wavelengths.
     wavelengths: prism_spectrum::SampledWavelengths,
+    /// The last pass's (index, r²), from which the next radius continues.
+    radius: Option<(u32, f64)>,
     /// Rays the photon pass traced, reported with the first tile's statistics.
     photon_rays: std::sync::atomic::AtomicU64,
 }
@@ -46,6 +48,7 @@ impl PhotonEstimator {
             maps: PhotonMaps::default(),
             iteration: None,
             wavelengths: prism_spectrum::SampledWavelengths::sample_visible(0.5),
+            radius: None,
             photon_rays: std::sync::atomic::AtomicU64::new(0),
         }
     }
@@ -138,7 +141,9 @@ impl Estimator for PhotonEstimator {
         // Drop the last pass's photons before the next are shot.
         self.maps = PhotonMaps::default();
         self.wavelengths = pass_wavelengths(pass.settings.seed, iteration);
-        let radius_m = plan.radius_at(iteration);
+        let radius = plan.radius_from(iteration, self.radius);
+        self.radius = Some(radius);
+        let radius_m = radius.1.sqrt() as f32;
         let shot = shoot(
             scene,
             &self.wavelengths,

@@ -155,17 +155,26 @@ impl PhotonPlan {
     /// The gather radius of pass `iteration` (0-based): Knaus & Zwicker 2011's
     /// r²ᵢ₊₁ = r²ᵢ (i + α)/(i + 1) when progressive, else the fixed radius.
     pub fn radius_at(&self, iteration: u32) -> f32 {
-        match self.alpha {
-            None => self.radius_m,
-            Some(alpha) => {
-                let alpha = f64::from(alpha);
-                let mut r2 = f64::from(self.radius_m).powi(2);
-                for i in 0..iteration {
-                    r2 *= (f64::from(i) + alpha) / (f64::from(i) + 1.0);
-                }
-                r2.sqrt() as f32
-            }
+        self.radius_from(iteration, None).1.sqrt() as f32
+    }
+
+    /// (iteration, r²) of pass `iteration`, continuing from `known` — an earlier pass's
+    /// (iteration, r²) — when given: passes mostly come in order, so each step is O(1).
+    pub fn radius_from(&self, iteration: u32, known: Option<(u32, f64)>) -> (u32, f64) {
+        let r2_0 = f64::from(self.radius_m).powi(2);
+        let Some(alpha) = self.alpha else {
+            return (iteration, r2_0);
+        };
+        let alpha = f64::from(alpha);
+        let (mut i, mut r2) = match known {
+            Some((k, r2)) if k <= iteration => (k, r2),
+            _ => (0, r2_0),
+        };
+        while i < iteration {
+            r2 *= (f64::from(i) + alpha) / (f64::from(i) + 1.0);
+            i += 1;
         }
+        (iteration, r2)
     }
 }
 
@@ -190,5 +199,8 @@ mod tests {
         assert!((r2 * r2 - r1 * r1 * (1.0 + 2.0 / 3.0) / 2.0).abs() < 1e-8);
         // r² ~ i^(α−1): the radius keeps shrinking.
         assert!(plan.radius_at(1000) < 0.1 * 1000f32.powf(-1.0 / 6.0) * 1.5);
+        // Continuing from an earlier pass gives the same radius.
+        let (_, r2) = plan.radius_from(1000, Some(plan.radius_from(400, None)));
+        assert!((r2.sqrt() as f32 - plan.radius_at(1000)).abs() < 1e-7);
     }
 }
