@@ -111,8 +111,10 @@ impl CameraPaths<'_> {
         let mut le_cache = SpectrumCache::new();
         let mut reflectance_cache = SpectrumCache::new();
         let mut steps = Vec::new();
-        // The first non-specular vertex is behind; since then only specular vertices (and
-        // at least one): emission met now is what the caustic map gave.
+        // The first non-specular vertex is behind, the path left it by a non-Dirac lobe,
+        // and since then it met only specular vertices (at least one): emission met now is
+        // what the caustic map gave (its gather evaluates the non-Dirac lobes only, so a
+        // Dirac lobe of a mixed BSDF at that vertex stays the path's).
         let mut after_first_diffuse = false;
         let mut specular_chain = false;
         let mut chain_specular_count = 0u32;
@@ -246,6 +248,7 @@ impl CameraPaths<'_> {
             );
             let vertex =
                 ScatterVertex::Surface(SurfaceVertex::new(&si, &bsdf, ray.direction, shading_maps));
+            let mut gathered_here = false;
             if vertex.is_specular() {
                 if after_first_diffuse {
                     chain_specular_count += 1;
@@ -256,6 +259,7 @@ impl CameraPaths<'_> {
                 } else {
                     after_first_diffuse = true;
                     specular_chain = true;
+                    gathered_here = true;
                     self.gather_caustics(
                         &vertex,
                         si.p,
@@ -297,6 +301,9 @@ impl CameraPaths<'_> {
                     counters.non_finite_contributions += 1;
                 }
                 break;
+            }
+            if gathered_here && bs.specular {
+                specular_chain = false;
             }
             path.beta *= bs.weight;
             let glazing_pass = bs.transmission
