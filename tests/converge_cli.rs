@@ -431,3 +431,50 @@ fn report_holds_the_chart_the_table_and_every_method_s_images() {
         stderr(&o)
     );
 }
+
+/// `--method photon_progressive` and `--method photon` run on a scene written for `path`
+/// (every photon parameter has a default): the progressive method's error falls from the
+/// first checkpoint to the last. `light` runs beside them: converge's uniform passes give
+/// every pixel the same first sample index, which the splatting methods take as a moved
+/// uniform plan.
+#[test]
+fn photon_methods_run_on_a_path_scene() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = small_scene(dir.path(), "small.json", 0.6);
+    let json = dir.path().join("run.json");
+    let o = prism(&[
+        "converge",
+        s(&scene),
+        "--reference-spp",
+        "64",
+        "--method",
+        "photon_progressive",
+        "--method",
+        "photon",
+        "--method",
+        "light",
+        "--max-spp",
+        "16",
+        "--checkpoints",
+        "3",
+        "--json",
+        s(&json),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v = read_json(&json);
+    assert_eq!(
+        v["methods"][0]["canonical"],
+        "photon_progressive+uniform:independent"
+    );
+    assert_eq!(v["methods"][1]["canonical"], "photon+uniform:independent");
+    assert_eq!(v["methods"][2]["canonical"], "light+uniform:independent");
+    let checkpoints = v["methods"][0]["checkpoints"].as_array().unwrap();
+    let relmse: Vec<f64> = checkpoints
+        .iter()
+        .map(|c| c["relmse"].as_f64().unwrap())
+        .collect();
+    assert!(
+        relmse.iter().all(|e| e.is_finite()) && relmse[relmse.len() - 1] < relmse[0],
+        "{relmse:?}"
+    );
+}

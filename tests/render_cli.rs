@@ -431,6 +431,59 @@ fn a_scene_with_media_is_explained_and_rendered_by_the_scalar_tracer() {
     );
 }
 
+/// The same fog scene with `photon_progressive`: `--explain` names its settings (photons per
+/// pass, radius, α, the storage estimate and limit), and it renders a lit, finite image.
+#[test]
+fn a_photon_integrator_is_explained_and_renders() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("fog.json");
+    std::fs::write(
+        &scene,
+        r#"{"world_medium": "fog",
+            "media": {"fog": {"sigma_a_per_m": 0.05, "sigma_s_per_m": {"rgb": [0.2, 0.3, 0.5]},
+                              "phase": {"type": "hg", "g": 0.5}}},
+            "integrator": {"type": "photon_progressive", "photons_per_pass": 5000, "alpha": 0.7},
+            "camera": {"transform": {"look_at": {"eye": [0, 1, 4], "target": [0, 0, 0], "up": [0, 1, 0]}}},
+            "shapes": [{"type": "rectangle", "size_m": [10, 10],
+                        "transform": {"rotate": {"axis": [1, 0, 0], "angle_deg": -90}}}],
+            "lights": [{"type": "point", "position_m": [0, 2, 0], "power_lm": 1000}]}"#,
+    )
+    .unwrap();
+    let out = dir.path().join("fog.exr");
+    let o = prism(&["render", s(&scene), "-o", s(&out), "--explain"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = String::from_utf8_lossy(&o.stdout);
+    for needle in [
+        "photon_progressive, max_depth 8: 5000 photons per pass",
+        "initial radius ",
+        "α 0.700",
+        "photon storage ≤ ",
+        "limit",
+    ] {
+        assert!(text.contains(needle), "missing `{needle}` in:\n{text}");
+    }
+    let o = prism(&[
+        "render",
+        s(&scene),
+        "-o",
+        s(&out),
+        "--resolution",
+        "16x12",
+        "--spp",
+        "4",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let image = read_exr(&out).unwrap();
+    assert!(
+        image
+            .pixels()
+            .iter()
+            .all(|p| p.iter().all(|c| c.is_finite()))
+            && image.pixels().iter().any(|p| p[1] > 0.0),
+        "a lit fog scene rendered black or non-finite"
+    );
+}
+
 /// The `simd: <isa> (<why>)` line of `render --explain` with `PRISM_SIMD` set to `env`.
 fn explain_simd_line(env: Option<&str>, extra: &[&str]) -> String {
     let mut args = vec!["render", "scenes/cornell-box.json", "--explain"];

@@ -278,7 +278,9 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
         sampler: match description.integrator {
             prism_scene::Integrator::Path { sampler, .. }
             | prism_scene::Integrator::Light { sampler, .. }
-            | prism_scene::Integrator::Bdpt { sampler, .. } => sampler,
+            | prism_scene::Integrator::Bdpt { sampler, .. }
+            | prism_scene::Integrator::Photon { sampler, .. }
+            | prism_scene::Integrator::PhotonProgressive { sampler, .. } => sampler,
             prism_scene::Integrator::Depth
             | prism_scene::Integrator::Normal
             | prism_scene::Integrator::Albedo

@@ -4,8 +4,10 @@
 //!   tracing) or `bdpt` (bidirectional path tracing), each with the scene's `max_depth`,
 //!   `rr_depth` and (`path`, `bdpt`) `mis` when the scene's integrator is one of these three
 //!   (so one scene compares the methods at equal depth), else the defaults; or one of the
-//!   diagnostic integrators (`ambient_occlusion`, `depth`, `normal`, `albedo`). `photon`
-//!   (photon mapping) is a known name that this build does not have yet.
+//!   diagnostic integrators (`ambient_occlusion`, `depth`, `normal`, `albedo`); or `photon`
+//!   / `photon_progressive` (photon mapping), with the scene's photon settings when the
+//!   scene's integrator is that one, else every photon default, and the scene's depth and
+//!   roulette.
 //! - PLAN: how samples are distributed over the pixels — `uniform` (the default: the same
 //!   spp everywhere), `predicted` (the bandwidth predictor's per-pixel plan, computed once
 //!   before the first pass with `prism render --plan predicted`'s defaults) or `adaptive`
@@ -24,7 +26,7 @@ use prism_render::integrator::AmbientOcclusion;
 use prism_render::{Integrator, SamplerKind};
 
 /// Integrator names: (name, available in this build, what it is).
-pub const INTEGRATORS: [(&str, bool, &str); 8] = [
+pub const INTEGRATORS: [(&str, bool, &str); 9] = [
     ("path", true, "spectral path tracer (NEE + MIS)"),
     (
         "light",
@@ -40,7 +42,16 @@ pub const INTEGRATORS: [(&str, bool, &str); 8] = [
     ("depth", true, "diagnostic"),
     ("normal", true, "diagnostic"),
     ("albedo", true, "diagnostic"),
-    ("photon", false, "photon mapping (not built yet)"),
+    (
+        "photon",
+        true,
+        "photon mapping, fixed radius (caustic map and volume beams; biased)",
+    ),
+    (
+        "photon_progressive",
+        true,
+        "progressive photon mapping (Knaus & Zwicker 2011; consistent)",
+    ),
 ];
 
 /// Sample plans: (name, available, what it is).
@@ -218,7 +229,7 @@ impl Method {
     /// quantity; a run compares one quantity only.
     pub fn quantity(&self) -> &'static str {
         match self.integrator {
-            "path" | "light" | "bdpt" => "radiance",
+            "path" | "light" | "bdpt" | "photon" | "photon_progressive" => "radiance",
             other => other,
         }
     }
@@ -244,6 +255,16 @@ impl Method {
                 max_depth,
                 rr_depth,
                 ..
+            }
+            | prism_scene::Integrator::Photon {
+                max_depth,
+                rr_depth,
+                ..
+            }
+            | prism_scene::Integrator::PhotonProgressive {
+                max_depth,
+                rr_depth,
+                ..
             } => Some((max_depth, None, rr_depth)),
             prism_scene::Integrator::Depth
             | prism_scene::Integrator::Normal
@@ -259,6 +280,8 @@ impl Method {
             } => (max_depth, mis, rr_depth),
             prism_scene::Integrator::Light { .. }
             | prism_scene::Integrator::Bdpt { .. }
+            | prism_scene::Integrator::Photon { .. }
+            | prism_scene::Integrator::PhotonProgressive { .. }
             | prism_scene::Integrator::Depth
             | prism_scene::Integrator::Normal
             | prism_scene::Integrator::Albedo
@@ -280,6 +303,8 @@ impl Method {
             } => fluorescence_lanes,
             prism_scene::Integrator::Light { .. }
             | prism_scene::Integrator::Bdpt { .. }
+            | prism_scene::Integrator::Photon { .. }
+            | prism_scene::Integrator::PhotonProgressive { .. }
             | prism_scene::Integrator::Depth
             | prism_scene::Integrator::Normal
             | prism_scene::Integrator::Albedo
@@ -299,6 +324,8 @@ impl Method {
                     prism_scene::Integrator::Path { spectral_mis, .. } => spectral_mis,
                     prism_scene::Integrator::Light { .. }
                     | prism_scene::Integrator::Bdpt { .. }
+                    | prism_scene::Integrator::Photon { .. }
+                    | prism_scene::Integrator::PhotonProgressive { .. }
                     | prism_scene::Integrator::Depth
                     | prism_scene::Integrator::Normal
                     | prism_scene::Integrator::Albedo
@@ -323,6 +350,23 @@ impl Method {
                     1,
                 )?))
             }
+            ("photon", d @ prism_scene::Integrator::Photon { .. }) => *d,
+            ("photon", _) => prism_scene::Integrator::Photon {
+                max_depth,
+                sampler,
+                rr_depth,
+                photons_per_pass: None,
+                radius: prism_scene::PhotonRadius::Fixed(None),
+            },
+            ("photon_progressive", d @ prism_scene::Integrator::PhotonProgressive { .. }) => *d,
+            ("photon_progressive", _) => prism_scene::Integrator::PhotonProgressive {
+                max_depth,
+                sampler,
+                rr_depth,
+                photons_per_pass: None,
+                initial_radius_m: None,
+                alpha: prism_scene::DEFAULT_PHOTON_ALPHA,
+            },
             ("depth", _) => prism_scene::Integrator::Depth,
             ("normal", _) => prism_scene::Integrator::Normal,
             ("albedo", _) => prism_scene::Integrator::Albedo,
@@ -359,10 +403,6 @@ mod tests {
     fn unknown_and_unbuilt_names_are_errors_listing_the_known_ones() {
         for (text, says) in [
             ("vcm", "unknown integrator `vcm`"),
-            (
-                "photon",
-                "`photon` (photon mapping (not built yet)) is not available",
-            ),
             (
                 "bdpt+predicted",
                 "the sample plan `predicted` is for `path`, not `bdpt`",
@@ -436,6 +476,30 @@ mod tests {
         match m.integrator(&prism_scene::Integrator::Depth).unwrap() {
             Integrator::Path(p) => assert_eq!(p.max_depth, 8),
             other => panic!("{other:?}"),
+        }
+    }
+
+    #[test]
+    fn photon_methods_take_the_scene_depth_and_the_photon_defaults() {
+        let scene = prism_scene::Integrator::Path {
+            max_depth: 5,
+            sampler: SamplerKind::Sobol,
+            mis: prism_scene::MisHeuristic::Power,
+            rr_depth: 2,
+            fluorescence_lanes: prism_scene::FluorescenceLanes::All,
+            spectral_mis: true,
+        };
+        for (name, progressive) in [("photon", false), ("photon_progressive", true)] {
+            let m = Method::parse(name).unwrap();
+            assert_eq!(m.quantity(), "radiance");
+            match m.integrator(&scene).unwrap() {
+                Integrator::Photon(p) => {
+                    assert_eq!((p.max_depth, p.rr_depth), (5, 2));
+                    assert_eq!(p.photons_per_pass, None);
+                    assert_eq!(p.is_progressive(), progressive);
+                }
+                other => panic!("{other:?}"),
+            }
         }
     }
 }

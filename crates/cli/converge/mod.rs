@@ -55,9 +55,9 @@ pub struct ConvergeArgs {
     #[arg(long = "reference-spp", default_value_t = DEFAULT_REFERENCE_SPP)]
     pub reference_spp: u32,
     /// A method, INTEGRATOR[+PLAN][:SAMPLER] (repeat for several; default `path`, the path
-    /// tracer with the uniform plan and the independent sampler). Integrators: path,
-    /// ambient_occlusion, depth, normal, albedo; plans: uniform, predicted, adaptive (path
-    /// only); samplers: independent, sobol.
+    /// tracer with the uniform plan and the independent sampler). Integrators: path, light,
+    /// bdpt, photon, photon_progressive, ambient_occlusion, depth, normal, albedo; plans:
+    /// uniform, predicted, adaptive (path only); samplers: independent, sobol.
     #[arg(long = "method", value_name = "METHOD")]
     pub methods: Vec<String>,
     /// Time budget per method, seconds, on the --clock (wall or render CPU time; default 10

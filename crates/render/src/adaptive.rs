@@ -71,26 +71,15 @@ impl PerPixelPasses {
             if count.iter().all(|&c| c == 0) {
                 continue;
             }
-            let plan = SamplePlan::from_counts(scene.resolution, count, vec![1; n])?;
-            // Pixels that all start at one index are an ordinary pass from that index:
-            // the light-path estimators (bdpt, light tracer) share one sample range per
-            // tile and refuse per-pixel starts.
-            let (plan, first_sample) = match start.first() {
-                Some(&s) if start.iter().all(|&t| t == s) => (plan, s),
-                Some(_) | None => (plan.with_first_samples(start)?, 0),
-            };
+            // Pixels that all start at one index are an ordinary pass from there for the
+            // light-path estimators (the driver's `uniform_first_sample`).
+            let plan = SamplePlan::from_counts(scene.resolution, count, vec![1; n])?
+                .with_first_samples(start)?;
             let film = match (&mut self.half, into_half) {
                 (Some(half), true) => half,
                 _ => &mut self.film,
             };
-            stats.add(&render_pass(
-                scene,
-                settings,
-                &plan,
-                film,
-                first_sample,
-                progress,
-            )?);
+            stats.add(&render_pass(scene, settings, &plan, film, 0, progress)?);
         }
         for (d, c) in self.done.iter_mut().zip(counts) {
             *d += c;

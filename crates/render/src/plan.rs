@@ -339,6 +339,10 @@ impl RenderPlan {
                         .into(),
                 );
             }
+            Integrator::Photon(m) => {
+                let (text, reason) = photon_explain(m, scene);
+                choose("integrator", text, reason);
+            }
             Integrator::Bdpt(b) => {
                 choose(
                     "integrator",
@@ -632,4 +636,41 @@ impl fmt::Display for RenderPlan {
         }
         writeln!(f, "simd: {}", self.simd)
     }
+}
+
+/// `--explain`'s line for a photon integrator: its settings as this scene resolves them
+/// (photons per pass, radius, α, the memory estimate against the limit).
+fn photon_explain(m: &crate::integrator::PhotonMapper, scene: &RenderScene) -> (String, String) {
+    let plan = match m.plan(scene) {
+        Ok(plan) => plan,
+        Err(e) => return (m.name().to_string(), e.to_string()),
+    };
+    let mib = |b: u64| b as f64 / f64::from(1u32 << 20);
+    let radius = match (plan.alpha, plan.nearest) {
+        (Some(alpha), _) => format!(
+            "initial radius {:.4} m shrinking as r²ᵢ₊₁ = r²ᵢ(i + α)/(i + 1), α {alpha:.3} \
+             (Knaus & Zwicker 2011)",
+            plan.radius_m
+        ),
+        (None, Some(k)) => format!("radius: distance to the {k}-th nearest photon"),
+        (None, None) => format!("fixed radius {:.4} m (biased)", plan.radius_m),
+    };
+    let limit = match plan.limit_bytes {
+        Some(l) => format!("limit {:.0} MiB", mib(l)),
+        None => "no memory limit known".into(),
+    };
+    (
+        format!(
+            "{}, max_depth {}: {} photons per pass (one pass per sample index), {radius}; \
+             caustic map on surfaces, beam estimate in media; photon storage ≤ {:.1} MiB \
+             per pass ({limit})",
+            m.name(),
+            m.max_depth,
+            plan.photons_per_pass,
+            mib(plan.estimate_bytes)
+        ),
+        "the scene's `integrator` section (defaults: one photon per pixel, radius from the \
+         scene bounds and the pixel footprint, α 2/3)"
+            .into(),
+    )
 }

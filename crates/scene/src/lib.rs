@@ -27,7 +27,9 @@ pub use camera::{Camera, CameraKind, FisheyeFit, FisheyeProjection, FovAxis};
 pub use daylight::{DateTime, DaylightSky, SkyModel, SkyNormalisation, SunPosition};
 pub use error::{JsonPath, PathSegment, Position, SceneError};
 pub use film::{Aov, Film, PixelFilter, Reconstruction};
-pub use integrator::{FluorescenceLanes, Integrator, MisHeuristic, SamplerKind};
+pub use integrator::{
+    FluorescenceLanes, Integrator, MisHeuristic, PhotonRadius, SamplerKind, DEFAULT_PHOTON_ALPHA,
+};
 pub use light::{Light, LightKind, Strength};
 pub use material::{
     ConductorOptics, Ior, LafortuneLobe, LibraryKind, Material, MaterialKind, Microfacet, Roughness,

@@ -200,6 +200,30 @@ pub const SCHEMA: &[ObjectSchema] = &[
         "integrator<bdpt>",
         &[&["type", "max_depth", "sampler", "mis", "rr_depth"]],
     ),
+    row(
+        "integrator<photon>",
+        &[&[
+            "type",
+            "max_depth",
+            "sampler",
+            "rr_depth",
+            "photons_per_pass",
+            "radius_m",
+            "nearest_photons",
+        ]],
+    ),
+    row(
+        "integrator<photon_progressive>",
+        &[&[
+            "type",
+            "max_depth",
+            "sampler",
+            "rr_depth",
+            "photons_per_pass",
+            "initial_radius_m",
+            "alpha",
+        ]],
+    ),
     // reradiation.rs: the entries have no `type`; `<bfc>` and `<dye>` name the two forms,
     // told apart by the `bfc` and `absorption`/`emission` keys.
     row("reradiation.*<bfc>", &[&["bfc", "negatives"]]),

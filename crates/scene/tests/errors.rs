@@ -247,8 +247,31 @@ fn unknown_type_suggests_the_closest_type() {
     assert_eq!(
         e,
         "DIR/scene.json:1:16: integrator: unknown integrator type `ambient_occlusoin`, expected \
-         one of `depth`, `normal`, `albedo`, `ambient_occlusion`, `path`, `light`, `bdpt` \
-         (did you mean `ambient_occlusion`?)"
+         one of `depth`, `normal`, `albedo`, `ambient_occlusion`, `path`, `light`, `bdpt`, \
+         `photon`, `photon_progressive` (did you mean `ambient_occlusion`?)"
+    );
+    // The photon integrators' keys: positioned errors for bad values and unknown keys.
+    let e = dir.error(r#"{"integrator": {"type": "photon_progressive", "alpha": 1.2}}"#);
+    assert!(
+        e.starts_with(
+            "DIR/scene.json:1:56: integrator.alpha: `alpha` must lie strictly between 0 and 1"
+        ),
+        "{e}"
+    );
+    let e =
+        dir.error(r#"{"integrator": {"type": "photon", "radius_m": 0.1, "nearest_photons": 8}}"#);
+    assert!(
+        e.contains("integrator.nearest_photons: give only one of"),
+        "{e}"
+    );
+    let e = dir.error(r#"{"integrator": {"type": "photon_progressive", "initial_radius_m": -1}}"#);
+    assert!(e.contains("integrator.initial_radius_m"), "{e}");
+    let e = dir.error(r#"{"integrator": {"type": "photon", "photons_per_pass": 0}}"#);
+    assert!(e.contains("integrator.photons_per_pass"), "{e}");
+    let e = dir.error(r#"{"integrator": {"type": "photon_progressive", "radius_m": 0.1}}"#);
+    assert!(
+        e.contains("integrator.radius_m") && e.contains("unknown"),
+        "{e}"
     );
     let e = dir.error(r#"{"lights": [{"type": "spotlight"}]}"#);
     assert!(e.ends_with("(did you mean `spot`?)"), "{e}");

@@ -5,10 +5,41 @@ use glam::DVec3;
 
 use super::camera_sample::CameraSample;
 use super::driver::RenderStats;
-use super::estimator::TileWork;
+use super::estimator::{Estimator, Pass, TileWork};
 use super::Integrator;
-use crate::film::{FilmTile, SurfaceAov};
+use crate::film::{FilmTile, LightSplats, SurfaceAov};
 use crate::scene_build::RenderScene;
+
+/// A diagnostic integrator (depth, normal, albedo, ambient occlusion) as an `Estimator`.
+pub(crate) struct Diagnostic(pub Integrator);
+
+impl Estimator for Diagnostic {
+    fn name(&self) -> &'static str {
+        self.0.name()
+    }
+
+    fn prepare(&mut self, _scene: &RenderScene, _pass: &Pass) -> Result<(), String> {
+        Ok(())
+    }
+
+    fn splats_light_paths(&self) -> bool {
+        false
+    }
+
+    fn sample_indices_per_prepare(&self) -> Option<u32> {
+        None
+    }
+
+    fn render_tile(
+        &self,
+        scene: &RenderScene,
+        work: &TileWork,
+        tile: &mut FilmTile,
+        _splats: &mut LightSplats,
+    ) -> RenderStats {
+        render_tile(&self.0, scene, work, tile)
+    }
+}
 
 /// Renders the work item with the diagnostic `integrator` (not `Path`, `Light`, `Bdpt`).
 pub(crate) fn render_tile(

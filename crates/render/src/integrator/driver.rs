@@ -194,10 +194,10 @@ pub fn render_pass(
     first_sample: u32,
     progress: &(dyn Fn(u64) + Sync),
 ) -> Result<RenderStats, RenderError> {
-    let mut estimator = scene.integrator;
+    let mut estimator = scene.integrator.estimator();
     let pass_index = u32::from(first_sample > 0);
     render_pass_with(
-        &mut estimator,
+        estimator.as_mut(),
         scene,
         &Pass {
             index: pass_index,
@@ -230,17 +230,119 @@ pub fn render_pass_with(
     pass.plan.check_resolution(scene.resolution)?;
     pass.plan.check_resolution(film.resolution())?;
     if estimator.splats_light_paths() && pass.plan.has_per_pixel_first_samples() {
-        // Their work items are sample ranges shared by a whole tile.
-        return Err(RenderError::Estimator(format!(
-            "{} takes the same samples in every pixel: a plan whose pixels start their \
-             samples at different indices (a predicted or adaptive plan) is for `path`",
-            estimator.name()
-        )));
+        // Their work items are sample ranges shared by a whole tile: a plan whose pixels
+        // all start at one index (`prism converge`'s uniform passes) is the uniform plan
+        // moved by that index; any other is refused.
+        let Some(first) = uniform_first_sample(pass.plan) else {
+            return Err(RenderError::Estimator(format!(
+                "{} takes the same samples in every pixel: a plan whose pixels start their \
+                 samples at different indices (a predicted or adaptive plan) is for `path`",
+                estimator.name()
+            )));
+        };
+        let plan = plan_counts(pass.plan)?;
+        let moved = Pass {
+            first_sample: pass.first_sample + first,
+            plan: &plan,
+            ..*pass
+        };
+        return render_pass_with(estimator, scene, &moved, film, progress);
+    }
+    if let Some(per_prepare) = estimator.sample_indices_per_prepare() {
+        return render_in_sample_steps(estimator, scene, pass, film, progress, per_prepare);
     }
     estimator
         .prepare(scene, pass)
         .map_err(RenderError::Estimator)?;
-    let estimator = &*estimator;
+    run_prepared(&*estimator, scene, pass, film, progress)
+}
+
+/// `render_pass_with` for an estimator that prepares every `per_prepare` sample indices:
+/// the pass cut into passes of at most that many indices, `prepare` before each. The
+/// pixels' sample ranges must start at the same index.
+fn render_in_sample_steps(
+    estimator: &mut (impl Estimator + ?Sized),
+    scene: &RenderScene,
+    pass: &Pass,
+    film: &mut Film,
+    progress: &(dyn Fn(u64) + Sync),
+    per_prepare: u32,
+) -> Result<RenderStats, RenderError> {
+    let resolution = pass.plan.resolution();
+    let Some(first) = uniform_first_sample(pass.plan) else {
+        return Err(RenderError::Estimator(format!(
+            "{} renders one pass per sample index, the same in every pixel: a plan whose \
+             pixels start their samples at different indices (a predicted or adaptive plan) \
+             is for `path`",
+            estimator.name()
+        )));
+    };
+    let counts: Vec<u32> = pixels_of(resolution)
+        .map(|p| pass.plan.camera_samples(p))
+        .collect();
+    let light: Vec<u32> = pixels_of(resolution)
+        .map(|p| pass.plan.light_samples(p))
+        .collect();
+    let most = counts.iter().copied().max().unwrap_or(0);
+    let n = counts.len();
+    let step = per_prepare.max(1);
+    let mut total = RenderStats::default();
+    let mut k = 0u32;
+    while k < most {
+        let sub_counts: Vec<u32> = counts
+            .iter()
+            .map(|c| c.saturating_sub(k).min(step))
+            .collect();
+        let plan = SamplePlan::from_counts(resolution, sub_counts, light.clone())?
+            .with_first_samples(vec![first + k; n])?;
+        let sub = Pass {
+            index: pass.index + k,
+            settings: pass.settings,
+            plan: &plan,
+            first_sample: pass.first_sample,
+        };
+        estimator
+            .prepare(scene, &sub)
+            .map_err(RenderError::Estimator)?;
+        total.add(&run_prepared(&*estimator, scene, &sub, film, progress)?);
+        k += step;
+    }
+    Ok(total)
+}
+
+/// The pixels of a `resolution` film, row-major (the plans' order).
+fn pixels_of(resolution: UVec2) -> impl Iterator<Item = UVec2> {
+    (0..resolution.y).flat_map(move |y| (0..resolution.x).map(move |x| UVec2::new(x, y)))
+}
+
+/// The index every pixel of `plan` starts at, if they all start at one.
+fn uniform_first_sample(plan: &SamplePlan) -> Option<u32> {
+    let first = plan.first_sample(UVec2::ZERO);
+    pixels_of(plan.resolution())
+        .all(|p| plan.first_sample(p) == first)
+        .then_some(first)
+}
+
+/// `plan`'s counts without its per-pixel first samples.
+fn plan_counts(plan: &SamplePlan) -> Result<SamplePlan, RenderError> {
+    let resolution = plan.resolution();
+    let counts = pixels_of(resolution)
+        .map(|p| plan.camera_samples(p))
+        .collect();
+    let light = pixels_of(resolution)
+        .map(|p| plan.light_samples(p))
+        .collect();
+    Ok(SamplePlan::from_counts(resolution, counts, light)?)
+}
+
+/// Every work item of a prepared pass, in parallel, merged in a fixed order.
+fn run_prepared(
+    estimator: &(impl Estimator + ?Sized),
+    scene: &RenderScene,
+    pass: &Pass,
+    film: &mut Film,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Result<RenderStats, RenderError> {
     let sampler = PixelSampler::with_kind(pass.settings.sampler, pass.settings.seed);
     let uses_lens = scene.camera.uses_lens_sample();
     let tile_size_px = pass.settings.tile_size_px;

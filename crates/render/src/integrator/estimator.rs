@@ -75,6 +75,12 @@ pub trait Estimator: Sync {
     /// into sample ranges so that each item's splat list stays small.
     fn splats_light_paths(&self) -> bool;
 
+    /// `Some(n)`: `prepare` must run before every n sample indices, which must be the same
+    /// in every pixel — the driver then cuts each pass into passes of at most n indices
+    /// (a photon integrator shoots one photon pass per sample index). `None`: one
+    /// `prepare` per pass, however many samples it holds.
+    fn sample_indices_per_prepare(&self) -> Option<u32>;
+
     /// Renders the work item into `tile` (camera side) and `splats` (light side); returns
     /// what it did.
     fn render_tile(

@@ -212,6 +212,10 @@ impl Estimator for LightTracer {
         true
     }
 
+    fn sample_indices_per_prepare(&self) -> Option<u32> {
+        None
+    }
+
     fn render_tile(
         &self,
         scene: &RenderScene,

@@ -7,6 +7,9 @@
 //! - `light`: light tracing, every light-path vertex connected to the camera
 //!   (`light_tracer`);
 //! - `bdpt`: bidirectional path tracing with MIS over all strategies (`bdpt`);
+//! - `photon`, `photon_progressive`: caustic and volume photon maps next to `path`'s
+//!   estimators (`photon`), the only methods whose passes keep state (their photons), so
+//!   the driver runs each method through `Integrator::estimator`;
 //! - the diagnostic ones — `depth`, `normal`, `albedo`, `ambient_occlusion` — each in its
 //!   own file, sharing one tile loop (`diagnostic`).
 //!
@@ -40,6 +43,7 @@ pub mod packet;
 mod path;
 mod path_estimator;
 mod path_state;
+pub mod photon;
 mod scatter_vertex;
 
 pub use ambient_occlusion::AmbientOcclusion;
@@ -53,12 +57,12 @@ pub use lane_wavelengths::LaneWavelengths;
 pub use light_tracer::LightTracer;
 pub use path::{mis_weight, FirstHit, PathCounters, PathResult, PathTracer};
 pub use path_state::{PathOrigin, PathState, MAX_NULL_EVENTS};
+pub use photon::{PhotonEstimator, PhotonMapper, RadiusRule};
 pub use scatter_vertex::{MediumVertex, ScatterEval, ScatterSample, ScatterVertex, SurfaceVertex};
 
 use glam::DVec3;
 use prism_geometry::{Ray, SurfaceInteraction};
 
-use crate::film::{FilmTile, LightSplats};
 use crate::sampler::SampleStream;
 use crate::scene_build::RenderScene;
 
@@ -78,6 +82,8 @@ pub enum Integrator {
     Light(LightTracer),
     /// Bidirectional path tracing.
     Bdpt(Bdpt),
+    /// `photon` or `photon_progressive` (`PhotonMapper::is_progressive`).
+    Photon(PhotonMapper),
 }
 
 impl Integrator {
@@ -128,7 +134,93 @@ impl Integrator {
                 mis,
                 strategy: None,
             }),
+            prism_scene::Integrator::Photon {
+                max_depth,
+                rr_depth,
+                photons_per_pass,
+                radius,
+                ..
+            } => Integrator::Photon(PhotonMapper {
+                max_depth: max_depth.max(1),
+                rr_depth,
+                photons_per_pass,
+                radius: match radius {
+                    prism_scene::PhotonRadius::Fixed(r) => RadiusRule::Fixed(r.map(|r| r as f32)),
+                    prism_scene::PhotonRadius::Nearest(k) => RadiusRule::Nearest(k),
+                },
+                memory_limit_bytes: None,
+            }),
+            prism_scene::Integrator::PhotonProgressive {
+                max_depth,
+                rr_depth,
+                photons_per_pass,
+                initial_radius_m,
+                alpha,
+                ..
+            } => Integrator::Photon(PhotonMapper {
+                max_depth: max_depth.max(1),
+                rr_depth,
+                photons_per_pass,
+                radius: RadiusRule::Progressive {
+                    initial_m: initial_radius_m.map(|r| r as f32),
+                    alpha: alpha as f32,
+                },
+                memory_limit_bytes: None,
+            }),
         })
+    }
+
+    /// The estimator that renders this method's passes, with the state they keep (a photon
+    /// integrator's photons): what the driver runs.
+    pub fn estimator(&self) -> Box<dyn Estimator> {
+        match self {
+            Integrator::Depth
+            | Integrator::Normal
+            | Integrator::Albedo
+            | Integrator::AmbientOcclusion(_) => Box::new(diagnostic::Diagnostic(*self)),
+            Integrator::Path(p) => Box::new(*p),
+            Integrator::Light(l) => Box::new(*l),
+            Integrator::Bdpt(b) => Box::new(*b),
+            Integrator::Photon(m) => Box::new(PhotonEstimator::new(*m)),
+        }
+    }
+
+    /// Sets the most bytes a method's per-pass storage may take (the photon integrators'
+    /// photons; `None`: their default, 75 % of the machine's memory). Other methods keep
+    /// no per-pass storage worth a limit.
+    pub fn set_memory_limit_bytes(&mut self, limit: Option<u64>) {
+        match self {
+            Integrator::Photon(m) => m.memory_limit_bytes = limit,
+            Integrator::Depth
+            | Integrator::Normal
+            | Integrator::Albedo
+            | Integrator::AmbientOcclusion(_)
+            | Integrator::Path(_)
+            | Integrator::Light(_)
+            | Integrator::Bdpt(_) => {}
+        }
+    }
+
+    /// Err with the reason when this method cannot render `scene` at all (checked when a
+    /// scene is built and again by `prepare`): the photon integrators' refusals (no lights,
+    /// re-radiation, emissive media) and their memory estimate.
+    pub fn refuse_scene(
+        &self,
+        scene: &RenderScene,
+    ) -> Result<(), crate::scene_build::SceneBuildError> {
+        match self {
+            Integrator::Photon(m) => match photon::refusal(m, scene) {
+                Some(reason) => Err(reason),
+                None => m.plan(scene).map(|_| ()),
+            },
+            Integrator::Depth
+            | Integrator::Normal
+            | Integrator::Albedo
+            | Integrator::AmbientOcclusion(_)
+            | Integrator::Path(_)
+            | Integrator::Light(_)
+            | Integrator::Bdpt(_) => Ok(()),
+        }
     }
 
     /// The path tracer that measures illuminance sensors for this method: the method's
@@ -146,6 +238,11 @@ impl Integrator {
                 spectral_mis: true,
             },
             Integrator::Bdpt(b) => b.path_tracer(),
+            Integrator::Photon(m) => PathTracer {
+                max_depth: m.max_depth,
+                rr_depth: m.rr_depth,
+                ..PathTracer::default()
+            },
             Integrator::Depth
             | Integrator::Normal
             | Integrator::Albedo
@@ -156,7 +253,10 @@ impl Integrator {
     /// True for the methods that estimate radiance (the others are diagnostics).
     pub fn is_spectral(&self) -> bool {
         match self {
-            Integrator::Path(_) | Integrator::Light(_) | Integrator::Bdpt(_) => true,
+            Integrator::Path(_)
+            | Integrator::Light(_)
+            | Integrator::Bdpt(_)
+            | Integrator::Photon(_) => true,
             Integrator::Depth
             | Integrator::Normal
             | Integrator::Albedo
@@ -172,6 +272,7 @@ impl Integrator {
         match self {
             Integrator::Light(_) | Integrator::Bdpt(_) => Err(media_refusal(self.name(), names)),
             Integrator::Path(_)
+            | Integrator::Photon(_)
             | Integrator::Depth
             | Integrator::Normal
             | Integrator::Albedo
@@ -189,6 +290,7 @@ impl Integrator {
             Integrator::Path(_) => "path",
             Integrator::Light(_) => "light",
             Integrator::Bdpt(_) => "bdpt",
+            Integrator::Photon(m) => m.name(),
         }
     }
 
@@ -209,55 +311,10 @@ impl Integrator {
             Integrator::Albedo => albedo::shade(scene, hit),
             Integrator::AmbientOcclusion(ao) => ao.shade(&scene.geometry, ray, hit, stream, rays),
             // Spectral: their own estimators.
-            Integrator::Path(_) | Integrator::Light(_) | Integrator::Bdpt(_) => DVec3::ZERO,
-        }
-    }
-}
-
-impl Estimator for Integrator {
-    fn name(&self) -> &'static str {
-        Integrator::name(self)
-    }
-
-    fn prepare(&mut self, scene: &RenderScene, pass: &Pass) -> Result<(), String> {
-        match self {
-            Integrator::Depth
-            | Integrator::Normal
-            | Integrator::Albedo
-            | Integrator::AmbientOcclusion(_) => Ok(()),
-            Integrator::Path(p) => p.prepare(scene, pass),
-            Integrator::Light(l) => l.prepare(scene, pass),
-            Integrator::Bdpt(b) => b.prepare(scene, pass),
-        }
-    }
-
-    fn splats_light_paths(&self) -> bool {
-        match self {
-            Integrator::Depth
-            | Integrator::Normal
-            | Integrator::Albedo
-            | Integrator::AmbientOcclusion(_) => false,
-            Integrator::Path(p) => p.splats_light_paths(),
-            Integrator::Light(l) => l.splats_light_paths(),
-            Integrator::Bdpt(b) => b.splats_light_paths(),
-        }
-    }
-
-    fn render_tile(
-        &self,
-        scene: &RenderScene,
-        work: &TileWork,
-        tile: &mut FilmTile,
-        splats: &mut LightSplats,
-    ) -> RenderStats {
-        match self {
-            Integrator::Depth
-            | Integrator::Normal
-            | Integrator::Albedo
-            | Integrator::AmbientOcclusion(_) => diagnostic::render_tile(self, scene, work, tile),
-            Integrator::Path(p) => p.render_tile(scene, work, tile, splats),
-            Integrator::Light(l) => l.render_tile(scene, work, tile, splats),
-            Integrator::Bdpt(b) => b.render_tile(scene, work, tile, splats),
+            Integrator::Path(_)
+            | Integrator::Light(_)
+            | Integrator::Bdpt(_)
+            | Integrator::Photon(_) => DVec3::ZERO,
         }
     }
 }

@@ -28,6 +28,10 @@ impl Estimator for PathTracer {
         false
     }
 
+    fn sample_indices_per_prepare(&self) -> Option<u32> {
+        None
+    }
+
     fn render_tile(
         &self,
         scene: &RenderScene,

@@ -78,7 +78,7 @@ impl SceneFeature {
             SceneFeature::DeltaLights => "delta lights",
             SceneFeature::NonRectangleAreaLights => "non-rectangle area lights",
             SceneFeature::ThinLensCamera => "thin-lens camera",
-            SceneFeature::LightPaths => "light tracing or BDPT",
+            SceneFeature::LightPaths => "light tracing, BDPT or photon mapping",
             SceneFeature::Reradiation => "re-radiation (fluorescence)",
         }
     }
@@ -143,8 +143,9 @@ impl SceneFeature {
                 "a thin-lens camera: every camera ray needs a lens sample (depth of field)"
             }
             SceneFeature::LightPaths => {
-                "the light tracer or BDPT: paths also start at the lights and are connected \
-                 to the camera, splatted onto the film"
+                "the light tracer, BDPT or a photon integrator: paths also start at the \
+                 lights (connected to the camera and splatted onto the film, or stored as \
+                 photons)"
             }
             SceneFeature::Reradiation => {
                 "a `fluorescent` material: a lane absorbs at one wavelength and re-emits at \
@@ -229,7 +230,9 @@ impl SceneFeatures {
             | Integrator::Normal
             | Integrator::Albedo
             | Integrator::AmbientOcclusion(_) => f.insert(SceneFeature::DiagnosticIntegrator),
-            Integrator::Light(_) | Integrator::Bdpt(_) => f.insert(SceneFeature::LightPaths),
+            Integrator::Light(_) | Integrator::Bdpt(_) | Integrator::Photon(_) => {
+                f.insert(SceneFeature::LightPaths)
+            }
             Integrator::Path(_) => {}
         }
         match camera {

@@ -80,8 +80,17 @@ const INTEGRATORS: &[&str] = &[
     "integrator<path>",
     "integrator<light>",
     "integrator<bdpt>",
+    "integrator<photon>",
+    "integrator<photon_progressive>",
 ];
-const TRANSPORT: &[&str] = &["integrator<path>", "integrator<light>", "integrator<bdpt>"];
+const TRANSPORT: &[&str] = &[
+    "integrator<path>",
+    "integrator<light>",
+    "integrator<bdpt>",
+    "integrator<photon>",
+    "integrator<photon_progressive>",
+];
+const PHOTON: &[&str] = &["integrator<photon>", "integrator<photon_progressive>"];
 const SHAPES: &[&str] = &[
     "shapes[]<mesh>",
     "shapes[]<sphere>",
@@ -260,6 +269,21 @@ pub const FIELD_USES: &[FieldRow] = &[
         &["integrator<path>"],
         &["spectral_mis"],
         "Integrator::from_description (PathTracer::spectral_mis)",
+    ),
+    read(
+        PHOTON,
+        &["photons_per_pass"],
+        "Integrator::from_description (PhotonMapper::photons_per_pass)",
+    ),
+    read(
+        &["integrator<photon>"],
+        &["radius_m", "nearest_photons"],
+        "Integrator::from_description (PhotonMapper::radius)",
+    ),
+    read(
+        &["integrator<photon_progressive>"],
+        &["initial_radius_m", "alpha"],
+        "Integrator::from_description (PhotonMapper::radius, RadiusRule::Progressive)",
     ),
     // media
     read(

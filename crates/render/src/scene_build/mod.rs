@@ -177,6 +177,7 @@ impl RenderScene {
             media,
         };
         built.set_packet_tracing(true);
+        built.integrator.refuse_scene(&built)?;
         Ok(built)
     }
 

@@ -313,6 +313,10 @@ impl Estimator for Bdpt {
         true
     }
 
+    fn sample_indices_per_prepare(&self) -> Option<u32> {
+        None
+    }
+
     fn render_tile(
         &self,
         scene: &RenderScene,

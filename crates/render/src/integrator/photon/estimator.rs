@@ -1,0 +1,244 @@
+//! `photon` and `photon_progressive` as an `Estimator`. A pass of the photon integrators
+//! is one camera sample index: the driver renders them one index at a time
+//! (`Estimator::sample_indices_per_prepare`), and `prepare` shoots that pass's photons at
+//! that pass's wavelengths (one `SampledWavelengths` for every photon and camera path of
+//! the pass, as pbrt-v4's SPPM) with that pass's radius, dropping the previous pass's.
+//! The film averages the passes' images: with the radius of pass i shrinking as
+//! r²ᵢ₊₁ = r²ᵢ(i + α)/(i + 1), that average is Knaus & Zwicker 2011's progressive photon
+//! mapping, whose bias and variance both vanish (their §4); it needs no per-pixel
+//! statistics, which is what lets the passes run in any grouping and a render of N
+//! samples equal N one-sample passes. `prism render --spp N` is N photon passes.
+
+use prism_spectrum::SampledSpectrum;
+
+use super::camera::{pass_wavelengths, CameraPaths, PhotonMaps};
+use super::photon_map::PhotonTree;
+use super::settings::{PhotonMapper, PhotonPlan};
+use super::shoot::shoot;
+use crate::film::xyz::XyzWeights;
+use crate::film::{FilmTile, LightSplats, SurfaceAov};
+use crate::integrator::camera_sample::CameraSample;
+use crate::integrator::driver::RenderStats;
+use crate::integrator::estimator::{Estimator, Pass, TileWork};
+use crate::integrator::lane_wavelengths::LaneWavelengths;
+use crate::integrator::{PathCounters, PathTracer};
+use crate::scene_build::{RenderScene, SceneBuildError};
+
+/// A photon integrator with the state its passes keep: the resolved settings and the
+/// current pass's photons.
+pub struct PhotonEstimator {
+    pub mapper: PhotonMapper,
+    plan: Option<PhotonPlan>,
+    maps: PhotonMaps,
+    /// The pass (sample index) the maps are for.
+    iteration: Option<u32>,
+    /// The pass's wavelengths.
+    wavelengths: prism_spectrum::SampledWavelengths,
+    /// The last pass's (index, r²), from which the next radius continues.
+    radius: Option<(u32, f64)>,
+    /// Rays the photon pass traced, reported with the first tile's statistics.
+    photon_rays: std::sync::atomic::AtomicU64,
+}
+
+impl PhotonEstimator {
+    pub fn new(mapper: PhotonMapper) -> Self {
+        Self {
+            mapper,
+            plan: None,
+            maps: PhotonMaps::default(),
+            iteration: None,
+            wavelengths: prism_spectrum::SampledWavelengths::sample_visible(0.5),
+            radius: None,
+            photon_rays: std::sync::atomic::AtomicU64::new(0),
+        }
+    }
+
+    fn tracer(&self) -> PathTracer {
+        PathTracer {
+            max_depth: self.mapper.max_depth,
+            rr_depth: self.mapper.rr_depth,
+            ..PathTracer::default()
+        }
+    }
+
+    /// Stored photons of the current pass (caustic, volume).
+    pub fn photon_counts(&self) -> (usize, usize) {
+        (self.maps.caustic.len(), self.maps.volume.len())
+    }
+}
+
+/// Why a photon integrator cannot render `scene`, if it cannot.
+pub fn refusal(mapper: &PhotonMapper, scene: &RenderScene) -> Option<SceneBuildError> {
+    let file = &scene.file;
+    let name = mapper.name();
+    if scene.lights.is_empty() {
+        return Some(SceneBuildError::new(
+            file,
+            "integrator",
+            format!(
+                "`{name}` shoots photons from the lights, and the scene has none (add a \
+                 `lights` entry)"
+            ),
+        ));
+    }
+    if let Some(material) = scene.reradiating_material() {
+        return Some(SceneBuildError::new(
+            file,
+            format!("materials.{material}"),
+            format!(
+                "material '{material}' re-radiates (fluorescence): `{name}` carries one \
+                 wavelength set per pass and does not shift it; use path"
+            ),
+        ));
+    }
+    if let Some(media) = &scene.media {
+        for (m, medium) in media.media.iter().enumerate() {
+            let optics = medium.optics();
+            let what = if optics.fluorescence.is_some() {
+                "re-radiates (a fluorophore)"
+            } else if optics.emission.is_some() {
+                "emits light (`emission`)"
+            } else {
+                continue;
+            };
+            let medium_name = &media.names[m];
+            return Some(SceneBuildError::new(
+                file,
+                format!("media.{medium_name}"),
+                format!(
+                    "medium '{medium_name}' {what}: `{name}` shoots photons from lights only \
+                     and does not trace that; use path"
+                ),
+            ));
+        }
+    }
+    None
+}
+
+impl Estimator for PhotonEstimator {
+    fn name(&self) -> &'static str {
+        self.mapper.name()
+    }
+
+    fn prepare(&mut self, scene: &RenderScene, pass: &Pass) -> Result<(), String> {
+        if let Some(reason) = refusal(&self.mapper, scene) {
+            return Err(reason.to_string());
+        }
+        let plan = match self.plan {
+            Some(p) => p,
+            None => {
+                let p = self.mapper.plan(scene).map_err(|e| e.to_string())?;
+                self.plan = Some(p);
+                p
+            }
+        };
+        // The driver gives a photon integrator passes of one sample index, the same in
+        // every pixel.
+        let iteration = pass.first_sample + pass.plan.first_sample(glam::UVec2::ZERO);
+        if self.iteration == Some(iteration) {
+            return Ok(());
+        }
+        // Drop the last pass's photons before the next are shot.
+        self.maps = PhotonMaps::default();
+        self.wavelengths = pass_wavelengths(pass.settings.seed, iteration);
+        let radius = plan.radius_from(iteration, self.radius);
+        self.radius = Some(radius);
+        let radius_m = radius.1.sqrt() as f32;
+        let shot = shoot(
+            scene,
+            &self.wavelengths,
+            plan.photons_per_pass,
+            pass.settings.seed,
+            iteration,
+            self.mapper.max_depth,
+            if plan.nearest.is_some() {
+                0.0
+            } else {
+                radius_m
+            },
+        );
+        let mut caustic = PhotonTree::build(shot.caustic);
+        let mut volume = PhotonTree::build(shot.volume);
+        if let Some(k) = plan.nearest {
+            // A lone photon's radius is bounded by 25 times the default radius.
+            let most = 25.0 * plan.radius_m;
+            caustic.set_nearest_neighbour_radii(k as usize, most);
+            volume.set_nearest_neighbour_radii(k as usize, most);
+        }
+        self.maps = PhotonMaps { caustic, volume };
+        self.photon_rays
+            .store(shot.rays, std::sync::atomic::Ordering::Relaxed);
+        self.iteration = Some(iteration);
+        Ok(())
+    }
+
+    fn splats_light_paths(&self) -> bool {
+        false
+    }
+
+    fn sample_indices_per_prepare(&self) -> Option<u32> {
+        Some(1)
+    }
+
+    fn render_tile(
+        &self,
+        scene: &RenderScene,
+        work: &TileWork,
+        tile: &mut FilmTile,
+        _splats: &mut LightSplats,
+    ) -> RenderStats {
+        let mut counters = PathCounters::default();
+        let mut stats = RenderStats::default();
+        stats.rays_traced += self
+            .photon_rays
+            .swap(0, std::sync::atomic::Ordering::Relaxed);
+        let paths = CameraPaths {
+            tracer: self.tracer(),
+            maps: &self.maps,
+        };
+        for pixel in tile.bounds().pixels() {
+            for s in work.samples_of(pixel) {
+                debug_assert_eq!(Some(s), self.iteration, "one photon pass per sample index");
+                let mut cs = CameraSample::start(tile, work, pixel, s);
+                // The stream's wavelength dimension is not read: the pass's set is used.
+                let _ = cs.stream.get_1d();
+                let mut wavelengths = LaneWavelengths::new(self.wavelengths);
+                let result = scene
+                    .camera
+                    .generate_ray_only(cs.film_point, cs.lens)
+                    .map(|ray| {
+                        paths.radiance(scene, &ray, &mut wavelengths, &mut cs.stream, &mut counters)
+                    });
+                let sensor = wavelengths.sensor();
+                let xyz_weights = XyzWeights::new(sensor);
+                let (radiance, aov) = match result {
+                    None => (SampledSpectrum::splat(0.0), None),
+                    Some((radiance, first_hit)) => {
+                        stats.rays_traced += 1;
+                        let aov = first_hit.map(|si| SurfaceAov {
+                            depth_m: si.t,
+                            normal: si.n_shading,
+                            albedo_rgb: scene.albedo(si.material_id),
+                        });
+                        (radiance, aov)
+                    }
+                };
+                if radiance.has_non_finite() {
+                    stats.non_finite_samples += 1;
+                }
+                tile.add_sample_with(
+                    pixel,
+                    cs.film_point,
+                    radiance,
+                    sensor,
+                    &xyz_weights,
+                    cs.filter_weight,
+                    aov.as_ref(),
+                );
+                stats.samples += 1;
+            }
+        }
+        stats.add_path_counters(&counters);
+        stats
+    }
+}
