@@ -7,13 +7,16 @@
 //! The stream's dimensions: `integrator::dimensions`.
 
 use std::fmt;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Mutex;
+use std::time::{Duration, Instant};
 
 use glam::UVec2;
 use rayon::prelude::*;
 
 use super::estimator::{Estimator, Pass, TileWork};
 use super::PathCounters;
-use crate::film::{AovSelection, Film, FilmImage, FilmTile, LightSplats, SpectralBins};
+use crate::film::{AovSelection, Film, FilmImage, FilmTile, LightSplats, SpectralBins, TileBounds};
 use crate::sampler::{PixelSampler, SamplerKind};
 use crate::scene_build::RenderScene;
 use prism_bandwidth::{BandwidthError, SamplePlan};
@@ -204,6 +207,7 @@ pub fn render_pass(
             settings,
             plan,
             first_sample,
+            footprint_plan: None,
         },
         film,
         progress,
@@ -227,6 +231,76 @@ pub fn render_pass_with(
     film: &mut Film,
     progress: &(dyn Fn(u64) + Sync),
 ) -> Result<RenderStats, RenderError> {
+    let never = AtomicBool::new(false);
+    let control = PassControl {
+        stop: &never,
+        items_done: 0,
+        checkpoint: None,
+    };
+    render_pass_controlled(estimator, scene, pass, film, progress, &control).map(|o| o.stats)
+}
+
+/// What may interrupt a pass and what it saves on the way (`prism render --checkpoint-every`,
+/// `--resume`, Ctrl-C).
+pub struct PassControl<'a> {
+    /// Once set, no further work item starts; the items in flight finish and are merged.
+    pub stop: &'a AtomicBool,
+    /// Work items already in the film (`PassOutcome::items_done` of the checkpoint being
+    /// resumed; 0 for a fresh film). Only estimators whose items must be merged in order
+    /// use it; the others skip the tiles whose pixels already hold all their samples.
+    pub items_done: usize,
+    /// At most every `Duration`, between work items, the film so far and the items done:
+    /// a consistent state to resume from (the callback writes the checkpoint).
+    pub checkpoint: Option<(Duration, &'a (dyn Fn(&Film, usize) + Sync))>,
+}
+
+/// How far a controlled pass got.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PassOutcome {
+    pub stats: RenderStats,
+    /// Work items in the film (for resuming the ordered kind: see `PassControl`).
+    pub items_done: usize,
+    /// Every work item of the pass is in the film.
+    pub complete: bool,
+}
+
+/// A checkpoint is due when `every` has passed since the last one.
+struct CheckpointClock<'a> {
+    last: Mutex<Instant>,
+    every: Duration,
+    write: &'a (dyn Fn(&Film, usize) + Sync),
+}
+
+impl CheckpointClock<'_> {
+    fn due(&self) -> bool {
+        self.last
+            .lock()
+            .map(|mut last| {
+                if last.elapsed() >= self.every {
+                    *last = Instant::now();
+                    true
+                } else {
+                    false
+                }
+            })
+            .unwrap_or(false)
+    }
+}
+
+/// [`render_pass_with`] that stops when `control.stop` is set, continues a film restored
+/// from a checkpoint, and hands out checkpoints. The film it leaves is the film of an
+/// uninterrupted pass restricted to the items done, and continuing it (a second call with
+/// `items_done` from the outcome) gives the uninterrupted film bit for bit: items are
+/// merged either into pixels that nothing else touches (tiles of an estimator that writes
+/// its own pixels only, on a film that does not splat) or in item order.
+pub fn render_pass_controlled(
+    estimator: &mut (impl Estimator + ?Sized),
+    scene: &RenderScene,
+    pass: &Pass,
+    film: &mut Film,
+    progress: &(dyn Fn(u64) + Sync),
+    control: &PassControl,
+) -> Result<PassOutcome, RenderError> {
     pass.plan.check_resolution(scene.resolution)?;
     pass.plan.check_resolution(film.resolution())?;
     if estimator.splats_light_paths() && pass.plan.has_per_pixel_first_samples() {
@@ -245,31 +319,75 @@ pub fn render_pass_with(
     let uses_lens = scene.camera.uses_lens_sample();
     let tile_size_px = pass.settings.tile_size_px;
     let all_samples = pass.first_sample..u32::MAX;
-    if !estimator.splats_light_paths() {
-        // Integer counts: their sum does not depend on the order tiles finish in.
-        let total = std::sync::Mutex::new(RenderStats::default());
+    let clock = control.checkpoint.map(|(every, write)| CheckpointClock {
+        last: Mutex::new(Instant::now()),
+        every,
+        write,
+    });
+    let stop = control.stop;
+    if !estimator.splats_light_paths() && !film.splats() {
+        // Tiles write their own pixels only: each is added once into pixels at zero, in
+        // whatever order they finish (same bits as any order), under a lock so that a
+        // checkpoint sees whole tiles. Tiles whose pixels hold all their samples already
+        // (a resumed checkpoint) are skipped.
+        let all_tiles = film.tiles(tile_size_px);
+        let tiles: Vec<TileBounds> = all_tiles
+            .iter()
+            .copied()
+            .filter(|b| {
+                !b.pixels()
+                    .all(|p| film.sample_count(p) == pass.plan.camera_samples(p))
+            })
+            .collect();
+        let skipped = all_tiles.len() - tiles.len();
+        let maker = film.tile_maker();
         let no_splats = film.unused_light_splats();
-        film.render_tiles(tile_size_px, |tile| {
+        let shared = Mutex::new((&mut *film, RenderStats::default(), skipped));
+        tiles.par_iter().for_each(|bounds| {
+            if stop.load(Ordering::Relaxed) {
+                return;
+            }
             let work = TileWork {
                 pass,
                 sampler: &sampler,
                 sample_indices: all_samples.clone(),
                 uses_lens,
             };
+            let mut tile = maker.new_tile(*bounds);
             let mut splats = no_splats.clone();
-            let stats = estimator.render_tile(scene, &work, tile, &mut splats);
+            let stats = estimator.render_tile(scene, &work, &mut tile, &mut splats);
             debug_assert_eq!(splats.splat_count(), 0, "{} splats", estimator.name());
             progress(stats.samples);
-            if let Ok(mut t) = total.lock() {
-                t.add(&stats);
+            if let Ok(mut guard) = shared.lock() {
+                let (film, total, done) = &mut *guard;
+                film.merge_tile(&tile);
+                total.add(&stats);
+                *done += 1;
+                if let Some(clock) = &clock {
+                    if clock.due() {
+                        (clock.write)(film, *done);
+                    }
+                }
             }
         });
-        return Ok(total.into_inner().unwrap_or_default());
+        let (_, stats, done) = shared
+            .into_inner()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        return Ok(PassOutcome {
+            stats,
+            items_done: done,
+            complete: done == all_tiles.len(),
+        });
     }
-    // Light-path estimators: tiles cut into sample ranges of about LIGHT_PATHS_PER_ITEM
-    // camera samples (one light path each).
+    // Estimators that splat light paths (and films that splat): tiles cut into sample
+    // ranges of about LIGHT_PATHS_PER_ITEM camera samples (one light path each), merged
+    // in item order.
     let mut items = Vec::new();
     for bounds in film.tiles(tile_size_px) {
+        if !estimator.splats_light_paths() {
+            items.push((bounds, all_samples.clone()));
+            continue;
+        }
         let most = bounds
             .pixels()
             .map(|p| pass.plan.camera_samples(p))
@@ -284,14 +402,23 @@ pub fn render_pass_with(
             k = end;
         }
     }
-    let template = film.light_splats();
+    let template = if estimator.splats_light_paths() {
+        film.light_splats()
+    } else {
+        film.unused_light_splats()
+    };
     let mut total = RenderStats::default();
-    for batch in items.chunks(ITEMS_PER_BATCH) {
+    let mut done = control.items_done.min(items.len());
+    while done < items.len() && !stop.load(Ordering::Relaxed) {
+        let batch = &items[done..(done + ITEMS_PER_BATCH).min(items.len())];
         let film_ref = &*film;
         let template = &template;
-        let results: Vec<(FilmTile, LightSplats, RenderStats)> = batch
+        let results: Vec<Option<(FilmTile, LightSplats, RenderStats)>> = batch
             .par_iter()
             .map(|(bounds, range)| {
+                if stop.load(Ordering::Relaxed) {
+                    return None;
+                }
                 let work = TileWork {
                     pass,
                     sampler: &sampler,
@@ -302,16 +429,29 @@ pub fn render_pass_with(
                 let mut splats = template.clone();
                 let stats = estimator.render_tile(scene, &work, &mut tile, &mut splats);
                 progress(stats.samples);
-                (tile, splats, stats)
+                Some((tile, splats, stats))
             })
             .collect();
-        for (tile, splats, stats) in &results {
+        // The longest finished prefix: later items wait for a resume, in order.
+        for (tile, splats, stats) in results.iter().map_while(Option::as_ref) {
             film.merge_tile(tile);
-            film.merge_light_splats(splats);
+            if estimator.splats_light_paths() {
+                film.merge_light_splats(splats);
+            }
             total.add(stats);
+            done += 1;
+        }
+        if let Some(clock) = &clock {
+            if done < items.len() && clock.due() {
+                (clock.write)(film, done);
+            }
         }
     }
-    Ok(total)
+    Ok(PassOutcome {
+        stats: total,
+        items_done: done,
+        complete: done == items.len(),
+    })
 }
 
 /// Total camera samples of a render: pixels × spp (for progress bars).
