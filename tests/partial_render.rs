@@ -43,7 +43,6 @@ fn assert_picture_within(a: &Path, b: &Path, ulps: u32) -> usize {
     let picture = |c: &BTreeMap<String, Vec<u32>>| -> BTreeMap<String, Vec<u32>> {
         c.iter()
             .filter(|(k, _)| !k.starts_with("sums.") && !k.starts_with("counts."))
-            .filter(|(k, _)| *k != "plan.spp")
             .map(|(k, v)| (k.clone(), v.clone()))
             .collect()
     };
@@ -251,4 +250,294 @@ fn merged_ranges_equal_the_whole_render() {
             case.scene
         );
     }
+}
+
+/// A copy of a scene beside `dir` with `edit` applied to its text (asset paths made
+/// absolute so the copy finds them).
+fn edited_scene(dir: &Path, name: &str, edit: impl Fn(String) -> String) -> PathBuf {
+    let text = std::fs::read_to_string(scene(name)).unwrap();
+    let text = text.replace(
+        "\"cornell-box/",
+        &format!("\"{}/", scene("cornell-box").display()),
+    );
+    let edited = edit(text.clone());
+    assert_ne!(edited, text, "the edit changed nothing");
+    let path = dir.join(format!("edited-{name}"));
+    std::fs::write(&path, edited).unwrap();
+    path
+}
+
+#[test]
+fn resuming_another_render_is_refused_naming_what_changed() {
+    let dir = tempfile::tempdir().unwrap();
+    let cornell = scene("cornell-box.json");
+    let out = dir.path().join("r.exr");
+    let checkpoint = dir.path().join("r.partial.exr");
+    let base = ["--resolution", "48x32", "--spp", "8", "--threads", "2"];
+    let mut args = vec![s(&cornell), "-o", s(&out), "--stop-after-items", "1"];
+    args.extend_from_slice(&base);
+    assert!(!render(&args).status.success());
+    assert!(checkpoint.exists());
+
+    let mut args = vec![s(&cornell), "-o", s(&out), "--resume", s(&checkpoint)];
+    args.extend_from_slice(&["--resolution", "48x32", "--spp", "16"]);
+    let o = render(&args);
+    assert_eq!(o.status.code(), Some(1));
+    let err = stderr(&o);
+    assert!(err.contains("spp: 8 in the file, 16 now"), "{err}");
+
+    let mut args = vec![s(&cornell), "-o", s(&out), "--resume", s(&checkpoint)];
+    args.extend_from_slice(&["--resolution", "48x32", "--spp", "8", "--seed", "9"]);
+    let err = stderr(&render(&args));
+    assert!(err.contains("seed: 0 in the file, 9 now"), "{err}");
+
+    let edited = edited_scene(dir.path(), "cornell-box.json", |t| {
+        t.replace("\"max_depth\": 7", "\"max_depth\": 6")
+    });
+    let mut args = vec![s(&edited), "-o", s(&out), "--resume", s(&checkpoint)];
+    args.extend_from_slice(&base);
+    let err = stderr(&render(&args));
+    assert!(err.contains("scene: its content changed"), "{err}");
+    assert!(!err.contains("spp:"), "only the scene changed: {err}");
+
+    // Options that do not change the image are not part of the identity.
+    let other = dir.path().join("elsewhere.exr");
+    let mut args = vec![
+        s(&cornell),
+        "-o",
+        s(&other),
+        "--resume",
+        s(&checkpoint),
+        "--threads",
+        "1",
+        "--checkpoint-every",
+        "5m",
+        "--progress",
+        "none",
+    ];
+    args.extend_from_slice(&["--resolution", "48x32", "--spp", "8"]);
+    let o = render(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+}
+
+#[test]
+fn merge_refuses_overlaps_and_other_renders_and_warns_of_gaps() {
+    let dir = tempfile::tempdir().unwrap();
+    let cornell = scene("cornell-box.json");
+    let part = |name: &str, range: &str, seed: &str| {
+        let path = dir.path().join(name);
+        let o = render(&[
+            s(&cornell),
+            "-o",
+            s(&path),
+            "--resolution",
+            "16x12",
+            "--spp",
+            "16",
+            "--samples",
+            range,
+            "--seed",
+            seed,
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        path
+    };
+    let a = part("a.exr", "0..8", "0");
+    let b = part("b.exr", "4..12", "0");
+    let c = part("c.exr", "12..16", "0");
+    let foreign = part("foreign.exr", "8..12", "5");
+    let out = dir.path().join("m.exr");
+
+    let o = prism(&["merge", s(&a), s(&b), "-o", s(&out)]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr(&o).contains("(samples 0..8) and"), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("(samples 4..12) overlap"),
+        "{}",
+        stderr(&o)
+    );
+
+    let o = prism(&["merge", s(&a), s(&a), "-o", s(&out)]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(
+        stderr(&o).contains("the same file given twice"),
+        "{}",
+        stderr(&o)
+    );
+
+    let o = prism(&["merge", s(&a), s(&foreign), "-o", s(&out)]);
+    assert_eq!(o.status.code(), Some(1));
+    let err = stderr(&o);
+    assert!(
+        err.contains("parts of different renders") && err.contains("seed"),
+        "{err}"
+    );
+    assert!(!out.exists(), "nothing written on a refusal");
+
+    let o = prism(&["merge", s(&c), s(&a), "-o", s(&out)]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("warning: no part holds the samples 8..12"),
+        "{}",
+        stderr(&o)
+    );
+    let (all, header) = channels(&out);
+    assert_eq!(header.text["prism:ranges_done"], "0..8,12..16");
+    assert_eq!(header.text["prism:complete"], "false");
+    // Weighted by sample counts: 12 samples per pixel.
+    assert!(all["spp.Y"].iter().all(|&v| f32::from_bits(v) == 12.0));
+
+    // An interrupted checkpoint is not a part.
+    let stopped = dir.path().join("stopped.exr");
+    let o = render(&[
+        s(&cornell),
+        "-o",
+        s(&stopped),
+        "--resolution",
+        "48x32",
+        "--spp",
+        "16",
+        "--samples",
+        "8..12",
+        "--threads",
+        "2",
+        "--stop-after-items",
+        "1",
+    ]);
+    assert!(!o.status.success());
+    let checkpoint = dir.path().join("stopped.partial.exr");
+    let o = prism(&["merge", s(&checkpoint), "-o", s(&out)]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr(&o).contains("--resume"), "{}", stderr(&o));
+}
+
+#[test]
+fn predicted_plan_ranges_split_each_pixels_own_samples() {
+    let dir = tempfile::tempdir().unwrap();
+    let cornell = scene("cornell-box.json");
+    let common = ["--resolution", "24x16", "--spp", "8", "--plan", "predicted"];
+    let whole = dir.path().join("whole.exr");
+    let mut args = vec![s(&cornell), "-o", s(&whole)];
+    args.extend_from_slice(&common);
+    let o = render(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let mut parts = Vec::new();
+    for (k, range) in ["0..3", "3..8"].iter().enumerate() {
+        let part = dir.path().join(format!("p{k}.exr"));
+        let mut args = vec![s(&cornell), "-o", s(&part), "--samples", range];
+        args.extend_from_slice(&common);
+        let o = render(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        parts.push(part);
+    }
+    let (w, _) = channels(&whole);
+    let n_p: Vec<u32> = w["spp.Y"]
+        .iter()
+        .map(|&v| f32::from_bits(v) as u32)
+        .collect();
+    assert!(n_p.iter().any(|&n| n != 8), "the plan is not uniform");
+    // The part stores the plan, and pixel p gets [⌊a·N_p/N⌋, ⌊b·N_p/N⌋).
+    let (p0, _) = channels(&parts[0]);
+    assert_eq!(p0["counts.plan"], n_p);
+    for (i, &n) in n_p.iter().enumerate() {
+        assert_eq!(p0["counts.samples"][i], 3 * n / 8, "pixel {i}");
+    }
+    let merged = dir.path().join("merged.exr");
+    let o = prism(&["merge", s(&parts[0]), s(&parts[1]), "-o", s(&merged)]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_picture_within(&whole, &merged, 1);
+}
+
+/// `kill(2)` of a child.
+fn signal(child: &std::process::Child, sig: i32) {
+    // SAFETY: sending a signal to a process this test started and has not reaped.
+    unsafe {
+        libc::kill(child.id() as i32, sig);
+    }
+}
+
+#[test]
+fn signals_at_random_moments_leave_only_whole_files() {
+    use std::os::unix::process::ExitStatusExt;
+    let dir = tempfile::tempdir().unwrap();
+    let cornell = scene("cornell-box.json");
+    let out = dir.path().join("long.exr");
+    let checkpoint = dir.path().join("long.partial.exr");
+    // A fixed pseudo-random sequence (LCG) of moments: the same 50 every run.
+    let mut state: u64 = 0x2545_f491_4f6c_dd1d;
+    let mut next = |n: u64| {
+        state = state
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        (state >> 33) % n
+    };
+    let mut stopped = 0;
+    for run in 0..50 {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_prism"))
+            .args([
+                "render",
+                s(&cornell),
+                "-o",
+                s(&out),
+                "--resolution",
+                "48x36",
+                "--spp",
+                "48",
+                "--threads",
+                "2",
+                "--checkpoint-every",
+                "1s",
+            ])
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap();
+        let sig = if run % 2 == 0 {
+            libc::SIGINT
+        } else {
+            libc::SIGTERM
+        };
+        std::thread::sleep(Duration::from_millis(next(250)));
+        signal(&child, sig);
+        let twice = run % 3 == 0;
+        if twice {
+            std::thread::sleep(Duration::from_millis(next(20)));
+            signal(&child, sig);
+        }
+        let status = child.wait().unwrap();
+        let code = status.code();
+        assert!(
+            status.success() || code == Some(128 + sig) || status.signal() == Some(sig),
+            "run {run}: {status:?}"
+        );
+        if code == Some(128 + sig) {
+            stopped += 1;
+        }
+        for entry in std::fs::read_dir(dir.path()).unwrap() {
+            let path = entry.unwrap().path();
+            let name = path.file_name().unwrap().to_string_lossy().into_owned();
+            assert!(!name.ends_with(".tmp"), "run {run}: {name} left behind");
+            // Every file that exists is whole: it reads back.
+            let (_, file) = channels(&path);
+            if path == out
+                && file
+                    .text
+                    .get("prism:complete")
+                    .is_some_and(|c| c == "false")
+            {
+                assert!(
+                    checkpoint.exists(),
+                    "run {run}: a partial output without checkpoint"
+                );
+            }
+        }
+        for f in [&out, &checkpoint] {
+            let _ = std::fs::remove_file(f);
+        }
+    }
+    // The moments reach into the render: most runs are stopped by the first signal.
+    assert!(
+        stopped >= 10,
+        "only {stopped} of 50 runs were stopped mid-render"
+    );
 }

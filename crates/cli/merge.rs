@@ -168,12 +168,16 @@ pub fn run(args: &MergeArgs) -> Result<ExitCode, String> {
         PartialHeader,
         Option<Vec<u32>>,
     )> = None;
+    let mut plan_layers = Vec::new();
     let mut wall_time_s = 0.0;
     for &i in &order {
         let part = read_partial(&infos[i].path)?;
         wall_time_s += part.header.wall_time_s;
         match &mut total {
-            None => total = Some((part.sums, part.header, part.plan)),
+            None => {
+                plan_layers = part.plan_layers;
+                total = Some((part.sums, part.header, part.plan));
+            }
             Some((sums, _, plan)) => {
                 if *plan != part.plan {
                     return Err(format!(
@@ -200,7 +204,8 @@ pub fn run(args: &MergeArgs) -> Result<ExitCode, String> {
     header.items_done = 0;
     header.wall_time_s = wall_time_s;
     let film = Film::from_sums(&sums).map_err(|e| e.to_string())?;
-    let image = film.finish();
+    let mut image = film.finish();
+    image.aovs.extend(plan_layers);
     let keep_sums = args
         .output
         .file_name()

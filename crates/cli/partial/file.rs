@@ -5,7 +5,7 @@
 //! EXR has no 64-bit channel, and a hi/lo pair of float32 holds 48 of a double's 53
 //! significand bits, so each f64 sum is stored as its two 32-bit halves in `UINT` channels
 //! `sums.<plane>.hi` / `.lo`, which OpenEXR keeps bit for bit. Counts are `counts.<plane>`,
-//! a per-pixel plan's sample counts `plan.spp`. The header (text attributes) holds the
+//! a per-pixel plan's sample counts `counts.plan`. The header (text attributes) holds the
 //! render's identity (`identity.rs`), the sample range, the ranges done, whether the
 //! range is complete, the work items done (for resuming) and the time spent.
 
@@ -56,6 +56,9 @@ pub struct PartialFile {
     pub sums: FilmSums,
     /// Per-pixel samples of the whole render (`--plan predicted`), row-major.
     pub plan: Option<Vec<u32>>,
+    /// The predictor's layers (`bandwidth.*`, `plan.*`): the same in every part, as every
+    /// process computes the same plan.
+    pub plan_layers: Vec<prism_render::AovPlane>,
 }
 
 /// `<stem>.partial.exr` beside `output` (`long.exr` → `long.partial.exr`).
@@ -155,7 +158,7 @@ pub fn raw_channels(sums: &FilmSums, plan: Option<&[u32]>) -> Vec<(String, Vec<u
         raw.push((format!("counts.{name}"), values.clone()));
     }
     if let Some(plan) = plan {
-        raw.push(("plan.spp".to_string(), plan.to_vec()));
+        raw.push(("counts.plan".to_string(), plan.to_vec()));
     }
     raw
 }
@@ -254,6 +257,15 @@ pub fn read_partial(path: &Path) -> Result<PartialFile, String> {
         },
         sums,
         plan,
+        plan_layers: file
+            .floats
+            .iter()
+            .filter(|(k, _)| k.starts_with("bandwidth.") || k.starts_with("plan."))
+            .map(|(k, v)| prism_render::AovPlane {
+                name: k.clone(),
+                values: v.clone(),
+            })
+            .collect(),
     })
 }
 
@@ -320,5 +332,5 @@ fn sums_from_raw(
     };
     sums.check()
         .map_err(|e| format!("{}: {e}", path.display()))?;
-    Ok((sums, raw.get("plan.spp").cloned()))
+    Ok((sums, raw.get("counts.plan").cloned()))
 }
