@@ -264,3 +264,65 @@ fn the_slurm_scripts_carry_the_directives_the_page_relies_on() {
         assert!(o.status.success(), "{name}: {}", stderr(&o));
     }
 }
+
+#[test]
+fn the_gnu_parallel_line_of_the_page_renders_and_merges() {
+    // GNU parallel runs its command through a shell with {} replaced by each argument;
+    // here sh does the same for the page's line, on a tiny film.
+    let page =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/scale-out.md"))
+            .unwrap();
+    let line = page
+        .lines()
+        .find(|l| l.starts_with("parallel -j 4 '"))
+        .expect("the parallel line");
+    let command = line
+        .trim_start_matches("parallel -j 4 '")
+        .split("' ::: ")
+        .next()
+        .unwrap();
+    let args: Vec<&str> = line.split("' ::: ").nth(1).unwrap().split(' ').collect();
+    assert_eq!(args[..4], ["0", "1", "2", "3"]);
+    let merge_line = page
+        .lines()
+        .find(|l| l.trim_start().starts_with("&& prism merge"))
+        .unwrap()
+        .trim_start()
+        .trim_start_matches("&& ");
+    let dir = tempfile::tempdir().unwrap();
+    let bin = env!("CARGO_BIN_EXE_prism");
+    let local = |c: &str| {
+        c.replacen("prism ", &format!("{bin} "), 1).replace(
+            "scene.json",
+            &format!("{} --resolution 12x8", cornell().display()),
+        )
+    };
+    let jobs: Vec<_> = args[..4]
+        .iter()
+        .map(|i| {
+            Command::new("/bin/sh")
+                .arg("-c")
+                .arg(local(&command.replace("{}", i)))
+                .current_dir(dir.path())
+                .spawn()
+                .unwrap()
+        })
+        .collect();
+    for job in jobs {
+        check_ok(&job.wait_with_output().unwrap(), "parallel job");
+    }
+    let o = Command::new("/bin/sh")
+        .arg("-c")
+        .arg(local(merge_line))
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    check_ok(&o, "merge");
+    let header = read_raw_channels(&dir.path().join("final.exr"))
+        .unwrap()
+        .text;
+    assert_eq!(
+        header["prism:ranges_done"],
+        "0..128,128..256,256..384,384..512"
+    );
+}

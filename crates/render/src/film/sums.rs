@@ -199,8 +199,8 @@ impl Film {
         let bins = self.spectral_bins.map_or(0, |b| b.count() as usize);
         for b in 0..bins {
             let values = get(&format!("bin.{b}"));
-            for i in 0..n {
-                self.spectral[i * bins + b] = values[i];
+            for (pixel, v) in self.spectral.chunks_exact_mut(bins).zip(values) {
+                pixel[b] = *v;
             }
         }
         self.light = sums.light_paths.map(|paths| {
@@ -212,8 +212,8 @@ impl Film {
             if !light.spectral_sum.is_empty() {
                 for b in 0..bins {
                     let values = get(&format!("light.bin.{b}"));
-                    for i in 0..n {
-                        light.spectral_sum[i * bins + b] = values[i];
+                    for (pixel, v) in light.spectral_sum.chunks_exact_mut(bins).zip(values) {
+                        pixel[b] = *v;
                     }
                 }
             }

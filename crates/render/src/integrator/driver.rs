@@ -251,8 +251,11 @@ pub struct PassControl<'a> {
     pub items_done: usize,
     /// At most every `Duration`, between work items, the film so far and the items done:
     /// a consistent state to resume from (the callback writes the checkpoint).
-    pub checkpoint: Option<(Duration, &'a (dyn Fn(&Film, usize) + Sync))>,
+    pub checkpoint: Option<(Duration, &'a CheckpointFn<'a>)>,
 }
+
+/// Receives the film so far and the work items done (see `PassControl::checkpoint`).
+pub type CheckpointFn<'a> = dyn Fn(&Film, usize) + Sync + 'a;
 
 /// How far a controlled pass got.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -268,7 +271,7 @@ pub struct PassOutcome {
 struct CheckpointClock<'a> {
     last: Mutex<Instant>,
     every: Duration,
-    write: &'a (dyn Fn(&Film, usize) + Sync),
+    write: &'a CheckpointFn<'a>,
 }
 
 impl CheckpointClock<'_> {
