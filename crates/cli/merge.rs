@@ -100,15 +100,13 @@ pub fn run(args: &MergeArgs) -> Result<ExitCode, String> {
     if let Some(p) = infos.iter().find(|p| p.hash != first.hash) {
         let a = read_partial(&first.path)?;
         let b = read_partial(&p.path)?;
-        let fields: Vec<(&'static str, String)> = a
-            .header
-            .identity
-            .iter()
-            .map(|(k, v)| (leak_name(k), v.clone()))
-            .collect();
-        let differences = crate::partial::identity::RenderIdentity { fields }
-            .differences(&b.header.identity)
-            .join("; ");
+        let differences = crate::partial::identity::field_differences(
+            &a.header.identity,
+            &b.header.identity,
+            "in the first",
+            "in the second",
+        )
+        .join("; ");
         return Err(format!(
             "{} and {} are parts of different renders (identity {} and {}); {}",
             first.path.display(),
@@ -239,25 +237,4 @@ pub fn run(args: &MergeArgs) -> Result<ExitCode, String> {
         start.elapsed().as_secs_f64()
     );
     Ok(ExitCode::SUCCESS)
-}
-
-/// The identity's field names are static in this build; a name read from a file is
-/// matched against them.
-fn leak_name(name: &str) -> &'static str {
-    const NAMES: [&str; 9] = [
-        "scene",
-        "spp",
-        "seed",
-        "resolution",
-        "integrator",
-        "sampler",
-        "plan",
-        "spectral_bins",
-        "aovs",
-    ];
-    NAMES
-        .iter()
-        .find(|n| **n == name)
-        .copied()
-        .unwrap_or("unknown field")
 }

@@ -73,34 +73,43 @@ impl RenderIdentity {
             .collect()
     }
 
-    /// What differs from the fields of a header (`stored`): "name: stored → this run" per
-    /// field; empty when none does.
+    /// What differs from the fields of a header (`stored`): "name: stored in the file,
+    /// this run's now" per field; empty when none does.
     pub fn differences(&self, stored: &[(String, String)]) -> Vec<String> {
-        let mut out = Vec::new();
-        for (name, value) in &self.fields {
-            match stored.iter().find(|(k, _)| k == name) {
-                Some((_, v)) if v == value => {}
-                Some((_, v)) => out.push(describe(name, v, value)),
-                None => out.push(format!("{name}: not recorded in the file")),
-            }
-        }
-        for (name, _) in stored {
-            if !self.fields.iter().any(|(k, _)| k == name) {
-                out.push(format!(
-                    "{name}: recorded in the file, unknown to this version"
-                ));
-            }
-        }
-        out
+        let own: Vec<(String, String)> = self
+            .fields
+            .iter()
+            .map(|(k, v)| (k.to_string(), v.clone()))
+            .collect();
+        field_differences(stored, &own, "in the file", "now")
     }
 }
 
-fn describe(name: &str, stored: &str, now: &str) -> String {
-    if name == "scene" {
-        format!("scene: its content changed (hash {stored} in the file, {now} now)")
-    } else {
-        format!("{name}: {stored} in the file, {now} now")
+/// Field by field, what differs between two identities `a` and `b` (as read from headers),
+/// each side named by its label: "spp: 512 in the file, 256 now".
+pub fn field_differences(
+    a: &[(String, String)],
+    b: &[(String, String)],
+    a_label: &str,
+    b_label: &str,
+) -> Vec<String> {
+    let mut out = Vec::new();
+    for (name, value) in b {
+        match a.iter().find(|(k, _)| k == name) {
+            Some((_, v)) if v == value => {}
+            Some((_, v)) if name == "scene" => out.push(format!(
+                "scene: its content changed (hash {v} {a_label}, {value} {b_label})"
+            )),
+            Some((_, v)) => out.push(format!("{name}: {v} {a_label}, {value} {b_label}")),
+            None => out.push(format!("{name}: not recorded {a_label}")),
+        }
     }
+    for (name, _) in a {
+        if !b.iter().any(|(k, _)| k == name) {
+            out.push(format!("{name}: not recorded {b_label}"));
+        }
+    }
+    out
 }
 
 #[cfg(test)]
