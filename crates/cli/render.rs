@@ -287,11 +287,21 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode, String> {
             }
         }
     }
+    // A resumed render's spp is the checkpoint's unless given (it is checked against the
+    // whole identity later).
+    let resumed_spp = match &args.resume {
+        Some(path) => prism_image::io::raw_exr::read_text_attributes(path)
+            .map_err(|e| format!("--resume: {e}"))?
+            .get(&format!("{}.spp", crate::partial::identity::HASH_ATTRIBUTE))
+            .and_then(|v| v.parse::<u32>().ok()),
+        None => None,
+    };
     let settings = RenderSettings {
         // A range's end is the default: `--samples 256..512` is half of a 512-spp render.
         spp: args
             .spp
             .or(args.samples.map(|r| r.end))
+            .or(resumed_spp)
             .unwrap_or(scene.spp),
         seed: args.seed.unwrap_or(scene.seed),
         tile_size_px: DEFAULT_TILE_SIZE_PX,
@@ -449,6 +459,23 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode, String> {
             .aovs
             .retain(|a| !a.name.starts_with("bandwidth.") && !a.name.starts_with("plan."));
     }
+    // A range of the sample sequence (given, or resumed) is written as a partial EXR.
+    let range_output = args.samples.is_some()
+        || rendered.range
+            != (SampleRange {
+                start: 0,
+                end: settings.spp,
+            });
+    if range_output && !exr_output {
+        return Err(format!(
+            "{} renders the samples {} of {}: a range is written as a partial EXR; {} is \
+             not an .exr output",
+            args.scene.display(),
+            rendered.range,
+            settings.spp,
+            output.display()
+        ));
+    }
     if !rendered.complete {
         let signal = crate::partial::signals::received();
         rendered.write_partial(&rendered.checkpoint)?;
@@ -461,7 +488,7 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode, String> {
             &header,
             &rendered.sums,
         ));
-        if args.samples.is_some() {
+        if range_output {
             rendered.write_partial(&output)?;
         } else {
             write_output(&output, &rendered.image, &marks)?;
@@ -491,7 +518,7 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode, String> {
             signal.map_or(1, |s| (128 + s).clamp(1, 255)) as u8,
         ));
     }
-    if args.samples.is_some() {
+    if range_output {
         rendered.write_partial(&output)?;
     } else {
         write_output(&output, &rendered.image, &[])?;
@@ -548,9 +575,10 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode, String> {
         scene.resolution.x,
         scene.resolution.y,
         settings.spp,
-        match args.samples {
-            Some(r) => format!(", samples {r}"),
-            None => String::new(),
+        if range_output {
+            format!(", samples {}", rendered.range)
+        } else {
+            String::new()
         },
         wall_time_s,
         rendered.stats.rays_traced as f64 / wall_time_s.max(1e-9) / 1e6
