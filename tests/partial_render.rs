@@ -554,3 +554,53 @@ fn signals_at_random_moments_leave_only_whole_files() {
     eprintln!("{stopped} of 50 runs stopped mid-render by the first signal");
     assert!(stopped >= 1, "no run was stopped mid-render");
 }
+
+#[test]
+fn sensor_ranges_merge_into_the_whole_measurement() {
+    let dir = tempfile::tempdir().unwrap();
+    let room = edited_scene(dir.path(), "daylight-room.json", |t| {
+        t.replace(
+            r#""relative_error": 0.03, "min_samples": 1024, "max_samples": 200000"#,
+            r#""samples": 600"#,
+        )
+    });
+    let common = ["--resolution", "12x8", "--spp", "4"];
+    let whole = dir.path().join("whole.exr");
+    let mut args = vec![s(&room), "-o", s(&whole)];
+    args.extend_from_slice(&common);
+    let o = render(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let mut parts = Vec::new();
+    for (k, range) in ["1..4", "0..1"].iter().enumerate() {
+        let part = dir.path().join(format!("s{k}.exr"));
+        let mut args = vec![s(&room), "-o", s(&part), "--samples", range];
+        args.extend_from_slice(&common);
+        let o = render(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        assert!(dir
+            .path()
+            .join(format!("s{k}.sensors.partial.json"))
+            .exists());
+        parts.push(part);
+    }
+    let merged = dir.path().join("merged.exr");
+    let o = prism(&["merge", s(&parts[0]), s(&parts[1]), "-o", s(&merged)]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let read = |p: &str| -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join(p)).unwrap()).unwrap()
+    };
+    let (w, m) = (read("whole.sensors.json"), read("merged.sensors.json"));
+    let points = |v: &serde_json::Value| v["sensors"][0]["points"].as_array().unwrap().clone();
+    let (wp, mp) = (points(&w), points(&m));
+    assert_eq!(wp.len(), 28);
+    for (a, b) in wp.iter().zip(&mp) {
+        assert_eq!(a["samples"], b["samples"]);
+        let close = |key: &str, tol: f64| {
+            let (x, y) = (a[key].as_f64().unwrap(), b[key].as_f64().unwrap());
+            assert!((x - y).abs() <= tol * x.abs(), "{key}: {x} and {y}");
+        };
+        // The same samples; replicate sums added in another order (f64).
+        close("illuminance_lx", 1e-12);
+        close("std_error_lx", 1e-9);
+    }
+}

@@ -229,6 +229,8 @@ pub fn run(args: &MergeArgs) -> Result<ExitCode, String> {
         }
         .map_err(|e| e.to_string())?;
     }
+    let paths: Vec<&Path> = order.iter().map(|&i| infos[i].path.as_path()).collect();
+    merge_sensors(&paths, &first.hash, &args.output, wall_time_s)?;
     eprintln!(
         "wrote {} ({} parts, samples {}, {:.2} s)",
         args.output.display(),
@@ -237,4 +239,84 @@ pub fn run(args: &MergeArgs) -> Result<ExitCode, String> {
         start.elapsed().as_secs_f64()
     );
     Ok(ExitCode::SUCCESS)
+}
+
+/// The parts' sensor sums (`partial::sensor_sums`), when they have them: added in range
+/// order into the readings of the whole measurement, `<output stem>.sensors.json/.csv`.
+fn merge_sensors(
+    parts: &[&Path],
+    identity: &str,
+    output: &Path,
+    wall_time_s: f64,
+) -> Result<(), String> {
+    use crate::partial::sensor_sums::{read, sidecar_path};
+    let sidecars: Vec<PathBuf> = parts.iter().map(|p| sidecar_path(p)).collect();
+    let present = sidecars.iter().filter(|p| p.exists()).count();
+    if present == 0 {
+        return Ok(());
+    }
+    if present < sidecars.len() {
+        let missing: Vec<String> = sidecars
+            .iter()
+            .filter(|p| !p.exists())
+            .map(|p| p.display().to_string())
+            .collect();
+        eprintln!(
+            "warning: the sensors are not merged: {} of {} parts have sensor sums ({} \
+             missing)",
+            present,
+            sidecars.len(),
+            missing.join(", ")
+        );
+        return Ok(());
+    }
+    let mut total: Option<Vec<prism_render::sensor::SensorSums>> = None;
+    for path in &sidecars {
+        let (hash, sums) = read(path)?;
+        if hash != identity {
+            return Err(format!(
+                "{}: sensor sums of another render (identity {hash}, the parts' {identity})",
+                path.display()
+            ));
+        }
+        match &mut total {
+            None => total = Some(sums),
+            Some(total) => {
+                if total.len() != sums.len() {
+                    return Err(format!(
+                        "{}: {} sensors; the first part has {}",
+                        path.display(),
+                        sums.len(),
+                        total.len()
+                    ));
+                }
+                for (a, b) in total.iter_mut().zip(&sums) {
+                    a.add(b).map_err(|e| format!("{}: {e}", path.display()))?;
+                }
+            }
+        }
+    }
+    let readings: Vec<prism_render::sensor::SensorReading> = total
+        .unwrap_or_default()
+        .iter()
+        .map(|s| s.reading())
+        .collect();
+    let stats = prism_render::sensor::SensorStats {
+        samples: readings
+            .iter()
+            .flat_map(|r| r.points.iter().map(|p| p.samples))
+            .sum(),
+        ..Default::default()
+    };
+    let (json_path, csv_path) = crate::sensors::sensor_paths(output);
+    let value = crate::sensors::readings_json(parts[0], &readings, &stats, wall_time_s);
+    let text = serde_json::to_string_pretty(&value).map_err(|e| e.to_string())? + "\n";
+    crate::sensors::write_atomic(&json_path, &text, "sensor readings")?;
+    crate::sensors::write_atomic(
+        &csv_path,
+        &crate::sensors::readings_csv(&readings),
+        "sensor readings",
+    )?;
+    eprintln!("wrote {} and {}", json_path.display(), csv_path.display());
+    Ok(())
 }

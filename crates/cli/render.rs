@@ -424,6 +424,14 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode, String> {
     if let Some(stats) = &args.stats_json {
         temp_files.push(prism_image::io::temp_sibling(stats));
     }
+    if !description.sensors.is_empty() {
+        let (json, csv) = crate::sensors::sensor_paths(&output);
+        temp_files.push(prism_image::io::temp_sibling(&json));
+        temp_files.push(prism_image::io::temp_sibling(&csv));
+        temp_files.push(prism_image::io::temp_sibling(
+            &crate::partial::sensor_sums::sidecar_path(&output),
+        ));
+    }
     crate::partial::signals::install(&temp_files)?;
     let (plan, extra_aovs) = match args.plan.plan {
         PlanArg::Uniform | PlanArg::Adaptive => (
@@ -546,7 +554,17 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode, String> {
         eprintln!("wrote {}", path.display());
     }
     if !description.sensors.is_empty() {
-        if rendered.range.start == 0 {
+        if range_output {
+            measure_sensor_share(
+                args,
+                &pool,
+                &scene,
+                &description,
+                &settings,
+                &rendered,
+                &output,
+            )?;
+        } else {
             measure_and_write_sensors(
                 args,
                 &pool,
@@ -555,13 +573,6 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode, String> {
                 &settings,
                 &output,
             )?;
-        } else {
-            eprintln!(
-                "{}: the sensors are measured by the part whose range starts at 0, not by \
-                 --samples {}",
-                args.scene.display(),
-                rendered.range
-            );
         }
     }
     if let Some(path) = &args.stats_json {
@@ -744,6 +755,63 @@ fn write_json(path: &Path, value: &serde_json::Value) -> Result<(), String> {
         ));
     }
     Ok(())
+}
+
+/// A range render's share of the sensors: their sums beside the part, for `prism merge`
+/// (`partial::sensor_sums`). Adaptive sensors cannot be split: the part whose range starts
+/// at 0 measures them whole, the others say so.
+fn measure_sensor_share(
+    args: &RenderArgs,
+    pool: &rayon::ThreadPool,
+    scene: &RenderScene,
+    description: &prism_scene::SceneDescription,
+    settings: &RenderSettings,
+    rendered: &crate::partial::job::Rendered,
+    output: &Path,
+) -> Result<(), String> {
+    let share = prism_render::sensor::SampleShare {
+        start: rendered.range.start,
+        end: rendered.range.end,
+        total: settings.spp,
+    };
+    let result = pool.install(|| {
+        prism_render::sensor::measure_sensor_share(
+            scene,
+            &description.sensors,
+            settings.seed,
+            share,
+            &|_| {},
+        )
+    });
+    match result {
+        Ok((sums, _)) => {
+            let path = crate::partial::sensor_sums::sidecar_path(output);
+            let value = crate::partial::sensor_sums::to_json(
+                &rendered.identity.hash(),
+                &rendered.range.to_string(),
+                &sums,
+            );
+            let text = serde_json::to_string_pretty(&value).map_err(|e| e.to_string())? + "\n";
+            crate::sensors::write_atomic(&path, &text, "sensor sums")?;
+            eprintln!("wrote {}", path.display());
+            Ok(())
+        }
+        Err(why) if rendered.range.start == 0 => {
+            eprintln!(
+                "{}: {why}; this part (samples {}) measures the sensors whole",
+                args.scene.display(),
+                rendered.range
+            );
+            measure_and_write_sensors(args, pool, scene, &description.sensors, settings, output)
+        }
+        Err(why) => {
+            eprintln!(
+                "{}: {why}; the part whose range starts at 0 measures them, not this one",
+                args.scene.display()
+            );
+            Ok(())
+        }
+    }
 }
 
 /// Measures the scene's sensors on `pool` and writes their readings beside the image.

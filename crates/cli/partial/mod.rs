@@ -5,4 +5,5 @@ pub mod file;
 pub mod identity;
 pub mod job;
 pub mod range;
+pub mod sensor_sums;
 pub mod signals;
