@@ -157,3 +157,37 @@ pub fn convert_pixels(pixels: &mut [[f32; 3]], from: &RgbColorSpace, to: &RgbCol
     );
     crate::rgb_matrix::apply_rgb_matrix(pixels, m);
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_failed_or_panicking_write_leaves_no_temporary_file_and_the_old_file_whole() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("image.exr");
+        std::fs::write(&path, b"previous").unwrap();
+        let tmp = temp_sibling(&path);
+        let failed = write_atomically(&path, |t| {
+            std::fs::write(t, b"half").unwrap();
+            Err(ImageError::invalid("stopped"))
+        });
+        assert!(failed.is_err());
+        assert!(!tmp.exists());
+        let panicked = std::panic::catch_unwind(|| {
+            let _ = write_atomically(&path, |t| {
+                std::fs::write(t, b"half").unwrap();
+                panic!("a writer panics");
+            });
+        });
+        assert!(panicked.is_err());
+        assert!(!tmp.exists(), "the panic left {}", tmp.display());
+        assert_eq!(std::fs::read(&path).unwrap(), b"previous");
+        write_atomically(&path, |t| {
+            std::fs::write(t, b"new").map_err(|e| ImageError::io(t, "write", e))
+        })
+        .unwrap();
+        assert_eq!(std::fs::read(&path).unwrap(), b"new");
+        assert!(!tmp.exists());
+    }
+}
