@@ -9,6 +9,11 @@
 //! W·m⁻²·sr⁻¹·nm⁻¹). PNG: the RGB sRGB-encoded (16 bit). See docs/rendering.md.
 //! A scene with `sensors` also gets `<output stem>.sensors.json` and `.sensors.csv`
 //! (illuminance in lx with standard errors, uniformity; docs/lighting.md).
+//!
+//! Partial renders (crates/cli/partial/, docs/rendering.md): `--samples A..B` renders one
+//! range of the sample sequence into a partial EXR for `prism merge`, `--checkpoint-every`
+//! saves `<output stem>.partial.exr`, `--resume` continues one bit for bit, and Ctrl-C or
+//! SIGTERM stops between work items, saving the work (exit 128 + signal).
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
