@@ -6,8 +6,11 @@ mod compare;
 mod converge;
 mod daylight_factor;
 mod falsecolour;
+mod merge;
 mod merl_export;
+mod partial;
 mod plan_args;
+mod progress;
 mod render;
 mod sensors;
 mod simd;
@@ -38,6 +41,9 @@ enum Command {
     /// Error against time for each method: progressive renders, RMSE/relMSE/ΔE2000 at
     /// checkpoints, a log–log chart (PNG/SVG) with fitted slopes, JSON (docs/converge.md).
     Converge(converge::ConvergeArgs),
+    /// Add the partial images of disjoint sample ranges of one render (`render --samples`)
+    /// into the image of their union, weighted by sample counts (docs/scale-out.md).
+    Merge(merge::MergeArgs),
     /// Write a material of a scene file as a MERL BRDF table (90×90×180 half/difference angles).
     MerlExport(merl_export::MerlExportArgs),
     /// Render a scene file to an EXR or PNG image (docs/rendering.md).
@@ -54,16 +60,19 @@ fn main() -> ExitCode {
         libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
     let cli = Cli::parse();
+    let done = |r: Result<(), String>| r.map(|()| ExitCode::SUCCESS);
     let result = match cli.command {
-        Command::Color(args) => color::run(&args),
-        Command::Compare(args) => compare::run(&args),
-        Command::Converge(args) => converge::run(&args),
-        Command::MerlExport(args) => merl_export::run(&args),
+        Command::Color(args) => done(color::run(&args)),
+        Command::Compare(args) => done(compare::run(&args)),
+        Command::Converge(args) => done(converge::run(&args)),
+        Command::Merge(args) => merge::run(&args),
+        Command::MerlExport(args) => done(merl_export::run(&args)),
+        // Non-zero without an error when a signal stopped it (the work is saved).
         Command::Render(args) => render::run(&args),
-        Command::Tonemap(args) => tonemap::run(&args),
+        Command::Tonemap(args) => done(tonemap::run(&args)),
     };
     match result {
-        Ok(()) => ExitCode::SUCCESS,
+        Ok(code) => code,
         Err(message) => {
             eprintln!("error: {message}");
             ExitCode::FAILURE

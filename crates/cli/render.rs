@@ -9,14 +9,18 @@
 //! W·m⁻²·sr⁻¹·nm⁻¹). PNG: the RGB sRGB-encoded (16 bit). See docs/rendering.md.
 //! A scene with `sensors` also gets `<output stem>.sensors.json` and `.sensors.csv`
 //! (illuminance in lx with standard errors, uniformity; docs/lighting.md).
+//!
+//! Partial renders (crates/cli/partial/, docs/rendering.md): `--samples A..B` renders one
+//! range of the sample sequence into a partial EXR for `prism merge`, `--checkpoint-every`
+//! saves `<output stem>.partial.exr`, `--resume` continues one bit for bit, and Ctrl-C or
+//! SIGTERM stops between work items, saving the work (exit 128 + signal).
 
-use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
+use std::process::ExitCode;
 use std::time::{Duration, Instant};
 
 use clap::Args;
 use glam::UVec2;
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use prism_image::io::exr::ExrWriteOptions;
 use prism_image::io::spectral_exr::write_exr_with_spectral_bands;
 use prism_image::io::{write_image, ImageFormat};
@@ -24,12 +28,13 @@ use prism_image::Image;
 use prism_render::film::spectral_bins::{MAX_SPECTRAL_BINS, MIN_SPECTRAL_BINS};
 use prism_render::integrator::DEFAULT_TILE_SIZE_PX;
 use prism_render::{
-    render_plan, total_samples, FilmImage, PlanRequest, RenderPlan, RenderScene, RenderSettings,
-    RenderStats, SamplerKind, SpectralBins,
+    total_samples, FilmImage, PlanRequest, RenderPlan, RenderScene, RenderSettings, RenderStats,
+    SamplerKind, SpectralBins,
 };
 use prism_spectrum::rgb_space::RgbColorSpace;
 use serde_json::json;
 
+use crate::partial::range::SampleRange;
 use crate::plan_args::PlanArg;
 
 #[derive(Args, Debug)]
@@ -80,10 +85,42 @@ pub struct RenderArgs {
     /// vertices; MIS-weighted) or S,T,unweighted (weight 1), for debugging.
     #[arg(long = "bdpt-strategy", value_name = "S,T[,unweighted]", value_parser = prism_render::integrator::BdptStrategy::parse)]
     pub bdpt_strategy: Option<prism_render::integrator::BdptStrategy>,
+    /// Render only samples [A, B) of each pixel's spp-sample sequence (`--spp` defaults to
+    /// B) and write a partial EXR with the film's sums, for `prism merge`
+    /// (docs/scale-out.md).
+    #[arg(long, value_name = "A..B", value_parser = crate::partial::range::parse_range)]
+    pub samples: Option<SampleRange>,
+    /// Write the film so far to `<output stem>.partial.exr` this often (Ns, Nm or Nh, at
+    /// least 1s), atomically; `--resume` continues from it.
+    #[arg(long = "checkpoint-every", value_name = "DURATION", value_parser = crate::partial::range::parse_duration)]
+    pub checkpoint_every: Option<Duration>,
+    /// Continue the render saved in this partial image (a checkpoint, or the partial
+    /// output of an interrupted render); the result is the uninterrupted render's, bit for
+    /// bit. Refused when the scene or an option that changes the image differs.
+    #[arg(long, value_name = "PARTIAL.exr")]
+    pub resume: Option<PathBuf>,
+    /// Progress on stderr: `auto` a bar with ETA on a terminal (nothing otherwise),
+    /// `plain` a line of text every `--progress-every` (for log files), `none`.
+    #[arg(long, value_enum, default_value = "auto")]
+    pub progress: ProgressArg,
+    /// Stops as Ctrl-C would once this many work items are done (tests of resuming).
+    #[arg(long = "stop-after-items", hide = true)]
+    pub stop_after_items: Option<usize>,
+    /// Interval of `--progress plain` (Ns, Nm or Nh).
+    #[arg(long = "progress-every", value_name = "DURATION", default_value = "10s", value_parser = crate::partial::range::parse_duration)]
+    pub progress_every: Duration,
     #[command(flatten)]
     pub plan: crate::plan_args::PlanArgs,
     #[command(flatten)]
     pub simd: crate::simd::SimdArgs,
+}
+
+/// How `prism render` reports progress.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum ProgressArg {
+    Auto,
+    Plain,
+    None,
 }
 
 pub(crate) fn parse_resolution(s: &str) -> Result<UVec2, String> {
@@ -163,7 +200,7 @@ fn spectral_bins(args: &RenderArgs, output: &Path) -> Result<Option<SpectralBins
 type LayerPlanes<'a> = (String, Vec<String>, Vec<&'a [f32]>);
 
 /// The film as a prism-post image with every layer.
-fn to_image(film: &FilmImage) -> Result<Image, String> {
+pub(crate) fn to_image(film: &FilmImage) -> Result<Image, String> {
     let (w, h) = (film.width as usize, film.height as usize);
     let mut image =
         Image::new(w, h, film.rgb.clone(), RgbColorSpace::srgb()).map_err(|e| e.to_string())?;
@@ -209,22 +246,7 @@ fn peak_memory_bytes() -> Option<u64> {
     Some(kib * 1024)
 }
 
-fn progress_bar(total: u64) -> ProgressBar {
-    if !std::io::stderr().is_terminal() {
-        return ProgressBar::hidden();
-    }
-    let bar = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr());
-    let style = ProgressStyle::with_template(
-        "{elapsed_precise} [{bar:40}] {percent:>3}% {per_sec} samples, ETA {eta}",
-    )
-    .unwrap_or_else(|_| ProgressStyle::default_bar())
-    .progress_chars("=> ");
-    bar.set_style(style);
-    bar.enable_steady_tick(Duration::from_millis(200));
-    bar
-}
-
-pub fn run(args: &RenderArgs) -> Result<(), String> {
+pub fn run(args: &RenderArgs) -> Result<ExitCode, String> {
     args.simd.apply()?;
     args.plan.check()?;
     let description = prism_scene::load_scene(&args.scene).map_err(|e| e.to_string())?;
@@ -270,8 +292,22 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
             }
         }
     }
+    // A resumed render's spp is the checkpoint's unless given (it is checked against the
+    // whole identity later).
+    let resumed_spp = match &args.resume {
+        Some(path) => prism_image::io::raw_exr::read_text_attributes(path)
+            .map_err(|e| format!("--resume: {e}"))?
+            .get(&format!("{}.spp", crate::partial::identity::HASH_ATTRIBUTE))
+            .and_then(|v| v.parse::<u32>().ok()),
+        None => None,
+    };
     let settings = RenderSettings {
-        spp: args.spp.unwrap_or(scene.spp),
+        // A range's end is the default: `--samples 256..512` is half of a 512-spp render.
+        spp: args
+            .spp
+            .or(args.samples.map(|r| r.end))
+            .or(resumed_spp)
+            .unwrap_or(scene.spp),
         seed: args.seed.unwrap_or(scene.seed),
         tile_size_px: DEFAULT_TILE_SIZE_PX,
         // The path tracer's sampler is the scene's choice; every other integrator uses Sobol.
@@ -315,7 +351,7 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
             sample_plan: args.plan.kind(),
         };
         print!("{}", RenderPlan::new(&scene, &request));
-        return Ok(());
+        return Ok(ExitCode::SUCCESS);
     }
     let mut pool = rayon::ThreadPoolBuilder::new();
     if let Some(n) = args.threads {
@@ -346,7 +382,8 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
             &description.sensors,
             &settings,
             &output,
-        );
+        )
+        .map(|()| ExitCode::SUCCESS);
     }
     if args.plan.plan != PlanArg::Uniform
         && !matches!(scene.integrator, prism_render::Integrator::Path(_))
@@ -359,56 +396,160 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
             scene.integrator.name()
         ));
     }
-    let bar = progress_bar(total_samples(scene.resolution, settings.spp));
-    let start = Instant::now();
-    let (mut film, stats) = match args.plan.plan {
-        PlanArg::Uniform => {
-            let plan = prism_bandwidth::SamplePlan::uniform(scene.resolution, settings.spp)
-                .map_err(|e| e.to_string())?;
-            pool.install(|| render_plan(&scene, &settings, &plan, &|n| bar.inc(n)))
+    if args.plan.plan == PlanArg::Adaptive {
+        if args.samples.is_some() || args.checkpoint_every.is_some() || args.resume.is_some() {
+            return Err(
+                "--plan adaptive chooses each pass from the image so far, so it cannot \
+                 render a sample range (--samples), checkpoint or resume; use --plan \
+                 uniform or predicted"
+                    .into(),
+            );
         }
+        return render_adaptive(
+            args,
+            &description,
+            &pool,
+            &scene,
+            &settings,
+            &output,
+            threads,
+        )
+        .map(|()| ExitCode::SUCCESS);
+    }
+    if args.samples.is_some() && !matches!(ImageFormat::from_path(&output), Ok(ImageFormat::Exr)) {
+        return Err(format!(
+            "--samples writes a partial EXR (the film's sums beside the image); {} is not an \
+             .exr output",
+            output.display()
+        ));
+    }
+    let checkpoint = crate::partial::file::checkpoint_path(&output);
+    let mut temp_files = vec![
+        prism_image::io::temp_sibling(&output),
+        prism_image::io::temp_sibling(&checkpoint),
+    ];
+    if let Some(stats) = &args.stats_json {
+        temp_files.push(prism_image::io::temp_sibling(stats));
+    }
+    if !description.sensors.is_empty() {
+        let (json, csv) = crate::sensors::sensor_paths(&output);
+        temp_files.push(prism_image::io::temp_sibling(&json));
+        temp_files.push(prism_image::io::temp_sibling(&csv));
+        temp_files.push(prism_image::io::temp_sibling(
+            &crate::partial::sensor_sums::sidecar_path(&output),
+        ));
+    }
+    crate::partial::signals::install(&temp_files)?;
+    let (plan, extra_aovs) = match args.plan.plan {
+        PlanArg::Uniform | PlanArg::Adaptive => (
+            prism_bandwidth::SamplePlan::uniform(scene.resolution, settings.spp)
+                .map_err(|e| e.to_string())?,
+            Vec::new(),
+        ),
         PlanArg::Predicted => {
+            // Deterministic in the seed: every process of a split render computes it alike.
             let predictor = args.plan.predictor(settings.spp, settings.seed);
             let prediction = pool
                 .install(|| prism_render::predictor::predict(&scene, &predictor, settings.seed))
                 .map_err(|e| format!("{}: {e}", args.scene.display()))?;
-            pool.install(|| {
-                render_plan(&scene, &settings, &prediction.allocated.plan, &|n| {
-                    bar.inc(n)
-                })
-            })
-            .map(|(mut film, stats)| {
-                film.aovs.extend(prediction.aov_planes());
-                (film, stats)
-            })
+            let aovs = prediction.aov_planes();
+            (prediction.allocated.plan, aovs)
         }
-        PlanArg::Adaptive => pool.install(|| {
-            prism_render::adaptive::render_adaptive(&scene, &settings, settings.spp, &|n| {
-                bar.inc(n)
-            })
-        }),
-    }
-    .map_err(|e| format!("{}: {e}", args.scene.display()))?;
-    let wall_time_s = start.elapsed().as_secs_f64();
-    bar.finish_and_clear();
-    if !matches!(ImageFormat::from_path(&output), Ok(ImageFormat::Exr)) {
+    };
+    let mut rendered = crate::partial::job::render(
+        args,
+        &description,
+        &scene,
+        &settings,
+        &plan,
+        extra_aovs,
+        &output,
+        &pool,
+    )?;
+    let exr_output = matches!(ImageFormat::from_path(&output), Ok(ImageFormat::Exr));
+    if !exr_output {
         // Only EXR holds layers; the plan's are extra.
-        film.aovs
+        rendered
+            .image
+            .aovs
             .retain(|a| !a.name.starts_with("bandwidth.") && !a.name.starts_with("plan."));
     }
-
-    let image = to_image(&film)?;
-    match &film.spectral {
-        Some(bins) => write_exr_with_spectral_bands(
-            &output,
-            &image,
-            &bins.centres_nm,
-            &bins.planes,
-            &ExrWriteOptions::default(),
-        ),
-        None => write_image(&output, &image),
+    // A range of the sample sequence (given, or resumed) is written as a partial EXR.
+    let range_output = args.samples.is_some()
+        || rendered.range
+            != (SampleRange {
+                start: 0,
+                end: settings.spp,
+            });
+    if range_output && !exr_output {
+        return Err(format!(
+            "{} renders the samples {} of {}: a range is written as a partial EXR; {} is \
+             not an .exr output",
+            args.scene.display(),
+            rendered.range,
+            settings.spp,
+            output.display()
+        ));
     }
-    .map_err(|e| e.to_string())?;
+    if !rendered.complete {
+        let signal = crate::partial::signals::received();
+        rendered.write_partial(&rendered.checkpoint)?;
+        let header = rendered.header();
+        let mut marks = vec![(
+            crate::partial::file::COMPLETE.to_string(),
+            "false".to_string(),
+        )];
+        marks.extend(crate::partial::file::header_attributes(
+            &header,
+            &rendered.sums,
+        ));
+        if range_output {
+            rendered.write_partial(&output)?;
+        } else {
+            write_output(&output, &rendered.image, &marks)?;
+        }
+        let done: u64 = rendered
+            .sums
+            .sample_counts()
+            .iter()
+            .map(|&c| u64::from(c))
+            .sum();
+        eprintln!(
+            "{}: stopped by {} after {} of the range's samples ({} work items); wrote the \
+             checkpoint {} and the PARTIAL image {}; continue with --resume {}",
+            args.scene.display(),
+            signal.map_or("--stop-after-items", crate::partial::signals::name),
+            done,
+            rendered.items_done,
+            rendered.checkpoint.display(),
+            output.display(),
+            rendered.checkpoint.display()
+        );
+        if let Some(path) = &args.stats_json {
+            write_stats(path, &scene, &settings, threads, &rendered)?;
+        }
+        // The shell's convention for a signal (130 for SIGINT, 143 for SIGTERM).
+        return Ok(ExitCode::from(
+            signal.map_or(1, |s| (128 + s).clamp(1, 255)) as u8,
+        ));
+    }
+    if range_output {
+        rendered.write_partial(&output)?;
+    } else {
+        write_output(&output, &rendered.image, &[])?;
+    }
+    // The checkpoint is superseded by the finished output.
+    if rendered.checkpoint != output {
+        match std::fs::remove_file(&rendered.checkpoint) {
+            Ok(()) => {}
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+            Err(e) => eprintln!(
+                "warning: cannot remove the checkpoint {}: {e}",
+                rendered.checkpoint.display()
+            ),
+        }
+    }
+    let film = &rendered.image;
     if args.false_colour == Some(crate::falsecolour::FalseColourQuantity::Luminance) {
         let path = crate::falsecolour::write_luminance(
             &output,
@@ -420,18 +561,50 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
         eprintln!("wrote {}", path.display());
     }
     if !description.sensors.is_empty() {
-        measure_and_write_sensors(
-            args,
-            &pool,
-            &scene,
-            &description.sensors,
-            &settings,
-            &output,
-        )?;
+        if range_output {
+            measure_sensor_share(
+                args,
+                &pool,
+                &scene,
+                &description,
+                &settings,
+                &rendered,
+                &output,
+            )?;
+        } else {
+            measure_and_write_sensors(
+                args,
+                &pool,
+                &scene,
+                &description.sensors,
+                &settings,
+                &output,
+            )?;
+        }
     }
     if let Some(path) = &args.stats_json {
-        write_stats(path, &scene, &settings, threads, wall_time_s, &stats)?;
+        write_stats(path, &scene, &settings, threads, &rendered)?;
     }
+    report_medium_mismatches(args, &rendered.stats);
+    let wall_time_s = rendered.wall_time_s;
+    eprintln!(
+        "wrote {} ({}×{}, {} spp{}, {:.2} s, {:.3} M rays/s)",
+        output.display(),
+        scene.resolution.x,
+        scene.resolution.y,
+        settings.spp,
+        if range_output {
+            format!(", samples {}", rendered.range)
+        } else {
+            String::new()
+        },
+        wall_time_s,
+        rendered.stats.rays_traced as f64 / wall_time_s.max(1e-9) / 1e6
+    );
+    Ok(ExitCode::SUCCESS)
+}
+
+fn report_medium_mismatches(args: &RenderArgs, stats: &RenderStats) {
     if stats.medium_mismatches > 0 {
         eprintln!(
             "{}: warning: paths met a medium boundary {} times from a medium other than the \
@@ -441,6 +614,76 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
             stats.medium_mismatches
         );
     }
+}
+
+/// Writes the finished image (EXR with every layer and the spectral bins, or PNG/HDR) with
+/// `metadata` as header text.
+fn write_output(
+    output: &Path,
+    film: &FilmImage,
+    metadata: &[(String, String)],
+) -> Result<(), String> {
+    let mut image = to_image(film)?;
+    image.metadata.extend(metadata.iter().cloned());
+    match &film.spectral {
+        Some(bins) => write_exr_with_spectral_bands(
+            output,
+            &image,
+            &bins.centres_nm,
+            &bins.planes,
+            &ExrWriteOptions::default(),
+        ),
+        None => write_image(output, &image),
+    }
+    .map_err(|e| e.to_string())
+}
+
+/// `--plan adaptive`: passes chosen from the image so far (no ranges or checkpoints).
+fn render_adaptive(
+    args: &RenderArgs,
+    description: &prism_scene::SceneDescription,
+    pool: &rayon::ThreadPool,
+    scene: &RenderScene,
+    settings: &RenderSettings,
+    output: &Path,
+    threads: usize,
+) -> Result<(), String> {
+    let progress = crate::progress::Progress::start(
+        args.progress,
+        args.progress_every,
+        total_samples(scene.resolution, settings.spp),
+        &args.scene.display().to_string(),
+    );
+    let start = Instant::now();
+    let result = pool.install(|| {
+        prism_render::adaptive::render_adaptive(scene, settings, settings.spp, &|n| progress.inc(n))
+    });
+    progress.finish();
+    let (mut film, stats) = result.map_err(|e| format!("{}: {e}", args.scene.display()))?;
+    let wall_time_s = start.elapsed().as_secs_f64();
+    if !matches!(ImageFormat::from_path(output), Ok(ImageFormat::Exr)) {
+        film.aovs
+            .retain(|a| !a.name.starts_with("bandwidth.") && !a.name.starts_with("plan."));
+    }
+    write_output(output, &film, &[])?;
+    if args.false_colour == Some(crate::falsecolour::FalseColourQuantity::Luminance) {
+        let path = crate::falsecolour::write_luminance(
+            output,
+            &film.luminance_cd_m2(),
+            (film.width as usize, film.height as usize),
+            args.false_colour_scale,
+            args.false_colour_range,
+        )?;
+        eprintln!("wrote {}", path.display());
+    }
+    if !description.sensors.is_empty() {
+        measure_and_write_sensors(args, pool, scene, &description.sensors, settings, output)?;
+    }
+    if let Some(path) = &args.stats_json {
+        let value = stats_value(scene, settings, threads, wall_time_s, &stats);
+        write_json(path, &value)?;
+    }
+    report_medium_mismatches(args, &stats);
     eprintln!(
         "wrote {} ({}×{}, {} spp, {:.2} s, {:.3} M rays/s)",
         output.display(),
@@ -453,15 +696,14 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
     Ok(())
 }
 
-fn write_stats(
-    path: &Path,
+fn stats_value(
     scene: &RenderScene,
     settings: &RenderSettings,
     threads: usize,
     wall_time_s: f64,
     stats: &RenderStats,
-) -> Result<(), String> {
-    let value = json!({
+) -> serde_json::Value {
+    json!({
         "wall_time_s": wall_time_s,
         "rays_traced": stats.rays_traced,
         "rays_per_second": stats.rays_traced as f64 / wall_time_s.max(1e-9),
@@ -479,14 +721,38 @@ fn write_stats(
         "medium_mismatches": stats.medium_mismatches,
         // The fast paths' ISA (`--explain` says why).
         "simd": prism_cpu::active().isa().name(),
-    });
-    let text = serde_json::to_string_pretty(&value).map_err(|e| e.to_string())? + "\n";
+    })
+}
+
+/// The statistics of a (possibly partial or resumed) render: the common ones, and the
+/// sample range with the time spent on it in this run and in earlier runs.
+fn write_stats(
+    path: &Path,
+    scene: &RenderScene,
+    settings: &RenderSettings,
+    threads: usize,
+    rendered: &crate::partial::job::Rendered,
+) -> Result<(), String> {
+    let mut value = stats_value(
+        scene,
+        settings,
+        threads,
+        rendered.wall_time_s,
+        &rendered.stats,
+    );
+    value["ranges"] = json!([{
+        "samples": [rendered.range.start, rendered.range.end],
+        "complete": rendered.complete,
+        "wall_time_s": rendered.wall_time_s,
+        "earlier_wall_time_s": rendered.earlier_wall_time_s,
+    }]);
+    write_json(path, &value)
+}
+
+fn write_json(path: &Path, value: &serde_json::Value) -> Result<(), String> {
+    let text = serde_json::to_string_pretty(value).map_err(|e| e.to_string())? + "\n";
     // Atomic like the image: a temporary sibling renamed over the destination.
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let tmp = path.with_file_name(format!(".{name}.{}.tmp", std::process::id()));
+    let tmp = prism_image::io::temp_sibling(path);
     let result = std::fs::write(&tmp, text).and_then(|()| std::fs::rename(&tmp, path));
     if let Err(e) = result {
         let _ = std::fs::remove_file(&tmp);
@@ -498,6 +764,63 @@ fn write_stats(
     Ok(())
 }
 
+/// A range render's share of the sensors: their sums beside the part, for `prism merge`
+/// (`partial::sensor_sums`). Adaptive sensors cannot be split: the part whose range starts
+/// at 0 measures them whole, the others say so.
+fn measure_sensor_share(
+    args: &RenderArgs,
+    pool: &rayon::ThreadPool,
+    scene: &RenderScene,
+    description: &prism_scene::SceneDescription,
+    settings: &RenderSettings,
+    rendered: &crate::partial::job::Rendered,
+    output: &Path,
+) -> Result<(), String> {
+    let share = prism_render::sensor::SampleShare {
+        start: rendered.range.start,
+        end: rendered.range.end,
+        total: settings.spp,
+    };
+    let result = pool.install(|| {
+        prism_render::sensor::measure_sensor_share(
+            scene,
+            &description.sensors,
+            settings.seed,
+            share,
+            &|_| {},
+        )
+    });
+    match result {
+        Ok((sums, _)) => {
+            let path = crate::partial::sensor_sums::sidecar_path(output);
+            let value = crate::partial::sensor_sums::to_json(
+                &rendered.identity.hash(),
+                &rendered.range.to_string(),
+                &sums,
+            );
+            let text = serde_json::to_string_pretty(&value).map_err(|e| e.to_string())? + "\n";
+            crate::sensors::write_atomic(&path, &text, "sensor sums")?;
+            eprintln!("wrote {}", path.display());
+            Ok(())
+        }
+        Err(why) if rendered.range.start == 0 => {
+            eprintln!(
+                "{}: {why}; this part (samples {}) measures the sensors whole",
+                args.scene.display(),
+                rendered.range
+            );
+            measure_and_write_sensors(args, pool, scene, &description.sensors, settings, output)
+        }
+        Err(why) => {
+            eprintln!(
+                "{}: {why}; the part whose range starts at 0 measures them, not this one",
+                args.scene.display()
+            );
+            Ok(())
+        }
+    }
+}
+
 /// Measures the scene's sensors on `pool` and writes their readings beside the image.
 fn measure_and_write_sensors(
     args: &RenderArgs,
@@ -507,13 +830,18 @@ fn measure_and_write_sensors(
     settings: &RenderSettings,
     output: &Path,
 ) -> Result<(), String> {
-    let bar = progress_bar(prism_render::sensor::total_points(sensors));
+    let bar = crate::progress::Progress::start(
+        args.progress,
+        args.progress_every,
+        prism_render::sensor::total_points(sensors),
+        &args.scene.display().to_string(),
+    );
     let start = Instant::now();
     let (readings, stats) = pool.install(|| {
         prism_render::sensor::measure_sensors(scene, sensors, settings.seed, &|n| bar.inc(n))
     });
     let wall_time_s = start.elapsed().as_secs_f64();
-    bar.finish_and_clear();
+    bar.finish();
     let (json_path, csv_path) = crate::sensors::sensor_paths(output);
     let mut value = crate::sensors::readings_json(&args.scene, &readings, &stats, wall_time_s);
     let mut csv = crate::sensors::readings_csv(&readings);

@@ -38,12 +38,13 @@ pub use camera::{
 };
 pub use error::InvalidParameter;
 pub use film::{
-    AovPlane, AovSelection, Film, FilmImage, FilmTile, Filter, FilterSample, FilterSampler,
-    SpectralBins, SpectralPlanes, SurfaceAov, TileBounds,
+    AovPlane, AovSelection, Film, FilmImage, FilmSums, FilmTile, Filter, FilterSample,
+    FilterSampler, SpectralBins, SpectralPlanes, SurfaceAov, TileBounds,
 };
 pub use integrator::{
-    film_for, render, render_pass, render_pass_with, render_plan, total_samples, Estimator,
-    Integrator, RenderError, RenderSettings, RenderStats,
+    film_for, render, render_pass, render_pass_controlled, render_pass_with, render_plan,
+    total_samples, Estimator, Integrator, PassControl, PassOutcome, RenderError, RenderSettings,
+    RenderStats,
 };
 pub use plan::{PlanChoice, PlanRequest, RenderPlan, SamplePlanKind};
 pub use sampler::{PixelSampler, SampleStream, SamplerKind};

@@ -6,6 +6,7 @@ pub mod exr;
 mod exr_rgb;
 pub mod png;
 pub mod quantise;
+pub mod raw_exr;
 pub mod rgbe;
 pub mod spectral_exr;
 mod zlib_strips;
@@ -67,8 +68,9 @@ pub fn write_image(path: &Path, image: &Image) -> Result<()> {
     }
 }
 
-/// The temporary sibling a write goes to before it is renamed over `path`.
-fn temp_sibling(path: &Path) -> PathBuf {
+/// The temporary sibling a write goes to before it is renamed over `path` (a process that
+/// must remove it from a signal handler computes it in advance).
+pub fn temp_sibling(path: &Path) -> PathBuf {
     let name = path
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
@@ -79,14 +81,24 @@ fn temp_sibling(path: &Path) -> PathBuf {
 /// Runs `write` on a temporary path beside `path`, then renames it to `path`; on failure
 /// the temporary file is removed and the destination is left as it was.
 pub(crate) fn write_atomically(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
-    let tmp = temp_sibling(path);
-    let result = write(&tmp).and_then(|()| {
-        std::fs::rename(&tmp, path).map_err(|e| ImageError::io(path, "rename the finished file", e))
+    let tmp = TempFile(temp_sibling(path));
+    let result = write(&tmp.0).and_then(|()| {
+        std::fs::rename(&tmp.0, path)
+            .map_err(|e| ImageError::io(path, "rename the finished file", e))
     });
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
+    // The guard removes the temporary file on every way out — an error, or a panic
+    // unwinding through `write`; after the rename it is gone and the removal fails quietly.
+    drop(tmp);
     result
+}
+
+/// Removes its path when dropped.
+struct TempFile(PathBuf);
+
+impl Drop for TempFile {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_file(&self.0);
+    }
 }
 
 /// [`write_atomically`] through a buffered writer; errors name `path`, not the temp file.
@@ -150,4 +162,38 @@ pub fn convert_pixels(pixels: &mut [[f32; 3]], from: &RgbColorSpace, to: &RgbCol
         prism_spectrum::adaptation::AdaptationMethod::None,
     );
     crate::rgb_matrix::apply_rgb_matrix(pixels, m);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_failed_or_panicking_write_leaves_no_temporary_file_and_the_old_file_whole() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("image.exr");
+        std::fs::write(&path, b"previous").unwrap();
+        let tmp = temp_sibling(&path);
+        let failed = write_atomically(&path, |t| {
+            std::fs::write(t, b"half").unwrap();
+            Err(ImageError::invalid("stopped"))
+        });
+        assert!(failed.is_err());
+        assert!(!tmp.exists());
+        let panicked = std::panic::catch_unwind(|| {
+            let _ = write_atomically(&path, |t| {
+                std::fs::write(t, b"half").unwrap();
+                panic!("a writer panics");
+            });
+        });
+        assert!(panicked.is_err());
+        assert!(!tmp.exists(), "the panic left {}", tmp.display());
+        assert_eq!(std::fs::read(&path).unwrap(), b"previous");
+        write_atomically(&path, |t| {
+            std::fs::write(t, b"new").map_err(|e| ImageError::io(t, "write", e))
+        })
+        .unwrap();
+        assert_eq!(std::fs::read(&path).unwrap(), b"new");
+        assert!(!tmp.exists());
+    }
 }

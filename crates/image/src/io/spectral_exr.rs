@@ -13,6 +13,7 @@
 use std::path::Path;
 
 use ::exr::meta::attribute::AttributeValue;
+use ::exr::prelude::FlatSamples;
 use glam::DVec3;
 use prism_spectrum::data::cmfs;
 use prism_spectrum::photometry::y_bar_integral_nm;
@@ -342,6 +343,19 @@ pub fn write_exr_with_spectral_bands(
     planes: &[Vec<f32>],
     options: &ExrWriteOptions,
 ) -> Result<()> {
+    write_exr_with_spectral_bands_and_raw(path, image, wavelengths_nm, planes, Vec::new(), options)
+}
+
+/// [`write_exr_with_spectral_bands`] with `raw` channels beside them in the same part
+/// (what `crate::io::raw_exr::write_exr_with_raw` adds to a spectral image).
+pub(crate) fn write_exr_with_spectral_bands_and_raw(
+    path: &Path,
+    image: &Image,
+    wavelengths_nm: &[f64],
+    planes: &[Vec<f32>],
+    raw: Vec<(String, FlatSamples)>,
+    options: &ExrWriteOptions,
+) -> Result<()> {
     let pixels = image.width() * image.height();
     if wavelengths_nm.is_empty() || planes.len() != wavelengths_nm.len() {
         return Err(ImageError::invalid(format!(
@@ -365,6 +379,7 @@ pub fn write_exr_with_spectral_bands(
         )));
     }
     let (mut channels, mut attributes) = image_channels(path, image, options)?;
+    channels.extend(raw);
     for (wl, plane) in wavelengths_nm.iter().zip(planes) {
         channels.push((
             emissive_channel_name(*wl),

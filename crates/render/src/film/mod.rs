@@ -13,6 +13,7 @@ mod filter_table;
 mod image;
 mod light_splats;
 pub mod spectral_bins;
+mod sums;
 mod tile;
 pub mod xyz;
 
@@ -21,6 +22,7 @@ pub use filter_sampler::{FilterSample, FilterSampler};
 pub use image::{AovPlane, FilmImage, SpectralPlanes};
 pub use light_splats::LightSplats;
 pub use spectral_bins::SpectralBins;
+pub use sums::{CountPlane, FilmSums, SumPlane, SumsMismatch};
 pub use tile::{FilmTile, SurfaceAov, TileBounds};
 
 use std::sync::Arc;
@@ -80,6 +82,43 @@ impl AovSelection {
 
     pub fn any(&self) -> bool {
         self.depth || self.normal || self.albedo || self.illumination || self.variance
+    }
+}
+
+/// Makes empty tiles of a film (`Film::tile_maker`).
+#[derive(Clone, Debug)]
+pub struct TileMaker {
+    resolution: UVec2,
+    aov_selection: AovSelection,
+    spectral_bins: Option<SpectralBins>,
+    filter_sampler: Arc<FilterSampler>,
+    splat: bool,
+}
+
+impl TileMaker {
+    /// An empty tile over `bounds` (clipped to the film).
+    pub fn new_tile(&self, bounds: TileBounds) -> FilmTile {
+        let b = TileBounds {
+            min: bounds.min.min(self.resolution),
+            max: bounds
+                .max
+                .min(self.resolution)
+                .max(bounds.min.min(self.resolution)),
+        };
+        let mut tile = FilmTile::new(
+            b,
+            self.aov_selection,
+            self.spectral_bins,
+            Arc::clone(&self.filter_sampler),
+        );
+        if self.splat {
+            tile.splat = Some(tile::SplatBuffer::new(
+                b,
+                self.resolution,
+                self.filter_sampler.filter().radius_px(),
+            ));
+        }
+        tile
     }
 }
 
@@ -211,27 +250,27 @@ impl Film {
 
     /// An empty tile over `bounds` (clipped to the film).
     pub fn new_tile(&self, bounds: TileBounds) -> FilmTile {
-        let b = TileBounds {
-            min: bounds.min.min(self.resolution),
-            max: bounds
-                .max
-                .min(self.resolution)
-                .max(bounds.min.min(self.resolution)),
-        };
-        let mut tile = FilmTile::new(
-            b,
-            self.aov_selection,
-            self.spectral_bins,
-            Arc::clone(&self.filter_sampler),
-        );
-        if self.splat {
-            tile.splat = Some(tile::SplatBuffer::new(
-                b,
-                self.resolution,
-                self.filter_sampler.filter().radius_px(),
-            ));
+        self.tile_maker().new_tile(bounds)
+    }
+
+    /// What makes this film's tiles, without borrowing the film (so that tiles can be
+    /// made while the film is being merged into).
+    pub fn tile_maker(&self) -> TileMaker {
+        TileMaker {
+            resolution: self.resolution,
+            aov_selection: self.aov_selection,
+            spectral_bins: self.spectral_bins,
+            filter_sampler: Arc::clone(&self.filter_sampler),
+            splat: self.splat,
         }
-        tile
+    }
+
+    /// Camera samples pixel `pixel` holds (0 outside the film).
+    pub fn sample_count(&self, pixel: UVec2) -> u32 {
+        if pixel.x >= self.resolution.x || pixel.y >= self.resolution.y {
+            return 0;
+        }
+        self.pixels[pixel.y as usize * self.resolution.x as usize + pixel.x as usize].sample_count
     }
 
     /// The same film reconstructing by splatting (`true`: every sample reaches every pixel

@@ -7,13 +7,16 @@
 //! The stream's dimensions: `integrator::dimensions`.
 
 use std::fmt;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Mutex;
+use std::time::{Duration, Instant};
 
 use glam::UVec2;
 use rayon::prelude::*;
 
 use super::estimator::{Estimator, Pass, TileWork};
 use super::PathCounters;
-use crate::film::{AovSelection, Film, FilmImage, FilmTile, LightSplats, SpectralBins};
+use crate::film::{AovSelection, Film, FilmImage, FilmTile, LightSplats, SpectralBins, TileBounds};
 use crate::sampler::{PixelSampler, SamplerKind};
 use crate::scene_build::RenderScene;
 use prism_bandwidth::{BandwidthError, SamplePlan};
@@ -204,6 +207,7 @@ pub fn render_pass(
             settings,
             plan,
             first_sample,
+            footprint_plan: None,
         },
         film,
         progress,
@@ -227,6 +231,84 @@ pub fn render_pass_with(
     film: &mut Film,
     progress: &(dyn Fn(u64) + Sync),
 ) -> Result<RenderStats, RenderError> {
+    let never = AtomicBool::new(false);
+    let control = PassControl {
+        stop: &never,
+        resumed: false,
+        items_done: 0,
+        checkpoint: None,
+    };
+    render_pass_controlled(estimator, scene, pass, film, progress, &control).map(|o| o.stats)
+}
+
+/// What may interrupt a pass and what it saves on the way (`prism render --checkpoint-every`,
+/// `--resume`, Ctrl-C).
+pub struct PassControl<'a> {
+    /// Once set, no further work item starts; the items in flight finish and are merged.
+    pub stop: &'a AtomicBool,
+    /// The film is a checkpoint of this same pass (not the sum of earlier passes): tiles
+    /// whose pixels hold all the pass's samples already are skipped. False for a pass that
+    /// adds to a film of earlier passes (progressive renders, photon passes).
+    pub resumed: bool,
+    /// Work items already in the film (`PassOutcome::items_done` of the checkpoint being
+    /// resumed; 0 for a fresh film). Only estimators whose items must be merged in order
+    /// use it; the others skip the tiles whose pixels already hold all their samples.
+    pub items_done: usize,
+    /// At most every `Duration`, between work items, the film so far and the items done:
+    /// a consistent state to resume from (the callback writes the checkpoint).
+    pub checkpoint: Option<(Duration, &'a CheckpointFn<'a>)>,
+}
+
+/// Receives the film so far and the work items done (see `PassControl::checkpoint`).
+pub type CheckpointFn<'a> = dyn Fn(&Film, usize) + Sync + 'a;
+
+/// How far a controlled pass got.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PassOutcome {
+    pub stats: RenderStats,
+    /// Work items in the film (for resuming the ordered kind: see `PassControl`).
+    pub items_done: usize,
+    /// Every work item of the pass is in the film.
+    pub complete: bool,
+}
+
+/// A checkpoint is due when `every` has passed since the last one.
+struct CheckpointClock<'a> {
+    last: Mutex<Instant>,
+    every: Duration,
+    write: &'a CheckpointFn<'a>,
+}
+
+impl CheckpointClock<'_> {
+    fn due(&self) -> bool {
+        self.last
+            .lock()
+            .map(|mut last| {
+                if last.elapsed() >= self.every {
+                    *last = Instant::now();
+                    true
+                } else {
+                    false
+                }
+            })
+            .unwrap_or(false)
+    }
+}
+
+/// [`render_pass_with`] that stops when `control.stop` is set, continues a film restored
+/// from a checkpoint, and hands out checkpoints. The film it leaves is the film of an
+/// uninterrupted pass restricted to the items done, and continuing it (a second call with
+/// `items_done` from the outcome) gives the uninterrupted film bit for bit: items are
+/// merged either into pixels that nothing else touches (tiles of an estimator that writes
+/// its own pixels only, on a film that does not splat) or in item order.
+pub fn render_pass_controlled(
+    estimator: &mut (impl Estimator + ?Sized),
+    scene: &RenderScene,
+    pass: &Pass,
+    film: &mut Film,
+    progress: &(dyn Fn(u64) + Sync),
+    control: &PassControl,
+) -> Result<PassOutcome, RenderError> {
     pass.plan.check_resolution(scene.resolution)?;
     pass.plan.check_resolution(film.resolution())?;
     if estimator.splats_light_paths() && pass.plan.has_per_pixel_first_samples() {
@@ -246,20 +328,22 @@ pub fn render_pass_with(
             plan: &plan,
             ..*pass
         };
-        return render_pass_with(estimator, scene, &moved, film, progress);
+        return render_pass_controlled(estimator, scene, &moved, film, progress, control);
     }
     if let Some(per_prepare) = estimator.sample_indices_per_prepare() {
-        return render_in_sample_steps(estimator, scene, pass, film, progress, per_prepare);
+        return render_in_sample_steps(estimator, scene, pass, film, progress, per_prepare, control);
     }
     estimator
         .prepare(scene, pass)
         .map_err(RenderError::Estimator)?;
-    run_prepared(&*estimator, scene, pass, film, progress)
+    run_prepared(&*estimator, scene, pass, film, progress, control)
 }
 
 /// `render_pass_with` for an estimator that prepares every `per_prepare` sample indices:
 /// the pass cut into passes of at most that many indices, `prepare` before each. The
-/// pixels' sample ranges must start at the same index.
+/// pixels' sample ranges must start at the same index. A stop request ends the pass
+/// between steps; checkpoints inside such a pass and resuming one are refused (a step's
+/// state, its photons, is not in the film): split the work with sample ranges instead.
 fn render_in_sample_steps(
     estimator: &mut (impl Estimator + ?Sized),
     scene: &RenderScene,
@@ -267,7 +351,15 @@ fn render_in_sample_steps(
     film: &mut Film,
     progress: &(dyn Fn(u64) + Sync),
     per_prepare: u32,
-) -> Result<RenderStats, RenderError> {
+    control: &PassControl,
+) -> Result<PassOutcome, RenderError> {
+    if control.checkpoint.is_some() || control.resumed {
+        return Err(RenderError::Estimator(format!(
+            "{} cannot checkpoint or resume within a pass (its photons are not in the \
+             film): render sample ranges (--samples A..B) and merge them instead",
+            estimator.name()
+        )));
+    }
     let resolution = pass.plan.resolution();
     let Some(first) = uniform_first_sample(pass.plan) else {
         return Err(RenderError::Estimator(format!(
@@ -288,7 +380,21 @@ fn render_in_sample_steps(
     let step = per_prepare.max(1);
     let mut total = RenderStats::default();
     let mut k = 0u32;
+    let never = AtomicBool::new(false);
+    let step_control = PassControl {
+        stop: &never,
+        resumed: false,
+        items_done: 0,
+        checkpoint: None,
+    };
     while k < most {
+        if control.stop.load(std::sync::atomic::Ordering::Relaxed) {
+            return Ok(PassOutcome {
+                stats: total,
+                items_done: 0,
+                complete: false,
+            });
+        }
         let sub_counts: Vec<u32> = counts
             .iter()
             .map(|c| c.saturating_sub(k).min(step))
@@ -297,17 +403,21 @@ fn render_in_sample_steps(
             .with_first_samples(vec![first + k; n])?;
         let sub = Pass {
             index: pass.index + k,
-            settings: pass.settings,
             plan: &plan,
-            first_sample: pass.first_sample,
+            ..*pass
         };
         estimator
             .prepare(scene, &sub)
             .map_err(RenderError::Estimator)?;
-        total.add(&run_prepared(&*estimator, scene, &sub, film, progress)?);
+        let outcome = run_prepared(&*estimator, scene, &sub, film, progress, &step_control)?;
+        total.add(&outcome.stats);
         k += step;
     }
-    Ok(total)
+    Ok(PassOutcome {
+        stats: total,
+        items_done: 0,
+        complete: true,
+    })
 }
 
 /// The pixels of a `resolution` film, row-major (the plans' order).
@@ -335,43 +445,90 @@ fn plan_counts(plan: &SamplePlan) -> Result<SamplePlan, RenderError> {
     Ok(SamplePlan::from_counts(resolution, counts, light)?)
 }
 
-/// Every work item of a prepared pass, in parallel, merged in a fixed order.
+/// Every work item of a prepared pass, in parallel, merged in a fixed order, under
+/// `control` (see [`render_pass_controlled`]).
 fn run_prepared(
     estimator: &(impl Estimator + ?Sized),
     scene: &RenderScene,
     pass: &Pass,
     film: &mut Film,
     progress: &(dyn Fn(u64) + Sync),
-) -> Result<RenderStats, RenderError> {
+    control: &PassControl,
+) -> Result<PassOutcome, RenderError> {
     let sampler = PixelSampler::with_kind(pass.settings.sampler, pass.settings.seed);
     let uses_lens = scene.camera.uses_lens_sample();
     let tile_size_px = pass.settings.tile_size_px;
     let all_samples = pass.first_sample..u32::MAX;
-    if !estimator.splats_light_paths() {
-        // Integer counts: their sum does not depend on the order tiles finish in.
-        let total = std::sync::Mutex::new(RenderStats::default());
+    let clock = control.checkpoint.map(|(every, write)| CheckpointClock {
+        last: Mutex::new(Instant::now()),
+        every,
+        write,
+    });
+    let stop = control.stop;
+    if !estimator.splats_light_paths() && !film.splats() {
+        // Tiles write their own pixels only: each is added once into pixels at zero, in
+        // whatever order they finish (same bits as any order), under a lock so that a
+        // checkpoint sees whole tiles. Tiles whose pixels hold all their samples already
+        // (a resumed checkpoint) are skipped.
+        let all_tiles = film.tiles(tile_size_px);
+        let tiles: Vec<TileBounds> = all_tiles
+            .iter()
+            .copied()
+            .filter(|b| {
+                !(control.resumed
+                    && b.pixels()
+                        .all(|p| film.sample_count(p) == pass.plan.camera_samples(p)))
+            })
+            .collect();
+        let skipped = all_tiles.len() - tiles.len();
+        let maker = film.tile_maker();
         let no_splats = film.unused_light_splats();
-        film.render_tiles(tile_size_px, |tile| {
+        let shared = Mutex::new((&mut *film, RenderStats::default(), skipped));
+        tiles.par_iter().for_each(|bounds| {
+            if stop.load(Ordering::Relaxed) {
+                return;
+            }
             let work = TileWork {
                 pass,
                 sampler: &sampler,
                 sample_indices: all_samples.clone(),
                 uses_lens,
             };
+            let mut tile = maker.new_tile(*bounds);
             let mut splats = no_splats.clone();
-            let stats = estimator.render_tile(scene, &work, tile, &mut splats);
+            let stats = estimator.render_tile(scene, &work, &mut tile, &mut splats);
             debug_assert_eq!(splats.splat_count(), 0, "{} splats", estimator.name());
             progress(stats.samples);
-            if let Ok(mut t) = total.lock() {
-                t.add(&stats);
+            if let Ok(mut guard) = shared.lock() {
+                let (film, total, done) = &mut *guard;
+                film.merge_tile(&tile);
+                total.add(&stats);
+                *done += 1;
+                if let Some(clock) = &clock {
+                    if clock.due() {
+                        (clock.write)(film, *done);
+                    }
+                }
             }
         });
-        return Ok(total.into_inner().unwrap_or_default());
+        let (_, stats, done) = shared
+            .into_inner()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        return Ok(PassOutcome {
+            stats,
+            items_done: done,
+            complete: done == all_tiles.len(),
+        });
     }
-    // Light-path estimators: tiles cut into sample ranges of about LIGHT_PATHS_PER_ITEM
-    // camera samples (one light path each).
+    // Estimators that splat light paths (and films that splat): tiles cut into sample
+    // ranges of about LIGHT_PATHS_PER_ITEM camera samples (one light path each), merged
+    // in item order.
     let mut items = Vec::new();
     for bounds in film.tiles(tile_size_px) {
+        if !estimator.splats_light_paths() {
+            items.push((bounds, all_samples.clone()));
+            continue;
+        }
         let most = bounds
             .pixels()
             .map(|p| pass.plan.camera_samples(p))
@@ -386,14 +543,23 @@ fn run_prepared(
             k = end;
         }
     }
-    let template = film.light_splats();
+    let template = if estimator.splats_light_paths() {
+        film.light_splats()
+    } else {
+        film.unused_light_splats()
+    };
     let mut total = RenderStats::default();
-    for batch in items.chunks(ITEMS_PER_BATCH) {
+    let mut done = control.items_done.min(items.len());
+    while done < items.len() && !stop.load(Ordering::Relaxed) {
+        let batch = &items[done..(done + ITEMS_PER_BATCH).min(items.len())];
         let film_ref = &*film;
         let template = &template;
-        let results: Vec<(FilmTile, LightSplats, RenderStats)> = batch
+        let results: Vec<Option<(FilmTile, LightSplats, RenderStats)>> = batch
             .par_iter()
             .map(|(bounds, range)| {
+                if stop.load(Ordering::Relaxed) {
+                    return None;
+                }
                 let work = TileWork {
                     pass,
                     sampler: &sampler,
@@ -404,16 +570,29 @@ fn run_prepared(
                 let mut splats = template.clone();
                 let stats = estimator.render_tile(scene, &work, &mut tile, &mut splats);
                 progress(stats.samples);
-                (tile, splats, stats)
+                Some((tile, splats, stats))
             })
             .collect();
-        for (tile, splats, stats) in &results {
+        // The longest finished prefix: later items wait for a resume, in order.
+        for (tile, splats, stats) in results.iter().map_while(Option::as_ref) {
             film.merge_tile(tile);
-            film.merge_light_splats(splats);
+            if estimator.splats_light_paths() {
+                film.merge_light_splats(splats);
+            }
             total.add(stats);
+            done += 1;
+        }
+        if let Some(clock) = &clock {
+            if done < items.len() && clock.due() {
+                (clock.write)(film, done);
+            }
         }
     }
-    Ok(total)
+    Ok(PassOutcome {
+        stats: total,
+        items_done: done,
+        complete: done == items.len(),
+    })
 }
 
 /// Total camera samples of a render: pixels × spp (for progress bars).

@@ -30,6 +30,22 @@ pub struct Pass<'a> {
     /// Sample index of each pixel's first sample in this pass (plus the plan's own
     /// per-pixel start, `SamplePlan::first_sample`).
     pub first_sample: u32,
+    /// When this pass is one sample range of a longer render (`prism render --samples`,
+    /// a resumed range): that render's plan. A sample's ray footprint (texture filtering)
+    /// follows the samples its pixel gets in the whole render, so that the range's samples
+    /// are the whole render's. `None`: the pass's own plan (a progressive pass scales by
+    /// its own count).
+    pub footprint_plan: Option<&'a SamplePlan>,
+}
+
+impl Pass<'_> {
+    /// The sample count a pixel's ray footprints are scaled for (see `footprint_plan`).
+    #[inline]
+    pub fn footprint_samples(&self, pixel: UVec2) -> u32 {
+        self.footprint_plan
+            .unwrap_or(self.plan)
+            .camera_samples(pixel)
+    }
 }
 
 /// One work item: the camera samples of a tile that the item renders.

@@ -49,8 +49,9 @@ mod scatter_vertex;
 pub use ambient_occlusion::AmbientOcclusion;
 pub use bdpt::{Bdpt, BdptStrategy};
 pub use driver::{
-    film_for, render, render_pass, render_pass_with, render_plan, total_samples, RenderError,
-    RenderSettings, RenderStats, DEFAULT_TILE_SIZE_PX,
+    film_for, render, render_pass, render_pass_controlled, render_pass_with, render_plan,
+    total_samples, PassControl, PassOutcome, RenderError, RenderSettings, RenderStats,
+    DEFAULT_TILE_SIZE_PX,
 };
 pub use estimator::{Estimator, Pass, TileWork};
 pub use lane_wavelengths::LaneWavelengths;

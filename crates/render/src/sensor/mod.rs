@@ -235,7 +235,10 @@ fn run_samples(
     }
 }
 
-/// Measures one point under `sampling`.
+/// Measures one point under `sampling`: all its samples, or with `share` = (a, b, N) the
+/// samples [⌊a·S/N⌋, ⌊b·S/N⌋) of its S fixed samples (a sample range of a render; an
+/// adaptive point takes all its samples whatever `share` is: the caller refuses that).
+#[allow(clippy::too_many_arguments)]
 fn measure_point(
     tracer: &PathTracer,
     scene: &RenderScene,
@@ -244,7 +247,8 @@ fn measure_point(
     position_m: [f64; 3],
     normal: [f64; 3],
     sampling: SensorSampling,
-) -> (PointReading, PathCounters) {
+    share: Option<SampleShare>,
+) -> (PointReading, ReplicateStats, PathCounters) {
     let p = DVec3::from(position_m).as_vec3a();
     let n = DVec3::from(normal).normalize().as_vec3a();
     let mut counters = PathCounters::default();
@@ -273,7 +277,14 @@ fn measure_point(
         );
     };
     match sampling {
-        SensorSampling::Fixed { samples } => take(&mut stats, 0, samples),
+        SensorSampling::Fixed { samples } => match share {
+            None => take(&mut stats, 0, samples),
+            Some(share) => take(
+                &mut stats,
+                share.of(samples, true),
+                share.of(samples, false),
+            ),
+        },
         SensorSampling::Adaptive {
             relative_error,
             absolute_error_lx,
@@ -314,8 +325,129 @@ fn measure_point(
             std_error_lx: stats.std_error(),
             samples: stats.samples(),
         },
+        stats,
         counters,
     )
+}
+
+/// A sample range [start, end) of a render of `total` samples per pixel, applied to a
+/// sensor point's own sample count S: [⌊start·S/total⌋, ⌊end·S/total⌋), so that the
+/// ranges of any split of [0, total) take each of the S samples once.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SampleShare {
+    pub start: u32,
+    pub end: u32,
+    pub total: u32,
+}
+
+impl SampleShare {
+    fn of(self, samples: u32, first: bool) -> u32 {
+        let k = if first { self.start } else { self.end };
+        (u64::from(k) * u64::from(samples) / u64::from(self.total.max(1))) as u32
+    }
+}
+
+/// A point's replicate sums: the exact state of its measurement, which the sums of other
+/// sample ranges of the same measurement can be added to.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PointSums {
+    pub position_m: [f64; 3],
+    pub normal: [f64; 3],
+    pub replicates: ReplicateStats,
+}
+
+/// A sensor's point sums (see [`measure_sensor_share`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct SensorSums {
+    pub name: String,
+    pub grid_resolution: Option<[u32; 2]>,
+    pub points: Vec<PointSums>,
+}
+
+impl SensorSums {
+    /// Adds the sums of another sample range of the same sensor; an error names what
+    /// differs.
+    pub fn add(&mut self, other: &SensorSums) -> Result<(), String> {
+        if self.name != other.name || self.points.len() != other.points.len() {
+            return Err(format!(
+                "sensor {} ({} points) and sensor {} ({} points)",
+                self.name,
+                self.points.len(),
+                other.name,
+                other.points.len()
+            ));
+        }
+        for (a, b) in self.points.iter_mut().zip(&other.points) {
+            a.replicates.merge(&b.replicates).ok_or_else(|| {
+                format!("sensor {}: the points have different replicates", self.name)
+            })?;
+        }
+        Ok(())
+    }
+
+    /// The readings of the samples held: the mean of the replicate means and its standard
+    /// error, as a whole measurement gives them.
+    pub fn reading(&self) -> SensorReading {
+        SensorReading {
+            name: self.name.clone(),
+            grid_resolution: self.grid_resolution,
+            points: self
+                .points
+                .iter()
+                .map(|p| PointReading {
+                    position_m: p.position_m,
+                    normal: p.normal,
+                    illuminance_lx: p.replicates.mean(),
+                    std_error_lx: p.replicates.std_error(),
+                    samples: p.replicates.samples(),
+                })
+                .collect(),
+        }
+    }
+}
+
+/// Measures `share` of the samples of every sensor (all of them fixed-count: an adaptive
+/// sensor decides its count from its samples so far, which no range can; an error names
+/// it), returning the sums to add to other ranges' (`prism render --samples`, `prism
+/// merge`).
+pub fn measure_sensor_share(
+    scene: &RenderScene,
+    sensors: &[Sensor],
+    seed: u64,
+    share: SampleShare,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Result<(Vec<SensorSums>, SensorStats), String> {
+    if let Some(s) = sensors
+        .iter()
+        .find(|s| matches!(s.sampling, SensorSampling::Adaptive { .. }))
+    {
+        return Err(format!(
+            "sensor {} stops when its standard error is reached (relative_error / \
+             absolute_error_lx), which a sample range cannot decide: give it a fixed \
+             `samples` count",
+            s.name
+        ));
+    }
+    let (all, stats) = measure_all(scene, sensors, seed, Some(share), progress);
+    Ok((
+        all.into_iter()
+            .map(|(reading, replicates)| SensorSums {
+                name: reading.name,
+                grid_resolution: reading.grid_resolution,
+                points: reading
+                    .points
+                    .iter()
+                    .zip(replicates)
+                    .map(|(p, replicates)| PointSums {
+                        position_m: p.position_m,
+                        normal: p.normal,
+                        replicates,
+                    })
+                    .collect(),
+            })
+            .collect(),
+        stats,
+    ))
 }
 
 /// Measures every sensor of `sensors` in `scene` (points in parallel on the current rayon
@@ -326,12 +458,25 @@ pub fn measure_sensors(
     seed: u64,
     progress: &(dyn Fn(u64) + Sync),
 ) -> (Vec<SensorReading>, SensorStats) {
+    let (all, stats) = measure_all(scene, sensors, seed, None, progress);
+    (all.into_iter().map(|(r, _)| r).collect(), stats)
+}
+
+/// Every sensor's readings and each point's replicates.
+#[allow(clippy::type_complexity)]
+fn measure_all(
+    scene: &RenderScene,
+    sensors: &[Sensor],
+    seed: u64,
+    share: Option<SampleShare>,
+    progress: &(dyn Fn(u64) + Sync),
+) -> (Vec<(SensorReading, Vec<ReplicateStats>)>, SensorStats) {
     let tracer = sensor_tracer(scene);
     let mut readings = Vec::with_capacity(sensors.len());
     let mut stats = SensorStats::default();
     for (s, sensor) in sensors.iter().enumerate() {
         let sensor_seed = sensor_seed(seed, s);
-        let results: Vec<(PointReading, PathCounters)> = (0..sensor.kind.len())
+        let results: Vec<(PointReading, ReplicateStats, PathCounters)> = (0..sensor.kind.len())
             .into_par_iter()
             .map(|i| {
                 let (position_m, normal) = sensor.kind.point(i);
@@ -343,26 +488,32 @@ pub fn measure_sensors(
                     position_m,
                     normal,
                     sensor.sampling,
+                    share,
                 );
                 progress(1);
                 r
             })
             .collect();
         let mut points = Vec::with_capacity(results.len());
-        for (p, c) in results {
+        let mut replicates = Vec::with_capacity(results.len());
+        for (p, r, c) in results {
             stats.samples += p.samples;
             stats.rays_traced += c.rays;
             stats.non_finite_contributions += c.non_finite_contributions;
             points.push(p);
+            replicates.push(r);
         }
-        readings.push(SensorReading {
-            name: sensor.name.clone(),
-            grid_resolution: match sensor.kind {
-                prism_scene::SensorKind::Grid { resolution, .. } => Some(resolution),
-                _ => None,
+        readings.push((
+            SensorReading {
+                name: sensor.name.clone(),
+                grid_resolution: match sensor.kind {
+                    prism_scene::SensorKind::Grid { resolution, .. } => Some(resolution),
+                    _ => None,
+                },
+                points,
             },
-            points,
-        });
+            replicates,
+        ));
     }
     (readings, stats)
 }

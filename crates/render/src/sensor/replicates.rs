@@ -76,6 +76,34 @@ impl ReplicateStats {
         self.counts.iter().sum()
     }
 
+    /// Σ of each replicate's samples.
+    pub fn sums(&self) -> &[f64] {
+        &self.sums
+    }
+
+    /// Samples of each replicate.
+    pub fn counts(&self) -> &[u64] {
+        &self.counts
+    }
+
+    /// Replicates with these sums and counts (as `sums` and `counts` gave them); `None`
+    /// when the lengths differ.
+    pub fn from_parts(sums: Vec<f64>, counts: Vec<u64>) -> Option<Self> {
+        (sums.len() == counts.len()).then_some(Self { sums, counts })
+    }
+
+    /// Adds the samples of `other`, other samples of the same replicates (a sample range
+    /// of the same measurement); `None` when the replicate counts differ.
+    pub fn merge(&mut self, other: &ReplicateStats) -> Option<()> {
+        if self.sums.len() != other.sums.len() {
+            return None;
+        }
+        for (r, (s, n)) in other.sums.iter().zip(&other.counts).enumerate() {
+            self.add(r as u32, *s, *n);
+        }
+        Some(())
+    }
+
     fn means(&self) -> impl Iterator<Item = f64> + '_ {
         self.sums
             .iter()

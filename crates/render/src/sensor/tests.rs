@@ -348,3 +348,34 @@ fn scrambled_replicates_beat_independent_samples_on_a_lit_room() {
         "RQMC variance {var_rqmc} vs independent {var_independent}"
     );
 }
+
+#[test]
+fn sample_ranges_of_a_fixed_sensor_add_up_to_the_whole_measurement() {
+    let json = r#"{"lights": [{"type": "sky", "luminance_cd_m2": 50}],
+        "shapes": [{"type": "cuboid", "size_m": [1, 0.2, 1], "transform": {"translate": [0.3, 1.5, 0]}}],
+        "sensors": [{"type": "grid", "name": "g", "origin_m": [-1, 0, -1], "u_m": [2, 0, 0], "v_m": [0, 0, 2],
+                     "resolution": [2, 2], "samples": 700}]}"#;
+    let (room, sensors) = scene(json);
+    let (whole, _) = measure_sensors(&room, &sensors, 3, &|_| {});
+    // [0, 3) and [3, 8) of an 8-sample render: ⌊3·700/8⌋ = 262 and the remaining 438.
+    let share = |start, end| SampleShare {
+        start,
+        end,
+        total: 8,
+    };
+    let (mut sums, first) = measure_sensor_share(&room, &sensors, 3, share(0, 3), &|_| {}).unwrap();
+    assert_eq!(first.samples, 4 * 262);
+    let (rest, _) = measure_sensor_share(&room, &sensors, 3, share(3, 8), &|_| {}).unwrap();
+    sums[0].add(&rest[0]).unwrap();
+    let merged = sums[0].reading();
+    for (m, w) in merged.points.iter().zip(&whole[0].points) {
+        assert_eq!(m.samples, w.samples);
+        // The same samples; the replicate sums are added in another order (f64).
+        assert!((m.illuminance_lx - w.illuminance_lx).abs() <= 1e-12 * w.illuminance_lx);
+        assert!((m.std_error_lx - w.std_error_lx).abs() <= 1e-9 * w.std_error_lx);
+    }
+    // An adaptive sensor cannot be split.
+    let (adaptive, sensors) = scene(&json.replace("\"samples\": 700", "\"relative_error\": 0.1"));
+    let err = measure_sensor_share(&adaptive, &sensors, 3, share(0, 3), &|_| {}).unwrap_err();
+    assert!(err.contains("sensor g") && err.contains("fixed"), "{err}");
+}
