@@ -16,6 +16,7 @@ mod tonemap;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
+use prism_cpu::memory::MemoryBudget;
 
 #[derive(Parser)]
 #[command(
@@ -24,6 +25,11 @@ use clap::{Parser, Subcommand};
     about = "Prism: a spectral, predictive renderer with a tone-reproduction toolkit"
 )]
 struct Cli {
+    /// Memory a command may use, e.g. 512M or 8G (default: 75 % of the physical memory):
+    /// `render`, `converge`, `compare` and `tonemap` estimate what they need before they
+    /// allocate and refuse above it (docs/reliability.md).
+    #[arg(long = "max-memory", global = true, value_name = "SIZE", value_parser = prism_cpu::memory::parse_size)]
+    max_memory: Option<u64>,
     #[command(subcommand)]
     command: Command,
 }
@@ -54,13 +60,17 @@ fn main() -> ExitCode {
         libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
     let cli = Cli::parse();
+    let budget = match cli.max_memory {
+        Some(bytes) => MemoryBudget::given(bytes),
+        None => MemoryBudget::machine_default(),
+    };
     let result = match cli.command {
         Command::Color(args) => color::run(&args),
-        Command::Compare(args) => compare::run(&args),
-        Command::Converge(args) => converge::run(&args),
+        Command::Compare(args) => compare::run(&args, &budget),
+        Command::Converge(args) => converge::run(&args, &budget),
         Command::MerlExport(args) => merl_export::run(&args),
-        Command::Render(args) => render::run(&args),
-        Command::Tonemap(args) => tonemap::run(&args),
+        Command::Render(args) => render::run(&args, &budget),
+        Command::Tonemap(args) => tonemap::run(&args, &budget),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

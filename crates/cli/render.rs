@@ -17,11 +17,13 @@ use std::time::{Duration, Instant};
 use clap::Args;
 use glam::UVec2;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use prism_cpu::memory::MemoryBudget;
 use prism_image::io::exr::ExrWriteOptions;
 use prism_image::io::spectral_exr::write_exr_with_spectral_bands;
 use prism_image::io::{write_image, ImageFormat};
 use prism_image::Image;
 use prism_render::film::spectral_bins::{MAX_SPECTRAL_BINS, MIN_SPECTRAL_BINS};
+use prism_render::film::{AovSelection, FilmMemory};
 use prism_render::integrator::DEFAULT_TILE_SIZE_PX;
 use prism_render::{
     render_plan, total_samples, FilmImage, PlanRequest, RenderPlan, RenderScene, RenderSettings,
@@ -41,10 +43,10 @@ pub struct RenderArgs {
     #[arg(short = 'o', long = "output")]
     pub output: Option<PathBuf>,
     /// Samples per pixel (default: the scene's `film.spp`).
-    #[arg(long)]
+    #[arg(long, value_parser = parse_spp)]
     pub spp: Option<u32>,
-    /// Worker threads (default: one per core).
-    #[arg(long)]
+    /// Worker threads (default: one per core; at most 4 per logical CPU).
+    #[arg(long, value_parser = prism_cpu::threads::parse_thread_count)]
     pub threads: Option<usize>,
     /// Sampler seed (default: the scene's `film.seed`).
     #[arg(long)]
@@ -97,6 +99,63 @@ pub(crate) fn parse_resolution(s: &str) -> Result<UVec2, String> {
         },
         None => Err(format!("`{s}`: expected WIDTHxHEIGHT, e.g. 64x48")),
     }
+}
+
+/// `--spp N`: a whole number from 1 to 2³² − 1, said in those words.
+pub(crate) fn parse_spp(s: &str) -> Result<u32, String> {
+    match s.trim().parse::<u64>() {
+        Ok(n) if (1..=u64::from(u32::MAX)).contains(&n) => Ok(n as u32),
+        Ok(0) => Err("0: expected at least 1 sample per pixel".into()),
+        Ok(_) => Err(format!("`{s}`: at most {} samples per pixel", u32::MAX)),
+        Err(_) => Err(format!(
+            "`{s}`: expected a whole number of samples per pixel, e.g. 64"
+        )),
+    }
+}
+
+/// The render's estimated memory (film, AOVs, spectral bins, output image) checked against
+/// `budget` before the scene is built.
+fn check_memory(
+    args: &RenderArgs,
+    description: &prism_scene::SceneDescription,
+    spectral_bins: Option<SpectralBins>,
+    budget: &MemoryBudget,
+) -> Result<(), String> {
+    let [w, h] = description.film.resolution;
+    let resolution = args.resolution.unwrap_or(UVec2::new(w, h));
+    let light_plane = match description.integrator {
+        prism_scene::Integrator::Light { .. } | prism_scene::Integrator::Bdpt { .. } => true,
+        prism_scene::Integrator::Path { .. }
+        | prism_scene::Integrator::Depth
+        | prism_scene::Integrator::Normal
+        | prism_scene::Integrator::Albedo
+        | prism_scene::Integrator::AmbientOcclusion { .. } => false,
+    };
+    let film = FilmMemory {
+        resolution,
+        // Which AOVs the scene records is known only once it is built: count them all.
+        aovs: AovSelection::ALL,
+        spectral_bins: spectral_bins.map_or(0, |b| b.count()),
+        light_plane,
+    };
+    let what = match spectral_bins {
+        Some(b) => format!(
+            "{}: rendering {}×{} px with {} spectral bins",
+            args.scene.display(),
+            resolution.x,
+            resolution.y,
+            b.count()
+        ),
+        None => format!(
+            "{}: rendering {}×{} px",
+            args.scene.display(),
+            resolution.x,
+            resolution.y
+        ),
+    };
+    budget
+        .check(&what, film.total_bytes())
+        .map_err(|e| e.to_string())
 }
 
 /// Where the image goes (see the module docs).
@@ -224,7 +283,7 @@ fn progress_bar(total: u64) -> ProgressBar {
     bar
 }
 
-pub fn run(args: &RenderArgs) -> Result<(), String> {
+pub fn run(args: &RenderArgs, budget: &MemoryBudget) -> Result<(), String> {
     args.simd.apply()?;
     args.plan.check()?;
     let description = prism_scene::load_scene(&args.scene).map_err(|e| e.to_string())?;
@@ -233,6 +292,9 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
         check_output(&output)?;
     }
     let spectral_bins = spectral_bins(args, &output)?;
+    if !args.explain && !args.sensors_only {
+        check_memory(args, &description, spectral_bins, budget)?;
+    }
     if args.false_colour == Some(crate::falsecolour::FalseColourQuantity::Illuminance)
         && !description
             .sensors
@@ -317,9 +379,6 @@ pub fn run(args: &RenderArgs) -> Result<(), String> {
     }
     let mut pool = rayon::ThreadPoolBuilder::new();
     if let Some(n) = args.threads {
-        if n == 0 {
-            return Err("--threads must be at least 1".into());
-        }
         pool = pool.num_threads(n);
     }
     let pool = pool

@@ -2,11 +2,15 @@
 //! (any EXR/HDR, not only Prism's), or a labelled contact sheet of every operator.
 
 use std::collections::BTreeMap;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use clap::Args;
+use prism_cpu::memory::MemoryBudget;
+use prism_image::io::read_dimensions;
 use prism_post::colour::{GamutMethod, GamutTarget, WhiteBalance};
-use prism_post::pipeline::{tonemap_file, OperatorChoice, TonemapFileReport, TonemapOptions};
+use prism_post::pipeline::{
+    tonemap_file, OperatorChoice, TonemapFileReport, TonemapOptions, TONEMAP_BYTES_PER_PIXEL,
+};
 use prism_post::tonemap::ToneOperator;
 
 #[derive(Args, Debug)]
@@ -172,7 +176,28 @@ impl From<CatArg> for prism_spectrum::AdaptationMethod {
     }
 }
 
-pub fn run(args: &TonemapArgs) -> Result<(), String> {
+/// Bytes tone-mapping `input` will need, from its header (see `TONEMAP_BYTES_PER_PIXEL`;
+/// a contact sheet holds a tile per operator at most the input's size in all).
+fn check_memory(input: &Path, budget: &MemoryBudget) -> Result<(), String> {
+    let d = read_dimensions(input).map_err(|e| e.to_string())?;
+    let estimate = d
+        .pixels()
+        .saturating_mul(4 * d.channels as u64 + TONEMAP_BYTES_PER_PIXEL);
+    budget
+        .check(
+            &format!(
+                "tone-mapping {} ({}×{} px, {} channels)",
+                input.display(),
+                d.width,
+                d.height,
+                d.channels
+            ),
+            estimate,
+        )
+        .map_err(|e| e.to_string())
+}
+
+pub fn run(args: &TonemapArgs, budget: &MemoryBudget) -> Result<(), String> {
     if args.list {
         return print_list(args.json);
     }
@@ -182,6 +207,7 @@ pub fn run(args: &TonemapArgs) -> Result<(), String> {
         _ => return Err("tonemap needs IN, -o OUT and --op NAME (or --list)".to_string()),
     };
     let (exposure_ev, auto_exposure) = parse_exposure(&args.exposure)?;
+    check_memory(input, budget)?;
     let options = TonemapOptions {
         operator: OperatorChoice::parse(op).map_err(|e| format!("--op {op}: {e}"))?,
         params: parse_params(&args.params)?,

@@ -19,6 +19,12 @@
 //! build, a film tile) and pass the [`Simd`] down to the kernels on worker threads, so
 //! tests run kernels at any ISA by passing it explicitly ([`each_isa`]), in parallel,
 //! without touching the process-wide choice.
+//!
+//! The machine's other limits live here too: [`memory`] (the `--max-memory` budget and the
+//! physical memory) and [`threads`] (the bound on `--threads`).
+
+pub mod memory;
+pub mod threads;
 
 use std::fmt;
 use std::sync::atomic::{AtomicU8, Ordering};

@@ -64,6 +64,12 @@ impl From<ToneOperator> for OperatorChoice {
     }
 }
 
+/// Peak bytes per pixel of [`tonemap_file`] with one operator, beyond 4 bytes per stored
+/// channel of the input as decoded: the input's RGB in f32, the operator's output and
+/// its luminance planes, the encoder's buffer. Measured on a 2048² float RGB EXR
+/// (docs/reliability.md); the memory check's estimate.
+pub const TONEMAP_BYTES_PER_PIXEL: u64 = 32;
+
 /// Options of `prism tonemap` (CLI defaults in [`Default`]: `--wb none`, `--gamut clip`,
 /// `--target srgb`, `--exposure 0`).
 #[derive(Debug, Clone)]

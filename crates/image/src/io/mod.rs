@@ -2,6 +2,7 @@
 //! Every write goes to a temporary file in the destination's directory that is renamed
 //! over the destination only once complete, so a failed write never leaves half a file.
 
+mod dimensions;
 pub mod exr;
 mod exr_rgb;
 pub mod png;
@@ -15,6 +16,8 @@ use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 use prism_spectrum::rgb_space::RgbColorSpace;
+
+pub use dimensions::{read_dimensions, ImageDimensions};
 
 use crate::error::{ImageError, Result};
 use crate::image::Image;

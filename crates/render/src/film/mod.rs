@@ -12,6 +12,7 @@ mod filter_sampler;
 mod filter_table;
 mod image;
 mod light_splats;
+pub mod memory_estimate;
 pub mod spectral_bins;
 mod tile;
 pub mod xyz;
@@ -20,6 +21,7 @@ pub use filter::Filter;
 pub use filter_sampler::{FilterSample, FilterSampler};
 pub use image::{AovPlane, FilmImage, SpectralPlanes};
 pub use light_splats::LightSplats;
+pub use memory_estimate::FilmMemory;
 pub use spectral_bins::SpectralBins;
 pub use tile::{FilmTile, SurfaceAov, TileBounds};
 
