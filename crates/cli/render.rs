@@ -197,6 +197,23 @@ fn check_output(path: &Path) -> Result<(), String> {
     }
 }
 
+/// The folder of `path` (an output beside the image) must exist, checked before rendering.
+pub(crate) fn check_parent(what: &str, path: &Path) -> Result<(), String> {
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    if dir.is_dir() {
+        Ok(())
+    } else {
+        Err(format!(
+            "{what} {}: the directory {} does not exist",
+            path.display(),
+            dir.display()
+        ))
+    }
+}
+
 /// `--spectral-bins N` checked against its range and the output format (before rendering).
 fn spectral_bins(args: &RenderArgs, output: &Path) -> Result<Option<SpectralBins>, String> {
     let Some(n) = args.spectral_bins else {
@@ -290,6 +307,12 @@ pub fn run(args: &RenderArgs, budget: &MemoryBudget) -> Result<(), String> {
     let output = output_path(args, description.film.output.as_deref());
     if !args.explain {
         check_output(&output)?;
+        if let Some(stats) = &args.stats_json {
+            check_parent("--stats-json", stats)?;
+        }
+        if args.false_colour.is_some() {
+            crate::falsecolour::check_options(args.false_colour_scale, args.false_colour_range)?;
+        }
     }
     let spectral_bins = spectral_bins(args, &output)?;
     if !args.explain && !args.sensors_only {
@@ -538,7 +561,10 @@ fn write_stats(
         "simd": prism_cpu::active().isa().name(),
     });
     let text = serde_json::to_string_pretty(&value).map_err(|e| e.to_string())? + "\n";
-    // Atomic like the image: a temporary sibling renamed over the destination.
+    // Atomic like the image: a temporary sibling renamed over the destination (through a
+    // symbolic link, like the image).
+    let target = prism_image::io::write_target(path);
+    let path = target.as_path();
     let name = path
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())

@@ -60,6 +60,9 @@ pub struct TonemapArgs {
     /// List every operator with its parameters, defaults and reference.
     #[arg(long)]
     pub list: bool,
+    /// Allow -o to be the input file itself (replaced once the result is complete).
+    #[arg(long)]
+    pub overwrite: bool,
     /// Print the report (or the --list catalogue) as JSON.
     #[arg(long)]
     pub json: bool,
@@ -151,7 +154,7 @@ fn print_summary(report: &TonemapFileReport) {
         );
     }
     for failure in &report.failures {
-        println!("note: no tile for {failure:?}");
+        println!("note: no tile for {}: {}", failure.operator, failure.error);
     }
 }
 
@@ -207,6 +210,15 @@ pub fn run(args: &TonemapArgs, budget: &MemoryBudget) -> Result<(), String> {
         _ => return Err("tonemap needs IN, -o OUT and --op NAME (or --list)".to_string()),
     };
     let (exposure_ev, auto_exposure) = parse_exposure(&args.exposure)?;
+    if !args.overwrite && prism_image::io::same_file(input, output) {
+        return Err(format!(
+            "-o {}: it is the input file; give another output, or --overwrite to replace the \
+             input once the result is complete",
+            output.display()
+        ));
+    }
+    crate::render::check_parent("-o", output)?;
+    prism_image::io::ImageFormat::from_path(output).map_err(|e| e.to_string())?;
     check_memory(input, budget)?;
     let options = TonemapOptions {
         operator: OperatorChoice::parse(op).map_err(|e| format!("--op {op}: {e}"))?,

@@ -147,6 +147,8 @@ impl Clock {
 
 /// Writes `bytes` to a temporary sibling and renames it over `path`.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), String> {
+    let target = prism_image::io::write_target(path);
+    let path = target.as_path();
     let name = path
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
@@ -158,23 +160,6 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), String> {
         return Err(format!("cannot write {}: {e}", path.display()));
     }
     Ok(())
-}
-
-/// The directory of `path` must exist (checked before rendering).
-fn check_parent(what: &str, path: &Path) -> Result<(), String> {
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
-    if dir.is_dir() {
-        Ok(())
-    } else {
-        Err(format!(
-            "{what} {}: the directory {} does not exist",
-            path.display(),
-            dir.display()
-        ))
-    }
 }
 
 fn check_arguments(args: &ConvergeArgs) -> Result<Budget, String> {
@@ -192,10 +177,10 @@ fn check_arguments(args: &ConvergeArgs) -> Result<Budget, String> {
                 o.display()
             ));
         }
-        check_parent("chart", o)?;
+        crate::render::check_parent("chart", o)?;
     }
     if let Some(j) = &args.json {
-        check_parent("--json", j)?;
+        crate::render::check_parent("--json", j)?;
     }
     if let Some(d) = &args.save_final {
         if !d.is_dir() {

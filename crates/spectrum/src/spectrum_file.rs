@@ -187,7 +187,7 @@ pub fn parse_spectral_text(text: &str, path: &Path) -> Result<SpectralColumns, S
 
 /// Reads a spectral file from disk.
 pub fn read_spectral_file(path: &Path) -> Result<SpectralColumns, SpectrumFileError> {
-    let text = std::fs::read_to_string(path)
+    let text = prism_cpu::text_file::read_text(path)
         .map_err(|e| SpectrumFileError::new(path, None, format!("cannot read: {e}")))?;
     parse_spectral_text(&text, path)
 }

@@ -5,6 +5,7 @@
 mod dimensions;
 pub mod exr;
 mod exr_rgb;
+mod output_path;
 pub mod png;
 pub mod quantise;
 pub mod rgbe;
@@ -18,6 +19,7 @@ use std::path::{Path, PathBuf};
 use prism_spectrum::rgb_space::RgbColorSpace;
 
 pub use dimensions::{read_dimensions, ImageDimensions};
+pub use output_path::{same_file, write_target};
 
 use crate::error::{ImageError, Result};
 use crate::image::Image;
@@ -81,7 +83,10 @@ fn temp_sibling(path: &Path) -> PathBuf {
 
 /// Runs `write` on a temporary path beside `path`, then renames it to `path`; on failure
 /// the temporary file is removed and the destination is left as it was.
+/// An output that is a symbolic link is written through to its target ([`write_target`]).
 pub(crate) fn write_atomically(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
+    let target = write_target(path);
+    let path = target.as_path();
     let tmp = temp_sibling(path);
     let result = write(&tmp).and_then(|()| {
         std::fs::rename(&tmp, path).map_err(|e| ImageError::io(path, "rename the finished file", e))
