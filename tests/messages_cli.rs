@@ -179,3 +179,87 @@ fn equal_and_black_images_compare_without_nan() {
         (Some(0.0), Some(0.0))
     );
 }
+
+#[test]
+fn photometric_images_get_the_auto_exposure_unless_one_is_given() {
+    let dir = tempfile::tempdir().unwrap();
+    // A dim emitter: a render in cd/m² far below 1 (black under `linear` at 0 EV).
+    let scene = write(
+        dir.path(),
+        "dim.json",
+        br#"{"film": {"resolution": [16, 16], "spp": 4},
+            "lights": [{"type": "point", "position_m": [0, 0, 0], "power_lm": 0.01}],
+            "shapes": [{"type": "sphere", "transform": {"translate": [0, 0, -3]}}]}"#,
+    );
+    let exr = dir.path().join("dim.exr");
+    let o = prism(&["render", s(&scene), "-o", s(&exr)]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let json = |extra: &[&str]| -> serde_json::Value {
+        let png = dir.path().join("dim.png");
+        let mut args = vec![
+            "tonemap",
+            s(&exr),
+            "-o",
+            s(&png),
+            "--op",
+            "linear",
+            "--json",
+        ];
+        args.extend(extra);
+        let o = prism(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        serde_json::from_slice(&o.stdout).unwrap()
+    };
+    let auto = json(&[]);
+    assert_eq!(auto["auto_exposure_photometric"], true, "{auto}");
+    assert!(auto["exposure_ev"].as_f64().unwrap() > 1.0, "{auto}");
+    let kept = json(&["--exposure", "0"]);
+    assert_eq!(kept["auto_exposure_photometric"], false);
+    assert_eq!(kept["exposure_ev"], 0.0);
+    // The text report says so in one line.
+    let png = dir.path().join("dim.png");
+    let o = prism(&["tonemap", s(&exr), "-o", s(&png), "--op", "linear"]);
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(
+        text.matches("the image is photometric").count(),
+        1,
+        "{text}"
+    );
+    // An exposure whose scale overflows says so, not that the input had NaN/∞.
+    let err = refused(&[
+        "tonemap",
+        s(&exr),
+        "-o",
+        s(&png),
+        "--op",
+        "linear",
+        "--exposure",
+        "1e6",
+    ]);
+    assert!(err.contains("outside the range of 32-bit floats"), "{err}");
+    let bright = write(
+        dir.path(),
+        "bright.json",
+        br#"{"film": {"resolution": [16, 16], "spp": 4},
+            "lights": [{"type": "point", "position_m": [0, 0, 0], "power_lm": 1e9}],
+            "shapes": [{"type": "sphere", "transform": {"translate": [0, 0, -3]}}]}"#,
+    );
+    let exr = dir.path().join("bright.exr");
+    let o = prism(&["render", s(&bright), "-o", s(&exr)]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = prism(&[
+        "tonemap",
+        s(&exr),
+        "-o",
+        s(&png),
+        "--op",
+        "linear",
+        "--exposure",
+        "127",
+    ]);
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        text.contains("overflowed to ∞") && !text.contains("NaN/∞ components"),
+        "{text}"
+    );
+}

@@ -46,13 +46,10 @@ pub struct TonemapArgs {
     /// Exposure in stops applied first (input × 2^EV), or `auto`: the EV that maps the
     /// log-average luminance to middle grey 0.18 (for absolute renders with the
     /// operators that are not scale invariant: linear, aces, agx, …).
-    #[arg(
-        long,
-        default_value = "0",
-        allow_hyphen_values = true,
-        value_name = "EV|auto"
-    )]
-    pub exposure: String,
+    /// Left out: 0, except for an image with `prism:cd_m2_per_unit` (a render in cd/m²)
+    /// and an operator that is not absolute, which gets `auto` (said on one line).
+    #[arg(long, allow_hyphen_values = true, value_name = "EV|auto")]
+    pub exposure: Option<String>,
     /// cd/m² per unit of the input, for the absolute operators when the file has no
     /// `prism:cd_m2_per_unit` header (overrides it when it has).
     #[arg(long, value_name = "CD_M2")]
@@ -131,7 +128,13 @@ fn print_list(json: bool) -> Result<(), String> {
 }
 
 fn print_summary(report: &TonemapFileReport) {
-    if report.auto_exposure {
+    if report.auto_exposure_photometric {
+        println!(
+            "exposure auto: {:+.2} EV (the image is photometric, prism:cd_m2_per_unit, and no \
+             --exposure was given; --exposure 0 keeps its scale)",
+            report.exposure_ev
+        );
+    } else if report.auto_exposure {
         println!(
             "exposure auto: {:+.2} EV (log-average luminance → 0.18)",
             report.exposure_ev
@@ -147,6 +150,13 @@ fn print_summary(report: &TonemapFileReport) {
         report.target,
         100.0 * report.gamut_fraction_outside
     );
+    if report.exposure_overflow_pixels > 0 {
+        println!(
+            "note: {} pixels overflowed to ∞ when scaled by 2^{:.2} (the exposure) and were \
+             mapped to black; lower --exposure",
+            report.exposure_overflow_pixels, report.exposure_ev
+        );
+    }
     if report.non_finite_pixels > 0 {
         println!(
             "note: {} input pixels had NaN/∞ components (mapped to black)",
@@ -209,7 +219,10 @@ pub fn run(args: &TonemapArgs, budget: &MemoryBudget) -> Result<(), String> {
         (Some(i), Some(o), Some(op)) => (i, o, op),
         _ => return Err("tonemap needs IN, -o OUT and --op NAME (or --list)".to_string()),
     };
-    let (exposure_ev, auto_exposure) = parse_exposure(&args.exposure)?;
+    let (exposure_ev, auto_exposure) = match &args.exposure {
+        Some(text) => parse_exposure(text)?,
+        None => (0.0, false),
+    };
     if !args.overwrite && prism_image::io::same_file(input, output) {
         return Err(format!(
             "-o {}: it is the input file; give another output, or --overwrite to replace the \
@@ -229,6 +242,7 @@ pub fn run(args: &TonemapArgs, budget: &MemoryBudget) -> Result<(), String> {
         target: GamutTarget::parse(&args.target).map_err(|e| e.to_string())?,
         exposure_ev,
         auto_exposure,
+        auto_exposure_if_photometric: args.exposure.is_none(),
         luminance_scale_cd_m2: args.luminance_scale,
     };
     let report = tonemap_file(input, output, &options).map_err(|e| e.to_string())?;

@@ -92,6 +92,10 @@ pub struct TonemapOptions {
     /// `--exposure auto`: `exposure_ev` is replaced by the EV that maps the log-average
     /// luminance to middle grey ([`auto_exposure_ev`]); the report gives the EV used.
     pub auto_exposure: bool,
+    /// No `--exposure` was given: a photometric image (one with `prism:cd_m2_per_unit`)
+    /// tone-mapped by an operator that is not absolute gets the auto exposure, as renders
+    /// in cd/m² are otherwise black (an explicit `--exposure 0` keeps the scale).
+    pub auto_exposure_if_photometric: bool,
     /// `--luminance-scale CD_M2`: cd/m² per unit, overriding `prism:cd_m2_per_unit`.
     pub luminance_scale_cd_m2: Option<f64>,
 }
@@ -107,6 +111,7 @@ impl Default for TonemapOptions {
             target: GamutTarget::Srgb,
             exposure_ev: 0.0,
             auto_exposure: false,
+            auto_exposure_if_photometric: false,
             luminance_scale_cd_m2: None,
         }
     }
@@ -137,6 +142,9 @@ pub struct TonemapFileReport {
     /// The exposure applied (computed when `auto_exposure`).
     pub exposure_ev: f64,
     pub auto_exposure: bool,
+    /// The auto exposure was chosen because the image is photometric and no exposure was
+    /// given (`TonemapOptions::auto_exposure_if_photometric`).
+    pub auto_exposure_photometric: bool,
     pub luminance_scale_cd_m2: Option<f64>,
     pub white_balance: String,
     /// The chromatic adaptation transform of the white balance (`--cat`).
@@ -151,6 +159,8 @@ pub struct TonemapFileReport {
     pub failures: Vec<SheetFailure>,
     /// Input pixels with a NaN/∞ component (reported, mapped as black).
     pub non_finite_pixels: u64,
+    /// Finite input pixels that the exposure scale 2^EV made infinite (mapped as black).
+    pub exposure_overflow_pixels: u64,
     /// Fraction of pixels outside the target gamut before gamut mapping.
     pub gamut_fraction_outside: f64,
     pub timings: TonemapTimings,
@@ -180,7 +190,21 @@ pub fn tonemap_file(
             options.exposure_ev
         )));
     }
-    let exposure_ev = if options.auto_exposure {
+    let photometric_auto = options.auto_exposure_if_photometric
+        && !options.auto_exposure
+        && image.cd_m2_per_unit.is_some()
+        && match options.operator {
+            OperatorChoice::One(op) => !op.info().absolute,
+            // The sheet holds absolute operators, which read the scale themselves.
+            OperatorChoice::All => false,
+        };
+    let auto_exposure = options.auto_exposure || photometric_auto;
+    let non_finite_input = image
+        .pixels()
+        .par_iter()
+        .filter(|p| !p.iter().all(|c| c.is_finite()))
+        .count() as u64;
+    let exposure_ev = if auto_exposure {
         auto_exposure_ev(&image).ok_or_else(|| {
             ImageError::format(
                 input,
@@ -190,12 +214,24 @@ pub fn tonemap_file(
     } else {
         options.exposure_ev
     };
+    let mut exposure_overflow_pixels = 0;
     if exposure_ev != 0.0 {
         let factor = 2f64.powf(exposure_ev) as f32;
-        image
+        if !(factor.is_finite() && factor > 0.0) {
+            return Err(ImageError::invalid(format!(
+                "--exposure {exposure_ev}: the scale 2^{exposure_ev} is outside the range of \
+                 32-bit floats; expected an exposure between -149 and 127 stops"
+            )));
+        }
+        exposure_overflow_pixels = image
             .pixels_mut()
             .par_iter_mut()
-            .for_each(|p| *p = p.map(|c| c * factor));
+            .map(|p| {
+                let finite = p.iter().all(|c| c.is_finite());
+                *p = p.map(|c| c * factor);
+                u64::from(finite && !p.iter().all(|c| c.is_finite()))
+            })
+            .sum();
     }
     let space = image.color_space.clone();
     let wb_source_xy = match &options.wb {
@@ -270,14 +306,16 @@ pub fn tonemap_file(
         operator: options.operator.name(),
         params: options.params.clone(),
         exposure_ev,
-        auto_exposure: options.auto_exposure,
+        auto_exposure,
+        auto_exposure_photometric: photometric_auto,
         luminance_scale_cd_m2: options.luminance_scale_cd_m2,
         white_balance: options.wb.name(),
         chromatic_adaptation: options.cat.name(),
         white_balance_source_xy: wb_source_xy,
         gamut_method: options.gamut.name(),
         target: options.target.name(),
-        non_finite_pixels: tone.first().map_or(0, |r| r.non_finite_pixels),
+        non_finite_pixels: non_finite_input,
+        exposure_overflow_pixels,
         tone,
         failures,
         gamut_fraction_outside: sheet_outside.unwrap_or(gamut.fraction_outside),
