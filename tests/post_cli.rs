@@ -49,7 +49,7 @@ fn fails_with(args: &[&str], needles: &[&str]) {
 }
 
 fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("prism-post-cli-{}", std::process::id()));
+    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("prism-post-cli");
     std::fs::create_dir_all(&dir).unwrap();
     dir.join(name)
 }

@@ -48,8 +48,8 @@ mod tests {
 
     #[test]
     fn text_files_are_read_with_positioned_errors() {
-        let dir = std::env::temp_dir().join(format!("prism-text-file-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let temp = tempfile::tempdir().unwrap();
+        let dir = temp.path().to_path_buf();
         let bom = dir.join("bom.json");
         std::fs::write(&bom, "\u{feff}{\"a\": 1}").unwrap();
         assert_eq!(read_text(&bom).unwrap(), "{\"a\": 1}");
@@ -62,6 +62,5 @@ mod tests {
         );
         assert!(read_text(&dir).unwrap_err().contains("is a directory"));
         assert_eq!(read_text(&dir.join("none")).unwrap_err(), "no such file");
-        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -42,7 +42,8 @@ mod tests {
 
     #[test]
     fn links_are_followed_to_their_target() {
-        let dir = std::env::temp_dir().join(format!("prism-output-path-{}", std::process::id()));
+        let temp = tempfile::tempdir().unwrap();
+        let dir = temp.path().to_path_buf();
         std::fs::create_dir_all(dir.join("sub")).unwrap();
         let target = dir.join("sub/real.png");
         std::os::unix::fs::symlink("sub/real.png", dir.join("link.png")).unwrap();
@@ -52,6 +53,5 @@ mod tests {
         std::fs::write(&target, "x").unwrap();
         assert!(same_file(&dir.join("link2.png"), &target));
         assert!(!same_file(&dir.join("none.png"), &target));
-        std::fs::remove_dir_all(&dir).unwrap();
     }
 }
