@@ -219,7 +219,8 @@ fn photometric_images_get_the_auto_exposure_unless_one_is_given() {
     // The text report says so in one line.
     let png = dir.path().join("dim.png");
     let o = prism(&["tonemap", s(&exr), "-o", s(&png), "--op", "linear"]);
-    let text = String::from_utf8_lossy(&o.stdout);
+    let text = stderr(&o);
+    assert!(o.stdout.is_empty(), "status lines go to standard error");
     assert_eq!(
         text.matches("the image is photometric").count(),
         1,
@@ -257,9 +258,27 @@ fn photometric_images_get_the_auto_exposure_unless_one_is_given() {
         "--exposure",
         "127",
     ]);
-    let text = String::from_utf8_lossy(&o.stdout);
+    let text = stderr(&o);
     assert!(
         text.contains("overflowed to ∞") && !text.contains("NaN/∞ components"),
         "{text}"
     );
+}
+
+#[test]
+fn a_light_of_zero_power_is_warned_about() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = write(
+        dir.path(),
+        "dark.json",
+        br#"{"film": {"resolution": [8, 8], "spp": 1},
+            "lights": [{"type": "point", "position_m": [0, 0, 0], "power_lm": 100},
+                       {"type": "point", "position_m": [0, 1, 0], "power_lm": 0}],
+            "shapes": [{"type": "sphere", "transform": {"translate": [0, 0, -3]}}]}"#,
+    );
+    let o = prism(&["render", s(&scene), "--explain"]);
+    let err = stderr(&o);
+    assert!(o.status.success(), "{err}");
+    assert!(err.contains("lights[1] has zero power"), "{err}");
+    assert!(!err.contains("lights[0]"), "{err}");
 }

@@ -386,6 +386,17 @@ pub fn run(args: &RenderArgs, budget: &MemoryBudget) -> Result<(), String> {
             scene.integrator.name()
         );
     }
+    // One built light per `lights` entry, in order (prism-render light::build).
+    let radius_m = scene.lights.scene_sphere().radius_m;
+    for (i, light) in scene.lights.lights().iter().enumerate() {
+        if !(light.power_w(radius_m) > 0.0) {
+            eprintln!(
+                "{}: warning: lights[{i}] has zero power: it emits nothing (check its \
+                 strength and spectrum)",
+                args.scene.display()
+            );
+        }
+    }
     if args.explain {
         let request = PlanRequest {
             spp: settings.spp,

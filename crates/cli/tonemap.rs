@@ -127,20 +127,22 @@ fn print_list(json: bool) -> Result<(), String> {
     Ok(())
 }
 
+/// The status lines, on standard error like every command's (standard output is for data:
+/// `--json`, tables).
 fn print_summary(report: &TonemapFileReport) {
     if report.auto_exposure_photometric {
-        println!(
+        eprintln!(
             "exposure auto: {:+.2} EV (the image is photometric, prism:cd_m2_per_unit, and no \
              --exposure was given; --exposure 0 keeps its scale)",
             report.exposure_ev
         );
     } else if report.auto_exposure {
-        println!(
+        eprintln!(
             "exposure auto: {:+.2} EV (log-average luminance → 0.18)",
             report.exposure_ev
         );
     }
-    println!(
+    eprintln!(
         "wrote {} ({}×{}, {}, {} → {}, {:.2} % of pixels outside the gamut before mapping)",
         report.output,
         report.width,
@@ -151,20 +153,20 @@ fn print_summary(report: &TonemapFileReport) {
         100.0 * report.gamut_fraction_outside
     );
     if report.exposure_overflow_pixels > 0 {
-        println!(
+        eprintln!(
             "note: {} pixels overflowed to ∞ when scaled by 2^{:.2} (the exposure) and were \
              mapped to black; lower --exposure",
             report.exposure_overflow_pixels, report.exposure_ev
         );
     }
     if report.non_finite_pixels > 0 {
-        println!(
+        eprintln!(
             "note: {} input pixels had NaN/∞ components (mapped to black)",
             report.non_finite_pixels
         );
     }
     for failure in &report.failures {
-        println!("note: no tile for {}: {}", failure.operator, failure.error);
+        eprintln!("note: no tile for {}: {}", failure.operator, failure.error);
     }
 }
 
