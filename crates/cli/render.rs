@@ -389,7 +389,8 @@ pub fn run(args: &RenderArgs, budget: &MemoryBudget) -> Result<(), String> {
     // One built light per `lights` entry, in order (prism-render light::build).
     let radius_m = scene.lights.scene_sphere().radius_m;
     for (i, light) in scene.lights.lights().iter().enumerate() {
-        if !(light.power_w(radius_m) > 0.0) {
+        let power_w = light.power_w(radius_m);
+        if power_w.is_nan() || power_w <= 0.0 {
             eprintln!(
                 "{}: warning: lights[{i}] has zero power: it emits nothing (check its \
                  strength and spectrum)",
