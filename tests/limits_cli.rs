@@ -122,4 +122,20 @@ fn thread_and_sample_counts_are_bounded_as_usage_errors() {
         "{err}"
     );
     assert!(!err.contains("0..="), "{err}");
+    // Every whole-number option says its bound in words.
+    for (command, option) in [
+        ("render", "--seed"),
+        ("render", "--spectral-bins"),
+        ("converge", "--checkpoints"),
+        ("converge", "--max-spp"),
+        ("converge", "--reference-spp"),
+    ] {
+        let o = prism(&[command, s(&sphere), option, "99999999999999999999999"]);
+        assert_eq!(o.status.code(), Some(2), "{option}: {}", stderr(&o));
+        let err = stderr(&o);
+        assert!(
+            err.contains("at most") && !err.contains("0..="),
+            "{option}: {err}"
+        );
+    }
 }

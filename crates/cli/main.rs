@@ -7,6 +7,7 @@ mod converge;
 mod daylight_factor;
 mod falsecolour;
 mod merl_export;
+mod numbers;
 mod plan_args;
 mod render;
 mod sensors;

@@ -49,7 +49,7 @@ pub struct RenderArgs {
     #[arg(long, value_parser = prism_cpu::threads::parse_thread_count)]
     pub threads: Option<usize>,
     /// Sampler seed (default: the scene's `film.seed`).
-    #[arg(long)]
+    #[arg(long, value_parser = crate::numbers::parse_u64)]
     pub seed: Option<u64>,
     /// Film resolution override, WIDTHxHEIGHT (e.g. 64x48), for previews and tests.
     #[arg(long, value_parser = parse_resolution)]
@@ -62,7 +62,7 @@ pub struct RenderArgs {
     pub stats_json: Option<PathBuf>,
     /// Also write the spectral radiance in N equal bins over 360–830 nm (1–471) as
     /// `S0.<λ>nm` channels of the EXR (Fichet et al. 2021 layout, W·m⁻²·sr⁻¹·nm⁻¹).
-    #[arg(long = "spectral-bins", value_name = "N")]
+    #[arg(long = "spectral-bins", value_name = "N", value_parser = crate::numbers::parse_u32)]
     pub spectral_bins: Option<u32>,
     /// Measure the scene's `sensors` only (`<output stem>.sensors.json/.csv`), no image.
     #[arg(long = "sensors-only")]
@@ -103,11 +103,14 @@ pub(crate) fn parse_resolution(s: &str) -> Result<UVec2, String> {
 
 /// `--spp N`: a whole number from 1 to 2³² − 1, said in those words.
 pub(crate) fn parse_spp(s: &str) -> Result<u32, String> {
-    match s.trim().parse::<u64>() {
-        Ok(n) if (1..=u64::from(u32::MAX)).contains(&n) => Ok(n as u32),
+    let t = s.trim();
+    let digits = !t.is_empty() && t.chars().all(|c| c.is_ascii_digit());
+    match t.parse::<u64>() {
         Ok(0) => Err("0: expected at least 1 sample per pixel".into()),
-        Ok(_) => Err(format!("`{s}`: at most {} samples per pixel", u32::MAX)),
-        Err(_) => Err(format!(
+        Ok(n) if n <= u64::from(u32::MAX) => Ok(n as u32),
+        // Too large for u32, or for u64: still digits.
+        Ok(_) | Err(_) if digits => Err(format!("`{s}`: at most {} samples per pixel", u32::MAX)),
+        Ok(_) | Err(_) => Err(format!(
             "`{s}`: expected a whole number of samples per pixel, e.g. 64"
         )),
     }
