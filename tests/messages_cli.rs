@@ -106,6 +106,15 @@ fn outputs_and_options_are_checked_before_rendering() {
     ]);
     assert!(err.contains("minimum > 0"), "{err}");
     assert!(!out.exists(), "refused before the render");
+    // compare's error map, before the metrics.
+    let o = prism(&["render", s(&scene), "-o", s(&out)]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let map = dir.path().join("missing/map.png");
+    let err = refused(&["compare", s(&out), s(&out), "--error-map", s(&map)]);
+    assert!(
+        err.contains("--error-map") && err.contains("does not exist"),
+        "{err}"
+    );
 }
 
 #[cfg(unix)]

@@ -173,6 +173,11 @@ fn check_memory(args: &CompareArgs, budget: &MemoryBudget) -> Result<(), String>
 
 pub fn run(args: &CompareArgs, budget: &MemoryBudget) -> Result<(), String> {
     args.simd.apply()?;
+    if let Some(map) = &args.error_map {
+        // Checked before the metrics run, which take long on large images.
+        crate::render::check_parent("--error-map", map)?;
+        ImageFormat::from_path(map).map_err(|e| format!("--error-map: {e}"))?;
+    }
     check_memory(args, budget)?;
     if args.tmqi {
         let t = tmqi_files(&args.test, &args.reference).map_err(|e| e.to_string())?;
