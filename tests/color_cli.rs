@@ -129,25 +129,53 @@ fn color_without_json_prints_a_table() {
     }
 }
 
-struct TempFile(PathBuf);
+/// A file in its own temporary folder, removed with it.
+struct TempFile {
+    _dir: tempfile::TempDir,
+    path: PathBuf,
+}
 
 impl TempFile {
     fn new(name: &str, text: &str) -> Self {
-        let dir = std::env::temp_dir().join(format!("prism-color-test-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let path = dir.join(name);
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join(name);
         std::fs::write(&path, text).unwrap();
-        Self(path)
+        Self { _dir: dir, path }
     }
     fn arg(&self) -> &str {
-        self.0.to_str().unwrap()
+        self.path.to_str().unwrap()
     }
 }
 
-impl Drop for TempFile {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_file(&self.0);
+#[test]
+fn large_values_stay_in_columns_and_ccts_out_of_range_are_flagged() {
+    // A 10⁶ K blackbody: huge XYZ, a CCT far beyond Ohno 2013's table.
+    let out = prism(&["color", "--spectrum", "blackbody:1000000"]);
+    assert!(out.status.success());
+    let text = String::from_utf8(out.stdout).unwrap();
+    for line in text
+        .lines()
+        .filter(|l| l.starts_with("XYZ") || l.starts_with("linear"))
+    {
+        let fields: Vec<&str> = line[13..].split_whitespace().collect();
+        assert_eq!(fields.len(), 3, "numbers ran together: {line}");
+        for f in fields {
+            assert!(f.parse::<f64>().is_ok(), "{f} in {line}");
+        }
     }
+    assert!(text.contains("outside the method's valid range"), "{text}");
+    let v = json_of(&["color", "--spectrum", "blackbody:500", "--json"]);
+    assert_eq!(v["CCT_in_valid_range"], false, "{v}");
+    let v = json_of(&["color", "--spectrum", "blackbody:6500", "--json"]);
+    assert_eq!(v["CCT_in_valid_range"], true, "{v}");
+    // A reflectance without an illuminant is treated as radiance, with a warning.
+    let out = prism(&["color", "--spectrum", "colorchecker:dark skin"]);
+    assert!(out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("is a reflectance but no --illuminant"),
+        "{err}"
+    );
 }
 
 fn expect_error(args: &[&str], needles: &[&str]) {

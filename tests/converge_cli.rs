@@ -145,10 +145,13 @@ fn converge_metrics_agree_with_prism_compare_and_the_reference_is_cached() {
     let finals = dir.path().join("finals");
     std::fs::create_dir(&finals).unwrap();
     let json = dir.path().join("run.json");
+    let cache = dir.path().join("cache");
     let run = |json: &Path| {
         prism(&[
             "converge",
             s(&scene),
+            "--cache-dir",
+            s(&cache),
             "--reference-spp",
             "256",
             "--method",
@@ -175,10 +178,7 @@ fn converge_metrics_agree_with_prism_compare_and_the_reference_is_cached() {
     let v = read_json(&json);
     let reference = v["reference"]["path"].as_str().unwrap().to_string();
     assert_eq!(v["reference"]["source"], "rendered");
-    assert!(
-        Path::new(&reference).starts_with(dir.path()),
-        "next to the scene"
-    );
+    assert!(Path::new(&reference).starts_with(&cache), "in --cache-dir");
     assert!(reference.contains("small.reference-24x16-256spp-"));
     for (i, label) in ["path", "path_uniform_sobol"].iter().enumerate() {
         let image = finals.join(format!("{i}-{label}.exr"));
@@ -211,6 +211,38 @@ fn converge_metrics_agree_with_prism_compare_and_the_reference_is_cached() {
     assert!(stderr(&o).contains("rendering one"), "{}", stderr(&o));
     let edited = read_json(&dir.path().join("edited.json"));
     assert_ne!(edited["reference"]["path"].as_str().unwrap(), reference);
+}
+
+#[test]
+fn an_unwritable_reference_cache_is_refused_before_rendering() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = small_scene(dir.path(), "small.json", 0.6);
+    // A cache "directory" under a regular file cannot be created, whoever runs the test
+    // (a read-only folder would not stop root).
+    let blocker = dir.path().join("file");
+    std::fs::write(&blocker, "").unwrap();
+    let json = dir.path().join("run.json");
+    let o = prism(&[
+        "converge",
+        s(&scene),
+        "--cache-dir",
+        s(&blocker.join("cache")),
+        "--max-spp",
+        "2",
+        "--json",
+        s(&json),
+    ]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(
+        err.contains("--cache-dir") && err.contains("cannot create"),
+        "{err}"
+    );
+    assert!(
+        !err.contains("rendering one"),
+        "refused before the reference renders: {err}"
+    );
+    assert!(!json.exists());
 }
 
 #[test]

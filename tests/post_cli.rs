@@ -39,6 +39,14 @@ fn ok(args: &[&str]) -> String {
     String::from_utf8(out.stdout).unwrap()
 }
 
+/// Standard error of a successful run (status lines).
+fn ok_status(args: &[&str]) -> String {
+    let out = prism(args);
+    let err = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(out.status.success(), "{args:?}: {err}");
+    err
+}
+
 fn fails_with(args: &[&str], needles: &[&str]) {
     let out = prism(args);
     assert!(!out.status.success(), "{args:?} should fail");
@@ -49,7 +57,7 @@ fn fails_with(args: &[&str], needles: &[&str]) {
 }
 
 fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("prism-post-cli-{}", std::process::id()));
+    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("prism-post-cli");
     std::fs::create_dir_all(&dir).unwrap();
     dir.join(name)
 }
@@ -507,7 +515,7 @@ fn exposure_auto_brings_an_absolute_render_to_middle_grey() {
         / (w * h) as f64;
     assert!((ln_mapped.exp() - 0.18).abs() < 1e-4, "{}", ln_mapped.exp());
 
-    let text = ok(&[
+    let text = ok_status(&[
         "tonemap",
         input.to_str().unwrap(),
         "-o",

@@ -7,7 +7,7 @@ use clap::{ArgGroup, Args, ValueEnum};
 use glam::DVec3;
 use prism_spectrum::adaptation::{adaptation_matrix, AdaptationMethod};
 use prism_spectrum::bfc::NegativesPolicy;
-use prism_spectrum::cct::{blackbody_dense, xyz_to_cct_ohno2013};
+use prism_spectrum::cct::{blackbody_dense, xyz_to_cct_ohno2013, CCT_MAX_K, CCT_MIN_K, DUV_MAX};
 use prism_spectrum::colorimetry::{
     emission_to_xyz_cd_per_m2, illuminant_white_xyz, reflectance_to_xyz, xyz_to_lab, xyz_to_xy,
 };
@@ -225,6 +225,8 @@ struct ColorReport {
     xy: Option<[f64; 2]>,
     cct_k: Option<f64>,
     duv: Option<f64>,
+    /// CCT and Duv within Ohno 2013's valid range (false: an extrapolation).
+    cct_in_range: Option<bool>,
     lab: Option<DVec3>,
     linear_srgb: DVec3,
     srgb: DVec3,
@@ -261,6 +263,13 @@ fn compute(args: &ColorArgs, spectrum: &str) -> Result<ColorReport, String> {
             spectrum_label = label;
         }
         None => {
+            if spectrum.starts_with(COLORCHECKER_PREFIX) {
+                eprintln!(
+                    "warning: --spectrum {spectrum} is a reflectance but no --illuminant was \
+                     given: it is treated as spectral radiance; give --illuminant D65 (or \
+                     another) for its colour under a light"
+                );
+            }
             let (spectrum, label) = resolve_spectrum(spectrum, Role::Emission, "--spectrum")?;
             let radiance = spectrum.to_dense();
             report_xyz = emission_to_xyz_cd_per_m2(&radiance, observer);
@@ -282,6 +291,7 @@ fn compute(args: &ColorArgs, spectrum: &str) -> Result<ColorReport, String> {
         xy: chromaticity(report_xyz),
         cct_k,
         duv,
+        cct_in_range: cct.map(|c| c.in_valid_range()),
         lab,
         linear_srgb,
         srgb: DVec3::from_array(encoded),
@@ -298,14 +308,37 @@ fn to_json(r: &ColorReport) -> Value {
         "xy": r.xy,
         "CCT_K": r.cct_k,
         "Duv": r.duv,
+        "CCT_in_valid_range": r.cct_in_range,
         "Lab": r.lab.map(vec3),
         "linear_sRGB": vec3(r.linear_srgb),
         "sRGB": vec3(r.srgb),
     })
 }
 
+/// `v` with seven significant digits in at most 13 characters: fixed notation between
+/// 10⁻³ and 10⁷, scientific outside, so columns never run together.
+fn number(v: f64) -> String {
+    let magnitude = v.abs();
+    if v == 0.0 || !v.is_finite() {
+        format!("{v}")
+    } else if (1e-3..1e7).contains(&magnitude) {
+        let decimals = (6 - magnitude.log10().floor() as i32).clamp(0, 9) as usize;
+        format!("{v:.decimals$}")
+    } else {
+        format!("{v:.6e}")
+    }
+}
+
+/// Right-aligned columns of width 14 (one space at least between numbers).
+fn columns(values: &[f64]) -> String {
+    values
+        .iter()
+        .map(|&v| format!(" {:>13}", number(v)))
+        .collect()
+}
+
 fn print_table(r: &ColorReport) {
-    let row = |name: &str, v: DVec3| println!("{name:<13}{:>14.6}{:>14.6}{:>14.6}", v.x, v.y, v.z);
+    let row = |name: &str, v: DVec3| println!("{name:<13}{}", columns(&[v.x, v.y, v.z]));
     match &r.illuminant {
         Some(illum) => {
             println!("{:<13}{} (reflectance)", "spectrum", r.spectrum);
@@ -326,11 +359,25 @@ fn print_table(r: &ColorReport) {
         r.xyz,
     );
     match r.xy {
-        Some([x, y]) => println!("{:<13}{x:>14.6}{y:>14.6}", "xy"),
+        Some([x, y]) => println!("{:<13}{}", "xy", columns(&[x, y])),
         None => println!("{:<13}{:>14}", "xy", "undefined"),
     }
     match (r.cct_k, r.duv) {
-        (Some(t), Some(d)) => println!("{:<13}{t:>12.1} K   Duv {d:+.5}  (CIE 1931)", "CCT"),
+        (Some(t), Some(d)) => {
+            let flag = if r.cct_in_range == Some(true) {
+                String::new()
+            } else {
+                format!(
+                    "  outside the method's valid range ({CCT_MIN_K}–{CCT_MAX_K} K, \
+                     |Duv| ≤ {DUV_MAX}): an extrapolation, not a temperature"
+                )
+            };
+            println!(
+                "{:<13}{} K   Duv {d:+.5}  (CIE 1931){flag}",
+                "CCT",
+                columns(&[t])
+            )
+        }
         _ => println!("{:<13}{:>14}", "CCT", "undefined"),
     }
     if let Some(lab) = r.lab {

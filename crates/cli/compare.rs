@@ -5,10 +5,11 @@
 use std::path::{Path, PathBuf};
 
 use clap::{Args, ValueEnum};
-use prism_image::io::{write_image, ImageFormat};
+use prism_cpu::memory::MemoryBudget;
+use prism_image::io::{read_dimensions, write_image, ImageDimensions, ImageFormat};
 use prism_post::metrics::flip::DEFAULT_PPD;
 use prism_post::metrics::tmqi::Tmqi;
-use prism_post::metrics::{CompareOptions, Comparison, FlipMaps};
+use prism_post::metrics::{CompareOptions, Comparison, FlipMaps, COMPARE_BYTES_PER_PIXEL};
 use prism_post::pipeline::{compare_files_report, compare_files_with, tmqi_files};
 
 /// Which FLIP map `--error-map` writes.
@@ -55,6 +56,17 @@ pub struct CompareArgs {
     pub simd: crate::simd::SimdArgs,
 }
 
+/// PSNR with three decimals, or ±∞ (identical images; a black reference).
+fn psnr_text(db: f64) -> String {
+    if db == f64::INFINITY {
+        "+∞".to_string()
+    } else if db == f64::NEG_INFINITY {
+        "−∞".to_string()
+    } else {
+        format!("{db:.3}")
+    }
+}
+
 fn print_table(c: &Comparison) {
     let row3 = |name: &str, v: [f64; 3]| {
         println!("{name:<18}{:>14.6e}{:>14.6e}{:>14.6e}", v[0], v[1], v[2]);
@@ -63,7 +75,7 @@ fn print_table(c: &Comparison) {
     println!("{:<18}{:>14.6e}", "MSE", c.mse);
     println!("{:<18}{:>14.6e}", "RMSE", c.rmse);
     println!("{:<18}{:>14.6e}", "relMSE", c.relmse);
-    println!("{:<18}{:>14.3} dB", "PSNR", c.psnr_db);
+    println!("{:<18}{:>14} dB", "PSNR", psnr_text(c.psnr_db));
     match c.ssim {
         Some(s) => println!("{:<18}{s:>14.6}", "SSIM"),
         None => println!("{:<18}{:>14}", "SSIM", "n/a (< 11×11)"),
@@ -93,7 +105,11 @@ fn print_table(c: &Comparison) {
     row3("  MSE", c.per_channel.mse);
     row3("  RMSE", c.per_channel.rmse);
     row3("  relMSE", c.per_channel.relmse);
-    row3("  PSNR (dB)", c.per_channel.psnr_db);
+    let p = c.per_channel.psnr_db.map(psnr_text);
+    println!("{:<18}{:>14}{:>14}{:>14}", "  PSNR (dB)", p[0], p[1], p[2]);
+    if let Some(note) = c.psnr_note {
+        println!("{:<18}{note}", "");
+    }
     if c.non_finite_pixels > 0 {
         println!("{:<18}{:>14}", "non-finite pixels", c.non_finite_pixels);
     }
@@ -164,8 +180,37 @@ fn print_tmqi(t: &Tmqi) {
     );
 }
 
-pub fn run(args: &CompareArgs) -> Result<(), String> {
+/// Bytes a comparison of the two files will need, from their headers: each image as
+/// decoded (4 bytes per stored channel) and the metrics' working set per reference pixel.
+fn check_memory(args: &CompareArgs, budget: &MemoryBudget) -> Result<(), String> {
+    let header = |p: &Path| read_dimensions(p).map_err(|e| e.to_string());
+    let (test, reference) = (header(&args.test)?, header(&args.reference)?);
+    let decoded = |d: &ImageDimensions| d.pixels().saturating_mul(4 * d.channels as u64);
+    let estimate = decoded(&test)
+        .saturating_add(decoded(&reference))
+        .saturating_add(reference.pixels().saturating_mul(COMPARE_BYTES_PER_PIXEL));
+    budget
+        .check(
+            &format!(
+                "comparing {} with {} ({}×{} px)",
+                args.test.display(),
+                args.reference.display(),
+                reference.width,
+                reference.height
+            ),
+            estimate,
+        )
+        .map_err(|e| e.to_string())
+}
+
+pub fn run(args: &CompareArgs, budget: &MemoryBudget) -> Result<(), String> {
     args.simd.apply()?;
+    if let Some(map) = &args.error_map {
+        // Checked before the metrics run, which take long on large images.
+        crate::render::check_parent("--error-map", map)?;
+        ImageFormat::from_path(map).map_err(|e| format!("--error-map: {e}"))?;
+    }
+    check_memory(args, budget)?;
     if args.tmqi {
         let t = tmqi_files(&args.test, &args.reference).map_err(|e| e.to_string())?;
         if args.json {

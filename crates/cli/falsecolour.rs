@@ -37,6 +37,18 @@ pub fn parse_range(s: &str) -> Result<(f64, f64), String> {
     }
 }
 
+/// The ramp's options checked before rendering: a log scale needs a minimum above 0.
+pub fn check_options(scale: ScaleArg, range: Option<(f64, f64)>) -> Result<(), String> {
+    match (scale, range) {
+        (ScaleArg::Log, Some((min, max))) if min <= 0.0 => Err(format!(
+            "--false-colour-range {min}:{max} with --false-colour-scale log: expected a \
+             minimum > 0 (a log scale has no 0), e.g. {}:{max}",
+            max / 1000.0
+        )),
+        (ScaleArg::Log | ScaleArg::Linear, _) => Ok(()),
+    }
+}
+
 fn options(
     scale: ScaleArg,
     range: Option<(f64, f64)>,

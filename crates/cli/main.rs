@@ -8,6 +8,7 @@ mod daylight_factor;
 mod falsecolour;
 mod merge;
 mod merl_export;
+mod numbers;
 mod partial;
 mod plan_args;
 mod progress;
@@ -19,6 +20,7 @@ mod tonemap;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
+use prism_cpu::memory::MemoryBudget;
 
 #[derive(Parser)]
 #[command(
@@ -27,6 +29,11 @@ use clap::{Parser, Subcommand};
     about = "Prism: a spectral, predictive renderer with a tone-reproduction toolkit"
 )]
 struct Cli {
+    /// Memory a command may use, e.g. 512M or 8G (default: 75 % of the physical memory):
+    /// `render`, `converge`, `compare` and `tonemap` estimate what they need before they
+    /// allocate and refuse above it (docs/reliability.md).
+    #[arg(long = "max-memory", global = true, value_name = "SIZE", value_parser = prism_cpu::memory::parse_size)]
+    max_memory: Option<u64>,
     #[command(subcommand)]
     command: Command,
 }
@@ -60,16 +67,22 @@ fn main() -> ExitCode {
         libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
     let cli = Cli::parse();
+    let budget = match cli.max_memory {
+        Some(bytes) => MemoryBudget::given(bytes),
+        None => MemoryBudget::machine_default(),
+    };
+    // Decoders refuse files whose headers declare more than the limit.
+    prism_image::io::exr::set_exr_decode_limit_bytes(budget.limit_bytes);
     let done = |r: Result<(), String>| r.map(|()| ExitCode::SUCCESS);
     let result = match cli.command {
         Command::Color(args) => done(color::run(&args)),
-        Command::Compare(args) => done(compare::run(&args)),
-        Command::Converge(args) => done(converge::run(&args)),
+        Command::Compare(args) => done(compare::run(&args, &budget)),
+        Command::Converge(args) => done(converge::run(&args, &budget)),
         Command::Merge(args) => merge::run(&args),
         Command::MerlExport(args) => done(merl_export::run(&args)),
         // Non-zero without an error when a signal stopped it (the work is saved).
-        Command::Render(args) => render::run(&args),
-        Command::Tonemap(args) => done(tonemap::run(&args)),
+        Command::Render(args) => render::run(&args, &budget),
+        Command::Tonemap(args) => done(tonemap::run(&args, &budget)),
     };
     match result {
         Ok(code) => code,

@@ -21,11 +21,13 @@ use std::time::{Duration, Instant};
 
 use clap::Args;
 use glam::UVec2;
+use prism_cpu::memory::MemoryBudget;
 use prism_image::io::exr::ExrWriteOptions;
 use prism_image::io::spectral_exr::write_exr_with_spectral_bands;
 use prism_image::io::{write_image, ImageFormat};
 use prism_image::Image;
 use prism_render::film::spectral_bins::{MAX_SPECTRAL_BINS, MIN_SPECTRAL_BINS};
+use prism_render::film::{AovSelection, FilmMemory};
 use prism_render::integrator::DEFAULT_TILE_SIZE_PX;
 use prism_render::{
     total_samples, FilmImage, PlanRequest, RenderPlan, RenderScene, RenderSettings, RenderStats,
@@ -46,13 +48,13 @@ pub struct RenderArgs {
     #[arg(short = 'o', long = "output")]
     pub output: Option<PathBuf>,
     /// Samples per pixel (default: the scene's `film.spp`).
-    #[arg(long)]
+    #[arg(long, value_parser = parse_spp)]
     pub spp: Option<u32>,
-    /// Worker threads (default: one per core).
-    #[arg(long)]
+    /// Worker threads (default: one per core; at most 4 per logical CPU).
+    #[arg(long, value_parser = prism_cpu::threads::parse_thread_count)]
     pub threads: Option<usize>,
     /// Sampler seed (default: the scene's `film.seed`).
-    #[arg(long)]
+    #[arg(long, value_parser = crate::numbers::parse_u64)]
     pub seed: Option<u64>,
     /// Film resolution override, WIDTHxHEIGHT (e.g. 64x48), for previews and tests.
     #[arg(long, value_parser = parse_resolution)]
@@ -65,7 +67,7 @@ pub struct RenderArgs {
     pub stats_json: Option<PathBuf>,
     /// Also write the spectral radiance in N equal bins over 360–830 nm (1–471) as
     /// `S0.<λ>nm` channels of the EXR (Fichet et al. 2021 layout, W·m⁻²·sr⁻¹·nm⁻¹).
-    #[arg(long = "spectral-bins", value_name = "N")]
+    #[arg(long = "spectral-bins", value_name = "N", value_parser = crate::numbers::parse_u32)]
     pub spectral_bins: Option<u32>,
     /// Measure the scene's `sensors` only (`<output stem>.sensors.json/.csv`), no image.
     #[arg(long = "sensors-only")]
@@ -136,6 +138,68 @@ pub(crate) fn parse_resolution(s: &str) -> Result<UVec2, String> {
     }
 }
 
+/// `--spp N`: a whole number from 1 to 2³² − 1, said in those words.
+pub(crate) fn parse_spp(s: &str) -> Result<u32, String> {
+    let t = s.trim();
+    let digits = !t.is_empty() && t.chars().all(|c| c.is_ascii_digit());
+    match t.parse::<u64>() {
+        Ok(0) => Err("0: expected at least 1 sample per pixel".into()),
+        Ok(n) if n <= u64::from(u32::MAX) => Ok(n as u32),
+        // Too large for u32, or for u64: still digits.
+        Ok(_) | Err(_) if digits => Err(format!("`{s}`: at most {} samples per pixel", u32::MAX)),
+        Ok(_) | Err(_) => Err(format!(
+            "`{s}`: expected a whole number of samples per pixel, e.g. 64"
+        )),
+    }
+}
+
+/// The render's estimated memory (film, AOVs, spectral bins, output image) checked against
+/// `budget` before the scene is built.
+fn check_memory(
+    args: &RenderArgs,
+    description: &prism_scene::SceneDescription,
+    spectral_bins: Option<SpectralBins>,
+    budget: &MemoryBudget,
+) -> Result<(), String> {
+    let [w, h] = description.film.resolution;
+    let resolution = args.resolution.unwrap_or(UVec2::new(w, h));
+    let light_plane = match description.integrator {
+        prism_scene::Integrator::Light { .. } | prism_scene::Integrator::Bdpt { .. } => true,
+        prism_scene::Integrator::Path { .. }
+        | prism_scene::Integrator::Photon { .. }
+        | prism_scene::Integrator::PhotonProgressive { .. }
+        | prism_scene::Integrator::Depth
+        | prism_scene::Integrator::Normal
+        | prism_scene::Integrator::Albedo
+        | prism_scene::Integrator::AmbientOcclusion { .. } => false,
+    };
+    let film = FilmMemory {
+        resolution,
+        // Which AOVs the scene records is known only once it is built: count them all.
+        aovs: AovSelection::ALL,
+        spectral_bins: spectral_bins.map_or(0, |b| b.count()),
+        light_plane,
+    };
+    let what = match spectral_bins {
+        Some(b) => format!(
+            "{}: rendering {}×{} px with {} spectral bins",
+            args.scene.display(),
+            resolution.x,
+            resolution.y,
+            b.count()
+        ),
+        None => format!(
+            "{}: rendering {}×{} px",
+            args.scene.display(),
+            resolution.x,
+            resolution.y
+        ),
+    };
+    budget
+        .check(&what, film.total_bytes())
+        .map_err(|e| e.to_string())
+}
+
 /// Where the image goes (see the module docs).
 fn output_path(args: &RenderArgs, scene_output: Option<&Path>) -> PathBuf {
     if let Some(o) = &args.output {
@@ -172,6 +236,23 @@ fn check_output(path: &Path) -> Result<(), String> {
             path.display(),
             dir.display()
         )),
+    }
+}
+
+/// The folder of `path` (an output beside the image) must exist, checked before rendering.
+pub(crate) fn check_parent(what: &str, path: &Path) -> Result<(), String> {
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    if dir.is_dir() {
+        Ok(())
+    } else {
+        Err(format!(
+            "{what} {}: the directory {} does not exist",
+            path.display(),
+            dir.display()
+        ))
     }
 }
 
@@ -246,15 +327,24 @@ fn peak_memory_bytes() -> Option<u64> {
     Some(kib * 1024)
 }
 
-pub fn run(args: &RenderArgs) -> Result<ExitCode, String> {
+pub fn run(args: &RenderArgs, budget: &MemoryBudget) -> Result<ExitCode, String> {
     args.simd.apply()?;
     args.plan.check()?;
     let description = prism_scene::load_scene(&args.scene).map_err(|e| e.to_string())?;
     let output = output_path(args, description.film.output.as_deref());
     if !args.explain {
         check_output(&output)?;
+        if let Some(stats) = &args.stats_json {
+            check_parent("--stats-json", stats)?;
+        }
+        if args.false_colour.is_some() {
+            crate::falsecolour::check_options(args.false_colour_scale, args.false_colour_range)?;
+        }
     }
     let spectral_bins = spectral_bins(args, &output)?;
+    if !args.explain && !args.sensors_only {
+        check_memory(args, &description, spectral_bins, budget)?;
+    }
     if args.false_colour == Some(crate::falsecolour::FalseColourQuantity::Illuminance)
         && !description
             .sensors
@@ -267,6 +357,9 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode, String> {
         ));
     }
     let mut scene = RenderScene::build(&description, args.resolution).map_err(|e| e.to_string())?;
+    scene
+        .integrator
+        .set_memory_limit_bytes(Some(budget.limit_bytes));
     if let Some(strategy) = args.bdpt_strategy {
         match &mut scene.integrator {
             prism_render::Integrator::Bdpt(b) => {
@@ -339,6 +432,18 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode, String> {
             scene.integrator.name()
         );
     }
+    // One built light per `lights` entry, in order (prism-render light::build).
+    let radius_m = scene.lights.scene_sphere().radius_m;
+    for (i, light) in scene.lights.lights().iter().enumerate() {
+        let power_w = light.power_w(radius_m);
+        if power_w.is_nan() || power_w <= 0.0 {
+            eprintln!(
+                "{}: warning: lights[{i}] has zero power: it emits nothing (check its \
+                 strength and spectrum)",
+                args.scene.display()
+            );
+        }
+    }
     if args.explain {
         let request = PlanRequest {
             spp: settings.spp,
@@ -355,9 +460,6 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode, String> {
     }
     let mut pool = rayon::ThreadPoolBuilder::new();
     if let Some(n) = args.threads {
-        if n == 0 {
-            return Err("--threads must be at least 1".into());
-        }
         pool = pool.num_threads(n);
     }
     let pool = pool
@@ -751,7 +853,10 @@ fn write_stats(
 
 fn write_json(path: &Path, value: &serde_json::Value) -> Result<(), String> {
     let text = serde_json::to_string_pretty(value).map_err(|e| e.to_string())? + "\n";
-    // Atomic like the image: a temporary sibling renamed over the destination.
+    // Atomic like the image: a temporary sibling renamed over the destination (through a
+    // symbolic link, like the image).
+    let target = prism_image::io::write_target(path);
+    let path = target.as_path();
     let tmp = prism_image::io::temp_sibling(path);
     let result = std::fs::write(&tmp, text).and_then(|()| std::fs::rename(&tmp, path));
     if let Err(e) = result {

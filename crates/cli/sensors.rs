@@ -22,6 +22,8 @@ pub fn sensor_paths(output: &Path) -> (PathBuf, PathBuf) {
 
 /// Writes `text` to `path` through a temporary sibling.
 pub fn write_atomic(path: &Path, text: &str, what: &str) -> Result<(), String> {
+    let target = prism_image::io::write_target(path);
+    let path = target.as_path();
     let name = path
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())

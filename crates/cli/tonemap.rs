@@ -2,11 +2,15 @@
 //! (any EXR/HDR, not only Prism's), or a labelled contact sheet of every operator.
 
 use std::collections::BTreeMap;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use clap::Args;
+use prism_cpu::memory::MemoryBudget;
+use prism_image::io::read_dimensions;
 use prism_post::colour::{GamutMethod, GamutTarget, WhiteBalance};
-use prism_post::pipeline::{tonemap_file, OperatorChoice, TonemapFileReport, TonemapOptions};
+use prism_post::pipeline::{
+    tonemap_file, OperatorChoice, TonemapFileReport, TonemapOptions, TONEMAP_BYTES_PER_PIXEL,
+};
 use prism_post::sheet::{SheetScore, TileOrder};
 use prism_post::tonemap::ToneOperator;
 
@@ -43,13 +47,10 @@ pub struct TonemapArgs {
     /// Exposure in stops applied first (input × 2^EV), or `auto`: the EV that maps the
     /// log-average luminance to middle grey 0.18 (for absolute renders with the
     /// operators that are not scale invariant: linear, aces, agx, …).
-    #[arg(
-        long,
-        default_value = "0",
-        allow_hyphen_values = true,
-        value_name = "EV|auto"
-    )]
-    pub exposure: String,
+    /// Left out: 0, except for an image with `prism:cd_m2_per_unit` (a render in cd/m²)
+    /// and an operator that is not absolute, which gets `auto` (said on one line).
+    #[arg(long, allow_hyphen_values = true, value_name = "EV|auto")]
+    pub exposure: Option<String>,
     /// cd/m² per unit of the input, for the absolute operators when the file has no
     /// `prism:cd_m2_per_unit` header (overrides it when it has).
     #[arg(long, value_name = "CD_M2")]
@@ -66,6 +67,9 @@ pub struct TonemapArgs {
     /// List every operator with its parameters, defaults and reference.
     #[arg(long)]
     pub list: bool,
+    /// Allow -o to be the input file itself (replaced once the result is complete).
+    #[arg(long)]
+    pub overwrite: bool,
     /// Print the report (or the --list catalogue) as JSON.
     #[arg(long)]
     pub json: bool,
@@ -133,14 +137,22 @@ fn print_list(json: bool) -> Result<(), String> {
     Ok(())
 }
 
+/// The status lines, on standard error like every command's (standard output is for data:
+/// `--json`, tables).
 fn print_summary(report: &TonemapFileReport) {
-    if report.auto_exposure {
-        println!(
+    if report.auto_exposure_photometric {
+        eprintln!(
+            "exposure auto: {:+.2} EV (the image is photometric, prism:cd_m2_per_unit, and no \
+             --exposure was given; --exposure 0 keeps its scale)",
+            report.exposure_ev
+        );
+    } else if report.auto_exposure {
+        eprintln!(
             "exposure auto: {:+.2} EV (log-average luminance → 0.18)",
             report.exposure_ev
         );
     }
-    println!(
+    eprintln!(
         "wrote {} ({}×{}, {}, {} → {}, {:.2} % of pixels outside the gamut before mapping)",
         report.output,
         report.width,
@@ -150,14 +162,21 @@ fn print_summary(report: &TonemapFileReport) {
         report.target,
         100.0 * report.gamut_fraction_outside
     );
+    if report.exposure_overflow_pixels > 0 {
+        eprintln!(
+            "note: {} pixels overflowed to ∞ when scaled by 2^{:.2} (the exposure) and were \
+             mapped to black; lower --exposure",
+            report.exposure_overflow_pixels, report.exposure_ev
+        );
+    }
     if report.non_finite_pixels > 0 {
-        println!(
+        eprintln!(
             "note: {} input pixels had NaN/∞ components (mapped to black)",
             report.non_finite_pixels
         );
     }
     for failure in &report.failures {
-        println!("note: no tile for {failure:?}");
+        eprintln!("note: no tile for {}: {}", failure.operator, failure.error);
     }
     if !report.scores.is_empty() {
         println!("{:<20}{:>8}{:>8}{:>8}", "operator", "TMQI", "S", "N");
@@ -215,7 +234,28 @@ impl From<CatArg> for prism_spectrum::AdaptationMethod {
     }
 }
 
-pub fn run(args: &TonemapArgs) -> Result<(), String> {
+/// Bytes tone-mapping `input` will need, from its header (see `TONEMAP_BYTES_PER_PIXEL`;
+/// a contact sheet holds a tile per operator at most the input's size in all).
+fn check_memory(input: &Path, budget: &MemoryBudget) -> Result<(), String> {
+    let d = read_dimensions(input).map_err(|e| e.to_string())?;
+    let estimate = d
+        .pixels()
+        .saturating_mul(4 * d.channels as u64 + TONEMAP_BYTES_PER_PIXEL);
+    budget
+        .check(
+            &format!(
+                "tone-mapping {} ({}×{} px, {} channels)",
+                input.display(),
+                d.width,
+                d.height,
+                d.channels
+            ),
+            estimate,
+        )
+        .map_err(|e| e.to_string())
+}
+
+pub fn run(args: &TonemapArgs, budget: &MemoryBudget) -> Result<(), String> {
     if args.list {
         return print_list(args.json);
     }
@@ -224,7 +264,20 @@ pub fn run(args: &TonemapArgs) -> Result<(), String> {
         (Some(i), Some(o), Some(op)) => (i, o, op),
         _ => return Err("tonemap needs IN, -o OUT and --op NAME (or --list)".to_string()),
     };
-    let (exposure_ev, auto_exposure) = parse_exposure(&args.exposure)?;
+    let (exposure_ev, auto_exposure) = match &args.exposure {
+        Some(text) => parse_exposure(text)?,
+        None => (0.0, false),
+    };
+    if !args.overwrite && prism_image::io::same_file(input, output) {
+        return Err(format!(
+            "-o {}: it is the input file; give another output, or --overwrite to replace the \
+             input once the result is complete",
+            output.display()
+        ));
+    }
+    crate::render::check_parent("-o", output)?;
+    prism_image::io::ImageFormat::from_path(output).map_err(|e| e.to_string())?;
+    check_memory(input, budget)?;
     let order = match (args.sort, args.score) {
         (SortArg::Catalogue, _) => TileOrder::Catalogue,
         (SortArg::Score, Some(_)) => TileOrder::ScoreDescending,
@@ -241,6 +294,7 @@ pub fn run(args: &TonemapArgs) -> Result<(), String> {
         target: GamutTarget::parse(&args.target).map_err(|e| e.to_string())?,
         exposure_ev,
         auto_exposure,
+        auto_exposure_if_photometric: args.exposure.is_none(),
         luminance_scale_cd_m2: args.luminance_scale,
         score: args.score.map(SheetScore::from),
         order,

@@ -20,9 +20,11 @@ use std::time::Instant;
 
 use clap::Args;
 use glam::UVec2;
+use prism_cpu::memory::MemoryBudget;
 use prism_image::io::write_image;
 use prism_image::Image;
 use prism_post::metrics::PreparedReference;
+use prism_render::film::{AovSelection, FilmMemory};
 use prism_render::integrator::DEFAULT_TILE_SIZE_PX;
 use prism_render::{render, RenderScene, RenderSettings, SamplerKind};
 use serde_json::{json, Value};
@@ -48,11 +50,15 @@ pub struct ConvergeArgs {
     pub scene: PathBuf,
     /// The converged image to measure against (EXR, HDR or PNG, the render's size, linear
     /// like `prism render`'s EXR). Left out: one is rendered with Owen-scrambled Sobol at
-    /// --reference-spp and cached next to the scene (`<stem>.reference-WxH-Nspp-HASH.exr`).
+    /// --reference-spp and cached in --cache-dir (`<stem>.reference-WxH-Nspp-HASH.exr`).
     #[arg(long)]
     pub reference: Option<PathBuf>,
+    /// Where rendered references are cached (created if missing; default
+    /// $XDG_CACHE_HOME/prism, else ~/.cache/prism).
+    #[arg(long = "cache-dir", value_name = "DIR")]
+    pub cache_dir: Option<PathBuf>,
     /// Samples per pixel of a reference rendered because --reference was left out.
-    #[arg(long = "reference-spp", default_value_t = DEFAULT_REFERENCE_SPP)]
+    #[arg(long = "reference-spp", default_value_t = DEFAULT_REFERENCE_SPP, value_parser = crate::render::parse_spp)]
     pub reference_spp: u32,
     /// A method, INTEGRATOR[+PLAN][:SAMPLER] (repeat for several; default `path`, the path
     /// tracer with the uniform plan and the independent sampler). Integrators: path, light,
@@ -66,10 +72,10 @@ pub struct ConvergeArgs {
     pub budget_s: Option<f64>,
     /// Samples per pixel per method at most; alone, it makes the checkpoint schedule
     /// deterministic (1 spp to N spp, geometric).
-    #[arg(long = "max-spp", value_name = "N")]
+    #[arg(long = "max-spp", value_name = "N", value_parser = crate::render::parse_spp)]
     pub max_spp: Option<u32>,
     /// Checkpoints per method (geometrically spaced, ≥ 3).
-    #[arg(long, default_value_t = 12)]
+    #[arg(long, default_value_t = 12, value_parser = crate::numbers::parse_u32)]
     pub checkpoints: u32,
     /// Chart file (.png or .svg); repeat for both.
     #[arg(short = 'o', long = "output", value_name = "CHART")]
@@ -80,11 +86,11 @@ pub struct ConvergeArgs {
     /// Film resolution override, WIDTHxHEIGHT (the reference must match).
     #[arg(long, value_parser = crate::render::parse_resolution)]
     pub resolution: Option<UVec2>,
-    /// Worker threads (default: one per core).
-    #[arg(long)]
+    /// Worker threads (default: one per core; at most 4 per logical CPU).
+    #[arg(long, value_parser = prism_cpu::threads::parse_thread_count)]
     pub threads: Option<usize>,
     /// Sampler seed of the methods (default: the scene's `film.seed`).
-    #[arg(long)]
+    #[arg(long, value_parser = crate::numbers::parse_u64)]
     pub seed: Option<u64>,
     /// Also render each method's final sample count in one pass without checkpoints and
     /// report the time converge added (wall and CPU), in the JSON and on stderr.
@@ -148,6 +154,8 @@ impl Clock {
 
 /// Writes `bytes` to a temporary sibling and renames it over `path`.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), String> {
+    let target = prism_image::io::write_target(path);
+    let path = target.as_path();
     let name = path
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
@@ -159,23 +167,6 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), String> {
         return Err(format!("cannot write {}: {e}", path.display()));
     }
     Ok(())
-}
-
-/// The directory of `path` must exist (checked before rendering).
-fn check_parent(what: &str, path: &Path) -> Result<(), String> {
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
-    if dir.is_dir() {
-        Ok(())
-    } else {
-        Err(format!(
-            "{what} {}: the directory {} does not exist",
-            path.display(),
-            dir.display()
-        ))
-    }
 }
 
 fn check_arguments(args: &ConvergeArgs) -> Result<Budget, String> {
@@ -198,10 +189,10 @@ fn check_arguments(args: &ConvergeArgs) -> Result<Budget, String> {
                 o.display()
             ));
         }
-        check_parent("chart", o)?;
+        crate::render::check_parent("chart", o)?;
     }
     if let Some(j) = &args.json {
-        check_parent("--json", j)?;
+        crate::render::check_parent("--json", j)?;
     }
     if let Some(d) = &args.save_final {
         if !d.is_dir() {
@@ -230,9 +221,6 @@ fn check_arguments(args: &ConvergeArgs) -> Result<Budget, String> {
     if args.reference_spp == 0 {
         return Err("--reference-spp must be at least 1".into());
     }
-    if args.threads == Some(0) {
-        return Err("--threads must be at least 1".into());
-    }
     Ok(Budget {
         time_s: match (args.budget_s, args.max_spp) {
             (Some(b), _) => b,
@@ -243,6 +231,40 @@ fn check_arguments(args: &ConvergeArgs) -> Result<Budget, String> {
         max_spp: args.max_spp,
         checkpoints: args.checkpoints,
     })
+}
+
+/// The run's estimated memory checked against `memory` before the scene is built: the
+/// reference's film and image, one method's film at a time, and the prepared reference
+/// with a checkpoint's comparison.
+fn check_memory(
+    args: &ConvergeArgs,
+    description: &prism_scene::SceneDescription,
+    memory: &MemoryBudget,
+) -> Result<(), String> {
+    let [w, h] = description.film.resolution;
+    let resolution = args.resolution.unwrap_or(UVec2::new(w, h));
+    let film = FilmMemory {
+        resolution,
+        aovs: AovSelection::ALL,
+        spectral_bins: 0,
+        light_plane: true,
+    };
+    let pixels = u64::from(resolution.x) * u64::from(resolution.y);
+    let estimate = film
+        .total_bytes()
+        .saturating_mul(2)
+        .saturating_add(pixels.saturating_mul(prism_post::metrics::COMPARE_BYTES_PER_PIXEL));
+    memory
+        .check(
+            &format!(
+                "{}: converging {}×{} px",
+                args.scene.display(),
+                resolution.x,
+                resolution.y
+            ),
+            estimate,
+        )
+        .map_err(|e| e.to_string())
 }
 
 /// The 1-minute load average and the logical CPU count (for the JSON: timings on a busy
@@ -293,9 +315,14 @@ fn file_label(method: &Method) -> String {
         .collect()
 }
 
-pub fn run(args: &ConvergeArgs) -> Result<(), String> {
+pub fn run(args: &ConvergeArgs, memory: &MemoryBudget) -> Result<(), String> {
     args.simd.apply()?;
     let budget = check_arguments(args)?;
+    // The cache must take the reference before one is rendered for it.
+    let cache_dir = match &args.reference {
+        Some(_) => None,
+        None => Some(reference::prepare_cache_dir(args.cache_dir.as_deref())?),
+    };
     let methods: Vec<Method> = if args.methods.is_empty() {
         vec![Method::parse("path")?]
     } else {
@@ -320,6 +347,7 @@ pub fn run(args: &ConvergeArgs) -> Result<(), String> {
     let scene_bytes = std::fs::read(&args.scene)
         .map_err(|e| format!("{}: cannot read the scene: {e}", args.scene.display()))?;
     let description = prism_scene::load_scene(&args.scene).map_err(|e| e.to_string())?;
+    check_memory(args, &description, memory)?;
     let mut scene = RenderScene::build(&description, args.resolution).map_err(|e| e.to_string())?;
     let resolution = scene.resolution;
     // A user's reference is checked before anything renders or is written.
@@ -363,7 +391,7 @@ pub fn run(args: &ConvergeArgs) -> Result<(), String> {
                 seed: reference_seed,
                 integrator: integrator_description(&integrator),
             };
-            let path = key.cache_path();
+            let path = key.cache_path(cache_dir.as_deref().unwrap_or(Path::new(".")));
             let cached = path
                 .is_file()
                 .then(|| load_reference(&path, resolution).ok());
@@ -447,6 +475,9 @@ pub fn run(args: &ConvergeArgs) -> Result<(), String> {
     let mut report_entries = Vec::new();
     for (index, (method, integrator)) in methods.iter().zip(&integrators).enumerate() {
         scene.integrator = *integrator;
+        scene
+            .integrator
+            .set_memory_limit_bytes(Some(memory.limit_bytes));
         let settings = RenderSettings {
             spp: 1,
             seed,

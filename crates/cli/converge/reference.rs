@@ -1,7 +1,8 @@
 //! The reference image of `prism converge`: a file the user gives (checked before anything
 //! renders: it must exist, be an image and have the render's size), or one rendered at a
-//! stated spp and cached next to the scene under a name that carries a hash of everything
-//! it depends on, so that editing the scene file invalidates it.
+//! stated spp and cached in a cache directory (`--cache-dir`, default the platform's) under a
+//! name that carries a hash of everything it depends on, so that editing the scene file
+//! invalidates it. A scene's folder may be read-only or shared, so nothing is written there.
 
 use std::path::{Path, PathBuf};
 
@@ -64,6 +65,51 @@ pub fn fnv1a64(parts: &[&[u8]]) -> u64 {
     h
 }
 
+/// The platform cache directory of Prism: `$XDG_CACHE_HOME/prism`, else
+/// `$HOME/.cache/prism` (XDG Base Directory specification), else the system's temporary
+/// directory's `prism-cache`.
+pub fn default_cache_dir() -> PathBuf {
+    let non_empty = |k: &str| {
+        std::env::var_os(k)
+            .filter(|v| !v.is_empty())
+            .map(PathBuf::from)
+    };
+    if let Some(xdg) = non_empty("XDG_CACHE_HOME") {
+        return xdg.join("prism");
+    }
+    if let Some(home) = non_empty("HOME") {
+        return home.join(".cache").join("prism");
+    }
+    std::env::temp_dir().join("prism-cache")
+}
+
+/// The cache directory (`given` or the default), created if missing and checked writable
+/// before anything renders.
+pub fn prepare_cache_dir(given: Option<&Path>) -> Result<PathBuf, String> {
+    let dir = given.map_or_else(default_cache_dir, Path::to_path_buf);
+    let what = match given {
+        Some(_) => "--cache-dir",
+        None => "the reference cache (--cache-dir)",
+    };
+    std::fs::create_dir_all(&dir).map_err(|e| {
+        format!(
+            "{what} {}: cannot create the directory ({e}); give a writable --cache-dir DIR              or a --reference",
+            dir.display()
+        )
+    })?;
+    let probe = dir.join(format!(".prism-write-test.{}", std::process::id()));
+    match std::fs::write(&probe, b"") {
+        Ok(()) => {
+            let _ = std::fs::remove_file(&probe);
+            Ok(dir)
+        }
+        Err(e) => Err(format!(
+            "{what} {}: cannot write there ({e}); give a writable --cache-dir DIR or a              --reference",
+            dir.display()
+        )),
+    }
+}
+
 /// What a cached reference depends on.
 pub struct ReferenceKey<'a> {
     pub scene_file: &'a Path,
@@ -77,10 +123,14 @@ pub struct ReferenceKey<'a> {
 }
 
 impl ReferenceKey<'_> {
-    /// `<scene dir>/<stem>.reference-<W>x<H>-<spp>spp-<hash>.exr`; the hash covers the scene
-    /// file's bytes, the size, spp, seed, integrator and Prism's version.
-    pub fn cache_path(&self) -> PathBuf {
+    /// `<dir>/<stem>.reference-<W>x<H>-<spp>spp-<hash>.exr`; the hash covers the scene
+    /// file's absolute path (scenes of one name in different folders differ) and bytes, the
+    /// size, spp, seed, integrator and Prism's version.
+    pub fn cache_path(&self, dir: &Path) -> PathBuf {
+        let absolute = std::fs::canonicalize(self.scene_file)
+            .unwrap_or_else(|_| self.scene_file.to_path_buf());
         let hash = fnv1a64(&[
+            absolute.to_string_lossy().as_bytes(),
             self.scene_bytes,
             format!("{}x{}", self.resolution.x, self.resolution.y).as_bytes(),
             &self.spp.to_le_bytes(),
@@ -97,10 +147,7 @@ impl ReferenceKey<'_> {
             "{stem}.reference-{}x{}-{}spp-{hash:016x}.exr",
             self.resolution.x, self.resolution.y, self.spp
         );
-        match self.scene_file.parent() {
-            Some(dir) => dir.join(name),
-            None => PathBuf::from(name),
-        }
+        dir.join(name)
     }
 }
 
@@ -129,13 +176,36 @@ mod tests {
             seed: 0,
             integrator: "path".into(),
         };
-        let a = key(b"{}", 1024).cache_path();
-        assert!(a.starts_with("scenes"));
+        let a = key(b"{}", 1024).cache_path(Path::new("cache"));
+        assert!(a.starts_with("cache"));
         let name = a.file_name().unwrap().to_string_lossy().into_owned();
         assert!(name.starts_with("box.reference-64x48-1024spp-"), "{name}");
         assert!(name.ends_with(".exr"));
-        assert_ne!(a, key(b"{ }", 1024).cache_path());
-        assert_ne!(a, key(b"{}", 2048).cache_path());
+        assert_ne!(a, key(b"{ }", 1024).cache_path(Path::new("cache")));
+        assert_ne!(a, key(b"{}", 2048).cache_path(Path::new("cache")));
+        let elsewhere = ReferenceKey {
+            scene_file: Path::new("other/box.json"),
+            ..key(b"{}", 1024)
+        };
+        assert_ne!(
+            a,
+            elsewhere.cache_path(Path::new("cache")),
+            "the folder counts"
+        );
+    }
+
+    #[test]
+    fn an_unwritable_cache_is_refused_before_rendering() {
+        let dir = tempfile::tempdir().unwrap();
+        let made = prepare_cache_dir(Some(&dir.path().join("a/b"))).unwrap();
+        assert!(made.is_dir());
+        let file = dir.path().join("file");
+        std::fs::write(&file, "").unwrap();
+        let e = prepare_cache_dir(Some(&file.join("sub"))).unwrap_err();
+        assert!(
+            e.contains("--cache-dir") && e.contains("cannot create"),
+            "{e}"
+        );
     }
 
     #[test]

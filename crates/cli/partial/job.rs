@@ -282,7 +282,14 @@ pub fn render(
     };
     let outcome = pool.install(|| {
         let mut estimator = scene.integrator.estimator();
-        render_pass_controlled(estimator.as_mut(), scene, &pass, &mut film, &on_item, &control)
+        render_pass_controlled(
+            estimator.as_mut(),
+            scene,
+            &pass,
+            &mut film,
+            &on_item,
+            &control,
+        )
     });
     progress.finish();
     let outcome = outcome.map_err(|e| format!("{}: {e}", args.scene.display()))?;

@@ -19,6 +19,14 @@
 //! build, a film tile) and pass the [`Simd`] down to the kernels on worker threads, so
 //! tests run kernels at any ISA by passing it explicitly ([`each_isa`]), in parallel,
 //! without touching the process-wide choice.
+//!
+//! The machine's other limits live here too: [`memory`] (the `--max-memory` budget and the
+//! physical memory) and [`threads`] (the bound on `--threads`); and [`text_file`], how
+//! every crate reads a user's text file, because this crate is the one below all others.
+
+pub mod memory;
+pub mod text_file;
+pub mod threads;
 
 use std::fmt;
 use std::sync::atomic::{AtomicU8, Ordering};

@@ -61,10 +61,18 @@ impl TriangleMesh {
     /// becomes an error, never a panic during rendering.
     pub fn validate(&self) -> Result<(), String> {
         let nv = self.positions.len();
-        if let Some(i) = self.positions.iter().position(|p| !p.is_finite()) {
+        if self.indices.is_empty() {
+            // An empty file, plain text or a point cloud would otherwise render as nothing.
             return Err(format!(
-                "vertex {i} has a non-finite position {:?}",
-                self.positions[i]
+                "no faces ({nv} vertices); expected a triangle mesh (OBJ `f` lines, a PLY \
+                 `face` element)"
+            ));
+        }
+        if let Some(i) = self.positions.iter().position(|p| !p.is_finite()) {
+            let p = self.positions[i];
+            return Err(format!(
+                "vertex {i} has a non-finite position ({}, {}, {}); expected finite numbers",
+                p.x, p.y, p.z
             ));
         }
         if let Some(n) = &self.normals {

@@ -16,8 +16,8 @@ use crate::mesh::{TriangleMesh, NO_MATERIAL};
 /// material id (named in `material_names`, from the MTL files).
 pub fn load_obj(path: impl AsRef<Path>) -> Result<TriangleMesh, MeshLoadError> {
     let path = path.as_ref();
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| MeshLoadError::new(path, None, format!("cannot read OBJ file: {e}")))?;
+    let text = prism_cpu::text_file::read_text(path)
+        .map_err(|e| MeshLoadError::new(path, None, format!("cannot read the OBJ file: {e}")))?;
     let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
     let options = tobj::LoadOptions {
         triangulate: true,

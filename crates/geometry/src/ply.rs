@@ -12,10 +12,50 @@ use ply_rs::ply::{DefaultElement, Property};
 use crate::error::MeshLoadError;
 use crate::mesh::TriangleMesh;
 
+/// ply-rs' error text in the project's words: its ASCII messages are "Line N: …" followed
+/// by the offending text and a nested `Custom { kind: …, error: "… error at 1:3: expected
+/// one of …" }` (Debug output of its grammar). Returns the line and a sentence.
+fn ply_error_message(raw: &str) -> (Option<usize>, String) {
+    let line = raw
+        .strip_prefix("Line ")
+        .and_then(|r| r.split(':').next())
+        .and_then(|n| n.trim().parse::<usize>().ok());
+    let text = raw
+        .split_once("String: '")
+        .and_then(|(_, r)| r.split_once('\''))
+        .map(|(t, _)| t.trim());
+    let column = raw
+        .rsplit_once("error at ")
+        .and_then(|(_, r)| r.split(':').nth(1))
+        .and_then(|c| c.trim().parse::<usize>().ok());
+    match (line, text) {
+        (Some(line), Some(text)) => {
+            let at = column.map_or(String::new(), |c| format!(" at column {c}"));
+            (
+                Some(line),
+                format!(
+                    "cannot read `{text}`{at}; expected the numbers the header declares for \
+                     this element, separated by spaces"
+                ),
+            )
+        }
+        // Other messages (header, binary data): their first line, without nested Debug.
+        _ => {
+            let first = raw.lines().next().unwrap_or(raw).trim();
+            let first = first.split(" Custom {").next().unwrap_or(first);
+            let first = first.split("ParseError {").next().unwrap_or(first).trim();
+            (line, first.trim_end_matches(':').to_string())
+        }
+    }
+}
+
 /// Load a PLY mesh file.
 pub fn load_ply(path: impl AsRef<Path>) -> Result<TriangleMesh, MeshLoadError> {
     let path = path.as_ref();
     let err = |msg: String| MeshLoadError::new(path, None, msg);
+    if path.is_dir() {
+        return Err(err("it is a directory; expected a PLY file".into()));
+    }
     let file = std::fs::File::open(path).map_err(|e| err(format!("cannot open PLY file: {e}")))?;
     let mut reader = BufReader::new(file);
     // ply-rs has a few panicking paths on malformed input; user input must never panic here.
@@ -29,8 +69,8 @@ pub fn load_ply(path: impl AsRef<Path>) -> Result<TriangleMesh, MeshLoadError> {
         } else {
             ""
         };
-        // ply-rs ASCII messages carry "Line N" themselves.
-        err(format!("cannot parse PLY: {}{hint}", e.to_string().trim()))
+        let (line, message) = ply_error_message(&e.to_string());
+        MeshLoadError::new(path, line, format!("cannot parse PLY: {message}{hint}"))
     })?;
 
     let vertices = ply.payload.get("vertex").ok_or_else(|| {

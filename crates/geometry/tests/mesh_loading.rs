@@ -121,8 +121,19 @@ fn ply_errors_name_the_file_and_the_problem() {
         .unwrap()
         .replace("0.5 0.5 1 0 0 1", "0.5 zz 1 0 0 1");
     std::fs::write(&ascii_bad, text).unwrap();
-    let e = load_ply(&ascii_bad).unwrap_err().to_string();
-    assert!(e.contains("ascii_bad.ply") && e.contains("Line"), "{e}");
+    let e = load_ply(&ascii_bad).unwrap_err();
+    assert_eq!(e.line, Some(20), "{e}");
+    let e = e.to_string();
+    assert!(
+        e.contains("ascii_bad.ply:20:") && e.contains("`0.5 zz 1 0 0 1") && e.contains("column"),
+        "{e}"
+    );
+    // No Debug output of the parser's internals.
+    for internal in ["ParseError", "LineCol", "Custom {", "kind:"] {
+        assert!(!e.contains(internal), "{internal}: {e}");
+    }
+    let e = load_ply(&d).unwrap_err().to_string();
+    assert!(e.contains("is a directory"), "{e}");
 
     let missing = d.join("does_not_exist.ply");
     let e = load_ply(&missing).unwrap_err().to_string();
@@ -210,6 +221,24 @@ fn obj_errors_name_the_file_line_and_expectation() {
             && s.contains("4 vertices are defined"),
         "{s}"
     );
+
+    // Files without faces are errors, not empty meshes: empty, plain text, points only.
+    for (name, text) in [
+        ("empty.obj", ""),
+        ("notes.obj", "this is not a mesh\njust text\n"),
+        ("points.obj", "v 0 0 0\nv 1 0 0\n"),
+    ] {
+        let path = d.join(name);
+        std::fs::write(&path, text).unwrap();
+        let s = load_obj(&path).unwrap_err().to_string();
+        assert!(s.contains(name) && s.contains("no faces"), "{s}");
+    }
+    let nan = d.join("nan.obj");
+    std::fs::write(&nan, "v nan 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    let s = load_obj(&nan).unwrap_err().to_string();
+    assert!(s.contains("(NaN, 0, 0)") && !s.contains("Vec3A"), "{s}");
+    let s = load_obj(&d).unwrap_err().to_string();
+    assert!(s.contains("is a directory"), "{s}");
 
     let unknown_mtl = d.join("unknown_mtl.obj");
     std::fs::write(&unknown_mtl, OBJ.replace("usemtl blue", "usemtl green")).unwrap();

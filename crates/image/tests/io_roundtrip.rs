@@ -16,7 +16,7 @@ use prism_spectrum::rgb_space::RgbColorSpace;
 use prism_spectrum::Observer;
 
 fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("prism-post-tests-{}", std::process::id()));
+    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("prism-post-tests");
     std::fs::create_dir_all(&dir).unwrap();
     dir.join(name)
 }
@@ -427,7 +427,7 @@ fn rgb_image_with_spectral_bands_keeps_rgb_layers_and_bands_in_one_file() {
         .collect();
     // Its own directory: the atomic-write test checks the shared scratch folder for
     // temporary files while the tests run in parallel.
-    let dir = std::env::temp_dir().join(format!("prism-post-bands-{}", std::process::id()));
+    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("prism-post-bands");
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("rgb_and_bands.exr");
     write_exr_with_spectral_bands(

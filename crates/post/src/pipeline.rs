@@ -68,6 +68,12 @@ impl From<ToneOperator> for OperatorChoice {
     }
 }
 
+/// Peak bytes per pixel of [`tonemap_file`] with one operator, beyond 4 bytes per stored
+/// channel of the input as decoded: the input's RGB in f32, the operator's output and
+/// its luminance planes, the encoder's buffer. Measured on a 2048² float RGB EXR
+/// (docs/reliability.md); the memory check's estimate.
+pub const TONEMAP_BYTES_PER_PIXEL: u64 = 32;
+
 /// Options of `prism tonemap` (CLI defaults in [`Default`]: `--wb none`, `--gamut clip`,
 /// `--target srgb`, `--exposure 0`).
 #[derive(Debug, Clone)]
@@ -90,6 +96,10 @@ pub struct TonemapOptions {
     /// `--exposure auto`: `exposure_ev` is replaced by the EV that maps the log-average
     /// luminance to middle grey ([`auto_exposure_ev`]); the report gives the EV used.
     pub auto_exposure: bool,
+    /// No `--exposure` was given: a photometric image (one with `prism:cd_m2_per_unit`)
+    /// tone-mapped by an operator that is not absolute gets the auto exposure, as renders
+    /// in cd/m² are otherwise black (an explicit `--exposure 0` keeps the scale).
+    pub auto_exposure_if_photometric: bool,
     /// `--luminance-scale CD_M2`: cd/m² per unit, overriding `prism:cd_m2_per_unit`.
     pub luminance_scale_cd_m2: Option<f64>,
     /// `--score tmqi`: score the output (each tile of a sheet) against the HDR input as the
@@ -110,6 +120,7 @@ impl Default for TonemapOptions {
             target: GamutTarget::Srgb,
             exposure_ev: 0.0,
             auto_exposure: false,
+            auto_exposure_if_photometric: false,
             luminance_scale_cd_m2: None,
             score: None,
             order: TileOrder::Catalogue,
@@ -142,6 +153,9 @@ pub struct TonemapFileReport {
     /// The exposure applied (computed when `auto_exposure`).
     pub exposure_ev: f64,
     pub auto_exposure: bool,
+    /// The auto exposure was chosen because the image is photometric and no exposure was
+    /// given (`TonemapOptions::auto_exposure_if_photometric`).
+    pub auto_exposure_photometric: bool,
     pub luminance_scale_cd_m2: Option<f64>,
     pub white_balance: String,
     /// The chromatic adaptation transform of the white balance (`--cat`).
@@ -159,6 +173,8 @@ pub struct TonemapFileReport {
     /// `--score`: which score, and one entry per scored operator in the sheet's tile order.
     pub score: Option<SheetScore>,
     pub scores: Vec<TileScore>,
+    /// Finite input pixels that the exposure scale 2^EV made infinite (mapped as black).
+    pub exposure_overflow_pixels: u64,
     /// Fraction of pixels outside the target gamut before gamut mapping.
     pub gamut_fraction_outside: f64,
     pub timings: TonemapTimings,
@@ -188,7 +204,21 @@ pub fn tonemap_file(
             options.exposure_ev
         )));
     }
-    let exposure_ev = if options.auto_exposure {
+    let photometric_auto = options.auto_exposure_if_photometric
+        && !options.auto_exposure
+        && image.cd_m2_per_unit.is_some()
+        && match options.operator {
+            OperatorChoice::One(op) => !op.info().absolute,
+            // The sheet holds absolute operators, which read the scale themselves.
+            OperatorChoice::All => false,
+        };
+    let auto_exposure = options.auto_exposure || photometric_auto;
+    let non_finite_input = image
+        .pixels()
+        .par_iter()
+        .filter(|p| !p.iter().all(|c| c.is_finite()))
+        .count() as u64;
+    let exposure_ev = if auto_exposure {
         auto_exposure_ev(&image).ok_or_else(|| {
             ImageError::format(
                 input,
@@ -198,12 +228,24 @@ pub fn tonemap_file(
     } else {
         options.exposure_ev
     };
+    let mut exposure_overflow_pixels = 0;
     if exposure_ev != 0.0 {
         let factor = 2f64.powf(exposure_ev) as f32;
-        image
+        if !(factor.is_finite() && factor > 0.0) {
+            return Err(ImageError::invalid(format!(
+                "--exposure {exposure_ev}: the scale 2^{exposure_ev} is outside the range of \
+                 32-bit floats; expected an exposure between -149 and 127 stops"
+            )));
+        }
+        exposure_overflow_pixels = image
             .pixels_mut()
             .par_iter_mut()
-            .for_each(|p| *p = p.map(|c| c * factor));
+            .map(|p| {
+                let finite = p.iter().all(|c| c.is_finite());
+                *p = p.map(|c| c * factor);
+                u64::from(finite && !p.iter().all(|c| c.is_finite()))
+            })
+            .sum();
     }
     let space = image.color_space.clone();
     let wb_source_xy = match &options.wb {
@@ -292,14 +334,16 @@ pub fn tonemap_file(
         operator: options.operator.name(),
         params: options.params.clone(),
         exposure_ev,
-        auto_exposure: options.auto_exposure,
+        auto_exposure,
+        auto_exposure_photometric: photometric_auto,
         luminance_scale_cd_m2: options.luminance_scale_cd_m2,
         white_balance: options.wb.name(),
         chromatic_adaptation: options.cat.name(),
         white_balance_source_xy: wb_source_xy,
         gamut_method: options.gamut.name(),
         target: options.target.name(),
-        non_finite_pixels: tone.first().map_or(0, |r| r.non_finite_pixels),
+        non_finite_pixels: non_finite_input,
+        exposure_overflow_pixels,
         tone,
         score: options.score,
         scores,

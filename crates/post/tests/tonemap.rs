@@ -131,7 +131,7 @@ fn absolute_operators_need_a_scale_and_accept_either_source() {
 fn tonemap_file_writes_png_and_exr_and_compare_files_reads_them_back() {
     use prism_image::io;
     use prism_post::{compare_files, tonemap_file, TonemapOptions};
-    let dir = std::env::temp_dir().join(format!("prism-post-pipeline-{}", std::process::id()));
+    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("prism-post-pipeline");
     std::fs::create_dir_all(&dir).unwrap();
     let input = dir.join("in.exr");
     let pixels = (0..64 * 48)
@@ -198,7 +198,7 @@ fn tonemap_file_runs_exposure_white_balance_operator_gamut_and_the_contact_sheet
     use prism_image::io;
     use prism_post::colour::{GamutMethod, GamutTarget, WhiteBalance};
     use prism_post::{tonemap_file, OperatorChoice, TonemapOptions};
-    let dir = std::env::temp_dir().join(format!("prism-post-sheet-{}", std::process::id()));
+    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("prism-post-sheet");
     std::fs::create_dir_all(&dir).unwrap();
     let input = dir.join("in.exr");
     let (w, h) = (96, 54);

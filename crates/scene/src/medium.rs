@@ -229,7 +229,7 @@ fn parse_phase(v: &V) -> Result<Phase> {
 /// Reads a table of (cos θ, value) rows: comma, tab or space separated; `#` comments and
 /// a header line of names are skipped. Errors give the file's line.
 fn read_phase_table(path: &std::path::Path) -> std::result::Result<(Vec<f64>, Vec<f64>), String> {
-    let text = std::fs::read_to_string(path)
+    let text = prism_cpu::text_file::read_text(path)
         .map_err(|e| format!("cannot read {}: {e}", path.display()))?;
     let (mut cos_theta, mut values) = (Vec::new(), Vec::new());
     for (i, line) in text.lines().enumerate() {

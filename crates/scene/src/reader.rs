@@ -309,6 +309,12 @@ impl<'a> V<'a> {
             )));
         }
         let resolved = self.cx.base_dir.join(given);
+        if resolved.is_dir() {
+            return Err(self.err(format!(
+                "{what} file `{given}` is a directory ({}); expected a file",
+                resolved.display()
+            )));
+        }
         if !resolved.is_file() {
             return Err(self.err(format!(
                 "{what} file `{given}` not found (looked for {})",

@@ -72,7 +72,7 @@ pub const TOP_LEVEL_FIELDS: [&str; 14] = [
 /// Reads and parses a scene file; assets resolve relative to its folder.
 pub fn load_scene(path: impl AsRef<Path>) -> std::result::Result<SceneDescription, SceneError> {
     let path = path.as_ref();
-    let text = std::fs::read_to_string(path).map_err(|e| SceneError {
+    let text = prism_cpu::text_file::read_text(path).map_err(|e| SceneError {
         file: path.to_path_buf(),
         position: None,
         path: JsonPath::default(),

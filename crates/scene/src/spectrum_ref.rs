@@ -159,11 +159,24 @@ fn load_file(v: &V, file: &V, column: Option<&V>, usage: SpectrumUse) -> Result<
             )));
         }
     };
-    // Every spectrum a scene uses (reflectance, emission, coefficients, IOR) is ≥ 0.
-    let _ = usage;
+    // Every spectrum a scene uses (reflectance, emission, coefficients, IOR) is ≥ 0; a
+    // reflectance is ≤ 1 (as constants and RGB are); and every table must reach the
+    // wavelengths the renderer samples, or it is silently black.
+    let at_file = |e: prism_spectrum::error::SpectrumFileError| {
+        file.err(format!("cannot load spectrum: {e}"))
+    };
     columns
         .require_non_negative(index, &path, "spectral values")
-        .map_err(|e| file.err(format!("cannot load spectrum: {e}")))?;
+        .map_err(at_file)?;
+    match usage {
+        SpectrumUse::Reflectance => columns
+            .require_at_most_one(index, &path, "a reflectance")
+            .map_err(at_file)?,
+        SpectrumUse::NonNegative | SpectrumUse::Positive => {}
+    }
+    columns
+        .require_coverage(&path, (360.0, 830.0))
+        .map_err(at_file)?;
     Ok(SpectrumRef::File {
         path,
         column: columns.names[index].clone(),

@@ -104,6 +104,36 @@ fn bad_spectrum_file_names_both_files_and_the_line() {
 }
 
 #[test]
+fn spectrum_files_that_would_render_wrong_are_refused() {
+    let dir = Dir::new("wrong-csv");
+    // A reflectance above 1 (a percentage), as a constant 1.5 already is.
+    dir.write("percent.csv", "400,0.1\n500,85\n700,90\n");
+    let e = dir.error(r#"{"materials": {"m": {"type": "lambert", "reflectance": "percent.csv"}}}"#);
+    assert!(
+        e.contains("DIR/percent.csv:2: a reflectance must be at most 1, found 85 at 500 nm"),
+        "{e}"
+    );
+    // Emission may exceed 1.
+    dir.write("bright.csv", "400,10\n700,90\n");
+    let scene =
+        r#"{"lights": [{"type": "point", "position_m": [0, 0, 0], "spectrum": "bright.csv"}]}"#;
+    assert!(dir.load(scene).is_ok());
+    // One row, or a table outside 360–830 nm: black without a word before.
+    dir.write("one.csv", "550,0.5\n");
+    let e = dir.error(r#"{"spectra": {"one": "one.csv"}}"#);
+    assert!(
+        e.contains("DIR/one.csv:1: 1 row: expected a table of at least two"),
+        "{e}"
+    );
+    dir.write("micro.csv", "10,0.5\n20,0.6\n");
+    let e = dir.error(r#"{"spectra": {"micro": "micro.csv"}}"#);
+    assert!(
+        e.contains("DIR/micro.csv:1: the table covers 10–20 nm, outside the 360–830 nm"),
+        "{e}"
+    );
+}
+
+#[test]
 fn bad_values_are_refused_with_the_valid_range() {
     let dir = Dir::new("bad-values");
     let e = dir.error(r#"{"shapes": [{"type": "sphere", "radius_m": -1}]}"#);

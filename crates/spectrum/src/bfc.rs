@@ -115,7 +115,7 @@ pub struct BfcData {
 
 /// Reads and parses a BFC-450 file.
 pub fn load_bfc(path: &Path, policy: NegativesPolicy) -> Result<BfcData, SpectrumFileError> {
-    let text = std::fs::read_to_string(path).map_err(|e| {
+    let text = prism_cpu::text_file::read_text(path).map_err(|e| {
         SpectrumFileError::new(path, None, format!("cannot read the BFC-450 file: {e}"))
     })?;
     parse_bfc(&text, path, policy)

@@ -25,6 +25,8 @@ use crate::table::DenseSpectrum;
 pub const CCT_MIN_K: f64 = 1000.0;
 /// Highest temperature of the Planckian table in K.
 pub const CCT_MAX_K: f64 = 100_000.0;
+/// |Duv| up to which a CCT is meaningful (Ohno 2013's range; ANSI C78.377 uses less).
+pub const DUV_MAX: f64 = 0.05;
 /// Geometric spacing of the Planckian table at its low end (Ohno 2013; colour-science default).
 const TABLE_SPACING: f64 = 1.001;
 /// |Duv| from which the parabolic solution replaces the triangular one (Ohno 2013).
@@ -151,6 +153,14 @@ pub fn uv_to_cct_ohno2013(uv: DVec2) -> Option<CctDuv> {
         cct_k: t_parabolic,
         duv: duv_parabolic,
     })
+}
+
+impl CctDuv {
+    /// Whether the result is within the method's valid range ([`CCT_MIN_K`]–[`CCT_MAX_K`],
+    /// |Duv| ≤ [`DUV_MAX`]); outside it the number is an extrapolation, not a temperature.
+    pub fn in_valid_range(&self) -> bool {
+        (CCT_MIN_K..=CCT_MAX_K).contains(&self.cct_k) && self.duv.abs() <= DUV_MAX
+    }
 }
 
 /// CCT and Duv of CIE 1931 XYZ (via CIE 1960 uv). `None` for black or non-finite input.

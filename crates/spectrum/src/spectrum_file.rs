@@ -53,6 +53,59 @@ impl SpectralColumns {
     }
 }
 
+impl SpectralColumns {
+    /// Every value of column `index` at most 1 (a reflectance or transmittance); the error
+    /// names the line and wavelength of the first above.
+    pub fn require_at_most_one(
+        &self,
+        index: usize,
+        path: &Path,
+        what: &str,
+    ) -> Result<(), SpectrumFileError> {
+        match self.columns[index].iter().position(|&v| v > 1.0) {
+            Some(row) => Err(SpectrumFileError::new(
+                path,
+                Some(self.lines[row]),
+                format!(
+                    "{what} must be at most 1, found {} at {} nm (a percentage? divide by 100)",
+                    self.columns[index][row], self.wavelengths_nm[row]
+                ),
+            )),
+            None => Ok(()),
+        }
+    }
+
+    /// The table reaches into `range_nm` (the renderer's wavelengths) with at least two
+    /// rows: a table is zero outside its rows, so one that misses the range is black.
+    pub fn require_coverage(
+        &self,
+        path: &Path,
+        range_nm: (f64, f64),
+    ) -> Result<(), SpectrumFileError> {
+        let (lo, hi) = range_nm;
+        match self.wavelengths_nm.as_slice() {
+            [] | [_] => Err(SpectrumFileError::new(
+                path,
+                self.lines.first().copied(),
+                format!(
+                    "{} row: expected a table of at least two wavelengths over {lo}–{hi} nm \
+                     (for a constant, give a number instead of a file)",
+                    self.wavelengths_nm.len()
+                ),
+            )),
+            [first, .., last] if *last < lo || *first > hi => Err(SpectrumFileError::new(
+                path,
+                self.lines.first().copied(),
+                format!(
+                    "the table covers {first}–{last} nm, outside the {lo}–{hi} nm the renderer \
+                     samples: it would be zero (black) there; expected wavelengths in nm"
+                ),
+            )),
+            _ => Ok(()),
+        }
+    }
+}
+
 fn split_fields(line: &str) -> Vec<&str> {
     if line.contains(',') {
         line.split(',').map(str::trim).collect()
@@ -187,7 +240,7 @@ pub fn parse_spectral_text(text: &str, path: &Path) -> Result<SpectralColumns, S
 
 /// Reads a spectral file from disk.
 pub fn read_spectral_file(path: &Path) -> Result<SpectralColumns, SpectrumFileError> {
-    let text = std::fs::read_to_string(path)
+    let text = prism_cpu::text_file::read_text(path)
         .map_err(|e| SpectrumFileError::new(path, None, format!("cannot read: {e}")))?;
     parse_spectral_text(&text, path)
 }

@@ -275,8 +275,8 @@ mod tests {
             2 => -3.5,
             k => (k as f32 * 0.37 + c as f32).powf(2.3) * 1e-2,
         };
-        let dir = std::env::temp_dir().join(format!("prism-exr-rgb-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let temp = tempfile::tempdir().unwrap();
+        let dir = temp.path().to_path_buf();
         let mut cases = 0;
         for half in [false, true] {
             for compression in [

@@ -2,8 +2,10 @@
 //! Every write goes to a temporary file in the destination's directory that is renamed
 //! over the destination only once complete, so a failed write never leaves half a file.
 
+mod dimensions;
 pub mod exr;
 mod exr_rgb;
+mod output_path;
 pub mod png;
 pub mod quantise;
 pub mod raw_exr;
@@ -16,6 +18,9 @@ use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 use prism_spectrum::rgb_space::RgbColorSpace;
+
+pub use dimensions::{read_dimensions, ImageDimensions};
+pub use output_path::{same_file, write_target};
 
 use crate::error::{ImageError, Result};
 use crate::image::Image;
@@ -80,7 +85,10 @@ pub fn temp_sibling(path: &Path) -> PathBuf {
 
 /// Runs `write` on a temporary path beside `path`, then renames it to `path`; on failure
 /// the temporary file is removed and the destination is left as it was.
+/// An output that is a symbolic link is written through to its target ([`write_target`]).
 pub(crate) fn write_atomically(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
+    let target = write_target(path);
+    let path = target.as_path();
     let tmp = TempFile(temp_sibling(path));
     let result = write(&tmp.0).and_then(|()| {
         std::fs::rename(&tmp.0, path)

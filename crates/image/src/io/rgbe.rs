@@ -53,16 +53,16 @@ pub fn decode_rgbe(rgbe: [u8; 4]) -> [f32; 3] {
     ]
 }
 
-struct Header {
-    width: usize,
-    height: usize,
+pub(crate) struct Header {
+    pub(crate) width: usize,
+    pub(crate) height: usize,
     xyz: bool,
     exposure: f64,
     primaries: Option<[f64; 8]>,
     lines: Vec<String>,
 }
 
-fn read_header(path: &Path, input: &mut impl BufRead) -> Result<Header> {
+pub(crate) fn read_header(path: &Path, input: &mut impl BufRead) -> Result<Header> {
     let bad = |m: String| ImageError::format(path, m);
     let mut total = 0usize;
     let mut line = String::new();

@@ -5,8 +5,9 @@
 //!   clamped to 0) and counted in `non_finite_pixels`;
 //! - mse, rmse: mean over pixels and channels of (a − b)²;
 //! - relmse: mean of (a − b)² / (b² + ε), ε = 1e-2 (Rousselle et al. 2011 style);
-//! - psnr_db = 10 log10(peak² / mse), peak = the largest channel value of the reference
-//!   (∞, written as JSON null, for identical images);
+//! - psnr_db = 10 log10(peak² / mse), peak = the largest channel value of the reference:
+//!   +∞ for identical images (a black pair included), −∞ for a black reference and a test
+//!   image that is not; JSON has null there and `psnr_note` says why. No metric is NaN.
 //! - ssim: Wang et al. 2004 on relative luminance Y, dynamic range L = the reference's
 //!   largest Y (see [`ssim`]); null for images smaller than 11×11;
 //! - ΔE2000: XYZ → CIELAB against the white of the reference's colour space with Y
@@ -58,6 +59,9 @@ pub struct Comparison {
     pub rmse: f64,
     pub relmse: f64,
     pub psnr_db: f64,
+    /// Why `psnr_db` is infinite (JSON writes ±∞ as null); absent when it is finite.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub psnr_note: Option<&'static str>,
     pub ssim: Option<f64>,
     pub delta_e2000_mean: f64,
     pub delta_e2000_p95: f64,
@@ -124,6 +128,34 @@ impl Default for CompareOptions {
         }
     }
 }
+
+/// PSNR in dB of `mse` at `peak`: 10 log10(peak² / mse), +∞ when mse is 0 (equal images,
+/// whatever the peak: 0/0 would be NaN for a black pair), −∞ when the peak is 0 and the
+/// images differ.
+pub fn psnr_db(peak: f64, mse: f64) -> f64 {
+    if mse == 0.0 {
+        f64::INFINITY
+    } else {
+        10.0 * (peak * peak / mse).log10()
+    }
+}
+
+/// Why [`psnr_db`] is infinite, for readers of JSON (where ±∞ is null).
+pub fn psnr_note(peak: f64, mse: f64) -> Option<&'static str> {
+    if mse == 0.0 {
+        Some("identical images: PSNR is +∞")
+    } else if peak == 0.0 {
+        Some("black reference (peak 0) and a test image that is not: PSNR is −∞")
+    } else {
+        None
+    }
+}
+
+/// Bytes per pixel of `prism compare` beyond the two images as decoded: the prepared
+/// reference's clean pixels and CIELAB, ΔE per pixel, SSIM planes and FLIP's maps. With
+/// 24 for two RGB images it is 136, above the 123 measured on a 2048² pair of float EXRs
+/// (docs/reliability.md); the memory check's estimate.
+pub const COMPARE_BYTES_PER_PIXEL: u64 = 112;
 
 /// Compares `test` against `reference`; an error when the sizes differ.
 pub fn compare(test: &Image, reference: &Image) -> Result<Comparison> {
@@ -205,10 +237,58 @@ mod tests {
         assert_eq!(c.mse, 0.0);
         assert_eq!(c.relmse, 0.0);
         assert_eq!(c.delta_e2000_mean, 0.0);
-        assert!(c.psnr_db.is_infinite());
+        assert_eq!(c.psnr_db, f64::INFINITY);
+        assert_eq!(c.per_channel.psnr_db, [f64::INFINITY; 3]);
+        assert_eq!(c.psnr_note, Some("identical images: PSNR is +∞"));
         assert!((c.ssim.unwrap() - 1.0).abs() < 1e-6);
         let flip = c.flip.unwrap();
         assert_eq!((flip.ldr_flip_mean, flip.hdr_flip_p95), (0.0, 0.0));
+    }
+
+    /// Every number of a comparison, in a fixed order.
+    fn numbers(c: &Comparison) -> Vec<(String, f64)> {
+        let mut v = vec![
+            ("mse".to_string(), c.mse),
+            ("rmse".into(), c.rmse),
+            ("relmse".into(), c.relmse),
+            ("psnr_db".into(), c.psnr_db),
+            ("delta_e2000_mean".into(), c.delta_e2000_mean),
+            ("delta_e2000_p95".into(), c.delta_e2000_p95),
+        ];
+        v.extend(c.ssim.map(|s| ("ssim".to_string(), s)));
+        for k in 0..3 {
+            v.push((format!("mse[{k}]"), c.per_channel.mse[k]));
+            v.push((format!("relmse[{k}]"), c.per_channel.relmse[k]));
+            v.push((format!("psnr_db[{k}]"), c.per_channel.psnr_db[k]));
+        }
+        if let Some(f) = &c.flip {
+            v.push(("ldr_flip_mean".into(), f.ldr_flip_mean));
+            v.push(("ldr_flip_p95".into(), f.ldr_flip_p95));
+            v.push(("hdr_flip_mean".into(), f.hdr_flip_mean));
+            v.push(("hdr_flip_p95".into(), f.hdr_flip_p95));
+        }
+        v
+    }
+
+    #[test]
+    fn black_images_give_no_nan() {
+        let black = Image::new(16, 16, vec![[0.0; 3]; 256], RgbColorSpace::srgb()).unwrap();
+        let c = compare(&black, &black).unwrap();
+        for (name, value) in numbers(&c) {
+            assert!(!value.is_nan(), "{name} is NaN for two black images");
+        }
+        assert_eq!(c.psnr_db, f64::INFINITY);
+        assert_eq!((c.mse, c.relmse, c.delta_e2000_mean), (0.0, 0.0, 0.0));
+        // A black reference against a grey test image: the peak is 0.
+        let grey = Image::new(16, 16, vec![[0.5; 3]; 256], RgbColorSpace::srgb()).unwrap();
+        let c = compare(&grey, &black).unwrap();
+        for (name, value) in numbers(&c) {
+            assert!(!value.is_nan(), "{name} is NaN against a black reference");
+        }
+        assert_eq!(c.psnr_db, f64::NEG_INFINITY);
+        assert!(c.psnr_note.unwrap().contains("black reference"));
+        let json = serde_json::to_value(&c).unwrap();
+        assert!(json["psnr_db"].is_null() && json["psnr_note"].is_string());
     }
 
     /// FLIP runs on Rec.709: a P3 test against its sRGB conversion scores 0 (to rounding),

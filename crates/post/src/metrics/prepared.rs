@@ -178,7 +178,7 @@ impl PreparedReference {
         let mse_c = sums.se.map(|s| s / n);
         let relmse_c = sums.rel.map(|s| s / n);
         let peak = self.peak_c.iter().cloned().fold(0.0, f64::max);
-        let psnr = |peak: f64, mse: f64| 10.0 * (peak * peak / mse).log10();
+        let psnr = super::psnr_db;
         let mse = mse_c.iter().sum::<f64>() / 3.0;
 
         let ssim = if options.ssim {
@@ -224,6 +224,7 @@ impl PreparedReference {
             rmse: mse.sqrt(),
             relmse: relmse_c.iter().sum::<f64>() / 3.0,
             psnr_db: psnr(peak, mse),
+            psnr_note: super::psnr_note(peak, mse),
             ssim,
             delta_e2000_mean: sums.de / n,
             delta_e2000_p95: de_p95,

@@ -331,7 +331,15 @@ pub fn render_pass_controlled(
         return render_pass_controlled(estimator, scene, &moved, film, progress, control);
     }
     if let Some(per_prepare) = estimator.sample_indices_per_prepare() {
-        return render_in_sample_steps(estimator, scene, pass, film, progress, per_prepare, control);
+        return render_in_sample_steps(
+            estimator,
+            scene,
+            pass,
+            film,
+            progress,
+            per_prepare,
+            control,
+        );
     }
     estimator
         .prepare(scene, pass)

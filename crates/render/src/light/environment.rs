@@ -156,11 +156,14 @@ impl EnvironmentLight {
             ));
         }
         if let Some(i) = pixels.iter().position(|p| !p.iter().all(|c| c.is_finite())) {
+            let p = pixels[i];
             return Err(format!(
-                "pixel ({}, {}) is not finite: {:?}",
+                "texel ({}, {}) is not finite: ({}, {}, {}); expected finite radiance",
                 i % width,
                 i / width,
-                pixels[i]
+                p[0],
+                p[1],
+                p[2]
             ));
         }
         let upsampled: Vec<(SigmoidPolynomial, f32)> = pixels
@@ -228,6 +231,27 @@ impl EnvironmentLight {
         scene: SceneSphere,
     ) -> Result<Self, String> {
         let image = prism_image::io::read_image(path).map_err(|e| e.to_string())?;
+        // Radiance is never negative: a negative texel is a broken or signed-difference
+        // image, which clamping would hide (checked on the file's values, before a gamut
+        // conversion that may legitimately leave out-of-gamut colours negative).
+        let width = image.width();
+        if let Some(i) = image
+            .pixels()
+            .iter()
+            .position(|p| p.iter().any(|&c| c < 0.0))
+        {
+            let p = image.pixels()[i];
+            return Err(format!(
+                "{}: texel ({}, {}) (column, row from the top left) has a negative value \
+                 ({}, {}, {}); expected radiance ≥ 0",
+                path.display(),
+                i % width,
+                i / width,
+                p[0],
+                p[1],
+                p[2]
+            ));
+        }
         let space = &image.color_space;
         let close =
             |a: &[f64; 2], b: &[f64; 2]| (a[0] - b[0]).abs().max((a[1] - b[1]).abs()) < 5e-4;
@@ -662,7 +686,23 @@ mod tests {
             e.contains("lights[0].file: cannot use the environment map: "),
             "{e}"
         );
-        assert!(e.contains("nan.exr: pixel (4, 1) is not finite"), "{e}");
+        assert!(
+            e.contains("nan.exr: texel (4, 1) is not finite: (NaN, 0, 0)"),
+            "{e}"
+        );
+        let mut pixels = synthetic_pixels();
+        pixels[19] = [0.5, -0.25, 0.0];
+        let image = prism_image::Image::new(16, 8, pixels, RgbColorSpace::srgb()).unwrap();
+        prism_image::io::write_image(&dir.path().join("negative.exr"), &image).unwrap();
+        let e = build_error(
+            dir.path(),
+            r#"{"lights": [{"type": "environment", "file": "negative.exr"}]}"#,
+        );
+        assert!(
+            e.contains("negative.exr: texel (3, 1)") && e.contains("(0.5, -0.25, 0)"),
+            "{e}"
+        );
+        assert!(e.contains("expected radiance ≥ 0"), "{e}");
         let e = build_error(
             dir.path(),
             r#"{"lights": [{"type": "environment", "file": "nan.exr", "transform": {"scale": [1, 2, 1]}}]}"#,

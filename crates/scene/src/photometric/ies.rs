@@ -239,7 +239,7 @@ pub fn parse_ies(text: &str, file: &Path) -> Result<IntensityDistribution, Photo
         }
         _ => {
             let tilt_path = file.parent().unwrap_or(Path::new("")).join(tilt_value);
-            let tilt_text = std::fs::read_to_string(&tilt_path).map_err(|e| {
+            let tilt_text = prism_cpu::text_file::read_text(&tilt_path).map_err(|e| {
                 err(
                     Some(tilt_n),
                     format!("cannot read the tilt file {}: {e}", tilt_path.display()),
