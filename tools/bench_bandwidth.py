@@ -11,9 +11,12 @@ the predictor issue asks for, from each run's `ratios` block:
     cargo build --release
     python3 tools/bench_bandwidth.py [--budget-s 20] [--reference-spp 2048] [--scenes a,b]
 
-The MERL tables of scenes/bandwidth/fig9-spheres.json are written first by
-`prism merl-export` from scenes/bandwidth/merl-sources.json when missing (33 MB each, not
-committed). Writes tools/bench-results/bandwidth.json (per-scene converge JSON inside).
+The paper's Fig. 9 spheres are measured materials: the benchmark renders
+scenes/bandwidth/fig9-spheres.json with its three conductors replaced by MERL tables
+`merl-export`ed from them (scenes/bandwidth/merl-sources.json; written to scenes/merl/ when
+missing, 33 MB each, not committed), so that the predictor's MERL path is what runs. The
+committed scene keeps the analytic materials, so that it builds on a clean checkout.
+Writes tools/bench-results/bandwidth.json (per-scene converge JSON inside).
 """
 
 import argparse
@@ -27,11 +30,13 @@ import tempfile
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 PRISM = os.path.join(ROOT, "target", "release", "prism")
 SCENES = {
-    "fig9-spheres": ("scenes/bandwidth/fig9-spheres.json", None),
+    "fig9-spheres": ("MERL", None),
     "fig17-curved-area": ("scenes/bandwidth/fig17-curved-area.json", None),
     "glossy-env": ("scenes/glossy-env.json", "160x90"),
 }
 MERL = ["gold-ggx", "sharp-copper", "rough-nickel"]
+# fig9-spheres.json's material → the MERL table that replaces it.
+MERL_FOR = {"gold": "gold-ggx", "copper": "sharp-copper", "nickel": "rough-nickel"}
 METHODS = ["path", "path+adaptive", "path+predicted"]
 
 
@@ -41,6 +46,23 @@ def ensure_merl():
         if not os.path.exists(out):
             subprocess.run([PRISM, "merl-export", "scenes/bandwidth/merl-sources.json",
                             "--material", name, "-o", out], cwd=ROOT, check=True)
+
+
+def merl_scene(work):
+    """fig9-spheres.json with its conductors replaced by their MERL tables, written into
+    `work` with absolute paths."""
+    with open(os.path.join(ROOT, "scenes", "bandwidth", "fig9-spheres.json")) as f:
+        scene = json.load(f)
+    for material, table in MERL_FOR.items():
+        scene["materials"][material] = {
+            "type": "merl", "file": os.path.join(ROOT, "scenes", "merl", f"{table}.binary")}
+    for light in scene["lights"]:
+        if "file" in light:
+            light["file"] = os.path.join(ROOT, "scenes", "bandwidth", light["file"])
+    path = os.path.join(work, "fig9-spheres-merl.json")
+    with open(path, "w") as f:
+        json.dump(scene, f, indent=2)
+    return path
 
 
 def summarise(data):
@@ -82,6 +104,8 @@ def main():
     results = {}
     for name in opts.scenes.split(","):
         scene, resolution = SCENES[name]
+        if scene == "MERL":
+            scene = merl_scene(work)
         out = os.path.join(work, f"{name}.json")
         command = [PRISM, "converge", scene, "--clock", "cpu", "--budget-s",
                    str(opts.budget_s), "--reference-spp", str(opts.reference_spp),

@@ -16,6 +16,9 @@ use prism_render::{PlanRequest, RenderPlan, RenderScene};
 const DECISIONS: &[(&str, bool, bool, &[SceneFeature])] = {
     use SceneFeature::*;
     &[
+        ("bandwidth/fig17-curved-area.json", false, true, &[NonLambertianBsdfs, Quadrics]),
+        ("bandwidth/fig9-spheres.json", false, true, &[Textures, NonLambertianBsdfs, Quadrics, InfiniteLights]),
+        ("bandwidth/merl-sources.json", false, true, &[NonLambertianBsdfs, Quadrics]),
         ("cameras/fisheye-equidistant.json", false, true, &[DiagnosticIntegrator, NonLambertianBsdfs, Quadrics]),
         ("cameras/fisheye-equisolid.json", false, true, &[DiagnosticIntegrator, NonLambertianBsdfs, Quadrics]),
         ("cameras/fisheye-orthographic.json", false, true, &[DiagnosticIntegrator, NonLambertianBsdfs, Quadrics]),
