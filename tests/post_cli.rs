@@ -682,7 +682,12 @@ fn compare_reports_flip_and_writes_its_error_map() {
     let leftovers: Vec<_> = std::fs::read_dir(map.parent().unwrap())
         .unwrap()
         .filter_map(|e| e.ok())
-        .filter(|e| e.file_name().to_string_lossy().ends_with(".tmp"))
+        // Only this write's temporaries: the folder is shared with tests running beside
+        // this one, whose writes are in flight.
+        .filter(|e| {
+            let name = e.file_name().to_string_lossy().into_owned();
+            name.starts_with(".flip-map.png.") && name.ends_with(".tmp")
+        })
         .collect();
     assert!(leftovers.is_empty(), "{leftovers:?}");
 

@@ -1,5 +1,6 @@
 //! The `prism` command: spectral rendering, colorimetry and tone reproduction.
 
+mod atomic_write;
 mod bispectral;
 mod color;
 mod compare;

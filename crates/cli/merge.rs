@@ -311,10 +311,10 @@ fn merge_sensors(
     let (json_path, csv_path) = crate::sensors::sensor_paths(output);
     let value = crate::sensors::readings_json(parts[0], &readings, &stats, wall_time_s);
     let text = serde_json::to_string_pretty(&value).map_err(|e| e.to_string())? + "\n";
-    crate::sensors::write_atomic(&json_path, &text, "sensor readings")?;
-    crate::sensors::write_atomic(
+    crate::atomic_write::write_atomic(&json_path, text.as_bytes(), "sensor readings")?;
+    crate::atomic_write::write_atomic(
         &csv_path,
-        &crate::sensors::readings_csv(&readings),
+        crate::sensors::readings_csv(&readings).as_bytes(),
         "sensor readings",
     )?;
     eprintln!("wrote {} and {}", json_path.display(), csv_path.display());

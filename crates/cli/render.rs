@@ -853,20 +853,7 @@ fn write_stats(
 
 fn write_json(path: &Path, value: &serde_json::Value) -> Result<(), String> {
     let text = serde_json::to_string_pretty(value).map_err(|e| e.to_string())? + "\n";
-    // Atomic like the image: a temporary sibling renamed over the destination (through a
-    // symbolic link, like the image).
-    let target = prism_image::io::write_target(path);
-    let path = target.as_path();
-    let tmp = prism_image::io::temp_sibling(path);
-    let result = std::fs::write(&tmp, text).and_then(|()| std::fs::rename(&tmp, path));
-    if let Err(e) = result {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(format!(
-            "cannot write the statistics {}: {e}",
-            path.display()
-        ));
-    }
-    Ok(())
+    crate::atomic_write::write_atomic(path, text.as_bytes(), "statistics")
 }
 
 /// A range render's share of the sensors: their sums beside the part, for `prism merge`
@@ -904,7 +891,7 @@ fn measure_sensor_share(
                 &sums,
             );
             let text = serde_json::to_string_pretty(&value).map_err(|e| e.to_string())? + "\n";
-            crate::sensors::write_atomic(&path, &text, "sensor sums")?;
+            crate::atomic_write::write_atomic(&path, text.as_bytes(), "sensor sums")?;
             eprintln!("wrote {}", path.display());
             Ok(())
         }
@@ -959,8 +946,8 @@ fn measure_and_write_sensors(
         csv = crate::daylight_factor::add_to_csv(&csv, &readings, e_out);
     }
     let text = serde_json::to_string_pretty(&value).map_err(|e| e.to_string())? + "\n";
-    crate::sensors::write_atomic(&json_path, &text, "sensor readings")?;
-    crate::sensors::write_atomic(&csv_path, &csv, "sensor readings")?;
+    crate::atomic_write::write_atomic(&json_path, text.as_bytes(), "sensor readings")?;
+    crate::atomic_write::write_atomic(&csv_path, csv.as_bytes(), "sensor readings")?;
     if args.false_colour == Some(crate::falsecolour::FalseColourQuantity::Illuminance) {
         for path in crate::falsecolour::write_illuminance(
             output,

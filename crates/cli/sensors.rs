@@ -20,23 +20,6 @@ pub fn sensor_paths(output: &Path) -> (PathBuf, PathBuf) {
     )
 }
 
-/// Writes `text` to `path` through a temporary sibling.
-pub fn write_atomic(path: &Path, text: &str, what: &str) -> Result<(), String> {
-    let target = prism_image::io::write_target(path);
-    let path = target.as_path();
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let tmp = path.with_file_name(format!(".{name}.{}.tmp", std::process::id()));
-    let result = std::fs::write(&tmp, text).and_then(|()| std::fs::rename(&tmp, path));
-    if let Err(e) = result {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(format!("cannot write the {what} {}: {e}", path.display()));
-    }
-    Ok(())
-}
-
 /// The JSON document of the readings.
 pub fn readings_json(
     scene: &Path,

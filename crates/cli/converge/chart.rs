@@ -15,7 +15,6 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::fit::PowerFit;
-use super::write_atomic;
 
 static FONT: &[u8] = include_bytes!("../../../assets/fonts/DejaVuSans-subset.ttf");
 const FAMILY: &str = "sans-serif";
@@ -250,7 +249,7 @@ pub fn write_chart(path: &Path, title: &str, x_axis: &str, curves: &[Curve]) -> 
             ))
         }
     };
-    write_atomic(path, &bytes)
+    crate::atomic_write::write_atomic(path, &bytes, "chart")
 }
 
 #[cfg(test)]

@@ -152,23 +152,6 @@ impl Clock {
     }
 }
 
-/// Writes `bytes` to a temporary sibling and renames it over `path`.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), String> {
-    let target = prism_image::io::write_target(path);
-    let path = target.as_path();
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let tmp = path.with_file_name(format!(".{name}.{}.tmp", std::process::id()));
-    let result = std::fs::write(&tmp, bytes).and_then(|()| std::fs::rename(&tmp, path));
-    if let Err(e) = result {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(format!("cannot write {}: {e}", path.display()));
-    }
-    Ok(())
-}
-
 fn check_arguments(args: &ConvergeArgs) -> Result<Budget, String> {
     if args.outputs.is_empty() && args.json.is_none() && args.report.is_none() {
         return Err(
@@ -733,7 +716,7 @@ pub fn run(args: &ConvergeArgs, memory: &MemoryBudget) -> Result<(), String> {
             "methods": methods_json,
         });
         let text = serde_json::to_string_pretty(&value).map_err(|e| e.to_string())? + "\n";
-        write_atomic(path, text.as_bytes())?;
+        crate::atomic_write::write_atomic(path, text.as_bytes(), "convergence data")?;
         eprintln!("wrote {}", path.display());
     }
     Ok(())

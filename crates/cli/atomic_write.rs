@@ -1,0 +1,13 @@
+//! The commands' text and byte outputs (JSON, CSV, charts, sensor sums) written as the
+//! images are: into a temporary sibling, renamed over the destination (through a symbolic
+//! link to its target), the temporary removed when the write fails or panics
+//! (`prism_image::io::write_bytes_atomically`). One place, so that every output follows the
+//! same rules (docs/reliability.md, "What is atomic").
+
+use std::path::Path;
+
+/// Writes `bytes` to `path` atomically; `what` names the output in the error.
+pub fn write_atomic(path: &Path, bytes: &[u8], what: &str) -> Result<(), String> {
+    prism_image::io::write_bytes_atomically(path, bytes)
+        .map_err(|e| format!("cannot write the {what}: {e}"))
+}
