@@ -471,10 +471,8 @@ impl PathTracer {
             };
             let mut si = scene.geometry.shading_interaction(&ray, &hit);
             // The boundary's own word for the side the ray arrives from.
-            if let Some(b) = media.boundary(hit.instance_id) {
-                if b.medium_towards(-ray.direction, si.n_geometric) != medium {
-                    counters.medium_mismatches += 1;
-                }
+            if media.arrives_mismatched(medium, hit.instance_id, ray.direction, si.n_geometric) {
+                counters.medium_mismatches += 1;
             }
             // A medium boundary that scatters nothing: cross it, not a bounce.
             if media.is_interface(si.material_id) {
@@ -486,14 +484,11 @@ impl PathTracer {
                 }
                 continue;
             }
-            if let Some(footprint) = &scene.texture_footprint {
-                match &current_differential {
-                    Some(rd) => si.compute_differentials(rd),
-                    None => {
-                        si.compute_differentials(&footprint.approximate(si.p, differential_scale))
-                    }
-                }
-            }
+            scene.set_texture_differentials(
+                &mut si,
+                current_differential.as_ref(),
+                differential_scale,
+            );
             let material = scene.material(si.material_id);
             let dims = path.next_vertex_dimensions();
             let reradiation_dims = scene

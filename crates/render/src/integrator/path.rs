@@ -312,14 +312,11 @@ impl PathTracer {
             // No curvature: shading never reads it, nor does the film's G-buffer (depth,
             // normal, albedo); it cost ≈ 1 % of a Cornell box render at every first hit.
             let mut si = scene.geometry.shading_interaction(&ray, &hit);
-            if let Some(footprint) = &scene.texture_footprint {
-                match &current_differential {
-                    Some(rd) => si.compute_differentials(rd),
-                    None => {
-                        si.compute_differentials(&footprint.approximate(si.p, differential_scale))
-                    }
-                }
-            }
+            scene.set_texture_differentials(
+                &mut si,
+                current_differential.as_ref(),
+                differential_scale,
+            );
             let material = scene.material(si.material_id);
             // The vertex's block (`dimensions`): reserved in order, each computed only when
             // used — the same values as drawing all of them (`SampleStream::reserve`).

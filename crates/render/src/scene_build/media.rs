@@ -84,6 +84,21 @@ impl MediaScene {
             .unwrap_or(false)
     }
 
+    /// True when the boundary hit at `instance_id` (geometric normal `n`, reached along
+    /// `direction`) says the ray arrives from another medium than `current`: the scene's
+    /// media nest inconsistently there (counted in `PathCounters::medium_mismatches`).
+    #[inline]
+    pub fn arrives_mismatched(
+        &self,
+        current: Option<u32>,
+        instance_id: u32,
+        direction: glam::Vec3A,
+        n: glam::Vec3A,
+    ) -> bool {
+        self.boundary(instance_id)
+            .is_some_and(|b| b.medium_towards(-direction, n) != current)
+    }
+
     /// The medium of a ray that leaves a hit on `instance_id` (geometric normal `n`) along
     /// `direction`, having arrived in `current`.
     #[inline]

@@ -227,6 +227,24 @@ impl RenderScene {
         &self.materials[(material_id as usize).min(last)]
     }
 
+    /// The texture-filtering differentials of a hit in a textured scene: the ray's own
+    /// (`ray`, while the path is specular from the camera) or the camera footprint
+    /// approximation scaled by `scale` (pbrt-v4 §10.1.2). Untextured scenes skip it.
+    #[inline]
+    pub fn set_texture_differentials(
+        &self,
+        si: &mut prism_geometry::SurfaceInteraction,
+        ray: Option<&prism_geometry::RayDifferential>,
+        scale: f32,
+    ) {
+        if let Some(footprint) = &self.texture_footprint {
+            match ray {
+                Some(rd) => si.compute_differentials(rd),
+                None => si.compute_differentials(&footprint.approximate(si.p, scale)),
+            }
+        }
+    }
+
     /// Albedo of a hit's `material_id`.
     #[inline]
     pub fn albedo(&self, material_id: u32) -> [f32; 3] {

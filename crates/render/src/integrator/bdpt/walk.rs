@@ -63,9 +63,7 @@ pub fn random_walk<'s>(
             break;
         };
         let mut si = scene.geometry.shading_interaction(&ray, &hit);
-        if let Some(footprint) = &scene.texture_footprint {
-            si.compute_differentials(&footprint.approximate(si.p, 1.0));
-        }
+        scene.set_texture_differentials(&mut si, None, 1.0);
         let material = scene.material(si.material_id);
         let dims = path_state.next_vertex_dimensions();
         let opacity = if scene.has_masks {

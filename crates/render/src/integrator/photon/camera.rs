@@ -170,10 +170,9 @@ impl CameraPaths<'_> {
             let mut si = scene.geometry.shading_interaction(&ray, &hit);
             if let Some(media) = media {
                 // The boundary's own word for the side the ray arrives from (as `path`).
-                if let Some(b) = media.boundary(hit.instance_id) {
-                    if b.medium_towards(-ray.direction, si.n_geometric) != medium {
-                        counters.medium_mismatches += 1;
-                    }
+                if media.arrives_mismatched(medium, hit.instance_id, ray.direction, si.n_geometric)
+                {
+                    counters.medium_mismatches += 1;
                 }
                 if media.is_interface(si.material_id) {
                     medium =
