@@ -5,46 +5,11 @@
 //! Spectral coefficients come from CSV files, so the expected Y is the exact
 //! ∫ L(λ) ȳ(λ) dλ / ∫ ȳ dλ over 360–830 nm (the film's normalisation).
 
-use std::path::PathBuf;
-
 use prism_render::{render, FilmImage, RenderScene, RenderSettings};
-use prism_scene::load_scene;
 use prism_spectrum::data::{cmfs, Observer};
 
-struct Dir(PathBuf);
-
-impl Dir {
-    fn new(test: &str) -> Dir {
-        let dir = std::env::temp_dir().join(format!("prism-media-{}-{test}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
-        Dir(dir)
-    }
-    fn write(&self, name: &str, bytes: &[u8]) -> PathBuf {
-        let p = self.0.join(name);
-        std::fs::write(&p, bytes).unwrap();
-        p
-    }
-    fn scene(&self, json: &str) -> RenderScene {
-        let path = self.write("scene.json", json.as_bytes());
-        let description = load_scene(&path).unwrap_or_else(|e| panic!("{e}"));
-        RenderScene::build(&description, None).unwrap_or_else(|e| panic!("{e}"))
-    }
-    fn build_error(&self, json: &str) -> String {
-        let path = self.write("scene.json", json.as_bytes());
-        let description = load_scene(&path).unwrap_or_else(|e| panic!("{e}"));
-        match RenderScene::build(&description, None) {
-            Ok(_) => panic!("built a scene that should be refused: {json}"),
-            Err(e) => e.to_string().replace(&self.0.display().to_string(), "DIR"),
-        }
-    }
-}
-
-impl Drop for Dir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
+mod support;
+use support::Dir;
 
 fn render_scene(scene: &RenderScene, spp: u32, seed: u64) -> FilmImage {
     let settings = RenderSettings {
@@ -158,7 +123,7 @@ fn slab_scene(media: &str, integrator: &str) -> String {
 /// view axis (τ exact by the trapezoid rule over voxel centres, edge values held).
 #[test]
 fn beer_lambert_through_an_absorbing_slab() {
-    let dir = Dir::new("beer-lambert");
+    let dir = Dir::new("media", "beer-lambert");
     let points = [(360.0, 0.5), (550.0, 1.5), (830.0, 3.0)];
     let (csv, sigma_a) = spectrum_csv(&points);
     dir.write("sigma_a.csv", csv.as_bytes());
@@ -216,7 +181,7 @@ fn beer_lambert_through_an_absorbing_slab() {
 /// L = Le_m·(1 − e^(−σa·d)).
 #[test]
 fn an_emissive_slab_glows_with_its_closed_form() {
-    let dir = Dir::new("emissive");
+    let dir = Dir::new("media", "emissive");
     let points = [(360.0, 0.5), (550.0, 1.5), (830.0, 3.0)];
     let (csv, sigma_a) = spectrum_csv(&points);
     dir.write("sigma_a.csv", csv.as_bytes());
@@ -284,7 +249,7 @@ fn airlight_sun(sigma_s: f64, sigma_t: f64, intensity: f64, d: f64, gamma: f64, 
 /// the single-scattering integral, Henyey–Greenstein, Rayleigh and a tabulated one.
 #[test]
 fn airlight_of_a_point_light() {
-    let dir = Dir::new("airlight");
+    let dir = Dir::new("media", "airlight");
     let (sigma_s, sigma_a, intensity) = (0.4, 0.1, 3.0);
     let sigma_t = sigma_s + sigma_a;
     let light: [f64; 3] = [0.0, 1.0, -1.5];
@@ -362,7 +327,7 @@ fn airlight_of_a_point_light() {
 /// scattering; homogeneous and a random grid.
 #[test]
 fn furnace_inside_an_emitting_sphere() {
-    let dir = Dir::new("furnace");
+    let dir = Dir::new("media", "furnace");
     let (csv, _) = spectrum_csv(&[(360.0, 1.0), (600.0, 20.0), (830.0, 5.0)]);
     dir.write("sigma_s.csv", csv.as_bytes());
     let mut state = 12345u64;
@@ -409,7 +374,7 @@ fn furnace_inside_an_emitting_sphere() {
 /// emitter): spectral MIS on and off have the same mean, and on has the lower variance.
 #[test]
 fn spectral_mis_keeps_the_mean_and_lowers_the_variance() {
-    let dir = Dir::new("spectral-mis");
+    let dir = Dir::new("media", "spectral-mis");
     let csv = "wavelength_nm,value\n360,2\n489,2\n490,6\n589,6\n590,9\n830,9\n";
     dir.write("bands.csv", csv.as_bytes());
     let media = r#""slab": {"sigma_s_per_m": "bands.csv", "phase": {"type": "hg", "g": 0.5}}"#;
@@ -435,7 +400,7 @@ fn spectral_mis_keeps_the_mean_and_lowers_the_variance() {
 /// Light-path methods and the packet tracer refuse media; path renders them.
 #[test]
 fn light_bdpt_and_packets_refuse_media() {
-    let dir = Dir::new("refusals");
+    let dir = Dir::new("media", "refusals");
     let media = r#""slab": {"sigma_a_per_m": 1}"#;
     for method in ["light", "bdpt"] {
         let e = dir.build_error(&slab_scene(media, &format!(r#"{{"type": "{method}"}}"#)));
@@ -467,7 +432,7 @@ fn light_bdpt_and_packets_refuse_media() {
 /// Bad inputs only render can see, refused at their JSON path.
 #[test]
 fn media_errors_name_the_entry() {
-    let dir = Dir::new("errors");
+    let dir = Dir::new("media", "errors");
     // An open mesh (one triangle) around an interior medium.
     dir.write("tri.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
     let e = dir.build_error(
@@ -522,7 +487,7 @@ fn media_errors_name_the_entry() {
 /// off, and warns of a point light inside a closed dielectric (a volumetric caustic).
 #[test]
 fn the_plan_lists_media_and_warns_of_volumetric_caustics() {
-    let dir = Dir::new("plan");
+    let dir = Dir::new("media", "plan");
     dir.write(
         "grid.vol",
         &vol_bytes([2, 3, 4], [-1.0; 3], [1.0; 3], &[0.5; 24]),
@@ -584,7 +549,7 @@ fn the_plan_lists_media_and_warns_of_volumetric_caustics() {
 /// render` warns); consistent ones are not.
 #[test]
 fn inconsistent_boundaries_are_counted() {
-    let dir = Dir::new("mismatch");
+    let dir = Dir::new("media", "mismatch");
     let scene = |inner_exterior: &str| {
         format!(
             r#"{{
@@ -622,7 +587,7 @@ fn inconsistent_boundaries_are_counted() {
 /// (the lane average biased it): the two agree.
 #[test]
 fn after_dispersion_spectral_mis_on_and_off_agree() {
-    let dir = Dir::new("dispersion");
+    let dir = Dir::new("media", "dispersion");
     let csv = "wavelength_nm,value\n360,2\n489,2\n490,6\n589,6\n590,9\n830,9\n";
     dir.write("bands.csv", csv.as_bytes());
     let mut results = Vec::new();

@@ -15,40 +15,8 @@ use prism_bandwidth::SamplePlan;
 use prism_render::{film_for, render_pass, RenderScene, RenderSettings};
 use prism_scene::load_scene;
 
-struct Dir(PathBuf);
-
-impl Dir {
-    fn new(test: &str) -> Dir {
-        let dir = std::env::temp_dir().join(format!("prism-photon-{}-{test}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
-        Dir(dir)
-    }
-    fn write(&self, name: &str, bytes: &[u8]) -> PathBuf {
-        let p = self.0.join(name);
-        std::fs::write(&p, bytes).unwrap();
-        p
-    }
-    fn scene(&self, json: &str) -> RenderScene {
-        let path = self.write("scene.json", json.as_bytes());
-        let description = load_scene(&path).unwrap_or_else(|e| panic!("{e}"));
-        RenderScene::build(&description, None).unwrap_or_else(|e| panic!("{e}"))
-    }
-    fn build_error(&self, json: &str) -> String {
-        let path = self.write("scene.json", json.as_bytes());
-        let description = load_scene(&path).unwrap_or_else(|e| panic!("{e}"));
-        match RenderScene::build(&description, None) {
-            Ok(_) => panic!("built a scene that should be refused: {json}"),
-            Err(e) => e.to_string().replace(&self.0.display().to_string(), "DIR"),
-        }
-    }
-}
-
-impl Drop for Dir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
+mod support;
+use support::Dir;
 
 /// The mean Y over `window` (x0, y0, x1, y1; exclusive ends) of each of `passes`
 /// independent passes (sample indices `first..first + passes`, each in its own film,
@@ -126,7 +94,7 @@ fn airlight_sun(sigma_s: f64, sigma_t: f64, intensity: f64, d: f64, gamma: f64, 
 /// passes' radii (second order in r/d ≈ 0.02).
 #[test]
 fn photon_progressive_converges_to_the_airlight() {
-    let dir = Dir::new("airlight");
+    let dir = Dir::new("photon", "airlight");
     let (sigma_s, sigma_a, intensity) = (0.4, 0.1, 3.0);
     let sigma_t = sigma_s + sigma_a;
     let light: [f64; 3] = [0.0, 1.0, -1.5];
@@ -161,7 +129,7 @@ const LE: f64 = 2.0;
 /// Floor 1 %: the photons' discs reach past the wall within r²/2 of it.
 #[test]
 fn photon_integrators_in_the_furnace() {
-    let dir = Dir::new("furnace");
+    let dir = Dir::new("photon", "furnace");
     dir.write(
         "sigma_s.csv",
         b"wavelength_nm,value\n360,1\n600,20\n830,5\n",
@@ -276,7 +244,7 @@ fn caustic_under_a_glass_sphere_converges() {
 /// storage estimate above the memory limit, naming the count, the estimate and the limit.
 #[test]
 fn refusals_name_the_reason() {
-    let dir = Dir::new("refusals");
+    let dir = Dir::new("photon", "refusals");
     let e = dir.build_error(
         r#"{"integrator": {"type": "photon"},
             "shapes": [{"type": "sphere", "radius_m": 1}]}"#,
@@ -365,7 +333,7 @@ fn photon_images_do_not_depend_on_the_thread_count() {
 /// 3 % for the kernel's blur across the window's edge (radius 0.04 m, a third of a pixel).
 #[test]
 fn caustics_on_a_coated_floor_keep_path_energy() {
-    let dir = Dir::new("coated");
+    let dir = Dir::new("photon", "coated");
     let json = |integrator: &str| {
         format!(
             r#"{{
@@ -414,7 +382,7 @@ fn caustics_on_a_coated_floor_keep_path_energy() {
 /// −2.9 % ± 2.7 % at 768 passes).
 #[test]
 fn spot_in_fog_without_glass_agrees_with_path() {
-    let dir = Dir::new("spot-fog");
+    let dir = Dir::new("photon", "spot-fog");
     let path =
         PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes/stress/spot-fog-glass.json");
     let mut json: serde_json::Value =
