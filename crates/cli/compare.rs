@@ -152,18 +152,7 @@ pub fn check_report_path(path: &Path) -> Result<(), String> {
             path.display()
         ));
     }
-    let parent = match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    };
-    if !parent.is_dir() {
-        return Err(format!(
-            "--report {}: the directory {} does not exist",
-            path.display(),
-            parent.display()
-        ));
-    }
-    Ok(())
+    crate::atomic_write::check_parent("--report", path)
 }
 
 fn print_tmqi(t: &Tmqi) {
@@ -207,7 +196,7 @@ pub fn run(args: &CompareArgs, budget: &MemoryBudget) -> Result<(), String> {
     args.simd.apply()?;
     if let Some(map) = &args.error_map {
         // Checked before the metrics run, which take long on large images.
-        crate::render::check_parent("--error-map", map)?;
+        crate::atomic_write::check_parent("--error-map", map)?;
         ImageFormat::from_path(map).map_err(|e| format!("--error-map: {e}"))?;
     }
     check_memory(args, budget)?;

@@ -239,23 +239,6 @@ fn check_output(path: &Path) -> Result<(), String> {
     }
 }
 
-/// The folder of `path` (an output beside the image) must exist, checked before rendering.
-pub(crate) fn check_parent(what: &str, path: &Path) -> Result<(), String> {
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
-    if dir.is_dir() {
-        Ok(())
-    } else {
-        Err(format!(
-            "{what} {}: the directory {} does not exist",
-            path.display(),
-            dir.display()
-        ))
-    }
-}
-
 /// `--spectral-bins N` checked against its range and the output format (before rendering).
 fn spectral_bins(args: &RenderArgs, output: &Path) -> Result<Option<SpectralBins>, String> {
     let Some(n) = args.spectral_bins else {
@@ -335,7 +318,7 @@ pub fn run(args: &RenderArgs, budget: &MemoryBudget) -> Result<ExitCode, String>
     if !args.explain {
         check_output(&output)?;
         if let Some(stats) = &args.stats_json {
-            check_parent("--stats-json", stats)?;
+            crate::atomic_write::check_parent("--stats-json", stats)?;
         }
         if args.false_colour.is_some() {
             crate::falsecolour::check_options(args.false_colour_scale, args.false_colour_range)?;

@@ -275,7 +275,7 @@ pub fn run(args: &TonemapArgs, budget: &MemoryBudget) -> Result<(), String> {
             output.display()
         ));
     }
-    crate::render::check_parent("-o", output)?;
+    crate::atomic_write::check_parent("-o", output)?;
     prism_image::io::ImageFormat::from_path(output).map_err(|e| e.to_string())?;
     check_memory(input, budget)?;
     let order = match (args.sort, args.score) {

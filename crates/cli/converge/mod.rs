@@ -172,10 +172,10 @@ fn check_arguments(args: &ConvergeArgs) -> Result<Budget, String> {
                 o.display()
             ));
         }
-        crate::render::check_parent("chart", o)?;
+        crate::atomic_write::check_parent("chart", o)?;
     }
     if let Some(j) = &args.json {
-        crate::render::check_parent("--json", j)?;
+        crate::atomic_write::check_parent("--json", j)?;
     }
     if let Some(d) = &args.save_final {
         if !d.is_dir() {
