@@ -10,8 +10,8 @@
 //! ```
 //!
 //! and says why in its commit message. The vector kernels run as `PRISM_SIMD=scalar` (the
-//! baseline SSE2 kernels: AVX2 renders the same bits, AVX-512's 16 lanes sum finished
-//! samples in another order), so the hashes hold on any x86-64 machine.
+//! baseline SSE2 kernels; AVX2 and AVX-512 render the same bits, the film's sums being
+//! exact), so the hashes hold on any x86-64 machine.
 
 use std::collections::BTreeMap;
 use std::hash::Hasher;

@@ -33,11 +33,6 @@ fn channels(path: &Path) -> (BTreeMap<String, Vec<u32>>, RawChannels) {
 
 /// The picture's channels (R, G, B, layers, spectral bins) of two files agree bit for bit.
 fn assert_same_picture(a: &Path, b: &Path) {
-    assert_picture_within(a, b, 0);
-}
-
-/// The pictures of two files agree to `ulps` float32 units in the last place everywhere.
-fn assert_picture_within(a: &Path, b: &Path, ulps: u32) -> usize {
     let (ca, _) = channels(a);
     let (cb, _) = channels(b);
     let picture = |c: &BTreeMap<String, Vec<u32>>| -> BTreeMap<String, Vec<u32>> {
@@ -54,31 +49,19 @@ fn assert_picture_within(a: &Path, b: &Path, ulps: u32) -> usize {
         a.display(),
         b.display()
     );
-    let mut differing = 0;
     for (name, values) in &pa {
         let other = &pb[name];
         for (i, (x, y)) in values.iter().zip(other).enumerate() {
-            if x == y {
-                continue;
-            }
-            differing += 1;
-            let (fx, fy) = (f32::from_bits(*x), f32::from_bits(*y));
-            // Same sign: the distance of the bit patterns is the distance in ulps.
-            let apart = if (fx >= 0.0) == (fy >= 0.0) {
-                x.abs_diff(*y)
-            } else {
-                u32::MAX
-            };
             assert!(
-                apart <= ulps,
-                "{} and {}: channel {name} pixel {i}: {fx} and {fy} ({apart} ulps apart, \
-                 {ulps} allowed)",
+                x == y,
+                "{} and {}: channel {name} pixel {i}: {} and {}",
                 a.display(),
-                b.display()
+                b.display(),
+                f32::from_bits(*x),
+                f32::from_bits(*y)
             );
         }
     }
-    differing
 }
 
 fn render(args: &[&str]) -> std::process::Output {
@@ -238,15 +221,14 @@ fn merged_ranges_equal_the_whole_render() {
             header.text["prism:ranges_done"],
             format!("0..{},{}..{spp}", spp / 2, spp / 2)
         );
-        // The parts' sums start at zero where the whole render's continue, so an f64 sum
-        // may differ in its last bit (addition is not associative); written as float32,
-        // a value then differs by one ulp at most, and rarely.
-        let differing = assert_picture_within(&whole, &merged, 1);
-        let (all, _) = channels(&whole);
-        let values: usize = all.values().map(Vec::len).sum();
-        assert!(
-            differing * 1000 <= values,
-            "{}: {differing} of {values} values differ",
+        // The film's sums are exact (fixed point), so the parts add up to the whole render
+        // bit for bit, in whichever order they are given.
+        assert_same_picture(&whole, &merged);
+        let (whole_sums, _) = channels(&whole);
+        assert_eq!(
+            whole_sums["spp.Y"],
+            channels(&merged).0["spp.Y"],
+            "{}",
             case.scene
         );
     }
@@ -459,7 +441,7 @@ fn predicted_plan_ranges_split_each_pixels_own_samples() {
     let merged = dir.path().join("merged.exr");
     let o = prism(&["merge", s(&parts[0]), s(&parts[1]), "-o", s(&merged)]);
     assert!(o.status.success(), "{}", stderr(&o));
-    assert_picture_within(&whole, &merged, 1);
+    assert_same_picture(&whole, &merged);
 }
 
 /// `kill(2)` of a child.
@@ -599,8 +581,8 @@ fn sensor_ranges_merge_into_the_whole_measurement() {
             let (x, y) = (a[key].as_f64().unwrap(), b[key].as_f64().unwrap());
             assert!((x - y).abs() <= tol * x.abs(), "{key}: {x} and {y}");
         };
-        // The same samples; replicate sums added in another order (f64).
-        close("illuminance_lx", 1e-12);
-        close("std_error_lx", 1e-9);
+        // The same samples, in exact sums: the same readings bit for bit.
+        close("illuminance_lx", 0.0);
+        close("std_error_lx", 0.0);
     }
 }

@@ -2,9 +2,10 @@
 //! normalised so far) and the exact state of the film, so a render can continue from it
 //! (`--resume`) and parts can be added (`prism merge`).
 //!
-//! EXR has no 64-bit channel, and a hi/lo pair of float32 holds 48 of a double's 53
-//! significand bits, so each f64 sum is stored as its two 32-bit halves in `UINT` channels
-//! `sums.<plane>.hi` / `.lo`, which OpenEXR keeps bit for bit. Counts are `counts.<plane>`,
+//! The film's sums are exact 128-bit fixed-point integers (`prism_render::film::FixedSum`,
+//! units of 2⁻⁶⁰). EXR has no 64-bit channel, and float32 pairs would keep only 48 bits, so
+//! each sum is stored as four 32-bit words of its two's complement in `UINT` channels
+//! `sums.<plane>.w3` (most significant) … `.w0`, which OpenEXR keeps bit for bit. Counts are `counts.<plane>`,
 //! a per-pixel plan's sample counts `counts.plan`. The header (text attributes) holds the
 //! render's identity (`identity.rs`), the sample range, the ranges done, whether the
 //! range is complete, the work items done (for resuming) and the time spent.
@@ -15,10 +16,13 @@ use std::path::{Path, PathBuf};
 use glam::UVec2;
 use prism_image::io::exr::ExrWriteOptions;
 use prism_image::io::raw_exr::{read_raw_channels, write_exr_with_raw};
-use prism_render::film::{CountPlane, FilmSums, SumPlane};
+use prism_render::film::{CountPlane, FilmSums, FixedSum, SumPlane};
 use prism_render::{AovSelection, FilmImage, SpectralBins};
 
 use super::range::{format_ranges, parse_range, parse_ranges, SampleRange};
+
+/// The format `prism:partial` names: 2 since the sums are fixed point.
+pub const FORMAT_VERSION: &str = "2";
 
 /// Header attributes.
 pub const VERSION: &str = "prism:partial";
@@ -110,7 +114,7 @@ fn parse_aovs(path: &Path, s: &str) -> Result<AovSelection, String> {
 /// Header text attributes of a partial file (beside the identity's).
 pub fn header_attributes(header: &PartialHeader, sums: &FilmSums) -> Vec<(String, String)> {
     let mut out = vec![
-        (VERSION.to_string(), "1".to_string()),
+        (VERSION.to_string(), FORMAT_VERSION.to_string()),
         (RANGE.to_string(), header.range.to_string()),
         (RANGES_DONE.to_string(), format_ranges(&header.ranges_done)),
         (COMPLETE.to_string(), header.complete.to_string()),
@@ -145,14 +149,15 @@ pub fn header_attributes(header: &PartialHeader, sums: &FilmSums) -> Vec<(String
 pub fn raw_channels(sums: &FilmSums, plan: Option<&[u32]>) -> Vec<(String, Vec<u32>)> {
     let mut raw = Vec::new();
     for SumPlane { name, values } in &sums.sums {
-        raw.push((
-            format!("sums.{name}.hi"),
-            values.iter().map(|v| (v.to_bits() >> 32) as u32).collect(),
-        ));
-        raw.push((
-            format!("sums.{name}.lo"),
-            values.iter().map(|v| v.to_bits() as u32).collect(),
-        ));
+        for word in (0..4).rev() {
+            raw.push((
+                format!("sums.{name}.w{word}"),
+                values
+                    .iter()
+                    .map(|v| (v.to_bits() as u128 >> (32 * word)) as u32)
+                    .collect(),
+            ));
+        }
     }
     for CountPlane { name, values } in &sums.counts {
         raw.push((format!("counts.{name}"), values.clone()));
@@ -196,9 +201,10 @@ pub fn read_partial(path: &Path) -> Result<PartialFile, String> {
         })
     };
     let version = get(VERSION)?;
-    if version != "1" {
+    if version != FORMAT_VERSION {
         return Err(format!(
-            "{}: partial image version {version}; this prism reads version 1",
+            "{}: partial image version {version}; this prism reads version {FORMAT_VERSION} \
+             (version 1 held f64 sums, which do not merge exactly: render the part again)",
             path.display()
         ));
     }
@@ -304,14 +310,18 @@ fn sums_from_raw(
     };
     let mut sums = Vec::new();
     for plane in &layout.sums {
-        let hi = channel(format!("sums.{}.hi", plane.name))?;
-        let lo = channel(format!("sums.{}.lo", plane.name))?;
+        let words = (0..4)
+            .map(|w| channel(format!("sums.{}.w{w}", plane.name)))
+            .collect::<Result<Vec<_>, _>>()?;
         sums.push(SumPlane {
             name: plane.name.clone(),
-            values: hi
-                .iter()
-                .zip(lo)
-                .map(|(&h, &l)| f64::from_bits((u64::from(h) << 32) | u64::from(l)))
+            values: (0..words[0].len())
+                .map(|i| {
+                    let bits = words.iter().enumerate().fold(0u128, |b, (w, plane)| {
+                        b | (u128::from(plane[i]) << (32 * w))
+                    });
+                    FixedSum::from_bits(bits as i128)
+                })
                 .collect(),
         });
     }

@@ -1,5 +1,6 @@
 //! The sensors' share of a sample-range part: `<part stem>.sensors.partial.json` beside
-//! the partial EXR, holding each point's replicate sums (f64 bits as hex, so they are exact)
+//! the partial EXR, holding each point's replicate sums (the exact fixed-point integers as 32 hex digits,
+//! two's complement)
 //! and counts, which `prism merge` adds into `<output stem>.sensors.json/.csv` with the
 //! mean and standard error of the whole measurement (docs/scale-out.md).
 
@@ -18,7 +19,8 @@ pub fn sidecar_path(image: &Path) -> PathBuf {
 }
 
 pub fn to_json(identity_hash: &str, range: &str, sensors: &[SensorSums]) -> Value {
-    let hex = |v: &f64| Value::String(format!("{:016x}", v.to_bits()));
+    let hex =
+        |v: &prism_render::film::FixedSum| Value::String(format!("{:032x}", v.to_bits() as u128));
     json!({
         "prism_partial_sensors": 1,
         "identity": identity_hash,
@@ -79,13 +81,14 @@ pub fn read(path: &Path) -> Result<(String, Vec<SensorSums>), String> {
             };
             let sums = p["sums"]
                 .as_array()
-                .ok_or_else(|| bad(&format!("{at}.sums"), "an array of hex f64 bits"))?
+                .ok_or_else(|| bad(&format!("{at}.sums"), "an array of hex fixed-point sums"))?
                 .iter()
                 .map(|h| {
                     h.as_str()
-                        .and_then(|h| u64::from_str_radix(h, 16).ok())
-                        .map(f64::from_bits)
-                        .ok_or_else(|| bad(&format!("{at}.sums"), "16 hex digits per sum"))
+                        .filter(|h| h.len() == 32)
+                        .and_then(|h| u128::from_str_radix(h, 16).ok())
+                        .map(|bits| prism_render::film::FixedSum::from_bits(bits as i128))
+                        .ok_or_else(|| bad(&format!("{at}.sums"), "32 hex digits per sum"))
                 })
                 .collect::<Result<Vec<_>, _>>()?;
             let counts = serde_json::from_value::<Vec<u64>>(p["counts"].clone())

@@ -26,6 +26,8 @@ pub(crate) struct FilterTable {
     /// f₁(i · r / N), i = 0..=N, plus one copy of the last value so that the interpolation
     /// at x = r reads inside the table.
     values: Vec<f32>,
+    /// max |f₁|²: a bound on the weight of any tap, f₁(x) f₁(y).
+    max_weight: f64,
 }
 
 impl FilterTable {
@@ -45,11 +47,19 @@ impl FilterTable {
             })
             .collect();
         values.push(values[INTERVALS]);
+        let max_abs = values.iter().fold(0.0f32, |m, v| m.max(v.abs()));
         Self {
             radius_px,
             inv_step_per_px: (INTERVALS as f64 / f64::from(radius_px)) as f32,
             values,
+            max_weight: f64::from(max_abs) * f64::from(max_abs),
         }
+    }
+
+    /// A bound on |f₁(x) f₁(y)|, the weight of any tap (interpolation stays within the
+    /// nodes' range).
+    pub fn max_weight(&self) -> f64 {
+        self.max_weight
     }
 
     /// f₁(x) by linear interpolation; exactly 0 for |x| > r (and NaN).

@@ -30,6 +30,7 @@ use glam::{DVec3, UVec2, Vec2};
 use prism_spectrum::{SampledSpectrum, SampledWavelengths};
 
 use super::filter_sampler::FilterSampler;
+use super::fixed_sum::{FixedSum, FixedSum3};
 use super::spectral_bins::SpectralBins;
 use super::xyz::XyzWeights;
 
@@ -233,10 +234,10 @@ impl LightSplats {
 /// The film's sums of light-side contributions.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub(crate) struct LightPlane {
-    /// Σ f̂ · A · C per pixel, XYZ.
-    pub xyz_sum: Vec<DVec3>,
+    /// Σ f̂ · A · C per pixel, XYZ (exact: `fixed_sum`).
+    pub xyz_sum: Vec<FixedSum3>,
     /// Per pixel and bin, pixel-major (empty without bins).
-    pub spectral_sum: Vec<f64>,
+    pub spectral_sum: Vec<FixedSum>,
     /// Light paths traced (N).
     pub paths: u64,
 }
@@ -244,8 +245,10 @@ pub(crate) struct LightPlane {
 impl LightPlane {
     pub fn new(pixels: usize, bins: Option<SpectralBins>) -> Self {
         Self {
-            xyz_sum: vec![DVec3::ZERO; pixels],
-            spectral_sum: bins.map_or(Vec::new(), |b| vec![0.0; pixels * b.count() as usize]),
+            xyz_sum: vec![FixedSum3::default(); pixels],
+            spectral_sum: bins.map_or(Vec::new(), |b| {
+                vec![FixedSum::ZERO; pixels * b.count() as usize]
+            }),
             paths: 0,
         }
     }
@@ -266,14 +269,15 @@ impl LightPlane {
                 let row = (r.y0 as usize + j) * width + r.x0 as usize;
                 let xyz_row = xyz * f64::from(wy);
                 for (i, &wx) in columns.iter().enumerate() {
-                    self.xyz_sum[row + i] += xyz_row * f64::from(wx);
+                    self.xyz_sum[row + i].add_f64(xyz_row * f64::from(wx));
                 }
             }
         }
         if let Some(bins) = splats.bins {
             let n = bins.count() as usize;
             for t in &splats.spectral {
-                self.spectral_sum[t.pixel as usize * n + t.bin as usize] += f64::from(t.value);
+                self.spectral_sum[t.pixel as usize * n + t.bin as usize] +=
+                    FixedSum::from_f64(f64::from(t.value));
             }
         }
     }
@@ -284,7 +288,7 @@ impl LightPlane {
         if self.paths == 0 {
             DVec3::ZERO
         } else {
-            self.xyz_sum[i] / self.paths as f64
+            self.xyz_sum[i].to_dvec3() / self.paths as f64
         }
     }
 
@@ -294,7 +298,7 @@ impl LightPlane {
         if self.paths == 0 || self.spectral_sum.is_empty() {
             0.0
         } else {
-            self.spectral_sum[i * n + b] / self.paths as f64
+            self.spectral_sum[i * n + b].to_f64() / self.paths as f64
         }
     }
 }

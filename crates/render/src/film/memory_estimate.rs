@@ -2,7 +2,8 @@
 //! command can refuse a size that would not fit (`prism_cpu::memory::MemoryBudget`)
 //! instead of being killed half-way.
 //!
-//! Per pixel: the film's accumulators (`PixelAccum`, `AovAccum`, f64 spectral sums, the
+//! Per pixel: the film's accumulators (`PixelAccum`, `AovAccum`, 16-byte fixed-point
+//! spectral sums, the
 //! light plane of estimators that splat), the resolved `FilmImage` (XYZ, RGB, Y, AOV and
 //! spectral planes in f32) and the output image with its layers, counted twice (the image
 //! and the encoder's buffer). It is an upper estimate: the stages do not all live at once.
@@ -11,7 +12,10 @@
 use glam::UVec2;
 
 use super::tile::{AovAccum, PixelAccum};
-use super::AovSelection;
+use super::{AovSelection, FixedSum};
+
+/// Bytes of one exact sum.
+const FIXED: u64 = std::mem::size_of::<FixedSum>() as u64;
 
 /// The film a render will allocate.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -44,8 +48,12 @@ impl FilmMemory {
             } else {
                 0
             }
-            + 8 * bins
-            + if self.light_plane { 24 + 8 * bins } else { 0 };
+            + FIXED * bins
+            + if self.light_plane {
+                3 * FIXED + FIXED * bins
+            } else {
+                0
+            };
         let layers = 4 * (self.aov_channels() + bins);
         // XYZ, RGB and Y in f32, then the layers.
         let film_image = 28 + layers;
@@ -81,7 +89,7 @@ mod tests {
             aovs: AovSelection::ALL,
             ..base
         };
-        assert!(bins.bytes_per_pixel() >= base.bytes_per_pixel() + 10 * (8 + 4));
+        assert!(bins.bytes_per_pixel() >= base.bytes_per_pixel() + 10 * (16 + 4));
         assert!(all.bytes_per_pixel() > base.bytes_per_pixel() + 100);
         assert_eq!(base.total_bytes(), 1000 * base.bytes_per_pixel());
         let huge = FilmMemory {

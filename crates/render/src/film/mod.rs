@@ -1,4 +1,6 @@
-//! Film: per-pixel XYZ accumulation in f64 with filter weights and sample counts, optional
+//! Film: per-pixel XYZ accumulation in exact fixed point (`fixed_sum`: sums that do not
+//! depend on the order samples arrive in, so sample-range parts merge bit for bit) with
+//! filter weights and sample counts, optional
 //! surface AOVs, an optional illumination AOV and optional spectral bins, tile-parallel
 //! rendering with deterministic merging, and the finished image (pbrt-v4 §5.4 "Film and
 //! imaging", `RGBFilm` / `GBufferFilm` / `SpectralFilm`, with XYZ in place of RGB).
@@ -10,6 +12,7 @@
 pub mod filter;
 mod filter_sampler;
 mod filter_table;
+pub mod fixed_sum;
 mod image;
 mod light_splats;
 pub mod memory_estimate;
@@ -20,6 +23,7 @@ pub mod xyz;
 
 pub use filter::Filter;
 pub use filter_sampler::{FilterSample, FilterSampler};
+pub use fixed_sum::{FixedSum, FixedSum3};
 pub use image::{AovPlane, FilmImage, SpectralPlanes};
 pub use light_splats::LightSplats;
 pub use memory_estimate::FilmMemory;
@@ -134,7 +138,7 @@ pub struct Film {
     aovs: Vec<AovAccum>,
     spectral_bins: Option<SpectralBins>,
     /// Σ w · L̂_b per pixel and bin, pixel-major; empty without spectral bins.
-    spectral: Vec<f64>,
+    spectral: Vec<FixedSum>,
     /// Reconstruct by splatting (see `with_splatting`).
     splat: bool,
     /// Light-side contributions (`light_splats`), once an estimator splats light paths.
@@ -182,7 +186,7 @@ impl Film {
 
     /// The same film with spectral `bins` (see `with_spectral_bins`).
     pub fn with_bins(mut self, bins: SpectralBins) -> Self {
-        self.spectral = vec![0.0; self.pixels.len() * bins.count() as usize];
+        self.spectral = vec![FixedSum::ZERO; self.pixels.len() * bins.count() as usize];
         self.spectral_bins = Some(bins);
         self
     }
@@ -288,16 +292,15 @@ impl Film {
         self.splat
     }
 
-    /// Adds a tile's sums into the film. Merging tiles in any fixed order gives the same
-    /// result; tiles of one pass never overlap, so within a pass the order does not matter
-    /// at all.
+    /// Adds a tile's sums into the film. The sums are exact (`fixed_sum`), so merging
+    /// tiles in any order gives the same film.
     pub fn merge_tile(&mut self, tile: &FilmTile) {
         if let Some(buffer) = &tile.splat {
             let width = self.resolution.x as usize;
             for (k, pixel) in buffer.bounds.pixels().enumerate() {
                 let i = pixel.y as usize * width + pixel.x as usize;
-                let [x, y, z, w] = buffer.sums[k];
-                self.pixels[i].xyz_sum += DVec3::new(x, y, z);
+                let [x, y, z, w] = buffer.pixel_sums(k);
+                self.pixels[i].xyz_sum += FixedSum3([x, y, z]);
                 self.pixels[i].weight_sum += w;
             }
         }
@@ -312,7 +315,7 @@ impl Film {
                 let n = bins.count() as usize;
                 let src = &tile.spectral[k * n..(k + 1) * n];
                 for (d, s) in self.spectral[i * n..(i + 1) * n].iter_mut().zip(src) {
-                    *d += s;
+                    *d += *s;
                 }
             }
         }
@@ -338,7 +341,7 @@ impl Film {
             dst.merge(src);
         }
         for (dst, src) in self.spectral.iter_mut().zip(&other.spectral) {
-            *dst += src;
+            *dst += *src;
         }
         Some(())
     }
@@ -367,7 +370,7 @@ impl Film {
     }
 
     /// A copy of the colour sums only (no AOVs, no spectral bins): what [`Film::rgb`] needs,
-    /// at the cost of one memcpy of 48 bytes per pixel. `prism converge` takes one at each
+    /// at the cost of one memcpy of 96 bytes per pixel. `prism converge` takes one at each
     /// checkpoint on the render thread and computes the image and its errors elsewhere.
     pub fn colour_snapshot(&self) -> Film {
         Film {
@@ -482,7 +485,7 @@ impl Film {
                     .iter()
                     .map(|a| {
                         if a.hit_count > 0 {
-                            (a.depth_sum / f64::from(a.hit_count)) as f32
+                            (a.surface.depth().to_f64() / f64::from(a.hit_count)) as f32
                         } else {
                             f32::INFINITY
                         }
@@ -493,12 +496,12 @@ impl Film {
                     values,
                 });
             }
-            let planes = |field: fn(&AovAccum) -> DVec3, names: [&str; 3]| {
+            let planes = |field: fn(&AovAccum) -> FixedSum3, names: [&str; 3]| {
                 let means: Vec<DVec3> = self
                     .aovs
                     .iter()
                     .zip(counts.clone())
-                    .map(|(a, c)| per_sample(field(a), c))
+                    .map(|(a, c)| per_sample(field(a).to_dvec3(), c))
                     .collect();
                 (0..3)
                     .map(|k| AovPlane {
@@ -509,13 +512,13 @@ impl Film {
             };
             if sel.normal {
                 aovs.extend(planes(
-                    |a| a.normal_sum,
+                    |a| a.surface.normal(),
                     ["normal.X", "normal.Y", "normal.Z"],
                 ));
             }
             if sel.albedo {
                 aovs.extend(planes(
-                    |a| a.albedo_sum,
+                    |a| a.surface.albedo(),
                     ["albedo.R", "albedo.G", "albedo.B"],
                 ));
             }
@@ -533,7 +536,8 @@ impl Film {
                     .map(|(a, p)| {
                         let n = f64::from(p.sample_count);
                         if n >= 2.0 {
-                            ((a.y_sq_sum - a.y_sum * a.y_sum / n) / (n - 1.0)).max(0.0) as f32
+                            let (sum, sum_sq) = (a.y_sum.to_f64(), a.y_sq_sum.to_f64());
+                            ((sum_sq - sum * sum / n) / (n - 1.0)).max(0.0) as f32
                         } else {
                             0.0
                         }
@@ -554,8 +558,9 @@ impl Film {
                         .zip(self.spectral.chunks_exact(n))
                         .enumerate()
                         .map(|(i, (p, sums))| {
-                            let camera = if p.own_weight_sum != 0.0 {
-                                sums[b] / p.own_weight_sum
+                            let own_weight = p.own_weight_sum.to_f64();
+                            let camera = if own_weight != 0.0 {
+                                sums[b].to_f64() / own_weight
                             } else {
                                 0.0
                             };

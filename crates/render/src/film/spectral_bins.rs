@@ -113,7 +113,7 @@ impl SpectralBins {
     #[inline]
     pub(crate) fn accumulate(
         &self,
-        sums: &mut [f64],
+        sums: &mut [super::fixed_sum::FixedSum],
         radiance: SampledSpectrum,
         wavelengths: &SampledWavelengths,
         weight: f64,
@@ -127,7 +127,7 @@ impl SpectralBins {
                 continue;
             }
             if let Some(b) = self.bin_of(wavelengths.wavelength_nm(lane)) {
-                sums[b] += scale * l / p;
+                sums[b] += super::fixed_sum::FixedSum::from_f64(scale * l / p);
             }
         }
     }
@@ -178,8 +178,9 @@ mod tests {
         let mut w = SampledWavelengths::sample_visible(0.3);
         let p0 = w.pdf()[0];
         w.terminate_secondary();
-        let mut sums = vec![0.0; 4];
-        bins.accumulate(&mut sums, SampledSpectrum::one(), &w, 1.0);
+        let mut fixed = vec![crate::film::FixedSum::ZERO; 4];
+        bins.accumulate(&mut fixed, SampledSpectrum::one(), &w, 1.0);
+        let sums: Vec<f64> = fixed.iter().map(|s| s.to_f64()).collect();
         let b = bins.bin_of(w.wavelength_nm(0)).unwrap();
         let want = 1.0 / (f64::from(p0) * bins.width_nm());
         assert!(

@@ -1,21 +1,22 @@
 //! The film's raw accumulators as named planes: what a checkpoint or a sample-range part
 //! stores so that a render can continue (`Film::set_sums`) or parts can be added
 //! (`FilmSums::add`) with the sums themselves, not the normalised image — a mean cannot be
-//! continued or weighted without them. f64 planes keep every bit; integer planes are the
-//! counts. The order of the planes is fixed by the film's AOVs, bins and light plane, so
+//! continued or weighted without them. Sum planes hold the exact fixed-point sums
+//! (`fixed_sum`), so adding parts gives the film of the whole range bit for bit; integer
+//! planes are the counts. The order of the planes is fixed by the film's AOVs, bins and light plane, so
 //! two films of the same configuration have the same names in the same order.
 
-use glam::{DVec3, UVec2};
+use glam::UVec2;
 
 use super::light_splats::LightPlane;
 use super::tile::{AovAccum, PixelAccum};
-use super::{AovSelection, Film, Filter, SpectralBins};
+use super::{AovSelection, Film, Filter, FixedSum, FixedSum3, SpectralBins};
 
-/// One f64 sum per pixel, row-major.
+/// One exact sum per pixel, row-major.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SumPlane {
     pub name: String,
-    pub values: Vec<f64>,
+    pub values: Vec<FixedSum>,
 }
 
 /// One count per pixel, row-major.
@@ -66,55 +67,66 @@ const AOV_SUMS: [&str; 12] = [
 ];
 const LIGHT_SUMS: [&str; 3] = ["light.X", "light.Y", "light.Z"];
 
-fn pixel_values(p: &PixelAccum) -> [f64; 5] {
-    [
-        p.xyz_sum.x,
-        p.xyz_sum.y,
-        p.xyz_sum.z,
-        p.weight_sum,
-        p.own_weight_sum,
-    ]
+fn pixel_values(p: &PixelAccum) -> [FixedSum; 5] {
+    let [x, y, z] = p.xyz_sum.0;
+    [x, y, z, p.weight_sum, p.own_weight_sum]
 }
 
-fn aov_values(a: &AovAccum) -> [f64; 12] {
+fn aov_values(a: &AovAccum) -> [FixedSum; 12] {
+    let ([nx, ny, nz], [ar, ag, ab], [ix, iy, iz]) = (
+        a.surface.normal().0,
+        a.surface.albedo().0,
+        a.illumination_sum.0,
+    );
     [
-        a.depth_sum,
-        a.normal_sum.x,
-        a.normal_sum.y,
-        a.normal_sum.z,
-        a.albedo_sum.x,
-        a.albedo_sum.y,
-        a.albedo_sum.z,
-        a.illumination_sum.x,
-        a.illumination_sum.y,
-        a.illumination_sum.z,
+        a.surface.depth(),
+        nx,
+        ny,
+        nz,
+        ar,
+        ag,
+        ab,
+        ix,
+        iy,
+        iz,
         a.y_sum,
         a.y_sq_sum,
     ]
+}
+
+/// Planes `prefix` + `names[k]` of the k-th value of each pixel's `values` (one pass over
+/// the pixels: the limbs of the surface sums are joined once per pixel).
+fn planes<const N: usize>(
+    names: &[&str; N],
+    prefix: &str,
+    values: impl ExactSizeIterator<Item = [FixedSum; N]>,
+) -> Vec<SumPlane> {
+    let mut planes: Vec<SumPlane> = names
+        .iter()
+        .map(|name| SumPlane {
+            name: format!("{prefix}{name}"),
+            values: Vec::with_capacity(values.len()),
+        })
+        .collect();
+    for v in values {
+        for (plane, value) in planes.iter_mut().zip(v) {
+            plane.values.push(value);
+        }
+    }
+    planes
 }
 
 impl Film {
     /// The film's accumulators as planes (see [`FilmSums`]).
     pub fn sums(&self) -> FilmSums {
         let n = self.pixels.len();
-        let mut sums = Vec::new();
-        for (k, name) in PIXEL_SUMS.iter().enumerate() {
-            sums.push(SumPlane {
-                name: (*name).into(),
-                values: self.pixels.iter().map(|p| pixel_values(p)[k]).collect(),
-            });
-        }
+        let mut sums = planes(&PIXEL_SUMS, "", self.pixels.iter().map(pixel_values));
         let mut counts = vec![CountPlane {
             name: "samples".into(),
             values: self.pixels.iter().map(|p| p.sample_count).collect(),
         }];
         if self.aov_selection.any() {
-            for (k, name) in AOV_SUMS.iter().enumerate() {
-                sums.push(SumPlane {
-                    name: format!("aov.{name}"),
-                    values: self.aovs.iter().map(|a| aov_values(a)[k]).collect(),
-                });
-            }
+            sums.extend(planes(&AOV_SUMS, "aov.", self.aovs.iter().map(aov_values)));
             counts.push(CountPlane {
                 name: "hits".into(),
                 values: self.aovs.iter().map(|a| a.hit_count).collect(),
@@ -131,7 +143,7 @@ impl Film {
             for (k, name) in LIGHT_SUMS.iter().enumerate() {
                 sums.push(SumPlane {
                     name: (*name).into(),
-                    values: light.xyz_sum.iter().map(|v| v[k]).collect(),
+                    values: light.xyz_sum.iter().map(|v| v.0[k]).collect(),
                 });
             }
             if !light.spectral_sum.is_empty() {
@@ -163,7 +175,7 @@ impl Film {
             sums.light_paths.is_some(),
         ))?;
         let n = self.pixels.len();
-        let get = |name: &str| -> &[f64] {
+        let get = |name: &str| -> &[FixedSum] {
             sums.sums
                 .iter()
                 .find(|p| p.name == name)
@@ -175,22 +187,25 @@ impl Film {
                 .find(|p| p.name == name)
                 .map_or(&[], |p| &p.values)
         };
-        let px: Vec<&[f64]> = PIXEL_SUMS.iter().map(|s| get(s)).collect();
+        let px: Vec<&[FixedSum]> = PIXEL_SUMS.iter().map(|s| get(s)).collect();
         let samples = count("samples");
+        let triple = |planes: &[&[FixedSum]], i: usize| {
+            FixedSum3([planes[0][i], planes[1][i], planes[2][i]])
+        };
         for (i, p) in self.pixels.iter_mut().enumerate() {
-            p.xyz_sum = DVec3::new(px[0][i], px[1][i], px[2][i]);
+            p.xyz_sum = triple(&px[0..3], i);
             p.weight_sum = px[3][i];
             p.own_weight_sum = px[4][i];
             p.sample_count = samples[i];
         }
         if self.aov_selection.any() {
-            let av: Vec<&[f64]> = AOV_SUMS.iter().map(|s| get(&format!("aov.{s}"))).collect();
+            let av: Vec<&[FixedSum]> = AOV_SUMS.iter().map(|s| get(&format!("aov.{s}"))).collect();
             let hits = count("hits");
             for (i, a) in self.aovs.iter_mut().enumerate() {
-                a.depth_sum = av[0][i];
-                a.normal_sum = DVec3::new(av[1][i], av[2][i], av[3][i]);
-                a.albedo_sum = DVec3::new(av[4][i], av[5][i], av[6][i]);
-                a.illumination_sum = DVec3::new(av[7][i], av[8][i], av[9][i]);
+                for (lane, plane) in av[..7].iter().enumerate() {
+                    a.surface.set(lane, plane[i]);
+                }
+                a.illumination_sum = triple(&av[7..10], i);
                 a.y_sum = av[10][i];
                 a.y_sq_sum = av[11][i];
                 a.hit_count = hits[i];
@@ -205,9 +220,9 @@ impl Film {
         }
         self.light = sums.light_paths.map(|paths| {
             let mut light = LightPlane::new(n, self.spectral_bins);
-            let lx: Vec<&[f64]> = LIGHT_SUMS.iter().map(|s| get(s)).collect();
+            let lx: Vec<&[FixedSum]> = LIGHT_SUMS.iter().map(|s| get(s)).collect();
             for (i, v) in light.xyz_sum.iter_mut().enumerate() {
-                *v = DVec3::new(lx[0][i], lx[1][i], lx[2][i]);
+                *v = triple(&lx, i);
             }
             if !light.spectral_sum.is_empty() {
                 for b in 0..bins {
@@ -340,7 +355,7 @@ impl FilmSums {
         self.check()?;
         for (dst, src) in self.sums.iter_mut().zip(&other.sums) {
             for (d, s) in dst.values.iter_mut().zip(&src.values) {
-                *d += s;
+                *d += *s;
             }
         }
         for (dst, src) in self.counts.iter_mut().zip(&other.counts) {
@@ -367,7 +382,7 @@ impl FilmSums {
 mod tests {
     use super::*;
     use crate::film::AovSelection;
-    use glam::Vec2;
+    use glam::{DVec3, Vec2};
 
     fn film_with_samples(seed: u32) -> Film {
         let mut film = Film::new(UVec2::new(5, 3), Filter::default(), AovSelection::ALL)
@@ -404,6 +419,10 @@ mod tests {
         let mut total = a.clone();
         total.add(&b).unwrap();
         assert!(total.sample_counts().iter().all(|&c| c == 6));
+        // Exact: b + a is a + b, bit for bit.
+        let mut reversed = b.clone();
+        reversed.add(&a).unwrap();
+        assert_eq!(reversed, total);
         let other = Film::new(UVec2::new(5, 3), Filter::default(), AovSelection::NONE)
             .unwrap()
             .sums();

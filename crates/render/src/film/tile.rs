@@ -10,6 +10,7 @@ use prism_spectrum::{SampledSpectrum, SampledWavelengths};
 
 use super::filter_sampler::FilterSampler;
 use super::filter_table::FilterTable;
+use super::fixed_sum::{split_limbs, FixedSum, FixedSum3, HIGH_LIMB_SCALE, MAGIC};
 use super::spectral_bins::SpectralBins;
 use super::xyz::{xyz_of_sample, XyzWeights};
 use super::AovSelection;
@@ -53,26 +54,27 @@ pub struct SurfaceAov {
     pub albedo_rgb: [f32; 3],
 }
 
-/// Colour sums of one pixel.
+/// Colour sums of one pixel (exact: `fixed_sum`).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub(crate) struct PixelAccum {
     /// Σ wᵢ XYZᵢ.
-    pub xyz_sum: DVec3,
+    pub xyz_sum: FixedSum3,
     /// Σ wᵢ.
-    pub weight_sum: f64,
+    pub weight_sum: FixedSum,
     /// Number of samples added.
     pub sample_count: u32,
     /// Σ wᵢ of the pixel's own samples (equals `weight_sum` unless the film splats); the
     /// spectral bins are normalised by it.
-    pub own_weight_sum: f64,
+    pub own_weight_sum: FixedSum,
 }
 
 impl PixelAccum {
     /// Σ wᵢ XYZᵢ / Σ wᵢ (black when no weight landed).
     #[inline]
     pub fn mean_xyz(&self) -> DVec3 {
-        if self.weight_sum != 0.0 {
-            self.xyz_sum / self.weight_sum
+        let w = self.weight_sum.to_f64();
+        if w != 0.0 {
+            self.xyz_sum.to_dvec3() / w
         } else {
             DVec3::ZERO
         }
@@ -84,15 +86,13 @@ impl PixelAccum {
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub(crate) struct AovAccum {
     pub hit_count: u32,
-    pub depth_sum: f64,
-    pub normal_sum: DVec3,
-    pub albedo_sum: DVec3,
+    /// Σ depth, normal and albedo of the first hits.
+    pub surface: SurfaceSums,
     /// Σ XYZ of the illumination spectra (`FilmTile::add_illumination`).
-    pub illumination_sum: DVec3,
-    /// Σ Y and Σ Y² of the camera samples (`AovSelection::variance`; f64 sums of values of
-    /// order 1 over at most millions of samples keep ~10 significant digits).
-    pub y_sum: f64,
-    pub y_sq_sum: f64,
+    pub illumination_sum: FixedSum3,
+    /// Σ Y and Σ Y² of the camera samples (`AovSelection::variance`).
+    pub y_sum: FixedSum,
+    pub y_sq_sum: FixedSum,
 }
 
 impl PixelAccum {
@@ -107,30 +107,102 @@ impl PixelAccum {
 impl AovAccum {
     pub fn merge(&mut self, other: &AovAccum) {
         self.hit_count += other.hit_count;
-        self.depth_sum += other.depth_sum;
-        self.normal_sum += other.normal_sum;
-        self.albedo_sum += other.albedo_sum;
+        self.surface.merge(&other.surface);
         self.illumination_sum += other.illumination_sum;
         self.y_sum += other.y_sum;
         self.y_sq_sum += other.y_sq_sum;
     }
 }
 
+/// Σ depth (m), Σ normal (X, Y, Z) and Σ albedo (R, G, B) of a pixel's first hits, exact
+/// (`fixed_sum`) as limbs like `SplatBuffer::sums`: lanes 0–6 the high limbs (units of
+/// 2⁻²⁰), 8–14 the low ones (2⁻⁶⁰), lanes 7 and 15 unused. Limbs, so that the seven values
+/// of a sample split and add as a few packed operations (every sample of every render
+/// records them). `merge` carries the low limbs into the high ones, which keeps a film's
+/// low limbs below 2⁴⁰; a high limb holds sums below 2⁴³ (m of depth, or samples).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(crate) struct SurfaceSums(pub [i64; 16]);
+
+impl SurfaceSums {
+    /// Depth, normal and albedo sums as `FixedSum`s (lanes 0–6).
+    #[inline]
+    pub fn get(&self, lane: usize) -> FixedSum {
+        FixedSum::from_limbs(self.0[lane], self.0[lane + 8])
+    }
+
+    pub fn set(&mut self, lane: usize, value: FixedSum) {
+        (self.0[lane], self.0[lane + 8]) = value.to_limbs();
+    }
+
+    pub fn depth(&self) -> FixedSum {
+        self.get(0)
+    }
+
+    pub fn normal(&self) -> FixedSum3 {
+        FixedSum3([self.get(1), self.get(2), self.get(3)])
+    }
+
+    pub fn albedo(&self) -> FixedSum3 {
+        FixedSum3([self.get(4), self.get(5), self.get(6)])
+    }
+
+    /// Adds one hit's depth, normal and albedo (lane 7 is zero).
+    #[inline(always)]
+    pub fn add(&mut self, values: [f64; 8]) {
+        let most = values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        if most < (1u64 << 31) as f64 {
+            // |v · 2²⁰| < 2⁵¹: the magic-number split, lane by lane (LLVM packs it).
+            for (lane, v) in values.iter().enumerate() {
+                let (high, low) = split_limbs(v * HIGH_LIMB_SCALE);
+                self.0[lane] = self.0[lane].wrapping_add(high);
+                self.0[lane + 8] = self.0[lane + 8].wrapping_add(low);
+            }
+        } else {
+            for (lane, v) in values.iter().enumerate() {
+                let (high, low) = FixedSum::from_f64(*v).to_limbs();
+                self.0[lane] = self.0[lane].wrapping_add(high);
+                self.0[lane + 8] = self.0[lane + 8].wrapping_add(low);
+            }
+        }
+    }
+
+    /// Adds `other` and carries the low limbs into the high ones.
+    pub fn merge(&mut self, other: &SurfaceSums) {
+        for lane in 0..8 {
+            let sum = FixedSum::from_limbs(
+                self.0[lane].wrapping_add(other.0[lane]),
+                self.0[lane + 8].wrapping_add(other.0[lane + 8]),
+            );
+            (self.0[lane], self.0[lane + 8]) = sum.to_limbs();
+        }
+    }
+}
+
 /// Splatting (Mitsuba 3's `ImageBlock`): a tile's samples also reach pixels up to the
 /// filter radius outside it, so it keeps Σ f·XYZ and Σ f over its bounds grown by the
-/// radius (clipped to the film); `Film::merge_tile` adds them in a fixed order.
+/// radius (clipped to the film); `Film::merge_tile` adds them into the pixels' exact sums.
 #[derive(Clone, Debug, PartialEq)]
 pub(crate) struct SplatBuffer {
     pub bounds: TileBounds,
-    /// Per pixel [Σ f·X, Σ f·Y, Σ f·Z, Σ f]: four f64 in a row, so that one splat tap is
-    /// two packed multiply-adds (SSE2) instead of four scalar ones and a separate weight.
-    pub sums: Vec<[f64; 4]>,
+    /// Per pixel Σ f·X, Σ f·Y, Σ f·Z, Σ f in fixed point (`fixed_sum`) as two limbs each:
+    /// lanes 0–3 the high limbs (units of 2⁻²⁰), lanes 4–7 the low ones (units of 2⁻⁶⁰).
+    /// Limbs, not i128, so that one tap is a few packed operations: the product f·value
+    /// splits into limbs with two magic-number roundings (`fixed_sum::split_limbs`) and
+    /// adds with 64-bit integer lanes (SSE2 or AVX2). A limb sum is exact while it stays
+    /// in i64: the low limbs take 2²⁴ taps per pixel, the high ones Σ|f·value| < 2⁴³,
+    /// within one tile pass.
+    pub sums: Vec<[i64; 8]>,
     pub radius_px: f32,
     /// The widest kernels to run (`prism_cpu::active()` when the tile was made): where it
-    /// allows AVX2, a tap is one 256-bit multiply and add (same bits as SSE2's two) and
-    /// the filter profile's table reads are gathers.
+    /// allows AVX2, a tap is 256-bit operations and the filter profile's table reads are
+    /// gathers.
     simd: prism_cpu::Simd,
 }
+
+/// |f · value| below this (2³¹) takes the packed limb split (|f · value · 2²⁰| < 2⁵¹).
+const FAST_SPLIT_LIMIT: f64 = 2_147_483_648.0;
+/// |f · value| below this (2⁴³) fits the high limb at all.
+const LIMB_LIMIT: f64 = 8_796_093_022_208.0;
 
 impl SplatBuffer {
     pub fn new(tile: TileBounds, film_size: UVec2, radius_px: f32) -> Self {
@@ -141,35 +213,54 @@ impl SplatBuffer {
         };
         Self {
             bounds,
-            sums: vec![[0.0; 4]; bounds.pixel_count()],
+            sums: vec![[0; 8]; bounds.pixel_count()],
             radius_px,
             simd: prism_cpu::active(),
         }
     }
 
+    /// Whether a sample of colour `xyz` can be splatted with `table`'s weights (every tap
+    /// within the limbs' range); `Film` drops it like a non-finite one otherwise.
+    #[inline]
+    pub fn admits(xyz: DVec3, table: &FilterTable) -> bool {
+        xyz.abs().max_element().max(1.0) * table.max_weight() < LIMB_LIMIT
+    }
+
+    /// The sums of buffer pixel `i`: Σ f·X, Σ f·Y, Σ f·Z, Σ f.
+    #[inline]
+    pub fn pixel_sums(&self, i: usize) -> [FixedSum; 4] {
+        let s = &self.sums[i];
+        std::array::from_fn(|k| FixedSum::from_limbs(s[k], s[k + 4]))
+    }
+
     /// Adds `xyz` at film point `p` to every pixel whose centre is within the radius, with
-    /// the weights of the tabulated profile (`FilterTable`).
+    /// the weights of the tabulated profile (`FilterTable`). `xyz` must be admitted
+    /// (`admits`).
     #[inline]
     pub fn splat(&mut self, p: Vec2, xyz: DVec3, table: &FilterTable) {
+        let bound = xyz.abs().max_element().max(1.0) * table.max_weight();
+        if bound >= FAST_SPLIT_LIMIT {
+            return self.splat_with::<false, false, true>(p, xyz, table);
+        }
         #[cfg(target_arch = "x86_64")]
         if self.simd.avx2() {
             // SAFETY: a `Simd` allows AVX2 (and AVX) only on a CPU that has it.
             return unsafe { self.splat_avx2(p, xyz, table) };
         }
-        self.splat_with::<false, false>(p, xyz, table)
+        self.splat_with::<false, false, false>(p, xyz, table)
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx,avx2")]
     unsafe fn splat_avx2(&mut self, p: Vec2, xyz: DVec3, table: &FilterTable) {
-        self.splat_with::<true, true>(p, xyz, table)
+        self.splat_with::<true, true, false>(p, xyz, table)
     }
 
     /// `splat`'s body; `AVX`: the taps as 256-bit operations, `GATHER`: up to 4 × 4 taps'
-    /// profile values in one `FilterTable::eval8_avx2` (both only inside `splat_avx2`;
-    /// the AVX-only form the AVX CPUs without AVX2 ran is gone with `prism_cpu`'s ladder).
+    /// profile values in one `FilterTable::eval8_avx2` (both only inside `splat_avx2`),
+    /// `WIDE`: taps of |f · value| ≥ 2³¹, split through `FixedSum::from_f64` one by one.
     #[inline(always)]
-    fn splat_with<const AVX: bool, const GATHER: bool>(
+    fn splat_with<const AVX: bool, const GATHER: bool, const WIDE: bool>(
         &mut self,
         p: Vec2,
         xyz: DVec3,
@@ -188,7 +279,7 @@ impl SplatBuffer {
         }
         // Separable filters (f = f₁(x) f₁(y)): one profile value per row and column.
         const MAX_TAPS: usize = 16;
-        if (x1 - x0) as usize >= MAX_TAPS || (y1 - y0) as usize >= MAX_TAPS {
+        if WIDE || (x1 - x0) as usize >= MAX_TAPS || (y1 - y0) as usize >= MAX_TAPS {
             return self.splat_wide(p, xyz, table, (x0, x1, y0, y1));
         }
         let (columns, rows) = ((x1 - x0 + 1) as usize, (y1 - y0 + 1) as usize);
@@ -225,13 +316,13 @@ impl SplatBuffer {
         let first_column = (x0 - min.x) as usize;
         // The weight's own sum rides along as a fourth component of value 1: w · 1 = w
         // exactly, so the sums are those of separate colour and weight accumulators. A tap
-        // of weight 0 adds ±0 to a sum that starts at +0 — no change — so no test for it.
+        // of weight 0 adds zero limbs — no change — so no test for it.
         let value = [xyz.x, xyz.y, xyz.z, 1.0];
         for (y, &wy) in (y0..=y1).zip(&wy[..rows]) {
             let row = (y - min.y) as usize * width + first_column;
-            if let Ok(sums) = <&mut [[f64; 4]; 4]>::try_from(&mut self.sums[row..row + columns]) {
+            if let Ok(sums) = <&mut [[i64; 8]; 4]>::try_from(&mut self.sums[row..row + columns]) {
                 // Four columns (every sample of a radius-2 filter not exactly on a pixel
-                // edge): unrolled, the same products in the same order.
+                // edge): unrolled.
                 for (s, &wxk) in sums.iter_mut().zip(&wx[..4]) {
                     add_scaled::<AVX>(s, f64::from(wxk * wy), &value);
                 }
@@ -243,7 +334,9 @@ impl SplatBuffer {
         }
     }
 
-    /// `splat` for filters wider than 16 taps (not reached by the shipped filters' radii).
+    /// `splat` for filters wider than 16 taps (not reached by the shipped filters' radii)
+    /// and for taps too bright for the packed limb split: each product f · value through
+    /// `FixedSum::from_f64` (the same rounding, so the same sums).
     fn splat_wide(
         &mut self,
         p: Vec2,
@@ -253,6 +346,7 @@ impl SplatBuffer {
     ) {
         let width = self.bounds.size().x as usize;
         let min = self.bounds.min.as_ivec2();
+        let value = [xyz.x, xyz.y, xyz.z, 1.0];
         for y in y0..=y1 {
             let wy = table.eval(y as f32 + 0.5 - p.y);
             for x in x0..=x1 {
@@ -260,56 +354,93 @@ impl SplatBuffer {
                 if w == 0.0 {
                     continue;
                 }
-                let i = (y - min.y) as usize * width + (x - min.x) as usize;
-                add_scaled::<false>(&mut self.sums[i], w, &[xyz.x, xyz.y, xyz.z, 1.0]);
+                let s = &mut self.sums[(y - min.y) as usize * width + (x - min.x) as usize];
+                for (k, v) in value.iter().enumerate() {
+                    let (high, low) = FixedSum::from_f64(w * v).to_limbs();
+                    s[k] = s[k].wrapping_add(high);
+                    s[k + 4] = s[k + 4].wrapping_add(low);
+                }
             }
         }
     }
 }
 
-/// sum += w · value, lane by lane (a multiply, then an add: the same bits as the scalar
-/// loop). On x86-64 two packed SSE2 multiply-adds — SSE2 is part of the x86-64 baseline — or,
-/// with `AVX` (called only from `SplatBuffer::splat_avx`), one 256-bit multiply and add;
-/// left to itself LLVM interleaves two taps and spends more on shuffles than on the
-/// arithmetic.
+/// sum += w · value in limbs (see `SplatBuffer::sums`), lane by lane: the product w · value
+/// (scaled by 2²⁰, a power of two, so the same rounding as the unscaled product), split
+/// with `fixed_sum::split_limbs`' two magic-number roundings, added as 64-bit integers. On
+/// x86-64 packed SSE2 operations — SSE2 is part of the x86-64 baseline — or, with `AVX`
+/// (only in code running on an AVX2 CPU), 256-bit ones; the caller keeps
+/// |w · value| < 2³¹.
 #[inline(always)]
-fn add_scaled<const AVX: bool>(sum: &mut [f64; 4], w: f64, value: &[f64; 4]) {
+fn add_scaled<const AVX: bool>(sum: &mut [i64; 8], w: f64, value: &[f64; 4]) {
+    let w = w * HIGH_LIMB_SCALE;
     #[cfg(target_arch = "x86_64")]
     {
+        use super::fixed_sum::LOW_LIMB_SCALE;
         use std::arch::x86_64::{
-            _mm256_add_pd, _mm256_loadu_pd, _mm256_mul_pd, _mm256_set1_pd, _mm256_storeu_pd,
-            _mm_add_pd, _mm_loadu_pd, _mm_mul_pd, _mm_set1_pd, _mm_storeu_pd,
+            _mm256_add_epi64, _mm256_add_pd, _mm256_castpd_si256, _mm256_loadu_pd,
+            _mm256_loadu_si256, _mm256_mul_pd, _mm256_set1_epi64x, _mm256_set1_pd,
+            _mm256_storeu_si256, _mm256_sub_epi64, _mm256_sub_pd, _mm_add_epi64, _mm_add_pd,
+            _mm_castpd_si128, _mm_loadu_pd, _mm_loadu_si128, _mm_mul_pd, _mm_set1_epi64x,
+            _mm_set1_pd, _mm_storeu_si128, _mm_sub_epi64, _mm_sub_pd,
         };
         let (s, v) = (sum.as_mut_ptr(), value.as_ptr());
+        let magic_bits = MAGIC.to_bits() as i64;
         if AVX {
-            // SAFETY: `AVX` is true only in code running on an AVX CPU (`splat_avx`); both
-            // pointers address four f64 of the arrays borrowed here, `sum` uniquely.
+            // SAFETY: `AVX` is true only in code running on an AVX2 CPU (`splat_avx2`);
+            // `v` addresses four f64 of `value`, `s` eight i64 of `sum` (borrowed uniquely),
+            // all with unaligned loads and stores.
             unsafe {
-                let r = _mm256_add_pd(
-                    _mm256_loadu_pd(s),
-                    _mm256_mul_pd(_mm256_set1_pd(w), _mm256_loadu_pd(v)),
+                let magic = _mm256_set1_pd(MAGIC);
+                let x = _mm256_mul_pd(_mm256_set1_pd(w), _mm256_loadu_pd(v));
+                let t = _mm256_add_pd(x, magic);
+                let high = _mm256_sub_epi64(_mm256_castpd_si256(t), _mm256_set1_epi64x(magic_bits));
+                let rest = _mm256_mul_pd(
+                    _mm256_sub_pd(x, _mm256_sub_pd(t, magic)),
+                    _mm256_set1_pd(LOW_LIMB_SCALE),
                 );
-                _mm256_storeu_pd(s, r);
+                let low = _mm256_sub_epi64(
+                    _mm256_castpd_si256(_mm256_add_pd(rest, magic)),
+                    _mm256_set1_epi64x(magic_bits),
+                );
+                let hs = s.cast::<std::arch::x86_64::__m256i>();
+                _mm256_storeu_si256(hs, _mm256_add_epi64(_mm256_loadu_si256(hs), high));
+                let ls = s.add(4).cast::<std::arch::x86_64::__m256i>();
+                _mm256_storeu_si256(ls, _mm256_add_epi64(_mm256_loadu_si256(ls), low));
             }
             return;
         }
-        // SAFETY: SSE2 is always present on x86-64; both pointers address four f64 of the
-        // arrays borrowed here (unaligned loads and stores), and `sum` is borrowed uniquely.
+        // SAFETY: SSE2 is always present on x86-64; `v` addresses four f64 of `value`, `s`
+        // eight i64 of `sum` (borrowed uniquely), with unaligned loads and stores.
         unsafe {
-            let w = _mm_set1_pd(w);
-            let lo = _mm_add_pd(_mm_loadu_pd(s), _mm_mul_pd(w, _mm_loadu_pd(v)));
-            let hi = _mm_add_pd(
-                _mm_loadu_pd(s.add(2)),
-                _mm_mul_pd(w, _mm_loadu_pd(v.add(2))),
-            );
-            _mm_storeu_pd(s, lo);
-            _mm_storeu_pd(s.add(2), hi);
+            let (magic, mb) = (_mm_set1_pd(MAGIC), _mm_set1_epi64x(magic_bits));
+            let (wv, scale) = (_mm_set1_pd(w), _mm_set1_pd(LOW_LIMB_SCALE));
+            for half in 0..2 {
+                let x = _mm_mul_pd(wv, _mm_loadu_pd(v.add(2 * half)));
+                let t = _mm_add_pd(x, magic);
+                let high = _mm_sub_epi64(_mm_castpd_si128(t), mb);
+                let rest = _mm_mul_pd(_mm_sub_pd(x, _mm_sub_pd(t, magic)), scale);
+                let low = _mm_sub_epi64(_mm_castpd_si128(_mm_add_pd(rest, magic)), mb);
+                let hs = s.add(2 * half).cast::<std::arch::x86_64::__m128i>();
+                _mm_storeu_si128(hs, _mm_add_epi64(_mm_loadu_si128(hs), high));
+                let ls = s.add(4 + 2 * half).cast::<std::arch::x86_64::__m128i>();
+                _mm_storeu_si128(ls, _mm_add_epi64(_mm_loadu_si128(ls), low));
+            }
         }
     }
     #[cfg(not(target_arch = "x86_64"))]
-    for (s, v) in sum.iter_mut().zip(value) {
-        *s += w * v;
+    for (k, v) in value.iter().enumerate() {
+        let (high, low) = split_limbs(w * v);
+        sum[k] = sum[k].wrapping_add(high);
+        sum[k + 4] = sum[k + 4].wrapping_add(low);
     }
+}
+
+/// Whether a sample colour can be added: finite and representable in the fixed-point sums
+/// (`fixed_sum`); the callers count others as black.
+#[inline(always)]
+fn admissible(xyz: DVec3) -> bool {
+    FixedSum::is_representable(xyz.abs().max_element())
 }
 
 /// ⌊x⌋ for |x| ≤ 2³⁰ without a library call (truncation, then one step down for negative
@@ -339,7 +470,7 @@ pub struct FilmTile {
     pub(crate) aovs: Vec<AovAccum>,
     /// Σ w · L̂_b per pixel and bin (pixel-major, `bins.count()` per pixel); empty without
     /// spectral bins.
-    pub(crate) spectral: Vec<f64>,
+    pub(crate) spectral: Vec<FixedSum>,
     spectral_bins: Option<SpectralBins>,
     /// Whether `add_illumination` records anything.
     record_illumination: bool,
@@ -367,7 +498,8 @@ impl FilmTile {
             } else {
                 Vec::new()
             },
-            spectral: spectral_bins.map_or_else(Vec::new, |b| vec![0.0; n * b.count() as usize]),
+            spectral: spectral_bins
+                .map_or_else(Vec::new, |b| vec![FixedSum::ZERO; n * b.count() as usize]),
             spectral_bins,
             record_illumination: aov_selection.illumination,
             record_variance: aov_selection.variance,
@@ -456,8 +588,9 @@ impl FilmTile {
             return false;
         };
         if let (true, Some(a)) = (self.record_illumination, self.aovs.get_mut(i)) {
-            if !radiance.has_non_finite() {
-                a.illumination_sum += weights.xyz(radiance);
+            let xyz = weights.xyz(radiance);
+            if admissible(xyz) {
+                a.illumination_sum.add_f64(xyz);
             }
         }
         true
@@ -563,7 +696,7 @@ impl FilmTile {
             debug_assert!(false, "pixel {pixel} outside tile {:?}", self.bounds);
             return false;
         };
-        let xyz = if xyz.is_finite() { xyz } else { DVec3::ZERO };
+        let xyz = if admissible(xyz) { xyz } else { DVec3::ZERO };
         let w = if filter_weight.is_finite() {
             f64::from(filter_weight)
         } else {
@@ -585,25 +718,35 @@ impl FilmTile {
     ) -> bool {
         let p = &mut self.pixels[i];
         p.sample_count += 1;
-        p.own_weight_sum += w;
+        p.own_weight_sum += FixedSum::from_f64(w);
         match &mut self.splat {
-            Some(buffer) => buffer.splat(film_point, xyz, self.filter_sampler.table()),
+            Some(buffer) => {
+                let table = self.filter_sampler.table();
+                // A colour whose taps would not fit the buffer's limbs counts as black, like
+                // a non-finite one (≥ 2⁴³ / max f: far above any physical radiance).
+                let xyz = if SplatBuffer::admits(xyz, table) {
+                    xyz
+                } else {
+                    DVec3::ZERO
+                };
+                buffer.splat(film_point, xyz, table)
+            }
             None => {
-                p.xyz_sum += w * xyz;
-                p.weight_sum += w;
+                p.xyz_sum.add_f64(w * xyz);
+                p.weight_sum += FixedSum::from_f64(w);
             }
         }
         if self.record_variance {
             if let Some(a) = self.aovs.get_mut(i) {
-                a.y_sum += xyz.y;
-                a.y_sq_sum += xyz.y * xyz.y;
+                a.y_sum += FixedSum::from_f64(xyz.y);
+                a.y_sq_sum += FixedSum::from_f64(xyz.y * xyz.y);
             }
         }
         if let (Some(a), Some(hit)) = (self.aovs.get_mut(i), aov) {
             a.hit_count += 1;
-            a.depth_sum += f64::from(hit.depth_m);
-            a.normal_sum += hit.normal.as_dvec3();
-            a.albedo_sum += DVec3::from(hit.albedo_rgb.map(f64::from));
+            let (n, c) = (hit.normal, hit.albedo_rgb);
+            a.surface
+                .add([hit.depth_m, n.x, n.y, n.z, c[0], c[1], c[2], 0.0].map(f64::from));
         }
         true
     }
@@ -650,6 +793,23 @@ mod tests {
         for w in &wide {
             assert_eq!(sse2.sums, w.sums, "{}", w.simd);
         }
-        assert!(sse2.sums.iter().any(|s| s[3] > 0.0));
+        assert!(sse2.sums.iter().any(|s| s[3] > 0));
+        // The limbs hold the same sums as the exact conversion of each tap.
+        let mut wide_path = SplatBuffer {
+            simd: prism_cpu::Simd::SCALAR,
+            ..SplatBuffer::new(tile, UVec2::new(64, 64), 2.0)
+        };
+        for k in 0..500u32 {
+            let f = k as f32;
+            let p = Vec2::new(
+                16.0 + (f * 0.618_034).fract() * 16.0,
+                16.0 + (f * 0.414_214).fract() * 16.0,
+            );
+            let xyz = DVec3::new(0.1 + f64::from(k % 7), 1.0 / (1.0 + f64::from(k)), 0.25);
+            wide_path.splat_with::<false, false, true>(p, xyz, &table);
+        }
+        for i in 0..sse2.sums.len() {
+            assert_eq!(sse2.pixel_sums(i), wide_path.pixel_sums(i), "pixel {i}");
+        }
     }
 }

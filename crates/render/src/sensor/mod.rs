@@ -22,6 +22,7 @@ use glam::{DVec3, UVec2, Vec3A};
 use prism_scene::{Sensor, SensorSampling};
 use rayon::prelude::*;
 
+use crate::film::FixedSum;
 use crate::integrator::{PathCounters, PathTracer};
 use crate::sampler::PixelSampler;
 use crate::scene_build::RenderScene;
@@ -206,16 +207,16 @@ fn run_samples(
             c += CHUNK_SAMPLES;
         }
     }
-    let chunks: Vec<(u32, f64, u64, PathCounters)> = items
+    let chunks: Vec<(u32, FixedSum, u64, PathCounters)> = items
         .into_par_iter()
         .map(|(r, start, end)| {
-            let mut sum = 0.0;
+            let mut sum = FixedSum::ZERO;
             let mut counters = PathCounters::default();
             for k in start..end {
                 let mut stream = samplers[r as usize]
                     .stream(point, k)
                     .with_sobol_dimensions(sobol_dimensions);
-                sum += sample_illuminance_lx(
+                sum += FixedSum::from_f64(sample_illuminance_lx(
                     tracer,
                     scene,
                     p,
@@ -223,7 +224,7 @@ fn run_samples(
                     light_samples,
                     &mut stream,
                     &mut counters,
-                );
+                ));
             }
             (r, sum, u64::from(end - start), counters)
         })

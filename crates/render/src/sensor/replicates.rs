@@ -23,6 +23,7 @@
 //! (~300 at 1 % on the benchmark; 16 replicates of twice as many points give ~15 % less
 //! variance, 8 of four times ~35 %, at the price of a noisier standard error).
 
+use crate::film::FixedSum;
 use crate::sampler::{PixelSampler, SamplerKind};
 
 /// Replicates per point (see the module comment). A point with fewer samples than this
@@ -53,20 +54,22 @@ pub fn replicate_count(total: u32, replicates: u32, r: u32) -> u32 {
 /// Per-replicate sums of one point's samples.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct ReplicateStats {
-    sums: Vec<f64>,
+    /// Exact (`FixedSum`), so sample-range parts merge into the whole measurement's sums
+    /// bit for bit.
+    sums: Vec<FixedSum>,
     counts: Vec<u64>,
 }
 
 impl ReplicateStats {
     pub fn new(replicates: u32) -> Self {
         Self {
-            sums: vec![0.0; replicates as usize],
+            sums: vec![FixedSum::ZERO; replicates as usize],
             counts: vec![0; replicates as usize],
         }
     }
 
     /// Adds `count` samples summing to `sum` to replicate `r`.
-    pub fn add(&mut self, r: u32, sum: f64, count: u64) {
+    pub fn add(&mut self, r: u32, sum: FixedSum, count: u64) {
         self.sums[r as usize] += sum;
         self.counts[r as usize] += count;
     }
@@ -77,7 +80,7 @@ impl ReplicateStats {
     }
 
     /// Σ of each replicate's samples.
-    pub fn sums(&self) -> &[f64] {
+    pub fn sums(&self) -> &[FixedSum] {
         &self.sums
     }
 
@@ -88,7 +91,7 @@ impl ReplicateStats {
 
     /// Replicates with these sums and counts (as `sums` and `counts` gave them); `None`
     /// when the lengths differ.
-    pub fn from_parts(sums: Vec<f64>, counts: Vec<u64>) -> Option<Self> {
+    pub fn from_parts(sums: Vec<FixedSum>, counts: Vec<u64>) -> Option<Self> {
         (sums.len() == counts.len()).then_some(Self { sums, counts })
     }
 
@@ -109,7 +112,7 @@ impl ReplicateStats {
             .iter()
             .zip(&self.counts)
             .filter(|(_, &n)| n > 0)
-            .map(|(s, &n)| s / n as f64)
+            .map(|(s, &n)| s.to_f64() / n as f64)
     }
 
     /// The reading: the average of the replicate means (0 before any sample).
@@ -163,14 +166,14 @@ mod tests {
             .into_iter()
             .enumerate()
         {
-            s.add(r as u32, sum, n);
+            s.add(r as u32, FixedSum::from_f64(sum), n);
         }
         assert_eq!(s.samples(), 9);
         assert!((s.mean() - 3.0).abs() < 1e-12);
         assert!((s.std_error() - (14.0 / 3.0 / 4.0f64).sqrt()).abs() < 1e-12);
         // Empty replicates do not count.
         let mut t = ReplicateStats::new(3);
-        t.add(0, 5.0, 1);
+        t.add(0, FixedSum::from_f64(5.0), 1);
         assert_eq!((t.mean(), t.std_error()), (5.0, 0.0));
         assert_eq!(ReplicateStats::new(2).mean(), 0.0);
     }
