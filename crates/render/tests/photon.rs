@@ -529,3 +529,47 @@ fn spot_in_fog_without_glass_agrees_with_path() {
         3e-2 * expected,
     );
 }
+
+/// Issue 20's check (a) of the photon reference, at a test's budget: on spot-fog-glass
+/// (16×16), the mean over the pixels below the glass sphere where its caustic cone lands
+/// — where `path` finds the light only by a BSDF sample through the sphere that hits the
+/// small lamp, rarely, i.e. in fireflies — from `photon_progressive` against a long `path`
+/// run. 4 s.e. (path's, whose fireflies the s.e. of 16384 passes covers) and a floor of
+/// 5 % for the kernel's blur of the caustic's edge across the window's border.
+/// tools/photon_reference_check.py runs the same check at 128×128 with the speed
+/// target's reference budget.
+#[test]
+fn spot_fog_glass_caustic_cone_agrees_with_a_long_path_run() {
+    let window = (7, 9, 9, 11);
+    let path = with_integrator(
+        repository_scene("stress/spot-fog-glass.json", 16),
+        prism_scene::Integrator::Path {
+            max_depth: 8,
+            sampler: prism_scene::SamplerKind::Independent,
+            mis: prism_scene::MisHeuristic::Power,
+            rr_depth: 3,
+            fluorescence_lanes: prism_scene::FluorescenceLanes::All,
+            spectral_mis: true,
+        },
+    );
+    let (expected, expected_se) = mean_se(&pass_means(&path, 16384, 51, window));
+    let scene = with_integrator(
+        repository_scene("stress/spot-fog-glass.json", 16),
+        prism_scene::Integrator::PhotonProgressive {
+            max_depth: 8,
+            sampler: prism_scene::SamplerKind::Independent,
+            rr_depth: 3,
+            photons_per_pass: Some(4000),
+            initial_radius_m: None,
+            alpha: prism_scene::DEFAULT_PHOTON_ALPHA,
+        },
+    );
+    let means = pass_means(&scene, 1024, 52, window);
+    assert_close(
+        "caustic cone",
+        mean_se(&means),
+        expected,
+        expected_se,
+        5e-2 * expected,
+    );
+}
