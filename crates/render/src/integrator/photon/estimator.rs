@@ -3,11 +3,15 @@
 //! (`Estimator::sample_indices_per_prepare`), and `prepare` shoots that pass's photons at
 //! that pass's wavelengths (one `SampledWavelengths` for every photon and camera path of
 //! the pass, as pbrt-v4's SPPM) with that pass's radius, dropping the previous pass's.
-//! The film averages the passes' images: with the radius of pass i shrinking as
-//! r²ᵢ₊₁ = r²ᵢ(i + α)/(i + 1), that average is Knaus & Zwicker 2011's progressive photon
-//! mapping, whose bias and variance both vanish (their §4); it needs no per-pixel
-//! statistics, which is what lets the passes run in any grouping and a render of N
-//! samples equal N one-sample passes. `prism render --spp N` is N photon passes.
+//! The film averages the passes' images. `photon_progressive` shrinks its radii as passes
+//! add up, so that bias and variance both vanish: in media the beam estimate's radius of
+//! pass i follows r²ᵢ₊₁ = r²ᵢ(i + α)/(i + 1) for the whole pass (Knaus & Zwicker 2011,
+//! §4); on surfaces each pixel keeps its own radius and photon count (stochastic
+//! progressive photon mapping, Hachisuka & Jensen 2009, `sppm`), which `prepare` updates
+//! from what the pixel's visible point found in the pass before. Those statistics make
+//! pass i depend on passes 0 … i − 1: a progressive render's passes run in order from the
+//! first, in one estimator, and a range starting later is refused with the reason.
+//! `prism render --spp N` is N photon passes.
 
 use prism_spectrum::SampledSpectrum;
 
