@@ -166,7 +166,11 @@ def main():
         "difference_in_standard_errors": difference / se if se > 0 else None,
         "within_4_se": abs(difference) <= 4 * se,
         "wall_s": time.time() - started,
-        "command": "python3 tools/photon_reference_check.py " + " ".join(sys.argv[1:]),
+        "binary": "target/debug/prism (test profile)" if "debug" in args.prism
+                  else os.path.relpath(args.prism, ROOT),
+        "options": {"reference_spp": args.reference_spp,
+                    "reference_seeds": args.reference_seeds,
+                    "path_spp": args.path_spp, "path_seeds": args.path_seeds},
     }
     tmp = RESULT + ".tmp"
     with open(tmp, "w") as f:
