@@ -432,7 +432,8 @@ fn a_scene_with_media_is_explained_and_rendered_by_the_scalar_tracer() {
 }
 
 /// The same fog scene with `photon_progressive`: `--explain` names its settings (photons per
-/// pass, radius, α, the storage estimate and limit), and it renders a lit, finite image.
+/// pass, radius, α, the storage estimate and limit), it renders a lit, finite image, and a
+/// sample range that starts after 0 is refused (its per-pixel radii need the passes before).
 #[test]
 fn a_photon_integrator_is_explained_and_renders() {
     let dir = tempfile::tempdir().unwrap();
@@ -482,6 +483,33 @@ fn a_photon_integrator_is_explained_and_renders() {
             && image.pixels().iter().any(|p| p[1] > 0.0),
         "a lit fog scene rendered black or non-finite"
     );
+    // Its per-pixel statistics come from the passes before: a range after sample 0 is
+    // refused with the reason, one from 0 renders.
+    let part = dir.path().join("part.exr");
+    let range = |samples: &str| {
+        prism(&[
+            "render",
+            s(&scene),
+            "-o",
+            s(&part),
+            "--resolution",
+            "16x12",
+            "--spp",
+            "4",
+            "--samples",
+            samples,
+        ])
+    };
+    let o = range("2..4");
+    assert!(!o.status.success());
+    assert!(
+        stderr(&o).contains("keeps per-pixel statistics from pass to pass")
+            && stderr(&o).contains("starts at sample 2"),
+        "{}",
+        stderr(&o)
+    );
+    let o = range("0..2");
+    assert!(o.status.success(), "{}", stderr(&o));
 }
 
 /// The `simd: <isa> (<why>)` line of `render --explain` with `PRISM_SIMD` set to `env`.

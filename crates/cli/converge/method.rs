@@ -50,7 +50,7 @@ pub const INTEGRATORS: [(&str, bool, &str); 9] = [
     (
         "photon_progressive",
         true,
-        "progressive photon mapping (Knaus & Zwicker 2011; consistent)",
+        "progressive photon mapping (stochastic on surfaces, Hachisuka & Jensen 2009; consistent)",
     ),
 ];
 

@@ -10,8 +10,9 @@ use glam::UVec2;
 use prism_bandwidth::{adaptive_error, adaptive_pass_counts, SamplePlan};
 
 use crate::film::{AovPlane, Film, FilmImage};
+use crate::integrator::{Estimator, Pass};
 use crate::scene_build::RenderScene;
-use crate::{film_for, render_pass, RenderError, RenderSettings, RenderStats};
+use crate::{film_for, render_pass_with, RenderError, RenderSettings, RenderStats};
 
 /// Samples per pixel of the uniform first pass (Cycles' default minimum before adapting).
 pub const ADAPTIVE_FIRST_PASS_SPP: u32 = 4;
@@ -25,8 +26,11 @@ pub const ADAPTIVE_PASSES: u32 = 8;
 /// its own sample sequence (`SamplePlan::with_first_samples`), so the passes add up to one
 /// render of the summed counts. Split (adaptive sampling): the first ⌈c/2⌉ of a pixel's c
 /// samples in a pass go to film A, the rest to film B, and |I − A| (I = A + B) estimates
-/// the error. Used by `render_adaptive` and by `prism converge`'s per-pixel plans.
+/// the error. Used by `render_adaptive` and by `prism converge`'s per-pixel plans. One
+/// estimator renders every pass, so state that passes build on (`photon_progressive`'s
+/// per-pixel statistics) carries from one to the next.
 pub struct PerPixelPasses {
+    estimator: Box<dyn Estimator>,
     done: Vec<u32>,
     /// Film B (or the only film when not split).
     film: Film,
@@ -38,6 +42,7 @@ impl PerPixelPasses {
     pub fn new(scene: &RenderScene, settings: &RenderSettings, split: bool) -> Self {
         let n = scene.resolution.x as usize * scene.resolution.y as usize;
         Self {
+            estimator: scene.integrator.estimator(),
             done: vec![0; n],
             film: film_for(scene, settings),
             half: split.then(|| film_for(scene, settings)),
@@ -79,7 +84,21 @@ impl PerPixelPasses {
                 (Some(half), true) => half,
                 _ => &mut self.film,
             };
-            stats.add(&render_pass(scene, settings, &plan, film, 0, progress)?);
+            // As `render_pass` with first sample 0: the plan carries each pixel's start.
+            let pass = Pass {
+                index: 0,
+                settings,
+                plan: &plan,
+                first_sample: 0,
+                footprint_plan: None,
+            };
+            stats.add(&render_pass_with(
+                self.estimator.as_mut(),
+                scene,
+                &pass,
+                film,
+                progress,
+            )?);
         }
         for (d, c) in self.done.iter_mut().zip(counts) {
             *d += c;

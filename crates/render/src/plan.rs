@@ -648,8 +648,9 @@ fn photon_explain(m: &crate::integrator::PhotonMapper, scene: &RenderScene) -> (
     let mib = |b: u64| b as f64 / f64::from(1u32 << 20);
     let radius = match (plan.alpha, plan.nearest) {
         (Some(alpha), _) => format!(
-            "initial radius {:.4} m shrinking as r²ᵢ₊₁ = r²ᵢ(i + α)/(i + 1), α {alpha:.3} \
-             (Knaus & Zwicker 2011)",
+            "initial radius {:.4} m, α {alpha:.3}: per pixel on surfaces (stochastic \
+             progressive photon mapping, Hachisuka & Jensen 2009), r²ᵢ₊₁ = r²ᵢ(i + α)/(i + 1) \
+             in media (Knaus & Zwicker 2011)",
             plan.radius_m
         ),
         (None, Some(k)) => format!("radius: distance to the {k}-th nearest photon"),

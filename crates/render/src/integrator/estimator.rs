@@ -78,8 +78,9 @@ impl TileWork<'_> {
     }
 }
 
-/// A rendering method.
-pub trait Estimator: Sync {
+/// A rendering method. `Send`: a render that spans several calls of the driver (`prism
+/// converge`'s passes) keeps one estimator, and with it the state its passes build up.
+pub trait Estimator: Send + Sync {
     /// The name used in scene files, `--method` and statistics.
     fn name(&self) -> &'static str;
 

@@ -81,6 +81,19 @@ impl Radiance {
     }
 }
 
+/// How a camera path gathers the caustic map, and what its gather found.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CausticGather {
+    /// `Some(R)`: the photons within R of the visible point, kernel 1/(π R²) — the pixel's
+    /// radius of stochastic progressive photon mapping (`sppm`); `None`: every photon whose
+    /// own sphere holds the point, kernel 1/(π rp²).
+    pub radius_m: Option<f32>,
+    /// Photons found within the radius that the path's depth admits (the M of the pixel's
+    /// update), whatever their contribution: photons from behind the surface count too,
+    /// as in pbrt-v4's SPPM.
+    pub found: u32,
+}
+
 /// The camera-path tracer of a pass.
 pub struct CameraPaths<'a> {
     pub tracer: PathTracer,
@@ -95,6 +108,7 @@ impl CameraPaths<'_> {
         camera_ray: &Ray,
         wavelengths: &mut LaneWavelengths,
         stream: &mut SampleStream,
+        gather: &mut CausticGather,
         counters: &mut PathCounters,
     ) -> (SampledSpectrum, Option<FirstHit>) {
         let max_depth = self.tracer.max_depth;
@@ -270,6 +284,7 @@ impl CameraPaths<'_> {
                         si.p,
                         path.beta,
                         max_depth - path.depth,
+                        gather,
                         &mut sum,
                         counters,
                     );
@@ -342,22 +357,26 @@ impl CameraPaths<'_> {
         (sum.finish(&path.wavelengths), first_hit)
     }
 
-    /// Jensen 1996 eq. 9 at a surface vertex: Σ f(ωo, ωp) ΔΦp / (π rp²) over the caustic
-    /// photons whose sphere holds `p` (f without the cosine: the photons' flux is already
-    /// per projected area), of at most `depth_left` scattering events.
+    /// Jensen 1996 eq. 9 at a surface vertex: Σ f(ωo, ωp) ΔΦp / (π r²) over the caustic
+    /// photons within r of `p` (f without the cosine: the photons' flux is already per
+    /// projected area), of at most `depth_left` scattering events. r is the pixel's radius
+    /// when `gather` has one (Hachisuka & Jensen 2009), else each photon's own.
+    #[allow(clippy::too_many_arguments)]
     fn gather_caustics(
         &self,
         vertex: &ScatterVertex,
         p: Vec3A,
         beta: SampledSpectrum,
         depth_left: u32,
+        gather: &mut CausticGather,
         sum: &mut Radiance,
         counters: &mut PathCounters,
     ) {
-        self.maps.caustic.for_each_containing(p, |ph| {
+        let mut add = |ph: &Photon, radius_m: f32| {
             if u32::from(ph.depth) > depth_left {
                 return;
             }
+            gather.found += 1;
             let Some(eval) = vertex.eval(-ph.direction(), TransportMode::Radiance) else {
                 return;
             };
@@ -365,10 +384,17 @@ impl CameraPaths<'_> {
             if cos <= 0.0 || eval.f_cos.is_black() {
                 return;
             }
-            let kernel = 1.0 / (std::f32::consts::PI * ph.radius_m * ph.radius_m);
+            let kernel = 1.0 / (std::f32::consts::PI * radius_m * radius_m);
             let c = beta * eval.f_cos * ph.beta() * (kernel / cos);
             sum.add_photon(ph, c, counters);
-        });
+        };
+        match gather.radius_m {
+            Some(r) => self.maps.caustic.for_each_within(p, r, |ph| add(ph, r)),
+            None => self
+                .maps
+                .caustic
+                .for_each_containing(p, |ph| add(ph, ph.radius_m)),
+        }
     }
 
     /// Jarosz et al. 2008 eq. 13, the beam radiance estimate along `segment` in medium

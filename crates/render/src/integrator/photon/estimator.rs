@@ -3,18 +3,23 @@
 //! (`Estimator::sample_indices_per_prepare`), and `prepare` shoots that pass's photons at
 //! that pass's wavelengths (one `SampledWavelengths` for every photon and camera path of
 //! the pass, as pbrt-v4's SPPM) with that pass's radius, dropping the previous pass's.
-//! The film averages the passes' images: with the radius of pass i shrinking as
-//! r²ᵢ₊₁ = r²ᵢ(i + α)/(i + 1), that average is Knaus & Zwicker 2011's progressive photon
-//! mapping, whose bias and variance both vanish (their §4); it needs no per-pixel
-//! statistics, which is what lets the passes run in any grouping and a render of N
-//! samples equal N one-sample passes. `prism render --spp N` is N photon passes.
+//! The film averages the passes' images. `photon_progressive` shrinks its radii as passes
+//! add up, so that bias and variance both vanish: in media the beam estimate's radius of
+//! pass i follows r²ᵢ₊₁ = r²ᵢ(i + α)/(i + 1) for the whole pass (Knaus & Zwicker 2011,
+//! §4); on surfaces each pixel keeps its own radius and photon count (stochastic
+//! progressive photon mapping, Hachisuka & Jensen 2009, `sppm`), which `prepare` updates
+//! from what the pixel's visible point found in the pass before. Those statistics make
+//! pass i depend on passes 0 … i − 1: a progressive render's passes run in order from the
+//! first, in one estimator, and a range starting later is refused with the reason.
+//! `prism render --spp N` is N photon passes.
 
 use prism_spectrum::SampledSpectrum;
 
-use super::camera::{pass_wavelengths, CameraPaths, PhotonMaps};
+use super::camera::{pass_wavelengths, CameraPaths, CausticGather, PhotonMaps};
 use super::photon_map::PhotonTree;
 use super::settings::{PhotonMapper, PhotonPlan};
 use super::shoot::shoot;
+use super::sppm::SppmStatistics;
 use crate::film::xyz::XyzWeights;
 use crate::film::{FilmTile, LightSplats, SurfaceAov};
 use crate::integrator::camera_sample::CameraSample;
@@ -38,6 +43,8 @@ pub struct PhotonEstimator {
     radius: Option<(u32, f64)>,
     /// Rays the photon pass traced, reported with the first tile's statistics.
     photon_rays: std::sync::atomic::AtomicU64,
+    /// `photon_progressive`: every pixel's surface-gather radius and photon count.
+    sppm: Option<SppmStatistics>,
 }
 
 impl PhotonEstimator {
@@ -50,6 +57,7 @@ impl PhotonEstimator {
             wavelengths: prism_spectrum::SampledWavelengths::sample_visible(0.5),
             radius: None,
             photon_rays: std::sync::atomic::AtomicU64::new(0),
+            sppm: None,
         }
     }
 
@@ -64,6 +72,49 @@ impl PhotonEstimator {
     /// Stored photons of the current pass (caustic, volume).
     pub fn photon_counts(&self) -> (usize, usize) {
         (self.maps.caustic.len(), self.maps.volume.len())
+    }
+
+    /// `photon_progressive`: `pixel`'s surface-gather statistics for the current pass
+    /// (`None` for `photon`, or before the first pass).
+    pub fn pixel_statistics(&self, pixel: glam::UVec2) -> Option<super::PixelStatistics> {
+        self.sppm.as_ref().map(|s| s.pixel(pixel))
+    }
+
+    /// The per-pixel statistics ready for pass `iteration`: fresh at pass 0, else the
+    /// last pass's counts folded in. Passes must come in order (pass i's radii are the
+    /// result of passes 0 … i − 1).
+    fn advance_statistics(
+        &mut self,
+        plan: &PhotonPlan,
+        resolution: glam::UVec2,
+        iteration: u32,
+    ) -> Result<(), String> {
+        let Some(alpha) = plan.alpha else {
+            return Ok(());
+        };
+        if iteration == 0 {
+            self.sppm = Some(SppmStatistics::new(resolution, plan.radius_m, alpha));
+            return Ok(());
+        }
+        let expected = self.sppm.as_ref().map(|s| s.pass() + 1);
+        match &mut self.sppm {
+            Some(stats) if expected == Some(iteration) && stats.resolution() == resolution => {
+                stats.advance();
+                Ok(())
+            }
+            _ => Err(format!(
+                "`{}` keeps per-pixel statistics from pass to pass (stochastic progressive \
+                 photon mapping, Hachisuka & Jensen 2009), so its passes run in order from \
+                 sample 0 in one render: this one starts at sample {iteration}{}; render \
+                 samples 0.. in one range instead (no `--samples A..B` with A > 0, no \
+                 resuming between passes)",
+                self.mapper.name(),
+                match expected {
+                    Some(e) => format!(" where sample {e} was next"),
+                    None => String::new(),
+                }
+            )),
+        }
     }
 }
 
@@ -138,6 +189,7 @@ impl Estimator for PhotonEstimator {
         if self.iteration == Some(iteration) {
             return Ok(());
         }
+        self.advance_statistics(&plan, pass.plan.resolution(), iteration)?;
         // Drop the last pass's photons before the next are shot.
         self.maps = PhotonMaps::default();
         self.wavelengths = pass_wavelengths(pass.settings.seed, iteration);
@@ -203,12 +255,26 @@ impl Estimator for PhotonEstimator {
                 // The stream's wavelength dimension is not read: the pass's set is used.
                 let _ = cs.stream.get_1d();
                 let mut wavelengths = LaneWavelengths::new(self.wavelengths);
+                let mut gather = CausticGather {
+                    radius_m: self.sppm.as_ref().map(|s| s.pixel(pixel).radius_m() as f32),
+                    found: 0,
+                };
                 let result = scene
                     .camera
                     .generate_ray_only(cs.film_point, cs.lens)
                     .map(|ray| {
-                        paths.radiance(scene, &ray, &mut wavelengths, &mut cs.stream, &mut counters)
+                        paths.radiance(
+                            scene,
+                            &ray,
+                            &mut wavelengths,
+                            &mut cs.stream,
+                            &mut gather,
+                            &mut counters,
+                        )
                     });
+                if let Some(stats) = &self.sppm {
+                    stats.record(pixel, gather.found);
+                }
                 let sensor = wavelengths.sensor();
                 let xyz_weights = XyzWeights::new(sensor);
                 let (radiance, aov) = match result {

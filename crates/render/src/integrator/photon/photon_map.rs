@@ -4,7 +4,9 @@
 //! median of the longest axis, at most `LEAF_PHOTONS` photons per leaf. The same tree
 //! answers the three questions the photon integrators ask:
 //!
-//! - every photon whose sphere contains a point (the surface gather, Jensen 1996 eq. 9);
+//! - every photon whose sphere contains a point (the surface gather, Jensen 1996 eq. 9),
+//!   or whose centre lies within a given radius of it (the per-pixel radius of stochastic
+//!   progressive photon mapping, Hachisuka & Jensen 2009);
 //! - every photon whose sphere a ray segment crosses, with the segment parameter of its
 //!   centre's projection (the beam radiance estimate, Jarosz et al. 2008 eq. 13);
 //! - the k nearest photons of a photon (`photon`'s k-NN radius).
@@ -211,6 +213,36 @@ impl PhotonTree {
         }
     }
 
+    /// Calls `f` with every photon whose centre lies within `radius_m` of `x` (the
+    /// photons' own radii play no part: the nodes' boxes hold the centres all the same).
+    #[inline]
+    pub fn for_each_within(&self, x: Vec3A, radius_m: f32, mut f: impl FnMut(&Photon)) {
+        if self.nodes.is_empty() {
+            return;
+        }
+        let r2 = radius_m * radius_m;
+        let mut stack = [0u32; 64];
+        let mut top = 1usize;
+        while top > 0 {
+            top -= 1;
+            let node = &self.nodes[stack[top] as usize];
+            if box_distance_squared(node.lo, node.hi, x) >= r2 {
+                continue;
+            }
+            if node.leaf {
+                for ph in &self.photons[node.a as usize..node.b as usize] {
+                    if (ph.position() - x).length_squared() < r2 {
+                        f(ph);
+                    }
+                }
+            } else if top + 2 <= stack.len() {
+                stack[top] = node.a;
+                stack[top + 1] = node.b;
+                top += 2;
+            }
+        }
+    }
+
     /// Calls `f(photon, t)` with every photon whose sphere the segment o + t·d, t ∈
     /// [t0, t1] (`d` unit) passes within the photon's radius of, with the parameter t of
     /// the centre's projection on the line, itself in [t0, t1] (the disc the photon
@@ -352,6 +384,14 @@ mod tests {
                 .filter(|p| (p.position() - x).length_squared() < p.radius_m * p.radius_m)
                 .count();
             assert_eq!(found, expected);
+            let radius_m = 0.02 + 0.1 * rng.uniform();
+            let mut within = 0;
+            tree.for_each_within(x, radius_m, |_| within += 1);
+            let expected = photons
+                .iter()
+                .filter(|p| (p.position() - x).length_squared() < radius_m * radius_m)
+                .count();
+            assert_eq!(within, expected);
             let d = Vec3A::new(
                 rng.uniform() - 0.5,
                 rng.uniform() - 0.5,

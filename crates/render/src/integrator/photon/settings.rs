@@ -14,8 +14,9 @@ pub enum RadiusRule {
     Fixed(Option<f32>),
     /// `photon`: each photon's radius is the distance to its k-th nearest neighbour.
     Nearest(u32),
-    /// `photon_progressive`: r²ᵢ₊₁ = r²ᵢ(i + α)/(i + 1) from the initial radius (`None`:
-    /// the default radius) (Knaus & Zwicker 2011, eq. 20 with the 2-D kernel).
+    /// `photon_progressive` from the initial radius (`None`: the default radius): in media
+    /// r²ᵢ₊₁ = r²ᵢ(i + α)/(i + 1) (Knaus & Zwicker 2011, eq. 20 with the 2-D kernel); on
+    /// surfaces per pixel, with α the fraction of photons kept (`sppm`).
     Progressive { initial_m: Option<f32>, alpha: f32 },
 }
 
@@ -152,8 +153,9 @@ impl PhotonMapper {
 }
 
 impl PhotonPlan {
-    /// The gather radius of pass `iteration` (0-based): Knaus & Zwicker 2011's
-    /// r²ᵢ₊₁ = r²ᵢ (i + α)/(i + 1) when progressive, else the fixed radius.
+    /// The gather radius of pass `iteration` (0-based) in media (on surfaces too unless
+    /// progressive): Knaus & Zwicker 2011's r²ᵢ₊₁ = r²ᵢ (i + α)/(i + 1) when progressive,
+    /// else the fixed radius.
     pub fn radius_at(&self, iteration: u32) -> f32 {
         self.radius_from(iteration, None).1.sqrt() as f32
     }
