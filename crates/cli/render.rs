@@ -584,21 +584,14 @@ pub fn run(args: &RenderArgs, budget: &MemoryBudget) -> Result<ExitCode, String>
             crate::partial::file::COMPLETE.to_string(),
             "false".to_string(),
         )];
-        marks.extend(crate::partial::file::header_attributes(
-            &header,
-            &rendered.sums,
-        ));
+        let sums = rendered.film.sums();
+        marks.extend(crate::partial::file::header_attributes(&header, &sums));
         if range_output {
             rendered.write_partial(&output)?;
         } else {
             write_output(&output, &rendered.image, &marks)?;
         }
-        let done: u64 = rendered
-            .sums
-            .sample_counts()
-            .iter()
-            .map(|&c| u64::from(c))
-            .sum();
+        let done: u64 = sums.sample_counts().iter().map(|&c| u64::from(c)).sum();
         eprintln!(
             "{}: stopped by {} after {} of the range's samples ({} work items); wrote the \
              checkpoint {} and the PARTIAL image {}; continue with --resume {}",

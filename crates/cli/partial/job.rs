@@ -6,7 +6,6 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use prism_bandwidth::SamplePlan;
-use prism_render::film::FilmSums;
 use prism_render::integrator::Pass;
 use prism_render::{
     film_for, render_pass_controlled, AovPlane, Film, FilmImage, PassControl, RenderScene,
@@ -24,7 +23,9 @@ use crate::render::RenderArgs;
 /// What a pass left.
 pub struct Rendered {
     pub image: FilmImage,
-    pub sums: FilmSums,
+    /// The film itself: its sums (`Film::sums`, as large as the film) are made only when a
+    /// partial file is written.
+    pub film: Film,
     pub stats: RenderStats,
     pub complete: bool,
     pub items_done: usize,
@@ -66,7 +67,7 @@ impl Rendered {
             path,
             &self.image,
             &self.header(),
-            &self.sums,
+            &self.film.sums(),
             self.plan.as_deref(),
         )
     }
@@ -242,7 +243,7 @@ pub fn render(
     let write_checkpoint = |film: &Film, items: usize| {
         let rendered = Rendered {
             image: film.finish(),
-            sums: film.sums(),
+            film: film.clone(),
             stats: RenderStats::default(),
             complete: false,
             items_done: items,
@@ -298,7 +299,7 @@ pub fn render(
     image.aovs.extend(extra_aovs);
     Ok(Rendered {
         image,
-        sums: film.sums(),
+        film,
         stats: outcome.stats,
         complete: outcome.complete,
         items_done: outcome.items_done,

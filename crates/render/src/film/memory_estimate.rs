@@ -57,8 +57,10 @@ impl FilmMemory {
         let layers = 4 * (self.aov_channels() + bins);
         // XYZ, RGB and Y in f32, then the layers.
         let film_image = 28 + layers;
-        // RGB and luminance in f32, the layers; the encoder holds as much again.
-        let output = 2 * (16 + layers);
+        // RGB and luminance in f32, the layers; the encoder holds as much again; and the
+        // temporaries of building the image (luminance in cd/m², layers interleaved) with
+        // what the allocator keeps of freed tiles, 64 bytes as measured (docs/reliability.md).
+        let output = 2 * (16 + layers) + 64;
         accumulators + film_image + output
     }
 
