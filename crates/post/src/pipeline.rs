@@ -71,9 +71,10 @@ impl From<ToneOperator> for OperatorChoice {
 }
 
 /// Peak bytes per pixel of [`tonemap_file`] with one operator, beyond 4 bytes per stored
-/// channel of the input as decoded: the input's RGB in f32, the operator's output and
-/// its luminance planes, the encoder's buffer. Measured on a 2048² float RGB EXR
-/// (docs/reliability.md); the memory check's estimate.
+/// channel of the input as decoded: the operator's output (12) and a local operator's
+/// luminance planes, or after the input is dropped the encoder's buffers. Measured on
+/// 8192² float RGB EXRs (tools/measure_memory.py, docs/reliability.md: 24 in all for the
+/// global operators, 28 for durand02); the memory check's estimate.
 pub const TONEMAP_BYTES_PER_PIXEL: u64 = 32;
 
 /// Options of `prism tonemap` (CLI defaults in [`Default`]: `--wb none`, `--gamut clip`,
@@ -318,6 +319,10 @@ pub fn tonemap_file(
         }
     };
     let tone_ms = ms(t);
+    // The input is not read again: its memory goes back before the gamut mapping and the
+    // encoder's buffers are allocated (the peak is then the larger of input and output
+    // together, and output and encoder together; docs/reliability.md).
+    drop(image);
 
     let t = Instant::now();
     let out_space = out.color_space.clone();
