@@ -427,6 +427,13 @@ pub fn run(args: &RenderArgs, budget: &MemoryBudget) -> Result<ExitCode, String>
             );
         }
     }
+    // A spectral render of a camera or a light shut inside a closed shape is black; the
+    // diagnostic integrators (depth, normals) show the geometry whatever the light.
+    if scene.integrator.is_spectral() {
+        for warning in prism_render::enclosure::enclosure_warnings(&scene, &description) {
+            eprintln!("{}: warning: {warning}", args.scene.display());
+        }
+    }
     if args.explain {
         let request = PlanRequest {
             spp: settings.spp,
