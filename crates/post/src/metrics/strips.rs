@@ -559,4 +559,27 @@ mod tests {
         .to_string();
         assert!(e.contains("sizes differ"), "{e}");
     }
+
+    /// From EXR files read band by band (Prism's writer: ZIP blocks of 16 rows, cut by
+    /// strips of 7), the comparison of the images read whole.
+    #[test]
+    fn strips_of_exr_files_give_the_comparison_of_the_images_read_whole() {
+        use prism_image::io::exr::{write_exr, ExrWriteOptions};
+        use prism_image::io::read_image;
+        let (test, reference) = pair(70, 50, RgbColorSpace::display_p3(), RgbColorSpace::srgb());
+        let dir = std::env::temp_dir().join(format!("prism-strips-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let (a, b) = (dir.join("test.exr"), dir.join("reference.exr"));
+        write_exr(&a, &test, &ExrWriteOptions::default()).unwrap();
+        write_exr(&b, &reference, &ExrWriteOptions::default()).unwrap();
+        let options = CompareOptions::default();
+        let want = PreparedReference::new(&read_image(&b).unwrap())
+            .compare_with_maps(&read_image(&a).unwrap(), &options)
+            .unwrap();
+        let (t, r) = (RowSource::open(&a).unwrap(), RowSource::open(&b).unwrap());
+        assert!(t.is_streamed() && r.is_streamed());
+        let got = compare_rows(&t, &r, &options, 7).unwrap();
+        let _ = std::fs::remove_dir_all(&dir);
+        assert_eq!(got, want);
+    }
 }
