@@ -170,3 +170,7 @@ fn rgbe() {
 fn png() {
     fuzz(Target::Png);
 }
+#[test]
+fn cli_values() {
+    fuzz(Target::CliValues);
+}

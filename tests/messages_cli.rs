@@ -291,3 +291,76 @@ fn a_light_of_zero_power_is_warned_about() {
     assert!(err.contains("lights[1] has zero power"), "{err}");
     assert!(!err.contains("lights[0]"), "{err}");
 }
+
+/// `prism render --explain` of `scene` (written to `dir`): its standard error.
+fn explain(dir: &Path, name: &str, scene: &str) -> String {
+    let path = write(dir, name, scene.as_bytes());
+    let o = prism(&["render", s(&path), "--explain"]);
+    let err = stderr(&o);
+    assert!(o.status.success(), "{err}");
+    err
+}
+
+#[test]
+fn a_camera_inside_a_closed_one_sided_shape_is_warned_about() {
+    let dir = tempfile::tempdir().unwrap();
+    // The default camera sits at the origin, inside the dome; the lamp is inside too.
+    let scene = |dome_material: &str| {
+        format!(
+            r#"{{"film": {{"resolution": [8, 8], "spp": 1}},
+                "materials": {{"white": {{"type": "lambert", "reflectance": 0.8}},
+                               "both": {{"type": "two_sided", "material": "white"}},
+                               "glass": {{"type": "dielectric", "ior": 1.5}}}},
+                "lights": [{{"type": "point", "position_m": [0, 0.5, 0], "power_lm": 100}}],
+                "shapes": [{{"type": "sphere", "transform": {{"translate": [0, 0, -1]}},
+                             "radius_m": 0.2}},
+                           {{"name": "dome", "type": "sphere", "radius_m": 4,
+                             "material": "{dome_material}"}}]}}"#
+        )
+    };
+    let err = explain(dir.path(), "inside.json", &scene("white"));
+    assert!(
+        err.contains("inside.json: warning: the camera is inside shapes[1] (`dome`)")
+            && err.contains("two_sided"),
+        "{err}"
+    );
+    assert_eq!(err.matches("warning").count(), 1, "{err}");
+    assert!(!err.contains("lights[0]"), "{err}");
+    // Seen from inside, a two-sided or a transmissive dome is not black.
+    for material in ["both", "glass"] {
+        let err = explain(dir.path(), "fine.json", &scene(material));
+        assert!(!err.contains("warning"), "{material}: {err}");
+    }
+}
+
+#[test]
+fn a_light_shut_inside_a_closed_opaque_shape_is_warned_about() {
+    let dir = tempfile::tempdir().unwrap();
+    // The spot light sits inside a closed box in front of the camera (outside it).
+    let scene = |box_material: &str| {
+        format!(
+            r#"{{"film": {{"resolution": [8, 8], "spp": 1}},
+                "materials": {{"white": {{"type": "lambert", "reflectance": 0.8}},
+                               "both": {{"type": "two_sided", "material": "white"}},
+                               "glass": {{"type": "dielectric", "ior": 1.5}}}},
+                "lights": [{{"type": "point", "position_m": [3, 3, 0], "power_lm": 100}},
+                           {{"type": "point", "position_m": [0, 0.1, -5], "power_lm": 100}}],
+                "shapes": [{{"name": "box", "type": "cuboid", "size_m": [1, 1, 1],
+                             "material": "{box_material}",
+                             "transform": {{"translate": [0, 0, -5]}}}}]}}"#
+        )
+    };
+    for material in ["white", "both"] {
+        let err = explain(dir.path(), "shut.json", &scene(material));
+        assert!(
+            err.contains("shut.json: warning: lights[1] is inside shapes[0] (`box`)"),
+            "{material}: {err}"
+        );
+        assert!(
+            !err.contains("lights[0]") && !err.contains("the camera is inside"),
+            "{err}"
+        );
+    }
+    let err = explain(dir.path(), "glass.json", &scene("glass"));
+    assert!(!err.contains("warning"), "{err}");
+}

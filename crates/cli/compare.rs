@@ -6,8 +6,10 @@ use std::path::{Path, PathBuf};
 
 use clap::{Args, ValueEnum};
 use prism_cpu::memory::MemoryBudget;
+use prism_image::io::strips::RowSource;
 use prism_image::io::{read_dimensions, write_image, ImageDimensions, ImageFormat};
 use prism_post::metrics::flip::DEFAULT_PPD;
+use prism_post::metrics::strips::strip_compare_bytes;
 use prism_post::metrics::tmqi::Tmqi;
 use prism_post::metrics::{CompareOptions, Comparison, FlipMaps, COMPARE_BYTES_PER_PIXEL};
 use prism_post::pipeline::{compare_files_report, compare_files_with, tmqi_files};
@@ -169,15 +171,34 @@ fn print_tmqi(t: &Tmqi) {
     );
 }
 
-/// Bytes a comparison of the two files will need, from their headers: each image as
-/// decoded (4 bytes per stored channel) and the metrics' working set per reference pixel.
+/// Bytes a comparison of the two files will need, from their headers. `--tmqi` and
+/// `--report` hold both images as decoded (4 bytes per stored channel) and the prepared
+/// reference's working set; the metrics alone read EXRs in strips
+/// (`strip_compare_bytes`), an input of another format decoded whole, and
+/// `--error-map` adds its false-colour image and encoder (24 bytes per pixel).
 fn check_memory(args: &CompareArgs, budget: &MemoryBudget) -> Result<(), String> {
     let header = |p: &Path| read_dimensions(p).map_err(|e| e.to_string());
     let (test, reference) = (header(&args.test)?, header(&args.reference)?);
     let decoded = |d: &ImageDimensions| d.pixels().saturating_mul(4 * d.channels as u64);
-    let estimate = decoded(&test)
-        .saturating_add(decoded(&reference))
-        .saturating_add(reference.pixels().saturating_mul(COMPARE_BYTES_PER_PIXEL));
+    let per_pixel = |bytes: u64| reference.pixels().saturating_mul(bytes);
+    let estimate = if args.tmqi || args.report.is_some() {
+        decoded(&test)
+            .saturating_add(decoded(&reference))
+            .saturating_add(per_pixel(COMPARE_BYTES_PER_PIXEL))
+    } else {
+        let whole = |path: &Path, d: &ImageDimensions| {
+            if RowSource::streams(path) {
+                0
+            } else {
+                decoded(d)
+            }
+        };
+        let map = if args.error_map.is_some() { 24 } else { 0 };
+        whole(&args.test, &test)
+            .saturating_add(whole(&args.reference, &reference))
+            .saturating_add(per_pixel(map))
+            .saturating_add(strip_compare_bytes(reference.width, reference.height))
+    };
     budget
         .check(
             &format!(

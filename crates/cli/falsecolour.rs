@@ -23,20 +23,6 @@ pub enum ScaleArg {
     Log,
 }
 
-/// `MIN:MAX` of the false-colour ramp.
-pub fn parse_range(s: &str) -> Result<(f64, f64), String> {
-    let parse = |t: &str| t.trim().parse::<f64>().ok().filter(|v| v.is_finite());
-    match s.split_once(':') {
-        Some((a, b)) => match (parse(a), parse(b)) {
-            (Some(a), Some(b)) if b > a => Ok((a, b)),
-            _ => Err(format!(
-                "`{s}`: expected MIN:MAX with MIN < MAX, e.g. 0:500"
-            )),
-        },
-        None => Err(format!("`{s}`: expected MIN:MAX, e.g. 0:500")),
-    }
-}
-
 /// The ramp's options checked before rendering: a log scale needs a minimum above 0.
 pub fn check_options(scale: ScaleArg, range: Option<(f64, f64)>) -> Result<(), String> {
     match (scale, range) {

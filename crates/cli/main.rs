@@ -9,7 +9,6 @@ mod daylight_factor;
 mod falsecolour;
 mod merge;
 mod merl_export;
-mod numbers;
 mod partial;
 mod plan_args;
 mod progress;

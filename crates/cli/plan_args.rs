@@ -47,7 +47,7 @@ pub struct PlanArgs {
     #[arg(long, value_enum, default_value = "uniform")]
     pub plan: PlanArg,
     /// `--plan predicted`: probe light samples per pixel (n_b).
-    #[arg(long = "plan-nb", value_name = "N", default_value_t = DEFAULT_PROBE_SAMPLES, value_parser = crate::numbers::parse_u32)]
+    #[arg(long = "plan-nb", value_name = "N", default_value_t = DEFAULT_PROBE_SAMPLES, value_parser = prism_args::numbers::parse_u32)]
     pub plan_nb: u32,
     /// `--plan predicted`: share of the budget spread uniformly, in [0, 1].
     #[arg(long = "plan-floor", value_name = "F", default_value_t = DEFAULT_FLOOR)]

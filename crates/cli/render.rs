@@ -48,16 +48,16 @@ pub struct RenderArgs {
     #[arg(short = 'o', long = "output")]
     pub output: Option<PathBuf>,
     /// Samples per pixel (default: the scene's `film.spp`).
-    #[arg(long, value_parser = parse_spp)]
+    #[arg(long, value_parser = prism_args::numbers::parse_spp)]
     pub spp: Option<u32>,
     /// Worker threads (default: one per core; at most 4 per logical CPU).
     #[arg(long, value_parser = prism_cpu::threads::parse_thread_count)]
     pub threads: Option<usize>,
     /// Sampler seed (default: the scene's `film.seed`).
-    #[arg(long, value_parser = crate::numbers::parse_u64)]
+    #[arg(long, value_parser = prism_args::numbers::parse_u64)]
     pub seed: Option<u64>,
     /// Film resolution override, WIDTHxHEIGHT (e.g. 64x48), for previews and tests.
-    #[arg(long, value_parser = parse_resolution)]
+    #[arg(long, value_parser = prism_args::resolution::parse_resolution)]
     pub resolution: Option<UVec2>,
     /// Print the render plan (what the scene needs and why) and exit without rendering.
     #[arg(long)]
@@ -67,7 +67,7 @@ pub struct RenderArgs {
     pub stats_json: Option<PathBuf>,
     /// Also write the spectral radiance in N equal bins over 360–830 nm (1–471) as
     /// `S0.<λ>nm` channels of the EXR (Fichet et al. 2021 layout, W·m⁻²·sr⁻¹·nm⁻¹).
-    #[arg(long = "spectral-bins", value_name = "N", value_parser = crate::numbers::parse_u32)]
+    #[arg(long = "spectral-bins", value_name = "N", value_parser = prism_args::numbers::parse_u32)]
     pub spectral_bins: Option<u32>,
     /// Measure the scene's `sensors` only (`<output stem>.sensors.json/.csv`), no image.
     #[arg(long = "sensors-only")]
@@ -81,7 +81,7 @@ pub struct RenderArgs {
     pub false_colour_scale: crate::falsecolour::ScaleArg,
     /// Value range of the false-colour ramp, MIN:MAX (default: 0 to the maximum, or three
     /// decades below the maximum on a log scale).
-    #[arg(long = "false-colour-range", value_parser = crate::falsecolour::parse_range)]
+    #[arg(long = "false-colour-range", value_parser = prism_args::value_range::parse_range)]
     pub false_colour_range: Option<(f64, f64)>,
     /// `bdpt` only: write one strategy's image, S,T (S light-subpath and T camera-subpath
     /// vertices; MIS-weighted) or S,T,unweighted (weight 1), for debugging.
@@ -90,11 +90,11 @@ pub struct RenderArgs {
     /// Render only samples [A, B) of each pixel's spp-sample sequence (`--spp` defaults to
     /// B) and write a partial EXR with the film's sums, for `prism merge`
     /// (docs/scale-out.md).
-    #[arg(long, value_name = "A..B", value_parser = crate::partial::range::parse_range)]
+    #[arg(long, value_name = "A..B", value_parser = prism_args::sample_range::parse_range)]
     pub samples: Option<SampleRange>,
     /// Write the film so far to `<output stem>.partial.exr` this often (Ns, Nm or Nh, at
     /// least 1s), atomically; `--resume` continues from it.
-    #[arg(long = "checkpoint-every", value_name = "DURATION", value_parser = crate::partial::range::parse_duration)]
+    #[arg(long = "checkpoint-every", value_name = "DURATION", value_parser = prism_args::duration::parse_duration)]
     pub checkpoint_every: Option<Duration>,
     /// Continue the render saved in this partial image (a checkpoint, or the partial
     /// output of an interrupted render); the result is the uninterrupted render's, bit for
@@ -109,7 +109,7 @@ pub struct RenderArgs {
     #[arg(long = "stop-after-items", hide = true)]
     pub stop_after_items: Option<usize>,
     /// Interval of `--progress plain` (Ns, Nm or Nh).
-    #[arg(long = "progress-every", value_name = "DURATION", default_value = "10s", value_parser = crate::partial::range::parse_duration)]
+    #[arg(long = "progress-every", value_name = "DURATION", default_value = "10s", value_parser = prism_args::duration::parse_duration)]
     pub progress_every: Duration,
     #[command(flatten)]
     pub plan: crate::plan_args::PlanArgs,
@@ -123,34 +123,6 @@ pub enum ProgressArg {
     Auto,
     Plain,
     None,
-}
-
-pub(crate) fn parse_resolution(s: &str) -> Result<UVec2, String> {
-    let parse = |t: &str| t.trim().parse::<u32>().ok().filter(|&v| v >= 1);
-    match s.split_once(['x', 'X']) {
-        Some((w, h)) => match (parse(w), parse(h)) {
-            (Some(w), Some(h)) => Ok(UVec2::new(w, h)),
-            _ => Err(format!(
-                "`{s}`: expected WIDTHxHEIGHT with both ≥ 1, e.g. 64x48"
-            )),
-        },
-        None => Err(format!("`{s}`: expected WIDTHxHEIGHT, e.g. 64x48")),
-    }
-}
-
-/// `--spp N`: a whole number from 1 to 2³² − 1, said in those words.
-pub(crate) fn parse_spp(s: &str) -> Result<u32, String> {
-    let t = s.trim();
-    let digits = !t.is_empty() && t.chars().all(|c| c.is_ascii_digit());
-    match t.parse::<u64>() {
-        Ok(0) => Err("0: expected at least 1 sample per pixel".into()),
-        Ok(n) if n <= u64::from(u32::MAX) => Ok(n as u32),
-        // Too large for u32, or for u64: still digits.
-        Ok(_) | Err(_) if digits => Err(format!("`{s}`: at most {} samples per pixel", u32::MAX)),
-        Ok(_) | Err(_) => Err(format!(
-            "`{s}`: expected a whole number of samples per pixel, e.g. 64"
-        )),
-    }
 }
 
 /// The render's estimated memory (film, AOVs, spectral bins, output image) checked against
@@ -425,6 +397,13 @@ pub fn run(args: &RenderArgs, budget: &MemoryBudget) -> Result<ExitCode, String>
                  strength and spectrum)",
                 args.scene.display()
             );
+        }
+    }
+    // A spectral render of a camera or a light shut inside a closed shape is black; the
+    // diagnostic integrators (depth, normals) show the geometry whatever the light.
+    if scene.integrator.is_spectral() {
+        for warning in prism_render::enclosure::enclosure_warnings(&scene, &description) {
+            eprintln!("{}: warning: {warning}", args.scene.display());
         }
     }
     if args.explain {

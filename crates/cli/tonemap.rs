@@ -1,7 +1,6 @@
 //! `prism tonemap`: white balance, tone operator, gamut mapping and encoding of an HDR image
 //! (any EXR/HDR, not only Prism's), or a labelled contact sheet of every operator.
 
-use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use clap::Args;
@@ -75,37 +74,6 @@ pub struct TonemapArgs {
     pub json: bool,
     #[command(flatten)]
     pub simd: crate::simd::SimdArgs,
-}
-
-fn parse_params(raw: &[String]) -> Result<BTreeMap<String, f64>, String> {
-    let mut params = BTreeMap::new();
-    for item in raw {
-        let (key, value) = item
-            .split_once('=')
-            .ok_or_else(|| format!("--param {item}: expected KEY=VALUE, e.g. --param key=0.18"))?;
-        let number: f64 = value
-            .trim()
-            .parse()
-            .map_err(|_| format!("--param {item}: expected a number after `=`, found `{value}`"))?;
-        if !number.is_finite() {
-            return Err(format!("--param {item}: expected a finite number"));
-        }
-        params.insert(key.trim().to_string(), number);
-    }
-    Ok(params)
-}
-
-/// `--exposure EV|auto` → (EV, auto).
-fn parse_exposure(raw: &str) -> Result<(f64, bool), String> {
-    if raw.trim().eq_ignore_ascii_case("auto") {
-        return Ok((0.0, true));
-    }
-    match raw.trim().parse::<f64>() {
-        Ok(ev) if ev.is_finite() => Ok((ev, false)),
-        _ => Err(format!(
-            "--exposure {raw}: expected a finite number of stops (e.g. -2.5) or `auto`"
-        )),
-    }
 }
 
 fn print_list(json: bool) -> Result<(), String> {
@@ -265,7 +233,7 @@ pub fn run(args: &TonemapArgs, budget: &MemoryBudget) -> Result<(), String> {
         _ => return Err("tonemap needs IN, -o OUT and --op NAME (or --list)".to_string()),
     };
     let (exposure_ev, auto_exposure) = match &args.exposure {
-        Some(text) => parse_exposure(text)?,
+        Some(text) => prism_args::tone_values::parse_exposure(text)?,
         None => (0.0, false),
     };
     if !args.overwrite && prism_image::io::same_file(input, output) {
@@ -287,7 +255,7 @@ pub fn run(args: &TonemapArgs, budget: &MemoryBudget) -> Result<(), String> {
     };
     let options = TonemapOptions {
         operator: OperatorChoice::parse(op).map_err(|e| format!("--op {op}: {e}"))?,
-        params: parse_params(&args.params)?,
+        params: prism_args::tone_values::parse_params(&args.params)?,
         wb: WhiteBalance::parse(&args.wb).map_err(|e| e.to_string())?,
         cat: args.cat.into(),
         gamut: GamutMethod::parse(&args.gamut).map_err(|e| e.to_string())?,

@@ -58,7 +58,7 @@ pub struct ConvergeArgs {
     #[arg(long = "cache-dir", value_name = "DIR")]
     pub cache_dir: Option<PathBuf>,
     /// Samples per pixel of a reference rendered because --reference was left out.
-    #[arg(long = "reference-spp", default_value_t = DEFAULT_REFERENCE_SPP, value_parser = crate::render::parse_spp)]
+    #[arg(long = "reference-spp", default_value_t = DEFAULT_REFERENCE_SPP, value_parser = prism_args::numbers::parse_spp)]
     pub reference_spp: u32,
     /// A method, INTEGRATOR[+PLAN][:SAMPLER] (repeat for several; default `path`, the path
     /// tracer with the uniform plan and the independent sampler). Integrators: path, light,
@@ -72,10 +72,10 @@ pub struct ConvergeArgs {
     pub budget_s: Option<f64>,
     /// Samples per pixel per method at most; alone, it makes the checkpoint schedule
     /// deterministic (1 spp to N spp, geometric).
-    #[arg(long = "max-spp", value_name = "N", value_parser = crate::render::parse_spp)]
+    #[arg(long = "max-spp", value_name = "N", value_parser = prism_args::numbers::parse_spp)]
     pub max_spp: Option<u32>,
     /// Checkpoints per method (geometrically spaced, ≥ 3).
-    #[arg(long, default_value_t = 12, value_parser = crate::numbers::parse_u32)]
+    #[arg(long, default_value_t = 12, value_parser = prism_args::numbers::parse_u32)]
     pub checkpoints: u32,
     /// Chart file (.png or .svg); repeat for both.
     #[arg(short = 'o', long = "output", value_name = "CHART")]
@@ -84,13 +84,13 @@ pub struct ConvergeArgs {
     #[arg(long)]
     pub json: Option<PathBuf>,
     /// Film resolution override, WIDTHxHEIGHT (the reference must match).
-    #[arg(long, value_parser = crate::render::parse_resolution)]
+    #[arg(long, value_parser = prism_args::resolution::parse_resolution)]
     pub resolution: Option<UVec2>,
     /// Worker threads (default: one per core; at most 4 per logical CPU).
     #[arg(long, value_parser = prism_cpu::threads::parse_thread_count)]
     pub threads: Option<usize>,
     /// Sampler seed of the methods (default: the scene's `film.seed`).
-    #[arg(long, value_parser = crate::numbers::parse_u64)]
+    #[arg(long, value_parser = prism_args::numbers::parse_u64)]
     pub seed: Option<u64>,
     /// Also render each method's final sample count in one pass without checkpoints and
     /// report the time converge added (wall and CPU), in the JSON and on stderr.

@@ -24,16 +24,18 @@ pub fn parse_thread_count(text: &str) -> Result<usize, String> {
         .trim()
         .parse()
         .map_err(|_| format!("`{text}`: expected a whole number of threads from 1 to {max}"))?;
-    check_thread_count(n, max)
+    check_thread_count(text, n, max)
 }
 
-fn check_thread_count(n: usize, max: usize) -> Result<usize, String> {
+fn check_thread_count(text: &str, n: usize, max: usize) -> Result<usize, String> {
     if n == 0 {
-        return Err(format!("0: expected at least 1 thread (at most {max})"));
+        return Err(format!(
+            "`{text}`: expected at least 1 thread (at most {max})"
+        ));
     }
     if n > max {
         return Err(format!(
-            "{n}: at most {max} threads ({MAX_THREADS_PER_CPU} per logical CPU, {} here)",
+            "`{text}`: at most {max} threads ({MAX_THREADS_PER_CPU} per logical CPU, {} here)",
             max / MAX_THREADS_PER_CPU
         ));
     }
@@ -46,10 +48,14 @@ mod tests {
 
     #[test]
     fn thread_counts_are_bounded_by_four_per_cpu() {
-        assert_eq!(check_thread_count(1, 8), Ok(1));
-        assert_eq!(check_thread_count(8, 8), Ok(8));
-        assert!(check_thread_count(9, 8).unwrap_err().contains("at most 8"));
-        assert!(check_thread_count(0, 8).unwrap_err().contains("at least 1"));
+        assert_eq!(check_thread_count("1", 1, 8), Ok(1));
+        assert_eq!(check_thread_count("8", 8, 8), Ok(8));
+        assert!(check_thread_count("9", 9, 8)
+            .unwrap_err()
+            .contains("at most 8"));
+        assert!(check_thread_count("0", 0, 8)
+            .unwrap_err()
+            .contains("at least 1"));
         assert!(parse_thread_count("100000").is_err() || max_threads() >= 100000);
         assert!(parse_thread_count("many")
             .unwrap_err()

@@ -33,10 +33,14 @@ pub enum Target {
     Rgbe,
     /// PNG (the texture path).
     Png,
+    /// The command line's option values (`--resolution`, `--spp`, `--samples A..B`,
+    /// durations, `--max-memory`, `--threads`, ranges, exposures, …): the input is one
+    /// value, given to every parser.
+    CliValues,
 }
 
 impl Target {
-    pub const ALL: [Target; 14] = [
+    pub const ALL: [Target; 15] = [
         Target::SceneJson,
         Target::SceneBuild,
         Target::SpectrumCsv,
@@ -51,6 +55,7 @@ impl Target {
         Target::SpectralExr,
         Target::Rgbe,
         Target::Png,
+        Target::CliValues,
     ];
 
     pub fn name(self) -> &'static str {
@@ -69,6 +74,7 @@ impl Target {
             Target::SpectralExr => "spectral-exr",
             Target::Rgbe => "rgbe",
             Target::Png => "png",
+            Target::CliValues => "cli-values",
         }
     }
 
@@ -87,6 +93,7 @@ impl Target {
             Target::Exr | Target::SpectralExr => "exr",
             Target::Rgbe => "hdr",
             Target::Png => "png",
+            Target::CliValues => "txt",
         }
     }
 
@@ -121,6 +128,7 @@ impl Target {
                 "scenes/textures/leaf-mask.png",
                 "scenes/textures/roughness.png",
             ],
+            Target::CliValues => &[],
         };
         let mut seeds: Vec<Vec<u8>> = files
             .iter()
@@ -178,6 +186,7 @@ impl Target {
             Target::Png => prism_image::io::png::read_png(path)
                 .map(drop)
                 .map_err(|e| text(&e)),
+            Target::CliValues => cli_values(path),
         }
     }
 
@@ -241,9 +250,115 @@ fn built_in_seeds(target: Target) -> Vec<Vec<u8>> {
         }
         Target::SpectrumCsv => seeds.push(b"wavelength_nm,value\n380,0.1\n780,0.9\n".to_vec()),
         Target::SpectralExr => seeds.extend(spectral_exr_seed()),
+        Target::CliValues => seeds.extend(CLI_VALUE_SEEDS.iter().map(|v| v.as_bytes().to_vec())),
         Target::Bfc | Target::Ies | Target::Vol | Target::Exr | Target::Rgbe | Target::Png => {}
     }
     seeds
+}
+
+/// Option values: valid ones of every form and the hardening issue's bad inputs.
+const CLI_VALUE_SEEDS: &[&str] = &[
+    "64x48",
+    "100000x100000",
+    "0x4",
+    "64",
+    "99999999999",
+    "4294967296",
+    "-1",
+    "0",
+    "256..512",
+    "512..256",
+    "0..4,8..16",
+    "60s",
+    "5m",
+    "1h",
+    "0s",
+    "1.5m",
+    "512M",
+    "8G",
+    "1.5T",
+    "1e309",
+    "0:500",
+    "500:0",
+    "auto",
+    "-2.5",
+    "key=0.18",
+    "key=NaN",
+    "100000",
+    "2 ",
+    " 7 ",
+];
+
+/// Every option-value parser of the command line on the text in `path`; `Err` naming the
+/// file when one refuses it with a message that repeats the value (as a user sees it, so
+/// the runner counts it as a named error), and `Err` without the file's name (a failure)
+/// when a message does not repeat the value. Text that is not UTF-8 never reaches these
+/// parsers (clap refuses it first).
+fn cli_values(path: &Path) -> Result<(), String> {
+    let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let Ok(value) = std::str::from_utf8(&bytes) else {
+        return Ok(());
+    };
+    let ok = |r: Result<(), String>| r;
+    let parsers: [(&str, Result<(), String>); 12] = [
+        (
+            "--resolution",
+            ok(prism_args::resolution::parse_resolution(value).map(drop)),
+        ),
+        ("--spp", ok(prism_args::numbers::parse_spp(value).map(drop))),
+        (
+            "--seed",
+            ok(prism_args::numbers::parse_u64(value).map(drop)),
+        ),
+        (
+            "--spectral-bins",
+            ok(prism_args::numbers::parse_u32(value).map(drop)),
+        ),
+        (
+            "--samples",
+            ok(prism_args::sample_range::parse_range(value).map(drop)),
+        ),
+        (
+            "ranges_done",
+            ok(prism_args::sample_range::parse_ranges(value).map(drop)),
+        ),
+        (
+            "--checkpoint-every",
+            ok(prism_args::duration::parse_duration(value).map(drop)),
+        ),
+        (
+            "--false-colour-range",
+            ok(prism_args::value_range::parse_range(value).map(drop)),
+        ),
+        (
+            "--exposure",
+            ok(prism_args::tone_values::parse_exposure(value).map(drop)),
+        ),
+        (
+            "--param",
+            ok(prism_args::tone_values::parse_params(&[value.to_string()]).map(drop)),
+        ),
+        (
+            "--max-memory",
+            ok(prism_cpu::memory::parse_size(value).map(drop)),
+        ),
+        (
+            "--threads",
+            ok(prism_cpu::threads::parse_thread_count(value).map(drop)),
+        ),
+    ];
+    let mut refused = None;
+    for (option, result) in parsers {
+        if let Err(message) = result {
+            if !message.contains(value.trim()) {
+                return Err(format!(
+                    "{option} {value:?}: the message does not repeat the value: {message}"
+                ));
+            }
+            refused.get_or_insert(format!("{}: {option} {value}: {message}", path.display()));
+        }
+    }
+    refused.map_or(Ok(()), Err)
 }
 
 /// A 4×3 spectral EXR of 8 bands, written by Prism's own writer (uncompressed, so that

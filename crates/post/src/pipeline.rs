@@ -24,6 +24,7 @@ use crate::colour::{
     apply_white_balance, apply_with_source_white, illumination_white_xyz, map_gamut, GamutMethod,
     GamutTarget, SceneWhite, WhiteBalance, ILLUMINATION_LAYER,
 };
+use crate::metrics::strips::{compare_rows, strip_rows};
 use crate::metrics::tmqi::{check_size, tmqi_images, Tmqi};
 use crate::metrics::{CompareOptions, Comparison, ErrorMaps, PreparedReference};
 use crate::report::compare_page::{compare_page, CompareInput};
@@ -32,6 +33,7 @@ use crate::sheet::{
     contact_sheet_scored, score_tmqi, SheetFailure, SheetOptions, SheetScore, TileOrder, TileScore,
 };
 use crate::tonemap::{ToneOperator, ToneParams, ToneReport};
+use prism_image::io::strips::RowSource;
 use prism_image::io::{read_image, write_image, ImageFormat};
 use prism_image::Image;
 use prism_image::{ImageError, Result};
@@ -69,9 +71,10 @@ impl From<ToneOperator> for OperatorChoice {
 }
 
 /// Peak bytes per pixel of [`tonemap_file`] with one operator, beyond 4 bytes per stored
-/// channel of the input as decoded: the input's RGB in f32, the operator's output and
-/// its luminance planes, the encoder's buffer. Measured on a 2048² float RGB EXR
-/// (docs/reliability.md); the memory check's estimate.
+/// channel of the input as decoded: the operator's output (12) and a local operator's
+/// luminance planes, or after the input is dropped the encoder's buffers. Measured on
+/// 8192² float RGB EXRs (tools/measure_memory.py, docs/reliability.md: 24 in all for the
+/// global operators, 28 for durand02); the memory check's estimate.
 pub const TONEMAP_BYTES_PER_PIXEL: u64 = 32;
 
 /// Options of `prism tonemap` (CLI defaults in [`Default`]: `--wb none`, `--gamut clip`,
@@ -316,6 +319,10 @@ pub fn tonemap_file(
         }
     };
     let tone_ms = ms(t);
+    // The input is not read again: its memory goes back before the gamut mapping and the
+    // encoder's buffers are allocated (the peak is then the larger of input and output
+    // together, and output and encoder together; docs/reliability.md).
+    drop(image);
 
     let t = Instant::now();
     let out_space = out.color_space.clone();
@@ -426,14 +433,40 @@ pub fn tmqi_files(ldr: &Path, hdr: &Path) -> Result<Tmqi> {
     tmqi_images(&read_image(ldr)?, &read_image(hdr)?)
 }
 
-/// [`compare_files`] with a choice of metrics, and the maps asked for.
+/// [`compare_files`] with a choice of metrics, and the maps asked for. The images are read
+/// in strips where their format allows (`metrics::strips`: the whole-image numbers, in
+/// bounded memory).
 pub fn compare_files_with(
     test: &Path,
     reference: &Path,
     options: &CompareOptions,
 ) -> Result<(Comparison, ErrorMaps)> {
-    let (a, b) = read_pair(test, reference)?;
-    PreparedReference::new(&b).compare_with_maps(&a, options)
+    let a = RowSource::open(test)?;
+    let b = RowSource::open(reference)?;
+    check_sizes(
+        (test, (a.width(), a.height())),
+        (reference, (b.width(), b.height())),
+    )?;
+    compare_rows(&a, &b, options, strip_rows(b.width()))
+}
+
+/// An error naming both files when their sizes differ.
+fn check_sizes(
+    (test, a): (&Path, (usize, usize)),
+    (reference, b): (&Path, (usize, usize)),
+) -> Result<()> {
+    if a != b {
+        return Err(ImageError::invalid(format!(
+            "{} is {}×{} but {} is {}×{}: compare needs equal sizes",
+            test.display(),
+            a.0,
+            a.1,
+            reference.display(),
+            b.0,
+            b.1
+        )));
+    }
+    Ok(())
 }
 
 /// [`compare_files_with`] (FLIP and the ΔE2000 map always computed) that also writes the
@@ -488,16 +521,9 @@ pub fn compare_files_report(
 pub fn read_pair(test: &Path, reference: &Path) -> Result<(Image, Image)> {
     let a = read_image(test)?;
     let b = read_image(reference)?;
-    if (a.width(), a.height()) != (b.width(), b.height()) {
-        return Err(ImageError::invalid(format!(
-            "{} is {}×{} but {} is {}×{}: compare needs equal sizes",
-            test.display(),
-            a.width(),
-            a.height(),
-            reference.display(),
-            b.width(),
-            b.height()
-        )));
-    }
+    check_sizes(
+        (test, (a.width(), a.height())),
+        (reference, (b.width(), b.height())),
+    )?;
     Ok((a, b))
 }

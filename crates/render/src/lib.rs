@@ -14,6 +14,7 @@ pub mod adaptive;
 pub mod bsdf;
 pub mod bsdf_angular_table;
 pub mod camera;
+pub mod enclosure;
 pub mod error;
 pub mod file_error;
 pub mod film;

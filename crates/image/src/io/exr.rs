@@ -301,7 +301,7 @@ pub fn read_exr(path: &Path) -> Result<Image> {
 
 /// The colour space of a `chromaticities` attribute; OpenEXR's default (none) is that of
 /// ITU-R BT.709 (= sRGB).
-fn space_of(chromaticities: &Option<Chromaticities>) -> RgbColorSpace {
+pub(crate) fn space_of(chromaticities: &Option<Chromaticities>) -> RgbColorSpace {
     match chromaticities {
         Some(c) => color_space_from_chromaticities(
             [

@@ -19,7 +19,7 @@ use ::exr::block::UncompressedBlock;
 use ::exr::meta::attribute::{AttributeValue, Chromaticities, LevelMode, SampleType};
 use ::exr::meta::BlockDescription;
 use ::exr::prelude::f16;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 /// What the fast path read: size, interleaved pixels, chromaticities and the attributes the
 /// general path collects (custom attributes and `software`).
@@ -92,6 +92,8 @@ pub(crate) fn read_rgb_exr(path: &Path) -> Option<RgbExr> {
         pixels.chunks_mut(width * band_rows).map(Some).collect();
     let mut pending: Vec<Vec<Chunk>> = (0..bands).map(|_| Vec::new()).collect();
     let failed = AtomicBool::new(false);
+    let in_flight = AtomicUsize::new(0);
+    let max_in_flight = 4 * rayon::current_num_threads();
     let meta = &meta;
     let complete = rayon::scope(|scope| {
         for chunk in reader.all_chunks(false).ok()? {
@@ -117,8 +119,8 @@ pub(crate) fn read_rgb_exr(path: &Path) -> Option<RgbExr> {
             if chunks.len() == per_band {
                 let chunks = std::mem::take(chunks);
                 let band_pixels = rows[band].take()?;
-                let failed = &failed;
-                scope.spawn(move |_| {
+                let (failed, in_flight) = (&failed, &in_flight);
+                let decode = move || {
                     let ok = decode_band(
                         chunks,
                         band_pixels,
@@ -132,7 +134,19 @@ pub(crate) fn read_rgb_exr(path: &Path) -> Option<RgbExr> {
                     if !ok {
                         failed.store(true, Ordering::Relaxed);
                     }
-                });
+                };
+                // Reading outpaces decompression: past a few bands per thread waiting,
+                // the reader decodes this band itself, so that the compressed chunks held
+                // stay a few bands instead of growing towards the whole file.
+                if in_flight.load(Ordering::Acquire) >= max_in_flight {
+                    decode();
+                } else {
+                    in_flight.fetch_add(1, Ordering::AcqRel);
+                    scope.spawn(move |_| {
+                        decode();
+                        in_flight.fetch_sub(1, Ordering::AcqRel);
+                    });
+                }
             } else if chunks.len() > per_band {
                 return None;
             }

@@ -11,6 +11,7 @@ pub mod quantise;
 pub mod raw_exr;
 pub mod rgbe;
 pub mod spectral_exr;
+pub mod strips;
 mod zlib_strips;
 
 use std::fs::File;

@@ -26,8 +26,10 @@
 pub mod ciede2000;
 mod fast_f64;
 pub mod flip;
+mod ordered_sum;
 mod prepared;
 mod ssim;
+pub mod strips;
 pub mod tmqi;
 
 use serde::Serialize;

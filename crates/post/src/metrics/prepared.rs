@@ -50,15 +50,15 @@ pub struct PreparedReference {
 
 /// Per-chunk sums of the fused pass.
 #[derive(Clone, Copy, Default)]
-struct Sums {
-    se: [f64; 3],
-    rel: [f64; 3],
-    de: f64,
-    non_finite: u64,
+pub(super) struct Sums {
+    pub(super) se: [f64; 3],
+    pub(super) rel: [f64; 3],
+    pub(super) de: f64,
+    pub(super) non_finite: u64,
 }
 
 impl Sums {
-    fn add(self, o: Sums) -> Sums {
+    pub(super) fn add(self, o: Sums) -> Sums {
         Sums {
             se: [0, 1, 2].map(|c| self.se[c] + o.se[c]),
             rel: [0, 1, 2].map(|c| self.rel[c] + o.rel[c]),
@@ -68,7 +68,7 @@ impl Sums {
     }
 }
 
-fn finite(p: &[f32; 3]) -> bool {
+pub(super) fn finite(p: &[f32; 3]) -> bool {
     p[0].is_finite() && p[1].is_finite() && p[2].is_finite()
 }
 
@@ -168,7 +168,17 @@ impl PreparedReference {
             .par_chunks(CHUNK)
             .zip(de.par_chunks_mut(CHUNK))
             .enumerate()
-            .map(|(k, (chunk, out))| avx2!(simd, compare_chunk(self, k * CHUNK, chunk, out)))
+            .map(|(k, (chunk, out))| {
+                let (start, len) = (k * CHUNK, chunk.len());
+                let reference = &self.pixels[start..start + len];
+                let lab = &self.lab[start / BLOCK..];
+                let converter = &self.lab_converter;
+                let init = Sums::default();
+                avx2!(
+                    simd,
+                    compare_chunk(converter, reference, lab, init, chunk, out)
+                )
+            })
             // Collected, then added in order: a rayon reduce would add the chunks in an
             // order that follows its splitting, and change the last bits between runs.
             .collect::<Vec<Sums>>()
@@ -279,7 +289,7 @@ impl PreparedReference {
 
 /// CIELAB of one block of sanitised reference pixels.
 #[inline(always)]
-fn reference_block(conv: &LabConverter, block: &[[f32; 3]]) -> LabBlock {
+pub(super) fn reference_block(conv: &LabConverter, block: &[[f32; 3]]) -> LabBlock {
     let mut rgb = [[0.0f64; BLOCK]; 3];
     for (i, p) in block.iter().enumerate() {
         for c in 0..3 {
@@ -291,24 +301,29 @@ fn reference_block(conv: &LabConverter, block: &[[f32; 3]]) -> LabBlock {
     out
 }
 
-/// The fused pass over one chunk of test pixels starting at pixel `start` (a multiple of
-/// [`BLOCK`]): squared and relative squared errors, non-finite count, ΔE₀₀ into `out` and
-/// its sum. Per block: the errors and the planes in a scalar loop, then CIELAB and ΔE₀₀ in
-/// loops over the planes that the compiler vectorises.
+/// The fused pass over one chunk of test pixels against the sanitised `reference` pixels
+/// at the same places and their CIELAB blocks `lab` (block 0 starting at the chunk's first
+/// pixel): squared and relative squared errors, non-finite count, ΔE₀₀ into `out` and its
+/// sum, added pixel by pixel to `init` (a chunk's sums so far: a comparison in strips
+/// continues a chunk that a strip boundary cut). Per block: the errors and the planes in a
+/// scalar loop, then CIELAB and ΔE₀₀ in loops over the planes that the compiler vectorises
+/// (lane by lane: a pixel's ΔE₀₀ does not depend on its block).
 #[inline(always)]
-fn compare_chunk(
-    prepared: &PreparedReference,
-    start: usize,
+pub(super) fn compare_chunk(
+    converter: &LabConverter,
+    reference: &[[f32; 3]],
+    lab: &[LabBlock],
+    init: Sums,
     chunk: &[[f32; 3]],
     out: &mut [f64],
 ) -> Sums {
-    let mut s = Sums::default();
+    let mut s = init;
     let mut rgb = [[0.0f64; BLOCK]; 3];
-    let mut lab = LabBlock::default();
+    let mut lab_test = LabBlock::default();
     let mut de = [0.0f64; BLOCK];
     for (j, (block, out)) in chunk.chunks(BLOCK).zip(out.chunks_mut(BLOCK)).enumerate() {
-        let first = start + j * BLOCK;
-        let reference = &prepared.pixels[first..first + block.len()];
+        let first = j * BLOCK;
+        let reference = &reference[first..first + block.len()];
         for (i, (p, q)) in block.iter().zip(reference).enumerate() {
             s.non_finite += u64::from(!finite(p));
             let p = sanitise(*p, 1.0);
@@ -321,8 +336,8 @@ fn compare_chunk(
             }
         }
         // Padding lanes of a short last block keep stale values; only `len` lanes are read.
-        lab_block(&prepared.lab_converter, &rgb, &mut lab);
-        delta_e_2000_block(&lab, &prepared.lab[first / BLOCK], block.len(), &mut de);
+        lab_block(converter, &rgb, &mut lab_test);
+        delta_e_2000_block(&lab_test, &lab[j], block.len(), &mut de);
         for (o, d) in out.iter_mut().zip(&de) {
             *o = *d;
             s.de += *d;

@@ -6,6 +6,8 @@
 
 use rayon::prelude::*;
 
+use super::ordered_sum::OrderedSum;
+
 const RADIUS: usize = 5;
 const SIGMA: f64 = 1.5;
 
@@ -47,20 +49,51 @@ fn blur_valid(plane: &[f32], w: usize, h: usize, k: &[f32; 2 * RADIUS + 1]) -> V
     out
 }
 
+/// Side of the window: SSIM has a value for the positions where it fits in the image.
+pub(crate) const WINDOW: usize = 2 * RADIUS + 1;
+
+/// Whether a w×h image has at least one window position.
+pub(crate) fn fits(w: usize, h: usize) -> bool {
+    w >= WINDOW && h >= WINDOW
+}
+
 /// Mean SSIM of two w×h planes with dynamic range `l`; `None` when the image is smaller
 /// than the 11×11 window.
 pub(crate) fn ssim(x: &[f32], y: &[f32], w: usize, h: usize, l: f64) -> Option<f64> {
-    if w < 2 * RADIUS + 1 || h < 2 * RADIUS + 1 {
+    if !fits(w, h) {
         return None;
     }
-    let k = kernel();
     // Moments of x − mean(x): variances are shift-invariant, and centring keeps the f32
     // moments E[x²] − μ² from cancelling catastrophically (exact for flat regions).
-    let mean = |v: &[f32]| (ordered_sum(v.len(), |i| v[i] as f64) / v.len() as f64) as f32;
+    let mean = |v: &[f32]| {
+        let mut sum = OrderedSum::new();
+        sum.add_range(0, v.len(), |i| v[i] as f64);
+        (sum.finish() / v.len() as f64) as f32
+    };
     let (mean_x, mean_y) = (mean(x), mean(y));
     let x: Vec<f32> = x.par_iter().map(|a| a - mean_x).collect();
     let y: Vec<f32> = y.par_iter().map(|a| a - mean_y).collect();
-    let (x, y) = (x.as_slice(), y.as_slice());
+    let mut sum = OrderedSum::new();
+    add_window_terms(&x, &y, w, (mean_x, mean_y), l, 0, &mut sum);
+    let positions = (w - 2 * RADIUS) * (h - 2 * RADIUS);
+    Some(sum.finish() / positions as f64)
+}
+
+/// Adds to `sum` the SSIM of every window position inside rows of the centred planes `x`
+/// and `y` (w wide, at least 11 rows: one output row per input row but the last 10), as
+/// terms `first …` of the image's sum (positions row-major over the image's
+/// (w − 10)-wide grid of windows). `means` are the means the planes were centred on.
+pub(crate) fn add_window_terms(
+    x: &[f32],
+    y: &[f32],
+    w: usize,
+    (mean_x, mean_y): (f32, f32),
+    l: f64,
+    first: usize,
+    sum: &mut OrderedSum,
+) {
+    let h = x.len() / w;
+    let k = kernel();
     let product = |a: &[f32], b: &[f32]| -> Vec<f32> {
         a.par_iter().zip(b.par_iter()).map(|(p, q)| p * q).collect()
     };
@@ -71,7 +104,7 @@ pub(crate) fn ssim(x: &[f32], y: &[f32], w: usize, h: usize, l: f64) -> Option<f
     let xy = blur_valid(&product(x, y), w, h, &k);
     let c1 = (0.01 * l).powi(2);
     let c2 = (0.03 * l).powi(2);
-    let sum = ordered_sum(mu_x.len(), |i| {
+    sum.add_range(first, mu_x.len(), |i| {
         let (cx, cy) = (mu_x[i] as f64, mu_y[i] as f64);
         let sxx = xx[i] as f64 - cx * cx;
         let syy = yy[i] as f64 - cy * cy;
@@ -79,19 +112,6 @@ pub(crate) fn ssim(x: &[f32], y: &[f32], w: usize, h: usize, l: f64) -> Option<f
         let (mx, my) = (cx + mean_x as f64, cy + mean_y as f64);
         ((2.0 * mx * my + c1) * (2.0 * sxy + c2)) / ((mx * mx + my * my + c1) * (sxx + syy + c2))
     });
-    Some(sum / mu_x.len() as f64)
-}
-
-/// Σ f(i) for i < n, in parallel but in an order that does not depend on how rayon splits
-/// the work (fixed blocks, their sums added in order), so that a comparison gives the same
-/// bits on every run.
-fn ordered_sum(n: usize, f: impl Fn(usize) -> f64 + Sync) -> f64 {
-    const BLOCK: usize = 4096;
-    let blocks: Vec<f64> = (0..n.div_ceil(BLOCK))
-        .into_par_iter()
-        .map(|b| (b * BLOCK..((b + 1) * BLOCK).min(n)).map(&f).sum())
-        .collect();
-    blocks.iter().sum()
 }
 
 #[cfg(test)]

@@ -8,6 +8,7 @@ use rayon::prelude::*;
 
 use super::colour::{filtered_to_hunt_lab, hyab, rgb_to_hunt_lab, rgb_to_ycxcz, ycxcz_grey};
 use super::kernels::Kernels;
+use super::Rows;
 
 /// Colour error exponent q_c, redistribution break p_c and target p_t, feature exponent
 /// q_f (Andersson et al. 2020, sec. 3).
@@ -62,7 +63,7 @@ struct BandSide {
 }
 
 fn band_side(
-    image: &[[f32; 3]],
+    image: Rows<'_>,
     (w, h): (usize, usize),
     (y0, y1): (usize, usize),
     k: &Kernels,
@@ -76,7 +77,7 @@ fn band_side(
     let mut pad: [Vec<f32>; 4] = std::array::from_fn(|_| vec![0.0; w + 2 * halo]);
     for j in 0..band_h {
         let sy = (y0 + j).saturating_sub(halo).min(h - 1);
-        let row = &image[sy * w..(sy + 1) * w];
+        let row = image.row(sy, w);
         let [pad_y, pad_cx, pad_cz, pad_grey] = &mut pad;
         let pads = pad_y
             .iter_mut()
@@ -133,12 +134,16 @@ fn band_side(
 }
 
 /// The LDR-FLIP map of `test` against `reference` (linear Rec.709, `w × h`, row-major)
-/// after `transform`, written into `out` (one value per pixel) or, with `keep_max`, each
-/// value the larger of the old and the new (HDR-FLIP's maximum over exposures).
+/// after `transform`, for the image rows from `first_row` on that `out` covers, written
+/// into `out` (one value per pixel) or, with `keep_max`, each value the larger of the old
+/// and the new (HDR-FLIP's maximum over exposures). `test` and `reference` must hold the
+/// rows of `out` and the filters' halo around them (clamped to the image).
+#[allow(clippy::too_many_arguments)]
 pub(super) fn flip_map_into(
-    test: &[[f32; 3]],
-    reference: &[[f32; 3]],
+    test: Rows<'_>,
+    reference: Rows<'_>,
     (w, h): (usize, usize),
+    first_row: usize,
     k: &Kernels,
     transform: &(impl Fn([f32; 3]) -> [f32; 3] + Sync),
     out: &mut [f32],
@@ -149,7 +154,7 @@ pub(super) fn flip_map_into(
     out.par_chunks_mut(BAND_ROWS * w)
         .enumerate()
         .for_each(|(b, out)| {
-            let y0 = b * BAND_ROWS;
+            let y0 = first_row + b * BAND_ROWS;
             let y1 = y0 + out.len() / w;
             let r = band_side(reference, (w, h), (y0, y1), k, transform);
             let t = band_side(test, (w, h), (y0, y1), k, transform);

@@ -36,14 +36,11 @@ impl ExposureRange {
     /// non-negative): c_start from its largest luminance, c_stop from its median (the
     /// element at rank ⌊n/2⌋ in ascending order).
     pub fn automatic(reference: impl Iterator<Item = [f32; 3]>) -> Self {
-        // Rec.709 luminance in f64: a sum near f32::MAX must not round to ∞ (c_start = −∞,
-        // endless exposures).
-        let mut y: Vec<f64> = reference
-            .map(|p| {
-                let p = p.map(f64::from);
-                0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]
-            })
-            .collect();
+        Self::from_luminances(reference.map(luminance).collect())
+    }
+
+    /// [`Self::automatic`] from the reference's luminances ([`luminance`]), in any order.
+    pub fn from_luminances(mut y: Vec<f64>) -> Self {
         let max = y.iter().cloned().fold(0.0f64, f64::max);
         let mid = y.len() / 2;
         let (_, median, _) = y.select_nth_unstable_by(mid, f64::total_cmp);
@@ -62,6 +59,13 @@ impl ExposureRange {
     pub fn stops(&self, i: usize) -> f64 {
         self.start_stops + i as f64 * (self.stop_stops - self.start_stops) / (self.count - 1) as f64
     }
+}
+
+/// Rec.709 luminance in f64: a sum near f32::MAX must not round to ∞ (c_start = −∞,
+/// endless exposures).
+pub fn luminance(p: [f32; 3]) -> f64 {
+    let p = p.map(f64::from);
+    0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]
 }
 
 /// The ACES fit clamped to [0, 1].

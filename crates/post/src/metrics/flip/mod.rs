@@ -110,6 +110,116 @@ fn finite_or_black(p: [f32; 3]) -> [f32; 3] {
     }
 }
 
+/// HDR-FLIP's view of a sample: non-finite → black, negatives → 0.
+fn hdr_clean(p: [f32; 3]) -> [f32; 3] {
+    finite_or_black(p).map(|v| v.max(0.0))
+}
+
+/// The samples below 0 in `test` and `reference`, which HDR-FLIP clamps to 0.
+pub(crate) fn negative_samples(test: &[[f32; 3]], reference: &[[f32; 3]]) -> u64 {
+    [test, reference]
+        .iter()
+        .flat_map(|img| img.iter().flatten())
+        .filter(|v| **v < 0.0)
+        .count() as u64
+}
+
+/// The luminance of a reference pixel (linear Rec.709) that HDR-FLIP's exposure range is
+/// computed from ([`ExposureRange::from_luminances`]).
+pub(crate) fn exposure_luminance(p: [f32; 3]) -> f64 {
+    exposure::luminance(hdr_clean(p))
+}
+
+/// Rows `first …` of an image `w` pixels wide (a strip of it, or all of it from row 0).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Rows<'a> {
+    pixels: &'a [[f32; 3]],
+    first: usize,
+}
+
+impl<'a> Rows<'a> {
+    pub(crate) fn new(pixels: &'a [[f32; 3]], first: usize) -> Self {
+        Self { pixels, first }
+    }
+
+    /// Image row `y` (which the strip must hold).
+    fn row(&self, y: usize, w: usize) -> &'a [[f32; 3]] {
+        let at = (y - self.first) * w;
+        &self.pixels[at..at + w]
+    }
+}
+
+/// LDR-FLIP and HDR-FLIP maps for bands of rows, at one viewing condition: what
+/// [`ldr_flip`] and [`hdr_flip`] compute, a strip of rows at a time.
+pub(crate) struct FlipRows {
+    kernels: Kernels,
+}
+
+impl FlipRows {
+    /// For `ppd` pixels per degree (checked by the caller, [`check_ppd`]).
+    pub(crate) fn new(ppd: f64) -> Self {
+        Self {
+            kernels: Kernels::new(ppd),
+        }
+    }
+
+    /// Rows above and below a band that its filters read.
+    pub(crate) fn halo_rows(&self) -> usize {
+        self.kernels
+            .spatial_radius_px
+            .max(self.kernels.feature_radius_px)
+    }
+
+    /// LDR-FLIP of the image rows from `first_row` that `out` covers; `test` and
+    /// `reference` hold them and [`Self::halo_rows`] around them (clamped to the image).
+    pub(crate) fn ldr(
+        &self,
+        test: Rows<'_>,
+        reference: Rows<'_>,
+        size: (usize, usize),
+        first_row: usize,
+        out: &mut [f32],
+    ) {
+        let clip = |p: [f32; 3]| finite_or_black(p).map(|v| v.clamp(0.0, 1.0));
+        band::flip_map_into(
+            test,
+            reference,
+            size,
+            first_row,
+            &self.kernels,
+            &clip,
+            out,
+            false,
+        );
+    }
+
+    /// HDR-FLIP over `exposures` of the rows as [`Self::ldr`].
+    pub(crate) fn hdr(
+        &self,
+        test: Rows<'_>,
+        reference: Rows<'_>,
+        size: (usize, usize),
+        exposures: &ExposureRange,
+        first_row: usize,
+        out: &mut [f32],
+    ) {
+        for i in 0..exposures.count {
+            let scale = exposures.stops(i).exp2() as f32;
+            let tone = |p: [f32; 3]| hdr_clean(p).map(|v| exposure::aces(v * scale));
+            band::flip_map_into(
+                test,
+                reference,
+                size,
+                first_row,
+                &self.kernels,
+                &tone,
+                out,
+                i > 0,
+            );
+        }
+    }
+}
+
 /// LDR-FLIP of `test` against `reference` (linear Rec.709, `w × h`), clipped to [0, 1].
 pub fn ldr_flip(
     test: &[[f32; 3]],
@@ -122,9 +232,10 @@ pub fn ldr_flip(
     let mut values = vec![0.0f32; w * h];
     let clip = |p: [f32; 3]| finite_or_black(p).map(|v| v.clamp(0.0, 1.0));
     band::flip_map_into(
-        test,
-        reference,
+        Rows::new(test, 0),
+        Rows::new(reference, 0),
         (w, h),
+        0,
         &Kernels::new(ppd),
         &clip,
         &mut values,
@@ -146,20 +257,11 @@ pub fn hdr_flip(
     ppd: f64,
 ) -> Result<HdrFlip> {
     check(test, reference, w, h, ppd)?;
-    let negative_samples = [test, reference]
-        .iter()
-        .flat_map(|img| img.iter().flatten())
-        .filter(|v| **v < 0.0)
-        .count() as u64;
-    let clean = |p: [f32; 3]| finite_or_black(p).map(|v| v.max(0.0));
-    let exposures = ExposureRange::automatic(reference.iter().map(|&p| clean(p)));
-    let kernels = Kernels::new(ppd);
+    let negative_samples = negative_samples(test, reference);
+    let exposures = ExposureRange::automatic(reference.iter().map(|&p| hdr_clean(p)));
     let mut values = vec![0.0f32; w * h];
-    for i in 0..exposures.count {
-        let scale = exposures.stops(i).exp2() as f32;
-        let tone = |p: [f32; 3]| clean(p).map(|v| exposure::aces(v * scale));
-        band::flip_map_into(test, reference, (w, h), &kernels, &tone, &mut values, i > 0);
-    }
+    let (test, reference) = (Rows::new(test, 0), Rows::new(reference, 0));
+    FlipRows::new(ppd).hdr(test, reference, (w, h), &exposures, 0, &mut values);
     Ok(HdrFlip {
         map: FlipMap {
             width: w,

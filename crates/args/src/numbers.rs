@@ -1,5 +1,5 @@
-//! Whole-number options (`--seed`, `--checkpoints`, `--spectral-bins`, …) parsed with
-//! messages in the project's words: clap's own parser answers "not in 0..=4294967295".
+//! Whole-number options (`--seed`, `--checkpoints`, `--spectral-bins`, `--spp`, …) parsed
+//! with messages in the project's words: clap's own parser answers "not in 0..=4294967295".
 
 /// A whole number from 0 to `u32::MAX`.
 pub fn parse_u32(text: &str) -> Result<u32, String> {
@@ -25,6 +25,21 @@ fn parse(text: &str) -> Result<u64, String> {
     })
 }
 
+/// `--spp N`: a whole number from 1 to 2³² − 1, said in those words.
+pub fn parse_spp(s: &str) -> Result<u32, String> {
+    let t = s.trim();
+    let digits = !t.is_empty() && t.chars().all(|c| c.is_ascii_digit());
+    match t.parse::<u64>() {
+        Ok(0) => Err(format!("`{s}`: expected at least 1 sample per pixel")),
+        Ok(n) if n <= u64::from(u32::MAX) => Ok(n as u32),
+        // Too large for u32, or for u64: still digits.
+        Ok(_) | Err(_) if digits => Err(format!("`{s}`: at most {} samples per pixel", u32::MAX)),
+        Ok(_) | Err(_) => Err(format!(
+            "`{s}`: expected a whole number of samples per pixel, e.g. 64"
+        )),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -41,5 +56,9 @@ mod tests {
             .contains("at most"));
         assert!(parse_u32("-3").unwrap_err().contains("≥ 0"));
         assert!(parse_u32("1.5").unwrap_err().contains("whole number"));
+        assert_eq!(parse_spp("64"), Ok(64));
+        assert!(parse_spp("0").unwrap_err().contains("at least 1"));
+        assert!(parse_spp("99999999999").unwrap_err().contains("at most"));
+        assert!(parse_spp("6.5").unwrap_err().contains("`6.5`"));
     }
 }
