@@ -757,9 +757,24 @@ mod tests {
     use super::*;
     use crate::film::Filter;
 
-    /// Every ISA's splat gives the SSE2 taps' bits: the AVX taps (one 256-bit multiply and
-    /// add per tap against two 128-bit ones, no fused multiply-add in either) and the
-    /// AVX2 gathers (each ISA the machine runs, `prism_cpu::each_isa`).
+    /// 500 film points spread over a 16 × 16 tile at (16, 16), with colours of several
+    /// magnitudes.
+    fn splat_points() -> impl Iterator<Item = (Vec2, DVec3)> {
+        (0..500u32).map(|k| {
+            let f = k as f32;
+            let p = Vec2::new(
+                16.0 + (f * 0.618_034).fract() * 16.0,
+                16.0 + (f * 0.414_214).fract() * 16.0,
+            );
+            let xyz = DVec3::new(0.1 + f64::from(k % 7), 1.0 / (1.0 + f64::from(k)), 0.25);
+            (p, xyz)
+        })
+    }
+
+    /// Every ISA's splat gives the SSE2 taps' limbs: the AVX2 taps (256-bit operations
+    /// against two 128-bit ones, no fused multiply-add in either) and the AVX2 gathers (each
+    /// ISA the machine runs, `prism_cpu::each_isa`); and the limbs hold the sums of each
+    /// tap's exact conversion (`FixedSum::from_f64`, the path of bright taps).
     #[test]
     fn every_isa_splats_the_sse2_sums() {
         // Radius 2 px, σ = ½ px (α = 2 px⁻²): the Cornell box's filter, 4 × 4 taps.
@@ -778,13 +793,7 @@ mod tests {
                 ..sse2.clone()
             })
             .collect();
-        for k in 0..500u32 {
-            let f = k as f32;
-            let p = Vec2::new(
-                16.0 + (f * 0.618_034).fract() * 16.0,
-                16.0 + (f * 0.414_214).fract() * 16.0,
-            );
-            let xyz = DVec3::new(0.1 + f64::from(k % 7), 1.0 / (1.0 + f64::from(k)), 0.25);
+        for (p, xyz) in splat_points() {
             sse2.splat(p, xyz, &table);
             for w in &mut wide {
                 w.splat(p, xyz, &table);
@@ -799,13 +808,7 @@ mod tests {
             simd: prism_cpu::Simd::SCALAR,
             ..SplatBuffer::new(tile, UVec2::new(64, 64), 2.0)
         };
-        for k in 0..500u32 {
-            let f = k as f32;
-            let p = Vec2::new(
-                16.0 + (f * 0.618_034).fract() * 16.0,
-                16.0 + (f * 0.414_214).fract() * 16.0,
-            );
-            let xyz = DVec3::new(0.1 + f64::from(k % 7), 1.0 / (1.0 + f64::from(k)), 0.25);
+        for (p, xyz) in splat_points() {
             wide_path.splat_with::<false, false, true>(p, xyz, &table);
         }
         for i in 0..sse2.sums.len() {
