@@ -234,6 +234,57 @@ fn merged_ranges_equal_the_whole_render() {
     }
 }
 
+/// `photon_progressive` (per-pixel SPPM statistics, Hachisuka & Jensen 2009) on the
+/// caustic under a glass sphere in thin fog: the part 2..4 replays the statistics of
+/// passes 0 and 1 (and says so), so the parts 0..2 and 2..4 merge into the 0..4 render
+/// bit for bit.
+#[test]
+fn photon_progressive_ranges_replay_the_passes_before_and_merge_exactly() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(scene("stress/caustic-glass-sphere.json")).unwrap();
+    let text = text.replace(
+        r#""integrator": {"type": "path", "max_depth": 8},"#,
+        r#""integrator": {"type": "photon_progressive", "max_depth": 6, "photons_per_pass": 4000, "alpha": 0.7},
+  "world_medium": "fog",
+  "media": {"fog": {"sigma_a_per_m": 0.02, "sigma_s_per_m": 0.1}},"#,
+    );
+    assert!(
+        text.contains("photon_progressive"),
+        "the scene's integrator line changed"
+    );
+    let file = dir.path().join("caustic.json");
+    std::fs::write(&file, text).unwrap();
+    let extra = ["--resolution", "24x24", "--spp", "4"];
+    let whole = dir.path().join("whole.exr");
+    let mut args = vec![s(&file), "-o", s(&whole)];
+    args.extend_from_slice(&extra);
+    let o = render(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let mut parts = Vec::new();
+    for (k, range) in ["2..4", "0..2"].iter().enumerate() {
+        let part = dir.path().join(format!("part{k}.exr"));
+        let mut args = vec![
+            s(&file),
+            "-o",
+            s(&part),
+            "--samples",
+            range,
+            "--threads",
+            "2",
+        ];
+        args.extend_from_slice(&extra);
+        let o = render(&args);
+        assert!(o.status.success(), "{range}: {}", stderr(&o));
+        let replays = stderr(&o).contains("replays the per-pixel statistics of passes 0..2");
+        assert_eq!(replays, *range == "2..4", "{range}: {}", stderr(&o));
+        parts.push(part);
+    }
+    let merged = dir.path().join("merged.exr");
+    let o = prism(&["merge", s(&parts[0]), s(&parts[1]), "-o", s(&merged)]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_same_picture(&whole, &merged);
+}
+
 /// A copy of a scene beside `dir` with `edit` applied to its text (asset paths made
 /// absolute so the copy finds them).
 fn edited_scene(dir: &Path, name: &str, edit: impl Fn(String) -> String) -> PathBuf {

@@ -159,6 +159,36 @@ fn range_plan(
     Ok((out, 0))
 }
 
+/// What a range of a render whose passes depend on the passes before replays first, and
+/// what that costs (`photon_progressive`'s per-pixel statistics); `None` when nothing is
+/// replayed.
+fn replay_note(scene: &RenderScene, range: SampleRange) -> Option<String> {
+    let prism_render::Integrator::Photon(mapper) = &scene.integrator else {
+        return None;
+    };
+    if !mapper.is_progressive() || range.start == 0 {
+        return None;
+    }
+    let photons = mapper
+        .plan(scene)
+        .map(|p| {
+            format!(
+                "{} photons",
+                u64::from(p.photons_per_pass) * u64::from(range.start)
+            )
+        })
+        .unwrap_or_else(|_| "their photons".to_string());
+    Some(format!(
+        "{} replays the per-pixel statistics of passes 0..{} before it renders {range}: the \
+         photon tracing of {} passes ({photons}) and each pixel's camera path of every one of \
+         them up to its first diffuse vertex, none of it added to the image (a part saves no \
+         photon work of the passes before it; docs/scale-out.md)",
+        mapper.name(),
+        range.start,
+        range.start
+    ))
+}
+
 /// Renders the range of `args` (or the resumed checkpoint's) of `plan` into a film and
 /// returns it with what it did. `extra_aovs` are added to the image (the predictor's).
 #[allow(clippy::too_many_arguments)]
@@ -232,6 +262,9 @@ pub fn render(
         }
     }
     let (pass_plan, first_sample) = range_plan(plan, !per_pixel_plan, range, total)?;
+    if let Some(line) = replay_note(scene, range) {
+        eprintln!("{}: {line}", args.scene.display());
+    }
     let checkpoint = checkpoint_path(output);
     let start = Instant::now();
     let progress = Progress::start(

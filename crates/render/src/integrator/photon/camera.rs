@@ -92,6 +92,11 @@ pub struct CausticGather {
     /// update), whatever their contribution: photons from behind the surface count too,
     /// as in pbrt-v4's SPPM.
     pub found: u32,
+    /// Only count: the path adds nothing and ends at its gather (a replayed pass, whose
+    /// statistics are wanted but not its image). Everything up to the gather — the stream,
+    /// the throughput that roulette and the media read — is as in a rendered pass, so the
+    /// count is the rendered pass's.
+    pub count_only: bool,
 }
 
 /// The camera-path tracer of a pass.
@@ -145,7 +150,7 @@ impl CameraPaths<'_> {
                     let segment = Ray::new(ray.origin, ray.direction, 0.0, t_end);
                     let (profile, end) =
                         segment_transmittance(med, &optics, &segment, &mut steps, &mut r);
-                    if path.depth < max_depth {
+                    if path.depth < max_depth && !gather.count_only {
                         self.beam(
                             &segment,
                             m,
@@ -164,7 +169,8 @@ impl CameraPaths<'_> {
                 }
                 rng = Some(r);
             }
-            let skip_emission = after_first_diffuse && specular_chain && chain_specular_count > 0;
+            let skip_emission = (after_first_diffuse && specular_chain && chain_specular_count > 0)
+                || gather.count_only;
             let Some(hit) = hit else {
                 if !skip_emission {
                     let (d, prev) = (ray.direction, &path.prev_ctx);
@@ -288,6 +294,9 @@ impl CameraPaths<'_> {
                         &mut sum,
                         counters,
                     );
+                    if gather.count_only {
+                        break;
+                    }
                 }
                 if !lights.is_empty() {
                     let (uc, ul) = (
@@ -377,6 +386,9 @@ impl CameraPaths<'_> {
                 return;
             }
             gather.found += 1;
+            if gather.count_only {
+                return;
+            }
             let Some(eval) = vertex.eval(-ph.direction(), TransportMode::Radiance) else {
                 return;
             };

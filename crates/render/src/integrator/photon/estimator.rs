@@ -9,14 +9,15 @@
 //! §4); on surfaces each pixel keeps its own radius and photon count (stochastic
 //! progressive photon mapping, Hachisuka & Jensen 2009, `sppm`), which `prepare` updates
 //! from what the pixel's visible point found in the pass before. Those statistics make
-//! pass i depend on passes 0 … i − 1: a progressive render's passes run in order from the
-//! first, in one estimator, and a range starting later is refused with the reason.
+//! pass i depend on passes 0 … i − 1: passes come in order in one estimator, and a range
+//! that starts later replays the statistics of the passes before it (`replay`).
 //! `prism render --spp N` is N photon passes.
 
 use prism_spectrum::SampledSpectrum;
 
 use super::camera::{pass_wavelengths, CameraPaths, CausticGather, PhotonMaps};
 use super::photon_map::PhotonTree;
+use super::replay::replay_pass;
 use super::settings::{PhotonMapper, PhotonPlan};
 use super::shoot::shoot;
 use super::sppm::SppmStatistics;
@@ -81,39 +82,38 @@ impl PhotonEstimator {
     }
 
     /// The per-pixel statistics ready for pass `iteration`: fresh at pass 0, else the
-    /// last pass's counts folded in. Passes must come in order (pass i's radii are the
-    /// result of passes 0 … i − 1).
+    /// last pass's counts folded in. Pass i's radii are the result of passes 0 … i − 1:
+    /// passes this estimator did not render (a range that starts after 0, a resumed
+    /// render, a pass out of order) are replayed first (`replay`), so that the pass is
+    /// the one an uninterrupted render from sample 0 gives, bit for bit.
     fn advance_statistics(
         &mut self,
+        scene: &RenderScene,
+        pass: &Pass,
         plan: &PhotonPlan,
-        resolution: glam::UVec2,
         iteration: u32,
-    ) -> Result<(), String> {
+    ) {
         let Some(alpha) = plan.alpha else {
-            return Ok(());
+            return;
         };
-        if iteration == 0 {
-            self.sppm = Some(SppmStatistics::new(resolution, plan.radius_m, alpha));
-            return Ok(());
-        }
-        let expected = self.sppm.as_ref().map(|s| s.pass() + 1);
-        match &mut self.sppm {
-            Some(stats) if expected == Some(iteration) && stats.resolution() == resolution => {
+        let resolution = pass.plan.resolution();
+        let continues = self
+            .sppm
+            .as_ref()
+            .is_some_and(|s| s.resolution() == resolution && s.pass() < iteration);
+        if continues {
+            if let Some(stats) = &mut self.sppm {
                 stats.advance();
-                Ok(())
             }
-            _ => Err(format!(
-                "`{}` keeps per-pixel statistics from pass to pass (stochastic progressive \
-                 photon mapping, Hachisuka & Jensen 2009), so its passes run in order from \
-                 sample 0 in one render: this one starts at sample {iteration}{}; render \
-                 samples 0.. in one range instead (no `--samples A..B` with A > 0, no \
-                 resuming between passes)",
-                self.mapper.name(),
-                match expected {
-                    Some(e) => format!(" where sample {e} was next"),
-                    None => String::new(),
-                }
-            )),
+        } else {
+            self.sppm = Some(SppmStatistics::new(resolution, plan.radius_m, alpha));
+        }
+        let tracer = self.tracer();
+        if let Some(stats) = &mut self.sppm {
+            while stats.pass() < iteration {
+                replay_pass(scene, pass, plan, tracer, stats, stats.pass());
+                stats.advance();
+            }
         }
     }
 }
@@ -189,7 +189,7 @@ impl Estimator for PhotonEstimator {
         if self.iteration == Some(iteration) {
             return Ok(());
         }
-        self.advance_statistics(&plan, pass.plan.resolution(), iteration)?;
+        self.advance_statistics(scene, pass, &plan, iteration);
         // Drop the last pass's photons before the next are shot.
         self.maps = PhotonMaps::default();
         self.wavelengths = pass_wavelengths(pass.settings.seed, iteration);
@@ -258,6 +258,7 @@ impl Estimator for PhotonEstimator {
                 let mut gather = CausticGather {
                     radius_m: self.sppm.as_ref().map(|s| s.pixel(pixel).radius_m() as f32),
                     found: 0,
+                    count_only: false,
                 };
                 let result = scene
                     .camera

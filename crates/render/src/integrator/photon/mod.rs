@@ -11,6 +11,7 @@
 //! - `photon_map`: the stored photon and the tree over the photons' spheres;
 //! - `medium_flight`: photon flights, camera-segment and shadow-ray transmittance in media;
 //! - `shoot`: one pass's photon tracing, in parallel;
+//! - `replay`: the statistics of passes rendered elsewhere, without their image;
 //! - `camera`: camera paths with the caustic gather and the beam estimate;
 //! - `estimator`: the `Estimator` (one photon pass per sample index).
 
@@ -18,6 +19,7 @@ mod camera;
 mod estimator;
 mod medium_flight;
 mod photon_map;
+mod replay;
 mod settings;
 mod shoot;
 mod sppm;
