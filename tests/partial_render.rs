@@ -241,19 +241,7 @@ fn merged_ranges_equal_the_whole_render() {
 #[test]
 fn photon_progressive_ranges_replay_the_passes_before_and_merge_exactly() {
     let dir = tempfile::tempdir().unwrap();
-    let text = std::fs::read_to_string(scene("stress/caustic-glass-sphere.json")).unwrap();
-    let text = text.replace(
-        r#""integrator": {"type": "path", "max_depth": 8},"#,
-        r#""integrator": {"type": "photon_progressive", "max_depth": 6, "photons_per_pass": 4000, "alpha": 0.7},
-  "world_medium": "fog",
-  "media": {"fog": {"sigma_a_per_m": 0.02, "sigma_s_per_m": 0.1}},"#,
-    );
-    assert!(
-        text.contains("photon_progressive"),
-        "the scene's integrator line changed"
-    );
-    let file = dir.path().join("caustic.json");
-    std::fs::write(&file, text).unwrap();
+    let file = photon_progressive_scene(dir.path());
     let extra = ["--resolution", "24x24", "--spp", "4"];
     let whole = dir.path().join("whole.exr");
     let mut args = vec![s(&file), "-o", s(&whole)];
@@ -283,6 +271,65 @@ fn photon_progressive_ranges_replay_the_passes_before_and_merge_exactly() {
     let o = prism(&["merge", s(&parts[0]), s(&parts[1]), "-o", s(&merged)]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert_same_picture(&whole, &merged);
+}
+
+/// A photon_progressive render stopped between passes (as Ctrl-C stops it) leaves a
+/// checkpoint of the passes done; resuming it replays their per-pixel statistics and
+/// renders the rest, bit for bit the uninterrupted render.
+#[test]
+fn photon_progressive_checkpoints_resume_between_passes() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = photon_progressive_scene(dir.path());
+    let extra = ["--resolution", "24x24", "--spp", "4"];
+    let whole = dir.path().join("whole.exr");
+    let mut args = vec![s(&file), "-o", s(&whole)];
+    args.extend_from_slice(&extra);
+    let o = render(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = dir.path().join("long.exr");
+    let checkpoint = dir.path().join("long.partial.exr");
+    let mut args = vec![s(&file), "-o", s(&out), "--stop-after-items", "1"];
+    args.extend_from_slice(&extra);
+    let o = render(&args);
+    assert!(!o.status.success(), "the stop did not stop it");
+    let (counts, header) = channels(&checkpoint);
+    assert_eq!(header.text["prism:complete"], "false");
+    assert_eq!(
+        header.text["prism:items_done"], "1",
+        "one pass in the checkpoint"
+    );
+    assert!(counts["counts.samples"].iter().all(|&c| c == 1));
+    let mut args = vec![
+        s(&file),
+        "-o",
+        s(&out),
+        "--threads",
+        "1",
+        "--resume",
+        s(&checkpoint),
+    ];
+    args.extend_from_slice(&extra);
+    let o = render(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_same_picture(&whole, &out);
+}
+
+/// caustic-glass-sphere in thin fog with `photon_progressive`, beside `dir`.
+fn photon_progressive_scene(dir: &Path) -> PathBuf {
+    let text = std::fs::read_to_string(scene("stress/caustic-glass-sphere.json")).unwrap();
+    let text = text.replace(
+        r#""integrator": {"type": "path", "max_depth": 8},"#,
+        r#""integrator": {"type": "photon_progressive", "max_depth": 6, "photons_per_pass": 4000, "alpha": 0.7},
+  "world_medium": "fog",
+  "media": {"fog": {"sigma_a_per_m": 0.02, "sigma_s_per_m": 0.1}},"#,
+    );
+    assert!(
+        text.contains("photon_progressive"),
+        "the scene's integrator line changed"
+    );
+    let file = dir.join("caustic.json");
+    std::fs::write(&file, text).unwrap();
+    file
 }
 
 /// A copy of a scene beside `dir` with `edit` applied to its text (asset paths made

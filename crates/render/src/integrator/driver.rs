@@ -349,9 +349,9 @@ pub fn render_pass_controlled(
 
 /// `render_pass_with` for an estimator that prepares every `per_prepare` sample indices:
 /// the pass cut into passes of at most that many indices, `prepare` before each. The
-/// pixels' sample ranges must start at the same index. A stop request ends the pass
-/// between steps; checkpoints inside such a pass and resuming one are refused (a step's
-/// state, its photons, is not in the film): split the work with sample ranges instead.
+/// pixels' sample ranges must start at the same index. The steps are the pass's work items:
+/// a stop request ends the pass between steps, checkpoints are handed out between steps
+/// with the steps done, and a resumed pass starts at the next step.
 fn render_in_sample_steps(
     estimator: &mut (impl Estimator + ?Sized),
     scene: &RenderScene,
@@ -361,13 +361,6 @@ fn render_in_sample_steps(
     per_prepare: u32,
     control: &PassControl,
 ) -> Result<PassOutcome, RenderError> {
-    if control.checkpoint.is_some() || control.resumed {
-        return Err(RenderError::Estimator(format!(
-            "{} cannot checkpoint or resume within a pass (its photons are not in the \
-             film): render sample ranges (--samples A..B) and merge them instead",
-            estimator.name()
-        )));
-    }
     let resolution = pass.plan.resolution();
     let Some(first) = uniform_first_sample(pass.plan) else {
         return Err(RenderError::Estimator(format!(
@@ -387,7 +380,23 @@ fn render_in_sample_steps(
     let n = counts.len();
     let step = per_prepare.max(1);
     let mut total = RenderStats::default();
-    let mut k = 0u32;
+    // The work items of such a pass are its steps: a checkpoint holds the film of the steps
+    // done, and resuming it continues with the next step (an estimator that keeps state
+    // across steps, photon_progressive's per-pixel radii, replays the steps before it).
+    let mut steps_done = if control.resumed {
+        control.items_done
+    } else {
+        0
+    };
+    let mut k = u32::try_from(steps_done)
+        .ok()
+        .and_then(|s| s.checked_mul(step))
+        .unwrap_or(u32::MAX);
+    let clock = control.checkpoint.map(|(every, write)| CheckpointClock {
+        last: Mutex::new(Instant::now()),
+        every,
+        write,
+    });
     let never = AtomicBool::new(false);
     let step_control = PassControl {
         stop: &never,
@@ -399,7 +408,7 @@ fn render_in_sample_steps(
         if control.stop.load(std::sync::atomic::Ordering::Relaxed) {
             return Ok(PassOutcome {
                 stats: total,
-                items_done: 0,
+                items_done: steps_done,
                 complete: false,
             });
         }
@@ -419,11 +428,17 @@ fn render_in_sample_steps(
             .map_err(RenderError::Estimator)?;
         let outcome = run_prepared(&*estimator, scene, &sub, film, progress, &step_control)?;
         total.add(&outcome.stats);
-        k += step;
+        k = k.saturating_add(step);
+        steps_done += 1;
+        if let Some(clock) = &clock {
+            if k < most && clock.due() {
+                (clock.write)(film, steps_done);
+            }
+        }
     }
     Ok(PassOutcome {
         stats: total,
-        items_done: 0,
+        items_done: steps_done,
         complete: true,
     })
 }
