@@ -242,12 +242,8 @@ fn merged_ranges_equal_the_whole_render() {
 fn photon_progressive_ranges_replay_the_passes_before_and_merge_exactly() {
     let dir = tempfile::tempdir().unwrap();
     let file = photon_progressive_scene(dir.path());
-    let extra = ["--resolution", "24x24", "--spp", "4"];
-    let whole = dir.path().join("whole.exr");
-    let mut args = vec![s(&file), "-o", s(&whole)];
-    args.extend_from_slice(&extra);
-    let o = render(&args);
-    assert!(o.status.success(), "{}", stderr(&o));
+    let extra = PHOTON_EXTRA;
+    let whole = render_whole(&file, dir.path(), &extra);
     let mut parts = Vec::new();
     for (k, range) in ["2..4", "0..2"].iter().enumerate() {
         let part = dir.path().join(format!("part{k}.exr"));
@@ -280,12 +276,8 @@ fn photon_progressive_ranges_replay_the_passes_before_and_merge_exactly() {
 fn photon_progressive_checkpoints_resume_between_passes() {
     let dir = tempfile::tempdir().unwrap();
     let file = photon_progressive_scene(dir.path());
-    let extra = ["--resolution", "24x24", "--spp", "4"];
-    let whole = dir.path().join("whole.exr");
-    let mut args = vec![s(&file), "-o", s(&whole)];
-    args.extend_from_slice(&extra);
-    let o = render(&args);
-    assert!(o.status.success(), "{}", stderr(&o));
+    let extra = PHOTON_EXTRA;
+    let whole = render_whole(&file, dir.path(), &extra);
     let out = dir.path().join("long.exr");
     let checkpoint = dir.path().join("long.partial.exr");
     let mut args = vec![s(&file), "-o", s(&out), "--stop-after-items", "1"];
@@ -312,6 +304,19 @@ fn photon_progressive_checkpoints_resume_between_passes() {
     let o = render(&args);
     assert!(o.status.success(), "{}", stderr(&o));
     assert_same_picture(&whole, &out);
+}
+
+/// The size and samples of the photon_progressive tests.
+const PHOTON_EXTRA: [&str; 4] = ["--resolution", "24x24", "--spp", "4"];
+
+/// `file` rendered whole (all its samples, no range) into `dir`/whole.exr.
+fn render_whole(file: &Path, dir: &Path, extra: &[&str]) -> PathBuf {
+    let whole = dir.join("whole.exr");
+    let mut args = vec![s(file), "-o", s(&whole)];
+    args.extend_from_slice(extra);
+    let o = render(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    whole
 }
 
 /// caustic-glass-sphere in thin fog with `photon_progressive`, beside `dir`.
