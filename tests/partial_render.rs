@@ -196,20 +196,14 @@ fn merged_ranges_equal_the_whole_render() {
         let spp: u32 = case.extra[case.extra.iter().position(|a| *a == "--spp").unwrap() + 1]
             .parse()
             .unwrap();
-        let whole = dir.path().join("whole.exr");
-        let mut args = vec![s(&file), "-o", s(&whole)];
-        args.extend_from_slice(case.extra);
-        assert!(render(&args).status.success());
+        let whole = render_whole(&file, dir.path(), case.extra);
         let mut parts = Vec::new();
         for (k, range) in [format!("{}..{spp}", spp / 2), format!("0..{}", spp / 2)]
             .iter()
             .enumerate()
         {
             let part = dir.path().join(format!("part{k}.exr"));
-            let mut args = vec![s(&file), "-o", s(&part), "--samples", range];
-            args.extend_from_slice(case.extra);
-            let o = render(&args);
-            assert!(o.status.success(), "{}: {}", case.scene, stderr(&o));
+            render_range(&file, &part, range, case.extra);
             parts.push(part);
         }
         let merged = dir.path().join("merged.exr");
@@ -247,18 +241,12 @@ fn photon_progressive_ranges_replay_the_passes_before_and_merge_exactly() {
     let mut parts = Vec::new();
     for (k, range) in ["2..4", "0..2"].iter().enumerate() {
         let part = dir.path().join(format!("part{k}.exr"));
-        let mut args = vec![
-            s(&file),
-            "-o",
-            s(&part),
-            "--samples",
+        let o = render_range(
+            &file,
+            &part,
             range,
-            "--threads",
-            "2",
-        ];
-        args.extend_from_slice(&extra);
-        let o = render(&args);
-        assert!(o.status.success(), "{range}: {}", stderr(&o));
+            &[&extra[..], &["--threads", "2"]].concat(),
+        );
         let replays = stderr(&o).contains("replays the per-pixel statistics of passes 0..2");
         assert_eq!(replays, *range == "2..4", "{range}: {}", stderr(&o));
         parts.push(part);
@@ -304,6 +292,20 @@ fn photon_progressive_checkpoints_resume_between_passes() {
     let o = render(&args);
     assert!(o.status.success(), "{}", stderr(&o));
     assert_same_picture(&whole, &out);
+}
+
+/// `file`'s samples `range` rendered into the partial image `part`; returns the output.
+fn render_range(file: &Path, part: &Path, range: &str, extra: &[&str]) -> std::process::Output {
+    let mut args = vec![s(file), "-o", s(part), "--samples", range];
+    args.extend_from_slice(extra);
+    let o = render(&args);
+    assert!(
+        o.status.success(),
+        "{} {range}: {}",
+        file.display(),
+        stderr(&o)
+    );
+    o
 }
 
 /// The size and samples of the photon_progressive tests.
@@ -515,18 +517,11 @@ fn predicted_plan_ranges_split_each_pixels_own_samples() {
     let dir = tempfile::tempdir().unwrap();
     let cornell = scene("cornell-box.json");
     let common = ["--resolution", "24x16", "--spp", "8", "--plan", "predicted"];
-    let whole = dir.path().join("whole.exr");
-    let mut args = vec![s(&cornell), "-o", s(&whole)];
-    args.extend_from_slice(&common);
-    let o = render(&args);
-    assert!(o.status.success(), "{}", stderr(&o));
+    let whole = render_whole(&cornell, dir.path(), &common);
     let mut parts = Vec::new();
     for (k, range) in ["0..3", "3..8"].iter().enumerate() {
         let part = dir.path().join(format!("p{k}.exr"));
-        let mut args = vec![s(&cornell), "-o", s(&part), "--samples", range];
-        args.extend_from_slice(&common);
-        let o = render(&args);
-        assert!(o.status.success(), "{}", stderr(&o));
+        render_range(&cornell, &part, range, &common);
         parts.push(part);
     }
     let (w, _) = channels(&whole);
@@ -650,18 +645,11 @@ fn sensor_ranges_merge_into_the_whole_measurement() {
         )
     });
     let common = ["--resolution", "12x8", "--spp", "4"];
-    let whole = dir.path().join("whole.exr");
-    let mut args = vec![s(&room), "-o", s(&whole)];
-    args.extend_from_slice(&common);
-    let o = render(&args);
-    assert!(o.status.success(), "{}", stderr(&o));
+    render_whole(&room, dir.path(), &common);
     let mut parts = Vec::new();
     for (k, range) in ["1..4", "0..1"].iter().enumerate() {
         let part = dir.path().join(format!("s{k}.exr"));
-        let mut args = vec![s(&room), "-o", s(&part), "--samples", range];
-        args.extend_from_slice(&common);
-        let o = render(&args);
-        assert!(o.status.success(), "{}", stderr(&o));
+        render_range(&room, &part, range, &common);
         assert!(dir
             .path()
             .join(format!("s{k}.sensors.partial.json"))

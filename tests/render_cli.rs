@@ -380,47 +380,51 @@ fn explain_prints_the_plan_and_renders_nothing() {
     assert!(!out.exists(), "--explain must not render");
 }
 
-/// A scene with fog: `--explain` lists the medium and why the packet tracer is off, and
-/// the render goes through the scalar tracer and comes out non-black.
-#[test]
-fn a_scene_with_media_is_explained_and_rendered_by_the_scalar_tracer() {
-    let dir = tempfile::tempdir().unwrap();
-    let scene = dir.path().join("fog.json");
+/// A lit fog scene in `dir` (a floor, a point light), with `integrator` (a JSON member line
+/// ending in a comma, or nothing for the default path tracer).
+fn fog_scene(dir: &Path, integrator: &str) -> PathBuf {
+    let scene = dir.join("fog.json");
     std::fs::write(
         &scene,
-        r#"{"world_medium": "fog",
-            "media": {"fog": {"sigma_a_per_m": 0.05, "sigma_s_per_m": {"rgb": [0.2, 0.3, 0.5]},
-                              "phase": {"type": "hg", "g": 0.5}}},
-            "camera": {"transform": {"look_at": {"eye": [0, 1, 4], "target": [0, 0, 0], "up": [0, 1, 0]}}},
-            "shapes": [{"type": "rectangle", "size_m": [10, 10],
-                        "transform": {"rotate": {"axis": [1, 0, 0], "angle_deg": -90}}}],
-            "lights": [{"type": "point", "position_m": [0, 2, 0], "power_lm": 1000}]}"#,
+        format!(
+            r#"{{"world_medium": "fog",
+            "media": {{"fog": {{"sigma_a_per_m": 0.05, "sigma_s_per_m": {{"rgb": [0.2, 0.3, 0.5]}},
+                              "phase": {{"type": "hg", "g": 0.5}}}}}},
+            {integrator}
+            "camera": {{"transform": {{"look_at": {{"eye": [0, 1, 4], "target": [0, 0, 0], "up": [0, 1, 0]}}}}}},
+            "shapes": [{{"type": "rectangle", "size_m": [10, 10],
+                        "transform": {{"rotate": {{"axis": [1, 0, 0], "angle_deg": -90}}}}}}],
+            "lights": [{{"type": "point", "position_m": [0, 2, 0], "power_lm": 1000}}]}}"#
+        ),
     )
     .unwrap();
-    let out = dir.path().join("fog.exr");
-    let o = prism(&["render", s(&scene), "-o", s(&out), "--explain"]);
+    scene
+}
+
+/// `--explain` of `scene` succeeds and prints every one of `needles`.
+fn assert_explains(scene: &Path, out: &Path, needles: &[&str]) {
+    let o = prism(&["render", s(scene), "-o", s(out), "--explain"]);
     assert!(o.status.success(), "{}", stderr(&o));
     let text = String::from_utf8_lossy(&o.stdout);
-    for needle in [
-        "medium",
-        "`fog`: homogeneous, σt ",
-        "chromatic σt",
-        "not used: the scene has participating media (fog): the packet tracer samples no media",
-    ] {
+    for needle in needles {
         assert!(text.contains(needle), "missing `{needle}` in:\n{text}");
     }
+}
+
+/// `scene` renders at 16×12, 4 spp, into `out`: finite everywhere and lit somewhere.
+fn assert_renders_lit(scene: &Path, out: &Path) {
     let o = prism(&[
         "render",
-        s(&scene),
+        s(scene),
         "-o",
-        s(&out),
+        s(out),
         "--resolution",
         "16x12",
         "--spp",
         "4",
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
-    let image = read_exr(&out).unwrap();
+    let image = read_exr(out).unwrap();
     assert!(
         image
             .pixels()
@@ -431,6 +435,26 @@ fn a_scene_with_media_is_explained_and_rendered_by_the_scalar_tracer() {
     );
 }
 
+/// A scene with fog: `--explain` lists the medium and why the packet tracer is off, and
+/// the render goes through the scalar tracer and comes out non-black.
+#[test]
+fn a_scene_with_media_is_explained_and_rendered_by_the_scalar_tracer() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = fog_scene(dir.path(), "");
+    let out = dir.path().join("fog.exr");
+    assert_explains(
+        &scene,
+        &out,
+        &[
+            "medium",
+            "`fog`: homogeneous, σt ",
+            "chromatic σt",
+            "not used: the scene has participating media (fog): the packet tracer samples no media",
+        ],
+    );
+    assert_renders_lit(&scene, &out);
+}
+
 /// The same fog scene with `photon_progressive`: `--explain` names its settings (photons per
 /// pass, radius, α, the storage estimate and limit), it renders a lit, finite image, and a
 /// sample range that starts after 0 replays the passes before (its per-pixel radii need
@@ -438,52 +462,23 @@ fn a_scene_with_media_is_explained_and_rendered_by_the_scalar_tracer() {
 #[test]
 fn a_photon_integrator_is_explained_and_renders() {
     let dir = tempfile::tempdir().unwrap();
-    let scene = dir.path().join("fog.json");
-    std::fs::write(
-        &scene,
-        r#"{"world_medium": "fog",
-            "media": {"fog": {"sigma_a_per_m": 0.05, "sigma_s_per_m": {"rgb": [0.2, 0.3, 0.5]},
-                              "phase": {"type": "hg", "g": 0.5}}},
-            "integrator": {"type": "photon_progressive", "photons_per_pass": 5000, "alpha": 0.7},
-            "camera": {"transform": {"look_at": {"eye": [0, 1, 4], "target": [0, 0, 0], "up": [0, 1, 0]}}},
-            "shapes": [{"type": "rectangle", "size_m": [10, 10],
-                        "transform": {"rotate": {"axis": [1, 0, 0], "angle_deg": -90}}}],
-            "lights": [{"type": "point", "position_m": [0, 2, 0], "power_lm": 1000}]}"#,
-    )
-    .unwrap();
-    let out = dir.path().join("fog.exr");
-    let o = prism(&["render", s(&scene), "-o", s(&out), "--explain"]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let text = String::from_utf8_lossy(&o.stdout);
-    for needle in [
-        "photon_progressive, max_depth 8: 5000 photons per pass",
-        "initial radius ",
-        "α 0.700",
-        "photon storage ≤ ",
-        "limit",
-    ] {
-        assert!(text.contains(needle), "missing `{needle}` in:\n{text}");
-    }
-    let o = prism(&[
-        "render",
-        s(&scene),
-        "-o",
-        s(&out),
-        "--resolution",
-        "16x12",
-        "--spp",
-        "4",
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let image = read_exr(&out).unwrap();
-    assert!(
-        image
-            .pixels()
-            .iter()
-            .all(|p| p.iter().all(|c| c.is_finite()))
-            && image.pixels().iter().any(|p| p[1] > 0.0),
-        "a lit fog scene rendered black or non-finite"
+    let scene = fog_scene(
+        dir.path(),
+        r#""integrator": {"type": "photon_progressive", "photons_per_pass": 5000, "alpha": 0.7},"#,
     );
+    let out = dir.path().join("fog.exr");
+    assert_explains(
+        &scene,
+        &out,
+        &[
+            "photon_progressive, max_depth 8: 5000 photons per pass",
+            "initial radius ",
+            "α 0.700",
+            "photon storage ≤ ",
+            "limit",
+        ],
+    );
+    assert_renders_lit(&scene, &out);
     // Its per-pixel statistics come from the passes before: a range after sample 0
     // replays them (and says what that costs); one from 0 has nothing to replay.
     let part = dir.path().join("part.exr");

@@ -7,17 +7,15 @@
 //! Each sample's value is rounded once, to the nearest multiple of 2⁻⁶⁰ ≈ 8.7·10⁻¹⁹
 //! (ties to even); a sum holds up to 2⁶⁷ ≈ 1.5·10²⁰. A single value of magnitude 2⁶⁶ or
 //! more is not representable (`is_representable`), nor, on a splatting film, a sample colour
-//! of 2⁴² ≈ 4.4·10¹² or more (`SPLAT_MAX_VALUE`): callers treat them like non-finite values.
+//! whose taps reach 2⁴³ (`SplatBuffer::admits`): callers treat them like non-finite values.
 
 /// Fractional bits of the fixed point.
 pub const FRACTION_BITS: u32 = 60;
 /// Largest magnitude a single added value may have (exclusive), 2⁶⁶.
 pub const MAX_VALUE: f64 = 73_786_976_294_838_206_464.0;
-/// Largest colour component of a sample a splatting film takes (exclusive), 2⁴²: its taps
-/// (filter weight ≤ 2) must fit the high limb of `SplatBuffer`'s sums.
-pub const SPLAT_MAX_VALUE: f64 = (1u64 << 42) as f64;
 
-/// Bits of the low limb of `SplatLimbs` (the high limb counts units of 2⁻²⁰).
+/// Bits of the low limb of `SplatBuffer::sums` and `SurfaceSums` (the high limb counts units
+/// of 2⁻²⁰).
 pub(crate) const LOW_LIMB_BITS: u32 = 40;
 /// 2^(FRACTION_BITS − LOW_LIMB_BITS): the scale of the high limb.
 pub(crate) const HIGH_LIMB_SCALE: f64 = (1u64 << (FRACTION_BITS - LOW_LIMB_BITS)) as f64;
@@ -28,7 +26,7 @@ pub(crate) const LOW_LIMB_SCALE: f64 = (1u64 << LOW_LIMB_BITS) as f64;
 pub(crate) const MAGIC: f64 = 6_755_399_441_055_744.0;
 
 /// A sum of f64 values in fixed point (see the module docs).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub struct FixedSum(i128);
 
 impl FixedSum {
