@@ -2,11 +2,16 @@
 //! point (`dimensions`: film 2, lens 2; the wavelength dimension is the estimator's).
 
 use glam::{UVec2, Vec2};
+use prism_spectrum::{SampledSpectrum, SampledWavelengths};
 
 use super::dimensions::LENS_DIMENSIONS;
 use super::estimator::TileWork;
-use crate::film::FilmTile;
+use super::path::FirstHit;
+use super::RenderStats;
+use crate::film::xyz::XyzWeights;
+use crate::film::{FilmTile, SurfaceAov};
 use crate::sampler::SampleStream;
+use crate::scene_build::RenderScene;
 
 /// A camera sample before its first ray.
 #[derive(Clone, Copy, Debug)]
@@ -41,5 +46,48 @@ impl CameraSample {
             lens,
             stream,
         }
+    }
+}
+
+impl CameraSample {
+    /// Adds this sample of `pixel` to `tile`: its `estimate` (radiance at `sensor`, and
+    /// the first hit for the AOVs; `None` when the film point had no camera ray, a zero),
+    /// counted in `stats` (a traced ray, a non-finite estimate, a sample).
+    #[allow(clippy::too_many_arguments)]
+    pub fn add_to_tile(
+        &self,
+        tile: &mut FilmTile,
+        scene: &RenderScene,
+        pixel: UVec2,
+        sensor: &SampledWavelengths,
+        xyz_weights: &XyzWeights,
+        estimate: Option<(SampledSpectrum, Option<FirstHit>)>,
+        stats: &mut RenderStats,
+    ) {
+        let (radiance, aov) = match estimate {
+            None => (SampledSpectrum::splat(0.0), None),
+            Some((radiance, first_hit)) => {
+                stats.rays_traced += 1;
+                let aov = first_hit.map(|si| SurfaceAov {
+                    depth_m: si.t,
+                    normal: si.n_shading,
+                    albedo_rgb: scene.albedo(si.material_id),
+                });
+                (radiance, aov)
+            }
+        };
+        if radiance.has_non_finite() {
+            stats.non_finite_samples += 1;
+        }
+        tile.add_sample_with(
+            pixel,
+            self.film_point,
+            radiance,
+            sensor,
+            xyz_weights,
+            self.filter_weight,
+            aov.as_ref(),
+        );
+        stats.samples += 1;
     }
 }

@@ -3,7 +3,7 @@
 //! scene is one the packet tracer serves (`RenderScene::packet`, its allow-list) and the
 //! plan takes one light sample per hit.
 
-use prism_spectrum::{SampledSpectrum, SampledWavelengths};
+use prism_spectrum::SampledWavelengths;
 
 use super::camera_sample::CameraSample;
 use super::driver::RenderStats;
@@ -12,7 +12,7 @@ use super::lane_wavelengths::LaneWavelengths;
 use super::packet::{render_tile as render_packet_tile, TileJob};
 use super::{PathCounters, PathTracer};
 use crate::film::xyz::XyzWeights;
-use crate::film::{FilmTile, LightSplats, SurfaceAov};
+use crate::film::{FilmTile, LightSplats};
 use crate::scene_build::RenderScene;
 
 impl Estimator for PathTracer {
@@ -124,34 +124,21 @@ impl Estimator for PathTracer {
                     // at the wavelengths the film records.
                     let sensor = wavelengths.sensor();
                     let xyz_weights = XyzWeights::new(sensor);
-                    let (radiance, aov) = match result {
-                        None => (SampledSpectrum::splat(0.0), None),
-                        Some(r) => {
-                            stats.rays_traced += 1;
-                            if let Some(white) = r.illumination {
-                                tile.add_illumination_with(pixel, white, &xyz_weights);
-                            }
-                            let aov = r.first_hit.map(|si| SurfaceAov {
-                                depth_m: si.t,
-                                normal: si.n_shading,
-                                albedo_rgb: scene.albedo(si.material_id),
-                            });
-                            (r.radiance, aov)
+                    let estimate = result.map(|r| {
+                        if let Some(white) = r.illumination {
+                            tile.add_illumination_with(pixel, white, &xyz_weights);
                         }
-                    };
-                    if radiance.has_non_finite() {
-                        stats.non_finite_samples += 1;
-                    }
-                    tile.add_sample_with(
+                        (r.radiance, r.first_hit)
+                    });
+                    cs.add_to_tile(
+                        tile,
+                        scene,
                         pixel,
-                        cs.film_point,
-                        radiance,
                         sensor,
                         &xyz_weights,
-                        cs.filter_weight,
-                        aov.as_ref(),
+                        estimate,
+                        &mut stats,
                     );
-                    stats.samples += 1;
                 }
             }
         }

@@ -13,8 +13,6 @@
 //! that starts later replays the statistics of the passes before it (`replay`).
 //! `prism render --spp N` is N photon passes.
 
-use prism_spectrum::SampledSpectrum;
-
 use super::camera::{pass_wavelengths, CameraPaths, CausticGather, PhotonMaps};
 use super::photon_map::PhotonTree;
 use super::replay::replay_pass;
@@ -22,7 +20,7 @@ use super::settings::{PhotonMapper, PhotonPlan};
 use super::shoot::shoot;
 use super::sppm::SppmStatistics;
 use crate::film::xyz::XyzWeights;
-use crate::film::{FilmTile, LightSplats, SurfaceAov};
+use crate::film::{FilmTile, LightSplats};
 use crate::integrator::camera_sample::CameraSample;
 use crate::integrator::driver::RenderStats;
 use crate::integrator::estimator::{Estimator, Pass, TileWork};
@@ -278,31 +276,7 @@ impl Estimator for PhotonEstimator {
                 }
                 let sensor = wavelengths.sensor();
                 let xyz_weights = XyzWeights::new(sensor);
-                let (radiance, aov) = match result {
-                    None => (SampledSpectrum::splat(0.0), None),
-                    Some((radiance, first_hit)) => {
-                        stats.rays_traced += 1;
-                        let aov = first_hit.map(|si| SurfaceAov {
-                            depth_m: si.t,
-                            normal: si.n_shading,
-                            albedo_rgb: scene.albedo(si.material_id),
-                        });
-                        (radiance, aov)
-                    }
-                };
-                if radiance.has_non_finite() {
-                    stats.non_finite_samples += 1;
-                }
-                tile.add_sample_with(
-                    pixel,
-                    cs.film_point,
-                    radiance,
-                    sensor,
-                    &xyz_weights,
-                    cs.filter_weight,
-                    aov.as_ref(),
-                );
-                stats.samples += 1;
+                cs.add_to_tile(tile, scene, pixel, sensor, &xyz_weights, result, &mut stats);
             }
         }
         stats.add_path_counters(&counters);
