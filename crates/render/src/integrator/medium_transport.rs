@@ -46,7 +46,7 @@ use super::fluorescent_vertex;
 use super::lane_wavelengths::LaneWavelengths;
 use super::path::{FirstHit, PathCounters, PathResult, PathTracer};
 use super::path_state::{PathOrigin, PathState};
-use super::scatter_vertex::{MediumVertex, ScatterVertex, SurfaceVertex};
+use super::scatter_vertex::{MediumVertex, ScatterVertex, SurfaceVertex, VertexLightSample};
 use crate::bsdf::TransportMode;
 use crate::light::LightHit;
 use crate::medium::{Fluorophore, Medium, OpticsAtLanes, PhaseFunction};
@@ -736,29 +736,18 @@ impl PathTracer {
         counters: &mut PathCounters,
     ) -> SampledSpectrum {
         let zero = SampledSpectrum::splat(0.0);
-        let lights = &scene.lights;
-        let Some((l, pmf)) = lights.sample(u_choice) else {
-            return zero;
-        };
-        let ctx = vertex.light_context();
-        let Some(ls) = lights
-            .light(l)
-            .sample_li_cached(l, &ctx, u, wavelengths, le_cache)
+        let Some(VertexLightSample {
+            sample: ls,
+            pmf,
+            eval,
+            normal,
+        }) = vertex.sample_light(scene, u_choice, u, wavelengths, le_cache)
         else {
             return zero;
         };
-        if ls.pdf <= 0.0 || ls.radiance.is_black() {
-            return zero;
-        }
-        let Some(eval) = vertex.eval(ls.wi, TransportMode::Radiance) else {
-            return zero;
-        };
-        if eval.f_cos.is_black() {
-            return zero;
-        }
         let scatter_pdf = vertex.pdf(&eval, TransportMode::Radiance);
         let start_medium = match instance {
-            Some(id) => media.after_surface(medium, id, ls.wi, ctx.n),
+            Some(id) => media.after_surface(medium, id, ls.wi, normal),
             None => medium,
         };
         counters.rays += 1;

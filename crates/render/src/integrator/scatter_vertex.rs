@@ -13,7 +13,11 @@ use prism_geometry::{Frame, SurfaceInteraction};
 use prism_spectrum::SampledSpectrum;
 
 use crate::bsdf::{Bsdf, TransportMode};
-use crate::light::LightSampleContext;
+use crate::light::{LightSample, LightSampleContext};
+use crate::scene_build::RenderScene;
+use crate::spectrum_cache::SpectrumCache;
+
+use super::lane_wavelengths::LaneWavelengths;
 use crate::medium::PhaseFunction;
 
 /// A surface vertex: the hit, its BSDF and shading frame.
@@ -111,7 +115,51 @@ impl<'a> SurfaceVertex<'a> {
     }
 }
 
+/// A light sample seen from a vertex, before its shadow ray: what next-event estimation
+/// (`medium_transport`, the photon camera path) weights and traces.
+pub(crate) struct VertexLightSample {
+    pub sample: LightSample,
+    /// Probability of having chosen the light.
+    pub pmf: f32,
+    /// The vertex's f · cos towards the light.
+    pub eval: ScatterEval,
+    /// The vertex's geometric normal (zero in a medium), for the shadow ray's start.
+    pub normal: Vec3A,
+}
+
 impl ScatterVertex<'_> {
+    /// Chooses a light with `u_choice`, samples it with `u` (radiance from `le_cache` where
+    /// uniform) and evaluates this vertex towards it; `None` where a step yields nothing (no
+    /// light, a zero pdf or radiance, a zero f · cos).
+    pub(crate) fn sample_light(
+        &self,
+        scene: &RenderScene,
+        u_choice: f32,
+        u: Vec2,
+        wavelengths: &LaneWavelengths,
+        le_cache: &mut SpectrumCache,
+    ) -> Option<VertexLightSample> {
+        let lights = &scene.lights;
+        let (l, pmf) = lights.sample(u_choice)?;
+        let ctx = self.light_context();
+        let sample = lights
+            .light(l)
+            .sample_li_cached(l, &ctx, u, wavelengths, le_cache)?;
+        if sample.pdf <= 0.0 || sample.radiance.is_black() {
+            return None;
+        }
+        let eval = self.eval(sample.wi, TransportMode::Radiance)?;
+        if eval.f_cos.is_black() {
+            return None;
+        }
+        Some(VertexLightSample {
+            sample,
+            pmf,
+            eval,
+            normal: ctx.n,
+        })
+    }
+
     /// Position, metres (world).
     #[inline(always)]
     pub fn p(&self) -> Vec3A {

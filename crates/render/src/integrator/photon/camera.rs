@@ -27,9 +27,9 @@ use crate::integrator::dimensions::MediumDimensions;
 use crate::integrator::lane_wavelengths::LaneWavelengths;
 use crate::integrator::medium_transport::MediumRng;
 use crate::integrator::path_state::PathState;
-use crate::integrator::scatter_vertex::{ScatterVertex, SurfaceVertex};
+use crate::integrator::scatter_vertex::{ScatterVertex, SurfaceVertex, VertexLightSample};
 use crate::integrator::{mis_weight, FirstHit, PathCounters, PathTracer};
-use crate::light::{LightHit, LightSampleContext};
+use crate::light::LightHit;
 use crate::sampler::SampleStream;
 use crate::scene_build::RenderScene;
 use crate::spectrum_cache::SpectrumCache;
@@ -461,30 +461,19 @@ impl CameraPaths<'_> {
         counters: &mut PathCounters,
     ) -> SampledSpectrum {
         let zero = SampledSpectrum::splat(0.0);
-        let lights = &scene.lights;
-        let Some((l, pmf)) = lights.sample(u_choice) else {
-            return zero;
-        };
-        let ctx: LightSampleContext = vertex.light_context();
-        let Some(ls) = lights
-            .light(l)
-            .sample_li_cached(l, &ctx, u, wavelengths, le_cache)
+        let Some(VertexLightSample {
+            sample: ls,
+            pmf,
+            eval,
+            normal,
+        }) = vertex.sample_light(scene, u_choice, u, wavelengths, le_cache)
         else {
             return zero;
         };
-        if ls.pdf <= 0.0 || ls.radiance.is_black() {
-            return zero;
-        }
-        let Some(eval) = vertex.eval(ls.wi, TransportMode::Radiance) else {
-            return zero;
-        };
-        if eval.f_cos.is_black() {
-            return zero;
-        }
         counters.rays += 1;
         let transmittance = match (scene.media.as_ref(), rng) {
             (Some(media), Some(rng)) => {
-                let start = media.after_surface(medium, instance, ls.wi, ctx.n);
+                let start = media.after_surface(medium, instance, ls.wi, normal);
                 shadow_transmittance(
                     scene,
                     media,
