@@ -229,13 +229,33 @@ fn merged_ranges_equal_the_whole_render() {
 }
 
 /// `photon_progressive` (per-pixel SPPM statistics, Hachisuka & Jensen 2009) on the
-/// caustic under a glass sphere in thin fog: the part 2..4 replays the statistics of
-/// passes 0 and 1 (and says so), so the parts 0..2 and 2..4 merge into the 0..4 render
-/// bit for bit.
+/// caustic under a glass sphere in thin fog, on a plain and on an image-textured floor (the
+/// camera rays' differentials follow the whole render's pass count in every part): the
+/// part 2..4 replays the statistics of passes 0 and 1 (and says so), so the parts 0..2 and
+/// 2..4 merge into the 0..4 render bit for bit.
 #[test]
 fn photon_progressive_ranges_replay_the_passes_before_and_merge_exactly() {
+    for textured in [false, true] {
+        photon_progressive_ranges_merge_exactly(textured);
+    }
+}
+
+fn photon_progressive_ranges_merge_exactly(textured: bool) {
     let dir = tempfile::tempdir().unwrap();
     let file = photon_progressive_scene(dir.path());
+    if textured {
+        let text = std::fs::read_to_string(&file).unwrap();
+        let bricks = scene("textures/bricks-albedo.png");
+        let edited = text.replace(
+            r#""floor": {"type": "lambert", "reflectance": 0.7},"#,
+            &format!(
+                r#""floor": {{"type": "lambert", "reflectance": {{"texture": {{"type": "image", "file": "{}", "uv_scale": [8, 8]}}}}}},"#,
+                bricks.display()
+            ),
+        );
+        assert_ne!(edited, text, "the floor's line changed");
+        std::fs::write(&file, edited).unwrap();
+    }
     let extra = PHOTON_EXTRA;
     let whole = render_whole(&file, dir.path(), &extra);
     let mut parts = Vec::new();

@@ -400,6 +400,13 @@ impl Geometry {
         &self.instances
     }
 
+    /// World-space bounds (min, max) of instance `instance_id`, metres; `None` for an empty
+    /// mesh or an unknown id.
+    pub fn instance_world_bounds(&self, instance_id: u32) -> Option<(Vec3A, Vec3A)> {
+        let inst = self.instances.get(instance_id as usize)?;
+        instance_bounds(inst, &self.meshes)
+    }
+
     /// Number of distinct meshes stored (instances share them).
     pub fn mesh_count(&self) -> usize {
         self.meshes.len()

@@ -664,11 +664,19 @@ fn photon_explain(m: &crate::integrator::PhotonMapper, scene: &RenderScene) -> (
         format!(
             "{}, max_depth {}: {} photons per pass (one pass per sample index), {radius}; \
              caustic map on surfaces, beam estimate in media; photon storage ≤ {:.1} MiB \
-             per pass ({limit})",
+             per pass{} ({limit})",
             m.name(),
             m.max_depth,
             plan.photons_per_pass,
-            mib(plan.estimate_bytes)
+            mib(plan.estimate_bytes - plan.statistics_bytes),
+            if plan.statistics_bytes > 0 {
+                format!(
+                    " and {:.1} MiB of per-pixel statistics",
+                    mib(plan.statistics_bytes)
+                )
+            } else {
+                String::new()
+            }
         ),
         "the scene's `integrator` section (defaults: one photon per pixel, radius from the \
          scene bounds and the pixel footprint, α 2/3)"

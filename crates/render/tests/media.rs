@@ -9,7 +9,7 @@ use prism_render::{render, FilmImage, RenderScene, RenderSettings};
 use prism_spectrum::data::{cmfs, Observer};
 
 mod support;
-use support::Dir;
+use support::{vol_bytes, Dir};
 
 fn render_scene(scene: &RenderScene, spp: u32, seed: u64) -> FilmImage {
     let settings = RenderSettings {
@@ -74,24 +74,6 @@ fn spectrum_csv(points: &[(f64, f64)]) -> (String, impl Fn(f64) -> f64 + '_) {
         points[points.len() - 1].1
     };
     (text, f)
-}
-
-/// A Mitsuba `.vol` (version 3, float32, 1 channel) of `values` (x fastest) over the box.
-fn vol_bytes(res: [i32; 3], min: [f32; 3], max: [f32; 3], values: &[f32]) -> Vec<u8> {
-    let mut b = b"VOL".to_vec();
-    b.push(3);
-    b.extend_from_slice(&1i32.to_le_bytes());
-    for r in res {
-        b.extend_from_slice(&r.to_le_bytes());
-    }
-    b.extend_from_slice(&1i32.to_le_bytes());
-    for x in min.iter().chain(max.iter()) {
-        b.extend_from_slice(&x.to_le_bytes());
-    }
-    for v in values {
-        b.extend_from_slice(&v.to_le_bytes());
-    }
-    b
 }
 
 const SLAB_D_M: f64 = 0.5;

@@ -46,6 +46,14 @@ impl Pass<'_> {
             .unwrap_or(self.plan)
             .camera_samples(pixel)
     }
+
+    /// The factor a camera ray's differentials are scaled by in `pixel`: several samples
+    /// share the pixel, each one's differential covers a fraction of it (pbrt-v4
+    /// `GetCameraSample`/`ScaleDifferentials`: max(1/8, 1/√spp) of `footprint_samples`).
+    #[inline]
+    pub fn differential_scale(&self, pixel: UVec2) -> f32 {
+        (1.0 / (self.footprint_samples(pixel).max(1) as f32).sqrt()).max(0.125)
+    }
 }
 
 /// One work item: the camera samples of a tile that the item renders.

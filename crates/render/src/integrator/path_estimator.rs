@@ -73,12 +73,9 @@ impl Estimator for PathTracer {
             for pixel in tile.bounds().pixels() {
                 let light_samples = work.light_samples(pixel);
                 let samples = work.samples_of(pixel);
-                // Several samples share the pixel: each one's differential covers a
-                // fraction of it (pbrt-v4 `GetCameraSample`/`ScaleDifferentials`:
-                // max(1/8, 1/√spp)); a progressive pass scales by its own sample count, a
-                // range of a render by the render's (`Pass::footprint_samples`).
-                let count = pass.footprint_samples(pixel);
-                let differential_scale = (1.0 / (count.max(1) as f32).sqrt()).max(0.125);
+                // A progressive pass scales by its own sample count, a range of a render
+                // by the render's (`Pass::footprint_samples`).
+                let differential_scale = pass.differential_scale(pixel);
                 for s in samples {
                     let mut cs = CameraSample::start(tile, work, pixel, s);
                     let mut wavelengths = LaneWavelengths::new(SampledWavelengths::sample_visible(

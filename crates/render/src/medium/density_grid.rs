@@ -153,6 +153,11 @@ impl DensityGrid {
         self.resolution
     }
 
+    /// The grid's box (min, max), metres: the density is 0 outside it.
+    pub fn bounds_m(&self) -> (Vec3A, Vec3A) {
+        (self.bounds_min_m, self.bounds_min_m + self.extent_m)
+    }
+
     /// The largest density anywhere (the max voxel).
     pub fn max_density(&self) -> f32 {
         self.values.iter().copied().fold(0.0, f32::max)

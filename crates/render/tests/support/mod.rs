@@ -43,3 +43,22 @@ impl Drop for Dir {
         let _ = std::fs::remove_dir_all(&self.0);
     }
 }
+
+/// A Mitsuba `.vol` (version 3, float32, 1 channel) of `values` (x fastest) over the box.
+#[allow(dead_code)] // not every test binary that shares this module writes grids
+pub fn vol_bytes(res: [i32; 3], min: [f32; 3], max: [f32; 3], values: &[f32]) -> Vec<u8> {
+    let mut b = b"VOL".to_vec();
+    b.push(3);
+    b.extend_from_slice(&1i32.to_le_bytes());
+    for r in res {
+        b.extend_from_slice(&r.to_le_bytes());
+    }
+    b.extend_from_slice(&1i32.to_le_bytes());
+    for x in min.iter().chain(max.iter()) {
+        b.extend_from_slice(&x.to_le_bytes());
+    }
+    for v in values {
+        b.extend_from_slice(&v.to_le_bytes());
+    }
+    b
+}

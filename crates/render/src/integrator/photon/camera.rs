@@ -17,12 +17,13 @@
 //! only if d + k ≤ max_depth (d + 1 + k at a surface, which scatters once more).
 
 use glam::Vec3A;
-use prism_geometry::Ray;
+use prism_geometry::{Ray, RayDifferential};
 use prism_spectrum::{SampledSpectrum, SampledWavelengths};
 
 use super::medium_flight::{segment_transmittance, shadow_transmittance, Transmittance};
 use super::photon_map::{Photon, PhotonTree};
 use crate::bsdf::TransportMode;
+use crate::integrator::camera_sample::CameraSample;
 use crate::integrator::dimensions::MediumDimensions;
 use crate::integrator::lane_wavelengths::LaneWavelengths;
 use crate::integrator::medium_transport::MediumRng;
@@ -99,6 +100,40 @@ pub struct CausticGather {
     pub count_only: bool,
 }
 
+/// Whether the camera path left its first non-specular vertex by a non-Dirac lobe and has
+/// met specular vertices only since (at least one): emission it meets now, on a surface or
+/// in a medium, is light of L S⁺ D paths, which the caustic map gave.
+#[inline]
+fn after_specular_chain(after_first_diffuse: bool, specular_chain: bool, count: u32) -> bool {
+    after_first_diffuse && specular_chain && count > 0
+}
+
+/// A pass's camera ray, with its differentials (scaled for the pixel's samples) where
+/// the scene filters textures: the camera path's first hits are filtered over the ray's
+/// footprint, as `path`'s (later hits over the camera footprint approximation).
+pub struct CameraRay {
+    pub ray: Ray,
+    pub differential: Option<RayDifferential>,
+}
+
+/// The camera ray of sample `cs`; differentials only where textures read them (the ray
+/// itself has the same bits either way).
+pub fn camera_ray(scene: &RenderScene, cs: &CameraSample, scale: f32) -> Option<CameraRay> {
+    if scene.texture_footprint.is_none() {
+        let ray = scene.camera.generate_ray_only(cs.film_point, cs.lens)?;
+        return Some(CameraRay {
+            ray,
+            differential: None,
+        });
+    }
+    let mut differential = scene.camera.generate_ray(cs.film_point, cs.lens)?;
+    differential.scale_differentials(scale);
+    Some(CameraRay {
+        ray: differential.ray,
+        differential: Some(differential),
+    })
+}
+
 /// The camera-path tracer of a pass.
 pub struct CameraPaths<'a> {
     pub tracer: PathTracer,
@@ -106,11 +141,14 @@ pub struct CameraPaths<'a> {
 }
 
 impl CameraPaths<'_> {
-    /// Radiance along `camera_ray`; the first surface hit for the film's AOVs.
+    /// Radiance along `camera_ray` (its differentials scaled by `differential_scale`);
+    /// the first surface hit for the film's AOVs.
+    #[allow(clippy::too_many_arguments)]
     pub fn radiance(
         &self,
         scene: &RenderScene,
-        camera_ray: &Ray,
+        camera_ray: &CameraRay,
+        differential_scale: f32,
         wavelengths: &mut LaneWavelengths,
         stream: &mut SampleStream,
         gather: &mut CausticGather,
@@ -123,10 +161,11 @@ impl CameraPaths<'_> {
             all_lanes: SampledSpectrum::splat(0.0),
             hero_photons: SampledSpectrum::splat(0.0),
         };
-        let mut path = PathState::new(camera_ray.origin, None, *stream, *wavelengths);
+        let mut path = PathState::new(camera_ray.ray.origin, None, *stream, *wavelengths);
+        let mut current_differential = camera_ray.differential;
         let mut medium = media.and_then(|m| m.camera);
         let mut first_hit = None;
-        let mut ray = *camera_ray;
+        let mut ray = camera_ray.ray;
         let mut le_cache = SpectrumCache::new();
         let mut reflectance_cache = SpectrumCache::new();
         let mut steps = Vec::new();
@@ -148,29 +187,39 @@ impl CameraPaths<'_> {
                     let optics = med.optics().at(path.wavelengths.transport());
                     let t_end = hit.map_or(f32::INFINITY, |h| h.t);
                     let segment = Ray::new(ray.origin, ray.direction, 0.0, t_end);
-                    let (profile, end) =
-                        segment_transmittance(med, &optics, &segment, &mut steps, &mut r);
+                    let crossed = segment_transmittance(med, &optics, &segment, &mut steps, &mut r);
                     if path.depth < max_depth && !gather.count_only {
                         self.beam(
                             &segment,
                             m,
                             &med.optics().phase,
-                            &profile,
+                            &crossed.transmittance,
                             path.beta,
                             max_depth - path.depth,
                             &mut sum,
                             counters,
                         );
+                        // The medium's own emission, as `path` takes it at its collisions
+                        // (depth < max_depth), unless the caustic map holds it (D S⁺ then
+                        // the medium: photons that emissive media shoot).
+                        if !after_specular_chain(
+                            after_first_diffuse,
+                            specular_chain,
+                            chain_specular_count,
+                        ) {
+                            sum.add(path.beta * crossed.emitted, counters);
+                        }
                     }
-                    path.beta *= end;
+                    path.beta *= crossed.end;
                     if path.beta.is_black() {
                         break;
                     }
                 }
                 rng = Some(r);
             }
-            let skip_emission = (after_first_diffuse && specular_chain && chain_specular_count > 0)
-                || gather.count_only;
+            let skip_emission =
+                after_specular_chain(after_first_diffuse, specular_chain, chain_specular_count)
+                    || gather.count_only;
             let Some(hit) = hit else {
                 if !skip_emission {
                     let (d, prev) = (ray.direction, &path.prev_ctx);
@@ -188,6 +237,11 @@ impl CameraPaths<'_> {
                 break;
             };
             let mut si = scene.geometry.shading_interaction(&ray, &hit);
+            scene.set_texture_differentials(
+                &mut si,
+                current_differential.as_ref(),
+                differential_scale,
+            );
             if let Some(media) = media {
                 // The boundary's own word for the side the ray arrives from (as `path`).
                 if media.arrives_mismatched(medium, hit.instance_id, ray.direction, si.n_geometric)
@@ -354,6 +408,7 @@ impl CameraPaths<'_> {
                 medium = media.after_surface(medium, hit.instance_id, wi, si.n_geometric);
             }
             ray = Ray::spawn_off_surface(vertex.p(), si.n_geometric, wi);
+            current_differential = None;
             counters.rays += 1;
             let stream = path.stream;
             if path.roulette(self.tracer.rr_depth, || stream.get_1d_at(dims.roulette())) {

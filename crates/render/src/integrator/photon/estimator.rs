@@ -13,7 +13,8 @@
 //! that starts later replays the statistics of the passes before it (`replay`).
 //! `prism render --spp N` is N photon passes.
 
-use super::camera::{pass_wavelengths, CameraPaths, CausticGather, PhotonMaps};
+use super::camera::{camera_ray, pass_wavelengths, CameraPaths, CausticGather, PhotonMaps};
+use super::medium_sources::PhotonSources;
 use super::photon_map::PhotonTree;
 use super::replay::replay_pass;
 use super::settings::{PhotonMapper, PhotonPlan};
@@ -33,6 +34,8 @@ use crate::scene_build::{RenderScene, SceneBuildError};
 pub struct PhotonEstimator {
     pub mapper: PhotonMapper,
     plan: Option<PhotonPlan>,
+    /// The lights and emissive media photons start from.
+    sources: Option<PhotonSources>,
     maps: PhotonMaps,
     /// The pass (sample index) the maps are for.
     iteration: Option<u32>,
@@ -51,6 +54,7 @@ impl PhotonEstimator {
         Self {
             mapper,
             plan: None,
+            sources: None,
             maps: PhotonMaps::default(),
             iteration: None,
             wavelengths: prism_spectrum::SampledWavelengths::sample_visible(0.5),
@@ -89,6 +93,7 @@ impl PhotonEstimator {
         scene: &RenderScene,
         pass: &Pass,
         plan: &PhotonPlan,
+        sources: &PhotonSources,
         iteration: u32,
     ) {
         let Some(alpha) = plan.alpha else {
@@ -109,7 +114,7 @@ impl PhotonEstimator {
         let tracer = self.tracer();
         if let Some(stats) = &mut self.sppm {
             while stats.pass() < iteration {
-                replay_pass(scene, pass, plan, tracer, stats, stats.pass());
+                replay_pass(scene, pass, plan, sources, tracer, stats, stats.pass());
                 stats.advance();
             }
         }
@@ -120,13 +125,17 @@ impl PhotonEstimator {
 pub fn refusal(mapper: &PhotonMapper, scene: &RenderScene) -> Option<SceneBuildError> {
     let file = &scene.file;
     let name = mapper.name();
-    if scene.lights.is_empty() {
+    let sources = match PhotonSources::build(scene) {
+        Ok(s) => s,
+        Err(e) => return Some(e),
+    };
+    if sources.is_empty(scene) {
         return Some(SceneBuildError::new(
             file,
             "integrator",
             format!(
-                "`{name}` shoots photons from the lights, and the scene has none (add a \
-                 `lights` entry)"
+                "`{name}` shoots photons from the lights and emissive media, and the scene \
+                 has neither (add a `lights` entry)"
             ),
         ));
     }
@@ -143,20 +152,16 @@ pub fn refusal(mapper: &PhotonMapper, scene: &RenderScene) -> Option<SceneBuildE
     if let Some(media) = &scene.media {
         for (m, medium) in media.media.iter().enumerate() {
             let optics = medium.optics();
-            let what = if optics.fluorescence.is_some() {
-                "re-radiates (a fluorophore)"
-            } else if optics.emission.is_some() {
-                "emits light (`emission`)"
-            } else {
+            if optics.fluorescence.is_none() {
                 continue;
-            };
+            }
             let medium_name = &media.names[m];
             return Some(SceneBuildError::new(
                 file,
                 format!("media.{medium_name}"),
                 format!(
-                    "medium '{medium_name}' {what}: `{name}` shoots photons from lights only \
-                     and does not trace that; use path"
+                    "medium '{medium_name}' re-radiates (a fluorophore): `{name}` carries one \
+                     wavelength set per pass and does not shift it; use path"
                 ),
             ));
         }
@@ -170,9 +175,13 @@ impl Estimator for PhotonEstimator {
     }
 
     fn prepare(&mut self, scene: &RenderScene, pass: &Pass) -> Result<(), String> {
-        if let Some(reason) = refusal(&self.mapper, scene) {
-            return Err(reason.to_string());
+        if self.sources.is_none() {
+            if let Some(reason) = refusal(&self.mapper, scene) {
+                return Err(reason.to_string());
+            }
+            self.sources = Some(PhotonSources::build(scene).map_err(|e| e.to_string())?);
         }
+        let sources = self.sources.clone().unwrap_or_default();
         let plan = match self.plan {
             Some(p) => p,
             None => {
@@ -187,7 +196,7 @@ impl Estimator for PhotonEstimator {
         if self.iteration == Some(iteration) {
             return Ok(());
         }
-        self.advance_statistics(scene, pass, &plan, iteration);
+        self.advance_statistics(scene, pass, &plan, &sources, iteration);
         // Drop the last pass's photons before the next are shot.
         self.maps = PhotonMaps::default();
         self.wavelengths = pass_wavelengths(pass.settings.seed, iteration);
@@ -196,6 +205,7 @@ impl Estimator for PhotonEstimator {
         let radius_m = radius.1.sqrt() as f32;
         let shot = shoot(
             scene,
+            &sources,
             &self.wavelengths,
             plan.photons_per_pass,
             pass.settings.seed,
@@ -258,19 +268,18 @@ impl Estimator for PhotonEstimator {
                     found: 0,
                     count_only: false,
                 };
-                let result = scene
-                    .camera
-                    .generate_ray_only(cs.film_point, cs.lens)
-                    .map(|ray| {
-                        paths.radiance(
-                            scene,
-                            &ray,
-                            &mut wavelengths,
-                            &mut cs.stream,
-                            &mut gather,
-                            &mut counters,
-                        )
-                    });
+                let scale = work.pass.differential_scale(pixel);
+                let result = camera_ray(scene, &cs, scale).map(|ray| {
+                    paths.radiance(
+                        scene,
+                        &ray,
+                        scale,
+                        &mut wavelengths,
+                        &mut cs.stream,
+                        &mut gather,
+                        &mut counters,
+                    )
+                });
                 if let Some(stats) = &self.sppm {
                     stats.record(pixel, gather.found);
                 }

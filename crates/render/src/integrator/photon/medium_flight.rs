@@ -113,15 +113,32 @@ impl Transmittance<'_> {
     }
 }
 
-/// The transmittance of `ray` (unit direction) over [t_min, t_max] through `medium`:
-/// (the profile, T at the end). `steps` is the buffer a grid's ratio tracking fills.
+/// What a camera segment through a medium carries.
+pub struct Segment<'a> {
+    /// T from the segment's start to any point on it.
+    pub transmittance: Transmittance<'a>,
+    /// T at the segment's end.
+    pub end: SampledSpectrum,
+    /// The radiance the medium emits towards the segment's start, ∫ T(t) σa(t) Le dt (0
+    /// where it does not emit).
+    pub emitted: SampledSpectrum,
+}
+
+/// The transmittance of `ray` (unit direction) over [t_min, t_max] through `medium`, and
+/// what the medium emits along it. `steps` is the buffer a grid's ratio tracking fills.
+///
+/// Emission: in a homogeneous medium the closed form σa·Le·(1 − e^(−σt·L))/σt; in a grid,
+/// each ratio-tracking collision t_i (a Poisson process of rate σ̄) adds
+/// T̂(t_i⁻)·σa·d(t_i)·Le/σ̄ — by Campbell's theorem the sum's mean is ∫ T σa d Le dt, since the
+/// running product before t_i estimates T(t_i) without bias (Novák et al. 2014).
 pub fn segment_transmittance<'a>(
     medium: &Medium,
     optics: &OpticsAtLanes,
     ray: &Ray,
     steps: &'a mut Vec<(f32, SampledSpectrum)>,
     rng: &mut MediumRng,
-) -> (Transmittance<'a>, SampledSpectrum) {
+) -> Segment<'a> {
+    let emits = !optics.emission.is_black();
     match medium {
         Medium::Homogeneous(_) => {
             let length = ray.t_max - ray.t_min;
@@ -132,17 +149,31 @@ pub fn segment_transmittance<'a>(
             } else {
                 SampledSpectrum::splat(1.0)
             };
-            (
-                Transmittance::Homogeneous {
+            let mut emitted = SampledSpectrum::splat(0.0);
+            if emits {
+                for lane in 0..4 {
+                    let sigma_t = optics.sigma_t[lane];
+                    // σt = 0 means σa = 0 (σt = σa + σs): nothing is emitted.
+                    if sigma_t > 0.0 {
+                        emitted[lane] =
+                            optics.sigma_a[lane] * optics.emission[lane] * (1.0 - end[lane])
+                                / sigma_t;
+                    }
+                }
+            }
+            Segment {
+                transmittance: Transmittance::Homogeneous {
                     sigma_t: optics.sigma_t,
                     t0: ray.t_min,
                 },
                 end,
-            )
+                emitted,
+            }
         }
         Medium::Grid(_) => {
             steps.clear();
             let mut tr = SampledSpectrum::splat(1.0);
+            let mut emitted = SampledSpectrum::splat(0.0);
             let sigma_t_max = optics.sigma_t.max_component();
             'stretches: for stretch in medium.stretches(ray) {
                 let sigma_bar = sigma_t_max * stretch.density_bound;
@@ -156,6 +187,9 @@ pub fn segment_transmittance<'a>(
                         break;
                     }
                     let density = medium.density(ray.origin + ray.direction * t);
+                    if emits {
+                        emitted += tr * optics.sigma_a * optics.emission * (density / sigma_bar);
+                    }
                     let sigma_n =
                         (SampledSpectrum::splat(sigma_bar) - optics.sigma_t * density).clamp_zero();
                     tr *= sigma_n * (1.0 / sigma_bar);
@@ -165,7 +199,11 @@ pub fn segment_transmittance<'a>(
                     }
                 }
             }
-            (Transmittance::Steps(steps), tr)
+            Segment {
+                transmittance: Transmittance::Steps(steps),
+                end: tr,
+                emitted,
+            }
         }
     }
 }
@@ -225,8 +263,7 @@ pub fn shadow_transmittance(
             );
             let med = media.medium(m);
             let optics = med.optics().at(wavelengths);
-            let (_, end) = segment_transmittance(med, &optics, &segment, &mut steps, rng);
-            tr *= end;
+            tr *= segment_transmittance(med, &optics, &segment, &mut steps, rng).end;
         }
         if tr.is_black() {
             return zero;

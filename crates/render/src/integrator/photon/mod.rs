@@ -18,6 +18,7 @@
 mod camera;
 mod estimator;
 mod medium_flight;
+mod medium_sources;
 mod photon_map;
 mod replay;
 mod settings;

@@ -12,7 +12,8 @@
 use glam::UVec2;
 use rayon::prelude::*;
 
-use super::camera::{pass_wavelengths, CameraPaths, CausticGather, PhotonMaps};
+use super::camera::{camera_ray, pass_wavelengths, CameraPaths, CausticGather, PhotonMaps};
+use super::medium_sources::PhotonSources;
 use super::photon_map::PhotonTree;
 use super::settings::PhotonPlan;
 use super::shoot::shoot;
@@ -35,6 +36,7 @@ pub fn replay_pass(
     scene: &RenderScene,
     pass: &Pass,
     plan: &PhotonPlan,
+    sources: &PhotonSources,
     tracer: PathTracer,
     stats: &SppmStatistics,
     iteration: u32,
@@ -46,6 +48,7 @@ pub fn replay_pass(
     let radius_m = r2.sqrt() as f32;
     let shot = shoot(
         scene,
+        sources,
         &wavelengths,
         plan.photons_per_pass,
         seed,
@@ -104,10 +107,12 @@ pub fn replay_pass(
                     found: 0,
                     count_only: true,
                 };
-                if let Some(ray) = scene.camera.generate_ray_only(cs.film_point, cs.lens) {
+                let scale = pass.differential_scale(pixel);
+                if let Some(ray) = camera_ray(scene, &cs, scale) {
                     let _ = paths.radiance(
                         scene,
                         &ray,
+                        scale,
                         &mut lanes,
                         &mut cs.stream,
                         &mut gather,

@@ -5,6 +5,7 @@
 //! memory limit.
 
 use super::photon_map::TREE_BYTES_PER_PHOTON;
+use super::sppm::SppmStatistics;
 use crate::scene_build::{RenderScene, SceneBuildError};
 
 /// How the gather radius is chosen.
@@ -45,8 +46,12 @@ pub struct PhotonPlan {
     pub alpha: Option<f32>,
     /// k-NN radius: k.
     pub nearest: Option<u32>,
-    /// Upper bound of one pass's photon storage, bytes.
+    /// Upper bound of the photon integrator's own memory, bytes: one pass's photon
+    /// storage plus, when progressive, the per-pixel statistics (`statistics_bytes`).
     pub estimate_bytes: u64,
+    /// Of `estimate_bytes`: photon_progressive's per-pixel radius and count, kept for the
+    /// whole render (0 otherwise).
+    pub statistics_bytes: u64,
     /// The limit it was checked against, bytes (`None`: none known).
     pub limit_bytes: Option<u64>,
 }
@@ -123,7 +128,13 @@ impl PhotonMapper {
         let radius_m = radius.unwrap_or_else(|| Self::default_radius_m(scene));
         let stored =
             u64::from(photons_per_pass) * stored_per_path(self.max_depth, scene.media.is_some());
-        let estimate_bytes = stored * TREE_BYTES_PER_PHOTON as u64;
+        let photon_bytes = stored * TREE_BYTES_PER_PHOTON as u64;
+        let statistics_bytes = if alpha.is_some() {
+            pixels * SppmStatistics::BYTES_PER_PIXEL
+        } else {
+            0
+        };
+        let estimate_bytes = photon_bytes + statistics_bytes;
         let limit_bytes = self.memory_limit_bytes.or_else(default_memory_limit_bytes);
         if let Some(limit) = limit_bytes {
             if estimate_bytes > limit {
@@ -132,11 +143,22 @@ impl PhotonMapper {
                     "integrator",
                     format!(
                         "`{}` with {photons_per_pass} photons per pass may store {stored} \
-                         photons, about {} MiB ({estimate_bytes} bytes), above the memory \
-                         limit of {} MiB ({limit} bytes): lower `photons_per_pass`",
+                         photons ({photon_bytes} bytes){}, about {} MiB ({estimate_bytes} \
+                         bytes) in all, above the memory limit of {} MiB ({limit} bytes): \
+                         lower `photons_per_pass`{}",
                         self.name(),
+                        if statistics_bytes > 0 {
+                            format!(" and keep {statistics_bytes} bytes of per-pixel statistics")
+                        } else {
+                            String::new()
+                        },
                         estimate_bytes.div_ceil(1 << 20),
                         limit / (1 << 20),
+                        if statistics_bytes > 0 {
+                            " or the resolution"
+                        } else {
+                            ""
+                        },
                     ),
                 ));
             }
@@ -147,6 +169,7 @@ impl PhotonMapper {
             alpha,
             nearest,
             estimate_bytes,
+            statistics_bytes,
             limit_bytes,
         })
     }
@@ -192,6 +215,7 @@ mod tests {
             alpha: Some(2.0 / 3.0),
             nearest: None,
             estimate_bytes: 0,
+            statistics_bytes: 0,
             limit_bytes: None,
         };
         assert_eq!(plan.radius_at(0), 0.1);

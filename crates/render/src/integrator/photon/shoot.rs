@@ -1,7 +1,8 @@
 //! Photon tracing for one pass (Jensen 1996 §2.1; pbrt-v4 `SPPMIntegrator`'s photon pass):
-//! each photon starts at a light chosen by power, from `Light::sample_le` (infinite lights
-//! from a disc over the scene's bounds), with flux β = Le·|cos θ|/(pmf·p_pos·p_dir·N) for N
-//! photons, and walks the scene at the pass's wavelengths (a dispersive surface keeps
+//! each photon starts at a source chosen by power — a light, from `Light::sample_le`
+//! (infinite lights from a disc over the scene's bounds), with flux
+//! β = Le·|cos θ|/(pmf·p_pos·p_dir·N) for N photons, or an emissive medium
+//! (`medium_sources`) — and walks the scene at the pass's wavelengths (a dispersive surface keeps
 //! only the hero, as in `path`):
 //!
 //! - a photon that reaches a non-specular surface after one or more specular bounces and
@@ -22,11 +23,13 @@ use prism_spectrum::{SampledSpectrum, SampledWavelengths};
 use rayon::prelude::*;
 
 use super::medium_flight::{medium_at_start, photon_flight, Flight};
+use super::medium_sources::{PhotonSources, Source};
 use super::photon_map::Photon;
 use crate::bsdf::TransportMode;
 use crate::integrator::lane_wavelengths::LaneWavelengths;
 use crate::integrator::medium_transport::MediumRng;
 use crate::integrator::scatter_vertex::{MediumVertex, ScatterVertex, SurfaceVertex};
+use crate::light::warp::sample_uniform_sphere;
 use crate::scene_build::RenderScene;
 use crate::spectrum_cache::SpectrumCache;
 
@@ -52,10 +55,13 @@ pub fn mix_seed(seed: u64, iteration: u32, index: u64) -> u64 {
     z ^ (z >> 31)
 }
 
-/// Traces `count` photons of pass `iteration` at `wavelengths` with gather radius
-/// `radius_m` (stored in each photon), paths of at most `max_depth` scattering events.
+/// Traces `count` photons of pass `iteration` at `wavelengths` from `sources` with gather
+/// radius `radius_m` (stored in each photon), paths of at most `max_depth` scattering
+/// events.
+#[allow(clippy::too_many_arguments)]
 pub fn shoot(
     scene: &RenderScene,
+    sources: &PhotonSources,
     wavelengths: &SampledWavelengths,
     count: u32,
     seed: u64,
@@ -78,6 +84,7 @@ pub fn shoot(
                     count,
                     max_depth,
                     radius_m,
+                    sources,
                     &mut rng,
                     &mut out,
                 );
@@ -135,6 +142,80 @@ fn average_r(r_u: SampledSpectrum, lanes: &LaneWavelengths) -> f32 {
     }
 }
 
+/// A photon as it leaves its source.
+struct PhotonStart {
+    beta: SampledSpectrum,
+    ray: Ray,
+    medium: Option<u32>,
+    depth: u32,
+}
+
+/// A photon from a source chosen by power: a light's `sample_le` (flux
+/// Le·|cos θ|/(pmf·p_pos·p_dir·N)), or a point of an emissive medium (`medium_sources`).
+fn start_photon(
+    scene: &RenderScene,
+    sources: &PhotonSources,
+    wavelengths: &SampledWavelengths,
+    count: u32,
+    rng: &mut MediumRng,
+    out: &mut ShotPhotons,
+) -> Option<PhotonStart> {
+    let lights = &scene.lights;
+    let media = scene.media.as_ref();
+    match sources.choose(rng.uniform()) {
+        Source::Lights { group_pmf, u_light } => {
+            let (l, light_pmf) = lights.sample(u_light)?;
+            let pmf = group_pmf * light_pmf;
+            let light = lights.light(l);
+            let (u_pos, u_dir) = (u2(rng), u2(rng));
+            let le = light.sample_le(lights.scene_sphere(), u_pos, u_dir, wavelengths)?;
+            if le.pdf_pos <= 0.0 || le.pdf_dir <= 0.0 || le.radiance.is_black() {
+                return None;
+            }
+            let cos = if le.n == glam::Vec3A::ZERO {
+                1.0
+            } else {
+                le.n.dot(le.ray.direction).abs()
+            };
+            let beta = le.radiance * (cos / (pmf * le.pdf_pos * le.pdf_dir * count as f32));
+            let medium = media.and_then(|m| {
+                out.rays += 1;
+                medium_at_start(scene, m, &le.ray)
+            });
+            Some(PhotonStart {
+                beta,
+                ray: le.ray,
+                medium,
+                depth: 0,
+            })
+        }
+        Source::Medium { index, pmf } => {
+            let media = media?;
+            let source = &sources.media[index];
+            let p = sources.point_in_box(index, [rng.uniform(), rng.uniform(), rng.uniform()]);
+            let ray = Ray::infinite(p, sample_uniform_sphere(u2(rng)));
+            out.rays += 1;
+            if medium_at_start(scene, media, &ray) != Some(source.medium) {
+                return None;
+            }
+            let medium = media.medium(source.medium);
+            let density = medium.density(p);
+            if density <= 0.0 {
+                return None;
+            }
+            let optics = medium.optics().at(wavelengths);
+            let scale =
+                density * source.volume_m3 * 4.0 * std::f32::consts::PI / (pmf * count as f32);
+            Some(PhotonStart {
+                beta: optics.sigma_a * optics.emission * scale,
+                ray,
+                medium: Some(source.medium),
+                depth: 1,
+            })
+        }
+    }
+}
+
 #[allow(clippy::too_many_arguments)]
 fn trace_photon(
     scene: &RenderScene,
@@ -142,37 +223,24 @@ fn trace_photon(
     count: u32,
     max_depth: u32,
     radius_m: f32,
+    sources: &PhotonSources,
     rng: &mut MediumRng,
     out: &mut ShotPhotons,
 ) {
-    let lights = &scene.lights;
-    let Some((l, pmf)) = lights.sample(rng.uniform()) else {
-        return;
-    };
-    let light = lights.light(l);
+    let media = scene.media.as_ref();
     let mut lanes = LaneWavelengths::new(*wavelengths);
-    let (u_pos, u_dir) = (u2(rng), u2(rng));
-    let Some(le) = light.sample_le(lights.scene_sphere(), u_pos, u_dir, wavelengths) else {
+    let Some(start) = start_photon(scene, sources, wavelengths, count, rng, out) else {
         return;
     };
-    if le.pdf_pos <= 0.0 || le.pdf_dir <= 0.0 || le.radiance.is_black() {
+    let (mut beta, mut ray, mut medium) = (start.beta, start.ray, start.medium);
+    let mut r_u = SampledSpectrum::splat(1.0);
+    // Scattering events so far (an emitting medium's emission counts as one: `path` adds
+    // medium emission only at depth < max_depth); a specular bounce was met and nothing
+    // non-specular.
+    let mut depth = start.depth;
+    if depth >= max_depth {
         return;
     }
-    let cos = if le.n == glam::Vec3A::ZERO {
-        1.0
-    } else {
-        le.n.dot(le.ray.direction).abs()
-    };
-    let mut beta = le.radiance * (cos / (pmf * le.pdf_pos * le.pdf_dir * count as f32));
-    let mut r_u = SampledSpectrum::splat(1.0);
-    let mut ray = le.ray;
-    let media = scene.media.as_ref();
-    let mut medium = media.and_then(|m| {
-        out.rays += 1;
-        medium_at_start(scene, m, &ray)
-    });
-    // Scattering events so far; a specular bounce was met and nothing non-specular.
-    let mut depth = 0u32;
     let mut caustic_chain = true;
     let mut had_specular = false;
     let mut null_events = 0u32;

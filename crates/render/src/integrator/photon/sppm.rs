@@ -70,6 +70,10 @@ pub struct SppmStatistics {
 }
 
 impl SppmStatistics {
+    /// Memory per pixel: its statistics and its count of the current pass's photons.
+    pub const BYTES_PER_PIXEL: u64 =
+        (std::mem::size_of::<PixelStatistics>() + std::mem::size_of::<AtomicU32>()) as u64;
+
     /// Pass 0's statistics: every pixel at `radius_m`, no photons.
     pub fn new(resolution: UVec2, radius_m: f32, alpha: f32) -> Self {
         let n = resolution.x as usize * resolution.y as usize;
