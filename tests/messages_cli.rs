@@ -364,3 +364,45 @@ fn a_light_shut_inside_a_closed_opaque_shape_is_warned_about() {
     let err = explain(dir.path(), "glass.json", &scene("glass"));
     assert!(!err.contains("warning"), "{err}");
 }
+
+/// An area light (a small glowing sphere, or a panel) inside a closed opaque box the camera
+/// is outside of is warned about like a point light; in a glass box, or with the camera in
+/// the box too, it is not.
+#[test]
+fn an_area_light_shut_inside_a_closed_opaque_shape_is_warned_about() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = |emitter: &str, box_material: &str, eye_z: f64| {
+        format!(
+            r#"{{"camera": {{"type": "pinhole", "fov_deg": 40,
+                            "transform": {{"look_at": {{"eye": [0, 0, {eye_z}], "target": [0, 0, -5]}}}}}},
+                "film": {{"resolution": [8, 8], "spp": 1}},
+                "materials": {{"white": {{"type": "lambert", "reflectance": 0.8}},
+                               "glass": {{"type": "dielectric", "ior": 1.5}}}},
+                "lights": [{{"type": "area", "shape": "lamp", "luminance_cd_m2": 1000}}],
+                "shapes": [{{"name": "box", "type": "cuboid", "size_m": [2, 2, 2],
+                             "material": "{box_material}",
+                             "transform": {{"translate": [0, 0, -5]}}}},
+                           {emitter}]}}"#
+        )
+    };
+    let sphere = r#"{"name": "lamp", "type": "sphere", "radius_m": 0.1, "material": "white",
+                     "transform": {"translate": [0, 0, -5]}}"#;
+    let panel = r#"{"name": "lamp", "type": "rectangle", "size_m": [0.5, 0.5], "material": "white",
+                    "transform": [{"rotate": {"axis": [1, 0, 0], "angle_deg": 90}},
+                                  {"translate": [0, 0.9, -5]}]}"#;
+    for (what, emitter) in [("sphere", sphere), ("panel", panel)] {
+        let err = explain(dir.path(), "shut.json", &scene(emitter, "white", 0.0));
+        assert!(
+            err.contains("shut.json: warning: lights[0] is inside shapes[0] (`box`)"),
+            "{what}: {err}"
+        );
+        let err = explain(dir.path(), "glass.json", &scene(emitter, "glass", 0.0));
+        assert!(!err.contains("warning"), "{what} in glass: {err}");
+        // The camera inside the box sees the lamp: nothing to warn about.
+        let err = explain(dir.path(), "inside.json", &scene(emitter, "white", -4.5));
+        assert!(
+            !err.contains("lights[0] is inside"),
+            "{what}, camera inside: {err}"
+        );
+    }
+}

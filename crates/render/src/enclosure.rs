@@ -1,7 +1,8 @@
 //! Scenes that render black without an error, found by tracing a few rays before the
 //! render: the camera inside a closed shape whose one-sided material faces away from it
-//! (it sees the back of every face, which reflects nothing), and a point-like light inside
-//! a closed opaque shape that the camera is outside of (nothing it emits can leave).
+//! (it sees the back of every face, which reflects nothing), and a light inside a closed
+//! opaque shape that the camera is outside of (nothing it emits can leave): a point-like
+//! light at its position, an area light at a few points just off its emitting surface.
 //!
 //! "Inside" is tested by parity: along each of [`DIRECTIONS`] fixed directions the ray is
 //! followed through every surface until it escapes, and a point is inside a shape when
@@ -119,6 +120,35 @@ fn opaque(material: &Material) -> bool {
     }
 }
 
+/// Points just off an area light's emitting surface: where `sample_le` starts light paths
+/// for a few fixed samples, moved a little along the emitted direction (so a point is
+/// outside the emitter's own surface and on the side light leaves from).
+fn emitting_points(scene: &RenderScene, instances: &std::ops::Range<u32>) -> Vec<Vec3A> {
+    let lights = &scene.lights;
+    let Some(l) = instances
+        .clone()
+        .find_map(|instance| lights.area_light_of_instance(instance))
+    else {
+        return Vec::new();
+    };
+    let light = lights.light(l);
+    let sphere = lights.scene_sphere();
+    let step_m = 1e-4 * sphere.radius_m.max(1e-3);
+    let wavelengths = prism_spectrum::SampledWavelengths::sample_visible(0.5);
+    [(0.1, 0.2), (0.6, 0.4), (0.35, 0.8), (0.85, 0.65)]
+        .iter()
+        .filter_map(|&(a, b)| {
+            let le = light.sample_le(
+                sphere,
+                glam::Vec2::new(a, b),
+                glam::Vec2::new(b, a),
+                &wavelengths,
+            )?;
+            Some(le.ray.origin + le.ray.direction * step_m)
+        })
+        .collect()
+}
+
 /// `shapes[i]` with its name, for messages.
 fn shape_path(description: &SceneDescription, i: usize) -> String {
     match description.shapes.get(i).and_then(|s| s.name.as_deref()) {
@@ -169,30 +199,45 @@ pub fn enclosure_warnings(scene: &RenderScene, description: &SceneDescription) -
     }
 
     for (i, light) in description.lights.iter().enumerate() {
-        let position = match &light.kind {
+        // The points light leaves from, and the light's own shape (not its enclosure).
+        let (points, own_shape) = match &light.kind {
             LightKind::Point { position_m }
             | LightKind::Spot { position_m, .. }
-            | LightKind::Luminaire { position_m, .. } => position_m.map(|v| v as f32),
-            // Directional and sky lights come from outside the scene; an area light is a
-            // surface (not a point to test), left out.
+            | LightKind::Luminaire { position_m, .. } => {
+                (vec![Vec3A::from(position_m.map(|v| v as f32))], None)
+            }
+            LightKind::Area { shape, .. } => {
+                (emitting_points(scene, &ranges[*shape]), Some(*shape))
+            }
+            // Directional and sky lights come from outside the scene.
             LightKind::Directional { .. }
-            | LightKind::Area { .. }
             | LightKind::Environment { .. }
             | LightKind::UniformSky
             | LightKind::Daylight(_) => continue,
         };
-        let rays = rays_from(geometry, &shape_of, Vec3A::from(position));
-        for s in enclosing(&rays, shapes) {
-            let shut = !camera_inside.contains(&s)
-                && all_of(&rays, s, &|c| opaque(scene.material(c.material_id)));
-            if shut {
-                warnings.push(format!(
-                    "lights[{i}] is inside {}, a closed opaque shape that the camera is outside \
-                     of: nothing it emits leaves the shape (move the light, or give the shape a \
-                     transmissive material)",
-                    shape_path(description, s)
-                ));
-            }
+        let rays: Vec<Vec<Vec<Crossing>>> = points
+            .iter()
+            .map(|&p| rays_from(geometry, &shape_of, p))
+            .collect();
+        let Some(first) = rays.first() else {
+            continue;
+        };
+        // Shut in: every point of the light is inside the same closed opaque shape.
+        let shut_in = enclosing(first, shapes).into_iter().filter(|&s| {
+            Some(s) != own_shape
+                && !camera_inside.contains(&s)
+                && rays.iter().all(|r| {
+                    enclosing(r, shapes).contains(&s)
+                        && all_of(r, s, &|c| opaque(scene.material(c.material_id)))
+                })
+        });
+        for s in shut_in {
+            warnings.push(format!(
+                "lights[{i}] is inside {}, a closed opaque shape that the camera is outside \
+                 of: nothing it emits leaves the shape (move the light, or give the shape a \
+                 transmissive material)",
+                shape_path(description, s)
+            ));
         }
     }
     warnings
