@@ -102,6 +102,13 @@ impl Image {
         &mut self.pixels
     }
 
+    /// Moves the pixels out, leaving the image without any (its size, colour space and
+    /// metadata stay): for a consumer that maps them in place and makes the result with
+    /// [`Image::with_pixels`]. The emptied image is only good for its metadata.
+    pub fn take_pixels(&mut self) -> Vec<[f32; 3]> {
+        std::mem::take(&mut self.pixels)
+    }
+
     pub fn into_pixels(self) -> Vec<[f32; 3]> {
         self.pixels
     }

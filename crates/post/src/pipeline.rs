@@ -288,27 +288,34 @@ pub fn tonemap_file(
         score: options.score,
         order: options.order,
     };
-    let (mut out, tone, failures, sheet_outside, scores) = match options.operator {
-        OperatorChoice::One(op) => {
-            match options.score {
-                Some(SheetScore::Tmqi) => {
-                    check_size(image.width(), image.height()).map_err(in_file)?
-                }
-                None => {}
-            }
+    // The input is not read after the operator: one operator maps it in place (no second
+    // image), and otherwise its memory goes back before the gamut mapping and the
+    // encoder's buffers are allocated (docs/reliability.md).
+    let (mut out, tone, failures, sheet_outside, scores) = match (options.operator, options.score) {
+        (OperatorChoice::One(op), None) => {
+            let result = op.apply_in_place(image, &params).map_err(in_file)?;
+            (
+                result.image,
+                vec![result.report],
+                Vec::new(),
+                None,
+                Vec::new(),
+            )
+        }
+        (OperatorChoice::One(op), Some(SheetScore::Tmqi)) => {
+            check_size(image.width(), image.height()).map_err(in_file)?;
             let result = op.apply(&image, &params).map_err(in_file)?;
-            let scores = match options.score {
-                Some(SheetScore::Tmqi) => vec![TileScore {
-                    operator: op.name(),
-                    tmqi: score_tmqi(&result.image, &image, &sheet_options).map_err(in_file)?,
-                }],
-                None => Vec::new(),
-            };
+            let scores = vec![TileScore {
+                operator: op.name(),
+                tmqi: score_tmqi(&result.image, &image, &sheet_options).map_err(in_file)?,
+            }];
+            drop(image);
             (result.image, vec![result.report], Vec::new(), None, scores)
         }
-        OperatorChoice::All => {
+        (OperatorChoice::All, _) => {
             let sheet = contact_sheet_scored(&image, &ToneOperator::ALL, &params, &sheet_options)
                 .map_err(in_file)?;
+            drop(image);
             (
                 sheet.image,
                 sheet.reports,
@@ -319,10 +326,6 @@ pub fn tonemap_file(
         }
     };
     let tone_ms = ms(t);
-    // The input is not read again: its memory goes back before the gamut mapping and the
-    // encoder's buffers are allocated (the peak is then the larger of input and output
-    // together, and output and encoder together; docs/reliability.md).
-    drop(image);
 
     let t = Instant::now();
     let out_space = out.color_space.clone();

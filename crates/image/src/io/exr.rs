@@ -431,6 +431,9 @@ pub(crate) fn write_exr_channels(
 /// with its name, `chromaticities` from the colour space, `prism:cd_m2_per_unit` (double)
 /// when the image has an absolute scale, and the metadata as text attributes.
 pub fn write_exr(path: &Path, image: &Image, options: &ExrWriteOptions) -> Result<()> {
+    if image.layers().is_empty() {
+        return write_rgb_exr(path, image, options);
+    }
     let (channels, attributes) = image_channels(path, image, options)?;
     write_exr_channels(
         path,
@@ -441,6 +444,50 @@ pub fn write_exr(path: &Path, image: &Image, options: &ExrWriteOptions) -> Resul
         attributes,
         options,
     )
+}
+
+/// [`write_exr`] of an image without layers: the encoder pulls `R`, `G`, `B` from the pixels
+/// block by block, so no planar copy of the image is made (`prism tonemap` writes its
+/// output within the memory of one image). The file holds what the general path writes.
+fn write_rgb_exr(path: &Path, image: &Image, options: &ExrWriteOptions) -> Result<()> {
+    let mut layer_attributes = LayerAttributes::default();
+    for (name, value) in image_attributes(path, image)? {
+        layer_attributes.other.insert(text(path, &name)?, value);
+    }
+    let (width, pixels) = (image.width(), image.pixels());
+    let rgb = move |pos: ::exr::math::Vec2<usize>| pixels[pos.y() * width + pos.x()];
+    macro_rules! write_layer {
+        ($channels:expr) => {{
+            let layer = ::exr::prelude::Layer::new(
+                (image.width(), image.height()),
+                layer_attributes,
+                encoding(options),
+                $channels,
+            );
+            let mut exr_image = ::exr::prelude::Image::from_layer(layer);
+            exr_image.attributes.chromaticities = Some(chromaticities_of(&image.color_space));
+            write_atomically(path, |tmp| {
+                exr_image
+                    .write()
+                    .to_file(tmp)
+                    .map_err(|e| exr_error(path, "write", e))
+            })
+        }};
+    }
+    match options.sample_type {
+        ExrSampleType::F32 => write_layer!(::exr::prelude::SpecificChannels::rgb(
+            move |pos: ::exr::math::Vec2<usize>| {
+                let [r, g, b] = rgb(pos);
+                (r, g, b)
+            }
+        )),
+        ExrSampleType::F16 => write_layer!(::exr::prelude::SpecificChannels::rgb(
+            move |pos: ::exr::math::Vec2<usize>| {
+                let [r, g, b] = rgb(pos);
+                (f16::from_f32(r), f16::from_f32(g), f16::from_f32(b))
+            }
+        )),
+    }
 }
 
 /// Channels and header attributes of `image` as [`write_exr`] writes them.
@@ -483,6 +530,11 @@ pub(crate) fn image_channels(
             channels.push((name, flat_samples(plane, options.sample_type)));
         }
     }
+    Ok((channels, image_attributes(path, image)?))
+}
+
+/// The header attributes of `image`: its absolute scale and its metadata as text.
+fn image_attributes(path: &Path, image: &Image) -> Result<Vec<(String, AttributeValue)>> {
     let mut attributes = Vec::new();
     if let Some(scale) = image.cd_m2_per_unit {
         attributes.push((
@@ -500,5 +552,75 @@ pub(crate) fn image_channels(
         }
         attributes.push((key.clone(), AttributeValue::Text(text(path, value)?)));
     }
-    Ok((channels, attributes))
+    Ok(attributes)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The layer-less writer (samples pulled from the pixels) writes what the general one
+    /// (planar copies) writes — the same pixels bit for bit, size, scale, metadata and
+    /// colour space — for every sample type and compression. (Not the same bytes: the
+    /// crate orders the header's custom attributes from a hash map.)
+    #[test]
+    fn rgb_writer_writes_what_the_general_writer_writes() {
+        let dir = tempfile::tempdir().unwrap();
+        let (w, h) = (37, 23);
+        let pixels: Vec<[f32; 3]> = (0..w * h)
+            .map(|i| {
+                let v = i as f32 * 0.37;
+                [
+                    v.sin().abs() * 40.0,
+                    (v * 0.5).cos(),
+                    -0.25 + (i % 7) as f32,
+                ]
+            })
+            .collect();
+        let mut image = Image::new(w, h, pixels, RgbColorSpace::rec2020()).unwrap();
+        image.cd_m2_per_unit = Some(179.0);
+        image
+            .metadata
+            .insert("prism:tone_operator".into(), "aces".into());
+        for sample_type in [ExrSampleType::F32, ExrSampleType::F16] {
+            for compression in [
+                ExrCompression::None,
+                ExrCompression::Rle,
+                ExrCompression::Zip,
+                ExrCompression::Piz,
+            ] {
+                let options = ExrWriteOptions {
+                    sample_type,
+                    compression,
+                };
+                let (fast, general) = (dir.path().join("fast.exr"), dir.path().join("general.exr"));
+                write_rgb_exr(&fast, &image, &options).unwrap();
+                let (channels, attributes) = image_channels(&general, &image, &options).unwrap();
+                write_exr_channels(
+                    &general,
+                    w,
+                    h,
+                    channels,
+                    Some(chromaticities_of(&image.color_space)),
+                    attributes,
+                    &options,
+                )
+                .unwrap();
+                let (a, b) = (
+                    crate::io::read_image(&fast).unwrap(),
+                    crate::io::read_image(&general).unwrap(),
+                );
+                let bits = |i: &Image| -> Vec<u32> {
+                    i.pixels().iter().flatten().map(|c| c.to_bits()).collect()
+                };
+                let what = format!("{sample_type:?} {compression:?}");
+                assert!(bits(&a) == bits(&b), "{what}");
+                assert_eq!((a.width(), a.height()), (w, h), "{what}");
+                assert_eq!(a.cd_m2_per_unit, b.cd_m2_per_unit, "{what}");
+                assert_eq!(a.metadata, b.metadata, "{what}");
+                assert_eq!(a.color_space, b.color_space, "{what}");
+                assert!(a.layers().is_empty() && b.layers().is_empty(), "{what}");
+            }
+        }
+    }
 }

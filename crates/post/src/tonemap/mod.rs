@@ -119,10 +119,22 @@ pub struct ToneResult {
     pub report: ToneReport,
 }
 
+/// Where an operator reads its input pixels, and where its mapping pass writes.
+pub(crate) enum Input<'a> {
+    /// The caller's pixels, read only; the output goes to a new (or reused) buffer.
+    Borrowed(&'a [[f32; 3]]),
+    /// The caller's pixels, owned (`ToneOperator::apply_in_place`): read by the statistics
+    /// passes, then overwritten chunk by chunk by the mapping pass, so that input and
+    /// output are never held together (`prism tonemap`'s bounded memory).
+    Owned(std::sync::Mutex<Option<Vec<[f32; 3]>>>),
+}
+
 /// Everything an operator's `apply` needs: the image, exposure factor, luminance weights,
 /// and resolved parameters.
 pub(crate) struct Context<'a> {
+    /// The image's size, colour space and scale (its pixels are `input`'s).
     pub image: &'a Image,
+    pub input: Input<'a>,
     pub params: &'a ToneParams,
     pub info: &'static OperatorInfo,
     /// 2^EV.
@@ -137,6 +149,18 @@ pub(crate) struct Context<'a> {
 }
 
 impl Context<'_> {
+    /// `read` of the input pixels (before the mapping pass: afterwards an owned input is
+    /// gone and `read` sees none).
+    pub fn read_pixels<R>(&self, read: impl FnOnce(&[[f32; 3]]) -> R) -> R {
+        match &self.input {
+            Input::Borrowed(pixels) => read(pixels),
+            Input::Owned(pixels) => {
+                let guard = pixels.lock().unwrap_or_else(|e| e.into_inner());
+                read(guard.as_deref().unwrap_or(&[]))
+            }
+        }
+    }
+
     /// The output pixel buffer, `n` long: the reused one when given, else a new one.
     /// Its contents are overwritten by the mapping pass.
     pub fn output_buffer(&self, n: usize) -> Vec<[f32; 3]> {
@@ -310,6 +334,19 @@ impl ToneOperator {
         self.apply_with(image, params, buffer, prism_cpu::active())
     }
 
+    /// As [`ToneOperator::apply`], mapping `image`'s own pixels: the result is the same,
+    /// bit for bit, and the input's memory holds the output (no second image).
+    pub fn apply_in_place(self, mut image: Image, params: &ToneParams) -> Result<ToneResult> {
+        let pixels = image.take_pixels();
+        self.run(
+            &image,
+            Input::Owned(std::sync::Mutex::new(Some(pixels))),
+            params,
+            Vec::new(),
+            prism_cpu::active(),
+        )
+    }
+
     /// As [`ToneOperator::apply_into`], with the kernels of `simd` (tests compare ISAs).
     pub(crate) fn apply_with(
         self,
@@ -318,9 +355,21 @@ impl ToneOperator {
         buffer: Vec<[f32; 3]>,
         simd: prism_cpu::Simd,
     ) -> Result<ToneResult> {
+        self.run(image, Input::Borrowed(image.pixels()), params, buffer, simd)
+    }
+
+    fn run(
+        self,
+        image: &Image,
+        input: Input,
+        params: &ToneParams,
+        buffer: Vec<[f32; 3]>,
+        simd: prism_cpu::Simd,
+    ) -> Result<ToneResult> {
         self.validate(params)?;
         let ctx = Context {
             image,
+            input,
             params,
             info: self.info(),
             exposure: 2f64.powf(params.exposure_ev) as f32,

@@ -19,7 +19,7 @@ use prism_cpu::Simd;
 
 use super::fast_math;
 use super::kernels::{self, avx2};
-use super::Context;
+use super::{Context, Input};
 
 /// Pixels per rayon task (≈ 48 KiB of RGB f32: big enough to amortise scheduling, small
 /// enough to balance 2–16 threads on a 4K image).
@@ -299,14 +299,16 @@ pub(crate) fn stats_chunk(chunk: &[[f32; 3]], scale: f32, w: [f32; 3]) -> Acc {
 /// Every operator takes this one pass, log-average or not: a variant without the log sum
 /// measured slower (its loop vectorised worse), and the identity makes the log nearly free.
 pub(crate) fn luminance_stats(ctx: &Context, scale: f32, w: [f32; 3]) -> LuminanceStats {
-    let (image, simd) = (ctx.image, ctx.simd);
-    let partial: Vec<Acc> = image
-        .pixels()
-        .par_chunks(CHUNK)
-        .map(|chunk| kernels::stats_task(simd, chunk, scale, w))
-        .collect();
+    let simd = ctx.simd;
+    let (partial, n): (Vec<Acc>, usize) = ctx.read_pixels(|pixels| {
+        let partial = pixels
+            .par_chunks(CHUNK)
+            .map(|chunk| kernels::stats_task(simd, chunk, scale, w))
+            .collect();
+        (partial, pixels.len())
+    });
     let acc = partial.into_iter().fold(Acc::EMPTY, Acc::merge);
-    let n = image.pixels().len() as f64;
+    let n = n as f64;
     LuminanceStats {
         log_average: (acc.sum_log / n).exp(),
         mean: acc.sum / n,
@@ -369,19 +371,40 @@ pub(crate) fn map_luminance_chunk<C: LuminanceCurve>(
 
 /// The image's pixels through `task` in parallel chunks of `CHUNK` pixels — `task(start,
 /// input, output)` with `start` the index of the chunk's first pixel, returning its
-/// (non-finite, negative) input pixel counts — into a new output buffer.
+/// (non-finite, negative) input pixel counts — into a new output buffer, or, for an owned
+/// input, into the input itself (each chunk copied aside first: the same bits).
 pub(crate) fn map_chunks(
     ctx: &Context,
     task: impl Fn(usize, &[[f32; 3]], &mut [[f32; 3]]) -> (u64, u64) + Sync,
 ) -> Mapped {
-    let image = ctx.image;
-    let mut pixels = ctx.output_buffer(image.pixels().len());
-    let (non_finite, negative) = pixels
-        .par_chunks_mut(CHUNK)
-        .zip(image.pixels().par_chunks(CHUNK))
-        .enumerate()
-        .map(|(k, (o, i))| task(k * CHUNK, i, o))
-        .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
+    let (pixels, (non_finite, negative)) = match &ctx.input {
+        Input::Borrowed(input) => {
+            let mut pixels = ctx.output_buffer(input.len());
+            let counts = pixels
+                .par_chunks_mut(CHUNK)
+                .zip(input.par_chunks(CHUNK))
+                .enumerate()
+                .map(|(k, (o, i))| task(k * CHUNK, i, o))
+                .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
+            (pixels, counts)
+        }
+        Input::Owned(input) => {
+            let mut pixels = input
+                .lock()
+                .unwrap_or_else(|e| e.into_inner())
+                .take()
+                .unwrap_or_default();
+            let counts = pixels
+                .par_chunks_mut(CHUNK)
+                .enumerate()
+                .map(|(k, o)| {
+                    let i = o.to_vec();
+                    task(k * CHUNK, &i, o)
+                })
+                .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
+            (pixels, counts)
+        }
+    };
     Mapped {
         pixels,
         non_finite_pixels: non_finite,
@@ -481,11 +504,13 @@ fn luminance_chunk(input: &[[f32; 3]], out: &mut [f32], scale: f32, w: [f32; 3])
 
 /// The sanitised luminance plane `w · sanitise(p, scale)` (row-major), for local operators.
 pub(crate) fn luminance_plane(ctx: &Context, scale: f32, w: [f32; 3]) -> Vec<f32> {
-    let (image, simd) = (ctx.image, ctx.simd);
-    let mut plane = vec![0.0f32; image.pixels().len()];
-    plane
-        .par_chunks_mut(CHUNK)
-        .zip(image.pixels().par_chunks(CHUNK))
-        .for_each(|(o, i)| avx2!(simd, luminance_chunk(i, o, scale, w)));
-    plane
+    let simd = ctx.simd;
+    ctx.read_pixels(|pixels| {
+        let mut plane = vec![0.0f32; pixels.len()];
+        plane
+            .par_chunks_mut(CHUNK)
+            .zip(pixels.par_chunks(CHUNK))
+            .for_each(|(o, i)| avx2!(simd, luminance_chunk(i, o, scale, w)));
+        plane
+    })
 }

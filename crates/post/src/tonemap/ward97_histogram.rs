@@ -97,40 +97,40 @@ pub fn histogram_ceiling(hist: &mut [f64], bin_width: f64, display_log_range: f6
 /// parallel).
 fn foveal_means(ctx: &Context, scale: f32, fw: usize, fh: usize) -> Vec<f64> {
     let (w, h) = (ctx.image.width(), ctx.image.height());
-    let sums = ctx
-        .image
-        .pixels()
-        .par_chunks(w)
-        .enumerate()
-        .fold(
-            || vec![(0.0f64, 0u64); fw * fh],
-            |mut acc, (y, row)| {
-                let by = y * fh / h;
-                let mut x0 = 0;
-                for bx in 0..fw {
-                    let x1 = (bx + 1) * w / fw;
-                    let s: f32 = row[x0..x1]
-                        .iter()
-                        .map(|p| dot(ctx.weights, sanitise(*p, scale)))
-                        .sum();
-                    let cell = &mut acc[by * fw + bx];
-                    cell.0 += s as f64;
-                    cell.1 += (x1 - x0) as u64;
-                    x0 = x1;
-                }
-                acc
-            },
-        )
-        .reduce(
-            || vec![(0.0, 0); fw * fh],
-            |mut a, b| {
-                a.iter_mut().zip(b).for_each(|(a, b)| {
-                    a.0 += b.0;
-                    a.1 += b.1;
-                });
-                a
-            },
-        );
+    let sums = ctx.read_pixels(|pixels| {
+        pixels
+            .par_chunks(w)
+            .enumerate()
+            .fold(
+                || vec![(0.0f64, 0u64); fw * fh],
+                |mut acc, (y, row)| {
+                    let by = y * fh / h;
+                    let mut x0 = 0;
+                    for bx in 0..fw {
+                        let x1 = (bx + 1) * w / fw;
+                        let s: f32 = row[x0..x1]
+                            .iter()
+                            .map(|p| dot(ctx.weights, sanitise(*p, scale)))
+                            .sum();
+                        let cell = &mut acc[by * fw + bx];
+                        cell.0 += s as f64;
+                        cell.1 += (x1 - x0) as u64;
+                        x0 = x1;
+                    }
+                    acc
+                },
+            )
+            .reduce(
+                || vec![(0.0, 0); fw * fh],
+                |mut a, b| {
+                    a.iter_mut().zip(b).for_each(|(a, b)| {
+                        a.0 += b.0;
+                        a.1 += b.1;
+                    });
+                    a
+                },
+            )
+    });
     sums.into_iter()
         .map(|(s, n)| if n > 0 { s / n as f64 } else { 0.0 })
         .collect()

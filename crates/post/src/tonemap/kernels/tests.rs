@@ -37,6 +37,7 @@ pub(crate) fn same_bits_as_scalar<C: RegisterCurve>(
         let curve = &curve_at(simd);
         let ctx = Context {
             image,
+            input: crate::tonemap::Input::Borrowed(image.pixels()),
             params: &params,
             info: &crate::tonemap::linear::INFO,
             exposure: scale,
