@@ -509,6 +509,40 @@ fn a_photon_integrator_is_explained_and_renders() {
     assert!(!stderr(&o).contains("replays"), "{}", stderr(&o));
 }
 
+/// A ball of glowing gas inside an `interface` sphere beside the point light, with
+/// `photon_progressive`: `--explain` says where photons start (the lights and the medium, by
+/// power, plus the per-pixel statistics in the memory line), and it renders lit and finite.
+#[test]
+fn photons_from_an_emissive_medium_are_explained_and_render() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("glow.json");
+    std::fs::write(
+        &scene,
+        r#"{"media": {"glow": {"sigma_a_per_m": 2, "sigma_s_per_m": 1, "emission": 50}},
+            "integrator": {"type": "photon_progressive", "photons_per_pass": 5000},
+            "materials": {"boundary": {"type": "interface"}},
+            "camera": {"transform": {"look_at": {"eye": [0, 1, 4], "target": [0, 0, 0], "up": [0, 1, 0]}}},
+            "shapes": [{"type": "rectangle", "size_m": [10, 10],
+                        "transform": {"rotate": {"axis": [1, 0, 0], "angle_deg": -90}}},
+                       {"type": "sphere", "radius_m": 0.5, "material": "boundary",
+                        "interior_medium": "glow", "transform": {"translate": [0, 0.6, 0]}}],
+            "lights": [{"type": "point", "position_m": [0, 2, 0], "power_lm": 1000}]}"#,
+    )
+    .unwrap();
+    let out = dir.path().join("glow.exr");
+    assert_explains(
+        &scene,
+        &out,
+        &[
+            "MiB of per-pixel statistics",
+            "photons from the lights ",
+            "medium 'glow' ",
+            "(by power)",
+        ],
+    );
+    assert_renders_lit(&scene, &out);
+}
+
 /// The `simd: <isa> (<why>)` line of `render --explain` with `PRISM_SIMD` set to `env`.
 fn explain_simd_line(env: Option<&str>, extra: &[&str]) -> String {
     let mut args = vec!["render", "scenes/cornell-box.json", "--explain"];

@@ -677,7 +677,7 @@ fn photon_explain(m: &crate::integrator::PhotonMapper, scene: &RenderScene) -> (
             } else {
                 String::new()
             }
-        ),
+        ) + &crate::integrator::photon::source_shares(scene),
         "the scene's `integrator` section (defaults: one photon per pixel, radius from the \
          scene bounds and the pixel footprint, α 2/3)"
             .into(),

@@ -163,6 +163,34 @@ impl PhotonSources {
     }
 }
 
+/// `--explain`'s words for where photons start when media emit: "; photons from the lights
+/// 40 %, medium 'glow' 60 %" (by power); nothing without emissive media.
+pub fn source_shares(scene: &RenderScene) -> String {
+    let Ok(sources) = PhotonSources::build(scene) else {
+        return String::new();
+    };
+    let Some(media) = &scene.media else {
+        return String::new();
+    };
+    if sources.media.is_empty() {
+        return String::new();
+    }
+    let percent = |pmf: f32| match 100.0 * pmf {
+        p if p > 0.0 && p < 0.5 => "< 1 %".to_string(),
+        p if p < 100.0 && p > 99.5 => "> 99 %".to_string(),
+        p => format!("{p:.0} %"),
+    };
+    let mut parts = vec![format!("the lights {}", percent(sources.lights_pmf))];
+    for (s, &pmf) in sources.media.iter().zip(&sources.media_pmf) {
+        parts.push(format!(
+            "medium '{}' {}",
+            media.names[s.medium as usize],
+            percent(pmf)
+        ));
+    }
+    format!("; photons from {} (by power)", parts.join(", "))
+}
+
 /// ∫ a(λ)·b(λ) dλ over 360–830 nm at 1 nm (as `Light::power_w`'s integral).
 fn product_integral_nm(a: &Spectrum, b: &Spectrum) -> f64 {
     (360..=830)

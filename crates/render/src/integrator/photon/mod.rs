@@ -26,6 +26,7 @@ mod shoot;
 mod sppm;
 
 pub use estimator::{refusal, PhotonEstimator};
+pub use medium_sources::source_shares;
 pub use photon_map::{Photon, PhotonTree};
 pub use settings::{default_memory_limit_bytes, PhotonMapper, PhotonPlan, RadiusRule};
 pub use sppm::{PixelStatistics, SppmStatistics};
