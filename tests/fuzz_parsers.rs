@@ -66,6 +66,9 @@ fn fuzz(target: Target) {
         budget: Duration::from_secs(env_or("PRISM_FUZZ_SECONDS", 15)),
         per_input: Duration::from_secs(5),
         seed: 0x5eed ^ target as u64,
+        max_seed_bytes: std::env::var("PRISM_FUZZ_MAX_SEED_BYTES")
+            .ok()
+            .and_then(|v| v.parse().ok()),
     };
     // What a user's --max-memory does for decoders: files declaring more are refused.
     prism_image::io::exr::set_exr_decode_limit_bytes(ALLOCATION_LIMIT_BYTES as u64 / 4);
@@ -88,13 +91,16 @@ fn fuzz(target: Target) {
     );
     std::panic::set_hook(hook);
     eprintln!(
-        "fuzz {}: {} executions ({} parsed, {} refused), slowest {:?}, {} failures",
+        "fuzz {}: {} executions ({} parsed, {} refused), slowest {:?}, {} failures ({} seeds, \
+         {} left out by size)",
         target.name(),
         report.executions,
         report.ok,
         report.errors,
         report.slowest,
-        report.failures.len()
+        report.failures.len(),
+        report.seeds_used,
+        report.seeds_left_out
     );
     assert!(
         report.executions >= 100,

@@ -20,6 +20,9 @@ pub struct Limits {
     /// An input that takes longer is a hang.
     pub per_input: Duration,
     pub seed: u64,
+    /// Leave out seeds larger than this (a long run of an image decoder at the speed of
+    /// its small seeds); `None`: every seed.
+    pub max_seed_bytes: Option<usize>,
 }
 
 /// Why one input failed.
@@ -38,11 +41,19 @@ pub struct Report {
     pub errors: u64,
     pub slowest: Duration,
     pub failures: Vec<Failure>,
+    /// Seeds used, and seeds left out by `Limits::max_seed_bytes`.
+    pub seeds_used: usize,
+    pub seeds_left_out: usize,
 }
 
 /// Runs `target` on its seeds and on mutations of them, writing inputs into `dir`.
 pub fn run(target: Target, root: &Path, dir: &Path, limits: &Limits) -> Report {
-    let seeds = target.seeds(root);
+    let all_seeds = target.seeds(root);
+    let seed_count = all_seeds.len();
+    let seeds: Vec<Vec<u8>> = all_seeds
+        .into_iter()
+        .filter(|s| limits.max_seed_bytes.is_none_or(|most| s.len() <= most))
+        .collect();
     let path = target.input_path(dir);
     let file_name = path
         .file_name()
@@ -56,6 +67,8 @@ pub fn run(target: Target, root: &Path, dir: &Path, limits: &Limits) -> Report {
         errors: 0,
         slowest: Duration::ZERO,
         failures: Vec::new(),
+        seeds_used: seeds.len(),
+        seeds_left_out: seed_count - seeds.len(),
     };
     if let Err(e) = target.prepare(root, dir) {
         report.failures.push(Failure {
