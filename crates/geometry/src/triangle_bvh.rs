@@ -116,19 +116,13 @@ impl<Id: Copy> TriangleBvh<Id> {
         let mut ray = bvh_ray(origin, direction, t_min, t_max);
         let mut state = Traversal::new(bvh, direction);
         let mut node;
-        obvhs::traverse!(
-            bvh,
-            node,
-            state,
-            node.intersect_ray(&ray, state.oct_inv4),
-            {
-                let slot = state.primitive_id as usize;
-                let t = test(&self.leaf_triangles[slot], self.leaf_ids[slot], ray.tmax);
-                if t < ray.tmax {
-                    ray.tmax = t;
-                }
+        obvhs::traverse!(bvh, node, state, node_hits(node, &ray, state.oct_inv4), {
+            let slot = state.primitive_id as usize;
+            let t = test(&self.leaf_triangles[slot], self.leaf_ids[slot], ray.tmax);
+            if t < ray.tmax {
+                ray.tmax = t;
             }
-        );
+        });
     }
 
     /// Any-hit traversal: whether `test(primitive, id, t_max)` accepts any primitive whose
@@ -150,19 +144,13 @@ impl<Id: Copy> TriangleBvh<Id> {
         let mut node;
         let mut hit = false;
         'outer: {
-            obvhs::traverse!(
-                bvh,
-                node,
-                state,
-                node.intersect_ray(&ray, state.oct_inv4),
-                {
-                    let slot = state.primitive_id as usize;
-                    if test(&self.leaf_triangles[slot], self.leaf_ids[slot], ray.tmax) {
-                        hit = true;
-                        break 'outer;
-                    }
+            obvhs::traverse!(bvh, node, state, node_hits(node, &ray, state.oct_inv4), {
+                let slot = state.primitive_id as usize;
+                if test(&self.leaf_triangles[slot], self.leaf_ids[slot], ray.tmax) {
+                    hit = true;
+                    break 'outer;
                 }
-            );
+            });
         }
         hit
     }
@@ -175,6 +163,74 @@ impl<Id: Copy> TriangleBvh<Id> {
             wt.intersect(*a, *b, *c, t_max).is_some()
         })
     }
+}
+
+/// Which children of `node` the ray enters within `[ray.tmin, ray.tmax]`: obvhs'
+/// `CwBvhNode::intersect_ray_simd` (the same slab arithmetic, lane order and NaN handling,
+/// four children at a time in SSE through glam's `Vec4`), except that a child's entry
+/// distance is bounded below by the ray's own `tmin` where obvhs clamps it to ≥ 10⁻⁴
+/// whatever `tmin` is (`cwbvh::node::EPSILON`): a hit closer than 10⁻⁴ m to the origin (a
+/// ray leaving a point 10 µm in front of a wall) was never reached.
+#[inline(always)]
+fn node_hits(node: &obvhs::cwbvh::node::CwBvhNode, ray: &obvhs::ray::Ray, oct_inv4: u32) -> u32 {
+    use glam::Vec4;
+    use obvhs::cwbvh::node::extract_byte64;
+    let dir_inv = node.compute_extent() * ray.inv_direction;
+    let origin = (Vec3A::from(node.p) - ray.origin) * ray.inv_direction;
+    let (rdx, rdy, rdz) = (
+        ray.direction.x < 0.0,
+        ray.direction.y < 0.0,
+        ray.direction.z < 0.0,
+    );
+    let (child_bits8, bit_index8) = node.get_child_and_index_bits(oct_inv4);
+    let (t_lo, t_hi) = (Vec4::splat(ray.tmin), Vec4::splat(ray.tmax));
+    let mut hit_mask = 0u32;
+    for i in 0..2 {
+        let q = |v: &[u8; 8]| {
+            Vec4::new(
+                f32::from(v[i * 4]),
+                f32::from(v[i * 4 + 1]),
+                f32::from(v[i * 4 + 2]),
+                f32::from(v[i * 4 + 3]),
+            )
+        };
+        let slab = |lo: Vec4, hi: Vec4, negative: bool, inv: f32, o: f32| {
+            let (near, far) = if negative { (hi, lo) } else { (lo, hi) };
+            let (inv, o) = (Vec4::splat(inv), Vec4::splat(o));
+            (near * inv + o, far * inv + o)
+        };
+        let (tmin_x, tmax_x) = slab(
+            q(&node.child_min_x),
+            q(&node.child_max_x),
+            rdx,
+            dir_inv.x,
+            origin.x,
+        );
+        let (tmin_y, tmax_y) = slab(
+            q(&node.child_min_y),
+            q(&node.child_max_y),
+            rdy,
+            dir_inv.y,
+            origin.y,
+        );
+        let (tmin_z, tmax_z) = slab(
+            q(&node.child_min_z),
+            q(&node.child_max_z),
+            rdz,
+            dir_inv.z,
+            origin.z,
+        );
+        let tmin = tmin_x.max(tmin_y.max(tmin_z)).max(t_lo);
+        let tmax = tmax_x.min(tmax_y.min(tmax_z)).min(t_hi);
+        let mask = tmin.cmple(tmax).bitmask();
+        for j in 0..4 {
+            if mask & (1 << j) != 0 {
+                let child = i * 4 + j;
+                hit_mask |= extract_byte64(child_bits8, child) << extract_byte64(bit_index8, child);
+            }
+        }
+    }
+    hit_mask
 }
 
 /// Traversal state for obvhs' `traverse!` macro (the fields it reads and writes). obvhs'

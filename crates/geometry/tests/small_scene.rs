@@ -153,15 +153,7 @@ struct Agreement {
     /// world-space hit an ulp closer, and a baked hit's `t` is then recomputed in object
     /// space (which may move it a few ulps more, docs/geometry.md "Precision").
     near_ties: usize,
-    /// The small path hit closer than [`OBVHS_NODE_T_MIN`], where the BVH cannot see.
-    bvh_blind: usize,
 }
-
-/// obvhs' CWBVH node test clamps the entry distance of every child box to at least 10⁻⁴
-/// (`cwbvh::node::EPSILON`, whatever the ray's `t_min`), so the BVH path misses hits at
-/// `t < 10⁻⁴`, e.g. a ray leaving a point 7 µm in front of a wall; the small path finds
-/// them. Such rays are counted, not compared.
-const OBVHS_NODE_T_MIN: f32 = 1e-4;
 
 /// Distance between the two builds' hit points below which hits on different leaves count
 /// as a tie: 1 µm, ≈ 16 ulps of f32 at the box's 1 m coordinates (grazing rays stretch the
@@ -173,10 +165,6 @@ const NEAR_TIE_M: f32 = 1e-6;
 fn compare(small: &Geometry, bvh: &Geometry, ray: &Ray, stats: &mut Agreement) -> Option<Hit> {
     let (a, b) = (small.intersect(ray), bvh.intersect(ray));
     stats.rays += 1;
-    if a.is_some_and(|h| h.t < OBVHS_NODE_T_MIN) {
-        stats.bvh_blind += 1;
-        return a;
-    }
     assert_eq!(small.occluded(ray), bvh.occluded(ray), "occlusion {ray:?}");
     assert_eq!(a.is_some(), small.occluded(ray), "closest vs any {ray:?}");
     match (a, b) {
@@ -409,4 +397,33 @@ fn small_scene_threshold_counts_leaves() {
             "{leaves} leaves"
         );
     }
+}
+
+/// Rays leaving points 10 µm (and 1 µm) in front of a wall find it through the BVH as
+/// through the small path: obvhs' node test clamped every child's entry distance to
+/// ≥ 10⁻⁴ whatever the ray's `t_min` and lost these hits; Prism's own node test
+/// (`triangle_bvh::node_hits`) bounds it by `t_min`.
+#[test]
+fn hits_micrometres_from_the_origin_are_found_through_the_bvh() {
+    let (small, bvh) = both(|b: &mut GeometryBuilder| drop(cornell(b)));
+    let mut rng = Pcg64::seed_from_u64(5);
+    let mut found = 0;
+    for gap_m in [1e-5f32, 1e-6] {
+        for _ in 0..2_000 {
+            // A random direction towards the back wall (the plane z = −1), from a point
+            // `gap_m` in front of it along that direction, above the boxes.
+            let d =
+                Vec3A::new(rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0), -1.0).normalize();
+            let p = Vec3A::new(rng.gen_range(-0.8..0.8), rng.gen_range(0.4..0.9), -1.0);
+            let origin = p - d * gap_m;
+            let ray = Ray::new(origin, d, 0.0, f32::INFINITY);
+            let (a, b) = (small.intersect(&ray), bvh.intersect(&ray));
+            let b = b.unwrap_or_else(|| panic!("the BVH lost the wall {gap_m} m ahead: {ray:?}"));
+            assert_eq!(a.map(|h| h.t), Some(b.t), "{ray:?}");
+            assert!((b.t - gap_m).abs() < 1e-6, "{ray:?}: t {}", b.t);
+            assert!(bvh.occluded(&ray), "{ray:?}");
+            found += 1;
+        }
+    }
+    assert_eq!(found, 4_000);
 }
