@@ -92,7 +92,7 @@ pub fn exr_decode_limit_bytes() -> u64 {
 
 /// Reads the headers and refuses a file whose parts would need more sample memory than
 /// the limit (a corrupt or hostile data window would otherwise be allocated as it is).
-fn check_declared_size(path: &Path) -> Result<()> {
+pub(crate) fn check_declared_size(path: &Path) -> Result<()> {
     let meta = ::exr::meta::MetaData::read_from_file(path, false)
         .map_err(|e| exr_error(path, "read the header of", e))?;
     let mut bytes: u128 = 0;
@@ -107,6 +107,27 @@ fn check_declared_size(path: &Path) -> Result<()> {
         bytes += w * h * per_pixel;
     }
     let limit = exr_decode_limit_bytes();
+    // The decoder allocates a chunk's declared size up to the header's largest block (a
+    // tile's area or a scan-line block) before it reads it: a hostile tile size in a small
+    // file asked for 1.9 GB (found by the fuzzer).
+    for (part, header) in meta.headers.iter().enumerate() {
+        let block = header.max_block_byte_size() as u128;
+        if block > u128::from(limit) {
+            return Err(ImageError::format(
+                path,
+                format!(
+                    "part {part}'s header declares blocks of {block} bytes ({}): more than \
+                     the {limit}-byte limit for decoding an EXR (--max-memory)",
+                    match header.blocks {
+                        ::exr::meta::BlockDescription::Tiles(t) =>
+                            format!("{}×{} tiles", t.tile_size.0, t.tile_size.1),
+                        ::exr::meta::BlockDescription::ScanLines =>
+                            format!("scan-line blocks {} px wide", header.layer_size.0),
+                    }
+                ),
+            ));
+        }
+    }
     if bytes > u128::from(limit) {
         let first = meta
             .headers
@@ -207,6 +228,7 @@ pub(crate) fn sample_at(samples: &FlatSamples, i: usize) -> f32 {
 /// channels become layers split at their last `.`; a spectral EXR without RGB channels is
 /// reduced to XYZ with the CIE 1931 observer, then to linear sRGB.
 pub fn read_exr(path: &Path) -> Result<Image> {
+    check_declared_size(path)?;
     if let Some(rgb) = super::exr_rgb::read_rgb_exr(path) {
         let space = space_of(&rgb.chromaticities);
         let mut image = Image::new(rgb.width, rgb.height, rgb.pixels, space)
@@ -558,6 +580,39 @@ fn image_attributes(path: &Path, image: &Image) -> Result<Vec<(String, Attribute
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A header whose tiles would need more than the decode limit per block (a small file
+    /// declaring 65536×32768 tiles; the fuzzer found one that made the decoder allocate
+    /// 1.9 GB before reading a byte of the block) is refused with the block size, by every
+    /// reader, before any block is read.
+    #[test]
+    fn huge_declared_blocks_are_refused_before_decoding() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("tiles.exr");
+        let image = Image::filled(8, 8, [0.5; 3], RgbColorSpace::srgb()).unwrap();
+        write_exr(&path, &image, &ExrWriteOptions::default()).unwrap();
+        let mut bytes = std::fs::read(&path).unwrap();
+        let at = bytes
+            .windows(9)
+            .position(|w| w == b"tiledesc\0")
+            .expect("the writer writes tiles");
+        // The attribute "tiles": its type name "tiledesc\0", its size (4 bytes), then the
+        // x and y tile sizes (u32 each).
+        let sizes = at + 9 + 4;
+        bytes[sizes..sizes + 4].copy_from_slice(&65536u32.to_le_bytes());
+        bytes[sizes + 4..sizes + 8].copy_from_slice(&32768u32.to_le_bytes());
+        std::fs::write(&path, &bytes).unwrap();
+        let e = crate::io::read_image(&path).unwrap_err().to_string();
+        assert!(
+            e.contains("tiles.exr") && e.contains("65536×32768 tiles") && e.contains("limit"),
+            "{e}"
+        );
+        // compare's strip reader too.
+        let Err(e) = crate::io::strips::RowSource::open(&path) else {
+            panic!("the strip reader opened a file with 65536×32768 tiles");
+        };
+        assert!(e.to_string().contains("65536×32768 tiles"), "{e}");
+    }
 
     /// The layer-less writer (samples pulled from the pixels) writes what the general one
     /// (planar copies) writes — the same pixels bit for bit, size, scale, metadata and

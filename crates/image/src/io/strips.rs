@@ -128,6 +128,8 @@ impl ExrRows {
     /// A source for `path` when its one part can be read by blocks (module text); `None`
     /// for anything else, which `read_image` then reads or refuses with its message.
     fn open(path: &Path) -> Option<RowSource> {
+        // A header the limits refuse goes to `read_image`, which says why.
+        super::exr::check_declared_size(path).ok()?;
         let meta = MetaData::read_from_file(path, false).ok()?;
         let [header] = meta.headers.as_slice() else {
             return None;
