@@ -17,7 +17,9 @@ rm -f "$work"/profiles/*.profraw
 sysroot="$(rustc --print sysroot)"
 tools="$sysroot/lib/rustlib/$(rustc -vV | sed -n 's/^host: //p')/bin"
 [ -x "$tools/llvm-cov" ] || { echo "llvm-cov missing: rustup component add llvm-tools" >&2; exit 1; }
+# Build scripts are instrumented too: their profiles go aside, not into the checkout.
 binary="$(CARGO_TARGET_DIR="$work/target" RUSTFLAGS="-Cinstrument-coverage" \
+    LLVM_PROFILE_FILE="$work/build-profiles/%p.profraw" \
     cargo test --release --test fuzz_parsers --no-run --message-format=json 2>/dev/null \
     | python3 -c 'import json,sys
 for line in sys.stdin:
