@@ -1,6 +1,7 @@
 //! `prism.compare`: the metrics of `prism compare --json` (MSE, relMSE, PSNR, SSIM,
 //! ΔE2000, LDR- and HDR-FLIP, per channel) of a test image against a reference.
 
+use prism_image::io::read_dimensions;
 use prism_post::metrics::flip::DEFAULT_PPD;
 use prism_post::metrics::{compare_with, CompareOptions};
 use prism_post::pipeline::compare_files_with;
@@ -33,7 +34,13 @@ pub fn compare<'py>(
     };
     let comparison = match (path_of(test)?, path_of(reference)?) {
         (Some(a), Some(b)) => py
-            .detach(|| compare_files_with(&a, &b, &options))
+            .detach(|| {
+                // Both headers first, as `prism compare`'s memory check reads them: the
+                // CLI's message for a missing or broken file.
+                read_dimensions(&a)?;
+                read_dimensions(&b)?;
+                compare_files_with(&a, &b, &options)
+            })
             .map(|(comparison, _)| comparison),
         _ => {
             let a = image_argument(test, "test")?;

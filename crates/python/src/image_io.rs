@@ -10,7 +10,7 @@ use prism_image::io::exr::ExrWriteOptions;
 use prism_image::io::spectral_exr::{
     has_emissive_channels, read_spectral_exr, write_exr_with_spectral_bands, SpectralImage,
 };
-use prism_image::io::ImageFormat;
+use prism_image::io::{read_dimensions, ImageFormat};
 use prism_image::io::{convert_pixels, read_image as read_file, write_image as write_file};
 use prism_image::rgb_matrix::same_colorimetry;
 use prism_image::Image;
@@ -275,6 +275,9 @@ pub fn path_of(value: &Bound<'_, PyAny>) -> PyResult<Option<PathBuf>> {
 
 /// Reads `path` as the CLI does, with every pixel in linear Rec.709.
 pub fn read_prism_image(path: &Path) -> PyResult<PyImage> {
+    // The header first, as `prism tonemap` and `prism compare` read it for their memory
+    // check before decoding: a missing or broken file gets the CLI's message.
+    read_dimensions(path).map_err(errors::image)?;
     let mut image = read_file(path).map_err(errors::image)?;
     let srgb = RgbColorSpace::srgb();
     if !same_colorimetry(&image.color_space, &srgb) {
