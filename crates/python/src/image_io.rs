@@ -10,8 +10,8 @@ use prism_image::io::exr::ExrWriteOptions;
 use prism_image::io::spectral_exr::{
     has_emissive_channels, read_spectral_exr, write_exr_with_spectral_bands, SpectralImage,
 };
-use prism_image::io::{read_dimensions, ImageFormat};
 use prism_image::io::{convert_pixels, read_image as read_file, write_image as write_file};
+use prism_image::io::{read_dimensions, ImageFormat};
 use prism_image::rgb_matrix::same_colorimetry;
 use prism_image::Image;
 use prism_spectrum::rgb_space::RgbColorSpace;

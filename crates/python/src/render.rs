@@ -395,6 +395,9 @@ fn peak_memory_bytes() -> Option<u64> {
     Some(kib * 1024)
 }
 
+/// One layer being assembled: name, channel names, one plane per channel.
+type LayerPlanes<'a> = (&'a str, Vec<&'a str>, Vec<&'a [f32]>);
+
 fn build_result(
     py: Python<'_>,
     image: &FilmImage,
@@ -411,7 +414,7 @@ fn build_result(
         plane_to_array(py, &image.luminance_cd_m2(), w, h)?,
     )?;
     aov_channels.set_item("luminance", vec!["Y"])?;
-    let mut layers: Vec<(&str, Vec<&str>, Vec<&[f32]>)> = Vec::new();
+    let mut layers: Vec<LayerPlanes> = Vec::new();
     for plane in &image.aovs {
         let (layer, channel) = plane.name.split_once('.').unwrap_or(("", &plane.name));
         match layers.iter_mut().find(|(l, _, _)| *l == layer) {
