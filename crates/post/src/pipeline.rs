@@ -197,9 +197,28 @@ pub fn tonemap_file(
 ) -> Result<TonemapFileReport> {
     let start = Instant::now();
     let t = Instant::now();
-    let mut image = read_image(input)?;
+    let image = read_image(input)?;
     let read_ms = ms(t);
+    let (out, mut report) = tonemap_image(image, input, options)?;
+    let t = Instant::now();
+    write_image(output, &out)?;
+    report.output = output.display().to_string();
+    report.timings.read_ms = read_ms;
+    report.timings.write_ms = ms(t);
+    report.timings.total_ms = ms(start);
+    Ok(report)
+}
 
+/// The stages of [`tonemap_file`] between reading and writing, on an image in memory (the
+/// Python package's `prism.tonemap`): returns the display image (linear values of the
+/// target in [0, 1]) and the report, whose `output` is empty and whose read and write
+/// times are 0. `input` names the image in messages and in the report.
+pub fn tonemap_image(
+    mut image: Image,
+    input: &Path,
+    options: &TonemapOptions,
+) -> Result<(Image, TonemapFileReport)> {
+    let start = Instant::now();
     let t = Instant::now();
     if !options.exposure_ev.is_finite() {
         return Err(ImageError::invalid(format!(
@@ -333,12 +352,9 @@ pub fn tonemap_file(
     out.color_space = options.target.space();
     let gamut_ms = ms(t);
 
-    let t = Instant::now();
-    write_image(output, &out)?;
-    let write_ms = ms(t);
-    Ok(TonemapFileReport {
+    let report = TonemapFileReport {
         input: input.display().to_string(),
-        output: output.display().to_string(),
+        output: String::new(),
         width: out.width(),
         height: out.height(),
         operator: options.operator.name(),
@@ -360,14 +376,15 @@ pub fn tonemap_file(
         failures,
         gamut_fraction_outside: sheet_outside.unwrap_or(gamut.fraction_outside),
         timings: TonemapTimings {
-            read_ms,
+            read_ms: 0.0,
             exposure_white_balance_ms,
             tone_ms,
             gamut_ms,
-            write_ms,
+            write_ms: 0.0,
             total_ms: ms(start),
         },
-    })
+    };
+    Ok((out, report))
 }
 
 /// The scene white for `--wb scene`: the luminance-weighted mean chromaticity of the

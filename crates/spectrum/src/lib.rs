@@ -8,6 +8,7 @@ pub mod adaptation;
 pub mod bfc;
 pub mod blackbody;
 pub mod cct;
+pub mod color_report;
 pub mod colorimetry;
 pub mod constants;
 pub mod data;

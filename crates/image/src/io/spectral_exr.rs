@@ -274,6 +274,23 @@ pub(crate) fn spectral_from_channels(path: &Path, data: &ExrChannels) -> Result<
     Ok(image)
 }
 
+/// Whether the EXR file at `path` has emissive spectral channels (`S0.<λ>nm`), from its
+/// header only: callers that read an image and want its bands too (the Python package's
+/// `read_image`) read them only when there are some.
+pub fn has_emissive_channels(path: &Path) -> Result<bool> {
+    let file = std::fs::File::open(path).map_err(|e| ImageError::io(path, "open", e))?;
+    let meta = ::exr::meta::MetaData::read_from_buffered(std::io::BufReader::new(file), false)
+        .map_err(|e| ImageError::format(path, format!("not a readable EXR file: {e}")))?;
+    Ok(meta.headers.iter().any(|header| {
+        header.channels.list.iter().any(|channel| {
+            matches!(
+                parse_spectral_channel(&channel.name.to_string()),
+                Some((SpectralChannelKind::Emissive { stokes: 0 }, _))
+            )
+        })
+    }))
+}
+
 /// Reads the emissive bands of a spectral EXR file.
 pub fn read_spectral_exr(path: &Path) -> Result<SpectralImage> {
     spectral_from_channels(path, &read_exr_channels(path)?)

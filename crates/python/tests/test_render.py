@@ -1,0 +1,112 @@
+"""prism.render against `prism render` (EXR channels bit for bit), dict scenes, progress,
+the GIL and Ctrl-C."""
+
+import _thread
+import json
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import prism
+
+SCENE = "scenes/cornell-box.json"
+SMALL = dict(spp=4, resolution=(40, 30), threads=2)
+
+
+def assert_layers_equal(render, image):
+    assert set(render.aovs) == set(image.layers)
+    for name, values in render.aovs.items():
+        ours = dict(zip(render.aov_channels[name], np.atleast_3d(values).transpose(2, 0, 1)))
+        theirs = dict(
+            zip(image.layer_channels[name], np.atleast_3d(image.layers[name]).transpose(2, 0, 1))
+        )
+        assert set(ours) == set(theirs), name
+        for channel in ours:
+            assert np.array_equal(ours[channel], theirs[channel]), f"{name}.{channel}"
+
+
+def test_cornell_box_equals_the_cli_exr_bit_for_bit(cli, root, tmp_path, monkeypatch):
+    monkeypatch.chdir(root)
+    out = tmp_path / "cornell.exr"
+    cli("render", SCENE, "--spp", 4, "--resolution", "40x30", "--threads", 2,
+        "--spectral-bins", 5, "-o", out, "--progress", "none")
+    exr = prism.read_image(out)
+    render = prism.render(SCENE, spectral_bins=5, **SMALL)
+    assert render.rgb.dtype == np.float32 and render.rgb.shape == (30, 40, 3)
+    assert np.array_equal(render.rgb, exr.rgb)
+    assert_layers_equal(render, exr)
+    assert render.cd_m2_per_unit == exr.cd_m2_per_unit
+    assert render.spectral.shape == (30, 40, 5)
+    assert np.array_equal(render.spectral, exr.spectral)
+    assert np.array_equal(render.wavelengths_nm, exr.wavelengths_nm)
+    assert render.xyz.shape == (30, 40, 3)
+    assert render.stats["spp"] == 4 and render.stats["resolution"] == [40, 30]
+    assert render.sensors == []
+
+
+def test_dict_scene_equals_the_file(root):
+    scene = json.loads((root / SCENE).read_text())
+    from_dict = prism.render(scene, base_dir=root / "scenes", **SMALL)
+    from_file = prism.render(root / SCENE, **SMALL)
+    assert np.array_equal(from_dict.rgb, from_file.rgb)
+    scene["film"]["seed"] = 1
+    other = prism.render(scene, base_dir=root / "scenes", **SMALL)
+    assert not np.array_equal(other.rgb, from_file.rgb)
+
+
+def test_progress_reaches_the_total(root):
+    calls = []
+    prism.render(root / SCENE, progress=lambda done, total: calls.append((done, total)), **SMALL)
+    assert calls and calls[-1] == (40 * 30 * 4, 40 * 30 * 4)
+    assert all(a[0] <= b[0] for a, b in zip(calls, calls[1:]))
+
+
+def long_render(root, progress=None):
+    # 256 work items (16 × 16 px tiles) of about 0.5 M samples each: minutes in all, and a
+    # stop is honoured between items.
+    return prism.render(root / SCENE, spp=2000, resolution=(256, 256), threads=2,
+                        progress=progress)
+
+
+def test_ctrl_c_stops_the_render_and_raises_keyboard_interrupt(root):
+    timer = threading.Timer(0.5, _thread.interrupt_main)
+    start = time.monotonic()
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        long_render(root)
+    elapsed = time.monotonic() - start
+    timer.join()
+    # The items in flight when Ctrl-C comes finish first (a few seconds at most).
+    assert elapsed < 15, elapsed
+
+
+def test_an_exception_from_the_callback_stops_the_render(root):
+    def fail(done, total):
+        raise RuntimeError("stop here")
+
+    with pytest.raises(RuntimeError, match="stop here"):
+        long_render(root, progress=fail)
+
+
+def test_the_gil_is_released_while_rendering(root):
+    ticks = []
+    stop = threading.Event()
+
+    def count():
+        while not stop.is_set():
+            ticks.append(1)
+            time.sleep(0.001)
+
+    thread = threading.Thread(target=count)
+    thread.start()
+    try:
+        start = time.monotonic()
+        prism.render(root / SCENE, spp=64, resolution=(64, 64), threads=1)
+        elapsed = time.monotonic() - start
+    finally:
+        stop.set()
+        thread.join()
+    # A thread blocked on the GIL would tick a few times at most.
+    assert len(ticks) > 0.1 * elapsed / 0.001, (len(ticks), elapsed)
