@@ -66,10 +66,15 @@ fn read_file(
         .map_err(|e| ImportError::file(path, format!("cannot read the scene file: {e}")))?;
     let doc = roxmltree::Document::parse(&text).map_err(|e| {
         let pos = e.pos();
+        let text = e.to_string();
+        let suffix = format!(" at {}:{}", pos.row, pos.col);
         ImportError {
             file: path.to_path_buf(),
             position: Some((pos.row, pos.col)),
-            message: format!("malformed XML: {e}"),
+            message: format!(
+                "malformed XML: {}",
+                text.strip_suffix(&suffix).unwrap_or(&text)
+            ),
         }
     })?;
     let file = Arc::new(path.to_path_buf());
