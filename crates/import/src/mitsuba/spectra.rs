@@ -61,7 +61,7 @@ pub fn spectrum(
                     )
                 })?;
                 props.finish("spectrum blackbody", &mut out.unsupported);
-                if !(t > 0.0) {
+                if t <= 0.0 {
                     return Err(ImportError::at(
                         &el.at,
                         format!("blackbody temperature: expected > 0 K, found {t}"),

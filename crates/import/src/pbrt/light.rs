@@ -146,13 +146,13 @@ pub fn light(
             l.insert("type".into(), json!("sky"));
             l.insert("spectrum".into(), s);
             l.insert("scale".into(), json!(scale));
-            params.float("illuminance")?.map(|_| {
+            if params.float("illuminance")?.is_some() {
                 im.out.unsupported.note(
                     "infinite light illuminance",
                     "ignored: the light keeps L × scale",
                     at,
-                )
-            });
+                );
+            }
         }
         other => {
             im.out.unsupported.note(

@@ -451,13 +451,13 @@ pub fn texture(
         if ud != 0.0 || vd != 0.0 {
             t.insert("uv_offset".into(), json!([ud, vd]));
         }
-        params.string("mapping")?.filter(|m| m != "uv").map(|m| {
+        if let Some(m) = params.string("mapping")?.filter(|m| m != "uv") {
             im.out.unsupported.note(
                 format!("texture mapping \"{m}\""),
                 "imported as uv mapping",
                 at,
-            )
-        });
+            );
+        }
     }
     params.finish(&format!("Texture \"{class}\""), &mut im.out.unsupported);
     let prism = im.out.unique_texture_name(name);

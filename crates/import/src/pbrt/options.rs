@@ -210,7 +210,7 @@ impl RenderOptions {
             }
             _ => {
                 out.unsupported.note(
-                    format!("{directive}"),
+                    directive.to_string(),
                     "not imported: Prism chooses this itself",
                     at,
                 );

@@ -99,7 +99,7 @@ pub fn shape(
                     ))
                 }
             };
-            if indices.is_empty() || indices.len() % per_face != 0 {
+            if indices.is_empty() || !indices.len().is_multiple_of(per_face) {
                 return Err(ImportError::at(
                     at,
                     format!(
@@ -110,9 +110,12 @@ pub fn shape(
             }
             let n = params.point3s("N")?;
             let uv = params.floats("uv")?;
-            for v in [&n.as_ref().map(Vec::len), &uv.as_ref().map(|u| u.len() / 2)] {
-                if let Some(len) = v {
-                    if *len != p.len() {
+            for len in [n.as_ref().map(Vec::len), uv.as_ref().map(|u| u.len() / 2)]
+                .into_iter()
+                .flatten()
+            {
+                {
+                    if len != p.len() {
                         return Err(ImportError::at(
                             at,
                             format!(
