@@ -141,3 +141,78 @@ pub fn import(path: &Path, options: &ImportOptions) -> Result<Imported, ImportEr
     ctx.out.integrator = Some(integrator::integrator_json(&ctx));
     Ok(ctx.out.finish())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn import_text(text: &str) -> Imported {
+        let dir =
+            std::env::temp_dir().join(format!("prism-import-xml-unit-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join(format!("t{}.xml", text.len()));
+        std::fs::write(&path, text).unwrap();
+        let r = import(
+            &path,
+            &ImportOptions {
+                output_dir: dir.clone(),
+                side_dir: "a".into(),
+                ..Default::default()
+            },
+        );
+        std::fs::remove_file(&path).unwrap();
+        r.unwrap()
+    }
+
+    #[test]
+    fn fov_axis_smaller_and_larger_follow_the_aspect_ratio() {
+        for (axis, expected) in [
+            ("smaller", "vertical"),
+            ("larger", "horizontal"),
+            ("y", "vertical"),
+            ("diagonal", "diagonal"),
+        ] {
+            let i = import_text(&format!(
+                "<scene version=\"3.0.0\"><sensor type=\"perspective\"><string name=\"fov_axis\" value=\"{axis}\"/>\
+                 <float name=\"fov\" value=\"30\"/><film type=\"hdrfilm\"><integer name=\"width\" value=\"200\"/>\
+                 <integer name=\"height\" value=\"100\"/></film></sensor></scene>"
+            ));
+            assert_eq!(i.scene["camera"]["fov_axis"], expected, "{axis}");
+        }
+    }
+
+    #[test]
+    fn sphere_center_radius_conductor_names_and_plastic() {
+        let i = import_text(
+            "<scene version=\"3.0.0\"><shape type=\"sphere\"><point name=\"center\" x=\"1\" y=\"2\" z=\"3\"/>\
+             <float name=\"radius\" value=\"0.5\"/><bsdf type=\"roughconductor\"><string name=\"material\" value=\"Au\"/>\
+             <float name=\"alpha\" value=\"0.2\"/><string name=\"distribution\" value=\"ggx\"/></bsdf></shape>\
+             <bsdf type=\"plastic\" id=\"p\"><rgb name=\"diffuse_reflectance\" value=\"0.2, 0.3, 0.4\"/></bsdf></scene>",
+        );
+        let s = &i.scene["shapes"][0];
+        assert_eq!(s["radius_m"], 0.5);
+        assert_eq!(s["transform"]["matrix"][1][3], 2.0);
+        let m = &i.scene["materials"][s["material"].as_str().unwrap()];
+        assert_eq!(m["metal"], "Au");
+        assert_eq!(m["roughness"], 0.2);
+        let p = &i.scene["materials"]["p"];
+        assert_eq!(p["type"], "coated");
+        assert!((p["ior"].as_f64().unwrap() - 1.49 / 1.000277).abs() < 1e-12);
+        assert!(i
+            .unsupported
+            .lines()
+            .iter()
+            .any(|l| l.contains("bsdf plastic")));
+    }
+
+    #[test]
+    fn unlimited_depth_and_the_depth_offset() {
+        let i = import_text("<scene version=\"3.0.0\"><integrator type=\"path\"><integer name=\"max_depth\" value=\"-1\"/></integrator></scene>");
+        assert_eq!(
+            i.scene["integrator"]["max_depth"],
+            integrator::UNLIMITED_BOUNCES
+        );
+        let i = import_text("<scene version=\"3.0.0\"><integrator type=\"path\"><integer name=\"max_depth\" value=\"3\"/></integrator></scene>");
+        assert_eq!(i.scene["integrator"]["max_depth"], 2);
+    }
+}

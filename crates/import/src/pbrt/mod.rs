@@ -360,3 +360,81 @@ pub fn look_at(eye: DVec3, look: DVec3, up: DVec3) -> Option<DMat4> {
 pub fn finish(im: &mut Importer, params: &Params, context: &str) {
     params.finish(context, &mut im.out.unsupported);
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn import_text(text: &str) -> Imported {
+        let dir =
+            std::env::temp_dir().join(format!("prism-import-pbrt-unit-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join(format!("t{}.pbrt", text.len()));
+        std::fs::write(&path, text).unwrap();
+        let r = import(
+            &path,
+            &ImportOptions {
+                output_dir: dir.clone(),
+                side_dir: "a".into(),
+                ..Default::default()
+            },
+        );
+        std::fs::remove_file(&path).unwrap();
+        r.unwrap()
+    }
+
+    /// pbrt's LookAt with up +Y looking down −Z puts image right at world −X (pbrt's
+    /// left-handed camera); `Scale -1 1 1` before it, as exporters write, undoes that.
+    #[test]
+    fn camera_handedness_follows_pbrt() {
+        let plain = import_text("LookAt 0 0 5  0 0 0  0 1 0\nCamera \"perspective\"\nWorldBegin\n");
+        let m = &plain.scene["camera"]["transform"]["matrix"];
+        assert_eq!(m[0], json_row([-1.0, 0.0, 0.0, 0.0]));
+        let flipped = import_text(
+            "Scale -1 1 1\nLookAt 0 0 5  0 0 0  0 1 0\nCamera \"perspective\"\nWorldBegin\n",
+        );
+        let m = &flipped.scene["camera"]["transform"]["matrix"];
+        assert_eq!(m[0], json_row([1.0, 0.0, 0.0, 0.0]));
+        assert_eq!(m[2], json_row([0.0, 0.0, 1.0, 5.0]));
+    }
+
+    fn json_row(r: [f64; 4]) -> Value {
+        serde_json::json!(r)
+    }
+
+    #[test]
+    fn named_metals_roughness_remap_and_mix() {
+        let i = import_text(
+            "WorldBegin\nMakeNamedMaterial \"au\" \"string type\" \"conductor\" \"spectrum eta\" \"metal-Au-eta\" \"spectrum k\" \"metal-Au-k\" \"float roughness\" 0.09\n\
+             MakeNamedMaterial \"d\" \"string type\" \"diffuse\"\n\
+             MakeNamedMaterial \"m\" \"string type\" \"mix\" \"string materials\" [\"au\" \"d\"] \"float amount\" 0.25\n",
+        );
+        let au = &i.scene["materials"]["au"];
+        assert_eq!(au["metal"], "Au");
+        assert!((au["roughness"].as_f64().unwrap() - 0.3).abs() < 1e-12);
+        assert_eq!(
+            i.scene["materials"]["m"]["materials"],
+            serde_json::json!(["au", "d"])
+        );
+        assert_eq!(i.scene["materials"]["m"]["weight"], 0.25);
+    }
+
+    #[test]
+    fn instances_compose_transforms_and_meshes_become_side_files() {
+        let i = import_text(
+            "WorldBegin\nObjectBegin \"tri\"\nShape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0]\nObjectEnd\n\
+             Translate 2 0 0\nObjectInstance \"tri\"\nTranslate 0 3 0\nObjectInstance \"tri\"\n",
+        );
+        let shapes = i.scene["shapes"].as_array().unwrap();
+        assert_eq!(shapes.len(), 2);
+        assert_eq!(shapes[1]["transform"]["matrix"][1][3], 3.0);
+        assert_eq!(shapes[1]["transform"]["matrix"][0][3], 2.0);
+        assert_eq!(i.side_files.len(), 1);
+        assert_eq!(
+            String::from_utf8_lossy(&i.side_files[0].contents)
+                .lines()
+                .last(),
+            Some("f 1 2 3")
+        );
+    }
+}

@@ -253,3 +253,28 @@ pub fn emission_factor(s: &PbrtSpectrum) -> Option<f64> {
     let y = tristimulus_sums(dense, Observer::Cie1931).y;
     (y > 0.0).then(|| y_bar / y)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// pbrt normalises a light spectrum to luminance 1 (× scale): with the factor, Prism's
+    /// spectrum has ∫S·ȳ = ∫ȳ (pixel luminance 1), whatever the spectrum's own level.
+    #[test]
+    fn emission_factor_gives_unit_luminance_and_leaves_rgb_alone() {
+        let y_bar = tristimulus_sums(&DenseSpectrum::constant(1.0), Observer::Cie1931).y;
+        for s in [constant(3.0), constant(0.25)] {
+            let f = emission_factor(&s).unwrap();
+            let y = tristimulus_sums(s.dense.as_ref().unwrap(), Observer::Cie1931).y;
+            assert!((f * y / y_bar - 1.0).abs() < 1e-12);
+        }
+        assert_eq!(emission_factor(&constant(2.0)), Some(0.5));
+        let rgb = PbrtSpectrum {
+            value: json!({"rgb": [1, 2, 3]}),
+            is_rgb: true,
+            dense: None,
+        };
+        assert_eq!(emission_factor(&rgb), Some(1.0));
+        assert_eq!(emission_factor(&constant(0.0)), None);
+    }
+}
