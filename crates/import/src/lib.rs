@@ -8,6 +8,7 @@
 
 pub mod error;
 pub mod mitsuba;
+pub mod obj;
 pub mod output;
 pub mod pbrt;
 pub mod unsupported;

@@ -7,6 +7,7 @@ pub mod emitter;
 pub mod integrator;
 pub mod props;
 pub mod sensor;
+pub mod serialized;
 pub mod shape;
 pub mod spectra;
 pub mod texture;
@@ -203,6 +204,27 @@ mod tests {
             .lines()
             .iter()
             .any(|l| l.contains("bsdf plastic")));
+    }
+
+    #[test]
+    fn serialized_meshes_become_obj_side_files() {
+        let dir =
+            std::env::temp_dir().join(format!("prism-import-xml-unit-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(
+            dir.join("tri.serialized"),
+            serialized::tests::one_triangle(),
+        )
+        .unwrap();
+        let i = import_text(
+            "<scene version=\"3.0.0\"><shape type=\"serialized\"><string name=\"filename\" value=\"tri.serialized\"/></shape></scene>",
+        );
+        assert_eq!(i.scene["shapes"][0]["file"], "a/serialized-0.obj");
+        let obj = String::from_utf8(i.side_files[0].contents.clone()).unwrap();
+        assert!(
+            obj.contains("v 0 1 0.5\n") && obj.ends_with("f 1/1 2/2 3/3\n"),
+            "{obj}"
+        );
     }
 
     #[test]

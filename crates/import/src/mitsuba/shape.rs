@@ -9,6 +9,7 @@ use crate::error::ImportError;
 use crate::mitsuba::bsdf::material;
 use crate::mitsuba::emitter::area_light;
 use crate::mitsuba::props::Props;
+use crate::mitsuba::serialized::read_serialized;
 use crate::mitsuba::transform::parse_transform;
 use crate::mitsuba::xml::Element;
 use crate::mitsuba::Ctx;
@@ -43,6 +44,42 @@ pub fn shape(ctx: &mut Ctx, el: &Element) -> Result<(), ImportError> {
                 );
             }
         }
+        "serialized" => {
+            let file = props.string("filename")?.ok_or_else(|| {
+                ImportError::at(&el.at, "shape serialized: needs <string name=\"filename\">")
+            })?;
+            let index = props.integer("shape_index")?.unwrap_or(0);
+            let path = el.base_dir().join(file);
+            let bytes = std::fs::read(&path).map_err(|e| {
+                ImportError::at(&el.at, format!("shape serialized: {}: {e}", path.display()))
+            })?;
+            let mesh = usize::try_from(index)
+                .map_err(|_| format!("shape_index {index}: expected ≥ 0"))
+                .and_then(|i| read_serialized(&bytes, i))
+                .map_err(|e| {
+                    ImportError::at(&el.at, format!("shape serialized {}: {e}", path.display()))
+                })?;
+            let obj = crate::obj::obj_text(
+                &mesh.positions,
+                mesh.normals.as_deref(),
+                mesh.uvs.as_deref(),
+                &mesh.triangles,
+                false,
+            );
+            let n = ctx.out.side_files.len();
+            let side = ctx
+                .out
+                .add_side_file(&format!("serialized-{n}.obj"), obj.into_bytes());
+            s.insert("type".into(), json!("mesh"));
+            s.insert("file".into(), json!(side));
+            if props.boolean("face_normals")? == Some(true) {
+                ctx.out.unsupported.note(
+                    "shape face_normals",
+                    "ignored: Prism shades meshes with the file's vertex normals when it has them",
+                    &el.at,
+                );
+            }
+        }
         "rectangle" => {
             s.insert("type".into(), json!("rectangle"));
             s.insert("size_m".into(), json!([2, 2]));
@@ -65,7 +102,7 @@ pub fn shape(ctx: &mut Ctx, el: &Element) -> Result<(), ImportError> {
         other => {
             ctx.out.unsupported.note(
                 format!("shape type=\"{other}\""),
-                "not imported (Prism reads obj, ply, rectangle, cube, sphere and disk from Mitsuba)",
+                "not imported (Prism reads obj, ply, serialized, rectangle, cube, sphere and disk from Mitsuba)",
                 &el.at,
             );
             return Ok(());

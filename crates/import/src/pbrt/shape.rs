@@ -137,7 +137,7 @@ pub fn shape(
                     triangles.push([f[0], f[3], f[2]]);
                 }
             }
-            let obj = obj_text(&p, n.as_deref(), uv.as_deref(), &triangles, flip);
+            let obj = crate::obj::obj_text(&p, n.as_deref(), uv.as_deref(), &triangles, flip);
             im.mesh_count += 1;
             let file = im
                 .out
@@ -233,43 +233,4 @@ pub fn instance(im: &mut Importer, name: &str, at: &Location) -> Result<(), Impo
         push_shape(im, &shape_name, s.shape, &matrix);
     }
     Ok(())
-}
-
-fn obj_text(
-    p: &[DVec3],
-    n: Option<&[DVec3]>,
-    uv: Option<&[f64]>,
-    triangles: &[[usize; 3]],
-    flip: bool,
-) -> String {
-    let mut s = String::from("# written by prism import from a pbrt mesh\n");
-    for v in p {
-        s.push_str(&format!("v {} {} {}\n", v.x, v.y, v.z));
-    }
-    if let Some(n) = n {
-        for v in n {
-            s.push_str(&format!("vn {} {} {}\n", v.x, v.y, v.z));
-        }
-    }
-    if let Some(uv) = uv {
-        for c in uv.chunks(2) {
-            s.push_str(&format!("vt {} {}\n", c[0], c[1]));
-        }
-    }
-    for t in triangles {
-        let t = if flip { [t[0], t[2], t[1]] } else { *t };
-        let corner = |i: usize| match (uv.is_some(), n.is_some()) {
-            (true, true) => format!("{0}/{0}/{0}", i + 1),
-            (true, false) => format!("{0}/{0}", i + 1),
-            (false, true) => format!("{0}//{0}", i + 1),
-            (false, false) => format!("{}", i + 1),
-        };
-        s.push_str(&format!(
-            "f {} {} {}\n",
-            corner(t[0]),
-            corner(t[1]),
-            corner(t[2])
-        ));
-    }
-    s
 }
