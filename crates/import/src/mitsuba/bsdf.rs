@@ -179,7 +179,10 @@ fn convert(ctx: &mut Ctx, props: &Props, kind: &str) -> Result<Value, ImportErro
         }
         "twosided" => {
             let inner = props.objects("bsdf");
-            let refs = props.objects("ref");
+            let refs = props
+                .objects("ref")
+                .into_iter()
+                .filter(|r| r.attr("name").is_none());
             let nested: Vec<&Element> = inner.into_iter().chain(refs).collect();
             match nested.as_slice() {
                 [one] => {

@@ -130,7 +130,7 @@ pub fn shape(ctx: &mut Ctx, el: &Element) -> Result<(), ImportError> {
     let bsdfs: Vec<&Element> = props
         .objects("bsdf")
         .into_iter()
-        .chain(props.objects("ref"))
+        .chain(props.objects("ref").into_iter().filter(|r| is_bsdf_ref(r)))
         .collect();
     match bsdfs.as_slice() {
         [] => {}
@@ -167,4 +167,10 @@ pub fn shape(ctx: &mut Ctx, el: &Element) -> Result<(), ImportError> {
     }
     props.finish(&format!("shape {kind}"), &mut ctx.out.unsupported);
     Ok(())
+}
+
+/// A `<ref>` that names the shape's BSDF: unnamed or named `bsdf` (named refs such as
+/// `interior` are media and are read by name).
+fn is_bsdf_ref(r: &Element) -> bool {
+    matches!(r.attr("name"), None | Some("bsdf"))
 }

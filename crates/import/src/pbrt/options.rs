@@ -163,6 +163,14 @@ impl RenderOptions {
                 }
                 out.film.insert("spp".into(), json!(spp as u64));
                 if let Some(seed) = params.float("seed")? {
+                    if !(0.0..=9_007_199_254_740_992.0).contains(&seed) || seed.fract() != 0.0 {
+                        return Err(ImportError::at(
+                            at,
+                            format!(
+                                "Sampler seed: expected a whole number in [0, 2^53], found {seed}"
+                            ),
+                        ));
+                    }
                     out.film.insert("seed".into(), json!(seed as u64));
                 }
                 self.sampler = Some(match kind {
