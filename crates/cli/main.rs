@@ -7,6 +7,7 @@ mod compare;
 mod converge;
 mod daylight_factor;
 mod falsecolour;
+mod import;
 mod merge;
 mod merl_export;
 mod partial;
@@ -48,6 +49,9 @@ enum Command {
     /// Error against time for each method: progressive renders, RMSE/relMSE/ΔE2000 at
     /// checkpoints, a log–log chart (PNG/SVG) with fitted slopes, JSON (docs/converge.md).
     Converge(converge::ConvergeArgs),
+    /// Translate a Mitsuba 3 (.xml) or pbrt-v4 (.pbrt) scene into Prism's JSON, listing what
+    /// is not imported exactly (docs/import.md).
+    Import(import::ImportArgs),
     /// Add the partial images of disjoint sample ranges of one render (`render --samples`)
     /// into the image of their union, weighted by sample counts (docs/scale-out.md).
     Merge(merge::MergeArgs),
@@ -78,6 +82,7 @@ fn main() -> ExitCode {
         Command::Color(args) => done(color::run(&args)),
         Command::Compare(args) => done(compare::run(&args, &budget)),
         Command::Converge(args) => done(converge::run(&args, &budget)),
+        Command::Import(args) => done(import::run(&args)),
         Command::Merge(args) => merge::run(&args),
         Command::MerlExport(args) => done(merl_export::run(&args)),
         // Non-zero without an error when a signal stopped it (the work is saved).

@@ -41,8 +41,11 @@ use crate::plan_args::PlanArg;
 
 #[derive(Args, Debug)]
 pub struct RenderArgs {
-    /// The scene file (JSON, docs/scene-format.md).
+    /// The scene file: Prism JSON (docs/scene-format.md), or Mitsuba 3 XML (.xml) or
+    /// pbrt-v4 (.pbrt), imported on the fly (docs/import.md).
     pub scene: PathBuf,
+    #[command(flatten)]
+    pub import: crate::import::ImportFlags,
     /// Output image (.exr or .png; .hdr also works). Default: the scene's `film.output`,
     /// else `<scene stem>.exr` in the current directory.
     #[arg(short = 'o', long = "output")]
@@ -285,7 +288,7 @@ fn peak_memory_bytes() -> Option<u64> {
 pub fn run(args: &RenderArgs, budget: &MemoryBudget) -> Result<ExitCode, String> {
     args.simd.apply()?;
     args.plan.check()?;
-    let description = prism_scene::load_scene(&args.scene).map_err(|e| e.to_string())?;
+    let (description, _side_files) = crate::import::load_any_scene(&args.scene, &args.import)?;
     let output = output_path(args, description.film.output.as_deref());
     if !args.explain {
         check_output(&output)?;

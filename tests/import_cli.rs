@@ -1,0 +1,333 @@
+//! Scene import (issue 26, part 2): Mitsuba 3 XML and pbrt-v4 scenes through `prism import`
+//! and `prism render SCENE.xml|SCENE.pbrt`.
+//!
+//! - Mitsuba's Cornell box as XML (scenes/import/cornell-box.xml) renders within 1 % per
+//!   channel of Mitsuba's reference (as scenes/cornell-box.json does, tests/cornell_mitsuba.rs)
+//!   and of scenes/cornell-box.json's own render;
+//! - the pbrt-v4 room (scenes/import/room.pbrt) within 1 % of its hand-written Prism JSON;
+//! - import → JSON → render equals the direct render bit for bit;
+//! - malformed files get file:line:column errors; what is not imported is listed once per
+//!   kind (an error with --strict).
+//!
+//! Tolerances: the 1 % limits are the issue's; each comparison also checks that its Monte
+//! Carlo standard error (from independent 8 × 8-pixel blocks) is small enough for 1 % to mean
+//! something (4 standard errors below it).
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use prism_image::io::exr::read_exr;
+use prism_render::{render, RenderScene, RenderSettings};
+
+const MITSUBA_FILM_FACTOR: f64 = 106.857 / 106.750_259_4;
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn prism() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_prism"))
+}
+
+/// Imports `scene` in process as `prism render` does and returns the description.
+fn import(scene: &Path) -> prism_scene::SceneDescription {
+    let dir = scene.parent().unwrap().to_path_buf();
+    let options = prism_import::ImportOptions {
+        defines: Vec::new(),
+        output_dir: dir.clone(),
+        side_dir: std::env::temp_dir()
+            .join(format!("prism-import-test-{}", std::process::id()))
+            .to_string_lossy()
+            .into_owned(),
+    };
+    let imported = prism_import::import_file(scene, &options).unwrap();
+    for f in &imported.side_files {
+        let p = Path::new(&f.relative_path);
+        std::fs::create_dir_all(p.parent().unwrap()).unwrap();
+        std::fs::write(p, &f.contents).unwrap();
+    }
+    let as_json = dir.join("imported.json");
+    prism_scene::parse_scene_str(&imported.to_json_text(), as_json).unwrap()
+}
+
+fn render_rgb(
+    description: &prism_scene::SceneDescription,
+    spp: u32,
+    seed: u64,
+) -> (Vec<[f64; 3]>, usize) {
+    let scene = RenderScene::build(description, None).unwrap();
+    let sampler = match description.integrator {
+        prism_scene::Integrator::Path { sampler, .. } => sampler,
+        _ => panic!("these scenes use the path tracer"),
+    };
+    let settings = RenderSettings {
+        spp,
+        seed,
+        sampler,
+        ..RenderSettings::default()
+    };
+    let (film, stats) = render(&scene, &settings, &|_| {});
+    assert_eq!(stats.non_finite_samples, 0);
+    (
+        film.rgb.iter().map(|p| p.map(f64::from)).collect(),
+        film.width as usize,
+    )
+}
+
+/// Per channel: relative difference of the image means, and the standard error of that
+/// difference from 8 × 8 blocks (independent Monte Carlo estimates of the same structure).
+fn compare_means(a: &[[f64; 3]], b: &[[f64; 3]], width: usize, label: &str) {
+    let height = a.len() / width;
+    let block = 8;
+    for c in 0..3 {
+        let mean = |img: &[[f64; 3]]| img.iter().map(|p| p[c]).sum::<f64>() / img.len() as f64;
+        let (ma, mb) = (mean(a), mean(b));
+        let mut diffs = Vec::new();
+        for by in 0..height / block {
+            for bx in 0..width / block {
+                let mut d = 0.0;
+                for y in by * block..(by + 1) * block {
+                    for x in bx * block..(bx + 1) * block {
+                        d += a[y * width + x][c] - b[y * width + x][c];
+                    }
+                }
+                diffs.push(d / (block * block) as f64);
+            }
+        }
+        let m = diffs.len() as f64;
+        let dm = diffs.iter().sum::<f64>() / m;
+        let sd = (diffs.iter().map(|d| (d - dm).powi(2)).sum::<f64>() / (m - 1.0)).sqrt();
+        let se_rel = sd / m.sqrt() / mb;
+        let rel = (ma - mb) / mb;
+        eprintln!("{label} channel {c}: {ma:.6} vs {mb:.6}, relative {rel:+.5}, standard error {se_rel:.5}");
+        assert!(
+            4.0 * se_rel < 0.01,
+            "{label} channel {c}: too noisy for a 1 % test (SE {se_rel})"
+        );
+        assert!(
+            rel.abs() <= 0.01,
+            "{label} channel {c}: {rel:+.4} (limit ±1 %)"
+        );
+    }
+}
+
+#[test]
+fn mitsuba_cornell_box_xml_renders_within_one_percent_of_mitsuba_and_of_the_json_scene() {
+    let imported = import(&root().join("scenes/import/cornell-box.xml"));
+    let json = prism_scene::load_scene(root().join("scenes/cornell-box.json")).unwrap();
+    // 256 spp (the scene's 64 leave the blue channel's standard error at 0.34 %).
+    let (ours, width) = render_rgb(&imported, 256, 1);
+    let (theirs, _) = render_rgb(&json, 256, 2);
+    compare_means(&ours, &theirs, width, "cornell xml vs json");
+    let reference = read_exr(&root().join("tests/fixtures/cornell_mitsuba_reference.exr")).unwrap();
+    let reference: Vec<[f64; 3]> = reference
+        .pixels()
+        .iter()
+        .map(|p| p.map(|c| f64::from(c) / MITSUBA_FILM_FACTOR))
+        .collect();
+    compare_means(&ours, &reference, width, "cornell xml vs Mitsuba");
+}
+
+#[test]
+fn pbrt_room_renders_within_one_percent_of_its_prism_json() {
+    let imported = import(&root().join("scenes/import/room.pbrt"));
+    let json = prism_scene::load_scene(root().join("scenes/import/room.json")).unwrap();
+    let (ours, width) = render_rgb(&imported, 256, 1);
+    let (theirs, _) = render_rgb(&json, 256, 2);
+    compare_means(&ours, &theirs, width, "room pbrt vs json");
+}
+
+fn pixels(path: &Path) -> Vec<[f32; 3]> {
+    read_exr(path).unwrap().pixels().to_vec()
+}
+
+fn run_ok(cmd: &mut Command) -> String {
+    let out = cmd.output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(out.status.success(), "{cmd:?} failed: {stderr}");
+    stderr
+}
+
+#[test]
+fn import_then_render_equals_direct_render_bit_for_bit() {
+    let dir = tempfile::tempdir().unwrap();
+    for scene in ["scenes/import/cornell-box.xml", "scenes/import/room.pbrt"] {
+        let src = root().join(scene);
+        let json = dir.path().join("imported.json");
+        run_ok(prism().args(["import"]).arg(&src).arg("-o").arg(&json));
+        let via_json = dir.path().join("via-json.exr");
+        let direct = dir.path().join("direct.exr");
+        run_ok(
+            prism()
+                .arg("render")
+                .arg(&json)
+                .args(["--spp", "4", "--resolution", "48x48", "-o"])
+                .arg(&via_json),
+        );
+        run_ok(
+            prism()
+                .arg("render")
+                .arg(&src)
+                .args(["--spp", "4", "--resolution", "48x48", "-o"])
+                .arg(&direct),
+        );
+        let (a, b) = (pixels(&via_json), pixels(&direct));
+        assert_eq!(a.len(), 48 * 48);
+        assert!(
+            a.iter().flatten().any(|v| *v > 0.0),
+            "{scene}: a black image proves nothing"
+        );
+        assert_eq!(
+            a, b,
+            "{scene}: import → JSON → render differs from the direct render"
+        );
+    }
+    // The pbrt room's inline meshes went to imported-assets/ beside the JSON.
+    assert!(dir.path().join("imported-assets/mesh-1.obj").is_file());
+}
+
+#[test]
+fn mitsuba_defines_override_defaults() {
+    let dir = tempfile::tempdir().unwrap();
+    let json = dir.path().join("small.json");
+    run_ok(
+        prism()
+            .args(["import", "-D", "res=32", "-D", "spp=3"])
+            .arg(root().join("scenes/import/cornell-box.xml"))
+            .arg("-o")
+            .arg(&json),
+    );
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(v["film"]["resolution"], serde_json::json!([32, 32]));
+    assert_eq!(v["film"]["spp"], serde_json::json!(3));
+    // Prism's max_depth = Mitsuba's − 1.
+    assert_eq!(v["integrator"]["max_depth"], serde_json::json!(7));
+}
+
+#[test]
+fn malformed_scenes_get_positioned_errors() {
+    let cases = [
+        (
+            "unclosed-tag.xml",
+            "unclosed-tag.xml:4:5: malformed XML: expected 'shape' tag, not 'shap'",
+        ),
+        (
+            "undefined-param.xml",
+            "undefined-param.xml:4:13: attribute value=\"$res\": undefined parameter $res",
+        ),
+        (
+            "unknown-ref.xml",
+            "unknown-ref.xml:3:9: <ref id=\"whte\">: no object has this id (ids: white)",
+        ),
+        (
+            "bad-number.xml",
+            "bad-number.xml:3:9: parameter `radius`: expected a number, found \"one\"",
+        ),
+        (
+            "unterminated-string.pbrt",
+            "unterminated-string.pbrt:3:20: unterminated string",
+        ),
+        (
+            "unknown-directive.pbrt",
+            "unknown-directive.pbrt:3:3: unknown directive `Shpe`",
+        ),
+        (
+            "short-lookat.pbrt",
+            "short-lookat.pbrt:2:1: LookAt: expected 9 numbers, found `WorldBegin` after 8",
+        ),
+        (
+            "bad-type.pbrt",
+            "bad-type.pbrt:2:16: parameter \"real radius\": unknown type `real`",
+        ),
+        (
+            "missing-bracket.pbrt",
+            "missing-bracket.pbrt:2:33: unexpected end of file: expected values and `]`",
+        ),
+        (
+            "unbalanced.pbrt",
+            "unbalanced.pbrt:2:1: AttributeBegin without a matching AttributeEnd",
+        ),
+    ];
+    let dir = tempfile::tempdir().unwrap();
+    for (file, expected) in cases {
+        let out = prism()
+            .arg("import")
+            .arg(root().join("tests/fixtures/import").join(file))
+            .arg("-o")
+            .arg(dir.path().join("x.json"))
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{file}: accepted");
+        assert!(
+            stderr.contains(expected),
+            "{file}: expected `{expected}` in:\n{stderr}"
+        );
+        assert!(
+            !dir.path().join("x.json").exists(),
+            "{file}: wrote output despite the error"
+        );
+    }
+}
+
+#[test]
+fn what_is_not_imported_is_listed_once_per_kind_and_refused_with_strict() {
+    let dir = tempfile::tempdir().unwrap();
+    let src = root().join("tests/fixtures/import/unsupported.xml");
+    let json = dir.path().join("u.json");
+    let stderr = run_ok(prism().arg("import").arg(&src).arg("-o").arg(&json));
+    let warnings: Vec<&str> = stderr
+        .lines()
+        .filter(|l| l.starts_with("warning: "))
+        .collect();
+    assert!(
+        warnings[0].contains("unsupported.xml:2:5: bsdf type=\"hair\" (2 times)"),
+        "{stderr}"
+    );
+    assert!(
+        warnings
+            .iter()
+            .any(|w| w.contains("unsupported.xml:6:5: shape type=\"cylinder\"")),
+        "{stderr}"
+    );
+    assert!(
+        warnings
+            .iter()
+            .any(|w| w.contains("unsupported.xml:8:9: shape sphere: parameter `wobble`")),
+        "{stderr}"
+    );
+    assert_eq!(warnings.iter().filter(|w| w.contains("hair")).count(), 1);
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(
+        v["shapes"].as_array().unwrap().len(),
+        2,
+        "the cylinder is not imported, the spheres are"
+    );
+
+    let out = prism()
+        .arg("import")
+        .arg("--strict")
+        .arg(&src)
+        .arg("-o")
+        .arg(dir.path().join("s.json"))
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(
+        stderr.contains("unsupported.xml:2:5: not imported exactly (--strict)"),
+        "{stderr}"
+    );
+    assert!(!dir.path().join("s.json").exists());
+    // render refuses it too with --strict.
+    let out = prism()
+        .args(["render", "--strict"])
+        .arg(&src)
+        .arg("-o")
+        .arg(dir.path().join("s.exr"))
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+}
