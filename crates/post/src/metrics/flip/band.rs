@@ -21,6 +21,7 @@ use rayon::prelude::*;
 
 use super::colour::{filtered_to_hunt_lab, hyab, rgb_to_hunt_lab, rgb_to_ycxcz, ycxcz_grey};
 use super::kernels::Kernels;
+use super::pow::pow_non_negative;
 use super::Rows;
 
 /// Colour error exponent q_c, redistribution break p_c and target p_t (Andersson et al.
@@ -398,25 +399,45 @@ fn terms_row_any(
     }
 }
 
-/// One output row from both sides' terms: written, or with `keep_max` each value the
-/// larger of the old and the new.
-fn combine_row(r: &Side, t: &Side, cmax: f32, out: &mut [f32], keep_max: bool) {
+dispatch! {
+    /// One output row from both sides' terms (CIELAB l, a, b, edge, point of the
+    /// reference, then of the test): written, or with `keep_max` each value the larger of
+    /// the old and the new.
+    fn combine_row<>(
+        r: [&[f32]; 5],
+        t: [&[f32]; 5],
+        cmax: f32,
+        out: &mut [f32],
+        keep_max: bool,
+    ) => combine_row_any
+}
+
+#[inline(always)]
+fn combine_row_any(r: [&[f32]; 5], t: [&[f32]; 5], cmax: f32, out: &mut [f32], keep_max: bool) {
+    let n = out.len();
+    let [rl, ra, rb, re, rp] = r.map(|v| &v[..n]);
+    let [tl, ta, tb, te, tp] = t.map(|v| &v[..n]);
     let pccmax = PC * cmax;
-    for (x, o) in out.iter_mut().enumerate() {
-        let lab = |s: &Side| [s.lab[0][x], s.lab[1][x], s.lab[2][x]];
-        let de = hyab(lab(r), lab(t)).powf(QC);
+    for x in 0..n {
+        let de = pow_non_negative(hyab([rl[x], ra[x], rb[x]], [tl[x], ta[x], tb[x]]), QC);
         let colour = if de < pccmax {
             PT / pccmax * de
         } else {
             PT + (de - pccmax) / (cmax - pccmax) * (1.0 - PT)
         };
-        let feature_diff = (r.edge[x] - t.edge[x])
-            .abs()
-            .max((r.point[x] - t.point[x]).abs());
+        let feature_diff = (re[x] - te[x]).abs().max((rp[x] - tp[x]).abs());
         // (feature_diff / √2)^q_f with q_f = ½.
         let feature = (feature_diff / std::f32::consts::SQRT_2).sqrt();
-        let v = colour.powf(1.0 - feature);
-        *o = if keep_max { o.max(v) } else { v };
+        let v = pow_non_negative(colour, 1.0 - feature);
+        out[x] = if keep_max { out[x].max(v) } else { v };
+    }
+}
+
+impl Side {
+    /// The terms [`combine_row`] reads.
+    fn terms(&self) -> [&[f32]; 5] {
+        let [l, a, b] = &self.lab;
+        [l, a, b, &self.edge, &self.point]
     }
 }
 
@@ -452,7 +473,7 @@ pub(super) fn flip_map_into<T: Fn([f32; 3]) -> [f32; 3] + Sync>(
                 for (i, out) in out.chunks_exact_mut(w).enumerate() {
                     r.filter_row(simd, f, w, i);
                     t.filter_row(simd, f, w, i);
-                    combine_row(&r, &t, cmax, out, e > 0);
+                    combine_row(simd, r.terms(), t.terms(), cmax, out, e > 0);
                 }
             }
         });

@@ -18,6 +18,7 @@ mod band;
 mod colour;
 pub mod exposure;
 mod kernels;
+mod pow;
 
 use crate::falsecolour::{false_colour, FalseColourOptions, FalseColourScale, Palette};
 use prism_image::{Image, ImageError, Result};
