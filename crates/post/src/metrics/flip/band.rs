@@ -36,6 +36,41 @@ pub(super) const BAND_ROWS: usize = 64;
 /// Pixels summed at once in [`correlate`]: one AVX-512 register, two AVX2 ones.
 const LANES: usize = 16;
 
+/// Defines `$name(simd, args)`: `$body_fn(args)` compiled for the widest ISA `simd`
+/// allows. The same operations run at every ISA (no fused multiply-adds), so the bits
+/// are the same; `$body_fn` must be `#[inline(always)]`.
+macro_rules! dispatch {
+    ($(#[$doc:meta])* fn $name:ident <$($g:ident: $bound:path),*> ($($arg:ident: $ty:ty),* $(,)?) => $body_fn:ident) => {
+        $(#[$doc])*
+        #[allow(clippy::too_many_arguments)]
+        fn $name<$($g: $bound),*>(simd: Simd, $($arg: $ty),*) {
+            #[cfg(target_arch = "x86_64")]
+            {
+                #[target_feature(enable = "avx512f,avx512dq,avx512vl,avx512bw,avx2,fma")]
+                #[allow(clippy::too_many_arguments)]
+                unsafe fn avx512<$($g: $bound),*>($($arg: $ty),*) {
+                    $body_fn($($arg),*)
+                }
+                #[target_feature(enable = "avx2,fma")]
+                #[allow(clippy::too_many_arguments)]
+                unsafe fn avx2<$($g: $bound),*>($($arg: $ty),*) {
+                    $body_fn($($arg),*)
+                }
+                if simd.avx512() {
+                    // SAFETY: a `Simd` allows AVX-512 only on a CPU that has it.
+                    return unsafe { avx512($($arg),*) };
+                }
+                if simd.avx2() {
+                    // SAFETY: a `Simd` allows AVX2 only on a CPU that has it.
+                    return unsafe { avx2($($arg),*) };
+                }
+            }
+            let _ = simd;
+            $body_fn($($arg),*)
+        }
+    };
+}
+
 /// The largest colour error: HyAB between Hunt-adjusted green and blue, to the power q_c.
 fn c_max() -> f32 {
     hyab(
@@ -59,7 +94,7 @@ impl Folded {
     /// `None` unless `k` is exactly symmetric or antisymmetric about its centre.
     pub(super) fn new(k: &[f32]) -> Option<Self> {
         let r = k.len() / 2;
-        if k.len() % 2 == 0 {
+        if k.len().is_multiple_of(2) {
             return None;
         }
         let symmetric = (1..=r).all(|t| k[r - t] == k[r + t]);
@@ -158,6 +193,91 @@ fn correlate_folded<const ODD: bool>(
     }
 }
 
+/// [`correlate`] of one source with `N` kernels of one radius at once: each pair of
+/// source samples is read once for all of them. Each output gets exactly the operations
+/// [`correlate`] would give it.
+#[inline(always)]
+fn correlate_many<const N: usize>(
+    s: &[f32],
+    c: usize,
+    stride: usize,
+    ks: [&Folded; N],
+    outs: [&mut [f32]; N],
+) {
+    let r = ks[0].radius();
+    assert!(ks.iter().all(|k| k.radius() == r), "kernels of one radius");
+    let n = outs[0].len();
+    let mut outs = outs;
+    let mut x = 0;
+    while x + LANES <= n {
+        let centre: &[f32; LANES] = s[c + x..c + x + LANES].try_into().unwrap();
+        let mut acc = [[0.0f32; LANES]; N];
+        for (a, k) in acc.iter_mut().zip(&ks) {
+            if !k.antisymmetric {
+                *a = centre.map(|v| k.centre * v);
+            }
+        }
+        for t in 0..r {
+            let d = (t + 1) * stride;
+            let a: &[f32; LANES] = s[c + x + d..c + x + d + LANES].try_into().unwrap();
+            let b: &[f32; LANES] = s[c + x - d..c + x - d + LANES].try_into().unwrap();
+            let mut sum = [0.0f32; LANES];
+            let mut diff = [0.0f32; LANES];
+            for j in 0..LANES {
+                sum[j] = a[j] + b[j];
+                diff[j] = a[j] - b[j];
+            }
+            for (acc, k) in acc.iter_mut().zip(&ks) {
+                let (kt, v) = (k.taps[t], if k.antisymmetric { &diff } else { &sum });
+                for j in 0..LANES {
+                    acc[j] += kt * v[j];
+                }
+            }
+        }
+        for (o, a) in outs.iter_mut().zip(&acc) {
+            o[x..x + LANES].copy_from_slice(a);
+        }
+        x += LANES;
+    }
+    for x in x..n {
+        for (o, k) in outs.iter_mut().zip(&ks) {
+            let mut acc = if k.antisymmetric {
+                0.0
+            } else {
+                k.centre * s[c + x]
+            };
+            for (t, &kt) in k.taps.iter().enumerate() {
+                let d = (t + 1) * stride;
+                let (a, b) = (s[c + x + d], s[c + x - d]);
+                acc += kt * if k.antisymmetric { a - b } else { a + b };
+            }
+            o[x] = acc;
+        }
+    }
+}
+
+dispatch! {
+    /// [`correlate_many`] with two kernels.
+    fn correlate2<>(
+        s: &[f32],
+        c: usize,
+        stride: usize,
+        ks: [&Folded; 2],
+        outs: [&mut [f32]; 2],
+    ) => correlate_many
+}
+
+dispatch! {
+    /// [`correlate_many`] with three kernels.
+    fn correlate3<>(
+        s: &[f32],
+        c: usize,
+        stride: usize,
+        ks: [&Folded; 3],
+        outs: [&mut [f32]; 3],
+    ) => correlate_many
+}
+
 /// The filters of [`Kernels`], folded.
 pub(super) struct Filters {
     halo: usize,
@@ -247,17 +367,30 @@ impl Side {
         let c = (i + halo) * w;
         let [py, pcx, pcz, pg] = &self.planes;
         let [vy, vcx, vcz1, vcz2, vg, vd1, vd2] = &mut self.vertical;
-        let jobs: [(&[f32], &Folded, &mut Vec<f32>); 7] = [
-            (py, &f.y, vy),
-            (pcx, &f.cx, vcx),
-            (pcz, &f.cz1, vcz1),
-            (pcz, &f.cz2, vcz2),
-            (pg, &f.gauss, vg),
-            (pg, &f.d1, vd1),
-            (pg, &f.d2, vd2),
-        ];
-        for (plane, k, row) in jobs {
-            correlate(simd, plane, c, w, k, &mut row[halo..halo + w]);
+        let inner = halo..halo + w;
+        correlate(simd, py, c, w, &f.y, &mut vy[inner.clone()]);
+        correlate(simd, pcx, c, w, &f.cx, &mut vcx[inner.clone()]);
+        correlate2(
+            simd,
+            pcz,
+            c,
+            w,
+            [&f.cz1, &f.cz2],
+            [&mut vcz1[inner.clone()], &mut vcz2[inner.clone()]],
+        );
+        correlate3(
+            simd,
+            pg,
+            c,
+            w,
+            [&f.gauss, &f.d1, &f.d2],
+            [
+                &mut vg[inner.clone()],
+                &mut vd1[inner.clone()],
+                &mut vd2[inner],
+            ],
+        );
+        for row in &mut self.vertical {
             // Clamp-to-edge padding commutes with the separable filter.
             let (left, right) = (row[halo], row[halo + w - 1]);
             row[..halo].fill(left);
@@ -266,60 +399,19 @@ impl Side {
         let [vy, vcx, vcz1, vcz2, vg, vd1, vd2] = &self.vertical;
         let [hy, hcx, hcz1, hcz2, ex, ey, px, py] = &mut self.horizontal;
         // Edges: ∂x = d1 ⊗ g, ∂y = g ⊗ d1; points likewise with d2.
-        let jobs: [(&[f32], &Folded, &mut Vec<f32>); 8] = [
-            (vy, &f.y, hy),
-            (vcx, &f.cx, hcx),
-            (vcz1, &f.cz1, hcz1),
-            (vcz2, &f.cz2, hcz2),
-            (vg, &f.d1, ex),
-            (vd1, &f.gauss, ey),
-            (vg, &f.d2, px),
-            (vd2, &f.gauss, py),
-        ];
-        for (row, k, out) in jobs {
-            correlate(simd, row, halo, 1, k, out);
-        }
+        correlate(simd, vy, halo, 1, &f.y, hy);
+        correlate(simd, vcx, halo, 1, &f.cx, hcx);
+        correlate(simd, vcz1, halo, 1, &f.cz1, hcz1);
+        correlate(simd, vcz2, halo, 1, &f.cz2, hcz2);
+        correlate2(simd, vg, halo, 1, [&f.d1, &f.d2], [ex, px]);
+        correlate(simd, vd1, halo, 1, &f.gauss, ey);
+        correlate(simd, vd2, halo, 1, &f.gauss, py);
         let [l, a, b] = &mut self.lab;
         let (edge, point) = (&mut self.edge, &mut self.point);
         terms_row(
             simd, hy, hcx, hcz1, hcz2, ex, ey, px, py, l, a, b, edge, point,
         );
     }
-}
-
-/// Defines `$name(simd, args)`: `$body_fn(args)` compiled for the widest ISA `simd`
-/// allows. The same operations run at every ISA (no fused multiply-adds), so the bits
-/// are the same; `$body_fn` must be `#[inline(always)]`.
-macro_rules! dispatch {
-    ($(#[$doc:meta])* fn $name:ident <$($g:ident: $bound:path),*> ($($arg:ident: $ty:ty),* $(,)?) => $body_fn:ident) => {
-        $(#[$doc])*
-        #[allow(clippy::too_many_arguments)]
-        fn $name<$($g: $bound),*>(simd: Simd, $($arg: $ty),*) {
-            #[cfg(target_arch = "x86_64")]
-            {
-                #[target_feature(enable = "avx512f,avx512dq,avx512vl,avx512bw,avx2,fma")]
-                #[allow(clippy::too_many_arguments)]
-                unsafe fn avx512<$($g: $bound),*>($($arg: $ty),*) {
-                    $body_fn($($arg),*)
-                }
-                #[target_feature(enable = "avx2,fma")]
-                #[allow(clippy::too_many_arguments)]
-                unsafe fn avx2<$($g: $bound),*>($($arg: $ty),*) {
-                    $body_fn($($arg),*)
-                }
-                if simd.avx512() {
-                    // SAFETY: a `Simd` allows AVX-512 only on a CPU that has it.
-                    return unsafe { avx512($($arg),*) };
-                }
-                if simd.avx2() {
-                    // SAFETY: a `Simd` allows AVX2 only on a CPU that has it.
-                    return unsafe { avx2($($arg),*) };
-                }
-            }
-            let _ = simd;
-            $body_fn($($arg),*)
-        }
-    };
 }
 
 dispatch! {
