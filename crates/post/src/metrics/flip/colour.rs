@@ -32,22 +32,35 @@ const XYZ_TO_RGB: [[f32; 3]; 3] = [
 /// The white (RGB (1, 1, 1)) in XYZ: the reference white of YyCxCz and CIELAB.
 const WHITE_XYZ: [f32; 3] = [23359437.0 / 24577794.0, 1.0, 80288307.0 / 73733382.0];
 
+/// `[f(v₀), f(v₁), f(v₂)]`, always inlined (`<[T; 3]>::map` may not be, which keeps the
+/// per-pixel loops that call it from being vectorised).
+#[inline(always)]
+pub(super) fn map3<T: Copy, U>(v: [T; 3], f: impl Fn(T) -> U) -> [U; 3] {
+    [f(v[0]), f(v[1]), f(v[2])]
+}
+
+#[inline(always)]
 fn mul(m: &[[f32; 3]; 3], v: [f32; 3]) -> [f32; 3] {
-    [0, 1, 2].map(|r| m[r][0] * v[0] + m[r][1] * v[1] + m[r][2] * v[2])
+    map3([0, 1, 2], |r| {
+        m[r][0] * v[0] + m[r][1] * v[1] + m[r][2] * v[2]
+    })
 }
 
 /// Linear RGB → YyCxCz: Yy = 116 Y/Yn − 16, Cx = 500 (X/Xn − Y/Yn), Cz = 200 (Y/Yn − Z/Zn).
+#[inline(always)]
 pub(super) fn rgb_to_ycxcz(rgb: [f32; 3]) -> [f32; 3] {
     let xyz = mul(&RGB_TO_XYZ, rgb);
-    let [x, y, z] = [0, 1, 2].map(|c| xyz[c] / WHITE_XYZ[c]);
+    let [x, y, z] = map3([0, 1, 2], |c| xyz[c] / WHITE_XYZ[c]);
     [116.0 * y - 16.0, 500.0 * (x - y), 200.0 * (y - z)]
 }
 
 /// The achromatic channel of YyCxCz on [0, 1] (Y / Yn): what the feature detectors see.
+#[inline(always)]
 pub(super) fn ycxcz_grey(yy: f32) -> f32 {
     (yy + 16.0) / 116.0
 }
 
+#[inline(always)]
 fn ycxcz_to_rgb(c: [f32; 3]) -> [f32; 3] {
     let y = ycxcz_grey(c[0]);
     let xyz = [
@@ -61,6 +74,7 @@ fn ycxcz_to_rgb(c: [f32; 3]) -> [f32; 3] {
 /// ∛t for t > 0 without a libm call (the per-pixel colour conversion's hot spot): a
 /// bit-level first guess (within ~5 %) and two Halley steps, each cubing the relative
 /// error, to f32 rounding.
+#[inline(always)]
 fn cbrt_positive(t: f32) -> f32 {
     let mut y = f32::from_bits(t.to_bits() / 3 + 0x2A51_37A0);
     for _ in 0..2 {
@@ -70,6 +84,7 @@ fn cbrt_positive(t: f32) -> f32 {
     y
 }
 
+#[inline(always)]
 fn lab_f(t: f32) -> f32 {
     const DELTA: f32 = 6.0 / 29.0;
     if t > DELTA * DELTA * DELTA {
@@ -80,9 +95,10 @@ fn lab_f(t: f32) -> f32 {
 }
 
 /// Linear RGB → CIELAB (white = RGB (1, 1, 1)) with the Hunt adjustment a, b ← 0.01 L a, b.
+#[inline(always)]
 pub(super) fn rgb_to_hunt_lab(rgb: [f32; 3]) -> [f32; 3] {
     let xyz = mul(&RGB_TO_XYZ, rgb);
-    let [fx, fy, fz] = [0, 1, 2].map(|c| lab_f(xyz[c] / WHITE_XYZ[c]));
+    let [fx, fy, fz] = map3([0, 1, 2], |c| lab_f(xyz[c] / WHITE_XYZ[c]));
     let l = 116.0 * fy - 16.0;
     [
         l,
@@ -93,11 +109,13 @@ pub(super) fn rgb_to_hunt_lab(rgb: [f32; 3]) -> [f32; 3] {
 
 /// A filtered YyCxCz colour → linear RGB clamped to the unit cube (the filtered colour may
 /// leave it) → Hunt-adjusted CIELAB.
+#[inline(always)]
 pub(super) fn filtered_to_hunt_lab(c: [f32; 3]) -> [f32; 3] {
-    rgb_to_hunt_lab(ycxcz_to_rgb(c).map(|v| v.clamp(0.0, 1.0)))
+    rgb_to_hunt_lab(map3(ycxcz_to_rgb(c), |v| v.clamp(0.0, 1.0)))
 }
 
 /// HyAB distance (Abasi et al. 2020): |ΔL| + ‖(Δa, Δb)‖.
+#[inline(always)]
 pub(super) fn hyab(p: [f32; 3], q: [f32; 3]) -> f32 {
     let (da, db) = (p[1] - q[1], p[2] - q[2]);
     // No overflow or underflow to guard against at CIELAB magnitudes: plain sqrt, not hypot.

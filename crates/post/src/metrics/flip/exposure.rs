@@ -69,6 +69,7 @@ pub fn luminance(p: [f32; 3]) -> f64 {
 }
 
 /// The ACES fit clamped to [0, 1].
+#[inline(always)]
 pub(super) fn aces(x: f32) -> f32 {
     let x2 = x * x;
     if !x2.is_finite() {

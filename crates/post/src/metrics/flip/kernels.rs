@@ -85,7 +85,13 @@ impl Kernels {
             .map(|x| (-x * x / (2.0 * sd * sd)).exp())
             .collect();
         let g_sum: f64 = g.iter().sum();
-        let d1 = balance(xs.iter().zip(&g).map(|(x, g)| -x * g).collect());
+        let mut d1 = balance(xs.iter().zip(&g).map(|(x, g)| -x * g).collect());
+        // The positive and negative sums of the odd d1 are equal but summed in different
+        // orders: mirror the right half so the kernel is exactly antisymmetric (the band
+        // filters fold it, `band::Folded`).
+        for t in 1..=fr {
+            d1[fr - t] = -d1[fr + t];
+        }
         let d2 = balance(
             xs.iter()
                 .zip(&g)

@@ -18,12 +18,16 @@ mod band;
 mod colour;
 pub mod exposure;
 mod kernels;
+mod pow;
 
 use crate::falsecolour::{false_colour, FalseColourOptions, FalseColourScale, Palette};
 use prism_image::{Image, ImageError, Result};
 
+use band::Filters;
+use colour::map3;
 pub use exposure::ExposureRange;
 use kernels::Kernels;
+use prism_cpu::Simd;
 
 /// The reference implementation's default viewing condition: 3840 px across 0.7 m, seen
 /// from 0.7 m, in pixels per degree.
@@ -102,6 +106,7 @@ fn check(test: &[[f32; 3]], reference: &[[f32; 3]], w: usize, h: usize, ppd: f64
 }
 
 /// Non-finite → black (the caller counts them as every metric does).
+#[inline(always)]
 fn finite_or_black(p: [f32; 3]) -> [f32; 3] {
     if p.iter().all(|v| v.is_finite()) {
         p
@@ -111,8 +116,9 @@ fn finite_or_black(p: [f32; 3]) -> [f32; 3] {
 }
 
 /// HDR-FLIP's view of a sample: non-finite → black, negatives → 0.
+#[inline(always)]
 fn hdr_clean(p: [f32; 3]) -> [f32; 3] {
-    finite_or_black(p).map(|v| v.max(0.0))
+    map3(finite_or_black(p), |v| v.max(0.0))
 }
 
 /// The samples below 0 in `test` and `reference`, which HDR-FLIP clamps to 0.
@@ -152,22 +158,30 @@ impl<'a> Rows<'a> {
 /// LDR-FLIP and HDR-FLIP maps for bands of rows, at one viewing condition: what
 /// [`ldr_flip`] and [`hdr_flip`] compute, a strip of rows at a time.
 pub(crate) struct FlipRows {
-    kernels: Kernels,
+    filters: Filters,
+    simd: Simd,
+}
+
+/// LDR-FLIP's view of a sample: non-finite → black, clipped to [0, 1].
+#[inline(always)]
+fn ldr_clip(p: [f32; 3]) -> [f32; 3] {
+    map3(finite_or_black(p), |v| v.clamp(0.0, 1.0))
 }
 
 impl FlipRows {
-    /// For `ppd` pixels per degree (checked by the caller, [`check_ppd`]).
+    /// For `ppd` pixels per degree (checked by the caller, [`check_ppd`]), with the
+    /// filter kernels of the process-wide ISA (`prism_cpu::active`; every ISA gives the
+    /// same bits).
     pub(crate) fn new(ppd: f64) -> Self {
         Self {
-            kernels: Kernels::new(ppd),
+            filters: Filters::new(&Kernels::new(ppd)),
+            simd: prism_cpu::active(),
         }
     }
 
     /// Rows above and below a band that its filters read.
     pub(crate) fn halo_rows(&self) -> usize {
-        self.kernels
-            .spatial_radius_px
-            .max(self.kernels.feature_radius_px)
+        self.filters.halo()
     }
 
     /// LDR-FLIP of the image rows from `first_row` that `out` covers; `test` and
@@ -180,16 +194,15 @@ impl FlipRows {
         first_row: usize,
         out: &mut [f32],
     ) {
-        let clip = |p: [f32; 3]| finite_or_black(p).map(|v| v.clamp(0.0, 1.0));
         band::flip_map_into(
             test,
             reference,
             size,
             first_row,
-            &self.kernels,
-            &clip,
+            &self.filters,
+            &[ldr_clip],
             out,
-            false,
+            self.simd,
         );
     }
 
@@ -203,20 +216,22 @@ impl FlipRows {
         first_row: usize,
         out: &mut [f32],
     ) {
-        for i in 0..exposures.count {
-            let scale = exposures.stops(i).exp2() as f32;
-            let tone = |p: [f32; 3]| hdr_clean(p).map(|v| exposure::aces(v * scale));
-            band::flip_map_into(
-                test,
-                reference,
-                size,
-                first_row,
-                &self.kernels,
-                &tone,
-                out,
-                i > 0,
-            );
-        }
+        let tones: Vec<_> = (0..exposures.count)
+            .map(|i| {
+                let scale = exposures.stops(i).exp2() as f32;
+                move |p: [f32; 3]| map3(hdr_clean(p), |v| exposure::aces(v * scale))
+            })
+            .collect();
+        band::flip_map_into(
+            test,
+            reference,
+            size,
+            first_row,
+            &self.filters,
+            &tones,
+            out,
+            self.simd,
+        );
     }
 }
 
@@ -230,17 +245,8 @@ pub fn ldr_flip(
 ) -> Result<FlipMap> {
     check(test, reference, w, h, ppd)?;
     let mut values = vec![0.0f32; w * h];
-    let clip = |p: [f32; 3]| finite_or_black(p).map(|v| v.clamp(0.0, 1.0));
-    band::flip_map_into(
-        Rows::new(test, 0),
-        Rows::new(reference, 0),
-        (w, h),
-        0,
-        &Kernels::new(ppd),
-        &clip,
-        &mut values,
-        false,
-    );
+    let (test, reference) = (Rows::new(test, 0), Rows::new(reference, 0));
+    FlipRows::new(ppd).ldr(test, reference, (w, h), 0, &mut values);
     Ok(FlipMap {
         width: w,
         height: h,
