@@ -181,18 +181,19 @@ impl Drop for DoneOnDrop<'_> {
     }
 }
 
-/// `render(scene, spp=None, seed=None, threads=None, resolution=None, spectral_bins=None,
+/// `render(scene, spp=None, seed=0, threads=None, resolution=None, spectral_bins=None,
 /// progress=None, base_dir=None)`.
 ///
 /// `scene`: a path or a dict in the JSON schema (docs/scene-format.md; relative asset paths
-/// of a dict resolve against `base_dir`, default the current directory). `spp`, `seed`:
-/// default the scene's `film.spp` and `film.seed`, as in the CLI. `resolution`: (width,
+/// of a dict resolve against `base_dir`, default the current directory). `spp`: default the
+/// scene's `film.spp`, as in the CLI. `seed`: the sampler's seed, 0 unless given (`None`:
+/// the scene's `film.seed`, as the CLI without `--seed`). `resolution`: (width,
 /// height). `spectral_bins`: N equal bins over 360–830 nm in `.spectral`. `progress`:
 /// called as `progress(samples_done, samples_total)` about ten times a second (an
 /// exception from it stops the render and is raised). Ctrl-C stops the render and raises
 /// KeyboardInterrupt.
 #[pyfunction]
-#[pyo3(signature = (scene, spp=None, seed=None, threads=None, resolution=None, spectral_bins=None, progress=None, base_dir=None))]
+#[pyo3(signature = (scene, spp=None, seed=Some(0), threads=None, resolution=None, spectral_bins=None, progress=None, base_dir=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn render(
     py: Python<'_>,

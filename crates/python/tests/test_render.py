@@ -52,8 +52,11 @@ def test_dict_scene_equals_the_file(root):
     from_file = prism.render(root / SCENE, **SMALL)
     assert np.array_equal(from_dict.rgb, from_file.rgb)
     scene["film"]["seed"] = 1
-    other = prism.render(scene, base_dir=root / "scenes", **SMALL)
+    # seed=None takes the scene's film.seed; the default seed is 0 whatever the scene says.
+    other = prism.render(scene, base_dir=root / "scenes", seed=None, **SMALL)
     assert not np.array_equal(other.rgb, from_file.rgb)
+    default = prism.render(scene, base_dir=root / "scenes", **SMALL)
+    assert np.array_equal(default.rgb, from_file.rgb)
 
 
 def test_progress_reaches_the_total(root):
