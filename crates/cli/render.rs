@@ -277,14 +277,6 @@ pub(crate) fn to_image(film: &FilmImage) -> Result<Image, String> {
     Ok(image)
 }
 
-/// Peak resident set size (VmHWM in /proc/self/status), bytes; `None` off Linux.
-fn peak_memory_bytes() -> Option<u64> {
-    let status = std::fs::read_to_string("/proc/self/status").ok()?;
-    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
-    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kib * 1024)
-}
-
 pub fn run(args: &RenderArgs, budget: &MemoryBudget) -> Result<ExitCode, String> {
     args.simd.apply()?;
     args.plan.check()?;
@@ -740,7 +732,8 @@ fn render_adaptive(
         measure_and_write_sensors(args, pool, scene, &description.sensors, settings, output)?;
     }
     if let Some(path) = &args.stats_json {
-        let value = stats_value(scene, settings, threads, wall_time_s, &stats);
+        let value =
+            prism_render::stats_json::stats_json(scene, settings, threads, wall_time_s, &stats);
         write_json(path, &value)?;
     }
     report_medium_mismatches(args, &stats);
@@ -756,34 +749,6 @@ fn render_adaptive(
     Ok(())
 }
 
-fn stats_value(
-    scene: &RenderScene,
-    settings: &RenderSettings,
-    threads: usize,
-    wall_time_s: f64,
-    stats: &RenderStats,
-) -> serde_json::Value {
-    json!({
-        "wall_time_s": wall_time_s,
-        "rays_traced": stats.rays_traced,
-        "rays_per_second": stats.rays_traced as f64 / wall_time_s.max(1e-9),
-        "samples": stats.samples,
-        "peak_memory_bytes": peak_memory_bytes(),
-        "resolution": [scene.resolution.x, scene.resolution.y],
-        "spp": settings.spp,
-        "threads": threads,
-        "integrator": scene.integrator.name(),
-        "non_finite_samples": stats.non_finite_samples,
-        "non_finite_contributions": stats.non_finite_contributions,
-        "bounces": stats.bounces,
-        "roulette_terminations": stats.roulette_terminations,
-        "light_paths": stats.light_paths,
-        "medium_mismatches": stats.medium_mismatches,
-        // The fast paths' ISA (`--explain` says why).
-        "simd": prism_cpu::active().isa().name(),
-    })
-}
-
 /// The statistics of a (possibly partial or resumed) render: the common ones, and the
 /// sample range with the time spent on it in this run and in earlier runs.
 fn write_stats(
@@ -793,7 +758,7 @@ fn write_stats(
     threads: usize,
     rendered: &crate::partial::job::Rendered,
 ) -> Result<(), String> {
-    let mut value = stats_value(
+    let mut value = prism_render::stats_json::stats_json(
         scene,
         settings,
         threads,

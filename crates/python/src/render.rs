@@ -24,7 +24,7 @@ use prism_render::integrator::{Pass, DEFAULT_TILE_SIZE_PX};
 use prism_render::sensor::{measure_sensors, SensorReading};
 use prism_render::{
     film_for, render_pass_controlled, FilmImage, PassControl, PassOutcome, RenderScene,
-    RenderSettings, RenderStats, SamplerKind, SpectralBins,
+    RenderSettings, SamplerKind, SpectralBins,
 };
 use prism_scene::SceneDescription;
 use pyo3::exceptions::PyUserWarning;
@@ -349,7 +349,7 @@ pub fn render(
             })
         })
     };
-    let stats = stats_value(
+    let stats = prism_render::stats_json::stats_json(
         &render_scene,
         &settings,
         thread_count,
@@ -357,43 +357,6 @@ pub fn render(
         &outcome.stats,
     );
     build_result(py, &image, &stats, &readings)
-}
-
-/// The object `prism render --stats-json` writes (without the sample ranges of partial
-/// renders, which Python renders do not make).
-fn stats_value(
-    scene: &RenderScene,
-    settings: &RenderSettings,
-    threads: usize,
-    wall_time_s: f64,
-    stats: &RenderStats,
-) -> serde_json::Value {
-    serde_json::json!({
-        "wall_time_s": wall_time_s,
-        "rays_traced": stats.rays_traced,
-        "rays_per_second": stats.rays_traced as f64 / wall_time_s.max(1e-9),
-        "samples": stats.samples,
-        "peak_memory_bytes": peak_memory_bytes(),
-        "resolution": [scene.resolution.x, scene.resolution.y],
-        "spp": settings.spp,
-        "threads": threads,
-        "integrator": scene.integrator.name(),
-        "non_finite_samples": stats.non_finite_samples,
-        "non_finite_contributions": stats.non_finite_contributions,
-        "bounces": stats.bounces,
-        "roulette_terminations": stats.roulette_terminations,
-        "light_paths": stats.light_paths,
-        "medium_mismatches": stats.medium_mismatches,
-        "simd": prism_cpu::active().isa().name(),
-    })
-}
-
-/// Peak resident set size (VmHWM in /proc/self/status), bytes; `None` off Linux.
-fn peak_memory_bytes() -> Option<u64> {
-    let status = std::fs::read_to_string("/proc/self/status").ok()?;
-    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
-    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kib * 1024)
 }
 
 /// One layer being assembled: name, channel names, one plane per channel.

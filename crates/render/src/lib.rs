@@ -30,6 +30,7 @@ pub mod sampling;
 pub mod scene_build;
 pub mod sensor;
 pub mod spectrum_cache;
+pub mod stats_json;
 pub mod texture;
 
 pub use camera::{
