@@ -143,6 +143,23 @@ fn photon_progressive_converges_to_the_airlight() {
 /// Le of the furnace's wall.
 const LE: f64 = 2.0;
 
+/// The furnace: a camera in the medium `medium` (JSON) filling a closed black sphere of
+/// radius 1 m whose wall emits `LE` on both sides, rendered by `integrator` (JSON).
+fn furnace_json(integrator: &str, medium: &str) -> String {
+    format!(
+        r#"{{
+  "camera": {{"type": "pinhole", "fov_deg": 20, "medium": "fog",
+              "transform": {{"look_at": {{"eye": [0, 0, 0.2], "target": [0, 0, -1], "up": [0, 1, 0]}}}}}},
+  "film": {{"resolution": [4, 4], "filter": {{"type": "box", "radius_px": 0.5}}}},
+  "integrator": {integrator},
+  "media": {{"fog": {medium}}},
+  "materials": {{"black": {{"type": "lambert", "reflectance": 0}}}},
+  "shapes": [{{"type": "sphere", "name": "wall", "radius_m": 1, "material": "black", "interior_medium": "fog"}}],
+  "lights": [{{"type": "area", "shape": "wall", "two_sided": true, "spectrum": 1, "scale": {LE}}}]
+}}"#
+    )
+}
+
 /// Issue 20 test 3 for both photon integrators: a camera inside a closed black sphere
 /// that emits Le, filled with a non-absorbing medium (spectral σs 1–20 m⁻¹, g 0.8): the
 /// beam estimate plus the attenuated wall give Le. The central pixels look at the wall
@@ -159,19 +176,10 @@ fn photon_integrators_in_the_furnace() {
         r#"{"type": "photon", "max_depth": 2000, "rr_depth": 2000, "photons_per_pass": 2000, "radius_m": 0.3}"#,
         r#"{"type": "photon_progressive", "max_depth": 2000, "rr_depth": 2000, "photons_per_pass": 2000, "initial_radius_m": 0.35}"#,
     ] {
-        let json = format!(
-            r#"{{
-  "camera": {{"type": "pinhole", "fov_deg": 20, "medium": "fog",
-              "transform": {{"look_at": {{"eye": [0, 0, 0.2], "target": [0, 0, -1], "up": [0, 1, 0]}}}}}},
-  "film": {{"resolution": [4, 4], "filter": {{"type": "box", "radius_px": 0.5}}}},
-  "integrator": {integrator},
-  "media": {{"fog": {{"sigma_s_per_m": "sigma_s.csv", "phase": {{"type": "hg", "g": 0.8}}}}}},
-  "materials": {{"black": {{"type": "lambert", "reflectance": 0}}}},
-  "shapes": [{{"type": "sphere", "name": "wall", "radius_m": 1, "material": "black", "interior_medium": "fog"}}],
-  "lights": [{{"type": "area", "shape": "wall", "two_sided": true, "spectrum": 1, "scale": {LE}}}]
-}}"#
-        );
-        let scene = dir.scene(&json);
+        let scene = dir.scene(&furnace_json(
+            integrator,
+            r#"{"sigma_s_per_m": "sigma_s.csv", "phase": {"type": "hg", "g": 0.8}}"#,
+        ));
         let means = pass_means(&scene, 400, 3, (0, 0, 4, 4));
         assert_close(scene.integrator.name(), mean_se(&means), LE, 0.0, 1e-2 * LE);
     }
@@ -223,19 +231,7 @@ fn photon_integrators_in_an_emissive_furnace() {
             ),
         ),
     ] {
-        let json = format!(
-            r#"{{
-  "camera": {{"type": "pinhole", "fov_deg": 20, "medium": "fog",
-              "transform": {{"look_at": {{"eye": [0, 0, 0.2], "target": [0, 0, -1], "up": [0, 1, 0]}}}}}},
-  "film": {{"resolution": [4, 4], "filter": {{"type": "box", "radius_px": 0.5}}}},
-  "integrator": {integrator},
-  "media": {{"fog": {medium}}},
-  "materials": {{"black": {{"type": "lambert", "reflectance": 0}}}},
-  "shapes": [{{"type": "sphere", "name": "wall", "radius_m": 1, "material": "black", "interior_medium": "fog"}}],
-  "lights": [{{"type": "area", "shape": "wall", "two_sided": true, "spectrum": 1, "scale": {LE}}}]
-}}"#
-        );
-        let scene = dir.scene(&json);
+        let scene = dir.scene(&furnace_json(integrator, &medium));
         let means = pass_means(&scene, 1600, 5, (0, 0, 4, 4));
         let what = format!(
             "{} in {}",
