@@ -32,6 +32,7 @@ const DECISIONS: &[(&str, bool, bool, &[SceneFeature])] = {
         ("daylight-room.json", false, true, &[ThinGlazing, NonLambertianBsdfs, InfiniteLights]),
         ("fluorescence.json", false, true, &[DeltaLights, Reradiation]),
         ("glossy-env.json", false, true, &[Dispersion, NonLambertianBsdfs, Quadrics, InfiniteLights]),
+        ("import/room.json", false, true, &[NonLambertianBsdfs, Quadrics, InfiniteLights]),
         ("material-gallery.json", false, true, &[ThinGlazing, NonLambertianBsdfs, Quadrics, InfiniteLights]),
         ("merl/sources.json", false, true, &[NonLambertianBsdfs, Quadrics]),
         ("minimal.json", false, false, &[DiagnosticIntegrator, Quadrics]),
