@@ -74,13 +74,20 @@ def long_render(root, progress=None):
 
 
 def test_ctrl_c_stops_the_render_and_raises_keyboard_interrupt(root):
-    timer = threading.Timer(0.5, _thread.interrupt_main)
-    start = time.monotonic()
-    timer.start()
+    # Ctrl-C as the signal handler sees it (`interrupt_main`), sent once samples are being
+    # rendered: from the progress callback, so that it lands while the render runs whatever
+    # the machine's load (a 0.5 s timer once landed outside the render on a busy CI machine).
+    sent = []
+
+    def interrupt_once(done, total):
+        if done > 0 and not sent:
+            sent.append(time.monotonic())
+            _thread.interrupt_main()
+
     with pytest.raises(KeyboardInterrupt):
-        long_render(root)
-    elapsed = time.monotonic() - start
-    timer.join()
+        long_render(root, progress=interrupt_once)
+    assert sent, "the render never reported progress"
+    elapsed = time.monotonic() - sent[0]
     # The items in flight when Ctrl-C comes finish first (a few seconds at most).
     assert elapsed < 15, elapsed
 
