@@ -353,18 +353,8 @@ pub fn run(args: &RenderArgs, budget: &MemoryBudget) -> Result<ExitCode, String>
             .unwrap_or(scene.spp),
         seed: args.seed.unwrap_or(scene.seed),
         tile_size_px: DEFAULT_TILE_SIZE_PX,
-        // The path tracer's sampler is the scene's choice; every other integrator uses Sobol.
-        sampler: match description.integrator {
-            prism_scene::Integrator::Path { sampler, .. }
-            | prism_scene::Integrator::Light { sampler, .. }
-            | prism_scene::Integrator::Bdpt { sampler, .. }
-            | prism_scene::Integrator::Photon { sampler, .. }
-            | prism_scene::Integrator::PhotonProgressive { sampler, .. } => sampler,
-            prism_scene::Integrator::Depth
-            | prism_scene::Integrator::Normal
-            | prism_scene::Integrator::Albedo
-            | prism_scene::Integrator::AmbientOcclusion { .. } => SamplerKind::Sobol,
-        },
+        // The scene's sampler for the integrators that take one, Sobol otherwise.
+        sampler: description.integrator.render_sampler(),
         spectral_bins,
         // Cheap, and what `prism tonemap --wb scene` reads: always in EXR outputs.
         illumination_aov: matches!(ImageFormat::from_path(&output), Ok(ImageFormat::Exr)),

@@ -24,7 +24,7 @@ use prism_render::integrator::{Pass, DEFAULT_TILE_SIZE_PX};
 use prism_render::sensor::{measure_sensors, SensorReading};
 use prism_render::{
     film_for, render_pass_controlled, FilmImage, PassControl, PassOutcome, RenderScene,
-    RenderSettings, SamplerKind, SpectralBins,
+    RenderSettings, SpectralBins,
 };
 use prism_scene::SceneDescription;
 use pyo3::exceptions::PyUserWarning;
@@ -227,18 +227,8 @@ pub fn render(
         spp: spp.unwrap_or(render_scene.spp),
         seed: seed.unwrap_or(render_scene.seed),
         tile_size_px: DEFAULT_TILE_SIZE_PX,
-        // As `prism render`: the path tracer's sampler is the scene's, others use Sobol.
-        sampler: match description.integrator {
-            prism_scene::Integrator::Path { sampler, .. }
-            | prism_scene::Integrator::Light { sampler, .. }
-            | prism_scene::Integrator::Bdpt { sampler, .. }
-            | prism_scene::Integrator::Photon { sampler, .. }
-            | prism_scene::Integrator::PhotonProgressive { sampler, .. } => sampler,
-            prism_scene::Integrator::Depth
-            | prism_scene::Integrator::Normal
-            | prism_scene::Integrator::Albedo
-            | prism_scene::Integrator::AmbientOcclusion { .. } => SamplerKind::Sobol,
-        },
+        // The scene's sampler for the integrators that take one, Sobol otherwise.
+        sampler: description.integrator.render_sampler(),
         spectral_bins,
         // What `prism render` records in an EXR output.
         illumination_aov: true,
