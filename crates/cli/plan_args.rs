@@ -3,7 +3,7 @@
 
 use clap::{Args, ValueEnum};
 use prism_bandwidth::allocation::DEFAULT_FLOOR;
-use prism_bandwidth::{Allocation, AllocationSettings, VarianceBandwidth};
+use prism_bandwidth::{Allocation, AllocationSettings, VarianceBandwidth, DEFAULT_POOL_RADIUS_PX};
 use prism_render::predictor::{PredictorSettings, DEFAULT_PROBE_SAMPLES};
 use prism_render::SamplePlanKind;
 
@@ -62,6 +62,14 @@ pub struct PlanArgs {
     /// `--plan predicted`: how V̂_p is predicted.
     #[arg(long = "plan-variance", value_enum, default_value = "eq9")]
     pub plan_variance: VarianceArg,
+    /// `--plan predicted`: V̂_p is pooled over the (2R+1)² pixels of the same material around
+    /// each pixel (0: per pixel, as the paper).
+    #[arg(long = "plan-pool-px", value_name = "R", default_value_t = DEFAULT_POOL_RADIUS_PX, value_parser = prism_args::numbers::parse_u32)]
+    pub plan_pool_px: u32,
+    /// `--plan predicted`: one-bounce indirect estimates per pixel, which add the indirect
+    /// light's mean and variance to the prediction (0: direct light only, as the paper).
+    #[arg(long = "plan-indirect", value_name = "N", default_value_t = DEFAULT_PROBE_SAMPLES, value_parser = prism_args::numbers::parse_u32)]
+    pub plan_indirect: u32,
 }
 
 impl PlanArg {
@@ -89,12 +97,14 @@ impl PlanArgs {
             || self.plan_floor != DEFAULT_FLOOR
             || self.plan_allocation != AllocationArg::Relative
             || self.plan_variance != VarianceArg::Eq9
-            || self.plan_visibility != OnOff::On;
+            || self.plan_visibility != OnOff::On
+            || self.plan_pool_px != DEFAULT_POOL_RADIUS_PX
+            || self.plan_indirect != DEFAULT_PROBE_SAMPLES;
         if self.plan != PlanArg::Predicted && predictor_flags_given {
             return Err(
-                "--plan-nb, --plan-floor, --plan-allocation, --plan-variance and \
-                 --plan-visibility set up the predictor: add \
-                 --plan predicted"
+                "--plan-nb, --plan-floor, --plan-allocation, --plan-variance, \
+                 --plan-visibility, --plan-pool-px and --plan-indirect set up the \
+                 predictor: add --plan predicted"
                     .into(),
             );
         }
@@ -139,6 +149,8 @@ impl PlanArgs {
                 VarianceArg::Measured => VarianceBandwidth::Measured,
             },
             visibility: self.plan_visibility == OnOff::On,
+            pool_radius_px: self.plan_pool_px,
+            indirect_samples: self.plan_indirect,
         }
     }
 }

@@ -49,6 +49,11 @@ pub struct AllocationInputs<'a> {
     pub mean_y: &'a [f32],
     /// Eq. 11's level per pixel (negative: sub-pixel anti-aliasing).
     pub shading_level: &'a [i32],
+    /// Pixels whose prediction carries no information (a surface where the probe found no
+    /// light at all): they get the uniform share a_p = 1 instead of the floor, since
+    /// their light is there but unseen (it came by paths the probe does not follow).
+    /// `None`: every pixel is informed.
+    pub uninformed: Option<&'a [bool]>,
 }
 
 /// The plan and the relative sample density a_p / mean(a) (expected N_p / budget) that
@@ -85,8 +90,13 @@ pub fn allocate(
                 "sample allocation shading level",
                 inputs.shading_level.len(),
             ),
+            (
+                "sample allocation uninformed mask",
+                inputs.uninformed.map_or(n, <[bool]>::len),
+            ),
         ],
     )?;
+    let informed = |i: usize| inputs.uninformed.is_none_or(|u| !u[i]);
     if !(settings.mean_spp > 0.0 && settings.mean_spp.is_finite()) {
         return Err(BandwidthError::invalid(
             "sample allocation",
@@ -107,13 +117,14 @@ pub fn allocate(
         .map(|i| shape(settings.allocation, inputs.variance[i], inputs.mean_y[i]))
         .map(|s| if s.is_finite() { s } else { 0.0 })
         .collect();
-    let mean_s = s.iter().sum::<f64>() / n as f64;
+    let informed_count = (0..n).filter(|&i| informed(i)).count();
+    let mean_s =
+        (0..n).filter(|&i| informed(i)).map(|i| s[i]).sum::<f64>() / informed_count.max(1) as f64;
     // a_p; with nothing predicted anywhere (mean(s) = 0) the plan is uniform.
-    let a: Vec<f64> = s
-        .iter()
-        .map(|&s_p| {
-            if mean_s > 0.0 {
-                settings.floor + (1.0 - settings.floor) * s_p / mean_s
+    let a: Vec<f64> = (0..n)
+        .map(|i| {
+            if mean_s > 0.0 && informed(i) {
+                settings.floor + (1.0 - settings.floor) * s[i] / mean_s
             } else {
                 1.0
             }
@@ -220,6 +231,7 @@ mod tests {
             variance: &variance,
             mean_y: &mean,
             shading_level: &levels,
+            uninformed: None,
         };
         let out = allocate(
             UVec2::new(2, 2),
@@ -239,12 +251,48 @@ mod tests {
     }
 
     #[test]
+    fn uninformed_pixels_get_the_uniform_share() {
+        // Pixels 0, 1 as above; pixel 2 saw no light (uninformed), pixel 3 is predicted
+        // dark. s over the informed pixels = [1, 3, 0], mean 4/3: a = 0.25 + 0.75 s/mean =
+        // [0.8125, 1.9375, 0.25] and 1 for pixel 2 — mean 1, the budget kept.
+        let variance = [1.0, 9.0, 0.0, 0.0];
+        let mean = [((1.0f64 - 0.01).sqrt()) as f32; 4];
+        let levels = [0; 4];
+        let uninformed = [false, false, true, false];
+        let inputs = AllocationInputs {
+            variance: &variance,
+            mean_y: &mean,
+            shading_level: &levels,
+            uninformed: Some(&uninformed),
+        };
+        let out = allocate(
+            UVec2::new(2, 2),
+            inputs,
+            settings(Allocation::RelativeError),
+        )
+        .unwrap();
+        let expected = [0.8125, 1.9375, 1.0, 0.25];
+        for (d, e) in out.relative_density.iter().zip(expected) {
+            assert!((d - e).abs() < 1e-5, "{:?}", out.relative_density);
+        }
+        let short = AllocationInputs {
+            uninformed: Some(&uninformed[..3]),
+            ..inputs
+        };
+        let e = allocate(UVec2::new(2, 2), short, settings(Allocation::RelativeError))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("uninformed"), "{e}");
+    }
+
+    #[test]
     fn the_papers_allocation_is_proportional_to_the_variance() {
         let variance = [1.0, 9.0];
         let inputs = AllocationInputs {
             variance: &variance,
             mean_y: &[0.0, 100.0],
             shading_level: &[0, 0],
+            uninformed: None,
         };
         let mut s = settings(Allocation::Variance);
         s.floor = 0.0;
@@ -259,6 +307,7 @@ mod tests {
             variance: &[0.0, 4.0, 4.0, 4.0],
             mean_y: &[1.0; 4],
             shading_level: &[-2, 0, 0, 0],
+            uninformed: None,
         };
         let mut s = settings(Allocation::RelativeError);
         s.mean_spp = 8.0;
@@ -271,6 +320,7 @@ mod tests {
             variance: &[0.0; 2],
             mean_y: &[1.0; 2],
             shading_level: &[-1, -2],
+            uninformed: None,
         };
         s.mean_spp = 5.0;
         let out = allocate(UVec2::new(2, 1), tight, s).unwrap();
@@ -284,6 +334,7 @@ mod tests {
             variance: &[0.3, 4.0, 0.0, 1.0, 2.5, 0.1],
             mean_y: &[1.0; 6],
             shading_level: &[0; 6],
+            uninformed: None,
         };
         let out = allocate(
             UVec2::new(3, 2),
@@ -310,6 +361,7 @@ mod tests {
             variance: &[0.0; 6],
             mean_y: &[0.5; 6],
             shading_level: &[3; 6],
+            uninformed: None,
         };
         let out = allocate(
             UVec2::new(3, 2),

@@ -38,6 +38,8 @@ pub mod sample_plan;
 mod stochastic_rounding;
 #[cfg(test)]
 mod test_rng;
+pub mod variance_model;
+pub mod variance_pooling;
 pub mod visibility;
 
 pub use adaptive_error::{adaptive_error, adaptive_pass_counts};
@@ -52,4 +54,6 @@ pub use operators::Bounce;
 pub use pixel_prediction::{predict_pixel, PixelFootprint, PixelPrediction, VarianceBandwidth};
 pub use probe::{LightSample, ShadingProbe};
 pub use sample_plan::{SamplePlan, DEFAULT_LIGHT_SAMPLES};
+pub use variance_model::{model_variance, ModelledVariance};
+pub use variance_pooling::{pool_variance, PixelClass, DEFAULT_POOL_RADIUS_PX};
 pub use visibility::{Visibility, VisibilitySummary};

@@ -40,8 +40,21 @@ pub struct PixelPrediction {
     /// V̂_p: eq. 9 plus the samples' mean lane variance (colour noise of hero-wavelength
     /// sampling), in Y² (the probe's units squared).
     pub variance: f32,
-    /// L̂_p: the mean of the n_b samples' weights λᵢ/pᵢ, Y.
+    /// V̂_p's shading part alone: eq. 9 (cycles·Y²/sr) or, for `Measured`, the weights'
+    /// sample variance (Y²).
+    pub shading_variance: f32,
+    /// V̂_p's colour part alone: the samples' mean lane variance (Y²).
+    pub colour_variance: f32,
+    /// L̂_p: the mean of the n_b samples' weights λᵢ/pᵢ (blocked shadow rays count 0), plus
+    /// the mean one-bounce indirect estimate where the probe takes them, Y.
     pub mean_y: f32,
+    /// The per-sample variance of the probe's one-bounce indirect estimates (Y²; 0 without
+    /// them; `ShadingProbe::sample_indirect`).
+    pub indirect_variance: f32,
+    /// The unbiased sample variance of the n_b samples' weights with their shadow rays'
+    /// outcomes (blocked = 0): the per-sample variance of the direct-light estimator at the
+    /// hit, in Y² (not eq. 9; what calibrates eq. 9's scale).
+    pub measured_variance: f32,
     /// The shadow rays' outcomes (`visibility` module).
     pub visibility: VisibilitySummary,
 }
@@ -143,7 +156,9 @@ pub fn predict_pixel(
         VarianceBandwidth::Incident | VarianceBandwidth::OneBounce => {
             for (sample, nu) in &per_sample {
                 let Some(nu) = nu else { continue };
-                if sample.is_delta() {
+                // A delta light is one direction; a blocked shadow ray (traced only with
+                // `--plan-visibility on`) brings no light to integrate.
+                if sample.is_delta() || sample.is_blocked() {
                     continue;
                 }
                 let nu_a = match variance_bandwidth {
@@ -161,26 +176,27 @@ pub fn predict_pixel(
             variance_sum *= std::f64::consts::TAU;
         }
         VarianceBandwidth::Measured => {
-            // Σ (wᵢ − mean)² over all n_b draws (missing ones are zeros) · n_b / (n_b − 1),
-            // so that the division by n_b below leaves the unbiased sample variance.
-            let mean =
-                samples.iter().map(|s| f64::from(s.weight_y())).sum::<f64>() / f64::from(n_b);
-            let present: f64 = samples
-                .iter()
-                .map(|s| (f64::from(s.weight_y()) - mean).powi(2))
-                .sum();
-            let missing = f64::from(n_b - samples.len() as u32) * mean * mean;
-            if n_b > 1 {
-                variance_sum = (present + missing) * f64::from(n_b) / f64::from(n_b - 1);
-            }
+            variance_sum = weight_variance_sum(samples, n_b, LightSample::weight_y);
         }
     }
     // Colour noise (beyond the paper; the "spectral" term): the lanes' variance,
     // averaged over the n_b samples like the weights.
-    let lane_variance_sum: f64 = samples.iter().map(|s| f64::from(s.lane_variance)).sum();
-    let variance = ((variance_sum + lane_variance_sum) / f64::from(n_b)) as f32;
-    let mean_y =
-        (samples.iter().map(|s| f64::from(s.weight_y())).sum::<f64>() / f64::from(n_b)) as f32;
+    let lane_variance_sum: f64 = samples
+        .iter()
+        .filter(|s| !s.is_blocked())
+        .map(|s| f64::from(s.lane_variance))
+        .sum();
+    let n = f64::from(n_b);
+    let variance = ((variance_sum + lane_variance_sum) / n) as f32;
+    // With shadow rays traced, blocked samples light nothing: L̂ is then the direct light
+    // that arrives, not the unoccluded one (a shadow is dark, and its relative error large).
+    let mean_y = (samples
+        .iter()
+        .map(|s| f64::from(s.visible_weight_y()))
+        .sum::<f64>()
+        / n) as f32;
+    let measured_variance =
+        (weight_variance_sum(samples, n_b, LightSample::visible_weight_y) / n) as f32;
     let mut visibility = VisibilitySummary::default();
     for sample in samples {
         match sample.visibility {
@@ -205,9 +221,28 @@ pub fn predict_pixel(
         bandwidth,
         image_bandwidth_cycles_per_px,
         variance,
+        shading_variance: (variance_sum / n) as f32,
+        colour_variance: (lane_variance_sum / n) as f32,
         mean_y,
+        indirect_variance: 0.0,
+        measured_variance,
         visibility,
     })
+}
+
+/// Σ (wᵢ − mean)² over all n_b draws (missing ones are zeros) · n_b / (n_b − 1), so that a
+/// division by n_b leaves the unbiased sample variance of `weight`; 0 for n_b = 1.
+fn weight_variance_sum(samples: &[LightSample], n_b: u32, weight: fn(&LightSample) -> f32) -> f64 {
+    if n_b <= 1 {
+        return 0.0;
+    }
+    let mean = samples.iter().map(|s| f64::from(weight(s))).sum::<f64>() / f64::from(n_b);
+    let present: f64 = samples
+        .iter()
+        .map(|s| (f64::from(weight(s)) - mean).powi(2))
+        .sum();
+    let missing = f64::from(n_b - samples.len() as u32) * mean * mean;
+    (present + missing) * f64::from(n_b) / f64::from(n_b - 1)
 }
 
 #[cfg(test)]

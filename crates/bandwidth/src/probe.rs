@@ -78,6 +78,24 @@ impl LightSample {
         }
     }
 
+    /// [`weight_y`](Self::weight_y) with the shadow ray's outcome: 0 where it was blocked
+    /// (an untraced sample counts as visible).
+    pub fn visible_weight_y(&self) -> f32 {
+        if self.is_blocked() {
+            0.0
+        } else {
+            self.weight_y()
+        }
+    }
+
+    /// True where the sample's shadow ray was traced and blocked.
+    pub fn is_blocked(&self) -> bool {
+        match self.visibility {
+            Visibility::Blocked { .. } => true,
+            Visibility::Visible | Visibility::Unknown => false,
+        }
+    }
+
     /// χ_i = L_i ρ of eq. 9 (no cosine): `radiance_y · bsdf_cos_per_sr / cos_theta_i`,
     /// 0 at grazing incidence.
     pub fn chi_y(&self) -> f32 {
@@ -105,4 +123,14 @@ pub trait ShadingProbe: Sync {
     /// probe's own seed — seed them per pixel as the renderer's `PixelSampler` does, never
     /// per thread — so a predicted plan is the same for any thread count.
     fn sample_lights(&self, pixel: UVec2, hit: &GBufferHit, count: u32, out: &mut Vec<LightSample>);
+
+    /// Beyond the paper: clears `out` and fills it with `count` one-bounce indirect
+    /// estimates at `hit` (Y: a BSDF-sampled direction, the surface it meets, one light
+    /// sample there with its shadow ray; 0 where the direction meets nothing or an emitter,
+    /// whose light `sample_lights` counts), so that L̂_p and V̂_p see the light the paper's
+    /// direct-only probe misses. Deterministic like `sample_lights`. The default (a probe
+    /// without geometry) has none.
+    fn sample_indirect(&self, _pixel: UVec2, _hit: &GBufferHit, _count: u32, out: &mut Vec<f32>) {
+        out.clear();
+    }
 }

@@ -178,6 +178,7 @@ pub fn oracle_allocation(
             variance: &layer.samples,
             mean_y: &mean_y,
             shading_level: &levels,
+            uninformed: None,
         },
         PredictorSettings::defaults(PREDICTED_PLAN_SPP, seed).allocation,
     )

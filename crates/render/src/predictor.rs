@@ -11,9 +11,9 @@
 use glam::{DVec3, UVec2, Vec2, Vec3A};
 use prism_bandwidth::pixel_prediction::MAX_IMAGE_BANDWIDTH_CYCLES_PER_PX;
 use prism_bandwidth::{
-    allocate, predict_pixel, Allocated, AllocationInputs, AllocationSettings, Bandwidth,
-    BandwidthBuffer, GBufferHit, LightSample, PixelFootprint, PixelPrediction, ShadingProbe,
-    VarianceBandwidth, VisibilitySummary,
+    allocate, model_variance, predict_pixel, Allocated, AllocationInputs, AllocationSettings,
+    Bandwidth, BandwidthBuffer, GBufferHit, LightSample, PixelClass, PixelFootprint,
+    PixelPrediction, ShadingProbe, VarianceBandwidth, VisibilitySummary, DEFAULT_POOL_RADIUS_PX,
 };
 use prism_spectrum::colorimetry::sampled_radiance_to_xyz;
 use prism_spectrum::{SampledSpectrum, SampledWavelengths};
@@ -35,6 +35,12 @@ pub struct PredictorSettings {
     pub variance_bandwidth: VarianceBandwidth,
     /// Shadow edges from the probe's shadow rays (`--plan-visibility`; off = the paper).
     pub visibility: bool,
+    /// One-bounce indirect estimates per pixel (`--plan-indirect`; 0 = the paper's
+    /// direct-only probe; `ShadingProbe::sample_indirect`).
+    pub indirect_samples: u32,
+    /// V̂_p pooled over the (2r+1)² pixels of the same surface around each pixel
+    /// (`--plan-pool-px`; 0 = the paper's per-pixel V̂_p; prism_bandwidth::variance_pooling).
+    pub pool_radius_px: u32,
 }
 
 impl PredictorSettings {
@@ -52,6 +58,8 @@ impl PredictorSettings {
             },
             variance_bandwidth: VarianceBandwidth::Incident,
             visibility: true,
+            pool_radius_px: DEFAULT_POOL_RADIUS_PX,
+            indirect_samples: DEFAULT_PROBE_SAMPLES,
         }
     }
 }
@@ -178,9 +186,33 @@ fn escaping_pixel(
         image_bandwidth_cycles_per_px: (background_nu_a * rad_per_px)
             .min(MAX_IMAGE_BANDWIDTH_CYCLES_PER_PX),
         variance: variance as f32,
+        shading_variance: 0.0,
+        colour_variance: variance as f32,
         mean_y: mean.y as f32,
+        indirect_variance: 0.0,
+        measured_variance: 0.0,
         visibility: VisibilitySummary::default(),
     }
+}
+
+/// The mean and the unbiased sample variance of `values` (0, 0 when empty; variance 0
+/// for one value).
+fn mean_and_variance(values: &[f32]) -> (f32, f32) {
+    if values.is_empty() {
+        return (0.0, 0.0);
+    }
+    let n = values.len() as f64;
+    let mean = values.iter().map(|v| f64::from(*v)).sum::<f64>() / n;
+    let variance = if values.len() > 1 {
+        values
+            .iter()
+            .map(|v| (f64::from(*v) - mean).powi(2))
+            .sum::<f64>()
+            / (n - 1.0)
+    } else {
+        0.0
+    };
+    (mean as f32, variance as f32)
 }
 
 /// Where a hit pixel's image bandwidth comes from, for the visibility pass: the eye
@@ -271,17 +303,23 @@ pub fn predict_with_probe<'a>(
         .filter(|l| l.is_infinite())
         .map(|l| l.bandwidth().angular_cycles_per_rad)
         .fold(0.0f32, f32::max);
-    type PixelRow = Vec<(PixelPrediction, f32, Option<EyeGeometry>)>;
+    type PixelRow = Vec<(PixelPrediction, f32, Option<EyeGeometry>, PixelClass)>;
     let rows: Vec<PixelRow> = (0..resolution.y)
         .into_par_iter()
         .map(|y| {
             let mut samples: Vec<LightSample> = Vec::new();
+            let mut indirect: Vec<f32> = Vec::new();
             (0..resolution.x)
                 .map(|x| {
                     let pixel = UVec2::new(x, y);
                     let Some(rad_per_px) = angular_footprint(scene, pixel).filter(|a| *a > 0.0)
                     else {
-                        return Ok((PixelPrediction::default(), 0.0, None));
+                        return Ok((
+                            PixelPrediction::default(),
+                            0.0,
+                            None,
+                            PixelClass::Unpredicted,
+                        ));
                     };
                     let footprint = PixelFootprint {
                         rad_per_px,
@@ -290,20 +328,34 @@ pub fn predict_with_probe<'a>(
                     match centre_ray(scene, pixel) {
                         CentreRay::Hit(hit) => {
                             probe.sample_lights(pixel, &hit, settings.probe_samples, &mut samples);
-                            let p = predict_pixel(
+                            let mut p = predict_pixel(
                                 &hit,
                                 &samples,
                                 footprint,
                                 settings.variance_bandwidth,
                             )
                             .map_err(|e| e.to_string())?;
+                            probe.sample_indirect(
+                                pixel,
+                                &hit,
+                                settings.indirect_samples,
+                                &mut indirect,
+                            );
+                            let (mean, variance) = mean_and_variance(&indirect);
+                            p.mean_y += mean;
+                            p.indirect_variance = variance;
                             let c = hit.curvature();
                             let eye = EyeGeometry {
                                 depth_m: hit.depth_m(),
                                 cos_theta_x: hit.cos_theta_view(),
                                 rad_per_px,
                             };
-                            Ok((p, c.k1.abs().max(c.k2.abs()), Some(eye)))
+                            Ok((
+                                p,
+                                c.k1.abs().max(c.k2.abs()),
+                                Some(eye),
+                                PixelClass::Material(hit.material_id()),
+                            ))
                         }
                         CentreRay::Escapes(direction) => Ok((
                             escaping_pixel(
@@ -315,8 +367,14 @@ pub fn predict_with_probe<'a>(
                             ),
                             0.0,
                             None,
+                            PixelClass::Background,
                         )),
-                        CentreRay::None => Ok((PixelPrediction::default(), 0.0, None)),
+                        CentreRay::None => Ok((
+                            PixelPrediction::default(),
+                            0.0,
+                            None,
+                            PixelClass::Unpredicted,
+                        )),
                     }
                 })
                 .collect::<Result<Vec<_>, String>>()
@@ -325,10 +383,12 @@ pub fn predict_with_probe<'a>(
     let mut pixels = Vec::new();
     let mut curvature = Vec::new();
     let mut eye = Vec::new();
-    for (p, c, e) in rows.into_iter().flatten() {
+    let mut class = Vec::new();
+    for (p, c, e, k) in rows.into_iter().flatten() {
         pixels.push(p);
         curvature.push(c);
         eye.push(e);
+        class.push(k);
     }
     if settings.visibility {
         add_shadow_edges(resolution, &mut pixels, &eye);
@@ -337,17 +397,29 @@ pub fn predict_with_probe<'a>(
         .iter()
         .map(|p| p.image_bandwidth_cycles_per_px)
         .collect();
-    let variance: Vec<f32> = pixels.iter().map(|p| p.variance).collect();
-    let mean_y: Vec<f32> = pixels.iter().map(|p| p.mean_y).collect();
-    let buffer = BandwidthBuffer::new(resolution, &b, &variance, &curvature)
+    let modelled = model_variance(
+        resolution,
+        &pixels,
+        &class,
+        settings.pool_radius_px,
+        settings.variance_bandwidth == VarianceBandwidth::Measured,
+    )
+    .map_err(|e| e.to_string())?;
+    for (p, v) in pixels.iter_mut().zip(&modelled.variance) {
+        p.variance = *v;
+    }
+    let variance = &modelled.variance;
+    let mean_y = &modelled.mean_y;
+    let buffer = BandwidthBuffer::new(resolution, &b, variance, &curvature)
         .map_err(|e| unsupported(&e.to_string()))?;
     let levels = &buffer.levels()[0].shading_level;
     let allocated = allocate(
         resolution,
         AllocationInputs {
-            variance: &variance,
-            mean_y: &mean_y,
+            variance,
+            mean_y,
             shading_level: levels,
+            uninformed: Some(&modelled.uninformed),
         },
         settings.allocation,
     )

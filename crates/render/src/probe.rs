@@ -5,7 +5,9 @@
 //!
 //! Values are luminance-like Y in the output normalisation (prism-bandwidth's probe docs),
 //! estimated from one set of hero wavelengths per sample. Occlusion is ignored, as in
-//! Bagher's eq. 1.
+//! Bagher's eq. 1, unless `trace_visibility` (then blocked samples carry no light in
+//! L̂, eq. 9 and the colour noise; docs/bandwidth.md). `sample_indirect` adds one-bounce
+//! indirect estimates (beyond the paper).
 //!
 //! Bandwidths (cycles per metre / per radian): each light's `Light::bandwidth`
 //! (light/bandwidth.rs), except environment maps, which answer per direction from eq. 7's
@@ -36,6 +38,10 @@ use crate::light::environment_bandwidth::EnvironmentBandwidth;
 use crate::light::{Light, LightHit, LightSampleContext};
 use crate::sampler::{PixelSampler, SamplerKind};
 use crate::scene_build::RenderScene;
+
+/// Sample indices of the indirect estimates (`sample_indirect`), apart from the light
+/// samples' 0..n_b.
+const INDIRECT_STREAM_OFFSET: u32 = 1 << 30;
 
 /// A `ShadingProbe` over a built scene.
 pub struct RenderProbe<'a> {
@@ -239,6 +245,65 @@ impl RenderProbe<'_> {
             }
         }
         pdf
+    }
+
+    /// One BSDF-sampled direction from `si`, the non-emitting surface it meets and one light
+    /// sample there with its shadow ray: the one-bounce indirect radiance estimate towards
+    /// the eye, or `None` where it is zero.
+    fn one_bounce_indirect(
+        &self,
+        si: &SurfaceInteraction,
+        frame: &Frame,
+        wo_local: Vec3A,
+        material: &crate::material::Material,
+        wavelengths: &SampledWavelengths,
+        stream: &mut crate::sampler::SampleStream,
+    ) -> Option<SampledSpectrum> {
+        let lights = &self.scene.lights;
+        let bsdf = material.bsdf(si, wavelengths);
+        let bs = bsdf.sample(
+            wo_local,
+            stream.get_1d(),
+            stream.get_2d(),
+            TransportMode::Radiance,
+        )?;
+        if bs.pdf.is_nan() || bs.pdf <= 0.0 {
+            return None;
+        }
+        let throughput = bs.f * (bs.wi.z.abs() / bs.pdf);
+        let ray = Ray::spawn(si.p, frame.from_local(bs.wi));
+        let hit = self.scene.geometry.intersect(&ray)?;
+        if lights.area_light_of_instance(hit.instance_id).is_some() {
+            return None;
+        }
+        let second = self.scene.geometry.shading_interaction(&ray, &hit);
+        let second_bsdf = self
+            .scene
+            .material(second.material_id)
+            .bsdf(&second, wavelengths);
+        if second_bsdf.is_specular() {
+            return None;
+        }
+        let second_frame = Frame::from_zx(second.n_shading, second.dpdu);
+        let (l, pmf) = lights.sample(stream.get_1d())?;
+        let ctx = LightSampleContext {
+            p: second.p,
+            n: second.n_geometric,
+        };
+        let ls = lights
+            .light(l)
+            .sample_li(&ctx, stream.get_2d(), wavelengths)?;
+        let density = if ls.delta { pmf } else { pmf * ls.pdf };
+        if density.is_nan()
+            || density <= 0.0
+            || self.shadow_ray(&second, &ls) != Visibility::Visible
+        {
+            return None;
+        }
+        let wi2 = second_frame.to_local(ls.wi);
+        let wo2 = second_frame.to_local(-ray.direction.normalize());
+        let f2 = second_bsdf.eval(wo2, wi2, TransportMode::Radiance) * wi2.z.abs();
+        Some(throughput * f2 * ls.radiance * (1.0 / density))
     }
 
     /// What the shadow ray of light sample `ls` from `si` meets.
@@ -449,6 +514,35 @@ impl ShadingProbe for RenderProbe<'_> {
             }
         }
     }
+
+    fn sample_indirect(&self, pixel: UVec2, hit: &GBufferHit, count: u32, out: &mut Vec<f32>) {
+        out.clear();
+        let lights = &self.scene.lights;
+        let si = hit_interaction(hit);
+        let material = self.scene.material(hit.material_id());
+        let frame = Frame::from_zx(si.n_shading, si.dpdu);
+        let wo_local = frame.to_local(hit.view_direction());
+        let sampler = PixelSampler::with_kind(SamplerKind::Independent, self.seed);
+        for k in 0..count {
+            // Streams apart from `sample_lights`' (indices 0..count).
+            let mut stream = sampler.stream(pixel, INDIRECT_STREAM_OFFSET + k);
+            let wavelengths = SampledWavelengths::sample_visible(stream.get_1d());
+            out.push(
+                self.one_bounce_indirect(
+                    &si,
+                    &frame,
+                    wo_local,
+                    material,
+                    &wavelengths,
+                    &mut stream,
+                )
+                .map_or(0.0, |l| luminance_y(l, &wavelengths)),
+            );
+        }
+        if lights.is_empty() {
+            out.iter_mut().for_each(|v| *v = 0.0);
+        }
+    }
 }
 
 #[cfg(test)]
@@ -502,6 +596,44 @@ mod tests {
         // Deterministic per pixel.
         let mut again = Vec::new();
         probe.sample_lights(UVec2::new(3, 4), &hit, 64, &mut again);
+        assert_eq!(out, again);
+    }
+
+    /// One bounce of indirect light inside a Lambertian sphere (albedo a, radius R) around a
+    /// point light of intensity I at its centre: every wall point leaves L_o = a I/(π R²),
+    /// so the indirect radiance at the wall is a·L_o = a² I/(π R²) (0.159 for a = ½, I = 2,
+    /// R = 1), within 5 standard errors.
+    #[test]
+    fn indirect_estimates_inside_a_lambertian_sphere_match_the_closed_form() {
+        let json = r#"{"materials": {"grey": {"type": "lambert", "reflectance": 0.5},
+                "inside": {"type": "two_sided", "material": "grey"}},
+            "shapes": [{"type": "sphere", "radius_m": 1.0, "material": "inside"}],
+            "lights": [{"type": "point", "position_m": [0, 0, 0], "spectrum": 1.0, "scale": 2.0}]}"#;
+        let scene = RenderScene::build(&parse_scene_str(json, "t.json").unwrap(), None).unwrap();
+        let probe = RenderProbe::new(&scene, 7);
+        let hit = GBufferHit::new(
+            Vec3A::new(0.0, -1.0, 0.0),
+            0.5,
+            Vec3A::Y,
+            Curvature::default(),
+            Vec3A::Y,
+            1,
+        )
+        .unwrap();
+        let n = 4096;
+        let mut out = Vec::new();
+        probe.sample_indirect(UVec2::new(1, 2), &hit, n, &mut out);
+        assert_eq!(out.len(), n as usize);
+        let values: Vec<f64> = out.iter().map(|v| f64::from(*v)).collect();
+        let mean = values.iter().sum::<f64>() / f64::from(n);
+        let sd = (values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / f64::from(n - 1)).sqrt();
+        let expected = 0.25 * 2.0 / std::f64::consts::PI;
+        assert!(
+            (mean - expected).abs() < 5.0 * sd / f64::from(n).sqrt(),
+            "{mean} vs {expected} (sd {sd})"
+        );
+        let mut again = Vec::new();
+        probe.sample_indirect(UVec2::new(1, 2), &hit, n, &mut again);
         assert_eq!(out, again);
     }
 
