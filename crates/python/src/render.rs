@@ -322,6 +322,8 @@ pub fn render(
     if let Some(e) = raised {
         return Err(e);
     }
+    // A Ctrl-C that came while the last items finished still raises.
+    py.check_signals()?;
     let outcome = outcome
         .ok_or_else(|| RenderError::new_err(format!("{label}: the render thread panicked")))?
         .map_err(|e| RenderError::new_err(format!("{label}: {e}")))?;
