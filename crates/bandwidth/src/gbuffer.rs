@@ -5,7 +5,7 @@
 //! render fills it from the camera ray through each pixel's centre (one hit per pixel);
 //! prism-bandwidth only reads it.
 
-use glam::{UVec2, Vec3A};
+use glam::{UVec2, Vec2, Vec3A};
 use prism_geometry::Curvature;
 
 use crate::error::{pixel_count, pixel_index, BandwidthError};
@@ -23,6 +23,7 @@ pub struct GBufferHit {
     curvature: Curvature,
     view_direction: Vec3A,
     material_id: u32,
+    uv: Vec2,
 }
 
 impl GBufferHit {
@@ -88,7 +89,29 @@ impl GBufferHit {
             curvature,
             view_direction,
             material_id,
+            uv: Vec2::ZERO,
         })
+    }
+
+    /// The same hit with the surface's texture coordinates (so that a probe reads the
+    /// material's textures where the pixel sees them; (0, 0) unless given). Non-finite
+    /// coordinates are an error.
+    pub fn with_uv(mut self, uv: Vec2) -> Result<Self, BandwidthError> {
+        if !uv.is_finite() {
+            return Err(BandwidthError::invalid(
+                "G-buffer hit",
+                "uv",
+                uv,
+                "finite texture coordinates",
+            ));
+        }
+        self.uv = uv;
+        Ok(self)
+    }
+
+    /// The surface's texture coordinates at the hit.
+    pub fn uv(&self) -> Vec2 {
+        self.uv
     }
 
     /// World-space position, metres.

@@ -140,7 +140,9 @@ fn centre_ray(scene: &RenderScene, pixel: UVec2) -> CentreRay {
         si.curvature,
         view,
         si.material_id,
-    ) {
+    )
+    .and_then(|hit| hit.with_uv(si.uv))
+    {
         Ok(hit) => CentreRay::Hit(hit),
         Err(_) => CentreRay::None,
     }

@@ -24,7 +24,7 @@
 //! sees. Delta lights and Dirac lobes report pdf 0 and fold their selection probability
 //! into their weight.
 
-use glam::{UVec2, Vec2, Vec3A};
+use glam::{UVec2, Vec3A};
 use prism_bandwidth::{
     Bandwidth, GBufferHit, LightSample, MaterialBandwidth, ShadingProbe, Visibility,
 };
@@ -206,7 +206,7 @@ fn hit_interaction(hit: &GBufferHit) -> SurfaceInteraction {
         t: hit.depth_m(),
         n_geometric: n,
         n_shading: n,
-        uv: Vec2::ZERO,
+        uv: hit.uv(),
         dpdu: frame.x,
         dpdv: frame.y,
         dndu: Vec3A::ZERO,

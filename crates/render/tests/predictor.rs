@@ -89,3 +89,42 @@ fn a_hard_shadow_edge_is_sharp_and_only_visibility_sees_it() {
         "the paper's predictor (no visibility) sees {sharp_without} sharp pixels"
     );
 }
+
+/// The probe reads a material's textures where each pixel sees them (its G-buffer hit
+/// carries the uv): a checkerboard of reflectance 0.1 / 0.7 in 4 × 4 cells on a plane
+/// under a uniform sky gives L̂ ≈ a·L_sky per cell, 0.1 on even cells and 0.7 on odd ones
+/// (within the estimate's spread), not one value everywhere.
+#[test]
+fn the_probe_reads_uv_textures_at_each_pixel() {
+    let scene = build(&format!(
+        r#"{{{CAMERA},
+        "materials": {{"checks": {{"type": "lambert", "reflectance":
+            {{"texture": {{"type": "checkerboard", "a": 0.1, "b": 0.7, "uv_scale": [4, 4]}}}}}}}},
+        "shapes": [{{"type": "rectangle", "size_m": [3, 3], "material": "checks",
+            "transform": {{"rotate": {{"axis": [1, 0, 0], "angle_deg": -90}}}}}}],
+        "lights": [{{"type": "sky", "spectrum": 1.0}}]}}"#
+    ));
+    let p = run(&scene, true);
+    let (mut dark, mut bright) = (Vec::new(), Vec::new());
+    for pixel in &p.pixels {
+        if pixel.mean_y <= 0.0 {
+            continue;
+        }
+        if pixel.mean_y < 0.4 {
+            dark.push(f64::from(pixel.mean_y));
+        } else {
+            bright.push(f64::from(pixel.mean_y));
+        }
+    }
+    let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
+    eprintln!(
+        "checkerboard: {} dark pixels (mean L̂ {:.3}), {} bright (mean L̂ {:.3})",
+        dark.len(),
+        mean(&dark),
+        bright.len(),
+        mean(&bright)
+    );
+    assert!(dark.len() > 200 && bright.len() > 200);
+    assert!((mean(&dark) - 0.1).abs() < 0.02, "{}", mean(&dark));
+    assert!((mean(&bright) - 0.7).abs() < 0.05, "{}", mean(&bright));
+}
