@@ -123,4 +123,9 @@ impl Bxdf for BlinnPhong {
     fn is_reflection_only(&self) -> bool {
         true
     }
+
+    #[inline]
+    fn is_isotropic(&self) -> bool {
+        true
+    }
 }

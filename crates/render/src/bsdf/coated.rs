@@ -149,4 +149,10 @@ impl Bxdf for Coated {
     fn is_reflection_only(&self) -> bool {
         true
     }
+
+    /// A smooth coat over a Lambertian base.
+    #[inline]
+    fn is_isotropic(&self) -> bool {
+        true
+    }
 }

@@ -135,4 +135,9 @@ impl Bxdf for Conductor {
     fn is_reflection_only(&self) -> bool {
         true
     }
+
+    /// Isotropic with one roughness for both tangent directions.
+    fn is_isotropic(&self) -> bool {
+        self.distribution.alpha_x == self.distribution.alpha_y
+    }
 }

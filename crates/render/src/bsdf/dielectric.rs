@@ -269,4 +269,9 @@ impl Bxdf for Dielectric {
     fn is_reflection_only(&self) -> bool {
         false
     }
+
+    /// Isotropic with one roughness for both tangent directions.
+    fn is_isotropic(&self) -> bool {
+        self.distribution.alpha_x == self.distribution.alpha_y
+    }
 }

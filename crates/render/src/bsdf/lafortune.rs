@@ -175,4 +175,9 @@ impl Bxdf for Lafortune {
     fn is_reflection_only(&self) -> bool {
         true
     }
+
+    /// Isotropic when every lobe weighs x and y alike (C_x = C_y).
+    fn is_isotropic(&self) -> bool {
+        self.lobes[..self.count].iter().all(|j| j.cx == j.cy)
+    }
 }

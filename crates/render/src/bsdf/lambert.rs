@@ -60,6 +60,11 @@ impl Bxdf for Lambert {
     fn is_reflection_only(&self) -> bool {
         true
     }
+
+    #[inline]
+    fn is_isotropic(&self) -> bool {
+        true
+    }
 }
 
 /// Solid-angle pdf of cosine-weighted hemisphere sampling above the surface (0 when either

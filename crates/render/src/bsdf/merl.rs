@@ -996,6 +996,11 @@ impl Bxdf for Measured<'_> {
     fn is_reflection_only(&self) -> bool {
         true
     }
+
+    /// The MERL format is isotropic (φ_h = 0).
+    fn is_isotropic(&self) -> bool {
+        true
+    }
 }
 
 #[cfg(test)]

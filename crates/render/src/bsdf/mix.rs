@@ -100,6 +100,11 @@ impl Bxdf for Mix<'_> {
         self.parts().all(|(c, _)| c.is_reflection_only())
     }
 
+    /// Isotropic when every leaf is.
+    fn is_isotropic(&self) -> bool {
+        self.components[..self.count].iter().all(Bxdf::is_isotropic)
+    }
+
     #[inline]
     fn eval(&self, wo: Vec3A, wi: Vec3A, mode: TransportMode) -> SampledSpectrum {
         let mut f = SampledSpectrum::zero();

@@ -195,6 +195,11 @@ pub trait Bxdf {
 
     /// Reflects only (one-sided, so `Bsdf::two_sided` applies).
     fn is_reflection_only(&self) -> bool;
+
+    /// f(ωₒ, ωᵢ) depends on the azimuths only through φₒ − φᵢ (no preferred tangent
+    /// direction), so one incident azimuth's slice of a table gives the others by rotation
+    /// (`bsdf_angular_table`).
+    fn is_isotropic(&self) -> bool;
 }
 
 /// Number of variates of `estimate_albedo`.
@@ -394,6 +399,10 @@ impl<M: Bxdf> Bxdf for Lobe<'_, M> {
     fn is_reflection_only(&self) -> bool {
         dispatch_lobe!(self, l => l.is_reflection_only())
     }
+    #[inline]
+    fn is_isotropic(&self) -> bool {
+        dispatch_lobe!(self, l => l.is_isotropic())
+    }
 }
 
 /// Never called: no `NoMix` value exists.
@@ -420,6 +429,9 @@ impl Bxdf for NoMix {
         match *self {}
     }
     fn is_reflection_only(&self) -> bool {
+        match *self {}
+    }
+    fn is_isotropic(&self) -> bool {
         match *self {}
     }
 }

@@ -150,4 +150,9 @@ impl Bxdf for OrenNayar {
     fn is_reflection_only(&self) -> bool {
         true
     }
+
+    #[inline]
+    fn is_isotropic(&self) -> bool {
+        true
+    }
 }

@@ -131,4 +131,9 @@ impl Bxdf for Phong {
     fn is_reflection_only(&self) -> bool {
         true
     }
+
+    #[inline]
+    fn is_isotropic(&self) -> bool {
+        true
+    }
 }

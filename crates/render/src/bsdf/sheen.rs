@@ -139,6 +139,11 @@ impl Bxdf for Sheen {
     fn is_reflection_only(&self) -> bool {
         true
     }
+
+    #[inline]
+    fn is_isotropic(&self) -> bool {
+        true
+    }
 }
 
 #[cfg(test)]

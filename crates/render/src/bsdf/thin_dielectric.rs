@@ -110,4 +110,9 @@ impl Bxdf for ThinDielectric {
     fn is_reflection_only(&self) -> bool {
         false
     }
+
+    #[inline]
+    fn is_isotropic(&self) -> bool {
+        true
+    }
 }

@@ -130,4 +130,9 @@ impl Bxdf for Ward {
     fn is_reflection_only(&self) -> bool {
         true
     }
+
+    /// Isotropic with one slope deviation for both tangent directions.
+    fn is_isotropic(&self) -> bool {
+        self.alpha_x == self.alpha_y
+    }
 }
