@@ -1,9 +1,11 @@
 #!/usr/bin/env python3
-"""Peak memory per pixel of `prism compare` and `prism tonemap` on large float EXRs.
+"""Peak memory per pixel of `prism compare` (plain, `--report`, `--tmqi`) and `prism
+tonemap` on large float EXRs (needs numpy: `pip install numpy`).
 
     cargo build --release
     python3 tools/measure_memory.py [--large 8192] [--small 1024] [--prism PATH]
-        [--tonemap-ops reinhard02,aces,durand02] [--skip-compare]
+        [--tonemap-ops reinhard02,aces,durand02] [--skip-compare] [--skip-report]
+        [--skip-tmqi]
 
 Writes two float RGB EXRs per size (uncompressed scan lines, written here with numpy: a
 smooth image with noise as the reference, the same with multiplicative noise as the test)
@@ -11,7 +13,8 @@ into a temporary folder (PRISM_MEASURE_DIR, else the system's), runs each comman
 size as its own process and reads its peak RSS from wait4's ru_maxrss. The figure per
 pixel is the growth between the sizes, (peak(large) − peak(small)) / (large² − small²): the
 baseline (the binary, its tables, thread stacks, a strip of rows) cancels. The images are
-deleted at the end. Prints one JSON object and writes tools/bench-results/memory.json.
+deleted at the end. Prints one JSON object and writes tools/bench-results/memory.json,
+where commands not run this time keep their last result.
 """
 
 import argparse
@@ -97,6 +100,11 @@ def make_pair(size, folder):
         write_exr(path, np.concatenate(rows, axis=0))
 
 
+def ldr_png(reference):
+    """The tone-mapped PNG made from `reference` for the TMQI run."""
+    return reference[: -len(".exr")] + "-ldr.png"
+
+
 def peak_rss(command):
     start = time.time()
     proc = subprocess.Popen(command, cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
@@ -114,6 +122,8 @@ def main():
     parser.add_argument("--prism", default=os.path.join(ROOT, "target", "release", "prism"))
     parser.add_argument("--tonemap-ops", default="reinhard02,aces,durand02")
     parser.add_argument("--skip-compare", action="store_true")
+    parser.add_argument("--skip-tmqi", action="store_true")
+    parser.add_argument("--skip-report", action="store_true")
     parser.add_argument("--generate", nargs=2, metavar=("SIZE", "FOLDER"), help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.generate:
@@ -132,6 +142,16 @@ def main():
         jobs = []
         if not args.skip_compare:
             jobs.append(("compare", lambda t, r, o: ["compare", t, r, "--json"]))
+        if not args.skip_report:
+            jobs.append(("compare --report",
+                         lambda t, r, o: ["compare", t, r, "--json", "--report", f"{o}.html"]))
+        if not args.skip_tmqi:
+            # A tone-mapped PNG of each reference, made before the measured runs.
+            for size, (_, reference) in pairs.items():
+                subprocess.run([args.prism, "tonemap", reference, "-o", ldr_png(reference),
+                                "--op", "reinhard02"], check=True, stderr=subprocess.DEVNULL)
+            jobs.append(("compare --tmqi",
+                         lambda t, r, o: ["compare", ldr_png(r), r, "--tmqi", "--json"]))
         for op in filter(None, args.tonemap_ops.split(",")):
             for ext in ("png", "exr"):
                 jobs.append((f"tonemap {op} → {ext}",
@@ -142,7 +162,7 @@ def main():
             for size, (test, reference) in pairs.items():
                 out = os.path.join(folder, f"out-{size}")
                 peaks[size], seconds = peak_rss([args.prism, *job(test, reference, out)])
-                for ext in ("png", "exr"):
+                for ext in ("png", "exr", "html"):
                     if os.path.exists(f"{out}.{ext}"):
                         os.remove(f"{out}.{ext}")
             growth = (peaks[args.large] - peaks[args.small]) / (args.large ** 2 - args.small ** 2)
@@ -166,9 +186,17 @@ def main():
         "cpus": os.cpu_count(),
         "results": results,
     }
+    out = os.path.join(ROOT, "tools", "bench-results", "memory.json")
+    # Commands not measured in this run keep their last result.
+    measured = {r["command"] for r in results}
+    if os.path.exists(out):
+        with open(out) as f:
+            previous = json.load(f)
+        if (previous.get("large_px"), previous.get("small_px")) == (args.large, args.small):
+            kept = [r for r in previous.get("results", []) if r["command"] not in measured]
+            report["results"] = kept + results
     text = json.dumps(report, indent=2)
     print(text)
-    out = os.path.join(ROOT, "tools", "bench-results", "memory.json")
     with open(out, "w") as f:
         f.write(text + "\n")
 

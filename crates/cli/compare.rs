@@ -10,8 +10,8 @@ use prism_image::io::strips::RowSource;
 use prism_image::io::{read_dimensions, write_image, ImageDimensions, ImageFormat};
 use prism_post::metrics::flip::DEFAULT_PPD;
 use prism_post::metrics::strips::strip_compare_bytes;
-use prism_post::metrics::tmqi::Tmqi;
-use prism_post::metrics::{CompareOptions, Comparison, FlipMaps, COMPARE_BYTES_PER_PIXEL};
+use prism_post::metrics::tmqi::{Tmqi, TMQI_BYTES_PER_PIXEL};
+use prism_post::metrics::{CompareOptions, Comparison, FlipMaps};
 use prism_post::pipeline::{compare_files_report, compare_files_with, tmqi_files};
 
 /// Which FLIP map `--error-map` writes.
@@ -171,9 +171,16 @@ fn print_tmqi(t: &Tmqi) {
     );
 }
 
-/// Bytes a comparison of the two files will need, from their headers. `--tmqi` and
-/// `--report` hold both images as decoded (4 bytes per stored channel) and the prepared
-/// reference's working set; the metrics alone read EXRs in strips
+/// Bytes per pixel `--report` holds beyond the strip comparison's working set
+/// (`strip_compare_bytes`): the ΔE2000 map (4), the PNGs of A and B (RGBE: at most 4 each)
+/// and of the three false-colour maps (at most 3 each), and one image's data URI as the
+/// page is written (4/3 of its PNG).
+const REPORT_BYTES_PER_PIXEL: u64 = 4 + 8 + 9 + 6;
+
+/// Bytes a comparison of the two files will need, from their headers. `--tmqi` holds the
+/// tone-mapped PNG as decoded, the HDR source only where it does not stream, and the
+/// luminance planes; `--report` the strip comparison's working set, its maps and the
+/// page's compressed images ([`REPORT_BYTES_PER_PIXEL`]); the metrics alone read EXRs in strips
 /// (`strip_compare_bytes`), an input of another format decoded whole, and
 /// `--error-map` adds its false-colour image and encoder (24 bytes per pixel).
 fn check_memory(args: &CompareArgs, budget: &MemoryBudget) -> Result<(), String> {
@@ -181,19 +188,26 @@ fn check_memory(args: &CompareArgs, budget: &MemoryBudget) -> Result<(), String>
     let (test, reference) = (header(&args.test)?, header(&args.reference)?);
     let decoded = |d: &ImageDimensions| d.pixels().saturating_mul(4 * d.channels as u64);
     let per_pixel = |bytes: u64| reference.pixels().saturating_mul(bytes);
-    let estimate = if args.tmqi || args.report.is_some() {
+    let whole = |path: &Path, d: &ImageDimensions| {
+        if RowSource::streams(path) {
+            0
+        } else {
+            decoded(d)
+        }
+    };
+    let map = if args.error_map.is_some() { 24 } else { 0 };
+    let estimate = if args.tmqi {
+        // The HDR source's luminance is read in bands (tmqi_files), the PNG decoded
+        // whole; then two f64 luminance planes and the next scale's (a quarter each).
         decoded(&test)
-            .saturating_add(decoded(&reference))
-            .saturating_add(per_pixel(COMPARE_BYTES_PER_PIXEL))
+            .saturating_add(whole(&args.reference, &reference))
+            .saturating_add(per_pixel(TMQI_BYTES_PER_PIXEL))
+    } else if args.report.is_some() {
+        whole(&args.test, &test)
+            .saturating_add(whole(&args.reference, &reference))
+            .saturating_add(per_pixel(REPORT_BYTES_PER_PIXEL + map))
+            .saturating_add(strip_compare_bytes(reference.width, reference.height))
     } else {
-        let whole = |path: &Path, d: &ImageDimensions| {
-            if RowSource::streams(path) {
-                0
-            } else {
-                decoded(d)
-            }
-        };
-        let map = if args.error_map.is_some() { 24 } else { 0 };
         whole(&args.test, &test)
             .saturating_add(whole(&args.reference, &reference))
             .saturating_add(per_pixel(map))

@@ -18,9 +18,15 @@ pub const AUTO_EXPOSURE_KEY: f64 = 0.18;
 /// The exposure in stops, EV = log2(key / L̄) with L̄ = exp(mean ln Y) over the pixels
 /// whose luminance Y is finite and > 0; `None` when no pixel has one (a black image).
 pub fn auto_exposure_ev(image: &Image) -> Option<f64> {
-    let w = image.luminance_weights();
-    let (sum_ln, count) = image
-        .pixels()
+    let (sum_ln, count) = log_luminance_sums(image.pixels(), image.luminance_weights());
+    exposure_ev_from_sums(sum_ln, count)
+}
+
+/// Σ ln Y and the count over the pixels whose luminance Y = `weights` · RGB is finite and
+/// > 0: sums of bands of an image add up to the whole image's.
+pub fn log_luminance_sums(pixels: &[[f32; 3]], weights: [f32; 3]) -> (f64, u64) {
+    let w = weights;
+    pixels
         .par_chunks(4096)
         .map(|chunk| {
             chunk.iter().fold((0.0f64, 0u64), |(sum, n), p| {
@@ -32,7 +38,11 @@ pub fn auto_exposure_ev(image: &Image) -> Option<f64> {
                 }
             })
         })
-        .reduce(|| (0.0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
+        .reduce(|| (0.0, 0), |a, b| (a.0 + b.0, a.1 + b.1))
+}
+
+/// [`auto_exposure_ev`] from [`log_luminance_sums`].
+pub fn exposure_ev_from_sums(sum_ln: f64, count: u64) -> Option<f64> {
     if count == 0 {
         return None;
     }

@@ -18,25 +18,29 @@ use prism_spectrum::AdaptationMethod;
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::auto_exposure::auto_exposure_ev;
+use crate::auto_exposure::{auto_exposure_ev, exposure_ev_from_sums, log_luminance_sums};
 use crate::colour::scene_illumination::ILLUMINATION_CHANNELS;
 use crate::colour::{
     apply_white_balance, apply_with_source_white, illumination_white_xyz, map_gamut, GamutMethod,
     GamutTarget, SceneWhite, WhiteBalance, ILLUMINATION_LAYER,
 };
 use crate::metrics::strips::{compare_rows, strip_rows};
-use crate::metrics::tmqi::{check_size, tmqi_images, Tmqi};
-use crate::metrics::{CompareOptions, Comparison, ErrorMaps, PreparedReference};
-use crate::report::compare_page::{compare_page, CompareInput};
+use crate::metrics::tmqi::{check_size, hdr_luminance, ldr_luminance, tmqi_owned, Tmqi};
+use crate::metrics::{CompareOptions, Comparison, ErrorMaps};
+use crate::report::compare_page::{compare_page, map_figures, CompareInput};
+use crate::report::embed::ReportImageRows;
 use crate::report::write_report;
 use crate::sheet::{
     contact_sheet_scored, score_tmqi, SheetFailure, SheetOptions, SheetScore, TileOrder, TileScore,
 };
 use crate::tonemap::{ToneOperator, ToneParams, ToneReport};
+use prism_image::image::luminance_weights;
 use prism_image::io::strips::RowSource;
-use prism_image::io::{read_image, write_image, ImageFormat};
+use prism_image::io::{convert_pixels, read_dimensions, read_image, write_image, ImageFormat};
+use prism_image::rgb_matrix::same_colorimetry;
 use prism_image::Image;
 use prism_image::{ImageError, Result};
+use prism_spectrum::rgb_space::RgbColorSpace;
 
 /// `--op NAME` or `--op all` (contact sheet).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -450,7 +454,42 @@ pub fn tmqi_files(ldr: &Path, hdr: &Path) -> Result<Tmqi> {
             hdr.display()
         )));
     }
-    tmqi_images(&read_image(ldr)?, &read_image(hdr)?)
+    // The tone-mapped image is decoded into its luminance (8 bytes per pixel) and
+    // dropped, then the HDR source is read in bands into its own: the two images never
+    // exist whole at once.
+    let source_size = read_dimensions(hdr)?;
+    let (w, h) = (source_size.width, source_size.height);
+    let image = read_image(ldr)?;
+    check_sizes((ldr, (image.width(), image.height())), (hdr, (w, h)))?;
+    check_size(w, h)?;
+    let ldr_y = if same_colorimetry(&image.color_space, &RgbColorSpace::srgb()) {
+        let y = ldr_luminance(image.pixels());
+        drop(image);
+        y
+    } else {
+        let space = image.color_space.clone();
+        let mut pixels = image.into_pixels();
+        to_rec709(&mut pixels, &space);
+        ldr_luminance(&pixels)
+    };
+    let source = RowSource::open(hdr)?;
+    let mut hdr_y = Vec::with_capacity(w * h);
+    let band = strip_rows(w);
+    for start in (0..h).step_by(band) {
+        let mut rows = source.read_rows(start..(start + band).min(h))?;
+        to_rec709(&mut rows, source.color_space());
+        hdr_y.extend(hdr_luminance(&rows));
+    }
+    drop(source);
+    tmqi_owned(ldr_y, hdr_y, w, h)
+}
+
+/// Pixels in `space` converted to linear Rec.709 in place.
+fn to_rec709(pixels: &mut [[f32; 3]], space: &RgbColorSpace) {
+    let srgb = RgbColorSpace::srgb();
+    if !same_colorimetry(space, &srgb) {
+        convert_pixels(pixels, space, &srgb);
+    }
 }
 
 /// [`compare_files`] with a choice of metrics, and the maps asked for. The images are read
@@ -491,14 +530,21 @@ fn check_sizes(
 
 /// [`compare_files_with`] (FLIP and the ΔE2000 map always computed) that also writes the
 /// HTML report of the comparison to `report` (report/compare_page.rs), atomically. EXR and
-/// HDR inputs are shown scene-referred (with an exposure control), PNGs as they are.
+/// HDR inputs are shown scene-referred (with an exposure control), PNGs as they are. EXRs
+/// are read in strips for the metrics and again for the page, whose images are compressed
+/// band by band: what stays whole is the maps and the compressed PNGs.
 pub fn compare_files_report(
     test: &Path,
     reference: &Path,
     options: &CompareOptions,
     report: &Path,
 ) -> Result<(Comparison, ErrorMaps)> {
-    let (a, b) = read_pair(test, reference)?;
+    let a = RowSource::open(test)?;
+    let b = RowSource::open(reference)?;
+    check_sizes(
+        (test, (a.width(), a.height())),
+        (reference, (b.width(), b.height())),
+    )?;
     let options = CompareOptions {
         flip_ppd: Some(
             options
@@ -508,42 +554,63 @@ pub fn compare_files_report(
         delta_e2000_map: true,
         ..*options
     };
-    let (comparison, maps) = PreparedReference::new(&b).compare_with_maps(&a, &options)?;
+    let band = strip_rows(b.width());
+    let (comparison, maps) = compare_rows(&a, &b, &options, band)?;
     let scene_referred = |path: &Path| match ImageFormat::from_path(path) {
         Ok(ImageFormat::Exr | ImageFormat::Hdr) => true,
         Ok(ImageFormat::Png) | Err(_) => false,
     };
+    let hdr = scene_referred(test) || scene_referred(reference);
+    let figures = map_figures(&maps, comparison.width, comparison.height, hdr)?;
     let label = |path: &Path| {
         path.file_name().map_or_else(
             || path.display().to_string(),
             |n| n.to_string_lossy().into_owned(),
         )
     };
+    let input = |path: &Path, source: &RowSource| -> Result<CompareInput> {
+        let scene = scene_referred(path);
+        let (w, h) = (source.width(), source.height());
+        let mut rows = if scene {
+            ReportImageRows::radiance(w, h)?
+        } else {
+            ReportImageRows::display(w, h)?
+        };
+        for start in (0..h).step_by(band) {
+            rows.push(
+                &source.read_rows(start..(start + band).min(h))?,
+                source.color_space(),
+            )?;
+        }
+        Ok(CompareInput {
+            label: label(path),
+            image: rows.finish()?,
+            scene_referred: scene,
+        })
+    };
+    let (test_input, reference_input) = (input(test, &a)?, input(reference, &b)?);
+    // The viewer starts where `--exposure auto` would put the reference.
+    let reference_exposure_ev = if hdr {
+        let weights = luminance_weights(b.color_space());
+        let (mut sum_ln, mut count) = (0.0, 0);
+        for start in (0..b.height()).step_by(band) {
+            let rows = b.read_rows(start..(start + band).min(b.height()))?;
+            let (s, n) = log_luminance_sums(&rows, weights);
+            sum_ln += s;
+            count += n;
+        }
+        exposure_ev_from_sums(sum_ln, count)
+    } else {
+        None
+    };
+    drop((a, b));
     let page = compare_page(
-        &CompareInput {
-            label: label(test),
-            image: &a,
-            scene_referred: scene_referred(test),
-        },
-        &CompareInput {
-            label: label(reference),
-            image: &b,
-            scene_referred: scene_referred(reference),
-        },
+        test_input,
+        reference_input,
+        reference_exposure_ev,
         &comparison,
-        &maps,
-    )?;
+        figures,
+    );
     write_report(report, &page)?;
     Ok((comparison, maps))
-}
-
-/// The images at `test` and `reference`; an error naming both when their sizes differ.
-pub fn read_pair(test: &Path, reference: &Path) -> Result<(Image, Image)> {
-    let a = read_image(test)?;
-    let b = read_image(reference)?;
-    check_sizes(
-        (test, (a.width(), a.height())),
-        (reference, (b.width(), b.height())),
-    )?;
-    Ok((a, b))
 }

@@ -111,7 +111,7 @@ impl Drop for TempFile {
 }
 
 /// [`write_atomically`] through a buffered writer; errors name `path`, not the temp file.
-pub(crate) fn write_stream_atomically(
+pub fn write_stream_atomically(
     path: &Path,
     write: impl FnOnce(&mut BufWriter<File>) -> std::io::Result<()>,
 ) -> Result<()> {

@@ -159,36 +159,103 @@ pub fn false_colour(
     height: usize,
     options: &FalseColourOptions,
 ) -> Result<Image> {
-    if values.len() != width * height || width == 0 || height == 0 {
-        return Err(ImageError::Invalid(format!(
-            "false colour: {} values for a {width} × {height} image",
-            values.len()
-        )));
+    let rows = FalseColourRows::new(values, width, height, options)?;
+    let mut px = Vec::with_capacity(rows.width() * rows.height());
+    for y in 0..rows.height() {
+        rows.extend_with_row(y, &mut px);
     }
-    let range = resolve_range(values, options)?;
-    let cell = options.cell_px.max(1);
-    let (iw, ih) = (width * cell, height * cell);
-    let legend_w = 150usize;
-    let out_h = ih.max(220);
-    let out_w = iw + legend_w;
-    let background = [0.02f32; 3];
-    let text = [1.0f32; 3];
-    let mut px = vec![background; out_w * out_h];
-    for y in 0..ih {
-        for x in 0..iw {
-            let v = f64::from(values[(y / cell) * width + x / cell]);
-            px[y * out_w + x] = options.palette.colour(position(v, options.scale, range));
+    Image::new(rows.width(), rows.height(), px, RgbColorSpace::srgb())
+}
+
+/// [`false_colour`]'s image one row at a time, so that a large map can be encoded without
+/// its false-colour image ever existing whole: the legend panel is drawn once (150 px wide,
+/// the image's height), the map's colours as each row is asked for.
+pub struct FalseColourRows<'a> {
+    values: &'a [f32],
+    width: usize,
+    scale: FalseColourScale,
+    palette: Palette,
+    range: (f64, f64),
+    cell_px: usize,
+    /// The map's size in output pixels (cells of `cell_px`).
+    map_size: (usize, usize),
+    out_height: usize,
+    legend: Vec<[f32; 3]>,
+}
+
+const LEGEND_WIDTH_PX: usize = 150;
+const LEGEND_MIN_HEIGHT_PX: usize = 220;
+const BACKGROUND: [f32; 3] = [0.02; 3];
+
+impl<'a> FalseColourRows<'a> {
+    pub fn new(
+        values: &'a [f32],
+        width: usize,
+        height: usize,
+        options: &FalseColourOptions,
+    ) -> Result<Self> {
+        if values.len() != width * height || width == 0 || height == 0 {
+            return Err(ImageError::Invalid(format!(
+                "false colour: {} values for a {width} × {height} image",
+                values.len()
+            )));
         }
+        let range = resolve_range(values, options)?;
+        let cell = options.cell_px.max(1);
+        let (iw, ih) = (width * cell, height * cell);
+        let out_height = ih.max(LEGEND_MIN_HEIGHT_PX);
+        Ok(Self {
+            values,
+            width,
+            scale: options.scale,
+            palette: options.palette,
+            range,
+            cell_px: cell,
+            map_size: (iw, ih),
+            out_height,
+            legend: legend_panel(out_height, range, options),
+        })
     }
-    // Colour bar: top = max.
-    let (bar_x, bar_w, bar_top, bar_h) = (iw + 12, 18, 24usize, out_h - 40);
+
+    /// Output width in pixels: the map and its legend.
+    pub fn width(&self) -> usize {
+        self.map_size.0 + LEGEND_WIDTH_PX
+    }
+
+    pub fn height(&self) -> usize {
+        self.out_height
+    }
+
+    /// Appends output row `y` (linear sRGB) to `out`.
+    pub fn extend_with_row(&self, y: usize, out: &mut Vec<[f32; 3]>) {
+        let (iw, ih) = self.map_size;
+        if y < ih {
+            let row = &self.values[(y / self.cell_px) * self.width..][..self.width];
+            out.extend((0..iw).map(|x| {
+                let v = f64::from(row[x / self.cell_px]);
+                self.palette.colour(position(v, self.scale, self.range))
+            }));
+        } else {
+            out.extend(std::iter::repeat_n(BACKGROUND, iw));
+        }
+        out.extend_from_slice(&self.legend[y * LEGEND_WIDTH_PX..][..LEGEND_WIDTH_PX]);
+    }
+}
+
+/// The legend beside the map: the quantity's unit, a colour bar (top = maximum) and six
+/// labelled ticks, `LEGEND_WIDTH_PX × height`.
+fn legend_panel(height: usize, range: (f64, f64), options: &FalseColourOptions) -> Vec<[f32; 3]> {
+    let w = LEGEND_WIDTH_PX;
+    let text = [1.0f32; 3];
+    let mut px = vec![BACKGROUND; w * height];
+    let (bar_x, bar_w, bar_top, bar_h) = (12, 18, 24usize, height - 40);
     for y in 0..bar_h {
         let t = 1.0 - y as f64 / (bar_h - 1).max(1) as f64;
         for x in 0..bar_w {
-            px[(bar_top + y) * out_w + bar_x + x] = options.palette.colour(t);
+            px[(bar_top + y) * w + bar_x + x] = options.palette.colour(t);
         }
     }
-    draw_text(&mut px, out_w, (iw + 8, 6), &options.unit, 2, text);
+    draw_text(&mut px, w, (8, 6), &options.unit, 2, text);
     let ticks = 6;
     for k in 0..ticks {
         let t = k as f64 / (ticks - 1) as f64;
@@ -198,19 +265,19 @@ pub fn false_colour(
         };
         let y = bar_top + ((1.0 - t) * (bar_h - 1) as f64) as usize;
         for x in 0..5 {
-            px[y * out_w + bar_x + bar_w + x] = text;
+            px[y * w + bar_x + bar_w + x] = text;
         }
         let ty = y.saturating_sub(GLYPH_HEIGHT / 2);
         draw_text(
             &mut px,
-            out_w,
+            w,
             (bar_x + bar_w + 8, ty),
             &format_value(v),
             1,
             text,
         );
     }
-    Image::new(out_w, out_h, px, RgbColorSpace::srgb())
+    px
 }
 
 #[cfg(test)]

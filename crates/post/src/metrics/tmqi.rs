@@ -77,15 +77,29 @@ pub fn tmqi_images(ldr: &Image, hdr: &Image) -> Result<Tmqi> {
             hdr.height()
         )));
     }
-    let y = |p: [f64; 3]| LUMINANCE[0] * p[0] + LUMINANCE[1] * p[1] + LUMINANCE[2] * p[2];
+    let hdr_y = hdr_luminance(&rec709(hdr));
+    let ldr_y = ldr_luminance(&rec709(ldr));
+    tmqi_owned(ldr_y, hdr_y, ldr.width(), ldr.height())
+}
+
+/// Luminance of linear Rec.709 scene values (non-finite → 0), as TMQI reads the HDR image.
+pub fn hdr_luminance(rec709: &[[f32; 3]]) -> Vec<f64> {
+    let linear = |v: f32| if v.is_finite() { f64::from(v) } else { 0.0 };
+    rec709.iter().map(|p| luminance(p.map(linear))).collect()
+}
+
+/// Luminance of linear Rec.709 display values re-encoded to sRGB code values (0–255), as
+/// TMQI reads the tone-mapped image.
+pub fn ldr_luminance(rec709: &[[f32; 3]]) -> Vec<f64> {
     let code = |v: f32| {
         let v = if v.is_finite() { f64::from(v) } else { 0.0 };
         255.0 * TransferFunction::Srgb.encode(v.clamp(0.0, 1.0))
     };
-    let ldr_y: Vec<f64> = rec709(ldr).iter().map(|p| y(p.map(code))).collect();
-    let linear = |v: f32| if v.is_finite() { f64::from(v) } else { 0.0 };
-    let hdr_y: Vec<f64> = rec709(hdr).iter().map(|p| y(p.map(linear))).collect();
-    tmqi(&ldr_y, &hdr_y, ldr.width(), ldr.height())
+    rec709.iter().map(|p| luminance(p.map(code))).collect()
+}
+
+fn luminance(p: [f64; 3]) -> f64 {
+    LUMINANCE[0] * p[0] + LUMINANCE[1] * p[1] + LUMINANCE[2] * p[2]
 }
 
 /// An error unless a `w × h` image is large enough for TMQI's 5 scales.
@@ -101,15 +115,25 @@ pub fn check_size(w: usize, h: usize) -> Result<()> {
 /// TMQI of an LDR image's luminance in code values (0–255) against its HDR source's
 /// linear luminance, both `w × h` row-major.
 pub fn tmqi(ldr_y: &[f64], hdr_y: &[f64], w: usize, h: usize) -> Result<Tmqi> {
-    if ldr_y.len() != w * h || hdr_y.len() != w * h {
+    tmqi_owned(ldr_y.to_vec(), hdr_y.to_vec(), w, h)
+}
+
+/// Bytes per pixel [`tmqi_owned`] holds at most: the two f64 luminance planes and the next
+/// scale's (a quarter each); the filtered rows (11 per moment) are per row, not per pixel.
+pub const TMQI_BYTES_PER_PIXEL: u64 = 16 + 4;
+
+/// [`tmqi`] on planes it may overwrite (working set: [`TMQI_BYTES_PER_PIXEL`]).
+pub fn tmqi_owned(mut ldr: Vec<f64>, mut hdr: Vec<f64>, w: usize, h: usize) -> Result<Tmqi> {
+    if ldr.len() != w * h || hdr.len() != w * h {
         return Err(ImageError::invalid(format!(
             "TMQI needs two {w}×{h} images, got {} and {} pixels",
-            ldr_y.len(),
-            hdr_y.len()
+            ldr.len(),
+            hdr.len()
         )));
     }
     check_size(w, h)?;
-    let (lo, hi) = hdr_y
+    let natural = naturalness_of(&ldr, w, h);
+    let (lo, hi) = hdr
         .iter()
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| {
             (l.min(v), h.max(v))
@@ -120,8 +144,9 @@ pub fn tmqi(ldr_y: &[f64], hdr_y: &[f64], w: usize, h: usize) -> Result<Tmqi> {
     } else {
         0.0
     };
-    let mut hdr: Vec<f64> = hdr_y.iter().map(|v| factor * (v - lo)).collect();
-    let mut ldr = ldr_y.to_vec();
+    for v in hdr.iter_mut() {
+        *v = factor * (*v - lo);
+    }
     let (mut sw, mut sh) = (w, h);
     let mut per_scale = [0.0; 5];
     let mut frequency = 32.0;
@@ -137,7 +162,6 @@ pub fn tmqi(ldr_y: &[f64], hdr_y: &[f64], w: usize, h: usize) -> Result<Tmqi> {
         .zip(SCALE_WEIGHTS)
         .map(|(s, b)| s.max(0.0).powf(b))
         .product();
-    let natural = naturalness_of(ldr_y, w, h);
     Ok(Tmqi {
         tmqi: combine(structural, natural),
         tmqi_structural_fidelity: structural,
@@ -219,56 +243,68 @@ fn window() -> [f64; 2 * WINDOW_RADIUS + 1] {
     k.map(|v| v / s)
 }
 
-/// Separable 'valid' filtering: (w − 10) × (h − 10).
-fn blur_valid(p: &[f64], w: usize, h: usize) -> Vec<f64> {
-    let k = window();
-    let n = k.len();
-    let (ow, oh) = (w + 1 - n, h + 1 - n);
-    let mut horizontal = vec![0.0; ow * h];
-    for y in 0..h {
-        for x in 0..ow {
-            horizontal[y * ow + x] = (0..n).map(|t| k[t] * p[y * w + x + t]).sum();
-        }
-    }
-    let mut out = vec![0.0; ow * oh];
-    for y in 0..oh {
-        for (t, kt) in k.iter().enumerate() {
-            for x in 0..ow {
-                out[y * ow + x] += kt * horizontal[(y + t) * ow + x];
-            }
-        }
-    }
-    out
-}
-
-/// S_l: the mean local structural fidelity at `f` cycles/degree.
+/// S_l: the mean local structural fidelity at `f` cycles/degree, over the positions
+/// where the 11×11 window fits ('valid' filtering). Rows are filtered horizontally as the
+/// window reaches them and kept in a ring of 11, so the moments never exist as whole
+/// planes; the sums run in the order whole-plane filtering would take.
 fn local_structure(hdr: &[f64], ldr: &[f64], w: usize, h: usize, f: f64) -> f64 {
     // Centred moments (variances are shift-invariant; centring keeps E[x²] − μ² exact
     // enough at the HDR's 2³² scale).
-    let centre = |v: &[f64]| {
-        let m = v.iter().sum::<f64>() / v.len() as f64;
-        v.iter().map(|x| x - m).collect::<Vec<f64>>()
+    let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
+    let (hdr_mean, ldr_mean) = (mean(hdr), mean(ldr));
+    let k = window();
+    let n = k.len();
+    let (ow, oh) = (w + 1 - n, h + 1 - n);
+    // Per ring slot: the horizontally filtered x, y, x², y², xy of one input row.
+    const MOMENTS: usize = 5;
+    let mut ring = vec![0.0; n * MOMENTS * ow];
+    let mut centred = vec![[0.0; MOMENTS]; w];
+    let mut filter_row = |row: usize, slot: &mut [f64]| {
+        for (c, m) in centred.iter_mut().enumerate() {
+            let (x, y) = (hdr[row * w + c] - hdr_mean, ldr[row * w + c] - ldr_mean);
+            *m = [x, y, x * x, y * y, x * y];
+        }
+        for (moment, out) in slot.chunks_exact_mut(ow).enumerate() {
+            for (col, o) in out.iter_mut().enumerate() {
+                *o = (0..n).map(|t| k[t] * centred[col + t][moment]).sum();
+            }
+        }
     };
-    let (x, y) = (centre(hdr), centre(ldr));
-    let prod = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(p, q)| p * q).collect::<Vec<_>>();
-    let (mx, my) = (blur_valid(&x, w, h), blur_valid(&y, w, h));
-    let (xx, yy, xy) = (
-        blur_valid(&prod(&x, &x), w, h),
-        blur_valid(&prod(&y, &y), w, h),
-        blur_valid(&prod(&x, &y), w, h),
-    );
+    for row in 0..n - 1 {
+        filter_row(row, &mut ring[row * MOMENTS * ow..(row + 1) * MOMENTS * ow]);
+    }
     let tau = 128.0 / (1.4 * csf(f));
     let visible = |sd: f64| phi((sd - tau) / (tau / 3.0));
-    let sum: f64 = (0..mx.len())
-        .map(|i| {
-            let sx = (xx[i] - mx[i] * mx[i]).max(0.0).sqrt();
-            let sy = (yy[i] - my[i] * my[i]).max(0.0).sqrt();
-            let sxy = xy[i] - mx[i] * my[i];
+    let mut sum = 0.0;
+    let mut moments = vec![[0.0; MOMENTS]; ow];
+    for out_row in 0..oh {
+        let newest = out_row + n - 1;
+        let slot = newest % n;
+        filter_row(
+            newest,
+            &mut ring[slot * MOMENTS * ow..(slot + 1) * MOMENTS * ow],
+        );
+        for m in moments.iter_mut() {
+            *m = [0.0; MOMENTS];
+        }
+        for (t, kt) in k.iter().enumerate() {
+            let slot = &ring[((out_row + t) % n) * MOMENTS * ow..][..MOMENTS * ow];
+            for (moment, filtered) in slot.chunks_exact(ow).enumerate() {
+                for (m, v) in moments.iter_mut().zip(filtered) {
+                    m[moment] += kt * v;
+                }
+            }
+        }
+        for &[mx, my, xx, yy, xy] in &moments {
+            let sx = (xx - mx * mx).max(0.0).sqrt();
+            let sy = (yy - my * my).max(0.0).sqrt();
+            let sxy = xy - mx * my;
             let (vx, vy) = (visible(sx), visible(sy));
-            ((2.0 * vx * vy + C1) / (vx * vx + vy * vy + C1)) * ((sxy + C2) / (sx * sy + C2))
-        })
-        .sum();
-    sum / mx.len() as f64
+            sum +=
+                ((2.0 * vx * vy + C1) / (vx * vx + vy * vy + C1)) * ((sxy + C2) / (sx * sy + C2));
+        }
+    }
+    sum / (ow * oh) as f64
 }
 
 /// The next scale: 2×2 box average (the last row/column repeated at odd sizes), every
@@ -288,6 +324,78 @@ fn half(p: &[f64], w: usize, h: usize) -> (Vec<f64>, usize, usize) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Whole-plane separable 'valid' filtering, (w − 10) × (h − 10): what the streamed
+    /// moments must equal.
+    fn blur_valid(p: &[f64], w: usize, h: usize) -> Vec<f64> {
+        let k = window();
+        let n = k.len();
+        let (ow, oh) = (w + 1 - n, h + 1 - n);
+        let mut horizontal = vec![0.0; ow * h];
+        for y in 0..h {
+            for x in 0..ow {
+                horizontal[y * ow + x] = (0..n).map(|t| k[t] * p[y * w + x + t]).sum();
+            }
+        }
+        let mut out = vec![0.0; ow * oh];
+        for y in 0..oh {
+            for (t, kt) in k.iter().enumerate() {
+                for x in 0..ow {
+                    out[y * ow + x] += kt * horizontal[(y + t) * ow + x];
+                }
+            }
+        }
+        out
+    }
+
+    /// S_l from whole planes of every moment (the implementation before rows were
+    /// streamed).
+    fn local_structure_whole(hdr: &[f64], ldr: &[f64], w: usize, h: usize, f: f64) -> f64 {
+        let centre = |v: &[f64]| {
+            let m = v.iter().sum::<f64>() / v.len() as f64;
+            v.iter().map(|x| x - m).collect::<Vec<f64>>()
+        };
+        let (x, y) = (centre(hdr), centre(ldr));
+        let prod = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(p, q)| p * q).collect::<Vec<_>>();
+        let (mx, my) = (blur_valid(&x, w, h), blur_valid(&y, w, h));
+        let (xx, yy, xy) = (
+            blur_valid(&prod(&x, &x), w, h),
+            blur_valid(&prod(&y, &y), w, h),
+            blur_valid(&prod(&x, &y), w, h),
+        );
+        let tau = 128.0 / (1.4 * csf(f));
+        let visible = |sd: f64| phi((sd - tau) / (tau / 3.0));
+        let mut sum = 0.0;
+        for i in 0..mx.len() {
+            let sx = (xx[i] - mx[i] * mx[i]).max(0.0).sqrt();
+            let sy = (yy[i] - my[i] * my[i]).max(0.0).sqrt();
+            let sxy = xy[i] - mx[i] * my[i];
+            let (vx, vy) = (visible(sx), visible(sy));
+            sum +=
+                ((2.0 * vx * vy + C1) / (vx * vx + vy * vy + C1)) * ((sxy + C2) / (sx * sy + C2));
+        }
+        sum / mx.len() as f64
+    }
+
+    #[test]
+    fn streamed_rows_give_whole_plane_filtering_bit_for_bit() {
+        let (w, h) = (37, 29);
+        let hdr: Vec<f64> = (0..w * h)
+            .map(|i| 1e6 * ((i as f64 * 0.37).sin() + 1.1) * (1.0 + (i % 7) as f64))
+            .collect();
+        let ldr: Vec<f64> = (0..w * h)
+            .map(|i| 128.0 + 100.0 * (i as f64 * 0.011).cos() + (i % 5) as f64)
+            .collect();
+        for f in [16.0, 4.0, 1.0] {
+            let streamed = local_structure(&hdr, &ldr, w, h, f);
+            let whole = local_structure_whole(&hdr, &ldr, w, h, f);
+            assert_eq!(
+                streamed.to_bits(),
+                whole.to_bits(),
+                "{streamed} vs {whole} at f = {f}"
+            );
+        }
+    }
 
     #[test]
     fn naturalness_follows_the_densities_at_known_points() {

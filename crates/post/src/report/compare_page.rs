@@ -1,12 +1,13 @@
 //! The page of `prism compare A B --report OUT.html`: the metric table, A and B in the
 //! viewer (B the reference), and the FLIP and ΔE2000 maps in false colour with legends.
 
-use prism_image::Image;
 use prism_image::Result;
+use prism_spectrum::rgb_space::RgbColorSpace;
 
+use super::embed::ReportImageRows;
 use super::{Labelled, ReportImage, ReportPage, Section};
-use crate::auto_exposure::auto_exposure_ev;
-use crate::falsecolour::{false_colour, FalseColourOptions, FalseColourScale, Palette};
+use crate::falsecolour::{FalseColourOptions, FalseColourRows, FalseColourScale, Palette};
+use crate::metrics::flip::FlipMap;
 use crate::metrics::{Comparison, ErrorMaps};
 
 /// ΔE2000 the map's colour ramp spans; larger differences take the top colour. Fixed, so
@@ -14,20 +15,13 @@ use crate::metrics::{Comparison, ErrorMaps};
 pub const DELTA_E_MAP_MAX: f64 = 10.0;
 
 /// One input of the comparison as the report shows it.
-pub struct CompareInput<'a> {
+pub struct CompareInput {
     /// The file name (or any label) shown above the viewer.
     pub label: String,
-    pub image: &'a Image,
-    /// Scene-referred (EXR, HDR: exposure control) or display-referred (PNG).
+    /// Embedded as [`ReportImage::radiance`] when scene-referred (EXR, HDR: the viewer gets
+    /// an exposure control), else as [`ReportImage::display`] (PNG).
+    pub image: ReportImage,
     pub scene_referred: bool,
-}
-
-fn embed(input: &CompareInput) -> Result<ReportImage> {
-    if input.scene_referred {
-        ReportImage::radiance(input.image)
-    } else {
-        ReportImage::display(input.image)
-    }
 }
 
 fn number(v: f64) -> String {
@@ -86,6 +80,30 @@ pub fn metric_rows(c: &Comparison) -> Vec<Vec<String>> {
     rows
 }
 
+/// Rows per band when a false-colour map is encoded.
+const MAP_BAND_ROWS: usize = 256;
+
+/// A false-colour map encoded band by band (its image never exists whole).
+fn false_colour_figure(
+    values: &[f32],
+    width: usize,
+    height: usize,
+    options: &FalseColourOptions,
+) -> Result<ReportImage> {
+    let rows = FalseColourRows::new(values, width, height, options)?;
+    let mut encoded = ReportImageRows::display(rows.width(), rows.height())?;
+    let srgb = RgbColorSpace::srgb();
+    let mut band = Vec::new();
+    for start in (0..rows.height()).step_by(MAP_BAND_ROWS) {
+        band.clear();
+        for y in start..(start + MAP_BAND_ROWS).min(rows.height()) {
+            rows.extend_with_row(y, &mut band);
+        }
+        encoded.push(&band, &srgb)?;
+    }
+    encoded.finish()
+}
+
 /// The false-colour maps of a comparison (FLIP's in magma over [0, 1], ΔE2000 on the
 /// lighting ramp over [0, [`DELTA_E_MAP_MAX`]]), each with its legend. LDR-FLIP only for
 /// two display-referred inputs, else both FLIP maps.
@@ -100,46 +118,56 @@ pub fn map_figures(
         if hdr {
             figures.push(Labelled {
                 label: "HDR-FLIP (0 … 1, magma)".into(),
-                image: ReportImage::display(&flip.hdr.to_image("HDR-FLIP")?)?,
+                image: flip_figure(&flip.hdr, "HDR-FLIP")?,
             });
         }
         figures.push(Labelled {
             label: "LDR-FLIP (0 … 1, magma)".into(),
-            image: ReportImage::display(&flip.ldr.to_image("LDR-FLIP")?)?,
+            image: flip_figure(&flip.ldr, "LDR-FLIP")?,
         });
     }
     if let Some(de) = &maps.delta_e2000 {
-        let image = false_colour(
-            de,
-            width,
-            height,
-            &FalseColourOptions {
-                scale: FalseColourScale::Linear,
-                range: Some((0.0, DELTA_E_MAP_MAX)),
-                unit: "dE2000".into(),
-                cell_px: 1,
-                palette: Palette::Lighting,
-            },
-        )?;
+        let options = FalseColourOptions {
+            scale: FalseColourScale::Linear,
+            range: Some((0.0, DELTA_E_MAP_MAX)),
+            unit: "dE2000".into(),
+            cell_px: 1,
+            palette: Palette::Lighting,
+        };
         figures.push(Labelled {
             label: format!("ΔE2000 (0 … {DELTA_E_MAP_MAX}, larger clipped)"),
-            image: ReportImage::display(&image)?,
+            image: false_colour_figure(de, width, height, &options)?,
         });
     }
     Ok(figures)
 }
 
-/// The whole compare page: `test` is A, `reference` is B.
+/// A FLIP map in magma over [0, 1] with its legend ([`FlipMap::to_image`]'s image).
+fn flip_figure(map: &FlipMap, title: &str) -> Result<ReportImage> {
+    let options = FalseColourOptions {
+        scale: FalseColourScale::Linear,
+        range: Some((0.0, 1.0)),
+        unit: title.into(),
+        cell_px: 1,
+        palette: Palette::Magma,
+    };
+    false_colour_figure(&map.values, map.width, map.height, &options)
+}
+
+/// The whole compare page: `test` is A, `reference` is B; the viewer starts at
+/// `reference_exposure_ev` (where `--exposure auto` would put the reference) when either is
+/// scene-referred; `figures` are the error maps ([`map_figures`]).
 pub fn compare_page(
-    test: &CompareInput,
-    reference: &CompareInput,
+    test: CompareInput,
+    reference: CompareInput,
+    reference_exposure_ev: Option<f64>,
     comparison: &Comparison,
-    maps: &ErrorMaps,
-) -> Result<ReportPage> {
+    figures: Vec<Labelled>,
+) -> ReportPage {
+    let title = format!("{} vs {}", test.label, reference.label);
     let hdr = test.scene_referred || reference.scene_referred;
-    // The viewer starts where `--exposure auto` would put the reference.
     let exposure_ev = if hdr {
-        auto_exposure_ev(reference.image).unwrap_or(0.0)
+        reference_exposure_ev.unwrap_or(0.0)
     } else {
         0.0
     };
@@ -164,23 +192,19 @@ pub fn compare_page(
         Section::Heading("A and B".into()),
         Section::Pair {
             a: Labelled {
-                label: test.label.clone(),
-                image: embed(test)?,
+                label: test.label,
+                image: test.image,
             },
             b: Labelled {
-                label: reference.label.clone(),
-                image: embed(reference)?,
+                label: reference.label,
+                image: reference.image,
             },
             exposure_ev,
         },
     ];
-    let figures = map_figures(maps, comparison.width, comparison.height, hdr)?;
     if !figures.is_empty() {
         sections.push(Section::Heading("Error maps".into()));
         sections.push(Section::Figures(figures));
     }
-    Ok(ReportPage {
-        title: format!("{} vs {}", test.label, reference.label),
-        sections,
-    })
+    ReportPage { title, sections }
 }

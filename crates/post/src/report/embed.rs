@@ -6,6 +6,10 @@
 //! browser's canvas and lose the mantissas. The page's script decodes, exposes and
 //! sRGB-encodes them (report/viewer.js).
 
+use std::cell::RefCell;
+use std::io::Write;
+use std::rc::Rc;
+
 use base64::Engine;
 use prism_image::io::convert_pixels;
 use prism_image::io::rgbe::encode_rgbe;
@@ -34,56 +38,21 @@ pub struct ReportImage {
     pub data: ImageData,
 }
 
-/// The image's pixels in linear Rec.709 (a copy, converted when in another space).
-fn rec709_pixels(image: &Image) -> Vec<[f32; 3]> {
-    let mut pixels = image.pixels().to_vec();
-    let srgb = RgbColorSpace::srgb();
-    if !same_colorimetry(&image.color_space, &srgb) {
-        convert_pixels(&mut pixels, &image.color_space, &srgb);
-    }
-    pixels
-}
-
 impl ReportImage {
     /// A display-referred image (linear display values in [0, 1], e.g. a decoded PNG or a
     /// false-colour map): clipped, sRGB-encoded, 8 bits.
     pub fn display(image: &Image) -> Result<Self> {
-        let bytes: Vec<u8> = rec709_pixels(image)
-            .par_iter()
-            .flat_map_iter(|p| {
-                p.map(|v| {
-                    let v = if v.is_finite() { f64::from(v) } else { 0.0 };
-                    (255.0 * TransferFunction::Srgb.encode(v.clamp(0.0, 1.0))).round() as u8
-                })
-            })
-            .collect();
-        Ok(Self {
-            width: image.width(),
-            height: image.height(),
-            data: ImageData::Display {
-                png: encode_png(&bytes, image.width(), image.height(), png::ColorType::Rgb)?,
-            },
-        })
+        let mut rows = ReportImageRows::display(image.width(), image.height())?;
+        rows.push(image.pixels(), &image.color_space)?;
+        rows.finish()
     }
 
     /// A scene-referred image (any scale): RGBE of its linear Rec.709 values; negative
     /// and non-finite components become 0.
     pub fn radiance(image: &Image) -> Result<Self> {
-        let codes: Vec<[u8; 4]> = rec709_pixels(image)
-            .par_iter()
-            .map(|p| encode_rgbe(*p))
-            .collect();
-        let mantissas: Vec<u8> = codes.iter().flat_map(|c| [c[0], c[1], c[2]]).collect();
-        let exponents: Vec<u8> = codes.iter().map(|c| c[3]).collect();
-        let (w, h) = (image.width(), image.height());
-        Ok(Self {
-            width: w,
-            height: h,
-            data: ImageData::Radiance {
-                mantissa_png: encode_png(&mantissas, w, h, png::ColorType::Rgb)?,
-                exponent_png: encode_png(&exponents, w, h, png::ColorType::Grayscale)?,
-            },
-        })
+        let mut rows = ReportImageRows::radiance(image.width(), image.height())?;
+        rows.push(image.pixels(), &image.color_space)?;
+        rows.finish()
     }
 
     /// Bytes this image adds to the page (base64 of its PNGs).
@@ -110,27 +79,175 @@ pub fn png_data_uri(png: &[u8]) -> String {
     uri
 }
 
+/// A [`ReportImage`] encoded as its rows arrive (top to bottom, in bands of any height),
+/// so that only the compressed PNGs grow with the image.
+pub struct ReportImageRows {
+    width: usize,
+    height: usize,
+    rows_done: usize,
+    encoding: RowEncoding,
+}
+
+enum RowEncoding {
+    Display(PngRows),
+    Radiance {
+        mantissas: PngRows,
+        // Boxed: the variants stay the same size.
+        exponents: Box<PngRows>,
+    },
+}
+
+impl ReportImageRows {
+    /// Rows of a display-referred image ([`ReportImage::display`]).
+    pub fn display(width: usize, height: usize) -> Result<Self> {
+        Ok(Self {
+            width,
+            height,
+            rows_done: 0,
+            encoding: RowEncoding::Display(PngRows::new(width, height, png::ColorType::Rgb)?),
+        })
+    }
+
+    /// Rows of a scene-referred image ([`ReportImage::radiance`]).
+    pub fn radiance(width: usize, height: usize) -> Result<Self> {
+        Ok(Self {
+            width,
+            height,
+            rows_done: 0,
+            encoding: RowEncoding::Radiance {
+                mantissas: PngRows::new(width, height, png::ColorType::Rgb)?,
+                exponents: Box::new(PngRows::new(width, height, png::ColorType::Grayscale)?),
+            },
+        })
+    }
+
+    /// The next whole rows, linear RGB in `space`.
+    pub fn push(&mut self, pixels: &[[f32; 3]], space: &RgbColorSpace) -> Result<()> {
+        let rows = pixels.len() / self.width.max(1);
+        if rows * self.width != pixels.len() || self.rows_done + rows > self.height {
+            return Err(ImageError::invalid(format!(
+                "report: {} pixels after {} of {} rows of a {}-pixel-wide image",
+                pixels.len(),
+                self.rows_done,
+                self.height,
+                self.width
+            )));
+        }
+        let srgb = RgbColorSpace::srgb();
+        let rec709: std::borrow::Cow<[[f32; 3]]> = if same_colorimetry(space, &srgb) {
+            pixels.into()
+        } else {
+            let mut copy = pixels.to_vec();
+            convert_pixels(&mut copy, space, &srgb);
+            copy.into()
+        };
+        match &mut self.encoding {
+            RowEncoding::Display(png) => {
+                let bytes: Vec<u8> = rec709
+                    .par_iter()
+                    .flat_map_iter(|p| {
+                        p.map(|v| {
+                            let v = if v.is_finite() { f64::from(v) } else { 0.0 };
+                            (255.0 * TransferFunction::Srgb.encode(v.clamp(0.0, 1.0))).round() as u8
+                        })
+                    })
+                    .collect();
+                png.write(&bytes)?;
+            }
+            RowEncoding::Radiance {
+                mantissas,
+                exponents,
+            } => {
+                let codes: Vec<[u8; 4]> = rec709.par_iter().map(|p| encode_rgbe(*p)).collect();
+                let m: Vec<u8> = codes.iter().flat_map(|c| [c[0], c[1], c[2]]).collect();
+                mantissas.write(&m)?;
+                let e: Vec<u8> = codes.iter().map(|c| c[3]).collect();
+                exponents.write(&e)?;
+            }
+        }
+        self.rows_done += rows;
+        Ok(())
+    }
+
+    /// The image, once every row was pushed.
+    pub fn finish(self) -> Result<ReportImage> {
+        if self.rows_done != self.height {
+            return Err(ImageError::invalid(format!(
+                "report: {} of {} rows were given",
+                self.rows_done, self.height
+            )));
+        }
+        let data = match self.encoding {
+            RowEncoding::Display(png) => ImageData::Display { png: png.finish()? },
+            RowEncoding::Radiance {
+                mantissas,
+                exponents,
+            } => ImageData::Radiance {
+                mantissa_png: mantissas.finish()?,
+                exponent_png: exponents.finish()?,
+            },
+        };
+        Ok(ReportImage {
+            width: self.width,
+            height: self.height,
+            data,
+        })
+    }
+}
+
+/// The bytes a PNG stream wrote, read back once it is finished.
+#[derive(Clone, Default)]
+struct SharedBytes(Rc<RefCell<Vec<u8>>>);
+
+impl Write for SharedBytes {
+    fn write(&mut self, bytes: &[u8]) -> std::io::Result<usize> {
+        self.0.borrow_mut().extend_from_slice(bytes);
+        Ok(bytes.len())
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        Ok(())
+    }
+}
+
 /// An untagged 8-bit PNG (no gAMA/cHRM/iCCP chunk, so browsers treat it as sRGB and draw
-/// it to a canvas unchanged).
-fn encode_png(bytes: &[u8], w: usize, h: usize, colour: png::ColorType) -> Result<Vec<u8>> {
-    let fail =
-        |e: png::EncodingError| ImageError::invalid(format!("report: cannot encode a PNG: {e}"));
-    let (Ok(w32), Ok(h32)) = (u32::try_from(w), u32::try_from(h)) else {
-        return Err(ImageError::invalid(format!(
-            "report: {w}×{h} is too large for PNG"
-        )));
-    };
-    let mut out = Vec::new();
-    {
-        let mut encoder = png::Encoder::new(&mut out, w32, h32);
+/// it to a canvas unchanged), compressed as its rows arrive.
+struct PngRows {
+    stream: png::StreamWriter<'static, SharedBytes>,
+    bytes: SharedBytes,
+}
+
+fn png_error(e: impl std::fmt::Display) -> ImageError {
+    ImageError::invalid(format!("report: cannot encode a PNG: {e}"))
+}
+
+impl PngRows {
+    fn new(w: usize, h: usize, colour: png::ColorType) -> Result<Self> {
+        let (Ok(w32), Ok(h32)) = (u32::try_from(w), u32::try_from(h)) else {
+            return Err(ImageError::invalid(format!(
+                "report: {w}×{h} is too large for PNG"
+            )));
+        };
+        let bytes = SharedBytes::default();
+        let mut encoder = png::Encoder::new(bytes.clone(), w32, h32);
         encoder.set_color(colour);
         encoder.set_depth(png::BitDepth::Eight);
         encoder.set_compression(png::Compression::Fast);
-        let mut writer = encoder.write_header().map_err(fail)?;
-        writer.write_image_data(bytes).map_err(fail)?;
-        writer.finish().map_err(fail)?;
+        let stream = encoder
+            .write_header()
+            .and_then(png::Writer::into_stream_writer)
+            .map_err(png_error)?;
+        Ok(Self { stream, bytes })
     }
-    Ok(out)
+
+    fn write(&mut self, data: &[u8]) -> Result<()> {
+        self.stream.write_all(data).map_err(png_error)
+    }
+
+    fn finish(self) -> Result<Vec<u8>> {
+        self.stream.finish().map_err(png_error)?;
+        Ok(self.bytes.0.take())
+    }
 }
 
 #[cfg(test)]
@@ -203,5 +320,48 @@ mod tests {
         // sRGB(0.2140) = 0.5 → 128 (127.5 rounded); 2.0 clips to 255.
         assert_eq!(bytes, vec![0, 0, 0, 128, 128, 128, 255, 255, 255]);
         assert!(png_data_uri(&png).starts_with("data:image/png;base64,iVBORw0KGgo"));
+    }
+
+    /// Bands of any height give the image one push of every row gives, and a short or
+    /// overlong image is an error, not a truncated PNG.
+    #[test]
+    fn images_pushed_in_bands_decode_to_the_whole_image() {
+        let (w, h) = (7, 10);
+        let pixels: Vec<[f32; 3]> = (0..w * h)
+            .map(|i| [i as f32 * 0.013, 0.5, (i % 3) as f32 * 40.0])
+            .collect();
+        let srgb = RgbColorSpace::srgb();
+        let image = Image::new(w, h, pixels.clone(), srgb.clone()).unwrap();
+        for (whole, mut rows) in [
+            (
+                ReportImage::display(&image).unwrap(),
+                ReportImageRows::display(w, h).unwrap(),
+            ),
+            (
+                ReportImage::radiance(&image).unwrap(),
+                ReportImageRows::radiance(w, h).unwrap(),
+            ),
+        ] {
+            for band in [0..3, 3..4, 4..10] {
+                rows.push(&pixels[band.start * w..band.end * w], &srgb)
+                    .unwrap();
+            }
+            let banded = rows.finish().unwrap();
+            let pngs = |image: &ReportImage| match &image.data {
+                ImageData::Display { png } => vec![decode(png).1],
+                ImageData::Radiance {
+                    mantissa_png,
+                    exponent_png,
+                } => vec![decode(mantissa_png).1, decode(exponent_png).1],
+            };
+            assert_eq!(pngs(&banded), pngs(&whole));
+        }
+        let mut short = ReportImageRows::display(w, h).unwrap();
+        short.push(&pixels[..3 * w], &srgb).unwrap();
+        assert!(short.finish().is_err());
+        let mut long = ReportImageRows::display(w, h).unwrap();
+        assert!(long
+            .push(&[pixels.clone(), pixels].concat(), &srgb)
+            .is_err());
     }
 }

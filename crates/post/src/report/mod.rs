@@ -75,7 +75,7 @@ pub fn escape(text: &str) -> String {
 }
 
 /// The `<img>` elements the viewer decodes for one image (hidden sources).
-fn source_images(out: &mut String, role: &str, image: &ReportImage) {
+fn source_images(out: &mut impl Write, role: &str, image: &ReportImage) {
     match &image.data {
         ImageData::Display { png } => {
             let _ = write!(
@@ -116,6 +116,13 @@ impl ReportPage {
     /// The whole page as one HTML5 document.
     pub fn to_html(&self) -> String {
         let mut out = String::new();
+        self.write_html(&mut out);
+        out
+    }
+
+    /// [`Self::to_html`] into `out` a piece at a time (an image's data URI is the largest
+    /// piece), so that a large page never exists whole in memory.
+    pub fn write_html(&self, out: &mut impl Write) {
         let _ = write!(
             out,
             "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n\
@@ -127,17 +134,33 @@ impl ReportPage {
             escape(&self.title)
         );
         for (index, section) in self.sections.iter().enumerate() {
-            section_html(&mut out, index, section);
+            section_html(out, index, section);
         }
         let _ = write!(
             out,
             "</main>\n<script>\n{VIEWER_JS}</script>\n</body>\n</html>\n"
         );
-        out
     }
 }
 
-fn section_html(out: &mut String, index: usize, section: &Section) {
+/// `fmt::Write` into an `io::Write`, keeping the first I/O error.
+struct IoText<'a, W: std::io::Write> {
+    out: &'a mut W,
+    error: Option<std::io::Error>,
+}
+
+impl<W: std::io::Write> Write for IoText<'_, W> {
+    fn write_str(&mut self, text: &str) -> std::fmt::Result {
+        if self.error.is_none() {
+            if let Err(e) = self.out.write_all(text.as_bytes()) {
+                self.error = Some(e);
+            }
+        }
+        Ok(())
+    }
+}
+
+fn section_html(out: &mut impl Write, index: usize, section: &Section) {
     match section {
         Section::Heading(text) => {
             let _ = writeln!(out, "<h2>{}</h2>", escape(text));
@@ -158,15 +181,15 @@ fn section_html(out: &mut String, index: usize, section: &Section) {
             for cell in header {
                 let _ = write!(out, "<th>{}</th>", escape(cell));
             }
-            out.push_str("</tr></thead>\n<tbody>\n");
+            let _ = out.write_str("</tr></thead>\n<tbody>\n");
             for row in rows {
-                out.push_str("<tr>");
+                let _ = out.write_str("<tr>");
                 for cell in row {
                     let _ = write!(out, "<td>{}</td>", escape(cell));
                 }
-                out.push_str("</tr>\n");
+                let _ = out.write_str("</tr>\n");
             }
-            out.push_str("</tbody>\n</table>\n");
+            let _ = out.write_str("</tbody>\n</table>\n");
         }
         Section::Pair { a, b, exposure_ev } => {
             let hdr = is_radiance(&a.image) || is_radiance(&b.image);
@@ -201,10 +224,10 @@ fn section_html(out: &mut String, index: usize, section: &Section) {
             );
             source_images(out, "a", &a.image);
             source_images(out, "b", &b.image);
-            out.push_str("\n</section>\n");
+            let _ = out.write_str("\n</section>\n");
         }
         Section::Figures(figures) => {
-            out.push_str("<div class=\"figures\">\n");
+            let _ = out.write_str("<div class=\"figures\">\n");
             for figure in figures {
                 match &figure.image.data {
                     ImageData::Display { png } => {
@@ -232,7 +255,7 @@ fn section_html(out: &mut String, index: usize, section: &Section) {
                     ),
                 }
             }
-            out.push_str("</div>\n");
+            let _ = out.write_str("</div>\n");
         }
         Section::Svg { caption, svg } => {
             // The XML declaration is not allowed inside HTML.
@@ -270,7 +293,11 @@ fn with_view_box(svg: &str) -> String {
 
 /// Writes `page` to `path` atomically (temporary sibling, then rename).
 pub fn write_report(path: &std::path::Path, page: &ReportPage) -> prism_image::Result<()> {
-    prism_image::io::write_bytes_atomically(path, page.to_html().as_bytes())
+    prism_image::io::write_stream_atomically(path, |out| {
+        let mut text = IoText { out, error: None };
+        page.write_html(&mut text);
+        text.error.map_or(Ok(()), Err)
+    })
 }
 
 #[cfg(test)]
