@@ -21,8 +21,8 @@ use serde::Serialize;
 use crate::auto_exposure::{auto_exposure_ev, exposure_ev_from_sums, log_luminance_sums};
 use crate::colour::scene_illumination::ILLUMINATION_CHANNELS;
 use crate::colour::{
-    apply_white_balance, apply_with_source_white, illumination_white_xyz, map_gamut, GamutMethod,
-    GamutTarget, SceneWhite, WhiteBalance, ILLUMINATION_LAYER,
+    apply_with_source_white, estimate_source_white_xyz, illumination_white_xyz, map_gamut,
+    GamutMethod, GamutTarget, SceneWhite, WhiteBalance, ILLUMINATION_LAYER,
 };
 use crate::metrics::strips::{compare_rows, strip_rows};
 use crate::metrics::tmqi::{check_size, hdr_luminance, ldr_luminance, tmqi_owned, Tmqi};
@@ -31,7 +31,8 @@ use crate::report::compare_page::{compare_page, map_figures, CompareInput};
 use crate::report::embed::ReportImageRows;
 use crate::report::write_report;
 use crate::sheet::{
-    contact_sheet_scored, score_tmqi, SheetFailure, SheetOptions, SheetScore, TileOrder, TileScore,
+    contact_sheet_from, contact_sheet_scored, score_tmqi, SheetFailure, SheetOptions, SheetScore,
+    TileOrder, TileScore,
 };
 use crate::tonemap::{ToneOperator, ToneParams, ToneReport};
 use prism_image::image::luminance_weights;
@@ -203,7 +204,8 @@ pub fn tonemap_file(
     let t = Instant::now();
     let image = read_image(input)?;
     let read_ms = ms(t);
-    let (out, mut report) = tonemap_image(image, input, options)?;
+    let reread = || read_image(input);
+    let (out, mut report) = tonemap_image_from(image, input, options, Some(&reread))?;
     let t = Instant::now();
     write_image(output, &out)?;
     report.output = output.display().to_string();
@@ -218,9 +220,21 @@ pub fn tonemap_file(
 /// target in [0, 1]) and the report, whose `output` is empty and whose read and write
 /// times are 0. `input` names the image in messages and in the report.
 pub fn tonemap_image(
+    image: Image,
+    input: &Path,
+    options: &TonemapOptions,
+) -> Result<(Image, TonemapFileReport)> {
+    tonemap_image_from(image, input, options, None)
+}
+
+/// [`tonemap_image`] with a way to read the input again: the contact sheet (`--op all`)
+/// then gives each operator a fresh copy (exposed and white-balanced as the first) instead
+/// of keeping the input beside each output (docs/reliability.md).
+pub fn tonemap_image_from(
     mut image: Image,
     input: &Path,
     options: &TonemapOptions,
+    reread: Option<&dyn Fn() -> Result<Image>>,
 ) -> Result<(Image, TonemapFileReport)> {
     let start = Instant::now();
     let t = Instant::now();
@@ -263,35 +277,32 @@ pub fn tonemap_image(
                  32-bit floats; expected an exposure between -149 and 127 stops"
             )));
         }
-        exposure_overflow_pixels = image
-            .pixels_mut()
-            .par_iter_mut()
-            .map(|p| {
-                let finite = p.iter().all(|c| c.is_finite());
-                *p = p.map(|c| c * factor);
-                u64::from(finite && !p.iter().all(|c| c.is_finite()))
-            })
-            .sum();
+        exposure_overflow_pixels = expose(&mut image, factor);
     }
     let space = image.color_space.clone();
-    let wb_source_xy = match &options.wb {
+    let source_white = match &options.wb {
         WhiteBalance::None => None,
-        WhiteBalance::Scene => {
-            let white = scene_white_of(&image, input)?;
-            let report = apply_with_source_white(
-                image.pixels_mut(),
-                &space,
-                &options.wb,
-                white,
-                options.cat,
-            );
-            Some(report.source_white_xy)
+        WhiteBalance::Scene => Some(scene_white_of(&image, input)?),
+        method => Some(
+            estimate_source_white_xyz(image.pixels(), &space, method)
+                .map_err(|e| ImageError::format(input, e.to_string()))?,
+        ),
+    };
+    let wb_source_xy = source_white.map(|white| {
+        apply_with_source_white(image.pixels_mut(), &space, &options.wb, white, options.cat)
+            .source_white_xy
+    });
+    // The contact sheet's fresh copies of the input, prepared as `image` was.
+    let prepared_again = |read: &dyn Fn() -> Result<Image>| -> Result<Image> {
+        let mut again = read()?;
+        if exposure_ev != 0.0 {
+            expose(&mut again, 2f64.powf(exposure_ev) as f32);
         }
-        method => {
-            let report = apply_white_balance(image.pixels_mut(), &space, method, options.cat)
-                .map_err(|e| ImageError::format(input, e.to_string()))?;
-            Some(report.source_white_xy)
+        if let Some(white) = source_white {
+            let space = again.color_space.clone();
+            apply_with_source_white(again.pixels_mut(), &space, &options.wb, white, options.cat);
         }
+        Ok(again)
     };
     let exposure_white_balance_ms = ms(t);
 
@@ -336,9 +347,17 @@ pub fn tonemap_image(
             (result.image, vec![result.report], Vec::new(), None, scores)
         }
         (OperatorChoice::All, _) => {
-            let sheet = contact_sheet_scored(&image, &ToneOperator::ALL, &params, &sheet_options)
-                .map_err(in_file)?;
-            drop(image);
+            let sheet = match reread {
+                Some(read) => contact_sheet_from(
+                    image,
+                    || prepared_again(read),
+                    &ToneOperator::ALL,
+                    &params,
+                    &sheet_options,
+                ),
+                None => contact_sheet_scored(&image, &ToneOperator::ALL, &params, &sheet_options),
+            }
+            .map_err(in_file)?;
             (
                 sheet.image,
                 sheet.reports,
@@ -389,6 +408,20 @@ pub fn tonemap_image(
         },
     };
     Ok((out, report))
+}
+
+/// Scales `image` by `factor` (an exposure); returns the pixels that were finite before
+/// and are not after (overflow).
+fn expose(image: &mut Image, factor: f32) -> u64 {
+    image
+        .pixels_mut()
+        .par_iter_mut()
+        .map(|p| {
+            let finite = p.iter().all(|c| c.is_finite());
+            *p = p.map(|c| c * factor);
+            u64::from(finite && !p.iter().all(|c| c.is_finite()))
+        })
+        .sum()
 }
 
 /// The scene white for `--wb scene`: the luminance-weighted mean chromaticity of the
@@ -613,4 +646,51 @@ pub fn compare_files_report(
     );
     write_report(report, &page)?;
     Ok((comparison, maps))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use prism_spectrum::rgb_space::RgbColorSpace;
+
+    /// A contact sheet whose operators each get a fresh copy of the input, exposed and
+    /// white-balanced again (`prism tonemap` reads the file again), is bit for bit the sheet
+    /// of one prepared image kept in memory, TMQI scores included.
+    #[test]
+    fn a_sheet_from_fresh_copies_is_the_sheet_of_the_kept_image() {
+        let (w, h) = (200, 180);
+        let pixels = (0..w * h)
+            .map(|i| {
+                let (x, y) = ((i % w) as f32 / w as f32, (i / w) as f32 / h as f32);
+                [
+                    0.2 + 3.0 * x * y,
+                    0.5 + (7.0 * x).sin().abs(),
+                    0.1 + 10.0 * y * y,
+                ]
+            })
+            .collect();
+        let image = Image::new(w, h, pixels, RgbColorSpace::srgb()).unwrap();
+        let options = TonemapOptions {
+            operator: OperatorChoice::All,
+            wb: WhiteBalance::GreyWorld,
+            exposure_ev: 1.5,
+            luminance_scale_cd_m2: Some(100.0),
+            score: Some(SheetScore::Tmqi),
+            ..TonemapOptions::default()
+        };
+        let path = Path::new("memory.exr");
+        let (kept, kept_report) = tonemap_image(image.clone(), path, &options).unwrap();
+        let reads = std::cell::Cell::new(0);
+        let read = || {
+            reads.set(reads.get() + 1);
+            Ok(image.clone())
+        };
+        let (fresh, fresh_report) =
+            tonemap_image_from(image.clone(), path, &options, Some(&read)).unwrap();
+        assert_eq!(reads.get(), ToneOperator::ALL.len() - 1);
+        assert_eq!(fresh.pixels(), kept.pixels());
+        assert_eq!(fresh_report.scores, kept_report.scores);
+        assert_eq!(fresh_report.scores.len(), ToneOperator::ALL.len());
+        assert!(fresh_report.failures.is_empty());
+    }
 }

@@ -82,6 +82,31 @@ pub fn tmqi_images(ldr: &Image, hdr: &Image) -> Result<Tmqi> {
     tmqi_owned(ldr_y, hdr_y, ldr.width(), ldr.height())
 }
 
+/// [`hdr_luminance`] of an image in any space, converted a band at a time.
+pub fn hdr_luminance_of(image: &Image) -> Vec<f64> {
+    luminance_in_bands(image, hdr_luminance)
+}
+
+/// [`ldr_luminance`] of an image in any space, converted a band at a time.
+pub fn ldr_luminance_of(image: &Image) -> Vec<f64> {
+    luminance_in_bands(image, ldr_luminance)
+}
+
+fn luminance_in_bands(image: &Image, luminance: fn(&[[f32; 3]]) -> Vec<f64>) -> Vec<f64> {
+    let srgb = RgbColorSpace::srgb();
+    if same_colorimetry(&image.color_space, &srgb) {
+        return luminance(image.pixels());
+    }
+    const BAND_PIXELS: usize = 1 << 16;
+    let mut out = Vec::with_capacity(image.pixels().len());
+    for band in image.pixels().chunks(BAND_PIXELS) {
+        let mut band = band.to_vec();
+        convert_pixels(&mut band, &image.color_space, &srgb);
+        out.extend(luminance(&band));
+    }
+    out
+}
+
 /// Luminance of linear Rec.709 scene values (non-finite → 0), as TMQI reads the HDR image.
 pub fn hdr_luminance(rec709: &[[f32; 3]]) -> Vec<f64> {
     let linear = |v: f32| if v.is_finite() { f64::from(v) } else { 0.0 };

@@ -142,6 +142,27 @@ pub fn contact_sheet_scored(
     params: &ToneParams,
     options: &SheetOptions,
 ) -> Result<ContactSheet> {
+    contact_sheet_from(
+        image.clone(),
+        || Ok(image.clone()),
+        operators,
+        params,
+        options,
+    )
+}
+
+/// [`contact_sheet_scored`] for an input that can be made again: each operator maps its own
+/// copy in place, `first` for the first operator and one from `again` for each next one
+/// (`prism tonemap` reads the file again), so that the input and an operator's output are
+/// never held together. `again` must give the image `first` is.
+pub fn contact_sheet_from(
+    first: Image,
+    mut again: impl FnMut() -> Result<Image>,
+    operators: &[ToneOperator],
+    params: &ToneParams,
+    options: &SheetOptions,
+) -> Result<ContactSheet> {
+    let image = &first;
     if operators.is_empty() {
         return Err(ImageError::invalid(
             "contact sheet: no operators to show".to_string(),
@@ -167,12 +188,33 @@ pub fn contact_sheet_scored(
         image.width().div_ceil(factor),
         image.height().div_ceil(factor),
     );
+    let (width, height) = (image.width(), image.height());
+    // TMQI's HDR side, once: the luminance of the input the operators are given.
+    let hdr_luminance = options
+        .score
+        .map(|SheetScore::Tmqi| tmqi::hdr_luminance_of(image));
     let mut reports = Vec::new();
     let mut failures = Vec::new();
     let (mut outside, mut counted) = (0usize, 0usize);
-    let mut buffer = Vec::new();
     let mut tiles = Vec::with_capacity(operators.len());
+    let mut spare = Some(first);
     for op in operators {
+        let input = match spare.take() {
+            Some(image) => image,
+            None => {
+                let image = again()?;
+                if (image.width(), image.height()) != (width, height) {
+                    return Err(ImageError::invalid(format!(
+                        "contact sheet: the input was {width}×{height} for the first operator \
+                         but {}×{} for {}",
+                        image.width(),
+                        image.height(),
+                        op.name()
+                    )));
+                }
+                image
+            }
+        };
         let own = ToneParams {
             values: params
                 .values
@@ -182,15 +224,8 @@ pub fn contact_sheet_scored(
                 .collect(),
             ..params.clone()
         };
-        let tile = match op.apply_into(image, &own, std::mem::take(&mut buffer)) {
+        let tile = match op.apply_in_place(input, &own) {
             Ok(result) => {
-                let score = match options.score {
-                    Some(SheetScore::Tmqi) => Some(TileScore {
-                        operator: op.name(),
-                        tmqi: score_tmqi(&result.image, image, options)?,
-                    }),
-                    None => None,
-                };
                 let mut pixels = downsample(&result.image, factor, tw, th);
                 let g = map_gamut(
                     &mut pixels,
@@ -202,7 +237,13 @@ pub fn contact_sheet_scored(
                 counted += g.pixel_count;
                 let label = label_for(*op, &own.values, &result.report.values);
                 reports.push(result.report);
-                buffer = result.image.into_pixels();
+                let score = match &hdr_luminance {
+                    Some(hdr) => Some(TileScore {
+                        operator: op.name(),
+                        tmqi: score_tmqi_owned(result.image, hdr.clone(), options)?,
+                    }),
+                    None => None,
+                };
                 Tile {
                     pixels: Some(pixels),
                     label,
@@ -299,6 +340,28 @@ pub fn contact_sheet_scored(
         },
         scores: tiles.into_iter().filter_map(|t| t.score).collect(),
     })
+}
+
+/// [`score_tmqi`] on an output it may overwrite, against the input's luminance
+/// ([`tmqi::hdr_luminance_of`]): the output's luminance is taken and the output dropped
+/// before TMQI's planes are made.
+fn score_tmqi_owned(
+    mut tone_mapped: Image,
+    hdr_luminance: Vec<f64>,
+    options: &SheetOptions,
+) -> Result<Tmqi> {
+    let space = tone_mapped.color_space.clone();
+    map_gamut(
+        tone_mapped.pixels_mut(),
+        &space,
+        options.target,
+        options.gamut,
+    );
+    tone_mapped.color_space = options.target.space();
+    let (w, h) = (tone_mapped.width(), tone_mapped.height());
+    let ldr = tmqi::ldr_luminance_of(&tone_mapped);
+    drop(tone_mapped);
+    tmqi::tmqi_owned(ldr, hdr_luminance, w, h)
 }
 
 /// TMQI of an operator's full-resolution output, gamut-mapped into the target as a
