@@ -533,13 +533,19 @@ pub fn compare_files_with(
     reference: &Path,
     options: &CompareOptions,
 ) -> Result<(Comparison, ErrorMaps)> {
+    let (a, b) = open_pair(test, reference)?;
+    compare_rows(&a, &b, options, strip_rows(b.width()))
+}
+
+/// Row sources of `test` and `reference`; an error naming both when their sizes differ.
+fn open_pair(test: &Path, reference: &Path) -> Result<(RowSource, RowSource)> {
     let a = RowSource::open(test)?;
     let b = RowSource::open(reference)?;
     check_sizes(
         (test, (a.width(), a.height())),
         (reference, (b.width(), b.height())),
     )?;
-    compare_rows(&a, &b, options, strip_rows(b.width()))
+    Ok((a, b))
 }
 
 /// An error naming both files when their sizes differ.
@@ -572,12 +578,7 @@ pub fn compare_files_report(
     options: &CompareOptions,
     report: &Path,
 ) -> Result<(Comparison, ErrorMaps)> {
-    let a = RowSource::open(test)?;
-    let b = RowSource::open(reference)?;
-    check_sizes(
-        (test, (a.width(), a.height())),
-        (reference, (b.width(), b.height())),
-    )?;
+    let (a, b) = open_pair(test, reference)?;
     let options = CompareOptions {
         flip_ppd: Some(
             options
