@@ -310,7 +310,12 @@ pub fn render(
                 let now = samples_done.load(Ordering::Relaxed);
                 if now != reported {
                     reported = now;
-                    if let Err(e) = callback.call1((now, total_samples)) {
+                    // A Ctrl-C sent from the callback itself is taken at once, not after
+                    // the next wait.
+                    if let Err(e) = callback
+                        .call1((now, total_samples))
+                        .and_then(|_| py.check_signals())
+                    {
                         stop.store(true, Ordering::SeqCst);
                         raised = Some(e);
                     }
