@@ -3,6 +3,7 @@ the GIL and Ctrl-C."""
 
 import _thread
 import json
+import signal
 import threading
 import time
 
@@ -86,6 +87,10 @@ def test_ctrl_c_stops_the_render_and_raises_keyboard_interrupt(root):
             sent.append(time.monotonic())
             _thread.interrupt_main()
 
+    # A process started in the background by a non-interactive shell (as a CI script may
+    # be) inherits SIGINT ignored, and then Python installs no handler and
+    # `interrupt_main` does nothing: the test installs Python's own handler.
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
     start = time.monotonic()
     try:
         long_render(root, progress=interrupt_once)
@@ -97,6 +102,8 @@ def test_ctrl_c_stops_the_render_and_raises_keyboard_interrupt(root):
         pytest.fail(f"no KeyboardInterrupt: Ctrl-C sent {bool(sent)}, "
                     f"{round(time.monotonic() - start, 2)} s, progress calls "
                     f"{seen[:3]} … {seen[-3:]} ({len(seen)})")
+    finally:
+        signal.signal(signal.SIGINT, previous)
     assert sent, "the render never reported progress"
     elapsed = time.monotonic() - sent[0]
     # The items in flight when Ctrl-C comes finish first (a few seconds at most).
