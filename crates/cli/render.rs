@@ -27,7 +27,7 @@ use prism_image::io::spectral_exr::write_exr_with_spectral_bands;
 use prism_image::io::{write_image, ImageFormat};
 use prism_image::Image;
 use prism_render::film::spectral_bins::{MAX_SPECTRAL_BINS, MIN_SPECTRAL_BINS};
-use prism_render::film::{AovSelection, FilmMemory};
+use prism_render::film::FilmMemory;
 use prism_render::integrator::DEFAULT_TILE_SIZE_PX;
 use prism_render::{
     total_samples, FilmImage, PlanRequest, RenderPlan, RenderScene, RenderSettings, RenderStats,
@@ -138,23 +138,11 @@ fn check_memory(
 ) -> Result<(), String> {
     let [w, h] = description.film.resolution;
     let resolution = args.resolution.unwrap_or(UVec2::new(w, h));
-    let light_plane = match description.integrator {
-        prism_scene::Integrator::Light { .. } | prism_scene::Integrator::Bdpt { .. } => true,
-        prism_scene::Integrator::Path { .. }
-        | prism_scene::Integrator::Photon { .. }
-        | prism_scene::Integrator::PhotonProgressive { .. }
-        | prism_scene::Integrator::Depth
-        | prism_scene::Integrator::Normal
-        | prism_scene::Integrator::Albedo
-        | prism_scene::Integrator::AmbientOcclusion { .. } => false,
-    };
-    let film = FilmMemory {
+    let film = FilmMemory::for_integrator(
+        &description.integrator,
         resolution,
-        // Which AOVs the scene records is known only once it is built: count them all.
-        aovs: AovSelection::ALL,
-        spectral_bins: spectral_bins.map_or(0, |b| b.count()),
-        light_plane,
-    };
+        spectral_bins.map_or(0, |b| b.count()),
+    );
     let what = match spectral_bins {
         Some(b) => format!(
             "{}: rendering {}×{} px with {} spectral bins",

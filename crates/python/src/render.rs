@@ -19,7 +19,10 @@ use glam::UVec2;
 use numpy::ndarray::Array2;
 use numpy::IntoPyArray;
 use prism_bandwidth::SamplePlan;
+use prism_cpu::memory::{format_bytes, parse_size, MemoryBudget};
+use prism_cpu::threads::{max_threads, MAX_THREADS_PER_CPU};
 use prism_render::film::spectral_bins::{MAX_SPECTRAL_BINS, MIN_SPECTRAL_BINS};
+use prism_render::film::FilmMemory;
 use prism_render::integrator::{Pass, DEFAULT_TILE_SIZE_PX};
 use prism_render::sensor::{measure_sensors, SensorReading};
 use prism_render::{
@@ -129,6 +132,46 @@ fn spectral_bins_of(count: Option<u32>) -> PyResult<Option<SpectralBins>> {
         .transpose()
 }
 
+/// `max_memory=`: bytes, or a size with a unit as the CLI's `--max-memory` takes.
+#[derive(FromPyObject)]
+pub enum MemorySize {
+    Bytes(u64),
+    Text(String),
+}
+
+/// The film's estimated memory against `max_memory` (default: the CLI's), checked before
+/// the scene is built.
+fn check_memory(
+    description: &SceneDescription,
+    label: &str,
+    resolution: Option<UVec2>,
+    spectral_bins: Option<SpectralBins>,
+    max_memory: Option<MemorySize>,
+) -> PyResult<()> {
+    let budget = match max_memory {
+        None => MemoryBudget::machine_default(),
+        Some(MemorySize::Bytes(bytes)) => MemoryBudget::given(bytes),
+        Some(MemorySize::Text(text)) => MemoryBudget::given(
+            parse_size(&text).map_err(|e| argument(format!("max_memory: {e}")))?,
+        ),
+    };
+    let [w, h] = description.film.resolution;
+    let resolution = resolution.unwrap_or(UVec2::new(w, h));
+    let film = FilmMemory::for_integrator(
+        &description.integrator,
+        resolution,
+        spectral_bins.map_or(0, |b| b.count()),
+    );
+    let what = format!("{label}: rendering {}×{} px", resolution.x, resolution.y);
+    budget.check(&what, film.total_bytes()).map_err(|over| {
+        argument(format!(
+            "{what} needs about {}, more than the memory limit of {} (max_memory= changes it)",
+            format_bytes(over.estimate_bytes),
+            format_bytes(over.budget.limit_bytes)
+        ))
+    })
+}
+
 fn warn(py: Python<'_>, message: String) -> PyResult<()> {
     let text = std::ffi::CString::new(message).map_err(|e| argument(e.to_string()))?;
     PyErr::warn(py, &py.get_type::<PyUserWarning>(), &text, 1)
@@ -182,7 +225,7 @@ impl Drop for DoneOnDrop<'_> {
 }
 
 /// `render(scene, spp=None, seed=0, threads=None, resolution=None, spectral_bins=None,
-/// progress=None, base_dir=None)`.
+/// progress=None, base_dir=None, max_memory=None)`.
 ///
 /// `scene`: a path or a dict in the JSON schema (docs/scene-format.md; relative asset paths
 /// of a dict resolve against `base_dir`, default the current directory). `spp`: default the
@@ -191,9 +234,12 @@ impl Drop for DoneOnDrop<'_> {
 /// height). `spectral_bins`: N equal bins over 360–830 nm in `.spectral`. `progress`:
 /// called as `progress(samples_done, samples_total)` about ten times a second (an
 /// exception from it stops the render and is raised). Ctrl-C stops the render and raises
-/// KeyboardInterrupt.
+/// KeyboardInterrupt. `threads`: 1 to 4 per logical CPU, as the CLI's `--threads`.
+/// `max_memory`: bytes (an int) or a size such as "8G", as the CLI's `--max-memory`
+/// (default 75 % of physical memory): a render whose film is estimated above it is an
+/// `ArgumentError` before anything is allocated.
 #[pyfunction]
-#[pyo3(signature = (scene, spp=None, seed=Some(0), threads=None, resolution=None, spectral_bins=None, progress=None, base_dir=None))]
+#[pyo3(signature = (scene, spp=None, seed=Some(0), threads=None, resolution=None, spectral_bins=None, progress=None, base_dir=None, max_memory=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn render(
     py: Python<'_>,
@@ -205,6 +251,7 @@ pub fn render(
     spectral_bins: Option<u32>,
     progress: Option<Bound<'_, PyAny>>,
     base_dir: Option<PathBuf>,
+    max_memory: Option<MemorySize>,
 ) -> PyResult<Render> {
     let (description, label) = load(&scene, base_dir)?;
     let spectral_bins = spectral_bins_of(spectral_bins)?;
@@ -217,9 +264,16 @@ pub fn render(
         }
         None => None,
     };
-    if threads == Some(0) {
-        return Err(argument("threads 0: expected at least 1 worker thread"));
+    if let Some(n) = threads {
+        let max = max_threads();
+        if n == 0 || n > max {
+            return Err(argument(format!(
+                "threads {n}: expected 1 to {max} worker threads ({MAX_THREADS_PER_CPU} per \
+                 logical CPU)"
+            )));
+        }
     }
+    check_memory(&description, &label, resolution, spectral_bins, max_memory)?;
     let render_scene = py
         .detach(|| RenderScene::build(&description, resolution))
         .map_err(|e| SceneError::new_err(e.to_string()))?;

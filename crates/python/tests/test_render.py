@@ -138,3 +138,20 @@ def test_the_gil_is_released_while_rendering(root):
         thread.join()
     # A thread blocked on the GIL would tick a few times at most.
     assert len(ticks) > 0.1 * elapsed / 0.001, (len(ticks), elapsed)
+
+
+def test_oversized_renders_and_thread_counts_are_refused_before_anything_is_allocated(root):
+    # A film of 10¹⁰ pixels is refused from its estimate (the CLI's), not by the allocator.
+    with pytest.raises(prism.ArgumentError,
+                       match=r"rendering 100000×100000 px needs about .* more than the "
+                             r"memory limit"):
+        prism.render(root / SCENE, resolution=(100000, 100000))
+    with pytest.raises(prism.ArgumentError, match="max_memory= changes it"):
+        prism.render(root / SCENE, resolution=(256, 256), max_memory="1M")
+    with pytest.raises(prism.ArgumentError, match="max_memory"):
+        prism.render(root / SCENE, max_memory="lots")
+    with pytest.raises(prism.ArgumentError, match="worker threads"):
+        prism.render(root / SCENE, threads=100000)
+    # A limit that fits renders as before.
+    small = prism.render(root / SCENE, spp=1, resolution=(8, 8), max_memory=1 << 30)
+    assert small.rgb.shape == (8, 8, 3)

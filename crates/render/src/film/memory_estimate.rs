@@ -29,6 +29,22 @@ pub struct FilmMemory {
 }
 
 impl FilmMemory {
+    /// The film a render of a scene with `integrator` allocates at `resolution` with
+    /// `spectral_bins`, every AOV counted (which ones the scene records is known only once
+    /// it is built).
+    pub fn for_integrator(
+        integrator: &prism_scene::Integrator,
+        resolution: UVec2,
+        spectral_bins: u32,
+    ) -> Self {
+        Self {
+            resolution,
+            aovs: AovSelection::ALL,
+            spectral_bins,
+            light_plane: integrator.splats_light_paths(),
+        }
+    }
+
     /// f32 channels of the AOV layers, `spp.Y` included.
     fn aov_channels(&self) -> u64 {
         let a = self.aovs;
