@@ -25,7 +25,7 @@ use crate::colour::{
     GamutMethod, GamutTarget, SceneWhite, WhiteBalance, ILLUMINATION_LAYER,
 };
 use crate::metrics::strips::{compare_rows, strip_rows};
-use crate::metrics::tmqi::{check_size, hdr_luminance, ldr_luminance, tmqi_owned, Tmqi};
+use crate::metrics::tmqi::{check_size, hdr_luminance_of, ldr_luminance_of, tmqi_owned, Tmqi};
 use crate::metrics::{CompareOptions, Comparison, ErrorMaps};
 use crate::report::compare_page::{compare_page, map_figures, CompareInput};
 use crate::report::embed::ReportImageRows;
@@ -37,11 +37,9 @@ use crate::sheet::{
 use crate::tonemap::{ToneOperator, ToneParams, ToneReport};
 use prism_image::image::luminance_weights;
 use prism_image::io::strips::RowSource;
-use prism_image::io::{convert_pixels, read_dimensions, read_image, write_image, ImageFormat};
-use prism_image::rgb_matrix::same_colorimetry;
+use prism_image::io::{read_dimensions, read_image, write_image, ImageFormat};
 use prism_image::Image;
 use prism_image::{ImageError, Result};
-use prism_spectrum::rgb_space::RgbColorSpace;
 
 /// `--op NAME` or `--op all` (contact sheet).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -268,9 +266,10 @@ pub fn tonemap_image_from(
     } else {
         options.exposure_ev
     };
+    // The scale of a non-zero exposure (0 stops leaves the pixels untouched).
+    let exposure_factor = (exposure_ev != 0.0).then(|| 2f64.powf(exposure_ev) as f32);
     let mut exposure_overflow_pixels = 0;
-    if exposure_ev != 0.0 {
-        let factor = 2f64.powf(exposure_ev) as f32;
+    if let Some(factor) = exposure_factor {
         if !(factor.is_finite() && factor > 0.0) {
             return Err(ImageError::invalid(format!(
                 "--exposure {exposure_ev}: the scale 2^{exposure_ev} is outside the range of \
@@ -295,8 +294,8 @@ pub fn tonemap_image_from(
     // The contact sheet's fresh copies of the input, prepared as `image` was.
     let prepared_again = |read: &dyn Fn() -> Result<Image>| -> Result<Image> {
         let mut again = read()?;
-        if exposure_ev != 0.0 {
-            expose(&mut again, 2f64.powf(exposure_ev) as f32);
+        if let Some(factor) = exposure_factor {
+            expose(&mut again, factor);
         }
         if let Some(white) = source_white {
             let space = again.color_space.clone();
@@ -495,34 +494,16 @@ pub fn tmqi_files(ldr: &Path, hdr: &Path) -> Result<Tmqi> {
     let image = read_image(ldr)?;
     check_sizes((ldr, (image.width(), image.height())), (hdr, (w, h)))?;
     check_size(w, h)?;
-    let ldr_y = if same_colorimetry(&image.color_space, &RgbColorSpace::srgb()) {
-        let y = ldr_luminance(image.pixels());
-        drop(image);
-        y
-    } else {
-        let space = image.color_space.clone();
-        let mut pixels = image.into_pixels();
-        to_rec709(&mut pixels, &space);
-        ldr_luminance(&pixels)
-    };
+    let ldr_y = ldr_luminance_of(image.pixels(), &image.color_space);
+    drop(image);
     let source = RowSource::open(hdr)?;
     let mut hdr_y = Vec::with_capacity(w * h);
-    let band = strip_rows(w);
-    for start in (0..h).step_by(band) {
-        let mut rows = source.read_rows(start..(start + band).min(h))?;
-        to_rec709(&mut rows, source.color_space());
-        hdr_y.extend(hdr_luminance(&rows));
-    }
+    source.for_each_band(strip_rows(w), |rows| {
+        hdr_y.extend(hdr_luminance_of(rows, source.color_space()));
+        Ok(())
+    })?;
     drop(source);
     tmqi_owned(ldr_y, hdr_y, w, h)
-}
-
-/// Pixels in `space` converted to linear Rec.709 in place.
-fn to_rec709(pixels: &mut [[f32; 3]], space: &RgbColorSpace) {
-    let srgb = RgbColorSpace::srgb();
-    if !same_colorimetry(space, &srgb) {
-        convert_pixels(pixels, space, &srgb);
-    }
 }
 
 /// [`compare_files`] with a choice of metrics, and the maps asked for. The images are read
@@ -602,7 +583,12 @@ pub fn compare_files_report(
             |n| n.to_string_lossy().into_owned(),
         )
     };
-    let input = |path: &Path, source: &RowSource| -> Result<CompareInput> {
+    // Each input is read once more, band by band, into its compressed image; the
+    // reference's bands also give the exposure the viewer starts at (where `--exposure
+    // auto` would put it).
+    let weights = luminance_weights(b.color_space());
+    let (mut sum_ln, mut count) = (0.0, 0);
+    let mut input = |path: &Path, source: &RowSource, meter: bool| -> Result<CompareInput> {
         let scene = scene_referred(path);
         let (w, h) = (source.width(), source.height());
         let mut rows = if scene {
@@ -610,29 +596,23 @@ pub fn compare_files_report(
         } else {
             ReportImageRows::display(w, h)?
         };
-        for start in (0..h).step_by(band) {
-            rows.push(
-                &source.read_rows(start..(start + band).min(h))?,
-                source.color_space(),
-            )?;
-        }
+        source.for_each_band(band, |pixels| {
+            if meter {
+                let (s, n) = log_luminance_sums(pixels, weights);
+                sum_ln += s;
+                count += n;
+            }
+            rows.push(pixels, source.color_space())
+        })?;
         Ok(CompareInput {
             label: label(path),
             image: rows.finish()?,
             scene_referred: scene,
         })
     };
-    let (test_input, reference_input) = (input(test, &a)?, input(reference, &b)?);
-    // The viewer starts where `--exposure auto` would put the reference.
+    let test_input = input(test, &a, false)?;
+    let reference_input = input(reference, &b, hdr)?;
     let reference_exposure_ev = if hdr {
-        let weights = luminance_weights(b.color_space());
-        let (mut sum_ln, mut count) = (0.0, 0);
-        for start in (0..b.height()).step_by(band) {
-            let rows = b.read_rows(start..(start + band).min(b.height()))?;
-            let (s, n) = log_luminance_sums(&rows, weights);
-            sum_ln += s;
-            count += n;
-        }
         exposure_ev_from_sums(sum_ln, count)
     } else {
         None

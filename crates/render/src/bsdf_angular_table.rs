@@ -72,9 +72,9 @@ impl MaterialAngularBandwidth {
         if bsdf.lobe.is_isotropic() {
             // One incident azimuth per θᵢ: the slice at φᵢ = k·2π/16 is that of φᵢ = 0
             // rotated by k cells in φₒ (the lobe depends on φₒ − φᵢ only). 16× fewer
-            // lobe evaluations and eq. 7 reductions; eq. 7's φ border (the map is not
-            // periodic) then falls elsewhere relative to the lobe than in a slice taken
-            // at φᵢ itself, which the test below bounds.
+            // lobe evaluations and eq. 7 reductions; with φₒ padded periodically
+            // (slice_bandwidth) only the alignment of the coarse wavelets to the lobe
+            // differs from a slice taken at φᵢ itself, which the test below bounds.
             let first: Vec<Vec<f32>> = (0..TABLE_CELLS)
                 .into_par_iter()
                 .map(|it| slice_bandwidth(&bsdf, cell_direction(it, 0, TABLE_CELLS), &wavelengths))
@@ -196,7 +196,8 @@ mod tests {
     }
 
     /// The isotropic shortcut against slices taken at every incident azimuth: the same
-    /// at φᵢ = 0 and close elsewhere (eq. 7's φ border is the only difference).
+    /// at φᵢ = 0 and close elsewhere (the coarse wavelets' alignment to the lobe is the
+    /// only difference; measured: every quantile printed is 1.000).
     #[test]
     fn rotated_slices_of_an_isotropic_lobe_match_slices_taken_at_each_azimuth() {
         for roughness in [0.05, 0.1, 0.3] {

@@ -159,6 +159,22 @@ pub fn color_space_from_chromaticities(
         })
 }
 
+/// `pixels` (linear RGB in `from`) in `to`: borrowed when the two spaces have the same
+/// colorimetry, else a converted copy ([`convert_pixels`]).
+pub fn pixels_in<'a>(
+    pixels: &'a [[f32; 3]],
+    from: &RgbColorSpace,
+    to: &RgbColorSpace,
+) -> std::borrow::Cow<'a, [[f32; 3]]> {
+    if crate::rgb_matrix::same_colorimetry(from, to) {
+        pixels.into()
+    } else {
+        let mut copy = pixels.to_vec();
+        convert_pixels(&mut copy, from, to);
+        copy.into()
+    }
+}
+
 /// Converts linear RGB pixels from one colour space to another through XYZ (no chromatic
 /// adaptation: white balance is a separate, explicit step).
 pub fn convert_pixels(pixels: &mut [[f32; 3]], from: &RgbColorSpace, to: &RgbColorSpace) {

@@ -108,6 +108,19 @@ impl RowSource {
         }
     }
 
+    /// Calls `each` with the image's rows in bands of `rows_per_band` (the last one
+    /// shorter), top to bottom; stops at the first error.
+    pub fn for_each_band(
+        &self,
+        rows_per_band: usize,
+        mut each: impl FnMut(&[[f32; 3]]) -> Result<()>,
+    ) -> Result<()> {
+        for start in (0..self.height).step_by(rows_per_band.max(1)) {
+            each(&self.read_rows(start..(start + rows_per_band.max(1)).min(self.height))?)?;
+        }
+        Ok(())
+    }
+
     /// Rows `rows` (within the image), row-major: the pixels `read_image` gives there.
     pub fn read_rows(&self, rows: Range<usize>) -> Result<Vec<[f32; 3]>> {
         assert!(

@@ -18,8 +18,7 @@
 //!   left out, where MATLAB's blkproc would zero-pad them) / 64.29 under Beta(4.4, 10.1);
 //! - TMQI = a S^α + (1 − a) N^β, a = 0.8012, α = 0.3046, β = 0.7088.
 
-use prism_image::io::convert_pixels;
-use prism_image::rgb_matrix::same_colorimetry;
+use prism_image::io::pixels_in;
 use prism_image::{Image, ImageError, Result};
 use prism_spectrum::rgb_space::{RgbColorSpace, TransferFunction};
 use serde::Serialize;
@@ -54,16 +53,6 @@ pub struct Tmqi {
 /// Rec.709 luminance weights (the authors' RGBtoYxy).
 const LUMINANCE: [f64; 3] = [0.2126, 0.7152, 0.0722];
 
-/// Pixels in linear Rec.709 (converted when the image is in another space).
-fn rec709(image: &Image) -> Vec<[f32; 3]> {
-    let mut px = image.pixels().to_vec();
-    let srgb = RgbColorSpace::srgb();
-    if !same_colorimetry(&image.color_space, &srgb) {
-        convert_pixels(&mut px, &image.color_space, &srgb);
-    }
-    px
-}
-
 /// TMQI of a tone-mapped image (as read: linear display values, e.g. a decoded PNG;
 /// re-encoded with the sRGB curve to 0–255 code values) against its HDR source (linear
 /// scene values; non-finite → 0). An error when the sizes differ.
@@ -77,32 +66,31 @@ pub fn tmqi_images(ldr: &Image, hdr: &Image) -> Result<Tmqi> {
             hdr.height()
         )));
     }
-    let hdr_y = hdr_luminance(&rec709(hdr));
-    let ldr_y = ldr_luminance(&rec709(ldr));
+    let hdr_y = hdr_luminance_of(hdr.pixels(), &hdr.color_space);
+    let ldr_y = ldr_luminance_of(ldr.pixels(), &ldr.color_space);
     tmqi_owned(ldr_y, hdr_y, ldr.width(), ldr.height())
 }
 
-/// [`hdr_luminance`] of an image in any space, converted a band at a time.
-pub fn hdr_luminance_of(image: &Image) -> Vec<f64> {
-    luminance_in_bands(image, hdr_luminance)
+/// [`hdr_luminance`] of pixels in `space`, converted to Rec.709 a band at a time.
+pub fn hdr_luminance_of(pixels: &[[f32; 3]], space: &RgbColorSpace) -> Vec<f64> {
+    luminance_in_bands(pixels, space, hdr_luminance)
 }
 
-/// [`ldr_luminance`] of an image in any space, converted a band at a time.
-pub fn ldr_luminance_of(image: &Image) -> Vec<f64> {
-    luminance_in_bands(image, ldr_luminance)
+/// [`ldr_luminance`] of pixels in `space`, converted to Rec.709 a band at a time.
+pub fn ldr_luminance_of(pixels: &[[f32; 3]], space: &RgbColorSpace) -> Vec<f64> {
+    luminance_in_bands(pixels, space, ldr_luminance)
 }
 
-fn luminance_in_bands(image: &Image, luminance: fn(&[[f32; 3]]) -> Vec<f64>) -> Vec<f64> {
-    let srgb = RgbColorSpace::srgb();
-    if same_colorimetry(&image.color_space, &srgb) {
-        return luminance(image.pixels());
-    }
+fn luminance_in_bands(
+    pixels: &[[f32; 3]],
+    space: &RgbColorSpace,
+    luminance: fn(&[[f32; 3]]) -> Vec<f64>,
+) -> Vec<f64> {
     const BAND_PIXELS: usize = 1 << 16;
-    let mut out = Vec::with_capacity(image.pixels().len());
-    for band in image.pixels().chunks(BAND_PIXELS) {
-        let mut band = band.to_vec();
-        convert_pixels(&mut band, &image.color_space, &srgb);
-        out.extend(luminance(&band));
+    let srgb = RgbColorSpace::srgb();
+    let mut out = Vec::with_capacity(pixels.len());
+    for band in pixels.chunks(BAND_PIXELS) {
+        out.extend(luminance(&pixels_in(band, space, &srgb)));
     }
     out
 }

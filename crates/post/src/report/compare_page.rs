@@ -144,13 +144,7 @@ pub fn map_figures(
 
 /// A FLIP map in magma over [0, 1] with its legend ([`FlipMap::to_image`]'s image).
 fn flip_figure(map: &FlipMap, title: &str) -> Result<ReportImage> {
-    let options = FalseColourOptions {
-        scale: FalseColourScale::Linear,
-        range: Some((0.0, 1.0)),
-        unit: title.into(),
-        cell_px: 1,
-        palette: Palette::Magma,
-    };
+    let options = FlipMap::false_colour_options(title);
     false_colour_figure(&map.values, map.width, map.height, &options)
 }
 

@@ -11,9 +11,8 @@ use std::io::Write;
 use std::rc::Rc;
 
 use base64::Engine;
-use prism_image::io::convert_pixels;
+use prism_image::io::pixels_in;
 use prism_image::io::rgbe::encode_rgbe;
-use prism_image::rgb_matrix::same_colorimetry;
 use prism_image::{Image, ImageError, Result};
 use prism_spectrum::rgb_space::{RgbColorSpace, TransferFunction};
 use rayon::prelude::*;
@@ -133,14 +132,7 @@ impl ReportImageRows {
                 self.width
             )));
         }
-        let srgb = RgbColorSpace::srgb();
-        let rec709: std::borrow::Cow<[[f32; 3]]> = if same_colorimetry(space, &srgb) {
-            pixels.into()
-        } else {
-            let mut copy = pixels.to_vec();
-            convert_pixels(&mut copy, space, &srgb);
-            copy.into()
-        };
+        let rec709 = pixels_in(pixels, space, &RgbColorSpace::srgb());
         match &mut self.encoding {
             RowEncoding::Display(png) => {
                 let bytes: Vec<u8> = rec709

@@ -16,7 +16,7 @@ use std::collections::BTreeMap;
 use serde::Serialize;
 
 use crate::colour::{map_gamut, GamutMethod, GamutTarget};
-use crate::metrics::tmqi::{self, tmqi_images, Tmqi};
+use crate::metrics::tmqi::{self, Tmqi};
 use crate::tonemap::{ToneOperator, ToneParams, ToneReport};
 use font5x7::{draw_text, ADVANCE, GLYPH_HEIGHT};
 use prism_image::Image;
@@ -192,7 +192,7 @@ pub fn contact_sheet_from(
     // TMQI's HDR side, once: the luminance of the input the operators are given.
     let hdr_luminance = options
         .score
-        .map(|SheetScore::Tmqi| tmqi::hdr_luminance_of(image));
+        .map(|SheetScore::Tmqi| tmqi::hdr_luminance_of(image.pixels(), &image.color_space));
     let mut reports = Vec::new();
     let mut failures = Vec::new();
     let (mut outside, mut counted) = (0usize, 0usize);
@@ -357,9 +357,8 @@ fn score_tmqi_owned(
         options.target,
         options.gamut,
     );
-    tone_mapped.color_space = options.target.space();
     let (w, h) = (tone_mapped.width(), tone_mapped.height());
-    let ldr = tmqi::ldr_luminance_of(&tone_mapped);
+    let ldr = tmqi::ldr_luminance_of(tone_mapped.pixels(), &options.target.space());
     drop(tone_mapped);
     tmqi::tmqi_owned(ldr, hdr_luminance, w, h)
 }
@@ -367,20 +366,12 @@ fn score_tmqi_owned(
 /// TMQI of an operator's full-resolution output, gamut-mapped into the target as a
 /// single-operator `prism tonemap` would write it, against the operators' input.
 pub fn score_tmqi(tone_mapped: &Image, hdr: &Image, options: &SheetOptions) -> Result<Tmqi> {
-    let mut pixels = tone_mapped.pixels().to_vec();
-    map_gamut(
-        &mut pixels,
-        &tone_mapped.color_space,
-        options.target,
-        options.gamut,
-    );
-    let ldr = Image::new(
-        tone_mapped.width(),
-        tone_mapped.height(),
-        pixels,
-        options.target.space(),
-    )?;
-    tmqi_images(&ldr, hdr)
+    // Different sizes are an error of tmqi_owned (plane lengths).
+    score_tmqi_owned(
+        tone_mapped.clone(),
+        tmqi::hdr_luminance_of(hdr.pixels(), &hdr.color_space),
+        options,
+    )
 }
 
 /// `name k=v …`: each parameter's given value, else the value the operator resolved (in

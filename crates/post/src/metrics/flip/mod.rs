@@ -63,14 +63,20 @@ impl FlipMap {
             &self.values,
             self.width,
             self.height,
-            &FalseColourOptions {
-                scale: FalseColourScale::Linear,
-                range: Some((0.0, 1.0)),
-                unit: title.into(),
-                cell_px: 1,
-                palette: Palette::Magma,
-            },
+            &Self::false_colour_options(title),
         )
+    }
+
+    /// How FLIP maps are drawn: magma over [0, 1], one pixel per value, the legend titled
+    /// `title`.
+    pub fn false_colour_options(title: &str) -> FalseColourOptions {
+        FalseColourOptions {
+            scale: FalseColourScale::Linear,
+            range: Some((0.0, 1.0)),
+            unit: title.into(),
+            cell_px: 1,
+            palette: Palette::Magma,
+        }
     }
 }
 
