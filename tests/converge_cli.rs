@@ -325,9 +325,9 @@ fn bad_references_and_methods_exit_with_a_clear_message_and_write_nothing() {
     }
 }
 
-/// The per-pixel plans run end to end: `path+predicted`, `path+adaptive` and `path+oracle`
-/// (fed the `variance.Y` layer of a `prism render` EXR) reach the same final spp as
-/// `path` and are in the JSON.
+/// The per-pixel plans run end to end: `path+predicted`, `path+predicted-hier`,
+/// `path+adaptive` and `path+oracle` (fed the `variance.Y` layer of a `prism render` EXR)
+/// reach the same final spp as `path` and are in the JSON.
 #[test]
 fn per_pixel_plans_converge_side_by_side() {
     let dir = tempfile::tempdir().unwrap();
@@ -348,6 +348,8 @@ fn per_pixel_plans_converge_side_by_side() {
         "--method",
         "path+predicted",
         "--method",
+        "path+predicted-hier",
+        "--method",
         "path+adaptive",
         "--method",
         "path+oracle",
@@ -366,18 +368,23 @@ fn per_pixel_plans_converge_side_by_side() {
     let data: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
     let methods = data["methods"].as_array().unwrap();
-    assert_eq!(methods.len(), 4);
-    for (m, plan) in methods
-        .iter()
-        .zip(["uniform", "predicted", "adaptive", "oracle"])
-    {
+    assert_eq!(methods.len(), 5);
+    for (m, plan) in methods.iter().zip([
+        "uniform",
+        "predicted",
+        "predicted-hier",
+        "adaptive",
+        "oracle",
+    ]) {
         assert_eq!(m["plan"], plan, "{m}");
         let last = m["checkpoints"].as_array().unwrap().last().unwrap().clone();
         assert_eq!(last["spp"], 16, "{plan}: {last}");
         // The predictor's CPU time, tables apart, only where it ran.
         for key in ["tables_cpu_s", "predict_cpu_s"] {
             match plan {
-                "predicted" => assert!(m[key].as_f64().unwrap() > 0.0, "{key}: {m}"),
+                "predicted" | "predicted-hier" => {
+                    assert!(m[key].as_f64().unwrap() > 0.0, "{key}: {m}")
+                }
                 _ => assert!(m[key].is_null(), "{plan} {key}"),
             }
         }

@@ -1,4 +1,4 @@
-//! `prism render --plan uniform|predicted|adaptive` end to end: the layers the plans write,
+//! `prism render --plan uniform|predicted|predicted-hier|adaptive` end to end: the layers the plans write,
 //! the budget they keep, and the errors of their flags (docs/bandwidth.md).
 
 use prism_image::io::exr::read_exr;
@@ -75,6 +75,18 @@ fn plan_flags_are_checked() {
             vec!["--plan", "predicted", "--plan-nb", "0"],
             "--plan-nb must be at least 1",
         ),
+        (
+            vec!["--plan", "predicted", "--plan-max-level", "2"],
+            "add --plan predicted-hier",
+        ),
+        (
+            vec!["--plan", "predicted-hier", "--plan-max-level", "9"],
+            "--plan-max-level 9: expected a level from 1",
+        ),
+        (
+            vec!["--plan", "predicted-hier", "--samples", "0..4"],
+            "cannot render a sample range (--samples)",
+        ),
     ] {
         let o = render(&flags, &out);
         assert!(!o.status.success(), "{flags:?}");
@@ -99,6 +111,50 @@ fn plan_flags_are_checked() {
     assert!(!out.exists(), "no output on error");
 }
 
+/// `--plan predicted-hier` (Bagher et al. 2013 §3.2): the smooth sky and floor of the
+/// glossy-env scene are shaded on a lattice; the pixels in between get no samples (`spp.Y`
+/// 0) and are filled from their shaded neighbours, so no pixel is left black, and the budget
+/// is the same.
+#[test]
+fn the_hierarchical_plan_fills_the_pixels_it_does_not_shade() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("hier.exr");
+    let o = prism(&[
+        "render",
+        "scenes/glossy-env.json",
+        "-o",
+        s(&out),
+        "--resolution",
+        "64x36",
+        "--spp",
+        "8",
+        "--plan",
+        "predicted-hier",
+        "--plan-max-level",
+        "2",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let image = read_exr(&out).unwrap();
+    let spp = &image.layer("spp").expect("spp layer").samples;
+    let unshaded = spp.iter().filter(|&&v| v == 0.0).count();
+    assert!(
+        unshaded > spp.len() / 4,
+        "{unshaded} of {} pixels interpolated",
+        spp.len()
+    );
+    let mean = spp.iter().map(|&v| f64::from(v)).sum::<f64>() / spp.len() as f64;
+    // Rounding as in the test above, with densities up to 16× larger on the lattice.
+    assert!((mean - 8.0).abs() < 0.5, "mean spp {mean}");
+    // Every interpolated pixel takes the values of its neighbours: the sky and the floor
+    // are lit, so none is black.
+    for (i, p) in image.pixels().iter().enumerate() {
+        assert!(p.iter().all(|v| v.is_finite()), "pixel {i}: {p:?}");
+        if spp[i] == 0.0 {
+            assert!(p.iter().sum::<f32>() > 0.0, "pixel {i} left black: {p:?}");
+        }
+    }
+}
+
 #[test]
 fn explain_names_the_plan() {
     let o = prism(&[
@@ -118,4 +174,15 @@ fn explain_names_the_plan() {
         text.contains("predicted variance (the paper's rule)"),
         "{text}"
     );
+    let o = prism(&[
+        "render",
+        "scenes/glossy-env.json",
+        "--explain",
+        "--plan",
+        "predicted-hier",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(text.contains("predicted-hier sample plan"), "{text}");
+    assert!(text.contains("at most 8 px apart"), "{text}");
 }

@@ -1,15 +1,17 @@
 #!/usr/bin/env python3
 """The bandwidth predictor's benchmark (docs/bandwidth.md): one `prism converge --clock cpu`
-run per scene with path, path+adaptive and path+predicted on one sampler, and the numbers
-the predictor issue asks for, from each run's `ratios` block:
+run per scene with path, path+adaptive, path+predicted and path+predicted-hier on one
+sampler, and the numbers the predictor issue asks for, from each run's `ratios` block, for
+each of the two predicted plans:
 
-- time to relMSE 1e-2: path ÷ path+predicted (speed-up; > 1 means the predictor helps);
-- relMSE at equal CPU time: path+adaptive ÷ path+predicted at each of path's checkpoints
+- time to relMSE 1e-2: path ÷ the plan (speed-up; > 1 means the predictor helps);
+- relMSE at equal CPU time: path+adaptive ÷ the plan at each of path's checkpoints
   from 4 spp on (> 1 means the predictor beats the variance-driven adaptive sampler);
-- predict_cpu_s and its share of path+predicted's time to relMSE 1e-2.
+- predict_cpu_s and its share of the plan's time to relMSE 1e-2.
 
     cargo build --release
     python3 tools/bench_bandwidth.py [--budget-s 20] [--reference-spp 2048] [--scenes a,b]
+        [--seed 1]
 
 The paper's Fig. 9 spheres are measured materials: the benchmark renders
 scenes/bandwidth/fig9-spheres.json with its three conductors replaced by MERL tables
@@ -37,7 +39,8 @@ SCENES = {
 MERL = ["gold-ggx", "sharp-copper", "rough-nickel"]
 # fig9-spheres.json's material → the MERL table that replaces it.
 MERL_FOR = {"gold": "gold-ggx", "copper": "sharp-copper", "nickel": "rough-nickel"}
-METHODS = ["path", "path+adaptive", "path+predicted"]
+METHODS = ["path", "path+adaptive", "path+predicted", "path+predicted-hier"]
+PREDICTED = ["path+predicted", "path+predicted-hier"]
 
 
 def ensure_merl():
@@ -65,12 +68,13 @@ def merl_scene(work):
     return path
 
 
-def summarise(data):
-    methods = {m["method"]: m for m in data["methods"]}
-    predicted, adaptive = methods["path+predicted"], methods["path+adaptive"]
+def summarise_plan(methods, name, clock):
+    """One predicted method's rows: time to relMSE 1e-2 against path, relMSE against
+    adaptive at equal CPU time (path's checkpoints from 4 spp on), the predictor's cost."""
+    predicted, adaptive = methods[name], methods["path+adaptive"]
     time_to = {row["relmse"]: row for row in predicted["ratios"]["time_to_relmse"]}
     ahead = {row["time_s"]: row["ratio"] for row in predicted["ratios"]["relmse_at_equal_time"]}
-    path_checkpoints = {c["time_s"] if data["clock"] == "wall" else c["cpu_time_s"]: c["spp"]
+    path_checkpoints = {c["time_s"] if clock == "wall" else c["cpu_time_s"]: c["spp"]
                         for c in methods["path"]["checkpoints"]}
     adaptive_vs_predicted = []
     for row in adaptive["ratios"]["relmse_at_equal_time"]:
@@ -79,17 +83,23 @@ def summarise(data):
             # (path ÷ predicted) ÷ (path ÷ adaptive) = adaptive ÷ predicted.
             adaptive_vs_predicted.append({"time_s": t, "path_spp": path_checkpoints[t],
                                           "ratio": ahead[t] / row["ratio"]})
+    target = time_to.get(0.01, {})
     return {
-        "time_to_relmse_1e-2_path_over_predicted": time_to[0.01]["speedup"],
-        "time_to_relmse_1e-2_s": {"path": time_to[0.01]["against_s"],
-                                  "path+predicted": time_to[0.01]["this_s"]},
-        "relmse_adaptive_over_predicted_at_equal_cpu": adaptive_vs_predicted,
+        "time_to_relmse_1e-2_path_over_this": target.get("speedup"),
+        "time_to_relmse_1e-2_s": {"path": target.get("against_s"), name: target.get("this_s")},
+        "relmse_adaptive_over_this_at_equal_cpu": adaptive_vs_predicted,
         "predict_cpu_s": predicted["predict_cpu_s"],
         "tables_cpu_s": predicted["tables_cpu_s"],
         "predict_cpu_fraction_of_time_to_target":
             predicted["predict_cpu_fraction_of_time_to_target"],
-        "final_relmse": {m: methods[m]["final"]["relmse"] for m in METHODS},
     }
+
+
+def summarise(data):
+    methods = {m["method"]: m for m in data["methods"]}
+    out = {name: summarise_plan(methods, name, data["clock"]) for name in PREDICTED}
+    out["final_relmse"] = {m: methods[m]["final"]["relmse"] for m in METHODS}
+    return out
 
 
 def main():
@@ -98,6 +108,7 @@ def main():
     parser.add_argument("--reference-spp", type=int, default=2048)
     parser.add_argument("--scenes", default=",".join(SCENES))
     parser.add_argument("--no-file", action="store_true")
+    parser.add_argument("--seed", type=int, default=1)
     opts = parser.parse_args()
     ensure_merl()
     work = tempfile.mkdtemp(prefix="prism-bandwidth-")
@@ -109,7 +120,7 @@ def main():
         out = os.path.join(work, f"{name}.json")
         command = [PRISM, "converge", scene, "--clock", "cpu", "--budget-s",
                    str(opts.budget_s), "--reference-spp", str(opts.reference_spp),
-                   "--seed", "1", "--json", out]
+                   "--seed", str(opts.seed), "--json", out]
         for m in METHODS:
             command += ["--method", m]
         if resolution:

@@ -3,6 +3,7 @@
 
 use clap::{Args, ValueEnum};
 use prism_bandwidth::allocation::DEFAULT_FLOOR;
+use prism_bandwidth::hierarchical_shading::DEFAULT_MAX_LEVEL;
 use prism_bandwidth::{Allocation, AllocationSettings, VarianceBandwidth, DEFAULT_POOL_RADIUS_PX};
 use prism_render::predictor::{PredictorSettings, DEFAULT_PROBE_SAMPLES};
 use prism_render::SamplePlanKind;
@@ -13,6 +14,9 @@ pub enum PlanArg {
     Uniform,
     /// The bandwidth predictor's per-pixel plan (Bagher et al. 2013).
     Predicted,
+    /// The predicted plan shaded hierarchically: pixels of eq. 11's level ≥ 1 are
+    /// interpolated from a lattice of shaded pixels (Bagher et al. 2013 §3.2; biased).
+    PredictedHier,
     /// Variance-driven passes after 4 spp (Cycles' adaptive sampling).
     Adaptive,
 }
@@ -70,6 +74,10 @@ pub struct PlanArgs {
     /// light's mean and variance to the prediction (0: direct light only, as the paper).
     #[arg(long = "plan-indirect", value_name = "N", default_value_t = DEFAULT_PROBE_SAMPLES, value_parser = prism_args::numbers::parse_u32)]
     pub plan_indirect: u32,
+    /// `--plan predicted-hier`: the coarsest lattice, 2^L pixels between shaded pixels
+    /// (1 to 8).
+    #[arg(long = "plan-max-level", value_name = "L", default_value_t = DEFAULT_MAX_LEVEL, value_parser = prism_args::numbers::parse_u32)]
+    pub plan_max_level: u32,
 }
 
 impl PlanArg {
@@ -78,12 +86,21 @@ impl PlanArg {
         match self {
             PlanArg::Uniform => "uniform",
             PlanArg::Predicted => "predicted",
+            PlanArg::PredictedHier => "predicted-hier",
             PlanArg::Adaptive => "adaptive",
         }
     }
 }
 
 impl PlanArgs {
+    /// True for the plans the predictor makes.
+    pub fn predicts(&self) -> bool {
+        match self.plan {
+            PlanArg::Predicted | PlanArg::PredictedHier => true,
+            PlanArg::Uniform | PlanArg::Adaptive => false,
+        }
+    }
+
     fn allocation(&self) -> Allocation {
         match self.plan_allocation {
             AllocationArg::Relative => Allocation::RelativeError,
@@ -100,13 +117,25 @@ impl PlanArgs {
             || self.plan_visibility != OnOff::On
             || self.plan_pool_px != DEFAULT_POOL_RADIUS_PX
             || self.plan_indirect != DEFAULT_PROBE_SAMPLES;
-        if self.plan != PlanArg::Predicted && predictor_flags_given {
+        if !self.predicts() && predictor_flags_given {
             return Err(
                 "--plan-nb, --plan-floor, --plan-allocation, --plan-variance, \
                  --plan-visibility, --plan-pool-px and --plan-indirect set up the \
-                 predictor: add --plan predicted"
+                 predictor: add --plan predicted or predicted-hier"
                     .into(),
             );
+        }
+        if self.plan_max_level != DEFAULT_MAX_LEVEL && self.plan != PlanArg::PredictedHier {
+            return Err("--plan-max-level sets up hierarchical shading: add --plan \
+                        predicted-hier"
+                .into());
+        }
+        if !(1..=8).contains(&self.plan_max_level) {
+            return Err(format!(
+                "--plan-max-level {}: expected a level from 1 (2 pixels between shaded \
+                 pixels) to 8 (256)",
+                self.plan_max_level
+            ));
         }
         if self.plan_nb == 0 {
             return Err("--plan-nb must be at least 1".into());
@@ -124,10 +153,12 @@ impl PlanArgs {
     pub fn kind(&self) -> SamplePlanKind {
         match self.plan {
             PlanArg::Uniform => SamplePlanKind::Uniform,
-            PlanArg::Predicted => SamplePlanKind::Predicted {
+            PlanArg::Predicted | PlanArg::PredictedHier => SamplePlanKind::Predicted {
                 probe_samples: self.plan_nb,
                 floor_per_mille: (self.plan_floor * 1000.0).round() as u32,
                 allocation: self.allocation(),
+                hierarchical_max_level: (self.plan == PlanArg::PredictedHier)
+                    .then_some(self.plan_max_level),
             },
             PlanArg::Adaptive => SamplePlanKind::Adaptive,
         }

@@ -433,6 +433,13 @@ pub fn run(args: &RenderArgs, budget: &MemoryBudget) -> Result<ExitCode, String>
             scene.integrator.name()
         ));
     }
+    if args.plan.plan == PlanArg::PredictedHier && args.samples.is_some() {
+        return Err(
+            "--plan predicted-hier interpolates the pixels it does not shade once the render \
+             is whole, so it cannot render a sample range (--samples); use --plan predicted"
+                .into(),
+        );
+    }
     if args.plan.plan == PlanArg::Adaptive {
         if args.samples.is_some() || args.checkpoint_every.is_some() || args.resume.is_some() {
             return Err(
@@ -477,20 +484,33 @@ pub fn run(args: &RenderArgs, budget: &MemoryBudget) -> Result<ExitCode, String>
         ));
     }
     crate::partial::signals::install(&temp_files)?;
-    let (plan, extra_aovs) = match args.plan.plan {
+    let (plan, extra_aovs, upsampling) = match args.plan.plan {
         PlanArg::Uniform | PlanArg::Adaptive => (
             prism_bandwidth::SamplePlan::uniform(scene.resolution, settings.spp)
                 .map_err(|e| e.to_string())?,
             Vec::new(),
+            None,
         ),
-        PlanArg::Predicted => {
+        PlanArg::Predicted | PlanArg::PredictedHier => {
             // Deterministic in the seed: every process of a split render computes it alike.
             let predictor = args.plan.predictor(settings.spp, settings.seed);
-            let prediction = pool
+            let mut prediction = pool
                 .install(|| prism_render::predictor::predict(&scene, &predictor, settings.seed))
                 .map_err(|e| format!("{}: {e}", args.scene.display()))?;
+            let upsampling = match args.plan.plan {
+                PlanArg::PredictedHier => Some(
+                    prediction
+                        .make_hierarchical(
+                            args.plan.plan_max_level,
+                            f64::from(settings.spp),
+                            settings.seed,
+                        )
+                        .map_err(|e| format!("{}: {e}", args.scene.display()))?,
+                ),
+                PlanArg::Predicted | PlanArg::Uniform | PlanArg::Adaptive => None,
+            };
             let aovs = prediction.aov_planes();
-            (prediction.allocated.plan, aovs)
+            (prediction.allocated.plan, aovs, upsampling)
         }
     };
     let mut rendered = crate::partial::job::render(
@@ -518,6 +538,19 @@ pub fn run(args: &RenderArgs, budget: &MemoryBudget) -> Result<ExitCode, String>
                 start: 0,
                 end: settings.spp,
             });
+    if range_output && upsampling.is_some() {
+        return Err(format!(
+            "{}: --plan predicted-hier interpolates the pixels it does not shade once the \
+             render is whole, so it cannot write a sample range; use --plan predicted",
+            args.scene.display()
+        ));
+    }
+    if let Some(upsampling) = &upsampling {
+        rendered
+            .image
+            .upsample(upsampling)
+            .map_err(|e| format!("{}: {e}", args.scene.display()))?;
+    }
     if range_output && !exr_output {
         return Err(format!(
             "{} renders the samples {} of {}: a range is written as a partial EXR; {} is \

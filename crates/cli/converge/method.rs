@@ -10,7 +10,9 @@
 //!   roulette.
 //! - PLAN: how samples are distributed over the pixels — `uniform` (the default: the same
 //!   spp everywhere), `predicted` (the bandwidth predictor's per-pixel plan, computed once
-//!   before the first pass with `prism render --plan predicted`'s defaults) or `adaptive`
+//!   before the first pass with `prism render --plan predicted`'s defaults),
+//!   `predicted-hier` (that plan shaded hierarchically, `prism render --plan
+//!   predicted-hier`'s defaults: interpolated pixels get no samples) or `adaptive`
 //!   (variance-driven passes after 4 spp) or `oracle` (the predicted plan's allocation fed
 //!   with a measured `variance.Y`, `--oracle-variance`: the best a predictor could do).
 //!   All but `uniform` are for `path` only.
@@ -55,9 +57,15 @@ pub const INTEGRATORS: [(&str, bool, &str); 9] = [
 ];
 
 /// Sample plans: (name, available, what it is).
-pub const PLANS: [(&str, bool, &str); 4] = [
+pub const PLANS: [(&str, bool, &str); 5] = [
     ("uniform", true, "same spp in every pixel"),
     ("predicted", true, "bandwidth predictor's per-pixel plan"),
+    (
+        "predicted-hier",
+        true,
+        "the predicted plan shaded hierarchically: low-bandwidth pixels interpolated from a \
+         lattice of shaded pixels (biased)",
+    ),
     (
         "adaptive",
         true,
@@ -81,6 +89,7 @@ pub const SAMPLERS: [(&str, &str); 2] = [
 pub enum PlanKind {
     Uniform,
     Predicted,
+    PredictedHier,
     Adaptive,
     Oracle,
 }
@@ -90,6 +99,7 @@ impl PlanKind {
         match self {
             PlanKind::Uniform => "uniform",
             PlanKind::Predicted => "predicted",
+            PlanKind::PredictedHier => "predicted-hier",
             PlanKind::Adaptive => "adaptive",
             PlanKind::Oracle => "oracle",
         }
@@ -175,6 +185,7 @@ impl Method {
         let plan = match plan {
             None | Some("uniform") => PlanKind::Uniform,
             Some("predicted") => PlanKind::Predicted,
+            Some("predicted-hier") => PlanKind::PredictedHier,
             Some("adaptive") => PlanKind::Adaptive,
             Some("oracle") => PlanKind::Oracle,
             Some(p) => match PLANS.iter().find(|(n, _, _)| *n == p) {

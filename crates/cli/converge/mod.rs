@@ -535,7 +535,8 @@ pub fn run(args: &ConvergeArgs, memory: &MemoryBudget) -> Result<(), String> {
         };
         if let Some(dir) = &args.save_final {
             let path = dir.join(format!("{index}-{}.exr", file_label(method)));
-            write_image(&path, &film_to_image(&run.film)?).map_err(|e| e.to_string())?;
+            write_image(&path, &film_to_image(&run.film, run.upsampling.as_deref())?)
+                .map_err(|e| e.to_string())?;
         }
         if args.report.is_some() {
             report_entries.push(report::MethodEntry::new(
@@ -544,7 +545,7 @@ pub fn run(args: &ConvergeArgs, memory: &MemoryBudget) -> Result<(), String> {
                 args.clock.of(last),
                 fits[1].map(|f| f.slope),
                 time_to_target,
-                &film_to_image(&run.film)?,
+                &film_to_image(&run.film, run.upsampling.as_deref())?,
                 &prepared,
             )?);
         }

@@ -1,12 +1,17 @@
 //! The samples of each progressive pass per method's sample plan (`prism converge`): uniform
 //! passes add the same count everywhere; `predicted` runs the bandwidth predictor once and
 //! each pass tops every pixel up to its share of the new mean (`Allocated::cumulative_counts`);
+//! `predicted-hier` does the same with the hierarchical plan, whose interpolated pixels get
+//! no samples and are filled at each checkpoint (`Upsampling`);
 //! `adaptive` keeps two films (each pass's samples of a pixel split between them) and, after
 //! 4 spp, spreads a uniform pass's total by the error between the full image and the half
 //! (`prism_render::adaptive` is the same method for `prism render`).
 
+use std::sync::Arc;
+
 use glam::UVec2;
-use prism_bandwidth::{adaptive_pass_counts, Allocated};
+use prism_bandwidth::hierarchical_shading::DEFAULT_MAX_LEVEL;
+use prism_bandwidth::{adaptive_pass_counts, Allocated, Upsampling};
 use prism_render::adaptive::{PerPixelPasses, ADAPTIVE_FIRST_PASS_SPP};
 use prism_render::predictor::{predict_with_probe, PredictorSettings};
 use prism_render::probe::RenderProbe;
@@ -32,6 +37,8 @@ pub struct PassPlanner {
     kind: PlanKind,
     passes: PerPixelPasses,
     allocated: Option<Allocated>,
+    /// `predicted-hier`: how the pixels without samples are filled.
+    pub upsampling: Option<Arc<Upsampling>>,
     /// `None` unless the plan is `predicted` and the platform has a process clock.
     pub predictor_cpu: Option<PredictorCpu>,
     seed: u64,
@@ -48,13 +55,21 @@ impl PassPlanner {
         oracle: Option<&Allocated>,
     ) -> Result<Self, String> {
         let mut predictor_cpu = None;
+        let mut upsampling = None;
         let allocated = match kind {
-            PlanKind::Predicted => {
+            PlanKind::Predicted | PlanKind::PredictedHier => {
                 let predictor = PredictorSettings::defaults(PREDICTED_PLAN_SPP, settings.seed);
                 let start = process_cpu_s();
                 let probe = RenderProbe::new(scene, settings.seed).with_bandwidth_tables()?;
                 let tables_done = process_cpu_s();
-                let prediction = predict_with_probe(scene, &predictor, probe)?;
+                let mut prediction = predict_with_probe(scene, &predictor, probe)?;
+                if kind == PlanKind::PredictedHier {
+                    upsampling = Some(Arc::new(prediction.make_hierarchical(
+                        DEFAULT_MAX_LEVEL,
+                        PREDICTED_PLAN_SPP,
+                        settings.seed,
+                    )?));
+                }
                 predictor_cpu = match (start, tables_done, process_cpu_s()) {
                     (Some(a), Some(b), Some(c)) => Some(PredictorCpu {
                         tables_cpu_s: b - a,
@@ -75,6 +90,7 @@ impl PassPlanner {
             kind,
             passes: PerPixelPasses::new(scene, settings, kind == PlanKind::Adaptive),
             allocated,
+            upsampling,
             predictor_cpu,
             seed: settings.seed,
             pass_count: 0,
@@ -93,13 +109,15 @@ impl PassPlanner {
         let pass = target - spp_done;
         let counts: Vec<u32> = match (self.kind, &self.allocated) {
             (PlanKind::Uniform, _) => vec![pass; n],
-            (PlanKind::Predicted | PlanKind::Oracle, Some(allocated)) => allocated
-                .cumulative_counts(f64::from(target), self.seed)
-                .iter()
-                .zip(self.passes.done())
-                .map(|(c, d)| c.saturating_sub(*d))
-                .collect(),
-            (PlanKind::Predicted | PlanKind::Oracle, None) => {
+            (PlanKind::Predicted | PlanKind::PredictedHier | PlanKind::Oracle, Some(allocated)) => {
+                allocated
+                    .cumulative_counts(f64::from(target), self.seed)
+                    .iter()
+                    .zip(self.passes.done())
+                    .map(|(c, d)| c.saturating_sub(*d))
+                    .collect()
+            }
+            (PlanKind::Predicted | PlanKind::PredictedHier | PlanKind::Oracle, None) => {
                 unreachable!("the predicted and oracle plans are made in `new`")
             }
             (PlanKind::Adaptive, _) if spp_done < ADAPTIVE_FIRST_PASS_SPP => vec![pass; n],

@@ -19,7 +19,9 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::mpsc;
 use std::time::Instant;
 
-use prism_bandwidth::Allocated;
+use std::sync::Arc;
+
+use prism_bandwidth::{Allocated, Upsampling};
 use prism_image::Image;
 use prism_post::metrics::{CompareOptions, Comparison, PreparedReference};
 use prism_render::adaptive::ADAPTIVE_FIRST_PASS_SPP;
@@ -100,6 +102,8 @@ pub struct MethodRun {
     pub metric_cpu_s: f64,
     /// Wall time the render thread spent copying the film at checkpoints, s.
     pub snapshot_wall_s: f64,
+    /// `predicted-hier`: how the film's pixels without samples are filled.
+    pub upsampling: Option<Arc<Upsampling>>,
     /// The predictor's CPU time (`predicted` plans; inside the method's clock).
     pub predictor_cpu: Option<super::pass_planner::PredictorCpu>,
 }
@@ -139,13 +143,18 @@ fn thread_cpu_s() -> Option<f64> {
     }
 }
 
-/// The film's image as prism-post sees it (linear Rec.709, like `prism render`'s EXR).
-pub fn film_to_image(film: &Film) -> Result<Image, String> {
+/// The film's image as prism-post sees it (linear Rec.709, like `prism render`'s EXR),
+/// with a hierarchical plan's interpolated pixels filled.
+pub fn film_to_image(film: &Film, upsampling: Option<&Upsampling>) -> Result<Image, String> {
     let resolution = film.resolution();
+    let mut rgb = film.rgb();
+    if let Some(u) = upsampling {
+        u.apply(&mut rgb).map_err(|e| e.to_string())?;
+    }
     Image::new(
         resolution.x as usize,
         resolution.y as usize,
-        film.rgb(),
+        rgb,
         RgbColorSpace::srgb(),
     )
     .map_err(|e| e.to_string())
@@ -172,7 +181,8 @@ pub fn run_method(
     pool: &rayon::ThreadPool,
     oracle: Option<&Allocated>,
 ) -> Result<MethodRun, String> {
-    let (sender, receiver) = mpsc::channel::<(f64, Option<f64>, u32, u64, Film)>();
+    type Snapshot = (f64, Option<f64>, u32, u64, Film, Option<Arc<Upsampling>>);
+    let (sender, receiver) = mpsc::channel::<Snapshot>();
     // CPU time the metric thread has spent, ns (subtracted from the process's CPU time).
     let metric_cpu_ns = AtomicU64::new(0);
     let metric_cpu_ns = &metric_cpu_ns;
@@ -184,9 +194,9 @@ pub fn run_method(
                 .build()
                 .map_err(|e| format!("cannot start the metric thread: {e}"))?;
             let mut out = Vec::new();
-            for (time_s, cpu_time_s, spp, samples, film) in receiver {
+            for (time_s, cpu_time_s, spp, samples, film, upsampling) in receiver {
                 let comparison = metric_pool.install(|| {
-                    let image = film_to_image(&film)?;
+                    let image = film_to_image(&film, upsampling.as_deref())?;
                     reference
                         .compare(
                             &image,
@@ -258,6 +268,7 @@ pub fn run_method(
                     spp_done,
                     stats.samples,
                     snapshot,
+                    planner.upsampling.clone(),
                 ))
                 .is_err()
             {
@@ -273,7 +284,9 @@ pub fn run_method(
             _ => None,
         };
         let predictor_cpu = planner.predictor_cpu;
+        let upsampling = planner.upsampling.clone();
         Ok(MethodRun {
+            upsampling,
             checkpoints,
             stats,
             render_wall_s,
@@ -311,7 +324,10 @@ pub fn run_plain(
                     }
                 }
             }
-            PlanKind::Uniform | PlanKind::Predicted | PlanKind::Oracle => {
+            PlanKind::Uniform
+            | PlanKind::Predicted
+            | PlanKind::PredictedHier
+            | PlanKind::Oracle => {
                 planner.render_pass(scene, settings, 0, spp)?;
             }
         }

@@ -84,8 +84,9 @@ pub fn identity(
     let sel = film.aov_selection();
     let plan = match args.plan.plan {
         PlanArg::Uniform => "uniform".to_string(),
-        PlanArg::Predicted | PlanArg::Adaptive => format!(
-            "{} nb={} floor={} allocation={:?} visibility={:?} variance={:?} pool={} indirect={}",
+        PlanArg::Predicted | PlanArg::PredictedHier | PlanArg::Adaptive => format!(
+            "{} nb={} floor={} allocation={:?} visibility={:?} variance={:?} pool={} indirect={} \
+             max_level={}",
             args.plan.plan.name(),
             args.plan.plan_nb,
             args.plan.plan_floor,
@@ -93,7 +94,8 @@ pub fn identity(
             args.plan.plan_visibility,
             args.plan.plan_variance,
             args.plan.plan_pool_px,
-            args.plan.plan_indirect
+            args.plan.plan_indirect,
+            args.plan.plan_max_level
         ),
     };
     RenderIdentity {

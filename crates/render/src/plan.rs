@@ -68,6 +68,8 @@ pub enum SamplePlanKind {
         probe_samples: u32,
         floor_per_mille: u32,
         allocation: prism_bandwidth::Allocation,
+        /// `predicted-hier`: hierarchical shading with lattices up to this level.
+        hierarchical_max_level: Option<u32>,
     },
     /// Variance-driven passes (`adaptive`).
     Adaptive,
@@ -121,8 +123,12 @@ fn sample_plan_text(kind: SamplePlanKind) -> (&'static str, String) {
             probe_samples,
             floor_per_mille,
             allocation,
+            hierarchical_max_level,
         } => (
-            "predicted",
+            match hierarchical_max_level {
+                Some(_) => "predicted-hier",
+                None => "predicted",
+            },
             format!(
                 "--plan predicted: a G-buffer of pixel-centre hits, {probe_samples} probe light \
                  samples per pixel, bandwidth by Bagher et al. 2013 eqs. 4-6, variance by eq. 9, \
@@ -137,7 +143,16 @@ fn sample_plan_text(kind: SamplePlanKind) -> (&'static str, String) {
                         "in proportion to the predicted variance (the paper's rule)"
                     }
                 }
-            ),
+            ) + &match hierarchical_max_level {
+                Some(level) => format!(
+                    "; hierarchical shading (§3.2): pixels of level ≥ 1 are interpolated \
+                     bilaterally from a lattice of shaded pixels, at most {} px apart, \
+                     and their samples go to that lattice (biased where the prediction \
+                     misses variation)",
+                    1u32 << level
+                ),
+                None => String::new(),
+            },
         ),
         SamplePlanKind::Adaptive => (
             "adaptive",

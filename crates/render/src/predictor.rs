@@ -12,8 +12,9 @@ use glam::{DVec3, UVec2, Vec2, Vec3A};
 use prism_bandwidth::pixel_prediction::MAX_IMAGE_BANDWIDTH_CYCLES_PER_PX;
 use prism_bandwidth::{
     allocate, model_variance, predict_pixel, Allocated, AllocationInputs, AllocationSettings,
-    Bandwidth, BandwidthBuffer, GBufferHit, LightSample, PixelClass, PixelFootprint,
-    PixelPrediction, ShadingProbe, VarianceBandwidth, VisibilitySummary, DEFAULT_POOL_RADIUS_PX,
+    Bandwidth, BandwidthBuffer, GBufferHit, HierarchyInputs, LightSample, PixelClass,
+    PixelFootprint, PixelPrediction, ShadingProbe, SurfacePoint, Upsampling, VarianceBandwidth,
+    VisibilitySummary, DEFAULT_POOL_RADIUS_PX,
 };
 use prism_spectrum::colorimetry::sampled_radiance_to_xyz;
 use prism_spectrum::{SampledSpectrum, SampledWavelengths};
@@ -72,6 +73,10 @@ pub struct Prediction {
     pub pixels: Vec<PixelPrediction>,
     pub buffer: BandwidthBuffer,
     pub allocated: Allocated,
+    /// Per pixel what the centre ray sees (the pooling's and the up-sampling's classes).
+    pub class: Vec<PixelClass>,
+    /// Per pixel the centre hit (`None` where the ray escapes or nothing was predicted).
+    pub surface: Vec<Option<SurfacePoint>>,
 }
 
 /// Why the predictor cannot plan a scene.
@@ -305,7 +310,13 @@ pub fn predict_with_probe<'a>(
         .filter(|l| l.is_infinite())
         .map(|l| l.bandwidth().angular_cycles_per_rad)
         .fold(0.0f32, f32::max);
-    type PixelRow = Vec<(PixelPrediction, f32, Option<EyeGeometry>, PixelClass)>;
+    type PixelRow = Vec<(
+        PixelPrediction,
+        f32,
+        Option<EyeGeometry>,
+        PixelClass,
+        Option<SurfacePoint>,
+    )>;
     let rows: Vec<PixelRow> = (0..resolution.y)
         .into_par_iter()
         .map(|y| {
@@ -321,6 +332,7 @@ pub fn predict_with_probe<'a>(
                             0.0,
                             None,
                             PixelClass::Unpredicted,
+                            None,
                         ));
                     };
                     let footprint = PixelFootprint {
@@ -352,11 +364,16 @@ pub fn predict_with_probe<'a>(
                                 cos_theta_x: hit.cos_theta_view(),
                                 rad_per_px,
                             };
+                            let surface = SurfacePoint {
+                                position_m: hit.position_m(),
+                                normal: hit.normal(),
+                            };
                             Ok((
                                 p,
                                 c.k1.abs().max(c.k2.abs()),
                                 Some(eye),
                                 PixelClass::Material(hit.material_id()),
+                                Some(surface),
                             ))
                         }
                         CentreRay::Escapes(direction) => Ok((
@@ -370,12 +387,14 @@ pub fn predict_with_probe<'a>(
                             0.0,
                             None,
                             PixelClass::Background,
+                            None,
                         )),
                         CentreRay::None => Ok((
                             PixelPrediction::default(),
                             0.0,
                             None,
                             PixelClass::Unpredicted,
+                            None,
                         )),
                     }
                 })
@@ -386,11 +405,13 @@ pub fn predict_with_probe<'a>(
     let mut curvature = Vec::new();
     let mut eye = Vec::new();
     let mut class = Vec::new();
-    for (p, c, e, k) in rows.into_iter().flatten() {
+    let mut surface = Vec::new();
+    for (p, c, e, k, s) in rows.into_iter().flatten() {
         pixels.push(p);
         curvature.push(c);
         eye.push(e);
         class.push(k);
+        surface.push(s);
     }
     if settings.visibility {
         add_shadow_edges(resolution, &mut pixels, &eye);
@@ -431,10 +452,38 @@ pub fn predict_with_probe<'a>(
         pixels,
         buffer,
         allocated,
+        class,
+        surface,
     })
 }
 
 impl Prediction {
+    /// Hierarchical shading (Bagher et al. 2013 §3.2) on this prediction: the lattice of
+    /// shaded pixels from eq. 11's levels (at most `max_level`) and the bilateral weights of
+    /// the others; the plan becomes the concentrated one (interpolated pixels get no camera
+    /// samples, their density goes to their parents; `mean_spp` and `seed` round it).
+    pub fn make_hierarchical(
+        &mut self,
+        max_level: u32,
+        mean_spp: f64,
+        seed: u64,
+    ) -> Result<Upsampling, String> {
+        let upsampling = Upsampling::plan(
+            self.resolution,
+            HierarchyInputs {
+                shading_level: &self.buffer.levels()[0].shading_level,
+                class: &self.class,
+                surface: &self.surface,
+                max_level,
+            },
+        )
+        .map_err(|e| e.to_string())?;
+        self.allocated = upsampling
+            .concentrate(&self.allocated, mean_spp, seed)
+            .map_err(|e| e.to_string())?;
+        Ok(upsampling)
+    }
+
     /// The EXR layers of the prediction (docs/bandwidth.md): ν_s (cycles/m), ν_a
     /// (cycles/rad), b_p (cycles/px), eq. 11's level, V̂_p and the planned camera samples.
     pub fn aov_planes(&self) -> Vec<AovPlane> {

@@ -62,3 +62,33 @@ impl FilmImage {
         y as usize * self.width as usize + x as usize
     }
 }
+
+impl FilmImage {
+    /// Fills the pixels that hierarchical shading interpolates (Bagher et al. 2013 §3.2)
+    /// from their shaded parents: the colour planes, the spectral bins and the per-sample
+    /// AOV means (depth, normal, albedo, illumination). `spp.Y` keeps their 0 and
+    /// `variance.Y` its 0 (nothing was sampled there); the predictor's `bandwidth.*` and
+    /// `plan.*` layers are per pixel already.
+    pub fn upsample(
+        &mut self,
+        upsampling: &prism_bandwidth::Upsampling,
+    ) -> Result<(), prism_bandwidth::BandwidthError> {
+        upsampling.apply(&mut self.xyz)?;
+        upsampling.apply(&mut self.rgb)?;
+        upsampling.apply(&mut self.y)?;
+        if let Some(spectral) = &mut self.spectral {
+            for plane in &mut spectral.planes {
+                upsampling.apply(plane)?;
+            }
+        }
+        for aov in &mut self.aovs {
+            let interpolated = ["depth.", "normal.", "albedo.", "illumination."]
+                .iter()
+                .any(|prefix| aov.name.starts_with(prefix));
+            if interpolated {
+                upsampling.apply(&mut aov.values)?;
+            }
+        }
+        Ok(())
+    }
+}
