@@ -21,6 +21,7 @@ use prism_spectrum::{SampledSpectrum, SampledWavelengths};
 use rayon::prelude::*;
 
 use crate::film::AovPlane;
+use crate::light::Light;
 use crate::probe::RenderProbe;
 use crate::scene_build::RenderScene;
 
@@ -156,6 +157,46 @@ fn centre_ray(scene: &RenderScene, pixel: UVec2) -> CentreRay {
 /// A pixel that sees the infinite lights directly: its noise is colour noise alone (the
 /// hero wavelengths' estimate of the radiance along the ray, sampled `count` times with
 /// stratified hero wavelengths) plus the anti-aliasing of the lights' own detail (b_p).
+/// ν_a of the infinite lights a pixel whose centre ray escapes along `direction` sees: an
+/// environment map's eq. 7 value in that direction, a sun disk's only within its radius
+/// plus two pixel footprints of the direction (elsewhere it adds nothing to what the pixel
+/// sees), the others' (uniform or analytic skies) own.
+fn background_angular_bandwidth(
+    scene: &RenderScene,
+    probe: &RenderProbe<'_>,
+    direction: Vec3A,
+    rad_per_px: f32,
+) -> f32 {
+    let lights = scene.lights.lights();
+    scene
+        .lights
+        .infinite_lights()
+        .iter()
+        .map(|&index| match &lights[index as usize] {
+            Light::Directional(sun) => {
+                let half_angle_rad = (1.0 - sun.one_minus_cos_half_angle).clamp(-1.0, 1.0).acos();
+                let off_rad = direction.dot(sun.to_light).clamp(-1.0, 1.0).acos();
+                if off_rad <= half_angle_rad + 2.0 * rad_per_px {
+                    lights[index as usize].bandwidth().angular_cycles_per_rad
+                } else {
+                    0.0
+                }
+            }
+            Light::Environment(_)
+            | Light::Sky(_)
+            | Light::Daylight(_)
+            | Light::Point(_)
+            | Light::Spot(_)
+            | Light::Area(_)
+            | Light::Goniometric(_) => {
+                probe
+                    .light_bandwidth_towards(index as usize, direction)
+                    .angular_cycles_per_rad
+            }
+        })
+        .fold(0.0f32, f32::max)
+}
+
 fn escaping_pixel(
     scene: &RenderScene,
     direction: Vec3A,
@@ -302,14 +343,6 @@ pub fn predict_with_probe<'a>(
     }
     let resolution = scene.resolution;
     probe.trace_visibility = settings.visibility;
-    // Infinite lights seen directly: the background's own angular bandwidth.
-    let background_nu_a = scene
-        .lights
-        .lights()
-        .iter()
-        .filter(|l| l.is_infinite())
-        .map(|l| l.bandwidth().angular_cycles_per_rad)
-        .fold(0.0f32, f32::max);
     type PixelRow = Vec<(
         PixelPrediction,
         f32,
@@ -381,7 +414,7 @@ pub fn predict_with_probe<'a>(
                                 scene,
                                 direction,
                                 settings.probe_samples,
-                                background_nu_a,
+                                background_angular_bandwidth(scene, &probe, direction, rad_per_px),
                                 rad_per_px,
                             ),
                             0.0,

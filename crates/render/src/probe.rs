@@ -137,7 +137,7 @@ impl<'a> RenderProbe<'a> {
     }
 
     /// ν_l of light `index` towards `wi`.
-    fn light_bandwidth_towards(&self, index: usize, wi: Vec3A) -> Bandwidth {
+    pub(crate) fn light_bandwidth_towards(&self, index: usize, wi: Vec3A) -> Bandwidth {
         let light = &self.scene.lights.lights()[index];
         match (light, self.environment_bandwidths.get(index)) {
             (Light::Environment(e), Some(Some(map))) => Bandwidth {

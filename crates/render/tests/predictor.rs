@@ -128,3 +128,81 @@ fn the_probe_reads_uv_textures_at_each_pixel() {
     assert!((mean(&dark) - 0.1).abs() < 0.02, "{}", mean(&dark));
     assert!((mean(&bright) - 0.7).abs() < 0.05, "{}", mean(&bright));
 }
+
+/// Pixels that see the sky directly take the bandwidth of what they look at: the sun's
+/// disk (0.53°) is sharp (b_p ≥ 0.25) in the pixels whose footprint reaches it, the uniform
+/// sky around it smooth (b_p < 0.05). Before, every background pixel took the largest ν_a
+/// of all infinite lights, so a sun anywhere made the whole sky "sharp" (b_p 1.66 here).
+#[test]
+fn the_sun_disk_is_sharp_and_the_sky_beside_it_smooth() {
+    let scene = build(
+        r#"{"camera": {"type": "pinhole", "fov_deg": 30,
+            "transform": {"look_at": {"eye": [0, 0, 0], "target": [0.3, 1, 0.4], "up": [0, 0, 1]}}},
+        "film": {"resolution": [33, 33]},
+        "materials": {"white": {"type": "lambert", "reflectance": 0.5}},
+        "shapes": [{"type": "sphere", "radius_m": 0.1, "material": "white",
+                    "transform": {"translate": [0, -5, 0]}}],
+        "lights": [{"type": "directional", "direction": [-0.3, -1, -0.4],
+                    "angular_diameter_deg": 0.53, "illuminance_lx": 100000},
+                   {"type": "sky", "spectrum": 1.0}]}"#,
+    );
+    let p = run(&scene, true);
+    let b = |x: usize, y: usize| p.pixels[y * 33 + x].image_bandwidth_cycles_per_px;
+    assert!(b(16, 16) >= 0.25, "the pixel looking at the sun: b_p {}", b(16, 16));
+    let mut sharp = 0;
+    for (i, (class, pixel)) in p.class.iter().zip(&p.pixels).enumerate() {
+        assert_eq!(*class, prism_bandwidth::PixelClass::Background, "pixel {i}");
+        let (x, y) = ((i % 33) as i32 - 16, (i / 33) as i32 - 16);
+        if x.abs() > 3 || y.abs() > 3 {
+            assert!(
+                pixel.image_bandwidth_cycles_per_px < 0.05,
+                "sky pixel ({x}, {y}) from the sun: b_p {}",
+                pixel.image_bandwidth_cycles_per_px
+            );
+        } else {
+            sharp += usize::from(pixel.image_bandwidth_cycles_per_px >= 0.25);
+        }
+    }
+    eprintln!("{sharp} pixels around the sun with b_p ≥ 0.25");
+}
+
+/// Hierarchical shading (§3.2) on the hard-shadow scene: the floor is interpolated from a
+/// lattice, but no interpolated pixel takes a parent on the other side of the shadow edge
+/// (the min-filtered cells), and the plan's budget is unchanged.
+#[test]
+fn hierarchical_shading_never_interpolates_across_a_shadow_edge() {
+    let scene = build(&format!(
+        r#"{{{CAMERA},
+        "materials": {{"white": {{"type": "lambert", "reflectance": 0.7}}}},
+        "shapes": [
+          {{"type": "rectangle", "size_m": [20, 20], "material": "white",
+            "transform": {{"rotate": {{"axis": [1, 0, 0], "angle_deg": -90}}}}}},
+          {{"type": "cuboid", "size_m": [0.8, 0.1, 0.8], "material": "white",
+            "transform": {{"translate": [0.3, 0.5, 0]}}}}],
+        "lights": [{{"type": "point", "position_m": [0.3, 2.5, 0], "spectrum": 1.0, "scale": 10}}]}}"#
+    ));
+    let mut p = run(&scene, true);
+    let before = p.allocated.relative_density.iter().sum::<f32>();
+    let upsampling = p.make_hierarchical(3, 16.0, 1).unwrap();
+    let after = p.allocated.relative_density.iter().sum::<f32>();
+    assert!((before - after).abs() < 1e-3 * before, "{before} → {after}");
+    let interpolated = upsampling.upsampled();
+    assert!(
+        interpolated.len() > 48 * 48 / 2,
+        "{} pixels interpolated",
+        interpolated.len()
+    );
+    let lit = |i: usize| p.pixels[i].visibility.visible_share().map(|s| s > 0.5);
+    for u in interpolated {
+        for &(parent, _) in u.parents() {
+            assert_eq!(
+                lit(u.index as usize),
+                lit(parent as usize),
+                "pixel {} interpolated from {parent} across the shadow edge",
+                u.index
+            );
+        }
+        let pixel = glam::UVec2::new(u.index % 48, u.index / 48);
+        assert_eq!(p.allocated.plan.camera_samples(pixel), 0);
+    }
+}
