@@ -386,20 +386,30 @@ mod tests {
         (levels, classes, surfaces)
     }
 
+    fn plan(
+        r: UVec2,
+        levels: &[i32],
+        class: &[PixelClass],
+        surface: &[Option<SurfacePoint>],
+        max_level: u32,
+    ) -> Upsampling {
+        Upsampling::plan(
+            r,
+            HierarchyInputs {
+                shading_level: levels,
+                class,
+                surface,
+                max_level,
+            },
+        )
+        .unwrap()
+    }
+
     #[test]
     fn levels_up_to_one_shade_every_pixel_and_interpolate_none() {
         let r = UVec2::new(7, 5);
         let (l, c, s) = inputs_for(r, 1, |_, _| PixelClass::Material(0));
-        let u = Upsampling::plan(
-            r,
-            HierarchyInputs {
-                shading_level: &l,
-                class: &c,
-                surface: &s,
-                max_level: 3,
-            },
-        )
-        .unwrap();
+        let u = plan(r, &l, &c, &s, 3);
         assert_eq!(u.shaded_count(), 35);
         assert!(u.upsampled().is_empty());
     }
@@ -409,16 +419,7 @@ mod tests {
         // Eq. 11's level 3 → lattice level 2: 0, 4, …, 16 on both axes = 25 shaded pixels.
         let r = UVec2::new(17, 17);
         let (l, c, s) = inputs_for(r, 3, |_, _| PixelClass::Material(0));
-        let u = Upsampling::plan(
-            r,
-            HierarchyInputs {
-                shading_level: &l,
-                class: &c,
-                surface: &s,
-                max_level: 3,
-            },
-        )
-        .unwrap();
+        let u = plan(r, &l, &c, &s, 3);
         assert_eq!(u.shaded_count(), 25);
         assert_eq!(u.upsampled().len(), 17 * 17 - 25);
         for p in u.upsampled() {
@@ -445,16 +446,7 @@ mod tests {
     fn max_level_bounds_the_lattice_spacing() {
         let r = UVec2::new(33, 1);
         let (l, c, s) = inputs_for(r, 7, |_, _| PixelClass::Material(0));
-        let u = Upsampling::plan(
-            r,
-            HierarchyInputs {
-                shading_level: &l,
-                class: &c,
-                surface: &s,
-                max_level: 2,
-            },
-        )
-        .unwrap();
+        let u = plan(r, &l, &c, &s, 2);
         // Lattice 0, 4, …, 32.
         let shaded: Vec<usize> = (0..33).filter(|&i| u.is_shaded(i)).collect();
         assert_eq!(shaded, (0..=32).step_by(4).collect::<Vec<_>>());
@@ -466,16 +458,7 @@ mod tests {
         // corner 4 of the other material; 1–3 have both corners on their own.
         let r = UVec2::new(9, 1);
         let (l, c, s) = inputs_for(r, 3, |x, _| PixelClass::Material(u32::from(x >= 5)));
-        let u = Upsampling::plan(
-            r,
-            HierarchyInputs {
-                shading_level: &l,
-                class: &c,
-                surface: &s,
-                max_level: 3,
-            },
-        )
-        .unwrap();
+        let u = plan(r, &l, &c, &s, 3);
         let shaded: Vec<usize> = (0..9).filter(|&i| u.is_shaded(i)).collect();
         assert_eq!(shaded, vec![0, 4, 5, 6, 7, 8]);
         // The background is only blended with the background.
@@ -486,16 +469,7 @@ mod tests {
                 PixelClass::Material(0)
             }
         });
-        let u = Upsampling::plan(
-            r,
-            HierarchyInputs {
-                shading_level: &l,
-                class: &c,
-                surface: &s,
-                max_level: 3,
-            },
-        )
-        .unwrap();
+        let u = plan(r, &l, &c, &s, 3);
         let shaded: Vec<usize> = (0..9).filter(|&i| u.is_shaded(i)).collect();
         assert_eq!(shaded, vec![0, 1, 2, 3, 4, 8]);
     }
@@ -509,16 +483,7 @@ mod tests {
             position_m: Vec3A::new(0.04, 0.0, 0.04),
             ..s[4].unwrap()
         });
-        let u = Upsampling::plan(
-            r,
-            HierarchyInputs {
-                shading_level: &l,
-                class: &c,
-                surface: &s,
-                max_level: 3,
-            },
-        )
-        .unwrap();
+        let u = plan(r, &l, &c, &s, 3);
         assert!((0..5).all(|i| u.is_shaded(i)));
     }
 
@@ -526,16 +491,7 @@ mod tests {
     fn concentrating_keeps_the_total_and_moves_density_to_the_parents() {
         let r = UVec2::new(5, 1);
         let (l, c, s) = inputs_for(r, 3, |_, _| PixelClass::Material(0));
-        let u = Upsampling::plan(
-            r,
-            HierarchyInputs {
-                shading_level: &l,
-                class: &c,
-                surface: &s,
-                max_level: 3,
-            },
-        )
-        .unwrap();
+        let u = plan(r, &l, &c, &s, 3);
         let uniform = Allocated {
             plan: SamplePlan::uniform(r, 4).unwrap(),
             relative_density: vec![1.0; 5],
@@ -560,16 +516,7 @@ mod tests {
         let r = UVec2::new(17, 1);
         let (mut l, c, s) = inputs_for(r, 7, |_, _| PixelClass::Material(0));
         l[11] = 0;
-        let u = Upsampling::plan(
-            r,
-            HierarchyInputs {
-                shading_level: &l,
-                class: &c,
-                surface: &s,
-                max_level: 3,
-            },
-        )
-        .unwrap();
+        let u = plan(r, &l, &c, &s, 3);
         let shaded: Vec<usize> = (0..17).filter(|&i| u.is_shaded(i)).collect();
         assert_eq!(shaded, vec![0, 8, 10, 11, 12, 16]);
     }

@@ -45,9 +45,9 @@ fn a_lambertian_plane_under_a_uniform_sky_is_smooth() {
     assert!((total / (48.0 * 48.0) - 16.0).abs() < 0.5, "{total}");
 }
 
-#[test]
-fn a_hard_shadow_edge_is_sharp_and_only_visibility_sees_it() {
-    let scene = build(&format!(
+/// A floor under a point light with a box between them: a hard shadow.
+fn hard_shadow_scene() -> RenderScene {
+    build(&format!(
         r#"{{{CAMERA},
         "materials": {{"white": {{"type": "lambert", "reflectance": 0.7}}}},
         "shapes": [
@@ -56,7 +56,12 @@ fn a_hard_shadow_edge_is_sharp_and_only_visibility_sees_it() {
           {{"type": "cuboid", "size_m": [0.8, 0.1, 0.8], "material": "white",
             "transform": {{"translate": [0.3, 0.5, 0]}}}}],
         "lights": [{{"type": "point", "position_m": [0.3, 2.5, 0], "spectrum": 1.0, "scale": 10}}]}}"#
-    ));
+    ))
+}
+
+#[test]
+fn a_hard_shadow_edge_is_sharp_and_only_visibility_sees_it() {
+    let scene = hard_shadow_scene();
     let with = run(&scene, true);
     // The pixels that see a surface lit by the light (floor and box top).
     let lit: Vec<usize> = (0..48 * 48)
@@ -148,7 +153,11 @@ fn the_sun_disk_is_sharp_and_the_sky_beside_it_smooth() {
     );
     let p = run(&scene, true);
     let b = |x: usize, y: usize| p.pixels[y * 33 + x].image_bandwidth_cycles_per_px;
-    assert!(b(16, 16) >= 0.25, "the pixel looking at the sun: b_p {}", b(16, 16));
+    assert!(
+        b(16, 16) >= 0.25,
+        "the pixel looking at the sun: b_p {}",
+        b(16, 16)
+    );
     let mut sharp = 0;
     for (i, (class, pixel)) in p.class.iter().zip(&p.pixels).enumerate() {
         assert_eq!(*class, prism_bandwidth::PixelClass::Background, "pixel {i}");
@@ -171,16 +180,7 @@ fn the_sun_disk_is_sharp_and_the_sky_beside_it_smooth() {
 /// (the min-filtered cells), and the plan's budget is unchanged.
 #[test]
 fn hierarchical_shading_never_interpolates_across_a_shadow_edge() {
-    let scene = build(&format!(
-        r#"{{{CAMERA},
-        "materials": {{"white": {{"type": "lambert", "reflectance": 0.7}}}},
-        "shapes": [
-          {{"type": "rectangle", "size_m": [20, 20], "material": "white",
-            "transform": {{"rotate": {{"axis": [1, 0, 0], "angle_deg": -90}}}}}},
-          {{"type": "cuboid", "size_m": [0.8, 0.1, 0.8], "material": "white",
-            "transform": {{"translate": [0.3, 0.5, 0]}}}}],
-        "lights": [{{"type": "point", "position_m": [0.3, 2.5, 0], "spectrum": 1.0, "scale": 10}}]}}"#
-    ));
+    let scene = hard_shadow_scene();
     let mut p = run(&scene, true);
     let before = p.allocated.relative_density.iter().sum::<f32>();
     let upsampling = p.make_hierarchical(3, 16.0, 1).unwrap();
