@@ -192,7 +192,7 @@ fn mitsuba_defines_override_defaults() {
     let json = dir.path().join("small.json");
     run_ok(
         prism()
-            .args(["import", "-D", "res=32", "-D", "spp=3"])
+            .args(["import", "-D", "resx=32", "-D", "resy=32", "-D", "spp=3"])
             .arg(root().join("scenes/import/cornell-box.xml"))
             .arg("-o")
             .arg(&json),
