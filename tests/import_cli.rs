@@ -331,3 +331,69 @@ fn what_is_not_imported_is_listed_once_per_kind_and_refused_with_strict() {
         .unwrap();
     assert!(!out.status.success());
 }
+
+/// pbrt-v4's image infinite light (an equal-area octahedral square, +x to the right of the
+/// square's centre) becomes an `environment` light whose equirectangular side file holds
+/// the same sky: a square bright on its right half (pbrt's x > 0) gives a map bright
+/// towards +X (u = ¼) and dark towards −X (u = ¾), and the light's transform is the CTM.
+#[test]
+fn pbrt_image_infinite_lights_become_equirectangular_environment_maps() {
+    let dir = tempfile::tempdir().unwrap();
+    let size = 32;
+    let square: Vec<[f32; 3]> = (0..size * size)
+        .map(|i| {
+            if i % size >= size / 2 {
+                [2.0; 3]
+            } else {
+                [0.0; 3]
+            }
+        })
+        .collect();
+    let image = prism_image::Image::new(
+        size,
+        size,
+        square,
+        prism_spectrum::rgb_space::RgbColorSpace::srgb(),
+    )
+    .unwrap();
+    prism_image::io::exr::write_exr(
+        &dir.path().join("sky.exr"),
+        &image,
+        &prism_image::io::exr::ExrWriteOptions::default(),
+    )
+    .unwrap();
+    let scene = dir.path().join("sky.pbrt");
+    std::fs::write(
+        &scene,
+        "LookAt 0 0 3  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" [ 40 ]\n\
+         Film \"rgb\" \"integer xresolution\" [ 8 ] \"integer yresolution\" [ 8 ]\n\
+         WorldBegin\n\
+         LightSource \"infinite\" \"string filename\" \"sky.exr\" \"float scale\" [ 1.5 ]\n\
+         Shape \"sphere\" \"float radius\" [ 0.5 ]\n",
+    )
+    .unwrap();
+    std::fs::create_dir(dir.path().join("out")).unwrap();
+    let json = dir.path().join("out/sky.json");
+    run_ok(prism().arg("import").arg(&scene).arg("-o").arg(&json));
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let light = &v["lights"][0];
+    assert_eq!(light["type"], "environment", "{light}");
+    assert_eq!(light["scale"], 1.5);
+    let map = read_exr(&json.parent().unwrap().join(light["file"].as_str().unwrap())).unwrap();
+    assert_eq!((map.width(), map.height()), (64, 32));
+    let row = 16;
+    let at = |u: f64| map.pixel((u * 64.0) as usize, row)[0];
+    assert!((at(0.25) - 2.0).abs() < 1e-4, "+X: {}", at(0.25));
+    assert!(at(0.75).abs() < 1e-4, "−X: {}", at(0.75));
+    // The JSON renders (the side file and transform are valid).
+    let out = dir.path().join("sky.exr.out.exr");
+    run_ok(
+        prism()
+            .arg("render")
+            .arg(&json)
+            .arg("-o")
+            .arg(&out)
+            .args(["--spp", "2"]),
+    );
+}

@@ -131,15 +131,27 @@ pub fn light(
             l.insert("scale".into(), json!(scale));
         }
         "infinite" => {
-            if let Some(p) = params.get("filename") {
-                im.out.unsupported.note(
-                    "LightSource infinite with an image",
-                    "not imported: pbrt-v4's environment images are equal-area octahedral maps, Prism's are equirectangular (convert the image and add an `environment` light)",
-                    &p.at,
-                );
-                for q in &params.list {
-                    q.used.set(true);
+            if let Some(file) = params.string("filename")? {
+                let path = at
+                    .file
+                    .parent()
+                    .unwrap_or(std::path::Path::new(""))
+                    .join(&file);
+                let map = environment_map(&path, at)?;
+                let name = format!("environment-{}.exr", im.out.side_files.len() + 1);
+                l.insert("type".into(), json!("environment"));
+                l.insert("file".into(), json!(im.out.add_side_file(&name, map)));
+                l.insert("transform".into(), crate::output::matrix_json(&ctm));
+                l.insert("scale".into(), json!(params.float_or("scale", 1.0)?));
+                if params.float("illuminance")?.is_some() {
+                    im.out.unsupported.note(
+                        "infinite light illuminance",
+                        "ignored: the map keeps its radiance × scale",
+                        at,
+                    );
                 }
+                params.finish("LightSource \"infinite\"", &mut im.out.unsupported);
+                im.out.lights.push(Value::Object(l));
                 return Ok(());
             }
             let (s, scale) = strength(im, params, "L", at)?;
@@ -157,7 +169,7 @@ pub fn light(
         other => {
             im.out.unsupported.note(
                 format!("LightSource \"{other}\""),
-                "not imported (Prism reads point, spot, distant and infinite from pbrt; goniometric files are not pbrt's EXR format in Prism — use a `luminaire` with an IES file)",
+                "not imported (Prism reads point, spot, distant and infinite, with or without an image, from pbrt; goniometric files are not pbrt's EXR format in Prism — use a `luminaire` with an IES file)",
                 at,
             );
             for q in &params.list {
@@ -169,4 +181,50 @@ pub fn light(
     params.finish(&format!("LightSource \"{kind}\""), &mut im.out.unsupported);
     im.out.lights.push(Value::Object(l));
     Ok(())
+}
+
+/// pbrt-v4's equal-area octahedral environment image at `path` as the bytes of an
+/// equirectangular linear-sRGB EXR (`octahedral`), for an `environment` light.
+fn environment_map(path: &std::path::Path, at: &Location) -> Result<Vec<u8>, ImportError> {
+    let image = prism_image::io::read_image(path)
+        .map_err(|e| ImportError::at(at, format!("LightSource infinite \"filename\": {e}")))?;
+    if image.width() != image.height() {
+        return Err(ImportError::at(
+            at,
+            format!(
+                "LightSource infinite \"filename\" {}: {}×{} pixels; pbrt-v4's environment \
+                 images are square (equal-area octahedral)",
+                path.display(),
+                image.width(),
+                image.height()
+            ),
+        ));
+    }
+    let srgb = prism_spectrum::rgb_space::RgbColorSpace::srgb();
+    let mut pixels = image.pixels().to_vec();
+    prism_image::io::convert_pixels(&mut pixels, &image.color_space, &srgb);
+    let (width, height, map) =
+        crate::pbrt::octahedral::octahedral_to_equirect(&pixels, image.width());
+    let equirect = prism_image::Image::new(width, height, map, srgb)
+        .map_err(|e| ImportError::at(at, format!("environment map: {e}")))?;
+    // The EXR encoder writes files: through a private temporary file.
+    let temp = std::env::temp_dir().join(format!(
+        "prism-import-env-{}-{}.exr",
+        std::process::id(),
+        std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map_or(0, |t| t.as_nanos())
+    ));
+    let written = prism_image::io::exr::write_exr(
+        &temp,
+        &equirect,
+        &prism_image::io::exr::ExrWriteOptions::default(),
+    )
+    .map_err(|e| ImportError::at(at, format!("environment map: {e}")))
+    .and_then(|()| {
+        std::fs::read(&temp)
+            .map_err(|e| ImportError::at(at, format!("environment map {}: {e}", temp.display())))
+    });
+    let _ = std::fs::remove_file(&temp);
+    written
 }

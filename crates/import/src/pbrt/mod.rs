@@ -4,6 +4,7 @@
 
 pub mod light;
 pub mod material;
+pub mod octahedral;
 pub mod options;
 pub mod params;
 pub mod parser;
