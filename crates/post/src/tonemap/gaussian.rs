@@ -10,9 +10,20 @@
 //!   measured at σ = 4.2, less for larger σ; tested below), and it preserves constants
 //!   (unit DC gain).
 //!
-//! Both passes are parallel: rows by rayon chunks, columns by strips of
-//! [`COLUMN_STRIP`] columns processed row by row (so the vertical recursion streams through
-//! memory instead of striding).
+//! [`gaussian_blur_bands`] reads its input a row at a time from a function and hands the
+//! blurred plane over a band of rows at a time, so that neither input nor output plane
+//! exists whole (`reinhard02-local` computes its luminance from the image and compares
+//! each band with the previous scale as it comes); [`fir_blurs_bands`] does so for several
+//! FIR σ at once, each band's input rows made once. The FIR keeps the row-filtered rows of
+//! one band and its halo. The recursive filter's vertical pass runs forward over whole
+//! columns before it can run backward, so it takes two sweeps: the first, top to bottom,
+//! filters the rows of each band and runs the forward recursion over them, keeping only
+//! its state where each band begins (3 values per column and band); the second, bottom to
+//! top, filters each band's rows again, runs the forward recursion from the kept state
+//! and the backward one from the band below. Every value goes through the same
+//! operations in the same order as in a whole-plane blur (rows in parallel, then columns
+//! in strips of [`COLUMN_STRIP`] processed row by row), so the bits are the same (tested
+//! against the whole-plane blur for band heights from 1 row up).
 
 use rayon::prelude::*;
 
@@ -30,11 +41,179 @@ const ROW_GROUP: usize = 8;
 /// Columns per task of the vertical pass (64 f32 = 256 bytes: four cache lines per row).
 const COLUMN_STRIP: usize = 64;
 
-/// Blurs `src` (row-major `width × height`) with a Gaussian of standard deviation
-/// `sigma_px` pixels into `dst`; `scratch` must have the same length (reused across
-/// calls to avoid allocation). σ ≤ 0 copies. `simd`: the widest kernels to run
-/// (`prism_cpu::active()` for the process's choice; every ISA gives the same bits).
+/// Rows per band of [`gaussian_blur_bands`] (a multiple of [`ROW_GROUP`]): 1 MiB per band
+/// of a 4096-pixel-wide plane, and the recursive filter's kept states 12 / 64 bytes per
+/// pixel.
+pub const BAND_ROWS: usize = 64;
+
+/// Blurs the `width × height` plane whose row `y` is written by `source(y, row)` (called
+/// from several threads, each row once per sweep: twice for the recursive filter) with a
+/// Gaussian of standard deviation `sigma_px` pixels, and hands the result to
+/// `consume(y0, rows)` in bands of whole rows (rows `y0 …`, `rows.len()` a multiple of
+/// `width`; each row exactly once, bottom band first for the recursive filter). The bits
+/// are those of the whole-plane blur. σ ≤ 0 hands the rows over unchanged. `simd`: the
+/// widest kernels to run (every ISA gives the same bits).
+pub fn gaussian_blur_bands<S, C>(
+    source: &S,
+    width: usize,
+    height: usize,
+    sigma_px: f32,
+    simd: Simd,
+    consume: C,
+) where
+    S: Fn(usize, &mut [f32]) + Sync,
+    C: FnMut(usize, &mut [f32]),
+{
+    blur_bands_of(source, width, height, sigma_px, simd, BAND_ROWS, consume)
+}
+
+/// [`gaussian_blur_bands`] with bands of `band_rows` rows (tests try several).
+fn blur_bands_of<S, C>(
+    source: &S,
+    width: usize,
+    height: usize,
+    sigma_px: f32,
+    simd: Simd,
+    band_rows: usize,
+    mut consume: C,
+) where
+    S: Fn(usize, &mut [f32]) + Sync,
+    C: FnMut(usize, &mut [f32]),
+{
+    if width == 0 || height == 0 {
+        return;
+    }
+    let band = band_rows.clamp(1, height);
+    if sigma_px.is_nan() || sigma_px <= 0.0 {
+        let mut rows = vec![0.0f32; band * width];
+        for y0 in (0..height).step_by(band) {
+            let rows = &mut rows[..((y0 + band).min(height) - y0) * width];
+            rows.par_chunks_mut(width)
+                .enumerate()
+                .for_each(|(i, row)| source(y0 + i, row));
+            consume(y0, rows);
+        }
+    } else if sigma_px < RECURSIVE_MIN_SIGMA {
+        fir_blurs_bands_of(
+            source,
+            width,
+            height,
+            &[sigma_px],
+            simd,
+            band,
+            |y0, _, _, rows| consume(y0, rows),
+        );
+    } else {
+        let c = YoungVanVliet::new(sigma_px);
+        c.blur_bands(source, width, height, simd, band, consume);
+    }
+}
+
+/// FIR blurs of one source at several σ (each below [`RECURSIVE_MIN_SIGMA`]), in one
+/// sweep over bands of rows: the band's source rows (with the largest halo) are made once,
+/// then each blur's rows (its row-filtered rows with their halo, then the vertical pass);
+/// `consume(y0, j, previous, rows)` gets blur `j`'s rows of the band, and blur `j − 1`'s as
+/// `previous` (empty for `j = 0`), `j` in order for each band from the top. The same bits
+/// as the whole-plane blur of each σ.
+pub fn fir_blurs_bands<S, C>(
+    source: &S,
+    width: usize,
+    height: usize,
+    sigmas: &[f32],
+    simd: Simd,
+    consume: C,
+) where
+    S: Fn(usize, &mut [f32]) + Sync,
+    C: FnMut(usize, usize, &mut [f32], &mut [f32]),
+{
+    fir_blurs_bands_of(source, width, height, sigmas, simd, BAND_ROWS, consume)
+}
+
+fn fir_blurs_bands_of<S, C>(
+    source: &S,
+    width: usize,
+    height: usize,
+    sigmas: &[f32],
+    simd: Simd,
+    band_rows: usize,
+    mut consume: C,
+) where
+    S: Fn(usize, &mut [f32]) + Sync,
+    C: FnMut(usize, usize, &mut [f32], &mut [f32]),
+{
+    if width == 0 || height == 0 || sigmas.is_empty() {
+        return;
+    }
+    assert!(sigmas.iter().all(|s| *s > 0.0 && *s < RECURSIVE_MIN_SIGMA));
+    let kernels: Vec<Vec<f32>> = sigmas.iter().map(|s| sampled_kernel(*s)).collect();
+    let halo = kernels.iter().map(|k| k.len() / 2).max().unwrap_or(0);
+    let band = band_rows.clamp(1, height);
+    let mut source_rows = vec![0.0f32; (band + 2 * halo).min(height) * width];
+    let mut filtered = vec![0.0f32; (band + 2 * halo).min(height) * width];
+    let (mut previous, mut current) = (vec![0.0f32; band * width], vec![0.0f32; band * width]);
+    for y0 in (0..height).step_by(band) {
+        let y1 = (y0 + band).min(height);
+        let (lo, hi) = (y0.saturating_sub(halo), (y1 + halo).min(height));
+        source_rows[..(hi - lo) * width]
+            .par_chunks_mut(width)
+            .enumerate()
+            .for_each(|(i, row)| source(lo + i, row));
+        for (j, kernel) in kernels.iter().enumerate() {
+            let r = kernel.len() / 2;
+            let (flo, fhi) = (y0.saturating_sub(r), (y1 + r).min(height));
+            let source_rows = &source_rows[(flo - lo) * width..(fhi - lo) * width];
+            filtered[..(fhi - flo) * width]
+                .par_chunks_mut(width)
+                .zip(source_rows.par_chunks(width))
+                .for_each_init(
+                    || vec![0.0f32; width + 2 * r],
+                    |padded, (o, i)| avx2!(simd, fir_row(i, o, padded, kernel)),
+                );
+            let filtered = &filtered[..(fhi - flo) * width];
+            let rows = &mut current[..(y1 - y0) * width];
+            rows.par_chunks_mut(width).enumerate().for_each(|(i, o)| {
+                avx2!(
+                    simd,
+                    fir_column_row_of(filtered, flo, o, y0 + i, height, kernel)
+                )
+            });
+            let earlier = if j == 0 {
+                &mut previous[..0]
+            } else {
+                &mut previous[..(y1 - y0) * width]
+            };
+            consume(y0, j, earlier, rows);
+            std::mem::swap(&mut previous, &mut current);
+        }
+    }
+}
+
+/// Blurs `src` (row-major `width × height`) into `dst` as one plane, through
+/// [`gaussian_blur_bands`] (for tests: the whole-plane blur of earlier versions is kept
+/// below to check the bands against).
+#[cfg(test)]
 pub fn gaussian_blur(
+    src: &[f32],
+    dst: &mut [f32],
+    width: usize,
+    height: usize,
+    sigma_px: f32,
+    simd: Simd,
+) {
+    gaussian_blur_bands(
+        &|y, row: &mut [f32]| row.copy_from_slice(&src[y * width..(y + 1) * width]),
+        width,
+        height,
+        sigma_px,
+        simd,
+        |y0, rows| dst[y0 * width..y0 * width + rows.len()].copy_from_slice(rows),
+    );
+}
+
+/// The whole-plane blur (rows of `src` into `scratch`, columns in place or into `dst`):
+/// what [`gaussian_blur_bands`] must reproduce bit for bit.
+#[cfg(test)]
+pub(crate) fn whole_plane_blur(
     src: &[f32],
     dst: &mut [f32],
     scratch: &mut [f32],
@@ -133,14 +312,14 @@ fn fir_any(taps: &[&[f32]], kernel: &[f32], out: &mut [f32]) {
     }
 }
 
-/// One row of the horizontal FIR: the row with `r` replicated edge pixels on both sides,
-/// and the taps as shifted views of it.
+/// One row of the horizontal FIR: `padded` holds the row from index `r` on; its `r`
+/// edge pixels are replicated on both sides and the taps are shifted views of it.
 #[inline(always)]
-fn fir_row(i: &[f32], o: &mut [f32], padded: &mut [f32], kernel: &[f32]) {
-    let (r, width) = (kernel.len() / 2, i.len());
-    padded[..r].fill(i[0]);
-    padded[r..r + width].copy_from_slice(i);
-    padded[r + width..].fill(i[width - 1]);
+fn fir_padded_row(o: &mut [f32], padded: &mut [f32], kernel: &[f32]) {
+    let (r, width) = (kernel.len() / 2, o.len());
+    let (first, last) = (padded[r], padded[r + width - 1]);
+    padded[..r].fill(first);
+    padded[r + width..].fill(last);
     let mut taps: [&[f32]; 2 * MAX_FIR_RADIUS + 1] = [&[]; 2 * MAX_FIR_RADIUS + 1];
     for (j, t) in taps.iter_mut().enumerate().take(kernel.len()) {
         *t = &padded[j..j + width];
@@ -148,7 +327,16 @@ fn fir_row(i: &[f32], o: &mut [f32], padded: &mut [f32], kernel: &[f32]) {
     fir_any(&taps[..kernel.len()], kernel, o);
 }
 
+/// [`fir_padded_row`] of the row `i`.
+#[inline(always)]
+fn fir_row(i: &[f32], o: &mut [f32], padded: &mut [f32], kernel: &[f32]) {
+    let r = kernel.len() / 2;
+    padded[r..r + i.len()].copy_from_slice(i);
+    fir_padded_row(o, padded, kernel)
+}
+
 /// Horizontal FIR, rows in parallel (edge pixels replicated).
+#[cfg(test)]
 fn fir_rows(src: &[f32], dst: &mut [f32], width: usize, kernel: &[f32], simd: Simd) {
     let r = kernel.len() / 2;
     dst.par_chunks_mut(width)
@@ -159,20 +347,28 @@ fn fir_rows(src: &[f32], dst: &mut [f32], width: usize, kernel: &[f32], simd: Si
         );
 }
 
-/// One output row of the vertical FIR: the taps are the source rows y − r … y + r,
-/// clamped at the edges.
+/// One output row of the vertical FIR: the taps are the row-filtered rows y − r … y + r,
+/// clamped at the edges, of which `src` holds rows `first …`.
 #[inline(always)]
-fn fir_column_row(src: &[f32], o: &mut [f32], y: usize, height: usize, kernel: &[f32]) {
+fn fir_column_row_of(
+    src: &[f32],
+    first: usize,
+    o: &mut [f32],
+    y: usize,
+    height: usize,
+    kernel: &[f32],
+) {
     let (r, width) = ((kernel.len() / 2) as isize, o.len());
     let last = height as isize - 1;
     let mut taps: [&[f32]; 2 * MAX_FIR_RADIUS + 1] = [&[]; 2 * MAX_FIR_RADIUS + 1];
     for (j, t) in taps.iter_mut().enumerate().take(kernel.len()) {
-        let yy = (y as isize + j as isize - r).clamp(0, last) as usize;
+        let yy = (y as isize + j as isize - r).clamp(0, last) as usize - first;
         *t = &src[yy * width..(yy + 1) * width];
     }
     fir_any(&taps[..kernel.len()], kernel, o);
 }
 
+#[cfg(test)]
 fn fir_columns(
     src: &[f32],
     dst: &mut [f32],
@@ -183,7 +379,7 @@ fn fir_columns(
 ) {
     dst.par_chunks_mut(width)
         .enumerate()
-        .for_each(|(y, o)| avx2!(simd, fir_column_row(src, o, y, height, kernel)));
+        .for_each(|(y, o)| avx2!(simd, fir_column_row_of(src, 0, o, y, height, kernel)));
 }
 
 /// Coefficients of the Young–van Vliet recursive Gaussian, normalised by b0.
@@ -288,8 +484,144 @@ impl YoungVanVliet {
         }
     }
 
-    /// The same recursion down every column, strips of columns in parallel, with the
-    /// kernels of `simd`.
+    /// The recursive blur in bands (module documentation): two sweeps over the bands,
+    /// the second handing them to `consume` from the bottom up.
+    fn blur_bands<S, C>(
+        &self,
+        source: &S,
+        width: usize,
+        height: usize,
+        simd: Simd,
+        band: usize,
+        mut consume: C,
+    ) where
+        S: Fn(usize, &mut [f32]) + Sync,
+        C: FnMut(usize, &mut [f32]),
+    {
+        let bands = height.div_ceil(band);
+        let range = |b: usize| (b * band, ((b + 1) * band).min(height));
+        let mut rows = vec![0.0f32; band * width];
+        // The vertical forward recursion's state (its last three outputs) in every column
+        // where each band begins, and after the last row.
+        let mut states = vec![[0.0f32; 3]; (bands + 1) * width];
+        for b in 0..bands {
+            let (y0, y1) = range(b);
+            let rows = &mut rows[..(y1 - y0) * width];
+            self.filter_band_rows(source, y0, rows, width, simd);
+            if b == 0 {
+                // The state starts at the edge value (as along a row).
+                for (s, v) in states[..width].iter_mut().zip(&rows[..width]) {
+                    *s = [*v; 3];
+                }
+            }
+            let (before, after) = states.split_at_mut((b + 1) * width);
+            let state = &mut after[..width];
+            state.copy_from_slice(&before[b * width..]);
+            self.recurse_columns(rows, width, state, false, simd);
+        }
+        // The backward recursion starts at the forward output of the last row; the
+        // last band's forward output is still in `rows`.
+        let mut backward: Vec<[f32; 3]> =
+            states[bands * width..].iter().map(|s| [s[0]; 3]).collect();
+        let mut forward = vec![[0.0f32; 3]; width];
+        for b in (0..bands).rev() {
+            let (y0, y1) = range(b);
+            let rows = &mut rows[..(y1 - y0) * width];
+            if b + 1 < bands {
+                self.filter_band_rows(source, y0, rows, width, simd);
+                forward.copy_from_slice(&states[b * width..(b + 1) * width]);
+                self.recurse_columns(rows, width, &mut forward, false, simd);
+            }
+            self.recurse_columns(rows, width, &mut backward, true, simd);
+            consume(y0, rows);
+        }
+    }
+
+    /// Rows `y0 …` of `source`, filtered along the rows into `rows` (groups of
+    /// [`ROW_GROUP`] rows in parallel).
+    fn filter_band_rows<S>(&self, source: &S, y0: usize, rows: &mut [f32], width: usize, simd: Simd)
+    where
+        S: Fn(usize, &mut [f32]) + Sync,
+    {
+        rows.par_chunks_mut(width * ROW_GROUP)
+            .enumerate()
+            .for_each_init(
+                || (Vec::new(), vec![0.0f32; width * ROW_GROUP]),
+                |(lanes, from), (g, group)| {
+                    let from = &mut from[..group.len()];
+                    for (i, row) in from.chunks_mut(width).enumerate() {
+                        source(y0 + g * ROW_GROUP + i, row);
+                    }
+                    avx2!(simd, filter_rows_kernel(self, from, group, width, lanes))
+                },
+            );
+    }
+
+    /// The vertical recursion (forward, or `backward`) down the rows of `rows` from the
+    /// state `state` of each column, which it leaves as it is after the last row; strips
+    /// of [`COLUMN_STRIP`] columns in parallel.
+    fn recurse_columns(
+        &self,
+        rows: &mut [f32],
+        width: usize,
+        state: &mut [[f32; 3]],
+        backward: bool,
+        simd: Simd,
+    ) {
+        let height = rows.len() / width;
+        let ptr = SharedPlane(rows.as_mut_ptr());
+        state
+            .par_chunks_mut(COLUMN_STRIP)
+            .enumerate()
+            .for_each(|(s, state)| {
+                let x0 = s * COLUMN_STRIP;
+                let n = state.len();
+                // SAFETY: each task reads and writes only columns x0..x0+n of every row;
+                // strips are disjoint and `rows` outlives the parallel loop.
+                let row = |y: usize| unsafe {
+                    std::slice::from_raw_parts_mut(ptr.get().add(y * width + x0), n)
+                };
+                avx2!(
+                    simd,
+                    recurse_strip_kernel(self, row, height, state, backward)
+                );
+            });
+    }
+
+    /// One strip of [`Self::recurse_columns`]: the same operations per value as along a
+    /// row ([`Self::filter_row`]), the strip's columns side by side.
+    #[inline(always)]
+    fn recurse_strip<'a>(
+        &self,
+        row: impl Fn(usize) -> &'a mut [f32],
+        height: usize,
+        state: &mut [[f32; 3]],
+        backward: bool,
+    ) {
+        let (b, [a1, a2, a3]) = (self.b, self.a);
+        let mut s = [[0.0f32; COLUMN_STRIP]; 3];
+        for (k, v) in state.iter().enumerate() {
+            s[0][k] = v[0];
+            s[1][k] = v[1];
+            s[2][k] = v[2];
+        }
+        if backward {
+            for y in (0..height).rev() {
+                recurse_row(row(y), &mut s, b, [a1, a2, a3]);
+            }
+        } else {
+            for y in 0..height {
+                recurse_row(row(y), &mut s, b, [a1, a2, a3]);
+            }
+        }
+        for (k, v) in state.iter_mut().enumerate() {
+            *v = [s[0][k], s[1][k], s[2][k]];
+        }
+    }
+
+    /// The same recursion down every column of a whole plane, strips of columns in
+    /// parallel, with the kernels of `simd` (the whole-plane blur the bands reproduce).
+    #[cfg(test)]
     pub fn filter_columns(&self, plane: &mut [f32], width: usize, height: usize, simd: Simd) {
         let strips = width.div_ceil(COLUMN_STRIP);
         let ptr = SharedPlane(plane.as_mut_ptr());
@@ -305,6 +637,7 @@ impl YoungVanVliet {
         });
     }
 
+    #[cfg(test)]
     #[inline(always)]
     fn columns_strip<'a>(&self, row: impl Fn(usize) -> &'a mut [f32], n: usize, height: usize) {
         let (b, [a1, a2, a3]) = (self.b, self.a);
@@ -353,6 +686,7 @@ fn filter_rows_kernel(
     c.filter_rows(from, rows, width, lanes)
 }
 
+#[cfg(test)]
 #[inline(always)]
 fn columns_strip_kernel<'a>(
     c: &YoungVanVliet,
@@ -361,6 +695,30 @@ fn columns_strip_kernel<'a>(
     height: usize,
 ) {
     c.columns_strip(row, n, height)
+}
+
+/// One step of the vertical recursion: row `r` of a strip (its columns side by side)
+/// from the state `s` of the three rows before it in the recursion's direction.
+#[inline(always)]
+fn recurse_row(r: &mut [f32], s: &mut [[f32; COLUMN_STRIP]; 3], b: f32, [a1, a2, a3]: [f32; 3]) {
+    for k in 0..r.len() {
+        let w = b * r[k] + a1 * s[0][k] + a2 * s[1][k] + a3 * s[2][k];
+        s[2][k] = s[1][k];
+        s[1][k] = s[0][k];
+        s[0][k] = w;
+        r[k] = w;
+    }
+}
+
+#[inline(always)]
+fn recurse_strip_kernel<'a>(
+    c: &YoungVanVliet,
+    row: impl Fn(usize) -> &'a mut [f32],
+    height: usize,
+    state: &mut [[f32; 3]],
+    backward: bool,
+) {
+    c.recurse_strip(row, height, state, backward)
 }
 
 #[derive(Clone, Copy)]
@@ -382,20 +740,11 @@ mod tests {
     fn impulse_response(sigma: f32, size: usize) -> Vec<f32> {
         let mut src = vec![0.0; size * size];
         src[(size / 2) * size + size / 2] = 1.0;
-        let mut scratch = vec![0.0; src.len()];
         let mut want = vec![0.0; src.len()];
-        gaussian_blur(
-            &src,
-            &mut want,
-            &mut scratch,
-            size,
-            size,
-            sigma,
-            Simd::SCALAR,
-        );
+        gaussian_blur(&src, &mut want, size, size, sigma, Simd::SCALAR);
         for simd in prism_cpu::each_isa() {
             let mut dst = vec![0.0; src.len()];
-            gaussian_blur(&src, &mut dst, &mut scratch, size, size, sigma, simd);
+            gaussian_blur(&src, &mut dst, size, size, sigma, simd);
             let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
             assert!(bits(&dst) == bits(&want), "σ = {sigma}, {simd}");
         }
@@ -439,18 +788,116 @@ mod tests {
         // Constants are preserved exactly up to rounding (edges replicated).
         let (w, h) = (37, 23);
         let src = vec![3.5f32; w * h];
-        let (mut dst, mut scratch) = (vec![0.0; w * h], vec![0.0; w * h]);
+        let mut dst = vec![0.0; w * h];
         for sigma in [0.5f32, 8.0] {
-            gaussian_blur(
-                &src,
-                &mut dst,
-                &mut scratch,
-                w,
-                h,
-                sigma,
-                prism_cpu::active(),
-            );
+            gaussian_blur(&src, &mut dst, w, h, sigma, prism_cpu::active());
             assert!(dst.iter().all(|v| (v - 3.5).abs() < 1e-4), "σ = {sigma}");
+        }
+    }
+
+    /// Bands of any height (1 row, fewer rows than the FIR's halo, not a multiple of the
+    /// row groups, the whole plane) give the whole-plane blur bit for bit, on planes
+    /// narrower and wider than a column strip, at every ISA; every row is handed over
+    /// exactly once.
+    #[test]
+    fn bands_give_the_whole_plane_blur_bit_for_bit() {
+        for (w, h) in [(1usize, 1usize), (5, 3), (70, 41), (131, 67)] {
+            let src: Vec<f32> = (0..w * h)
+                .map(|i| {
+                    let (x, y) = ((i % w) as f32, (i / w) as f32);
+                    (0.3 * x).sin().abs() * 7.0 + 0.05 * y + if i % 13 == 0 { 40.0 } else { 0.0 }
+                })
+                .collect();
+            for sigma in [0.0f32, 0.25, 1.02, 2.62, 3.0, 4.19, 10.7, 70.0] {
+                for simd in prism_cpu::each_isa() {
+                    let (mut want, mut scratch) = (vec![0.0; w * h], vec![0.0; w * h]);
+                    whole_plane_blur(&src, &mut want, &mut scratch, w, h, sigma, simd);
+                    for band in [1usize, 3, 8, 17, BAND_ROWS, h] {
+                        let mut got = vec![f32::NAN; w * h];
+                        let mut seen = vec![0u32; h];
+                        blur_bands_of(
+                            &|y, row: &mut [f32]| row.copy_from_slice(&src[y * w..(y + 1) * w]),
+                            w,
+                            h,
+                            sigma,
+                            simd,
+                            band,
+                            |y0, rows| {
+                                got[y0 * w..y0 * w + rows.len()].copy_from_slice(rows);
+                                for s in &mut seen[y0..y0 + rows.len() / w] {
+                                    *s += 1;
+                                }
+                            },
+                        );
+                        assert!(
+                            seen.iter().all(|s| *s == 1),
+                            "{w}×{h} σ {sigma} band {band}"
+                        );
+                        let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                        assert!(
+                            bits(&got) == bits(&want),
+                            "{w}×{h}, σ = {sigma}, band {band}, {simd}"
+                        );
+                    }
+                }
+            }
+        }
+    }
+
+    /// The FIR blurs of several σ in one sweep give each σ's whole-plane blur bit for bit,
+    /// each band's blurs in order with the previous one beside.
+    #[test]
+    fn several_fir_blurs_in_one_sweep_give_each_blur_bit_for_bit() {
+        let sigmas = [0.25f32, 0.4, 0.64, 1.024, 1.6384, 2.62144];
+        for (w, h) in [(1usize, 1usize), (5, 3), (70, 41), (131, 67)] {
+            let src: Vec<f32> = (0..w * h)
+                .map(|i| (0.7 * i as f32).cos().abs() * 3.0 + if i % 11 == 0 { 25.0 } else { 0.0 })
+                .collect();
+            for simd in prism_cpu::each_isa() {
+                let want: Vec<Vec<f32>> = sigmas
+                    .iter()
+                    .map(|s| {
+                        let (mut d, mut t) = (vec![0.0; w * h], vec![0.0; w * h]);
+                        whole_plane_blur(&src, &mut d, &mut t, w, h, *s, simd);
+                        d
+                    })
+                    .collect();
+                for band in [1usize, 3, 8, 17, BAND_ROWS, h] {
+                    let mut got = vec![vec![f32::NAN; w * h]; sigmas.len()];
+                    let mut order = Vec::new();
+                    fir_blurs_bands_of(
+                        &|y, row: &mut [f32]| row.copy_from_slice(&src[y * w..(y + 1) * w]),
+                        w,
+                        h,
+                        &sigmas,
+                        simd,
+                        band,
+                        |y0, j, previous, rows| {
+                            order.push((y0, j));
+                            if j > 0 {
+                                assert_eq!(previous, &got[j - 1][y0 * w..y0 * w + rows.len()]);
+                            } else {
+                                assert!(previous.is_empty());
+                            }
+                            got[j][y0 * w..y0 * w + rows.len()].copy_from_slice(rows);
+                        },
+                    );
+                    let bands: Vec<usize> = (0..h).step_by(band.clamp(1, h)).collect();
+                    let expected: Vec<(usize, usize)> = bands
+                        .iter()
+                        .flat_map(|y0| (0..sigmas.len()).map(move |j| (*y0, j)))
+                        .collect();
+                    assert_eq!(order, expected);
+                    let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                    for (j, (g, want)) in got.iter().zip(&want).enumerate() {
+                        assert!(
+                            bits(g) == bits(want),
+                            "{w}×{h}, σ {}, band {band}, {simd}",
+                            sigmas[j]
+                        );
+                    }
+                }
+            }
         }
     }
 }

@@ -495,8 +495,10 @@ pub(crate) fn map_pixels<M: PixelMap>(ctx: &Context, scale: f32, f: &M) -> Mappe
     })
 }
 
+/// `out[i] = w · sanitise(input[i], scale)`: one row of [`luminance_plane`], or of a plane
+/// computed a row at a time where it is needed.
 #[inline(always)]
-fn luminance_chunk(input: &[[f32; 3]], out: &mut [f32], scale: f32, w: [f32; 3]) {
+pub(crate) fn luminance_chunk(input: &[[f32; 3]], out: &mut [f32], scale: f32, w: [f32; 3]) {
     for (o, p) in out.iter_mut().zip(input) {
         *o = sanitised_luminance(*p, scale, w);
     }
