@@ -633,44 +633,31 @@ impl YoungVanVliet {
             let row = |y: usize| unsafe {
                 std::slice::from_raw_parts_mut(ptr.get().add(y * width + x0), n)
             };
-            avx2!(simd, columns_strip_kernel(self, row, n, height));
+            avx2!(simd, columns_strip_kernel(self, row, height));
         });
     }
 
     #[cfg(test)]
     #[inline(always)]
-    fn columns_strip<'a>(&self, row: impl Fn(usize) -> &'a mut [f32], n: usize, height: usize) {
+    fn columns_strip<'a>(&self, row: impl Fn(usize) -> &'a mut [f32], height: usize) {
         let (b, [a1, a2, a3]) = (self.b, self.a);
-        let mut s = [[0.0f32; COLUMN_STRIP]; 3];
-        for (k, v) in row(0).iter().enumerate() {
-            s[0][k] = *v;
-            s[1][k] = *v;
-            s[2][k] = *v;
-        }
+        // The recursion starts from the edge row repeated (constant extension).
+        let edge_state = |edge: &[f32]| {
+            let mut s = [[0.0f32; COLUMN_STRIP]; 3];
+            for (k, v) in edge.iter().enumerate() {
+                s[0][k] = *v;
+                s[1][k] = *v;
+                s[2][k] = *v;
+            }
+            s
+        };
+        let mut s = edge_state(row(0));
         for y in 0..height {
-            let r = row(y);
-            for k in 0..n {
-                let w = b * r[k] + a1 * s[0][k] + a2 * s[1][k] + a3 * s[2][k];
-                s[2][k] = s[1][k];
-                s[1][k] = s[0][k];
-                s[0][k] = w;
-                r[k] = w;
-            }
+            recurse_row(row(y), &mut s, b, [a1, a2, a3]);
         }
-        for (k, v) in row(height - 1).iter().enumerate() {
-            s[0][k] = *v;
-            s[1][k] = *v;
-            s[2][k] = *v;
-        }
+        let mut s = edge_state(row(height - 1));
         for y in (0..height).rev() {
-            let r = row(y);
-            for k in 0..n {
-                let w = b * r[k] + a1 * s[0][k] + a2 * s[1][k] + a3 * s[2][k];
-                s[2][k] = s[1][k];
-                s[1][k] = s[0][k];
-                s[0][k] = w;
-                r[k] = w;
-            }
+            recurse_row(row(y), &mut s, b, [a1, a2, a3]);
         }
     }
 }
@@ -691,10 +678,9 @@ fn filter_rows_kernel(
 fn columns_strip_kernel<'a>(
     c: &YoungVanVliet,
     row: impl Fn(usize) -> &'a mut [f32],
-    n: usize,
     height: usize,
 ) {
-    c.columns_strip(row, n, height)
+    c.columns_strip(row, height)
 }
 
 /// One step of the vertical recursion: row `r` of a strip (its columns side by side)
