@@ -538,13 +538,6 @@ pub fn run(args: &RenderArgs, budget: &MemoryBudget) -> Result<ExitCode, String>
                 start: 0,
                 end: settings.spp,
             });
-    if range_output && upsampling.is_some() {
-        return Err(format!(
-            "{}: --plan predicted-hier interpolates the pixels it does not shade once the \
-             render is whole, so it cannot write a sample range; use --plan predicted",
-            args.scene.display()
-        ));
-    }
     if let Some(upsampling) = &upsampling {
         rendered
             .image

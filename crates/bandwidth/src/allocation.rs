@@ -162,12 +162,18 @@ impl Allocated {
     /// (seed, pixel) with the same variate at every `mean_spp`, so the counts never
     /// decrease as `mean_spp` grows (progressive passes add the difference).
     pub fn cumulative_counts(&self, mean_spp: f64, seed: u64) -> Vec<u32> {
-        self.relative_density
-            .iter()
-            .enumerate()
-            .map(|(i, &d)| round_stochastic(f64::from(d) * mean_spp, seed, i as u64))
-            .collect()
+        counts_for_density(&self.relative_density, mean_spp, seed)
     }
+}
+
+/// Camera samples per pixel for relative densities `density` at `mean_spp`, rounded
+/// stochastically per (seed, pixel) ([`Allocated::cumulative_counts`]).
+pub(crate) fn counts_for_density(density: &[f32], mean_spp: f64, seed: u64) -> Vec<u32> {
+    density
+        .iter()
+        .enumerate()
+        .map(|(i, &d)| round_stochastic(f64::from(d) * mean_spp, seed, i as u64))
+        .collect()
 }
 
 /// x_p = k·a_p with the total `budget`, except that no pixel gets less than its minimum:

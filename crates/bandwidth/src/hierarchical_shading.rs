@@ -28,10 +28,9 @@
 
 use glam::{UVec2, Vec3A};
 
-use crate::allocation::Allocated;
+use crate::allocation::{counts_for_density, Allocated};
 use crate::error::{check_lengths, pixel_count, BandwidthError};
 use crate::sample_plan::{SamplePlan, DEFAULT_LIGHT_SAMPLES};
-use crate::stochastic_rounding::round_stochastic;
 use crate::variance_pooling::PixelClass;
 
 /// The default coarsest lattice: one shaded pixel per 8×8 at most.
@@ -313,7 +312,7 @@ impl Upsampling {
 
     /// `allocated` with each interpolated pixel's sample density moved to its parents in
     /// proportion to its weights (the total is kept: `mean_spp` stays the mean), counts
-    /// rounded as `allocate` rounds them.
+    /// rounded as [`Allocated::cumulative_counts`] rounds them.
     pub fn concentrate(
         &self,
         allocated: &Allocated,
@@ -336,19 +335,15 @@ impl Upsampling {
                 density[j as usize] += d * f64::from(w);
             }
         }
-        let counts = density
-            .iter()
-            .enumerate()
-            .map(|(i, &d)| round_stochastic(d * mean_spp, seed, i as u64))
-            .collect();
+        let relative_density: Vec<f32> = density.iter().map(|&d| d as f32).collect();
         let plan = SamplePlan::from_counts(
             self.resolution,
-            counts,
+            counts_for_density(&relative_density, mean_spp, seed),
             vec![DEFAULT_LIGHT_SAMPLES; self.shaded.len()],
         )?;
         Ok(Allocated {
             plan,
-            relative_density: density.iter().map(|&d| d as f32).collect(),
+            relative_density,
         })
     }
 }
