@@ -4,8 +4,12 @@
 //! Each source pixel goes through a transform first (a clip to [0, 1], or HDR-FLIP's tone
 //! curve at one exposure), so tone-mapped copies of the images never exist.
 //!
-//! HDR-FLIP runs every exposure of a band before the next band, in the same buffers: the
-//! band's planes are still in cache and nothing is allocated or cleared per exposure. The
+//! A band is split into column tiles (with the horizontal halo) so that the window of
+//! source rows the vertical filters read stays in a core's L2 cache; on a 4K image the
+//! planes of a whole band did not, and both cores waited on the shared L3.
+//!
+//! HDR-FLIP runs every exposure of a tile before the next tile, in the same buffers: the
+//! tile's planes are still in cache and nothing is allocated or cleared per exposure. The
 //! exposures cannot share filtered planes: the tone curve comes before the (linear)
 //! filters and is not linear, so each exposure is filtered from its own tone-mapped
 //! pixels, as the reference implementation does.
@@ -13,7 +17,7 @@
 //! The filters run vertically first, on four planes per image (Yy, Cx, Cz and the grey
 //! the feature detectors see), into padded rows; then horizontally, straight into the
 //! per-pixel colour and feature terms of one output row. Every kernel is symmetric or
-//! antisymmetric about its centre, so each pair of taps costs one multiply
+//! antisymmetric about its centre, so each pair of taps costs one fused multiply-add
 //! ([`Folded`]); the sums run 16 pixels at a time in registers ([`correlate`]).
 
 use prism_cpu::Simd;
@@ -33,12 +37,22 @@ const PT: f32 = 0.95;
 /// Output rows per band: the halo (2 × 10 rows at 67 ppd) costs ~30 % more filtering.
 pub(super) const BAND_ROWS: usize = 64;
 
+/// Output columns per tile of a band: the vertical filters' window (2 × 10 + 1 rows of
+/// four planes per image) stays in L2, at ~8 % more filtering for the tiles' halo.
+const TILE_COLS: usize = 256;
+
 /// Pixels summed at once in [`correlate`]: one AVX-512 register, two AVX2 ones.
 const LANES: usize = 16;
 
+/// Groups of [`LANES`] pixels [`correlate`] sums side by side (independent chains of
+/// additions), and [`correlate_many`] per kernel.
+const BLOCKS: usize = 4;
+const MANY_BLOCKS: usize = 2;
+
 /// Defines `$name(simd, args)`: `$body_fn(args)` compiled for the widest ISA `simd`
-/// allows. The same operations run at every ISA (no fused multiply-adds), so the bits
-/// are the same; `$body_fn` must be `#[inline(always)]`.
+/// allows. The same operations run at every ISA (multiply-adds are fused only where the
+/// code says `mul_add`, which is exact everywhere), so the bits are the same; `$body_fn`
+/// must be `#[inline(always)]`.
 macro_rules! dispatch {
     ($(#[$doc:meta])* fn $name:ident <$($g:ident: $bound:path),*> ($($arg:ident: $ty:ty),* $(,)?) => $body_fn:ident) => {
         $(#[$doc])*
@@ -109,12 +123,30 @@ impl Folded {
     pub(super) fn radius(&self) -> usize {
         self.taps.len()
     }
+
+    /// Without the outer taps whose weights (both sides) sum to less than 2⁻²⁵ of the
+    /// kernel's absolute sum: on inputs in [0, 1] they move a response by less than a
+    /// quarter of an f32 ulp of 1. The narrow Yy and Cx kernels at 67 ppd (σ ≈ 1 px, read
+    /// out to the widest kernel's radius, 10 px) lose 4 of their 10 taps each.
+    fn without_negligible_tail(mut self) -> Self {
+        let total = self.centre.abs() + 2.0 * self.taps.iter().map(|t| t.abs()).sum::<f32>();
+        let mut tail = 0.0;
+        while let Some(&last) = self.taps.last() {
+            tail += 2.0 * last.abs();
+            if tail >= total * 2f32.powi(-25) {
+                break;
+            }
+            self.taps.pop();
+        }
+        self
+    }
 }
 
 /// `out[x] = k[r] s[c + x] + Σₜ k[r + t] (s[c + x + t·stride] ± s[c + x − t·stride])`:
 /// the correlation of `k` with `s` along rows (stride 1) or columns (stride = width).
 /// Every pixel gets the same operations in the same order whatever its position or the
-/// ISA (no fused multiply-adds), so strips and whole images agree bit for bit.
+/// ISA (each tap one `mul_add`: the FMA instruction where the ISA has one, the exact
+/// fused libm call elsewhere), so strips and whole images agree bit for bit.
 fn correlate(simd: Simd, s: &[f32], c: usize, stride: usize, k: &Folded, out: &mut [f32]) {
     #[cfg(target_arch = "x86_64")]
     {
@@ -164,22 +196,12 @@ fn correlate_folded<const ODD: bool>(
 ) {
     let n = out.len();
     let mut x = 0;
+    while x + BLOCKS * LANES <= n {
+        correlate_block::<ODD, { BLOCKS * LANES }>(s, c + x, stride, k, &mut out[x..]);
+        x += BLOCKS * LANES;
+    }
     while x + LANES <= n {
-        let centre: &[f32; LANES] = s[c + x..c + x + LANES].try_into().unwrap();
-        let mut acc = if ODD {
-            [0.0; LANES]
-        } else {
-            centre.map(|v| k.centre * v)
-        };
-        for (t, &kt) in k.taps.iter().enumerate() {
-            let d = (t + 1) * stride;
-            let a: &[f32; LANES] = s[c + x + d..c + x + d + LANES].try_into().unwrap();
-            let b: &[f32; LANES] = s[c + x - d..c + x - d + LANES].try_into().unwrap();
-            for j in 0..LANES {
-                acc[j] += kt * if ODD { a[j] - b[j] } else { a[j] + b[j] };
-            }
-        }
-        out[x..x + LANES].copy_from_slice(&acc);
+        correlate_block::<ODD, LANES>(s, c + x, stride, k, &mut out[x..]);
         x += LANES;
     }
     for (x, o) in out.iter_mut().enumerate().skip(x) {
@@ -187,10 +209,36 @@ fn correlate_folded<const ODD: bool>(
         for (t, &kt) in k.taps.iter().enumerate() {
             let d = (t + 1) * stride;
             let (a, b) = (s[c + x + d], s[c + x - d]);
-            acc += kt * if ODD { a - b } else { a + b };
+            acc = kt.mul_add(if ODD { a - b } else { a + b }, acc);
         }
         *o = acc;
     }
+}
+
+/// `W` outputs of [`correlate_folded`] from `s[c..]`, summed side by side: `W` / [`LANES`]
+/// independent chains of additions hide their latency.
+#[inline(always)]
+fn correlate_block<const ODD: bool, const W: usize>(
+    s: &[f32],
+    c: usize,
+    stride: usize,
+    k: &Folded,
+    out: &mut [f32],
+) {
+    let mut acc = [0.0f32; W];
+    if !ODD {
+        let centre: &[f32; W] = s[c..c + W].try_into().unwrap();
+        acc = centre.map(|v| k.centre * v);
+    }
+    for (t, &kt) in k.taps.iter().enumerate() {
+        let d = (t + 1) * stride;
+        let hi: &[f32; W] = s[c + d..c + d + W].try_into().unwrap();
+        let lo: &[f32; W] = s[c - d..c - d + W].try_into().unwrap();
+        for j in 0..W {
+            acc[j] = kt.mul_add(if ODD { hi[j] - lo[j] } else { hi[j] + lo[j] }, acc[j]);
+        }
+    }
+    out[..W].copy_from_slice(&acc);
 }
 
 /// [`correlate`] of one source with `N` kernels of one radius at once: each pair of
@@ -209,34 +257,12 @@ fn correlate_many<const N: usize>(
     let n = outs[0].len();
     let mut outs = outs;
     let mut x = 0;
+    while x + MANY_BLOCKS * LANES <= n {
+        correlate_many_block::<N, { MANY_BLOCKS * LANES }>(s, c + x, stride, ks, &mut outs, x);
+        x += MANY_BLOCKS * LANES;
+    }
     while x + LANES <= n {
-        let centre: &[f32; LANES] = s[c + x..c + x + LANES].try_into().unwrap();
-        let mut acc = [[0.0f32; LANES]; N];
-        for (a, k) in acc.iter_mut().zip(&ks) {
-            if !k.antisymmetric {
-                *a = centre.map(|v| k.centre * v);
-            }
-        }
-        for t in 0..r {
-            let d = (t + 1) * stride;
-            let a: &[f32; LANES] = s[c + x + d..c + x + d + LANES].try_into().unwrap();
-            let b: &[f32; LANES] = s[c + x - d..c + x - d + LANES].try_into().unwrap();
-            let mut sum = [0.0f32; LANES];
-            let mut diff = [0.0f32; LANES];
-            for j in 0..LANES {
-                sum[j] = a[j] + b[j];
-                diff[j] = a[j] - b[j];
-            }
-            for (acc, k) in acc.iter_mut().zip(&ks) {
-                let (kt, v) = (k.taps[t], if k.antisymmetric { &diff } else { &sum });
-                for j in 0..LANES {
-                    acc[j] += kt * v[j];
-                }
-            }
-        }
-        for (o, a) in outs.iter_mut().zip(&acc) {
-            o[x..x + LANES].copy_from_slice(a);
-        }
+        correlate_many_block::<N, LANES>(s, c + x, stride, ks, &mut outs, x);
         x += LANES;
     }
     for x in x..n {
@@ -249,10 +275,51 @@ fn correlate_many<const N: usize>(
             for (t, &kt) in k.taps.iter().enumerate() {
                 let d = (t + 1) * stride;
                 let (a, b) = (s[c + x + d], s[c + x - d]);
-                acc += kt * if k.antisymmetric { a - b } else { a + b };
+                acc = kt.mul_add(if k.antisymmetric { a - b } else { a + b }, acc);
             }
             o[x] = acc;
         }
+    }
+}
+
+/// `W` outputs from `s[c..]` of each of [`correlate_many`]'s kernels, into
+/// `outs[…][x..]`, summed side by side as in [`correlate_block`].
+#[inline(always)]
+fn correlate_many_block<const N: usize, const W: usize>(
+    s: &[f32],
+    c: usize,
+    stride: usize,
+    ks: [&Folded; N],
+    outs: &mut [&mut [f32]; N],
+    x: usize,
+) {
+    let r = ks[0].radius();
+    let mut acc = [[0.0f32; W]; N];
+    let centre: &[f32; W] = s[c..c + W].try_into().unwrap();
+    for (a, k) in acc.iter_mut().zip(&ks) {
+        if !k.antisymmetric {
+            *a = centre.map(|v| k.centre * v);
+        }
+    }
+    for t in 0..r {
+        let d = (t + 1) * stride;
+        let hi: &[f32; W] = s[c + d..c + d + W].try_into().unwrap();
+        let lo: &[f32; W] = s[c - d..c - d + W].try_into().unwrap();
+        let mut sum = [0.0f32; W];
+        let mut diff = [0.0f32; W];
+        for j in 0..W {
+            sum[j] = hi[j] + lo[j];
+            diff[j] = hi[j] - lo[j];
+        }
+        for (acc, k) in acc.iter_mut().zip(&ks) {
+            let (kt, v) = (k.taps[t], if k.antisymmetric { &diff } else { &sum });
+            for j in 0..W {
+                acc[j] = kt.mul_add(v[j], acc[j]);
+            }
+        }
+    }
+    for (o, a) in outs.iter_mut().zip(&acc) {
+        o[x..x + W].copy_from_slice(a);
     }
 }
 
@@ -295,8 +362,10 @@ impl Filters {
         let fold = |v: &[f32]| Folded::new(v).expect("FLIP's kernels are (anti)symmetric");
         let f = Self {
             halo: k.spatial_radius_px.max(k.feature_radius_px),
-            y: fold(&k.y),
-            cx: fold(&k.cx),
+            // Only the kernels filtered alone: those summed together (Cz's two, the
+            // feature detector's three) share their source reads and must keep one radius.
+            y: fold(&k.y).without_negligible_tail(),
+            cx: fold(&k.cx).without_negligible_tail(),
             cz1: fold(&k.cz1),
             cz2: fold(&k.cz2),
             gauss: fold(&k.gauss),
@@ -313,9 +382,45 @@ impl Filters {
     }
 }
 
-/// One image's buffers for a band: the transformed planes (Yy, Cx, Cz, grey; `band_h × w`
-/// each), the vertically filtered rows padded by the halo (Yy, Cx, Cz twice, grey with the
-/// Gaussian, d1 and d2) and the output row's Hunt-adjusted CIELAB, edge and point terms.
+/// The columns of one tile of a band: output columns `x0..x1` and the source columns
+/// `lo..hi` its filters read (the halo around them, clamped to the image).
+#[derive(Debug, Clone, Copy)]
+struct Tile {
+    x0: usize,
+    x1: usize,
+    lo: usize,
+    hi: usize,
+}
+
+impl Tile {
+    fn width(&self) -> usize {
+        self.x1 - self.x0
+    }
+}
+
+/// The tiles a row of `w` pixels splits into: about [`TILE_COLS`] wide each, a multiple of
+/// [`LANES`] but the last.
+fn tiles(w: usize, halo: usize) -> Vec<Tile> {
+    let n = w.div_ceil(TILE_COLS);
+    let tw = w.div_ceil(n).next_multiple_of(LANES);
+    (0..w)
+        .step_by(tw)
+        .map(|x0| {
+            let x1 = (x0 + tw).min(w);
+            Tile {
+                x0,
+                x1,
+                lo: x0.saturating_sub(halo),
+                hi: (x1 + halo).min(w),
+            }
+        })
+        .collect()
+}
+
+/// One image's buffers for a tile of a band: the transformed planes (Yy, Cx, Cz, grey;
+/// `band_h` rows of the tile's source columns each), the vertically filtered rows padded
+/// by the halo (Yy, Cx, Cz twice, grey with the Gaussian, d1 and d2) and the output row's
+/// Hunt-adjusted CIELAB, edge and point terms.
 struct Side {
     planes: [Vec<f32>; 4],
     vertical: [Vec<f32>; 7],
@@ -326,19 +431,20 @@ struct Side {
 }
 
 impl Side {
-    fn new(w: usize, band_h: usize, halo: usize) -> Self {
+    /// For tiles up to `tw` pixels wide.
+    fn new(tw: usize, band_h: usize, halo: usize) -> Self {
         Self {
-            planes: std::array::from_fn(|_| vec![0.0; band_h * w]),
-            vertical: std::array::from_fn(|_| vec![0.0; w + 2 * halo]),
-            horizontal: std::array::from_fn(|_| vec![0.0; w]),
-            lab: std::array::from_fn(|_| vec![0.0; w]),
-            edge: vec![0.0; w],
-            point: vec![0.0; w],
+            planes: std::array::from_fn(|_| vec![0.0; band_h * (tw + 2 * halo)]),
+            vertical: std::array::from_fn(|_| vec![0.0; tw + 2 * halo]),
+            horizontal: std::array::from_fn(|_| vec![0.0; tw]),
+            lab: std::array::from_fn(|_| vec![0.0; tw]),
+            edge: vec![0.0; tw],
+            point: vec![0.0; tw],
         }
     }
 
-    /// The planes of the band's `band_h` source rows from image row `y0 − halo` (clamped)
-    /// after `transform`.
+    /// The planes of the band's `band_h` source rows from image row `y0 − halo` (clamped),
+    /// columns `tile.lo..tile.hi`, after `transform`.
     #[allow(clippy::too_many_arguments)]
     fn fill_planes(
         &mut self,
@@ -346,35 +452,42 @@ impl Side {
         image: Rows<'_>,
         (w, h): (usize, usize),
         y0: usize,
+        band_h: usize,
         halo: usize,
+        tile: Tile,
         transform: &impl Fn([f32; 3]) -> [f32; 3],
     ) {
-        let [py, pcx, pcz, pg] = &mut self.planes;
+        let pw = tile.hi - tile.lo;
+        let [py, pcx, pcz, pg] = self.planes.each_mut().map(|p| &mut p[..band_h * pw]);
         let rows = py
-            .chunks_exact_mut(w)
-            .zip(pcx.chunks_exact_mut(w))
-            .zip(pcz.chunks_exact_mut(w).zip(pg.chunks_exact_mut(w)));
+            .chunks_exact_mut(pw)
+            .zip(pcx.chunks_exact_mut(pw))
+            .zip(pcz.chunks_exact_mut(pw).zip(pg.chunks_exact_mut(pw)));
         for (j, ((ry, rcx), (rcz, rg))) in rows.enumerate() {
             let sy = (y0 + j).saturating_sub(halo).min(h - 1);
-            let src = image.row(sy, w);
+            let src = &image.row(sy, w)[tile.lo..tile.hi];
             planes_row(simd, src, transform, ry, rcx, rcz, rg);
         }
     }
 
-    /// Lab, edge and point of band row `i` (plane row `i + halo`).
-    fn filter_row(&mut self, simd: Simd, f: &Filters, w: usize, i: usize) {
+    /// Lab, edge and point of band row `i` (plane row `i + halo`) in `tile`.
+    fn filter_row(&mut self, simd: Simd, f: &Filters, tile: Tile, i: usize) {
         let halo = f.halo;
-        let c = (i + halo) * w;
+        let (pw, tw) = (tile.hi - tile.lo, tile.width());
+        // The planes start `pad` columns right of the padded rows' start (the halo that
+        // lies beyond the image's left edge).
+        let pad = halo - (tile.x0 - tile.lo);
+        let c = (i + halo) * pw;
         let [py, pcx, pcz, pg] = &self.planes;
         let [vy, vcx, vcz1, vcz2, vg, vd1, vd2] = &mut self.vertical;
-        let inner = halo..halo + w;
-        correlate(simd, py, c, w, &f.y, &mut vy[inner.clone()]);
-        correlate(simd, pcx, c, w, &f.cx, &mut vcx[inner.clone()]);
+        let inner = pad..pad + pw;
+        correlate(simd, py, c, pw, &f.y, &mut vy[inner.clone()]);
+        correlate(simd, pcx, c, pw, &f.cx, &mut vcx[inner.clone()]);
         correlate2(
             simd,
             pcz,
             c,
-            w,
+            pw,
             [&f.cz1, &f.cz2],
             [&mut vcz1[inner.clone()], &mut vcz2[inner.clone()]],
         );
@@ -382,7 +495,7 @@ impl Side {
             simd,
             pg,
             c,
-            w,
+            pw,
             [&f.gauss, &f.d1, &f.d2],
             [
                 &mut vg[inner.clone()],
@@ -390,14 +503,16 @@ impl Side {
                 &mut vd2[inner],
             ],
         );
+        let end = tw + 2 * halo;
         for row in &mut self.vertical {
             // Clamp-to-edge padding commutes with the separable filter.
-            let (left, right) = (row[halo], row[halo + w - 1]);
-            row[..halo].fill(left);
-            row[halo + w..].fill(right);
+            let (left, right) = (row[pad], row[pad + pw - 1]);
+            row[..pad].fill(left);
+            row[pad + pw..end].fill(right);
         }
         let [vy, vcx, vcz1, vcz2, vg, vd1, vd2] = &self.vertical;
-        let [hy, hcx, hcz1, hcz2, ex, ey, px, py] = &mut self.horizontal;
+        let [hy, hcx, hcz1, hcz2, ex, ey, px, py] =
+            self.horizontal.each_mut().map(|v| &mut v[..tw]);
         // Edges: ∂x = d1 ⊗ g, ∂y = g ⊗ d1; points likewise with d2.
         correlate(simd, vy, halo, 1, &f.y, hy);
         correlate(simd, vcx, halo, 1, &f.cx, hcx);
@@ -406,8 +521,9 @@ impl Side {
         correlate2(simd, vg, halo, 1, [&f.d1, &f.d2], [ex, px]);
         correlate(simd, vd1, halo, 1, &f.gauss, ey);
         correlate(simd, vd2, halo, 1, &f.gauss, py);
-        let [l, a, b] = &mut self.lab;
-        let (edge, point) = (&mut self.edge, &mut self.point);
+        let [l, a, b] = self.lab.each_mut().map(|v| &mut v[..tw]);
+        let (edge, point) = (&mut self.edge[..tw], &mut self.point[..tw]);
+        let [hy, hcx, hcz1, hcz2, ex, ey, px, py] = self.horizontal.each_ref().map(|v| &v[..tw]);
         terms_row(
             simd, hy, hcx, hcz1, hcz2, ex, ey, px, py, l, a, b, edge, point,
         );
@@ -510,16 +626,19 @@ fn combine_row_any(r: [&[f32]; 5], t: [&[f32]; 5], cmax: f32, out: &mut [f32], k
     let [rl, ra, rb, re, rp] = r.map(|v| &v[..n]);
     let [tl, ta, tb, te, tp] = t.map(|v| &v[..n]);
     let pccmax = PC * cmax;
+    // Loop-invariant quotients as factors: no division per pixel.
+    let (below, above) = (PT / pccmax, (1.0 - PT) / (cmax - pccmax));
+    let inv_fourth_root_2 = 0.5f32.powf(0.25);
     for x in 0..n {
         let de = pow_non_negative(hyab([rl[x], ra[x], rb[x]], [tl[x], ta[x], tb[x]]), QC);
         let colour = if de < pccmax {
-            PT / pccmax * de
+            below * de
         } else {
-            PT + (de - pccmax) / (cmax - pccmax) * (1.0 - PT)
+            PT + (de - pccmax) * above
         };
         let feature_diff = (re[x] - te[x]).abs().max((rp[x] - tp[x]).abs());
         // (feature_diff / √2)^q_f with q_f = ½.
-        let feature = (feature_diff / std::f32::consts::SQRT_2).sqrt();
+        let feature = feature_diff.sqrt() * inv_fourth_root_2;
         let v = pow_non_negative(colour, 1.0 - feature);
         out[x] = if keep_max { out[x].max(v) } else { v };
     }
@@ -551,21 +670,29 @@ pub(super) fn flip_map_into<T: Fn([f32; 3]) -> [f32; 3] + Sync>(
     simd: Simd,
 ) {
     let cmax = c_max();
+    let tiles = tiles(w, f.halo);
+    let tw = tiles[0].width();
     out.par_chunks_mut(BAND_ROWS * w)
         .enumerate()
         .for_each(|(b, out)| {
             let y0 = first_row + b * BAND_ROWS;
             let rows = out.len() / w;
             let band_h = rows + 2 * f.halo;
-            let mut r = Side::new(w, band_h, f.halo);
-            let mut t = Side::new(w, band_h, f.halo);
-            for (e, transform) in transforms.iter().enumerate() {
-                r.fill_planes(simd, reference, (w, h), y0, f.halo, transform);
-                t.fill_planes(simd, test, (w, h), y0, f.halo, transform);
-                for (i, out) in out.chunks_exact_mut(w).enumerate() {
-                    r.filter_row(simd, f, w, i);
-                    t.filter_row(simd, f, w, i);
-                    combine_row(simd, r.terms(), t.terms(), cmax, out, e > 0);
+            let mut r = Side::new(tw, band_h, f.halo);
+            let mut t = Side::new(tw, band_h, f.halo);
+            for &tile in &tiles {
+                for (e, transform) in transforms.iter().enumerate() {
+                    let fill = |s: &mut Side, image| {
+                        s.fill_planes(simd, image, (w, h), y0, band_h, f.halo, tile, transform)
+                    };
+                    fill(&mut r, reference);
+                    fill(&mut t, test);
+                    for (i, out) in out.chunks_exact_mut(w).enumerate() {
+                        r.filter_row(simd, f, tile, i);
+                        t.filter_row(simd, f, tile, i);
+                        let out = &mut out[tile.x0..tile.x1];
+                        combine_row(simd, r.terms(), t.terms(), cmax, out, e > 0);
+                    }
                 }
             }
         });
@@ -608,6 +735,8 @@ mod tests {
                 }
             }
         }
+        let f = Filters::new(&Kernels::new(super::super::DEFAULT_PPD));
+        assert_eq!((f.y.radius(), f.cx.radius(), f.cz1.radius()), (6, 6, 10));
         assert!(Folded::new(&[1.0, 2.0, 3.0]).is_none());
         assert!(Folded::new(&[1.0, 2.0]).is_none());
     }
