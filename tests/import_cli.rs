@@ -397,3 +397,126 @@ fn pbrt_image_infinite_lights_become_equirectangular_environment_maps() {
             .args(["--spp", "2"]),
     );
 }
+
+/// pbrt-v4's goniometric light becomes a `luminaire` with an IES side file: its image is
+/// read in pbrt's light space (the square's pole, light-space +z, is the CTM's +y), and its
+/// intensity per unit texel value equals a pbrt point light's of the same `I` and `scale`.
+/// An image bright on the pole's hemisphere only lights a floor below when the light is
+/// turned upside down, and then as a point light with the image's value as scale does.
+#[test]
+fn pbrt_goniometric_lights_become_luminaires_with_pbrt_intensities() {
+    let dir = tempfile::tempdir().unwrap();
+    let size = 32;
+    let square: Vec<[f32; 3]> = (0..size * size)
+        .map(|i| {
+            // pbrt's square: the z > 0 hemisphere is the diamond |2u − 1| + |2v − 1| < 1.
+            let u = ((i % size) as f64 + 0.5) / size as f64;
+            let v = ((i / size) as f64 + 0.5) / size as f64;
+            if (2.0 * u - 1.0).abs() + (2.0 * v - 1.0).abs() < 1.0 {
+                [0.25, 0.5, 0.75]
+            } else {
+                [0.0; 3]
+            }
+        })
+        .collect();
+    let image = prism_image::Image::new(
+        size,
+        size,
+        square,
+        prism_spectrum::rgb_space::RgbColorSpace::srgb(),
+    )
+    .unwrap();
+    prism_image::io::exr::write_exr(
+        &dir.path().join("gonio.exr"),
+        &image,
+        &prism_image::io::exr::ExrWriteOptions::default(),
+    )
+    .unwrap();
+    let scene = |light: &str| {
+        format!(
+            "LookAt 0 3 0  0 -1 0  0 0 1\nCamera \"perspective\" \"float fov\" [ 50 ]\n\
+             Film \"rgb\" \"integer xresolution\" [ 32 ] \"integer yresolution\" [ 32 ]\n\
+             Sampler \"independent\" \"integer pixelsamples\" [ 16 ]\n\
+             Integrator \"path\" \"integer maxdepth\" [ 1 ]\n\
+             WorldBegin\n\
+             AttributeBegin\n{light}\nAttributeEnd\n\
+             Shape \"trianglemesh\" \"point3 P\" [ -2 -1 -2  2 -1 -2  2 -1 2  -2 -1 2 ]\n\
+               \"integer indices\" [ 0 2 1  0 3 2 ]\n"
+        )
+    };
+    let render_mean = |name: &str, light: &str| -> (serde_json::Value, Vec<[f64; 3]>) {
+        let path = dir.path().join(format!("{name}.pbrt"));
+        std::fs::write(&path, scene(light)).unwrap();
+        let json = dir.path().join(format!("{name}.json"));
+        run_ok(prism().arg("import").arg(&path).arg("-o").arg(&json));
+        let v: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+        let description = prism_scene::load_scene(&json).unwrap();
+        let (rgb, _) = render_rgb(&description, 16, 7);
+        (v, rgb)
+    };
+    let gonio =
+        "LightSource \"goniometric\" \"string filename\" \"gonio.exr\" \"float scale\" [ 3 ]";
+    let (up_json, up) = render_mean("up", gonio);
+    let light = &up_json["lights"][0];
+    assert_eq!(light["type"], "luminaire", "{light}");
+    assert_eq!(light["aim"], serde_json::json!([0.0, 1.0, 0.0]), "{light}");
+    let (_, down) = render_mean("down", &format!("Rotate 180 1 0 0\n{gonio}"));
+    // The image's mean channel value on the lit hemisphere is 0.5: as a point light of
+    // scale 3 × 0.5.
+    let (_, point) = render_mean("point", "LightSource \"point\" \"float scale\" [ 1.5 ]");
+    let mean = |img: &[[f64; 3]]| img.iter().map(|p| p[0] + p[1] + p[2]).sum::<f64>();
+    assert!(mean(&point) > 0.0);
+    assert!(
+        mean(&up) < 1e-9 * mean(&point),
+        "up {} point {}",
+        mean(&up),
+        mean(&point)
+    );
+    compare_means(&down, &point, 32, "goniometric down vs point");
+}
+
+/// pbrt-v4's diffuse (like its conductors and coated layers) reflects on whichever side a
+/// ray arrives, so a floor's winding does not matter in pbrt: the imported floor lit from
+/// above renders the same whether its triangles face up or down, with pbrt's default
+/// material and with a `Material "diffuse"`.
+#[test]
+fn pbrt_surfaces_reflect_on_both_sides_as_in_pbrt() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = |material: &str, indices: &str| {
+        format!(
+            "LookAt 0 3 0  0 -1 0  0 0 1\nCamera \"perspective\" \"float fov\" [ 50 ]\n\
+             Film \"rgb\" \"integer xresolution\" [ 16 ] \"integer yresolution\" [ 16 ]\n\
+             Sampler \"independent\" \"integer pixelsamples\" [ 4 ]\n\
+             Integrator \"path\" \"integer maxdepth\" [ 1 ]\n\
+             WorldBegin\nLightSource \"point\" \"float scale\" [ 2 ]\n{material}\n\
+             Shape \"trianglemesh\" \"point3 P\" [ -2 -1 -2  2 -1 -2  2 -1 2  -2 -1 2 ]\n\
+               \"integer indices\" [ {indices} ]\n"
+        )
+    };
+    let render_scene = |name: &str, text: String| -> Vec<[f64; 3]> {
+        let path = dir.path().join(format!("{name}.pbrt"));
+        std::fs::write(&path, text).unwrap();
+        let json = dir.path().join(format!("{name}.json"));
+        run_ok(prism().arg("import").arg(&path).arg("-o").arg(&json));
+        render_rgb(&prism_scene::load_scene(&json).unwrap(), 4, 3).0
+    };
+    for material in [
+        "",
+        "Material \"diffuse\" \"rgb reflectance\" [ 0.2 0.4 0.6 ]",
+    ] {
+        let up = render_scene("up", scene(material, "0 2 1  0 3 2"));
+        let down = render_scene("down", scene(material, "0 1 2  0 2 3"));
+        assert!(up.iter().map(|p| p[1]).sum::<f64>() > 0.0, "{material}");
+        // The same paths, mirrored through the floor: equal to rounding.
+        let worst = up
+            .iter()
+            .zip(&down)
+            .flat_map(|(a, b)| (0..3).map(move |c| (a[c] - b[c]).abs() / a[c].max(1e-6)))
+            .fold(0.0f64, f64::max);
+        assert!(
+            worst < 1e-5,
+            "{material}: worst relative difference {worst}"
+        );
+    }
+}

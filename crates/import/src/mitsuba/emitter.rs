@@ -120,6 +120,14 @@ pub fn emitter(ctx: &mut Ctx, el: &Element) -> Result<(), ImportError> {
             light.insert("type".into(), json!("sky"));
             strength(ctx, &props, "radiance", &mut light)?;
         }
+        "sunsky" => {
+            ctx.out.unsupported.note(
+                "emitter type=\"sunsky\"",
+                "not imported: Mitsuba's sunsky is the Hosek–Wilkie sky and sun model; Prism's daylight skies (cie_sky, perez_sky, preetham_sky) are other models, and none reproduces its radiance distribution or its sun's level — add one of them by hand (docs/daylight.md)",
+                &el.at,
+            );
+            return Ok(());
+        }
         other => {
             ctx.out.unsupported.note(
                 format!("emitter type=\"{other}\""),

@@ -4,6 +4,9 @@ use glam::DVec3;
 use serde_json::{json, Map, Value};
 
 use crate::error::{ImportError, Location};
+use crate::pbrt::goniometric::{
+    candela_per_unit, ies_text, luminaire_json, GoniometricImage, LuminaireFrame,
+};
 use crate::pbrt::params::Params;
 use crate::pbrt::spectra::{emission_factor, spectrum};
 use crate::pbrt::{AreaLight, Importer};
@@ -24,8 +27,20 @@ fn strength(
             &p.at,
         );
     }
+    let (spectrum, factor) = strength_spectrum(im, params, name, at)?;
+    Ok((spectrum, scale * factor))
+}
+
+/// The light's spectrum parameter `name` (default Prism's RGB white, as pbrt's colour
+/// space illuminant) and the factor that gives it pbrt's unit luminance in Prism.
+fn strength_spectrum(
+    im: &mut Importer,
+    params: &Params,
+    name: &str,
+    at: &Location,
+) -> Result<(Value, f64), ImportError> {
     match params.get(name) {
-        None => Ok((json!({ "rgb": [1.0, 1.0, 1.0] }), scale)),
+        None => Ok((json!({ "rgb": [1.0, 1.0, 1.0] }), 1.0)),
         Some(p) => {
             let s = spectrum(&mut im.out, p)?;
             let factor = emission_factor(&s).ok_or_else(|| {
@@ -37,7 +52,7 @@ fn strength(
                     ),
                 )
             })?;
-            Ok((s.value, scale * factor))
+            Ok((s.value, factor))
         }
     }
 }
@@ -166,10 +181,53 @@ pub fn light(
                 );
             }
         }
+        "goniometric" => {
+            let Some(file) = params.string("filename")? else {
+                return Err(ImportError::at(
+                    at,
+                    "LightSource \"goniometric\": expected a \"string filename\" (pbrt-v4's \
+                     equal-area octahedral intensity image); without one pbrt emits nothing",
+                ));
+            };
+            let path = at
+                .file
+                .parent()
+                .unwrap_or(std::path::Path::new(""))
+                .join(&file);
+            let image = GoniometricImage::read(&path, at)?;
+            let frame = LuminaireFrame::new(&ctm).ok_or_else(|| {
+                ImportError::at(
+                    at,
+                    "LightSource \"goniometric\": the current transform is singular",
+                )
+            })?;
+            let (s, _) = strength_spectrum(im, params, "I", at)?;
+            let mut scale = params.float_or("scale", 1.0)?;
+            if let Some(power) = params.float("power")?.filter(|p| *p > 0.0) {
+                // pbrt-v4: k_e = 4π · mean Y (equal-area texels).
+                let k_e = 4.0 * std::f64::consts::PI * image.mean();
+                if k_e <= 0.0 {
+                    return Err(ImportError::at(
+                        at,
+                        format!("LightSource \"goniometric\" \"power\": {file} is black, so no scale gives it a power"),
+                    ));
+                }
+                scale *= power / k_e;
+            }
+            let text = ies_text(&image, &frame, &file);
+            let name = format!("goniometric-{}.ies", im.out.side_files.len() + 1);
+            let written = im.out.add_side_file(&name, text.into_bytes());
+            l = luminaire_json(&frame, &written);
+            l.insert("scale".into(), json!(candela_per_unit(scale, &s)));
+            l.insert("spectrum".into(), s);
+            params.finish("LightSource \"goniometric\"", &mut im.out.unsupported);
+            im.out.lights.push(Value::Object(l));
+            return Ok(());
+        }
         other => {
             im.out.unsupported.note(
                 format!("LightSource \"{other}\""),
-                "not imported (Prism reads point, spot, distant and infinite, with or without an image, from pbrt; goniometric files are not pbrt's EXR format in Prism — use a `luminaire` with an IES file)",
+                "not imported (Prism reads point, spot, distant, goniometric and infinite lights, with or without an image, from pbrt)",
                 at,
             );
             for q in &params.list {

@@ -65,9 +65,11 @@ fn eta(im: &mut Importer, params: &Params, default: f64) -> Result<Value, Import
     }
 }
 
-/// The Prism JSON of a pbrt material; `None` for `interface` (no surface).
+/// The Prism JSON of a pbrt material; `None` for `interface` (no surface). `name` names
+/// the one-sided material a `two_sided` wraps (`name-front`).
 fn convert(
     im: &mut Importer,
+    name: &str,
     kind: &str,
     params: &Params,
     at: &Location,
@@ -246,6 +248,18 @@ fn convert(
             m.insert("weight".into(), json!(amount));
         }
         "interface" => return Ok(None),
+        "measured" => {
+            out_note(
+                im,
+                "Material \"measured\"",
+                "pbrt-v4's measured BSDFs are RGL tensor files (.bsdf, Dupuy & Jakob 2018); Prism reads MERL tables (material `merl`), not that format: imported as diffuse 0.5",
+                at,
+            );
+            for q in &params.list {
+                q.used.set(true);
+            }
+            m.insert("type".into(), json!("lambert"));
+        }
         other => {
             out_note(
                 im,
@@ -265,7 +279,32 @@ fn convert(
         }
     }
     params.finish(&format!("Material \"{kind}\""), &mut im.out.unsupported);
-    Ok(Some(Value::Object(m)))
+    Ok(Some(both_sides(im, name, m)))
+}
+
+/// pbrt-v4's reflecting BxDFs (diffuse, conductor, the coated layers) scatter on whichever
+/// side of the surface the ray arrives (`SameHemisphere` in the shading frame), while
+/// Prism's lambert, conductor and coated are black from below: those become `two_sided`
+/// of the material (stored once under its own name). Dielectrics already scatter on both
+/// sides, and a mix's materials are wrapped themselves.
+fn both_sides(im: &mut Importer, name: &str, m: Map<String, Value>) -> Value {
+    let one_sided = match m.get("type").and_then(Value::as_str) {
+        Some("lambert" | "conductor" | "coated") => true,
+        Some(_) | None => false,
+    };
+    if !one_sided {
+        return Value::Object(m);
+    }
+    let inner = Value::Object(m);
+    let name = match im.out.materials.iter().find(|(_, v)| **v == inner) {
+        Some((n, _)) => n.clone(),
+        None => {
+            let n = im.out.unique_material_name(&format!("{name}-front"));
+            im.out.materials.insert(n.clone(), inner);
+            n
+        }
+    };
+    json!({ "type": "two_sided", "material": name })
 }
 
 fn out_note(im: &mut Importer, kind: &str, consequence: impl Into<String>, at: &Location) {
@@ -279,7 +318,7 @@ pub fn material(
     params: &Params,
     at: &Location,
 ) -> Result<Option<String>, ImportError> {
-    let Some(m) = convert(im, kind, params, at)? else {
+    let Some(m) = convert(im, kind, kind, params, at)? else {
         return Ok(None);
     };
     // The same parameters give the same material: reuse it.
@@ -291,6 +330,20 @@ pub fn material(
     Ok(Some(name))
 }
 
+/// The material of shapes before any `Material`: pbrt's default, diffuse 0.5 (Prism's
+/// lambert default), on both sides like every pbrt diffuse.
+pub fn default_material(im: &mut Importer) -> String {
+    let mut inner = Map::new();
+    inner.insert("type".into(), json!("lambert"));
+    let m = both_sides(im, "diffuse", inner);
+    if let Some((n, _)) = im.out.materials.iter().find(|(_, v)| **v == m) {
+        return n.clone();
+    }
+    let name = im.out.unique_material_name("diffuse");
+    im.out.materials.insert(name.clone(), m);
+    name
+}
+
 /// `MakeNamedMaterial`.
 pub fn named_material(
     im: &mut Importer,
@@ -299,7 +352,7 @@ pub fn named_material(
     params: &Params,
     at: &Location,
 ) -> Result<Option<String>, ImportError> {
-    let Some(m) = convert(im, kind, params, at)? else {
+    let Some(m) = convert(im, name, kind, params, at)? else {
         return Ok(None);
     };
     let prism = im.out.unique_material_name(name);

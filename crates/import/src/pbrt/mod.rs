@@ -2,6 +2,7 @@
 //! each for spectra, render options (camera, film, sampler, integrator), materials and
 //! textures, shapes and lights.
 
+pub mod goniometric;
 pub mod light;
 pub mod material;
 pub mod octahedral;
@@ -36,7 +37,7 @@ pub struct AreaLight {
 #[derive(Debug, Clone)]
 pub struct GraphicsState {
     pub ctm: DMat4,
-    /// Prism material name; None is pbrt's default (diffuse 0.5 = Prism's default).
+    /// Prism material name; None is pbrt's default (`material::default_material`).
     pub material: Option<String>,
     pub area_light: Option<AreaLight>,
     pub reverse_orientation: bool,
@@ -410,7 +411,10 @@ mod tests {
              MakeNamedMaterial \"d\" \"string type\" \"diffuse\"\n\
              MakeNamedMaterial \"m\" \"string type\" \"mix\" \"string materials\" [\"au\" \"d\"] \"float amount\" 0.25\n",
         );
-        let au = &i.scene["materials"]["au"];
+        // pbrt's conductor reflects on both sides: a two_sided of the conductor.
+        let materials = &i.scene["materials"];
+        assert_eq!(materials["au"]["type"], "two_sided");
+        let au = &materials[materials["au"]["material"].as_str().unwrap()];
         assert_eq!(au["metal"], "Au");
         assert!((au["roughness"].as_f64().unwrap() - 0.3).abs() < 1e-12);
         assert_eq!(

@@ -173,9 +173,11 @@ pub fn shape(
         }
     }
     params.finish(&format!("Shape \"{kind}\""), &mut im.out.unsupported);
-    if let Some(m) = &im.g.material {
-        s.insert("material".into(), json!(m));
-    }
+    let material = match im.g.material.clone() {
+        Some(m) => m,
+        None => crate::pbrt::material::default_material(im),
+    };
+    s.insert("material".into(), json!(material));
     if let Some((_, shapes)) = im.current_object.as_mut() {
         if im.g.area_light.is_some() {
             im.out.unsupported.note(
