@@ -114,10 +114,23 @@ pub struct RenderArgs {
     /// Interval of `--progress plain` (Ns, Nm or Nh).
     #[arg(long = "progress-every", value_name = "DURATION", default_value = "10s", value_parser = prism_args::duration::parse_duration)]
     pub progress_every: Duration,
+    /// How light samples at shading points choose a light: `auto` through the light BVH
+    /// from 8 lights with bounds on, by power below; `power` always by power; `bvh` through
+    /// the light BVH whenever a light has bounds.
+    #[arg(long = "light-selection", value_enum, default_value = "auto")]
+    pub light_selection: LightSelectionArg,
     #[command(flatten)]
     pub plan: crate::plan_args::PlanArgs,
     #[command(flatten)]
     pub simd: crate::simd::SimdArgs,
+}
+
+/// `--light-selection`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum LightSelectionArg {
+    Auto,
+    Power,
+    Bvh,
 }
 
 /// How `prism render` reports progress.
@@ -295,6 +308,22 @@ pub fn run(args: &RenderArgs, budget: &MemoryBudget) -> Result<ExitCode, String>
         ));
     }
     let mut scene = RenderScene::build(&description, args.resolution).map_err(|e| e.to_string())?;
+    match args.light_selection {
+        LightSelectionArg::Auto => {}
+        LightSelectionArg::Power => {
+            scene.set_light_bvh(false);
+            scene.set_packet_tracing(true);
+        }
+        LightSelectionArg::Bvh => {
+            if !scene.set_light_bvh(true) {
+                return Err(format!(
+                    "--light-selection bvh: {} has no light with bounds (only lights at \
+                     infinity, or none) for a light BVH to choose among",
+                    args.scene.display()
+                ));
+            }
+        }
+    }
     scene
         .integrator
         .set_memory_limit_bytes(Some(budget.limit_bytes));

@@ -223,6 +223,8 @@ impl RenderPlan {
                     "hero + 3 rotated wavelengths per path, visible-importance density".into(),
                     "spectral transport (Wilkie et al. 2014); 4 wavelengths share every ray".into(),
                 );
+                let (selection, why) = light_selection_text(scene);
+                choose("light selection", selection, why);
                 let names: Vec<String> = dispersive
                     .iter()
                     .map(|&i| format!("`{}`", scene.material_names[i]))
@@ -650,6 +652,52 @@ impl fmt::Display for RenderPlan {
             )?;
         }
         writeln!(f, "simd: {}", self.simd)
+    }
+}
+
+/// `--explain`'s light-selection line for light samples at shading points.
+fn light_selection_text(scene: &RenderScene) -> (String, String) {
+    let min = crate::light::LIGHT_BVH_MIN_BOUNDED;
+    match scene.lights.light_bvh() {
+        Some(bvh) => (
+            format!(
+                "light BVH over {} lights with bounds{}",
+                bvh.bounded_count(),
+                if bvh.infinite_count() > 0 {
+                    format!(
+                        ", {} at infinity chosen apart (each 1/{})",
+                        bvh.infinite_count(),
+                        bvh.infinite_count() + 1
+                    )
+                } else {
+                    String::new()
+                }
+            ),
+            format!(
+                "{}: each light sample descends the tree by the importance of its children \
+                 at the shading point (Conty Estevez & Kulla 2018; pbrt-v4 \
+                 BVHLightSampler), so near, facing lights get the samples",
+                if bvh.bounded_count() >= min {
+                    format!("{min} or more lights with bounds")
+                } else {
+                    "asked for (--light-selection bvh)".to_string()
+                }
+            ),
+        ),
+        None => (
+            format!(
+                "in proportion to power over {} light(s)",
+                scene.lights.len()
+            ),
+            if scene.lights.bounded_light_count() >= min {
+                "asked for (--light-selection power; pbrt-v4 PowerLightSampler)".to_string()
+            } else {
+                format!(
+                    "fewer than {min} lights with bounds: the light BVH gains little (pbrt-v4 \
+                     PowerLightSampler)"
+                )
+            },
+        ),
     }
 }
 

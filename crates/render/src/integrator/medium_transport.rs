@@ -461,7 +461,7 @@ impl PathTracer {
                     let c = if path.specular_bounce {
                         path.beta * le / average(r_u, spectral)
                     } else {
-                        let p_l = lights.pmf(l)
+                        let p_l = lights.pmf_at(&path.prev_ctx, l)
                             * lights.light(l).pdf_li(&path.prev_ctx, ray.direction, None);
                         path.beta * le / average(r_u + r_l * p_l, spectral)
                     };
@@ -538,7 +538,7 @@ impl PathTracer {
                     let c = if path.specular_bounce {
                         path.beta * le / average(r_u, spectral)
                     } else {
-                        let p_l = lights.pmf(l)
+                        let p_l = lights.pmf_at(&path.prev_ctx, l)
                             * light.pdf_li(&path.prev_ctx, ray.direction, Some(&light_hit));
                         path.beta * le / average(r_u + r_l * p_l, spectral)
                     };

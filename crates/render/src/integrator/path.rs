@@ -613,7 +613,8 @@ impl PathTracer {
             return 1.0;
         }
         let lights = &scene.lights;
-        let light_pdf = lights.pmf(l) * lights.light(l).pdf_li(prev_ctx, direction, hit);
+        let light_pdf =
+            lights.pmf_at(prev_ctx, l) * lights.light(l).pdf_li(prev_ctx, direction, hit);
         mis_weight(self.mis, prev_bsdf_pdf, light_pdf)
     }
 
@@ -635,7 +636,7 @@ impl PathTracer {
     ) -> (SampledSpectrum, SampledSpectrum) {
         let zero = SampledSpectrum::splat(0.0);
         let lights = &scene.lights;
-        let Some((l, pmf)) = lights.sample(u_choice) else {
+        let Some((l, pmf)) = lights.sample_at(ctx, u_choice) else {
             return (zero, zero);
         };
         let light = lights.light(l);

@@ -140,8 +140,8 @@ impl ScatterVertex<'_> {
         le_cache: &mut SpectrumCache,
     ) -> Option<VertexLightSample> {
         let lights = &scene.lights;
-        let (l, pmf) = lights.sample(u_choice)?;
         let ctx = self.light_context();
+        let (l, pmf) = lights.sample_at(&ctx, u_choice)?;
         let sample = lights
             .light(l)
             .sample_li_cached(l, &ctx, u, wavelengths, le_cache)?;

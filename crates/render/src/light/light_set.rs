@@ -1,6 +1,12 @@
 //! All lights of a scene: light selection in proportion to power (pbrt-v4 §12.6.3
-//! `PowerLightSampler`), the map from hit instances to area lights, and the infinite lights
-//! that escaping rays see.
+//! `PowerLightSampler`), or for light samples at a shading point, from
+//! [`LIGHT_BVH_MIN_BOUNDED`] lights with bounds on, by a light BVH (light_bvh.rs); the map
+//! from hit instances to area lights, and the infinite lights that escaping rays see.
+//!
+//! Which selection a caller uses is part of its estimator: next-event estimation in the
+//! path tracer and its medium and photon-camera variants calls `sample_at`/`pmf_at`; light
+//! paths (BDPT, photons), sensors and the predictor's probe choose by power (`sample`,
+//! `pmf`), as their weights assume.
 
 use std::ops::Range;
 
@@ -8,8 +14,10 @@ use prism_geometry::Geometry;
 use prism_scene::SceneDescription;
 
 use super::build::build_lights;
+use super::light_bounds::light_bounds;
+use super::light_bvh::LightBvh;
 use super::scene_sphere::SceneSphere;
-use super::Light;
+use super::{Light, LightSampleContext};
 use crate::scene_build::{shape_instance_ranges, SceneBuildError};
 
 /// `area_light_of_instance` value of instances that do not emit.
@@ -26,7 +34,16 @@ pub struct LightSet {
     infinite: Vec<u32>,
     /// The scene's bounding sphere (set by `build`; zero radius from `new`).
     scene: SceneSphere,
+    /// The light BVH over the lights with bounds (set by `build` when any has them).
+    bvh: Option<LightBvh>,
+    /// Whether `sample_at`/`pmf_at` use `bvh` (or choose by power).
+    bvh_on: bool,
 }
+
+/// From this many lights with bounds on, light samples at shading points choose through
+/// the light BVH; below it by power, as before (a handful of lights gains little and the
+/// packet tracer keeps serving them).
+pub const LIGHT_BVH_MIN_BOUNDED: usize = 8;
 
 impl LightSet {
     /// Lights given directly, selected in proportion to `power_w(scene_radius_m)`
@@ -65,6 +82,8 @@ impl LightSet {
                 center_m: glam::Vec3A::ZERO,
                 radius_m: scene_radius_m,
             },
+            bvh: None,
+            bvh_on: false,
         }
     }
 
@@ -96,7 +115,82 @@ impl LightSet {
         let built = build_lights(scene, geometry, shape_instances)?;
         let mut set = Self::new(built.lights, built.instance_light, built.scene.radius_m);
         set.scene = built.scene;
+        set.build_bvh(geometry);
         Ok(set)
+    }
+
+    /// The light BVH: each light's bounds (an area light's box is its instances'), the
+    /// lights at infinity apart; on from [`LIGHT_BVH_MIN_BOUNDED`] bounded lights.
+    fn build_bvh(&mut self, geometry: &Geometry) {
+        let mut boxes: Vec<Option<(glam::Vec3A, glam::Vec3A)>> = vec![None; self.lights.len()];
+        for (instance, &l) in self.instance_light.iter().enumerate() {
+            if l == NO_LIGHT {
+                continue;
+            }
+            if let Some((lo, hi)) = geometry.instance_world_bounds(instance as u32) {
+                let b = &mut boxes[l as usize];
+                *b = Some(b.map_or((lo, hi), |(a, c)| (a.min(lo), c.max(hi))));
+            }
+        }
+        let radius = self.scene.radius_m;
+        let mut bounded = Vec::new();
+        let mut infinite = Vec::new();
+        for (i, light) in self.lights.iter().enumerate() {
+            let phi = light.power_w(radius);
+            let phi = if phi.is_finite() {
+                phi.max(0.0) as f32
+            } else {
+                0.0
+            };
+            match light_bounds(light, boxes[i], phi) {
+                Some(b) => bounded.push((i as u32, b)),
+                None if light.is_infinite() => infinite.push(i as u32),
+                // An area light whose shape has no instance box emits nowhere.
+                None => {}
+            }
+        }
+        if bounded.is_empty() {
+            return;
+        }
+        let bvh = LightBvh::build(bounded, infinite, self.lights.len());
+        self.bvh_on = bvh.bounded_count() >= LIGHT_BVH_MIN_BOUNDED;
+        self.bvh = Some(bvh);
+    }
+
+    /// Turns the light BVH on or off for `sample_at`/`pmf_at` (where `build` made one);
+    /// whether it is on afterwards.
+    pub fn set_light_bvh(&mut self, on: bool) -> bool {
+        self.bvh_on = on && self.bvh.is_some();
+        self.bvh_on
+    }
+
+    /// Lights in the light BVH `build` made, on or off (0 without one).
+    pub fn bounded_light_count(&self) -> usize {
+        self.bvh.as_ref().map_or(0, LightBvh::bounded_count)
+    }
+
+    /// The light BVH when light samples at shading points use it.
+    pub fn light_bvh(&self) -> Option<&LightBvh> {
+        self.bvh.as_ref().filter(|_| self.bvh_on)
+    }
+
+    /// Picks a light for a light sample at `ctx`: through the light BVH when it is on,
+    /// else `sample`. (index, probability).
+    #[inline]
+    pub fn sample_at(&self, ctx: &LightSampleContext, u: f32) -> Option<(u32, f32)> {
+        match self.light_bvh() {
+            Some(bvh) => bvh.sample(ctx.p, ctx.n, u),
+            None => self.sample(u),
+        }
+    }
+
+    /// Probability that `sample_at(ctx, ·)` picks light `index`.
+    #[inline]
+    pub fn pmf_at(&self, ctx: &LightSampleContext, index: u32) -> f32 {
+        match self.light_bvh() {
+            Some(bvh) => bvh.pmf(ctx.p, ctx.n, index),
+            None => self.pmf(index),
+        }
     }
 
     /// The scene's bounding sphere that the infinite lights use.

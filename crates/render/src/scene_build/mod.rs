@@ -190,6 +190,18 @@ impl RenderScene {
         }
     }
 
+    /// Light samples at shading points choose through the light BVH (`true`, where the
+    /// scene has lights with bounds) or by power; whether the BVH is on afterwards. Turning
+    /// it on drops the packet form (the packet tracer chooses by power); after turning it
+    /// off, `set_packet_tracing(true)` lets the packet tracer serve the scene again.
+    pub fn set_light_bvh(&mut self, on: bool) -> bool {
+        let on = self.lights.set_light_bvh(on);
+        if on {
+            self.packet = None;
+        }
+        on
+    }
+
     /// The name of the first material that re-radiates (fluorescence), if any.
     pub fn reradiating_material(&self) -> Option<&str> {
         self.materials

@@ -136,6 +136,13 @@ impl PacketScene {
         if !outside.is_empty() {
             return Err(outside.names());
         }
+        if let Some(bvh) = scene.lights.light_bvh() {
+            return Err(format!(
+                "light samples choose among {} lights through the light BVH; the packet \
+                 tracer chooses by power",
+                bvh.bounded_count()
+            ));
+        }
         // Lanes test every patch of the scene: only a small scene has few enough.
         if let Some(why) = small_scene_not_used(&scene.geometry, scene.features) {
             return Err(why);

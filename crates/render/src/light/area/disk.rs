@@ -30,6 +30,11 @@ impl DiskEmitter {
         }
     }
 
+    /// The unit world normal of the emitting side (zero for a degenerate transform).
+    pub(crate) fn normal(&self) -> Vec3A {
+        self.normal
+    }
+
     pub fn area_m2(&self) -> f64 {
         f64::from(self.area_m2)
     }
