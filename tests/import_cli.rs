@@ -332,6 +332,23 @@ fn what_is_not_imported_is_listed_once_per_kind_and_refused_with_strict() {
     assert!(!out.status.success());
 }
 
+/// Writes a `size`² linear-sRGB EXR (pbrt's equal-area squares in these tests).
+fn write_square_exr(path: &Path, size: usize, pixels: Vec<[f32; 3]>) {
+    let image = prism_image::Image::new(
+        size,
+        size,
+        pixels,
+        prism_spectrum::rgb_space::RgbColorSpace::srgb(),
+    )
+    .unwrap();
+    prism_image::io::exr::write_exr(
+        path,
+        &image,
+        &prism_image::io::exr::ExrWriteOptions::default(),
+    )
+    .unwrap();
+}
+
 /// pbrt-v4's image infinite light (an equal-area octahedral square, +x to the right of the
 /// square's centre) becomes an `environment` light whose equirectangular side file holds
 /// the same sky: a square bright on its right half (pbrt's x > 0) gives a map bright
@@ -349,19 +366,7 @@ fn pbrt_image_infinite_lights_become_equirectangular_environment_maps() {
             }
         })
         .collect();
-    let image = prism_image::Image::new(
-        size,
-        size,
-        square,
-        prism_spectrum::rgb_space::RgbColorSpace::srgb(),
-    )
-    .unwrap();
-    prism_image::io::exr::write_exr(
-        &dir.path().join("sky.exr"),
-        &image,
-        &prism_image::io::exr::ExrWriteOptions::default(),
-    )
-    .unwrap();
+    write_square_exr(&dir.path().join("sky.exr"), size, square);
     let scene = dir.path().join("sky.pbrt");
     std::fs::write(
         &scene,
@@ -419,19 +424,7 @@ fn pbrt_goniometric_lights_become_luminaires_with_pbrt_intensities() {
             }
         })
         .collect();
-    let image = prism_image::Image::new(
-        size,
-        size,
-        square,
-        prism_spectrum::rgb_space::RgbColorSpace::srgb(),
-    )
-    .unwrap();
-    prism_image::io::exr::write_exr(
-        &dir.path().join("gonio.exr"),
-        &image,
-        &prism_image::io::exr::ExrWriteOptions::default(),
-    )
-    .unwrap();
+    write_square_exr(&dir.path().join("gonio.exr"), size, square);
     let scene = |light: &str| {
         format!(
             "LookAt 0 3 0  0 -1 0  0 0 1\nCamera \"perspective\" \"float fov\" [ 50 ]\n\

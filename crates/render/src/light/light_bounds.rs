@@ -242,29 +242,22 @@ pub fn light_bounds(
             two_sided,
         })
     };
+    // A point that may emit in every direction (a luminaire's table is bounded as a point
+    // light, as pbrt-v4 bounds its goniometric light).
+    let isotropic = |p: Vec3A| {
+        let (lo, hi) = point(p);
+        Some(LightBounds {
+            lo,
+            hi,
+            phi: phi_w,
+            normals: DirectionCone::entire_sphere(),
+            cos_theta_e: 0.0,
+            two_sided: false,
+        })
+    };
     match light {
-        Light::Point(l) => {
-            let (lo, hi) = point(l.position_m);
-            Some(LightBounds {
-                lo,
-                hi,
-                phi: phi_w,
-                normals: DirectionCone::entire_sphere(),
-                cos_theta_e: 0.0,
-                two_sided: false,
-            })
-        }
-        Light::Goniometric(l) => {
-            let (lo, hi) = point(l.position_m);
-            Some(LightBounds {
-                lo,
-                hi,
-                phi: phi_w,
-                normals: DirectionCone::entire_sphere(),
-                cos_theta_e: 0.0,
-                two_sided: false,
-            })
-        }
+        Light::Point(l) => isotropic(l.position_m),
+        Light::Goniometric(l) => isotropic(l.position_m),
         Light::Spot(l) => {
             let (lo, hi) = point(l.position_m);
             // pbrt-v4 `SpotLight::Bounds`: normals within the falloff start, light up to
