@@ -225,6 +225,19 @@ impl RenderPlan {
                 );
                 let (selection, why) = light_selection_text(scene);
                 choose("light selection", selection, why);
+                if let (SamplePlanKind::Predicted { .. }, crate::camera::Camera::ThinLens(_)) =
+                    (request.sample_plan, &scene.camera)
+                {
+                    choose(
+                        "predictor: defocus",
+                        "on: b_p capped at 1.22 / (circle of confusion in px) at each pixel's \
+                         hit"
+                        .into(),
+                        "the camera is a thin lens: the aperture low-passes what lies out of \
+                         focus (Soler et al. 2009), so detail there needs fewer samples"
+                            .into(),
+                    );
+                }
                 let names: Vec<String> = dispersive
                     .iter()
                     .map(|&i| format!("`{}`", scene.material_names[i]))

@@ -113,6 +113,36 @@ fn angular_footprint(scene: &RenderScene, pixel: UVec2) -> Option<f32> {
     Some(ax.max(ay))
 }
 
+/// The first zero of a uniform disc's Fourier transform, 2 J₁(πcf)/(πcf), times its
+/// diameter c: a circle of confusion c px wide passes nothing above 1.2197/c cycles/px.
+const DISC_CUTOFF_CYCLES: f32 = 1.2197;
+
+/// A thin lens low-passes what lies out of focus (Soler et al. 2009, "Fourier depth of
+/// field", §4: the aperture's spectrum filters the image): each surface pixel's b_p (shadow
+/// edges included) is capped by the circle of confusion's cut-off at its centre hit, so
+/// out-of-focus pixels need fewer samples for their detail. In-focus pixels (CoC ≤ 1 px)
+/// and background pixels keep theirs; the lens adds no shading-variance term here.
+fn defocus_low_pass(
+    scene: &RenderScene,
+    pixels: &mut [PixelPrediction],
+    surface: &[Option<SurfacePoint>],
+) {
+    let crate::camera::Camera::ThinLens(lens) = &scene.camera else {
+        return;
+    };
+    for (p, s) in pixels.iter_mut().zip(surface) {
+        let Some(s) = s else {
+            continue;
+        };
+        let coc_px = lens.circle_of_confusion_px(s.position_m);
+        if coc_px > 1.0 {
+            p.image_bandwidth_cycles_per_px = p
+                .image_bandwidth_cycles_per_px
+                .min(DISC_CUTOFF_CYCLES / coc_px);
+        }
+    }
+}
+
 /// What `pixel`'s centre ray meets.
 enum CentreRay {
     /// A surface: its G-buffer hit (with curvature, which shading skips).
@@ -449,6 +479,7 @@ pub fn predict_with_probe<'a>(
     if settings.visibility {
         add_shadow_edges(resolution, &mut pixels, &eye);
     }
+    defocus_low_pass(scene, &mut pixels, &surface);
     let b: Vec<f32> = pixels
         .iter()
         .map(|p| p.image_bandwidth_cycles_per_px)

@@ -206,3 +206,63 @@ fn hierarchical_shading_never_interpolates_across_a_shadow_edge() {
         assert_eq!(p.allocated.plan.camera_samples(pixel), 0);
     }
 }
+
+/// A thin lens low-passes what lies out of focus (Soler et al. 2009): b_p on the edge of a
+/// hard shadow (sharp, b_p ≥ 0.25, in focus) is capped by the circle of confusion's cut-off
+/// (1.22 / CoC cycles/px) when the floor is out of focus, so two defocus settings give b_p
+/// in the inverse ratio of their CoCs (within ×1.5, the issue's test), and the floor in
+/// focus keeps its own b_p.
+#[test]
+fn defocus_caps_b_p_by_the_circle_of_confusion() {
+    let scene = |focus_m: f32| {
+        build(&format!(
+            r#"{{"camera": {{"type": "thin_lens", "focal_length_mm": 50, "f_number": 1.0,
+                "focus_distance_m": {focus_m},
+                "transform": {{"look_at": {{"eye": [0, 4, 0], "target": [0, 0, 0],
+                    "up": [0, 0, -1]}}}}}},
+            "film": {{"resolution": [48, 48]}},
+            "materials": {{"white": {{"type": "lambert", "reflectance": 0.7}}}},
+            "shapes": [
+              {{"type": "rectangle", "size_m": [20, 20], "material": "white",
+                "transform": {{"rotate": {{"axis": [1, 0, 0], "angle_deg": -90}}}}}},
+              {{"type": "cuboid", "size_m": [0.8, 0.1, 0.8], "material": "white",
+                "transform": {{"translate": [0.3, 0.5, 0]}}}}],
+            "lights": [{{"type": "point", "position_m": [0.3, 2.5, 0], "spectrum": 1.0,
+                "scale": 10}}]}}"#
+        ))
+    };
+    // The largest b_p on the floor (depth 4 m; the box top is nearer).
+    let max_b = |focus_m: f32| -> (f32, f32) {
+        let s = scene(focus_m);
+        let prism_render::camera::Camera::ThinLens(lens) = &s.camera else {
+            panic!("a thin lens");
+        };
+        let coc = lens.circle_of_confusion_px(glam::Vec3A::ZERO);
+        let p = run(&s, true);
+        let b = p
+            .pixels
+            .iter()
+            .zip(&p.surface)
+            .filter(|(_, s)| s.is_some_and(|s| s.position_m.y.abs() < 1e-3))
+            .map(|(x, _)| x.image_bandwidth_cycles_per_px)
+            .fold(0.0f32, f32::max);
+        (b, coc)
+    };
+    let (focused, coc_focused) = max_b(4.0);
+    let (near, coc_near) = max_b(1.0);
+    let (nearer, coc_nearer) = max_b(0.5);
+    eprintln!(
+        "max b_p on the floor: in focus {focused:.3} (CoC {coc_focused:.2} px), focus 1 m \
+         {near:.3} (CoC {coc_near:.2} px), focus 0.5 m {nearer:.3} (CoC {coc_nearer:.2} px)"
+    );
+    assert!(coc_focused < 1e-3 && coc_near > 2.0 && coc_nearer > coc_near * 2.0);
+    assert!(
+        focused >= 0.25 && focused > near && near > nearer,
+        "{focused} {near} {nearer}"
+    );
+    let ratio = (near / nearer) / (coc_nearer / coc_near);
+    assert!(
+        (1.0 / 1.5..=1.5).contains(&ratio),
+        "b_p ratio / CoC ratio {ratio}"
+    );
+}

@@ -157,6 +157,16 @@ impl ThinLensCamera {
         2.0 * self.aperture_radius_m * f * (depth_m - df).abs() / (depth_m * (df - f))
     }
 
+    /// Diameter in pixels of the circle of confusion of the world point `world_point_m`
+    /// (its depth along the optical axis; 0 behind the lens).
+    pub fn circle_of_confusion_px(&self, world_point_m: Vec3A) -> f32 {
+        let depth_m = -self.frame.camera_to_world.inverse_point(world_point_m).z;
+        if depth_m <= 0.0 {
+            return 0.0;
+        }
+        self.circle_of_confusion_m(depth_m) * self.frame.size_px().x / self.sensor_width_m
+    }
+
     /// The aperture point (camera space, z = 0) of `lens_sample` ∈ [0, 1)².
     pub fn lens_point_m(&self, lens_sample: Vec2) -> Vec3A {
         let l = self.aperture_radius_m * sample_uniform_disk_concentric(lens_sample);
