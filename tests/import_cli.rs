@@ -513,3 +513,30 @@ fn pbrt_surfaces_reflect_on_both_sides_as_in_pbrt() {
         );
     }
 }
+
+/// pbrt-v4's `"illuminance"` on an image infinite light scales the map so that its
+/// illuminance on an upward (light-space +z) patch, computed pbrt's way (texels with z > 0,
+/// Y · cos θ, × 2π / N²), is the value asked for: a uniform map of 1 gives π/2 that way
+/// (half its true illuminance, π — pbrt counts each texel as 2π/N² sr), so the scale is
+/// E / (π/2). The importer reproduces pbrt's rendering.
+#[test]
+fn pbrt_image_infinite_illuminance_scales_as_pbrt_does() {
+    let dir = tempfile::tempdir().unwrap();
+    let size = 64;
+    write_square_exr(&dir.path().join("sky.exr"), size, vec![[1.0; 3]; size * size]);
+    let scene = dir.path().join("lit.pbrt");
+    std::fs::write(
+        &scene,
+        "WorldBegin\nLightSource \"infinite\" \"string filename\" \"sky.exr\" \
+         \"float illuminance\" [ 100 ]\n",
+    )
+    .unwrap();
+    let json = dir.path().join("lit.json");
+    let stderr = run_ok(prism().arg("import").arg(&scene).arg("-o").arg(&json));
+    assert!(!stderr.contains("illuminance"), "{stderr}");
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let scale = v["lights"][0]["scale"].as_f64().unwrap();
+    let expected = 100.0 / (std::f64::consts::PI / 2.0);
+    assert!((scale / expected - 1.0).abs() < 0.01, "{scale} vs {expected}");
+}

@@ -12,20 +12,32 @@ use crate::pbrt::spectra::{emission_factor, spectrum};
 use crate::pbrt::{AreaLight, Importer};
 
 /// The light's spectrum parameter `name` (default: the colour space's illuminant, Prism's
-/// RGB white) and Prism's scale for it.
+/// RGB white) and Prism's scale for it. `k_e` is pbrt-v4's emitted power per unit scale for
+/// `"power"` (the light's `Create`: 4π for a point, the cone's for a spot): with a positive
+/// power the scale is multiplied by power / k_e, as pbrt does; for lights without a `k_e`
+/// "power" is reported and ignored.
 fn strength(
     im: &mut Importer,
     params: &Params,
     name: &str,
     at: &Location,
+    k_e: Option<f64>,
 ) -> Result<(Value, f64), ImportError> {
-    let scale = params.float_or("scale", 1.0)?;
-    if let Some(p) = params.get("power") {
-        im.out.unsupported.note(
-            "light \"power\"",
-            "ignored: the light keeps its spectrum × scale",
-            &p.at,
-        );
+    let mut scale = params.float_or("scale", 1.0)?;
+    match (params.get("power"), k_e) {
+        (Some(_), Some(k_e)) => {
+            if let Some(power) = params.float("power")?.filter(|p| *p > 0.0) {
+                scale *= power / k_e;
+            }
+        }
+        (Some(p), None) => {
+            im.out.unsupported.note(
+                "light \"power\"",
+                "ignored: the light keeps its spectrum × scale",
+                &p.at,
+            );
+        }
+        (None, _) => {}
     }
     let (spectrum, factor) = strength_spectrum(im, params, name, at)?;
     Ok((spectrum, scale * factor))
@@ -69,7 +81,7 @@ pub fn area_light(
             format!("AreaLightSource \"{kind}\": expected diffuse"),
         ));
     }
-    let (spectrum, scale) = strength(im, params, "L", at)?;
+    let (spectrum, scale) = strength(im, params, "L", at, None)?;
     let two_sided = params.boolean("twosided")?.unwrap_or(false);
     if let Some(p) = params.get("filename") {
         im.out.unsupported.note(
@@ -103,7 +115,7 @@ pub fn light(
     match kind {
         "point" => {
             let from = point("from", DVec3::ZERO)?;
-            let (s, scale) = strength(im, params, "I", at)?;
+            let (s, scale) = strength(im, params, "I", at, Some(4.0 * std::f64::consts::PI))?;
             l.insert("type".into(), json!("point"));
             l.insert(
                 "position_m".into(),
@@ -116,8 +128,12 @@ pub fn light(
             let from = point("from", DVec3::ZERO)?;
             let to = point("to", DVec3::Z)?;
             let cone = params.float_or("coneangle", 30.0)?;
-            let delta = params.float_or("conedelta", 5.0)?;
-            let (s, scale) = strength(im, params, "I", at)?;
+            let delta = params.float_or("conedeltaangle", 5.0)?;
+            // pbrt-v4 `SpotLight::Create`: the power of a unit-intensity spot.
+            let (cos_end, cos_start) = (cone.to_radians().cos(), (cone - delta).to_radians().cos());
+            let k_e =
+                2.0 * std::f64::consts::PI * ((1.0 - cos_start) + (cos_start - cos_end) / 2.0);
+            let (s, scale) = strength(im, params, "I", at, Some(k_e))?;
             l.insert("type".into(), json!("spot"));
             l.insert(
                 "position_m".into(),
@@ -136,7 +152,7 @@ pub fn light(
         "distant" => {
             let from = point("from", DVec3::ZERO)?;
             let to = point("to", DVec3::Z)?;
-            let (s, scale) = strength(im, params, "L", at)?;
+            let (s, scale) = strength(im, params, "L", at, None)?;
             l.insert("type".into(), json!("directional"));
             l.insert(
                 "direction".into(),
@@ -152,34 +168,35 @@ pub fn light(
                     .parent()
                     .unwrap_or(std::path::Path::new(""))
                     .join(&file);
-                let map = environment_map(&path, at)?;
+                let (map, upper_illuminance) = environment_map(&path, at)?;
                 let name = format!("environment-{}.exr", im.out.side_files.len() + 1);
                 l.insert("type".into(), json!("environment"));
                 l.insert("file".into(), json!(im.out.add_side_file(&name, map)));
                 l.insert("transform".into(), crate::output::matrix_json(&ctm));
-                l.insert("scale".into(), json!(params.float_or("scale", 1.0)?));
-                if params.float("illuminance")?.is_some() {
-                    im.out.unsupported.note(
-                        "infinite light illuminance",
-                        "ignored: the map keeps its radiance × scale",
-                        at,
-                    );
+                let mut scale = params.float_or("scale", 1.0)?;
+                if let Some(e_v) = params.float("illuminance")?.filter(|e| *e > 0.0) {
+                    // pbrt-v4: the map's illuminance on an upward (light-space +z) patch.
+                    if upper_illuminance <= 0.0 {
+                        return Err(ImportError::at(
+                            at,
+                            format!("LightSource \"infinite\" \"illuminance\": {file} sends no light to an upward patch, so no scale gives it an illuminance"),
+                        ));
+                    }
+                    scale *= e_v / upper_illuminance;
                 }
+                l.insert("scale".into(), json!(scale));
                 params.finish("LightSource \"infinite\"", &mut im.out.unsupported);
                 im.out.lights.push(Value::Object(l));
                 return Ok(());
             }
-            let (s, scale) = strength(im, params, "L", at)?;
+            let (s, mut scale) = strength(im, params, "L", at, None)?;
+            if let Some(e_v) = params.float("illuminance")?.filter(|e| *e > 0.0) {
+                // pbrt-v4: a uniform sky of unit luminance gives π on an upward patch.
+                scale *= e_v / std::f64::consts::PI;
+            }
             l.insert("type".into(), json!("sky"));
             l.insert("spectrum".into(), s);
             l.insert("scale".into(), json!(scale));
-            if params.float("illuminance")?.is_some() {
-                im.out.unsupported.note(
-                    "infinite light illuminance",
-                    "ignored: the light keeps L × scale",
-                    at,
-                );
-            }
         }
         "goniometric" => {
             let Some(file) = params.string("filename")? else {
@@ -242,8 +259,10 @@ pub fn light(
 }
 
 /// pbrt-v4's equal-area octahedral environment image at `path` as the bytes of an
-/// equirectangular linear-sRGB EXR (`octahedral`), for an `environment` light.
-fn environment_map(path: &std::path::Path, at: &Location) -> Result<Vec<u8>, ImportError> {
+/// equirectangular linear-sRGB EXR (`octahedral`), for an `environment` light, and the
+/// illuminance it gives an upward (light-space +z) patch per unit scale, as pbrt-v4's
+/// `"illuminance"` computes it (Σ over texels with z > 0 of Y · cos θ × 2π / N²).
+fn environment_map(path: &std::path::Path, at: &Location) -> Result<(Vec<u8>, f64), ImportError> {
     let image = prism_image::io::read_image(path)
         .map_err(|e| ImportError::at(at, format!("LightSource infinite \"filename\": {e}")))?;
     if image.width() != image.height() {
@@ -261,8 +280,26 @@ fn environment_map(path: &std::path::Path, at: &Location) -> Result<Vec<u8>, Imp
     let srgb = prism_spectrum::rgb_space::RgbColorSpace::srgb();
     let mut pixels = image.pixels().to_vec();
     prism_image::io::convert_pixels(&mut pixels, &image.color_space, &srgb);
-    let (width, height, map) =
-        crate::pbrt::octahedral::octahedral_to_equirect(&pixels, image.width());
+    let n = image.width();
+    let upper_illuminance = pixels
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            let w = crate::pbrt::octahedral::square_to_sphere(
+                ((i % n) as f64 + 0.5) / n as f64,
+                ((i / n) as f64 + 0.5) / n as f64,
+            );
+            if w.z <= 0.0 {
+                return 0.0;
+            }
+            let y = 0.2126 * f64::from(p[0]) + 0.7152 * f64::from(p[1]) + 0.0722 * f64::from(p[2]);
+            y * w.z
+        })
+        .sum::<f64>()
+        * 2.0
+        * std::f64::consts::PI
+        / (n * n) as f64;
+    let (width, height, map) = crate::pbrt::octahedral::octahedral_to_equirect(&pixels, n);
     let equirect = prism_image::Image::new(width, height, map, srgb)
         .map_err(|e| ImportError::at(at, format!("environment map: {e}")))?;
     // The EXR encoder writes files: through a private temporary file.
@@ -284,5 +321,5 @@ fn environment_map(path: &std::path::Path, at: &Location) -> Result<Vec<u8>, Imp
             .map_err(|e| ImportError::at(at, format!("environment map {}: {e}", temp.display())))
     });
     let _ = std::fs::remove_file(&temp);
-    written
+    written.map(|bytes| (bytes, upper_illuminance))
 }

@@ -404,6 +404,42 @@ mod tests {
         serde_json::json!(r)
     }
 
+    /// pbrt-v4's photometric strengths: `power` of a point (k_e = 4π) and a spot (its
+    /// cone's), a uniform sky's `illuminance` (k_e = π); the spot's `conedeltaangle`.
+    #[test]
+    fn power_and_illuminance_scale_as_pbrt_does() {
+        use std::f64::consts::PI;
+        let i = import_text(
+            "WorldBegin\nLightSource \"point\" \"float power\" 100 \"float scale\" 2\n\
+             LightSource \"spot\" \"float power\" 100 \"float coneangle\" 30 \"float conedeltaangle\" 10\n\
+             LightSource \"infinite\" \"float illuminance\" 1000\n",
+        );
+        let lights = i.scene["lights"].as_array().unwrap();
+        let scale = |k: usize| lights[k]["scale"].as_f64().unwrap();
+        assert!(
+            (scale(0) - 2.0 * 100.0 / (4.0 * PI)).abs() < 1e-9,
+            "{}",
+            scale(0)
+        );
+        let (cos_end, cos_start) = (30f64.to_radians().cos(), 20f64.to_radians().cos());
+        let k_e = 2.0 * PI * ((1.0 - cos_start) + (cos_start - cos_end) / 2.0);
+        assert!((scale(1) - 100.0 / k_e).abs() < 1e-9, "{}", scale(1));
+        assert_eq!(lights[1]["falloff_start_deg"], 20.0);
+        assert!((scale(2) - 1000.0 / PI).abs() < 1e-9, "{}", scale(2));
+        let kinds: Vec<&str> = i
+            .unsupported
+            .kinds
+            .iter()
+            .map(|k| k.kind.as_str())
+            .collect();
+        assert!(
+            kinds.iter().all(|k| !k.contains("power")
+                && !k.contains("illuminance")
+                && !k.contains("conedelta")),
+            "{kinds:?}"
+        );
+    }
+
     #[test]
     fn named_metals_roughness_remap_and_mix() {
         let i = import_text(
