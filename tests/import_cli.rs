@@ -523,7 +523,11 @@ fn pbrt_surfaces_reflect_on_both_sides_as_in_pbrt() {
 fn pbrt_image_infinite_illuminance_scales_as_pbrt_does() {
     let dir = tempfile::tempdir().unwrap();
     let size = 64;
-    write_square_exr(&dir.path().join("sky.exr"), size, vec![[1.0; 3]; size * size]);
+    write_square_exr(
+        &dir.path().join("sky.exr"),
+        size,
+        vec![[1.0; 3]; size * size],
+    );
     let scene = dir.path().join("lit.pbrt");
     std::fs::write(
         &scene,
@@ -538,5 +542,8 @@ fn pbrt_image_infinite_illuminance_scales_as_pbrt_does() {
         serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
     let scale = v["lights"][0]["scale"].as_f64().unwrap();
     let expected = 100.0 / (std::f64::consts::PI / 2.0);
-    assert!((scale / expected - 1.0).abs() < 0.01, "{scale} vs {expected}");
+    assert!(
+        (scale / expected - 1.0).abs() < 0.01,
+        "{scale} vs {expected}"
+    );
 }

@@ -147,7 +147,6 @@ pub fn light(
             l.insert("falloff_start_deg".into(), json!(cone - delta));
             l.insert("spectrum".into(), s);
             l.insert("scale".into(), json!(scale));
-            im.out.unsupported.note("LightSource spot", "imported with the same cone angles; pbrt's smoothstep falloff between them may differ from Prism's (docs/lights.md)", at);
         }
         "distant" => {
             let from = point("from", DVec3::ZERO)?;
