@@ -332,6 +332,31 @@ fn what_is_not_imported_is_listed_once_per_kind_and_refused_with_strict() {
     assert!(!out.status.success());
 }
 
+/// A pbrt-v4 scene seen from 3 m above: `world` (lights, materials) over a 4 × 4 m floor
+/// at y = −1 wound by `indices`, `size` × `size` px, `spp` independent samples, direct light
+/// only.
+fn pbrt_floor_scene(size: u32, spp: u32, world: &str, indices: &str) -> String {
+    format!(
+        "LookAt 0 3 0  0 -1 0  0 0 1\nCamera \"perspective\" \"float fov\" [ 50 ]\n\
+         Film \"rgb\" \"integer xresolution\" [ {size} ] \"integer yresolution\" [ {size} ]\n\
+         Sampler \"independent\" \"integer pixelsamples\" [ {spp} ]\n\
+         Integrator \"path\" \"integer maxdepth\" [ 1 ]\n\
+         WorldBegin\n{world}\n\
+         Shape \"trianglemesh\" \"point3 P\" [ -2 -1 -2  2 -1 -2  2 -1 2  -2 -1 2 ]\n\
+           \"integer indices\" [ {indices} ]\n"
+    )
+}
+
+/// Writes `text` to `dir/name.pbrt`, imports it with `prism import` and returns the JSON's
+/// path.
+fn import_pbrt(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let path = dir.join(format!("{name}.pbrt"));
+    std::fs::write(&path, text).unwrap();
+    let json = dir.join(format!("{name}.json"));
+    run_ok(prism().arg("import").arg(&path).arg("-o").arg(&json));
+    json
+}
+
 /// Writes a `size`² linear-sRGB EXR (pbrt's equal-area squares in these tests).
 fn write_square_exr(path: &Path, size: usize, pixels: Vec<[f32; 3]>) {
     let image = prism_image::Image::new(
@@ -425,23 +450,13 @@ fn pbrt_goniometric_lights_become_luminaires_with_pbrt_intensities() {
         })
         .collect();
     write_square_exr(&dir.path().join("gonio.exr"), size, square);
-    let scene = |light: &str| {
-        format!(
-            "LookAt 0 3 0  0 -1 0  0 0 1\nCamera \"perspective\" \"float fov\" [ 50 ]\n\
-             Film \"rgb\" \"integer xresolution\" [ 32 ] \"integer yresolution\" [ 32 ]\n\
-             Sampler \"independent\" \"integer pixelsamples\" [ 16 ]\n\
-             Integrator \"path\" \"integer maxdepth\" [ 1 ]\n\
-             WorldBegin\n\
-             AttributeBegin\n{light}\nAttributeEnd\n\
-             Shape \"trianglemesh\" \"point3 P\" [ -2 -1 -2  2 -1 -2  2 -1 2  -2 -1 2 ]\n\
-               \"integer indices\" [ 0 2 1  0 3 2 ]\n"
-        )
-    };
     let render_mean = |name: &str, light: &str| -> (serde_json::Value, Vec<[f64; 3]>) {
-        let path = dir.path().join(format!("{name}.pbrt"));
-        std::fs::write(&path, scene(light)).unwrap();
-        let json = dir.path().join(format!("{name}.json"));
-        run_ok(prism().arg("import").arg(&path).arg("-o").arg(&json));
+        let world = format!("AttributeBegin\n{light}\nAttributeEnd");
+        let json = import_pbrt(
+            dir.path(),
+            name,
+            &pbrt_floor_scene(32, 16, &world, "0 2 1  0 3 2"),
+        );
         let v: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
         let description = prism_scene::load_scene(&json).unwrap();
@@ -476,30 +491,17 @@ fn pbrt_goniometric_lights_become_luminaires_with_pbrt_intensities() {
 #[test]
 fn pbrt_surfaces_reflect_on_both_sides_as_in_pbrt() {
     let dir = tempfile::tempdir().unwrap();
-    let scene = |material: &str, indices: &str| {
-        format!(
-            "LookAt 0 3 0  0 -1 0  0 0 1\nCamera \"perspective\" \"float fov\" [ 50 ]\n\
-             Film \"rgb\" \"integer xresolution\" [ 16 ] \"integer yresolution\" [ 16 ]\n\
-             Sampler \"independent\" \"integer pixelsamples\" [ 4 ]\n\
-             Integrator \"path\" \"integer maxdepth\" [ 1 ]\n\
-             WorldBegin\nLightSource \"point\" \"float scale\" [ 2 ]\n{material}\n\
-             Shape \"trianglemesh\" \"point3 P\" [ -2 -1 -2  2 -1 -2  2 -1 2  -2 -1 2 ]\n\
-               \"integer indices\" [ {indices} ]\n"
-        )
-    };
-    let render_scene = |name: &str, text: String| -> Vec<[f64; 3]> {
-        let path = dir.path().join(format!("{name}.pbrt"));
-        std::fs::write(&path, text).unwrap();
-        let json = dir.path().join(format!("{name}.json"));
-        run_ok(prism().arg("import").arg(&path).arg("-o").arg(&json));
+    let render_scene = |name: &str, material: &str, indices: &str| -> Vec<[f64; 3]> {
+        let world = format!("LightSource \"point\" \"float scale\" [ 2 ]\n{material}");
+        let json = import_pbrt(dir.path(), name, &pbrt_floor_scene(16, 4, &world, indices));
         render_rgb(&prism_scene::load_scene(&json).unwrap(), 4, 3).0
     };
     for material in [
         "",
         "Material \"diffuse\" \"rgb reflectance\" [ 0.2 0.4 0.6 ]",
     ] {
-        let up = render_scene("up", scene(material, "0 2 1  0 3 2"));
-        let down = render_scene("down", scene(material, "0 1 2  0 2 3"));
+        let up = render_scene("up", material, "0 2 1  0 3 2");
+        let down = render_scene("down", material, "0 1 2  0 2 3");
         assert!(up.iter().map(|p| p[1]).sum::<f64>() > 0.0, "{material}");
         // The same paths, mirrored through the floor: equal to rounding.
         let worst = up

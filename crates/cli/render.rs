@@ -312,7 +312,6 @@ pub fn run(args: &RenderArgs, budget: &MemoryBudget) -> Result<ExitCode, String>
         LightSelectionArg::Auto => {}
         LightSelectionArg::Power => {
             scene.set_light_bvh(false);
-            scene.set_packet_tracing(true);
         }
         LightSelectionArg::Bvh => {
             if !scene.set_light_bvh(true) {

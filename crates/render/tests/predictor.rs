@@ -47,8 +47,13 @@ fn a_lambertian_plane_under_a_uniform_sky_is_smooth() {
 
 /// A floor under a point light with a box between them: a hard shadow.
 fn hard_shadow_scene() -> RenderScene {
+    hard_shadow_scene_seen_by(CAMERA)
+}
+
+/// [`hard_shadow_scene`] with `camera` (the scene's `camera` and `film` entries).
+fn hard_shadow_scene_seen_by(camera: &str) -> RenderScene {
     build(&format!(
-        r#"{{{CAMERA},
+        r#"{{{camera},
         "materials": {{"white": {{"type": "lambert", "reflectance": 0.7}}}},
         "shapes": [
           {{"type": "rectangle", "size_m": [20, 20], "material": "white",
@@ -215,20 +220,12 @@ fn hierarchical_shading_never_interpolates_across_a_shadow_edge() {
 #[test]
 fn defocus_caps_b_p_by_the_circle_of_confusion() {
     let scene = |focus_m: f32| {
-        build(&format!(
-            r#"{{"camera": {{"type": "thin_lens", "focal_length_mm": 50, "f_number": 1.0,
+        hard_shadow_scene_seen_by(&format!(
+            r#""camera": {{"type": "thin_lens", "focal_length_mm": 50, "f_number": 1.0,
                 "focus_distance_m": {focus_m},
                 "transform": {{"look_at": {{"eye": [0, 4, 0], "target": [0, 0, 0],
                     "up": [0, 0, -1]}}}}}},
-            "film": {{"resolution": [48, 48]}},
-            "materials": {{"white": {{"type": "lambert", "reflectance": 0.7}}}},
-            "shapes": [
-              {{"type": "rectangle", "size_m": [20, 20], "material": "white",
-                "transform": {{"rotate": {{"axis": [1, 0, 0], "angle_deg": -90}}}}}},
-              {{"type": "cuboid", "size_m": [0.8, 0.1, 0.8], "material": "white",
-                "transform": {{"translate": [0.3, 0.5, 0]}}}}],
-            "lights": [{{"type": "point", "position_m": [0.3, 2.5, 0], "spectrum": 1.0,
-                "scale": 10}}]}}"#
+            "film": {{"resolution": [48, 48]}}"#
         ))
     };
     // The largest b_p on the floor (depth 4 m; the box top is nearer).

@@ -262,24 +262,12 @@ pub fn light(
 /// illuminance it gives an upward (light-space +z) patch per unit scale, as pbrt-v4's
 /// `"illuminance"` computes it (Σ over texels with z > 0 of Y · cos θ × 2π / N²).
 fn environment_map(path: &std::path::Path, at: &Location) -> Result<(Vec<u8>, f64), ImportError> {
-    let image = prism_image::io::read_image(path)
-        .map_err(|e| ImportError::at(at, format!("LightSource infinite \"filename\": {e}")))?;
-    if image.width() != image.height() {
-        return Err(ImportError::at(
-            at,
-            format!(
-                "LightSource infinite \"filename\" {}: {}×{} pixels; pbrt-v4's environment \
-                 images are square (equal-area octahedral)",
-                path.display(),
-                image.width(),
-                image.height()
-            ),
-        ));
-    }
+    let image = crate::pbrt::octahedral::read_square(path, at, "LightSource infinite")?;
     let srgb = prism_spectrum::rgb_space::RgbColorSpace::srgb();
     let mut pixels = image.pixels().to_vec();
     prism_image::io::convert_pixels(&mut pixels, &image.color_space, &srgb);
     let n = image.width();
+    let luminance = srgb.rgb_to_xyz.row(1);
     let upper_illuminance = pixels
         .iter()
         .enumerate()
@@ -291,8 +279,11 @@ fn environment_map(path: &std::path::Path, at: &Location) -> Result<(Vec<u8>, f6
             if w.z <= 0.0 {
                 return 0.0;
             }
-            let y = 0.2126 * f64::from(p[0]) + 0.7152 * f64::from(p[1]) + 0.0722 * f64::from(p[2]);
-            y * w.z
+            luminance.dot(glam::DVec3::new(
+                f64::from(p[0]),
+                f64::from(p[1]),
+                f64::from(p[2]),
+            )) * w.z
         })
         .sum::<f64>()
         * 2.0

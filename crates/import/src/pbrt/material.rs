@@ -295,16 +295,19 @@ fn both_sides(im: &mut Importer, name: &str, m: Map<String, Value>) -> Value {
     if !one_sided {
         return Value::Object(m);
     }
-    let inner = Value::Object(m);
-    let name = match im.out.materials.iter().find(|(_, v)| **v == inner) {
-        Some((n, _)) => n.clone(),
-        None => {
-            let n = im.out.unique_material_name(&format!("{name}-front"));
-            im.out.materials.insert(n.clone(), inner);
-            n
-        }
-    };
-    json!({ "type": "two_sided", "material": name })
+    let inner = shared_material(im, &format!("{name}-front"), Value::Object(m));
+    json!({ "type": "two_sided", "material": inner })
+}
+
+/// The name of a material equal to `m` if the scene has one (the same parameters give the
+/// same material), else of `m` stored under a new name from `base`.
+fn shared_material(im: &mut Importer, base: &str, m: Value) -> String {
+    if let Some((n, _)) = im.out.materials.iter().find(|(_, v)| **v == m) {
+        return n.clone();
+    }
+    let name = im.out.unique_material_name(base);
+    im.out.materials.insert(name.clone(), m);
+    name
 }
 
 fn out_note(im: &mut Importer, kind: &str, consequence: impl Into<String>, at: &Location) {
@@ -321,13 +324,7 @@ pub fn material(
     let Some(m) = convert(im, kind, kind, params, at)? else {
         return Ok(None);
     };
-    // The same parameters give the same material: reuse it.
-    if let Some((n, _)) = im.out.materials.iter().find(|(_, v)| **v == m) {
-        return Ok(Some(n.clone()));
-    }
-    let name = im.out.unique_material_name(kind);
-    im.out.materials.insert(name.clone(), m);
-    Ok(Some(name))
+    Ok(Some(shared_material(im, kind, m)))
 }
 
 /// The material of shapes before any `Material`: pbrt's default, diffuse 0.5 (Prism's
@@ -336,12 +333,7 @@ pub fn default_material(im: &mut Importer) -> String {
     let mut inner = Map::new();
     inner.insert("type".into(), json!("lambert"));
     let m = both_sides(im, "diffuse", inner);
-    if let Some((n, _)) = im.out.materials.iter().find(|(_, v)| **v == m) {
-        return n.clone();
-    }
-    let name = im.out.unique_material_name("diffuse");
-    im.out.materials.insert(name.clone(), m);
-    name
+    shared_material(im, "diffuse", m)
 }
 
 /// `MakeNamedMaterial`.

@@ -13,6 +13,32 @@ use std::f64::consts::PI;
 
 use glam::DVec3;
 
+use crate::error::{ImportError, Location};
+
+/// The image at `path` that pbrt-v4 reads as an equal-area square (`what`: the directive,
+/// for messages): an error unless it reads and is square.
+pub fn read_square(
+    path: &std::path::Path,
+    at: &Location,
+    what: &str,
+) -> Result<prism_image::Image, ImportError> {
+    let image = prism_image::io::read_image(path)
+        .map_err(|e| ImportError::at(at, format!("{what} \"filename\": {e}")))?;
+    if image.width() != image.height() {
+        return Err(ImportError::at(
+            at,
+            format!(
+                "{what} \"filename\" {}: {}×{} pixels; pbrt-v4 reads this image as a square \
+                 (equal-area octahedral)",
+                path.display(),
+                image.width(),
+                image.height()
+            ),
+        ));
+    }
+    Ok(image)
+}
+
 /// pbrt-v4's `EqualAreaSphereToSquare` (exact atan in place of its polynomial).
 pub fn sphere_to_square(d: DVec3) -> (f64, f64) {
     let (x, y, z) = (d.x.abs(), d.y.abs(), d.z.abs());

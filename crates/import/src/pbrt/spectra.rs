@@ -243,15 +243,20 @@ fn side_csv(out: &mut SceneBuilder, pairs: &[(f64, f64)]) -> PbrtSpectrum {
     }
 }
 
+/// Σȳ Δλ over Prism's grid: ∫S·ȳ of a spectrum of pbrt's luminance 1 once
+/// [`emission_factor`] is applied.
+pub fn unit_luminance_sum() -> f64 {
+    tristimulus_sums(&DenseSpectrum::constant(1.0), Observer::Cie1931).y
+}
+
 /// The factor that gives a pbrt light's spectrum pbrt's strength in Prism (module docs).
 pub fn emission_factor(s: &PbrtSpectrum) -> Option<f64> {
     if s.is_rgb {
         return Some(1.0);
     }
     let dense = s.dense.as_ref()?;
-    let y_bar = tristimulus_sums(&DenseSpectrum::constant(1.0), Observer::Cie1931).y;
     let y = tristimulus_sums(dense, Observer::Cie1931).y;
-    (y > 0.0).then(|| y_bar / y)
+    (y > 0.0).then(|| unit_luminance_sum() / y)
 }
 
 #[cfg(test)]

@@ -9,7 +9,7 @@
 //! normal in the cone and the directions from the box to p. It is 0 only where no part of
 //! the box can emit towards p (θ′ ≥ θ_e), so choosing by it is unbiased.
 
-use glam::Vec3A;
+use glam::{Vec3A, Vec4};
 
 use super::area::AreaShape;
 use super::Light;
@@ -105,121 +105,100 @@ impl LightBounds {
     }
 
     /// The importance bound at `p` with unit normal `n` (zero `n`: a point in a medium, no
-    /// cosine there): [`ImportanceBound::importance`].
+    /// cosine there): [`LightBounds4::importance`] of this bound alone.
     pub fn importance(&self, p: Vec3A, n: Vec3A) -> f32 {
-        ImportanceBound::new(self).importance(p, n)
+        LightBounds4::new([Some(self), None, None, None])
+            .importance(p, n)
+            .x
     }
 }
 
-/// A `LightBounds` in the form its importance is evaluated from: the box's bounding sphere
-/// and the cone's sines precomputed (a light BVH evaluates two per level per sample).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ImportanceBound {
-    centre: Vec3A,
-    /// Squared radius of the box's bounding sphere (half its diagonal), m².
-    radius2: f32,
-    w: Vec3A,
-    cos_o: f32,
-    sin_o: f32,
-    cos_e: f32,
-    phi: f32,
-    two_sided: bool,
+/// Up to four `LightBounds` in SIMD lanes, in the form their importance is evaluated from:
+/// each box's bounding sphere and each cone's sine precomputed (an empty lane has φ = 0 and
+/// importance 0). A light BVH evaluates the four children of a node at once.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LightBounds4 {
+    centre: [Vec4; 3],
+    /// Squared radius of each box's bounding sphere (half its diagonal), m².
+    radius2: Vec4,
+    w: [Vec4; 3],
+    cos_o: Vec4,
+    sin_o: Vec4,
+    cos_e: Vec4,
+    phi: Vec4,
+    /// 1 for two-sided emitters, else 0.
+    two_sided: Vec4,
 }
 
-impl ImportanceBound {
-    pub fn centre(&self) -> Vec3A {
-        self.centre
-    }
-    pub fn radius2(&self) -> f32 {
-        self.radius2
-    }
-    pub fn axis(&self) -> Vec3A {
-        self.w
-    }
-    pub fn cos_o(&self) -> f32 {
-        self.cos_o
-    }
-    pub fn sin_o(&self) -> f32 {
-        self.sin_o
-    }
-    pub fn cos_e(&self) -> f32 {
-        self.cos_e
-    }
-    pub fn phi(&self) -> f32 {
-        self.phi
-    }
-    pub fn two_sided(&self) -> bool {
-        self.two_sided
-    }
-
-    pub fn new(b: &LightBounds) -> Self {
-        let centre = b.centroid();
-        let cos_o = b.normals.cos_theta;
+impl LightBounds4 {
+    pub fn new(bounds: [Option<&LightBounds>; 4]) -> Self {
+        let lane =
+            |f: &dyn Fn(&LightBounds) -> f32| Vec4::from_array(bounds.map(|b| b.map_or(0.0, f)));
+        let sin = |c: f32| safe_sqrt(1.0 - c * c);
         Self {
-            centre,
-            radius2: (b.hi - centre).length_squared(),
-            w: b.normals.w,
-            cos_o,
-            sin_o: safe_sqrt(1.0 - cos_o * cos_o),
-            cos_e: b.cos_theta_e,
-            phi: b.phi,
-            two_sided: b.two_sided,
+            centre: [
+                lane(&|b| b.centroid().x),
+                lane(&|b| b.centroid().y),
+                lane(&|b| b.centroid().z),
+            ],
+            radius2: lane(&|b| (b.hi - b.centroid()).length_squared()),
+            w: [
+                lane(&|b| b.normals.w.x),
+                lane(&|b| b.normals.w.y),
+                lane(&|b| b.normals.w.z),
+            ],
+            cos_o: lane(&|b| b.normals.cos_theta),
+            sin_o: lane(&|b| sin(b.normals.cos_theta)),
+            cos_e: lane(&|b| b.cos_theta_e),
+            phi: lane(&|b| b.phi),
+            two_sided: lane(&|b| f32::from(u8::from(b.two_sided))),
         }
     }
 
-    /// Conty Estevez & Kulla 2018 eq. 3 with pbrt-v4's cone arithmetic: φ cos θ′ / d²
-    /// (· cos θ′_i at surfaces), 0 where θ′ ≥ θ_e. The distance is clamped to the bounding
-    /// sphere's radius so points inside the box stay finite.
+    /// Conty Estevez & Kulla 2018 eq. 3 with pbrt-v4's cone arithmetic, per lane:
+    /// φ cos θ′ / d² (· cos θ′_i at surfaces), 0 where θ′ ≥ θ_e. The distance is clamped
+    /// to the bounding sphere's radius so points inside the box stay finite.
     #[inline]
-    pub fn importance(&self, p: Vec3A, n: Vec3A) -> f32 {
+    pub fn importance(&self, p: Vec3A, n: Vec3A) -> Vec4 {
+        let zero = Vec4::ZERO;
+        let one = Vec4::ONE;
         // cos(a − b) clamped to 1 when a < b; sin likewise to 0.
-        let cos_sub = |sin_a: f32, cos_a: f32, sin_b: f32, cos_b: f32| {
-            if cos_a > cos_b {
-                1.0
-            } else {
-                cos_a * cos_b + sin_a * sin_b
-            }
+        let cos_sub = |sin_a: Vec4, cos_a: Vec4, sin_b: Vec4, cos_b: Vec4| {
+            Vec4::select(cos_a.cmpgt(cos_b), one, cos_a * cos_b + sin_a * sin_b)
         };
-        let sin_sub = |sin_a: f32, cos_a: f32, sin_b: f32, cos_b: f32| {
-            if cos_a > cos_b {
-                0.0
-            } else {
-                sin_a * cos_b - cos_a * sin_b
-            }
+        let sin_sub = |sin_a: Vec4, cos_a: Vec4, sin_b: Vec4, cos_b: Vec4| {
+            Vec4::select(cos_a.cmpgt(cos_b), zero, sin_a * cos_b - cos_a * sin_b)
         };
-        let to_p = p - self.centre;
-        let dist2 = to_p.length_squared();
-        let wi = if dist2 > 0.0 {
-            to_p / dist2.sqrt()
-        } else {
-            self.w
-        };
-        let mut cos_w = self.w.dot(wi);
-        if self.two_sided {
-            cos_w = cos_w.abs();
-        }
-        let sin_w = safe_sqrt(1.0 - cos_w * cos_w);
+        let safe_sqrt = |x: Vec4| x.max(zero).sqrt();
+        let t = [
+            Vec4::splat(p.x) - self.centre[0],
+            Vec4::splat(p.y) - self.centre[1],
+            Vec4::splat(p.z) - self.centre[2],
+        ];
+        let dist2 = t[0] * t[0] + t[1] * t[1] + t[2] * t[2];
+        let away = dist2.cmpgt(zero);
+        let inv = Vec4::select(away, one / dist2.sqrt(), zero);
+        let wi = [0, 1, 2].map(|k| Vec4::select(away, t[k] * inv, self.w[k]));
+        let mut cos_w = self.w[0] * wi[0] + self.w[1] * wi[1] + self.w[2] * wi[2];
+        cos_w = Vec4::select(self.two_sided.cmpgt(zero), cos_w.abs(), cos_w);
+        let sin_w = safe_sqrt(one - cos_w * cos_w);
         // θ_b: the half-angle of the bounding sphere seen from p (all directions inside).
-        let (sin_b, cos_b) = if dist2 <= self.radius2 {
-            (0.0, -1.0)
-        } else {
-            let sin2 = self.radius2 / dist2;
-            (sin2.sqrt(), safe_sqrt(1.0 - sin2))
-        };
+        let inside = dist2.cmple(self.radius2);
+        let sin2 = self.radius2 / dist2;
+        let sin_b = Vec4::select(inside, zero, sin2.sqrt());
+        let cos_b = Vec4::select(inside, -one, safe_sqrt(one - sin2));
         let cos_x = cos_sub(sin_w, cos_w, self.sin_o, self.cos_o);
         let sin_x = sin_sub(sin_w, cos_w, self.sin_o, self.cos_o);
         let cos_p = cos_sub(sin_x, cos_x, sin_b, cos_b);
-        if cos_p <= self.cos_e {
-            return 0.0;
-        }
-        let d2 = dist2.max(self.radius2).max(f32::MIN_POSITIVE);
+        let d2 = dist2.max(self.radius2).max(Vec4::splat(f32::MIN_POSITIVE));
         let mut importance = self.phi * cos_p / d2;
         if n != Vec3A::ZERO {
-            let cos_i = wi.dot(n).abs();
-            let sin_i = safe_sqrt(1.0 - cos_i * cos_i);
+            let cos_i = (wi[0] * n.x + wi[1] * n.y + wi[2] * n.z).abs();
+            let sin_i = safe_sqrt(one - cos_i * cos_i);
             importance *= cos_sub(sin_i, cos_i, sin_b, cos_b);
         }
-        importance.max(0.0)
+        let live = cos_p.cmpgt(self.cos_e) & self.phi.cmpgt(zero) & importance.cmpgt(zero);
+        Vec4::select(live, importance, zero)
     }
 }
 

@@ -4,15 +4,15 @@
 //! each with probability 1 / (their count + 1), the tree with the rest.
 //!
 //! The tree is built binary (pbrt-v4's bucketed split cost) and collapsed to four children
-//! per node, whose importances are evaluated together in SIMD lanes ([`Bounds4`]): half
+//! per node, whose importances are evaluated together in SIMD lanes ([`LightBounds4`]): half
 //! the levels, one vector evaluation per level.
 //!
 //! `sample` and `pmf` agree exactly: `pmf` follows the light's recorded path from the root
 //! (two bits per level) and multiplies the same child probabilities `sample` used.
 
-use glam::{Vec3A, Vec4};
+use glam::Vec3A;
 
-use super::light_bounds::{ImportanceBound, LightBounds};
+use super::light_bounds::{LightBounds, LightBounds4};
 
 /// Buckets per axis of the split search (pbrt-v4 uses 12).
 const BUCKETS: usize = 12;
@@ -52,92 +52,9 @@ enum Slot {
     Light(u32),
 }
 
-/// Four [`ImportanceBound`]s in SIMD lanes (an empty slot has φ = 0).
-#[derive(Clone, Debug, PartialEq)]
-struct Bounds4 {
-    centre: [Vec4; 3],
-    radius2: Vec4,
-    w: [Vec4; 3],
-    cos_o: Vec4,
-    sin_o: Vec4,
-    cos_e: Vec4,
-    phi: Vec4,
-    /// 1 for two-sided emitters, else 0.
-    two_sided: Vec4,
-}
-
-impl Bounds4 {
-    fn new(bounds: [Option<&LightBounds>; 4]) -> Self {
-        let b = bounds.map(|b| b.map(ImportanceBound::new));
-        let lane = |f: &dyn Fn(&ImportanceBound) -> f32| {
-            Vec4::from_array(b.map(|x| x.as_ref().map_or(0.0, f)))
-        };
-        Self {
-            centre: [
-                lane(&|x| x.centre().x),
-                lane(&|x| x.centre().y),
-                lane(&|x| x.centre().z),
-            ],
-            radius2: lane(&|x| x.radius2()),
-            w: [
-                lane(&|x| x.axis().x),
-                lane(&|x| x.axis().y),
-                lane(&|x| x.axis().z),
-            ],
-            cos_o: lane(&|x| x.cos_o()),
-            sin_o: lane(&|x| x.sin_o()),
-            cos_e: lane(&|x| x.cos_e()),
-            phi: lane(&|x| x.phi()),
-            two_sided: lane(&|x| f32::from(u8::from(x.two_sided()))),
-        }
-    }
-
-    /// [`ImportanceBound::importance`] of the four lanes at once (the same operations).
-    #[inline]
-    fn importance(&self, p: Vec3A, n: Vec3A) -> Vec4 {
-        let zero = Vec4::ZERO;
-        let one = Vec4::ONE;
-        let cos_sub = |sin_a: Vec4, cos_a: Vec4, sin_b: Vec4, cos_b: Vec4| {
-            Vec4::select(cos_a.cmpgt(cos_b), one, cos_a * cos_b + sin_a * sin_b)
-        };
-        let sin_sub = |sin_a: Vec4, cos_a: Vec4, sin_b: Vec4, cos_b: Vec4| {
-            Vec4::select(cos_a.cmpgt(cos_b), zero, sin_a * cos_b - cos_a * sin_b)
-        };
-        let safe_sqrt = |x: Vec4| x.max(zero).sqrt();
-        let t = [
-            Vec4::splat(p.x) - self.centre[0],
-            Vec4::splat(p.y) - self.centre[1],
-            Vec4::splat(p.z) - self.centre[2],
-        ];
-        let dist2 = t[0] * t[0] + t[1] * t[1] + t[2] * t[2];
-        let away = dist2.cmpgt(zero);
-        let inv = Vec4::select(away, one / dist2.sqrt(), zero);
-        let wi = [0, 1, 2].map(|k| Vec4::select(away, t[k] * inv, self.w[k]));
-        let mut cos_w = self.w[0] * wi[0] + self.w[1] * wi[1] + self.w[2] * wi[2];
-        cos_w = Vec4::select(self.two_sided.cmpgt(zero), cos_w.abs(), cos_w);
-        let sin_w = safe_sqrt(one - cos_w * cos_w);
-        let inside = dist2.cmple(self.radius2);
-        let sin2 = self.radius2 / dist2;
-        let sin_b = Vec4::select(inside, zero, sin2.sqrt());
-        let cos_b = Vec4::select(inside, -one, safe_sqrt(one - sin2));
-        let cos_x = cos_sub(sin_w, cos_w, self.sin_o, self.cos_o);
-        let sin_x = sin_sub(sin_w, cos_w, self.sin_o, self.cos_o);
-        let cos_p = cos_sub(sin_x, cos_x, sin_b, cos_b);
-        let d2 = dist2.max(self.radius2).max(Vec4::splat(f32::MIN_POSITIVE));
-        let mut importance = self.phi * cos_p / d2;
-        if n != Vec3A::ZERO {
-            let cos_i = (wi[0] * n.x + wi[1] * n.y + wi[2] * n.z).abs();
-            let sin_i = safe_sqrt(one - cos_i * cos_i);
-            importance *= cos_sub(sin_i, cos_i, sin_b, cos_b);
-        }
-        let live = cos_p.cmpgt(self.cos_e) & self.phi.cmpgt(zero) & importance.cmpgt(zero);
-        Vec4::select(live, importance, zero)
-    }
-}
-
 #[derive(Clone, Debug, PartialEq)]
 struct Node4 {
-    bounds: Bounds4,
+    bounds: LightBounds4,
     slots: [Slot; 4],
 }
 
@@ -204,7 +121,7 @@ impl LightBvh {
             bounds[k] = Some(binary[m].bounds());
         }
         self.nodes.push(Node4 {
-            bounds: Bounds4::new(bounds),
+            bounds: LightBounds4::new(bounds),
             slots: [Slot::Empty; 4],
         });
         for (k, &m) in members.iter().enumerate() {
@@ -355,6 +272,13 @@ fn cost(b: &LightBounds, extent_ratio: f32) -> f32 {
     b.phi * m_omega * extent_ratio * area.max(f32::MIN_POSITIVE)
 }
 
+/// The bucket of `b`'s centroid along `axis` between the centroids' bounds `clo`, `chi`
+/// (which differ along it).
+fn bucket(b: &LightBounds, axis: usize, clo: Vec3A, chi: Vec3A) -> usize {
+    let (lo, hi) = (clo[axis], chi[axis]);
+    (((b.centroid()[axis] - lo) / (hi - lo) * BUCKETS as f32) as usize).min(BUCKETS - 1)
+}
+
 /// Orders `items` and returns where the second child starts: the cheapest bucket boundary
 /// over the three axes (pbrt-v4 `BVHLightSampler::buildBVH`), the median of the longest
 /// axis where no boundary separates the centroids or the tree is deep.
@@ -372,11 +296,9 @@ fn split(items: &mut [(u32, LightBounds)], bounds: &LightBounds, depth: u32) -> 
             if hi <= lo {
                 continue;
             }
-            let bucket_of =
-                |c: f32| (((c - lo) / (hi - lo) * BUCKETS as f32) as usize).min(BUCKETS - 1);
             let mut buckets: [Option<LightBounds>; BUCKETS] = [None; BUCKETS];
             for (_, b) in items.iter() {
-                let k = bucket_of(b.centroid()[axis]);
+                let k = bucket(b, axis, clo, chi);
                 buckets[k] = Some(match buckets[k] {
                     Some(acc) => acc.union(b),
                     None => *b,
@@ -408,13 +330,9 @@ fn split(items: &mut [(u32, LightBounds)], bounds: &LightBounds, depth: u32) -> 
         }
     }
     if let Some((_, axis, boundary)) = best {
-        let by_bucket = |b: &LightBounds| {
-            let (lo, hi) = (clo[axis], chi[axis]);
-            (((b.centroid()[axis] - lo) / (hi - lo) * BUCKETS as f32) as usize).min(BUCKETS - 1)
-        };
         let mut mid = 0;
         for i in 0..items.len() {
-            if by_bucket(&items[i].1) < boundary {
+            if bucket(&items[i].1, axis, clo, chi) < boundary {
                 items.swap(i, mid);
                 mid += 1;
             }
@@ -531,10 +449,10 @@ mod tests {
         assert_eq!(bvh.pmf(q, Vec3A::NEG_Y, 0), 0.0);
     }
 
-    /// The four lanes give the scalar bound's importance (the same operations, to
-    /// rounding), empty lanes 0.
+    /// Each lane gives its bound's importance as evaluated alone (lanes do not mix), an
+    /// empty lane 0.
     #[test]
-    fn four_lanes_evaluate_the_scalar_importance() {
+    fn four_lanes_evaluate_each_bound_alone() {
         let panel = LightBounds {
             lo: Vec3A::new(-0.3, 2.0, -0.3),
             hi: Vec3A::new(0.3, 2.0, 0.3),
@@ -552,7 +470,7 @@ mod tests {
             ..point_light(Vec3A::new(1.0, 2.5, -1.0), 3.0)
         };
         let lamp = point_light(Vec3A::new(-2.0, 1.0, 0.5), 1.0);
-        let four = Bounds4::new([Some(&panel), Some(&spot), Some(&lamp), None]);
+        let four = LightBounds4::new([Some(&panel), Some(&spot), Some(&lamp), None]);
         for (p, n) in [
             (Vec3A::ZERO, Vec3A::Y),
             (Vec3A::new(1.5, 0.0, -1.0), Vec3A::new(0.0, 0.6, 0.8)),
@@ -561,10 +479,10 @@ mod tests {
         ] {
             let lanes = four.importance(p, n).to_array();
             for (k, b) in [panel, spot, lamp].iter().enumerate() {
-                let scalar = b.importance(p, n);
+                let alone = b.importance(p, n);
                 assert!(
-                    (lanes[k] - scalar).abs() <= 1e-5 * scalar.max(1e-6),
-                    "{p} lane {k}: {} vs {scalar}",
+                    (lanes[k] - alone).abs() <= 1e-5 * alone.max(1e-6),
+                    "{p} lane {k}: {} vs {alone}",
                     lanes[k]
                 );
             }

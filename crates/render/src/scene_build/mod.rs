@@ -75,6 +75,9 @@ pub struct RenderScene {
     /// The scene as flat diffuse patches for the packet tracer (`integrator::packet`), when
     /// it is one and packet tracing is on (the default).
     pub packet: Option<crate::integrator::packet::PacketScene>,
+    /// Whether packet tracing is asked for (`set_packet_tracing`); `packet` is then the
+    /// packet form where the scene allows one, re-evaluated when the light selection changes.
+    packet_tracing: bool,
     /// What the scene uses that a fast path may not support, computed once here; the
     /// packet tracer and the small-scene intersector run only where it is within their
     /// allow-lists (`PacketScene::SUPPORTS`, `SMALL_SCENE_SUPPORTS`).
@@ -173,6 +176,7 @@ impl RenderScene {
             texture_footprint,
             splat: scene.film.reconstruction == prism_scene::Reconstruction::Splat,
             packet: None,
+            packet_tracing: true,
             features,
             media,
         };
@@ -184,6 +188,7 @@ impl RenderScene {
     /// Packet tracing on (where the scene allows it, `PacketScene::new`) or off (every
     /// path through the scalar tracer; for tests and comparisons).
     pub fn set_packet_tracing(&mut self, on: bool) {
+        self.packet_tracing = on;
         self.packet = None;
         if on {
             self.packet = crate::integrator::packet::PacketScene::new(self).ok();
@@ -191,14 +196,11 @@ impl RenderScene {
     }
 
     /// Light samples at shading points choose through the light BVH (`true`, where the
-    /// scene has lights with bounds) or by power; whether the BVH is on afterwards. Turning
-    /// it on drops the packet form (the packet tracer chooses by power); after turning it
-    /// off, `set_packet_tracing(true)` lets the packet tracer serve the scene again.
+    /// scene has lights with bounds) or by power; whether the BVH is on afterwards. The
+    /// packet form is decided again (its allow-list excludes the light BVH).
     pub fn set_light_bvh(&mut self, on: bool) -> bool {
         let on = self.lights.set_light_bvh(on);
-        if on {
-            self.packet = None;
-        }
+        self.set_packet_tracing(self.packet_tracing);
         on
     }
 
