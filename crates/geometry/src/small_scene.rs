@@ -18,7 +18,11 @@
 //! - **Rectangles** (instance leaves) with the exact object-space test of
 //!   [`crate::Rectangle::intersect`]: each lane takes the ray to its rectangle's object space
 //!   with the operations of glam's `Affine3A::transform_point3a`/`transform_vector3a`, so
-//!   `t` is bit-identical to the instanced path.
+//!   `t` is bit-identical to the instanced path. With more than [`LANES`] rectangles, the
+//!   first batch holds the largest (walls, floors: always tested, they bound the ray early)
+//!   and the others are grouped by the Morton code of their centres, each batch with a world
+//!   box slab-tested eight batches at once like the triangles': in an open-plan office of
+//!   126 rectangles (96 ceiling panels) a ray tests ≈ 2 batches instead of 16.
 //! - Everything else (spheres, disks, meshes kept instanced) is left to the caller, which
 //!   tests those leaves one by one after the batches.
 //!
@@ -451,7 +455,10 @@ pub(crate) struct Candidate {
 pub(crate) struct SmallScene {
     triangles: Vec<TriangleBatch>,
     groups: Vec<BoxGroup>,
+    /// Batch 0 is always tested; batch `1 + LANES·g + l` has its box in lane `l` of
+    /// `rectangle_groups[g]`.
     rectangles: Vec<RectangleBatch>,
+    rectangle_groups: Vec<BoxGroup>,
     pub others: Vec<OtherLeaf>,
     /// The widest kernels to run (`prism_cpu::active()` at build; the AVX2 ones when it
     /// allows AVX2).
@@ -533,26 +540,21 @@ impl SmallSceneBuilder {
                 batch.primitive[l] = primitive;
             }
             triangles.push(batch);
-            // Padded like the BVH's leaf boxes (`padded_aabb`), so the slab test never culls
-            // a ray that grazes a triangle lying in a box face.
-            let b = padded_aabb(lo, hi);
-            let lane = i % LANES;
-            if lane == 0 {
-                groups.push(BoxGroup {
-                    lo: [F8::splat(f32::INFINITY); 3],
-                    hi: [F8::splat(f32::NEG_INFINITY); 3],
-                    valid: 0,
-                });
-            }
-            let g = groups.last_mut().expect("pushed above");
-            for axis in 0..3 {
-                g.lo[axis].0[lane] = b.min[axis];
-                g.hi[axis].0[lane] = b.max[axis];
-            }
-            g.valid |= 1 << lane;
+            push_box(&mut groups, i, lo, hi);
         }
-        let rectangles = self
-            .rectangles
+        let ordered = rectangles_in_batch_order(self.rectangles);
+        let mut rectangle_groups: Vec<BoxGroup> = Vec::new();
+        for (i, chunk) in ordered.chunks(LANES).enumerate().skip(1) {
+            let mut lo = Vec3A::splat(f32::INFINITY);
+            let mut hi = Vec3A::splat(f32::NEG_INFINITY);
+            for (r, to_world, _) in chunk {
+                let (l, h) = rectangle_world_box(r, to_world);
+                lo = lo.min(l);
+                hi = hi.max(h);
+            }
+            push_box(&mut rectangle_groups, i - 1, lo, hi);
+        }
+        let rectangles = ordered
             .chunks(LANES)
             .map(|chunk| {
                 let mut batch = RectangleBatch {
@@ -584,10 +586,87 @@ impl SmallSceneBuilder {
             triangles,
             groups,
             rectangles,
+            rectangle_groups,
             others: self.others,
             simd: prism_cpu::active(),
         }
     }
+}
+
+/// Puts the box (min, max) of batch `i` into lane `i % LANES` of the group that holds it,
+/// starting a new group at every multiple of [`LANES`]. Padded like the BVH's leaf boxes
+/// (`padded_aabb`), so the slab test never culls a ray that grazes a leaf lying in a box
+/// face.
+fn push_box(groups: &mut Vec<BoxGroup>, i: usize, lo: Vec3A, hi: Vec3A) {
+    let b = padded_aabb(lo, hi);
+    let lane = i % LANES;
+    if lane == 0 {
+        groups.push(BoxGroup {
+            lo: [F8::splat(f32::INFINITY); 3],
+            hi: [F8::splat(f32::NEG_INFINITY); 3],
+            valid: 0,
+        });
+    }
+    let g = groups.last_mut().expect("pushed above");
+    for axis in 0..3 {
+        g.lo[axis].0[lane] = b.min[axis];
+        g.hi[axis].0[lane] = b.max[axis];
+    }
+    g.valid |= 1 << lane;
+}
+
+/// World box of a rectangle (its four corners).
+fn rectangle_world_box(r: &Rectangle, to_world: &Transform) -> (Vec3A, Vec3A) {
+    let (w, h) = (r.half_width_m, r.half_height_m);
+    [(-w, -h), (w, -h), (w, h), (-w, h)]
+        .iter()
+        .map(|&(x, y)| to_world.point(Vec3A::new(x, y, 0.0)))
+        .fold(
+            (Vec3A::splat(f32::INFINITY), Vec3A::splat(f32::NEG_INFINITY)),
+            |(lo, hi), p| (lo.min(p), hi.max(p)),
+        )
+}
+
+/// The rectangles in the order their batches take: up to [`LANES`] as they come; beyond,
+/// the [`LANES`] largest by world area first (batch 0, tested without a box), the rest by
+/// the 30-bit Morton code of their box centres, so that each later batch is compact.
+fn rectangles_in_batch_order(
+    mut rectangles: Vec<(Rectangle, Transform, u32)>,
+) -> Vec<(Rectangle, Transform, u32)> {
+    if rectangles.len() <= LANES {
+        return rectangles;
+    }
+    let area = |(r, t, _): &(Rectangle, Transform, u32)| {
+        let u = t.vector(Vec3A::new(2.0 * r.half_width_m, 0.0, 0.0));
+        let v = t.vector(Vec3A::new(0.0, 2.0 * r.half_height_m, 0.0));
+        u.cross(v).length()
+    };
+    // Largest first; equal areas keep their scene order (a stable sort).
+    rectangles.sort_by(|a, b| area(b).total_cmp(&area(a)));
+    let mut rest = rectangles.split_off(LANES);
+    let centre = |(r, t, _): &(Rectangle, Transform, u32)| {
+        let (lo, hi) = rectangle_world_box(r, t);
+        (lo + hi) * 0.5
+    };
+    let (lo, hi) = rest.iter().map(centre).fold(
+        (Vec3A::splat(f32::INFINITY), Vec3A::splat(f32::NEG_INFINITY)),
+        |(lo, hi), c| (lo.min(c), hi.max(c)),
+    );
+    let extent = (hi - lo).max(Vec3A::splat(f32::MIN_POSITIVE));
+    let morton = |c: Vec3A| {
+        let q = ((c - lo) / extent * 1023.0).clamp(Vec3A::ZERO, Vec3A::splat(1023.0));
+        let spread = |v: u32| {
+            let mut x = v & 0x3ff;
+            x = (x | (x << 16)) & 0x0300_00ff;
+            x = (x | (x << 8)) & 0x0300_f00f;
+            x = (x | (x << 4)) & 0x030c_30c3;
+            (x | (x << 2)) & 0x0924_9249
+        };
+        spread(q.x as u32) | (spread(q.y as u32) << 1) | (spread(q.z as u32) << 2)
+    };
+    rest.sort_by_key(|r| morton(centre(r)));
+    rectangles.extend(rest);
+    rectangles
 }
 
 impl SmallScene {
@@ -838,10 +917,22 @@ fn closest_kernel<L: Lanes>(
     };
     let rect_base = s.triangles.len() * LANES;
     // Rectangles first: in a room they bound the ray early, so that boxes behind a wall
-    // are skipped.
-    for (i, rb) in s.rectangles.iter().enumerate() {
+    // are skipped. Batch 0 (the largest) always; the others where the ray meets their box
+    // before the closest hit so far.
+    if let Some(rb) = s.rectangles.first() {
         let (ok, t) = rectangle_lanes(rb, &r);
-        best.update(ok, t, keys(rect_base + i * LANES), zero8, zero8);
+        best.update(ok, t, keys(rect_base), zero8, zero8);
+    }
+    for (gi, g) in s.rectangle_groups.iter().enumerate() {
+        let bound = min_lane(&best.t.store()).min(t_max);
+        let mut mask = box_mask(g, &r, bound);
+        while mask != 0 {
+            let j = mask.trailing_zeros() as usize;
+            mask &= mask - 1;
+            let bi = 1 + gi * LANES + j;
+            let (ok, t) = rectangle_lanes(&s.rectangles[bi], &r);
+            best.update(ok, t, keys(rect_base + bi * LANES), zero8, zero8);
+        }
     }
     // Lanes with a zero edge function, tested by the scalar code: (t, key, b1, b2).
     let mut extra: Option<(f32, f32, f32, f32)> = None;
@@ -947,9 +1038,26 @@ fn any_kernel<L: Lanes>(
             }
         }
     }
-    s.rectangles
-        .iter()
-        .any(|rb| rectangle_lanes(rb, &r).0.bits() != 0)
+    if let Some(rb) = s.rectangles.first() {
+        if rectangle_lanes(rb, &r).0.bits() != 0 {
+            return true;
+        }
+    }
+    s.rectangle_groups.iter().enumerate().any(|(gi, g)| {
+        let mut mask = box_mask(g, &r, t_max);
+        while mask != 0 {
+            let j = mask.trailing_zeros() as usize;
+            mask &= mask - 1;
+            if rectangle_lanes(&s.rectangles[1 + gi * LANES + j], &r)
+                .0
+                .bits()
+                != 0
+            {
+                return true;
+            }
+        }
+        false
+    })
 }
 
 #[cfg(test)]

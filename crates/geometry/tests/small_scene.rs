@@ -125,6 +125,24 @@ fn mixed(b: &mut GeometryBuilder) {
     }
 }
 
+/// The Cornell box with 56 small panels at random tilts in a grid under its ceiling: more
+/// rectangles than one batch, so the largest go first and the rest are grouped by position
+/// and culled by their batches' boxes.
+fn many_rectangles(b: &mut GeometryBuilder) {
+    cornell(b);
+    let mut rng = Pcg64::seed_from_u64(9);
+    for i in 0..56 {
+        let (x, z) = ((i % 8) as f32 * 0.25 - 0.875, (i / 8) as f32 * 0.25 - 0.875);
+        let r = Rectangle {
+            half_width_m: rng.gen_range(0.02..0.1),
+            half_height_m: rng.gen_range(0.02..0.1),
+        };
+        let tilt = Transform::rotate(random_unit(&mut rng), rng.gen_range(0.0..3.0)).unwrap();
+        let at = Transform::translate(Vec3A::new(x, rng.gen_range(0.3..0.95), z));
+        b.add_instance(Shape::Rectangle(r), at.compose(&tilt), None);
+    }
+}
+
 /// The same scene built with the small path (default options) and with the BVH.
 fn both(scene: impl Fn(&mut GeometryBuilder)) -> (Geometry, Geometry) {
     let build = |options: BuildOptions| {
@@ -196,6 +214,7 @@ fn small_scene_path_matches_the_bvh_on_random_rays() {
             &(|b: &mut GeometryBuilder| drop(cornell(b))) as &dyn Fn(&mut GeometryBuilder),
         ),
         ("mixed", &mixed),
+        ("many rectangles", &many_rectangles),
     ] {
         let (small, bvh) = both(scene);
         let mut rng = Pcg64::seed_from_u64(11);
