@@ -6,7 +6,7 @@
 //! prism-bandwidth only reads it.
 
 use glam::{UVec2, Vec2, Vec3A};
-use prism_geometry::Curvature;
+use prism_geometry::{Curvature, Differentials};
 
 use crate::error::{pixel_count, pixel_index, BandwidthError};
 
@@ -24,6 +24,7 @@ pub struct GBufferHit {
     view_direction: Vec3A,
     material_id: u32,
     uv: Vec2,
+    differentials: Differentials,
 }
 
 impl GBufferHit {
@@ -90,6 +91,7 @@ impl GBufferHit {
             view_direction,
             material_id,
             uv: Vec2::ZERO,
+            differentials: Differentials::default(),
         })
     }
 
@@ -112,6 +114,36 @@ impl GBufferHit {
     /// The surface's texture coordinates at the hit.
     pub fn uv(&self) -> Vec2 {
         self.uv
+    }
+
+    /// The same hit with the camera ray's differentials there (one pixel step in x and y:
+    /// ∂p in metres, ∂u, ∂v), so that a probe knows the footprint its texture lookups
+    /// filter over (zero unless given). Non-finite values are an error.
+    pub fn with_differentials(
+        mut self,
+        differentials: Differentials,
+    ) -> Result<Self, BandwidthError> {
+        let d = &differentials;
+        let finite = d.dpdx.is_finite()
+            && d.dpdy.is_finite()
+            && [d.dudx, d.dvdx, d.dudy, d.dvdy]
+                .iter()
+                .all(|v| v.is_finite());
+        if !finite {
+            return Err(BandwidthError::invalid(
+                "G-buffer hit",
+                "differentials",
+                *d,
+                "finite ray differentials",
+            ));
+        }
+        self.differentials = differentials;
+        Ok(self)
+    }
+
+    /// The camera ray's differentials at the hit (zero when not given).
+    pub fn differentials(&self) -> Differentials {
+        self.differentials
     }
 
     /// World-space position, metres.

@@ -155,13 +155,16 @@ enum CentreRay {
 
 fn centre_ray(scene: &RenderScene, pixel: UVec2) -> CentreRay {
     let film_point = Vec2::new(pixel.x as f32 + 0.5, pixel.y as f32 + 0.5);
-    let Some(ray) = scene.camera.generate_ray_only(film_point, Vec2::splat(0.5)) else {
+    let Some(ray_differential) = scene.camera.generate_ray(film_point, Vec2::splat(0.5)) else {
         return CentreRay::None;
     };
+    let ray = ray_differential.ray;
     let Some(hit) = scene.geometry.intersect(&ray) else {
         return CentreRay::Escapes(ray.direction);
     };
-    let si = scene.geometry.interaction(&ray, &hit);
+    let mut si = scene.geometry.interaction(&ray, &hit);
+    // The footprint the pixel's texture lookups filter over (the texture term t).
+    si.compute_differentials(&ray_differential);
     let view = -ray.direction;
     // The side the camera sees: eq. 3's cosines are of that side.
     let normal = if si.n_shading.dot(view) < 0.0 {
@@ -178,6 +181,7 @@ fn centre_ray(scene: &RenderScene, pixel: UVec2) -> CentreRay {
         si.material_id,
     )
     .and_then(|hit| hit.with_uv(si.uv))
+    .and_then(|hit| hit.with_differentials(si.differentials))
     {
         Ok(hit) => CentreRay::Hit(hit),
         Err(_) => CentreRay::None,

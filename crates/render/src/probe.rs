@@ -28,7 +28,7 @@ use glam::{UVec2, Vec3A};
 use prism_bandwidth::{
     Bandwidth, GBufferHit, LightSample, MaterialBandwidth, ShadingProbe, Visibility,
 };
-use prism_geometry::{Differentials, Frame, Ray, SurfaceInteraction};
+use prism_geometry::{Frame, Ray, SurfaceInteraction};
 use prism_spectrum::colorimetry::sampled_radiance_to_xyz;
 use prism_spectrum::{SampledSpectrum, SampledWavelengths};
 
@@ -38,6 +38,7 @@ use crate::light::environment_bandwidth::EnvironmentBandwidth;
 use crate::light::{Light, LightHit, LightSampleContext};
 use crate::sampler::{PixelSampler, SamplerKind};
 use crate::scene_build::RenderScene;
+use crate::texture::{TextureBandwidth, TextureContext};
 
 /// Sample indices of the indirect estimates (`sample_indirect`), apart from the light
 /// samples' 0..n_b.
@@ -54,6 +55,9 @@ pub struct RenderProbe<'a> {
     pub material_tables: Vec<MaterialAngularBandwidth>,
     /// Trace the light samples' shadow rays (`Visibility`; the paper ignores visibility).
     pub trace_visibility: bool,
+    /// Per material (`material_id` order): its shading textures' bandwidths (the texture
+    /// term t); empty: t = 0.
+    pub texture_bandwidths: Vec<Vec<TextureBandwidth>>,
 }
 
 impl<'a> RenderProbe<'a> {
@@ -65,12 +69,14 @@ impl<'a> RenderProbe<'a> {
             environment_bandwidths: Vec::new(),
             material_tables: Vec::new(),
             trace_visibility: false,
+            texture_bandwidths: Vec::new(),
         }
     }
 
-    /// The same probe with eq. 7's per-direction map for every environment light and the
+    /// The same probe with eq. 7's per-direction map for every environment light, the
     /// angular bandwidth table of every material the scene's shapes use (others get a
-    /// constant), what the predictor runs with.
+    /// constant) and the bandwidths of those materials' textures, what the predictor runs
+    /// with.
     pub fn with_bandwidth_tables(mut self) -> Result<Self, String> {
         let mut used = vec![false; self.scene.materials.len()];
         for inst in self.scene.geometry.instances() {
@@ -92,6 +98,22 @@ impl<'a> RenderProbe<'a> {
                 }
             })
             .collect();
+        self.texture_bandwidths = self
+            .scene
+            .materials
+            .iter()
+            .zip(&used)
+            .map(|(m, &used)| {
+                if used {
+                    m.shading_textures()
+                        .into_iter()
+                        .map(TextureBandwidth::new)
+                        .collect::<Result<Vec<_>, _>>()
+                } else {
+                    Ok(Vec::new())
+                }
+            })
+            .collect::<Result<_, _>>()?;
         self.environment_bandwidths = self
             .scene
             .lights
@@ -111,16 +133,34 @@ impl<'a> RenderProbe<'a> {
         Ok(self)
     }
 
+    /// t at the hit `si` of material `material_id`: the largest of its shading textures'
+    /// bandwidths there (texture/bandwidth.rs), cycles/m; 0 without textures.
+    pub(crate) fn texture_bandwidth_at(&self, material_id: u32, si: &SurfaceInteraction) -> f32 {
+        let index = (material_id as usize).min(self.texture_bandwidths.len().saturating_sub(1));
+        let Some(textures) = self.texture_bandwidths.get(index) else {
+            return 0.0;
+        };
+        let ctx = TextureContext::from_interaction(si);
+        textures
+            .iter()
+            .map(|t| t.cycles_per_m(&ctx))
+            .fold(0.0, f32::max)
+    }
+
     /// ρ and t of the material `material_id` for light from `wi_local` seen from
-    /// `wo_local`.
+    /// `wo_local`, with the hit's texture term `texture_cycles_per_m`.
     fn material_bandwidth_at(
         &self,
         material_id: u32,
         bsdf: &Bsdf,
         wi_local: Vec3A,
         wo_local: Vec3A,
+        texture_cycles_per_m: f32,
     ) -> MaterialBandwidth {
-        let closed_form = material_bandwidth(bsdf);
+        let closed_form = MaterialBandwidth {
+            texture_cycles_per_m,
+            ..material_bandwidth(bsdf)
+        };
         // `NO_MATERIAL` (and any id past the end) is the default material, the last.
         let index = (material_id as usize).min(self.material_tables.len().saturating_sub(1));
         match self.material_tables.get(index) {
@@ -154,7 +194,8 @@ pub fn light_bandwidth(light: &Light) -> Bandwidth {
     light.bandwidth()
 }
 
-/// ρ of a BSDF (see the module docs): each lobe's `Bxdf::angular_bandwidth_cycles_per_rad`.
+/// ρ of a BSDF (see the module docs): each lobe's `Bxdf::angular_bandwidth_cycles_per_rad`;
+/// t = 0 (the probe adds the hit's texture term, `RenderProbe::texture_bandwidth_at`).
 pub fn material_bandwidth(bsdf: &Bsdf) -> MaterialBandwidth {
     MaterialBandwidth {
         angular_cycles_per_rad: bsdf.lobe.angular_bandwidth_cycles_per_rad(),
@@ -212,7 +253,8 @@ fn hit_interaction(hit: &GBufferHit) -> SurfaceInteraction {
         dndu: Vec3A::ZERO,
         dndv: Vec3A::ZERO,
         curvature: hit.curvature(),
-        differentials: Differentials::default(),
+        // The camera ray's footprint: texture lookups filter as the render's first hit does.
+        differentials: hit.differentials(),
         primitive_id: 0,
         material_id: hit.material_id(),
         object_id: 0,
@@ -379,6 +421,7 @@ impl ShadingProbe for RenderProbe<'_> {
         }
         let si = hit_interaction(hit);
         let material = self.scene.material(hit.material_id());
+        let texture_t = self.texture_bandwidth_at(hit.material_id(), &si);
         let frame = Frame::from_zx(si.n_shading, si.dpdu);
         let wo_local = frame.to_local(hit.view_direction());
         let ctx = LightSampleContext {
@@ -447,6 +490,7 @@ impl ShadingProbe for RenderProbe<'_> {
                             &bsdf,
                             wi_local,
                             wo_local,
+                            texture_t,
                         ),
                         lane_variance: lanes,
                         visibility,
@@ -505,6 +549,7 @@ impl ShadingProbe for RenderProbe<'_> {
                                 &bsdf,
                                 bs.wi,
                                 wo_local,
+                                texture_t,
                             ),
                             lane_variance: lanes,
                             visibility: Visibility::Unknown,

@@ -139,6 +139,78 @@ fn the_probe_reads_uv_textures_at_each_pixel() {
     assert!((mean(&bright) - 0.7).abs() < 0.05, "{}", mean(&bright));
 }
 
+/// A plane under a uniform sky whose reflectance is `texture` (a JSON texture object).
+fn textured_plane(texture: &str) -> RenderScene {
+    build(&format!(
+        r#"{{{CAMERA},
+        "materials": {{"tex": {{"type": "lambert", "reflectance": {{"texture": {texture}}}}}}},
+        "shapes": [{{"type": "rectangle", "size_m": [3, 3], "material": "tex",
+            "transform": {{"rotate": {{"axis": [1, 0, 0], "angle_deg": -90}}}}}}],
+        "lights": [{{"type": "sky", "spectrum": 1.0}}]}}"#
+    ))
+}
+
+/// Median b_p over the pixels that see the plane.
+fn median_b_p(p: &Prediction) -> f32 {
+    let mut b: Vec<f32> = p
+        .pixels
+        .iter()
+        .filter(|x| x.mean_y > 0.0)
+        .map(|x| x.image_bandwidth_cycles_per_px)
+        .collect();
+    b.sort_by(f32::total_cmp);
+    b[b.len() / 2]
+}
+
+/// Test f's texture case: the texture term t (texture/bandwidth.rs) makes a checkerboard
+/// whose fundamental is 0.4 cycles/px sharp (b_p ≥ 0.25) on a plane that is smooth
+/// (b_p < 0.05) without it, and a board of equal cells (a = b) stays smooth. The fine
+/// board's t is its fundamental alone (the pixel's box filter removes the harmonics): b_p
+/// 0.4. A board 16× coarser keeps harmonics up to the 7th: b_p 7·0.4/16 = 0.175.
+#[test]
+fn a_texture_at_0_4_cycles_per_pixel_is_sharp() {
+    // The view is 2·4·tan 20° = 2.91 m over 48 px; 0.4 cycles/px is a period of 2.5 px =
+    // 0.152 m, two cells of 0.076 m: uv_scale 3 m / 0.076 m = 39.6 on the 3 m plane.
+    let fine = run(
+        &textured_plane(r#"{"type": "checkerboard", "a": 0.1, "b": 0.7, "uv_scale": 39.6}"#),
+        true,
+    );
+    let flat = run(
+        &textured_plane(r#"{"type": "checkerboard", "a": 0.4, "b": 0.4, "uv_scale": 39.6}"#),
+        true,
+    );
+    let coarse = run(
+        &textured_plane(r#"{"type": "checkerboard", "a": 0.1, "b": 0.7, "uv_scale": 2.475}"#),
+        true,
+    );
+    let (b_fine, b_flat, b_coarse) = (median_b_p(&fine), median_b_p(&flat), median_b_p(&coarse));
+    eprintln!("checkerboard b_p (median): 0.4 cycles/px {b_fine}, equal cells {b_flat}, 16× coarser {b_coarse}");
+    assert!(b_fine >= 0.25, "{b_fine}");
+    assert!(b_flat < 0.05, "{b_flat}");
+    assert!((b_fine / 0.4 - 1.0).abs() < 0.2, "{b_fine}");
+    assert!((b_coarse / 0.175 - 1.0).abs() < 0.2, "{b_coarse}");
+}
+
+/// fBm in world space on the same plane: 4 octaves, 2 noise units per metre, gain 0.5,
+/// lacunarity 2. A pixel spans 0.0607 m = 0.121 noise units; the lookup keeps octave i while
+/// 2·0.121·2ⁱ ≤ 1, so octaves 0–2 (energies 1, ¼, 1/16); octaves 0–1 hold 95.2 % of that:
+/// t = β·2·2 cycles/m and b_p = t·0.0607 m/px.
+#[test]
+fn world_space_noise_gives_its_finest_resolved_octave() {
+    let p = run(
+        &textured_plane(
+            r#"{"type": "noise", "noise": "fbm", "space": "world", "frequency": 2,
+                "octaves": 4, "gain": 0.5, "lacunarity": 2, "a": 0.1, "b": 0.8}"#,
+        ),
+        true,
+    );
+    let b = median_b_p(&p);
+    let expected =
+        prism_render::texture::bandwidth::PERLIN_BETA_CYCLES_PER_UNIT * 2.0 * 2.0 * 0.0607;
+    eprintln!("world fBm: b_p median {b}, expected {expected}");
+    assert!((b / expected - 1.0).abs() < 0.25, "{b} vs {expected}");
+}
+
 /// Pixels that see the sky directly take the bandwidth of what they look at: the sun's
 /// disk (0.53°) is sharp (b_p ≥ 0.25) in the pixels whose footprint reaches it, the uniform
 /// sky around it smooth (b_p < 0.05). Before, every background pixel took the largest ν_a

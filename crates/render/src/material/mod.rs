@@ -194,6 +194,39 @@ impl Material {
         }
     }
 
+    /// The textures this material's shading varies with across a surface — reflectance,
+    /// roughness, opacity, normal and bump maps — for the predictor's texture term t.
+    pub fn shading_textures(&self) -> Vec<Arc<Texture>> {
+        let mut out = Vec::new();
+        self.push_shading_textures(&mut out);
+        out
+    }
+
+    fn push_shading_textures(&self, out: &mut Vec<Arc<Texture>>) {
+        match self {
+            Material::Surface(surface) => surface.push_shading_textures(out),
+            Material::TwoSided { material } => material.push_shading_textures(out),
+            Material::Mask {
+                material,
+                opacity_texture,
+                ..
+            } => {
+                out.extend(opacity_texture.iter().map(|t| t.texture.clone()));
+                material.push_shading_textures(out);
+            }
+            Material::NormalMap { material, texture } => {
+                out.push(texture.clone());
+                material.push_shading_textures(out);
+            }
+            Material::BumpMap {
+                material, height, ..
+            } => {
+                out.push(height.texture.clone());
+                material.push_shading_textures(out);
+            }
+        }
+    }
+
     /// True when any parameter is a texture (lookups want ray differentials).
     pub fn has_textures(&self) -> bool {
         match self {

@@ -18,7 +18,7 @@ use crate::bsdf::{
     BsdfLobe, Conductor, Dielectric, Lambert, LeafLobe, MicrofacetDistribution, Mix,
     ThinDielectric, MIX_MAX_COMPONENTS,
 };
-use crate::texture::{FloatTexture, TexturedSpectrum};
+use crate::texture::{FloatTexture, Texture, TexturedSpectrum};
 
 /// A surface ready to make lobes: the closed set of kinds that are not wrappers.
 #[derive(Clone, Debug, PartialEq)]
@@ -150,6 +150,28 @@ impl SurfaceMaterial {
             | SurfaceMaterial::ThinDielectric { .. }
             | SurfaceMaterial::Library(_)
             | SurfaceMaterial::Fluorescent(_) => false,
+        }
+    }
+
+    /// Appends the textures this surface's parameters read (`Material::shading_textures`).
+    pub(super) fn push_shading_textures(&self, out: &mut Vec<Arc<Texture>>) {
+        match self {
+            SurfaceMaterial::Lambert { reflectance } => match reflectance {
+                TexturedSpectrum::Texture { texture, .. } => out.push(texture.clone()),
+                TexturedSpectrum::Constant(_) => {}
+            },
+            SurfaceMaterial::Conductor {
+                roughness_texture, ..
+            }
+            | SurfaceMaterial::Dielectric {
+                roughness_texture, ..
+            } => out.extend(roughness_texture.iter().map(|t| t.texture.clone())),
+            SurfaceMaterial::Mix { materials, .. } => {
+                materials.iter().for_each(|m| m.push_shading_textures(out))
+            }
+            SurfaceMaterial::ThinDielectric { .. }
+            | SurfaceMaterial::Library(_)
+            | SurfaceMaterial::Fluorescent(_) => {}
         }
     }
 

@@ -9,6 +9,7 @@
 //! `UVMapping`). Images are read when the scene is built (`load`), through prism-image's
 //! decoders, and validated for their use there.
 
+pub mod bandwidth;
 pub mod checkerboard;
 pub mod footprint;
 pub mod load;
@@ -26,6 +27,7 @@ use prism_spectrum::{
     Spectrum,
 };
 
+pub use bandwidth::TextureBandwidth;
 pub use checkerboard::checkerboard_weight;
 pub use footprint::CameraFootprint;
 pub use load::{build_textures, TexturePurpose, TextureSet};
