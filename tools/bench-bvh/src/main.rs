@@ -10,7 +10,8 @@
 //! Run: `cargo run --release -p bench-bvh > tools/bench-results/bench-bvh.json` (numbers in
 //! docs/geometry.md);
 //! `cargo run --release -p bench-bvh -- --instanced-only [--scene NAME_PART]` runs only the
-//! instanced scenes (those whose name contains `NAME_PART`).
+//! instanced scenes (those whose name contains `NAME_PART`);
+//! `-- --peer DIR` serves a peer comparison (`peer_mode`; tools/peers/embree_bvh.py).
 
 use std::time::Instant;
 
@@ -243,8 +244,70 @@ fn mrays(x: f64) -> Value {
     json!((x / 1e4).round() / 100.0)
 }
 
+/// `--peer DIR`: the workload of a peer comparison (tools/peers/embree_bvh.py). Writes the
+/// benchmark mesh and the incoherent rays to DIR as raw little-endian arrays
+/// (`vertices.f32`: x y z per vertex; `indices.u32`: three per triangle; `rays.f32`: origin
+/// x y z, t_min, direction x y z, t_max per ray), builds the default BVH, prints one JSON line
+/// and then, per stdin line, traces every ray for the closest hit on one thread and prints
+/// one JSON line (seconds, hits): the driver alternates these runs with the peer's.
+fn peer_mode(dir: &std::path::Path) {
+    use std::io::{BufRead, Write};
+    let mesh = bench_mesh();
+    let rays = random_rays(1);
+    std::fs::create_dir_all(dir).expect("peer directory");
+    let write = |name: &str, bytes: Vec<u8>| {
+        let tmp = dir.join(format!("{name}.tmp"));
+        std::fs::write(&tmp, bytes).expect("write peer workload");
+        std::fs::rename(&tmp, dir.join(name)).expect("rename peer workload");
+    };
+    let f32s = |v: &mut Vec<u8>, xs: &[f32]| xs.iter().for_each(|x| v.extend(x.to_le_bytes()));
+    let mut vertices = Vec::new();
+    mesh.positions
+        .iter()
+        .for_each(|p| f32s(&mut vertices, &p.to_array()));
+    write("vertices.f32", vertices);
+    let indices: Vec<u8> = mesh
+        .indices
+        .iter()
+        .flat_map(|t| t.iter().flat_map(|i| i.to_le_bytes()))
+        .collect();
+    write("indices.u32", indices);
+    let mut ray_bytes = Vec::new();
+    for r in &rays {
+        let o = r.origin.to_array();
+        let d = r.direction.to_array();
+        f32s(
+            &mut ray_bytes,
+            &[o[0], o[1], o[2], r.t_min, d[0], d[1], d[2], r.t_max],
+        );
+    }
+    write("rays.f32", ray_bytes);
+    let (g, build_s, _) = build(&mesh, BuildQuality::default());
+    let ready = json!({"ready": true, "triangles": mesh.triangle_count(), "rays": rays.len(),
+                       "preset": BuildQuality::default().name(), "build_s": build_s});
+    println!("{ready}");
+    std::io::stdout().flush().expect("stdout");
+    for line in std::io::stdin().lock().lines() {
+        if line.is_err() {
+            break;
+        }
+        let start = Instant::now();
+        let hits = rays.iter().filter(|r| g.intersect(r).is_some()).count();
+        let seconds = start.elapsed().as_secs_f64();
+        println!("{}", json!({"seconds": seconds, "hits": hits}));
+        std::io::stdout().flush().expect("stdout");
+    }
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().collect();
+    if let Some(dir) = args
+        .iter()
+        .position(|a| a == "--peer")
+        .and_then(|i| args.get(i + 1))
+    {
+        return peer_mode(std::path::Path::new(dir));
+    }
     let instanced_only = args.iter().any(|a| a == "--instanced-only");
     let filter = args
         .iter()
