@@ -99,11 +99,12 @@ fn is_placeholder(path: &str) -> bool {
     })
 }
 
-/// Made by a tool's setup script and git-ignored (tools/mitsuba/.venv, tools/lighting/.venv).
+/// Made by a tool's setup or generator script and git-ignored (tools/mitsuba/.venv,
+/// tools/lighting/.venv, tools/bench-scenes/generated).
 fn is_generated(path: &str) -> bool {
     Path::new(path)
         .components()
-        .any(|c| matches!(c, Component::Normal(name) if name == ".venv"))
+        .any(|c| matches!(c, Component::Normal(name) if name == ".venv" || name == "generated"))
 }
 
 /// `page_dir/target` with `..` and `.` resolved lexically (the target may not exist).

@@ -81,8 +81,14 @@ def light_mask(ref):
 
 
 def worker(variant, threads):
-    """Loads the Cornell box in `variant`, warms up, then renders on request (stdin lines
-    `SPP SEED OUT.exr`, replies one JSON line each)."""
+    """Loads the Cornell box in `variant`, then serves renders (`serve`)."""
+    serve(variant, threads, lambda mi: (mi.cornell_box(), {}))
+
+
+def serve(variant, threads, scene_dict):
+    """Loads `scene_dict(mi)` → (dict, extra ready info) in `variant`, prints one JSON ready
+    line, then renders on request (stdin lines `SPP SEED OUT.exr`, one JSON reply line
+    each: render and CPU seconds of `mi.render` + `dr.eval`)."""
     mi = import_mitsuba()
     import drjit as dr
     import numpy as np
@@ -91,9 +97,11 @@ def worker(variant, threads):
     if threads:
         dr.set_thread_count(threads)
     t = time.perf_counter()
-    scene = mi.load_dict(mi.cornell_box())
+    d, extra = scene_dict(mi)
+    scene = mi.load_dict(d)
     load_s = time.perf_counter() - t
-    ready = {"ready": True, "variant": variant, "threads": dr.thread_count(), "load_s": load_s}
+    ready = {"ready": True, "variant": variant, "threads": dr.thread_count(), "load_s": load_s,
+             **extra}
     print(json.dumps(ready), flush=True)
     for line in sys.stdin:
         spp, seed, out = line.split(maxsplit=2)

@@ -26,7 +26,7 @@ docs/mitsuba.md). Also each renderer's per-channel mean over the reference's.
 
 The reference: Mitsuba (`llvm_ad_spectral`, or `scalar_spectral` without libLLVM) at
 --ref-spp, rendered in passes of 256 spp with distinct seeds and averaged, cached in
-tools/bench-scenes/generated/references/ under a hash of the scene and the translator.
+tools/bench-scenes/generated/references/ under a hash of the translated scene and its assets.
 
 Writes the JSON to tools/bench-results/bench-scenes.json (overwritten; git keeps history).
 Setup: bash tools/mitsuba/setup.sh; cargo build --release.
@@ -74,34 +74,15 @@ RESULT = ROOT / "tools" / "bench-results" / "bench-scenes.json"
 
 
 def worker(variant, threads, scene_path):
-    """Translates and loads one scene in `variant`, then renders on request (stdin lines
-    `SPP SEED OUT.exr`, one JSON reply line each)."""
-    mi = import_mitsuba()
-    import drjit as dr
-    import numpy as np
+    """Translates and loads one scene in `variant`, then serves renders (bench-cornell's
+    `serve`); the ready line carries the translation notes."""
     from prism_scene import translate
 
-    mi.set_variant(variant)
-    if threads:
-        dr.set_thread_count(threads)
-    t = time.perf_counter()
-    scene_dict, notes = translate(mi, scene_path)
-    scene = mi.load_dict(scene_dict)
-    load_s = time.perf_counter() - t
-    print(json.dumps({"ready": True, "variant": variant, "threads": dr.thread_count(),
-                      "load_s": load_s, "notes": notes}), flush=True)
-    for line in sys.stdin:
-        spp, seed, out = line.split(maxsplit=2)
-        t = time.perf_counter()
-        c = time.process_time()
-        img = mi.render(scene, spp=int(spp), seed=int(seed))
-        dr.eval(img)
-        dr.sync_thread()
-        render_s = time.perf_counter() - t
-        cpu_s = time.process_time() - c
-        mi.Bitmap(np.array(img, dtype=np.float32), pixel_format=mi.Bitmap.PixelFormat.RGB).write(
-            out.strip())
-        print(json.dumps({"render_s": render_s, "cpu_s": cpu_s, "file": out.strip()}), flush=True)
+    def scene_dict(mi):
+        d, notes = translate(mi, scene_path)
+        return d, {"notes": notes}
+
+    bench_cornell.serve(variant, threads, scene_dict)
 
 
 class Worker(bench_cornell.Worker):
@@ -126,11 +107,19 @@ class Worker(bench_cornell.Worker):
 
 
 def reference_key(scene_path, ref_spp, variant):
-    h = hashlib.sha256()
+    """Hash of what Mitsuba renders: the translated scene (so editing the translator
+    without changing its output keeps the cache), the generated assets it names, the spp
+    and the variant."""
+    from prism_scene import translate
+
+    mi = import_mitsuba()
+    mi.set_variant("scalar_spectral")
+    translated, _ = translate(mi, scene_path)
+    h = hashlib.sha256(json.dumps(translated, sort_keys=True, default=repr).encode())
     text = pathlib.Path(scene_path).read_text()
-    assets = [a for a in sorted(make_scenes.GENERATED.glob("*.*")) if a.name in text]
-    for p in [scene_path, ROOT / "tools" / "mitsuba" / "prism_scene.py", *assets]:
-        h.update(pathlib.Path(p).read_bytes())
+    for asset in sorted(make_scenes.GENERATED.glob("*.*")):
+        if asset.name in text:
+            h.update(asset.read_bytes())
     h.update(f"{ref_spp} {variant}".encode())
     return h.hexdigest()[:12]
 

@@ -310,6 +310,19 @@ class Translator:
             return None
         return {"distribution": dist, "alpha": float(r)}
 
+    def single_ior(self, m, where):
+        ior = m.get("ior", 1.5)
+        if not isinstance(ior, (int, float)):
+            self.fail(f"{where}.ior", "Mitsuba takes one index of refraction (no dispersion)")
+        return float(ior)
+
+    def smooth_or_rough(self, kind, params, m, where):
+        """Mitsuba's `kind` (smooth) or `rough<kind>` with Prism's roughness."""
+        rough = self.roughness(m, where)
+        if rough is None:
+            return {"type": kind, **params}
+        return {"type": f"rough{kind}", **params, **rough}
+
     def material(self, name, where, depth=0):
         mats = self.scene.get("materials", {})
         if name is None:
@@ -327,28 +340,16 @@ class Translator:
                 eta, k = tabulated(wl, cols["eta"]), tabulated(wl, cols["k"])
             else:
                 eta, k = self.spectrum(m["eta"], f"{where}.eta"), self.spectrum(m["k"], f"{where}.k")
-            out = {"eta": eta.mitsuba(), "k": k.mitsuba()}
-            rough = self.roughness(m, where)
-            if rough is None:
-                return {"type": "conductor", **out}
-            return {"type": "roughconductor", **out, **rough}
+            return self.smooth_or_rough("conductor", {"eta": eta.mitsuba(), "k": k.mitsuba()}, m, where)
         if kind == "dielectric":
-            ior = m.get("ior", 1.5)
-            if not isinstance(ior, (int, float)):
-                self.fail(f"{where}.ior", "Mitsuba's dielectrics take one index of refraction")
-            out = {"int_ior": float(ior), "ext_ior": 1.0}
-            rough = self.roughness(m, where)
-            if rough is None:
-                return {"type": "dielectric", **out}
-            return {"type": "roughdielectric", **out, **rough}
+            ior = self.single_ior(m, where)
+            return self.smooth_or_rough("dielectric", {"int_ior": ior, "ext_ior": 1.0}, m, where)
         if kind == "coated":
-            ior = m.get("ior", 1.5)
-            if not isinstance(ior, (int, float)):
-                self.fail(f"{where}.ior", "one index of refraction")
+            ior = self.single_ior(m, where)
             self.notes.append(f"{where}: Prism integrates the coat's internal Fresnel reflectance "
                               "exactly, Mitsuba's plastic uses a polynomial fit")
             return {"type": "plastic", "diffuse_reflectance": self.reflectance(m.get("diffuse"), f"{where}.diffuse"),
-                    "int_ior": float(ior), "ext_ior": 1.0, "nonlinear": bool(m.get("nonlinear", True))}
+                    "int_ior": ior, "ext_ior": 1.0, "nonlinear": bool(m.get("nonlinear", True))}
         if kind == "two_sided":
             return {"type": "twosided", "bsdf": self.material(m["material"], f"{where}.material", depth + 1)}
         if kind == "normal_map":

@@ -85,35 +85,25 @@ impl<'a> RenderProbe<'a> {
                 *u = true;
             }
         }
-        self.material_tables = self
+        // Per material the shapes use: its angular table and its textures' bandwidths.
+        let per_material: Vec<(MaterialAngularBandwidth, Vec<TextureBandwidth>)> = self
             .scene
             .materials
             .iter()
             .zip(&used)
             .map(|(m, &used)| {
-                if used {
-                    MaterialAngularBandwidth::build(m)
-                } else {
-                    MaterialAngularBandwidth::Constant(0.0)
+                if !used {
+                    return Ok((MaterialAngularBandwidth::Constant(0.0), Vec::new()));
                 }
+                let textures = m
+                    .shading_textures()
+                    .into_iter()
+                    .map(TextureBandwidth::new)
+                    .collect::<Result<Vec<_>, _>>()?;
+                Ok((MaterialAngularBandwidth::build(m), textures))
             })
-            .collect();
-        self.texture_bandwidths = self
-            .scene
-            .materials
-            .iter()
-            .zip(&used)
-            .map(|(m, &used)| {
-                if used {
-                    m.shading_textures()
-                        .into_iter()
-                        .map(TextureBandwidth::new)
-                        .collect::<Result<Vec<_>, _>>()
-                } else {
-                    Ok(Vec::new())
-                }
-            })
-            .collect::<Result<_, _>>()?;
+            .collect::<Result<_, String>>()?;
+        (self.material_tables, self.texture_bandwidths) = per_material.into_iter().unzip();
         self.environment_bandwidths = self
             .scene
             .lights
