@@ -231,6 +231,56 @@ fn background_angular_bandwidth(
         .fold(0.0f32, f32::max)
 }
 
+/// A mirror or smooth glass (a Dirac lobe) shows the sun's disk where the reflected cone of
+/// the pixel's footprint reaches it (test f: "a mirror sphere reflecting the sun"). The
+/// probe follows the centre ray's one mirror direction, which misses a 0.53° sun almost
+/// everywhere on a curved mirror, as the centre ray of a background pixel misses it
+/// (`background_angular_bandwidth`). The cone's half-angle per pixel: the view's own
+/// spread plus twice the normal's turn across the footprint, 2·k·d·rad_per_px / cos θ_x
+/// (k the larger principal curvature, d the depth). Within it of the sun's disk, the pixel
+/// sees the disk's edge: b_p = the sun's ν_a times that spread (cycles/px, clamped as
+/// eq. 6 clamps). Beyond the paper, like the shadow edges.
+fn mirrored_sun_bandwidth(
+    scene: &RenderScene,
+    probe: &RenderProbe<'_>,
+    hit: &GBufferHit,
+    rad_per_px: f32,
+) -> f32 {
+    if !probe.is_dirac_at(hit) {
+        return 0.0;
+    }
+    let (n, v) = (hit.normal(), hit.view_direction());
+    let mirrored = 2.0 * n.dot(v) * n - v;
+    let c = hit.curvature();
+    let turn = 2.0 * c.k1.abs().max(c.k2.abs()) * hit.depth_m() * rad_per_px
+        / hit.cos_theta_view().max(1e-3);
+    let spread_rad = rad_per_px + turn;
+    scene
+        .lights
+        .lights()
+        .iter()
+        .map(|light| match light {
+            Light::Directional(sun) => {
+                let half_angle_rad = (1.0 - sun.one_minus_cos_half_angle).clamp(-1.0, 1.0).acos();
+                let off_rad = mirrored.dot(sun.to_light).clamp(-1.0, 1.0).acos();
+                if off_rad <= half_angle_rad + spread_rad {
+                    (light.bandwidth().angular_cycles_per_rad * spread_rad)
+                        .min(prism_bandwidth::pixel_prediction::MAX_IMAGE_BANDWIDTH_CYCLES_PER_PX)
+                } else {
+                    0.0
+                }
+            }
+            Light::Environment(_)
+            | Light::Sky(_)
+            | Light::Daylight(_)
+            | Light::Point(_)
+            | Light::Spot(_)
+            | Light::Area(_)
+            | Light::Goniometric(_) => 0.0,
+        })
+        .fold(0.0f32, f32::max)
+}
+
 fn escaping_pixel(
     scene: &RenderScene,
     direction: Vec3A,
@@ -416,6 +466,9 @@ pub fn predict_with_probe<'a>(
                                 settings.variance_bandwidth,
                             )
                             .map_err(|e| e.to_string())?;
+                            p.image_bandwidth_cycles_per_px = p
+                                .image_bandwidth_cycles_per_px
+                                .max(mirrored_sun_bandwidth(scene, &probe, &hit, rad_per_px));
                             probe.sample_indirect(
                                 pixel,
                                 &hit,

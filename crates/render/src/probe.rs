@@ -166,6 +166,17 @@ impl<'a> RenderProbe<'a> {
         }
     }
 
+    /// Whether the material at `hit` scatters only in Dirac directions there (a mirror,
+    /// smooth glass), judged at the middle of the visible range.
+    pub(crate) fn is_dirac_at(&self, hit: &GBufferHit) -> bool {
+        let si = hit_interaction(hit);
+        let wavelengths = SampledWavelengths::sample_visible(0.5);
+        self.scene
+            .material(hit.material_id())
+            .bsdf(&si, &wavelengths)
+            .is_specular()
+    }
+
     /// ν_l of light `index` towards `wi`.
     pub(crate) fn light_bandwidth_towards(&self, index: usize, wi: Vec3A) -> Bandwidth {
         let light = &self.scene.lights.lights()[index];

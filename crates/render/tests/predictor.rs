@@ -211,6 +211,97 @@ fn world_space_noise_gives_its_finest_resolved_octave() {
     assert!((b / expected - 1.0).abs() < 0.25, "{b} vs {expected}");
 }
 
+/// Test f's mirror case: a mirror sphere reflecting the sun (0.53°) is sharp (b_p ≥ 0.25)
+/// in the pixels whose reflected footprint reaches the sun's disk — the highlight covers a
+/// fraction of one pixel here, and the probe's mirror direction from the centre ray misses
+/// it — and smooth where the sphere reflects only the uniform sky; with the sun behind the
+/// sphere only the rim is sharp, where the mirror shows what lies behind it.
+#[test]
+fn a_mirror_sphere_reflecting_the_sun_is_sharp_at_the_highlight() {
+    let scene_with_sun = |material: &str, travel: &str| {
+        build(&format!(
+            r#"{{"camera": {{"type": "pinhole", "fov_deg": 30,
+                "transform": {{"look_at": {{"eye": [0, 0, 4], "target": [0, 0, 0]}}}}}},
+            "film": {{"resolution": [48, 48]}},
+            "materials": {{"ball": {material}}},
+            "shapes": [{{"type": "sphere", "radius_m": 0.5, "material": "ball"}}],
+            "lights": [{{"type": "directional", "direction": {travel},
+                        "angular_diameter_deg": 0.53, "illuminance_lx": 100000}},
+                       {{"type": "sky", "spectrum": 1.0}}]}}"#
+        ))
+    };
+    let mirror = run(
+        &scene_with_sun(
+            r#"{"type": "conductor", "metal": "Ag"}"#,
+            "[-0.3, -0.4, -1]",
+        ),
+        true,
+    );
+    // Pixels on the sphere (not background).
+    let on_sphere: Vec<usize> = (0..48 * 48)
+        .filter(|&i| mirror.class[i] != prism_bandwidth::PixelClass::Background)
+        .collect();
+    let b = |p: &Prediction, i: usize| p.pixels[i].image_bandwidth_cycles_per_px;
+    let sharp: Vec<usize> = on_sphere
+        .iter()
+        .copied()
+        .filter(|&i| b(&mirror, i) >= 0.25)
+        .collect();
+    let smooth = on_sphere.iter().filter(|&&i| b(&mirror, i) < 0.05).count();
+    eprintln!(
+        "mirror sphere: {} pixels, {} sharp ({:?}), {smooth} smooth",
+        on_sphere.len(),
+        sharp.len(),
+        sharp.iter().map(|i| (i % 48, i / 48)).collect::<Vec<_>>()
+    );
+    assert!(
+        !sharp.is_empty() && sharp.len() <= 12,
+        "{} sharp pixels",
+        sharp.len()
+    );
+    assert!(
+        smooth >= on_sphere.len() * 3 / 4,
+        "{smooth} of {}",
+        on_sphere.len()
+    );
+    // The highlight sits where the sphere's normal halves the view and sun directions.
+    let half = (glam::Vec3A::new(0.3, 0.4, 1.0).normalize() + glam::Vec3A::Z).normalize();
+    let highlight = 0.5 * half;
+    let px = |i: usize| glam::Vec2::new((i % 48) as f32 + 0.5, (i / 48) as f32 + 0.5);
+    // Projected: 48 px over 2·4·tan 15° m at the sphere's depth (≈ 3.55 m for the cap).
+    let scale = 48.0 / (2.0 * (4.0 - highlight.z) * 15f32.to_radians().tan());
+    let expected = glam::Vec2::new(24.0 + highlight.x * scale, 24.0 - highlight.y * scale);
+    assert!(
+        sharp.iter().any(|&i| px(i).distance(expected) < 2.0),
+        "no sharp pixel near the highlight at {expected}"
+    );
+    // The sun behind the sphere: a mirror sphere reflects every direction, those behind it
+    // squeezed into a thin ring at the silhouette, so the sun's image moves to the rim.
+    let behind = run(
+        &scene_with_sun(r#"{"type": "conductor", "metal": "Ag"}"#, "[0.3, 0.4, 1]"),
+        true,
+    );
+    let rim: Vec<usize> = on_sphere
+        .iter()
+        .copied()
+        .filter(|&i| b(&behind, i) >= 0.25)
+        .collect();
+    eprintln!(
+        "sun behind: sharp pixels {:?}",
+        rim.iter().map(|i| (i % 48, i / 48)).collect::<Vec<_>>()
+    );
+    let radius_px = 0.5 * 48.0 / (2.0 * 4.0 * 15f32.to_radians().tan());
+    assert!(!rim.is_empty());
+    for &i in &rim {
+        let r = px(i).distance(glam::Vec2::splat(24.0));
+        assert!(
+            r > 0.8 * radius_px,
+            "pixel {:?} at {r} px from the centre",
+            px(i)
+        );
+    }
+}
+
 /// Pixels that see the sky directly take the bandwidth of what they look at: the sun's
 /// disk (0.53°) is sharp (b_p ≥ 0.25) in the pixels whose footprint reaches it, the uniform
 /// sky around it smooth (b_p < 0.05). Before, every background pixel took the largest ν_a
