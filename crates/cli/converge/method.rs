@@ -28,7 +28,7 @@ use prism_render::integrator::AmbientOcclusion;
 use prism_render::{Integrator, SamplerKind};
 
 /// Integrator names: (name, available in this build, what it is).
-pub const INTEGRATORS: [(&str, bool, &str); 9] = [
+pub const INTEGRATORS: [(&str, bool, &str); 10] = [
     ("path", true, "spectral path tracer (NEE + MIS)"),
     (
         "light",
@@ -53,6 +53,12 @@ pub const INTEGRATORS: [(&str, bool, &str); 9] = [
         "photon_progressive",
         true,
         "progressive photon mapping (stochastic on surfaces, Hachisuka & Jensen 2009; consistent)",
+    ),
+    (
+        "radiosity",
+        true,
+        "hierarchical radiosity with clustering and a final gather (diffuse scenes, area lights; \
+         biased by the solution's error bound)",
     ),
 ];
 
@@ -240,7 +246,7 @@ impl Method {
     /// quantity; a run compares one quantity only.
     pub fn quantity(&self) -> &'static str {
         match self.integrator {
-            "path" | "light" | "bdpt" | "photon" | "photon_progressive" => "radiance",
+            "path" | "light" | "bdpt" | "photon" | "photon_progressive" | "radiosity" => "radiance",
             other => other,
         }
     }
@@ -280,7 +286,8 @@ impl Method {
             prism_scene::Integrator::Depth
             | prism_scene::Integrator::Normal
             | prism_scene::Integrator::Albedo
-            | prism_scene::Integrator::AmbientOcclusion { .. } => None,
+            | prism_scene::Integrator::AmbientOcclusion { .. }
+            | prism_scene::Integrator::Radiosity { .. } => None,
         };
         let defaults = match prism_scene::Integrator::default() {
             prism_scene::Integrator::Path {
@@ -293,6 +300,7 @@ impl Method {
             | prism_scene::Integrator::Bdpt { .. }
             | prism_scene::Integrator::Photon { .. }
             | prism_scene::Integrator::PhotonProgressive { .. }
+            | prism_scene::Integrator::Radiosity { .. }
             | prism_scene::Integrator::Depth
             | prism_scene::Integrator::Normal
             | prism_scene::Integrator::Albedo
@@ -316,6 +324,7 @@ impl Method {
             | prism_scene::Integrator::Bdpt { .. }
             | prism_scene::Integrator::Photon { .. }
             | prism_scene::Integrator::PhotonProgressive { .. }
+            | prism_scene::Integrator::Radiosity { .. }
             | prism_scene::Integrator::Depth
             | prism_scene::Integrator::Normal
             | prism_scene::Integrator::Albedo
@@ -337,6 +346,7 @@ impl Method {
                     | prism_scene::Integrator::Bdpt { .. }
                     | prism_scene::Integrator::Photon { .. }
                     | prism_scene::Integrator::PhotonProgressive { .. }
+                    | prism_scene::Integrator::Radiosity { .. }
                     | prism_scene::Integrator::Depth
                     | prism_scene::Integrator::Normal
                     | prism_scene::Integrator::Albedo
@@ -377,6 +387,13 @@ impl Method {
                 photons_per_pass: None,
                 initial_radius_m: None,
                 alpha: prism_scene::DEFAULT_PHOTON_ALPHA,
+            },
+            ("radiosity", d @ prism_scene::Integrator::Radiosity { .. }) => *d,
+            ("radiosity", _) => prism_scene::Integrator::Radiosity {
+                error_bound_rel: 0.004,
+                iterations: 3,
+                gather_epsilon: 0.1,
+                sampler,
             },
             ("depth", _) => prism_scene::Integrator::Depth,
             ("normal", _) => prism_scene::Integrator::Normal,

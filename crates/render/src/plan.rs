@@ -373,6 +373,20 @@ impl RenderPlan {
                 let (text, reason) = photon_explain(m, scene);
                 choose("integrator", text, reason);
             }
+            Integrator::Radiosity(r) => {
+                choose(
+                    "integrator",
+                    format!(
+                        "hierarchical radiosity with clustering, error_bound_rel {}, {} \
+                         iteration(s), 16 bands of 25 nm over 380–780 nm; final gather: direct \
+                         light as `path` (max_depth 1), then the solution's reflected radiance",
+                        r.error_bound_rel, r.iterations
+                    ),
+                    "the scene's `integrator` section; the interpolated gather (gather_epsilon) \
+                     is not built yet, so every gather ray is traced"
+                        .into(),
+                );
+            }
             Integrator::Bdpt(b) => {
                 choose(
                     "integrator",

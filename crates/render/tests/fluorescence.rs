@@ -487,13 +487,13 @@ fn with(data: &Data, reradiation: &str, materials: &str) -> String {
         r#"{{"reradiation": {reradiation}, "materials": {materials},
             "shapes": [{{"type": "sphere", "radius_m": 1, "material": "m"}}]}}"#
     );
-    json.replace("ABS", &data.path("dye-abs.csv"))
-        .replace("EM", &data.path("dye-em.csv"))
-        .replace("BAND", &data.path("band.bfc"))
+    json.replace("@ABS@", &data.path("dye-abs.csv"))
+        .replace("@EM@", &data.path("dye-em.csv"))
+        .replace("@BAND@", &data.path("band.bfc"))
 }
 
-const DYE: &str = r#"{"dye": {"absorption": "ABS", "emission": "EM", "quantum_yield": 0.9,
-    "peak_absorptance": 0.8}, "band": {"bfc": "BAND"}}"#;
+const DYE: &str = r#"{"dye": {"absorption": "@ABS@", "emission": "@EM@", "quantum_yield": 0.9,
+    "peak_absorptance": 0.8}, "band": {"bfc": "@BAND@"}}"#;
 
 #[test]
 fn bad_inputs_are_errors_that_name_their_place() {
@@ -547,7 +547,7 @@ fn bad_inputs_are_errors_that_name_their_place() {
         (
             with(
                 &data,
-                r#"{"x": {"bfc": "BAND", "negatives": "drop"}}"#,
+                r#"{"x": {"bfc": "@BAND@", "negatives": "drop"}}"#,
                 "{}",
             ),
             &["reradiation.x.negatives", "`clamp`"],
@@ -590,7 +590,7 @@ fn bad_inputs_are_errors_that_name_their_place() {
             with(
                 &data,
                 &format!(
-                    r#"{{"x": {{"absorption": "{}", "emission": "EM", "quantum_yield": 0.9,
+                    r#"{{"x": {{"absorption": "{}", "emission": "@EM@", "quantum_yield": 0.9,
                         "peak_absorptance": 0.8}}}}"#,
                     p("uv.csv")
                 ),
@@ -602,7 +602,7 @@ fn bad_inputs_are_errors_that_name_their_place() {
             with(
                 &data,
                 &format!(
-                    r#"{{"x": {{"absorption": "ABS", "emission": "{}", "quantum_yield": 0.9,
+                    r#"{{"x": {{"absorption": "@ABS@", "emission": "{}", "quantum_yield": 0.9,
                         "peak_absorptance": 0.8}}}}"#,
                     p("plain-em.csv")
                 ),
@@ -613,7 +613,7 @@ fn bad_inputs_are_errors_that_name_their_place() {
         (
             with(
                 &data,
-                r#"{"x": {"absorption": "ABS", "emission": "EM", "quantum_yield": 1.5,
+                r#"{"x": {"absorption": "@ABS@", "emission": "@EM@", "quantum_yield": 1.5,
                     "peak_absorptance": 0.8}}"#,
                 "{}",
             ),
@@ -872,37 +872,37 @@ fn bad_fluorescence_keys_are_errors_that_name_their_place() {
             r#"{{"media": {{"ink": {{"sigma_s_per_m": 1, "fluorescence": {fluorescence}}}}},
                 "world_medium": "ink"}}"#
         );
-        json.replace("ABS", &data.path("dye-abs.csv"))
-            .replace("EM", &data.path("dye-em.csv"))
+        json.replace("@ABS@", &data.path("dye-abs.csv"))
+            .replace("@EM@", &data.path("dye-em.csv"))
             .replace("PLAIN", &data.path("plain-em.csv"))
             .replace("ZERO", &data.path("zero.csv"))
     };
     let cases: Vec<(String, &[&str])> = vec![
         (
             medium(
-                r#"{"absorption_per_m": "ABS", "emission": "EM", "quantum_yield": 0.9, "yield": 1}"#,
+                r#"{"absorption_per_m": "@ABS@", "emission": "@EM@", "quantum_yield": 0.9, "yield": 1}"#,
             ),
             &["media.ink.fluorescence", "yield"],
         ),
         (
-            medium(r#"{"emission": "EM", "quantum_yield": 0.9}"#),
+            medium(r#"{"emission": "@EM@", "quantum_yield": 0.9}"#),
             &["media.ink.fluorescence", "absorption_per_m"],
         ),
         (
-            medium(r#"{"absorption_per_m": "ABS", "emission": "EM", "quantum_yield": 1.5}"#),
+            medium(r#"{"absorption_per_m": "@ABS@", "emission": "@EM@", "quantum_yield": 1.5}"#),
             &["media.ink.fluorescence.quantum_yield", "1.5"],
         ),
         (
-            medium(r#"{"absorption_per_m": "ABS", "emission": "PLAIN", "quantum_yield": 0.9}"#),
+            medium(r#"{"absorption_per_m": "@ABS@", "emission": "PLAIN", "quantum_yield": 0.9}"#),
             &["media.ink.fluorescence.emission", "`photons`", "`energy`"],
         ),
         (
-            medium(r#"{"absorption_per_m": "ZERO", "emission": "EM", "quantum_yield": 0.9}"#),
+            medium(r#"{"absorption_per_m": "ZERO", "emission": "@EM@", "quantum_yield": 0.9}"#),
             &["media.ink.fluorescence", "zero"],
         ),
         (
             medium(
-                r#"{"absorption_per_m": "missing.csv", "emission": "EM", "quantum_yield": 0.9}"#,
+                r#"{"absorption_per_m": "missing.csv", "emission": "@EM@", "quantum_yield": 0.9}"#,
             ),
             &["media.ink.fluorescence.absorption_per_m", "not found"],
         ),

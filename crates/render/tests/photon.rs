@@ -18,78 +18,12 @@ use glam::UVec2;
 use prism_bandwidth::SamplePlan;
 use prism_render::integrator::{Pass, PhotonEstimator};
 use prism_render::{film_for, render_pass, render_pass_with, RenderScene, RenderSettings};
-use prism_scene::load_scene;
 
 mod support;
-use support::{vol_bytes, Dir};
-
-/// The mean Y over `window` (x0, y0, x1, y1; exclusive ends) of each of the first
-/// `passes` passes (sample indices 0, 1, …; one sample a pixel each, a photon pass being
-/// one sample index), each in its own film, all rendered by one estimator in order.
-fn pass_means(
-    scene: &RenderScene,
-    passes: u32,
-    seed: u64,
-    window: (u32, u32, u32, u32),
-) -> Vec<f64> {
-    let width = scene.resolution.x;
-    pass_images(scene, passes, seed)
-        .iter()
-        .map(|y| window_mean(y, width, window))
-        .collect()
-}
-
-/// The Y image of each of the first `passes` passes, as `pass_means` renders them.
-fn pass_images(scene: &RenderScene, passes: u32, seed: u64) -> Vec<Vec<f32>> {
-    let settings = RenderSettings {
-        spp: 1,
-        seed,
-        ..RenderSettings::default()
-    };
-    let plan = SamplePlan::uniform(scene.resolution, 1).unwrap();
-    let mut estimator = scene.integrator.estimator();
-    (0..passes)
-        .map(|i| {
-            let mut film = film_for(scene, &settings);
-            let pass = Pass {
-                index: i,
-                settings: &settings,
-                plan: &plan,
-                first_sample: i,
-                footprint_plan: None,
-            };
-            render_pass_with(estimator.as_mut(), scene, &pass, &mut film, &|_| {}).unwrap();
-            film.finish().y
-        })
-        .collect()
-}
-
-fn window_mean(y: &[f32], width: u32, (x0, y0, x1, y1): (u32, u32, u32, u32)) -> f64 {
-    let mut sum = 0.0;
-    for py in y0..y1 {
-        for px in x0..x1 {
-            sum += f64::from(y[(py * width + px) as usize]);
-        }
-    }
-    sum / f64::from((x1 - x0) * (y1 - y0))
-}
-
-/// Mean and standard error of independent samples.
-fn mean_se(x: &[f64]) -> (f64, f64) {
-    let n = x.len() as f64;
-    let mean = x.iter().sum::<f64>() / n;
-    let var = x.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0);
-    (mean, (var / n).sqrt())
-}
-
-fn assert_close(what: &str, (mean, se): (f64, f64), expected: f64, expected_se: f64, floor: f64) {
-    let se = (se * se + expected_se * expected_se).sqrt();
-    eprintln!("{what}: {mean:.5} vs {expected:.5}, s.e. {se:.2e}, floor {floor:.2e}");
-    assert!(
-        (mean - expected).abs() <= 4.0 * se + floor,
-        "{what}: {mean} vs {expected} (s.e. {se}, floor {floor})"
-    );
-}
+use support::{
+    assert_close, mean_se, pass_images, pass_means, repository_scene, vol_bytes, with_integrator,
+    Dir,
+};
 
 /// Sun et al. 2005's closed form of the single-scattering airlight of an isotropic point
 /// light of intensity I for the isotropic phase function (the `path` test's formula).
@@ -328,21 +262,6 @@ fn photon_camera_paths_filter_textures_like_path() {
     let path = pixel_variance(&scene_with(r#"{"type": "path", "max_depth": 1}"#));
     eprintln!("per-pixel variance over passes: photon_progressive {photon:.3e}, path {path:.3e}");
     assert!(photon <= 2.0 * path, "photon {photon:.3e}, path {path:.3e}");
-}
-
-/// The repository's scene `name` at `resolution`.
-fn repository_scene(name: &str, resolution: u32) -> RenderScene {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../scenes")
-        .join(name);
-    let description = load_scene(&path).unwrap_or_else(|e| panic!("{e}"));
-    RenderScene::build(&description, Some(UVec2::splat(resolution)))
-        .unwrap_or_else(|e| panic!("{e}"))
-}
-
-fn with_integrator(mut scene: RenderScene, description: prism_scene::Integrator) -> RenderScene {
-    scene.integrator = prism_render::Integrator::from_description(&description).unwrap();
-    scene
 }
 
 fn progressive(max_depth: u32, rr_depth: u32) -> prism_scene::Integrator {

@@ -213,6 +213,16 @@ pub const SCHEMA: &[ObjectSchema] = &[
         ]],
     ),
     row(
+        "integrator<radiosity>",
+        &[&[
+            "type",
+            "error_bound_rel",
+            "iterations",
+            "gather_epsilon",
+            "sampler",
+        ]],
+    ),
+    row(
         "integrator<photon_progressive>",
         &[&[
             "type",

@@ -278,7 +278,7 @@ fn unknown_type_suggests_the_closest_type() {
         e,
         "DIR/scene.json:1:16: integrator: unknown integrator type `ambient_occlusoin`, expected \
          one of `depth`, `normal`, `albedo`, `ambient_occlusion`, `path`, `light`, `bdpt`, \
-         `photon`, `photon_progressive` (did you mean `ambient_occlusion`?)"
+         `photon`, `photon_progressive`, `radiosity` (did you mean `ambient_occlusion`?)"
     );
     // The photon integrators' keys: positioned errors for bad values and unknown keys.
     let e = dir.error(r#"{"integrator": {"type": "photon_progressive", "alpha": 1.2}}"#);

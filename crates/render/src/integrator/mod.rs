@@ -44,6 +44,7 @@ mod path;
 mod path_estimator;
 mod path_state;
 pub mod photon;
+pub mod radiosity;
 mod scatter_vertex;
 
 pub use ambient_occlusion::AmbientOcclusion;
@@ -56,9 +57,10 @@ pub use driver::{
 pub use estimator::{Estimator, Pass, TileWork};
 pub use lane_wavelengths::LaneWavelengths;
 pub use light_tracer::LightTracer;
-pub use path::{mis_weight, FirstHit, PathCounters, PathResult, PathTracer};
+pub use path::{mis_weight, FirstHit, PathCounters, PathResult, PathTracer, SolutionGather};
 pub use path_state::{PathOrigin, PathState, MAX_NULL_EVENTS};
 pub use photon::{PhotonEstimator, PhotonMapper, RadiusRule};
+pub use radiosity::{RadiosityEstimator, RadiosityMethod};
 pub use scatter_vertex::{MediumVertex, ScatterEval, ScatterSample, ScatterVertex, SurfaceVertex};
 
 use glam::DVec3;
@@ -85,6 +87,8 @@ pub enum Integrator {
     Bdpt(Bdpt),
     /// `photon` or `photon_progressive` (`PhotonMapper::is_progressive`).
     Photon(PhotonMapper),
+    /// Hierarchical radiosity with a final gather.
+    Radiosity(RadiosityMethod),
 }
 
 impl Integrator {
@@ -168,6 +172,17 @@ impl Integrator {
                 },
                 memory_limit_bytes: None,
             }),
+            prism_scene::Integrator::Radiosity {
+                error_bound_rel,
+                iterations,
+                gather_epsilon,
+                ..
+            } => Integrator::Radiosity(RadiosityMethod {
+                error_bound_rel: error_bound_rel as f32,
+                iterations,
+                gather_epsilon: gather_epsilon as f32,
+                memory_limit_bytes: None,
+            }),
         })
     }
 
@@ -183,6 +198,7 @@ impl Integrator {
             Integrator::Light(l) => Box::new(*l),
             Integrator::Bdpt(b) => Box::new(*b),
             Integrator::Photon(m) => Box::new(PhotonEstimator::new(*m)),
+            Integrator::Radiosity(r) => Box::new(RadiosityEstimator::new(*r)),
         }
     }
 
@@ -192,6 +208,7 @@ impl Integrator {
     pub fn set_memory_limit_bytes(&mut self, limit: Option<u64>) {
         match self {
             Integrator::Photon(m) => m.memory_limit_bytes = limit,
+            Integrator::Radiosity(r) => r.memory_limit_bytes = limit,
             Integrator::Depth
             | Integrator::Normal
             | Integrator::Albedo
@@ -214,6 +231,11 @@ impl Integrator {
                 Some(reason) => Err(reason),
                 None => m.plan(scene).map(|_| ()),
             },
+            Integrator::Radiosity(_) => radiosity::patches::scene_patches(scene)
+                .map(|_| ())
+                .map_err(|m| {
+                    crate::scene_build::SceneBuildError::new(&scene.file, "integrator", m)
+                }),
             Integrator::Depth
             | Integrator::Normal
             | Integrator::Albedo
@@ -244,6 +266,7 @@ impl Integrator {
                 rr_depth: m.rr_depth,
                 ..PathTracer::default()
             },
+            Integrator::Radiosity(_) => PathTracer::default(),
             Integrator::Depth
             | Integrator::Normal
             | Integrator::Albedo
@@ -257,7 +280,8 @@ impl Integrator {
             Integrator::Path(_)
             | Integrator::Light(_)
             | Integrator::Bdpt(_)
-            | Integrator::Photon(_) => true,
+            | Integrator::Photon(_)
+            | Integrator::Radiosity(_) => true,
             Integrator::Depth
             | Integrator::Normal
             | Integrator::Albedo
@@ -271,7 +295,9 @@ impl Integrator {
     /// concern them.
     pub fn refuse_media(&self, names: &[String]) -> Result<(), String> {
         match self {
-            Integrator::Light(_) | Integrator::Bdpt(_) => Err(media_refusal(self.name(), names)),
+            Integrator::Light(_) | Integrator::Bdpt(_) | Integrator::Radiosity(_) => {
+                Err(media_refusal(self.name(), names))
+            }
             Integrator::Path(_)
             | Integrator::Photon(_)
             | Integrator::Depth
@@ -292,6 +318,7 @@ impl Integrator {
             Integrator::Light(_) => "light",
             Integrator::Bdpt(_) => "bdpt",
             Integrator::Photon(m) => m.name(),
+            Integrator::Radiosity(_) => "radiosity",
         }
     }
 
@@ -315,7 +342,8 @@ impl Integrator {
             Integrator::Path(_)
             | Integrator::Light(_)
             | Integrator::Bdpt(_)
-            | Integrator::Photon(_) => DVec3::ZERO,
+            | Integrator::Photon(_)
+            | Integrator::Radiosity(_) => DVec3::ZERO,
         }
     }
 }

@@ -11,7 +11,7 @@
 //! the same steps.
 
 use glam::{Vec2, Vec3A};
-use prism_geometry::{Ray, RayDifferential};
+use prism_geometry::{Ray, RayDifferential, SurfaceInteraction};
 use prism_scene::{FluorescenceLanes, MisHeuristic};
 use prism_spectrum::{SampledSpectrum, SampledWavelengths};
 
@@ -116,6 +116,17 @@ pub fn mis_weight(heuristic: MisHeuristic, a: f32, b: f32) -> f32 {
     }
 }
 
+/// A view-independent solution a final gather ends on: the radiance a surface point
+/// reflects towards `wo` (emission excluded).
+pub trait SolutionGather: Sync {
+    fn reflected_radiance(
+        &self,
+        si: &SurfaceInteraction,
+        wo: Vec3A,
+        wavelengths: &SampledWavelengths,
+    ) -> SampledSpectrum;
+}
+
 /// Adds β·x to `radiance` unless it is NaN/∞ (then counts it: one bad contribution cannot
 /// poison a pixel, and the stats say so). `count_incident`: also part of the indirect light
 /// at the first hit, `incident` (divided by the first bounce's throughput `first`; not
@@ -169,6 +180,7 @@ impl PathTracer {
             light_samples,
             want_illumination,
             counters,
+            None,
         )
     }
 
@@ -201,6 +213,7 @@ impl PathTracer {
             light_samples,
             want_illumination,
             counters,
+            None,
         )
     }
 
@@ -232,6 +245,36 @@ impl PathTracer {
             light_samples,
             want_illumination,
             counters,
+            None,
+        )
+    }
+
+    /// `radiance` of a final gather (`radiosity`): the path ends at depth `max_depth` on
+    /// `gather`'s reflected radiance instead of stopping there.
+    #[allow(clippy::too_many_arguments)]
+    pub fn radiance_gathered(
+        &self,
+        scene: &RenderScene,
+        camera_ray: &Ray,
+        wavelengths: &mut LaneWavelengths,
+        stream: &mut SampleStream,
+        light_samples: u32,
+        want_illumination: bool,
+        counters: &mut PathCounters,
+        gather: &dyn SolutionGather,
+    ) -> PathResult {
+        self.trace(
+            scene,
+            camera_ray,
+            None,
+            None,
+            1.0,
+            wavelengths,
+            stream,
+            light_samples,
+            want_illumination,
+            counters,
+            Some(gather),
         )
     }
 
@@ -249,6 +292,7 @@ impl PathTracer {
         light_samples: u32,
         want_illumination: bool,
         counters: &mut PathCounters,
+        gather: Option<&dyn SolutionGather>,
     ) -> PathResult {
         if let Some(media) = &scene.media {
             return self.trace_volumetric(
@@ -382,6 +426,20 @@ impl PathTracer {
                 }
             }
             if path.depth == self.max_depth {
+                // A final gather ends on the solution's reflected radiance (light that
+                // bounced at least once before this vertex; emission was counted above).
+                if let Some(g) = gather {
+                    let x = g.reflected_radiance(&si, -ray.direction, path.wavelengths.transport());
+                    add(
+                        &mut radiance,
+                        &mut incident_after_first,
+                        &first_bounce_beta,
+                        path.beta,
+                        x,
+                        path.depth >= 2,
+                        counters,
+                    );
+                }
                 break;
             }
             path.depth += 1;

@@ -36,11 +36,12 @@ pub enum SceneFeature {
     ThinLensCamera,
     LightPaths,
     Reradiation,
+    RadiositySolution,
 }
 
 impl SceneFeature {
     /// Every feature, in declaration order (bit `i` of `SceneFeatures` is `ALL[i]`).
-    pub const ALL: [SceneFeature; 17] = [
+    pub const ALL: [SceneFeature; 18] = [
         SceneFeature::DiagnosticIntegrator,
         SceneFeature::ParticipatingMedia,
         SceneFeature::OpacityMasks,
@@ -58,6 +59,7 @@ impl SceneFeature {
         SceneFeature::ThinLensCamera,
         SceneFeature::LightPaths,
         SceneFeature::Reradiation,
+        SceneFeature::RadiositySolution,
     ];
 
     /// Short name, as `--explain` lists it.
@@ -80,6 +82,7 @@ impl SceneFeature {
             SceneFeature::ThinLensCamera => "thin-lens camera",
             SceneFeature::LightPaths => "light tracing, BDPT or photon mapping",
             SceneFeature::Reradiation => "re-radiation (fluorescence)",
+            SceneFeature::RadiositySolution => "radiosity",
         }
     }
 
@@ -150,6 +153,10 @@ impl SceneFeature {
             SceneFeature::Reradiation => {
                 "a `fluorescent` material: a lane absorbs at one wavelength and re-emits at \
                  another, so spectra are evaluated again along the path"
+            }
+            SceneFeature::RadiositySolution => {
+                "the `radiosity` method: a hierarchical radiosity solution, then a final \
+                 gather per camera sample that ends on it"
             }
         }
     }
@@ -233,6 +240,7 @@ impl SceneFeatures {
             Integrator::Light(_) | Integrator::Bdpt(_) | Integrator::Photon(_) => {
                 f.insert(SceneFeature::LightPaths)
             }
+            Integrator::Radiosity(_) => f.insert(SceneFeature::RadiositySolution),
             Integrator::Path(_) => {}
         }
         match camera {

@@ -1,0 +1,200 @@
+//! The hierarchy the links connect: a binary cluster tree over the input patches (Smits,
+//! Arvo & Greenberg 1994; split at the median centre along the widest axis) whose leaves
+//! are the patches' root elements, each the root of its own lazily built quadtree.
+
+use glam::Vec3A;
+
+use crate::element::ElementShape;
+
+/// A node: a cluster of input patches or a (sub-)element of one patch.
+#[derive(Clone, Debug)]
+pub(crate) struct Node {
+    pub kind: NodeKind,
+    /// Surface area below the node, m².
+    pub area_m2: f32,
+    pub lo: Vec3A,
+    pub hi: Vec3A,
+}
+
+#[derive(Clone, Debug)]
+pub(crate) enum NodeKind {
+    Cluster {
+        children: [u32; 2],
+        /// Range of [`Hierarchy::order`] holding the cluster's patches.
+        patches: (u32, u32),
+    },
+    Element {
+        shape: ElementShape,
+        patch: u32,
+        level: u8,
+        /// Index of the first of four consecutive children; `None` for a leaf.
+        first_child: Option<u32>,
+    },
+}
+
+pub(crate) struct Hierarchy {
+    pub nodes: Vec<Node>,
+    pub root: u32,
+    /// Node of each input patch's root element.
+    pub patch_root: Vec<u32>,
+    /// Input patches in cluster order (each cluster's patches are contiguous).
+    pub order: Vec<u32>,
+    /// Prefix sums of the areas of `order` (length + 1), for area-weighted sampling.
+    pub order_area_prefix: Vec<f64>,
+}
+
+impl Hierarchy {
+    pub fn build(shapes: &[ElementShape]) -> Self {
+        let mut nodes: Vec<Node> = shapes
+            .iter()
+            .enumerate()
+            .map(|(i, s)| {
+                let (lo, hi) = s.bounds();
+                Node {
+                    kind: NodeKind::Element {
+                        shape: *s,
+                        patch: i as u32,
+                        level: 0,
+                        first_child: None,
+                    },
+                    area_m2: s.area_m2(),
+                    lo,
+                    hi,
+                }
+            })
+            .collect();
+        let patch_root = (0..shapes.len() as u32).collect();
+        let mut order: Vec<u32> = (0..shapes.len() as u32).collect();
+        let centres: Vec<Vec3A> = shapes.iter().map(|s| s.centre()).collect();
+        let root = build_clusters(&mut nodes, &mut order, 0, &centres);
+        let mut order_area_prefix = Vec::with_capacity(order.len() + 1);
+        let mut acc = 0.0f64;
+        order_area_prefix.push(0.0);
+        for &p in &order {
+            acc += f64::from(shapes[p as usize].area_m2());
+            order_area_prefix.push(acc);
+        }
+        Self {
+            nodes,
+            root,
+            patch_root,
+            order,
+            order_area_prefix,
+        }
+    }
+
+    /// The children of node `n` (none for a leaf element).
+    pub fn children(&self, n: u32) -> ChildIter {
+        match self.nodes[n as usize].kind {
+            NodeKind::Cluster { children, .. } => ChildIter {
+                first: children[0],
+                second: Some(children[1]),
+                count: 2,
+                consecutive: false,
+                at: 0,
+            },
+            NodeKind::Element { first_child, .. } => ChildIter {
+                first: first_child.unwrap_or(0),
+                second: None,
+                count: if first_child.is_some() { 4 } else { 0 },
+                consecutive: true,
+                at: 0,
+            },
+        }
+    }
+
+    /// Creates the four children of element `n` if it has none.
+    pub fn split_element(&mut self, n: u32) {
+        let (shape, patch, level) = match self.nodes[n as usize].kind {
+            NodeKind::Element {
+                shape,
+                patch,
+                level,
+                first_child: None,
+            } => (shape, patch, level),
+            NodeKind::Element { .. } | NodeKind::Cluster { .. } => return,
+        };
+        let first = self.nodes.len() as u32;
+        for child in shape.children() {
+            let (lo, hi) = child.bounds();
+            self.nodes.push(Node {
+                kind: NodeKind::Element {
+                    shape: child,
+                    patch,
+                    level: level + 1,
+                    first_child: None,
+                },
+                area_m2: child.area_m2(),
+                lo,
+                hi,
+            });
+        }
+        if let NodeKind::Element { first_child, .. } = &mut self.nodes[n as usize].kind {
+            *first_child = Some(first);
+        }
+    }
+}
+
+/// Iterator over a node's children.
+pub(crate) struct ChildIter {
+    first: u32,
+    second: Option<u32>,
+    count: u32,
+    consecutive: bool,
+    at: u32,
+}
+
+impl Iterator for ChildIter {
+    type Item = u32;
+    fn next(&mut self) -> Option<u32> {
+        if self.at >= self.count {
+            return None;
+        }
+        let i = self.at;
+        self.at += 1;
+        Some(if self.consecutive || i == 0 {
+            self.first + i
+        } else {
+            self.second.unwrap_or(self.first)
+        })
+    }
+}
+
+/// Builds the clusters over `order[..]` (whose first element sits at `offset` of the whole
+/// order) and returns the subtree's root.
+fn build_clusters(nodes: &mut Vec<Node>, order: &mut [u32], offset: u32, centres: &[Vec3A]) -> u32 {
+    if order.len() == 1 {
+        return order[0];
+    }
+    let (lo, hi) = order.iter().fold(
+        (Vec3A::splat(f32::INFINITY), Vec3A::splat(f32::NEG_INFINITY)),
+        |(lo, hi), &p| (lo.min(centres[p as usize]), hi.max(centres[p as usize])),
+    );
+    let extent = hi - lo;
+    let axis = if extent.x >= extent.y && extent.x >= extent.z {
+        0
+    } else if extent.y >= extent.z {
+        1
+    } else {
+        2
+    };
+    let mid = order.len() / 2;
+    order.select_nth_unstable_by(mid, |&a, &b| {
+        centres[a as usize][axis].total_cmp(&centres[b as usize][axis])
+    });
+    let (left, right) = order.split_at_mut(mid);
+    let a = build_clusters(nodes, left, offset, centres);
+    let b = build_clusters(nodes, right, offset + mid as u32, centres);
+    let (na, nb) = (&nodes[a as usize], &nodes[b as usize]);
+    let node = Node {
+        kind: NodeKind::Cluster {
+            children: [a, b],
+            patches: (offset, offset + order.len() as u32),
+        },
+        area_m2: na.area_m2 + nb.area_m2,
+        lo: na.lo.min(nb.lo),
+        hi: na.hi.max(nb.hi),
+    };
+    nodes.push(node);
+    nodes.len() as u32 - 1
+}

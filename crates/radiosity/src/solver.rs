@@ -1,0 +1,694 @@
+//! Hierarchical radiosity with clustering: links between nodes refined by the BFA oracle
+//! (Hanrahan, Salzman & Aupperle 1991 §4, with B the source's radiosity, F the receiver's
+//! form-factor bound, A its area), cluster sources (Smits, Arvo & Greenberg 1994), gathering
+//! and push–pull (HSA §5), spectral per band.
+//!
+//! Receivers are always elements: a link whose receiver is a cluster is refined to the
+//! cluster's patches, so energy reaches each patch with its own orientation (what Smits'
+//! α-links distribute) and no cluster stores directional energy. Sources may be clusters:
+//! they emit their area-averaged radiosity through a form factor sampled over their patches
+//! (the disk approximation), which the oracle only accepts where the power it may carry is
+//! below the bound.
+
+use std::time::Instant;
+
+use glam::Vec3A;
+use rayon::prelude::*;
+
+use crate::element::ElementShape;
+use crate::form_factor::{disk_approximation, element_to_element, point_to_polygon};
+use crate::hierarchy::{Hierarchy, NodeKind};
+
+/// A surface the solution covers: one side of a planar patch, uniform over it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct InputPatch {
+    pub shape: ElementShape,
+    /// Diffuse reflectance per band, in [0, 1).
+    pub reflectance: Vec<f32>,
+    /// Emitted radiosity (exitance, π × the Lambertian radiance) per band.
+    pub emission: Vec<f32>,
+}
+
+/// Whether the segment between two surface points is free (the caller offsets the points
+/// off their surfaces along `n_from` / `n_to`).
+pub trait Visibility: Sync {
+    fn visible(&self, from: Vec3A, n_from: Vec3A, to: Vec3A, n_to: Vec3A) -> bool;
+}
+
+/// No occluders: a convex enclosure, the closed-form tests.
+pub struct Unoccluded;
+
+impl Visibility for Unoccluded {
+    fn visible(&self, _: Vec3A, _: Vec3A, _: Vec3A, _: Vec3A) -> bool {
+        true
+    }
+}
+
+/// How the solution is refined and solved.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RadiositySettings {
+    /// A link is refined while the power it may carry (B_source · F · A_receiver, for the
+    /// band where it is largest) exceeds this fraction of the brightest emitter's power
+    /// (its exitance × area).
+    pub error_bound_rel: f32,
+    /// Deepest subdivision of an input patch (4^levels sub-elements at most).
+    pub max_levels: u8,
+    /// Gauss–Legendre nodes per dimension of an element-to-element form factor.
+    pub quadrature_nodes: usize,
+    /// Rays per link for its visibility fraction (and samples of a cluster source).
+    pub visibility_rays: usize,
+    /// Solving stops when no leaf's radiosity changes by more than this fraction of the
+    /// largest radiosity in a sweep.
+    pub solve_tolerance_rel: f32,
+    pub max_sweeps: u32,
+    /// `Some(bytes)`: refinement stops with an error beyond this size.
+    pub memory_limit_bytes: Option<u64>,
+}
+
+impl Default for RadiositySettings {
+    fn default() -> Self {
+        Self {
+            error_bound_rel: 0.004,
+            max_levels: 6,
+            quadrature_nodes: 3,
+            visibility_rays: 16,
+            solve_tolerance_rel: 1e-5,
+            max_sweeps: 500,
+            memory_limit_bytes: None,
+        }
+    }
+}
+
+/// Why a solution could not be built.
+#[derive(Clone, Debug, PartialEq)]
+pub enum RadiosityError {
+    NoPatches,
+    /// Input patch `patch`'s band arrays do not have the solution's band count.
+    BandCount {
+        patch: usize,
+        expected: usize,
+    },
+    /// Refinement needed more than the memory limit.
+    MemoryLimit {
+        limit_bytes: u64,
+        needed_bytes: u64,
+    },
+}
+
+impl std::fmt::Display for RadiosityError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            RadiosityError::NoPatches => write!(f, "the scene has no surface for radiosity"),
+            RadiosityError::BandCount { patch, expected } => {
+                write!(f, "patch {patch}: expected {expected} bands")
+            }
+            RadiosityError::MemoryLimit {
+                limit_bytes,
+                needed_bytes,
+            } => write!(
+                f,
+                "the radiosity hierarchy needs more than {:.1} MiB (limit {:.1} MiB, \
+                 --max-memory): raise the limit or the error bound",
+                *needed_bytes as f64 / 1048576.0,
+                *limit_bytes as f64 / 1048576.0
+            ),
+        }
+    }
+}
+
+impl std::error::Error for RadiosityError {}
+
+/// One link: the receiver gathers `form_factor × B(source)`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Link {
+    source: u32,
+    form_factor: f32,
+}
+
+/// What an iteration did.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct IterationStats {
+    /// Input patches.
+    pub patches: usize,
+    /// Leaf elements (the finest pieces the solution holds).
+    pub elements: usize,
+    pub links: usize,
+    pub memory_bytes: u64,
+    pub refine_s: f64,
+    pub solve_s: f64,
+    /// Gather + push–pull sweeps until converged.
+    pub sweeps: u32,
+}
+
+/// A hierarchical radiosity solution.
+pub struct Radiosity {
+    settings: RadiositySettings,
+    bands: usize,
+    hierarchy: Hierarchy,
+    reflectance: Vec<f32>,
+    emission: Vec<f32>,
+    /// Per node × band: radiosity (area average below the node).
+    radiosity: Vec<f32>,
+    /// Per node: the largest band radiosity below the node (the oracle's B).
+    radiosity_max: Vec<f32>,
+    /// Per node × band: irradiance gathered over the node's own links.
+    gathered: Vec<f32>,
+    links: Vec<Vec<Link>>,
+    /// The oracle's threshold, in the emission's units × m².
+    power_threshold: f32,
+    iterations: u32,
+}
+
+impl Radiosity {
+    pub fn new(
+        patches: &[InputPatch],
+        bands: usize,
+        settings: RadiositySettings,
+    ) -> Result<Self, RadiosityError> {
+        if patches.is_empty() {
+            return Err(RadiosityError::NoPatches);
+        }
+        for (i, p) in patches.iter().enumerate() {
+            if p.reflectance.len() != bands || p.emission.len() != bands {
+                return Err(RadiosityError::BandCount {
+                    patch: i,
+                    expected: bands,
+                });
+            }
+        }
+        let shapes: Vec<ElementShape> = patches.iter().map(|p| p.shape).collect();
+        let hierarchy = Hierarchy::build(&shapes);
+        let brightest = patches
+            .iter()
+            .map(|p| {
+                let b = p.emission.iter().copied().fold(0.0f32, f32::max);
+                (b, b * p.shape.area_m2())
+            })
+            .fold((0.0f32, 0.0f32), |a, b| if b.0 > a.0 { b } else { a });
+        let mut solution = Self {
+            settings,
+            bands,
+            reflectance: patches.iter().flat_map(|p| p.reflectance.clone()).collect(),
+            emission: patches.iter().flat_map(|p| p.emission.clone()).collect(),
+            radiosity: Vec::new(),
+            radiosity_max: Vec::new(),
+            gathered: Vec::new(),
+            links: Vec::new(),
+            power_threshold: settings.error_bound_rel * brightest.1,
+            hierarchy,
+            iterations: 0,
+        };
+        solution.grow_arrays();
+        solution.push_pull();
+        Ok(solution)
+    }
+
+    /// Bands per radiosity value.
+    pub fn bands(&self) -> usize {
+        self.bands
+    }
+
+    /// Input patch `patch`'s emitted radiosity per band.
+    pub fn emission(&self, patch: usize) -> &[f32] {
+        &self.emission[patch * self.bands..(patch + 1) * self.bands]
+    }
+
+    /// Input patch `patch`'s reflectance per band.
+    pub fn reflectance(&self, patch: usize) -> &[f32] {
+        &self.reflectance[patch * self.bands..(patch + 1) * self.bands]
+    }
+
+    /// Radiosity per band of the leaf element of input patch `patch` holding point `p`
+    /// (projected onto the patch's plane, clamped into it).
+    pub fn radiosity_at(&self, patch: usize, p: Vec3A) -> &[f32] {
+        let mut node = self.hierarchy.patch_root[patch];
+        let shape = match self.hierarchy.nodes[node as usize].kind {
+            NodeKind::Element { shape, .. } => shape,
+            NodeKind::Cluster { .. } => unreachable!("patch roots are elements"),
+        };
+        let (mut u, mut v) = shape.parameters_of(p);
+        u = u.clamp(0.0, 1.0);
+        v = v.clamp(0.0, 1.0);
+        if let ElementShape::Triangle { .. } = shape {
+            let s = u + v;
+            if s > 1.0 {
+                u /= s;
+                v /= s;
+            }
+        }
+        while let NodeKind::Element {
+            shape,
+            first_child: Some(first),
+            ..
+        } = self.hierarchy.nodes[node as usize].kind
+        {
+            let (c, cu, cv) = shape.child_at(u, v);
+            node = first + c as u32;
+            u = cu;
+            v = cv;
+        }
+        self.node_radiosity(node)
+    }
+
+    fn node_radiosity(&self, node: u32) -> &[f32] {
+        let b = node as usize * self.bands;
+        &self.radiosity[b..b + self.bands]
+    }
+
+    /// Power leaving all patches per band (Σ B·A).
+    pub fn total_power(&self) -> Vec<f32> {
+        let mut sum = vec![0.0f64; self.bands];
+        for &n in &self.hierarchy.patch_root {
+            let area = f64::from(self.hierarchy.nodes[n as usize].area_m2);
+            for (s, b) in sum.iter_mut().zip(self.node_radiosity(n)) {
+                *s += f64::from(*b) * area;
+            }
+        }
+        sum.into_iter().map(|s| s as f32).collect()
+    }
+
+    /// One iteration: refine the links against the current radiosities, then solve to
+    /// convergence.
+    pub fn iterate(
+        &mut self,
+        visibility: &dyn Visibility,
+    ) -> Result<IterationStats, RadiosityError> {
+        let start = Instant::now();
+        self.refine(visibility)?;
+        let refine_s = start.elapsed().as_secs_f64();
+        let start = Instant::now();
+        let sweeps = self.solve();
+        self.iterations += 1;
+        let mut stats = self.stats();
+        stats.refine_s = refine_s;
+        stats.solve_s = start.elapsed().as_secs_f64();
+        stats.sweeps = sweeps;
+        Ok(stats)
+    }
+
+    /// Sizes of the current hierarchy.
+    pub fn stats(&self) -> IterationStats {
+        let elements = self
+            .hierarchy
+            .nodes
+            .iter()
+            .filter(|n| {
+                matches!(
+                    n.kind,
+                    NodeKind::Element {
+                        first_child: None,
+                        ..
+                    }
+                )
+            })
+            .count();
+        IterationStats {
+            patches: self.hierarchy.patch_root.len(),
+            elements,
+            links: self.links.iter().map(Vec::len).sum(),
+            memory_bytes: self.memory_bytes(),
+            refine_s: 0.0,
+            solve_s: 0.0,
+            sweeps: 0,
+        }
+    }
+
+    fn memory_bytes(&self) -> u64 {
+        let nodes = self.hierarchy.nodes.len() as u64;
+        let links: u64 = self.links.iter().map(|l| l.capacity() as u64).sum();
+        nodes
+            * (std::mem::size_of::<crate::hierarchy::Node>() as u64
+                + std::mem::size_of::<Vec<Link>>() as u64
+                + 4 * (2 * self.bands as u64 + 1))
+            + links * std::mem::size_of::<Link>() as u64
+            + (self.reflectance.len() + self.emission.len()) as u64 * 4
+    }
+
+    fn grow_arrays(&mut self) {
+        let n = self.hierarchy.nodes.len();
+        self.radiosity.resize(n * self.bands, 0.0);
+        self.radiosity_max.resize(n, 0.0);
+        self.gathered.resize(n * self.bands, 0.0);
+        self.links.resize_with(n, Vec::new);
+    }
+
+    // ---- refinement -------------------------------------------------------------------
+
+    fn refine(&mut self, visibility: &dyn Visibility) -> Result<(), RadiosityError> {
+        if self.iterations == 0 {
+            let root = self.hierarchy.root;
+            self.refine_pair(root, root, visibility)?;
+        } else {
+            // Re-examine every link against the radiosities the last solve gave.
+            for r in 0..self.links.len() as u32 {
+                let links = std::mem::take(&mut self.links[r as usize]);
+                let mut kept = Vec::with_capacity(links.len());
+                let mut refined = Vec::new();
+                for link in links {
+                    if self.should_split(r, link.source) {
+                        refined.push(link.source);
+                    } else {
+                        kept.push(link);
+                    }
+                }
+                self.links[r as usize] = kept;
+                for s in refined {
+                    self.refine_split(r, s, visibility)?;
+                }
+            }
+        }
+        self.grow_arrays();
+        Ok(())
+    }
+
+    /// Whether the link r ← s may carry more than the threshold and can be split.
+    fn should_split(&self, r: u32, s: u32) -> bool {
+        let (bound, variation) = self.form_factor_bound(r, s);
+        bound > 0.0
+            && self.radiosity_max[s as usize] * variation * self.hierarchy.nodes[r as usize].area_m2
+                > self.power_threshold
+            && (self.splittable(r) || self.splittable(s))
+    }
+
+    fn splittable(&self, n: u32) -> bool {
+        match self.hierarchy.nodes[n as usize].kind {
+            NodeKind::Cluster { .. } => true,
+            NodeKind::Element { level, .. } => level < self.settings.max_levels,
+        }
+    }
+
+    fn refine_pair(&mut self, r: u32, s: u32, vis: &dyn Visibility) -> Result<(), RadiosityError> {
+        if r == s {
+            if let NodeKind::Cluster { children, .. } = self.hierarchy.nodes[r as usize].kind {
+                for &a in &children {
+                    for &b in &children {
+                        self.refine_pair(a, b, vis)?;
+                    }
+                }
+            }
+            return Ok(());
+        }
+        if let NodeKind::Cluster { children, .. } = self.hierarchy.nodes[r as usize].kind {
+            for c in children {
+                self.refine_pair(c, s, vis)?;
+            }
+            return Ok(());
+        }
+        if self.should_split(r, s) {
+            self.refine_split(r, s, vis)
+        } else if self.form_factor_bound(r, s).0 > 0.0 {
+            self.make_link(r, s, vis)
+        } else {
+            Ok(())
+        }
+    }
+
+    /// Splits the larger of r and s (a receiver cluster is always split first) and refines
+    /// the pairs of the parts.
+    fn refine_split(&mut self, r: u32, s: u32, vis: &dyn Visibility) -> Result<(), RadiosityError> {
+        let nodes = &self.hierarchy.nodes;
+        let split_source = self.splittable(s)
+            && (!self.splittable(r) || nodes[s as usize].area_m2 > nodes[r as usize].area_m2);
+        let split = if split_source { s } else { r };
+        if matches!(nodes[split as usize].kind, NodeKind::Element { .. }) {
+            self.hierarchy.split_element(split);
+            self.grow_arrays();
+            self.check_memory()?;
+        }
+        let parts: Vec<u32> = self.hierarchy.children(split).collect();
+        for part in parts {
+            if split_source {
+                self.refine_pair(r, part, vis)?;
+            } else {
+                self.refine_pair(part, s, vis)?;
+            }
+        }
+        Ok(())
+    }
+
+    fn check_memory(&self) -> Result<(), RadiosityError> {
+        if let Some(limit) = self.settings.memory_limit_bytes {
+            let needed = self.memory_bytes();
+            if needed > limit {
+                return Err(RadiosityError::MemoryLimit {
+                    limit_bytes: limit,
+                    needed_bytes: needed,
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// An upper estimate of the form factor from element r to node s and of its variation
+    /// over r (what pushing the link's average down gets wrong): for an element source the
+    /// exact point factors at r's centre and corners (their largest, and largest minus
+    /// smallest); for a cluster the solid-angle bound A/(π d²) of the boxes' distance, for
+    /// both.
+    fn form_factor_bound(&self, r: u32, s: u32) -> (f32, f32) {
+        let nodes = &self.hierarchy.nodes;
+        let receiver = match nodes[r as usize].kind {
+            NodeKind::Element { shape, .. } => shape,
+            NodeKind::Cluster { .. } => return (1.0, 1.0),
+        };
+        match nodes[s as usize].kind {
+            NodeKind::Element { shape, .. } => {
+                let (corners, count) = shape.corners();
+                let (rc, rn) = receiver.corners();
+                let n_r = receiver.normal();
+                let n_s = shape.normal();
+                let inset = |p: Vec3A| p + 0.01 * (receiver.centre() - p);
+                let (lo, hi) = std::iter::once(receiver.centre())
+                    .chain(rc[..rn].iter().map(|&p| inset(p)))
+                    .map(|x| point_to_polygon(x, n_r, &corners[..count], n_s))
+                    .fold((f32::INFINITY, 0.0f32), |(lo, hi), f| {
+                        (lo.min(f), hi.max(f))
+                    });
+                (hi, hi - lo)
+            }
+            NodeKind::Cluster { .. } => {
+                let (a, b) = (&nodes[r as usize], &nodes[s as usize]);
+                let gap = (b.lo - a.hi).max(a.lo - b.hi).max(Vec3A::ZERO);
+                let d2 = gap.length_squared();
+                let bound = if d2 <= 0.0 {
+                    1.0
+                } else {
+                    (b.area_m2 / (std::f32::consts::PI * d2)).min(1.0)
+                };
+                (bound, bound)
+            }
+        }
+    }
+
+    fn make_link(&mut self, r: u32, s: u32, vis: &dyn Visibility) -> Result<(), RadiosityError> {
+        let form_factor = self.link_form_factor(r, s, vis);
+        if form_factor > 0.0 {
+            self.links[r as usize].push(Link {
+                source: s,
+                form_factor,
+            });
+        }
+        Ok(())
+    }
+
+    /// The link's form factor with visibility: the exact unoccluded factor times the
+    /// fraction of free rays between facing point pairs (element source), or the disk
+    /// approximation over area-weighted points of the cluster's patches.
+    fn link_form_factor(&self, r: u32, s: u32, vis: &dyn Visibility) -> f32 {
+        let nodes = &self.hierarchy.nodes;
+        let receiver = match nodes[r as usize].kind {
+            NodeKind::Element { shape, .. } => shape,
+            NodeKind::Cluster { .. } => return 0.0,
+        };
+        let n_r = receiver.normal();
+        let rays = self.settings.visibility_rays.max(1);
+        match nodes[s as usize].kind {
+            NodeKind::Element { shape, .. } => {
+                let unoccluded =
+                    element_to_element(&receiver, &shape, self.settings.quadrature_nodes);
+                if unoccluded <= 0.0 {
+                    return 0.0;
+                }
+                let n_s = shape.normal();
+                let (mut facing, mut free) = (0u32, 0u32);
+                for k in 0..rays {
+                    let x = sample_point(&receiver, k, 0);
+                    let y = sample_point(&shape, k, 1);
+                    let d = y - x;
+                    if n_r.dot(d) <= 0.0 || n_s.dot(d) >= 0.0 {
+                        continue;
+                    }
+                    facing += 1;
+                    free += u32::from(vis.visible(x, n_r, y, n_s));
+                }
+                if facing == 0 {
+                    unoccluded
+                } else {
+                    unoccluded * free as f32 / facing as f32
+                }
+            }
+            NodeKind::Cluster { patches, .. } => {
+                let prefix = &self.hierarchy.order_area_prefix;
+                let (a0, a1) = (prefix[patches.0 as usize], prefix[patches.1 as usize]);
+                let piece = ((a1 - a0) / rays as f64) as f32;
+                let mut sum = 0.0;
+                for k in 0..rays {
+                    let (t, jitter) = r2(k as u32, 2);
+                    let target = a0 + (a1 - a0) * ((k as f64 + f64::from(t)) / rays as f64);
+                    let i = prefix[patches.0 as usize..=patches.1 as usize]
+                        .partition_point(|&a| a <= target)
+                        .saturating_sub(1)
+                        .min((patches.1 - patches.0 - 1) as usize);
+                    let patch = self.hierarchy.order[patches.0 as usize + i];
+                    let node = self.hierarchy.patch_root[patch as usize];
+                    let source = match nodes[node as usize].kind {
+                        NodeKind::Element { shape, .. } => shape,
+                        NodeKind::Cluster { .. } => continue,
+                    };
+                    let (u, v) = fold_into(&source, jitter, r2(k as u32, 3).0);
+                    let y = source.point(u, v);
+                    let x = sample_point(&receiver, k, 0);
+                    let n_s = source.normal();
+                    let f = disk_approximation(x, n_r, y, n_s, piece);
+                    if f > 0.0 && vis.visible(x, n_r, y, n_s) {
+                        sum += f;
+                    }
+                }
+                sum
+            }
+        }
+    }
+
+    // ---- solving ----------------------------------------------------------------------
+
+    /// Gathers over all links and pushes–pulls until the radiosities settle; the number
+    /// of sweeps.
+    fn solve(&mut self) -> u32 {
+        let tolerance = self.settings.solve_tolerance_rel;
+        for sweep in 1..=self.settings.max_sweeps {
+            self.gather();
+            let before = self.radiosity.clone();
+            self.push_pull();
+            let largest = self.radiosity.iter().copied().fold(0.0f32, f32::max);
+            let change = self
+                .radiosity
+                .iter()
+                .zip(&before)
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0f32, f32::max);
+            if change <= tolerance * largest {
+                return sweep;
+            }
+        }
+        self.settings.max_sweeps
+    }
+
+    /// Irradiance over each node's links from the sources' current radiosities.
+    fn gather(&mut self) {
+        let bands = self.bands;
+        let radiosity = &self.radiosity;
+        let links = &self.links;
+        self.gathered
+            .par_chunks_mut(bands)
+            .zip(links.par_iter())
+            .for_each(|(out, links)| {
+                out.fill(0.0);
+                for link in links {
+                    let b = &radiosity[link.source as usize * bands..][..bands];
+                    for (o, v) in out.iter_mut().zip(b) {
+                        *o += link.form_factor * v;
+                    }
+                }
+            });
+    }
+
+    /// Push irradiance down (inherited per area), pull radiosity up (area average).
+    fn push_pull(&mut self) {
+        let root = self.hierarchy.root;
+        let down = vec![0.0; self.bands];
+        self.push_pull_node(root, &down);
+    }
+
+    fn push_pull_node(&mut self, n: u32, down: &[f32]) {
+        let bands = self.bands;
+        let mut total: Vec<f32> = down.to_vec();
+        for (t, g) in total
+            .iter_mut()
+            .zip(&self.gathered[n as usize * bands..][..bands])
+        {
+            *t += g;
+        }
+        let children: Vec<u32> = self.hierarchy.children(n).collect();
+        let mut b = vec![0.0f32; bands];
+        let mut b_max = 0.0f32;
+        if children.is_empty() {
+            let patch = match self.hierarchy.nodes[n as usize].kind {
+                NodeKind::Element { patch, .. } => patch as usize,
+                NodeKind::Cluster { .. } => unreachable!("clusters have children"),
+            };
+            for (k, v) in b.iter_mut().enumerate() {
+                *v = self.emission[patch * bands + k]
+                    + self.reflectance[patch * bands + k] * total[k];
+                b_max = b_max.max(*v);
+            }
+        } else {
+            let area = self.hierarchy.nodes[n as usize].area_m2;
+            // Clusters pass nothing down: their receivers are their patches.
+            let pass = if matches!(
+                self.hierarchy.nodes[n as usize].kind,
+                NodeKind::Cluster { .. }
+            ) {
+                vec![0.0; bands]
+            } else {
+                total
+            };
+            for c in children {
+                self.push_pull_node(c, &pass);
+                let w = self.hierarchy.nodes[c as usize].area_m2 / area;
+                for (v, cb) in b
+                    .iter_mut()
+                    .zip(&self.radiosity[c as usize * bands..][..bands])
+                {
+                    *v += w * cb;
+                }
+                b_max = b_max.max(self.radiosity_max[c as usize]);
+            }
+        }
+        self.radiosity[n as usize * bands..][..bands].copy_from_slice(&b);
+        self.radiosity_max[n as usize] = b_max;
+    }
+}
+
+/// The k-th stratified point on `shape` (an R2 low-discrepancy sequence, offset
+/// by `stream` so that the two ends of a ray use different points).
+fn sample_point(shape: &ElementShape, k: usize, stream: u32) -> Vec3A {
+    let (a, b) = r2(k as u32, stream);
+    let (u, v) = fold_into(shape, a, b);
+    shape.point(u, v)
+}
+
+/// Maps a point of the unit square onto the shape's parameter domain (triangles fold the
+/// upper half over the diagonal).
+fn fold_into(shape: &ElementShape, a: f32, b: f32) -> (f32, f32) {
+    match shape {
+        ElementShape::Parallelogram { .. } => (a, b),
+        ElementShape::Triangle { .. } => {
+            if a + b > 1.0 {
+                (1.0 - a, 1.0 - b)
+            } else {
+                (a, b)
+            }
+        }
+    }
+}
+
+/// The R2 sequence (Roberts 2018), point k, shifted by `stream`.
+fn r2(k: u32, stream: u32) -> (f32, f32) {
+    const A1: f64 = 0.754_877_666_246_692_7;
+    const A2: f64 = 0.569_840_290_998_053_2;
+    let base = 0.5 + std::f64::consts::FRAC_1_PI * f64::from(stream);
+    let i = f64::from(k) + 1.0;
+    (
+        ((base + A1 * i).fract()) as f32,
+        ((base + A2 * i).fract()) as f32,
+    )
+}

@@ -1,0 +1,193 @@
+//! The `radiosity` method: a hierarchical radiosity solution with clustering
+//! (prism-radiosity), computed once in `prepare`, then a final gather per camera sample
+//! (Mostefaoui et al. §5 without the interpolation tree yet): emission and direct light as
+//! `path` computes them at the first hit (light sampling and BSDF sampling with MIS), and
+//! the light reflected more than once from the solution at the BSDF-sampled ray's hit.
+
+pub mod gather;
+pub mod patches;
+
+pub use self::gather::SolvedScene;
+
+use std::sync::Arc;
+use std::time::Instant;
+
+use glam::Vec3A;
+use prism_geometry::Ray;
+use prism_radiosity::{Radiosity, RadiositySettings, Visibility};
+
+pub use prism_spectrum::SampledWavelengths;
+
+use self::patches::{scene_patches, BANDS};
+use super::camera_sample::CameraSample;
+use super::driver::RenderStats;
+use super::estimator::{Estimator, Pass, TileWork};
+use super::lane_wavelengths::LaneWavelengths;
+use super::{PathCounters, PathTracer};
+use crate::film::xyz::XyzWeights;
+use crate::film::{FilmTile, LightSplats};
+use crate::scene_build::RenderScene;
+
+/// The `radiosity` integrator's settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RadiosityMethod {
+    pub error_bound_rel: f32,
+    pub iterations: u32,
+    pub gather_epsilon: f32,
+    /// `--max-memory` for the hierarchy.
+    pub memory_limit_bytes: Option<u64>,
+}
+
+/// The estimator: the solution, built by the first `prepare`.
+pub struct RadiosityEstimator {
+    method: RadiosityMethod,
+    solved: Option<Arc<SolvedScene>>,
+}
+
+impl RadiosityEstimator {
+    pub fn new(method: RadiosityMethod) -> Self {
+        Self {
+            method,
+            solved: None,
+        }
+    }
+}
+
+/// The scene's own ray tracer as the solution's visibility oracle.
+struct SceneVisibility<'a>(&'a RenderScene);
+
+impl Visibility for SceneVisibility<'_> {
+    fn visible(&self, from: Vec3A, n_from: Vec3A, to: Vec3A, n_to: Vec3A) -> bool {
+        let scale = |p: Vec3A| 1e-4 * (1.0 + p.abs().max_element());
+        let a = from + n_from * scale(from);
+        let b = to + n_to * scale(to);
+        !self.0.geometry.occluded(&Ray::spawn_to(a, b))
+    }
+}
+
+/// The solution for `scene`, with one line of statistics per iteration.
+pub fn solve(
+    scene: &RenderScene,
+    method: &RadiosityMethod,
+) -> Result<(SolvedScene, Vec<String>), String> {
+    let (patches, map) = scene_patches(scene)?;
+    let settings = RadiositySettings {
+        error_bound_rel: method.error_bound_rel,
+        memory_limit_bytes: method.memory_limit_bytes,
+        ..RadiositySettings::default()
+    };
+    let mut solution = Radiosity::new(&patches, BANDS, settings).map_err(|e| e.to_string())?;
+    let visibility = SceneVisibility(scene);
+    let mut lines = Vec::new();
+    for i in 1..=method.iterations {
+        let s = solution.iterate(&visibility).map_err(|e| e.to_string())?;
+        lines.push(format!(
+            "radiosity: iteration {i}: {} patches, {} elements, {} links, {:.1} MiB, refine {:.2} s, \
+             solve {:.2} s ({} sweeps)",
+            s.patches,
+            s.elements,
+            s.links,
+            s.memory_bytes as f64 / 1048576.0,
+            s.refine_s,
+            s.solve_s,
+            s.sweeps
+        ));
+    }
+    Ok((SolvedScene { solution, map }, lines))
+}
+
+impl Estimator for RadiosityEstimator {
+    fn name(&self) -> &'static str {
+        "radiosity"
+    }
+
+    fn prepare(&mut self, scene: &RenderScene, _pass: &Pass) -> Result<(), String> {
+        if self.solved.is_some() {
+            return Ok(());
+        }
+        let start = Instant::now();
+        let (solved, lines) = solve(scene, &self.method)?;
+        for line in lines {
+            eprintln!("{line}");
+        }
+        eprintln!(
+            "radiosity: solution in {:.2} s; final gather traces every gather ray \
+             (the interpolated gather of gather_epsilon {} is not built yet)",
+            start.elapsed().as_secs_f64(),
+            self.method.gather_epsilon
+        );
+        self.solved = Some(Arc::new(solved));
+        Ok(())
+    }
+
+    fn splats_light_paths(&self) -> bool {
+        false
+    }
+
+    fn sample_indices_per_prepare(&self) -> Option<u32> {
+        None
+    }
+
+    fn render_tile(
+        &self,
+        scene: &RenderScene,
+        work: &TileWork,
+        tile: &mut FilmTile,
+        _splats: &mut LightSplats,
+    ) -> RenderStats {
+        let mut counters = PathCounters::default();
+        let mut stats = RenderStats::default();
+        let Some(solved) = self.solved.as_deref() else {
+            return stats;
+        };
+        // One bounce (direct light with MIS), then the solution.
+        let tracer = PathTracer {
+            max_depth: 1,
+            rr_depth: u32::MAX,
+            ..PathTracer::default()
+        };
+        let settings = work.pass.settings;
+        for pixel in tile.bounds().pixels() {
+            let light_samples = work.light_samples(pixel);
+            for s in work.samples_of(pixel) {
+                let mut cs = CameraSample::start(tile, work, pixel, s);
+                let mut wavelengths =
+                    LaneWavelengths::new(SampledWavelengths::sample_visible(cs.stream.get_1d()));
+                let result = scene
+                    .camera
+                    .generate_ray_only(cs.film_point, cs.lens)
+                    .map(|ray| {
+                        tracer.radiance_gathered(
+                            scene,
+                            &ray,
+                            &mut wavelengths,
+                            &mut cs.stream,
+                            light_samples,
+                            settings.illumination_aov,
+                            &mut counters,
+                            solved,
+                        )
+                    });
+                let sensor = wavelengths.sensor();
+                let xyz_weights = XyzWeights::new(sensor);
+                let estimate = result.map(|r| {
+                    if let Some(white) = r.illumination {
+                        tile.add_illumination_with(pixel, white, &xyz_weights);
+                    }
+                    (r.radiance, r.first_hit)
+                });
+                cs.add_to_tile(
+                    tile,
+                    scene,
+                    pixel,
+                    sensor,
+                    &xyz_weights,
+                    estimate,
+                    &mut stats,
+                );
+            }
+        }
+        stats.add_path_counters(&counters);
+        stats
+    }
+}

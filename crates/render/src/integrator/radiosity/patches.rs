@@ -1,0 +1,263 @@
+//! The scene as radiosity input: one patch per side that reflects or emits of every
+//! rectangle and mesh triangle, with band-averaged Lambertian reflectance and emission,
+//! and the map from a hit (instance, primitive, side) back to its patch.
+
+use glam::Vec3A;
+use prism_geometry::{Geometry, Shape, NO_MATERIAL};
+use prism_radiosity::{ElementShape, InputPatch};
+use prism_spectrum::Spectrum;
+
+use crate::light::Light;
+use crate::material::{Material, SurfaceMaterial};
+use crate::scene_build::RenderScene;
+use crate::texture::TexturedSpectrum;
+
+/// Bands of the solution: 16 of 25 nm over 380–780 nm.
+pub const BANDS: usize = 16;
+pub const FIRST_BAND_NM: f64 = 380.0;
+pub const BAND_WIDTH_NM: f64 = 25.0;
+
+/// The band holding `wavelength_nm` (the end bands extend beyond 380–780 nm).
+#[inline]
+pub fn band_of(wavelength_nm: f32) -> usize {
+    (((f64::from(wavelength_nm) - FIRST_BAND_NM) / BAND_WIDTH_NM)
+        .floor()
+        .max(0.0) as usize)
+        .min(BANDS - 1)
+}
+
+/// A spectrum's mean over each band (5 points per band).
+fn band_means(spectrum: &Spectrum, scale: f64) -> Vec<f32> {
+    (0..BANDS)
+        .map(|b| {
+            let mean = (0..5)
+                .map(|k| {
+                    let nm = FIRST_BAND_NM + BAND_WIDTH_NM * (b as f64 + (k as f64 + 0.5) / 5.0);
+                    spectrum.eval_nm(nm)
+                })
+                .sum::<f64>()
+                / 5.0;
+            (mean * scale) as f32
+        })
+        .collect()
+}
+
+/// Where each instance's patches start.
+pub struct PatchMap {
+    /// Per instance: its first patch, `None` when it has none.
+    pub first_patch: Vec<Option<u32>>,
+    /// Per instance: patches per primitive (1 one-sided, 2 when both sides reflect or emit;
+    /// the front — the geometric normal's side — first).
+    pub sides: Vec<u8>,
+    /// Per patch: its normal.
+    pub normals: Vec<Vec3A>,
+}
+
+impl PatchMap {
+    /// The patch seen by a ray arriving at primitive `primitive` of instance `instance`
+    /// from direction `wo` (pointing away from the surface).
+    pub fn patch_of(&self, instance: u32, primitive: u32, wo: Vec3A) -> Option<usize> {
+        let first = (*self.first_patch.get(instance as usize)?)?;
+        let sides = u32::from(self.sides[instance as usize]);
+        let front = (first + primitive * sides) as usize;
+        if self.normals.get(front)?.dot(wo) > 0.0 {
+            Some(front)
+        } else if sides == 2 {
+            Some(front + 1)
+        } else {
+            None
+        }
+    }
+}
+
+/// A material's diffuse reflectance and whether it reflects on both sides; what radiosity
+/// cannot represent is an error naming it.
+fn lambertian(material: &Material) -> Result<(&Spectrum, bool), String> {
+    let (inner, two_sided) = match material {
+        Material::TwoSided { material } => (&**material, true),
+        m @ (Material::Surface(_)
+        | Material::Mask { .. }
+        | Material::NormalMap { .. }
+        | Material::BumpMap { .. }) => (m, false),
+    };
+    match inner {
+        Material::Surface(SurfaceMaterial::Lambert {
+            reflectance: TexturedSpectrum::Constant(s),
+        }) => Ok((s, two_sided)),
+        Material::Surface(SurfaceMaterial::Lambert {
+            reflectance: TexturedSpectrum::Texture { .. },
+        }) => Err("a textured `lambert` (radiosity takes constant reflectances only yet)".into()),
+        Material::Surface(
+            SurfaceMaterial::Conductor { .. }
+            | SurfaceMaterial::Dielectric { .. }
+            | SurfaceMaterial::ThinDielectric { .. }
+            | SurfaceMaterial::Mix { .. }
+            | SurfaceMaterial::Library(_)
+            | SurfaceMaterial::Fluorescent(_),
+        )
+        | Material::TwoSided { .. }
+        | Material::Mask { .. }
+        | Material::NormalMap { .. }
+        | Material::BumpMap { .. } => Err(
+            "not a constant `lambert` (or `two_sided` of one): radiosity transfers diffuse light \
+             only (the paper's directional transfers are not built yet)"
+                .into(),
+        ),
+    }
+}
+
+/// The patches of `scene` and their map; an error names what the solution cannot hold.
+pub fn scene_patches(scene: &RenderScene) -> Result<(Vec<InputPatch>, PatchMap), String> {
+    let geometry: &Geometry = &scene.geometry;
+    let mut patches = Vec::new();
+    let mut map = PatchMap {
+        first_patch: Vec::with_capacity(geometry.instances().len()),
+        sides: Vec::with_capacity(geometry.instances().len()),
+        normals: Vec::new(),
+    };
+    for light in scene.lights.lights() {
+        match light {
+            Light::Area(_) => {}
+            Light::Point(_)
+            | Light::Spot(_)
+            | Light::Directional(_)
+            | Light::Environment(_)
+            | Light::Sky(_)
+            | Light::Daylight(_)
+            | Light::Goniometric(_) => {
+                return Err(
+                    "`radiosity` takes area lights only yet (point, spot, goniometric, \
+                     directional and sky light are not shot into the solution): use `path`"
+                        .into(),
+                )
+            }
+        }
+    }
+    for (instance_id, inst) in geometry.instances().iter().enumerate() {
+        let area_light = scene
+            .lights
+            .area_light_of_instance(instance_id as u32)
+            .and_then(|l| match &scene.lights.lights()[l as usize] {
+                Light::Area(a) => Some(a),
+                Light::Point(_)
+                | Light::Spot(_)
+                | Light::Directional(_)
+                | Light::Environment(_)
+                | Light::Sky(_)
+                | Light::Daylight(_)
+                | Light::Goniometric(_) => None,
+            });
+        let emission =
+            area_light.map(|a| (band_means(&a.radiance, std::f64::consts::PI), a.two_sided));
+        // (world triangle or parallelogram, object-space geometric normal, material id)
+        let mut pieces: Vec<(ElementShape, Vec3A, u32)> = Vec::new();
+        match inst.shape {
+            Shape::Rectangle(r) => {
+                let t = &inst.to_world;
+                let (w, h) = (r.half_width_m, r.half_height_m);
+                let p0 = t.point(Vec3A::new(-w, -h, 0.0));
+                let e1 = t.point(Vec3A::new(w, -h, 0.0)) - p0;
+                let e2 = t.point(Vec3A::new(-w, h, 0.0)) - p0;
+                pieces.push((
+                    ElementShape::Parallelogram { p0, e1, e2 },
+                    Vec3A::Z,
+                    inst.material.unwrap_or(NO_MATERIAL),
+                ));
+            }
+            Shape::Mesh(id) => {
+                let mesh = geometry.mesh(id);
+                for (tri, idx) in mesh.indices.iter().enumerate() {
+                    let p = idx.map(|i| mesh.positions[i as usize]);
+                    let mut ng = (p[1] - p[0]).cross(p[2] - p[0]);
+                    if let Some(normals) = &mesh.normals {
+                        let ns: Vec3A = idx.iter().map(|&i| normals[i as usize]).sum();
+                        if ng.dot(ns) < 0.0 {
+                            ng = -ng;
+                        }
+                    }
+                    let w = p.map(|v| inst.to_world.point(v));
+                    pieces.push((
+                        ElementShape::Triangle {
+                            p0: w[0],
+                            e1: w[1] - w[0],
+                            e2: w[2] - w[0],
+                        },
+                        ng,
+                        inst.material.unwrap_or(mesh.material_ids[tri]),
+                    ));
+                }
+            }
+            Shape::Sphere(_) | Shape::Disk(_) => {
+                return Err(format!(
+                    "instance {instance_id} is a {}: `radiosity` meshes rectangles and triangle \
+                     meshes only yet (use a mesh, e.g. an icosphere)",
+                    if matches!(inst.shape, Shape::Sphere(_)) {
+                        "sphere"
+                    } else {
+                        "disk"
+                    }
+                ))
+            }
+        }
+        let mut kinds = Vec::with_capacity(pieces.len());
+        for &(_, _, material_id) in &pieces {
+            kinds.push(lambertian(scene.material(material_id)).map_err(|e| {
+                let name = scene
+                    .material_names
+                    .get((material_id as usize).min(scene.material_names.len() - 1))
+                    .cloned()
+                    .unwrap_or_default();
+                format!("material `{name}` is {e}")
+            })?);
+        }
+        let emits_back = emission.as_ref().is_some_and(|(_, two)| *two);
+        // Both sides get patches on every primitive of the instance when one needs them,
+        // so that a hit's patch is first + primitive × sides.
+        let both = emits_back || kinds.iter().any(|&(_, two_sided)| two_sided);
+        let sides: u8 = if both { 2 } else { 1 };
+        let first = patches.len() as u32;
+        let none = vec![0.0; BANDS];
+        let emitted = emission.as_ref().map_or(none.clone(), |(e, _)| e.clone());
+        for ((shape, ng_object, _), (reflectance, two_sided)) in pieces.into_iter().zip(kinds) {
+            let n = inst.to_world.normal(ng_object).normalize_or_zero();
+            let front = oriented(shape, n);
+            let rho = band_means(reflectance, 1.0);
+            patches.push(InputPatch {
+                shape: front,
+                reflectance: rho.clone(),
+                emission: emitted.clone(),
+            });
+            map.normals.push(front.normal());
+            if both {
+                let back = oriented(shape, -n);
+                patches.push(InputPatch {
+                    shape: back,
+                    reflectance: if two_sided { rho } else { none.clone() },
+                    emission: if emits_back {
+                        emitted.clone()
+                    } else {
+                        none.clone()
+                    },
+                });
+                map.normals.push(back.normal());
+            }
+        }
+        map.first_patch
+            .push((patches.len() as u32 > first).then_some(first));
+        map.sides.push(sides);
+    }
+    Ok((patches, map))
+}
+
+/// `shape` with its vertex order turned so that its normal points along `n`.
+fn oriented(shape: ElementShape, n: Vec3A) -> ElementShape {
+    if shape.normal().dot(n) >= 0.0 {
+        return shape;
+    }
+    match shape {
+        ElementShape::Parallelogram { p0, e1, e2 } => {
+            ElementShape::Parallelogram { p0, e1: e2, e2: e1 }
+        }
+        ElementShape::Triangle { p0, e1, e2 } => ElementShape::Triangle { p0, e1: e2, e2: e1 },
+    }
+}
