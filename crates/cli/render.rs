@@ -883,6 +883,10 @@ fn measure_and_write_sensors(
         prism_render::sensor::total_points(sensors),
         &args.scene.display().to_string(),
     );
+    // A radiosity solution that cannot be built is an error here, not path-traced lux.
+    if let Some(Err(e)) = scene.radiosity_solution() {
+        return Err(e);
+    }
     let start = Instant::now();
     let (readings, stats) = pool.install(|| {
         prism_render::sensor::measure_sensors(scene, sensors, settings.seed, &|n| bar.inc(n))

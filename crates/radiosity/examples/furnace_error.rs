@@ -1,6 +1,8 @@
 //! Prints the closed furnace's radiosity error against error_bound_rel (docs/radiosity.md).
 use glam::Vec3A;
-use prism_radiosity::{ElementShape, InputPatch, Radiosity, RadiositySettings, Unoccluded};
+use prism_radiosity::{
+    ElementShape, InputPatch, NoDirectLight, Radiosity, RadiositySettings, Unoccluded,
+};
 fn square(p0: Vec3A, e1: Vec3A, e2: Vec3A, rho: f32) -> InputPatch {
     InputPatch {
         shape: ElementShape::Parallelogram { p0, e1, e2 },
@@ -27,7 +29,7 @@ fn main() {
             let mut sol = Radiosity::new(&patches, 1, s).unwrap();
             let mut st = None;
             for _ in 0..3 {
-                st = Some(sol.iterate(&Unoccluded).unwrap());
+                st = Some(sol.iterate(&Unoccluded, &NoDirectLight).unwrap());
             }
             let expected = 1.0 / (1.0 - rho);
             let mut worst = 0.0f32;

@@ -15,6 +15,6 @@ pub mod solver;
 
 pub use element::ElementShape;
 pub use solver::{
-    InputPatch, IterationStats, Radiosity, RadiosityError, RadiositySettings, Unoccluded,
-    Visibility,
+    DirectIrradiance, InputPatch, IterationStats, NoDirectLight, Radiosity, RadiosityError,
+    RadiositySettings, Unoccluded, Visibility,
 };

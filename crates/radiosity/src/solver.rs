@@ -33,6 +33,28 @@ pub struct InputPatch {
 /// off their surfaces along `n_from` / `n_to`).
 pub trait Visibility: Sync {
     fn visible(&self, from: Vec3A, n_from: Vec3A, to: Vec3A, n_to: Vec3A) -> bool;
+
+    /// Whether the surface point `p` (normal `n`) is covered: inside or under other
+    /// geometry (a box standing on a floor), where no light arrives and none leaves. A
+    /// covered part of an element is left out of its radiosity, so that the part that is
+    /// seen is not darkened by it and no light is shot from under the box.
+    fn covered(&self, _p: Vec3A, _n: Vec3A) -> bool {
+        false
+    }
+}
+
+/// Irradiance per band from the lights that are not patches (point, spot and directional
+/// lights: what the final gather gets by next-event estimation), shadows included, at a
+/// point `p` of a surface facing `n`; added to `out`.
+pub trait DirectIrradiance: Sync {
+    fn irradiance(&self, p: Vec3A, n: Vec3A, out: &mut [f32]);
+}
+
+/// No lights besides the emitting patches.
+pub struct NoDirectLight;
+
+impl DirectIrradiance for NoDirectLight {
+    fn irradiance(&self, _: Vec3A, _: Vec3A, _: &mut [f32]) {}
 }
 
 /// No occluders: a convex enclosure, the closed-form tests.
@@ -123,6 +145,9 @@ impl std::error::Error for RadiosityError {}
 struct Link {
     source: u32,
     form_factor: f32,
+    /// Some of its visibility rays were blocked, some not: a shadow boundary crosses it,
+    /// so its factor may vary over the receiver by its whole value.
+    partial: bool,
 }
 
 /// What an iteration did.
@@ -154,8 +179,21 @@ pub struct Radiosity {
     /// Per node × band: irradiance gathered over the node's own links.
     gathered: Vec<f32>,
     links: Vec<Vec<Link>>,
+    /// Per node × band: the direct irradiance (`DirectIrradiance`) averaged over the
+    /// element's quadrature points; used at leaves.
+    direct: Vec<f32>,
+    /// Per node: the largest band's direct irradiance, largest minus smallest over those
+    /// points (what a leaf's average gets wrong); `None` until computed.
+    direct_variation: Vec<Option<f32>>,
+    /// Per node: which of its `visibility_rays` sample points are covered
+    /// (`Visibility::covered`, bit k for point k); `None` until computed.
+    covered: Vec<Option<u64>>,
+    /// Per node: the area below it that is not covered, m² (from the last push–pull).
+    free_area: Vec<f32>,
     /// The oracle's threshold, in the emission's units × m².
     power_threshold: f32,
+    /// The brightest emitter's power (exitance × area) of one band.
+    emitter_power: f32,
     iterations: u32,
 }
 
@@ -194,7 +232,12 @@ impl Radiosity {
             radiosity_max: Vec::new(),
             gathered: Vec::new(),
             links: Vec::new(),
+            direct: Vec::new(),
+            direct_variation: Vec::new(),
+            covered: Vec::new(),
+            free_area: Vec::new(),
             power_threshold: settings.error_bound_rel * brightest.1,
+            emitter_power: brightest.1,
             hierarchy,
             iterations: 0,
         };
@@ -221,6 +264,15 @@ impl Radiosity {
     /// Radiosity per band of the leaf element of input patch `patch` holding point `p`
     /// (projected onto the patch's plane, clamped into it).
     pub fn radiosity_at(&self, patch: usize, p: Vec3A) -> &[f32] {
+        self.node_radiosity(self.leaf_at(patch, p))
+    }
+
+    /// Area of the leaf element `radiosity_at` reads, m².
+    pub fn leaf_area_at(&self, patch: usize, p: Vec3A) -> f32 {
+        self.hierarchy.nodes[self.leaf_at(patch, p) as usize].area_m2
+    }
+
+    fn leaf_at(&self, patch: usize, p: Vec3A) -> u32 {
         let mut node = self.hierarchy.patch_root[patch];
         let shape = match self.hierarchy.nodes[node as usize].kind {
             NodeKind::Element { shape, .. } => shape,
@@ -247,7 +299,7 @@ impl Radiosity {
             u = cu;
             v = cv;
         }
-        self.node_radiosity(node)
+        node
     }
 
     fn node_radiosity(&self, node: u32) -> &[f32] {
@@ -255,11 +307,11 @@ impl Radiosity {
         &self.radiosity[b..b + self.bands]
     }
 
-    /// Power leaving all patches per band (Σ B·A).
+    /// Power leaving all patches per band (Σ B·A over their uncovered area).
     pub fn total_power(&self) -> Vec<f32> {
         let mut sum = vec![0.0f64; self.bands];
         for &n in &self.hierarchy.patch_root {
-            let area = f64::from(self.hierarchy.nodes[n as usize].area_m2);
+            let area = f64::from(self.free_area[n as usize]);
             for (s, b) in sum.iter_mut().zip(self.node_radiosity(n)) {
                 *s += f64::from(*b) * area;
             }
@@ -272,9 +324,33 @@ impl Radiosity {
     pub fn iterate(
         &mut self,
         visibility: &dyn Visibility,
+        direct: &dyn DirectIrradiance,
     ) -> Result<IterationStats, RadiosityError> {
         let start = Instant::now();
+        if self.iterations == 0 {
+            self.compute_coverage(visibility);
+            self.compute_direct(direct);
+            // Lights that are not patches count like emitters (of exitance ρ·E) for the
+            // oracle's reference power, and the first links see their light.
+            let lit = self
+                .hierarchy
+                .patch_root
+                .iter()
+                .enumerate()
+                .map(|(patch, &n)| {
+                    let d = &self.direct[n as usize * self.bands..][..self.bands];
+                    let rho = &self.reflectance[patch * self.bands..][..self.bands];
+                    let exitance = d.iter().zip(rho).map(|(e, r)| e * r).fold(0.0f32, f32::max);
+                    exitance * self.hierarchy.nodes[n as usize].area_m2
+                })
+                .fold(0.0f32, f32::max);
+            self.power_threshold = self.settings.error_bound_rel * self.emitter_power.max(lit);
+            self.push_pull();
+        }
         self.refine(visibility)?;
+        self.compute_coverage(visibility);
+        self.compute_direct(direct);
+        self.refine_direct(direct, visibility)?;
         let refine_s = start.elapsed().as_secs_f64();
         let start = Instant::now();
         let sweeps = self.solve();
@@ -319,13 +395,148 @@ impl Radiosity {
         nodes
             * (std::mem::size_of::<crate::hierarchy::Node>() as u64
                 + std::mem::size_of::<Vec<Link>>() as u64
-                + 4 * (2 * self.bands as u64 + 1))
+                + std::mem::size_of::<Option<f32>>() as u64
+                + 4 * (3 * self.bands as u64 + 1))
             + links * std::mem::size_of::<Link>() as u64
             + (self.reflectance.len() + self.emission.len()) as u64 * 4
     }
 
+    /// The coverage mask of every element that has none yet, in parallel.
+    fn compute_coverage(&mut self, vis: &dyn Visibility) {
+        self.grow_arrays();
+        let nodes = &self.hierarchy.nodes;
+        let rays = self.rays();
+        let todo: Vec<u32> = (0..nodes.len() as u32)
+            .filter(|&n| {
+                self.covered[n as usize].is_none()
+                    && matches!(nodes[n as usize].kind, NodeKind::Element { .. })
+            })
+            .collect();
+        let masks: Vec<u64> = todo
+            .par_iter()
+            .map(|&n| match nodes[n as usize].kind {
+                NodeKind::Element { shape, .. } => coverage_mask(&shape, rays, vis),
+                NodeKind::Cluster { .. } => 0,
+            })
+            .collect();
+        for (n, mask) in todo.into_iter().zip(masks) {
+            self.covered[n as usize] = Some(mask);
+        }
+    }
+
+    /// Visibility rays per link (at most 64: the coverage masks' width).
+    fn rays(&self) -> usize {
+        self.settings.visibility_rays.clamp(1, 64)
+    }
+
+    /// Whether sample point k of node n is covered.
+    fn is_covered(&self, n: u32, k: usize) -> bool {
+        self.covered
+            .get(n as usize)
+            .copied()
+            .flatten()
+            .is_some_and(|m| m & (1u64 << k) != 0)
+    }
+
+    /// Direct irradiance of every element that has none yet (new leaves), in parallel:
+    /// the mean over its uncovered sample points.
+    fn compute_direct(&mut self, light: &dyn DirectIrradiance) {
+        self.grow_arrays();
+        let bands = self.bands;
+        let rays = self.rays();
+        let todo: Vec<u32> = (0..self.hierarchy.nodes.len() as u32)
+            .filter(|&n| {
+                self.direct_variation[n as usize].is_none()
+                    && matches!(
+                        self.hierarchy.nodes[n as usize].kind,
+                        NodeKind::Element { .. }
+                    )
+            })
+            .collect();
+        let this = &*self;
+        let results: Vec<(Vec<f32>, f32)> = todo
+            .par_iter()
+            .map(|&n| {
+                let NodeKind::Element { shape, .. } = this.hierarchy.nodes[n as usize].kind else {
+                    return (vec![0.0; bands], 0.0);
+                };
+                let normal = shape.normal();
+                let mut mean = vec![0.0f32; bands];
+                let (mut lo, mut hi) = (f32::INFINITY, 0.0f32);
+                let mut at = vec![0.0f32; bands];
+                let mut count = 0u32;
+                for k in (0..rays).filter(|&k| !this.is_covered(n, k)) {
+                    at.fill(0.0);
+                    light.irradiance(sample_point(&shape, k, 0), normal, &mut at);
+                    let top = at.iter().copied().fold(0.0f32, f32::max);
+                    lo = lo.min(top);
+                    hi = hi.max(top);
+                    for (m, a) in mean.iter_mut().zip(&at) {
+                        *m += a;
+                    }
+                    count += 1;
+                }
+                if count > 0 {
+                    mean.iter_mut().for_each(|m| *m /= count as f32);
+                }
+                (mean, hi - lo.min(hi))
+            })
+            .collect();
+        for (n, (mean, variation)) in todo.into_iter().zip(results) {
+            self.direct[n as usize * bands..][..bands].copy_from_slice(&mean);
+            self.direct_variation[n as usize] = Some(variation);
+        }
+    }
+
+    /// Splits leaves whose direct light varies by more than the oracle allows (a shadow
+    /// edge of a point light crossing them), until none does.
+    fn refine_direct(
+        &mut self,
+        light: &dyn DirectIrradiance,
+        vis: &dyn Visibility,
+    ) -> Result<(), RadiosityError> {
+        loop {
+            let mut split = Vec::new();
+            for (n, node) in self.hierarchy.nodes.iter().enumerate() {
+                let NodeKind::Element {
+                    patch,
+                    level,
+                    first_child: None,
+                    ..
+                } = node.kind
+                else {
+                    continue;
+                };
+                let rho = self.reflectance[patch as usize * self.bands..][..self.bands]
+                    .iter()
+                    .copied()
+                    .fold(0.0f32, f32::max);
+                let variation = self.direct_variation[n].unwrap_or(0.0);
+                if level < self.settings.max_levels
+                    && rho * variation * node.area_m2 > self.power_threshold
+                {
+                    split.push(n as u32);
+                }
+            }
+            if split.is_empty() {
+                return Ok(());
+            }
+            for n in split {
+                self.hierarchy.split_element(n);
+            }
+            self.grow_arrays();
+            self.check_memory()?;
+            self.compute_coverage(vis);
+            self.compute_direct(light);
+        }
+    }
+
     fn grow_arrays(&mut self) {
         let n = self.hierarchy.nodes.len();
+        self.direct.resize(n * self.bands, 0.0);
+        self.direct_variation.resize(n, None);
+        self.covered.resize(n, None);
+        self.free_area.resize(n, 0.0);
         self.radiosity.resize(n * self.bands, 0.0);
         self.radiosity_max.resize(n, 0.0);
         self.gathered.resize(n * self.bands, 0.0);
@@ -345,7 +556,7 @@ impl Radiosity {
                 let mut kept = Vec::with_capacity(links.len());
                 let mut refined = Vec::new();
                 for link in links {
-                    if self.should_split(r, link.source) {
+                    if self.should_split(r, link.source, link.partial) {
                         refined.push(link.source);
                     } else {
                         kept.push(link);
@@ -361,9 +572,11 @@ impl Radiosity {
         Ok(())
     }
 
-    /// Whether the link r ← s may carry more than the threshold and can be split.
-    fn should_split(&self, r: u32, s: u32) -> bool {
+    /// Whether the link r ← s may carry more error than the threshold and can be split
+    /// (`partial`: partly visible, so its factor may vary by its whole bound).
+    fn should_split(&self, r: u32, s: u32, partial: bool) -> bool {
         let (bound, variation) = self.form_factor_bound(r, s);
+        let variation = if partial { bound } else { variation };
         bound > 0.0
             && self.radiosity_max[s as usize] * variation * self.hierarchy.nodes[r as usize].area_m2
                 > self.power_threshold
@@ -394,13 +607,25 @@ impl Radiosity {
             }
             return Ok(());
         }
-        if self.should_split(r, s) {
-            self.refine_split(r, s, vis)
-        } else if self.form_factor_bound(r, s).0 > 0.0 {
-            self.make_link(r, s, vis)
-        } else {
-            Ok(())
+        if self.should_split(r, s, false) {
+            return self.refine_split(r, s, vis);
         }
+        if self.form_factor_bound(r, s).0 <= 0.0 {
+            return Ok(());
+        }
+        let (form_factor, partial) = self.link_form_factor(r, s, vis);
+
+        if partial && self.should_split(r, s, true) {
+            return self.refine_split(r, s, vis);
+        }
+        if form_factor > 0.0 {
+            self.links[r as usize].push(Link {
+                source: s,
+                form_factor,
+                partial,
+            });
+        }
+        Ok(())
     }
 
     /// Splits the larger of r and s (a receiver cluster is always split first) and refines
@@ -414,6 +639,14 @@ impl Radiosity {
             self.hierarchy.split_element(split);
             self.grow_arrays();
             self.check_memory()?;
+            let rays = self.rays();
+            for c in self.hierarchy.children(split).collect::<Vec<_>>() {
+                if self.covered[c as usize].is_none() {
+                    if let NodeKind::Element { shape, .. } = self.hierarchy.nodes[c as usize].kind {
+                        self.covered[c as usize] = Some(coverage_mask(&shape, rays, vis));
+                    }
+                }
+            }
         }
         let parts: Vec<u32> = self.hierarchy.children(split).collect();
         for part in parts {
@@ -479,38 +712,28 @@ impl Radiosity {
         }
     }
 
-    fn make_link(&mut self, r: u32, s: u32, vis: &dyn Visibility) -> Result<(), RadiosityError> {
-        let form_factor = self.link_form_factor(r, s, vis);
-        if form_factor > 0.0 {
-            self.links[r as usize].push(Link {
-                source: s,
-                form_factor,
-            });
-        }
-        Ok(())
-    }
-
     /// The link's form factor with visibility: the exact unoccluded factor times the
     /// fraction of free rays between facing point pairs (element source), or the disk
-    /// approximation over area-weighted points of the cluster's patches.
-    fn link_form_factor(&self, r: u32, s: u32, vis: &dyn Visibility) -> f32 {
+    /// approximation over area-weighted points of the cluster's patches; and whether the
+    /// rays disagreed (a shadow boundary).
+    fn link_form_factor(&self, r: u32, s: u32, vis: &dyn Visibility) -> (f32, bool) {
         let nodes = &self.hierarchy.nodes;
         let receiver = match nodes[r as usize].kind {
             NodeKind::Element { shape, .. } => shape,
-            NodeKind::Cluster { .. } => return 0.0,
+            NodeKind::Cluster { .. } => return (0.0, false),
         };
         let n_r = receiver.normal();
-        let rays = self.settings.visibility_rays.max(1);
+        let rays = self.rays();
         match nodes[s as usize].kind {
             NodeKind::Element { shape, .. } => {
                 let unoccluded =
                     element_to_element(&receiver, &shape, self.settings.quadrature_nodes);
                 if unoccluded <= 0.0 {
-                    return 0.0;
+                    return (0.0, false);
                 }
                 let n_s = shape.normal();
                 let (mut facing, mut free) = (0u32, 0u32);
-                for k in 0..rays {
+                for k in (0..rays).filter(|&k| !self.is_covered(r, k)) {
                     let x = sample_point(&receiver, k, 0);
                     let y = sample_point(&shape, k, 1);
                     let d = y - x;
@@ -520,18 +743,24 @@ impl Radiosity {
                     facing += 1;
                     free += u32::from(vis.visible(x, n_r, y, n_s));
                 }
-                if facing == 0 {
-                    unoccluded
+                if (0..rays).all(|k| self.is_covered(r, k)) {
+                    (0.0, false)
+                } else if facing == 0 {
+                    (unoccluded, false)
                 } else {
-                    unoccluded * free as f32 / facing as f32
+                    (
+                        unoccluded * free as f32 / facing as f32,
+                        free > 0 && free < facing,
+                    )
                 }
             }
             NodeKind::Cluster { patches, .. } => {
                 let prefix = &self.hierarchy.order_area_prefix;
                 let (a0, a1) = (prefix[patches.0 as usize], prefix[patches.1 as usize]);
                 let piece = ((a1 - a0) / rays as f64) as f32;
-                let mut sum = 0.0;
-                for k in 0..rays {
+                let (mut sum, mut free, mut blocked) = (0.0, 0u32, 0u32);
+                let receivers = (0..rays).filter(|&k| !self.is_covered(r, k)).count();
+                for k in (0..rays).filter(|&k| !self.is_covered(r, k)) {
                     let (t, jitter) = r2(k as u32, 2);
                     let target = a0 + (a1 - a0) * ((k as f64 + f64::from(t)) / rays as f64);
                     let i = prefix[patches.0 as usize..=patches.1 as usize]
@@ -551,9 +780,18 @@ impl Radiosity {
                     let f = disk_approximation(x, n_r, y, n_s, piece);
                     if f > 0.0 && vis.visible(x, n_r, y, n_s) {
                         sum += f;
+                        free += 1;
+                    } else if f > 0.0 {
+                        blocked += 1;
                     }
                 }
-                sum
+                // Each receiver point stands for 1/receivers of the receiver.
+                let scale = if receivers > 0 {
+                    rays as f32 / receivers as f32
+                } else {
+                    0.0
+                };
+                (sum * scale, free > 0 && blocked > 0)
             }
         }
     }
@@ -625,13 +863,18 @@ impl Radiosity {
                 NodeKind::Element { patch, .. } => patch as usize,
                 NodeKind::Cluster { .. } => unreachable!("clusters have children"),
             };
+            let direct = &self.direct[n as usize * bands..][..bands];
             for (k, v) in b.iter_mut().enumerate() {
                 *v = self.emission[patch * bands + k]
-                    + self.reflectance[patch * bands + k] * total[k];
+                    + self.reflectance[patch * bands + k] * (total[k] + direct[k]);
                 b_max = b_max.max(*v);
             }
+            let covered = self.covered[n as usize].map_or(0, u64::count_ones) as f32;
+            self.free_area[n as usize] =
+                self.hierarchy.nodes[n as usize].area_m2 * (1.0 - covered / self.rays() as f32);
         } else {
-            let area = self.hierarchy.nodes[n as usize].area_m2;
+            // Averages over the uncovered area (the plain area where all is covered).
+            let mut free = 0.0f32;
             // Clusters pass nothing down: their receivers are their patches.
             let pass = if matches!(
                 self.hierarchy.nodes[n as usize].kind,
@@ -641,9 +884,17 @@ impl Radiosity {
             } else {
                 total
             };
-            for c in children {
+            for &c in &children {
                 self.push_pull_node(c, &pass);
-                let w = self.hierarchy.nodes[c as usize].area_m2 / area;
+                free += self.free_area[c as usize];
+            }
+            let area = self.hierarchy.nodes[n as usize].area_m2;
+            for &c in &children {
+                let w = if free > 0.0 {
+                    self.free_area[c as usize] / free
+                } else {
+                    self.hierarchy.nodes[c as usize].area_m2 / area
+                };
                 for (v, cb) in b
                     .iter_mut()
                     .zip(&self.radiosity[c as usize * bands..][..bands])
@@ -652,10 +903,19 @@ impl Radiosity {
                 }
                 b_max = b_max.max(self.radiosity_max[c as usize]);
             }
+            self.free_area[n as usize] = free;
         }
         self.radiosity[n as usize * bands..][..bands].copy_from_slice(&b);
         self.radiosity_max[n as usize] = b_max;
     }
+}
+
+/// Which of the first `rays` sample points of `shape` are covered (bit k: point k).
+fn coverage_mask(shape: &ElementShape, rays: usize, vis: &dyn Visibility) -> u64 {
+    let n = shape.normal();
+    (0..rays)
+        .filter(|&k| vis.covered(sample_point(shape, k, 0), n))
+        .fold(0u64, |m, k| m | (1u64 << k))
 }
 
 /// The k-th stratified point on `shape` (an R2 low-discrepancy sequence, offset

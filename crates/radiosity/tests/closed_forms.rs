@@ -2,7 +2,9 @@
 //! exchanged between two unit squares (Howell C-11), with push–pull conserving power.
 
 use glam::Vec3A;
-use prism_radiosity::{ElementShape, InputPatch, Radiosity, RadiositySettings, Unoccluded};
+use prism_radiosity::{
+    ElementShape, InputPatch, NoDirectLight, Radiosity, RadiositySettings, Unoccluded,
+};
 
 fn square(p0: Vec3A, e1: Vec3A, e2: Vec3A, reflectance: &[f32], emission: &[f32]) -> InputPatch {
     InputPatch {
@@ -35,7 +37,7 @@ fn furnace_errors(rho: f32, error_bound_rel: f32) -> (f32, f32) {
     };
     let mut solution = Radiosity::new(&patches, 1, settings).unwrap();
     for _ in 0..3 {
-        solution.iterate(&Unoccluded).unwrap();
+        solution.iterate(&Unoccluded, &NoDirectLight).unwrap();
     }
     let expected = 1.0 / (1.0 - rho);
     let mut worst = 0.0f32;
@@ -92,7 +94,7 @@ fn power_reaching_an_opposed_square_matches_the_configuration_factor() {
     let mut solution = Radiosity::new(&patches, 1, settings).unwrap();
     let mut last = None;
     for _ in 0..3 {
-        last = Some(solution.iterate(&Unoccluded).unwrap());
+        last = Some(solution.iterate(&Unoccluded, &NoDirectLight).unwrap());
     }
     let stats = last.unwrap();
     assert!(stats.elements > 2, "the receiver was refined: {stats:?}");
@@ -113,4 +115,42 @@ fn bad_input_is_an_error() {
     assert!(Radiosity::new(&[], 1, RadiositySettings::default()).is_err());
     let p = square(Vec3A::ZERO, Vec3A::X, Vec3A::Y, &[0.5], &[1.0, 2.0]);
     assert!(Radiosity::new(&[p], 1, RadiositySettings::default()).is_err());
+}
+
+/// A point light of intensity I (per band) at height 1 over the centre of a unit square:
+/// irradiance I cos θ / r², power ρ·I·Ω with Ω = 4 atan(ab / (h √(a² + b² + h²))) the
+/// solid angle of the square (a = b = ½, h = 1: 0.805 4 sr).
+struct PointAbove;
+
+impl prism_radiosity::DirectIrradiance for PointAbove {
+    fn irradiance(&self, p: Vec3A, n: Vec3A, out: &mut [f32]) {
+        let d = Vec3A::new(0.5, 0.5, 1.0) - p;
+        let r2 = d.length_squared();
+        let cos = n.dot(d) / r2.sqrt();
+        for o in out.iter_mut() {
+            *o += cos.max(0.0) / r2;
+        }
+    }
+}
+
+#[test]
+fn a_point_light_lights_the_solution_by_its_closed_form() {
+    let rho = 0.5;
+    let patches = vec![square(Vec3A::ZERO, Vec3A::X, Vec3A::Y, &[rho], &[0.0])];
+    let mut solution = Radiosity::new(&patches, 1, RadiositySettings::default()).unwrap();
+    let stats = solution.iterate(&Unoccluded, &PointAbove).unwrap();
+    let omega = 4.0 * (0.25f32 / 1.5f32.sqrt()).atan();
+    let power = solution.total_power()[0];
+    assert!(
+        (power / (rho * omega) - 1.0).abs() < 2e-3,
+        "{power} vs {}",
+        rho * omega
+    );
+    // Refined where the irradiance varies: centre 1, corner 1.5^−1.5 = 0.544 (the corner
+    // leaf holds its area mean, 0.61).
+    assert!(stats.elements > 1, "{stats:?}");
+    let centre = solution.radiosity_at(0, Vec3A::new(0.5, 0.5, 0.0))[0] / rho;
+    let corner = solution.radiosity_at(0, Vec3A::new(0.01, 0.01, 0.0))[0] / rho;
+    assert!((centre - 1.0).abs() < 0.03, "{centre}");
+    assert!((corner - 0.544).abs() < 0.08, "{corner}");
 }

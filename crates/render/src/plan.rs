@@ -382,8 +382,8 @@ impl RenderPlan {
                          light as `path` (max_depth 1), then the solution's reflected radiance",
                         r.error_bound_rel, r.iterations
                     ),
-                    "the scene's `integrator` section; the interpolated gather (gather_epsilon) \
-                     is not built yet, so every gather ray is traced"
+                    "the scene's `integrator` section; the interpolated gather (4D tree and \
+                     gathering list) is not built yet, so every gather ray is traced"
                         .into(),
                 );
             }

@@ -125,7 +125,16 @@ pub trait SolutionGather: Sync {
         wo: Vec3A,
         wavelengths: &SampledWavelengths,
     ) -> SampledSpectrum;
+
+    /// Whether the solution resolves the radiance at `si` seen from `distance_m` away: a
+    /// piecewise-constant element seen from closer than its size misses the variation
+    /// across it (the corner where a wall meets the floor), so the gather path continues.
+    fn resolves(&self, si: &SurfaceInteraction, wo: Vec3A, distance_m: f32) -> bool;
 }
+
+/// Most vertices a final gather path adds after its gather depth for hits too close for
+/// the solution (`SolutionGather::resolves`).
+pub const MAX_GATHER_EXTRA_BOUNCES: u32 = 2;
 
 /// Adds β·x to `radiance` unless it is NaN/∞ (then counts it: one bad contribution cannot
 /// poison a pixel, and the stats say so). `count_incident`: also part of the indirect light
@@ -221,7 +230,8 @@ impl PathTracer {
     /// non-specular point `origin` (an illuminance sensor): emission met by the ray is then
     /// MIS-weighted against light sampling from `origin` (whose light samples the caller
     /// takes), instead of counted in full as for a camera ray. `None` is a camera ray.
-    /// Textures are filtered with the camera footprint approximation.
+    /// Textures are filtered with the camera footprint approximation. With `gather`, the
+    /// path ends at depth `max_depth` on the solution's reflected radiance.
     #[allow(clippy::too_many_arguments)]
     pub fn radiance_from(
         &self,
@@ -233,6 +243,7 @@ impl PathTracer {
         light_samples: u32,
         want_illumination: bool,
         counters: &mut PathCounters,
+        gather: Option<&dyn SolutionGather>,
     ) -> PathResult {
         self.trace(
             scene,
@@ -245,7 +256,7 @@ impl PathTracer {
             light_samples,
             want_illumination,
             counters,
-            None,
+            gather,
         )
     }
 
@@ -425,10 +436,16 @@ impl PathTracer {
                     );
                 }
             }
-            if path.depth == self.max_depth {
+            if path.depth >= self.max_depth {
                 // A final gather ends on the solution's reflected radiance (light that
-                // bounced at least once before this vertex; emission was counted above).
-                if let Some(g) = gather {
+                // bounced at least once before this vertex; emission was counted above),
+                // unless the hit is too close for the solution's element there: then the
+                // path goes on (up to MAX_GATHER_EXTRA_BOUNCES more vertices).
+                let Some(g) = gather else {
+                    break;
+                };
+                let extra = path.depth - self.max_depth;
+                if extra >= MAX_GATHER_EXTRA_BOUNCES || g.resolves(&si, -ray.direction, hit.t) {
                     let x = g.reflected_radiance(&si, -ray.direction, path.wavelengths.transport());
                     add(
                         &mut radiance,
@@ -439,8 +456,8 @@ impl PathTracer {
                         path.depth >= 2,
                         counters,
                     );
+                    break;
                 }
-                break;
             }
             path.depth += 1;
             counters.bounces += 1;

@@ -82,6 +82,7 @@ const INTEGRATORS: &[&str] = &[
     "integrator<bdpt>",
     "integrator<photon>",
     "integrator<photon_progressive>",
+    "integrator<radiosity>",
 ];
 const TRANSPORT: &[&str] = &[
     "integrator<path>",
@@ -264,6 +265,21 @@ pub const FIELD_USES: &[FieldRow] = &[
         TRANSPORT,
         &["sampler"],
         "`prism render`: crates/cli/render.rs run (RenderSettings::sampler)",
+    ),
+    read(
+        &["integrator<radiosity>"],
+        &["error_bound_rel", "iterations"],
+        "Integrator::from_description (RadiosityMethod)",
+    ),
+    read(
+        &["integrator<radiosity>"],
+        &["sampler"],
+        "`prism render`: crates/cli/render.rs run (RenderSettings::sampler)",
+    ),
+    refused(
+        &["integrator<radiosity>"],
+        &["gather_epsilon"],
+        "refuse_unrendered: the interpolated gather (4D tree and gathering list) is not built",
     ),
     read(
         &["integrator<path>"],
@@ -623,6 +639,17 @@ pub fn refuse_unrendered(scene: &SceneDescription) -> Result<(), SceneBuildError
                 )
             }
         }
+    }
+    if let prism_scene::Integrator::Radiosity {
+        gather_epsilon: Some(_),
+        ..
+    } = scene.integrator
+    {
+        return refuse(
+            JsonPath::default().key("integrator").key("gather_epsilon"),
+            "the interpolated gather that `gather_epsilon` controls (the paper's 4D tree and \
+             gathering list) is not built yet: every gather ray is traced, so remove the key",
+        );
     }
     Ok(())
 }

@@ -85,6 +85,11 @@ pub struct RenderScene {
     /// The scene's participating media (`None` when it declares none): `path` then walks
     /// its paths through `integrator::medium_transport`.
     pub media: Option<media::MediaScene>,
+    /// The `radiosity` method's solution, solved once for the scene's own integrator
+    /// (`radiosity_solution`): the render's gathers and the illuminance sensors share it.
+    radiosity: std::sync::OnceLock<
+        Result<std::sync::Arc<crate::integrator::radiosity::SolvedScene>, String>,
+    >,
 }
 
 impl RenderScene {
@@ -179,10 +184,30 @@ impl RenderScene {
             packet_tracing: true,
             features,
             media,
+            radiosity: std::sync::OnceLock::new(),
         };
         built.set_packet_tracing(true);
         built.integrator.refuse_scene(&built)?;
         Ok(built)
+    }
+
+    /// The solution of the scene's `radiosity` integrator (`None` for other methods),
+    /// solved by the first call with its statistics on stderr; an error when it cannot be
+    /// built (the memory limit).
+    pub fn radiosity_solution(
+        &self,
+    ) -> Option<Result<std::sync::Arc<crate::integrator::radiosity::SolvedScene>, String>> {
+        let Integrator::Radiosity(method) = self.integrator else {
+            return None;
+        };
+        Some(
+            self.radiosity
+                .get_or_init(|| {
+                    crate::integrator::radiosity::solve_and_report(self, &method)
+                        .map(std::sync::Arc::new)
+                })
+                .clone(),
+        )
     }
 
     /// Packet tracing on (where the scene allows it, `PacketScene::new`) or off (every

@@ -22,8 +22,9 @@ use glam::Vec3A;
 use prism_geometry::{Frame, Ray};
 use prism_spectrum::{SampledSpectrum, SampledWavelengths};
 
+use super::SensorTracer;
 use crate::film::xyz::{cd_m2_per_unit, xyz_of_sample};
-use crate::integrator::{mis_weight, LaneWavelengths, PathCounters, PathOrigin, PathTracer};
+use crate::integrator::{mis_weight, LaneWavelengths, PathCounters, PathOrigin, SolutionGather};
 use crate::light::LightSampleContext;
 use crate::sampler::SampleStream;
 use crate::sampling::sample_cosine_hemisphere;
@@ -34,7 +35,7 @@ use crate::scene_build::RenderScene;
 /// + 2 (direction) + 3 per light sample dimensions, then the path's.
 #[allow(clippy::too_many_arguments)]
 pub fn sample_illuminance_lx(
-    tracer: &PathTracer,
+    sensor_tracer: &SensorTracer,
     scene: &RenderScene,
     p: Vec3A,
     n: Vec3A,
@@ -42,6 +43,11 @@ pub fn sample_illuminance_lx(
     stream: &mut SampleStream,
     counters: &mut PathCounters,
 ) -> f64 {
+    let tracer = &sensor_tracer.path;
+    let gather = sensor_tracer
+        .gather
+        .as_deref()
+        .map(|g| g as &dyn SolutionGather);
     let mut wavelengths = LaneWavelengths::new(SampledWavelengths::sample_visible(stream.get_1d()));
     let u_dir = stream.get_2d();
     let ctx = LightSampleContext { p, n };
@@ -102,6 +108,7 @@ pub fn sample_illuminance_lx(
             n_light,
             false,
             counters,
+            gather,
         );
         // cos θ / pdf = π.
         e += r.radiance * PI;

@@ -147,11 +147,35 @@ pub struct SensorStats {
     pub non_finite_contributions: u64,
 }
 
-/// The path tracer sensors use: the scene's method's (`Integrator::sensor_tracer`: its
-/// depth, roulette and MIS), or the default one (max depth 8, roulette from depth 3, power
-/// heuristic) when the scene renders with a diagnostic integrator.
-pub fn sensor_tracer(scene: &RenderScene) -> PathTracer {
-    scene.integrator.sensor_tracer()
+/// What measures the sensors: a path tracer and, for `radiosity`, the solution its paths
+/// end on.
+pub struct SensorTracer {
+    pub path: PathTracer,
+    pub gather: Option<std::sync::Arc<crate::integrator::radiosity::SolvedScene>>,
+}
+
+/// The sensors' tracer: for `radiosity`, direct light by light sampling at the sensor and
+/// the light arriving along the cosine-sampled ray from the solution at its hit (max depth
+/// 0, then the solution); for the other methods their own path tracer
+/// (`Integrator::sensor_tracer`: depth, roulette and MIS), or the default one (max depth 8,
+/// roulette from depth 3, power heuristic) for a diagnostic integrator. A radiosity scene
+/// whose solution cannot be built (the memory limit, which `prism render` reports before
+/// measuring) is measured by path tracing.
+pub fn sensor_tracer(scene: &RenderScene) -> SensorTracer {
+    match scene.radiosity_solution() {
+        Some(Ok(solved)) => SensorTracer {
+            path: PathTracer {
+                max_depth: 0,
+                rr_depth: u32::MAX,
+                ..PathTracer::default()
+            },
+            gather: Some(solved),
+        },
+        Some(Err(_)) | None => SensorTracer {
+            path: scene.integrator.sensor_tracer(),
+            gather: None,
+        },
+    }
 }
 
 /// Light samples per vertex for sensors: one per light up to 8 (stratified, so a few
@@ -183,7 +207,7 @@ fn sensor_seed(seed: u64, sensor: usize) -> u64 {
 /// (`replicates::replicate_count`), in parallel chunks merged in a fixed order.
 #[allow(clippy::too_many_arguments)]
 fn run_samples(
-    tracer: &PathTracer,
+    tracer: &SensorTracer,
     scene: &RenderScene,
     samplers: &[PixelSampler],
     point: UVec2,
@@ -241,7 +265,7 @@ fn run_samples(
 /// adaptive point takes all its samples whatever `share` is: the caller refuses that).
 #[allow(clippy::too_many_arguments)]
 fn measure_point(
-    tracer: &PathTracer,
+    tracer: &SensorTracer,
     scene: &RenderScene,
     seed: u64,
     index: UVec2,

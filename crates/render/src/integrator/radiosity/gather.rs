@@ -32,4 +32,13 @@ impl SolutionGather for SolvedScene {
             (b[k] - e[k]).max(0.0) * std::f32::consts::FRAC_1_PI
         })
     }
+
+    /// Resolved when the leaf element is seen from at least its own size (√area).
+    fn resolves(&self, si: &SurfaceInteraction, wo: Vec3A, distance_m: f32) -> bool {
+        let Some(patch) = self.map.patch_of(si.instance_id, si.primitive_id, wo) else {
+            return true;
+        };
+        let area = self.solution.leaf_area_at(patch, si.p);
+        distance_m * distance_m >= area
+    }
 }

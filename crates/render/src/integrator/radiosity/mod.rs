@@ -4,6 +4,7 @@
 //! `path` computes them at the first hit (light sampling and BSDF sampling with MIS), and
 //! the light reflected more than once from the solution at the BSDF-sampled ray's hit.
 
+mod direct;
 pub mod gather;
 pub mod patches;
 
@@ -18,6 +19,7 @@ use prism_radiosity::{Radiosity, RadiositySettings, Visibility};
 
 pub use prism_spectrum::SampledWavelengths;
 
+use self::direct::DeltaLights;
 use self::patches::{scene_patches, BANDS};
 use super::camera_sample::CameraSample;
 use super::driver::RenderStats;
@@ -33,7 +35,6 @@ use crate::scene_build::RenderScene;
 pub struct RadiosityMethod {
     pub error_bound_rel: f32,
     pub iterations: u32,
-    pub gather_epsilon: f32,
     /// `--max-memory` for the hierarchy.
     pub memory_limit_bytes: Option<u64>,
 }
@@ -63,6 +64,17 @@ impl Visibility for SceneVisibility<'_> {
         let b = to + n_to * scale(to);
         !self.0.geometry.occluded(&Ray::spawn_to(a, b))
     }
+
+    /// Covered when the ray along the normal meets a surface from behind first (the point
+    /// is inside a closed mesh, e.g. under a box standing on it).
+    fn covered(&self, p: Vec3A, n: Vec3A) -> bool {
+        let scale = 1e-4 * (1.0 + p.abs().max_element());
+        let ray = Ray::spawn(p + n * scale, n);
+        self.0.geometry.intersect(&ray).is_some_and(|hit| {
+            let si = self.0.geometry.interaction(&ray, &hit);
+            si.n_geometric.dot(n) > 0.0
+        })
+    }
 }
 
 /// The solution for `scene`, with one line of statistics per iteration.
@@ -78,9 +90,12 @@ pub fn solve(
     };
     let mut solution = Radiosity::new(&patches, BANDS, settings).map_err(|e| e.to_string())?;
     let visibility = SceneVisibility(scene);
+    let delta_lights = DeltaLights::new(scene);
     let mut lines = Vec::new();
     for i in 1..=method.iterations {
-        let s = solution.iterate(&visibility).map_err(|e| e.to_string())?;
+        let s = solution
+            .iterate(&visibility, &delta_lights)
+            .map_err(|e| e.to_string())?;
         lines.push(format!(
             "radiosity: iteration {i}: {} patches, {} elements, {} links, {:.1} MiB, refine {:.2} s, \
              solve {:.2} s ({} sweeps)",
@@ -96,6 +111,23 @@ pub fn solve(
     Ok((SolvedScene { solution, map }, lines))
 }
 
+/// `solve` with its statistics and time on stderr (what `prism render` prints).
+pub fn solve_and_report(
+    scene: &RenderScene,
+    method: &RadiosityMethod,
+) -> Result<SolvedScene, String> {
+    let start = Instant::now();
+    let (solved, lines) = solve(scene, method)?;
+    for line in lines {
+        eprintln!("{line}");
+    }
+    eprintln!(
+        "radiosity: solution in {:.2} s",
+        start.elapsed().as_secs_f64()
+    );
+    Ok(solved)
+}
+
 impl Estimator for RadiosityEstimator {
     fn name(&self) -> &'static str {
         "radiosity"
@@ -105,18 +137,14 @@ impl Estimator for RadiosityEstimator {
         if self.solved.is_some() {
             return Ok(());
         }
-        let start = Instant::now();
-        let (solved, lines) = solve(scene, &self.method)?;
-        for line in lines {
-            eprintln!("{line}");
-        }
-        eprintln!(
-            "radiosity: solution in {:.2} s; final gather traces every gather ray \
-             (the interpolated gather of gather_epsilon {} is not built yet)",
-            start.elapsed().as_secs_f64(),
-            self.method.gather_epsilon
-        );
-        self.solved = Some(Arc::new(solved));
+        // The scene's own solution when this is the scene's method (shared with its
+        // sensors), else one of its own (`prism converge` with another scene method).
+        self.solved = Some(match scene.radiosity_solution() {
+            Some(solution) if scene.integrator == super::Integrator::Radiosity(self.method) => {
+                solution?
+            }
+            Some(_) | None => Arc::new(solve_and_report(scene, &self.method)?),
+        });
         Ok(())
     }
 

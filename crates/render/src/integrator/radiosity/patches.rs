@@ -117,17 +117,16 @@ pub fn scene_patches(scene: &RenderScene) -> Result<(Vec<InputPatch>, PatchMap),
     };
     for light in scene.lights.lights() {
         match light {
-            Light::Area(_) => {}
-            Light::Point(_)
+            Light::Area(_)
+            | Light::Point(_)
             | Light::Spot(_)
             | Light::Directional(_)
-            | Light::Environment(_)
-            | Light::Sky(_)
-            | Light::Daylight(_)
-            | Light::Goniometric(_) => {
+            | Light::Goniometric(_) => {}
+            Light::Environment(_) | Light::Sky(_) | Light::Daylight(_) => {
                 return Err(
-                    "`radiosity` takes area lights only yet (point, spot, goniometric, \
-                     directional and sky light are not shot into the solution): use `path`"
+                    "`radiosity` takes area, point, spot, goniometric and directional lights \
+                     (environment maps and skies are not shot into the solution yet): use \
+                     `path`"
                         .into(),
                 )
             }
