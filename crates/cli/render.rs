@@ -75,6 +75,18 @@ pub struct RenderArgs {
     /// Measure the scene's `sensors` only (`<output stem>.sensors.json/.csv`), no image.
     #[arg(long = "sensors-only")]
     pub sensors_only: bool,
+    /// `radiosity`: write the solution to FILE once solved, to render more views of it
+    /// with --load-solution (docs/radiosity.md).
+    #[arg(long = "save-solution", value_name = "FILE")]
+    pub save_solution: Option<PathBuf>,
+    /// `radiosity`: render from the solution in FILE instead of solving (it must have been
+    /// solved for this scene's surfaces, materials and lights).
+    #[arg(long = "load-solution", value_name = "FILE")]
+    pub load_solution: Option<PathBuf>,
+    /// `radiosity`: write the solution as a PLY mesh with per-vertex illuminance (lx) and
+    /// luminance (cd/m²).
+    #[arg(long = "export-solution", value_name = "FILE.ply")]
+    pub export_solution: Option<PathBuf>,
     /// Also write a false-colour PNG with a legend: of the image's luminance (cd/m²) or of
     /// every grid sensor's illuminance (lx), as `<stem>.<what>.falsecolour.png`.
     #[arg(long = "false-colour", value_enum)]
@@ -326,6 +338,9 @@ pub fn run(args: &RenderArgs, budget: &MemoryBudget) -> Result<ExitCode, String>
     scene
         .integrator
         .set_memory_limit_bytes(Some(budget.limit_bytes));
+    if !args.explain {
+        radiosity_solution_files(args, &scene)?;
+    }
     if let Some(strategy) = args.bdpt_strategy {
         match &mut scene.integrator {
             prism_render::Integrator::Bdpt(b) => {
@@ -866,6 +881,60 @@ fn measure_sensor_share(
             Ok(())
         }
     }
+}
+
+/// `--load-solution`, `--save-solution`, `--export-solution`: refused for other methods;
+/// a loaded solution replaces solving, a saved or exported one is solved here (the render
+/// then reuses it).
+fn radiosity_solution_files(args: &RenderArgs, scene: &RenderScene) -> Result<(), String> {
+    use prism_render::integrator::radiosity::solution_io;
+    let flags = [
+        ("--load-solution", &args.load_solution),
+        ("--save-solution", &args.save_solution),
+        ("--export-solution", &args.export_solution),
+    ];
+    let given: Vec<&str> = flags
+        .iter()
+        .filter(|(_, v)| v.is_some())
+        .map(|(f, _)| *f)
+        .collect();
+    if given.is_empty() {
+        return Ok(());
+    }
+    if !matches!(scene.integrator, prism_render::Integrator::Radiosity(_)) {
+        return Err(format!(
+            "{}: {} needs the `radiosity` integrator; {} renders with `{}`",
+            given.join(", "),
+            if given.len() == 1 { "it" } else { "they" },
+            args.scene.display(),
+            scene.integrator.name()
+        ));
+    }
+    for (flag, path) in &flags[1..] {
+        if let Some(path) = path {
+            crate::atomic_write::check_parent(flag, path)?;
+        }
+    }
+    if let Some(path) = &args.load_solution {
+        scene.set_radiosity_solution(solution_io::load_solution(scene, path)?)?;
+    }
+    if args.save_solution.is_some() || args.export_solution.is_some() {
+        let solved = scene
+            .radiosity_solution()
+            .ok_or("the scene has no radiosity solution")??;
+        if let Some(path) = &args.save_solution {
+            solution_io::save_solution(&solved, path)?;
+            eprintln!("wrote {} (radiosity solution)", path.display());
+        }
+        if let Some(path) = &args.export_solution {
+            solution_io::export_ply(&solved, path)?;
+            eprintln!(
+                "wrote {} (illuminance and luminance per vertex)",
+                path.display()
+            );
+        }
+    }
+    Ok(())
 }
 
 /// Measures the scene's sensors on `pool` and writes their readings beside the image.

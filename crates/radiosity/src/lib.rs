@@ -11,10 +11,11 @@
 pub mod element;
 pub mod form_factor;
 mod hierarchy;
+mod solution_file;
 pub mod solver;
 
 pub use element::ElementShape;
 pub use solver::{
-    DirectIrradiance, InputPatch, IterationStats, NoDirectLight, Radiosity, RadiosityError,
-    RadiositySettings, Unoccluded, Visibility,
+    DirectIrradiance, InputPatch, IterationStats, LeafElement, NoDirectLight, Radiosity,
+    RadiosityError, RadiositySettings, Unoccluded, Visibility,
 };

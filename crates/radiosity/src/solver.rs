@@ -140,14 +140,26 @@ impl std::fmt::Display for RadiosityError {
 
 impl std::error::Error for RadiosityError {}
 
+/// A leaf of the solution (`Radiosity::leaves`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LeafElement<'a> {
+    pub shape: ElementShape,
+    pub patch: usize,
+    /// Radiosity per band (emission included).
+    pub radiosity: &'a [f32],
+    /// Irradiance arriving per band.
+    pub irradiance: &'a [f32],
+    pub covered_fraction: f32,
+}
+
 /// One link: the receiver gathers `form_factor × B(source)`.
 #[derive(Clone, Copy, Debug, PartialEq)]
-struct Link {
-    source: u32,
-    form_factor: f32,
+pub(crate) struct Link {
+    pub(crate) source: u32,
+    pub(crate) form_factor: f32,
     /// Some of its visibility rays were blocked, some not: a shadow boundary crosses it,
     /// so its factor may vary over the receiver by its whole value.
-    partial: bool,
+    pub(crate) partial: bool,
 }
 
 /// What an iteration did.
@@ -167,34 +179,37 @@ pub struct IterationStats {
 
 /// A hierarchical radiosity solution.
 pub struct Radiosity {
-    settings: RadiositySettings,
-    bands: usize,
-    hierarchy: Hierarchy,
-    reflectance: Vec<f32>,
-    emission: Vec<f32>,
+    pub(crate) settings: RadiositySettings,
+    pub(crate) bands: usize,
+    pub(crate) hierarchy: Hierarchy,
+    pub(crate) reflectance: Vec<f32>,
+    pub(crate) emission: Vec<f32>,
     /// Per node × band: radiosity (area average below the node).
-    radiosity: Vec<f32>,
+    pub(crate) radiosity: Vec<f32>,
     /// Per node: the largest band radiosity below the node (the oracle's B).
-    radiosity_max: Vec<f32>,
+    pub(crate) radiosity_max: Vec<f32>,
     /// Per node × band: irradiance gathered over the node's own links.
-    gathered: Vec<f32>,
-    links: Vec<Vec<Link>>,
+    pub(crate) gathered: Vec<f32>,
+    pub(crate) links: Vec<Vec<Link>>,
     /// Per node × band: the direct irradiance (`DirectIrradiance`) averaged over the
     /// element's quadrature points; used at leaves.
-    direct: Vec<f32>,
+    pub(crate) direct: Vec<f32>,
     /// Per node: the largest band's direct irradiance, largest minus smallest over those
     /// points (what a leaf's average gets wrong); `None` until computed.
-    direct_variation: Vec<Option<f32>>,
+    pub(crate) direct_variation: Vec<Option<f32>>,
     /// Per node: which of its `visibility_rays` sample points are covered
     /// (`Visibility::covered`, bit k for point k); `None` until computed.
-    covered: Vec<Option<u64>>,
+    pub(crate) covered: Vec<Option<u64>>,
     /// Per node: the area below it that is not covered, m² (from the last push–pull).
-    free_area: Vec<f32>,
+    pub(crate) free_area: Vec<f32>,
+    /// Per node × band: the irradiance arriving at a leaf (links, pushed, direct) from the
+    /// last push–pull; zero above the leaves.
+    pub(crate) irradiance: Vec<f32>,
     /// The oracle's threshold, in the emission's units × m².
-    power_threshold: f32,
+    pub(crate) power_threshold: f32,
     /// The brightest emitter's power (exitance × area) of one band.
-    emitter_power: f32,
-    iterations: u32,
+    pub(crate) emitter_power: f32,
+    pub(crate) iterations: u32,
 }
 
 impl Radiosity {
@@ -236,6 +251,7 @@ impl Radiosity {
             direct_variation: Vec::new(),
             covered: Vec::new(),
             free_area: Vec::new(),
+            irradiance: Vec::new(),
             power_threshold: settings.error_bound_rel * brightest.1,
             emitter_power: brightest.1,
             hierarchy,
@@ -265,6 +281,44 @@ impl Radiosity {
     /// (projected onto the patch's plane, clamped into it).
     pub fn radiosity_at(&self, patch: usize, p: Vec3A) -> &[f32] {
         self.node_radiosity(self.leaf_at(patch, p))
+    }
+
+    /// Whether this solution was solved for exactly these patches (a loaded solution
+    /// against the scene it is to render).
+    pub fn matches_patches(&self, patches: &[InputPatch]) -> bool {
+        patches.len() == self.hierarchy.patch_root.len()
+            && patches.iter().enumerate().all(|(i, p)| {
+                let root = self.hierarchy.patch_root[i] as usize;
+                matches!(self.hierarchy.nodes[root].kind, NodeKind::Element { shape, .. } if shape == p.shape)
+                    && p.reflectance == self.reflectance(i)
+                    && p.emission == self.emission(i)
+            })
+    }
+
+    /// Every leaf element: its shape, input patch, radiosity and arriving irradiance per
+    /// band, and the fraction of it that is covered (`Visibility::covered`).
+    pub fn leaves(&self) -> impl Iterator<Item = LeafElement<'_>> {
+        let bands = self.bands;
+        let rays = self.settings.visibility_rays.clamp(1, 64) as f32;
+        self.hierarchy
+            .nodes
+            .iter()
+            .enumerate()
+            .filter_map(move |(n, node)| match node.kind {
+                NodeKind::Element {
+                    shape,
+                    patch,
+                    first_child: None,
+                    ..
+                } => Some(LeafElement {
+                    shape,
+                    patch: patch as usize,
+                    radiosity: &self.radiosity[n * bands..][..bands],
+                    irradiance: &self.irradiance[n * bands..][..bands],
+                    covered_fraction: self.covered[n].map_or(0, u64::count_ones) as f32 / rays,
+                }),
+                NodeKind::Element { .. } | NodeKind::Cluster { .. } => None,
+            })
     }
 
     /// Area of the leaf element `radiosity_at` reads, m².
@@ -396,7 +450,7 @@ impl Radiosity {
             * (std::mem::size_of::<crate::hierarchy::Node>() as u64
                 + std::mem::size_of::<Vec<Link>>() as u64
                 + std::mem::size_of::<Option<f32>>() as u64
-                + 4 * (3 * self.bands as u64 + 1))
+                + 4 * (4 * self.bands as u64 + 2))
             + links * std::mem::size_of::<Link>() as u64
             + (self.reflectance.len() + self.emission.len()) as u64 * 4
     }
@@ -537,6 +591,7 @@ impl Radiosity {
         self.direct_variation.resize(n, None);
         self.covered.resize(n, None);
         self.free_area.resize(n, 0.0);
+        self.irradiance.resize(n * self.bands, 0.0);
         self.radiosity.resize(n * self.bands, 0.0);
         self.radiosity_max.resize(n, 0.0);
         self.gathered.resize(n * self.bands, 0.0);
@@ -863,11 +918,11 @@ impl Radiosity {
                 NodeKind::Element { patch, .. } => patch as usize,
                 NodeKind::Cluster { .. } => unreachable!("clusters have children"),
             };
-            let direct = &self.direct[n as usize * bands..][..bands];
-            for (k, v) in b.iter_mut().enumerate() {
-                *v = self.emission[patch * bands + k]
-                    + self.reflectance[patch * bands + k] * (total[k] + direct[k]);
-                b_max = b_max.max(*v);
+            for k in 0..bands {
+                let e = total[k] + self.direct[n as usize * bands + k];
+                self.irradiance[n as usize * bands + k] = e;
+                b[k] = self.emission[patch * bands + k] + self.reflectance[patch * bands + k] * e;
+                b_max = b_max.max(b[k]);
             }
             let covered = self.covered[n as usize].map_or(0, u64::count_ones) as f32;
             self.free_area[n as usize] =

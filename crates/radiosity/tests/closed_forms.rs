@@ -154,3 +154,30 @@ fn a_point_light_lights_the_solution_by_its_closed_form() {
     assert!((centre - 1.0).abs() < 0.03, "{centre}");
     assert!((corner - 0.544).abs() < 0.08, "{corner}");
 }
+
+/// A saved solution reads back to the same bytes and values; damaged files are errors.
+#[test]
+fn a_solution_survives_bytes_and_damage_is_an_error() {
+    let patches = cube(&[0.5, 0.7], &[1.0, 0.5]);
+    let mut solution = Radiosity::new(&patches, 2, RadiositySettings::default()).unwrap();
+    solution.iterate(&Unoccluded, &NoDirectLight).unwrap();
+    let bytes = solution.to_bytes();
+    let back = Radiosity::from_bytes(&bytes).unwrap();
+    assert_eq!(back.to_bytes(), bytes);
+    assert!(back.matches_patches(&patches));
+    assert!(!back.matches_patches(&cube(&[0.5, 0.7], &[1.0, 0.6])));
+    for (i, p) in patches.iter().enumerate() {
+        let x = p.shape.point(0.3, 0.8);
+        assert_eq!(back.radiosity_at(i, x), solution.radiosity_at(i, x));
+    }
+    assert_eq!(back.leaves().count(), solution.leaves().count());
+    for cut in [0, 7, 12, 100, bytes.len() / 2, bytes.len() - 1] {
+        assert!(
+            Radiosity::from_bytes(&bytes[..cut]).is_err(),
+            "cut at {cut}"
+        );
+    }
+    let mut longer = bytes.clone();
+    longer.push(0);
+    assert!(Radiosity::from_bytes(&longer).is_err());
+}

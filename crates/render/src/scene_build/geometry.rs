@@ -54,6 +54,9 @@ pub const SMALL_SCENE_SUPPORTS: SceneFeatures = SceneFeatures::of(&[
     SceneFeature::DeltaLights,
     SceneFeature::NonRectangleAreaLights,
     SceneFeature::ThinLensCamera,
+    // The solution's visibility and coverage rays are plain queries, and its gathers read
+    // the instance and primitive ids the small-scene records carry.
+    SceneFeature::RadiositySolution,
 ]);
 
 /// How to build the geometry of a scene with `features`: the default options, without the

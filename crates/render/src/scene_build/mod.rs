@@ -210,6 +210,24 @@ impl RenderScene {
         )
     }
 
+    /// Sets the `radiosity` solution (a loaded one) before anything solves it; an error
+    /// when the scene renders with another method or already has its solution.
+    pub fn set_radiosity_solution(
+        &self,
+        solved: crate::integrator::radiosity::SolvedScene,
+    ) -> Result<(), String> {
+        if !matches!(self.integrator, Integrator::Radiosity(_)) {
+            return Err(format!(
+                "{} renders with `{}`, not `radiosity`: a radiosity solution does not apply",
+                self.file.display(),
+                self.integrator.name()
+            ));
+        }
+        self.radiosity
+            .set(Ok(std::sync::Arc::new(solved)))
+            .map_err(|_| "the scene's radiosity solution is already solved".to_string())
+    }
+
     /// Packet tracing on (where the scene allows it, `PacketScene::new`) or off (every
     /// path through the scalar tracer; for tests and comparisons).
     pub fn set_packet_tracing(&mut self, on: bool) {

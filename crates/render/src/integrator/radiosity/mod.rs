@@ -7,6 +7,7 @@
 mod direct;
 pub mod gather;
 pub mod patches;
+pub mod solution_io;
 
 pub use self::gather::SolvedScene;
 

@@ -1,0 +1,327 @@
+//! A solution as bytes, to render more views of it later (`prism render
+//! --save-solution`/`--load-solution`): the hierarchy, the links and every per-node value,
+//! little-endian, after the magic `PRISMRAD` and a format version.
+
+use glam::Vec3A;
+
+use crate::element::ElementShape;
+use crate::hierarchy::{Hierarchy, Node, NodeKind};
+use crate::solver::{Link, Radiosity, RadiositySettings};
+
+const MAGIC: &[u8; 8] = b"PRISMRAD";
+const VERSION: u32 = 1;
+const NONE: u32 = u32::MAX;
+
+struct Writer(Vec<u8>);
+
+impl Writer {
+    fn u8(&mut self, v: u8) {
+        self.0.push(v);
+    }
+    fn u32(&mut self, v: u32) {
+        self.0.extend_from_slice(&v.to_le_bytes());
+    }
+    fn u64(&mut self, v: u64) {
+        self.0.extend_from_slice(&v.to_le_bytes());
+    }
+    fn f32(&mut self, v: f32) {
+        self.0.extend_from_slice(&v.to_le_bytes());
+    }
+    fn f64(&mut self, v: f64) {
+        self.0.extend_from_slice(&v.to_le_bytes());
+    }
+    fn vec3(&mut self, v: Vec3A) {
+        self.f32(v.x);
+        self.f32(v.y);
+        self.f32(v.z);
+    }
+    fn f32s(&mut self, v: &[f32]) {
+        v.iter().for_each(|&x| self.f32(x));
+    }
+}
+
+struct Reader<'a> {
+    bytes: &'a [u8],
+    at: usize,
+}
+
+impl Reader<'_> {
+    fn take(&mut self, n: usize) -> Result<&[u8], String> {
+        let end = self.at.checked_add(n).filter(|&e| e <= self.bytes.len());
+        let Some(end) = end else {
+            return Err(format!("truncated at byte {}", self.at));
+        };
+        let s = &self.bytes[self.at..end];
+        self.at = end;
+        Ok(s)
+    }
+    fn u8(&mut self) -> Result<u8, String> {
+        Ok(self.take(1)?[0])
+    }
+    fn u32(&mut self) -> Result<u32, String> {
+        Ok(u32::from_le_bytes(
+            self.take(4)?.try_into().unwrap_or([0; 4]),
+        ))
+    }
+    fn u64(&mut self) -> Result<u64, String> {
+        Ok(u64::from_le_bytes(
+            self.take(8)?.try_into().unwrap_or([0; 8]),
+        ))
+    }
+    fn f32(&mut self) -> Result<f32, String> {
+        Ok(f32::from_le_bytes(
+            self.take(4)?.try_into().unwrap_or([0; 4]),
+        ))
+    }
+    fn f64(&mut self) -> Result<f64, String> {
+        Ok(f64::from_le_bytes(
+            self.take(8)?.try_into().unwrap_or([0; 8]),
+        ))
+    }
+    fn vec3(&mut self) -> Result<Vec3A, String> {
+        Ok(Vec3A::new(self.f32()?, self.f32()?, self.f32()?))
+    }
+    fn f32s(&mut self, n: usize) -> Result<Vec<f32>, String> {
+        (0..n).map(|_| self.f32()).collect()
+    }
+    /// A count that the rest of the bytes can hold at `bytes_each` bytes per item.
+    fn count(&mut self, bytes_each: usize) -> Result<usize, String> {
+        let n = self.u32()? as usize;
+        if n.saturating_mul(bytes_each) > self.bytes.len() - self.at {
+            return Err(format!(
+                "a count of {n} at byte {} exceeds the file",
+                self.at - 4
+            ));
+        }
+        Ok(n)
+    }
+}
+
+impl Radiosity {
+    /// The solution as bytes (`from_bytes` reads them back).
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let mut w = Writer(MAGIC.to_vec());
+        w.u32(VERSION);
+        let s = &self.settings;
+        w.u32(self.bands as u32);
+        w.f32(s.error_bound_rel);
+        w.u8(s.max_levels);
+        w.u32(s.quadrature_nodes as u32);
+        w.u32(s.visibility_rays as u32);
+        w.f32(s.solve_tolerance_rel);
+        w.u32(s.max_sweeps);
+        w.f32(self.power_threshold);
+        w.f32(self.emitter_power);
+        w.u32(self.iterations);
+        let h = &self.hierarchy;
+        w.u32(h.patch_root.len() as u32);
+        w.f32s(&self.reflectance);
+        w.f32s(&self.emission);
+        h.patch_root.iter().for_each(|&v| w.u32(v));
+        h.order.iter().for_each(|&v| w.u32(v));
+        h.order_area_prefix.iter().for_each(|&v| w.f64(v));
+        w.u32(h.nodes.len() as u32);
+        w.u32(h.root);
+        for node in &h.nodes {
+            match node.kind {
+                NodeKind::Cluster { children, patches } => {
+                    w.u8(0);
+                    w.u32(children[0]);
+                    w.u32(children[1]);
+                    w.u32(patches.0);
+                    w.u32(patches.1);
+                }
+                NodeKind::Element {
+                    shape,
+                    patch,
+                    level,
+                    first_child,
+                } => {
+                    let (tag, p0, e1, e2) = match shape {
+                        ElementShape::Parallelogram { p0, e1, e2 } => (1, p0, e1, e2),
+                        ElementShape::Triangle { p0, e1, e2 } => (2, p0, e1, e2),
+                    };
+                    w.u8(tag);
+                    w.vec3(p0);
+                    w.vec3(e1);
+                    w.vec3(e2);
+                    w.u32(patch);
+                    w.u8(level);
+                    w.u32(first_child.unwrap_or(NONE));
+                }
+            }
+            w.f32(node.area_m2);
+            w.vec3(node.lo);
+            w.vec3(node.hi);
+        }
+        w.f32s(&self.radiosity);
+        w.f32s(&self.radiosity_max);
+        w.f32s(&self.gathered);
+        w.f32s(&self.direct);
+        w.f32s(&self.irradiance);
+        for v in &self.direct_variation {
+            w.f32(v.unwrap_or(f32::NAN));
+        }
+        for c in &self.covered {
+            w.u8(u8::from(c.is_some()));
+            w.u64(c.unwrap_or(0));
+        }
+        w.f32s(&self.free_area);
+        for links in &self.links {
+            w.u32(links.len() as u32);
+            for l in links {
+                w.u32(l.source);
+                w.f32(l.form_factor);
+                w.u8(u8::from(l.partial));
+            }
+        }
+        w.0
+    }
+
+    /// Reads `to_bytes`' output; an error says what is wrong and where.
+    pub fn from_bytes(bytes: &[u8]) -> Result<Self, String> {
+        if bytes.len() < 12 || &bytes[..8] != MAGIC {
+            return Err("not a Prism radiosity solution (no PRISMRAD header)".into());
+        }
+        let mut r = Reader { bytes, at: 8 };
+        let version = r.u32()?;
+        if version != VERSION {
+            return Err(format!(
+                "solution format version {version}; this build reads version {VERSION}"
+            ));
+        }
+        let bands = r.count(4)?;
+        let settings = RadiositySettings {
+            error_bound_rel: r.f32()?,
+            max_levels: r.u8()?,
+            quadrature_nodes: r.u32()? as usize,
+            visibility_rays: r.u32()? as usize,
+            solve_tolerance_rel: r.f32()?,
+            max_sweeps: r.u32()?,
+            memory_limit_bytes: None,
+        };
+        let power_threshold = r.f32()?;
+        let emitter_power = r.f32()?;
+        let iterations = r.u32()?;
+        let patches = r.count(8 * bands.max(1))?;
+        let reflectance = r.f32s(patches * bands)?;
+        let emission = r.f32s(patches * bands)?;
+        let patch_root: Vec<u32> = (0..patches).map(|_| r.u32()).collect::<Result<_, _>>()?;
+        let order: Vec<u32> = (0..patches).map(|_| r.u32()).collect::<Result<_, _>>()?;
+        let order_area_prefix: Vec<f64> =
+            (0..=patches).map(|_| r.f64()).collect::<Result<_, _>>()?;
+        let node_count = r.count(17)?;
+        let root = r.u32()?;
+        let index = |v: u32, what: &str| -> Result<u32, String> {
+            if (v as usize) < node_count {
+                Ok(v)
+            } else {
+                Err(format!("{what} {v} is not a node (there are {node_count})"))
+            }
+        };
+        index(root, "the root")?;
+        let mut nodes = Vec::with_capacity(node_count);
+        for _ in 0..node_count {
+            let kind = match r.u8()? {
+                0 => NodeKind::Cluster {
+                    children: [index(r.u32()?, "a child")?, index(r.u32()?, "a child")?],
+                    patches: (r.u32()?, r.u32()?),
+                },
+                tag @ (1 | 2) => {
+                    let (p0, e1, e2) = (r.vec3()?, r.vec3()?, r.vec3()?);
+                    let shape = if tag == 1 {
+                        ElementShape::Parallelogram { p0, e1, e2 }
+                    } else {
+                        ElementShape::Triangle { p0, e1, e2 }
+                    };
+                    let patch = r.u32()?;
+                    if patch as usize >= patches {
+                        return Err(format!("patch {patch} of {patches}"));
+                    }
+                    let level = r.u8()?;
+                    let first = r.u32()?;
+                    let first_child = if first == NONE {
+                        None
+                    } else {
+                        index(first.saturating_add(3), "a child")?;
+                        Some(first)
+                    };
+                    NodeKind::Element {
+                        shape,
+                        patch,
+                        level,
+                        first_child,
+                    }
+                }
+                other => return Err(format!("unknown node tag {other} at byte {}", r.at - 1)),
+            };
+            nodes.push(Node {
+                kind,
+                area_m2: r.f32()?,
+                lo: r.vec3()?,
+                hi: r.vec3()?,
+            });
+        }
+        for &p in &patch_root {
+            index(p, "a patch root")?;
+        }
+        let per_band = node_count * bands;
+        let radiosity = r.f32s(per_band)?;
+        let radiosity_max = r.f32s(node_count)?;
+        let gathered = r.f32s(per_band)?;
+        let direct = r.f32s(per_band)?;
+        let irradiance = r.f32s(per_band)?;
+        let direct_variation = (0..node_count)
+            .map(|_| r.f32().map(|v| (!v.is_nan()).then_some(v)))
+            .collect::<Result<_, _>>()?;
+        let covered = (0..node_count)
+            .map(|_| -> Result<Option<u64>, String> {
+                let some = r.u8()? != 0;
+                let mask = r.u64()?;
+                Ok(some.then_some(mask))
+            })
+            .collect::<Result<_, _>>()?;
+        let free_area = r.f32s(node_count)?;
+        let mut links = Vec::with_capacity(node_count);
+        for _ in 0..node_count {
+            let n = r.count(9)?;
+            let mut l = Vec::with_capacity(n);
+            for _ in 0..n {
+                l.push(Link {
+                    source: index(r.u32()?, "a link's source")?,
+                    form_factor: r.f32()?,
+                    partial: r.u8()? != 0,
+                });
+            }
+            links.push(l);
+        }
+        if r.at != bytes.len() {
+            return Err(format!("{} bytes after the solution", bytes.len() - r.at));
+        }
+        Ok(Self {
+            settings,
+            bands,
+            hierarchy: Hierarchy {
+                nodes,
+                root,
+                patch_root,
+                order,
+                order_area_prefix,
+            },
+            reflectance,
+            emission,
+            radiosity,
+            radiosity_max,
+            gathered,
+            links,
+            direct,
+            direct_variation,
+            covered,
+            free_area,
+            irradiance,
+            power_threshold,
+            emitter_power,
+            iterations,
+        })
+    }
+}

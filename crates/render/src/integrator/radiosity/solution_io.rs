@@ -1,0 +1,113 @@
+//! A solved scene on disk: `--save-solution` and `--load-solution` (the solution's own
+//! bytes, checked against the scene it is loaded for), and `--export-solution FILE.ply`
+//! (per-vertex illuminance and luminance of every leaf element, for walk-throughs).
+
+use std::io::Write;
+use std::path::Path;
+
+use prism_radiosity::Radiosity;
+use prism_spectrum::photometry::photopic_luminance_cd_per_m2;
+use prism_spectrum::DenseSpectrum;
+
+use super::gather::SolvedScene;
+use super::patches::{scene_patches, BANDS, BAND_WIDTH_NM, FIRST_BAND_NM};
+use crate::scene_build::RenderScene;
+
+/// Writes `bytes` to a temporary file beside `path`, then renames it (no half-written
+/// output).
+fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), String> {
+    let file_name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let tmp = path.with_file_name(format!(".{file_name}.tmp"));
+    let write = || -> std::io::Result<()> {
+        let mut f = std::fs::File::create(&tmp)?;
+        f.write_all(bytes)?;
+        f.sync_all()?;
+        std::fs::rename(&tmp, path)
+    };
+    write().map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        format!("{}: cannot write: {e}", path.display())
+    })
+}
+
+/// `--save-solution FILE`.
+pub fn save_solution(solved: &SolvedScene, path: &Path) -> Result<(), String> {
+    write_atomically(path, &solved.solution.to_bytes())
+}
+
+/// `--load-solution FILE`: the solution, if it was solved for `scene`'s patches.
+pub fn load_solution(scene: &RenderScene, path: &Path) -> Result<SolvedScene, String> {
+    let bytes = std::fs::read(path).map_err(|e| format!("{}: cannot read: {e}", path.display()))?;
+    let solution = Radiosity::from_bytes(&bytes).map_err(|e| format!("{}: {e}", path.display()))?;
+    let (patches, map) = scene_patches(scene)?;
+    if solution.bands() != BANDS || !solution.matches_patches(&patches) {
+        return Err(format!(
+            "{}: this solution was solved for another scene (its patches, reflectances or \
+             emission differ from {}'s): solve it again with --save-solution",
+            path.display(),
+            scene.file.display()
+        ));
+    }
+    Ok(SolvedScene { solution, map })
+}
+
+/// A band array as a spectrum over 360–830 nm (zero outside 380–780 nm) and its
+/// photometric value: lux of an irradiance, cd/m² of a radiance.
+fn photometric(values: &[f32]) -> f64 {
+    let spectrum = DenseSpectrum::from_fn(|nm| {
+        let band = (nm - FIRST_BAND_NM) / BAND_WIDTH_NM;
+        if (0.0..BANDS as f64).contains(&band) {
+            f64::from(values[band as usize])
+        } else {
+            0.0
+        }
+    });
+    photopic_luminance_cd_per_m2(&spectrum)
+}
+
+/// `--export-solution FILE.ply`: ASCII PLY, one face per leaf element (its own vertices:
+/// the solution is constant per element), with the element's illuminance (lx) and
+/// luminance (cd/m², the Lambertian B/π) on each vertex. Covered elements (under other
+/// geometry) are left out.
+pub fn export_ply(solved: &SolvedScene, path: &Path) -> Result<(), String> {
+    let mut vertices = String::new();
+    let mut faces = String::new();
+    let (mut vertex_count, mut face_count) = (0usize, 0usize);
+    for leaf in solved.solution.leaves() {
+        if leaf.covered_fraction >= 1.0 {
+            continue;
+        }
+        let lux = photometric(leaf.irradiance);
+        let radiance: Vec<f32> = leaf
+            .radiosity
+            .iter()
+            .map(|b| b * std::f32::consts::FRAC_1_PI)
+            .collect();
+        let luminance = photometric(&radiance);
+        let (corners, count) = leaf.shape.corners();
+        for c in &corners[..count] {
+            vertices.push_str(&format!(
+                "{} {} {} {lux:.6e} {luminance:.6e}\n",
+                c.x, c.y, c.z
+            ));
+        }
+        faces.push_str(&count.to_string());
+        for i in 0..count {
+            faces.push_str(&format!(" {}", vertex_count + i));
+        }
+        faces.push('\n');
+        vertex_count += count;
+        face_count += 1;
+    }
+    let header = format!(
+        "ply\nformat ascii 1.0\ncomment Prism radiosity solution: illuminance in lx, \
+         luminance in cd/m2 (Lambertian B/pi), metres\nelement vertex {vertex_count}\n\
+         property float x\nproperty float y\nproperty float z\n\
+         property float illuminance_lx\nproperty float luminance_cd_m2\n\
+         element face {face_count}\nproperty list uchar int vertex_indices\nend_header\n"
+    );
+    write_atomically(path, format!("{header}{vertices}{faces}").as_bytes())
+}
