@@ -1,6 +1,9 @@
-//! The solution's direct light from the lights that are not patches (point, spot,
-//! goniometric and directional lights): irradiance per band with shadows, by the same
-//! light sampling and shadow rays as the path tracer's next-event estimation.
+//! The solution's direct light from the lights that are not patches: point, spot,
+//! goniometric and directional lights (one shadow ray each) and skies and environment
+//! maps (`SKY_DIRECTIONS` stratified directions, the same at every point so that the
+//! estimate varies smoothly over a surface and the refinement sees shadows, not noise):
+//! irradiance per band with shadows, by the same light sampling and shadow rays as the
+//! path tracer's next-event estimation.
 
 use glam::{Vec2, Vec3A};
 use prism_radiosity::DirectIrradiance;
@@ -14,19 +17,25 @@ use crate::scene_build::RenderScene;
 /// Wavelengths per band averaged (a band's mean of a spiky lamp spectrum).
 const POINTS_PER_BAND: usize = 4;
 
-pub struct DeltaLights<'a> {
+/// Directions per point and sky (importance-sampled by the light, R2-stratified).
+const SKY_DIRECTIONS: u32 = 64;
+
+pub struct PointLikeAndSkyLights<'a> {
     scene: &'a RenderScene,
     /// Indices of the delta lights in the scene's light set.
     lights: Vec<u32>,
+    /// Indices of the skies and environment maps.
+    skies: Vec<u32>,
     /// The band wavelengths in groups of the four lanes.
     wavelength_sets: Vec<SampledWavelengths>,
 }
 
-impl<'a> DeltaLights<'a> {
+impl<'a> PointLikeAndSkyLights<'a> {
     pub fn new(scene: &'a RenderScene) -> Self {
         let lights = (0..scene.lights.len() as u32)
             .filter(|&l| scene.lights.light(l).is_delta())
             .collect();
+        let skies = scene.lights.infinite_lights().to_vec();
         let all: Vec<f32> = (0..BANDS * POINTS_PER_BAND)
             .map(|i| {
                 let (band, k) = (i / POINTS_PER_BAND, i % POINTS_PER_BAND);
@@ -46,12 +55,13 @@ impl<'a> DeltaLights<'a> {
         Self {
             scene,
             lights,
+            skies,
             wavelength_sets,
         }
     }
 }
 
-impl DirectIrradiance for DeltaLights<'_> {
+impl DirectIrradiance for PointLikeAndSkyLights<'_> {
     fn irradiance(&self, p: Vec3A, n: Vec3A, out: &mut [f32]) {
         let ctx = LightSampleContext { p, n };
         let tracer = PathTracer::default();
@@ -77,14 +87,61 @@ impl DirectIrradiance for DeltaLights<'_> {
             if t.is_black() {
                 continue;
             }
-            for (set, wavelengths) in self.wavelength_sets.iter().enumerate() {
-                let Some(ls) = light.sample_li(&ctx, u, wavelengths) else {
+            self.add_sample(light, &ctx, u, cos, 1.0, out);
+        }
+        for &l in &self.skies {
+            let light = self.scene.lights.light(l);
+            for k in 0..SKY_DIRECTIONS {
+                // R2 sequence (Roberts 2018): the same directions at every point.
+                let i = k as f32 + 1.0;
+                let u = Vec2::new(
+                    (0.5 + 0.754_877_7 * i).fract(),
+                    (0.5 + 0.569_840_3 * i).fract(),
+                );
+                let Some(first) = light.sample_li(&ctx, u, &self.wavelength_sets[0]) else {
                     continue;
                 };
-                for lane in 0..N_SPECTRUM_SAMPLES {
-                    let band = (set * N_SPECTRUM_SAMPLES + lane) / POINTS_PER_BAND;
-                    out[band] += ls.radiance[lane] * cos / ls.pdf / POINTS_PER_BAND as f32;
+                let cos = first.wi.dot(n);
+                if cos <= 0.0 || !(first.pdf > 0.0) {
+                    continue;
                 }
+                let t = tracer.transmittance(
+                    self.scene,
+                    p,
+                    &first,
+                    &self.wavelength_sets[0],
+                    &mut counters,
+                );
+                if t.is_black() {
+                    continue;
+                }
+                self.add_sample(light, &ctx, u, cos, 1.0 / SKY_DIRECTIONS as f32, out);
+            }
+        }
+    }
+}
+
+impl PointLikeAndSkyLights<'_> {
+    /// Adds weight · L cos θ / pdf of `light`'s sample `u` at every band wavelength.
+    fn add_sample(
+        &self,
+        light: &crate::light::Light,
+        ctx: &LightSampleContext,
+        u: Vec2,
+        cos: f32,
+        weight: f32,
+        out: &mut [f32],
+    ) {
+        for (set, wavelengths) in self.wavelength_sets.iter().enumerate() {
+            let Some(ls) = light.sample_li(ctx, u, wavelengths) else {
+                continue;
+            };
+            if !(ls.pdf > 0.0) {
+                continue;
+            }
+            for lane in 0..N_SPECTRUM_SAMPLES {
+                let band = (set * N_SPECTRUM_SAMPLES + lane) / POINTS_PER_BAND;
+                out[band] += weight * ls.radiance[lane] * cos / ls.pdf / POINTS_PER_BAND as f32;
             }
         }
     }

@@ -20,7 +20,7 @@ use prism_radiosity::{Radiosity, RadiositySettings, Visibility};
 
 pub use prism_spectrum::SampledWavelengths;
 
-use self::direct::DeltaLights;
+use self::direct::PointLikeAndSkyLights;
 use self::patches::{scene_patches, BANDS};
 use super::camera_sample::CameraSample;
 use super::driver::RenderStats;
@@ -91,11 +91,11 @@ pub fn solve(
     };
     let mut solution = Radiosity::new(&patches, BANDS, settings).map_err(|e| e.to_string())?;
     let visibility = SceneVisibility(scene);
-    let delta_lights = DeltaLights::new(scene);
+    let direct_lights = PointLikeAndSkyLights::new(scene);
     let mut lines = Vec::new();
     for i in 1..=method.iterations {
         let s = solution
-            .iterate(&visibility, &delta_lights)
+            .iterate(&visibility, &direct_lights)
             .map_err(|e| e.to_string())?;
         lines.push(format!(
             "radiosity: iteration {i}: {} patches, {} elements, {} links, {:.1} MiB, refine {:.2} s, \

@@ -115,23 +115,6 @@ pub fn scene_patches(scene: &RenderScene) -> Result<(Vec<InputPatch>, PatchMap),
         sides: Vec::with_capacity(geometry.instances().len()),
         normals: Vec::new(),
     };
-    for light in scene.lights.lights() {
-        match light {
-            Light::Area(_)
-            | Light::Point(_)
-            | Light::Spot(_)
-            | Light::Directional(_)
-            | Light::Goniometric(_) => {}
-            Light::Environment(_) | Light::Sky(_) | Light::Daylight(_) => {
-                return Err(
-                    "`radiosity` takes area, point, spot, goniometric and directional lights \
-                     (environment maps and skies are not shot into the solution yet): use \
-                     `path`"
-                        .into(),
-                )
-            }
-        }
-    }
     for (instance_id, inst) in geometry.instances().iter().enumerate() {
         let area_light = scene
             .lights
