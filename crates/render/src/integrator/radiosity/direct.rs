@@ -102,7 +102,7 @@ impl DirectIrradiance for PointLikeAndSkyLights<'_> {
                     continue;
                 };
                 let cos = first.wi.dot(n);
-                if cos <= 0.0 || !(first.pdf > 0.0) {
+                if cos <= 0.0 || first.pdf.is_nan() || first.pdf <= 0.0 {
                     continue;
                 }
                 let t = tracer.transmittance(
@@ -136,7 +136,7 @@ impl PointLikeAndSkyLights<'_> {
             let Some(ls) = light.sample_li(ctx, u, wavelengths) else {
                 continue;
             };
-            if !(ls.pdf > 0.0) {
+            if ls.pdf.is_nan() || ls.pdf <= 0.0 {
                 continue;
             }
             for lane in 0..N_SPECTRUM_SAMPLES {
