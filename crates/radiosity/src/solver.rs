@@ -402,6 +402,8 @@ impl Radiosity {
             self.push_pull();
         }
         self.refine(visibility)?;
+        // Links grow without splits too.
+        self.check_memory()?;
         self.compute_coverage(visibility);
         self.compute_direct(direct);
         self.refine_direct(direct, visibility)?;

@@ -181,3 +181,21 @@ fn a_solution_survives_bytes_and_damage_is_an_error() {
     longer.push(0);
     assert!(Radiosity::from_bytes(&longer).is_err());
 }
+
+/// `--max-memory`: refinement beyond the limit stops with an error naming the sizes.
+#[test]
+fn refinement_beyond_the_memory_limit_is_an_error() {
+    let patches = cube(&[0.5], &[1.0]);
+    let settings = RadiositySettings {
+        error_bound_rel: 0.000_25,
+        memory_limit_bytes: Some(8 * 1024),
+        ..RadiositySettings::default()
+    };
+    let mut solution = Radiosity::new(&patches, 1, settings).unwrap();
+    let e = solution.iterate(&Unoccluded, &NoDirectLight).unwrap_err();
+    assert!(
+        matches!(e, prism_radiosity::RadiosityError::MemoryLimit { .. }),
+        "{e:?}"
+    );
+    assert!(e.to_string().contains("--max-memory"), "{e}");
+}
