@@ -1,63 +1,37 @@
-//! `prism render` with the `radiosity` integrator: the solution saved, exported as PLY and
-//! loaded again for another render, and the errors of misused solution files.
+//! `prism render` with the `radiosity` integrator on the Cornell box: the solution saved,
+//! exported as PLY and loaded again for another render, and the errors of misused solution
+//! files.
 
 mod support;
 use support::prism_in as prism;
 
-/// A closed 2 m room (six inward rectangles) with a ceiling lamp and a point light.
-fn room(reflectance: f64) -> String {
-    let faces = [
-        (
-            "floor",
-            r#"[{"rotate": {"axis": [1, 0, 0], "angle_deg": -90}}, {"translate": [0, -1, 0]}]"#,
-        ),
-        (
-            "ceiling",
-            r#"[{"rotate": {"axis": [1, 0, 0], "angle_deg": 90}}, {"translate": [0, 1, 0]}]"#,
-        ),
-        ("back", r#"[{"translate": [0, 0, -1]}]"#),
-        (
-            "front",
-            r#"[{"rotate": {"axis": [0, 1, 0], "angle_deg": 180}}, {"translate": [0, 0, 1]}]"#,
-        ),
-        (
-            "left",
-            r#"[{"rotate": {"axis": [0, 1, 0], "angle_deg": 90}}, {"translate": [-1, 0, 0]}]"#,
-        ),
-        (
-            "right",
-            r#"[{"rotate": {"axis": [0, 1, 0], "angle_deg": -90}}, {"translate": [1, 0, 0]}]"#,
-        ),
-    ];
-    let mut shapes: Vec<String> = faces
-        .iter()
-        .map(|(n, t)| {
-            format!(r#"{{"type": "rectangle", "name": "{n}", "size_m": [2, 2], "material": "wall", "transform": {t}}}"#)
-        })
-        .collect();
-    shapes.push(
-        r#"{"type": "rectangle", "name": "lamp", "size_m": [0.4, 0.4], "material": "wall", "transform": [{"rotate": {"axis": [1, 0, 0], "angle_deg": 90}}, {"translate": [0, 0.99, 0]}]}"#
-            .into(),
+/// scenes/radiosity/cornell-box.json with its walls' reflectance scaled by `scale` (1: the
+/// scene itself), written into `dir` with the light's spectrum file given absolutely.
+fn cornell(dir: &std::path::Path, name: &str, scale: f64) {
+    let scenes = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+    let text = std::fs::read_to_string(scenes.join("radiosity/cornell-box.json")).unwrap();
+    let mut json: serde_json::Value = serde_json::from_str(&text).unwrap();
+    json["lights"][0]["spectrum"] = serde_json::Value::String(
+        scenes
+            .join("cornell-box/light-radiance.csv")
+            .display()
+            .to_string(),
     );
-    format!(
-        r#"{{
-  "camera": {{"type": "pinhole", "fov_deg": 70, "transform": {{"look_at": {{"eye": [0, 0, 0.9], "target": [0, 0, 0], "up": [0, 1, 0]}}}}}},
-  "film": {{"resolution": [12, 12], "spp": 2}},
-  "integrator": {{"type": "radiosity"}},
-  "materials": {{"wall": {{"type": "lambert", "reflectance": {reflectance}}}}},
-  "shapes": [{}],
-  "lights": [{{"type": "area", "shape": "lamp", "luminance_cd_m2": 1000}},
-             {{"type": "point", "position_m": [0.5, 0.5, 0.5], "intensity_cd": 20}}],
-  "sensors": [{{"type": "grid", "name": "floor", "origin_m": [-0.9, -0.99, -0.9], "u_m": [1.8, 0, 0], "v_m": [0, 0, 1.8], "resolution": [3, 3], "samples": 256}}]
-}}"#,
-        shapes.join(", ")
-    )
+    for m in json["materials"].as_object_mut().unwrap().values_mut() {
+        let rgb = m["reflectance"]["rgb"].as_array_mut().unwrap();
+        for c in rgb.iter_mut() {
+            *c = serde_json::json!(c.as_f64().unwrap() * scale);
+        }
+    }
+    json["film"]["resolution"] = serde_json::json!([12, 12]);
+    json["film"]["spp"] = serde_json::json!(2);
+    std::fs::write(dir.join(name), json.to_string()).unwrap();
 }
 
 #[test]
 fn a_saved_solution_renders_the_same_image_and_exports_a_ply() {
     let dir = tempfile::tempdir().unwrap();
-    std::fs::write(dir.path().join("room.json"), room(0.6)).unwrap();
+    cornell(dir.path(), "room.json", 1.0);
     let o = prism(
         dir.path(),
         &[
@@ -116,13 +90,12 @@ fn a_saved_solution_renders_the_same_image_and_exports_a_ply() {
 #[test]
 fn misused_solution_files_are_errors() {
     let dir = tempfile::tempdir().unwrap();
-    std::fs::write(dir.path().join("room.json"), room(0.6)).unwrap();
-    std::fs::write(dir.path().join("darker.json"), room(0.3)).unwrap();
-    std::fs::write(
-        dir.path().join("path.json"),
-        room(0.6).replace(r#""type": "radiosity""#, r#""type": "path""#),
-    )
-    .unwrap();
+    cornell(dir.path(), "room.json", 1.0);
+    cornell(dir.path(), "darker.json", 0.5);
+    let room = std::fs::read_to_string(dir.path().join("room.json")).unwrap();
+    let mut path: serde_json::Value = serde_json::from_str(&room).unwrap();
+    path["integrator"] = serde_json::json!({"type": "path"});
+    std::fs::write(dir.path().join("path.json"), path.to_string()).unwrap();
     let o = prism(
         dir.path(),
         &[

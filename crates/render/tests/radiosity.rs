@@ -177,38 +177,11 @@ fn sensors_read_the_solution_within_two_percent_of_path() {
 #[test]
 fn a_closed_emitting_box_reads_pi_l_over_one_minus_rho() {
     let dir = Dir::new("radiosity", "furnace");
-    let faces = [
-        (
-            "floor",
-            r#"[{"rotate": {"axis": [1, 0, 0], "angle_deg": -90}}, {"translate": [0, -1, 0]}]"#,
-        ),
-        (
-            "ceiling",
-            r#"[{"rotate": {"axis": [1, 0, 0], "angle_deg": 90}}, {"translate": [0, 1, 0]}]"#,
-        ),
-        ("back", r#"[{"translate": [0, 0, -1]}]"#),
-        (
-            "front",
-            r#"[{"rotate": {"axis": [0, 1, 0], "angle_deg": 180}}, {"translate": [0, 0, 1]}]"#,
-        ),
-        (
-            "left",
-            r#"[{"rotate": {"axis": [0, 1, 0], "angle_deg": 90}}, {"translate": [-1, 0, 0]}]"#,
-        ),
-        (
-            "right",
-            r#"[{"rotate": {"axis": [0, 1, 0], "angle_deg": -90}}, {"translate": [1, 0, 0]}]"#,
-        ),
-    ];
-    let shapes: Vec<String> = faces
+    let names = ["floor", "ceiling", "back", "front", "left", "right"];
+    let shapes = box_faces(&names, "grey");
+    let lights: Vec<String> = names
         .iter()
-        .map(|(name, t)| {
-            format!(r#"{{"type": "rectangle", "name": "{name}", "size_m": [2, 2], "material": "grey", "transform": {t}}}"#)
-        })
-        .collect();
-    let lights: Vec<String> = faces
-        .iter()
-        .map(|(name, _)| format!(r#"{{"type": "area", "shape": "{name}", "spectrum": 1}}"#))
+        .map(|name| format!(r#"{{"type": "area", "shape": "{name}", "spectrum": 1}}"#))
         .collect();
     let scene = |integrator: &str| {
         let json = format!(
@@ -317,27 +290,7 @@ fn office_sensors_agree_with_path() {
 #[test]
 fn a_sky_reaches_the_solution() {
     let dir = Dir::new("radiosity", "sky");
-    let faces = [
-        (
-            "floor",
-            r#"[{"rotate": {"axis": [1, 0, 0], "angle_deg": -90}}, {"translate": [0, -1, 0]}]"#,
-        ),
-        ("back", r#"[{"translate": [0, 0, -1]}]"#),
-        (
-            "left",
-            r#"[{"rotate": {"axis": [0, 1, 0], "angle_deg": 90}}, {"translate": [-1, 0, 0]}]"#,
-        ),
-        (
-            "right",
-            r#"[{"rotate": {"axis": [0, 1, 0], "angle_deg": -90}}, {"translate": [1, 0, 0]}]"#,
-        ),
-    ];
-    let shapes: Vec<String> = faces
-        .iter()
-        .map(|(n, t)| {
-            format!(r#"{{"type": "rectangle", "name": "{n}", "size_m": [2, 2], "material": "m", "transform": {t}}}"#)
-        })
-        .collect();
+    let shapes = box_faces(&["floor", "back", "left", "right"], "m");
     let measure = |integrator: &str| {
         let json = format!(
             r#"{{
@@ -375,4 +328,37 @@ fn a_sky_reaches_the_solution() {
             "point {i}: {g} vs {e}"
         );
     }
+}
+
+/// Named faces of the cube [−1, 1]³ as inward-facing 2 m rectangles of material
+/// `material` (scene JSON): floor, ceiling, back, front, left, right.
+fn box_faces(names: &[&str], material: &str) -> Vec<String> {
+    let transform = |name: &str| match name {
+        "floor" => {
+            r#"[{"rotate": {"axis": [1, 0, 0], "angle_deg": -90}}, {"translate": [0, -1, 0]}]"#
+        }
+        "ceiling" => {
+            r#"[{"rotate": {"axis": [1, 0, 0], "angle_deg": 90}}, {"translate": [0, 1, 0]}]"#
+        }
+        "back" => r#"[{"translate": [0, 0, -1]}]"#,
+        "front" => {
+            r#"[{"rotate": {"axis": [0, 1, 0], "angle_deg": 180}}, {"translate": [0, 0, 1]}]"#
+        }
+        "left" => {
+            r#"[{"rotate": {"axis": [0, 1, 0], "angle_deg": 90}}, {"translate": [-1, 0, 0]}]"#
+        }
+        "right" => {
+            r#"[{"rotate": {"axis": [0, 1, 0], "angle_deg": -90}}, {"translate": [1, 0, 0]}]"#
+        }
+        other => panic!("no face {other}"),
+    };
+    names
+        .iter()
+        .map(|&name| {
+            format!(
+                r#"{{"type": "rectangle", "name": "{name}", "size_m": [2, 2], "material": "{material}", "transform": {}}}"#,
+                transform(name)
+            )
+        })
+        .collect()
 }

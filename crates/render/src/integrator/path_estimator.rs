@@ -3,6 +3,7 @@
 //! scene is one the packet tracer serves (`RenderScene::packet`, its allow-list) and the
 //! plan takes one light sample per hit.
 
+use glam::UVec2;
 use prism_spectrum::SampledWavelengths;
 
 use super::camera_sample::CameraSample;
@@ -10,7 +11,7 @@ use super::driver::RenderStats;
 use super::estimator::{Estimator, Pass, TileWork};
 use super::lane_wavelengths::LaneWavelengths;
 use super::packet::{render_tile as render_packet_tile, TileJob};
-use super::{PathCounters, PathTracer};
+use super::{PathCounters, PathResult, PathTracer};
 use crate::film::xyz::XyzWeights;
 use crate::film::{FilmTile, LightSplats};
 use crate::scene_build::RenderScene;
@@ -70,76 +71,75 @@ impl Estimator for PathTracer {
             stats.samples += c.samples;
             stats.non_finite_samples += c.non_finite_samples;
         } else {
-            for pixel in tile.bounds().pixels() {
+            scalar_tile(scene, work, tile, &mut stats, |cs, pixel, wavelengths| {
                 let light_samples = work.light_samples(pixel);
-                let samples = work.samples_of(pixel);
-                // A progressive pass scales by its own sample count, a range of a render
-                // by the render's (`Pass::footprint_samples`).
-                let differential_scale = pass.differential_scale(pixel);
-                for s in samples {
-                    let mut cs = CameraSample::start(tile, work, pixel, s);
-                    let mut wavelengths = LaneWavelengths::new(SampledWavelengths::sample_visible(
-                        cs.stream.get_1d(),
-                    ));
-                    // Ray differentials only feed texture filtering: without textures the
-                    // camera ray alone (same bits) saves two camera rays per sample.
-                    let result = if scene.texture_footprint.is_none() {
-                        scene
-                            .camera
-                            .generate_ray_only(cs.film_point, cs.lens)
-                            .map(|ray| {
-                                self.radiance(
-                                    scene,
-                                    &ray,
-                                    &mut wavelengths,
-                                    &mut cs.stream,
-                                    light_samples,
-                                    settings.illumination_aov,
-                                    &mut counters,
-                                )
-                            })
-                    } else {
-                        scene
-                            .camera
-                            .generate_ray(cs.film_point, cs.lens)
-                            .map(|mut camera_ray| {
-                                camera_ray.scale_differentials(differential_scale);
-                                self.radiance_with_differentials(
-                                    scene,
-                                    &camera_ray.ray,
-                                    Some(&camera_ray),
-                                    differential_scale,
-                                    &mut wavelengths,
-                                    &mut cs.stream,
-                                    light_samples,
-                                    settings.illumination_aov,
-                                    &mut counters,
-                                )
-                            })
-                    };
-                    // One colour-matching lookup for the beauty and the illumination AOV,
-                    // at the wavelengths the film records.
-                    let sensor = wavelengths.sensor();
-                    let xyz_weights = XyzWeights::new(sensor);
-                    let estimate = result.map(|r| {
-                        if let Some(white) = r.illumination {
-                            tile.add_illumination_with(pixel, white, &xyz_weights);
-                        }
-                        (r.radiance, r.first_hit)
-                    });
-                    cs.add_to_tile(
-                        tile,
-                        scene,
-                        pixel,
-                        sensor,
-                        &xyz_weights,
-                        estimate,
-                        &mut stats,
-                    );
+                if scene.texture_footprint.is_none() {
+                    scene
+                        .camera
+                        .generate_ray_only(cs.film_point, cs.lens)
+                        .map(|ray| {
+                            self.radiance(
+                                scene,
+                                &ray,
+                                wavelengths,
+                                &mut cs.stream,
+                                light_samples,
+                                settings.illumination_aov,
+                                &mut counters,
+                            )
+                        })
+                } else {
+                    let differential_scale = pass.differential_scale(pixel);
+                    scene
+                        .camera
+                        .generate_ray(cs.film_point, cs.lens)
+                        .map(|mut camera_ray| {
+                            camera_ray.scale_differentials(differential_scale);
+                            self.radiance_with_differentials(
+                                scene,
+                                &camera_ray.ray,
+                                Some(&camera_ray),
+                                differential_scale,
+                                wavelengths,
+                                &mut cs.stream,
+                                light_samples,
+                                settings.illumination_aov,
+                                &mut counters,
+                            )
+                        })
                 }
-            }
+            });
         }
         stats.add_path_counters(&counters);
         stats
+    }
+}
+
+/// The scalar per-sample loop of a tile: each pixel's samples of the work item, a camera
+/// sample and hero wavelengths each, `radiance` for them (`None`: no camera ray), the
+/// illumination AOV and the sample added to the tile.
+pub(super) fn scalar_tile(
+    scene: &RenderScene,
+    work: &TileWork,
+    tile: &mut FilmTile,
+    stats: &mut RenderStats,
+    mut radiance: impl FnMut(&mut CameraSample, UVec2, &mut LaneWavelengths) -> Option<PathResult>,
+) {
+    for pixel in tile.bounds().pixels() {
+        for s in work.samples_of(pixel) {
+            let mut cs = CameraSample::start(tile, work, pixel, s);
+            let mut wavelengths =
+                LaneWavelengths::new(SampledWavelengths::sample_visible(cs.stream.get_1d()));
+            let result = radiance(&mut cs, pixel, &mut wavelengths);
+            let sensor = wavelengths.sensor();
+            let xyz_weights = XyzWeights::new(sensor);
+            let estimate = result.map(|r| {
+                if let Some(white) = r.illumination {
+                    tile.add_illumination_with(pixel, white, &xyz_weights);
+                }
+                (r.radiance, r.first_hit)
+            });
+            cs.add_to_tile(tile, scene, pixel, sensor, &xyz_weights, estimate, stats);
+        }
     }
 }

@@ -102,6 +102,27 @@ pub enum Material {
 }
 
 impl Material {
+    /// The reflectance of a plain `lambert` with a constant (untextured) reflectance; `None`
+    /// for every other material (wrappers included). What the packet tracer and the
+    /// radiosity solution can hold.
+    pub fn constant_lambert(&self) -> Option<&Spectrum> {
+        match self {
+            Material::Surface(SurfaceMaterial::Lambert { reflectance }) => reflectance.constant(),
+            Material::Surface(
+                SurfaceMaterial::Conductor { .. }
+                | SurfaceMaterial::Dielectric { .. }
+                | SurfaceMaterial::ThinDielectric { .. }
+                | SurfaceMaterial::Mix { .. }
+                | SurfaceMaterial::Library(_)
+                | SurfaceMaterial::Fluorescent(_),
+            )
+            | Material::TwoSided { .. }
+            | Material::Mask { .. }
+            | Material::NormalMap { .. }
+            | Material::BumpMap { .. } => None,
+        }
+    }
+
     /// The default material of shapes without one: lambert, reflectance 0.5.
     pub fn default_material() -> Self {
         Material::Surface(SurfaceMaterial::Lambert {

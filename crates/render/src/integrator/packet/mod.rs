@@ -40,7 +40,6 @@ use prism_spectrum::Spectrum;
 
 use crate::light::area::{AreaLight, AreaShape};
 use crate::light::Light;
-use crate::material::{Material, SurfaceMaterial};
 use crate::scene_build::{small_scene_not_used, RenderScene, SceneFeature, SceneFeatures};
 
 /// What a ray that hits patch `i` finds there (constant over the patch).
@@ -161,23 +160,7 @@ impl PacketScene {
         let mut reflectances: Vec<(u32, Spectrum)> = Vec::new();
         for leaf in &flat {
             let r = &leaf.record;
-            let constant = match scene.material(r.material_id) {
-                Material::Surface(SurfaceMaterial::Lambert { reflectance }) => {
-                    reflectance.constant()
-                }
-                Material::Surface(
-                    SurfaceMaterial::Conductor { .. }
-                    | SurfaceMaterial::Dielectric { .. }
-                    | SurfaceMaterial::ThinDielectric { .. }
-                    | SurfaceMaterial::Mix { .. }
-                    | SurfaceMaterial::Library(_)
-                    | SurfaceMaterial::Fluorescent(_),
-                )
-                | Material::TwoSided { .. }
-                | Material::Mask { .. }
-                | Material::NormalMap { .. }
-                | Material::BumpMap { .. } => None,
-            };
+            let constant = scene.material(r.material_id).constant_lambert();
             // Guaranteed by the features (`NonLambertianBsdfs`, `Textures`, …): a guard.
             let Some(constant) = constant else {
                 return Err(format!(

@@ -64,33 +64,10 @@ impl<'a> PointLikeAndSkyLights<'a> {
 impl DirectIrradiance for PointLikeAndSkyLights<'_> {
     fn irradiance(&self, p: Vec3A, n: Vec3A, out: &mut [f32]) {
         let ctx = LightSampleContext { p, n };
-        let tracer = PathTracer::default();
-        let mut counters = PathCounters::default();
         for &l in &self.lights {
-            let light = self.scene.lights.light(l);
-            let u = Vec2::splat(0.5);
-            let Some(first) = light.sample_li(&ctx, u, &self.wavelength_sets[0]) else {
-                continue;
-            };
-            let cos = first.wi.dot(n);
-            if cos <= 0.0 || first.pdf <= 0.0 {
-                continue;
-            }
-            // One shadow ray serves every wavelength (no medium, glazing or mask: refused).
-            let t = tracer.transmittance(
-                self.scene,
-                p,
-                &first,
-                &self.wavelength_sets[0],
-                &mut counters,
-            );
-            if t.is_black() {
-                continue;
-            }
-            self.add_sample(light, &ctx, u, cos, 1.0, out);
+            self.add_direction(l, &ctx, Vec2::splat(0.5), 1.0, out);
         }
         for &l in &self.skies {
-            let light = self.scene.lights.light(l);
             for k in 0..SKY_DIRECTIONS {
                 // R2 sequence (Roberts 2018): the same directions at every point.
                 let i = k as f32 + 1.0;
@@ -98,30 +75,45 @@ impl DirectIrradiance for PointLikeAndSkyLights<'_> {
                     (0.5 + 0.754_877_7 * i).fract(),
                     (0.5 + 0.569_840_3 * i).fract(),
                 );
-                let Some(first) = light.sample_li(&ctx, u, &self.wavelength_sets[0]) else {
-                    continue;
-                };
-                let cos = first.wi.dot(n);
-                if cos <= 0.0 || first.pdf.is_nan() || first.pdf <= 0.0 {
-                    continue;
-                }
-                let t = tracer.transmittance(
-                    self.scene,
-                    p,
-                    &first,
-                    &self.wavelength_sets[0],
-                    &mut counters,
-                );
-                if t.is_black() {
-                    continue;
-                }
-                self.add_sample(light, &ctx, u, cos, 1.0 / SKY_DIRECTIONS as f32, out);
+                self.add_direction(l, &ctx, u, 1.0 / SKY_DIRECTIONS as f32, out);
             }
         }
     }
 }
 
 impl PointLikeAndSkyLights<'_> {
+    /// Adds weight · L cos θ / pdf of light `l`'s sample `u` when it is above the surface
+    /// and unshadowed (one shadow ray serves every wavelength: media, glazing and masks
+    /// are refused).
+    fn add_direction(
+        &self,
+        l: u32,
+        ctx: &LightSampleContext,
+        u: Vec2,
+        weight: f32,
+        out: &mut [f32],
+    ) {
+        let light = self.scene.lights.light(l);
+        let Some(first) = light.sample_li(ctx, u, &self.wavelength_sets[0]) else {
+            return;
+        };
+        let cos = first.wi.dot(ctx.n);
+        if cos <= 0.0 || first.pdf.is_nan() || first.pdf <= 0.0 {
+            return;
+        }
+        let mut counters = PathCounters::default();
+        let t = PathTracer::default().transmittance(
+            self.scene,
+            ctx.p,
+            &first,
+            &self.wavelength_sets[0],
+            &mut counters,
+        );
+        if !t.is_black() {
+            self.add_sample(light, ctx, u, cos, weight, out);
+        }
+    }
+
     /// Adds weight · L cos θ / pdf of `light`'s sample `u` at every band wavelength.
     fn add_sample(
         &self,

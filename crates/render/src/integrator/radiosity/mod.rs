@@ -18,16 +18,12 @@ use glam::Vec3A;
 use prism_geometry::Ray;
 use prism_radiosity::{Radiosity, RadiositySettings, Visibility};
 
-pub use prism_spectrum::SampledWavelengths;
-
-use self::direct::PointLikeAndSkyLights;
+pub use self::direct::PointLikeAndSkyLights;
 use self::patches::{scene_patches, BANDS};
-use super::camera_sample::CameraSample;
 use super::driver::RenderStats;
 use super::estimator::{Estimator, Pass, TileWork};
-use super::lane_wavelengths::LaneWavelengths;
+use super::path_estimator::scalar_tile;
 use super::{PathCounters, PathTracer};
-use crate::film::xyz::XyzWeights;
 use crate::film::{FilmTile, LightSplats};
 use crate::scene_build::RenderScene;
 
@@ -176,46 +172,23 @@ impl Estimator for RadiosityEstimator {
             ..PathTracer::default()
         };
         let settings = work.pass.settings;
-        for pixel in tile.bounds().pixels() {
-            let light_samples = work.light_samples(pixel);
-            for s in work.samples_of(pixel) {
-                let mut cs = CameraSample::start(tile, work, pixel, s);
-                let mut wavelengths =
-                    LaneWavelengths::new(SampledWavelengths::sample_visible(cs.stream.get_1d()));
-                let result = scene
-                    .camera
-                    .generate_ray_only(cs.film_point, cs.lens)
-                    .map(|ray| {
-                        tracer.radiance_gathered(
-                            scene,
-                            &ray,
-                            &mut wavelengths,
-                            &mut cs.stream,
-                            light_samples,
-                            settings.illumination_aov,
-                            &mut counters,
-                            solved,
-                        )
-                    });
-                let sensor = wavelengths.sensor();
-                let xyz_weights = XyzWeights::new(sensor);
-                let estimate = result.map(|r| {
-                    if let Some(white) = r.illumination {
-                        tile.add_illumination_with(pixel, white, &xyz_weights);
-                    }
-                    (r.radiance, r.first_hit)
-                });
-                cs.add_to_tile(
-                    tile,
-                    scene,
-                    pixel,
-                    sensor,
-                    &xyz_weights,
-                    estimate,
-                    &mut stats,
-                );
-            }
-        }
+        scalar_tile(scene, work, tile, &mut stats, |cs, pixel, wavelengths| {
+            scene
+                .camera
+                .generate_ray_only(cs.film_point, cs.lens)
+                .map(|ray| {
+                    tracer.radiance_gathered(
+                        scene,
+                        &ray,
+                        wavelengths,
+                        &mut cs.stream,
+                        work.light_samples(pixel),
+                        settings.illumination_aov,
+                        &mut counters,
+                        solved,
+                    )
+                })
+        });
         stats.add_path_counters(&counters);
         stats
     }

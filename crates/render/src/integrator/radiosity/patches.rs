@@ -8,9 +8,8 @@ use prism_radiosity::{ElementShape, InputPatch};
 use prism_spectrum::Spectrum;
 
 use crate::light::Light;
-use crate::material::{Material, SurfaceMaterial};
+use crate::material::Material;
 use crate::scene_build::RenderScene;
-use crate::texture::TexturedSpectrum;
 
 /// Bands of the solution: 16 of 25 nm over 380–780 nm.
 pub const BANDS: usize = 16;
@@ -80,30 +79,15 @@ fn lambertian(material: &Material) -> Result<(&Spectrum, bool), String> {
         | Material::NormalMap { .. }
         | Material::BumpMap { .. }) => (m, false),
     };
-    match inner {
-        Material::Surface(SurfaceMaterial::Lambert {
-            reflectance: TexturedSpectrum::Constant(s),
-        }) => Ok((s, two_sided)),
-        Material::Surface(SurfaceMaterial::Lambert {
-            reflectance: TexturedSpectrum::Texture { .. },
-        }) => Err("a textured `lambert` (radiosity takes constant reflectances only yet)".into()),
-        Material::Surface(
-            SurfaceMaterial::Conductor { .. }
-            | SurfaceMaterial::Dielectric { .. }
-            | SurfaceMaterial::ThinDielectric { .. }
-            | SurfaceMaterial::Mix { .. }
-            | SurfaceMaterial::Library(_)
-            | SurfaceMaterial::Fluorescent(_),
-        )
-        | Material::TwoSided { .. }
-        | Material::Mask { .. }
-        | Material::NormalMap { .. }
-        | Material::BumpMap { .. } => Err(
+    inner
+        .constant_lambert()
+        .map(|s| (s, two_sided))
+        .ok_or_else(|| {
             "not a constant `lambert` (or `two_sided` of one): radiosity transfers diffuse light \
-             only (the paper's directional transfers are not built yet)"
-                .into(),
-        ),
-    }
+         only, from untextured reflectances (the paper's directional transfers and textured \
+         patches are not built yet)"
+                .into()
+        })
 }
 
 /// The patches of `scene` and their map; an error names what the solution cannot hold.
