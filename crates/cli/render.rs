@@ -916,18 +916,28 @@ fn radiosity_solution_files(args: &RenderArgs, scene: &RenderScene) -> Result<()
         }
     }
     if let Some(path) = &args.load_solution {
-        scene.set_radiosity_solution(solution_io::load_solution(scene, path)?)?;
+        let bytes =
+            std::fs::read(path).map_err(|e| format!("{}: cannot read: {e}", path.display()))?;
+        scene.set_radiosity_solution(solution_io::load_solution(scene, path, &bytes)?)?;
     }
     if args.save_solution.is_some() || args.export_solution.is_some() {
         let solved = scene
             .radiosity_solution()
             .ok_or("the scene has no radiosity solution")??;
         if let Some(path) = &args.save_solution {
-            solution_io::save_solution(&solved, path)?;
+            crate::atomic_write::write_atomic(
+                path,
+                &solved.solution.to_bytes(),
+                "radiosity solution",
+            )?;
             eprintln!("wrote {} (radiosity solution)", path.display());
         }
         if let Some(path) = &args.export_solution {
-            solution_io::export_ply(&solved, path)?;
+            crate::atomic_write::write_atomic(
+                path,
+                solution_io::to_ply(&solved).as_bytes(),
+                "radiosity solution PLY",
+            )?;
             eprintln!(
                 "wrote {} (illuminance and luminance per vertex)",
                 path.display()

@@ -615,16 +615,10 @@ fn push_box(groups: &mut Vec<BoxGroup>, i: usize, lo: Vec3A, hi: Vec3A) {
     g.valid |= 1 << lane;
 }
 
-/// World box of a rectangle (its four corners).
+/// World box of a rectangle (its four corners: the object box is flat).
 fn rectangle_world_box(r: &Rectangle, to_world: &Transform) -> (Vec3A, Vec3A) {
-    let (w, h) = (r.half_width_m, r.half_height_m);
-    [(-w, -h), (w, -h), (w, h), (-w, h)]
-        .iter()
-        .map(|&(x, y)| to_world.point(Vec3A::new(x, y, 0.0)))
-        .fold(
-            (Vec3A::splat(f32::INFINITY), Vec3A::splat(f32::NEG_INFINITY)),
-            |(lo, hi), p| (lo.min(p), hi.max(p)),
-        )
+    let (lo, hi) = r.bounds();
+    to_world.bounds(lo, hi)
 }
 
 /// The rectangles in the order their batches take: up to [`LANES`] as they come; beyond,
@@ -655,14 +649,7 @@ fn rectangles_in_batch_order(
     let extent = (hi - lo).max(Vec3A::splat(f32::MIN_POSITIVE));
     let morton = |c: Vec3A| {
         let q = ((c - lo) / extent * 1023.0).clamp(Vec3A::ZERO, Vec3A::splat(1023.0));
-        let spread = |v: u32| {
-            let mut x = v & 0x3ff;
-            x = (x | (x << 16)) & 0x0300_00ff;
-            x = (x | (x << 8)) & 0x0300_f00f;
-            x = (x | (x << 4)) & 0x030c_30c3;
-            (x | (x << 2)) & 0x0924_9249
-        };
-        spread(q.x as u32) | (spread(q.y as u32) << 1) | (spread(q.z as u32) << 2)
+        obvhs::ploc::morton::morton_encode_u32(q.x as u16, q.y as u16, q.z as u16)
     };
     rest.sort_by_key(|r| morton(centre(r)));
     rectangles.extend(rest);

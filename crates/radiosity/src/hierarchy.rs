@@ -84,23 +84,18 @@ impl Hierarchy {
     }
 
     /// The children of node `n` (none for a leaf element).
-    pub fn children(&self, n: u32) -> ChildIter {
-        match self.nodes[n as usize].kind {
-            NodeKind::Cluster { children, .. } => ChildIter {
-                first: children[0],
-                second: Some(children[1]),
-                count: 2,
-                consecutive: false,
-                at: 0,
-            },
-            NodeKind::Element { first_child, .. } => ChildIter {
-                first: first_child.unwrap_or(0),
-                second: None,
-                count: if first_child.is_some() { 4 } else { 0 },
-                consecutive: true,
-                at: 0,
-            },
-        }
+    pub fn children(&self, n: u32) -> std::iter::Take<std::array::IntoIter<u32, 4>> {
+        let (ids, count) = match self.nodes[n as usize].kind {
+            NodeKind::Cluster { children, .. } => ([children[0], children[1], 0, 0], 2),
+            NodeKind::Element {
+                first_child: Some(f),
+                ..
+            } => ([f, f + 1, f + 2, f + 3], 4),
+            NodeKind::Element {
+                first_child: None, ..
+            } => ([0; 4], 0),
+        };
+        ids.into_iter().take(count)
     }
 
     /// Creates the four children of element `n` if it has none.
@@ -132,31 +127,6 @@ impl Hierarchy {
         if let NodeKind::Element { first_child, .. } = &mut self.nodes[n as usize].kind {
             *first_child = Some(first);
         }
-    }
-}
-
-/// Iterator over a node's children.
-pub(crate) struct ChildIter {
-    first: u32,
-    second: Option<u32>,
-    count: u32,
-    consecutive: bool,
-    at: u32,
-}
-
-impl Iterator for ChildIter {
-    type Item = u32;
-    fn next(&mut self) -> Option<u32> {
-        if self.at >= self.count {
-            return None;
-        }
-        let i = self.at;
-        self.at += 1;
-        Some(if self.consecutive || i == 0 {
-            self.first + i
-        } else {
-            self.second.unwrap_or(self.first)
-        })
     }
 }
 

@@ -16,6 +16,6 @@ pub mod solver;
 
 pub use element::ElementShape;
 pub use solver::{
-    DirectIrradiance, InputPatch, IterationStats, LeafElement, NoDirectLight, Radiosity,
-    RadiosityError, RadiositySettings, Unoccluded, Visibility,
+    r2, DirectIrradiance, InputPatch, IterationStats, LeafAt, LeafElement, NoDirectLight,
+    Radiosity, RadiosityError, RadiositySettings, Unoccluded, Visibility,
 };

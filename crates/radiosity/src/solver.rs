@@ -43,9 +43,9 @@ pub trait Visibility: Sync {
     }
 }
 
-/// Irradiance per band from the lights that are not patches (point, spot and directional
-/// lights: what the final gather gets by next-event estimation), shadows included, at a
-/// point `p` of a surface facing `n`; added to `out`.
+/// Irradiance per band from the lights that are not patches (point-like, directional and
+/// sky lights: what the final gather gets by next-event estimation), shadows included, at
+/// a point `p` of a surface facing `n`; added to `out`.
 pub trait DirectIrradiance: Sync {
     fn irradiance(&self, p: Vec3A, n: Vec3A, out: &mut [f32]);
 }
@@ -152,6 +152,14 @@ pub struct LeafElement<'a> {
     pub covered_fraction: f32,
 }
 
+/// The leaf element at a point (`Radiosity::leaf_at`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LeafAt<'a> {
+    /// Radiosity per band (emission included).
+    pub radiosity: &'a [f32],
+    pub area_m2: f32,
+}
+
 /// One link: the receiver gathers `form_factor × B(source)`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct Link {
@@ -192,7 +200,7 @@ pub struct Radiosity {
     pub(crate) gathered: Vec<f32>,
     pub(crate) links: Vec<Vec<Link>>,
     /// Per node × band: the direct irradiance (`DirectIrradiance`) averaged over the
-    /// element's quadrature points; used at leaves.
+    /// element's uncovered sample points; used at leaves.
     pub(crate) direct: Vec<f32>,
     /// Per node: the largest band's direct irradiance, largest minus smallest over those
     /// points (what a leaf's average gets wrong); `None` until computed.
@@ -205,7 +213,7 @@ pub struct Radiosity {
     /// Per node × band: the irradiance arriving at a leaf (links, pushed, direct) from the
     /// last push–pull; zero above the leaves.
     pub(crate) irradiance: Vec<f32>,
-    /// The oracle's threshold, in the emission's units × m².
+    /// The oracle's threshold, in the emission's units × m² (set by the first iteration).
     pub(crate) power_threshold: f32,
     /// The brightest emitter's power (exitance × area) of one band.
     pub(crate) emitter_power: f32,
@@ -231,13 +239,15 @@ impl Radiosity {
         }
         let shapes: Vec<ElementShape> = patches.iter().map(|p| p.shape).collect();
         let hierarchy = Hierarchy::build(&shapes);
-        let brightest = patches
+        // The brightest emitter (largest exitance in any band) and its power.
+        let emitter_power = patches
             .iter()
             .map(|p| {
                 let b = p.emission.iter().copied().fold(0.0f32, f32::max);
                 (b, b * p.shape.area_m2())
             })
-            .fold((0.0f32, 0.0f32), |a, b| if b.0 > a.0 { b } else { a });
+            .fold((0.0f32, 0.0f32), |a, b| if b.0 > a.0 { b } else { a })
+            .1;
         let mut solution = Self {
             settings,
             bands,
@@ -252,8 +262,9 @@ impl Radiosity {
             covered: Vec::new(),
             free_area: Vec::new(),
             irradiance: Vec::new(),
-            power_threshold: settings.error_bound_rel * brightest.1,
-            emitter_power: brightest.1,
+            // Set by the first iteration, which knows the direct light too.
+            power_threshold: 0.0,
+            emitter_power,
             hierarchy,
             iterations: 0,
         };
@@ -280,7 +291,16 @@ impl Radiosity {
     /// Radiosity per band of the leaf element of input patch `patch` holding point `p`
     /// (projected onto the patch's plane, clamped into it).
     pub fn radiosity_at(&self, patch: usize, p: Vec3A) -> &[f32] {
-        self.node_radiosity(self.leaf_at(patch, p))
+        self.node_radiosity(self.leaf_node(patch, p))
+    }
+
+    /// The leaf element `radiosity_at` reads: its radiosity per band and its area.
+    pub fn leaf_at(&self, patch: usize, p: Vec3A) -> LeafAt<'_> {
+        let n = self.leaf_node(patch, p);
+        LeafAt {
+            radiosity: self.node_radiosity(n),
+            area_m2: self.hierarchy.nodes[n as usize].area_m2,
+        }
     }
 
     /// Whether this solution was solved for exactly these patches (a loaded solution
@@ -299,7 +319,6 @@ impl Radiosity {
     /// band, and the fraction of it that is covered (`Visibility::covered`).
     pub fn leaves(&self) -> impl Iterator<Item = LeafElement<'_>> {
         let bands = self.bands;
-        let rays = self.settings.visibility_rays.clamp(1, 64) as f32;
         self.hierarchy
             .nodes
             .iter()
@@ -315,18 +334,13 @@ impl Radiosity {
                     patch: patch as usize,
                     radiosity: &self.radiosity[n * bands..][..bands],
                     irradiance: &self.irradiance[n * bands..][..bands],
-                    covered_fraction: self.covered[n].map_or(0, u64::count_ones) as f32 / rays,
+                    covered_fraction: self.covered_fraction(n),
                 }),
                 NodeKind::Element { .. } | NodeKind::Cluster { .. } => None,
             })
     }
 
-    /// Area of the leaf element `radiosity_at` reads, m².
-    pub fn leaf_area_at(&self, patch: usize, p: Vec3A) -> f32 {
-        self.hierarchy.nodes[self.leaf_at(patch, p) as usize].area_m2
-    }
-
-    fn leaf_at(&self, patch: usize, p: Vec3A) -> u32 {
+    fn leaf_node(&self, patch: usize, p: Vec3A) -> u32 {
         let mut node = self.hierarchy.patch_root[patch];
         let shape = match self.hierarchy.nodes[node as usize].kind {
             NodeKind::Element { shape, .. } => shape,
@@ -483,6 +497,11 @@ impl Radiosity {
     /// Visibility rays per link (at most 64: the coverage masks' width).
     fn rays(&self) -> usize {
         self.settings.visibility_rays.clamp(1, 64)
+    }
+
+    /// The fraction of node n's sample points that are covered.
+    fn covered_fraction(&self, n: usize) -> f32 {
+        self.covered[n].map_or(0, u64::count_ones) as f32 / self.rays() as f32
     }
 
     /// Whether sample point k of node n is covered.
@@ -781,6 +800,11 @@ impl Radiosity {
         };
         let n_r = receiver.normal();
         let rays = self.rays();
+        // The receiver's uncovered sample points (a covered one receives nothing).
+        let receivers: Vec<usize> = (0..rays).filter(|&k| !self.is_covered(r, k)).collect();
+        if receivers.is_empty() {
+            return (0.0, false);
+        }
         match nodes[s as usize].kind {
             NodeKind::Element { shape, .. } => {
                 let unoccluded =
@@ -790,7 +814,7 @@ impl Radiosity {
                 }
                 let n_s = shape.normal();
                 let (mut facing, mut free) = (0u32, 0u32);
-                for k in (0..rays).filter(|&k| !self.is_covered(r, k)) {
+                for &k in &receivers {
                     let x = sample_point(&receiver, k, 0);
                     let y = sample_point(&shape, k, 1);
                     let d = y - x;
@@ -800,9 +824,7 @@ impl Radiosity {
                     facing += 1;
                     free += u32::from(vis.visible(x, n_r, y, n_s));
                 }
-                if (0..rays).all(|k| self.is_covered(r, k)) {
-                    (0.0, false)
-                } else if facing == 0 {
+                if facing == 0 {
                     (unoccluded, false)
                 } else {
                     (
@@ -816,8 +838,7 @@ impl Radiosity {
                 let (a0, a1) = (prefix[patches.0 as usize], prefix[patches.1 as usize]);
                 let piece = ((a1 - a0) / rays as f64) as f32;
                 let (mut sum, mut free, mut blocked) = (0.0, 0u32, 0u32);
-                let receivers = (0..rays).filter(|&k| !self.is_covered(r, k)).count();
-                for k in (0..rays).filter(|&k| !self.is_covered(r, k)) {
+                for &k in &receivers {
                     let (t, jitter) = r2(k as u32, 2);
                     let target = a0 + (a1 - a0) * ((k as f64 + f64::from(t)) / rays as f64);
                     let i = prefix[patches.0 as usize..=patches.1 as usize]
@@ -843,11 +864,7 @@ impl Radiosity {
                     }
                 }
                 // Each receiver point stands for 1/receivers of the receiver.
-                let scale = if receivers > 0 {
-                    rays as f32 / receivers as f32
-                } else {
-                    0.0
-                };
+                let scale = rays as f32 / receivers.len() as f32;
                 (sum * scale, free > 0 && blocked > 0)
             }
         }
@@ -912,10 +929,10 @@ impl Radiosity {
         {
             *t += g;
         }
-        let children: Vec<u32> = self.hierarchy.children(n).collect();
+        let children = self.hierarchy.children(n);
         let mut b = vec![0.0f32; bands];
         let mut b_max = 0.0f32;
-        if children.is_empty() {
+        if children.len() == 0 {
             let patch = match self.hierarchy.nodes[n as usize].kind {
                 NodeKind::Element { patch, .. } => patch as usize,
                 NodeKind::Cluster { .. } => unreachable!("clusters have children"),
@@ -926,9 +943,8 @@ impl Radiosity {
                 b[k] = self.emission[patch * bands + k] + self.reflectance[patch * bands + k] * e;
                 b_max = b_max.max(b[k]);
             }
-            let covered = self.covered[n as usize].map_or(0, u64::count_ones) as f32;
-            self.free_area[n as usize] =
-                self.hierarchy.nodes[n as usize].area_m2 * (1.0 - covered / self.rays() as f32);
+            self.free_area[n as usize] = self.hierarchy.nodes[n as usize].area_m2
+                * (1.0 - self.covered_fraction(n as usize));
         } else {
             // Averages over the uncovered area (the plain area where all is covered).
             let mut free = 0.0f32;
@@ -941,12 +957,12 @@ impl Radiosity {
             } else {
                 total
             };
-            for &c in &children {
+            for c in children.clone() {
                 self.push_pull_node(c, &pass);
                 free += self.free_area[c as usize];
             }
             let area = self.hierarchy.nodes[n as usize].area_m2;
-            for &c in &children {
+            for c in children {
                 let w = if free > 0.0 {
                     self.free_area[c as usize] / free
                 } else {
@@ -998,8 +1014,10 @@ fn fold_into(shape: &ElementShape, a: f32, b: f32) -> (f32, f32) {
     }
 }
 
-/// The R2 sequence (Roberts 2018), point k, shifted by `stream`.
-fn r2(k: u32, stream: u32) -> (f32, f32) {
+/// The R2 sequence (Roberts 2018), point k in [0, 1)², shifted by `stream` (0 starts at
+/// ½ + k·(α₁, α₂)): the stratified points of the sample rays, and of the renderer's sky
+/// directions.
+pub fn r2(k: u32, stream: u32) -> (f32, f32) {
     const A1: f64 = 0.754_877_666_246_692_7;
     const A2: f64 = 0.569_840_290_998_053_2;
     let base = 0.5 + std::f64::consts::FRAC_1_PI * f64::from(stream);

@@ -212,12 +212,18 @@ fn a_closed_emitting_box_reads_pi_l_over_one_minus_rho() {
     };
     let path = scene(r#"{"type": "path", "max_depth": 64, "rr_depth": 64}"#);
     let radiosity = scene(r#"{"type": "radiosity"}"#);
+    // L = 1 W·m⁻²·sr⁻¹·nm⁻¹ at every wavelength: E_v = K_m ∫ȳ dλ · π/(1 − ρ) lx.
+    let closed_form = prism_render::film::xyz::cd_m2_per_unit() * std::f64::consts::PI / 0.5;
     for (i, (&(e, e_se), &(g, g_se))) in path.iter().zip(&radiosity).enumerate() {
         let se = (e_se * e_se + g_se * g_se).sqrt();
         eprintln!("furnace point {i}: radiosity {g:.3} lx, path {e:.3} lx, s.e. {se:.3}");
         assert!(
             (g - e).abs() <= 0.005 * e + 4.0 * se,
             "point {i}: {g} vs {e}"
+        );
+        assert!(
+            (g - closed_form).abs() <= 0.005 * closed_form + 4.0 * g_se,
+            "point {i}: {g} vs π L/(1 − ρ) = {closed_form}"
         );
     }
 }

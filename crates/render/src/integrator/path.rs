@@ -119,21 +119,21 @@ pub fn mis_weight(heuristic: MisHeuristic, a: f32, b: f32) -> f32 {
 /// A view-independent solution a final gather ends on: the radiance a surface point
 /// reflects towards `wo` (emission excluded).
 pub trait SolutionGather: Sync {
+    /// The reflected radiance at `si`; with `seen_from_m`, `None` when the solution does
+    /// not resolve it from that distance (a piecewise-constant element seen from closer
+    /// than its size misses the variation across it, e.g. the corner where a wall meets
+    /// the floor), so that the gather path continues instead.
     fn reflected_radiance(
         &self,
         si: &SurfaceInteraction,
         wo: Vec3A,
         wavelengths: &SampledWavelengths,
-    ) -> SampledSpectrum;
-
-    /// Whether the solution resolves the radiance at `si` seen from `distance_m` away: a
-    /// piecewise-constant element seen from closer than its size misses the variation
-    /// across it (the corner where a wall meets the floor), so the gather path continues.
-    fn resolves(&self, si: &SurfaceInteraction, wo: Vec3A, distance_m: f32) -> bool;
+        seen_from_m: Option<f32>,
+    ) -> Option<SampledSpectrum>;
 }
 
 /// Most vertices a final gather path adds after its gather depth for hits too close for
-/// the solution (`SolutionGather::resolves`).
+/// the solution (`SolutionGather::reflected_radiance`'s `seen_from_m`).
 pub const MAX_GATHER_EXTRA_BOUNCES: u32 = 2;
 
 /// Adds β·x to `radiance` unless it is NaN/∞ (then counts it: one bad contribution cannot
@@ -445,8 +445,9 @@ impl PathTracer {
                     break;
                 };
                 let extra = path.depth - self.max_depth;
-                if extra >= MAX_GATHER_EXTRA_BOUNCES || g.resolves(&si, -ray.direction, hit.t) {
-                    let x = g.reflected_radiance(&si, -ray.direction, path.wavelengths.transport());
+                let seen_from_m = (extra < MAX_GATHER_EXTRA_BOUNCES).then_some(hit.t);
+                let transport = path.wavelengths.transport();
+                if let Some(x) = g.reflected_radiance(&si, -ray.direction, transport, seen_from_m) {
                     add(
                         &mut radiance,
                         &mut incident_after_first,

@@ -247,6 +247,13 @@ impl RenderScene {
         on
     }
 
+    /// The name of material `material_id` as `material` resolves it (`default` for
+    /// `NO_MATERIAL` and ids past the scene's materials).
+    pub fn material_name(&self, material_id: u32) -> &str {
+        let last = self.material_names.len() - 1;
+        &self.material_names[(material_id as usize).min(last)]
+    }
+
     /// The name of the first material that re-radiates (fluorescence), if any.
     pub fn reradiating_material(&self) -> Option<&str> {
         self.materials

@@ -29,7 +29,9 @@ use std::sync::Arc;
 
 use glam::{UVec2, Vec2};
 use prism_bandwidth::local_bandwidth::{Boundary, LocalBandwidth};
+use prism_image::image::luminance_weights;
 use prism_scene::{ImageChannel, NoiseKind, NoiseSpace, TextureFilter};
+use prism_spectrum::rgb_space::RgbColorSpace;
 
 use super::{Texture, TextureContext, TextureSource};
 
@@ -78,9 +80,11 @@ impl TextureBandwidth {
         let source = match &texture.source {
             TextureSource::Image(image) => {
                 let (w, h) = image.mip.level_size(0);
+                // Textures hold linear Rec.709 RGB (sRGB primaries).
+                let luminance = luminance_weights(&RgbColorSpace::srgb());
                 let values: Vec<f32> = (0..h as i64)
                     .flat_map(|y| (0..w as i64).map(move |x| (x, y)))
-                    .map(|(x, y)| scalar_of(image.channel, image.mip.texel(0, x, y)))
+                    .map(|(x, y)| scalar_of(image.channel, image.mip.texel(0, x, y), luminance))
                     .collect();
                 let resolution = UVec2::new(w as u32, h as u32);
                 let local =
@@ -214,10 +218,11 @@ fn wrap01(x: f32) -> f32 {
 }
 
 /// The scalar a texel contributes to shading variation: the channel of scalar uses, the
-/// Rec.709 luminance of colours (channel `average` is also what colour uses default to).
-fn scalar_of(channel: ImageChannel, rgba: [f32; 4]) -> f32 {
+/// luminance (`weights`: Y of linear RGB) of colours (channel `average` is also what colour
+/// uses default to).
+fn scalar_of(channel: ImageChannel, rgba: [f32; 4], weights: [f32; 3]) -> f32 {
     match channel {
-        ImageChannel::Average => 0.2126 * rgba[0] + 0.7152 * rgba[1] + 0.0722 * rgba[2],
+        ImageChannel::Average => weights[0] * rgba[0] + weights[1] * rgba[1] + weights[2] * rgba[2],
         ImageChannel::R => rgba[0],
         ImageChannel::G => rgba[1],
         ImageChannel::B => rgba[2],

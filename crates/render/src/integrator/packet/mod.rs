@@ -165,10 +165,7 @@ impl PacketScene {
             let Some(constant) = constant else {
                 return Err(format!(
                     "material '{}' is not a constant Lambertian",
-                    scene
-                        .material_names
-                        .get(r.material_id as usize)
-                        .map_or("default", String::as_str)
+                    scene.material_name(r.material_id)
                 ));
             };
             let slot = match reflectances.iter().position(|(id, _)| *id == r.material_id) {

@@ -9,7 +9,7 @@ use glam::{Vec2, Vec3A};
 use prism_radiosity::DirectIrradiance;
 use prism_spectrum::{SampledSpectrum, SampledWavelengths, N_SPECTRUM_SAMPLES};
 
-use super::patches::{BANDS, BAND_WIDTH_NM, FIRST_BAND_NM};
+use super::patches::{band_point_nm, BANDS};
 use crate::integrator::{PathCounters, PathTracer};
 use crate::light::LightSampleContext;
 use crate::scene_build::RenderScene;
@@ -38,10 +38,7 @@ impl<'a> PointLikeAndSkyLights<'a> {
         let skies = scene.lights.infinite_lights().to_vec();
         let all: Vec<f32> = (0..BANDS * POINTS_PER_BAND)
             .map(|i| {
-                let (band, k) = (i / POINTS_PER_BAND, i % POINTS_PER_BAND);
-                (FIRST_BAND_NM
-                    + BAND_WIDTH_NM * (band as f64 + (k as f64 + 0.5) / POINTS_PER_BAND as f64))
-                    as f32
+                band_point_nm(i / POINTS_PER_BAND, i % POINTS_PER_BAND, POINTS_PER_BAND) as f32
             })
             .collect();
         let wavelength_sets = all
@@ -69,12 +66,9 @@ impl DirectIrradiance for PointLikeAndSkyLights<'_> {
         }
         for &l in &self.skies {
             for k in 0..SKY_DIRECTIONS {
-                // R2 sequence (Roberts 2018): the same directions at every point.
-                let i = k as f32 + 1.0;
-                let u = Vec2::new(
-                    (0.5 + 0.754_877_7 * i).fract(),
-                    (0.5 + 0.569_840_3 * i).fract(),
-                );
+                // The same stratified directions at every point.
+                let (a, b) = prism_radiosity::r2(k, 0);
+                let u = Vec2::new(a, b);
                 self.add_direction(l, &ctx, u, 1.0 / SKY_DIRECTIONS as f32, out);
             }
         }

@@ -15,30 +15,26 @@ pub struct SolvedScene {
 }
 
 impl SolutionGather for SolvedScene {
-    /// (B − B_e)/π of the leaf element under the hit, at the band of each lane.
+    /// (B − B_e)/π of the leaf element under the hit, at the band of each lane; resolved
+    /// when the element is seen from at least its own size (√area).
     fn reflected_radiance(
         &self,
         si: &SurfaceInteraction,
         wo: Vec3A,
         wavelengths: &SampledWavelengths,
-    ) -> SampledSpectrum {
+        seen_from_m: Option<f32>,
+    ) -> Option<SampledSpectrum> {
         let Some(patch) = self.map.patch_of(si.instance_id, si.primitive_id, wo) else {
-            return SampledSpectrum::splat(0.0);
+            return Some(SampledSpectrum::splat(0.0));
         };
-        let b = self.solution.radiosity_at(patch, si.p);
+        let leaf = self.solution.leaf_at(patch, si.p);
+        if seen_from_m.is_some_and(|d| d * d < leaf.area_m2) {
+            return None;
+        }
         let e = self.solution.emission(patch);
-        SampledSpectrum::from_fn(|lane| {
+        Some(SampledSpectrum::from_fn(|lane| {
             let k = band_of(wavelengths.wavelength_nm(lane));
-            (b[k] - e[k]).max(0.0) * std::f32::consts::FRAC_1_PI
-        })
-    }
-
-    /// Resolved when the leaf element is seen from at least its own size (√area).
-    fn resolves(&self, si: &SurfaceInteraction, wo: Vec3A, distance_m: f32) -> bool {
-        let Some(patch) = self.map.patch_of(si.instance_id, si.primitive_id, wo) else {
-            return true;
-        };
-        let area = self.solution.leaf_area_at(patch, si.p);
-        distance_m * distance_m >= area
+            (leaf.radiosity[k] - e[k]).max(0.0) * std::f32::consts::FRAC_1_PI
+        }))
     }
 }

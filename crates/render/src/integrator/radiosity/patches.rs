@@ -3,6 +3,7 @@
 //! and the map from a hit (instance, primitive, side) back to its patch.
 
 use glam::Vec3A;
+use prism_geometry::triangle_geometry::triangle_local_geometry;
 use prism_geometry::{Geometry, Shape, NO_MATERIAL};
 use prism_radiosity::{ElementShape, InputPatch};
 use prism_spectrum::Spectrum;
@@ -25,15 +26,17 @@ pub fn band_of(wavelength_nm: f32) -> usize {
         .min(BANDS - 1)
 }
 
+/// Wavelength `k` of `count` evenly spaced midpoints in band `band`, nm.
+pub fn band_point_nm(band: usize, k: usize, count: usize) -> f64 {
+    FIRST_BAND_NM + BAND_WIDTH_NM * (band as f64 + (k as f64 + 0.5) / count as f64)
+}
+
 /// A spectrum's mean over each band (5 points per band).
 fn band_means(spectrum: &Spectrum, scale: f64) -> Vec<f32> {
     (0..BANDS)
         .map(|b| {
             let mean = (0..5)
-                .map(|k| {
-                    let nm = FIRST_BAND_NM + BAND_WIDTH_NM * (b as f64 + (k as f64 + 0.5) / 5.0);
-                    spectrum.eval_nm(nm)
-                })
+                .map(|k| spectrum.eval_nm(band_point_nm(b, k, 5)))
                 .sum::<f64>()
                 / 5.0;
             (mean * scale) as f32
@@ -103,15 +106,12 @@ pub fn scene_patches(scene: &RenderScene) -> Result<(Vec<InputPatch>, PatchMap),
         let area_light = scene
             .lights
             .area_light_of_instance(instance_id as u32)
-            .and_then(|l| match &scene.lights.lights()[l as usize] {
-                Light::Area(a) => Some(a),
-                Light::Point(_)
-                | Light::Spot(_)
-                | Light::Directional(_)
-                | Light::Environment(_)
-                | Light::Sky(_)
-                | Light::Daylight(_)
-                | Light::Goniometric(_) => None,
+            .and_then(|l| {
+                if let Light::Area(a) = scene.lights.light(l) {
+                    Some(a)
+                } else {
+                    None
+                }
             });
         let emission =
             area_light.map(|a| (band_means(&a.radiance, std::f64::consts::PI), a.two_sided));
@@ -134,13 +134,8 @@ pub fn scene_patches(scene: &RenderScene) -> Result<(Vec<InputPatch>, PatchMap),
                 let mesh = geometry.mesh(id);
                 for (tri, idx) in mesh.indices.iter().enumerate() {
                     let p = idx.map(|i| mesh.positions[i as usize]);
-                    let mut ng = (p[1] - p[0]).cross(p[2] - p[0]);
-                    if let Some(normals) = &mesh.normals {
-                        let ns: Vec3A = idx.iter().map(|&i| normals[i as usize]).sum();
-                        if ng.dot(ns) < 0.0 {
-                            ng = -ng;
-                        }
-                    }
+                    // The renderer's own geometric normal (on the shading normal's side).
+                    let ng = triangle_local_geometry(mesh, tri, [1.0 / 3.0; 3]).n_geometric;
                     let w = p.map(|v| inst.to_world.point(v));
                     pieces.push((
                         ElementShape::Triangle {
@@ -167,14 +162,11 @@ pub fn scene_patches(scene: &RenderScene) -> Result<(Vec<InputPatch>, PatchMap),
         }
         let mut kinds = Vec::with_capacity(pieces.len());
         for &(_, _, material_id) in &pieces {
-            kinds.push(lambertian(scene.material(material_id)).map_err(|e| {
-                let name = scene
-                    .material_names
-                    .get((material_id as usize).min(scene.material_names.len() - 1))
-                    .cloned()
-                    .unwrap_or_default();
-                format!("material `{name}` is {e}")
-            })?);
+            kinds.push(
+                lambertian(scene.material(material_id)).map_err(|e| {
+                    format!("material `{}` is {e}", scene.material_name(material_id))
+                })?,
+            );
         }
         let emits_back = emission.as_ref().is_some_and(|(_, two)| *two);
         // Both sides get patches on every primitive of the instance when one needs them,

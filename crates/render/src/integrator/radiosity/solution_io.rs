@@ -1,8 +1,8 @@
-//! A solved scene on disk: `--save-solution` and `--load-solution` (the solution's own
-//! bytes, checked against the scene it is loaded for), and `--export-solution FILE.ply`
+//! A solved scene as files, which the CLI reads and writes (through its atomic outputs):
+//! `--save-solution`/`--load-solution` (the solution's own bytes, `Radiosity::to_bytes`,
+//! checked against the scene they are loaded for) and `--export-solution FILE.ply`
 //! (per-vertex illuminance and luminance of every leaf element, for walk-throughs).
 
-use std::io::Write;
 use std::path::Path;
 
 use prism_radiosity::Radiosity;
@@ -13,35 +13,14 @@ use super::gather::SolvedScene;
 use super::patches::{scene_patches, BANDS, BAND_WIDTH_NM, FIRST_BAND_NM};
 use crate::scene_build::RenderScene;
 
-/// Writes `bytes` to a temporary file beside `path`, then renames it (no half-written
-/// output).
-fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), String> {
-    let file_name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let tmp = path.with_file_name(format!(".{file_name}.tmp"));
-    let write = || -> std::io::Result<()> {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
-        f.sync_all()?;
-        std::fs::rename(&tmp, path)
-    };
-    write().map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        format!("{}: cannot write: {e}", path.display())
-    })
-}
-
-/// `--save-solution FILE`.
-pub fn save_solution(solved: &SolvedScene, path: &Path) -> Result<(), String> {
-    write_atomically(path, &solved.solution.to_bytes())
-}
-
-/// `--load-solution FILE`: the solution, if it was solved for `scene`'s patches.
-pub fn load_solution(scene: &RenderScene, path: &Path) -> Result<SolvedScene, String> {
-    let bytes = std::fs::read(path).map_err(|e| format!("{}: cannot read: {e}", path.display()))?;
-    let solution = Radiosity::from_bytes(&bytes).map_err(|e| format!("{}: {e}", path.display()))?;
+/// `--load-solution FILE` (its `bytes`; `path` for messages): the solution, if it was
+/// solved for `scene`'s patches.
+pub fn load_solution(
+    scene: &RenderScene,
+    path: &Path,
+    bytes: &[u8],
+) -> Result<SolvedScene, String> {
+    let solution = Radiosity::from_bytes(bytes).map_err(|e| format!("{}: {e}", path.display()))?;
     let (patches, map) = scene_patches(scene)?;
     if solution.bands() != BANDS || !solution.matches_patches(&patches) {
         return Err(format!(
@@ -68,11 +47,11 @@ fn photometric(values: &[f32]) -> f64 {
     photopic_luminance_cd_per_m2(&spectrum)
 }
 
-/// `--export-solution FILE.ply`: ASCII PLY, one face per leaf element (its own vertices:
+/// `--export-solution FILE.ply`'s text: ASCII PLY, one face per leaf element (its own vertices:
 /// the solution is constant per element), with the element's illuminance (lx) and
 /// luminance (cd/m², the Lambertian B/π) on each vertex. Covered elements (under other
 /// geometry) are left out.
-pub fn export_ply(solved: &SolvedScene, path: &Path) -> Result<(), String> {
+pub fn to_ply(solved: &SolvedScene) -> String {
     let mut vertices = String::new();
     let mut faces = String::new();
     let (mut vertex_count, mut face_count) = (0usize, 0usize);
@@ -109,5 +88,5 @@ pub fn export_ply(solved: &SolvedScene, path: &Path) -> Result<(), String> {
          property float illuminance_lx\nproperty float luminance_cd_m2\n\
          element face {face_count}\nproperty list uchar int vertex_indices\nend_header\n"
     );
-    write_atomically(path, format!("{header}{vertices}{faces}").as_bytes())
+    format!("{header}{vertices}{faces}")
 }
