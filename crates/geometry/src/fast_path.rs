@@ -159,7 +159,7 @@ impl Geometry {
                         record,
                     });
                 }
-                Shape::Sphere(_) | Shape::Disk(_) => return None,
+                Shape::Sphere(_) | Shape::Disk(_) | Shape::Tiled(_) => return None,
             }
         }
         Some(leaves)

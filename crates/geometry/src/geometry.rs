@@ -28,6 +28,7 @@ use crate::ray::{Ray, RayDifferential};
 use crate::rectangle::Rectangle;
 use crate::small_scene::{SmallScene, SmallSceneBuilder, NO_PRIMITIVE};
 use crate::sphere::Sphere;
+use crate::tiling::Tiling;
 use crate::transform::Transform;
 use crate::triangle::{TriangleHit, WatertightRay};
 use crate::triangle_bvh::TriangleBvh;
@@ -44,6 +45,9 @@ pub enum Shape {
     Sphere(Sphere),
     Disk(Disk),
     Rectangle(Rectangle),
+    /// A periodic tile repeated over a grid (virtual ray tracing, [`crate::tiling`]); hits
+    /// report the tile's faces, with their own materials.
+    Tiled(Tiling),
 }
 
 /// A shape placed in the world.
@@ -62,7 +66,8 @@ pub struct Instance {
 pub struct Hit {
     pub t: f32,
     pub instance_id: u32,
-    /// Triangle index within the mesh (0 for analytic shapes).
+    /// Triangle index within the mesh (0 for analytic shapes); for a [`Shape::Tiled`]
+    /// instance `cell · triangles + triangle` (cell `i + j·cells[0]`).
     pub primitive_id: u32,
     /// Barycentrics of vertices 1 and 2 (0 for analytic shapes).
     pub b1: f32,
@@ -138,17 +143,32 @@ impl GeometryBuilder {
     }
 
     /// Place a shape; returns its instance id (the order of calls).
-    /// Returns `None` if `shape` names a mesh that was not added.
+    /// Returns `None` if `shape` names a mesh that was not added, or a tiling whose grid
+    /// is empty, whose period is not positive and finite, or whose cells × tile triangles
+    /// do not fit the 32-bit primitive id of a [`Hit`].
     pub fn add_instance(
         &mut self,
         shape: Shape,
         to_world: Transform,
         material: Option<u32>,
     ) -> Option<u32> {
-        if let Shape::Mesh(MeshId(m)) = shape {
-            if m as usize >= self.meshes.len() {
-                return None;
+        match shape {
+            Shape::Mesh(MeshId(m)) => {
+                if m as usize >= self.meshes.len() {
+                    return None;
+                }
             }
+            Shape::Tiled(tiling) => {
+                let tile = self.meshes.get(tiling.mesh.0 as usize)?;
+                let ids = u64::from(tiling.cells[0])
+                    * u64::from(tiling.cells[1])
+                    * tile.triangle_count() as u64;
+                let period_ok = tiling.period_m.iter().all(|p| p.is_finite() && *p > 0.0);
+                if ids == 0 || ids > u64::from(u32::MAX) || !period_ok {
+                    return None;
+                }
+            }
+            Shape::Sphere(_) | Shape::Disk(_) | Shape::Rectangle(_) => {}
         }
         self.instances.push(Instance {
             shape,
@@ -188,11 +208,14 @@ impl GeometryBuilder {
                     &mut leaves,
                     &mut leaf_ids,
                 ),
-                Shape::Mesh(MeshId(m)) => {
+                Shape::Mesh(MeshId(m))
+                | Shape::Tiled(Tiling {
+                    mesh: MeshId(m), ..
+                }) => {
                     mesh_needs_bvh[m as usize] = true;
                     kept.push(instance);
                 }
-                _ => kept.push(instance),
+                Shape::Sphere(_) | Shape::Disk(_) | Shape::Rectangle(_) => kept.push(instance),
             }
         }
         let triangles = leaves.len();
@@ -305,6 +328,13 @@ fn instance_bounds(inst: &Instance, meshes: &[MeshBvh]) -> Option<(Vec3A, Vec3A)
         Shape::Sphere(s) => s.bounds(),
         Shape::Disk(d) => d.bounds(),
         Shape::Rectangle(r) => r.bounds(),
+        Shape::Tiled(tiling) => {
+            let tile = meshes[tiling.mesh.0 as usize].bounds();
+            if tile.0.cmpgt(tile.1).any() {
+                return None;
+            }
+            tiling.bounds(tile)
+        }
     };
     if lo.cmpgt(hi).any() {
         return None;
@@ -569,6 +599,16 @@ impl Geometry {
                     b1: h.b1,
                     b2: h.b2,
                 }),
+            Shape::Tiled(tiling) => {
+                let tile = &self.meshes[tiling.mesh.0 as usize];
+                tiling.intersect(tile, o, d, ray.t_min, t_max).map(|h| Hit {
+                    t: h.hit.t,
+                    instance_id,
+                    primitive_id: h.cell * tile.mesh.triangle_count() as u32 + h.hit.triangle,
+                    b1: h.hit.b1,
+                    b2: h.hit.b2,
+                })
+            }
             _ => analytic_intersect(&inst.shape, &Ray::new(o, d, ray.t_min, t_max)).map(|t| Hit {
                 t,
                 instance_id,
@@ -617,6 +657,13 @@ impl Geometry {
         let (o, d) = object_ray(inst, ray);
         match inst.shape {
             Shape::Mesh(MeshId(m)) => self.meshes[m as usize].occluded(o, d, ray.t_min, ray.t_max),
+            Shape::Tiled(tiling) => tiling.occluded(
+                &self.meshes[tiling.mesh.0 as usize],
+                o,
+                d,
+                ray.t_min,
+                ray.t_max,
+            ),
             _ => analytic_intersect(&inst.shape, &Ray::new(o, d, ray.t_min, ray.t_max)).is_some(),
         }
     }
@@ -673,11 +720,31 @@ impl Geometry {
             Shape::Sphere(s) => (s.local_geometry(p_obj), 0, NO_MATERIAL, 0),
             Shape::Disk(dk) => (dk.local_geometry(p_obj), 0, NO_MATERIAL, 0),
             Shape::Rectangle(r) => (r.local_geometry(p_obj), 0, NO_MATERIAL, 0),
+            Shape::Tiled(tiling) => {
+                let mesh = &self.meshes[tiling.mesh.0 as usize].mesh;
+                let triangles = mesh.triangle_count() as u32;
+                let (cell, tri) = (hit.primitive_id / triangles, hit.primitive_id % triangles);
+                let b = [1.0 - hit.b1 - hit.b2, hit.b1, hit.b2];
+                let mut local = triangle_local_geometry(mesh, tri as usize, b);
+                local.p += tiling.cell_offset(cell);
+                (
+                    local,
+                    tri,
+                    mesh.material_ids[tri as usize],
+                    mesh.object_ids[tri as usize],
+                )
+            }
         };
         let mut si =
             SurfaceInteraction::from_local_with(&local, &inst.to_world, hit.t, with_curvature);
         si.primitive_id = primitive_id;
-        si.material_id = inst.material.unwrap_or(face_material);
+        // A tile's faces keep their own materials (the carrier's is the `tiled` one).
+        si.material_id = match inst.shape {
+            Shape::Tiled(_) => face_material,
+            Shape::Mesh(_) | Shape::Sphere(_) | Shape::Disk(_) | Shape::Rectangle(_) => {
+                inst.material.unwrap_or(face_material)
+            }
+        };
         si.object_id = object_id;
         si.instance_id = hit.instance_id;
         si
@@ -720,6 +787,6 @@ fn analytic_intersect(shape: &Shape, local: &Ray) -> Option<f32> {
         Shape::Sphere(s) => s.intersect(local),
         Shape::Disk(d) => d.intersect(local),
         Shape::Rectangle(r) => r.intersect(local),
-        Shape::Mesh(_) => None,
+        Shape::Mesh(_) | Shape::Tiled(_) => None,
     }
 }

@@ -21,6 +21,7 @@ pub mod sensor;
 pub mod shape;
 pub mod spectrum_ref;
 pub mod texture;
+pub mod tile;
 pub mod transform;
 
 pub use camera::{Camera, CameraKind, FisheyeFit, FisheyeProjection, FovAxis};
@@ -44,4 +45,5 @@ pub use texture::{
     ImageChannel, ImageEncoding, ImageTexture, NoiseKind, NoiseSpace, NoiseTexture, SpectrumParam,
     Texture, TextureFilter, TextureKind, UvTransform, WrapMode,
 };
+pub use tile::Tile;
 pub use transform::Transform;

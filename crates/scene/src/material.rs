@@ -72,6 +72,10 @@ pub enum MaterialKind {
     /// Scatters nothing: the boundary of a medium (Mitsuba's `null` BSDF). Crossing it is
     /// not a scattering event.
     Interface,
+    /// The surface is a periodic tile (index into `SceneDescription::tiles`) repeated over
+    /// the carrier shape: rays continue into the tile's geometry, whose faces have their own
+    /// materials. `levels` is the height of the tile's BRDF/BTDF pyramid.
+    Tiled { tile: usize, levels: u32 },
 }
 
 /// The material library (issue 8 and after): the kinds whose parameters are numbers and
@@ -189,7 +193,10 @@ pub enum Ior {
     },
 }
 
-const TYPES: [&str; 20] = [
+/// The most levels a `tiled` material's pyramid may have.
+pub const MAX_TILE_LEVELS: u32 = 8;
+
+const TYPES: [&str; 21] = [
     "lambert",
     "conductor",
     "dielectric",
@@ -210,6 +217,7 @@ const TYPES: [&str; 20] = [
     "sheen",
     "fluorescent",
     "interface",
+    "tiled",
 ];
 
 /// Rows of `schema::rows()` for the material library's kinds: the keys each accepts
@@ -259,6 +267,7 @@ pub(crate) fn parse_materials(
     spectra: &NamedSpectra,
     textures: &mut TextureTable,
     reradiation: &[Reradiation],
+    tiles: &[&str],
 ) -> Result<Vec<Material>> {
     let entries = v.map()?;
     let names: Vec<&str> = entries.iter().map(|(n, _)| *n).collect();
@@ -274,6 +283,7 @@ pub(crate) fn parse_materials(
         names: &names,
         fluorescent: &fluorescent,
         reradiation,
+        tiles,
     };
     let mut materials = Vec::with_capacity(entries.len());
     for (name, entry) in &entries {
@@ -321,7 +331,8 @@ fn references(kind: &MaterialKind) -> Vec<usize> {
         | MaterialKind::ThinDielectric { .. }
         | MaterialKind::Library(_)
         | MaterialKind::Fluorescent { .. }
-        | MaterialKind::Interface => Vec::new(),
+        | MaterialKind::Interface
+        | MaterialKind::Tiled { .. } => Vec::new(),
     }
 }
 
@@ -403,6 +414,8 @@ struct MaterialContext<'a> {
     /// The names of the `fluorescent` materials.
     fluorescent: &'a [&'a str],
     reradiation: &'a [Reradiation],
+    /// The names in the `tiles` section.
+    tiles: &'a [&'a str],
 }
 
 fn parse_material(
@@ -525,6 +538,24 @@ fn parse_material(
         "interface" => {
             v.tagged_object(schema!("materials.*<interface>"))?;
             MaterialKind::Interface
+        }
+        "tiled" => {
+            let o = v.tagged_object(schema!("materials.*<tiled>"))?;
+            let tile = crate::shape::named_index(
+                &o.req("tile", "a name in the `tiles` section")?,
+                "tile",
+                "tiles",
+                cx.tiles,
+            )?;
+            let levels = o.u32_or("levels", 1, 3)?;
+            if levels > MAX_TILE_LEVELS {
+                return Err(o.get("levels").unwrap_or(v.clone()).err(format!(
+                    "expected at most {MAX_TILE_LEVELS} levels (a pyramid of \
+                     {MAX_TILE_LEVELS} levels holds 4^{} cells at its base), found {levels}",
+                    MAX_TILE_LEVELS - 1
+                )));
+            }
+            MaterialKind::Tiled { tile, levels }
         }
         "thin_dielectric" => {
             let o = v.tagged_object(schema!("materials.*<thin_dielectric>"))?;

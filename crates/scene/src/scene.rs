@@ -18,6 +18,7 @@ use crate::sensor::{parse_sensors, Sensor};
 use crate::shape::{parse_meshes, parse_shape, MeshAsset, Shape, ShapeContext};
 use crate::spectrum_ref::{parse_spectrum, SpectrumRef, SpectrumUse};
 use crate::texture::{parse_textures, Texture, TextureTable};
+use crate::tile::{parse_tiles, tile_names, Tile};
 
 /// Everything render needs to build a scene, as plain data: angles in radians, lengths in
 /// metres, asset paths resolved, spectra loaded, references turned into indices.
@@ -50,9 +51,11 @@ pub struct SceneDescription {
     pub textures: Vec<Texture>,
     /// The `reradiation` section (fluorescent materials refer to it by index).
     pub reradiation: Vec<Reradiation>,
+    /// The `tiles` section (`tiled` materials refer to it by index).
+    pub tiles: Vec<Tile>,
 }
 
-pub const TOP_LEVEL_FIELDS: [&str; 14] = [
+pub const TOP_LEVEL_FIELDS: [&str; 15] = [
     "camera",
     "film",
     "integrator",
@@ -66,6 +69,7 @@ pub const TOP_LEVEL_FIELDS: [&str; 14] = [
     "sensors",
     "textures",
     "reradiation",
+    "tiles",
     "$schema",
 ];
 
@@ -142,14 +146,22 @@ fn parse_root(v: &V) -> Result<SceneDescription> {
     let reradiation = o
         .get("reradiation")
         .map_or(Ok(Vec::new()), |r| parse_reradiation(&r))?;
+    let tiles_section = o.get("tiles");
+    let tile_names = tiles_section.as_ref().map_or(Ok(Vec::new()), tile_names)?;
     let materials = o.get("materials").map_or(Ok(Vec::new()), |m| {
-        parse_materials(&m, &spectra, &mut textures, &reradiation)
+        parse_materials(&m, &spectra, &mut textures, &reradiation, &tile_names)
     })?;
     let mut meshes = o
         .get("meshes")
         .map_or(Ok(Vec::new()), |m| parse_meshes(&m))?;
 
     let material_names: Vec<&str> = materials.iter().map(|m| m.name.as_str()).collect();
+    let tiled: Vec<bool> = materials
+        .iter()
+        .map(|m| matches!(m.kind, crate::material::MaterialKind::Tiled { .. }))
+        .collect();
+    let tiles =
+        tiles_section.map_or(Ok(Vec::new()), |t| parse_tiles(&t, &material_names, &tiled))?;
     let medium_names: Vec<&str> = media.iter().map(|m| m.name.as_str()).collect();
     let shape_cx = ShapeContext {
         materials: &material_names,
@@ -223,5 +235,6 @@ fn parse_root(v: &V) -> Result<SceneDescription> {
         sensors,
         textures: textures.textures,
         reradiation,
+        tiles,
     })
 }

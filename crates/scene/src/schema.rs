@@ -386,6 +386,9 @@ pub const SCHEMA: &[ObjectSchema] = &[
     row("materials.*<thin_dielectric>", &[&["type", "ior"]]),
     row("materials.*<mix>", &[&["type", "materials", "weight"]]),
     row("materials.*<interface>", &[TYPE]),
+    row("materials.*<tiled>", &[&["type", "tile", "levels"]]),
+    // tile.rs
+    row("tiles.*", &[&["mesh", "period_m", "materials"]]),
     row("@ior", &[&["sellmeier", "cauchy"]]),
     row("@ior.sellmeier", &[&["b", "c_um2"]]),
     row("@ior.cauchy", &[&["a", "b_um2"]]),

@@ -34,6 +34,7 @@ fn scene_with(pattern: &str) -> Option<String> {
         "" => "{$}".into(),
         "film" => r#"{"film": {$}}"#.into(),
         "meshes.*" => r#"{"meshes": {"m": {$}}}"#.into(),
+        "tiles.*" => r#"{"tiles": {"t": {$}}}"#.into(),
         "@sun" => r#"{"lights": [{"type": "cie_sky", "sky_type": 1,
                     "zenith_luminance_cd_m2": 1, "sun": {$}}]}"#
             .into(),

@@ -153,6 +153,12 @@ fn area_shape(geometry: &Geometry, instances: Range<u32>) -> Result<AreaShape, &
         Shape::Sphere(s) => AreaShape::Sphere(SphereEmitter::new(s, first.to_world)),
         Shape::Disk(d) => AreaShape::Disk(DiskEmitter::new(d, first.to_world)),
         Shape::Rectangle(r) => AreaShape::Rectangle(RectangleEmitter::new(r, first.to_world)),
+        Shape::Tiled(_) => {
+            return Err(
+                "a shape with a `tiled` material cannot emit: its surface is the tile's faces, \
+                 which take the tile's own materials (make a separate emitting shape)",
+            )
+        }
     })
 }
 

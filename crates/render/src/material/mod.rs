@@ -468,6 +468,10 @@ fn build_one(
             opacity: 0.0,
             opacity_texture: None,
         },
+        // Never shaded: hits on a tiled carrier report the tile's faces with their own
+        // materials (prism-geometry `Shape::Tiled`). The default stands in, so that no
+        // wrapper's flag (masks in shadow rays) is raised for it.
+        MaterialKind::Tiled { .. } => Material::default_material(),
         MaterialKind::ThinDielectric { ior } => {
             Material::Surface(SurfaceMaterial::ThinDielectric {
                 ior: Ior::from_scene(ior).map_err(|e| err("ior", e))?,

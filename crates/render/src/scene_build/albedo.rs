@@ -100,6 +100,8 @@ fn albedo_at_depth(materials: &[Material], index: usize, depth: usize) -> [f32; 
         MaterialKind::ThinDielectric { .. } => [1.0; 3],
         // Reflects nothing.
         MaterialKind::Interface => [0.0; 3],
+        // Never hit: the tile's faces report their own materials.
+        MaterialKind::Tiled { .. } => [0.0; 3],
         MaterialKind::Library(kind) => crate::material::library::albedo_rgb(kind),
         // The reflected part only (the re-radiated part depends on the light); a BFC's or
         // dye's own R is not at hand here.

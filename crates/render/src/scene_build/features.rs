@@ -37,11 +37,12 @@ pub enum SceneFeature {
     LightPaths,
     Reradiation,
     RadiositySolution,
+    TiledSurfaces,
 }
 
 impl SceneFeature {
     /// Every feature, in declaration order (bit `i` of `SceneFeatures` is `ALL[i]`).
-    pub const ALL: [SceneFeature; 18] = [
+    pub const ALL: [SceneFeature; 19] = [
         SceneFeature::DiagnosticIntegrator,
         SceneFeature::ParticipatingMedia,
         SceneFeature::OpacityMasks,
@@ -60,6 +61,7 @@ impl SceneFeature {
         SceneFeature::LightPaths,
         SceneFeature::Reradiation,
         SceneFeature::RadiositySolution,
+        SceneFeature::TiledSurfaces,
     ];
 
     /// Short name, as `--explain` lists it.
@@ -83,6 +85,7 @@ impl SceneFeature {
             SceneFeature::LightPaths => "light tracing, BDPT or photon mapping",
             SceneFeature::Reradiation => "re-radiation (fluorescence)",
             SceneFeature::RadiositySolution => "radiosity",
+            SceneFeature::TiledSurfaces => "tiled surfaces",
         }
     }
 
@@ -157,6 +160,10 @@ impl SceneFeature {
             SceneFeature::RadiositySolution => {
                 "the `radiosity` method: a hierarchical radiosity solution, then a final \
                  gather per camera sample that ends on it"
+            }
+            SceneFeature::TiledSurfaces => {
+                "a `tiled` material: rays that reach the carrier continue into a periodic \
+                 tile's geometry, repeated over a grid (virtual ray tracing)"
             }
         }
     }
@@ -263,10 +270,18 @@ impl SceneFeatures {
         let default_material = materials.len() - 1;
         let mut used = vec![false; materials.len()];
         for shape in &scene.shapes {
-            used[shape
-                .material
-                .unwrap_or(default_material)
-                .min(default_material)] = true;
+            // A tiled carrier is never shaded: its tile's face materials are.
+            if let Some(tile) = super::tiles::tile_of(scene, shape.material) {
+                f.insert(SceneFeature::TiledSurfaces);
+                for &(_, m) in &scene.tiles[tile].materials {
+                    used[m.min(default_material)] = true;
+                }
+            } else {
+                used[shape
+                    .material
+                    .unwrap_or(default_material)
+                    .min(default_material)] = true;
+            }
             match shape.kind {
                 ShapeKind::Sphere { .. } | ShapeKind::Disk { .. } => {
                     f.insert(SceneFeature::Quadrics)

@@ -140,6 +140,8 @@ const INTEGRATOR: &str = "Integrator::from_description";
 const BUILD_GEOMETRY: &str = "scene_build::geometry::place_shapes";
 const BUILD_LIGHTS: &str = "light::build::build_lights";
 const BUILD_DAYLIGHT: &str = "light::daylight::build_daylight";
+const BUILD_TILES: &str =
+    "scene_build::tiles (TileMeshes::mesh, rectangle_carrier) via scene_build::geometry::place_shapes";
 const BUILD_MATERIAL: &str = "material::build_materials (build_one)";
 const SENSOR: &str = "sensor::measure_sensors (`prism render`)";
 const LOAD_TEXTURE: &str = "texture::build_textures, texture::load";
@@ -179,6 +181,12 @@ pub const FIELD_USES: &[FieldRow] = &[
     read(&[""], &["sensors"], SENSOR),
     read(&[""], &["textures"], LOAD_TEXTURE),
     read(&[""], &["reradiation"], BUILD_FLUORESCENT),
+    read(&[""], &["tiles"], BUILD_TILES),
+    read(
+        &["tiles.*"],
+        &["mesh", "period_m", "materials"],
+        BUILD_TILES,
+    ),
     read(
         &["reradiation.*<bfc>"],
         &["bfc", "negatives"],
@@ -535,6 +543,16 @@ pub const FIELD_USES: &[FieldRow] = &[
         &["materials", "weight"],
         BUILD_MATERIAL,
     ),
+    read(&["materials.*<tiled>"], &["type", "tile"], BUILD_TILES),
+    FieldRow {
+        patterns: &["materials.*<tiled>"],
+        keys: &["levels"],
+        use_: FieldUse::Annotation(
+            "the height of the tile's BRDF/BTDF pyramid, which only `radiosity` would read; \
+             `radiosity` refuses tiled surfaces until the pyramid is built, and `path` traces \
+             the tile's geometry exactly at every scale",
+        ),
+    },
     read(
         &["@ior"],
         &["sellmeier", "cauchy"],

@@ -29,6 +29,7 @@ use prism_scene::{MeshFormat, SceneDescription, ShapeKind};
 
 use super::error::SceneBuildError;
 use super::features::{SceneFeature, SceneFeatures};
+use super::tiles::{tile_of, CarrierQuad, TileMeshes};
 use super::transform::to_geometry_transform;
 
 /// The features the small-scene intersector handles. It only finds the closest surface:
@@ -57,6 +58,9 @@ pub const SMALL_SCENE_SUPPORTS: SceneFeatures = SceneFeatures::of(&[
     // The solution's visibility and coverage rays are plain queries, and its gathers read
     // the instance and primitive ids the small-scene records carry.
     SceneFeature::RadiositySolution,
+    // A tiled carrier is an instance leaf tested on its own (`others`), by the same
+    // virtual ray tracing as in the BVH.
+    SceneFeature::TiledSurfaces,
 ]);
 
 /// How to build the geometry of a scene with `features`: the default options, without the
@@ -116,7 +120,8 @@ pub fn build_geometry(scene: &SceneDescription) -> Result<Geometry, SceneBuildEr
 }
 
 /// The instance ids of each scene shape, in shape order, without building anything: one
-/// per shape, `transforms.len()` for an `instances` shape. Equal to the ranges
+/// per shape, `transforms.len()` for an `instances` shape, one per carrier quad for a
+/// `tiled` mesh (whose file is read for it). Equal to the ranges
 /// `build_geometry_with_instances` returns for the same scene.
 pub fn shape_instance_ranges(scene: &SceneDescription) -> Vec<Range<u32>> {
     let mut next = 0u32;
@@ -124,9 +129,14 @@ pub fn shape_instance_ranges(scene: &SceneDescription) -> Vec<Range<u32>> {
         .shapes
         .iter()
         .map(|shape| {
-            let count = match &shape.kind {
-                ShapeKind::Instances { transforms, .. } => transforms.len() as u32,
-                _ => 1,
+            let count = if tile_of(scene, shape.material).is_some() {
+                // A carrier that cannot be read fails the geometry build, which reports it.
+                carrier_quads(scene, &shape.kind).map_or(0, |q| q.len() as u32)
+            } else {
+                match &shape.kind {
+                    ShapeKind::Instances { transforms, .. } => transforms.len() as u32,
+                    _ => 1,
+                }
             };
             let range = next..next + count;
             next += count;
@@ -154,6 +164,7 @@ pub(crate) fn place_shapes(scene: &SceneDescription) -> Result<PlacedShapes, Sce
     let mut mesh_ids: Vec<Option<MeshId>> = vec![None; scene.meshes.len()];
     let mut unit_cube: Option<MeshId> = None;
     let mut vertex_normals = false;
+    let mut tile_meshes = TileMeshes::default();
 
     for (i, shape) in scene.shapes.iter().enumerate() {
         let place = match &shape.name {
@@ -178,6 +189,42 @@ pub(crate) fn place_shapes(scene: &SceneDescription) -> Result<PlacedShapes, Sce
         };
         let mut placements: Vec<(Shape, DMat4)> = Vec::new();
         let m = shape.transform.matrix;
+        if let Some(tile) = tile_of(scene, shape.material) {
+            let t = &scene.tiles[tile];
+            let material_name = &scene.materials[shape.material.expect("tile_of found it")].name;
+            let carriers = carrier_quads(scene, &shape.kind)
+                .map_err(|e| err(format!("material `{material_name}` is `tiled`: {e}")))?;
+            let mesh = tile_meshes
+                .mesh(scene, tile, &mut builder)
+                .map_err(|e| SceneBuildError::new(file, format!("tiles.{}", t.name), e))?;
+            let first = instance_count;
+            for (k, (quad, matrix)) in carriers.iter().enumerate() {
+                let at = |e: String| {
+                    if carriers.len() == 1 {
+                        err(e)
+                    } else {
+                        err(format!("quad {k}: {e}"))
+                    }
+                };
+                let (tiling, tile_to_world) =
+                    quad.tiling(&(m * *matrix), t.period_m, mesh).map_err(at)?;
+                let to_world = to_geometry_transform(&tile_to_world).ok_or_else(|| {
+                    at("the tile's placement is not invertible in single precision".into())
+                })?;
+                builder
+                    .add_instance(Shape::Tiled(tiling), to_world, material)
+                    .ok_or_else(|| {
+                        at(format!(
+                            "{} × {} periods of tile `{}` are too many copies to address \
+                             (cells × the tile's triangles must stay below 2³²)",
+                            tiling.cells[0], tiling.cells[1], t.name
+                        ))
+                    })?;
+                instance_count += 1;
+            }
+            ranges.push(first..instance_count);
+            continue;
+        }
         match &shape.kind {
             ShapeKind::Mesh { mesh } => placements.push((Shape::Mesh(mesh_id(*mesh)?), m)),
             ShapeKind::Instances { mesh, transforms } => {
@@ -238,8 +285,58 @@ pub(crate) fn place_shapes(scene: &SceneDescription) -> Result<PlacedShapes, Sce
     Ok(PlacedShapes {
         builder,
         ranges,
-        vertex_normals,
+        vertex_normals: vertex_normals || tile_meshes.vertex_normals,
     })
+}
+
+/// The carrier quads of a shape with a `tiled` material, each with the matrix that places
+/// it in the shape's space (an `instances` copy's transform; identity otherwise): a
+/// rectangle is one quad, a mesh its parallelogram quad faces. Other shapes are errors.
+fn carrier_quads(
+    scene: &SceneDescription,
+    kind: &ShapeKind,
+) -> Result<Vec<(CarrierQuad, DMat4)>, String> {
+    let mesh_quads = |m: usize| -> Result<Vec<CarrierQuad>, String> {
+        let asset = scene
+            .meshes
+            .get(m)
+            .ok_or_else(|| format!("mesh index {m} is not in the scene's meshes"))?;
+        let mesh = load_mesh(asset).map_err(|e| format!("cannot load the carrier mesh: {e}"))?;
+        CarrierQuad::of_mesh(&mesh)
+    };
+    Ok(match kind {
+        ShapeKind::Rectangle { size_m } => vec![(CarrierQuad::rectangle(*size_m), DMat4::IDENTITY)],
+        ShapeKind::Mesh { mesh } => mesh_quads(*mesh)?
+            .into_iter()
+            .map(|q| (q, DMat4::IDENTITY))
+            .collect(),
+        ShapeKind::Instances { mesh, transforms } => {
+            let quads = mesh_quads(*mesh)?;
+            transforms
+                .iter()
+                .flat_map(|t| quads.iter().map(move |q| (*q, t.matrix)))
+                .collect()
+        }
+        ShapeKind::Sphere { .. } | ShapeKind::Disk { .. } | ShapeKind::Cuboid { .. } => {
+            return Err(format!(
+                "its carrier must be a `rectangle` or a mesh of quadrilateral faces (patches \
+                 whose corners are tile corners), not a {}",
+                shape_kind_name(kind)
+            ))
+        }
+    })
+}
+
+/// What a shape kind is called in the scene format.
+fn shape_kind_name(kind: &ShapeKind) -> &'static str {
+    match kind {
+        ShapeKind::Mesh { .. } => "mesh",
+        ShapeKind::Instances { .. } => "mesh placed by `instances`",
+        ShapeKind::Sphere { .. } => "sphere",
+        ShapeKind::Disk { .. } => "disk",
+        ShapeKind::Rectangle { .. } => "rectangle",
+        ShapeKind::Cuboid { .. } => "cuboid",
+    }
 }
 
 fn builder_add_mesh(builder: &mut GeometryBuilder, mesh: TriangleMesh) -> MeshId {

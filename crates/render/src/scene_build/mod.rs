@@ -12,6 +12,7 @@ mod filter;
 mod geometry;
 pub mod media;
 pub mod spectrum;
+mod tiles;
 mod transform;
 
 pub use albedo::{material_albedo, reflectance_rgb, DEFAULT_ALBEDO};

@@ -148,6 +148,13 @@ pub fn scene_patches(scene: &RenderScene) -> Result<(Vec<InputPatch>, PatchMap),
                     ));
                 }
             }
+            Shape::Tiled(_) => {
+                return Err(format!(
+                    "instance {instance_id} has a `tiled` material: `radiosity` needs the tile's \
+                     BRDF/BTDF pyramid, which Prism does not build yet (render tiled surfaces \
+                     with `path`, which traces the tile geometry exactly)"
+                ))
+            }
             Shape::Sphere(_) | Shape::Disk(_) => {
                 return Err(format!(
                     "instance {instance_id} is a {}: `radiosity` meshes rectangles and triangle \

@@ -1,0 +1,297 @@
+//! `tiled` materials: a wicker panel traced by virtual ray tracing against the same panel
+//! modelled explicitly (every copy of the tile in a mesh), both rendered by `path`; and the
+//! errors of tiles that cannot be placed. The two renders use different seeds, so their
+//! pass means are independent and the comparison is a 4-s.e. test.
+
+use glam::Vec3A;
+use prism_geometry::{load_obj, TriangleMesh};
+
+mod support;
+use support::{assert_close, mean_se, pass_images, window_mean, Dir};
+
+const PERIOD_M: f32 = 0.1;
+const CELLS: [u32; 2] = [8, 6];
+
+fn wicker_path() -> std::path::PathBuf {
+    std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes/tiled/tiles/wicker.obj")
+}
+
+/// The scene around the panel: `panel` is its shape entries (JSON).
+fn scene_json(panel: &str, tiles: &str) -> String {
+    format!(
+        r#"{{
+  "camera": {{"type": "pinhole", "fov_deg": 40, "transform": {{"look_at": {{"eye": [0.25, 0.15, 1.3], "target": [0, 0, 0], "up": [0, 1, 0]}}}}}},
+  "film": {{"resolution": [32, 24], "spp": 1}},
+  "integrator": {{"type": "path", "max_depth": 6}},
+  {tiles}
+  "materials": {{
+    "cane": {{"type": "lambert", "reflectance": {{"rgb": [0.75, 0.55, 0.32]}}}},
+    "dark cane": {{"type": "lambert", "reflectance": {{"rgb": [0.42, 0.26, 0.12]}}}},
+    "wickerwork": {{"type": "tiled", "tile": "wicker", "levels": 3}},
+    "plaster": {{"type": "lambert", "reflectance": {{"rgb": [0.8, 0.8, 0.78]}}}}
+  }},
+  "shapes": [
+    {panel},
+    {{"type": "rectangle", "name": "wall", "size_m": [3, 3], "material": "plaster", "transform": {{"translate": [0, 0, -0.25]}}}},
+    {{"type": "rectangle", "name": "lamp", "size_m": [0.3, 0.3], "transform": [{{"rotate": {{"axis": [1, 0, 0], "angle_deg": 150}}}}, {{"translate": [-0.3, 0.9, 0.9]}}]}}
+  ],
+  "lights": [
+    {{"type": "area", "shape": "lamp", "luminance_cd_m2": 400000}},
+    {{"type": "point", "position_m": [0.6, 0.4, 1.2], "power_lm": 3000}}
+  ]
+}}"#
+    )
+}
+
+fn tiles_json(mesh: &str, period: &str) -> String {
+    format!(
+        r#""tiles": {{"wicker": {{"mesh": "{mesh}", "period_m": {period}, "materials": {{"strand_weft": "cane", "strand_warp": "dark cane"}}}}}},"#
+    )
+}
+
+/// The faces of `tile` with material `name`, copied to every cell of the panel (centred on
+/// the origin, as the rectangle carrier places them), as OBJ text with vertex normals.
+fn explicit_obj(tile: &TriangleMesh, name: &str) -> String {
+    let material = tile.material_names.iter().position(|n| n == name).unwrap() as u32;
+    let normals = tile
+        .normals
+        .as_ref()
+        .expect("the wicker tile has vertex normals");
+    let corner = Vec3A::new(
+        -0.5 * CELLS[0] as f32 * PERIOD_M,
+        -0.5 * CELLS[1] as f32 * PERIOD_M,
+        0.0,
+    );
+    let mut v = String::new();
+    let mut f = String::new();
+    let mut base = 1u32;
+    for j in 0..CELLS[1] {
+        for i in 0..CELLS[0] {
+            let offset = corner + Vec3A::new(i as f32 * PERIOD_M, j as f32 * PERIOD_M, 0.0);
+            for (p, n) in tile.positions.iter().zip(normals) {
+                let p = *p + offset;
+                v += &format!("v {} {} {}\nvn {} {} {}\n", p.x, p.y, p.z, n.x, n.y, n.z);
+            }
+            for (tri, m) in tile.indices.iter().zip(&tile.material_ids) {
+                if *m == material {
+                    let [a, b, c] = tri.map(|k| k + base);
+                    f += &format!("f {a}//{a} {b}//{b} {c}//{c}\n");
+                }
+            }
+            base += tile.positions.len() as u32;
+        }
+    }
+    v + &f
+}
+
+/// Pass means over 8×8-pixel blocks (4 × 3 of them) and the whole image.
+fn block_means(images: &[Vec<f32>]) -> Vec<(String, Vec<f64>)> {
+    let mut windows = vec![("image".to_string(), (0, 0, 32, 24))];
+    for by in 0..3 {
+        for bx in 0..4 {
+            windows.push((
+                format!("block ({bx}, {by})"),
+                (8 * bx, 8 * by, 8 * bx + 8, 8 * by + 8),
+            ));
+        }
+    }
+    windows
+        .into_iter()
+        .map(|(name, w)| (name, images.iter().map(|y| window_mean(y, 32, w)).collect()))
+        .collect()
+}
+
+#[test]
+fn virtual_ray_tracing_renders_what_the_explicit_mesh_renders() {
+    let dir = Dir::new("tiled", "explicit");
+    let tile = load_obj(wicker_path()).unwrap();
+    std::fs::create_dir_all(dir.0.join("tiles")).unwrap();
+    for file in ["wicker.obj", "wicker.mtl"] {
+        std::fs::copy(
+            wicker_path().with_file_name(file),
+            dir.0.join("tiles").join(file),
+        )
+        .unwrap();
+    }
+    dir.write("weft.obj", explicit_obj(&tile, "strand_weft").as_bytes());
+    dir.write("warp.obj", explicit_obj(&tile, "strand_warp").as_bytes());
+    let tiled = dir.scene(&scene_json(
+        r#"{"type": "rectangle", "name": "panel", "size_m": [0.8, 0.6], "material": "wickerwork"}"#,
+        &tiles_json("tiles/wicker.obj", "[0.1, 0.1]"),
+    ));
+    let tiled_images = pass_images(&tiled, 160, 31);
+    // The same panel as a mesh of 2 × 2 quads (4 × 3 periods each): four carriers.
+    dir.write("quads.obj", QUAD_PANEL_OBJ.as_bytes());
+    let quads = dir.scene(&scene_json(
+        r#"{"type": "mesh", "name": "panel", "file": "quads.obj", "material": "wickerwork"}"#,
+        &tiles_json("tiles/wicker.obj", "[0.1, 0.1]"),
+    ));
+    let quad_images = pass_images(&quads, 160, 33);
+    let explicit = dir.scene(&scene_json(
+        r#"{"type": "mesh", "file": "weft.obj", "material": "cane"},
+    {"type": "mesh", "file": "warp.obj", "material": "dark cane"}"#,
+        &tiles_json("tiles/wicker.obj", "[0.1, 0.1]"),
+    ));
+    let explicit_images = pass_images(&explicit, 160, 32);
+    for (carrier, images) in [("rectangle", &tiled_images), ("quad mesh", &quad_images)] {
+        for ((name, a), (_, b)) in block_means(images)
+            .into_iter()
+            .zip(block_means(&explicit_images))
+        {
+            let (expected, expected_se) = mean_se(&b);
+            assert_close(
+                &format!("{carrier}: {name}"),
+                mean_se(&a),
+                expected,
+                expected_se,
+                0.0,
+            );
+        }
+    }
+}
+
+/// The panel (0.8 m × 0.6 m, centred, normal +z) as 2 × 2 quadrilateral faces.
+const QUAD_PANEL_OBJ: &str = "v -0.4 -0.3 0\nv 0 -0.3 0\nv 0.4 -0.3 0\n\
+    v -0.4 0 0\nv 0 0 0\nv 0.4 0 0\n\
+    v -0.4 0.3 0\nv 0 0.3 0\nv 0.4 0.3 0\n\
+    f 1 2 5 4\nf 2 3 6 5\nf 4 5 8 7\nf 5 6 9 8\n";
+
+fn error_of(dir: &Dir, panel: &str, tiles: &str) -> String {
+    dir.build_error(&scene_json(panel, tiles))
+}
+
+#[test]
+fn tiles_that_cannot_be_placed_are_errors_naming_the_cause() {
+    let dir = Dir::new("tiled", "errors");
+    std::fs::create_dir_all(dir.0.join("tiles")).unwrap();
+    for file in ["wicker.obj", "wicker.mtl"] {
+        std::fs::copy(
+            wicker_path().with_file_name(file),
+            dir.0.join("tiles").join(file),
+        )
+        .unwrap();
+    }
+    let wicker = tiles_json("tiles/wicker.obj", "[0.1, 0.1]");
+    let panel = |shape: &str| {
+        format!(r#"{{"type": "{shape}", "name": "panel", "material": "wickerwork"}}"#)
+    };
+    // Not a rectangle.
+    let message = error_of(&dir, &panel("sphere"), &wicker);
+    assert!(
+        message.contains("shapes[0]") && message.contains("must be a `rectangle`"),
+        "{message}"
+    );
+    // A triangle mesh, and a quad that is not a parallelogram.
+    dir.write("triangle.obj", b"v 0 0 0\nv 0.4 0 0\nv 0 0.3 0\nf 1 2 3\n");
+    let message = error_of(
+        &dir,
+        r#"{"type": "mesh", "file": "triangle.obj", "material": "wickerwork"}"#,
+        &wicker,
+    );
+    assert!(
+        message.contains("quadrilateral faces") && message.contains("1 triangles"),
+        "{message}"
+    );
+    dir.write(
+        "kite.obj",
+        b"v 0 0 0\nv 0.4 0 0\nv 0.5 0.4 0\nv 0 0.3 0\nf 1 2 3 4\n",
+    );
+    let message = error_of(
+        &dir,
+        r#"{"type": "mesh", "file": "kite.obj", "material": "wickerwork"}"#,
+        &wicker,
+    );
+    assert!(message.contains("not a parallelogram"), "{message}");
+    // Not a whole number of periods.
+    let message = error_of(
+        &dir,
+        r#"{"type": "rectangle", "size_m": [0.85, 0.6], "material": "wickerwork"}"#,
+        &wicker,
+    );
+    assert!(
+        message.contains("shapes[0]") && message.contains("8.5000 periods"),
+        "{message}"
+    );
+    // A half-height sheet: its edge on y = 0 has no partner on y = 0.1 m.
+    dir.write(
+        "tiles/sheet.obj",
+        b"mtllib sheet.mtl\nv 0 0 0\nv 0.1 0 0\nv 0.1 0.05 0\nv 0 0.05 0\n\
+          usemtl strand_weft\nf 1 2 3\nusemtl strand_warp\nf 1 3 4\n",
+    );
+    dir.write(
+        "tiles/sheet.mtl",
+        b"newmtl strand_weft\nKd 1 1 1\nnewmtl strand_warp\nKd 1 1 1\n",
+    );
+    let rect = r#"{"type": "rectangle", "size_m": [0.8, 0.6], "material": "wickerwork"}"#;
+    let message = error_of(&dir, rect, &tiles_json("tiles/sheet.obj", "[0.1, 0.1]"));
+    assert!(
+        message.contains("tiles.wicker")
+            && message.contains("1 boundary edge on the period planes"),
+        "{message}"
+    );
+    // A usemtl name the scene does not map.
+    let unmapped = r#""tiles": {"wicker": {"mesh": "tiles/wicker.obj", "period_m": [0.1, 0.1], "materials": {"strand_weft": "cane"}}},"#;
+    let message = error_of(&dir, rect, unmapped);
+    assert!(
+        message.contains("tiles.wicker") && message.contains("usemtl strand_warp"),
+        "{message}"
+    );
+    // A tiled surface cannot emit, nor be held by `radiosity` (no pyramid yet).
+    let lit = scene_json(rect, &wicker).replace(r#""shape": "lamp""#, r#""shape": "panel""#);
+    let lit = lit.replace(
+        r#""size_m": [0.8, 0.6], "material""#,
+        r#""name": "panel", "size_m": [0.8, 0.6], "material""#,
+    );
+    let message = dir.build_error(&lit);
+    assert!(message.contains("cannot emit"), "{message}");
+    let radiosity = scene_json(rect, &wicker).replace(
+        r#""type": "path", "max_depth": 6"#,
+        r#""type": "radiosity""#,
+    );
+    let message = dir.build_error(&radiosity);
+    assert!(
+        message.contains("`tiled`") && message.contains("pyramid"),
+        "{message}"
+    );
+}
+
+#[test]
+fn the_scene_reader_checks_tiles_and_tiled_materials() {
+    let dir = Dir::new("tiled", "reader");
+    std::fs::create_dir_all(dir.0.join("tiles")).unwrap();
+    std::fs::copy(wicker_path(), dir.0.join("tiles/wicker.obj")).unwrap();
+    let parse_error = |json: &str| -> String {
+        let path = dir.write("scene.json", json.as_bytes());
+        match prism_scene::load_scene(&path) {
+            Ok(_) => panic!("parsed: {json}"),
+            Err(e) => e.to_string(),
+        }
+    };
+    let rect = r#"{"type": "rectangle", "size_m": [0.8, 0.6], "material": "wickerwork"}"#;
+    let message = parse_error(&scene_json(
+        rect,
+        &tiles_json("tiles/wicker.obj", "[0.1, 0]"),
+    ));
+    assert!(
+        message.contains("tiles.wicker.period_m") && message.contains("> 0"),
+        "{message}"
+    );
+    let message = parse_error(
+        &scene_json(rect, &tiles_json("tiles/wicker.obj", "[0.1, 0.1]"))
+            .replace(r#""tile": "wicker""#, r#""tile": "wickr""#),
+    );
+    assert!(message.contains("unknown tile `wickr`"), "{message}");
+    let message = parse_error(
+        &scene_json(rect, &tiles_json("tiles/wicker.obj", "[0.1, 0.1]"))
+            .replace(r#""levels": 3"#, r#""levels": 0"#),
+    );
+    assert!(message.contains("levels"), "{message}");
+    let message = parse_error(
+        &scene_json(rect, &tiles_json("tiles/wicker.obj", "[0.1, 0.1]"))
+            .replace(r#""strand_weft": "cane""#, r#""strand_weft": "wickerwork""#),
+    );
+    assert!(
+        message.contains("a tile's faces need a surface material"),
+        "{message}"
+    );
+}
