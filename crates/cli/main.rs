@@ -2,6 +2,7 @@
 
 mod atomic_write;
 mod bispectral;
+mod cache_dir;
 mod color;
 mod compare;
 mod converge;
@@ -16,6 +17,7 @@ mod progress;
 mod render;
 mod sensors;
 mod simd;
+mod tile_brdf;
 mod tonemap;
 
 use std::process::ExitCode;
@@ -59,6 +61,9 @@ enum Command {
     MerlExport(merl_export::MerlExportArgs),
     /// Render a scene file to an EXR or PNG image (docs/rendering.md).
     Render(render::RenderArgs),
+    /// The BRDF/BTDF pyramid of a scene's periodic tile (`tiles`), by path tracing the
+    /// repeated tile; cached in --cache-dir; prints a JSON summary (docs/radiosity.md).
+    TileBrdf(tile_brdf::TileBrdfArgs),
     /// Tone-map an HDR image (EXR/HDR): white balance, tone operator, gamut mapping, encoding.
     Tonemap(tonemap::TonemapArgs),
 }
@@ -87,6 +92,7 @@ fn main() -> ExitCode {
         Command::MerlExport(args) => done(merl_export::run(&args)),
         // Non-zero without an error when a signal stopped it (the work is saved).
         Command::Render(args) => render::run(&args, &budget),
+        Command::TileBrdf(args) => done(tile_brdf::run(&args)),
         Command::Tonemap(args) => done(tonemap::run(&args, &budget)),
     };
     match result {

@@ -304,7 +304,11 @@ pub fn run(args: &ConvergeArgs, memory: &MemoryBudget) -> Result<(), String> {
     // The cache must take the reference before one is rendered for it.
     let cache_dir = match &args.reference {
         Some(_) => None,
-        None => Some(reference::prepare_cache_dir(args.cache_dir.as_deref())?),
+        None => Some(crate::cache_dir::prepare_cache_dir(
+            args.cache_dir.as_deref(),
+            "the reference cache",
+            " or a --reference",
+        )?),
     };
     let methods: Vec<Method> = if args.methods.is_empty() {
         vec![Method::parse("path")?]

@@ -32,6 +32,7 @@ pub mod sensor;
 pub mod spectrum_cache;
 pub mod stats_json;
 pub mod texture;
+pub mod tile_pyramid;
 
 pub use camera::{
     ApertureSpec, Camera, CameraFrame, CameraImportance, CameraModel, CameraWiSample,

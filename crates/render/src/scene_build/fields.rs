@@ -548,9 +548,10 @@ pub const FIELD_USES: &[FieldRow] = &[
         patterns: &["materials.*<tiled>"],
         keys: &["levels"],
         use_: FieldUse::Annotation(
-            "the height of the tile's BRDF/BTDF pyramid, which only `radiosity` would read; \
-             `radiosity` refuses tiled surfaces until the pyramid is built, and `path` traces \
-             the tile's geometry exactly at every scale",
+            "the height of the tile's BRDF/BTDF pyramid: read by `prism tile-brdf` (its \
+             default --levels); a render does not use it: `radiosity` refuses tiled surfaces \
+             until its solver uses the pyramid, and `path` traces the tile's geometry exactly \
+             at every scale",
         ),
     },
     read(

@@ -68,7 +68,8 @@ impl TileMeshes {
             return Err(format!(
                 "{}: {seams} boundary edge{} on the period planes (x = 0 or {} m, y = 0 or {} m) \
                  find no partner on the opposite plane: the tile does not continue across its \
-                 period, so repeating it leaves open seams",
+                 period, so repeating it leaves open seams (a rim that lies exactly on a period \
+                 plane counts as a seam: move it inside the period)",
                 t.mesh.display(),
                 if seams == 1 { "" } else { "s" },
                 t.period_m[0],

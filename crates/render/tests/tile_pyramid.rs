@@ -1,0 +1,218 @@
+//! The BRDF/BTDF pyramid of a tile (`prism_render::tile_pyramid`) against closed forms (a
+//! flat Lambertian sheet: Γ = R/π, albedo R; a grid of strips: τ = its hole fraction at
+//! every angle), energy conservation on the wicker weave (white strands: albedo + scattered
+//! transmittance + τ = 1) and reciprocity of its top level.
+
+use prism_render::tile_pyramid::bins::{self, HEMISPHERE_BINS, SPHERE_BINS};
+use prism_render::tile_pyramid::{PyramidOptions, TilePyramid};
+use prism_scene::SceneDescription;
+
+mod support;
+use support::Dir;
+
+fn scene(dir: &Dir, tile_obj: &[u8], reflectance: f64) -> SceneDescription {
+    let text = String::from_utf8_lossy(tile_obj);
+    let mapped = ["strand_weft", "strand_warp"]
+        .iter()
+        .filter(|m| text.contains(&format!("usemtl {m}")))
+        .map(|m| format!(r#""{m}": "strand""#))
+        .collect::<Vec<_>>()
+        .join(", ");
+    std::fs::create_dir_all(dir.0.join("tiles")).unwrap();
+    dir.write("tiles/tile.obj", tile_obj);
+    dir.write(
+        "tiles/tile.mtl",
+        b"newmtl strand_weft\nKd 1 1 1\nnewmtl strand_warp\nKd 1 1 1\n",
+    );
+    let json = format!(
+        r#"{{
+  "tiles": {{"t": {{"mesh": "tiles/tile.obj", "period_m": [0.1, 0.1],
+                   "materials": {{{mapped}}}}}}},
+  "materials": {{"strand": {{"type": "lambert", "reflectance": {reflectance}}},
+                "tiled": {{"type": "tiled", "tile": "t"}}}},
+  "shapes": [{{"type": "rectangle", "size_m": [0.2, 0.2], "material": "tiled"}}]
+}}"#
+    );
+    let path = dir.write("scene.json", json.as_bytes());
+    prism_scene::load_scene(&path).unwrap_or_else(|e| panic!("{e}"))
+}
+
+fn options(samples: u32) -> PyramidOptions {
+    PyramidOptions {
+        levels: 2,
+        samples_per_bin_pair: samples,
+        transparency_samples: 4096,
+        ..PyramidOptions::default()
+    }
+}
+
+/// Mean over bands of a per-band value and its standard error (bands independent).
+fn band_mean((value, se): ([f32; 16], [f32; 16])) -> (f64, f64) {
+    let mean = value.iter().map(|&v| f64::from(v)).sum::<f64>() / 16.0;
+    let se = se.iter().map(|&s| f64::from(s).powi(2)).sum::<f64>().sqrt() / 16.0;
+    (mean, se)
+}
+
+const SHEET: &[u8] = b"mtllib tile.mtl\nv 0 0 0\nv 0.1 0 0\nv 0.1 0.1 0\nv 0 0.1 0\n\
+    usemtl strand_weft\nf 1 2 3\nf 1 3 4\n";
+
+#[test]
+fn a_flat_lambertian_sheet_has_gamma_r_over_pi_and_albedo_r() {
+    let dir = Dir::new("tile-pyramid", "sheet");
+    let r = 0.6;
+    let pyramid = TilePyramid::simulate(&scene(&dir, SHEET, r), 0, &options(16)).unwrap();
+    for incident in [0, 9, 22, 31, HEMISPHERE_BINS + 4, HEMISPHERE_BINS + 27] {
+        let (albedo, se) = band_mean(pyramid.albedo(incident));
+        eprintln!("incident {incident}: albedo {albedo:.5} ± {se:.5}");
+        // `lambert` is one-sided (as Mitsuba's `diffuse`): its back, facing −z, is black.
+        let expected = if bins::is_above(incident) { r } else { 0.0 };
+        assert!(
+            (albedo - expected).abs() <= 0.01 * expected + 4.0 * se,
+            "{albedo} vs {expected}"
+        );
+        let (t, _) = band_mean(pyramid.scattered_transmittance(incident));
+        assert_eq!(t, 0.0, "an opaque sheet transmits nothing");
+        assert_eq!(pyramid.transparency(0, 0, 0, incident), 0.0);
+        // Every outgoing bin on the light's side, every sub-cell: R/π.
+        let side = bins::is_above(incident);
+        for o in (0..SPHERE_BINS).filter(|&o| bins::is_above(o) == side) {
+            let g = pyramid.gamma(1, 1, 0, incident, o);
+            let mean = g.iter().map(|&v| f64::from(v)).sum::<f64>() / 16.0;
+            assert!(
+                (mean - expected / std::f64::consts::PI).abs() < 1e-4,
+                "Γ {mean} at bin {o}"
+            );
+        }
+    }
+}
+
+#[test]
+fn a_grid_of_strips_lets_its_hole_fraction_through_at_every_angle() {
+    let dir = Dir::new("tile-pyramid", "strips");
+    // One strip over x ∈ [0.03, 0.07] of each 0.1 m period: 60 % holes.
+    let strips = b"mtllib tile.mtl\nv 0.03 0 0\nv 0.07 0 0\nv 0.07 0.1 0\nv 0.03 0.1 0\n\
+        usemtl strand_weft\nf 1 2 3\nf 1 3 4\n";
+    let r = 0.5;
+    let pyramid = TilePyramid::simulate(&scene(&dir, strips, r), 0, &options(16)).unwrap();
+    for incident in [0, 13, 30, HEMISPHERE_BINS + 7] {
+        let tau = f64::from(pyramid.transparency(0, 0, 0, incident));
+        let se = (0.6f64 * 0.4 / 4096.0).sqrt();
+        assert!((tau - 0.6).abs() <= 4.0 * se, "τ {tau} at bin {incident}");
+        let (albedo, se) = band_mean(pyramid.albedo(incident));
+        let expected = if bins::is_above(incident) {
+            0.4 * r
+        } else {
+            0.0
+        };
+        assert!(
+            (albedo - expected).abs() <= 0.01 * expected + 4.0 * se,
+            "{albedo} vs {expected}"
+        );
+    }
+    // Seen straight down, each level-1 cell is 40 % strip (x ∈ [0.03, 0.05] of [0, 0.05]).
+    for (u, v) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+        let tau = f64::from(pyramid.transparency(1, u, v, 0));
+        assert!(
+            (tau - 0.6).abs() < 4.0 * (0.24f64 / 1024.0).sqrt(),
+            "τ {tau}"
+        );
+    }
+}
+
+/// The wicker tile with flat faces: its vertex normals leave out the weave's slope, and
+/// shading normals do not conserve energy (Veach 1997 §5.3), which the energy test must
+/// not mistake for the pyramid's error.
+fn wicker() -> Vec<u8> {
+    let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../scenes/tiled/tiles/wicker.obj");
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut out = String::new();
+    for line in text.lines() {
+        if line.starts_with("vn ") {
+            continue;
+        }
+        if let Some(face) = line.strip_prefix("f ") {
+            let corners: Vec<&str> = face
+                .split_whitespace()
+                .map(|c| c.split('/').next().unwrap())
+                .collect();
+            out += &format!("f {}\n", corners.join(" "));
+        } else {
+            out += &line.replace("mtllib wicker.mtl", "mtllib tile.mtl");
+            out += "\n";
+        }
+    }
+    out.into_bytes()
+}
+
+#[test]
+fn white_wicker_reflects_transmits_or_lets_through_all_the_light() {
+    let dir = Dir::new("tile-pyramid", "energy");
+    // White strands never lose throughput, so Russian roulette never ends a path: only
+    // the depth limit does, and it must not cut off light (32 bounces lose ≈ 3 %).
+    let pyramid = TilePyramid::simulate(
+        &scene(&dir, &wicker(), 1.0),
+        0,
+        &PyramidOptions {
+            max_depth: 4096,
+            ..options(256)
+        },
+    )
+    .unwrap();
+    for incident in [0, 10, 21, 28, HEMISPHERE_BINS + 3, HEMISPHERE_BINS + 18] {
+        let (albedo, se_a) = band_mean(pyramid.albedo(incident));
+        let (transmitted, se_t) = band_mean(pyramid.scattered_transmittance(incident));
+        let tau = f64::from(pyramid.transparency(0, 0, 0, incident));
+        let se_tau = (tau * (1.0 - tau) / 4096.0).sqrt();
+        let total = albedo + transmitted + tau;
+        let se = (se_a * se_a + se_t * se_t + se_tau * se_tau).sqrt();
+        eprintln!(
+            "incident {incident}: albedo {albedo:.4} + scattered {transmitted:.4} + τ {tau:.4} \
+             = {total:.4} ± {se:.4}"
+        );
+        assert!(
+            (total - 1.0).abs() <= 4.0 * se + 0.005,
+            "total {total} ± {se}"
+        );
+    }
+}
+
+#[test]
+fn the_top_level_brdf_of_the_wicker_is_reciprocal_within_its_binning() {
+    let dir = Dir::new("tile-pyramid", "reciprocity");
+    let pyramid = TilePyramid::simulate(&scene(&dir, &wicker(), 0.7), 0, &options(48)).unwrap();
+    let mut worst: f64 = 0.0;
+    for (i, o) in [(0, 9), (3, 20), (12, 29), (8, 17), (1, 26)] {
+        let g = |a: usize, b: usize| {
+            let v = pyramid.gamma(0, 0, 0, a, b);
+            let se = pyramid.gamma_standard_error(0, 0, 0, a, b);
+            band_mean((v.try_into().unwrap(), se))
+        };
+        let ((forward, se_f), (backward, se_b)) = (g(i, o), g(o, i));
+        let se = (se_f * se_f + se_b * se_b).sqrt();
+        let relative = (forward - backward).abs() / (0.5 * (forward + backward));
+        eprintln!("Γ({i}→{o}) {forward:.4} vs Γ({o}→{i}) {backward:.4} ± {se:.4}");
+        worst = worst.max(relative);
+        // The incident bin is taken at its centre and the outgoing one averaged: the two
+        // estimates differ by the variation of f across a bin (binning) and by noise.
+        assert!(
+            (forward - backward).abs() <= 0.15 * forward.max(backward) + 4.0 * se,
+            "{forward} vs {backward}"
+        );
+    }
+    eprintln!("largest relative difference {worst:.3}");
+}
+
+#[test]
+fn a_pyramid_file_reads_back_and_damage_is_an_error() {
+    let dir = Dir::new("tile-pyramid", "file");
+    let pyramid = TilePyramid::simulate(&scene(&dir, SHEET, 0.5), 0, &options(16)).unwrap();
+    let bytes = pyramid.to_bytes();
+    assert_eq!(TilePyramid::from_bytes(&bytes).unwrap(), pyramid);
+    let message = TilePyramid::from_bytes(&bytes[..bytes.len() - 4]).unwrap_err();
+    assert!(message.contains("truncated"), "{message}");
+    let message = TilePyramid::from_bytes(b"PRISMRAD and more bytes than a header").unwrap_err();
+    assert!(message.contains("PRISMBTF"), "{message}");
+    let too_few = TilePyramid::simulate(&scene(&dir, SHEET, 0.5), 0, &options(8)).unwrap_err();
+    assert!(too_few.contains("at least 16"), "{too_few}");
+}

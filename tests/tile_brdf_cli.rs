@@ -1,0 +1,102 @@
+//! `prism tile-brdf`: the pyramid of the example wicker tile computed once, then read from
+//! the cache; the summary's keys; the errors of a misnamed tile and of too few samples.
+
+mod support;
+use support::prism_in as prism;
+
+fn wicker_scene() -> String {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("scenes/tiled/wicker-wall.json")
+        .display()
+        .to_string()
+}
+
+#[test]
+fn the_pyramid_is_computed_once_and_then_read_from_the_cache() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = wicker_scene();
+    let args = [
+        "tile-brdf",
+        scene.as_str(),
+        "--tile",
+        "wicker",
+        "--levels",
+        "2",
+        "--samples",
+        "16",
+        "--cache-dir",
+        "cache",
+        "-o",
+        "summary.json",
+    ];
+    let first = prism(dir.path(), &args);
+    let stderr = String::from_utf8_lossy(&first.stderr);
+    assert!(first.status.success(), "{stderr}");
+    assert!(stderr.contains("computed and cached in"), "{stderr}");
+    let text = std::fs::read_to_string(dir.path().join("summary.json")).unwrap();
+    let summary: serde_json::Value = serde_json::from_str(&text).unwrap();
+    assert_eq!(summary["levels"], 2);
+    assert_eq!(summary["cells"], 5);
+    assert_eq!(summary["from_cache"], false);
+    let incident = summary["incident"].as_array().unwrap();
+    assert_eq!(incident.len(), 64);
+    for bin in incident {
+        let albedo = bin["albedo"].as_array().unwrap();
+        assert_eq!(albedo.len(), 16);
+        let tau = bin["transparency"].as_f64().unwrap();
+        assert!((0.0..=1.0).contains(&tau));
+        // The cane's reflectances are below 0.8: so is the weave's albedo.
+        assert!(albedo
+            .iter()
+            .all(|a| (0.0..0.8).contains(&a.as_f64().unwrap())));
+    }
+    // Seen straight on, the weave's holes let ≈ 16 % through (4 of 25 cm² of each period,
+    // narrowed by the strands' bulge).
+    let tau = incident[0]["transparency"].as_f64().unwrap();
+    assert!((0.1..0.2).contains(&tau), "τ {tau}");
+
+    let second = prism(dir.path(), &args);
+    let stderr = String::from_utf8_lossy(&second.stderr);
+    assert!(
+        second.status.success() && stderr.contains("read from"),
+        "{stderr}"
+    );
+    let again: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("summary.json")).unwrap())
+            .unwrap();
+    assert_eq!(again["from_cache"], true);
+    assert_eq!(again["incident"], summary["incident"]);
+}
+
+#[test]
+fn misnamed_tiles_and_too_few_samples_are_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = wicker_scene();
+    let o = prism(
+        dir.path(),
+        &["tile-brdf", &scene, "--tile", "wickr", "--cache-dir", "c"],
+    );
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && stderr.contains("no tile `wickr` (defined: `wicker`)"),
+        "{stderr}"
+    );
+    let o = prism(
+        dir.path(),
+        &[
+            "tile-brdf",
+            &scene,
+            "--tile",
+            "wicker",
+            "--samples",
+            "8",
+            "--cache-dir",
+            "c",
+        ],
+    );
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && stderr.contains("at least 64"),
+        "{stderr}"
+    );
+}
