@@ -549,9 +549,9 @@ pub const FIELD_USES: &[FieldRow] = &[
         keys: &["levels"],
         use_: FieldUse::Annotation(
             "the height of the tile's BRDF/BTDF pyramid: read by `prism tile-brdf` (its \
-             default --levels); a render does not use it: `radiosity` refuses tiled surfaces \
-             until its solver uses the pyramid, and `path` traces the tile's geometry exactly \
-             at every scale",
+             default --levels); a render does not use it: `radiosity` holds tiled surfaces by \
+             the pyramid's top level only, and `path` traces the tile's geometry exactly at \
+             every scale",
         ),
     },
     read(

@@ -91,6 +91,14 @@ pub struct RenderScene {
     radiosity: std::sync::OnceLock<
         Result<std::sync::Arc<crate::integrator::radiosity::SolvedScene>, String>,
     >,
+    /// The description, kept when the scene has tiled surfaces: `radiosity` computes their
+    /// pyramids from it (`tiled_surfaces`), whichever method the scene was built for
+    /// (`prism converge` swaps methods on one scene).
+    tile_description: Option<Box<SceneDescription>>,
+    /// Per material id, the diffuse-equivalent surface of a `tiled` material, computed by
+    /// the first `tiled_surfaces` call.
+    tiled_surfaces:
+        std::sync::OnceLock<Result<Vec<Option<crate::tile_pyramid::TiledSurface>>, String>>,
 }
 
 impl RenderScene {
@@ -137,6 +145,9 @@ impl RenderScene {
                 .map_err(|message| SceneBuildError::new(&file, "integrator", message))?;
         }
         let lights = LightSet::build(scene, &geometry)?;
+        let tile_description = features
+            .contains(SceneFeature::TiledSurfaces)
+            .then(|| Box::new(scene.clone()));
         let has_masks = materials.iter().any(|m| m.has_mask());
         let has_glazing = materials.iter().any(|m| m.has_thin_glazing());
         let has_dispersion = materials.iter().any(|m| m.is_dispersive());
@@ -186,10 +197,26 @@ impl RenderScene {
             features,
             media,
             radiosity: std::sync::OnceLock::new(),
+            tile_description,
+            tiled_surfaces: std::sync::OnceLock::new(),
         };
         built.set_packet_tracing(true);
         built.integrator.refuse_scene(&built)?;
         Ok(built)
+    }
+
+    /// Per material id, the diffuse-equivalent surface `radiosity` holds a `tiled`
+    /// material by (`None` for other materials; empty without tiled surfaces), computed
+    /// from the tiles' pyramids by the first call.
+    pub fn tiled_surfaces(&self) -> Result<&[Option<crate::tile_pyramid::TiledSurface>], String> {
+        let Some(description) = &self.tile_description else {
+            return Ok(&[]);
+        };
+        self.tiled_surfaces
+            .get_or_init(|| tiles::radiosity_surfaces(description, &self.geometry))
+            .as_ref()
+            .map(Vec::as_slice)
+            .map_err(|e| format!("{}: tiles: {e}", self.file.display()))
     }
 
     /// The solution of the scene's `radiosity` integrator (`None` for other methods),

@@ -13,6 +13,8 @@ use glam::{DMat4, DVec3, DVec4};
 use prism_geometry::{open_seam_edges, GeometryBuilder, MeshId, Tiling, TriangleMesh, NO_MATERIAL};
 use prism_scene::{MaterialKind, SceneDescription};
 
+use crate::tile_pyramid::{PyramidOptions, TilePyramid, TiledSurface};
+
 /// Two periods agree with an edge when they differ by at most this fraction of a period.
 const WHOLE_PERIODS_TOLERANCE: f64 = 1e-3;
 
@@ -257,4 +259,47 @@ impl CarrierQuad {
             tile_to_world,
         ))
     }
+}
+
+/// Per material id, the diffuse-equivalent surface `radiosity` uses for a `tiled` material
+/// that a shape uses (`None` for every other material): the top level of the tile's
+/// pyramid (`tile_pyramid`, 64 samples per bin pair) and the slab of its tile.
+pub(crate) fn radiosity_surfaces(
+    scene: &SceneDescription,
+    geometry: &prism_geometry::Geometry,
+) -> Result<Vec<Option<TiledSurface>>, String> {
+    let mut out = vec![None; scene.materials.len() + 1];
+    for (m, material) in scene.materials.iter().enumerate() {
+        let MaterialKind::Tiled { tile, .. } = material.kind else {
+            continue;
+        };
+        let slab = geometry
+            .instances()
+            .iter()
+            .find_map(|inst| match inst.shape {
+                prism_geometry::Shape::Tiled(t) if inst.material == Some(m as u32) => {
+                    let mesh = geometry.mesh(t.mesh);
+                    let (lo, hi) = mesh
+                        .positions
+                        .iter()
+                        .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), p| {
+                            (lo.min(p.z), hi.max(p.z))
+                        });
+                    Some((lo, hi))
+                }
+                _ => None,
+            });
+        let Some(slab) = slab else {
+            continue;
+        };
+        let options = PyramidOptions {
+            levels: 1,
+            samples_per_bin_pair: 64,
+            ..PyramidOptions::default()
+        };
+        let pyramid = TilePyramid::simulate(scene, tile, &options)
+            .map_err(|e| format!("the pyramid of tile `{}`: {e}", scene.tiles[tile].name))?;
+        out[m] = Some(pyramid.tiled_surface(slab));
+    }
+    Ok(out)
 }

@@ -213,6 +213,44 @@ impl TilePyramid {
     }
 }
 
+/// What `radiosity` keeps of a tile's pyramid: the whole period's diffuse-equivalent
+/// reflectance per side (Γ's albedo averaged over incident directions by their projected
+/// solid angle: the reflectance under uniform diffuse light) and its transparency per
+/// direction bin, with the slab the tile fills (metres along the carrier's normal).
+#[derive(Clone, Debug, PartialEq)]
+pub struct TiledSurface {
+    /// Per band, for light arriving on the front (+z) and on the back.
+    pub reflectance: [[f32; BANDS]; 2],
+    /// τ per direction bin (level 0), for light travelling against that bin's direction.
+    pub transparency: Vec<f32>,
+    /// The lowest and highest tile heights, metres.
+    pub slab_m: (f32, f32),
+}
+
+impl TilePyramid {
+    /// The pyramid's top level as a diffuse-equivalent surface (see [`TiledSurface`]).
+    pub fn tiled_surface(&self, slab_m: (f32, f32)) -> TiledSurface {
+        let side = |front: bool| -> [f32; BANDS] {
+            let mut r = [0.0f32; BANDS];
+            for i in (0..SPHERE_BINS).filter(|&i| bins::is_above(i) == front) {
+                let w = bins::projected_solid_angle_sr(i) / std::f32::consts::PI;
+                let (albedo, _) = self.albedo(i);
+                for b in 0..BANDS {
+                    r[b] += w * albedo[b];
+                }
+            }
+            r
+        };
+        TiledSurface {
+            reflectance: [side(true), side(false)],
+            transparency: (0..SPHERE_BINS)
+                .map(|i| self.transparency(0, 0, 0, i))
+                .collect(),
+            slab_m,
+        }
+    }
+}
+
 /// Sums over the samples of one incident bin, per (cell, outgoing bin, band), and τ per
 /// cell.
 struct IncidentResult {

@@ -10,6 +10,7 @@ use prism_radiosity::DirectIrradiance;
 use prism_spectrum::{SampledSpectrum, SampledWavelengths, N_SPECTRUM_SAMPLES};
 
 use super::patches::{band_point_nm, BANDS};
+use super::tiled::TiledCarriers;
 use crate::integrator::{PathCounters, PathTracer};
 use crate::light::LightSampleContext;
 use crate::scene_build::RenderScene;
@@ -22,6 +23,8 @@ const SKY_DIRECTIONS: u32 = 64;
 
 pub struct PointLikeAndSkyLights<'a> {
     scene: &'a RenderScene,
+    /// Points of tiled carriers are lit above their tile's slab.
+    carriers: &'a TiledCarriers,
     /// Indices of the delta lights in the scene's light set.
     lights: Vec<u32>,
     /// Indices of the skies and environment maps.
@@ -31,7 +34,7 @@ pub struct PointLikeAndSkyLights<'a> {
 }
 
 impl<'a> PointLikeAndSkyLights<'a> {
-    pub fn new(scene: &'a RenderScene) -> Self {
+    pub fn new(scene: &'a RenderScene, carriers: &'a TiledCarriers) -> Self {
         let lights = (0..scene.lights.len() as u32)
             .filter(|&l| scene.lights.light(l).is_delta())
             .collect();
@@ -51,6 +54,7 @@ impl<'a> PointLikeAndSkyLights<'a> {
             .collect();
         Self {
             scene,
+            carriers,
             lights,
             skies,
             wavelength_sets,
@@ -60,6 +64,7 @@ impl<'a> PointLikeAndSkyLights<'a> {
 
 impl DirectIrradiance for PointLikeAndSkyLights<'_> {
     fn irradiance(&self, p: Vec3A, n: Vec3A, out: &mut [f32]) {
+        let p = self.carriers.lift(p, n).unwrap_or(p);
         let ctx = LightSampleContext { p, n };
         for &l in &self.lights {
             self.add_direction(l, &ctx, Vec2::splat(0.5), 1.0, out);

@@ -16,7 +16,10 @@ pub struct SolvedScene {
 
 impl SolutionGather for SolvedScene {
     /// (B − B_e)/π of the leaf element under the hit, at the band of each lane; resolved
-    /// when the element is seen from at least its own size (√area).
+    /// when the element is seen from at least its own size (√area). On a tiled carrier the
+    /// hit is on the tile's faces, which cover 1 − τ(ωo) of the carrier as seen from ωo
+    /// (rays through the holes see what is behind): their radiance is the carrier's
+    /// reflected radiance divided by that share.
     fn reflected_radiance(
         &self,
         si: &SurfaceInteraction,
@@ -32,9 +35,16 @@ impl SolutionGather for SolvedScene {
             return None;
         }
         let e = self.solution.emission(patch);
+        // At most a 20-fold gain: beyond that the faces are slivers the carrier's average
+        // does not describe.
+        let faces_share = self
+            .map
+            .carriers
+            .transparency_towards(si.instance_id, wo)
+            .map_or(1.0, |tau| (1.0 - tau).max(0.05));
         Some(SampledSpectrum::from_fn(|lane| {
             let k = band_of(wavelengths.wavelength_nm(lane));
-            (leaf.radiosity[k] - e[k]).max(0.0) * std::f32::consts::FRAC_1_PI
+            (leaf.radiosity[k] - e[k]).max(0.0) * std::f32::consts::FRAC_1_PI / faces_share
         }))
     }
 }

@@ -8,11 +8,13 @@ mod direct;
 pub mod gather;
 pub mod patches;
 pub mod solution_io;
+pub mod tiled;
 
 pub use self::gather::SolvedScene;
 
 use std::sync::Arc;
 use std::time::Instant;
+use tiled::TiledCarriers;
 
 use glam::Vec3A;
 use prism_geometry::Ray;
@@ -52,19 +54,28 @@ impl RadiosityEstimator {
 }
 
 /// The scene's own ray tracer as the solution's visibility oracle.
-struct SceneVisibility<'a>(&'a RenderScene);
+struct SceneVisibility<'a>(&'a RenderScene, &'a TiledCarriers);
 
 impl Visibility for SceneVisibility<'_> {
+    /// Points of tiled carriers take their rays from above their tile's slab
+    /// (`TiledCarriers::lift`).
     fn visible(&self, from: Vec3A, n_from: Vec3A, to: Vec3A, n_to: Vec3A) -> bool {
         let scale = |p: Vec3A| 1e-4 * (1.0 + p.abs().max_element());
-        let a = from + n_from * scale(from);
-        let b = to + n_to * scale(to);
+        let a = self
+            .1
+            .lift(from, n_from)
+            .unwrap_or(from + n_from * scale(from));
+        let b = self.1.lift(to, n_to).unwrap_or(to + n_to * scale(to));
         !self.0.geometry.occluded(&Ray::spawn_to(a, b))
     }
 
     /// Covered when the ray along the normal meets a surface from behind first (the point
-    /// is inside a closed mesh, e.g. under a box standing on it).
+    /// is inside a closed mesh, e.g. under a box standing on it). A tiled carrier's point
+    /// stands for the macro-surface and is never covered by its own tile.
     fn covered(&self, p: Vec3A, n: Vec3A) -> bool {
+        if self.1.lift(p, n).is_some() {
+            return false;
+        }
         let scale = 1e-4 * (1.0 + p.abs().max_element());
         let ray = Ray::spawn(p + n * scale, n);
         self.0.geometry.intersect(&ray).is_some_and(|hit| {
@@ -86,8 +97,8 @@ pub fn solve(
         ..RadiositySettings::default()
     };
     let mut solution = Radiosity::new(&patches, BANDS, settings).map_err(|e| e.to_string())?;
-    let visibility = SceneVisibility(scene);
-    let direct_lights = PointLikeAndSkyLights::new(scene);
+    let visibility = SceneVisibility(scene, &map.carriers);
+    let direct_lights = PointLikeAndSkyLights::new(scene, &map.carriers);
     let mut lines = Vec::new();
     for i in 1..=method.iterations {
         let s = solution

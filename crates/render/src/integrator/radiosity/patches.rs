@@ -8,6 +8,7 @@ use prism_geometry::{Geometry, Shape, NO_MATERIAL};
 use prism_radiosity::{ElementShape, InputPatch};
 use prism_spectrum::Spectrum;
 
+use super::tiled::TiledCarriers;
 use crate::light::Light;
 use crate::material::Material;
 use crate::scene_build::RenderScene;
@@ -53,6 +54,11 @@ pub struct PatchMap {
     pub sides: Vec<u8>,
     /// Per patch: its normal.
     pub normals: Vec<Vec3A>,
+    /// Per instance: one patch (per side) for all its primitives (a tiled carrier, whose
+    /// primitives are its tile's faces).
+    pub whole_instance: Vec<bool>,
+    /// The tiled carriers (`tiled.rs`).
+    pub carriers: TiledCarriers,
 }
 
 impl PatchMap {
@@ -61,6 +67,11 @@ impl PatchMap {
     pub fn patch_of(&self, instance: u32, primitive: u32, wo: Vec3A) -> Option<usize> {
         let first = (*self.first_patch.get(instance as usize)?)?;
         let sides = u32::from(self.sides[instance as usize]);
+        let primitive = if self.whole_instance[instance as usize] {
+            0
+        } else {
+            primitive
+        };
         let front = (first + primitive * sides) as usize;
         if self.normals.get(front)?.dot(wo) > 0.0 {
             Some(front)
@@ -101,8 +112,37 @@ pub fn scene_patches(scene: &RenderScene) -> Result<(Vec<InputPatch>, PatchMap),
         first_patch: Vec::with_capacity(geometry.instances().len()),
         sides: Vec::with_capacity(geometry.instances().len()),
         normals: Vec::new(),
+        whole_instance: Vec::with_capacity(geometry.instances().len()),
+        carriers: TiledCarriers::of_geometry(geometry, scene.tiled_surfaces()?)?,
     };
     for (instance_id, inst) in geometry.instances().iter().enumerate() {
+        map.whole_instance
+            .push(matches!(inst.shape, Shape::Tiled(_)));
+        if let Some(c) = map
+            .carriers
+            .0
+            .iter()
+            .find(|c| c.instance == instance_id as u32)
+        {
+            // Front and back, each with the pyramid's reflectance for its side.
+            let shape = ElementShape::Parallelogram {
+                p0: c.p0,
+                e1: c.e1,
+                e2: c.e2,
+            };
+            map.first_patch.push(Some(patches.len() as u32));
+            map.sides.push(2);
+            for (side, n) in [c.normal, -c.normal].into_iter().enumerate() {
+                let oriented_shape = oriented(shape, n);
+                patches.push(InputPatch {
+                    shape: oriented_shape,
+                    reflectance: c.reflectance[side].clone(),
+                    emission: vec![0.0; BANDS],
+                });
+                map.normals.push(oriented_shape.normal());
+            }
+            continue;
+        }
         let area_light = scene
             .lights
             .area_light_of_instance(instance_id as u32)
@@ -150,9 +190,8 @@ pub fn scene_patches(scene: &RenderScene) -> Result<(Vec<InputPatch>, PatchMap),
             }
             Shape::Tiled(_) => {
                 return Err(format!(
-                    "instance {instance_id} has a `tiled` material: `radiosity` needs the tile's \
-                     BRDF/BTDF pyramid, which Prism does not build yet (render tiled surfaces \
-                     with `path`, which traces the tile geometry exactly)"
+                    "instance {instance_id}: internal error: a tiled carrier without its tile \
+                     pyramid"
                 ))
             }
             Shape::Sphere(_) | Shape::Disk(_) => {

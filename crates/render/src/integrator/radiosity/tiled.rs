@@ -1,0 +1,128 @@
+//! Tiled surfaces in the radiosity solution (Mostefaoui et al. §3, diffuse part): a tiled
+//! carrier is one patch per side whose reflectance is its tile pyramid's top level
+//! (`tile_pyramid::TiledSurface`), relative to the irradiance on the carrier's plane.
+//! Light through the tile's holes is not reflected: rays cross the carrier through its
+//! virtual geometry, so the transfers behind it see exactly the transparency τ (the
+//! paper's fourth kind of transfer). Points of a tiled patch therefore take their rays
+//! from above the tile's slab on their side, where the whole macro-surface's irradiance
+//! arrives: from the plane itself they would start inside the weave.
+
+use glam::Vec3A;
+use prism_geometry::{Geometry, Shape};
+
+use crate::tile_pyramid::bins;
+use crate::tile_pyramid::TiledSurface;
+
+/// One tiled carrier: its parallelogram, frame and slab.
+#[derive(Clone, Debug)]
+pub struct TiledCarrier {
+    pub instance: u32,
+    pub p0: Vec3A,
+    pub e1: Vec3A,
+    pub e2: Vec3A,
+    /// Unit normal (the tile's +z).
+    pub normal: Vec3A,
+    /// Unit tangent along `e1` (the tile's x).
+    pub tangent: Vec3A,
+    /// The tile's heights along `normal`, metres.
+    pub slab_m: (f32, f32),
+    /// τ per direction bin (`tile_pyramid::bins`).
+    pub transparency: Vec<f32>,
+    /// Reflectance per band, front then back.
+    pub reflectance: [Vec<f32>; 2],
+}
+
+/// Every tiled carrier of a scene.
+#[derive(Clone, Debug, Default)]
+pub struct TiledCarriers(pub Vec<TiledCarrier>);
+
+impl TiledCarriers {
+    /// The carriers of the `Shape::Tiled` instances of `geometry`, with the surfaces of
+    /// their materials (`surfaces[material id]`).
+    pub fn of_geometry(
+        geometry: &Geometry,
+        surfaces: &[Option<TiledSurface>],
+    ) -> Result<Self, String> {
+        let mut out = Vec::new();
+        for (instance, inst) in geometry.instances().iter().enumerate() {
+            let Shape::Tiled(tiling) = inst.shape else {
+                continue;
+            };
+            let surface = inst
+                .material
+                .and_then(|m| surfaces.get(m as usize))
+                .and_then(Option::as_ref)
+                .ok_or_else(|| {
+                    format!(
+                        "instance {instance}: internal error: its tile pyramid was not computed"
+                    )
+                })?;
+            let t = &inst.to_world;
+            let e1 = t.vector(Vec3A::new(
+                tiling.cells[0] as f32 * tiling.period_m[0],
+                0.0,
+                0.0,
+            ));
+            let e2 = t.vector(Vec3A::new(
+                0.0,
+                tiling.cells[1] as f32 * tiling.period_m[1],
+                0.0,
+            ));
+            // The tile-to-world map keeps heights in metres along the unit normal.
+            let normal = t.vector(Vec3A::Z).normalize();
+            out.push(TiledCarrier {
+                instance: instance as u32,
+                p0: t.point(Vec3A::ZERO),
+                e1,
+                e2,
+                normal,
+                tangent: e1.normalize(),
+                slab_m: surface.slab_m,
+                transparency: surface.transparency.clone(),
+                reflectance: surface.reflectance.map(|r| r.to_vec()),
+            });
+        }
+        Ok(Self(out))
+    }
+
+    /// The carrier that `p` lies on (within 10⁻⁴ of its size from its plane and inside its
+    /// parallelogram).
+    fn carrier_at(&self, p: Vec3A) -> Option<&TiledCarrier> {
+        self.0.iter().find(|c| {
+            let d = p - c.p0;
+            let size = c.e1.length().max(c.e2.length());
+            if d.dot(c.normal).abs() > 1e-4 * size {
+                return false;
+            }
+            // Parameters along e1, e2 (the normal equations of d = u e1 + v e2).
+            let (a, b, cc) = (c.e1.dot(c.e1), c.e1.dot(c.e2), c.e2.dot(c.e2));
+            let (r1, r2) = (d.dot(c.e1), d.dot(c.e2));
+            let det = a * cc - b * b;
+            let u = (cc * r1 - b * r2) / det;
+            let v = (a * r2 - b * r1) / det;
+            (-1e-4..=1.0001).contains(&u) && (-1e-4..=1.0001).contains(&v)
+        })
+    }
+
+    /// Where rays of the surface point `p` (normal `n`) start: above the tile's slab on the
+    /// side `n` faces when `p` is on a tiled carrier; `None` otherwise.
+    pub fn lift(&self, p: Vec3A, n: Vec3A) -> Option<Vec3A> {
+        let c = self.carrier_at(p)?;
+        let (lo, hi) = c.slab_m;
+        let margin = 1e-3 * (hi - lo).max(1e-3);
+        Some(if n.dot(c.normal) >= 0.0 {
+            p + c.normal * (hi.max(0.0) + margin)
+        } else {
+            p + c.normal * (lo.min(0.0) - margin)
+        })
+    }
+
+    /// τ of carrier `instance` for light leaving along `wo` (world, unit): the share of
+    /// its area that a viewer looking back along `wo` sees through.
+    pub fn transparency_towards(&self, instance: u32, wo: Vec3A) -> Option<f32> {
+        let c = self.0.iter().find(|c| c.instance == instance)?;
+        let bitangent = c.normal.cross(c.tangent);
+        let local = Vec3A::new(wo.dot(c.tangent), wo.dot(bitangent), wo.dot(c.normal));
+        Some(c.transparency[bins::bin_of(local.normalize_or_zero())])
+    }
+}
