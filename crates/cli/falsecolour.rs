@@ -61,8 +61,9 @@ fn sibling(output: &Path, middle: &str) -> PathBuf {
     output.with_file_name(format!("{stem}.{middle}.falsecolour.png"))
 }
 
-/// A file-name-safe version of a sensor name.
-fn safe(name: &str) -> String {
+/// A name as a file-name part: letters, digits, '-' and '_' kept, the rest '_' (sensor
+/// names here, tile names in `tile_brdf`).
+pub(crate) fn file_name_part(name: &str) -> String {
     name.chars()
         .map(|c| {
             if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
@@ -111,7 +112,7 @@ pub fn write_illuminance(
             &options(scale, range, "lx", cell),
         )
         .map_err(|e| format!("false colour of sensor `{}`: {e}", r.name))?;
-        let path = sibling(output, &safe(&r.name));
+        let path = sibling(output, &file_name_part(&r.name));
         write_image(&path, &img).map_err(|e| e.to_string())?;
         written.push(path);
     }

@@ -78,7 +78,7 @@ pub fn run(args: &TileBrdfArgs) -> Result<(), String> {
     let key = cache_key(&description, tile, &options)?;
     let cache_file = cache_dir.join(format!(
         "tile-{}-{key:016x}.prismbtf",
-        sanitized(&args.tile)
+        crate::falsecolour::file_name_part(&args.tile)
     ));
     let start = Instant::now();
     let (pyramid, from_cache) = match std::fs::read(&cache_file) {
@@ -195,18 +195,5 @@ fn mtl_bytes(obj_path: &Path, obj: &[u8]) -> Vec<u8> {
         .lines()
         .filter_map(|l| l.trim_start().strip_prefix("mtllib "))
         .flat_map(|name| std::fs::read(dir.join(name.trim())).unwrap_or_default())
-        .collect()
-}
-
-/// A tile name as a file-name part: letters, digits, '-' and '_' kept, the rest '_'.
-fn sanitized(name: &str) -> String {
-    name.chars()
-        .map(|c| {
-            if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
-                c
-            } else {
-                '_'
-            }
-        })
         .collect()
 }

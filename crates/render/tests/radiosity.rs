@@ -6,7 +6,9 @@
 use prism_scene::{Integrator, SamplerKind};
 
 mod support;
-use support::{assert_close, mean_se, pass_means, repository_scene, with_integrator, Dir};
+use support::{
+    assert_close, mean_se, pass_means, repository_scene, sensor_lux, with_integrator, Dir,
+};
 
 fn radiosity(error_bound_rel: f64) -> Integrator {
     Integrator::Radiosity {
@@ -140,16 +142,6 @@ fn cornell_with_sensors_lit(
         .unwrap_or_else(|e| panic!("{e}"))
 }
 
-fn sensor_lux(scene: &prism_render::RenderScene, dir: &Dir) -> Vec<(f64, f64)> {
-    let description = prism_scene::load_scene(&dir.0.join("scene.json")).unwrap();
-    let (readings, _) =
-        prism_render::sensor::measure_sensors(scene, &description.sensors, 7, &|_| {});
-    readings
-        .iter()
-        .flat_map(|r| r.points.iter().map(|p| (p.illuminance_lx, p.std_error_lx)))
-        .collect()
-}
-
 /// Illuminance sensors read the solution (direct light by light sampling, the rest from
 /// the solution at the cosine-sampled ray's hit): within 2 % of a 64-bounce path tracer
 /// (plus 4 s.e.) on the floor, the back wall and the ceiling.
@@ -160,9 +152,9 @@ fn sensors_read_the_solution_within_two_percent_of_path() {
         &dir,
         r#"{"type": "path", "max_depth": 64, "rr_depth": 5, "sampler": "independent"}"#,
     );
-    let expected = sensor_lux(&path, &dir);
+    let expected = sensor_lux(&path, &dir, 7);
     let scene = cornell_with_sensors(&dir, r#"{"type": "radiosity", "error_bound_rel": 0.0005}"#);
-    let got = sensor_lux(&scene, &dir);
+    let got = sensor_lux(&scene, &dir, 7);
     let mut failures = 0;
     for (i, (&(e, e_se), &(g, g_se))) in expected.iter().zip(&got).enumerate() {
         let se = (e_se * e_se + g_se * g_se).sqrt();
@@ -239,9 +231,9 @@ fn a_point_light_reaches_the_solution() {
         r#"{"type": "path", "max_depth": 64, "rr_depth": 5, "sampler": "independent"}"#,
         Some(light),
     );
-    let expected = sensor_lux(&path, &dir);
+    let expected = sensor_lux(&path, &dir, 7);
     let scene = cornell_with_sensors_lit(&dir, r#"{"type": "radiosity"}"#, Some(light));
-    let got = sensor_lux(&scene, &dir);
+    let got = sensor_lux(&scene, &dir, 7);
     let mut failures = 0;
     for (i, (&(e, e_se), &(g, g_se))) in expected.iter().zip(&got).enumerate() {
         let se = (e_se * e_se + g_se * g_se).sqrt();

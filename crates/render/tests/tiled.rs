@@ -7,7 +7,7 @@ use glam::Vec3A;
 use prism_geometry::{load_obj, TriangleMesh};
 
 mod support;
-use support::{assert_close, mean_se, pass_images, window_mean, Dir};
+use support::{assert_close, mean_se, pass_images, sensor_lux, window_mean, Dir};
 
 const PERIOD_M: f32 = 0.1;
 const CELLS: [u32; 2] = [8, 6];
@@ -362,16 +362,6 @@ fn room_with_wicker(dir: &Dir, integrator: &str) -> prism_render::RenderScene {
     prism_render::RenderScene::build(&description, None).unwrap_or_else(|e| panic!("{e}"))
 }
 
-fn sensor_lux(scene: &prism_render::RenderScene, dir: &Dir) -> Vec<(f64, f64)> {
-    let description = prism_scene::load_scene(&dir.0.join("scene.json")).unwrap();
-    let (readings, _) =
-        prism_render::sensor::measure_sensors(scene, &description.sensors, 9, &|_| {});
-    readings
-        .iter()
-        .flat_map(|r| r.points.iter().map(|p| (p.illuminance_lx, p.std_error_lx)))
-        .collect()
-}
-
 /// `radiosity` holds the tiled panel as a diffuse-equivalent patch per side (its pyramid's
 /// top level) seen through by the tile's own geometry: its sensors agree with `path`
 /// within 2 % + 4 s.e.
@@ -382,9 +372,9 @@ fn radiosity_with_a_tiled_panel_agrees_with_path_at_the_sensors() {
         &dir,
         r#"{"type": "path", "max_depth": 64, "rr_depth": 5, "sampler": "independent"}"#,
     );
-    let expected = sensor_lux(&path, &dir);
+    let expected = sensor_lux(&path, &dir, 9);
     let radiosity = room_with_wicker(&dir, r#"{"type": "radiosity", "error_bound_rel": 0.001}"#);
-    let got = sensor_lux(&radiosity, &dir);
+    let got = sensor_lux(&radiosity, &dir, 9);
     let mut failures = 0;
     for (i, (&(e, e_se), &(g, g_se))) in expected.iter().zip(&got).enumerate() {
         let se = (e_se * e_se + g_se * g_se).sqrt();
@@ -394,5 +384,73 @@ fn radiosity_with_a_tiled_panel_agrees_with_path_at_the_sensors() {
         );
         failures += usize::from((g - e).abs() > 0.02 * e + 4.0 * se);
     }
+    assert_eq!(failures, 0);
+}
+
+/// scenes/office/office.json with its floor paved by `scenes/office/tiles/paving.obj`
+/// (30 × 20 stones of 0.2 m, 15 mm high) and the integrator `integrator` (JSON), written
+/// into `dir` as `scene.json`.
+fn paved_office(dir: &Dir, integrator: &str) -> prism_render::RenderScene {
+    let office = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes/office");
+    std::fs::create_dir_all(dir.0.join("tiles")).unwrap();
+    for file in ["paving.obj", "paving.mtl"] {
+        std::fs::copy(
+            office.join("tiles").join(file),
+            dir.0.join("tiles").join(file),
+        )
+        .unwrap();
+    }
+    let text = std::fs::read_to_string(office.join("office.json")).unwrap();
+    let mut json: serde_json::Value = serde_json::from_str(&text).unwrap();
+    json["integrator"] = serde_json::from_str(integrator).unwrap();
+    json["tiles"] = serde_json::json!({"paving": {"mesh": "tiles/paving.obj", "period_m": [0.2, 0.2],
+        "materials": {"grout": "grout", "stone": "stone"}}});
+    json["materials"]["grout"] = serde_json::json!({"type": "lambert", "reflectance": 0.15});
+    json["materials"]["stone"] = serde_json::json!({"type": "lambert", "reflectance": 0.35});
+    json["materials"]["paving"] = serde_json::json!({"type": "tiled", "tile": "paving"});
+    for shape in json["shapes"].as_array_mut().unwrap() {
+        if shape["name"] == "floor" {
+            shape["material"] = serde_json::json!("paving");
+        }
+    }
+    // The luminaires' files, next to the office scene.
+    for light in json["lights"].as_array_mut().unwrap() {
+        if let Some(file) = light["file"].as_str() {
+            light["file"] = serde_json::json!(office.join(file).display().to_string());
+        }
+    }
+    let path = dir.write("scene.json", json.to_string().as_bytes());
+    let description = prism_scene::load_scene(&path).unwrap_or_else(|e| panic!("{e}"));
+    prism_render::RenderScene::build(&description, Some(glam::UVec2::splat(8)))
+        .unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// The issue's office with a tiled floor: radiosity (the paved floor as the diffuse
+/// equivalent of its pyramid) against `path` on the office's 240 work-plane points and two
+/// wall points.
+#[test]
+fn a_paved_office_reads_the_same_lux_by_radiosity_and_by_path() {
+    let dir = Dir::new("tiled", "office");
+    let path = paved_office(&dir, r#"{"type": "path", "max_depth": 64, "rr_depth": 5}"#);
+    let expected = sensor_lux(&path, &dir, 5);
+    let radiosity = paved_office(&dir, r#"{"type": "radiosity"}"#);
+    let got = sensor_lux(&radiosity, &dir, 5);
+    let (mut failures, mut sum_rel, mut worst) = (0, 0.0, 0.0f64);
+    for (&(e, e_se), &(g, g_se)) in expected.iter().zip(&got) {
+        let se = (e_se * e_se + g_se * g_se).sqrt();
+        let rel = g / e - 1.0;
+        sum_rel += rel;
+        worst = worst.max(rel.abs());
+        if (g - e).abs() > 0.02 * e + 4.0 * se {
+            eprintln!("radiosity {g:.2} lx vs path {e:.2} lx (s.e. {se:.2})");
+            failures += 1;
+        }
+    }
+    eprintln!(
+        "{} points: mean {:+.2} %, largest {:.2} %",
+        expected.len(),
+        100.0 * sum_rel / expected.len() as f64,
+        100.0 * worst
+    );
     assert_eq!(failures, 0);
 }

@@ -157,3 +157,15 @@ pub fn with_integrator(
     scene.integrator = prism_render::Integrator::from_description(&description).unwrap();
     scene
 }
+
+/// Illuminance and its standard error at every point of every sensor of the scene written
+/// as `scene.json` in `dir`, measured on `scene` with `seed`.
+pub fn sensor_lux(scene: &RenderScene, dir: &Dir, seed: u64) -> Vec<(f64, f64)> {
+    let description = load_scene(dir.0.join("scene.json")).unwrap();
+    let (readings, _) =
+        prism_render::sensor::measure_sensors(scene, &description.sensors, seed, &|_| {});
+    readings
+        .iter()
+        .flat_map(|r| r.points.iter().map(|p| (p.illuminance_lx, p.std_error_lx)))
+        .collect()
+}
