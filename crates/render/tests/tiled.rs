@@ -7,7 +7,9 @@ use glam::Vec3A;
 use prism_geometry::{load_obj, TriangleMesh};
 
 mod support;
-use support::{assert_close, mean_se, pass_images, sensor_lux, window_mean, Dir};
+use support::{
+    assert_close, lux_disagreements, mean_se, pass_images, sensor_lux, window_mean, Dir,
+};
 
 const PERIOD_M: f32 = 0.1;
 const CELLS: [u32; 2] = [8, 6];
@@ -375,16 +377,7 @@ fn radiosity_with_a_tiled_panel_agrees_with_path_at_the_sensors() {
     let expected = sensor_lux(&path, &dir, 9);
     let radiosity = room_with_wicker(&dir, r#"{"type": "radiosity", "error_bound_rel": 0.001}"#);
     let got = sensor_lux(&radiosity, &dir, 9);
-    let mut failures = 0;
-    for (i, (&(e, e_se), &(g, g_se))) in expected.iter().zip(&got).enumerate() {
-        let se = (e_se * e_se + g_se * g_se).sqrt();
-        eprintln!(
-            "point {i}: radiosity {g:.2} lx, path {e:.2} lx ({:+.2} %), s.e. {se:.2}",
-            100.0 * (g / e - 1.0)
-        );
-        failures += usize::from((g - e).abs() > 0.02 * e + 4.0 * se);
-    }
-    assert_eq!(failures, 0);
+    assert_eq!(lux_disagreements(&expected, &got), 0);
 }
 
 /// scenes/office/office.json with its floor paved by `scenes/office/tiles/paving.obj`

@@ -169,3 +169,18 @@ pub fn sensor_lux(scene: &RenderScene, dir: &Dir, seed: u64) -> Vec<(f64, f64)> 
         .flat_map(|r| r.points.iter().map(|p| (p.illuminance_lx, p.std_error_lx)))
         .collect()
 }
+
+/// The points where radiosity's reading `got` differs from path's `expected` by more than
+/// 2 % + 4 combined s.e. (each printed, with its relative difference).
+pub fn lux_disagreements(expected: &[(f64, f64)], got: &[(f64, f64)]) -> usize {
+    let mut failures = 0;
+    for (i, (&(e, e_se), &(g, g_se))) in expected.iter().zip(got).enumerate() {
+        let se = (e_se * e_se + g_se * g_se).sqrt();
+        eprintln!(
+            "point {i}: radiosity {g:.3} lx, path {e:.3} lx ({:+.2} %), s.e. {se:.3}",
+            100.0 * (g / e - 1.0)
+        );
+        failures += usize::from((g - e).abs() > 0.02 * e + 4.0 * se);
+    }
+    failures
+}
