@@ -604,7 +604,11 @@ impl Geometry {
                 tiling.intersect(tile, o, d, ray.t_min, t_max).map(|h| Hit {
                     t: h.hit.t,
                     instance_id,
-                    primitive_id: h.cell * tile.mesh.triangle_count() as u32 + h.hit.triangle,
+                    primitive_id: Tiling::primitive_id(
+                        h.cell,
+                        h.hit.triangle,
+                        tile.mesh.triangle_count() as u32,
+                    ),
                     b1: h.hit.b1,
                     b2: h.hit.b2,
                 })
@@ -722,8 +726,8 @@ impl Geometry {
             Shape::Rectangle(r) => (r.local_geometry(p_obj), 0, NO_MATERIAL, 0),
             Shape::Tiled(tiling) => {
                 let mesh = &self.meshes[tiling.mesh.0 as usize].mesh;
-                let triangles = mesh.triangle_count() as u32;
-                let (cell, tri) = (hit.primitive_id / triangles, hit.primitive_id % triangles);
+                let (cell, tri) =
+                    Tiling::cell_and_triangle(hit.primitive_id, mesh.triangle_count() as u32);
                 let b = [1.0 - hit.b1 - hit.b2, hit.b1, hit.b2];
                 let mut local = triangle_local_geometry(mesh, tri as usize, b);
                 local.p += tiling.cell_offset(cell);

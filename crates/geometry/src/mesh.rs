@@ -46,6 +46,18 @@ impl TriangleMesh {
         self.indices.len()
     }
 
+    /// Bounds (min, max) of the vertices the triangles use; inverted (∞, −∞) when there
+    /// are none.
+    pub fn bounds(&self) -> (Vec3A, Vec3A) {
+        self.indices.iter().flatten().fold(
+            (Vec3A::splat(f32::INFINITY), Vec3A::splat(f32::NEG_INFINITY)),
+            |(lo, hi), &i| {
+                let p = self.positions[i as usize];
+                (lo.min(p), hi.max(p))
+            },
+        )
+    }
+
     /// The three vertex positions of triangle `i`.
     #[inline]
     pub fn triangle(&self, i: usize) -> [Vec3A; 3] {

@@ -35,7 +35,7 @@ impl MeshBvh {
             .collect();
         let ids: Vec<u32> = (0..tris.len() as u32).collect();
         let bvh = TriangleBvh::build(&tris, &ids, quality);
-        let bounds = bounds_of(&mesh);
+        let bounds = mesh.bounds();
         Self { mesh, bvh, bounds }
     }
 
@@ -43,7 +43,7 @@ impl MeshBvh {
     /// baked into the world-space soup, where only `interaction` reads the mesh.
     pub(crate) fn without_bvh(mesh: TriangleMesh) -> Self {
         let bvh = TriangleBvh::build(&[], &[], BuildQuality::default());
-        let bounds = bounds_of(&mesh);
+        let bounds = mesh.bounds();
         Self { mesh, bvh, bounds }
     }
 
@@ -77,15 +77,4 @@ impl MeshBvh {
     pub fn occluded(&self, origin: Vec3A, direction: Vec3A, t_min: f32, t_max: f32) -> bool {
         self.bvh.occluded(origin, direction, t_min, t_max)
     }
-}
-
-/// Bounds over the vertices that triangles use; inverted (∞, −∞) for an empty mesh.
-fn bounds_of(mesh: &TriangleMesh) -> (Vec3A, Vec3A) {
-    mesh.indices.iter().flatten().fold(
-        (Vec3A::splat(f32::INFINITY), Vec3A::splat(f32::NEG_INFINITY)),
-        |(lo, hi), &i| {
-            let p = mesh.positions[i as usize];
-            (lo.min(p), hi.max(p))
-        },
-    )
 }

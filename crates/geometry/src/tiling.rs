@@ -53,6 +53,16 @@ impl Tiling {
         )
     }
 
+    /// The [`crate::Hit::primitive_id`] of `triangle` (of `triangles`) in cell `cell`.
+    pub fn primitive_id(cell: u32, triangle: u32, triangles: u32) -> u32 {
+        cell * triangles + triangle
+    }
+
+    /// (cell, triangle) of a primitive id made by [`Self::primitive_id`].
+    pub fn cell_and_triangle(primitive_id: u32, triangles: u32) -> (u32, u32) {
+        (primitive_id / triangles, primitive_id % triangles)
+    }
+
     /// Closest hit of the object-space ray `o + t·d`, `t` in `(t_min, t_max)`.
     pub(crate) fn intersect(
         &self,

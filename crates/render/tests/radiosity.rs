@@ -137,10 +137,7 @@ fn cornell_with_sensors_lit(
         "type": "points", "name": "ceiling", "samples": 16384,
         "positions_m": [[0.6, 0.999, 0.6], [-0.6, 0.999, -0.5]], "normal": [0, -1, 0]
     }]);
-    let path = dir.write("scene.json", json.to_string().as_bytes());
-    let description = prism_scene::load_scene(&path).unwrap_or_else(|e| panic!("{e}"));
-    prism_render::RenderScene::build(&description, Some(glam::UVec2::splat(8)))
-        .unwrap_or_else(|e| panic!("{e}"))
+    dir.scene_at(&json.to_string(), Some(8))
 }
 
 /// Illuminance sensors read the solution (direct light by light sampling, the rest from

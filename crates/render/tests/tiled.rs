@@ -359,9 +359,7 @@ fn room_with_wicker(dir: &Dir, integrator: &str) -> prism_render::RenderScene {
 }}"#,
         tiles = tiles_json("tiles/wicker.obj", "[0.1, 0.1]")
     );
-    let path = dir.write("scene.json", json.as_bytes());
-    let description = prism_scene::load_scene(&path).unwrap_or_else(|e| panic!("{e}"));
-    prism_render::RenderScene::build(&description, None).unwrap_or_else(|e| panic!("{e}"))
+    dir.scene(&json)
 }
 
 /// `radiosity` holds the tiled panel as a diffuse-equivalent patch per side (its pyramid's
@@ -412,10 +410,7 @@ fn paved_office(dir: &Dir, integrator: &str) -> prism_render::RenderScene {
             light["file"] = serde_json::json!(office.join(file).display().to_string());
         }
     }
-    let path = dir.write("scene.json", json.to_string().as_bytes());
-    let description = prism_scene::load_scene(&path).unwrap_or_else(|e| panic!("{e}"));
-    prism_render::RenderScene::build(&description, Some(glam::UVec2::splat(8)))
-        .unwrap_or_else(|e| panic!("{e}"))
+    dir.scene_at(&json.to_string(), Some(8))
 }
 
 /// The issue's office with a tiled floor: radiosity (the paved floor as the diffuse

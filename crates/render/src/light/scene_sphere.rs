@@ -45,14 +45,7 @@ impl SceneSphere {
                 Shape::Sphere(s) => s.bounds(),
                 Shape::Disk(d) => d.bounds(),
                 Shape::Rectangle(r) => r.bounds(),
-                Shape::Tiled(tiling) => {
-                    let tile = geometry.mesh(tiling.mesh);
-                    let tile_bounds = tile.positions.iter().fold(
-                        (Vec3A::splat(f32::INFINITY), Vec3A::splat(f32::NEG_INFINITY)),
-                        |(l, h), &p| (l.min(p), h.max(p)),
-                    );
-                    tiling.bounds(tile_bounds)
-                }
+                Shape::Tiled(tiling) => tiling.bounds(geometry.mesh(tiling.mesh).bounds()),
             };
             if l.cmpgt(h).any() {
                 continue; // an empty mesh

@@ -278,14 +278,8 @@ pub(crate) fn radiosity_surfaces(
             .iter()
             .find_map(|inst| match inst.shape {
                 prism_geometry::Shape::Tiled(t) if inst.material == Some(m as u32) => {
-                    let mesh = geometry.mesh(t.mesh);
-                    let (lo, hi) = mesh
-                        .positions
-                        .iter()
-                        .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), p| {
-                            (lo.min(p.z), hi.max(p.z))
-                        });
-                    Some((lo, hi))
+                    let (lo, hi) = geometry.mesh(t.mesh).bounds();
+                    Some((lo.z, hi.z))
                 }
                 _ => None,
             });

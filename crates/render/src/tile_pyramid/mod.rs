@@ -179,9 +179,18 @@ impl TilePyramid {
             return Err(format!("the scene has no tile {tile}"));
         }
         let cells = level_offset(options.levels);
+        // One scene per worker (the tile's OBJ is read and its BVH built once each); each
+        // incident bin only replaces the beam.
+        let d = simulation_description(description, tile, options.max_depth);
         let per_incident: Vec<IncidentResult> = (0..SPHERE_BINS)
             .into_par_iter()
-            .map(|incident| simulate_incident(description, tile, incident, options))
+            .map_init(
+                || RenderScene::build(&d, Some(UVec2::ONE)).map_err(|e| e.to_string()),
+                |scene, incident| {
+                    let scene = scene.as_mut().map_err(|e| e.clone())?;
+                    simulate_incident(&d, scene, tile, incident, options)
+                },
+            )
             .collect::<Result<_, String>>()?;
         let mut gamma = vec![0.0f32; cells * SPHERE_BINS * SPHERE_BINS * BANDS];
         let mut gamma_variance = vec![0.0f32; gamma.len()];
@@ -261,14 +270,13 @@ struct IncidentResult {
 }
 
 /// The simulation scene: tile `tile` repeated over `SIMULATION_PERIODS`² periods centred
-/// on the origin (normal +z), lit by a parallel beam of unit irradiance travelling along
-/// `beam`, rendered by `path` up to `max_depth` bounces.
-fn simulation_scene(
+/// on the origin (normal +z), lit by a parallel beam of unit irradiance (straight down
+/// until [`with_beam`] turns it), rendered by `path` up to `max_depth` bounces.
+fn simulation_description(
     description: &SceneDescription,
     tile: usize,
-    beam: Vec3A,
     max_depth: u32,
-) -> Result<RenderScene, String> {
+) -> SceneDescription {
     let mut d = description.clone();
     let material = match d
         .materials
@@ -296,14 +304,7 @@ fn simulation_scene(
         interior_medium: None,
         exterior_medium: None,
     }];
-    d.lights = vec![Light {
-        kind: LightKind::Directional {
-            direction: [f64::from(beam.x), f64::from(beam.y), f64::from(beam.z)],
-            angular_diameter_rad: 0.0,
-        },
-        spectrum: SpectrumRef::Constant(1.0),
-        strength: Strength::Scale(1.0),
-    }];
+    d.lights = vec![beam_light(Vec3A::NEG_Z)];
     d.light_media = vec![None];
     d.sensors.clear();
     d.media.clear();
@@ -317,22 +318,40 @@ fn simulation_scene(
         fluorescence_lanes: FluorescenceLanes::All,
         spectral_mis: true,
     };
-    RenderScene::build(&d, Some(UVec2::ONE)).map_err(|e| e.to_string())
+    d
 }
 
+/// A parallel beam of unit irradiance (normal to it) travelling along `beam`.
+fn beam_light(beam: Vec3A) -> Light {
+    Light {
+        kind: LightKind::Directional {
+            direction: [f64::from(beam.x), f64::from(beam.y), f64::from(beam.z)],
+            angular_diameter_rad: 0.0,
+        },
+        spectrum: SpectrumRef::Constant(1.0),
+        strength: Strength::Scale(1.0),
+    }
+}
+
+/// The sums of incident bin `incident` on `scene` (built from `simulation`, the
+/// simulation's description), whose beam it turns to come from that bin.
 fn simulate_incident(
-    description: &SceneDescription,
+    simulation: &SceneDescription,
+    scene: &mut RenderScene,
     tile: usize,
     incident: usize,
     options: &PyramidOptions,
 ) -> Result<IncidentResult, String> {
     let towards_light = bins::centre(incident);
-    let scene = simulation_scene(description, tile, -towards_light, options.max_depth)?;
+    let mut d = simulation.clone();
+    d.lights = vec![beam_light(-towards_light)];
+    scene.lights = crate::light::LightSet::build(&d, &scene.geometry).map_err(|e| e.to_string())?;
+    let scene = &*scene;
     let (lo, hi) = scene
         .geometry
         .instance_world_bounds(0)
         .ok_or("the tile has no geometry")?;
-    let period = description.tiles[tile].period_m.map(|p| p as f32);
+    let period = simulation.tiles[tile].period_m.map(|p| p as f32);
     let margin = 0.01 * period[0].max(period[1]);
     let (top, bottom) = (hi.z.max(0.0) + margin, lo.z.min(0.0) - margin);
     let cells = level_offset(options.levels);
@@ -382,7 +401,7 @@ fn simulate_incident(
             let origin = p + w * (height / w.z);
             let ray = Ray::infinite(origin, -w);
             let result = tracer.radiance(
-                &scene,
+                scene,
                 &ray,
                 &mut lanes,
                 &mut stream,

@@ -27,9 +27,14 @@ impl Dir {
         p
     }
     pub fn scene(&self, json: &str) -> RenderScene {
+        self.scene_at(json, None)
+    }
+    /// `json` written as `scene.json` and built at `resolution` (`None`: its film's).
+    pub fn scene_at(&self, json: &str, resolution: Option<u32>) -> RenderScene {
         let path = self.write("scene.json", json.as_bytes());
         let description = load_scene(&path).unwrap_or_else(|e| panic!("{e}"));
-        RenderScene::build(&description, None).unwrap_or_else(|e| panic!("{e}"))
+        RenderScene::build(&description, resolution.map(UVec2::splat))
+            .unwrap_or_else(|e| panic!("{e}"))
     }
     pub fn build_error(&self, json: &str) -> String {
         let path = self.write("scene.json", json.as_bytes());

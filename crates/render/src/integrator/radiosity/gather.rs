@@ -37,11 +37,9 @@ impl SolutionGather for SolvedScene {
         let e = self.solution.emission(patch);
         // At most a 20-fold gain: beyond that the faces are slivers the carrier's average
         // does not describe.
-        let faces_share = self
-            .map
-            .carriers
-            .transparency_towards(si.instance_id, wo)
-            .map_or(1.0, |tau| (1.0 - tau).max(0.05));
+        let faces_share = self.map.carrier[si.instance_id as usize].map_or(1.0, |c| {
+            (1.0 - self.map.carriers.transparency_towards(c as usize, wo)).max(0.05)
+        });
         Some(SampledSpectrum::from_fn(|lane| {
             let k = band_of(wavelengths.wavelength_nm(lane));
             (leaf.radiosity[k] - e[k]).max(0.0) * std::f32::consts::FRAC_1_PI / faces_share

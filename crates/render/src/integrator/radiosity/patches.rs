@@ -54,9 +54,9 @@ pub struct PatchMap {
     pub sides: Vec<u8>,
     /// Per patch: its normal.
     pub normals: Vec<Vec3A>,
-    /// Per instance: one patch (per side) for all its primitives (a tiled carrier, whose
-    /// primitives are its tile's faces).
-    pub whole_instance: Vec<bool>,
+    /// Per instance: its index in `carriers` when it is a tiled carrier, whose one patch
+    /// per side stands for all its primitives (its tile's faces).
+    pub carrier: Vec<Option<u32>>,
     /// The tiled carriers (`tiled.rs`).
     pub carriers: TiledCarriers,
 }
@@ -67,7 +67,7 @@ impl PatchMap {
     pub fn patch_of(&self, instance: u32, primitive: u32, wo: Vec3A) -> Option<usize> {
         let first = (*self.first_patch.get(instance as usize)?)?;
         let sides = u32::from(self.sides[instance as usize]);
-        let primitive = if self.whole_instance[instance as usize] {
+        let primitive = if self.carrier[instance as usize].is_some() {
             0
         } else {
             primitive
@@ -112,24 +112,19 @@ pub fn scene_patches(scene: &RenderScene) -> Result<(Vec<InputPatch>, PatchMap),
         first_patch: Vec::with_capacity(geometry.instances().len()),
         sides: Vec::with_capacity(geometry.instances().len()),
         normals: Vec::new(),
-        whole_instance: Vec::with_capacity(geometry.instances().len()),
+        carrier: Vec::with_capacity(geometry.instances().len()),
         carriers: TiledCarriers::of_geometry(geometry, scene.tiled_surfaces()?)?,
     };
     for (instance_id, inst) in geometry.instances().iter().enumerate() {
-        map.whole_instance
-            .push(matches!(inst.shape, Shape::Tiled(_)));
-        if let Some(c) = map
+        let carrier = map
             .carriers
             .0
             .iter()
-            .find(|c| c.instance == instance_id as u32)
-        {
+            .position(|c| c.instance == instance_id as u32);
+        map.carrier.push(carrier.map(|k| k as u32));
+        if let Some(c) = carrier.map(|k| &map.carriers.0[k]) {
             // Front and back, each with the pyramid's reflectance for its side.
-            let shape = ElementShape::Parallelogram {
-                p0: c.p0,
-                e1: c.e1,
-                e2: c.e2,
-            };
+            let shape = c.shape();
             map.first_patch.push(Some(patches.len() as u32));
             map.sides.push(2);
             for (side, n) in [c.normal, -c.normal].into_iter().enumerate() {

@@ -9,9 +9,21 @@
 
 use glam::Vec3A;
 use prism_geometry::{Geometry, Shape};
+use prism_radiosity::ElementShape;
 
 use crate::tile_pyramid::bins;
 use crate::tile_pyramid::TiledSurface;
+
+impl TiledCarrier {
+    /// The carrier's parallelogram, front along `normal`.
+    pub fn shape(&self) -> ElementShape {
+        ElementShape::Parallelogram {
+            p0: self.p0,
+            e1: self.e1,
+            e2: self.e2,
+        }
+    }
+}
 
 /// One tiled carrier: its parallelogram, frame and slab.
 #[derive(Clone, Debug)]
@@ -89,17 +101,11 @@ impl TiledCarriers {
     /// parallelogram).
     fn carrier_at(&self, p: Vec3A) -> Option<&TiledCarrier> {
         self.0.iter().find(|c| {
-            let d = p - c.p0;
             let size = c.e1.length().max(c.e2.length());
-            if d.dot(c.normal).abs() > 1e-4 * size {
+            if (p - c.p0).dot(c.normal).abs() > 1e-4 * size {
                 return false;
             }
-            // Parameters along e1, e2 (the normal equations of d = u e1 + v e2).
-            let (a, b, cc) = (c.e1.dot(c.e1), c.e1.dot(c.e2), c.e2.dot(c.e2));
-            let (r1, r2) = (d.dot(c.e1), d.dot(c.e2));
-            let det = a * cc - b * b;
-            let u = (cc * r1 - b * r2) / det;
-            let v = (a * r2 - b * r1) / det;
+            let (u, v) = c.shape().parameters_of(p);
             (-1e-4..=1.0001).contains(&u) && (-1e-4..=1.0001).contains(&v)
         })
     }
@@ -117,12 +123,13 @@ impl TiledCarriers {
         })
     }
 
-    /// τ of carrier `instance` for light leaving along `wo` (world, unit): the share of
-    /// its area that a viewer looking back along `wo` sees through.
-    pub fn transparency_towards(&self, instance: u32, wo: Vec3A) -> Option<f32> {
-        let c = self.0.iter().find(|c| c.instance == instance)?;
+    /// τ of carrier `carrier` (an index into the list) for light leaving along `wo`
+    /// (world, unit): the share of its area that a viewer looking back along `wo` sees
+    /// through.
+    pub fn transparency_towards(&self, carrier: usize, wo: Vec3A) -> f32 {
+        let c = &self.0[carrier];
         let bitangent = c.normal.cross(c.tangent);
         let local = Vec3A::new(wo.dot(c.tangent), wo.dot(bitangent), wo.dot(c.normal));
-        Some(c.transparency[bins::bin_of(local.normalize_or_zero())])
+        c.transparency[bins::bin_of(local.normalize_or_zero())]
     }
 }
