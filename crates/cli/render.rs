@@ -685,6 +685,11 @@ pub fn run(args: &RenderArgs, budget: &MemoryBudget) -> Result<ExitCode, String>
         write_stats(path, &scene, &settings, threads, &rendered)?;
     }
     report_medium_mismatches(args, &rendered.stats);
+    if let Some(Ok(solved)) = scene.radiosity_solution() {
+        if let Some(line) = solved.gather_statistics() {
+            eprintln!("{line}");
+        }
+    }
     let wall_time_s = rendered.wall_time_s;
     eprintln!(
         "wrote {} ({}×{}, {} spp{}, {:.2} s, {:.3} M rays/s)",

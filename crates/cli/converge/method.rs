@@ -392,7 +392,7 @@ impl Method {
             ("radiosity", _) => prism_scene::Integrator::Radiosity {
                 error_bound_rel: 0.004,
                 iterations: 3,
-                gather_epsilon: None,
+                gather_epsilon: 0.1,
                 sampler,
             },
             ("depth", _) => prism_scene::Integrator::Depth,

@@ -9,12 +9,14 @@
 //! solution answers the radiosity at any point of a patch ([`Radiosity::radiosity_at`]).
 
 pub mod element;
+pub mod final_gather;
 pub mod form_factor;
 mod hierarchy;
 mod solution_file;
 pub mod solver;
 
 pub use element::ElementShape;
+pub use final_gather::{ListedSource, ReceiverGather};
 pub use solver::{
     r2, DirectIrradiance, InputPatch, IterationStats, LeafAt, LeafElement, NoDirectLight,
     Radiosity, RadiosityError, RadiositySettings, Unoccluded, Visibility,

@@ -340,7 +340,7 @@ impl Radiosity {
             })
     }
 
-    fn leaf_node(&self, patch: usize, p: Vec3A) -> u32 {
+    pub(crate) fn leaf_node(&self, patch: usize, p: Vec3A) -> u32 {
         let mut node = self.hierarchy.patch_root[patch];
         let shape = match self.hierarchy.nodes[node as usize].kind {
             NodeKind::Element { shape, .. } => shape,
@@ -370,7 +370,7 @@ impl Radiosity {
         node
     }
 
-    fn node_radiosity(&self, node: u32) -> &[f32] {
+    pub(crate) fn node_radiosity(&self, node: u32) -> &[f32] {
         let b = node as usize * self.bands;
         &self.radiosity[b..b + self.bands]
     }
@@ -993,7 +993,7 @@ fn coverage_mask(shape: &ElementShape, rays: usize, vis: &dyn Visibility) -> u64
 
 /// The k-th stratified point on `shape` (an R2 low-discrepancy sequence, offset
 /// by `stream` so that the two ends of a ray use different points).
-fn sample_point(shape: &ElementShape, k: usize, stream: u32) -> Vec3A {
+pub(crate) fn sample_point(shape: &ElementShape, k: usize, stream: u32) -> Vec3A {
     let (a, b) = r2(k as u32, stream);
     let (u, v) = fold_into(shape, a, b);
     shape.point(u, v)
@@ -1001,7 +1001,7 @@ fn sample_point(shape: &ElementShape, k: usize, stream: u32) -> Vec3A {
 
 /// Maps a point of the unit square onto the shape's parameter domain (triangles fold the
 /// upper half over the diagonal).
-fn fold_into(shape: &ElementShape, a: f32, b: f32) -> (f32, f32) {
+pub(crate) fn fold_into(shape: &ElementShape, a: f32, b: f32) -> (f32, f32) {
     match shape {
         ElementShape::Parallelogram { .. } => (a, b),
         ElementShape::Triangle { .. } => {

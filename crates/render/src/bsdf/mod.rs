@@ -516,6 +516,13 @@ impl<'a> Bsdf<'a> {
         self.lobe.is_specular()
     }
 
+    /// True for a single Lambertian lobe: f is the same towards every direction of the
+    /// hemisphere, so a gather may sum its incident light before weighting it.
+    #[inline]
+    pub fn is_lambertian(&self) -> bool {
+        matches!(self.lobe, Lobe::Lambert(_))
+    }
+
     /// True when the lobe has any Dirac component (MIS must treat BSDF samples from it as
     /// unmatched by light sampling): a smooth coat over a diffuse base, a mix with a mirror.
     #[inline]

@@ -175,10 +175,12 @@ impl Integrator {
             prism_scene::Integrator::Radiosity {
                 error_bound_rel,
                 iterations,
+                gather_epsilon,
                 ..
             } => Integrator::Radiosity(RadiosityMethod {
                 error_bound_rel: error_bound_rel as f32,
                 iterations,
+                gather_epsilon: gather_epsilon as f32,
                 memory_limit_bytes: None,
             }),
         })

@@ -130,6 +130,27 @@ pub trait SolutionGather: Sync {
         wavelengths: &SampledWavelengths,
         seen_from_m: Option<f32>,
     ) -> Option<SampledSpectrum>;
+
+    /// The solution's light that a camera path's gather vertex `vertex` (at `si`, seen
+    /// from `wo`) reflects by an interpolated gather, and the receiver it used; `None`
+    /// where it does not serve the vertex (the path then reads `reflected_radiance` at its
+    /// next hit for all sources).
+    fn interpolated_reflection(
+        &self,
+        _scene: &RenderScene,
+        _si: &SurfaceInteraction,
+        _wo: Vec3A,
+        _vertex: &ScatterVertex,
+        _wavelengths: &SampledWavelengths,
+    ) -> Option<(SampledSpectrum, u32)> {
+        None
+    }
+
+    /// Whether the gather ray's hit `si` (seen from `wo`) is a source that `receiver`'s
+    /// interpolation left out (its gathering list): only those hits read the solution.
+    fn hits_listed_source(&self, _receiver: u32, _si: &SurfaceInteraction, _wo: Vec3A) -> bool {
+        true
+    }
 }
 
 /// Most vertices a final gather path adds after its gather depth for hits too close for
@@ -322,6 +343,9 @@ impl PathTracer {
         let mut current_differential = camera_differential.copied();
         let lights = &scene.lights;
         let mut radiance = SampledSpectrum::splat(0.0);
+        let camera_path = origin.is_none();
+        // The receiver element whose interpolated gather served the gather vertex.
+        let mut interpolated_gather: Option<u32> = None;
         let mut path = PathState::new(camera_ray.origin, origin, *stream, *wavelengths);
         // Indirect light arriving at the first hit, for the illumination AOV: contributions
         // after the first bounce divided by the first bounce's throughput factor.
@@ -445,6 +469,11 @@ impl PathTracer {
                     break;
                 };
                 let extra = path.depth - self.max_depth;
+                if let (Some(receiver), 0) = (interpolated_gather, extra) {
+                    if !g.hits_listed_source(receiver, &si, -ray.direction) {
+                        break;
+                    }
+                }
                 let seen_from_m = (extra < MAX_GATHER_EXTRA_BOUNCES).then_some(hit.t);
                 let transport = path.wavelengths.transport();
                 if let Some(x) = g.reflected_radiance(&si, -ray.direction, transport, seen_from_m) {
@@ -483,6 +512,27 @@ impl PathTracer {
             let vertex =
                 ScatterVertex::Surface(SurfaceVertex::new(&si, &bsdf, ray.direction, shading_maps));
             let ctx = vertex.light_context();
+            // The interpolated gather serves a camera path's gather vertex for all but its
+            // listed sources: the next hit reads the solution only on those.
+            if let (Some(g), true) = (gather, camera_path && path.depth == self.max_depth) {
+                if !vertex.is_specular() {
+                    let transport = path.wavelengths.transport();
+                    if let Some((x, receiver)) =
+                        g.interpolated_reflection(scene, &si, -ray.direction, &vertex, transport)
+                    {
+                        add(
+                            &mut radiance,
+                            &mut incident_after_first,
+                            &first_bounce_beta,
+                            path.beta,
+                            x,
+                            path.depth >= 2,
+                            counters,
+                        );
+                        interpolated_gather = Some(receiver);
+                    }
+                }
+            }
 
             // Next-event estimation.
             if !vertex.is_specular() && !lights.is_empty() {

@@ -193,6 +193,15 @@ impl ScatterVertex<'_> {
         }
     }
 
+    /// A surface vertex with a single Lambertian lobe (`Bsdf::is_lambertian`).
+    #[inline(always)]
+    pub fn is_lambertian(&self) -> bool {
+        match self {
+            ScatterVertex::Surface(s) => s.bsdf.is_lambertian(),
+            ScatterVertex::Medium(_) => false,
+        }
+    }
+
     /// The scattering function towards world direction `wi`; `None` where a shading-normal
     /// vertex refuses the direction's side.
     #[inline(always)]

@@ -284,10 +284,10 @@ pub const FIELD_USES: &[FieldRow] = &[
         &["sampler"],
         "`prism render`: crates/cli/render.rs run (RenderSettings::sampler)",
     ),
-    refused(
+    read(
         &["integrator<radiosity>"],
         &["gather_epsilon"],
-        "refuse_unrendered: the interpolated gather (4D tree and gathering list) is not built",
+        "Integrator::from_description (RadiosityMethod::gather_epsilon)",
     ),
     read(
         &["integrator<path>"],
@@ -658,17 +658,6 @@ pub fn refuse_unrendered(scene: &SceneDescription) -> Result<(), SceneBuildError
                 )
             }
         }
-    }
-    if let prism_scene::Integrator::Radiosity {
-        gather_epsilon: Some(_),
-        ..
-    } = scene.integrator
-    {
-        return refuse(
-            JsonPath::default().key("integrator").key("gather_epsilon"),
-            "the interpolated gather that `gather_epsilon` controls (the paper's 4D tree and \
-             gathering list) is not built yet: every gather ray is traced, so remove the key",
-        );
     }
     Ok(())
 }

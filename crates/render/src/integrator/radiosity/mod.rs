@@ -29,11 +29,16 @@ use super::{PathCounters, PathTracer};
 use crate::film::{FilmTile, LightSplats};
 use crate::scene_build::RenderScene;
 
+/// The interpolated gather's bound when the scene gives none (the default).
+pub const DEFAULT_GATHER_EPSILON: f32 = 0.1;
+
 /// The `radiosity` integrator's settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RadiosityMethod {
     pub error_bound_rel: f32,
     pub iterations: u32,
+    /// The interpolated gather's bound ε (paper §5); 0 traces every gather ray.
+    pub gather_epsilon: f32,
     /// `--max-memory` for the hierarchy.
     pub memory_limit_bytes: Option<u64>,
 }
@@ -54,7 +59,7 @@ impl RadiosityEstimator {
 }
 
 /// The scene's own ray tracer as the solution's visibility oracle.
-struct SceneVisibility<'a>(&'a RenderScene, &'a TiledCarriers);
+pub(crate) struct SceneVisibility<'a>(pub &'a RenderScene, pub &'a TiledCarriers);
 
 impl Visibility for SceneVisibility<'_> {
     /// Points of tiled carriers take their rays from above their tile's slab
@@ -116,7 +121,10 @@ pub fn solve(
             s.sweeps
         ));
     }
-    Ok((SolvedScene { solution, map }, lines))
+    Ok((
+        SolvedScene::new(solution, map, method.gather_epsilon),
+        lines,
+    ))
 }
 
 /// `solve` with its statistics and time on stderr (what `prism render` prints).

@@ -30,7 +30,13 @@ pub fn load_solution(
             scene.file.display()
         ));
     }
-    Ok(SolvedScene { solution, map })
+    // The scene's own ε; another method's scene (`prism converge`) gets the default.
+    let gather_epsilon = if let crate::integrator::Integrator::Radiosity(m) = scene.integrator {
+        m.gather_epsilon
+    } else {
+        super::DEFAULT_GATHER_EPSILON
+    };
+    Ok(SolvedScene::new(solution, map, gather_epsilon))
 }
 
 /// A band array as a spectrum over 360–830 nm (zero outside 380–780 nm) and its
