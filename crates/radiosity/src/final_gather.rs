@@ -10,7 +10,7 @@
 use glam::Vec3A;
 
 use crate::element::ElementShape;
-use crate::form_factor::point_to_polygon;
+use crate::form_factor::{area_sample_factor, point_to_polygon};
 use crate::hierarchy::NodeKind;
 use crate::solver::{fold_into, r2, sample_point, Radiosity, Visibility};
 
@@ -20,7 +20,7 @@ const SECTORS: usize = 8;
 const BINS: usize = RINGS * SECTORS;
 /// Points inside the receiver besides its vertices: they measure the variation.
 const INTERIOR_POINTS: usize = 4;
-/// Points on an element source (visibility) and on a cluster source (disk approximation).
+/// Points on an element source (visibility) and on a cluster source (area samples).
 const ELEMENT_SOURCE_POINTS: usize = 4;
 const CLUSTER_SOURCE_POINTS: usize = 8;
 /// An element nearer than this many times its own and the receiver's radii together is
@@ -381,7 +381,7 @@ impl Radiosity {
                         if rx.covered[k] {
                             continue;
                         }
-                        let f = point_factor(x, rx.normal, y, n_s, piece_m2);
+                        let f = area_sample_factor(x, rx.normal, y, n_s, piece_m2);
                         if f <= 0.0 || !vis.visible(x, rx.normal, y, n_s) {
                             continue;
                         }
@@ -499,8 +499,11 @@ impl ReceiverGather {
     /// The interpolated irradiance of all direction bins together at point `p`, in the
     /// bands `bands` (at most 16): what a Lambertian receiver reflects, times ρ/π.
     pub fn interpolate_total(&self, p: Vec3A, bands: &[usize], out: &mut [f32]) {
-        let weights = self.weights(p);
         out.fill(0.0);
+        if self.vertex_totals.is_empty() {
+            return; // every point covered: nothing stored
+        }
+        let weights = self.weights(p);
         for (vertex, &w) in weights[..self.vertices].iter().enumerate() {
             let row = &self.vertex_totals[vertex * self.bands..(vertex + 1) * self.bands];
             for (x, &band) in out.iter_mut().zip(bands) {
@@ -545,20 +548,6 @@ impl ReceiverGather {
             + (self.irradiance.len() + self.vertex_totals.len()) * 4
             + self.listed.len() * (std::mem::size_of::<ListedSource>() + 4 * self.bands)
     }
-}
-
-/// The point-to-point factor cos θ cos θ′ δA/(π r²) from `x` (normal `n_x`) to a piece of
-/// area `area_m2` at `y` (normal `n_y`). Not the disk approximation's δA/(π r² + δA): a
-/// cluster is accepted only far away, where that term would only bias it low (by 2 % for
-/// a quarter of 2 m² at 2 m).
-fn point_factor(x: Vec3A, n_x: Vec3A, y: Vec3A, n_y: Vec3A, area_m2: f32) -> f32 {
-    let d = y - x;
-    let r2 = d.length_squared();
-    let (cos_x, cos_y) = (n_x.dot(d), -n_y.dot(d));
-    if r2 <= 0.0 || cos_x <= 0.0 || cos_y <= 0.0 {
-        return 0.0;
-    }
-    cos_x * cos_y * area_m2 / (std::f32::consts::PI * r2 * r2)
 }
 
 /// Whether points `x` (normal `n_x`) and `y` (normal `n_y`) are on each other's front

@@ -1,8 +1,8 @@
 //! Form factors. The unoccluded point-to-polygon factor is exact (Lambert's contour
 //! integral, Cohen & Wallace 1993 eq. 4.19, after clipping the polygon to the receiver's
 //! hemisphere); an element-to-element factor is its area average over the receiver by
-//! Gauss–Legendre quadrature; a cluster's by the disk approximation of Wallace et al. 1989,
-//! the paper's transfer formula (Mostefaoui et al. §3): cos θ cos θ′ δA / (π r² + δA).
+//! Gauss–Legendre quadrature; a cluster's by area samples of its patches (Mostefaoui et
+//! al. §3 use the disk approximation instead, which biases far transfers low).
 
 use glam::{DVec3, Vec3A};
 
@@ -64,10 +64,14 @@ pub fn element_to_element(
         .sum()
 }
 
-/// The disk approximation of the factor from a point with normal `n_r` at `x` to a
-/// differential piece of area `area_m2` with normal `n_s` at `y`.
+/// The factor from a point with normal `n_r` at `x` to a piece of area `area_m2` with
+/// normal `n_s` at `y`, as one area sample of the factor's integral:
+/// cos θ cos θ′ δA / (π r²), capped at cos θ cos θ′ where r² < δA/π. Not the disk
+/// approximation of Wallace et al. 1989, cos θ cos θ′ δA / (π r² + δA) (the paper's
+/// transfer formula): for the pieces of a cluster seen from a few piece sizes away that
+/// term biases every transfer low (by 4 % for 1.25 m² pieces at 3 m).
 #[inline]
-pub fn disk_approximation(x: Vec3A, n_r: Vec3A, y: Vec3A, n_s: Vec3A, area_m2: f32) -> f32 {
+pub fn area_sample_factor(x: Vec3A, n_r: Vec3A, y: Vec3A, n_s: Vec3A, area_m2: f32) -> f32 {
     let d = y - x;
     let r2 = d.length_squared();
     if r2 <= 0.0 {
@@ -79,7 +83,7 @@ pub fn disk_approximation(x: Vec3A, n_r: Vec3A, y: Vec3A, n_s: Vec3A, area_m2: f
     if cos_r <= 0.0 || cos_s <= 0.0 {
         return 0.0;
     }
-    cos_r * cos_s * area_m2 / (std::f32::consts::PI * r2 + area_m2)
+    cos_r * cos_s * area_m2 / (std::f32::consts::PI * r2).max(area_m2)
 }
 
 #[cfg(test)]
@@ -122,18 +126,22 @@ mod tests {
         assert!((f - 1.0).abs() < 1e-3, "{f}");
     }
 
+    /// Area samples of a source 1 m across at 1.5 m (16 pieces, their centres) agree with
+    /// the exact factor within 1 %.
     #[test]
-    fn the_disk_approximation_agrees_with_the_exact_factor_far_away() {
+    fn area_samples_agree_with_the_exact_factor() {
         let receiver = square(Vec3A::ZERO, Vec3A::X * 0.1, Vec3A::Y * 0.1);
-        let source = square(Vec3A::new(0.0, 0.0, 5.0), Vec3A::Y * 0.1, Vec3A::X * 0.1);
+        let source = square(Vec3A::new(-0.45, -0.45, 1.5), Vec3A::Y, Vec3A::X);
         let exact = element_to_element(&receiver, &source, 4);
-        let disk = disk_approximation(
-            receiver.centre(),
-            receiver.normal(),
-            source.centre(),
-            source.normal(),
-            source.area_m2(),
-        );
-        assert!((disk / exact - 1.0).abs() < 1e-3, "{disk} {exact}");
+        let piece = source.area_m2() / 16.0;
+        let mut sampled = 0.0;
+        for i in 0..4 {
+            for j in 0..4 {
+                let y = source.point((i as f32 + 0.5) / 4.0, (j as f32 + 0.5) / 4.0);
+                let (x, n, n_s) = (receiver.centre(), receiver.normal(), source.normal());
+                sampled += area_sample_factor(x, n, y, n_s, piece);
+            }
+        }
+        assert!((sampled / exact - 1.0).abs() < 0.01, "{sampled} {exact}");
     }
 }

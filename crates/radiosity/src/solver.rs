@@ -7,7 +7,7 @@
 //! cluster's patches, so energy reaches each patch with its own orientation (what Smits'
 //! α-links distribute) and no cluster stores directional energy. Sources may be clusters:
 //! they emit their area-averaged radiosity through a form factor sampled over their patches
-//! (the disk approximation), which the oracle only accepts where the power it may carry is
+//! (`area_sample_factor`), which the oracle only accepts where the power it may carry is
 //! below the bound.
 
 use std::time::Instant;
@@ -16,7 +16,7 @@ use glam::Vec3A;
 use rayon::prelude::*;
 
 use crate::element::ElementShape;
-use crate::form_factor::{disk_approximation, element_to_element, point_to_polygon};
+use crate::form_factor::{area_sample_factor, element_to_element, point_to_polygon};
 use crate::hierarchy::{Hierarchy, NodeKind};
 
 /// A surface the solution covers: one side of a planar patch, uniform over it.
@@ -855,7 +855,7 @@ impl Radiosity {
                     let y = source.point(u, v);
                     let x = sample_point(&receiver, k, 0);
                     let n_s = source.normal();
-                    let f = disk_approximation(x, n_r, y, n_s, piece);
+                    let f = area_sample_factor(x, n_r, y, n_s, piece);
                     if f > 0.0 && vis.visible(x, n_r, y, n_s) {
                         sum += f;
                         free += 1;

@@ -86,11 +86,12 @@ fn refusals_name_what_radiosity_cannot_hold() {
     let cases = [
         (
             scene(
-                r#"{"type": "sphere", "radius_m": 1, "material": "m"}"#,
+                r#"{"type": "sphere", "radius_m": 1, "material": "m",
+                    "transform": {"scale": [1, 2, 1]}}"#,
                 lambert,
                 area,
             ),
-            "sphere",
+            "non-uniform scale",
         ),
         (
             scene(rect, r#"{"type": "dielectric", "ior": 1.5}"#, area),
@@ -120,7 +121,7 @@ fn refusals_name_what_radiosity_cannot_hold() {
 /// floor, the back wall and the ceiling (lit by reflected light only: all of its lux come
 /// from the solution).
 fn cornell_with_sensors(dir: &Dir, integrator: &str) -> prism_render::RenderScene {
-    cornell_with_sensors_lit(dir, integrator, None)
+    cornell_with_sensors_lit(dir, integrator, None, &[])
 }
 
 /// As `cornell_with_sensors`, with `light` (JSON) in place of the area light.
@@ -128,6 +129,7 @@ fn cornell_with_sensors_lit(
     dir: &Dir,
     integrator: &str,
     light: Option<&str>,
+    shapes: &[&str],
 ) -> prism_render::RenderScene {
     let root = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
     let text = std::fs::read_to_string(root.join("cornell-box.json")).unwrap();
@@ -140,6 +142,12 @@ fn cornell_with_sensors_lit(
     json["integrator"] = serde_json::from_str(integrator).unwrap();
     if let Some(light) = light {
         json["lights"] = serde_json::from_str(&format!("[{light}]")).unwrap();
+    }
+    if !shapes.is_empty() {
+        // In place of the two boxes.
+        let mut all: Vec<serde_json::Value> = json["shapes"].as_array().unwrap()[..6].to_vec();
+        all.extend(shapes.iter().map(|s| serde_json::from_str(s).unwrap()));
+        json["shapes"] = serde_json::Value::Array(all);
     }
     json["sensors"] = serde_json::json!([{
         "type": "points", "name": "probe", "samples": 16384,
@@ -237,9 +245,10 @@ fn a_point_light_reaches_the_solution() {
         &dir,
         r#"{"type": "path", "max_depth": 64, "rr_depth": 5, "sampler": "independent"}"#,
         Some(light),
+        &[],
     );
     let expected = sensor_lux(&path, &dir, 7);
-    let scene = cornell_with_sensors_lit(&dir, r#"{"type": "radiosity"}"#, Some(light));
+    let scene = cornell_with_sensors_lit(&dir, r#"{"type": "radiosity"}"#, Some(light), &[]);
     let got = sensor_lux(&scene, &dir, 7);
     let mut failures = 0;
     for (i, (&(e, e_se), &(g, g_se))) in expected.iter().zip(&got).enumerate() {
@@ -412,5 +421,41 @@ fn interpolated_gather_agrees_with_the_traced_gather() {
                 "block ({bx}, {by}): interpolated − traced {d} (s.e. {d_se}, level {level})"
             );
         }
+    }
+}
+
+/// Spheres and disks are meshed for the solution: the Cornell box with a sphere and a
+/// disk in place of its boxes, then lit by a small spherical area light instead of its
+/// rectangle; the sensors agree with `path` within 2 % plus 4 s.e.
+#[test]
+fn spheres_and_disks_reach_the_solution() {
+    let dir = Dir::new("radiosity", "spheres");
+    let shapes = [
+        r#"{"type": "sphere", "name": "ball", "radius_m": 0.3, "material": "white",
+            "transform": {"translate": [-0.35, -0.6, -0.2]}}"#,
+        r#"{"type": "disk", "name": "table", "radius_m": 0.3, "material": "white",
+            "transform": [{"rotate": {"axis": [1, 0, 0], "angle_deg": -90}},
+                          {"translate": [0.4, -0.5, 0.3]}]}"#,
+    ];
+    let bulb = r#"{"type": "sphere", "name": "bulb", "radius_m": 0.08, "material": "white",
+        "transform": {"translate": [0.1, 0.7, 0.1]}}"#;
+    let bulb_light = r#"{"type": "area", "shape": "bulb", "spectrum": 40}"#;
+    for (what, light, extra) in [
+        ("rectangle light", None, None),
+        ("sphere light", Some(bulb_light), Some(bulb)),
+    ] {
+        let mut all: Vec<&str> = shapes.to_vec();
+        all.extend(extra);
+        let path = cornell_with_sensors_lit(
+            &dir,
+            r#"{"type": "path", "max_depth": 64, "rr_depth": 5, "sampler": "independent"}"#,
+            light,
+            &all,
+        );
+        let expected = sensor_lux(&path, &dir, 9);
+        let scene = cornell_with_sensors_lit(&dir, r#"{"type": "radiosity"}"#, light, &all);
+        let got = sensor_lux(&scene, &dir, 9);
+        eprintln!("{what}:");
+        assert_eq!(lux_disagreements(&expected, &got), 0, "{what}");
     }
 }

@@ -9,8 +9,8 @@ use glam::{Vec2, Vec3A};
 use prism_radiosity::DirectIrradiance;
 use prism_spectrum::{SampledSpectrum, SampledWavelengths, N_SPECTRUM_SAMPLES};
 
+use super::patches::PatchMap;
 use super::patches::{band_point_nm, BANDS};
-use super::tiled::TiledCarriers;
 use crate::integrator::{PathCounters, PathTracer};
 use crate::light::LightSampleContext;
 use crate::scene_build::RenderScene;
@@ -23,8 +23,9 @@ const SKY_DIRECTIONS: u32 = 64;
 
 pub struct PointLikeAndSkyLights<'a> {
     scene: &'a RenderScene,
-    /// Points of tiled carriers are lit above their tile's slab.
-    carriers: &'a TiledCarriers,
+    /// Points of tiled carriers are lit above their tile's slab, of meshed spheres on the
+    /// sphere.
+    map: &'a PatchMap,
     /// Indices of the delta lights in the scene's light set.
     lights: Vec<u32>,
     /// Indices of the skies and environment maps.
@@ -34,7 +35,7 @@ pub struct PointLikeAndSkyLights<'a> {
 }
 
 impl<'a> PointLikeAndSkyLights<'a> {
-    pub fn new(scene: &'a RenderScene, carriers: &'a TiledCarriers) -> Self {
+    pub fn new(scene: &'a RenderScene, map: &'a PatchMap) -> Self {
         let lights = (0..scene.lights.len() as u32)
             .filter(|&l| scene.lights.light(l).is_delta())
             .collect();
@@ -54,7 +55,7 @@ impl<'a> PointLikeAndSkyLights<'a> {
             .collect();
         Self {
             scene,
-            carriers,
+            map,
             lights,
             skies,
             wavelength_sets,
@@ -64,7 +65,7 @@ impl<'a> PointLikeAndSkyLights<'a> {
 
 impl DirectIrradiance for PointLikeAndSkyLights<'_> {
     fn irradiance(&self, p: Vec3A, n: Vec3A, out: &mut [f32]) {
-        let p = self.carriers.lift(p, n).unwrap_or(p);
+        let p = self.map.lift(p, n).unwrap_or(p);
         let ctx = LightSampleContext { p, n };
         for &l in &self.lights {
             self.add_direction(l, &ctx, Vec2::splat(0.5), 1.0, out);

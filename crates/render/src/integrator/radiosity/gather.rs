@@ -73,7 +73,7 @@ impl SolvedScene {
         self.receivers
             .get(leaf as usize)?
             .get_or_init(|| {
-                let vis = SceneVisibility(scene, &self.map.carriers);
+                let vis = SceneVisibility(scene, &self.map);
                 let g = self
                     .solution
                     .receiver_gather(leaf, self.gather_epsilon, &vis)?;
@@ -119,7 +119,7 @@ impl SolutionGather for SolvedScene {
         wavelengths: &SampledWavelengths,
         seen_from_m: Option<f32>,
     ) -> Option<SampledSpectrum> {
-        let Some(patch) = self.map.patch_of(si.instance_id, si.primitive_id, wo) else {
+        let Some(patch) = self.map.patch_of(si.instance_id, si.primitive_id, si.p, wo) else {
             return Some(SampledSpectrum::splat(0.0));
         };
         let leaf = self.solution.leaf_at(patch, si.p);
@@ -152,7 +152,9 @@ impl SolutionGather for SolvedScene {
         if self.gather_epsilon <= 0.0 || self.map.carrier[si.instance_id as usize].is_some() {
             return None;
         }
-        let patch = self.map.patch_of(si.instance_id, si.primitive_id, wo)?;
+        let patch = self
+            .map
+            .patch_of(si.instance_id, si.primitive_id, si.p, wo)?;
         let leaf = self.solution.leaf_id(patch, si.p);
         let receiver = self.receiver(scene, leaf)?;
         let bands: [usize; N_SPECTRUM_SAMPLES] =
@@ -173,7 +175,7 @@ impl SolutionGather for SolvedScene {
 
     /// Whether the gather ray's hit lies on a source of `receiver`'s gathering list.
     fn hits_listed_source(&self, receiver: u32, si: &SurfaceInteraction, wo: Vec3A) -> bool {
-        let Some(patch) = self.map.patch_of(si.instance_id, si.primitive_id, wo) else {
+        let Some(patch) = self.map.patch_of(si.instance_id, si.primitive_id, si.p, wo) else {
             return false;
         };
         let leaf = self.solution.leaf_id(patch, si.p);

@@ -6,6 +6,7 @@
 
 mod direct;
 pub mod gather;
+pub mod meshed;
 pub mod patches;
 pub mod solution_io;
 pub mod tiled;
@@ -14,14 +15,13 @@ pub use self::gather::SolvedScene;
 
 use std::sync::Arc;
 use std::time::Instant;
-use tiled::TiledCarriers;
 
 use glam::Vec3A;
 use prism_geometry::Ray;
 use prism_radiosity::{Radiosity, RadiositySettings, Visibility};
 
 pub use self::direct::PointLikeAndSkyLights;
-use self::patches::{scene_patches, BANDS};
+use self::patches::{scene_patches, PatchMap, BANDS};
 use super::driver::RenderStats;
 use super::estimator::{Estimator, Pass, TileWork};
 use super::path_estimator::scalar_tile;
@@ -59,11 +59,11 @@ impl RadiosityEstimator {
 }
 
 /// The scene's own ray tracer as the solution's visibility oracle.
-pub(crate) struct SceneVisibility<'a>(pub &'a RenderScene, pub &'a TiledCarriers);
+pub(crate) struct SceneVisibility<'a>(pub &'a RenderScene, pub &'a PatchMap);
 
 impl Visibility for SceneVisibility<'_> {
-    /// Points of tiled carriers take their rays from above their tile's slab
-    /// (`TiledCarriers::lift`).
+    /// Points of tiled carriers take their rays from above their tile's slab, points of
+    /// meshed spheres from the sphere (`PatchMap::lift`).
     fn visible(&self, from: Vec3A, n_from: Vec3A, to: Vec3A, n_to: Vec3A) -> bool {
         let scale = |p: Vec3A| 1e-4 * (1.0 + p.abs().max_element());
         let a = self
@@ -78,9 +78,15 @@ impl Visibility for SceneVisibility<'_> {
     /// is inside a closed mesh, e.g. under a box standing on it). A tiled carrier's point
     /// stands for the macro-surface and is never covered by its own tile.
     fn covered(&self, p: Vec3A, n: Vec3A) -> bool {
-        if self.1.lift(p, n).is_some() {
+        if self.1.carriers.lift(p, n).is_some() {
             return false;
         }
+        let p = self
+            .1
+            .spheres
+            .iter()
+            .find_map(|s| s.lift(p, n))
+            .unwrap_or(p);
         let scale = 1e-4 * (1.0 + p.abs().max_element());
         let ray = Ray::spawn(p + n * scale, n);
         self.0.geometry.intersect(&ray).is_some_and(|hit| {
@@ -102,8 +108,8 @@ pub fn solve(
         ..RadiositySettings::default()
     };
     let mut solution = Radiosity::new(&patches, BANDS, settings).map_err(|e| e.to_string())?;
-    let visibility = SceneVisibility(scene, &map.carriers);
-    let direct_lights = PointLikeAndSkyLights::new(scene, &map.carriers);
+    let visibility = SceneVisibility(scene, &map);
+    let direct_lights = PointLikeAndSkyLights::new(scene, &map);
     let mut lines = Vec::new();
     for i in 1..=method.iterations {
         let s = solution

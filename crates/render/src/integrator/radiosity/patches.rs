@@ -1,5 +1,5 @@
 //! The scene as radiosity input: one patch per side that reflects or emits of every
-//! rectangle and mesh triangle, with band-averaged Lambertian reflectance and emission,
+//! rectangle and mesh triangle (spheres and disks meshed, `meshed.rs`), with band-averaged Lambertian reflectance and emission,
 //! and the map from a hit (instance, primitive, side) back to its patch.
 
 use glam::Vec3A;
@@ -8,6 +8,7 @@ use prism_geometry::{Geometry, Shape, NO_MATERIAL};
 use prism_radiosity::{ElementShape, InputPatch};
 use prism_spectrum::Spectrum;
 
+use super::meshed::{mesh_analytic, LiftSphere, Meshing};
 use super::tiled::TiledCarriers;
 use crate::light::Light;
 use crate::material::Material;
@@ -59,16 +60,22 @@ pub struct PatchMap {
     pub carrier: Vec<Option<u32>>,
     /// The tiled carriers (`tiled.rs`).
     pub carriers: TiledCarriers,
+    /// Per instance: how a sphere or disk was meshed (`meshed.rs`).
+    pub meshing: Vec<Option<Meshing>>,
+    /// The meshed spheres, whose patches' points rays start from lifted onto them.
+    pub spheres: Vec<LiftSphere>,
 }
 
 impl PatchMap {
-    /// The patch seen by a ray arriving at primitive `primitive` of instance `instance`
-    /// from direction `wo` (pointing away from the surface).
-    pub fn patch_of(&self, instance: u32, primitive: u32, wo: Vec3A) -> Option<usize> {
+    /// The patch seen by a ray arriving at point `p` of primitive `primitive` of instance
+    /// `instance` from direction `wo` (pointing away from the surface).
+    pub fn patch_of(&self, instance: u32, primitive: u32, p: Vec3A, wo: Vec3A) -> Option<usize> {
         let first = (*self.first_patch.get(instance as usize)?)?;
         let sides = u32::from(self.sides[instance as usize]);
         let primitive = if self.carrier[instance as usize].is_some() {
             0
+        } else if let Some(m) = &self.meshing[instance as usize] {
+            m.primitive_at(p)
         } else {
             primitive
         };
@@ -80,6 +87,16 @@ impl PatchMap {
         } else {
             None
         }
+    }
+}
+
+impl PatchMap {
+    /// Where rays of the patch point `p` (normal `n`) start when not just off its plane:
+    /// above a tiled carrier's slab, or on the sphere a meshed sphere's triangle stands for.
+    pub fn lift(&self, p: Vec3A, n: Vec3A) -> Option<Vec3A> {
+        self.carriers
+            .lift(p, n)
+            .or_else(|| self.spheres.iter().find_map(|s| s.lift(p, n)))
     }
 }
 
@@ -114,6 +131,8 @@ pub fn scene_patches(scene: &RenderScene) -> Result<(Vec<InputPatch>, PatchMap),
         normals: Vec::new(),
         carrier: Vec::with_capacity(geometry.instances().len()),
         carriers: TiledCarriers::of_geometry(geometry, scene.tiled_surfaces()?)?,
+        meshing: Vec::with_capacity(geometry.instances().len()),
+        spheres: Vec::new(),
     };
     for (instance_id, inst) in geometry.instances().iter().enumerate() {
         let carrier = map
@@ -122,6 +141,7 @@ pub fn scene_patches(scene: &RenderScene) -> Result<(Vec<InputPatch>, PatchMap),
             .iter()
             .position(|c| c.instance == instance_id as u32);
         map.carrier.push(carrier.map(|k| k as u32));
+        map.meshing.push(None);
         if let Some(c) = carrier.map(|k| &map.carriers.0[k]) {
             // Front and back, each with the pyramid's reflectance for its side.
             let shape = c.shape();
@@ -190,15 +210,11 @@ pub fn scene_patches(scene: &RenderScene) -> Result<(Vec<InputPatch>, PatchMap),
                 ))
             }
             Shape::Sphere(_) | Shape::Disk(_) => {
-                return Err(format!(
-                    "instance {instance_id} is a {}: `radiosity` meshes rectangles and triangle \
-                     meshes only yet (use a mesh, e.g. an icosphere)",
-                    if matches!(inst.shape, Shape::Sphere(_)) {
-                        "sphere"
-                    } else {
-                        "disk"
-                    }
-                ))
+                let (triangles, meshing, sphere) = mesh_analytic(instance_id, inst)?;
+                let material = inst.material.unwrap_or(NO_MATERIAL);
+                pieces.extend(triangles.into_iter().map(|(t, n)| (t, n, material)));
+                map.meshing[instance_id] = Some(meshing);
+                map.spheres.extend(sphere);
             }
         }
         let mut kinds = Vec::with_capacity(pieces.len());
