@@ -1,5 +1,6 @@
 //! `prism tile-brdf`: the pyramid of the example wicker tile computed once, then read from
-//! the cache; the summary's keys; the errors of a misnamed tile and of too few samples.
+//! the cache; a switched pyramid (`--no-self-shadowing`) under its own key; the summary's
+//! keys; the errors of a misnamed tile and of too few samples.
 
 mod support;
 use support::prism_in as prism;
@@ -66,6 +67,31 @@ fn the_pyramid_is_computed_once_and_then_read_from_the_cache() {
             .unwrap();
     assert_eq!(again["from_cache"], true);
     assert_eq!(again["incident"], summary["incident"]);
+
+    // Leaving self-shadowing out is another pyramid: computed anew under its own key, and
+    // brighter (every face facing the beam is lit).
+    let mut unshadowed_args = args.to_vec();
+    unshadowed_args.push("--no-self-shadowing");
+    let third = prism(dir.path(), &unshadowed_args);
+    let stderr = String::from_utf8_lossy(&third.stderr);
+    assert!(
+        third.status.success() && stderr.contains("computed and cached in"),
+        "{stderr}"
+    );
+    let unshadowed: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("summary.json")).unwrap())
+            .unwrap();
+    assert_eq!(unshadowed["self_shadowing"], false);
+    assert_eq!(unshadowed["interreflection"], true);
+    assert_ne!(unshadowed["cache_file"], summary["cache_file"]);
+    let mean = |s: &serde_json::Value| {
+        let bins = s["incident"].as_array().unwrap();
+        bins.iter()
+            .flat_map(|b| b["albedo"].as_array().unwrap().iter())
+            .map(|a| a.as_f64().unwrap())
+            .sum::<f64>()
+    };
+    assert!(mean(&unshadowed) > mean(&summary));
 }
 
 #[test]

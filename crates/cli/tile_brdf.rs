@@ -31,6 +31,14 @@ pub struct TileBrdfArgs {
     pub samples: u32,
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
+    /// Leave the tile's self-shadowing out: every face facing the beam is lit (the paper's
+    /// Fig. 6 comparison; also the material's `"self_shadowing": false`).
+    #[arg(long = "no-self-shadowing")]
+    pub no_self_shadowing: bool,
+    /// Leave the texture-scale inter-reflection out: single scattering only (the paper's
+    /// F_i, Fig. 5–6; also the material's `"interreflection": false`).
+    #[arg(long = "no-interreflection")]
+    pub no_interreflection: bool,
     /// Cache directory (default: $XDG_CACHE_HOME/prism, else ~/.cache/prism).
     #[arg(long = "cache-dir", value_name = "DIR")]
     pub cache_dir: Option<PathBuf>,
@@ -58,20 +66,27 @@ pub fn run(args: &TileBrdfArgs) -> Result<(), String> {
             }
         ));
     };
-    let levels = args.levels.unwrap_or_else(|| {
-        description
-            .materials
-            .iter()
-            .find_map(|m| match m.kind {
-                prism_scene::MaterialKind::Tiled { tile: t, levels } if t == tile => Some(levels),
-                _ => None,
-            })
-            .unwrap_or(3)
-    });
+    // The first `tiled` material that repeats the tile gives the defaults.
+    let (material_levels, self_shadowing, interreflection) = description
+        .materials
+        .iter()
+        .find_map(|m| match m.kind {
+            prism_scene::MaterialKind::Tiled {
+                tile: t,
+                levels,
+                self_shadowing,
+                interreflection,
+            } if t == tile => Some((levels, self_shadowing, interreflection)),
+            _ => None,
+        })
+        .unwrap_or((3, true, true));
+    let levels = args.levels.unwrap_or(material_levels);
     let options = PyramidOptions {
         levels,
         samples_per_bin_pair: args.samples,
         seed: args.seed,
+        self_shadowing: self_shadowing && !args.no_self_shadowing,
+        interreflection: interreflection && !args.no_interreflection,
         ..PyramidOptions::default()
     };
     let cache_dir = prepare_cache_dir(args.cache_dir.as_deref(), "the tile pyramid cache", "")?;
@@ -133,6 +148,8 @@ pub fn run(args: &TileBrdfArgs) -> Result<(), String> {
         "bands": {"first_nm": 380, "width_nm": 25, "count": 16},
         "samples_per_bin_pair": args.samples,
         "seed": args.seed,
+        "self_shadowing": options.self_shadowing,
+        "interreflection": options.interreflection,
         "cache_file": cache_file,
         "from_cache": from_cache,
         "seconds": seconds,

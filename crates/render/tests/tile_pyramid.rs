@@ -315,3 +315,43 @@ fn the_top_level_albedo_equals_the_light_traced_albedo_of_the_wicker() {
         assert!((albedo - traced).abs() <= 0.01 * traced + 4.0 * se);
     }
 }
+
+/// The paper's Fig. 6 switches. A flat sheet can neither shadow nor light itself: its
+/// albedo is the same with both left out. The wicker gains light without its
+/// self-shadowing and loses light without its inter-reflection.
+#[test]
+fn self_shadowing_and_interreflection_switch_independently() {
+    let dir = Dir::new("tile-pyramid", "switches");
+    let run = |tile: &[u8], samples: u32, self_shadowing: bool, interreflection: bool| {
+        let pyramid = TilePyramid::simulate(
+            &scene(&dir, tile, 0.7),
+            0,
+            &PyramidOptions {
+                levels: 1,
+                self_shadowing,
+                interreflection,
+                ..options(samples)
+            },
+        )
+        .unwrap();
+        [2, 21].map(|incident| band_mean(pyramid.albedo(incident)))
+    };
+    let sheet = (run(SHEET, 16, true, true), run(SHEET, 16, false, false));
+    for ((a, sa), (b, sb)) in sheet.0.into_iter().zip(sheet.1) {
+        eprintln!("sheet: both {a:.4} ± {sa:.4}, neither {b:.4} ± {sb:.4}");
+        assert!((a - b).abs() <= 4.0 * sa.hypot(sb) + 1e-6, "{a} vs {b}");
+    }
+    let weave = wicker();
+    let both = run(&weave, 192, true, true);
+    let unshadowed = run(&weave, 192, false, true);
+    let single = run(&weave, 192, true, false);
+    for k in 0..2 {
+        let ((a, sa), (u, su), (s, ss)) = (both[k], unshadowed[k], single[k]);
+        eprintln!(
+            "wicker, incident {k}: both {a:.4} ± {sa:.4}, unshadowed {u:.4} ± {su:.4}, \
+             single scattering {s:.4} ± {ss:.4}"
+        );
+        assert!(u - a > 4.0 * sa.hypot(su), "unshadowed {u} vs {a}");
+        assert!(a - s > 4.0 * sa.hypot(ss), "single {s} vs {a}");
+    }
+}

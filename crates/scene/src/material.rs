@@ -74,8 +74,14 @@ pub enum MaterialKind {
     Interface,
     /// The surface is a periodic tile (index into `SceneDescription::tiles`) repeated over
     /// the carrier shape: rays continue into the tile's geometry, whose faces have their own
-    /// materials. `levels` is the height of the tile's BRDF/BTDF pyramid.
-    Tiled { tile: usize, levels: u32 },
+    /// materials. `levels` is the height of the tile's BRDF/BTDF pyramid; `self_shadowing`
+    /// and `interreflection` switch those effects in the pyramid (the paper's Fig. 6).
+    Tiled {
+        tile: usize,
+        levels: u32,
+        self_shadowing: bool,
+        interreflection: bool,
+    },
 }
 
 /// The material library (issue 8 and after): the kinds whose parameters are numbers and
@@ -555,7 +561,12 @@ fn parse_material(
                     MAX_TILE_LEVELS - 1
                 )));
             }
-            MaterialKind::Tiled { tile, levels }
+            MaterialKind::Tiled {
+                tile,
+                levels,
+                self_shadowing: o.bool_or("self_shadowing", true)?,
+                interreflection: o.bool_or("interreflection", true)?,
+            }
         }
         "thin_dielectric" => {
             let o = v.tagged_object(schema!("materials.*<thin_dielectric>"))?;

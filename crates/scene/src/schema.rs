@@ -386,7 +386,16 @@ pub const SCHEMA: &[ObjectSchema] = &[
     row("materials.*<thin_dielectric>", &[&["type", "ior"]]),
     row("materials.*<mix>", &[&["type", "materials", "weight"]]),
     row("materials.*<interface>", &[TYPE]),
-    row("materials.*<tiled>", &[&["type", "tile", "levels"]]),
+    row(
+        "materials.*<tiled>",
+        &[&[
+            "type",
+            "tile",
+            "levels",
+            "self_shadowing",
+            "interreflection",
+        ]],
+    ),
     // tile.rs
     row("tiles.*", &[&["mesh", "period_m", "materials"]]),
     row("@ior", &[&["sellmeier", "cauchy"]]),

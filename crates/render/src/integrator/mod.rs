@@ -45,7 +45,7 @@ mod path_estimator;
 mod path_state;
 pub mod photon;
 pub mod radiosity;
-mod scatter_vertex;
+pub(crate) mod scatter_vertex;
 
 pub use ambient_occlusion::AmbientOcclusion;
 pub use bdpt::{Bdpt, BdptStrategy};

@@ -544,6 +544,11 @@ pub const FIELD_USES: &[FieldRow] = &[
         BUILD_MATERIAL,
     ),
     read(&["materials.*<tiled>"], &["type", "tile"], BUILD_TILES),
+    read(
+        &["materials.*<tiled>"],
+        &["self_shadowing", "interreflection"],
+        "scene_build::tiles tiled_surfaces (PyramidOptions), `prism tile-brdf`",
+    ),
     FieldRow {
         patterns: &["materials.*<tiled>"],
         keys: &["levels"],

@@ -270,7 +270,13 @@ pub(crate) fn radiosity_surfaces(
 ) -> Result<Vec<Option<TiledSurface>>, String> {
     let mut out = vec![None; scene.materials.len() + 1];
     for (m, material) in scene.materials.iter().enumerate() {
-        let MaterialKind::Tiled { tile, .. } = material.kind else {
+        let MaterialKind::Tiled {
+            tile,
+            self_shadowing,
+            interreflection,
+            ..
+        } = material.kind
+        else {
             continue;
         };
         let slab = geometry
@@ -289,6 +295,8 @@ pub(crate) fn radiosity_surfaces(
         let options = PyramidOptions {
             levels: 1,
             samples_per_bin_pair: 64,
+            self_shadowing,
+            interreflection,
             ..PyramidOptions::default()
         };
         let pyramid = TilePyramid::simulate(scene, tile, &options)

@@ -28,7 +28,9 @@ use prism_scene::{
 use prism_spectrum::{SampledSpectrum, SampledWavelengths};
 use rayon::prelude::*;
 
+use crate::bsdf::TransportMode;
 use crate::integrator::radiosity::patches::{band_point_nm, BANDS};
+use crate::integrator::scatter_vertex::{ScatterVertex, SurfaceVertex};
 use crate::integrator::{LaneWavelengths, PathCounters, PathTracer};
 use crate::sampler::PixelSampler;
 use crate::scene_build::RenderScene;
@@ -54,6 +56,12 @@ pub struct PyramidOptions {
     /// Longest path, in bounces.
     pub max_depth: u32,
     pub seed: u64,
+    /// Faces of the tile shadow each other from the beam (the paper's self-shadowing maps,
+    /// Fig. 3); off, every face that faces the beam is lit, as in the paper's Fig. 6.
+    pub self_shadowing: bool,
+    /// Light scattered by one face reaches others (the paper's texture-scale
+    /// inter-reflection F_i, Fig. 5); off, only single scattering leaves the tile.
+    pub interreflection: bool,
 }
 
 impl Default for PyramidOptions {
@@ -64,6 +72,8 @@ impl Default for PyramidOptions {
             transparency_samples: 4096,
             max_depth: 32,
             seed: 0,
+            self_shadowing: true,
+            interreflection: true,
         }
     }
 }
@@ -287,7 +297,12 @@ fn simulation_description(
         None => {
             d.materials.push(prism_scene::Material {
                 name: format!("tile `{}`", d.tiles[tile].name),
-                kind: MaterialKind::Tiled { tile, levels: 1 },
+                kind: MaterialKind::Tiled {
+                    tile,
+                    levels: 1,
+                    self_shadowing: true,
+                    interreflection: true,
+                },
             });
             d.materials.len() - 1
         }
@@ -333,6 +348,34 @@ fn beam_light(beam: Vec3A) -> Light {
     }
 }
 
+/// The beam's light that other faces of the tile keep from the first face `ray` meets
+/// (f · |cos θᵢ| · E⊥ with E⊥ = 1 where the shadow ray towards the beam is blocked): what
+/// switching self-shadowing off adds back.
+fn shadowed_beam(
+    scene: &RenderScene,
+    ray: &Ray,
+    towards_light: Vec3A,
+    lanes: &mut LaneWavelengths,
+) -> SampledSpectrum {
+    let none = SampledSpectrum::splat(0.0);
+    let Some(hit) = scene.geometry.intersect(ray) else {
+        return none;
+    };
+    let si = scene.geometry.shading_interaction(ray, &hit);
+    let side = si.n_geometric.dot(towards_light).signum();
+    let from = si.p + si.n_geometric * side * 1e-5 * (1.0 + si.p.abs().max_element());
+    if !scene.geometry.occluded(&Ray::spawn(from, towards_light)) {
+        return none;
+    }
+    let material = scene.material(si.material_id);
+    let mut cache = crate::spectrum_cache::SpectrumCache::new();
+    let bsdf = material.bsdf_cached(si.material_id, &si, lanes, &mut cache);
+    let vertex = ScatterVertex::Surface(SurfaceVertex::new(&si, &bsdf, ray.direction, false));
+    vertex
+        .eval(towards_light, TransportMode::Radiance)
+        .map_or(none, |e| e.f_cos)
+}
+
 /// The sums of incident bin `incident` on `scene` (built from `simulation`, the
 /// simulation's description), whose beam it turns to come from that bin.
 fn simulate_incident(
@@ -370,7 +413,11 @@ fn simulate_incident(
     let crossing = |uv: Vec2| Vec3A::new((uv.x - 0.5) * period[0], (uv.y - 0.5) * period[1], 0.0);
     let sampler = PixelSampler::with_kind(SamplerKind::Independent, options.seed);
     let tracer = PathTracer {
-        max_depth: options.max_depth,
+        max_depth: if options.interreflection {
+            options.max_depth
+        } else {
+            1
+        },
         ..PathTracer::default()
     };
     let cos_incident = towards_light.z.abs();
@@ -409,10 +456,11 @@ fn simulate_incident(
                 false,
                 &mut counters,
             );
-            let f = result
-                .radiance
-                .to_array()
-                .map(|l| f64::from(l / cos_incident));
+            let mut radiance = result.radiance;
+            if !options.self_shadowing {
+                radiance += shadowed_beam(scene, &ray, towards_light, &mut lanes);
+            }
+            let f = radiance.to_array().map(|l| f64::from(l / cos_incident));
             for cell in cell_indices(uv) {
                 for (k, &b) in bands.iter().enumerate() {
                     let at = (cell * SPHERE_BINS + outgoing) * BANDS + b;
