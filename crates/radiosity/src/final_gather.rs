@@ -12,7 +12,7 @@ use glam::Vec3A;
 use crate::element::ElementShape;
 use crate::form_factor::{area_sample_factor, point_to_polygon};
 use crate::hierarchy::NodeKind;
-use crate::solver::{fold_into, r2, sample_point, Radiosity, Visibility};
+use crate::solver::{sample_point, Radiosity, Visibility};
 
 /// Direction bins per hemisphere: rings of equal solid angle × sectors.
 const RINGS: usize = 4;
@@ -349,26 +349,16 @@ impl Radiosity {
             NodeKind::Cluster { patches, .. } => {
                 // Area-weighted points over the cluster's patches, each standing for the
                 // cluster's area over the point count.
-                let prefix = &self.hierarchy.order_area_prefix;
-                let (a0, a1) = (prefix[patches.0 as usize], prefix[patches.1 as usize]);
-                let piece_m2 = ((a1 - a0) / CLUSTER_SOURCE_POINTS as f64) as f32;
+                let piece_m2 =
+                    (self.hierarchy.cluster_area_m2(patches) / CLUSTER_SOURCE_POINTS as f64) as f32;
                 let mut b = [0.0f32; MAX_BANDS];
                 for j in 0..CLUSTER_SOURCE_POINTS {
-                    let (t, jitter) = r2(j as u32, 7);
-                    let target =
-                        a0 + (a1 - a0) * ((j as f64 + f64::from(t)) / CLUSTER_SOURCE_POINTS as f64);
-                    let i = prefix[patches.0 as usize..=patches.1 as usize]
-                        .partition_point(|&a| a <= target)
-                        .saturating_sub(1)
-                        .min((patches.1 - patches.0 - 1) as usize);
-                    let patch = self.hierarchy.order[patches.0 as usize + i];
-                    let root = self.hierarchy.patch_root[patch as usize];
-                    let NodeKind::Element { shape, .. } = self.hierarchy.nodes[root as usize].kind
+                    let Some((patch, shape, y)) =
+                        self.hierarchy
+                            .cluster_point(patches, j, CLUSTER_SOURCE_POINTS, (7, 8))
                     else {
                         continue;
                     };
-                    let (u, v) = fold_into(&shape, jitter, r2(j as u32, 8).0);
-                    let y = shape.point(u, v);
                     let n_s = shape.normal();
                     self.reflected_at(patch, y, &mut b);
                     if b[..bands].iter().all(|&x| x <= 0.0) {

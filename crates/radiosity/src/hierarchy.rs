@@ -83,6 +83,42 @@ impl Hierarchy {
         }
     }
 
+    /// Point `k` of `count` area-weighted points over the patches of a cluster (its
+    /// `patches` range of `order`): stratified over the cluster's area by `r2(k, streams.0)`
+    /// and placed within its patch by that point's second coordinate and
+    /// `r2(k, streams.1)`. The patch, its root element's shape and the point; `None` if the
+    /// patch's root is not an element.
+    pub fn cluster_point(
+        &self,
+        patches: (u32, u32),
+        k: usize,
+        count: usize,
+        streams: (u32, u32),
+    ) -> Option<(u32, ElementShape, Vec3A)> {
+        let prefix = &self.order_area_prefix;
+        let (a0, a1) = (prefix[patches.0 as usize], prefix[patches.1 as usize]);
+        let (t, jitter) = crate::solver::r2(k as u32, streams.0);
+        let target = a0 + (a1 - a0) * ((k as f64 + f64::from(t)) / count as f64);
+        let i = prefix[patches.0 as usize..=patches.1 as usize]
+            .partition_point(|&a| a <= target)
+            .saturating_sub(1)
+            .min((patches.1 - patches.0 - 1) as usize);
+        let patch = self.order[patches.0 as usize + i];
+        let NodeKind::Element { shape, .. } =
+            self.nodes[self.patch_root[patch as usize] as usize].kind
+        else {
+            return None;
+        };
+        let (u, v) =
+            crate::solver::fold_into(&shape, jitter, crate::solver::r2(k as u32, streams.1).0);
+        Some((patch, shape, shape.point(u, v)))
+    }
+
+    /// The area of the patches in a cluster's `patches` range, m².
+    pub fn cluster_area_m2(&self, patches: (u32, u32)) -> f64 {
+        self.order_area_prefix[patches.1 as usize] - self.order_area_prefix[patches.0 as usize]
+    }
+
     /// The children of node `n` (none for a leaf element).
     pub fn children(&self, n: u32) -> std::iter::Take<std::array::IntoIter<u32, 4>> {
         let (ids, count) = match self.nodes[n as usize].kind {

@@ -834,25 +834,14 @@ impl Radiosity {
                 }
             }
             NodeKind::Cluster { patches, .. } => {
-                let prefix = &self.hierarchy.order_area_prefix;
-                let (a0, a1) = (prefix[patches.0 as usize], prefix[patches.1 as usize]);
-                let piece = ((a1 - a0) / rays as f64) as f32;
+                let piece = (self.hierarchy.cluster_area_m2(patches) / rays as f64) as f32;
                 let (mut sum, mut free, mut blocked) = (0.0, 0u32, 0u32);
                 for &k in &receivers {
-                    let (t, jitter) = r2(k as u32, 2);
-                    let target = a0 + (a1 - a0) * ((k as f64 + f64::from(t)) / rays as f64);
-                    let i = prefix[patches.0 as usize..=patches.1 as usize]
-                        .partition_point(|&a| a <= target)
-                        .saturating_sub(1)
-                        .min((patches.1 - patches.0 - 1) as usize);
-                    let patch = self.hierarchy.order[patches.0 as usize + i];
-                    let node = self.hierarchy.patch_root[patch as usize];
-                    let source = match nodes[node as usize].kind {
-                        NodeKind::Element { shape, .. } => shape,
-                        NodeKind::Cluster { .. } => continue,
+                    let Some((_, source, y)) =
+                        self.hierarchy.cluster_point(patches, k, rays, (2, 3))
+                    else {
+                        continue;
                     };
-                    let (u, v) = fold_into(&source, jitter, r2(k as u32, 3).0);
-                    let y = source.point(u, v);
                     let x = sample_point(&receiver, k, 0);
                     let n_s = source.normal();
                     let f = area_sample_factor(x, n_r, y, n_s, piece);
