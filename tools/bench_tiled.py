@@ -18,6 +18,9 @@ import sys
 import tempfile
 import time
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import bench_results  # noqa: E402
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 CELLS = (20, 15)
 PERIOD_M = 0.1
@@ -126,12 +129,7 @@ def main():
         },
         "image_relmse_rgb": [float(x) for x in rel.groups()] if rel else None,
     }
-    text = json.dumps(result, indent=1)
-    print(text)
-    out = os.path.join(ROOT, "tools/bench-results/bench-tiled.json")
-    with open(out + ".tmp", "w") as f:
-        f.write(text + "\n")
-    os.replace(out + ".tmp", out)
+    bench_results.write("bench-tiled", result)
 
 
 if __name__ == "__main__":

@@ -21,6 +21,7 @@ import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "tools"))
+import bench_results  # noqa: E402
 from bench_tiled import read_tile  # noqa: E402
 
 PERIOD_M = 0.1
@@ -141,12 +142,7 @@ def main():
         "load_average_1min": os.getloadavg()[0],
         "results": results,
     }
-    text = json.dumps(result, indent=1)
-    print(text)
-    out = os.path.join(ROOT, "tools/bench-results/bench-tiled-radiosity.json")
-    with open(out + ".tmp", "w") as f:
-        f.write(text + "\n")
-    os.replace(out + ".tmp", out)
+    bench_results.write("bench-tiled-radiosity", result)
 
 
 if __name__ == "__main__":

@@ -18,6 +18,8 @@ import sys
 import tempfile
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.join(ROOT, "tools"))
+import bench_results  # noqa: E402
 
 
 def scene_with_radiosity(path):
@@ -94,12 +96,7 @@ def main():
         "scenes": rows,
         "refused": refused,
     }
-    text = json.dumps(result, indent=1)
-    print(text)
-    out = os.path.join(ROOT, "tools/bench-results/radiosity-stress.json")
-    with open(out + ".tmp", "w") as f:
-        f.write(text + "\n")
-    os.replace(out + ".tmp", out)
+    bench_results.write("radiosity-stress", result)
 
 
 if __name__ == "__main__":

@@ -32,25 +32,6 @@ const CLUSTER_NEAR_FACTOR: f32 = 10.0;
 /// The most bands a gather holds.
 pub const MAX_BANDS: usize = 64;
 
-/// A source of the gathering list: a leaf element whose light varies too much over the
-/// receiver to be interpolated. The renderer's gather rays that hit it read it.
-#[derive(Clone, Debug, PartialEq)]
-pub struct ListedSource {
-    /// Its leaf id ([`Radiosity::leaf_id`]).
-    pub leaf: u32,
-    pub shape: ElementShape,
-    /// Reflected radiosity B − B_e per band (the leaf's area average).
-    pub reflected: Vec<f32>,
-}
-
-impl ListedSource {
-    /// The exact unoccluded form factor from a point `x` facing `n` to the source.
-    pub fn form_factor(&self, x: Vec3A, n: Vec3A) -> f32 {
-        let (corners, count) = self.shape.corners();
-        point_to_polygon(x, n, &corners[..count], self.shape.normal())
-    }
-}
-
 /// The gather structure of one receiver element.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ReceiverGather {
@@ -66,8 +47,10 @@ pub struct ReceiverGather {
     irradiance: Vec<f32>,
     /// Per vertex × band: the irradiance of all bins together.
     vertex_totals: Vec<f32>,
-    /// The gathering list, by leaf id.
-    listed: Vec<ListedSource>,
+    /// The gathering list: the leaf ids ([`Radiosity::leaf_id`]) of the sources whose
+    /// light varies too much over the receiver to be interpolated, sorted; the
+    /// renderer's gather rays that hit one read the solution there.
+    listed: Vec<u32>,
     /// Sources stored on the vertices.
     pub interpolated_sources: u32,
 }
@@ -79,7 +62,8 @@ struct Candidate {
     totals: Vec<f32>,
     /// (receiver point, direction from it, irradiance per band).
     pieces: Vec<(usize, Vec3A, [f32; MAX_BANDS])>,
-    /// Area-mean reflected radiosity per band (for the list).
+    /// Reflected radiosity per band: an element source's mean over its points (what
+    /// its irradiance is computed from).
     reflected: [f32; MAX_BANDS],
 }
 
@@ -217,17 +201,8 @@ impl Radiosity {
 
         gather.interpolated_sources = accepted.len() as u32;
         gather.store(&accepted, &rx);
-        for c in listed {
-            let NodeKind::Element { shape, .. } = self.hierarchy.nodes[c.node as usize].kind else {
-                unreachable!("listed sources are leaf elements")
-            };
-            gather.listed.push(ListedSource {
-                leaf: c.node,
-                shape,
-                reflected: c.reflected[..self.bands].to_vec(),
-            });
-        }
-        gather.listed.sort_by_key(|l| l.leaf);
+        gather.listed = listed.iter().map(|c| c.node).collect();
+        gather.listed.sort_unstable();
         Some(gather)
     }
 
@@ -363,9 +338,6 @@ impl Radiosity {
                     self.reflected_at(patch, y, &mut b);
                     if b[..bands].iter().all(|&x| x <= 0.0) {
                         continue;
-                    }
-                    for (r, &x) in c.reflected[..bands].iter_mut().zip(&b[..bands]) {
-                        *r += x / CLUSTER_SOURCE_POINTS as f32;
                     }
                     for (k, &x) in rx.points.iter().enumerate() {
                         if rx.covered[k] {
@@ -521,13 +493,13 @@ impl ReceiverGather {
     }
 
     /// The gathering list.
-    pub fn listed(&self) -> &[ListedSource] {
+    pub fn listed(&self) -> &[u32] {
         &self.listed
     }
 
     /// Whether leaf `leaf` is on the gathering list.
     pub fn is_listed(&self, leaf: u32) -> bool {
-        self.listed.binary_search_by_key(&leaf, |l| l.leaf).is_ok()
+        self.listed.binary_search(&leaf).is_ok()
     }
 
     /// Bytes held (for the statistics).
@@ -536,7 +508,7 @@ impl ReceiverGather {
             + self.bins.len()
             + self.directions.len() * std::mem::size_of::<Vec3A>()
             + (self.irradiance.len() + self.vertex_totals.len()) * 4
-            + self.listed.len() * (std::mem::size_of::<ListedSource>() + 4 * self.bands)
+            + self.listed.len() * 4
     }
 }
 
@@ -609,8 +581,15 @@ mod tests {
                 got[1] += e[1];
             });
             let n = Vec3A::new(0.0, 0.0, 1.0);
-            for s in g.listed() {
-                got[0] += s.reflected[0] * s.form_factor(p, n);
+            // A listed leaf's light, by its exact factor (what the traced gather reads).
+            for &leaf in g.listed() {
+                let NodeKind::Element { shape, patch, .. } = r.hierarchy.nodes[leaf as usize].kind
+                else {
+                    unreachable!("listed sources are leaf elements")
+                };
+                let (corners, count) = shape.corners();
+                let reflected = r.node_radiosity(leaf)[0] - r.emission(patch as usize)[0];
+                got[0] += reflected * point_to_polygon(p, n, &corners[..count], shape.normal());
             }
             let rel = (got[0] - expected).abs() / expected;
             assert!(
@@ -631,9 +610,9 @@ mod tests {
         let none_listed = r.receiver_gather(leaf, 1e6, &Unoccluded).unwrap();
         assert!(none_listed.listed().is_empty());
         assert!(all_listed.listed().len() > 4);
-        for l in all_listed.listed() {
-            assert!(all_listed.is_listed(l.leaf));
-            assert!(!none_listed.is_listed(l.leaf));
+        for &leaf in all_listed.listed() {
+            assert!(all_listed.is_listed(leaf));
+            assert!(!none_listed.is_listed(leaf));
         }
     }
 }

@@ -16,7 +16,7 @@ mod solution_file;
 pub mod solver;
 
 pub use element::ElementShape;
-pub use final_gather::{ListedSource, ReceiverGather};
+pub use final_gather::ReceiverGather;
 pub use solver::{
     r2, DirectIrradiance, InputPatch, IterationStats, LeafAt, LeafElement, NoDirectLight,
     Radiosity, RadiosityError, RadiositySettings, Unoccluded, Visibility,
