@@ -1,13 +1,18 @@
 //! Prints the closed furnace's radiosity error against error_bound_rel (docs/radiosity.md).
+use std::sync::atomic::{AtomicU32, Ordering};
+
 use glam::Vec3A;
 use prism_radiosity::{
     ElementShape, InputPatch, NoDirectLight, Radiosity, RadiositySettings, Unoccluded,
 };
 fn square(p0: Vec3A, e1: Vec3A, e2: Vec3A, rho: f32) -> InputPatch {
+    // Each square is a surface of its own.
+    static NEXT_SURFACE: AtomicU32 = AtomicU32::new(0);
     InputPatch {
         shape: ElementShape::Parallelogram { p0, e1, e2 },
         reflectance: vec![rho],
         emission: vec![1.0],
+        surface: NEXT_SURFACE.fetch_add(1, Ordering::Relaxed),
     }
 }
 fn main() {

@@ -143,6 +143,22 @@ impl ElementShape {
         ((c * r1 - b * r2) / det, (a * r2 - b * r1) / det)
     }
 
+    /// The point of the element nearest to `p`'s projection onto its plane, kept `inset`
+    /// (in parameter units) inside its edges.
+    pub fn nearest_inner_point(&self, p: Vec3A, inset: f32) -> Vec3A {
+        let (u, v) = self.parameters_of(p);
+        let (mut u, mut v) = (u.clamp(inset, 1.0 - inset), v.clamp(inset, 1.0 - inset));
+        if let ElementShape::Triangle { .. } = self {
+            let excess = u + v - (1.0 - inset);
+            if excess > 0.0 {
+                // Back onto the hypotenuse, along its normal.
+                u = (u - 0.5 * excess).max(inset);
+                v = (v - 0.5 * excess).max(inset);
+            }
+        }
+        self.point(u, v)
+    }
+
     /// Quadrature nodes: `(u, v, weight)` with weights summing to 1 over the element,
     /// `n × n` Gauss–Legendre points on the square (mapped onto a triangle by the Duffy
     /// transform `(u, v(1 − u))`, weight ∝ 1 − u).

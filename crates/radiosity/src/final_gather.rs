@@ -546,10 +546,12 @@ mod tests {
         ];
         let patches: Vec<InputPatch> = faces
             .iter()
-            .map(|&(p0, e1, e2)| InputPatch {
+            .enumerate()
+            .map(|(i, &(p0, e1, e2))| InputPatch {
                 shape: ElementShape::Parallelogram { p0, e1, e2 },
                 reflectance: vec![rho; 2],
                 emission: vec![emission; 2],
+                surface: i as u32,
             })
             .collect();
         let settings = RadiositySettings {

@@ -9,7 +9,7 @@ use crate::hierarchy::{Hierarchy, Node, NodeKind};
 use crate::solver::{Link, Radiosity, RadiositySettings};
 
 const MAGIC: &[u8; 8] = b"PRISMRAD";
-const VERSION: u32 = 1;
+const VERSION: u32 = 2;
 const NONE: u32 = u32::MAX;
 
 struct Writer(Vec<u8>);
@@ -173,6 +173,11 @@ impl Radiosity {
                 w.u32(l.source);
                 w.f32(l.form_factor);
                 w.u8(u8::from(l.partial));
+                w.u32(l.source_shares.len() as u32);
+                for &(node, share) in l.source_shares.iter() {
+                    w.u32(node);
+                    w.f32(share);
+                }
             }
         }
         w.0
@@ -284,14 +289,24 @@ impl Radiosity {
         let free_area = r.f32s(node_count)?;
         let mut links = Vec::with_capacity(node_count);
         for _ in 0..node_count {
-            let n = r.count(9)?;
+            let n = r.count(13)?;
             let mut l = Vec::with_capacity(n);
             for _ in 0..n {
-                l.push(Link {
-                    source: index(r.u32()?, "a link's source")?,
-                    form_factor: r.f32()?,
-                    partial: r.u8()? != 0,
-                });
+                let source = index(r.u32()?, "a link's source")?;
+                let form_factor = r.f32()?;
+                let partial = r.u8()? != 0;
+                let share_count = r.count(8)?;
+                let mut source_shares = Vec::with_capacity(share_count);
+                for _ in 0..share_count {
+                    source_shares.push((index(r.u32()?, "a link's share")?, r.f32()?));
+                }
+                let link = Link {
+                    source,
+                    form_factor,
+                    partial,
+                    source_shares: source_shares.into_boxed_slice(),
+                };
+                l.push(link);
             }
             links.push(l);
         }

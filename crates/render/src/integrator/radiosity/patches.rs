@@ -153,6 +153,7 @@ pub fn scene_patches(scene: &RenderScene) -> Result<(Vec<InputPatch>, PatchMap),
                     shape: oriented_shape,
                     reflectance: c.reflectance[side].clone(),
                     emission: vec![0.0; BANDS],
+                    surface: instance_id as u32,
                 });
                 map.normals.push(oriented_shape.normal());
             }
@@ -241,6 +242,7 @@ pub fn scene_patches(scene: &RenderScene) -> Result<(Vec<InputPatch>, PatchMap),
                 shape: front,
                 reflectance: rho.clone(),
                 emission: emitted.clone(),
+                surface: instance_id as u32,
             });
             map.normals.push(front.normal());
             if both {
@@ -253,6 +255,7 @@ pub fn scene_patches(scene: &RenderScene) -> Result<(Vec<InputPatch>, PatchMap),
                     } else {
                         none.clone()
                     },
+                    surface: instance_id as u32,
                 });
                 map.normals.push(back.normal());
             }
