@@ -187,16 +187,22 @@ pub(crate) struct Link {
 const SOURCE_SHARE_DEPTH: u32 = 3;
 
 impl Link {
-    /// The source radiosity the link transfers, band `k`.
+    /// Adds what the link transfers, F · Σ share · B(node) per band (F · B(source)
+    /// without shares), to the receiver's irradiance `out`.
     #[inline]
-    fn source_radiosity(&self, radiosity: &[f32], bands: usize, k: usize) -> f32 {
-        if self.source_shares.is_empty() {
-            radiosity[self.source as usize * bands + k]
+    fn add_transfer(&self, radiosity: &[f32], bands: usize, out: &mut [f32]) {
+        let own = [(self.source, 1.0)];
+        let parts: &[(u32, f32)] = if self.source_shares.is_empty() {
+            &own
         } else {
-            self.source_shares
-                .iter()
-                .map(|&(node, share)| share * radiosity[node as usize * bands + k])
-                .sum()
+            &self.source_shares
+        };
+        for &(node, share) in parts {
+            let weight = self.form_factor * share;
+            let b = &radiosity[node as usize * bands..][..bands];
+            for (o, v) in out.iter_mut().zip(b) {
+                *o += weight * v;
+            }
         }
     }
 }
@@ -677,14 +683,8 @@ impl Radiosity {
                     if self.should_split(r, link.source, link.partial) {
                         refined.push(link.source);
                     } else {
-                        // An element source may have been split since the link was
-                        // made (a cluster's shares are its samples' nodes: kept).
-                        if let NodeKind::Element { .. } =
-                            self.hierarchy.nodes[link.source as usize].kind
-                        {
-                            if self.shares_outdated(&link) {
-                                link.source_shares = self.source_shares(r, link.source);
-                            }
+                        if self.shares_outdated(&link) {
+                            link.source_shares = self.source_shares(r, link.source);
                         }
                         kept.push(link);
                     }
@@ -802,8 +802,8 @@ impl Radiosity {
     /// An upper estimate of the form factor from element r to node s and of its variation
     /// over r (what pushing the link's average down gets wrong): for an element source the
     /// exact point factors at r's centre, its corners and its point nearest to s's centre
-    /// (their largest, and largest minus smallest); for a cluster the solid-angle bound A/(π d²) of the boxes' distance, for
-    /// both.
+    /// (their largest, and largest minus smallest); for a cluster the solid-angle bound
+    /// A/(π d²) of the boxes' distance, for both.
     fn form_factor_bound(&self, r: u32, s: u32) -> (f32, f32) {
         let nodes = &self.hierarchy.nodes;
         let receiver = match nodes[r as usize].kind {
@@ -850,25 +850,28 @@ impl Radiosity {
             return Vec::new();
         }
         let mut frontier = vec![s];
+        let mut next = Vec::new();
         for _ in 0..SOURCE_SHARE_DEPTH {
-            frontier = frontier
-                .iter()
-                .flat_map(|&n| {
-                    let children: Vec<u32> = self.hierarchy.children(n).collect();
-                    if children.is_empty() {
-                        vec![n]
-                    } else {
-                        children
-                    }
-                })
-                .collect();
+            next.clear();
+            for &n in &frontier {
+                let before = next.len();
+                next.extend(self.hierarchy.children(n));
+                if next.len() == before {
+                    next.push(n);
+                }
+            }
+            std::mem::swap(&mut frontier, &mut next);
         }
         frontier
     }
 
-    /// Whether element source s's link shares nodes that were split since (above the
-    /// share depth), or none while s now has children.
+    /// Whether a link from an element source shares nodes that were split since it was
+    /// made (above the share depth), or none while its source now has children. A
+    /// cluster's shares are its samples' nodes: never outdated.
     fn shares_outdated(&self, link: &Link) -> bool {
+        if let NodeKind::Cluster { .. } = self.hierarchy.nodes[link.source as usize].kind {
+            return false;
+        }
         let level = |n: u32| match self.hierarchy.nodes[n as usize].kind {
             NodeKind::Element { level, .. } => u32::from(level),
             NodeKind::Cluster { .. } => 0,
@@ -1069,9 +1072,7 @@ impl Radiosity {
             .for_each(|(out, links)| {
                 out.fill(0.0);
                 for link in links {
-                    for (k, o) in out.iter_mut().enumerate() {
-                        *o += link.form_factor * link.source_radiosity(radiosity, bands, k);
-                    }
+                    link.add_transfer(radiosity, bands, out);
                 }
             });
     }
