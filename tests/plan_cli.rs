@@ -61,6 +61,60 @@ fn predicted_and_adaptive_plans_write_their_layers_and_keep_the_budget() {
     assert!(image.layer("plan").is_none() && image.layer("bandwidth").is_none());
 }
 
+/// The BSDF angular tables (glossy-env's brushed copper) are written to --cache-dir once
+/// and read back by the next render, which comes out the same.
+#[test]
+fn predicted_plans_keep_their_bsdf_tables_in_the_cache_dir() {
+    let dir = tempfile::tempdir().unwrap();
+    let cache = dir.path().join("cache");
+    let tables = |cache: &std::path::Path| -> Vec<std::path::PathBuf> {
+        let mut files: Vec<_> = std::fs::read_dir(cache)
+            .map(|d| d.map(|e| e.unwrap().path()).collect())
+            .unwrap_or_default();
+        files.retain(|f| {
+            f.file_name()
+                .and_then(|n| n.to_str())
+                .is_some_and(|n| n.starts_with("bsdf-angular-table-") && n.ends_with(".bin"))
+        });
+        files.sort();
+        files
+    };
+    let first = dir.path().join("first.exr");
+    let o = render(&["--plan", "predicted", "--cache-dir", s(&cache)], &first);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let written = tables(&cache);
+    assert!(
+        !written.is_empty(),
+        "no table written to {}",
+        cache.display()
+    );
+    let modified: Vec<_> = written
+        .iter()
+        .map(|f| std::fs::metadata(f).unwrap().modified().unwrap())
+        .collect();
+    let second = dir.path().join("second.exr");
+    let o = render(&["--plan", "predicted", "--cache-dir", s(&cache)], &second);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(
+        tables(&cache),
+        written,
+        "the second render wrote other tables"
+    );
+    let again: Vec<_> = written
+        .iter()
+        .map(|f| std::fs::metadata(f).unwrap().modified().unwrap())
+        .collect();
+    assert_eq!(again, modified, "the second render rewrote its tables");
+    let (a, b) = (read_exr(&first).unwrap(), read_exr(&second).unwrap());
+    for layer in ["plan", "bandwidth"] {
+        assert_eq!(
+            a.layer(layer).unwrap().samples,
+            b.layer(layer).unwrap().samples,
+            "{layer}"
+        );
+    }
+}
+
 #[test]
 fn plan_flags_are_checked() {
     let dir = tempfile::tempdir().unwrap();

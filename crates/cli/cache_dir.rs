@@ -71,6 +71,21 @@ pub fn prepare_cache_dir(
     }
 }
 
+/// A cache directory for work that may also be done without one (the predictor's BSDF
+/// tables): `given` must be usable (an error otherwise); without it `prepared` (a
+/// directory the command prepared already) or the default, and `None` when the default is
+/// not writable.
+pub fn optional_cache_dir(
+    given: Option<&Path>,
+    prepared: Option<&Path>,
+) -> Result<Option<PathBuf>, String> {
+    match (given, prepared) {
+        (Some(dir), _) => prepare_cache_dir(Some(dir), "", "").map(Some),
+        (None, Some(dir)) => Ok(Some(dir.to_path_buf())),
+        (None, None) => Ok(prepare_cache_dir(None, "the BSDF table cache", "").ok()),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

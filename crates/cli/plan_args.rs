@@ -5,6 +5,7 @@ use clap::{Args, ValueEnum};
 use prism_bandwidth::allocation::DEFAULT_FLOOR;
 use prism_bandwidth::hierarchical_shading::DEFAULT_MAX_LEVEL;
 use prism_bandwidth::{Allocation, AllocationSettings, VarianceBandwidth, DEFAULT_POOL_RADIUS_PX};
+use prism_render::bsdf_table_cache::AngularTableCache;
 use prism_render::predictor::{PredictorSettings, DEFAULT_PROBE_SAMPLES};
 use prism_render::SamplePlanKind;
 
@@ -53,6 +54,11 @@ pub struct PlanArgs {
     /// `--plan predicted`: probe light samples per pixel (n_b).
     #[arg(long = "plan-nb", value_name = "N", default_value_t = DEFAULT_PROBE_SAMPLES, value_parser = prism_args::numbers::parse_u32)]
     pub plan_nb: u32,
+    /// `--plan predicted`: where the BSDF angular tables are kept across runs (created if
+    /// missing; default $XDG_CACHE_HOME/prism, else ~/.cache/prism, and built each run when
+    /// that is not writable).
+    #[arg(long = "cache-dir", value_name = "DIR")]
+    pub cache_dir: Option<std::path::PathBuf>,
     /// `--plan predicted`: share of the budget spread uniformly, in [0, 1].
     #[arg(long = "plan-floor", value_name = "F", default_value_t = DEFAULT_FLOOR)]
     pub plan_floor: f64,
@@ -116,12 +122,13 @@ impl PlanArgs {
             || self.plan_variance != VarianceArg::Eq9
             || self.plan_visibility != OnOff::On
             || self.plan_pool_px != DEFAULT_POOL_RADIUS_PX
-            || self.plan_indirect != DEFAULT_PROBE_SAMPLES;
+            || self.plan_indirect != DEFAULT_PROBE_SAMPLES
+            || self.cache_dir.is_some();
         if !self.predicts() && predictor_flags_given {
             return Err(
                 "--plan-nb, --plan-floor, --plan-allocation, --plan-variance, \
-                 --plan-visibility, --plan-pool-px and --plan-indirect set up the \
-                 predictor: add --plan predicted or predicted-hier"
+                 --plan-visibility, --plan-pool-px, --plan-indirect and --cache-dir set up \
+                 the predictor: add --plan predicted or predicted-hier"
                     .into(),
             );
         }
@@ -161,6 +168,17 @@ impl PlanArgs {
                     .then_some(self.plan_max_level),
             },
             PlanArg::Adaptive => SamplePlanKind::Adaptive,
+        }
+    }
+
+    /// The predictor's BSDF table cache (`--cache-dir`), for the predicted plans only.
+    pub fn table_cache(&self) -> Result<Option<AngularTableCache>, String> {
+        match self.plan {
+            PlanArg::Predicted | PlanArg::PredictedHier => Ok(
+                crate::cache_dir::optional_cache_dir(self.cache_dir.as_deref(), None)?
+                    .map(AngularTableCache::new),
+            ),
+            PlanArg::Uniform | PlanArg::Adaptive => Ok(None),
         }
     }
 

@@ -537,8 +537,13 @@ pub fn run(args: &RenderArgs, budget: &MemoryBudget) -> Result<ExitCode, String>
         PlanArg::Predicted | PlanArg::PredictedHier => {
             // Deterministic in the seed: every process of a split render computes it alike.
             let predictor = args.plan.predictor(settings.spp, settings.seed);
+            let table_cache = args.plan.table_cache()?;
             let mut prediction = pool
-                .install(|| prism_render::predictor::predict(&scene, &predictor, settings.seed))
+                .install(|| {
+                    let probe = prism_render::probe::RenderProbe::new(&scene, settings.seed)
+                        .with_bandwidth_tables_cached(table_cache.as_ref())?;
+                    prism_render::predictor::predict_with_probe(&scene, &predictor, probe)
+                })
                 .map_err(|e| format!("{}: {e}", args.scene.display()))?;
             let upsampling = match args.plan.plan {
                 PlanArg::PredictedHier => Some(

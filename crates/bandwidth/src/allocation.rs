@@ -146,10 +146,11 @@ pub fn allocate(
         camera_samples,
         vec![crate::sample_plan::DEFAULT_LIGHT_SAMPLES; n],
     )?;
-    let relative_density = expected
+    let relative_density: Vec<f32> = expected
         .iter()
         .map(|&x| (x / settings.mean_spp) as f32)
         .collect();
+    let plan = plan.with_relative_density(&relative_density)?;
     Ok(Allocated {
         plan,
         relative_density,

@@ -340,7 +340,8 @@ impl Upsampling {
             self.resolution,
             counts_for_density(&relative_density, mean_spp, seed),
             vec![DEFAULT_LIGHT_SAMPLES; self.shaded.len()],
-        )?;
+        )?
+        .with_relative_density(&relative_density)?;
         Ok(Allocated {
             plan,
             relative_density,

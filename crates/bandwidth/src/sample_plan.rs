@@ -17,6 +17,8 @@
 //! sequence: `first_samples` (default 0 everywhere) says where pixel p's samples of this
 //! plan start, so passes [0, n₁(p)), [n₁(p), n₂(p)), … equal one render of n₂(p) samples.
 
+use std::sync::Arc;
+
 use glam::UVec2;
 
 use crate::error::{pixel_count, pixel_index, BandwidthError};
@@ -25,13 +27,15 @@ use crate::error::{pixel_count, pixel_index, BandwidthError};
 pub const DEFAULT_LIGHT_SAMPLES: u32 = 1;
 
 /// Per-pixel camera and light sample counts, row-major like the film.
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct SamplePlan {
     resolution: UVec2,
     camera_samples: Vec<u32>,
     light_samples: Vec<u32>,
     /// Per pixel, the index of its first sample; `None`: 0 everywhere.
     first_samples: Option<Vec<u32>>,
+    /// Per pixel, 1 / its relative sample density (`with_relative_density`); `None`: 1.
+    splat_weights: Option<Arc<[f32]>>,
 }
 
 impl SamplePlan {
@@ -44,6 +48,7 @@ impl SamplePlan {
             camera_samples: vec![spp; n],
             light_samples: vec![DEFAULT_LIGHT_SAMPLES; n],
             first_samples: None,
+            splat_weights: None,
         })
     }
 
@@ -71,6 +76,7 @@ impl SamplePlan {
             camera_samples,
             light_samples,
             first_samples: None,
+            splat_weights: None,
         })
     }
 
@@ -96,6 +102,51 @@ impl SamplePlan {
                 pixel_index("sample plan", pixel, self.resolution).map_or(0, |i| first[i])
             }
         }
+    }
+
+    /// The same plan with the relative sample density of each pixel (a_p / mean(a), the
+    /// expected N_p over the mean: `Allocated::relative_density`): a splatting film spreads
+    /// a sample over its neighbours, where the density differs, so it weights each sample
+    /// by 1 / its own pixel's density (`splat_weight`). A pixel of density 0 (it takes no
+    /// samples) keeps weight 1; all densities 1 leave the plan as it is.
+    pub fn with_relative_density(mut self, density: &[f32]) -> Result<Self, BandwidthError> {
+        if density.len() != self.camera_samples.len() {
+            return Err(BandwidthError::LengthMismatch {
+                what: "sample plan relative density",
+                resolution: self.resolution,
+                found: density.len(),
+            });
+        }
+        if let Some(bad) = density.iter().find(|d| !(d.is_finite() && **d >= 0.0)) {
+            return Err(BandwidthError::invalid(
+                "sample plan",
+                "relative density",
+                bad,
+                "finite, ≥ 0",
+            ));
+        }
+        let weights: Arc<[f32]> = density
+            .iter()
+            .map(|&d| if d > 0.0 { 1.0 / d } else { 1.0 })
+            .collect();
+        // A uniform density is the plan without densities.
+        self.splat_weights = weights.iter().any(|&w| w != 1.0).then_some(weights);
+        Ok(self)
+    }
+
+    /// The weight a splatting film gives `pixel`'s samples: 1 / its relative density, 1
+    /// for a plan without densities (uniform) and outside the plan.
+    #[inline]
+    pub fn splat_weight(&self, pixel: UVec2) -> f32 {
+        match &self.splat_weights {
+            None => 1.0,
+            Some(w) => pixel_index("sample plan", pixel, self.resolution).map_or(1.0, |i| w[i]),
+        }
+    }
+
+    /// Every pixel's splat weight (row-major), `None` for a plan without densities.
+    pub fn splat_weights(&self) -> Option<&Arc<[f32]>> {
+        self.splat_weights.as_ref()
     }
 
     /// True when some pixel's samples start at its own index (`with_first_samples`).

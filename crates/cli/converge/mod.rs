@@ -24,6 +24,7 @@ use prism_cpu::memory::MemoryBudget;
 use prism_image::io::write_image;
 use prism_image::Image;
 use prism_post::metrics::PreparedReference;
+use prism_render::bsdf_table_cache::AngularTableCache;
 use prism_render::film::{AovSelection, FilmMemory};
 use prism_render::integrator::DEFAULT_TILE_SIZE_PX;
 use prism_render::{render, RenderScene, RenderSettings, SamplerKind};
@@ -53,8 +54,8 @@ pub struct ConvergeArgs {
     /// --reference-spp and cached in --cache-dir (`<stem>.reference-WxH-Nspp-HASH.exr`).
     #[arg(long)]
     pub reference: Option<PathBuf>,
-    /// Where rendered references are cached (created if missing; default
-    /// $XDG_CACHE_HOME/prism, else ~/.cache/prism).
+    /// Where rendered references and the predictor's BSDF angular tables are cached
+    /// (created if missing; default $XDG_CACHE_HOME/prism, else ~/.cache/prism).
     #[arg(long = "cache-dir", value_name = "DIR")]
     pub cache_dir: Option<PathBuf>,
     /// Samples per pixel of a reference rendered because --reference was left out.
@@ -457,6 +458,22 @@ pub fn run(args: &ConvergeArgs, memory: &MemoryBudget) -> Result<(), String> {
         }
         (None, false) => None,
     };
+    let wants_tables = methods.iter().any(|m| {
+        matches!(
+            m.plan,
+            method::PlanKind::Predicted | method::PlanKind::PredictedHier
+        )
+    });
+    let table_cache = if wants_tables {
+        crate::cache_dir::optional_cache_dir(args.cache_dir.as_deref(), cache_dir.as_deref())?
+            .map(AngularTableCache::new)
+    } else {
+        None
+    };
+    let plan_inputs = pass_planner::PlanInputs {
+        oracle: oracle.as_ref(),
+        table_cache: table_cache.as_ref(),
+    };
     let mut curves = Vec::new();
     let mut methods_json = Vec::new();
     let mut report_entries = Vec::new();
@@ -481,7 +498,7 @@ pub fn run(args: &ConvergeArgs, memory: &MemoryBudget) -> Result<(), String> {
             &prepared,
             &budget,
             &pool,
-            oracle.as_ref(),
+            plan_inputs,
         )?;
         let last = run
             .checkpoints
@@ -501,14 +518,8 @@ pub fn run(args: &ConvergeArgs, memory: &MemoryBudget) -> Result<(), String> {
         );
         let time_to_target = first_crossing(&series(1), TARGET_RELMSE);
         let overhead = if args.overhead {
-            let (plain_wall, plain_cpu) = run_plain(
-                &scene,
-                &settings,
-                method.plan,
-                last.spp,
-                &pool,
-                oracle.as_ref(),
-            )?;
+            let (plain_wall, plain_cpu) =
+                run_plain(&scene, &settings, method.plan, last.spp, &pool, plan_inputs)?;
             let wall_fraction = run.render_wall_s / plain_wall - 1.0;
             let cpu_fraction = match (run.cpu_s, plain_cpu) {
                 (Some(a), Some(b)) => Some(a / b - 1.0),

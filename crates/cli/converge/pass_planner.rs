@@ -13,6 +13,7 @@ use glam::UVec2;
 use prism_bandwidth::hierarchical_shading::DEFAULT_MAX_LEVEL;
 use prism_bandwidth::{adaptive_pass_counts, Allocated, Upsampling};
 use prism_render::adaptive::{PerPixelPasses, ADAPTIVE_FIRST_PASS_SPP};
+use prism_render::bsdf_table_cache::AngularTableCache;
 use prism_render::predictor::{predict_with_probe, PredictorSettings};
 use prism_render::probe::RenderProbe;
 use prism_render::{Film, RenderScene, RenderSettings, RenderStats};
@@ -31,6 +32,14 @@ pub struct PredictorCpu {
 /// The mean spp the predicted plan's densities are computed for (its anti-aliasing
 /// minimums depend on the budget; the densities are then scaled to each checkpoint).
 const PREDICTED_PLAN_SPP: f64 = 64.0;
+
+/// What a plan needs besides the scene: the oracle's allocation (`path+oracle`) and where
+/// the predictor keeps its BSDF tables (`--cache-dir`; `None`: built each run).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct PlanInputs<'a> {
+    pub oracle: Option<&'a Allocated>,
+    pub table_cache: Option<&'a AngularTableCache>,
+}
 
 /// A method's films and the state its plan carries between passes.
 pub struct PassPlanner {
@@ -52,7 +61,7 @@ impl PassPlanner {
         kind: PlanKind,
         scene: &RenderScene,
         settings: &RenderSettings,
-        oracle: Option<&Allocated>,
+        inputs: PlanInputs<'_>,
     ) -> Result<Self, String> {
         let mut predictor_cpu = None;
         let mut upsampling = None;
@@ -60,7 +69,8 @@ impl PassPlanner {
             PlanKind::Predicted | PlanKind::PredictedHier => {
                 let predictor = PredictorSettings::defaults(PREDICTED_PLAN_SPP, settings.seed);
                 let start = process_cpu_s();
-                let probe = RenderProbe::new(scene, settings.seed).with_bandwidth_tables()?;
+                let probe = RenderProbe::new(scene, settings.seed)
+                    .with_bandwidth_tables_cached(inputs.table_cache)?;
                 let tables_done = process_cpu_s();
                 let mut prediction = predict_with_probe(scene, &predictor, probe)?;
                 if kind == PlanKind::PredictedHier {
@@ -80,15 +90,20 @@ impl PassPlanner {
                 Some(prediction.allocated)
             }
             PlanKind::Oracle => Some(
-                oracle
+                inputs
+                    .oracle
                     .ok_or("path+oracle needs --oracle-variance FILE.exr")?
                     .clone(),
             ),
             PlanKind::Uniform | PlanKind::Adaptive => None,
         };
+        let mut passes = PerPixelPasses::new(scene, settings, kind == PlanKind::Adaptive);
+        if let Some(allocated) = &allocated {
+            passes = passes.with_relative_density(allocated.relative_density.clone());
+        }
         Ok(Self {
             kind,
-            passes: PerPixelPasses::new(scene, settings, kind == PlanKind::Adaptive),
+            passes,
             allocated,
             upsampling,
             predictor_cpu,

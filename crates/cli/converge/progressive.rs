@@ -21,7 +21,7 @@ use std::time::Instant;
 
 use std::sync::Arc;
 
-use prism_bandwidth::{Allocated, Upsampling};
+use prism_bandwidth::Upsampling;
 use prism_image::Image;
 use prism_post::metrics::{CompareOptions, Comparison, PreparedReference};
 use prism_render::adaptive::ADAPTIVE_FIRST_PASS_SPP;
@@ -29,7 +29,7 @@ use prism_render::{Film, RenderScene, RenderSettings, RenderStats};
 use prism_spectrum::rgb_space::RgbColorSpace;
 
 use super::method::PlanKind;
-use super::pass_planner::PassPlanner;
+use super::pass_planner::{PassPlanner, PlanInputs};
 
 /// How long a method may render.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -179,7 +179,7 @@ pub fn run_method(
     reference: &PreparedReference,
     budget: &Budget,
     pool: &rayon::ThreadPool,
-    oracle: Option<&Allocated>,
+    inputs: PlanInputs<'_>,
 ) -> Result<MethodRun, String> {
     type Snapshot = (f64, Option<f64>, u32, u64, Film, Option<Arc<Upsampling>>);
     let (sender, receiver) = mpsc::channel::<Snapshot>();
@@ -232,7 +232,7 @@ pub fn run_method(
         let cpu_start = process_cpu_s();
         let start = Instant::now();
         // A predicted plan's predictor runs here: its time is the method's.
-        let mut planner = pool.install(|| PassPlanner::new(plan, scene, settings, oracle))?;
+        let mut planner = pool.install(|| PassPlanner::new(plan, scene, settings, inputs))?;
         let mut stats = RenderStats::default();
         let mut spp_done = 0u32;
         let mut k = 0u32;
@@ -307,12 +307,12 @@ pub fn run_plain(
     plan: PlanKind,
     spp: u32,
     pool: &rayon::ThreadPool,
-    oracle: Option<&Allocated>,
+    inputs: PlanInputs<'_>,
 ) -> Result<(f64, Option<f64>), String> {
     let cpu_start = process_cpu_s();
     let start = Instant::now();
     pool.install(|| -> Result<(), String> {
-        let mut planner = PassPlanner::new(plan, scene, settings, oracle)?;
+        let mut planner = PassPlanner::new(plan, scene, settings, inputs)?;
         // Adaptive sampling needs its error passes; the others render in one pass.
         match plan {
             PlanKind::Adaptive => {

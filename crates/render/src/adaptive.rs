@@ -36,6 +36,8 @@ pub struct PerPixelPasses {
     film: Film,
     /// Film A, when split.
     half: Option<Film>,
+    /// `with_relative_density`; `None`: every sample weighs 1 on a splatting film.
+    relative_density: Option<Vec<f32>>,
 }
 
 impl PerPixelPasses {
@@ -46,7 +48,15 @@ impl PerPixelPasses {
             done: vec![0; n],
             film: film_for(scene, settings),
             half: split.then(|| film_for(scene, settings)),
+            relative_density: None,
         }
+    }
+
+    /// The plan's relative sample density per pixel (`Allocated::relative_density`),
+    /// which a splatting film weights samples by (`SamplePlan::with_relative_density`).
+    pub fn with_relative_density(mut self, density: Vec<f32>) -> Self {
+        self.relative_density = Some(density);
+        self
     }
 
     /// Samples each pixel has so far (row-major).
@@ -78,8 +88,11 @@ impl PerPixelPasses {
             }
             // Pixels that all start at one index are an ordinary pass from there for the
             // light-path estimators (the driver's `uniform_first_sample`).
-            let plan = SamplePlan::from_counts(scene.resolution, count, vec![1; n])?
+            let mut plan = SamplePlan::from_counts(scene.resolution, count, vec![1; n])?
                 .with_first_samples(start)?;
+            if let Some(density) = &self.relative_density {
+                plan = plan.with_relative_density(density)?;
+            }
             let film = match (&mut self.half, into_half) {
                 (Some(half), true) => half,
                 _ => &mut self.film,

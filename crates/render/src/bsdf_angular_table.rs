@@ -27,7 +27,7 @@ pub const TABLE_CELLS: usize = 16;
 pub const SLICE_TEXELS: usize = 64;
 
 /// The direction at the centre of cell (iθ, iφ) of an `n`×`n` hemisphere grid.
-fn cell_direction(i_theta: usize, i_phi: usize, n: usize) -> Vec3A {
+pub(crate) fn cell_direction(i_theta: usize, i_phi: usize, n: usize) -> Vec3A {
     let theta = std::f32::consts::FRAC_PI_2 * (i_theta as f32 + 0.5) / n as f32;
     let phi = std::f32::consts::TAU * (i_phi as f32 + 0.5) / n as f32;
     Vec3A::new(

@@ -13,6 +13,7 @@
 pub mod adaptive;
 pub mod bsdf;
 pub mod bsdf_angular_table;
+pub mod bsdf_table_cache;
 pub mod camera;
 pub mod enclosure;
 pub mod error;

@@ -224,7 +224,7 @@ fn background_angular_bandwidth(
             | Light::Area(_)
             | Light::Goniometric(_) => {
                 probe
-                    .light_bandwidth_towards(index as usize, direction)
+                    .light_bandwidth_towards(index as usize, direction, None)
                     .angular_cycles_per_rad
             }
         })

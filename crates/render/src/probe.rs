@@ -10,9 +10,10 @@
 //! indirect estimates (beyond the paper).
 //!
 //! Bandwidths (cycles per metre / per radian): each light's `Light::bandwidth`
-//! (light/bandwidth.rs), except environment maps, which answer per direction from eq. 7's
-//! map when the probe is given one (`with_environment_bandwidths`); the material's ρ from
-//! its lobe (`Bxdf::angular_bandwidth_cycles_per_rad`).
+//! (light/bandwidth.rs), except where the probe is given eq. 7's maps
+//! (`with_bandwidth_tables`): environment maps answer per direction, area lights per point
+//! of the emitter (`light/area_bandwidth.rs`); the material's ρ from its lobe
+//! (`Bxdf::angular_bandwidth_cycles_per_rad`) or its table.
 //!
 //! The samples alternate between the path tracer's two strategies, light sampling and BSDF
 //! sampling, and each sample's pdf is the mixture's (½ p_light + ½ p_bsdf), so eq. 9's
@@ -34,6 +35,8 @@ use prism_spectrum::{SampledSpectrum, SampledWavelengths};
 
 use crate::bsdf::{Bsdf, Bxdf, TransportMode};
 use crate::bsdf_angular_table::MaterialAngularBandwidth;
+use crate::bsdf_table_cache::AngularTableCache;
+use crate::light::area_bandwidth::AreaLightBandwidth;
 use crate::light::environment_bandwidth::EnvironmentBandwidth;
 use crate::light::{Light, LightHit, LightSampleContext};
 use crate::sampler::{PixelSampler, SamplerKind};
@@ -48,8 +51,8 @@ const INDIRECT_STREAM_OFFSET: u32 = 1 << 30;
 pub struct RenderProbe<'a> {
     pub scene: &'a RenderScene,
     pub seed: u64,
-    /// Per light (the scene's order): eq. 7's map for environment lights, else `None`.
-    pub environment_bandwidths: Vec<Option<EnvironmentBandwidth>>,
+    /// Per light (the scene's order): eq. 7's map where one is built, else `None`.
+    pub light_maps: Vec<Option<LightBandwidthMap>>,
     /// Per material (`material_id` order): its angular bandwidth table; empty: each lobe's
     /// closed form.
     pub material_tables: Vec<MaterialAngularBandwidth>,
@@ -66,7 +69,7 @@ impl<'a> RenderProbe<'a> {
         Self {
             scene,
             seed,
-            environment_bandwidths: Vec::new(),
+            light_maps: Vec::new(),
             material_tables: Vec::new(),
             trace_visibility: false,
             texture_bandwidths: Vec::new(),
@@ -77,7 +80,16 @@ impl<'a> RenderProbe<'a> {
     /// angular bandwidth table of every material the scene's shapes use (others get a
     /// constant) and the bandwidths of those materials' textures, what the predictor runs
     /// with.
-    pub fn with_bandwidth_tables(mut self) -> Result<Self, String> {
+    pub fn with_bandwidth_tables(self) -> Result<Self, String> {
+        self.with_bandwidth_tables_cached(None)
+    }
+
+    /// [`Self::with_bandwidth_tables`] with the BSDF tables read from (or written to)
+    /// `cache` (`bsdf_table_cache.rs`).
+    pub fn with_bandwidth_tables_cached(
+        mut self,
+        cache: Option<&AngularTableCache>,
+    ) -> Result<Self, String> {
         let mut used = vec![false; self.scene.materials.len()];
         for inst in self.scene.geometry.instances() {
             let id = inst.material.map_or(used.len() - 1, |m| m as usize);
@@ -100,26 +112,33 @@ impl<'a> RenderProbe<'a> {
                     .into_iter()
                     .map(TextureBandwidth::new)
                     .collect::<Result<Vec<_>, _>>()?;
-                Ok((MaterialAngularBandwidth::build(m), textures))
+                let table = match cache {
+                    Some(cache) => cache.table(m)?.0,
+                    None => MaterialAngularBandwidth::build(m),
+                };
+                Ok((table, textures))
             })
             .collect::<Result<_, String>>()?;
         (self.material_tables, self.texture_bandwidths) = per_material.into_iter().unzip();
-        self.environment_bandwidths = self
-            .scene
-            .lights
-            .lights()
-            .iter()
-            .map(|l| match l {
-                Light::Environment(e) => EnvironmentBandwidth::new(e).map(Some),
-                Light::Point(_)
-                | Light::Spot(_)
-                | Light::Directional(_)
-                | Light::Area(_)
-                | Light::Sky(_)
-                | Light::Daylight(_)
-                | Light::Goniometric(_) => Ok(None),
-            })
-            .collect::<Result<_, _>>()?;
+        self.light_maps =
+            self.scene
+                .lights
+                .lights()
+                .iter()
+                .map(|l| match l {
+                    Light::Environment(e) => EnvironmentBandwidth::new(e)
+                        .map(|m| Some(LightBandwidthMap::Environment(m))),
+                    Light::Area(a) => {
+                        AreaLightBandwidth::new(a).map(|m| m.map(LightBandwidthMap::Area))
+                    }
+                    Light::Point(_)
+                    | Light::Spot(_)
+                    | Light::Directional(_)
+                    | Light::Sky(_)
+                    | Light::Daylight(_)
+                    | Light::Goniometric(_) => Ok(None),
+                })
+                .collect::<Result<_, _>>()?;
         Ok(self)
     }
 
@@ -177,17 +196,43 @@ impl<'a> RenderProbe<'a> {
             .is_specular()
     }
 
-    /// ν_l of light `index` towards `wi`.
-    pub(crate) fn light_bandwidth_towards(&self, index: usize, wi: Vec3A) -> Bandwidth {
+    /// ν_l of light `index` towards `wi`, met at `at_m` on the light when it has a
+    /// position (area lights).
+    pub(crate) fn light_bandwidth_towards(
+        &self,
+        index: usize,
+        wi: Vec3A,
+        at_m: Option<Vec3A>,
+    ) -> Bandwidth {
         let light = &self.scene.lights.lights()[index];
-        match (light, self.environment_bandwidths.get(index)) {
-            (Light::Environment(e), Some(Some(map))) => Bandwidth {
+        match (light, self.light_maps.get(index).and_then(Option::as_ref)) {
+            (Light::Environment(e), Some(LightBandwidthMap::Environment(map))) => Bandwidth {
                 spatial_cycles_per_m: 0.0,
                 angular_cycles_per_rad: map.at(e, wi),
             },
-            _ => light.bandwidth(),
+            (Light::Area(_), Some(LightBandwidthMap::Area(map))) => {
+                match at_m.and_then(|p| map.at(p, wi)) {
+                    Some(spatial_cycles_per_m) => Bandwidth {
+                        spatial_cycles_per_m,
+                        ..light.bandwidth()
+                    },
+                    None => light.bandwidth(),
+                }
+            }
+            (_, Some(LightBandwidthMap::Environment(_) | LightBandwidthMap::Area(_)) | None) => {
+                light.bandwidth()
+            }
         }
     }
+}
+
+/// Eq. 7's per-point map of a light (`RenderProbe::light_maps`).
+#[derive(Clone, Debug)]
+pub enum LightBandwidthMap {
+    /// ν_a per direction (`light/environment_bandwidth.rs`).
+    Environment(EnvironmentBandwidth),
+    /// ν_s per point of the emitter (`light/area_bandwidth.rs`).
+    Area(AreaLightBandwidth),
 }
 
 /// ν_l of a light (see the module docs; the choices live in `light/bandwidth.rs`).
@@ -485,7 +530,11 @@ impl ShadingProbe for RenderProbe<'_> {
                         bsdf_cos_per_sr: reflectance_y(f, &wavelengths),
                         cos_theta_i: cos,
                         distance_m: ls.distance_m,
-                        light_bandwidth: self.light_bandwidth_towards(l as usize, ls.wi),
+                        light_bandwidth: self.light_bandwidth_towards(
+                            l as usize,
+                            ls.wi,
+                            Some(si.p + ls.wi * ls.distance_m),
+                        ),
                         material_bandwidth: self.material_bandwidth_at(
                             hit.material_id(),
                             &bsdf,
@@ -544,7 +593,11 @@ impl ShadingProbe for RenderProbe<'_> {
                             bsdf_cos_per_sr,
                             cos_theta_i: cos,
                             distance_m,
-                            light_bandwidth: self.light_bandwidth_towards(l as usize, wi),
+                            light_bandwidth: self.light_bandwidth_towards(
+                                l as usize,
+                                wi,
+                                light_hit.as_ref().map(|h| h.p),
+                            ),
                             material_bandwidth: self.material_bandwidth_at(
                                 hit.material_id(),
                                 &bsdf,

@@ -197,6 +197,9 @@ pub(crate) struct SplatBuffer {
     /// allows AVX2, a tap is 256-bit operations and the filter profile's table reads are
     /// gathers.
     simd: prism_cpu::Simd,
+    /// Per film pixel (row-major, `film_width` wide), the weight of the samples taken for
+    /// it (`SamplePlan::splat_weight`: 1 / its relative sample density); `None`: 1.
+    sample_weights: Option<(Arc<[f32]>, u32)>,
 }
 
 /// |f · value| below this (2³¹) takes the packed limb split (|f · value · 2²⁰| < 2⁵¹).
@@ -216,14 +219,27 @@ impl SplatBuffer {
             sums: vec![[0; 8]; bounds.pixel_count()],
             radius_px,
             simd: prism_cpu::active(),
+            sample_weights: None,
         }
     }
 
-    /// Whether a sample of colour `xyz` can be splatted with `table`'s weights (every tap
-    /// within the limbs' range); `Film` drops it like a non-finite one otherwise.
+    /// The weight of a sample taken for film pixel `pixel` (see `sample_weights`).
     #[inline]
-    pub fn admits(xyz: DVec3, table: &FilterTable) -> bool {
-        xyz.abs().max_element().max(1.0) * table.max_weight() < LIMB_LIMIT
+    fn sample_weight(&self, pixel: UVec2) -> f64 {
+        match &self.sample_weights {
+            None => 1.0,
+            Some((w, width)) => w
+                .get(pixel.y as usize * *width as usize + pixel.x as usize)
+                .map_or(1.0, |&w| f64::from(w)),
+        }
+    }
+
+    /// Whether a sample of colour `xyz` and weight `weight` can be splatted with
+    /// `table`'s weights (every tap within the limbs' range); `Film` drops it like a
+    /// non-finite one otherwise.
+    #[inline]
+    pub fn admits(xyz: DVec3, weight: f64, table: &FilterTable) -> bool {
+        (xyz.abs().max_element() * weight).max(weight) * table.max_weight() < LIMB_LIMIT
     }
 
     /// The sums of buffer pixel `i`: Σ f·X, Σ f·Y, Σ f·Z, Σ f.
@@ -234,26 +250,27 @@ impl SplatBuffer {
     }
 
     /// Adds `xyz` at film point `p` to every pixel whose centre is within the radius, with
-    /// the weights of the tabulated profile (`FilterTable`). `xyz` must be admitted
-    /// (`admits`).
+    /// the weights of the tabulated profile (`FilterTable`) times the sample's own
+    /// `weight` (1 but for plans of varying density). `xyz` must be admitted (`admits`).
     #[inline]
-    pub fn splat(&mut self, p: Vec2, xyz: DVec3, table: &FilterTable) {
-        let bound = xyz.abs().max_element().max(1.0) * table.max_weight();
+    pub fn splat(&mut self, p: Vec2, xyz: DVec3, weight: f64, table: &FilterTable) {
+        let value = [xyz.x * weight, xyz.y * weight, xyz.z * weight, weight];
+        let bound = (xyz.abs().max_element() * weight).max(weight) * table.max_weight();
         if bound >= FAST_SPLIT_LIMIT {
-            return self.splat_with::<false, false, true>(p, xyz, table);
+            return self.splat_with::<false, false, true>(p, value, table);
         }
         #[cfg(target_arch = "x86_64")]
         if self.simd.avx2() {
             // SAFETY: a `Simd` allows AVX2 (and AVX) only on a CPU that has it.
-            return unsafe { self.splat_avx2(p, xyz, table) };
+            return unsafe { self.splat_avx2(p, value, table) };
         }
-        self.splat_with::<false, false, false>(p, xyz, table)
+        self.splat_with::<false, false, false>(p, value, table)
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx,avx2")]
-    unsafe fn splat_avx2(&mut self, p: Vec2, xyz: DVec3, table: &FilterTable) {
-        self.splat_with::<true, true, false>(p, xyz, table)
+    unsafe fn splat_avx2(&mut self, p: Vec2, value: [f64; 4], table: &FilterTable) {
+        self.splat_with::<true, true, false>(p, value, table)
     }
 
     /// `splat`'s body; `AVX`: the taps as 256-bit operations, `GATHER`: up to 4 × 4 taps'
@@ -263,7 +280,7 @@ impl SplatBuffer {
     fn splat_with<const AVX: bool, const GATHER: bool, const WIDE: bool>(
         &mut self,
         p: Vec2,
-        xyz: DVec3,
+        value: [f64; 4],
         table: &FilterTable,
     ) {
         let r = self.radius_px;
@@ -280,7 +297,7 @@ impl SplatBuffer {
         // Separable filters (f = f₁(x) f₁(y)): one profile value per row and column.
         const MAX_TAPS: usize = 16;
         if WIDE || (x1 - x0) as usize >= MAX_TAPS || (y1 - y0) as usize >= MAX_TAPS {
-            return self.splat_wide(p, xyz, table, (x0, x1, y0, y1));
+            return self.splat_wide(p, value, table, (x0, x1, y0, y1));
         }
         let (columns, rows) = ((x1 - x0 + 1) as usize, (y1 - y0 + 1) as usize);
         // Profile values: a radius-2 filter's 4 + 4 in one gather call with AVX2
@@ -314,10 +331,10 @@ impl SplatBuffer {
         }
         let width = self.bounds.size().x as usize;
         let first_column = (x0 - min.x) as usize;
-        // The weight's own sum rides along as a fourth component of value 1: w · 1 = w
-        // exactly, so the sums are those of separate colour and weight accumulators. A tap
-        // of weight 0 adds zero limbs — no change — so no test for it.
-        let value = [xyz.x, xyz.y, xyz.z, 1.0];
+        // The weight's own sum rides along as a fourth component (the sample's weight, 1
+        // but for plans of varying density: w · 1 = w exactly), so the sums are those of
+        // separate colour and weight accumulators. A tap of weight 0 adds zero limbs — no
+        // change — so no test for it.
         for (y, &wy) in (y0..=y1).zip(&wy[..rows]) {
             let row = (y - min.y) as usize * width + first_column;
             if let Ok(sums) = <&mut [[i64; 8]; 4]>::try_from(&mut self.sums[row..row + columns]) {
@@ -340,13 +357,12 @@ impl SplatBuffer {
     fn splat_wide(
         &mut self,
         p: Vec2,
-        xyz: DVec3,
+        value: [f64; 4],
         table: &FilterTable,
         (x0, x1, y0, y1): (i32, i32, i32, i32),
     ) {
         let width = self.bounds.size().x as usize;
         let min = self.bounds.min.as_ivec2();
-        let value = [xyz.x, xyz.y, xyz.z, 1.0];
         for y in y0..=y1 {
             let wy = table.eval(y as f32 + 0.5 - p.y);
             for x in x0..=x1 {
@@ -483,6 +499,18 @@ pub struct FilmTile {
 }
 
 impl FilmTile {
+    /// On a splatting film, weights each sample by `plan`'s `splat_weight` of the pixel it
+    /// was taken for (1 / the pixel's relative sample density), so that where the density
+    /// varies a pixel's sum Σ f·w·L / Σ f·w is not pulled towards its denser neighbours.
+    /// Nothing changes for a film that does not splat (each sample stays in its pixel).
+    pub fn set_sample_weights(&mut self, plan: &prism_bandwidth::SamplePlan) {
+        if let Some(buffer) = &mut self.splat {
+            buffer.sample_weights = plan
+                .splat_weights()
+                .map(|w| (Arc::clone(w), plan.resolution().x));
+        }
+    }
+
     pub(crate) fn new(
         bounds: TileBounds,
         aov_selection: AovSelection,
@@ -702,7 +730,7 @@ impl FilmTile {
         } else {
             0.0
         };
-        self.accumulate(i, film_point, xyz, w, aov)
+        self.accumulate(i, pixel, film_point, xyz, w, aov)
     }
 
     /// Own-pixel counts and AOVs, and the colour: into the own pixel with weight `w`, or
@@ -711,6 +739,7 @@ impl FilmTile {
     fn accumulate(
         &mut self,
         i: usize,
+        pixel: UVec2,
         film_point: Vec2,
         xyz: DVec3,
         w: f64,
@@ -722,14 +751,15 @@ impl FilmTile {
         match &mut self.splat {
             Some(buffer) => {
                 let table = self.filter_sampler.table();
+                let weight = buffer.sample_weight(pixel);
                 // A colour whose taps would not fit the buffer's limbs counts as black, like
                 // a non-finite one (≥ 2⁴³ / max f: far above any physical radiance).
-                let xyz = if SplatBuffer::admits(xyz, table) {
+                let xyz = if SplatBuffer::admits(xyz, weight, table) {
                     xyz
                 } else {
                     DVec3::ZERO
                 };
-                buffer.splat(film_point, xyz, table)
+                buffer.splat(film_point, xyz, weight, table)
             }
             None => {
                 p.xyz_sum.add_f64(w * xyz);
@@ -794,9 +824,9 @@ mod tests {
             })
             .collect();
         for (p, xyz) in splat_points() {
-            sse2.splat(p, xyz, &table);
+            sse2.splat(p, xyz, 1.0, &table);
             for w in &mut wide {
-                w.splat(p, xyz, &table);
+                w.splat(p, xyz, 1.0, &table);
             }
         }
         for w in &wide {
@@ -809,10 +839,64 @@ mod tests {
             ..SplatBuffer::new(tile, UVec2::new(64, 64), 2.0)
         };
         for (p, xyz) in splat_points() {
-            wide_path.splat_with::<false, false, true>(p, xyz, &table);
+            wide_path.splat_with::<false, false, true>(p, [xyz.x, xyz.y, xyz.z, 1.0], &table);
         }
         for i in 0..sse2.sums.len() {
             assert_eq!(sse2.pixel_sums(i), wide_path.pixel_sums(i), "pixel {i}");
         }
+    }
+
+    /// A plan whose right pixel takes 4× the left's samples: with the plan's weights, the
+    /// splatted film equals the uniform plan's (the 4 copies of each sample weigh ¼ each);
+    /// without them the dark left pixel is pulled towards its bright neighbour.
+    #[test]
+    fn sample_weights_undo_a_plans_varying_density() {
+        use crate::film::{AovSelection, Film};
+        use prism_bandwidth::SamplePlan;
+        let resolution = UVec2::new(2, 1);
+        let filter = Filter::Gaussian(crate::film::filter::GaussianFilter::new(1.5, 2.0).unwrap());
+        let offsets: Vec<Vec2> = (0..16)
+            .map(|k| Vec2::new((k % 4) as f32 + 0.5, (k / 4) as f32 + 0.5) / 4.0)
+            .collect();
+        let render = |copies_right: usize, plan: Option<&SamplePlan>| -> Vec<[f32; 3]> {
+            let mut film = Film::new(resolution, filter.clone(), AovSelection::NONE)
+                .unwrap()
+                .with_splatting(true);
+            let mut tile = film.new_tile(film.bounds());
+            if let Some(plan) = plan {
+                tile.set_sample_weights(plan);
+            }
+            for (x, copies, value) in [(0u32, 1, 0.0), (1, copies_right, 1.0)] {
+                let pixel = UVec2::new(x, 0);
+                for _ in 0..copies {
+                    for &o in &offsets {
+                        let point = pixel.as_vec2() + o;
+                        tile.add_sample_xyz_at(pixel, point, DVec3::splat(value), 1.0, None);
+                    }
+                }
+            }
+            film.merge_tile(&tile);
+            film.rgb()
+        };
+        let uniform = render(1, None);
+        let plan = SamplePlan::from_counts(resolution, vec![16, 64], vec![1, 1])
+            .unwrap()
+            .with_relative_density(&[0.4, 1.6])
+            .unwrap();
+        let weighted = render(4, Some(&plan));
+        let unweighted = render(4, None);
+        assert!(
+            uniform[0][1] > 0.01,
+            "the filter reaches across: {uniform:?}"
+        );
+        for (u, w) in uniform.iter().zip(&weighted) {
+            for c in 0..3 {
+                assert!((u[c] - w[c]).abs() < 1e-5, "{uniform:?} vs {weighted:?}");
+            }
+        }
+        assert!(
+            unweighted[0][1] > 1.5 * uniform[0][1],
+            "{unweighted:?} vs {uniform:?}"
+        );
     }
 }

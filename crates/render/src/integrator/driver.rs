@@ -590,6 +590,7 @@ fn run_prepared(
                     uses_lens,
                 };
                 let mut tile = film_ref.new_tile(*bounds);
+                tile.set_sample_weights(pass.plan);
                 let mut splats = template.clone();
                 let stats = estimator.render_tile(scene, &work, &mut tile, &mut splats);
                 progress(stats.samples);

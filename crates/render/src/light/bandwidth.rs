@@ -4,6 +4,9 @@
 //! - point, spot, goniometric: a Dirac in position, ν_l = [∞, 0] (their angular
 //!   distributions are smooth); an ideal directional light: a Dirac in direction, [0, ∞];
 //! - area light of area A: a box of width √A in space, ν_s = 1/√A, ν_a = 0 (Lambertian);
+//!   the whole light's value, what a probe without maps uses and what a curved mesh or an
+//!   ellipsoid keeps; the predictor's probe answers per point of the emitter from eq. 7
+//!   (`area_bandwidth.rs`);
 //! - sun of angular diameter 2α: ν_a = 1/(2α); uniform sky: 0;
 //! - environment map W texels wide: its Nyquist rate, ν_a = W / 4π (W/2 cycles per 2π), as a
 //!   whole; per direction the predictor uses eq. 7's map (`environment_bandwidth.rs`);

@@ -38,6 +38,7 @@
 #![deny(clippy::wildcard_enum_match_arm)]
 
 pub mod area;
+pub mod area_bandwidth;
 mod bandwidth;
 mod build;
 pub mod daylight;

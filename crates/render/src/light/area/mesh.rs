@@ -41,7 +41,7 @@ impl EmitterMesh {
     }
 
     #[inline]
-    fn triangle(&self, i: usize) -> [Vec3A; 3] {
+    pub fn triangle(&self, i: usize) -> [Vec3A; 3] {
         self.indices[i].map(|k| self.positions[k as usize])
     }
 }
@@ -130,6 +130,16 @@ impl MeshEmitter {
 
     pub fn area_m2(&self) -> f64 {
         self.area_m2
+    }
+
+    /// The shared mesh, in its local space.
+    pub fn mesh(&self) -> &EmitterMesh {
+        &self.mesh
+    }
+
+    /// Each instance's placement (local → world).
+    pub fn instance_transforms(&self) -> impl Iterator<Item = &Transform> {
+        self.instances.iter().map(|i| &i.to_world)
     }
 
     pub fn triangle_count(&self) -> usize {

@@ -74,6 +74,11 @@ impl SphereEmitter {
         self.area_m2
     }
 
+    /// World centre and radius, m, when placed by a similarity (else an ellipsoid: `None`).
+    pub fn world_centre_and_radius_m(&self) -> Option<(Vec3A, f32)> {
+        self.similarity
+    }
+
     /// World centre and radius of a sphere seen from outside at `reference` (cone
     /// sampling applies), else `None`.
     ///
