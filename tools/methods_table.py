@@ -88,17 +88,8 @@ REFERENCE_SEED = 20201
 
 # Measurement notes on rows of this page (which binary, which runs were repeated when):
 # kept here so that rebuilding the page (`--no-run`) keeps them.
-MEASUREMENT_NOTES = """The media rows were measured with the test-profile binary (opt-level 2,
-no LTO), the older rows with the release binary, and before the change of media continuation
-rays (`Ray::spawn_off_surface`): their times are a little long, their errors are those of the
-earlier, very slightly biased paths. The three scenes with photon rows were measured again on
-{photon_rows_date} (test-profile binary, same options, every method of their sections),
-against the references above; bulb-in-glass-fog, whose `path` rows had been judged against
-`path`'s own reference (which misses the glow just as `path` does), was measured again with
-photon rows against `photon_progressive`'s reference on {bulb_rows_date} (release binary).
+MEASUREMENT_NOTES = """Every row of this page comes from the one run above (release binary).
 """
-PHOTON_ROWS_DATE = "2026-12-02 17:40 UTC"
-BULB_ROWS_DATE = "2026-12-03 06:40 UTC"
 
 # Consistent but biased methods: their error falls slower than t⁻¹ by design (the kernel's
 # bias shrinks with the radius; Knaus & Zwicker 2011 give relMSE ∝ t^(−α) at best), so a
@@ -302,7 +293,8 @@ def main():
                          "--reference-spp so the reference's noise stays negligible)")
     ap.add_argument("--clock", choices=["wall", "cpu"], default="cpu")
     ap.add_argument("--method", action="append", default=None,
-                    help="methods (default: path, path:sobol, light, bdpt; the first renders "
+                    help="methods (default: path, path:sobol, light, bdpt, path+predicted, "
+                         "path+adaptive; the first renders "
                          "the stress scenes' references)")
     ap.add_argument("--scenes", nargs="*", default=None, help="subset of stress scene names")
     ap.add_argument("--skip-cornell", action="store_true")
@@ -318,7 +310,8 @@ def main():
                 break
     if prism is None:
         sys.exit("build prism first (cargo build --release)")
-    methods = args.method or ["path", "path:sobol", "light", "bdpt"]
+    methods = args.method or ["path", "path:sobol", "light", "bdpt", "path+predicted",
+                              "path+adaptive"]
     for out_dir in (os.path.join(ROOT, "docs", "methods"),
                     os.path.join(ROOT, "tools", "bench-results", "methods")):
         os.makedirs(out_dir, exist_ok=True)
@@ -415,7 +408,13 @@ Methods (grammar `INTEGRATOR[+PLAN][:SAMPLER]`, [converge.md](converge.md)): `pa
 spectral path tracer (next-event estimation + MIS) with the uniform plan and the independent
 sampler; `path:sobol` the same with Owen-scrambled Sobol samples; `light` is light tracing
 (one light path per camera sample, every vertex connected to the camera); `bdpt` is
-bidirectional path tracing with power-heuristic MIS over all strategies. All take the scene's
+bidirectional path tracing with power-heuristic MIS over all strategies; `path+predicted` is
+the path tracer with the bandwidth predictor's per-pixel plan (Bagher et al. 2013,
+[bandwidth.md](bandwidth.md); its time includes the predictor's, the BSDF tables read from
+the cache directory after their first build) and `path+adaptive` the path tracer with
+variance-driven passes after 4 spp (Cycles' adaptive sampling), the baseline the predictor
+is measured against: on these scenes, which the predictor was not built for, their rows say
+where per-pixel allocation pays and where it does not. All take the scene's
 `max_depth` and `rr_depth`. A pinhole light tracer cannot reach pixels that see a specular
 surface (glass, mirrors) first, nor point-like lights seen directly: on scenes with such
 pixels `light`'s error stays at their missing value — a property of the method, not noise.
@@ -432,8 +431,7 @@ measured against their own method, so the kernel's bias they share with it does 
 The photon speed target
 (spot-fog-glass at 128², against `photon_progressive`'s own reference,
 `tools/photon_speed.py`) is in [rendering.md](rendering.md#photon-mapping).
-{MEASUREMENT_NOTES.format(photon_rows_date=PHOTON_ROWS_DATE, bulb_rows_date=BULB_ROWS_DATE)} The bandwidth predictor's plan
-(`path+predicted`) will get rows here when it exists.
+{MEASUREMENT_NOTES}
 
 {{bdpt_summary}}
 
