@@ -4,20 +4,17 @@
 
 use std::path::{Path, PathBuf};
 
-/// 64-bit FNV-1a (Fowler–Noll–Vo): a stable hash for cache names (std's `DefaultHasher`
-/// may change between Rust releases).
+use prism_render::stable_hash::Fnv1a64;
+
+/// The stable hash (`prism_render::stable_hash`) of `parts`, each followed by a 0xff
+/// byte so that ("ab", "c") and ("a", "bc") differ.
 pub fn fnv1a64(parts: &[&[u8]]) -> u64 {
-    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    let mut h = Fnv1a64::new();
     for part in parts {
-        for &b in *part {
-            h ^= u64::from(b);
-            h = h.wrapping_mul(0x0000_0100_0000_01b3);
-        }
-        // Separate the parts so that ("ab", "c") and ("a", "bc") differ.
-        h ^= 0xff;
-        h = h.wrapping_mul(0x0000_0100_0000_01b3);
+        h.write(part);
+        h.write(&[0xff]);
     }
-    h
+    h.finish()
 }
 
 /// The platform cache directory of Prism: `$XDG_CACHE_HOME/prism`, else

@@ -24,6 +24,7 @@ use crate::bsdf_angular_table::{
 use crate::material::Material;
 use crate::plan::probe_hit;
 use crate::probe::reflectance_y;
+use crate::stable_hash::Fnv1a64;
 
 /// Bumped whenever a table's construction or this file layout changes.
 const FORMAT_VERSION: u32 = 1;
@@ -116,26 +117,6 @@ pub fn fingerprint(material: &Material) -> Option<u64> {
         }
     }
     Some(hash.finish())
-}
-
-/// 64-bit FNV-1a (Fowler–Noll–Vo): stable across Rust releases, unlike std's hasher.
-struct Fnv1a64(u64);
-
-impl Fnv1a64 {
-    fn new() -> Self {
-        Self(0xcbf2_9ce4_8422_2325)
-    }
-
-    fn write(&mut self, bytes: &[u8]) {
-        for &b in bytes {
-            self.0 ^= u64::from(b);
-            self.0 = self.0.wrapping_mul(0x0000_0100_0000_01b3);
-        }
-    }
-
-    fn finish(&self) -> u64 {
-        self.0
-    }
 }
 
 fn table_len() -> usize {

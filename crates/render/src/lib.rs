@@ -31,6 +31,7 @@ pub mod sampling;
 pub mod scene_build;
 pub mod sensor;
 pub mod spectrum_cache;
+pub mod stable_hash;
 pub mod stats_json;
 pub mod texture;
 pub mod tile_pyramid;
