@@ -6,7 +6,7 @@ use glam::Vec3A;
 
 use crate::element::ElementShape;
 use crate::hierarchy::{Hierarchy, Node, NodeKind};
-use crate::solver::{Link, Radiosity, RadiositySettings};
+use crate::solver::{Link, LinkTotals, Radiosity, RadiositySettings};
 
 const MAGIC: &[u8; 8] = b"PRISMRAD";
 const VERSION: u32 = 2;
@@ -328,6 +328,7 @@ impl Radiosity {
             radiosity,
             radiosity_max,
             gathered,
+            link_totals: LinkTotals::of(links.iter().flatten()),
             links,
             direct,
             direct_variation,

@@ -179,6 +179,36 @@ pub(crate) struct Link {
     pub(crate) source_shares: Box<[(u32, f32)]>,
 }
 
+/// How many links and shares a solution holds (`Radiosity::link_totals`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(crate) struct LinkTotals {
+    pub(crate) links: u64,
+    pub(crate) shares: u64,
+}
+
+impl LinkTotals {
+    pub(crate) fn of<'a>(links: impl IntoIterator<Item = &'a Link>) -> Self {
+        let mut totals = Self::default();
+        for l in links {
+            totals.links += 1;
+            totals.shares += l.source_shares.len() as u64;
+        }
+        totals
+    }
+
+    fn add(&mut self, links: &[Link]) {
+        let more = Self::of(links);
+        self.links += more.links;
+        self.shares += more.shares;
+    }
+
+    fn remove(&mut self, links: &[Link]) {
+        let less = Self::of(links);
+        self.links -= less.links;
+        self.shares -= less.shares;
+    }
+}
+
 /// How far below a link's source its shares reach (at most 4^depth nodes). In a closed
 /// box lit by a small lamp (ρ 0.5 and 0.8, bounds 0.004 and 0.001) the links with the
 /// source's area average delivered −1.0 … +0.2 % of the power leaving the surfaces per
@@ -236,6 +266,10 @@ pub struct Radiosity {
     /// Per node × band: irradiance gathered over the node's own links.
     pub(crate) gathered: Vec<f32>,
     pub(crate) links: Vec<Vec<Link>>,
+    /// What `links` holds in all: links and their shares, kept as they change so that
+    /// `memory_bytes` (checked on every split) does not walk every link, which made
+    /// refinement quadratic in the links.
+    pub(crate) link_totals: LinkTotals,
     /// Per node × band: the direct irradiance (`DirectIrradiance`) averaged over the
     /// element's uncovered sample points; used at leaves.
     pub(crate) direct: Vec<f32>,
@@ -287,6 +321,7 @@ impl Radiosity {
             radiosity_max: Vec::new(),
             gathered: Vec::new(),
             links: Vec::new(),
+            link_totals: LinkTotals::default(),
             direct: Vec::new(),
             direct_variation: Vec::new(),
             covered: Vec::new(),
@@ -502,13 +537,7 @@ impl Radiosity {
 
     fn memory_bytes(&self) -> u64 {
         let nodes = self.hierarchy.nodes.len() as u64;
-        let links: u64 = self.links.iter().map(|l| l.capacity() as u64).sum();
-        let shares: u64 = self
-            .links
-            .iter()
-            .flatten()
-            .map(|l| l.source_shares.len() as u64)
-            .sum();
+        let LinkTotals { links, shares } = self.link_totals;
         nodes
             * (std::mem::size_of::<crate::hierarchy::Node>() as u64
                 + std::mem::size_of::<Vec<Link>>() as u64
@@ -677,6 +706,7 @@ impl Radiosity {
             // Re-examine every link against the radiosities the last solve gave.
             for r in 0..self.links.len() as u32 {
                 let links = std::mem::take(&mut self.links[r as usize]);
+                self.link_totals.remove(&links);
                 let mut kept = Vec::with_capacity(links.len());
                 let mut refined = Vec::new();
                 for mut link in links {
@@ -689,6 +719,7 @@ impl Radiosity {
                         kept.push(link);
                     }
                 }
+                self.link_totals.add(&kept);
                 self.links[r as usize] = kept;
                 for s in refined {
                     self.refine_split(r, s, visibility)?;
@@ -696,6 +727,11 @@ impl Radiosity {
             }
         }
         self.grow_arrays();
+        debug_assert_eq!(
+            self.link_totals,
+            LinkTotals::of(self.links.iter().flatten()),
+            "the running link totals drifted"
+        );
         Ok(())
     }
 
@@ -745,12 +781,14 @@ impl Radiosity {
             return self.refine_split(r, s, vis);
         }
         if factor.form_factor > 0.0 {
-            self.links[r as usize].push(Link {
+            let link = Link {
                 source: s,
                 form_factor: factor.form_factor,
                 partial: factor.partial,
                 source_shares: factor.source_shares,
-            });
+            };
+            self.link_totals.add(std::slice::from_ref(&link));
+            self.links[r as usize].push(link);
         }
         Ok(())
     }
