@@ -108,8 +108,7 @@ fn refusals_name_what_radiosity_cannot_hold() {
     );
     let path = dir.write("scene.json", json.as_bytes());
     let message = prism_scene::load_scene(&path)
-        .err()
-        .expect("a negative ε is refused")
+        .expect_err("a negative ε is refused")
         .to_string();
     assert!(
         message.contains("integrator.gather_epsilon") && message.contains("≥ 0"),

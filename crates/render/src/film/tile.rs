@@ -859,7 +859,7 @@ mod tests {
             .map(|k| Vec2::new((k % 4) as f32 + 0.5, (k / 4) as f32 + 0.5) / 4.0)
             .collect();
         let render = |copies_right: usize, plan: Option<&SamplePlan>| -> Vec<[f32; 3]> {
-            let mut film = Film::new(resolution, filter.clone(), AovSelection::NONE)
+            let mut film = Film::new(resolution, filter, AovSelection::NONE)
                 .unwrap()
                 .with_splatting(true);
             let mut tile = film.new_tile(film.bounds());

@@ -450,7 +450,7 @@ mod tests {
             [1.0, 2.0, 1.0],
             [0.0, 2.0, 1.0],
         ]
-        .map(|p| Vec3A::from_array(p))
+        .map(Vec3A::from_array)
         .to_vec();
         let mesh = Arc::new(EmitterMesh {
             positions,
@@ -501,7 +501,7 @@ mod tests {
             [0.0, 1.0, 0.0],
             [0.0, 0.0, 1.0],
         ]
-        .map(|p| Vec3A::from_array(p))
+        .map(Vec3A::from_array)
         .to_vec();
         let mesh = Arc::new(EmitterMesh {
             positions,

@@ -371,7 +371,7 @@ mod tests {
         let (w, h) = (64usize, 64usize);
         let texels = (0..w * h)
             .map(|i| {
-                let v = if (i % w / (period_texels / 2)) % 2 == 0 {
+                let v = if (i % w / (period_texels / 2)).is_multiple_of(2) {
                     0.0
                 } else {
                     1.0
