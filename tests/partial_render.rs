@@ -5,7 +5,7 @@
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
+use std::process::Stdio;
 use std::time::Duration;
 
 use prism_image::io::raw_exr::{read_raw_channels, RawChannels};
@@ -587,7 +587,7 @@ fn signals_at_random_moments_leave_only_whole_files() {
     };
     let mut stopped = 0;
     for run in 0..50 {
-        let mut child = Command::new(env!("CARGO_BIN_EXE_prism"))
+        let mut child = support::prism_command()
             .args([
                 "render",
                 s(&cornell),

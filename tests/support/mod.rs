@@ -12,9 +12,21 @@ pub fn prism(args: &[&str]) -> Output {
     prism_in(Path::new(env!("CARGO_MANIFEST_DIR")), args)
 }
 
+/// The `prism` binary as a command whose default cache directory (converge's references,
+/// the predictor's BSDF tables; `$XDG_CACHE_HOME/prism`) lies in cargo's temporary
+/// directory for tests, not in the user's home.
+pub fn prism_command() -> Command {
+    let mut command = Command::new(env!("CARGO_BIN_EXE_prism"));
+    command.env(
+        "XDG_CACHE_HOME",
+        Path::new(env!("CARGO_TARGET_TMPDIR")).join("xdg-cache"),
+    );
+    command
+}
+
 /// Runs the `prism` binary with `args` from `dir`.
 pub fn prism_in(dir: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_prism"))
+    prism_command()
         .current_dir(dir)
         .args(args)
         .output()
@@ -24,7 +36,7 @@ pub fn prism_in(dir: &Path, args: &[&str]) -> Output {
 /// Runs the `prism` binary with `args` from the repository root with `PRISM_SIMD` set to
 /// `simd` (`None`: unset, whatever the test process has).
 pub fn prism_simd(simd: Option<&str>, args: &[&str]) -> Output {
-    let mut command = Command::new(env!("CARGO_BIN_EXE_prism"));
+    let mut command = prism_command();
     command
         .current_dir(env!("CARGO_MANIFEST_DIR"))
         .args(args)
