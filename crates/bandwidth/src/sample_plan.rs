@@ -107,7 +107,7 @@ impl SamplePlan {
     /// The same plan with the relative sample density of each pixel (a_p / mean(a), the
     /// expected N_p over the mean: `Allocated::relative_density`): a splatting film spreads
     /// a sample over its neighbours, where the density differs, so it weights each sample
-    /// by 1 / its own pixel's density (`splat_weight`). A pixel of density 0 (it takes no
+    /// by 1 / its own pixel's density (`splat_weights`). A pixel of density 0 (it takes no
     /// samples) keeps weight 1; all densities 1 leave the plan as it is.
     pub fn with_relative_density(mut self, density: &[f32]) -> Result<Self, BandwidthError> {
         if density.len() != self.camera_samples.len() {
@@ -134,17 +134,8 @@ impl SamplePlan {
         Ok(self)
     }
 
-    /// The weight a splatting film gives `pixel`'s samples: 1 / its relative density, 1
-    /// for a plan without densities (uniform) and outside the plan.
-    #[inline]
-    pub fn splat_weight(&self, pixel: UVec2) -> f32 {
-        match &self.splat_weights {
-            None => 1.0,
-            Some(w) => pixel_index("sample plan", pixel, self.resolution).map_or(1.0, |i| w[i]),
-        }
-    }
-
-    /// Every pixel's splat weight (row-major), `None` for a plan without densities.
+    /// Every pixel's splat weight (row-major): 1 / its relative density, 1 where that is 0;
+    /// `None` for a plan without densities (every weight 1).
     pub fn splat_weights(&self) -> Option<&Arc<[f32]>> {
         self.splat_weights.as_ref()
     }

@@ -62,13 +62,16 @@ pub enum MaterialAngularBandwidth {
 impl MaterialAngularBandwidth {
     /// The table of `material` at a neutral hit (its textures at uv = (0.5, 0.5)).
     pub fn build(material: &Material) -> Self {
-        let hit = probe_hit();
-        let wavelengths = SampledWavelengths::sample_visible(0.5);
-        let bsdf = material.bsdf(&hit, &wavelengths);
-        let closed_form = bsdf.lobe.angular_bandwidth_cycles_per_rad();
-        if bsdf.is_specular() || bsdf.has_specular() || closed_form == 0.0 {
-            return Self::Constant(closed_form);
+        match with_tabulated_bsdf(material, |bsdf, wavelengths| {
+            Self::Table(Self::tabulate(bsdf, wavelengths))
+        }) {
+            Ok(table) => table,
+            Err(closed_form) => Self::Constant(closed_form),
         }
+    }
+
+    /// The table's values for a lobe that gets one (`with_tabulated_bsdf`).
+    fn tabulate(bsdf: &Bsdf, wavelengths: &SampledWavelengths) -> Vec<f32> {
         if bsdf.lobe.is_isotropic() {
             // One incident azimuth per θᵢ: the slice at φᵢ = k·2π/16 is that of φᵢ = 0
             // rotated by k cells in φₒ (the lobe depends on φₒ − φᵢ only). 16× fewer
@@ -77,14 +80,14 @@ impl MaterialAngularBandwidth {
             // differs from a slice taken at φᵢ itself, which the test below bounds.
             let first: Vec<Vec<f32>> = (0..TABLE_CELLS)
                 .into_par_iter()
-                .map(|it| slice_bandwidth(&bsdf, cell_direction(it, 0, TABLE_CELLS), &wavelengths))
+                .map(|it| slice_bandwidth(bsdf, cell_direction(it, 0, TABLE_CELLS), wavelengths))
                 .collect();
             let rotated: Vec<f32> = (0..TABLE_CELLS * TABLE_CELLS)
                 .flat_map(|i| rotated_in_phi(&first[i / TABLE_CELLS], i % TABLE_CELLS))
                 .collect();
-            return Self::Table(rotated);
+            return rotated;
         }
-        Self::Table(full_table(&bsdf, &wavelengths))
+        full_table(bsdf, wavelengths)
     }
 
     /// ρ for light from `wi_local` seen from `wo_local` (shading frame, z = normal).
@@ -107,6 +110,24 @@ impl MaterialAngularBandwidth {
             }
         }
     }
+}
+
+/// `f` of the BSDF a table is built from — `material`'s at the neutral hit, at the
+/// table's wavelengths — or, for a lobe that gets no table (Lambert: 0, Dirac: ∞, a smooth
+/// coat's Dirac part: its closed form), `Err` of the lobe's closed-form bandwidth. The one
+/// decision `build` and the cache's fingerprint (`bsdf_table_cache.rs`) share.
+pub(crate) fn with_tabulated_bsdf<R>(
+    material: &Material,
+    f: impl FnOnce(&Bsdf, &SampledWavelengths) -> R,
+) -> Result<R, f32> {
+    let hit = probe_hit();
+    let wavelengths = SampledWavelengths::sample_visible(0.5);
+    let bsdf = material.bsdf(&hit, &wavelengths);
+    let closed_form = bsdf.lobe.angular_bandwidth_cycles_per_rad();
+    if bsdf.is_specular() || bsdf.has_specular() || closed_form == 0.0 {
+        return Err(closed_form);
+    }
+    Ok(f(&bsdf, &wavelengths))
 }
 
 /// Every incident cell's slice taken at its own direction (any lobe).

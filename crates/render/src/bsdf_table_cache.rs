@@ -15,14 +15,12 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use prism_bandwidth::local_bandwidth::HAAR_BETA_CYCLES_PER_TEXEL;
-use prism_spectrum::SampledWavelengths;
 
 use crate::bsdf::{Bxdf, TransportMode};
 use crate::bsdf_angular_table::{
-    cell_direction, MaterialAngularBandwidth, SLICE_TEXELS, TABLE_CELLS,
+    cell_direction, with_tabulated_bsdf, MaterialAngularBandwidth, SLICE_TEXELS, TABLE_CELLS,
 };
 use crate::material::Material;
-use crate::plan::probe_hit;
 use crate::probe::reflectance_y;
 use crate::stable_hash::Fnv1a64;
 
@@ -88,35 +86,31 @@ impl AngularTableCache {
 
 /// The fingerprint of `material`'s table (module docs); `None` when `build` makes no table.
 pub fn fingerprint(material: &Material) -> Option<u64> {
-    let hit = probe_hit();
-    let wavelengths = SampledWavelengths::sample_visible(0.5);
-    let bsdf = material.bsdf(&hit, &wavelengths);
-    let closed_form = bsdf.lobe.angular_bandwidth_cycles_per_rad();
-    if bsdf.is_specular() || bsdf.has_specular() || closed_form == 0.0 {
-        return None;
-    }
-    let mut hash = Fnv1a64::new();
-    for word in [
-        FORMAT_VERSION,
-        TABLE_CELLS as u32,
-        SLICE_TEXELS as u32,
-        HAAR_BETA_CYCLES_PER_TEXEL.to_bits(),
-        u32::from(bsdf.lobe.is_isotropic()),
-        closed_form.to_bits(),
-    ] {
-        hash.write(&word.to_le_bytes());
-    }
-    let n = TABLE_CELLS;
-    let m = FINGERPRINT_OUTGOING;
-    for incident in 0..n * n {
-        let wi = cell_direction(incident / n, incident % n, n);
-        for outgoing in 0..m * m {
-            let wo = cell_direction(outgoing / m, outgoing % m, m);
-            let y = reflectance_y(bsdf.eval(wo, wi, TransportMode::Radiance), &wavelengths);
-            hash.write(&y.to_bits().to_le_bytes());
+    with_tabulated_bsdf(material, |bsdf, wavelengths| {
+        let mut hash = Fnv1a64::new();
+        for word in [
+            FORMAT_VERSION,
+            TABLE_CELLS as u32,
+            SLICE_TEXELS as u32,
+            HAAR_BETA_CYCLES_PER_TEXEL.to_bits(),
+            u32::from(bsdf.lobe.is_isotropic()),
+            bsdf.lobe.angular_bandwidth_cycles_per_rad().to_bits(),
+        ] {
+            hash.write(&word.to_le_bytes());
         }
-    }
-    Some(hash.finish())
+        let n = TABLE_CELLS;
+        let m = FINGERPRINT_OUTGOING;
+        for incident in 0..n * n {
+            let wi = cell_direction(incident / n, incident % n, n);
+            for outgoing in 0..m * m {
+                let wo = cell_direction(outgoing / m, outgoing % m, m);
+                let y = reflectance_y(bsdf.eval(wo, wi, TransportMode::Radiance), wavelengths);
+                hash.write(&y.to_bits().to_le_bytes());
+            }
+        }
+        hash.finish()
+    })
+    .ok()
 }
 
 fn table_len() -> usize {

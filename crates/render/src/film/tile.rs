@@ -198,7 +198,7 @@ pub(crate) struct SplatBuffer {
     /// gathers.
     simd: prism_cpu::Simd,
     /// Per film pixel (row-major, `film_width` wide), the weight of the samples taken for
-    /// it (`SamplePlan::splat_weight`: 1 / its relative sample density); `None`: 1.
+    /// it (`SamplePlan::splat_weights`: 1 / its relative sample density); `None`: 1.
     sample_weights: Option<(Arc<[f32]>, u32)>,
 }
 
@@ -499,8 +499,8 @@ pub struct FilmTile {
 }
 
 impl FilmTile {
-    /// On a splatting film, weights each sample by `plan`'s `splat_weight` of the pixel it
-    /// was taken for (1 / the pixel's relative sample density), so that where the density
+    /// On a splatting film, weights each sample by `plan`'s `splat_weights` entry of the
+    /// pixel it was taken for (1 / its relative sample density), so that where the density
     /// varies a pixel's sum Σ f·w·L / Σ f·w is not pulled towards its denser neighbours.
     /// Nothing changes for a film that does not splat (each sample stays in its pixel).
     pub fn set_sample_weights(&mut self, plan: &prism_bandwidth::SamplePlan) {
