@@ -264,6 +264,7 @@ mod tests {
     use super::*;
 
     use crate::test_rng::Rng;
+    use prism_testkit::windowed_spectrum;
 
     fn image(resolution: UVec2, f: impl Fn(f32, f32) -> f32) -> Vec<f32> {
         let mut v = Vec::with_capacity((resolution.x * resolution.y) as usize);
@@ -425,72 +426,10 @@ mod tests {
 
     /// 95 %-energy radius (cycles/texel) of the Hann-windowed 32×32 spectrum at (cx, cy).
     fn windowed_fft_radius(v: &[f32], n: u32, cx: u32, cy: u32) -> f32 {
-        let w = 32usize;
-        let mut win = vec![0f64; w * w];
-        let hann =
-            |i: usize| 0.5 - 0.5 * (2.0 * std::f64::consts::PI * (i as f64 + 0.5) / w as f64).cos();
-        let mut mean = 0.0;
-        for j in 0..w {
-            for i in 0..w {
-                let x = cx as usize + i - w / 2;
-                let y = cy as usize + j - w / 2;
-                mean += v[y * n as usize + x] as f64;
-            }
-        }
-        mean /= (w * w) as f64;
-        for j in 0..w {
-            for i in 0..w {
-                let x = cx as usize + i - w / 2;
-                let y = cy as usize + j - w / 2;
-                win[j * w + i] = (v[y * n as usize + x] as f64 - mean) * hann(i) * hann(j);
-            }
-        }
-        // Separable DFT.
-        let mut rows = vec![(0f64, 0f64); w * w];
-        for j in 0..w {
-            for k in 0..w {
-                let (mut re, mut im) = (0.0, 0.0);
-                for i in 0..w {
-                    let a = -2.0 * std::f64::consts::PI * (k * i) as f64 / w as f64;
-                    re += win[j * w + i] * a.cos();
-                    im += win[j * w + i] * a.sin();
-                }
-                rows[j * w + k] = (re, im);
-            }
-        }
-        let mut power = Vec::new();
-        for k in 0..w {
-            for l in 0..w {
-                let (mut re, mut im) = (0.0, 0.0);
-                for j in 0..w {
-                    let a = -2.0 * std::f64::consts::PI * (l * j) as f64 / w as f64;
-                    let (r, q) = rows[j * w + k];
-                    re += r * a.cos() - q * a.sin();
-                    im += r * a.sin() + q * a.cos();
-                }
-                let fk = if k <= w / 2 {
-                    k as f64
-                } else {
-                    k as f64 - w as f64
-                } / w as f64;
-                let fl = if l <= w / 2 {
-                    l as f64
-                } else {
-                    l as f64 - w as f64
-                } / w as f64;
-                power.push(((fk * fk + fl * fl).sqrt(), re * re + im * im));
-            }
-        }
-        power.sort_by(|a, b| a.0.partial_cmp(&b.0).unwrap());
-        let total: f64 = power.iter().map(|p| p.1).sum();
-        let mut acc = 0.0;
-        for (f, p) in power {
-            acc += p;
-            if acc >= 0.95 * total {
-                return f as f32;
-            }
-        }
-        0.5
+        let values: Vec<f64> = v.iter().map(|&x| f64::from(x)).collect();
+        let origin = (cx as usize - 16, cy as usize - 16);
+        let bins = windowed_spectrum::hann_power_spectrum(&values, n as usize, origin, 32);
+        windowed_spectrum::energy_radius(&bins, 0.95).unwrap_or(0.5) as f32
     }
 
     #[test]

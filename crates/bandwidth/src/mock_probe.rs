@@ -57,6 +57,7 @@ impl ShadingProbe for MockProbe {
             cos_theta_i,
             distance_m,
             light_bandwidth: self.light_bandwidth,
+            emitter_bandwidth: self.light_bandwidth,
             material_bandwidth: self.material_bandwidth,
             lane_variance: 0.0,
             visibility: Visibility::Unknown,

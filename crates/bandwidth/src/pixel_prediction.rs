@@ -198,24 +198,41 @@ pub fn predict_pixel(
     let measured_variance =
         (weight_variance_sum(samples, n_b, LightSample::visible_weight_y) / n) as f32;
     let mut visibility = VisibilitySummary::default();
+    // Eq. 5's weighting for the penumbra: each blocked sample's penumbra counts by its share
+    // of the light the traced samples would bring unoccluded, so that the shadow of a dim
+    // part of a light (a grazing sample, an environment's dark texel with a sharp edge)
+    // does not speak for the pixel.
+    let (mut penumbra_sum, mut traced_weight) = (0.0f64, 0.0f64);
     for sample in samples {
+        let weight = f64::from(sample.weight_y());
+        let towards_area_light = !sample.is_delta() && sample.distance_m.is_finite();
         match sample.visibility {
             Visibility::Unknown => {}
             Visibility::Visible => {
                 visibility.traced += 1;
                 visibility.visible += 1;
+                visibility.area_traced += u32::from(towards_area_light);
+                visibility.area_visible += u32::from(towards_area_light);
+                traced_weight += weight;
             }
             Visibility::Blocked { blocker_distance_m } => {
                 visibility.traced += 1;
-                visibility.penumbra_cycles_per_m =
-                    visibility.penumbra_cycles_per_m.max(penumbra_bandwidth(
-                        sample.light_bandwidth,
-                        sample.is_delta(),
-                        sample.distance_m,
-                        blocker_distance_m,
-                    ));
+                visibility.area_traced += u32::from(towards_area_light);
+                traced_weight += weight;
+                if weight > 0.0 {
+                    penumbra_sum += weight
+                        * f64::from(penumbra_bandwidth(
+                            sample.emitter_bandwidth,
+                            sample.is_delta(),
+                            sample.distance_m,
+                            blocker_distance_m,
+                        ));
+                }
             }
         }
+    }
+    if traced_weight > 0.0 {
+        visibility.penumbra_cycles_per_m = (penumbra_sum / traced_weight) as f32;
     }
     Ok(PixelPrediction {
         bandwidth,
@@ -274,6 +291,7 @@ mod tests {
             cos_theta_i: cos,
             distance_m: d,
             light_bandwidth: light,
+            emitter_bandwidth: light,
             material_bandwidth: MaterialBandwidth::new(rho, 0.0).unwrap(),
             lane_variance: 0.0,
             visibility: Visibility::Unknown,
@@ -302,6 +320,55 @@ mod tests {
         assert!((p.bandwidth.angular_cycles_per_rad - single.angular_cycles_per_rad).abs() < 1e-4);
         assert!(
             (p.image_bandwidth_cycles_per_px - single.angular_cycles_per_rad * 0.01).abs() < 1e-6
+        );
+    }
+
+    #[test]
+    fn a_penumbra_counts_by_its_share_of_the_light() {
+        // Sun-like light (ν_a 100) and a dim sky texel with a sharp edge (ν_a 10⁴), blocked
+        // 0.5 m away: penumbrae 200 and 2·10⁴ cycles/m. The sky brings 1 % of the light.
+        let blocked = |nu_a: f32, radiance_y: f32| LightSample {
+            visibility: Visibility::Blocked {
+                blocker_distance_m: 0.5,
+            },
+            ..sample(
+                Bandwidth::distant_light(nu_a).unwrap(),
+                5.0,
+                radiance_y,
+                0.5,
+                f32::INFINITY,
+            )
+        };
+        let penumbra = |samples: &[LightSample]| {
+            predict_pixel(
+                &plane_hit(1.0),
+                samples,
+                FOOTPRINT,
+                VarianceBandwidth::Incident,
+            )
+            .unwrap()
+            .visibility
+            .penumbra_cycles_per_m
+        };
+        let sun = blocked(100.0, 99.0);
+        let sky = blocked(1e4, 1.0);
+        assert!((penumbra(&[sun, sky]) - (0.99 * 200.0 + 0.01 * 2e4)).abs() < 1e-2);
+        // A visible sample brings light but no penumbra.
+        let lit = LightSample {
+            visibility: Visibility::Visible,
+            ..sun
+        };
+        assert!((penumbra(&[sun, lit]) - 100.0).abs() < 1e-3);
+        // Without shadow rays there is no penumbra.
+        assert_eq!(
+            penumbra(&[sample(
+                Bandwidth::distant_light(1.0).unwrap(),
+                5.0,
+                1.0,
+                0.5,
+                1.0
+            )]),
+            0.0
         );
     }
 
@@ -401,6 +468,7 @@ mod tests {
             cos_theta_i: 1.0,
             distance_m: f32::INFINITY,
             light_bandwidth: Bandwidth::distant_light(nu_env).unwrap(),
+            emitter_bandwidth: Bandwidth::distant_light(nu_env).unwrap(),
             material_bandwidth: MaterialBandwidth::new(f32::INFINITY, 0.0).unwrap(),
             lane_variance: 0.0,
             visibility: Visibility::Unknown,

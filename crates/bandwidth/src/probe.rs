@@ -51,6 +51,11 @@ pub struct LightSample {
     /// ν_l^i: bandwidth of the light field leaving the light along ω_i (eq. 4's input):
     /// spatial for area lights, angular for distant ones.
     pub light_bandwidth: Bandwidth,
+    /// ν_l of the light as a whole, which sets the penumbra of its shadows (`visibility`):
+    /// an area light's 1/√A, since a penumbra spans the whole emitter and not the detail
+    /// at the sampled point (`light_bandwidth` holds eq. 7's ν_s there, which is high on
+    /// the outline); for other lights the same as `light_bandwidth`.
+    pub emitter_bandwidth: Bandwidth,
     /// ρ and t of the material at the hit for (ω_i, ω_o) (eq. 3's B_{t,ρ}, eq. 9's ν_ρa).
     pub material_bandwidth: MaterialBandwidth,
     /// The colour noise of this sample's weight that luminance bandwidth misses: the

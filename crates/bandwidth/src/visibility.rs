@@ -52,7 +52,15 @@ pub struct VisibilitySummary {
     pub traced: u32,
     /// Of those, the visible ones.
     pub visible: u32,
-    /// The largest penumbra bandwidth over the blocked samples, cycles/m (0: none blocked).
+    /// Of the traced samples, those towards area lights (a position and an extent), and of
+    /// those the visible ones: a compact emitter's samples disagree only where the pixel
+    /// sees part of it, in its penumbra. (An environment's samples span the sky, so theirs
+    /// disagree wherever part of the sky is hidden; a delta light's never do.)
+    pub area_traced: u32,
+    pub area_visible: u32,
+    /// The blocked samples' penumbra bandwidths, each weighted by its share of the light
+    /// the traced samples would bring unoccluded (eq. 5's weighting), cycles/m (0: none
+    /// blocked).
     pub penumbra_cycles_per_m: f32,
 }
 
@@ -62,11 +70,38 @@ impl VisibilitySummary {
         (self.traced > 0).then(|| self.visible as f32 / self.traced as f32)
     }
 
-    /// Some traced samples see the light and some do not.
-    pub fn disagrees(&self) -> bool {
-        self.visible > 0 && self.visible < self.traced
+    /// Some of the samples towards area lights see them and some do not: the pixel lies in
+    /// a penumbra (or in the shadow of one of several area lights).
+    pub fn in_area_penumbra(&self) -> bool {
+        self.area_visible > 0 && self.area_visible < self.area_traced
+    }
+
+    /// Whether a neighbour's visible share differs from this one's by more than the
+    /// probes' sampling noise: by at least [`SHADOW_EDGE_SHARE_STEP`] and by more than
+    /// [`SHADOW_EDGE_STANDARD_ERRORS`] standard errors of the difference of two binomial
+    /// shares (pooled). `false` when either traced nothing.
+    pub fn differs_from(&self, neighbour: &VisibilitySummary) -> bool {
+        let (Some(a), Some(b)) = (self.visible_share(), neighbour.visible_share()) else {
+            return false;
+        };
+        let (n_a, n_b) = (self.traced as f32, neighbour.traced as f32);
+        let pooled = (self.visible + neighbour.visible) as f32 / (n_a + n_b);
+        let standard_error = (pooled * (1.0 - pooled) * (1.0 / n_a + 1.0 / n_b)).sqrt();
+        let step = (a - b).abs();
+        step >= SHADOW_EDGE_SHARE_STEP && step > SHADOW_EDGE_STANDARD_ERRORS * standard_error
     }
 }
+
+/// Two visible shares this far apart put a shadow boundary between two pixels: the shadow
+/// crosses in 4 pixels or fewer (a wider penumbra is smooth at the pixel scale).
+pub const SHADOW_EDGE_SHARE_STEP: f32 = 0.25;
+
+/// How many standard errors of sampling noise a share step must exceed. With 16 samples
+/// in the sun's umbra under a visible sky (share ≈ 0.2) noise alone steps 0.25 between
+/// ≈ 8 % of neighbour pairs and 2.5 standard errors (0.37 there) between ≈ 1 %; around a
+/// pooled share of ½ (a hard edge, 0 against 1, or a penumbra crossed in two pixels,
+/// ¼ against ¾) a step needs 0.44.
+pub const SHADOW_EDGE_STANDARD_ERRORS: f32 = 2.5;
 
 #[cfg(test)]
 mod tests {
@@ -85,10 +120,30 @@ mod tests {
         let s = VisibilitySummary {
             traced: 8,
             visible: 3,
+            area_traced: 8,
+            area_visible: 3,
             penumbra_cycles_per_m: 5.0,
         };
-        assert!(s.disagrees());
+        assert!(s.in_area_penumbra());
         assert_eq!(s.visible_share(), Some(0.375));
         assert_eq!(VisibilitySummary::default().visible_share(), None);
+    }
+
+    #[test]
+    fn only_steps_beyond_sampling_noise_are_shadow_edges() {
+        let share = |visible: u32| VisibilitySummary {
+            traced: 16,
+            visible,
+            penumbra_cycles_per_m: 1.0,
+            ..VisibilitySummary::default()
+        };
+        // A hard edge and a penumbra crossed in two pixels.
+        assert!(share(0).differs_from(&share(16)));
+        assert!(share(4).differs_from(&share(12)));
+        // Noise around 0.2: 1/16 against 6/16 is 0.31 apart, under 2.5 standard errors (0.37).
+        assert!(!share(1).differs_from(&share(6)));
+        // Under the step: a penumbra wider than 4 pixels.
+        assert!(!share(8).differs_from(&share(11)));
+        assert!(!share(8).differs_from(&VisibilitySummary::default()));
     }
 }

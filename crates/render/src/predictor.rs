@@ -356,13 +356,13 @@ struct EyeGeometry {
     rad_per_px: f32,
 }
 
-/// Two visible shares this far apart put a shadow boundary between two pixels.
-const SHADOW_EDGE_SHARE_STEP: f32 = 0.25;
-
-/// Shadow edges (`prism_bandwidth::visibility`): a pixel whose shadow rays disagree, or
-/// whose visible share differs from a 4-neighbour's by `SHADOW_EDGE_SHARE_STEP` or more,
-/// gets the penumbra's spatial bandwidth (its own or, when all its light samples were
-/// visible, its neighbours'), carried to the eye like a texture's (P_x then T_d′).
+/// Shadow edges (`prism_bandwidth::visibility`): a pixel in an area light's penumbra (its
+/// samples towards area lights disagree), or whose visible share differs from a
+/// 4-neighbour's beyond sampling noise (`VisibilitySummary::differs_from`), gets the
+/// penumbra's spatial bandwidth (its own or, when all its light samples were visible, its
+/// neighbours'), carried to the eye like a texture's (P_x then T_d′). An environment's
+/// samples disagreeing is no edge by itself: in the sun's umbra under a visible sky every
+/// pixel has both.
 fn add_shadow_edges(
     resolution: UVec2,
     pixels: &mut [PixelPrediction],
@@ -374,7 +374,7 @@ fn add_shadow_edges(
         let Some(eye) = eye[i] else { continue };
         let (x, y) = (i % w, i / w);
         let own = before[i];
-        let mut edge = own.disagrees();
+        let mut edge = own.in_area_penumbra();
         let mut penumbra = own.penumbra_cycles_per_m;
         let neighbours = [
             (x > 0).then(|| i - 1),
@@ -383,11 +383,9 @@ fn add_shadow_edges(
             (y + 1 < h).then(|| i + w),
         ];
         for n in neighbours.into_iter().flatten() {
-            if let (Some(a), Some(b)) = (own.visible_share(), before[n].visible_share()) {
-                if (a - b).abs() >= SHADOW_EDGE_SHARE_STEP {
-                    edge = true;
-                    penumbra = penumbra.max(before[n].penumbra_cycles_per_m);
-                }
+            if own.differs_from(&before[n]) {
+                edge = true;
+                penumbra = penumbra.max(before[n].penumbra_cycles_per_m);
             }
         }
         if !edge || penumbra <= 0.0 || eye.cos_theta_x <= 0.0 {

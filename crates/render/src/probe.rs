@@ -224,6 +224,22 @@ impl<'a> RenderProbe<'a> {
             }
         }
     }
+
+    /// `LightSample::emitter_bandwidth` of light `index`, whose bandwidth at the sampled
+    /// point is `at_point`: an area light's closed form (its size), for the penumbrae of
+    /// its shadows; any other light's `at_point`.
+    fn emitter_bandwidth(&self, index: usize, at_point: Bandwidth) -> Bandwidth {
+        match &self.scene.lights.lights()[index] {
+            light @ Light::Area(_) => light.bandwidth(),
+            Light::Point(_)
+            | Light::Spot(_)
+            | Light::Directional(_)
+            | Light::Environment(_)
+            | Light::Sky(_)
+            | Light::Daylight(_)
+            | Light::Goniometric(_) => at_point,
+        }
+    }
 }
 
 /// Eq. 7's per-point map of a light (`RenderProbe::light_maps`).
@@ -518,23 +534,29 @@ impl ShadingProbe for RenderProbe<'_> {
                         pdf_per_sr
                     };
                     let lanes = lane_variance(ls.radiance * f * (1.0 / divisor), &wavelengths);
-                    let visibility = if self.trace_visibility {
+                    let bsdf_cos_per_sr = reflectance_y(f, &wavelengths);
+                    // A sample the BSDF does not scatter towards the eye (the light behind
+                    // a reflector) lights nothing, blocked or not: its shadow ray, which
+                    // meets the surface's own back, would fake a shadow edge.
+                    let visibility = if self.trace_visibility && bsdf_cos_per_sr > 0.0 {
                         self.shadow_ray(&si, &ls)
                     } else {
                         Visibility::Unknown
                     };
+                    let light_bandwidth = self.light_bandwidth_towards(
+                        l as usize,
+                        ls.wi,
+                        Some(si.p + ls.wi * ls.distance_m),
+                    );
                     out.push(LightSample {
                         direction: ls.wi,
                         radiance_y,
                         pdf_per_sr,
-                        bsdf_cos_per_sr: reflectance_y(f, &wavelengths),
+                        bsdf_cos_per_sr,
                         cos_theta_i: cos,
                         distance_m: ls.distance_m,
-                        light_bandwidth: self.light_bandwidth_towards(
-                            l as usize,
-                            ls.wi,
-                            Some(si.p + ls.wi * ls.distance_m),
-                        ),
+                        light_bandwidth,
+                        emitter_bandwidth: self.emitter_bandwidth(l as usize, light_bandwidth),
                         material_bandwidth: self.material_bandwidth_at(
                             hit.material_id(),
                             &bsdf,
@@ -586,6 +608,11 @@ impl ShadingProbe for RenderProbe<'_> {
                             pdf_per_sr
                         };
                         let lanes = lane_variance(le * bs.f * (cos / divisor), &wavelengths);
+                        let light_bandwidth = self.light_bandwidth_towards(
+                            l as usize,
+                            wi,
+                            light_hit.as_ref().map(|h| h.p),
+                        );
                         out.push(LightSample {
                             direction: wi,
                             radiance_y,
@@ -593,11 +620,8 @@ impl ShadingProbe for RenderProbe<'_> {
                             bsdf_cos_per_sr,
                             cos_theta_i: cos,
                             distance_m,
-                            light_bandwidth: self.light_bandwidth_towards(
-                                l as usize,
-                                wi,
-                                light_hit.as_ref().map(|h| h.p),
-                            ),
+                            light_bandwidth,
+                            emitter_bandwidth: self.emitter_bandwidth(l as usize, light_bandwidth),
                             material_bandwidth: self.material_bandwidth_at(
                                 hit.material_id(),
                                 &bsdf,

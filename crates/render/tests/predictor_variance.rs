@@ -12,38 +12,9 @@ use std::path::Path;
 use prism_render::predictor::{predict, PredictorSettings};
 use prism_render::{render, RenderScene, RenderSettings};
 use prism_scene::{load_scene, Integrator};
+use prism_testkit::rank_correlation::spearman;
 
 const SPP: u32 = 1024;
-
-/// Ranks (0-based, ties averaged) of `values`.
-fn ranks(values: &[f64]) -> Vec<f64> {
-    let mut order: Vec<usize> = (0..values.len()).collect();
-    order.sort_by(|&a, &b| values[a].total_cmp(&values[b]));
-    let mut ranks = vec![0.0; values.len()];
-    let mut i = 0;
-    while i < order.len() {
-        let mut j = i;
-        while j + 1 < order.len() && values[order[j + 1]] == values[order[i]] {
-            j += 1;
-        }
-        let rank = (i + j) as f64 / 2.0;
-        for k in &order[i..=j] {
-            ranks[*k] = rank;
-        }
-        i = j + 1;
-    }
-    ranks
-}
-
-fn spearman(a: &[f64], b: &[f64]) -> f64 {
-    let (ra, rb) = (ranks(a), ranks(b));
-    let n = ra.len() as f64;
-    let (ma, mb) = (ra.iter().sum::<f64>() / n, rb.iter().sum::<f64>() / n);
-    let cov: f64 = ra.iter().zip(&rb).map(|(x, y)| (x - ma) * (y - mb)).sum();
-    let va: f64 = ra.iter().map(|x| (x - ma).powi(2)).sum();
-    let vb: f64 = rb.iter().map(|y| (y - mb).powi(2)).sum();
-    cov / (va * vb).sqrt()
-}
 
 fn median(values: &[f64]) -> f64 {
     let mut v = values.to_vec();
