@@ -139,25 +139,19 @@ fn read_table(path: &Path) -> Option<Vec<f32>> {
         .then_some(values)
 }
 
-/// Writes the table through a temporary sibling and a rename, so that a reader never sees
-/// half a file.
+/// Writes the table through a temporary sibling and a rename (`prism_image::io`'s atomic
+/// write), so that a reader never sees half a file.
 fn write_table(path: &Path, values: &[f32]) -> Result<(), String> {
-    let temporary = path.with_extension(format!("bin.{}.tmp", std::process::id()));
-    let write = || -> std::io::Result<()> {
-        let mut file = std::io::BufWriter::new(std::fs::File::create(&temporary)?);
+    prism_image::io::write_stream_atomically(path, |file| {
         file.write_all(MAGIC)?;
         file.write_all(&FORMAT_VERSION.to_le_bytes())?;
         file.write_all(&(TABLE_CELLS as u32).to_le_bytes())?;
         for v in values {
             file.write_all(&v.to_le_bytes())?;
         }
-        file.into_inner().map_err(|e| e.into_error())?.sync_all()?;
-        std::fs::rename(&temporary, path)
-    };
-    write().map_err(|e| {
-        let _ = std::fs::remove_file(&temporary);
-        format!("BSDF table cache {}: cannot write ({e})", path.display())
+        Ok(())
     })
+    .map_err(|e| format!("BSDF table cache: cannot write ({e})"))
 }
 
 #[cfg(test)]

@@ -118,8 +118,10 @@ pub fn write_stream_atomically(
     write_atomically(path, |tmp| {
         let file = File::create(tmp).map_err(|e| ImageError::io(path, "create", e))?;
         let mut out = BufWriter::new(file);
+        // On disk before the rename: a crash after it must not leave an empty file.
         write(&mut out)
-            .and_then(|()| out.flush())
+            .and_then(|()| out.into_inner().map_err(|e| e.into_error()))
+            .and_then(|file| file.sync_all())
             .map_err(|e| ImageError::io(path, "write", e))
     })
 }

@@ -45,8 +45,7 @@
 //! sampling (Hesterberg 1995) covers bins whose centre missed a thin lobe.
 
 use std::fmt;
-use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use glam::{Vec2, Vec3A};
 use prism_spectrum::{RgbGamut, SampledSpectrum};
@@ -370,37 +369,12 @@ impl MerlTable {
     }
 
     /// Writes the file through a temporary file in the same folder, renamed into place, so
-    /// a failure never leaves a half-written table.
+    /// a failure never leaves a half-written table (`prism_image::io`'s atomic write, the
+    /// one every output takes).
     pub fn write(&self, path: &Path) -> Result<(), MerlError> {
-        let dir = path
-            .parent()
-            .filter(|p| !p.as_os_str().is_empty())
-            .unwrap_or(Path::new("."));
-        let mut tmp = tempfile_in(dir).map_err(|e| e.at(path))?;
-        tmp.1
-            .write_all(&self.to_bytes())
-            .and_then(|_| tmp.1.sync_all())
-            .map_err(|e| MerlError::new(format!("cannot write: {e}")).at(path))?;
-        drop(tmp.1);
-        std::fs::rename(&tmp.0, path).map_err(|e| {
-            let _ = std::fs::remove_file(&tmp.0);
-            MerlError::new(format!("cannot move the written table into place: {e}")).at(path)
-        })
+        prism_image::io::write_bytes_atomically(path, &self.to_bytes())
+            .map_err(|e| MerlError::new(format!("cannot write the table: {e}")))
     }
-}
-
-/// A new file next to the target (its name unique to this process and moment).
-fn tempfile_in(dir: &Path) -> Result<(PathBuf, std::fs::File), MerlError> {
-    let stamp = std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .map_or(0, |d| d.as_nanos());
-    let path = dir.join(format!(".merl-{}-{stamp}.tmp", std::process::id()));
-    std::fs::OpenOptions::new()
-        .write(true)
-        .create_new(true)
-        .open(&path)
-        .map(|f| (path, f))
-        .map_err(|e| MerlError::new(format!("cannot create a temporary file: {e}")))
 }
 
 /// One bin, 8 bytes: the spectrum scale (exact f32, as the RGB→spectrum step gives it) and
