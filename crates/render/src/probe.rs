@@ -722,6 +722,50 @@ mod tests {
         assert_eq!(out, again);
     }
 
+    /// Shadow rays only where the BSDF scatters the light towards the eye: under a lamp, the
+    /// bottom of a sphere sees the lamp from behind, and its shadow rays, which would meet
+    /// the sphere itself, are not traced (they faked a shadow edge along the terminator).
+    /// The samples that are traced carry the lamp's size, 1/√A, for the penumbra.
+    #[test]
+    fn shadow_rays_are_traced_only_for_samples_that_light_the_hit() {
+        let json = r#"{"materials": {"white": {"type": "lambert", "reflectance": 0.8},
+                "black": {"type": "lambert", "reflectance": 0.0}},
+            "shapes": [{"type": "sphere", "material": "white"},
+                {"type": "rectangle", "name": "lamp", "size_m": [0.5, 0.5], "material": "black",
+                 "transform": [{"rotate": {"axis": [1, 0, 0], "angle_deg": 90}},
+                               {"translate": [0, 3, 0]}]}],
+            "lights": [{"type": "area", "shape": "lamp", "spectrum": 1.0}]}"#;
+        let scene = RenderScene::build(&parse_scene_str(json, "t.json").unwrap(), None).unwrap();
+        let mut probe = RenderProbe::new(&scene, 1);
+        probe.trace_visibility = true;
+        let hit_facing = |y: f32| {
+            GBufferHit::new(
+                Vec3A::new(0.0, y, 0.0),
+                2.0,
+                Vec3A::new(0.0, y, 0.0),
+                Curvature::default(),
+                Vec3A::new(0.0, y, 0.0),
+                0,
+            )
+            .unwrap()
+        };
+        let mut out = Vec::new();
+        probe.sample_lights(UVec2::ZERO, &hit_facing(-1.0), 32, &mut out);
+        assert!(!out.is_empty());
+        assert!(out
+            .iter()
+            .all(|s| s.bsdf_cos_per_sr == 0.0 && s.visibility == Visibility::Unknown));
+        probe.sample_lights(UVec2::ZERO, &hit_facing(1.0), 32, &mut out);
+        let lit: Vec<_> = out
+            .iter()
+            .filter(|s| s.visibility == Visibility::Visible)
+            .collect();
+        assert!(!lit.is_empty());
+        for s in lit {
+            assert!((s.emitter_bandwidth.spatial_cycles_per_m - 2.0).abs() < 1e-5);
+        }
+    }
+
     /// One bounce of indirect light inside a Lambertian sphere (albedo a, radius R) around a
     /// point light of intensity I at its centre: every wall point leaves L_o = a I/(π R²),
     /// so the indirect radiance at the wall is a·L_o = a² I/(π R²) (0.159 for a = ½, I = 2,
