@@ -58,6 +58,7 @@ impl ShadingProbe for MockProbe {
             distance_m,
             light_bandwidth: self.light_bandwidth,
             emitter_bandwidth: self.light_bandwidth,
+            light_index: 0,
             material_bandwidth: self.material_bandwidth,
             lane_variance: 0.0,
             visibility: Visibility::Unknown,

@@ -205,20 +205,21 @@ pub fn predict_pixel(
     let (mut penumbra_sum, mut traced_weight) = (0.0f64, 0.0f64);
     for sample in samples {
         let weight = f64::from(sample.weight_y());
-        let towards_area_light = !sample.is_delta() && sample.distance_m.is_finite();
         match sample.visibility {
             Visibility::Unknown => {}
             Visibility::Visible => {
                 visibility.traced += 1;
                 visibility.visible += 1;
-                visibility.area_traced += u32::from(towards_area_light);
-                visibility.area_visible += u32::from(towards_area_light);
                 traced_weight += weight;
             }
             Visibility::Blocked { blocker_distance_m } => {
                 visibility.traced += 1;
-                visibility.area_traced += u32::from(towards_area_light);
                 traced_weight += weight;
+                visibility.in_area_penumbra |= is_area_light_sample(sample)
+                    && samples.iter().any(|other| {
+                        other.light_index == sample.light_index
+                            && other.visibility == Visibility::Visible
+                    });
                 if weight > 0.0 {
                     penumbra_sum += weight
                         * f64::from(penumbra_bandwidth(
@@ -245,6 +246,12 @@ pub fn predict_pixel(
         measured_variance,
         visibility,
     })
+}
+
+/// A sample of a light with a position and an extent (an area light): not a delta light,
+/// at a finite distance.
+fn is_area_light_sample(sample: &LightSample) -> bool {
+    !sample.is_delta() && sample.distance_m.is_finite()
 }
 
 /// Σ (wᵢ − mean)² over all n_b draws (missing ones are zeros) · n_b / (n_b − 1), so that a
@@ -292,6 +299,7 @@ mod tests {
             distance_m: d,
             light_bandwidth: light,
             emitter_bandwidth: light,
+            light_index: 0,
             material_bandwidth: MaterialBandwidth::new(rho, 0.0).unwrap(),
             lane_variance: 0.0,
             visibility: Visibility::Unknown,
@@ -321,6 +329,39 @@ mod tests {
         assert!(
             (p.image_bandwidth_cycles_per_px - single.angular_cycles_per_rad * 0.01).abs() < 1e-6
         );
+    }
+
+    #[test]
+    fn only_one_area_lights_disagreeing_samples_make_a_penumbra() {
+        let lamp = Bandwidth::area_light(2.0).unwrap();
+        let of = |light_index: u32, visibility: Visibility| LightSample {
+            light_index,
+            visibility,
+            ..sample(lamp, 0.0, 1.0, 0.5, 2.0)
+        };
+        let blocked = Visibility::Blocked {
+            blocker_distance_m: 1.0,
+        };
+        let in_penumbra = |samples: &[LightSample]| {
+            predict_pixel(
+                &plane_hit(1.0),
+                samples,
+                FOOTPRINT,
+                VarianceBandwidth::Incident,
+            )
+            .unwrap()
+            .visibility
+            .in_area_penumbra
+        };
+        assert!(in_penumbra(&[of(0, Visibility::Visible), of(0, blocked)]));
+        // In the shadow of lamp 1, lit by lamp 0: no penumbra of either.
+        assert!(!in_penumbra(&[of(0, Visibility::Visible), of(1, blocked)]));
+        // A distant light's samples disagreeing are no area penumbra.
+        let sky = |visibility| LightSample {
+            visibility,
+            ..sample(lamp, 0.0, 1.0, 0.5, f32::INFINITY)
+        };
+        assert!(!in_penumbra(&[sky(Visibility::Visible), sky(blocked)]));
     }
 
     #[test]
@@ -469,6 +510,7 @@ mod tests {
             distance_m: f32::INFINITY,
             light_bandwidth: Bandwidth::distant_light(nu_env).unwrap(),
             emitter_bandwidth: Bandwidth::distant_light(nu_env).unwrap(),
+            light_index: 0,
             material_bandwidth: MaterialBandwidth::new(f32::INFINITY, 0.0).unwrap(),
             lane_variance: 0.0,
             visibility: Visibility::Unknown,

@@ -56,6 +56,9 @@ pub struct LightSample {
     /// at the sampled point (`light_bandwidth` holds eq. 7's ν_s there, which is high on
     /// the outline); for other lights the same as `light_bandwidth`.
     pub emitter_bandwidth: Bandwidth,
+    /// Which light the sample is of (the probe's numbering), so that disagreeing shadow
+    /// rays are a penumbra only when they are of one light.
+    pub light_index: u32,
     /// ρ and t of the material at the hit for (ω_i, ω_o) (eq. 3's B_{t,ρ}, eq. 9's ν_ρa).
     pub material_bandwidth: MaterialBandwidth,
     /// The colour noise of this sample's weight that luminance bandwidth misses: the

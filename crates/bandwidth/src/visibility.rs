@@ -52,12 +52,12 @@ pub struct VisibilitySummary {
     pub traced: u32,
     /// Of those, the visible ones.
     pub visible: u32,
-    /// Of the traced samples, those towards area lights (a position and an extent), and of
-    /// those the visible ones: a compact emitter's samples disagree only where the pixel
-    /// sees part of it, in its penumbra. (An environment's samples span the sky, so theirs
-    /// disagree wherever part of the sky is hidden; a delta light's never do.)
-    pub area_traced: u32,
-    pub area_visible: u32,
+    /// Some samples of one area light (a position and an extent) see it and some do not:
+    /// a compact emitter's samples disagree only where the pixel sees part of it, in its
+    /// penumbra. (An environment's samples span the sky, so theirs disagree wherever part
+    /// of the sky is hidden; a delta light's never do; samples of two lamps disagree in
+    /// the shadow of one of them.)
+    pub in_area_penumbra: bool,
     /// The blocked samples' penumbra bandwidths, each weighted by its share of the light
     /// the traced samples would bring unoccluded (eq. 5's weighting), cycles/m (0: none
     /// blocked).
@@ -68,12 +68,6 @@ impl VisibilitySummary {
     /// The visible share of the traced samples (`None` if none was traced).
     pub fn visible_share(&self) -> Option<f32> {
         (self.traced > 0).then(|| self.visible as f32 / self.traced as f32)
-    }
-
-    /// Some of the samples towards area lights see them and some do not: the pixel lies in
-    /// a penumbra (or in the shadow of one of several area lights).
-    pub fn in_area_penumbra(&self) -> bool {
-        self.area_visible > 0 && self.area_visible < self.area_traced
     }
 
     /// Whether a neighbour's visible share differs from this one's by more than the
@@ -120,11 +114,9 @@ mod tests {
         let s = VisibilitySummary {
             traced: 8,
             visible: 3,
-            area_traced: 8,
-            area_visible: 3,
+            in_area_penumbra: true,
             penumbra_cycles_per_m: 5.0,
         };
-        assert!(s.in_area_penumbra());
         assert_eq!(s.visible_share(), Some(0.375));
         assert_eq!(VisibilitySummary::default().visible_share(), None);
     }

@@ -374,7 +374,7 @@ fn add_shadow_edges(
         let Some(eye) = eye[i] else { continue };
         let (x, y) = (i % w, i / w);
         let own = before[i];
-        let mut edge = own.in_area_penumbra();
+        let mut edge = own.in_area_penumbra;
         let mut penumbra = own.penumbra_cycles_per_m;
         let neighbours = [
             (x > 0).then(|| i - 1),

@@ -557,6 +557,7 @@ impl ShadingProbe for RenderProbe<'_> {
                         distance_m: ls.distance_m,
                         light_bandwidth,
                         emitter_bandwidth: self.emitter_bandwidth(l as usize, light_bandwidth),
+                        light_index: l,
                         material_bandwidth: self.material_bandwidth_at(
                             hit.material_id(),
                             &bsdf,
@@ -622,6 +623,7 @@ impl ShadingProbe for RenderProbe<'_> {
                             distance_m,
                             light_bandwidth,
                             emitter_bandwidth: self.emitter_bandwidth(l as usize, light_bandwidth),
+                            light_index: l,
                             material_bandwidth: self.material_bandwidth_at(
                                 hit.material_id(),
                                 &bsdf,
