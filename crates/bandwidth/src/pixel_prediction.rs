@@ -331,6 +331,18 @@ mod tests {
         );
     }
 
+    /// The shadow-ray summary of a pixel on a plane 1 m away lit by `samples`.
+    fn visibility_of(samples: &[LightSample]) -> VisibilitySummary {
+        predict_pixel(
+            &plane_hit(1.0),
+            samples,
+            FOOTPRINT,
+            VarianceBandwidth::Incident,
+        )
+        .unwrap()
+        .visibility
+    }
+
     #[test]
     fn only_one_area_lights_disagreeing_samples_make_a_penumbra() {
         let lamp = Bandwidth::area_light(2.0).unwrap();
@@ -342,17 +354,7 @@ mod tests {
         let blocked = Visibility::Blocked {
             blocker_distance_m: 1.0,
         };
-        let in_penumbra = |samples: &[LightSample]| {
-            predict_pixel(
-                &plane_hit(1.0),
-                samples,
-                FOOTPRINT,
-                VarianceBandwidth::Incident,
-            )
-            .unwrap()
-            .visibility
-            .in_area_penumbra
-        };
+        let in_penumbra = |samples: &[LightSample]| visibility_of(samples).in_area_penumbra;
         assert!(in_penumbra(&[of(0, Visibility::Visible), of(0, blocked)]));
         // In the shadow of lamp 1, lit by lamp 0: no penumbra of either.
         assert!(!in_penumbra(&[of(0, Visibility::Visible), of(1, blocked)]));
@@ -380,17 +382,7 @@ mod tests {
                 f32::INFINITY,
             )
         };
-        let penumbra = |samples: &[LightSample]| {
-            predict_pixel(
-                &plane_hit(1.0),
-                samples,
-                FOOTPRINT,
-                VarianceBandwidth::Incident,
-            )
-            .unwrap()
-            .visibility
-            .penumbra_cycles_per_m
-        };
+        let penumbra = |samples: &[LightSample]| visibility_of(samples).penumbra_cycles_per_m;
         let sun = blocked(100.0, 99.0);
         let sky = blocked(1e4, 1.0);
         assert!((penumbra(&[sun, sky]) - (0.99 * 200.0 + 0.01 * 2e4)).abs() < 1e-2);
