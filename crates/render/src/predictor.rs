@@ -357,7 +357,7 @@ struct EyeGeometry {
 }
 
 /// Shadow edges (`prism_bandwidth::visibility`): a pixel in an area light's penumbra (its
-/// samples towards area lights disagree), or whose visible share differs from a
+/// samples of one area light disagree), or whose visible share differs from a
 /// 4-neighbour's beyond sampling noise (`VisibilitySummary::differs_from`), gets the
 /// penumbra's spatial bandwidth (its own or, when all its light samples were visible, its
 /// neighbours'), carried to the eye like a texture's (P_x then T_d′). An environment's
