@@ -224,7 +224,8 @@ fn background_angular_bandwidth(
             | Light::Area(_)
             | Light::Goniometric(_) => {
                 probe
-                    .light_bandwidth_towards(index as usize, direction, None)
+                    .light_bandwidths_towards(index as usize, direction, None)
+                    .0
                     .angular_cycles_per_rad
             }
         })

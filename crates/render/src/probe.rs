@@ -197,47 +197,39 @@ impl<'a> RenderProbe<'a> {
     }
 
     /// ν_l of light `index` towards `wi`, met at `at_m` on the light when it has a
-    /// position (area lights).
-    pub(crate) fn light_bandwidth_towards(
+    /// position (area lights): (the light field's bandwidth there, `LightSample::
+    /// light_bandwidth`; the emitter's, `LightSample::emitter_bandwidth`). The two differ
+    /// only for an area light with eq. 7's map, whose emitter bandwidth is its size (the
+    /// closed form): a penumbra spans the whole emitter, not the detail at the point.
+    pub(crate) fn light_bandwidths_towards(
         &self,
         index: usize,
         wi: Vec3A,
         at_m: Option<Vec3A>,
-    ) -> Bandwidth {
+    ) -> (Bandwidth, Bandwidth) {
         let light = &self.scene.lights.lights()[index];
         match (light, self.light_maps.get(index).and_then(Option::as_ref)) {
-            (Light::Environment(e), Some(LightBandwidthMap::Environment(map))) => Bandwidth {
-                spatial_cycles_per_m: 0.0,
-                angular_cycles_per_rad: map.at(e, wi),
-            },
+            (Light::Environment(e), Some(LightBandwidthMap::Environment(map))) => {
+                let b = Bandwidth {
+                    spatial_cycles_per_m: 0.0,
+                    angular_cycles_per_rad: map.at(e, wi),
+                };
+                (b, b)
+            }
             (Light::Area(_), Some(LightBandwidthMap::Area(map))) => {
-                match at_m.and_then(|p| map.at(p, wi)) {
+                let size = light.bandwidth();
+                let at_point = match at_m.and_then(|p| map.at(p, wi)) {
                     Some(spatial_cycles_per_m) => Bandwidth {
                         spatial_cycles_per_m,
-                        ..light.bandwidth()
+                        ..size
                     },
-                    None => light.bandwidth(),
-                }
+                    None => size,
+                };
+                (at_point, size)
             }
             (_, Some(LightBandwidthMap::Environment(_) | LightBandwidthMap::Area(_)) | None) => {
-                light.bandwidth()
+                (light.bandwidth(), light.bandwidth())
             }
-        }
-    }
-
-    /// `LightSample::emitter_bandwidth` of light `index`, whose bandwidth at the sampled
-    /// point is `at_point`: an area light's closed form (its size), for the penumbrae of
-    /// its shadows; any other light's `at_point`.
-    fn emitter_bandwidth(&self, index: usize, at_point: Bandwidth) -> Bandwidth {
-        match &self.scene.lights.lights()[index] {
-            light @ Light::Area(_) => light.bandwidth(),
-            Light::Point(_)
-            | Light::Spot(_)
-            | Light::Directional(_)
-            | Light::Environment(_)
-            | Light::Sky(_)
-            | Light::Daylight(_)
-            | Light::Goniometric(_) => at_point,
         }
     }
 }
@@ -543,7 +535,7 @@ impl ShadingProbe for RenderProbe<'_> {
                     } else {
                         Visibility::Unknown
                     };
-                    let light_bandwidth = self.light_bandwidth_towards(
+                    let (light_bandwidth, emitter_bandwidth) = self.light_bandwidths_towards(
                         l as usize,
                         ls.wi,
                         Some(si.p + ls.wi * ls.distance_m),
@@ -556,7 +548,7 @@ impl ShadingProbe for RenderProbe<'_> {
                         cos_theta_i: cos,
                         distance_m: ls.distance_m,
                         light_bandwidth,
-                        emitter_bandwidth: self.emitter_bandwidth(l as usize, light_bandwidth),
+                        emitter_bandwidth,
                         light_index: l,
                         material_bandwidth: self.material_bandwidth_at(
                             hit.material_id(),
@@ -609,7 +601,7 @@ impl ShadingProbe for RenderProbe<'_> {
                             pdf_per_sr
                         };
                         let lanes = lane_variance(le * bs.f * (cos / divisor), &wavelengths);
-                        let light_bandwidth = self.light_bandwidth_towards(
+                        let (light_bandwidth, emitter_bandwidth) = self.light_bandwidths_towards(
                             l as usize,
                             wi,
                             light_hit.as_ref().map(|h| h.p),
@@ -622,7 +614,7 @@ impl ShadingProbe for RenderProbe<'_> {
                             cos_theta_i: cos,
                             distance_m,
                             light_bandwidth,
-                            emitter_bandwidth: self.emitter_bandwidth(l as usize, light_bandwidth),
+                            emitter_bandwidth,
                             light_index: l,
                             material_bandwidth: self.material_bandwidth_at(
                                 hit.material_id(),

@@ -13,14 +13,14 @@
 //!
 //!     cargo test -p prism-render --test predictor_bandwidth -- --ignored --nocapture
 
-use std::path::Path;
+mod support;
 
 use glam::UVec2;
 use prism_render::predictor::{predict, PredictorSettings};
 use prism_render::{render, RenderScene, RenderSettings};
-use prism_scene::load_scene;
 use prism_testkit::rank_correlation::spearman;
 use prism_testkit::windowed_spectrum::{energy_radius, hann_power_spectrum, hann_weight};
+use support::repository_scene_at;
 
 const HALF_SPP: u32 = 2048;
 const WINDOW_PX: usize = 32;
@@ -54,11 +54,7 @@ fn luminance(scene: &RenderScene, seed: u64) -> Vec<f64> {
 }
 
 fn compare(scene_file: &str, resolution: UVec2) -> SceneComparison {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../..")
-        .join(scene_file);
-    let description = load_scene(&path).expect("benchmark scene loads");
-    let scene = RenderScene::build(&description, Some(resolution)).expect("scene builds");
+    let scene = repository_scene_at(scene_file, resolution);
     let prediction = predict(&scene, &PredictorSettings::defaults(64.0, 1), 1).unwrap();
     let b_p: Vec<f64> = prediction
         .pixels
@@ -121,13 +117,10 @@ fn quantile(values: &[f64], q: f64) -> f64 {
 fn predicted_bandwidth_follows_the_reference_images_spectrum() {
     let mut failures = Vec::new();
     for (scene, resolution) in [
-        ("scenes/bandwidth/fig9-spheres.json", UVec2::new(128, 128)),
-        (
-            "scenes/bandwidth/fig17-curved-area.json",
-            UVec2::new(128, 128),
-        ),
+        ("bandwidth/fig9-spheres.json", UVec2::new(128, 128)),
+        ("bandwidth/fig17-curved-area.json", UVec2::new(128, 128)),
         // Half the scene's 480×270: 98 windows in a minute of rendering.
-        ("scenes/glossy-env.json", UVec2::new(240, 135)),
+        ("glossy-env.json", UVec2::new(240, 135)),
     ] {
         let c = compare(scene, resolution);
         let predicted: Vec<f64> = c.windows.iter().map(|w| w.predicted).collect();

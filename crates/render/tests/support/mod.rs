@@ -145,14 +145,18 @@ pub fn assert_close(
     );
 }
 
-/// The repository's scene `name` at `resolution`.
+/// The repository's scene `name` at `resolution` × `resolution`.
 pub fn repository_scene(name: &str, resolution: u32) -> RenderScene {
+    repository_scene_at(name, UVec2::splat(resolution))
+}
+
+/// The repository's scene `name` (under scenes/) at `resolution` (width, height).
+pub fn repository_scene_at(name: &str, resolution: UVec2) -> RenderScene {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
         .join("../../scenes")
         .join(name);
     let description = load_scene(&path).unwrap_or_else(|e| panic!("{e}"));
-    RenderScene::build(&description, Some(UVec2::splat(resolution)))
-        .unwrap_or_else(|e| panic!("{e}"))
+    RenderScene::build(&description, Some(resolution)).unwrap_or_else(|e| panic!("{e}"))
 }
 
 pub fn with_integrator(
