@@ -18,6 +18,7 @@ pub mod mesh;
 pub mod mesh_bvh;
 pub mod obj;
 pub mod ply;
+mod ply_binary;
 pub mod ray;
 pub mod rectangle;
 mod small_scene;

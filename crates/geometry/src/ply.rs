@@ -1,16 +1,19 @@
 //! PLY loading through `ply-rs` (ASCII, binary little and big endian). Vertices need x, y, z;
 //! nx, ny, nz and u, v (or s, t, texture_u/texture_v, texture_s/texture_t) are used when
 //! present. Faces come from a `vertex_indices` or `vertex_index` list and are fan-triangulated.
+//! `ply-rs` reads the header and ASCII payloads; binary payloads are decoded by
+//! ply_binary.rs.
 
-use std::io::BufReader;
+use std::io::{BufReader, Read};
 use std::path::Path;
 
 use glam::{Vec2, Vec3A};
 use ply_rs::parser::Parser;
-use ply_rs::ply::{DefaultElement, Property};
+use ply_rs::ply::{DefaultElement, Encoding, Header, Payload, Property, PropertyType};
 
 use crate::error::MeshLoadError;
 use crate::mesh::TriangleMesh;
+use crate::ply_binary::decode_binary_payload;
 
 /// ply-rs' error text in the project's words: its ASCII messages are "Line N: …" followed
 /// by the offending text and a nested `Custom { kind: …, error: "… error at 1:3: expected
@@ -49,6 +52,81 @@ fn ply_error_message(raw: &str) -> (Option<usize>, String) {
     }
 }
 
+/// Vertex properties a triangle mesh uses: position, normal and the uv spellings PLY writers
+/// use.
+pub(crate) const VERTEX_PROPERTIES: [&str; 14] = [
+    "x",
+    "y",
+    "z",
+    "nx",
+    "ny",
+    "nz",
+    "u",
+    "v",
+    "s",
+    "t",
+    "texture_u",
+    "texture_v",
+    "texture_s",
+    "texture_t",
+];
+
+/// The face element's index list, by the names writers give it (first found wins).
+pub(crate) const FACE_INDEX_PROPERTIES: [&str; 2] = ["vertex_indices", "vertex_index"];
+
+/// The face element's corner lists.
+pub(crate) enum FaceIndices {
+    /// Face f's corners are `corners[starts[f]..starts[f + 1]]`.
+    Lists {
+        starts: Vec<usize>,
+        corners: Vec<i64>,
+    },
+    /// The face element declares no index list.
+    Missing,
+    /// The index list holds floating-point numbers (or is no list).
+    NotIntegers,
+}
+
+impl FaceIndices {
+    pub(crate) fn default_lists() -> Self {
+        FaceIndices::Lists {
+            starts: Vec::new(),
+            corners: Vec::new(),
+        }
+    }
+}
+
+/// The parts of a PLY payload a triangle mesh is made of, whatever the encoding.
+pub(crate) struct MeshColumns {
+    pub vertex_count: usize,
+    /// The vertex properties of [`VERTEX_PROPERTIES`] the file declares, with their values
+    /// (`None` for one declared as a list) in `vertex_columns`.
+    pub vertex_names: Vec<String>,
+    pub vertex_columns: Vec<Option<Vec<f32>>>,
+    pub face_count: usize,
+    pub faces: FaceIndices,
+}
+
+impl Default for MeshColumns {
+    fn default() -> Self {
+        MeshColumns {
+            vertex_count: 0,
+            vertex_names: Vec::new(),
+            vertex_columns: Vec::new(),
+            face_count: 0,
+            faces: FaceIndices::default_lists(),
+        }
+    }
+}
+
+impl MeshColumns {
+    /// The property's values: `None` if undeclared, `Some(None)` if declared as a list.
+    fn vertex(&self, name: &str) -> Option<Option<&[f32]>> {
+        let i = self.vertex_names.iter().position(|n| n == name)?;
+        Some(self.vertex_columns[i].as_deref())
+    }
+}
+
 /// Load a PLY mesh file.
 pub fn load_ply(path: impl AsRef<Path>) -> Result<TriangleMesh, MeshLoadError> {
     let path = path.as_ref();
@@ -58,12 +136,7 @@ pub fn load_ply(path: impl AsRef<Path>) -> Result<TriangleMesh, MeshLoadError> {
     }
     let file = std::fs::File::open(path).map_err(|e| err(format!("cannot open PLY file: {e}")))?;
     let mut reader = BufReader::new(file);
-    // ply-rs has a few panicking paths on malformed input; user input must never panic here.
-    let parsed = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        Parser::<DefaultElement>::new().read_ply(&mut reader)
-    }))
-    .map_err(|_| err("malformed PLY file (the PLY parser could not make sense of it)".into()))?;
-    let ply = parsed.map_err(|e| {
+    let parse_error = |e: std::io::Error| {
         let hint = if e.kind() == std::io::ErrorKind::UnexpectedEof {
             " — the file ends before all elements the header declares were read (truncated file?)"
         } else {
@@ -71,81 +144,179 @@ pub fn load_ply(path: impl AsRef<Path>) -> Result<TriangleMesh, MeshLoadError> {
         };
         let (line, message) = ply_error_message(&e.to_string());
         MeshLoadError::new(path, line, format!("cannot parse PLY: {message}{hint}"))
-    })?;
+    };
+    // ply-rs has a few panicking paths on malformed input; user input must never panic here.
+    let malformed = || err("malformed PLY file (the PLY parser could not make sense of it)".into());
+    let parser = Parser::<DefaultElement>::new();
+    let header = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        parser.read_header(&mut reader)
+    }))
+    .map_err(|_| malformed())?
+    .map_err(parse_error)?;
+    let columns = match header.encoding {
+        Encoding::Ascii => {
+            // Read again from the start so that ply-rs' error lines count the header's.
+            let mut file =
+                std::fs::File::open(path).map_err(|e| err(format!("cannot open PLY file: {e}")))?;
+            let ply = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                parser.read_ply(&mut file)
+            }))
+            .map_err(|_| malformed())?
+            .map_err(parse_error)?;
+            ascii_columns(&ply.header, &ply.payload)
+        }
+        Encoding::BinaryLittleEndian | Encoding::BinaryBigEndian => {
+            let mut bytes = Vec::new();
+            reader
+                .read_to_end(&mut bytes)
+                .map_err(|e| err(format!("cannot read PLY file: {e}")))?;
+            decode_binary_payload(&header, &bytes).map_err(err)?
+        }
+    };
+    if !header.elements.contains_key("vertex") {
+        return Err(err(
+            "no 'vertex' element; expected 'element vertex N' in the header".into(),
+        ));
+    }
+    mesh_from_columns(columns).map_err(err)
+}
 
-    let vertices = ply.payload.get("vertex").ok_or_else(|| {
-        err("no 'vertex' element; expected 'element vertex N' in the header".into())
-    })?;
-    let nv = vertices.len();
-    let get = |e: &DefaultElement, name: &str| e.get(name).and_then(scalar);
-    let has = |name: &str| vertices.first().is_some_and(|e| e.contains_key(name));
-    for c in ["x", "y", "z"] {
-        if nv > 0 && !has(c) {
-            return Err(err(format!(
-                "element 'vertex' has no scalar property '{c}'; expected x, y, z"
-            )));
+/// The columns of an ASCII payload read by ply-rs.
+fn ascii_columns(header: &Header, payload: &Payload<DefaultElement>) -> MeshColumns {
+    let mut columns = MeshColumns::default();
+    let no_elements = Vec::new();
+    if let Some(def) = header.elements.get("vertex") {
+        let vertices = payload.get("vertex").unwrap_or(&no_elements);
+        columns.vertex_count = vertices.len();
+        for (name, prop) in &def.properties {
+            if !VERTEX_PROPERTIES.contains(&name.as_str()) {
+                continue;
+            }
+            columns.vertex_names.push(name.clone());
+            columns.vertex_columns.push(match prop.data_type {
+                PropertyType::Scalar(_) => Some(
+                    vertices
+                        .iter()
+                        .map(|v| v.get(name).and_then(scalar).unwrap_or(0.0))
+                        .collect(),
+                ),
+                PropertyType::List(..) => None,
+            });
         }
     }
-    let mut positions = Vec::with_capacity(nv);
-    for (i, v) in vertices.iter().enumerate() {
-        let (Some(x), Some(y), Some(z)) = (get(v, "x"), get(v, "y"), get(v, "z")) else {
-            return Err(err(format!("vertex {i}: x, y, z must be numeric scalars")));
-        };
-        positions.push(Vec3A::new(x, y, z));
-    }
-    let normals = (has("nx") && has("ny") && has("nz")).then(|| {
-        vertices
+    if let Some(def) = header.elements.get("face") {
+        let faces = payload.get("face").unwrap_or(&no_elements);
+        columns.face_count = faces.len();
+        let list_name = FACE_INDEX_PROPERTIES
             .iter()
-            .map(|v| {
-                Vec3A::new(
-                    get(v, "nx").unwrap_or(0.0),
-                    get(v, "ny").unwrap_or(0.0),
-                    get(v, "nz").unwrap_or(0.0),
-                )
-            })
-            .collect::<Vec<_>>()
-    });
+            .find(|p| def.properties.contains_key(**p));
+        columns.faces = match list_name {
+            None => FaceIndices::Missing,
+            Some(list_name) => {
+                let mut starts = vec![0];
+                let mut corners = Vec::new();
+                let mut integers = true;
+                for face in faces {
+                    match face.get(*list_name).and_then(index_list) {
+                        Some(idx) => corners.extend(idx),
+                        None => integers = false,
+                    }
+                    starts.push(corners.len());
+                }
+                if integers {
+                    FaceIndices::Lists { starts, corners }
+                } else {
+                    FaceIndices::NotIntegers
+                }
+            }
+        };
+    }
+    columns
+}
+
+/// The mesh the columns describe: positions required; normals and uvs where declared; faces
+/// fan-triangulated. Errors are sentences naming the vertex or face.
+fn mesh_from_columns(columns: MeshColumns) -> Result<TriangleMesh, String> {
+    let nv = columns.vertex_count;
+    let mut xyz: [&[f32]; 3] = [&[]; 3];
+    for (slot, c) in xyz.iter_mut().zip(["x", "y", "z"]) {
+        match columns.vertex(c) {
+            None if nv > 0 => {
+                return Err(format!(
+                    "element 'vertex' has no scalar property '{c}'; expected x, y, z"
+                ))
+            }
+            Some(None) if nv > 0 => {
+                return Err("vertex 0: x, y, z must be numeric scalars".to_string())
+            }
+            None | Some(None) => {}
+            Some(Some(values)) => *slot = values,
+        }
+    }
+    let positions: Vec<Vec3A> = (0..nv)
+        .map(|i| Vec3A::new(xyz[0][i], xyz[1][i], xyz[2][i]))
+        .collect();
+    let scalar_column = |name: &str| -> Result<Option<&[f32]>, String> {
+        match columns.vertex(name) {
+            None => Ok(None),
+            Some(None) => Err(format!(
+                "vertex property '{name}' is a list; expected a scalar"
+            )),
+            Some(Some(values)) => Ok(Some(values)),
+        }
+    };
+    let normals = match (
+        scalar_column("nx")?,
+        scalar_column("ny")?,
+        scalar_column("nz")?,
+    ) {
+        (Some(x), Some(y), Some(z)) => Some(
+            (0..nv)
+                .map(|i| Vec3A::new(x[i], y[i], z[i]))
+                .collect::<Vec<_>>(),
+        ),
+        _ => None,
+    };
     let uv_names = [
         ("u", "v"),
         ("s", "t"),
         ("texture_u", "texture_v"),
         ("texture_s", "texture_t"),
     ];
-    let uvs = uv_names
-        .iter()
-        .find(|(u, v)| has(u) && has(v))
-        .map(|(u, v)| {
-            vertices
-                .iter()
-                .map(|e| Vec2::new(get(e, u).unwrap_or(0.0), get(e, v).unwrap_or(0.0)))
-                .collect::<Vec<_>>()
-        });
+    let mut uvs = None;
+    for (u, v) in uv_names {
+        if let (Some(u), Some(v)) = (scalar_column(u)?, scalar_column(v)?) {
+            uvs = Some((0..nv).map(|i| Vec2::new(u[i], v[i])).collect::<Vec<_>>());
+            break;
+        }
+    }
 
     let mut indices = Vec::new();
-    if let Some(faces) = ply.payload.get("face") {
-        for (f, face) in faces.iter().enumerate() {
-            let list = face
-                .get("vertex_indices")
-                .or_else(|| face.get("vertex_index"))
-                .ok_or_else(|| {
-                    err(format!(
-                        "face {f} has no 'vertex_indices' or 'vertex_index' list property"
-                    ))
-                })?;
-            let idx = index_list(list)
-                .ok_or_else(|| err(format!("face {f}: vertex indices must be an integer list")))?;
+    if columns.face_count > 0 {
+        let (starts, corners) = match &columns.faces {
+            FaceIndices::Lists { starts, corners } => (starts, corners),
+            FaceIndices::Missing => {
+                return Err(
+                    "face 0 has no 'vertex_indices' or 'vertex_index' list property".to_string(),
+                )
+            }
+            FaceIndices::NotIntegers => {
+                return Err("face 0: vertex indices must be an integer list".to_string())
+            }
+        };
+        indices.reserve(corners.len().saturating_sub(2 * columns.face_count));
+        for (f, span) in starts.windows(2).enumerate() {
+            let idx = &corners[span[0]..span[1]];
             if idx.len() < 3 {
-                return Err(err(format!(
+                return Err(format!(
                     "face {f} has {} vertices; expected at least 3",
                     idx.len()
-                )));
+                ));
             }
-            for &i in &idx {
-                if i < 0 || i as usize >= nv {
-                    return Err(err(format!(
-                        "face {f} refers to vertex {i}, but element 'vertex' has {nv} vertices (indices start at 0)"
-                    )));
-                }
+            if let Some(&i) = idx.iter().find(|&&i| i < 0 || i as usize >= nv) {
+                return Err(format!(
+                    "face {f} refers to vertex {i}, but element 'vertex' has {nv} vertices (indices start at 0)"
+                ));
             }
             // Fan triangulation (exact for convex polygons, which is what PLY writers emit).
             for k in 1..idx.len() - 1 {
@@ -156,7 +327,7 @@ pub fn load_ply(path: impl AsRef<Path>) -> Result<TriangleMesh, MeshLoadError> {
     let mut mesh = TriangleMesh::new(positions, indices);
     mesh.normals = normals;
     mesh.uvs = uvs;
-    mesh.validate().map_err(err)?;
+    mesh.validate()?;
     Ok(mesh)
 }
 

@@ -248,3 +248,122 @@ fn obj_errors_name_the_file_line_and_expectation() {
         "{s}"
     );
 }
+
+/// A binary PLY as other writers emit it: double positions, a colour and a per-vertex list
+/// the mesh does not use, an element between vertex and face, ushort list counts and uint
+/// indices. The decoder reads over what it does not use.
+fn ply_binary_mixed(big_endian: bool, face_count_type: &str, index_type: &str) -> Vec<u8> {
+    let format = if big_endian {
+        "binary_big_endian"
+    } else {
+        "binary_little_endian"
+    };
+    let mut out = format!(
+        "ply\nformat {format} 1.0\nelement vertex 5\nproperty double x\nproperty uchar red\n\
+         property double y\nproperty double z\nproperty list uchar float weights\n\
+         property short s\nproperty short t\nelement edge 1\nproperty int vertex1\n\
+         property int vertex2\nelement face 2\nproperty uchar flags\n\
+         property list {face_count_type} {index_type} vertex_indices\nend_header\n"
+    )
+    .into_bytes();
+    macro_rules! put {
+        ($x:expr) => {
+            if big_endian {
+                out.extend($x.to_be_bytes())
+            } else {
+                out.extend($x.to_le_bytes())
+            }
+        };
+    }
+    for (p, uv) in QUAD_POS.iter().zip(QUAD_UV) {
+        put!(p[0] as f64);
+        put!(200u8);
+        put!(p[1] as f64);
+        put!(p[2] as f64);
+        put!(2u8);
+        put!(0.25f32);
+        put!(0.75f32);
+        put!(uv[0] as i16);
+        put!(uv[1] as i16);
+    }
+    put!(0i32);
+    put!(1i32);
+    let faces: [&[u32]; 2] = [&[0, 1, 2, 3], &[0, 1, 4]];
+    for f in faces {
+        put!(7u8);
+        match face_count_type {
+            "char" => put!(if f.len() == 3 { -1i8 } else { f.len() as i8 }),
+            _ => put!(f.len() as u16),
+        }
+        for &i in f {
+            match index_type {
+                "float" => put!(i as f32),
+                _ => put!(i),
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn binary_ply_reads_over_the_properties_and_elements_it_does_not_use() {
+    let d = dir("ply_mixed");
+    for be in [false, true] {
+        let path = d.join(format!("mixed-{be}.ply"));
+        std::fs::write(&path, ply_binary_mixed(be, "ushort", "uint")).unwrap();
+        let m = load_ply(&path).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(m.positions.len(), 5);
+        assert_eq!(m.positions[4], Vec3A::new(0.5, 0.5, 1.0));
+        assert_eq!(m.indices, vec![[0, 1, 2], [0, 2, 3], [0, 1, 4]]);
+        assert!(m.normals.is_none());
+        // s, t are integers here: uv (1, 1) at vertex 2, (0, 0) at vertex 4 (0.5 truncated).
+        let uvs = m.uvs.as_ref().unwrap();
+        assert_eq!(uvs[2], Vec2::new(1.0, 1.0));
+        assert_eq!(uvs[4], Vec2::ZERO);
+    }
+}
+
+#[test]
+fn binary_ply_errors_name_the_element_and_what_was_expected() {
+    let d = dir("ply_mixed_bad");
+    let negative = d.join("negative-length.ply");
+    std::fs::write(&negative, ply_binary_mixed(false, "char", "uint")).unwrap();
+    let e = load_ply(&negative).unwrap_err().to_string();
+    assert!(
+        e.contains("negative-length.ply")
+            && e.contains("element 'face' 1")
+            && e.contains("length -1"),
+        "{e}"
+    );
+    let float_indices = d.join("float-indices.ply");
+    std::fs::write(&float_indices, ply_binary_mixed(false, "ushort", "float")).unwrap();
+    let e = load_ply(&float_indices).unwrap_err().to_string();
+    assert!(e.contains("integer list"), "{e}");
+
+    // A position declared as a list, and a file cut inside the face element.
+    let mut list_x = b"ply\nformat binary_little_endian 1.0\nelement vertex 3\n\
+        property list uchar float x\nproperty float y\nproperty float z\nelement face 1\n\
+        property list uchar int vertex_indices\nend_header\n"
+        .to_vec();
+    for p in &QUAD_POS[..3] {
+        list_x.push(1);
+        for c in p {
+            list_x.extend(c.to_le_bytes());
+        }
+    }
+    list_x.push(3);
+    for i in 0..3i32 {
+        list_x.extend(i.to_le_bytes());
+    }
+    let list_path = d.join("list-x.ply");
+    std::fs::write(&list_path, list_x).unwrap();
+    let e = load_ply(&list_path).unwrap_err().to_string();
+    assert!(e.contains("numeric scalars"), "{e}");
+    let cut = d.join("cut.ply");
+    std::fs::write(&cut, ply_bytes("binary_big_endian", true, 3, false)).unwrap();
+    let e = load_ply(&cut).unwrap_err().to_string();
+    assert!(
+        e.contains("cut.ply") && e.contains("element 'face' 1 of 2") && e.contains("truncated"),
+        "{e}"
+    );
+}
