@@ -995,7 +995,7 @@ impl Radiosity {
                 let (centre, n_s) = (shape.centre(), shape.normal());
                 let f = point_to_polygon(centre, n_s, &corners[..count], n_r);
                 let seen = if partial && f > 0.0 {
-                    self.seen_fraction(r, &receiver, centre, n_s, n as usize, vis)
+                    self.seen_fraction(r, receiver, centre, n_s, n as usize, vis)
                 } else {
                     1.0
                 };
