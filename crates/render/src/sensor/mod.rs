@@ -324,7 +324,11 @@ fn measure_point(
                 done = next;
                 let target = (relative_error * stats.mean().abs()).max(absolute_error_lx);
                 let se = stats.std_error();
-                if se <= target || done >= max_samples {
+                // No sample has found light yet: a relative target cannot be judged (the
+                // standard error of all zeros is 0, yet light that arrives by rare paths,
+                // through a door ajar, is not there). Only an absolute target can stop it.
+                let judged = stats.mean() != 0.0 || absolute_error_lx > 0.0;
+                if (judged && se <= target) || done >= max_samples {
                     break;
                 }
                 // n · (se / target)² samples reach the target if the variance per sample

@@ -169,6 +169,32 @@ fn adaptive_sensors_stop_at_the_requested_standard_error() {
     ));
 }
 
+/// A point no light reaches (inside a closed box, the lamp outside): all its samples are
+/// zero, so a relative target cannot be judged and it samples to `max_samples`; an
+/// absolute target stops it after the first batch (512 samples).
+#[test]
+fn a_point_no_sample_lights_is_not_judged_by_a_relative_target() {
+    let json = |rule: &str| {
+        format!(
+            r#"{{"lights": [{{"type": "point", "position_m": [0, 3, 0], "intensity_cd": 1000}}],
+                "shapes": [{{"type": "cuboid", "size_m": [1, 1, 1]}}],
+                "sensors": [{{"type": "point", "position_m": [0, 0, 0], {rule}}}]}}"#
+        )
+    };
+    for (rule, samples) in [
+        (r#""relative_error": 0.01, "max_samples": 4096"#, 4096),
+        (
+            r#""relative_error": 0.01, "absolute_error_lx": 1, "max_samples": 4096"#,
+            512,
+        ),
+    ] {
+        let r = measure(&json(rule));
+        let p = &r[0].points[0];
+        assert_eq!(p.illuminance_lx, 0.0, "{rule}: {p:?}");
+        assert_eq!(p.samples, samples, "{rule}: {p:?}");
+    }
+}
+
 #[test]
 fn running_stats_merge_like_one_pass() {
     let xs: Vec<f64> = (0..1000).map(|i| ((i * 37) % 101) as f64 * 0.5).collect();
