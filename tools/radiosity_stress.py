@@ -53,7 +53,7 @@ def main():
     ap.add_argument("--budget-s", type=float, default=5.0)
     ap.add_argument("--reference-spp", type=int, default=1024)
     args = ap.parse_args()
-    stress = sorted(f for f in os.listdir(os.path.join(ROOT, "scenes/stress")) if f.endswith(".json"))
+    stress = sorted(f for f in os.listdir(os.path.join(ROOT, "scenes/stress")) if f.endswith(".json") and not f.startswith("."))
     scenes = [os.path.join(ROOT, "scenes/cornell-box.json")] + [
         os.path.join(ROOT, "scenes/stress", f) for f in stress]
     rows, refused = [], {}
