@@ -10,7 +10,7 @@
 use glam::Vec3A;
 
 use crate::element::ElementShape;
-use crate::form_factor::{area_sample_factor, point_to_polygon};
+use crate::form_factor::{area_sample_factor, faces, point_to_polygon};
 use crate::hierarchy::NodeKind;
 use crate::solver::{sample_point, Radiosity, Visibility};
 
@@ -510,13 +510,6 @@ impl ReceiverGather {
             + (self.irradiance.len() + self.vertex_totals.len()) * 4
             + self.listed.len() * 4
     }
-}
-
-/// Whether points `x` (normal `n_x`) and `y` (normal `n_y`) are on each other's front
-/// sides.
-fn faces(x: Vec3A, n_x: Vec3A, y: Vec3A, n_y: Vec3A) -> bool {
-    let d = y - x;
-    n_x.dot(d) > 0.0 && n_y.dot(d) < 0.0
 }
 
 /// The receiver's frame: normal, tangent along its first edge, bitangent.

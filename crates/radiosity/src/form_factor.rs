@@ -8,6 +8,13 @@ use glam::{DVec3, Vec3A};
 
 use crate::element::ElementShape;
 
+/// Whether points `x` (normal `n_x`) and `y` (normal `n_y`) are on each other's front
+/// sides.
+pub(crate) fn faces(x: Vec3A, n_x: Vec3A, y: Vec3A, n_y: Vec3A) -> bool {
+    let d = y - x;
+    n_x.dot(d) > 0.0 && n_y.dot(d) < 0.0
+}
+
 /// Unoccluded form factor from a differential area at `x` with unit normal `n` to the
 /// one-sided planar polygon `polygon` (its front side is where `normal` points): the
 /// fraction of the energy leaving the differential area that reaches the polygon.

@@ -16,7 +16,7 @@ use glam::Vec3A;
 use rayon::prelude::*;
 
 use crate::element::ElementShape;
-use crate::form_factor::{area_sample_factor, element_to_element, point_to_polygon};
+use crate::form_factor::{area_sample_factor, element_to_element, faces, point_to_polygon};
 use crate::hierarchy::{Hierarchy, NodeKind};
 
 /// A surface the solution covers: one side of a planar patch, uniform over it.
@@ -1046,8 +1046,7 @@ impl Radiosity {
                 continue;
             }
             let x = sample_point(receiver, k, 0);
-            let d = y - x;
-            if n_r.dot(d) <= 0.0 || n_y.dot(d) >= 0.0 {
+            if !faces(x, n_r, y, n_y) {
                 continue;
             }
             tested += 1;
@@ -1090,8 +1089,7 @@ impl Radiosity {
                 for &k in &receivers {
                     let x = sample_point(&receiver, k, 0);
                     let y = sample_point(&shape, k, 1);
-                    let d = y - x;
-                    if n_r.dot(d) <= 0.0 || n_s.dot(d) >= 0.0 {
+                    if !faces(x, n_r, y, n_s) {
                         continue;
                     }
                     facing += 1;
