@@ -127,8 +127,9 @@ pub struct RenderArgs {
     #[arg(long = "progress-every", value_name = "DURATION", default_value = "10s", value_parser = prism_args::duration::parse_duration)]
     pub progress_every: Duration,
     /// How light samples at shading points choose a light: `auto` through the light BVH
-    /// from 8 lights with bounds on, by power below; `power` always by power; `bvh` through
-    /// the light BVH whenever a light has bounds.
+    /// from 8 lights with bounds on; below, lights at infinity apart (each 1/(their count +
+    /// 1)) and the others by power; `power` always by power, lights at infinity included;
+    /// `bvh` through the light BVH whenever a light has bounds.
     #[arg(long = "light-selection", value_enum, default_value = "auto")]
     pub light_selection: LightSelectionArg,
     #[command(flatten)]
@@ -323,10 +324,10 @@ pub fn run(args: &RenderArgs, budget: &MemoryBudget) -> Result<ExitCode, String>
     match args.light_selection {
         LightSelectionArg::Auto => {}
         LightSelectionArg::Power => {
-            scene.set_light_bvh(false);
+            scene.set_light_selection(prism_render::light::ShadingSelection::Power);
         }
         LightSelectionArg::Bvh => {
-            if !scene.set_light_bvh(true) {
+            if !scene.set_light_selection(prism_render::light::ShadingSelection::Bvh) {
                 return Err(format!(
                     "--light-selection bvh: {} has no light with bounds (only lights at \
                      infinity, or none) for a light BVH to choose among",

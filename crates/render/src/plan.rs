@@ -19,6 +19,7 @@ use prism_spectrum::SampledWavelengths;
 
 use crate::integrator::packet::PacketScene;
 use crate::integrator::Integrator;
+use crate::light::ShadingSelection;
 use crate::scene_build::{small_scene_not_used, RenderScene, SceneFeatures};
 
 /// One decision of the plan.
@@ -711,20 +712,38 @@ fn light_selection_text(scene: &RenderScene) -> (String, String) {
                 }
             ),
         ),
-        None => (
-            format!(
-                "in proportion to power over {} light(s)",
-                scene.lights.len()
-            ),
-            if scene.lights.bounded_light_count() >= min {
-                "asked for (--light-selection power; pbrt-v4 PowerLightSampler)".to_string()
-            } else {
-                format!(
-                    "fewer than {min} lights with bounds: the light BVH gains little (pbrt-v4 \
-                     PowerLightSampler)"
-                )
-            },
-        ),
+        None => {
+            let lights = scene.lights.lights();
+            let at_infinity = lights.iter().filter(|l| l.is_infinite()).count();
+            let by_power = format!("in proportion to power over {} light(s)", lights.len());
+            let few = format!("fewer than {min} lights with bounds: the light BVH gains little");
+            match scene.lights.shading_selection() {
+                ShadingSelection::Power => (
+                    by_power,
+                    "asked for (--light-selection power; pbrt-v4 PowerLightSampler)".to_string(),
+                ),
+                ShadingSelection::InfiniteApart
+                    if at_infinity > 0 && at_infinity < lights.len() =>
+                {
+                    (
+                        format!(
+                        "{at_infinity} light(s) at infinity apart (each 1/{}), the other {} in \
+                         proportion to power",
+                        at_infinity + 1,
+                        lights.len() - at_infinity
+                    ),
+                        format!(
+                        "{few}; the power of a light at infinity grows with the scene's size and \
+                         says little about which light lights a point, so it is chosen apart \
+                         as in pbrt-v4's BVHLightSampler"
+                    ),
+                    )
+                }
+                ShadingSelection::InfiniteApart | ShadingSelection::Bvh => {
+                    (by_power, format!("{few} (pbrt-v4 PowerLightSampler)"))
+                }
+            }
+        }
     }
 }
 

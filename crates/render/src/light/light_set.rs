@@ -1,7 +1,8 @@
 //! All lights of a scene: light selection in proportion to power (pbrt-v4 §12.6.3
-//! `PowerLightSampler`), or for light samples at a shading point, from
-//! [`LIGHT_BVH_MIN_BOUNDED`] lights with bounds on, by a light BVH (light_bvh.rs); the map
-//! from hit instances to area lights, and the infinite lights that escaping rays see.
+//! `PowerLightSampler`), or for light samples at a shading point one of
+//! [`ShadingSelection`] (from [`LIGHT_BVH_MIN_BOUNDED`] lights with bounds on, a light BVH,
+//! light_bvh.rs); the map from hit instances to area lights, and the infinite lights that
+//! escaping rays see.
 //!
 //! Which selection a caller uses is part of its estimator: next-event estimation in the
 //! path tracer and its medium and photon-camera variants calls `sample_at`/`pmf_at`; light
@@ -17,6 +18,7 @@ use super::build::build_lights;
 use super::light_bounds::light_bounds;
 use super::light_bvh::LightBvh;
 use super::scene_sphere::SceneSphere;
+use super::selection_table::SelectionTable;
 use super::{Light, LightSampleContext};
 use crate::scene_build::{shape_instance_ranges, SceneBuildError};
 
@@ -26,9 +28,10 @@ pub const NO_LIGHT: u32 = u32::MAX;
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct LightSet {
     lights: Vec<Light>,
-    /// Selection probabilities (sum 1) and their running sums.
-    pmf: Vec<f32>,
-    cdf: Vec<f32>,
+    /// Selection in proportion to power.
+    power: SelectionTable,
+    /// Lights at infinity apart, the rest by power (`ShadingSelection::InfiniteApart`).
+    infinite_apart: SelectionTable,
     /// Per geometry instance: index of the area light it carries, or `NO_LIGHT`.
     instance_light: Vec<u32>,
     infinite: Vec<u32>,
@@ -36,8 +39,22 @@ pub struct LightSet {
     scene: SceneSphere,
     /// The light BVH over the lights with bounds (set by `build` when any has them).
     bvh: Option<LightBvh>,
-    /// Whether `sample_at`/`pmf_at` use `bvh` (or choose by power).
-    bvh_on: bool,
+    /// How `sample_at`/`pmf_at` choose.
+    selection: ShadingSelection,
+}
+
+/// How light samples at shading points choose a light (`prism render --light-selection`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum ShadingSelection {
+    /// In proportion to power, lights at infinity included (pbrt-v4 `PowerLightSampler`).
+    Power,
+    /// Lights at infinity apart, each with probability 1 / (their count + 1); the others
+    /// share the rest in proportion to power (`SelectionTable::infinite_apart`). The same
+    /// as `Power` where a scene has lights of only one kind.
+    #[default]
+    InfiniteApart,
+    /// Through the light BVH (lights at infinity apart as in `InfiniteApart`).
+    Bvh,
 }
 
 /// From this many lights with bounds on, light samples at shading points choose through
@@ -47,25 +64,11 @@ pub const LIGHT_BVH_MIN_BOUNDED: usize = 8;
 
 impl LightSet {
     /// Lights given directly, selected in proportion to `power_w(scene_radius_m)`
-    /// (uniformly if every power is zero). `instance_light` maps instances to lights.
+    /// (uniformly if every power is zero), at shading points with the lights at infinity
+    /// apart. `instance_light` maps instances to lights.
     pub fn new(lights: Vec<Light>, instance_light: Vec<u32>, scene_radius_m: f32) -> Self {
-        let powers: Vec<f64> = lights
-            .iter()
-            .map(|l| l.power_w(scene_radius_m).max(0.0))
-            .map(|p| if p.is_finite() { p } else { 0.0 })
-            .collect();
-        let total: f64 = powers.iter().sum();
-        let pmf: Vec<f32> = if total > 0.0 {
-            powers.iter().map(|p| (p / total) as f32).collect()
-        } else {
-            vec![1.0 / lights.len().max(1) as f32; lights.len()]
-        };
-        let mut cdf = Vec::with_capacity(pmf.len());
-        let mut run = 0.0f32;
-        for p in &pmf {
-            run += p;
-            cdf.push(run);
-        }
+        let powers: Vec<f64> = lights.iter().map(|l| l.power_w(scene_radius_m)).collect();
+        let at_infinity: Vec<bool> = lights.iter().map(Light::is_infinite).collect();
         let infinite = lights
             .iter()
             .enumerate()
@@ -73,9 +76,9 @@ impl LightSet {
             .map(|(i, _)| i as u32)
             .collect();
         Self {
+            power: SelectionTable::proportional(&powers),
+            infinite_apart: SelectionTable::infinite_apart(&powers, &at_infinity),
             lights,
-            pmf,
-            cdf,
             instance_light,
             infinite,
             scene: SceneSphere {
@@ -83,7 +86,7 @@ impl LightSet {
                 radius_m: scene_radius_m,
             },
             bvh: None,
-            bvh_on: false,
+            selection: ShadingSelection::InfiniteApart,
         }
     }
 
@@ -153,15 +156,27 @@ impl LightSet {
             return;
         }
         let bvh = LightBvh::build(bounded, infinite, self.lights.len());
-        self.bvh_on = bvh.bounded_count() >= LIGHT_BVH_MIN_BOUNDED;
+        if bvh.bounded_count() >= LIGHT_BVH_MIN_BOUNDED {
+            self.selection = ShadingSelection::Bvh;
+        }
         self.bvh = Some(bvh);
     }
 
-    /// Turns the light BVH on or off for `sample_at`/`pmf_at` (where `build` made one);
-    /// whether it is on afterwards.
-    pub fn set_light_bvh(&mut self, on: bool) -> bool {
-        self.bvh_on = on && self.bvh.is_some();
-        self.bvh_on
+    /// Sets how `sample_at`/`pmf_at` choose; `false` (and nothing changed) for `Bvh` where
+    /// `build` made no light BVH (no light with bounds).
+    pub fn set_shading_selection(&mut self, selection: ShadingSelection) -> bool {
+        match selection {
+            ShadingSelection::Bvh if self.bvh.is_none() => false,
+            ShadingSelection::Bvh | ShadingSelection::Power | ShadingSelection::InfiniteApart => {
+                self.selection = selection;
+                true
+            }
+        }
+    }
+
+    /// How `sample_at`/`pmf_at` choose.
+    pub fn shading_selection(&self) -> ShadingSelection {
+        self.selection
     }
 
     /// Lights in the light BVH `build` made, on or off (0 without one).
@@ -171,16 +186,28 @@ impl LightSet {
 
     /// The light BVH when light samples at shading points use it.
     pub fn light_bvh(&self) -> Option<&LightBvh> {
-        self.bvh.as_ref().filter(|_| self.bvh_on)
+        self.bvh
+            .as_ref()
+            .filter(|_| self.selection == ShadingSelection::Bvh)
     }
 
-    /// Picks a light for a light sample at `ctx`: through the light BVH when it is on,
-    /// else `sample`. (index, probability).
+    /// The table light samples at shading points choose from where they do not use the
+    /// light BVH.
+    #[inline]
+    pub(crate) fn shading_table(&self) -> &SelectionTable {
+        match self.selection {
+            ShadingSelection::Power => &self.power,
+            ShadingSelection::InfiniteApart | ShadingSelection::Bvh => &self.infinite_apart,
+        }
+    }
+
+    /// Picks a light for a light sample at `ctx` as `shading_selection` says:
+    /// (index, probability).
     #[inline]
     pub fn sample_at(&self, ctx: &LightSampleContext, u: f32) -> Option<(u32, f32)> {
         match self.light_bvh() {
             Some(bvh) => bvh.sample(ctx.p, ctx.n, u),
-            None => self.sample(u),
+            None => self.shading_table().sample(u),
         }
     }
 
@@ -189,7 +216,7 @@ impl LightSet {
     pub fn pmf_at(&self, ctx: &LightSampleContext, index: u32) -> f32 {
         match self.light_bvh() {
             Some(bvh) => bvh.pmf(ctx.p, ctx.n, index),
-            None => self.pmf(index),
+            None => self.shading_table().pmf(index),
         }
     }
 
@@ -215,35 +242,16 @@ impl LightSet {
         &self.lights[index as usize]
     }
 
-    /// The running sums of the selection probabilities (`sample` picks the first light
-    /// whose sum exceeds u), for callers that pick for many samples at once.
-    pub(crate) fn selection_cdf(&self) -> &[f32] {
-        &self.cdf
-    }
-
-    /// The selection probabilities, light by light.
-    pub(crate) fn selection_pmf(&self) -> &[f32] {
-        &self.pmf
-    }
-
-    /// Picks a light for a light sample: (index, selection probability).
+    /// Picks a light in proportion to power: (index, selection probability).
     #[inline]
     pub fn sample(&self, u: f32) -> Option<(u32, f32)> {
-        if self.lights.is_empty() {
-            return None;
-        }
-        let i = self
-            .cdf
-            .partition_point(|&c| c <= u)
-            .min(self.lights.len() - 1);
-        let p = self.pmf[i];
-        (p > 0.0).then_some((i as u32, p))
+        self.power.sample(u)
     }
 
     /// Probability that `sample` picks light `index`.
     #[inline]
     pub fn pmf(&self, index: u32) -> f32 {
-        self.pmf.get(index as usize).copied().unwrap_or(0.0)
+        self.power.pmf(index)
     }
 
     /// The area light carried by geometry instance `instance_id`, if any.

@@ -54,6 +54,7 @@ pub mod photometry;
 pub mod piecewise_constant;
 mod point;
 pub mod scene_sphere;
+pub mod selection_table;
 pub mod sky;
 pub mod spot;
 #[cfg(test)]
@@ -65,7 +66,7 @@ pub use daylight::sky_light::DaylightSkyLight;
 pub use directional::DirectionalLight;
 pub use environment::EnvironmentLight;
 pub use goniometric::GoniometricLight;
-pub use light_set::{LightSet, LIGHT_BVH_MIN_BOUNDED, NO_LIGHT};
+pub use light_set::{LightSet, ShadingSelection, LIGHT_BVH_MIN_BOUNDED, NO_LIGHT};
 pub use point::PointLight;
 pub use scene_sphere::SceneSphere;
 pub use sky::UniformSky;

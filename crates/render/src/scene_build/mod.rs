@@ -266,13 +266,13 @@ impl RenderScene {
         }
     }
 
-    /// Light samples at shading points choose through the light BVH (`true`, where the
-    /// scene has lights with bounds) or by power; whether the BVH is on afterwards. The
-    /// packet form is decided again (its allow-list excludes the light BVH).
-    pub fn set_light_bvh(&mut self, on: bool) -> bool {
-        let on = self.lights.set_light_bvh(on);
+    /// How light samples at shading points choose a light; `false` (nothing changed) for
+    /// the light BVH where the scene has no light with bounds. The packet form is decided
+    /// again (its allow-list excludes the light BVH).
+    pub fn set_light_selection(&mut self, selection: crate::light::ShadingSelection) -> bool {
+        let done = self.lights.set_shading_selection(selection);
         self.set_packet_tracing(self.packet_tracing);
-        on
+        done
     }
 
     /// The name of material `material_id` as `material` resolves it (`default` for

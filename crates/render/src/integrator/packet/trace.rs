@@ -853,7 +853,7 @@ fn put_rectangle<const N: usize>(vertex: &mut VertexIn<N>, l: usize, rect: &Rect
 /// Lights with at most this many entries are picked for all lanes in one vector pass.
 const VECTOR_LIGHT_CHOICE_MAX: usize = 16;
 
-/// Each vertex's light choice (`LightSet::sample`), the chosen rectangle's fields and
+/// Each vertex's light choice (`LightSet::sample_at` without the BVH), the chosen rectangle's fields and
 /// L(λ), or a light sample by the scalar `Light` code for other lights (after
 /// `draw_variates`). `rectangle_in_lane[l]` names the light whose fields lane `l` of
 /// `vertex` already holds.
@@ -880,10 +880,11 @@ fn choose_lights<const N: usize>(
     if lights.is_empty() {
         return;
     }
-    let cdf = lights.selection_cdf();
-    let pmf = lights.selection_pmf();
+    let table = lights.shading_table();
+    let cdf = table.cdf_slice();
+    let pmf = table.pmf_slice();
     // One rectangle emitter with its radiance slot (a Cornell box, a room with one
-    // lamp): every lane picks it (`LightSet::sample` of one light) — its fields are
+    // lamp): every lane picks it (`LightSet::sample_at` of one light) — its fields are
     // written into the lanes once, its L(λ) and pmf for all lanes in vector passes.
     if let ([Some(rect)], [p]) = (job.packet.lights.as_slice(), pmf) {
         if let (Some(0), true) = (rect.radiance_slot, *p > 0.0) {
@@ -909,7 +910,7 @@ fn choose_lights<const N: usize>(
             return;
         }
     }
-    // `LightSet::sample`: the first light whose running sum exceeds u, i.e. the number of
+    // `SelectionTable::sample`: the first light whose running sum exceeds u, i.e. the number of
     // sums ≤ u (they never decrease).
     let mut chosen = [0u32; N];
     let last = cdf.len() as u32 - 1;
@@ -925,7 +926,7 @@ fn choose_lights<const N: usize>(
     } else {
         for l in 0..N {
             let uc = u[0][l].min(1.0 - f32::EPSILON);
-            chosen[l] = lights.sample(uc).map_or(0, |(i, _)| i);
+            chosen[l] = table.sample(uc).map_or(0, |(i, _)| i);
         }
     }
     for l in 0..N {
@@ -934,7 +935,7 @@ fn choose_lights<const N: usize>(
         };
         let li = chosen[l];
         let p = pmf[li as usize];
-        // `LightSet::sample` picks no light where p is not > 0.
+        // `SelectionTable::sample` picks no light where p is not > 0.
         if p.is_nan() || p <= 0.0 {
             continue;
         }
