@@ -5,9 +5,10 @@
 //! escaping rays see.
 //!
 //! Which selection a caller uses is part of its estimator: next-event estimation in the
-//! path tracer and its medium and photon-camera variants calls `sample_at`/`pmf_at`; light
-//! paths (BDPT, photons), sensors and the predictor's probe choose by power (`sample`,
-//! `pmf`), as their weights assume.
+//! path tracer, its medium and photon-camera variants and the illuminance sensors (whose
+//! gather rays the path tracer weighs) calls `sample_at`/`pmf_at`; light paths (BDPT,
+//! photons) and the predictor's probe choose by power (`sample`, `pmf`), as their weights
+//! assume.
 
 use std::ops::Range;
 

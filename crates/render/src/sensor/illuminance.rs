@@ -56,11 +56,13 @@ pub fn sample_illuminance_lx(
     let n_light = light_samples.max(1);
 
     // Next-event estimation: `n_light` light samples, the choice stratified over the
-    // selection CDF (see `PathTracer::radiance_from`), averaged.
+    // selection CDF (see `PathTracer::radiance_from`), averaged. The choice is the path
+    // tracer's at a shading point (`sample_at`): the cosine ray below weighs the emission
+    // it meets against that choice's probabilities (`PathTracer::emission_weight`).
     for k in 0..n_light {
         let u_choice = ((k as f32 + stream.get_1d()) / n_light as f32).min(1.0 - f32::EPSILON);
         let u_light = stream.get_2d();
-        let Some((l, pmf)) = lights.sample(u_choice) else {
+        let Some((l, pmf)) = lights.sample_at(&ctx, u_choice) else {
             continue;
         };
         if let Some(ls) = lights

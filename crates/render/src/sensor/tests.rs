@@ -405,3 +405,40 @@ fn sample_ranges_of_a_fixed_sensor_add_up_to_the_whole_measurement() {
     let err = measure_sensor_share(&adaptive, &sensors, 3, share(0, 3), &|_| {}).unwrap_err();
     assert!(err.contains("sensor g") && err.contains("fixed"), "{err}");
 }
+
+#[test]
+fn a_panel_under_a_sky_gives_its_form_factor_whichever_way_light_samples_choose() {
+    // A 1 × 1 m panel of 8000 cd/m² 2 m above an upward receiver, under a sky of 150 cd/m²
+    // that the panel hides in part: E = π L_panel F + π L_sky (1 − F), F the form factor
+    // from the receiver to the panel (four corner rectangles of 0.5 × 0.5 m; Howell's
+    // catalogue, differential area to a parallel rectangle). The sensor's cosine rays meet
+    // the panel and the sky and are weighed against the light samples' choice, so every
+    // choice must give the same lux.
+    let (l_panel, l_sky) = (8000.0, 150.0);
+    let corner = |x: f64, y: f64| {
+        let (ax, ay) = ((1.0 + x * x).sqrt(), (1.0 + y * y).sqrt());
+        (x / ax * (y / ax).atan() + y / ay * (x / ay).atan()) / std::f64::consts::TAU
+    };
+    let f = 4.0 * corner(0.25, 0.25);
+    let exact = std::f64::consts::PI * (l_panel * f + l_sky * (1.0 - f));
+    let json = format!(
+        r#"{{"materials": {{"black": {{"type": "lambert", "reflectance": 0}}}},
+            "shapes": [{{"type": "rectangle", "name": "panel", "size_m": [1, 1], "material": "black",
+                         "transform": [{{"rotate": {{"axis": [1, 0, 0], "angle_deg": 90}}}},
+                                       {{"translate": [0, 2, 0]}}]}}],
+            "lights": [{{"type": "area", "shape": "panel", "luminance_cd_m2": {l_panel}}},
+                       {{"type": "sky", "luminance_cd_m2": {l_sky}}}],
+            "sensors": [{{"type": "points", "positions_m": [[0, 0, 0]], "normals": [[0, 1, 0]],
+                          "samples": 20000}}]}}"#
+    );
+    let (mut scene, sensors) = scene(&json);
+    for selection in [
+        crate::light::ShadingSelection::InfiniteApart,
+        crate::light::ShadingSelection::Power,
+        crate::light::ShadingSelection::Bvh,
+    ] {
+        assert!(scene.set_light_selection(selection));
+        let r = measure_sensors(&scene, &sensors, 7, &|_| {}).0;
+        check(&r[0].points[0], exact, &format!("{selection:?}"));
+    }
+}
