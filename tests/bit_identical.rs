@@ -142,12 +142,20 @@ fn scenes_render_the_recorded_bits() {
     let recorded = std::fs::read_to_string(&fixture).unwrap();
     let mut differing = Vec::new();
     let mut checked = 0;
+    let mut keys = std::collections::BTreeSet::new();
     for line in recorded.lines().filter(|l| !l.starts_with('#')) {
         let (key, hash) = line.rsplit_once(' ').unwrap();
+        keys.insert(key);
         match current.get(key) {
             Some(now) if now == hash => checked += 1,
             Some(now) => differing.push(format!("{key}: recorded {hash}, now {now}")),
             None => differing.push(format!("{key}: recorded {hash}, no longer renders")),
+        }
+    }
+    // A scene added without re-recording would go unchecked.
+    for (key, now) in &current {
+        if !keys.contains(key.as_str()) {
+            differing.push(format!("{key}: renders ({now}) but is not recorded"));
         }
     }
     assert!(
