@@ -12,6 +12,8 @@
 
 use std::path::PathBuf;
 
+mod support;
+
 use prism_render::light::ShadingSelection;
 use prism_render::{render, RenderScene, RenderSettings};
 
@@ -155,4 +157,57 @@ fn lights_at_infinity_chosen_apart_are_unbiased_and_less_noisy_than_power_select
     );
     // Measured: 16–40× lower variance per channel.
     unbiased_and_less_noisy(&description, ShadingSelection::InfiniteApart, 0.25);
+}
+
+#[test]
+fn explain_names_the_light_selection_each_flag_gives() {
+    // A sky and one luminaire; the open office's 120 luminaires turn the light BVH on.
+    let explain = |scene: &str, selection: &str| -> String {
+        let o = support::prism(&["render", scene, "--explain", "--light-selection", selection]);
+        let text = format!(
+            "{}{}",
+            String::from_utf8_lossy(&o.stdout),
+            support::stderr(&o)
+        );
+        assert!(o.status.success(), "{scene} {selection}: {text}");
+        text.lines()
+            .skip_while(|l| !l.starts_with("light selection"))
+            .take(2)
+            .collect::<Vec<_>>()
+            .join("\n")
+    };
+    let sky_and_lamp = "scenes/stress/grazing-rough-conductor.json";
+    let office = "scenes/many-lights/open-office.json";
+    for (scene, selection, says) in [
+        (
+            sky_and_lamp,
+            "auto",
+            "1 light(s) at infinity apart (each 1/2), the other 1 in proportion to power",
+        ),
+        (
+            sky_and_lamp,
+            "infinite-apart",
+            "fewer than 8 lights with bounds",
+        ),
+        (
+            sky_and_lamp,
+            "power",
+            "in proportion to power over 2 light(s)",
+        ),
+        (
+            sky_and_lamp,
+            "bvh",
+            "light BVH over 1 lights with bounds, 1 at infinity chosen apart (each 1/2)",
+        ),
+        (office, "auto", "light BVH over 120 lights with bounds"),
+        (
+            office,
+            "infinite-apart",
+            "asked for (--light-selection infinite-apart)",
+        ),
+        (office, "power", "asked for (--light-selection power)"),
+    ] {
+        let line = explain(scene, selection);
+        assert!(line.contains(says), "{scene} {selection}: {line}");
+    }
 }

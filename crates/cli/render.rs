@@ -127,9 +127,9 @@ pub struct RenderArgs {
     #[arg(long = "progress-every", value_name = "DURATION", default_value = "10s", value_parser = prism_args::duration::parse_duration)]
     pub progress_every: Duration,
     /// How light samples at shading points choose a light: `auto` through the light BVH
-    /// from 8 lights with bounds on; below, lights at infinity apart (each 1/(their count +
-    /// 1)) and the others by power; `power` always by power, lights at infinity included;
-    /// `bvh` through the light BVH whenever a light has bounds.
+    /// from 8 lights with bounds on, below it `infinite-apart`; `infinite-apart` each light
+    /// at infinity with 1/(their count + 1), the others by power; `power` always by power,
+    /// lights at infinity included; `bvh` through the light BVH whenever a light has bounds.
     #[arg(long = "light-selection", value_enum, default_value = "auto")]
     pub light_selection: LightSelectionArg,
     #[command(flatten)]
@@ -142,6 +142,7 @@ pub struct RenderArgs {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum LightSelectionArg {
     Auto,
+    InfiniteApart,
     Power,
     Bvh,
 }
@@ -323,6 +324,9 @@ pub fn run(args: &RenderArgs, budget: &MemoryBudget) -> Result<ExitCode, String>
     let mut scene = RenderScene::build(&description, args.resolution).map_err(|e| e.to_string())?;
     match args.light_selection {
         LightSelectionArg::Auto => {}
+        LightSelectionArg::InfiniteApart => {
+            scene.set_light_selection(prism_render::light::ShadingSelection::InfiniteApart);
+        }
         LightSelectionArg::Power => {
             scene.set_light_selection(prism_render::light::ShadingSelection::Power);
         }

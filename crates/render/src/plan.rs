@@ -715,33 +715,49 @@ fn light_selection_text(scene: &RenderScene) -> (String, String) {
         None => {
             let lights = scene.lights.lights();
             let at_infinity = lights.iter().filter(|l| l.is_infinite()).count();
-            let by_power = format!("in proportion to power over {} light(s)", lights.len());
-            let few = format!("fewer than {min} lights with bounds: the light BVH gains little");
-            match scene.lights.shading_selection() {
-                ShadingSelection::Power => (
-                    by_power,
-                    "asked for (--light-selection power; pbrt-v4 PowerLightSampler)".to_string(),
-                ),
+            let selection = scene.lights.shading_selection();
+            // `auto` never chooses power alone, and below the BVH's threshold it chooses
+            // lights at infinity apart; from the threshold on only the flag can have.
+            let reason = match selection {
+                ShadingSelection::Power => "asked for (--light-selection power)".to_string(),
+                ShadingSelection::InfiniteApart | ShadingSelection::Bvh
+                    if scene.lights.bounded_light_count() >= min =>
+                {
+                    "asked for (--light-selection infinite-apart)".to_string()
+                }
+                ShadingSelection::InfiniteApart | ShadingSelection::Bvh => {
+                    format!("fewer than {min} lights with bounds: the light BVH gains little")
+                }
+            };
+            match selection {
                 ShadingSelection::InfiniteApart
                     if at_infinity > 0 && at_infinity < lights.len() =>
                 {
-                    (
-                        format!(
+                    let what = format!(
                         "{at_infinity} light(s) at infinity apart (each 1/{}), the other {} in \
                          proportion to power",
                         at_infinity + 1,
                         lights.len() - at_infinity
-                    ),
-                        format!(
-                        "{few}; the power of a light at infinity grows with the scene's size and \
-                         says little about which light lights a point, so it is chosen apart \
-                         as in pbrt-v4's BVHLightSampler"
-                    ),
-                    )
+                    );
+                    let why = format!(
+                        "{reason}; the power of a light at infinity grows with the scene's size \
+                         and says little about which light lights a point, so it is chosen \
+                         apart as in pbrt-v4's BVHLightSampler"
+                    );
+                    (what, why)
                 }
-                ShadingSelection::InfiniteApart | ShadingSelection::Bvh => {
-                    (by_power, format!("{few} (pbrt-v4 PowerLightSampler)"))
-                }
+                ShadingSelection::InfiniteApart | ShadingSelection::Bvh => (
+                    format!("in proportion to power over {} light(s)", lights.len()),
+                    format!(
+                        "{reason}; the lights are all at infinity or none is, where choosing \
+                         those at infinity apart is choosing by power (pbrt-v4 \
+                         PowerLightSampler)"
+                    ),
+                ),
+                ShadingSelection::Power => (
+                    format!("in proportion to power over {} light(s)", lights.len()),
+                    format!("{reason} (pbrt-v4 PowerLightSampler)"),
+                ),
             }
         }
     }
