@@ -59,8 +59,8 @@ pub enum ShadingSelection {
 }
 
 /// From this many lights with bounds on, light samples at shading points choose through
-/// the light BVH; below it by power, as before (a handful of lights gains little and the
-/// packet tracer keeps serving them).
+/// the light BVH; below it from `SelectionTable::infinite_apart` (a handful of lights gains
+/// little from the tree, and the packet tracer keeps serving them).
 pub const LIGHT_BVH_MIN_BOUNDED: usize = 8;
 
 impl LightSet {
