@@ -56,13 +56,20 @@ fn film_hash(film: &FilmImage) -> u64 {
     h.finish()
 }
 
-/// Every scene file under scenes/ (one and two levels deep), sorted.
+/// Every scene file under scenes/ (one and two levels deep), sorted; hidden files (the
+/// temporary copies tools/radiosity_stress.py writes next to a scene) left out.
 fn example_scenes(root: &Path) -> Vec<PathBuf> {
     let mut out = Vec::new();
     let mut dirs = vec![(root.join("scenes"), 0)];
     while let Some((dir, depth)) = dirs.pop() {
         for entry in std::fs::read_dir(&dir).unwrap() {
             let path = entry.unwrap().path();
+            if path
+                .file_name()
+                .is_some_and(|n| n.to_string_lossy().starts_with('.'))
+            {
+                continue;
+            }
             if path.is_dir() && depth == 0 {
                 dirs.push((path, depth + 1));
             } else if path.extension().is_some_and(|e| e == "json") {

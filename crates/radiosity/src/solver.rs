@@ -223,6 +223,14 @@ const SOURCE_SHARE_DEPTH: u32 = 3;
 /// 20× too bright).
 const SHARE_VISIBILITY_RAYS: usize = 4;
 
+/// Where a source node is weighed when no share centre faces the receiver
+/// (`facing_shares`): its four quadrants' centres, (u, v) on the element.
+const STRADDLE_POINTS: [(f32, f32); 4] = [(0.25, 0.25), (0.75, 0.25), (0.25, 0.75), (0.75, 0.75)];
+
+/// At most this many shares per link from `facing_shares` (a node whose points disagree
+/// is replaced by its children only while the link stays within it).
+const MAX_FACING_SHARES: usize = 256;
+
 /// A partly visible link refines at this fraction of the error bound (a separate, tighter
 /// bound for visibility error, as in Lischinski et al. 1994's BFV refinement). What a
 /// coarse partial link gets wrong is not a smooth variation: it pushes light onto the
@@ -986,8 +994,8 @@ impl Radiosity {
         let (corners, count) = receiver.corners();
         let n_r = receiver.normal();
         let mut shares: Vec<(u32, f32)> = frontier
-            .into_iter()
-            .map(|n| {
+            .iter()
+            .map(|&n| {
                 let node = &nodes[n as usize];
                 let NodeKind::Element { shape, .. } = node.kind else {
                     unreachable!("an element's descendants are elements")
@@ -1009,8 +1017,15 @@ impl Radiosity {
             .collect();
         let mut sum: f32 = shares.iter().map(|s| s.1).sum();
         if sum <= 0.0 {
-            // No centre sees r (a grazing or near pair): the area average, kept as shares
-            // so that the next refinement sees the same nodes and reuses them.
+            // No centre faces r, yet the link's factor is not 0: the source runs through
+            // r's plane (a floor under a wall that r is a face of), and only its part in
+            // front of r reaches r.
+            shares = self.facing_shares(r, receiver, frontier, partial, vis);
+            sum = shares.iter().map(|s| s.1).sum();
+        }
+        if sum <= 0.0 {
+            // Still nothing (a grazing or near pair): the area average, kept as shares so
+            // that the next refinement sees the same nodes and reuses them.
             for share in &mut shares {
                 share.1 = nodes[share.0 as usize].area_m2;
             }
@@ -1020,6 +1035,57 @@ impl Radiosity {
             share.1 /= sum;
         }
         shares.into_boxed_slice()
+    }
+
+    /// Shares of the source nodes `frontier` weighed by the mean point factor towards
+    /// receiver r of their [`STRADDLE_POINTS`] (times what r sees of each, for a
+    /// `partial` link), not of their centres: for a source that runs through r's plane,
+    /// whose centres may all lie behind r. A node whose points disagree (some in front of
+    /// r, some behind) is replaced by its children, recursively down to leaves, at most
+    /// [`MAX_FACING_SHARES`] nodes in all; otherwise a node straddling a wall r stands on
+    /// would carry the light of the wall's other side to r (a floor spanning two rooms,
+    /// seen from the partition's face in the dark one).
+    fn facing_shares(
+        &self,
+        r: u32,
+        receiver: &ElementShape,
+        frontier: Vec<u32>,
+        partial: bool,
+        vis: &dyn Visibility,
+    ) -> Vec<(u32, f32)> {
+        let nodes = &self.hierarchy.nodes;
+        let (corners, count) = receiver.corners();
+        let n_r = receiver.normal();
+        let mut kept: Vec<(u32, f32)> = Vec::with_capacity(frontier.len());
+        let mut pending = frontier;
+        while let Some(n) = pending.pop() {
+            let NodeKind::Element { shape, .. } = nodes[n as usize].kind else {
+                unreachable!("an element's descendants are elements")
+            };
+            let n_s = shape.normal();
+            let factors = STRADDLE_POINTS.map(|(u, v)| {
+                let y = shape.point(u, v);
+                let f = point_to_polygon(y, n_s, &corners[..count], n_r);
+                if partial && f > 0.0 {
+                    f * self.seen_fraction(r, receiver, y, n_s, n as usize, vis)
+                } else {
+                    f
+                }
+            });
+            let children = self.hierarchy.children(n);
+            let disagree = factors.iter().any(|&f| f > 0.0) && factors.iter().any(|&f| f <= 0.0);
+            if disagree
+                && children.len() > 0
+                && kept.len() + pending.len() + children.len() <= MAX_FACING_SHARES
+            {
+                pending.extend(children);
+                continue;
+            }
+            let f = factors.iter().sum::<f32>() / STRADDLE_POINTS.len() as f32;
+            let area = nodes[n as usize].area_m2 * (1.0 - self.covered_fraction(n as usize));
+            kept.push((n, f * area));
+        }
+        kept
     }
 
     /// The fraction of `SHARE_VISIBILITY_RAYS` uncovered sample points of receiver r
