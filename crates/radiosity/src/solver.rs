@@ -991,8 +991,6 @@ impl Radiosity {
         if frontier.is_empty() {
             return Box::default();
         }
-        let (corners, count) = receiver.corners();
-        let n_r = receiver.normal();
         let mut shares: Vec<(u32, f32)> = frontier
             .iter()
             .map(|&n| {
@@ -1000,18 +998,13 @@ impl Radiosity {
                 let NodeKind::Element { shape, .. } = node.kind else {
                     unreachable!("an element's descendants are elements")
                 };
-                let (centre, n_s) = (shape.centre(), shape.normal());
-                let f = point_to_polygon(centre, n_s, &corners[..count], n_r);
-                let seen = if partial && f > 0.0 {
-                    self.seen_fraction(r, receiver, centre, n_s, n as usize, vis)
-                } else {
-                    1.0
-                };
+                let y = shape.centre();
+                let f = self.share_point_factor(r, receiver, y, shape.normal(), n, partial, vis);
                 // Sample-point coverage, not `free_area`: a node split in this
                 // refinement has no push–pull area yet.
                 (
                     n,
-                    f * seen * node.area_m2 * (1.0 - self.covered_fraction(n as usize)),
+                    f * node.area_m2 * (1.0 - self.covered_fraction(n as usize)),
                 )
             })
             .collect();
@@ -1054,23 +1047,22 @@ impl Radiosity {
         vis: &dyn Visibility,
     ) -> Vec<(u32, f32)> {
         let nodes = &self.hierarchy.nodes;
-        let (corners, count) = receiver.corners();
-        let n_r = receiver.normal();
         let mut kept: Vec<(u32, f32)> = Vec::with_capacity(frontier.len());
         let mut pending = frontier;
         while let Some(n) = pending.pop() {
             let NodeKind::Element { shape, .. } = nodes[n as usize].kind else {
                 unreachable!("an element's descendants are elements")
             };
-            let n_s = shape.normal();
             let factors = STRADDLE_POINTS.map(|(u, v)| {
-                let y = shape.point(u, v);
-                let f = point_to_polygon(y, n_s, &corners[..count], n_r);
-                if partial && f > 0.0 {
-                    f * self.seen_fraction(r, receiver, y, n_s, n as usize, vis)
-                } else {
-                    f
-                }
+                self.share_point_factor(
+                    r,
+                    receiver,
+                    shape.point(u, v),
+                    shape.normal(),
+                    n,
+                    partial,
+                    vis,
+                )
             });
             let children = self.hierarchy.children(n);
             let disagree = factors.iter().any(|&f| f > 0.0) && factors.iter().any(|&f| f <= 0.0);
@@ -1086,6 +1078,29 @@ impl Radiosity {
             kept.push((n, f * area));
         }
         kept
+    }
+
+    /// The exact point factor from `y` (normal `n_y`, on share node `node`) to receiver r,
+    /// times the fraction of r's sample points that see `y` for a `partial` link: what a
+    /// share weighs at one point of its node.
+    #[allow(clippy::too_many_arguments)]
+    fn share_point_factor(
+        &self,
+        r: u32,
+        receiver: &ElementShape,
+        y: Vec3A,
+        n_y: Vec3A,
+        node: u32,
+        partial: bool,
+        vis: &dyn Visibility,
+    ) -> f32 {
+        let (corners, count) = receiver.corners();
+        let f = point_to_polygon(y, n_y, &corners[..count], receiver.normal());
+        if partial && f > 0.0 {
+            f * self.seen_fraction(r, receiver, y, n_y, node as usize, vis)
+        } else {
+            f
+        }
     }
 
     /// The fraction of `SHARE_VISIBILITY_RAYS` uncovered sample points of receiver r

@@ -731,7 +731,7 @@ fn light_selection_text(scene: &RenderScene) -> (String, String) {
             };
             match selection {
                 ShadingSelection::InfiniteApart
-                    if at_infinity > 0 && at_infinity < lights.len() =>
+                    if scene.lights.infinite_apart_differs_from_power() =>
                 {
                     let what = format!(
                         "{at_infinity} light(s) at infinity apart (each 1/{}), the other {} in \
@@ -749,9 +749,9 @@ fn light_selection_text(scene: &RenderScene) -> (String, String) {
                 ShadingSelection::InfiniteApart | ShadingSelection::Bvh => (
                     format!("in proportion to power over {} light(s)", lights.len()),
                     format!(
-                        "{reason}; the lights are all at infinity or none is, where choosing \
-                         those at infinity apart is choosing by power (pbrt-v4 \
-                         PowerLightSampler)"
+                        "{reason}; no light at infinity stands beside other lights with \
+                         power, where choosing those at infinity apart is choosing by power \
+                         (pbrt-v4 PowerLightSampler)"
                     ),
                 ),
                 ShadingSelection::Power => (

@@ -180,6 +180,12 @@ impl LightSet {
         self.selection
     }
 
+    /// Whether choosing lights at infinity apart differs from choosing by power here: the
+    /// scene has lights at infinity beside other lights with power.
+    pub fn infinite_apart_differs_from_power(&self) -> bool {
+        self.infinite_apart != self.power
+    }
+
     /// Lights in the light BVH `build` made, on or off (0 without one).
     pub fn bounded_light_count(&self) -> usize {
         self.bvh.as_ref().map_or(0, LightBvh::bounded_count)

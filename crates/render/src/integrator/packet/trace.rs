@@ -853,9 +853,9 @@ fn put_rectangle<const N: usize>(vertex: &mut VertexIn<N>, l: usize, rect: &Rect
 /// Lights with at most this many entries are picked for all lanes in one vector pass.
 const VECTOR_LIGHT_CHOICE_MAX: usize = 16;
 
-/// Each vertex's light choice (`LightSet::sample_at` without the BVH), the chosen rectangle's fields and
-/// L(λ), or a light sample by the scalar `Light` code for other lights (after
-/// `draw_variates`). `rectangle_in_lane[l]` names the light whose fields lane `l` of
+/// Each vertex's light choice (`LightSet::sample_at` without the BVH), the chosen
+/// rectangle's fields and L(λ), or a light sample by the scalar `Light` code for other
+/// lights (after `draw_variates`). `rectangle_in_lane[l]` names the light whose fields lane `l` of
 /// `vertex` already holds.
 #[inline(always)]
 fn choose_lights<const N: usize>(
@@ -910,8 +910,8 @@ fn choose_lights<const N: usize>(
             return;
         }
     }
-    // `SelectionTable::sample`: the first light whose running sum exceeds u, i.e. the number of
-    // sums ≤ u (they never decrease).
+    // `SelectionTable::sample`: the first light whose running sum exceeds u, i.e. the
+    // number of sums ≤ u (they never decrease).
     let mut chosen = [0u32; N];
     let last = cdf.len() as u32 - 1;
     if cdf.len() <= VECTOR_LIGHT_CHOICE_MAX {
