@@ -42,7 +42,9 @@ pub const ENV_VAR: &str = "PRISM_SIMD";
 pub enum Isa {
     /// The build's baseline (SSE2 on x86-64): the portable path.
     Scalar,
-    /// AVX2 with FMA (and AVX): 8 f32 lanes.
+    /// AVX2 with FMA (and AVX), plus the bit instructions every AVX2 CPU has (BMI1, BMI2,
+    /// LZCNT, POPCNT: x86-64-v3, which the BVH traversal's mask arithmetic uses): 8 f32
+    /// lanes.
     Avx2,
     /// AVX-512 F, DQ, VL and BW, with everything `Avx2` needs: 16 f32 lanes.
     Avx512,
@@ -81,7 +83,15 @@ impl Isa {
             return (self != Isa::Scalar).then(|| "x86-64 vector extensions".to_string());
         }
         if self >= Isa::Avx2 {
-            for (has, name) in [(cpu.avx, "AVX"), (cpu.avx2, "AVX2"), (cpu.fma, "FMA")] {
+            for (has, name) in [
+                (cpu.avx, "AVX"),
+                (cpu.avx2, "AVX2"),
+                (cpu.fma, "FMA"),
+                (cpu.bmi1, "BMI1"),
+                (cpu.bmi2, "BMI2"),
+                (cpu.lzcnt, "LZCNT"),
+                (cpu.popcnt, "POPCNT"),
+            ] {
                 if !has {
                     lacks.push(name);
                 }
@@ -140,6 +150,10 @@ struct Features {
     avx: bool,
     avx2: bool,
     fma: bool,
+    bmi1: bool,
+    bmi2: bool,
+    lzcnt: bool,
+    popcnt: bool,
     avx512f: bool,
     avx512dq: bool,
     avx512vl: bool,
@@ -155,6 +169,10 @@ impl Features {
             avx: has!("avx"),
             avx2: has!("avx2"),
             fma: has!("fma"),
+            bmi1: has!("bmi1"),
+            bmi2: has!("bmi2"),
+            lzcnt: has!("lzcnt"),
+            popcnt: has!("popcnt"),
             avx512f: has!("avx512f"),
             avx512dq: has!("avx512dq"),
             avx512vl: has!("avx512vl"),
@@ -169,6 +187,10 @@ impl Features {
             avx: false,
             avx2: false,
             fma: false,
+            bmi1: false,
+            bmi2: false,
+            lzcnt: false,
+            popcnt: false,
             avx512f: false,
             avx512dq: false,
             avx512vl: false,
@@ -201,7 +223,8 @@ impl Simd {
         self.0
     }
 
-    /// AVX, AVX2 and FMA kernels may run (`#[target_feature(enable = "avx2,fma")]`).
+    /// AVX, AVX2 and FMA kernels may run (`#[target_feature(enable = "avx2,fma")]`), and
+    /// with them the x86-64-v3 bit instructions (`bmi1,bmi2,lzcnt,popcnt`).
     #[inline(always)]
     pub fn avx2(self) -> bool {
         self.0 >= Isa::Avx2

@@ -261,6 +261,7 @@ impl GeometryBuilder {
             scene,
             small,
             single,
+            simd: prism_cpu::active(),
             triangles,
             instance_leaves,
         }
@@ -421,6 +422,8 @@ pub struct Geometry {
     small: Option<SmallScene>,
     /// The only leaf, an instance, traced without a box test.
     single: Option<u32>,
+    /// The widest kernels the scene BVH's traversal runs (`prism_cpu::active()` at build).
+    simd: prism_cpu::Simd,
     triangles: usize,
     instance_leaves: usize,
 }
@@ -463,6 +466,14 @@ impl Geometry {
         self.small.is_some()
     }
 
+    /// The same geometry with the kernels of `simd` (the tests that check every ISA's
+    /// traversal agrees; `simd` must be one this CPU runs, as `prism_cpu::each_isa` gives).
+    pub fn with_simd(mut self, simd: prism_cpu::Simd) -> Self {
+        self.simd = simd;
+        self.small = self.small.map(|s| s.with_simd(simd));
+        self
+    }
+
     /// A small scene with leaves other than baked triangles and rectangles (spheres,
     /// disks, instanced meshes), tested one by one after the batches.
     pub(crate) fn has_other_small_leaves(&self) -> bool {
@@ -479,6 +490,27 @@ impl Geometry {
                 .single
                 .and_then(|i| self.intersect_instance(i, ray, ray.t_max));
         };
+        #[cfg(target_arch = "x86_64")]
+        if self.simd.avx2() {
+            // SAFETY: `Simd::avx2` is true only where the CPU runs AVX2, FMA, BMI1/2, LZCNT
+            // and POPCNT.
+            return unsafe { self.intersect_scene_avx2(scene, ray) };
+        }
+        self.intersect_scene(scene, ray)
+    }
+
+    /// [`Self::intersect_scene`] compiled for x86-64-v3 (the `avx2` level): the same
+    /// arithmetic (Rust never fuses `a * b + c` into an FMA, so the hits are the same bits)
+    /// in VEX code, with one-instruction bit counts for the traversal's masks (docs/geometry.md).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt")]
+    unsafe fn intersect_scene_avx2(&self, scene: &TriangleBvh<Leaf>, ray: &Ray) -> Option<Hit> {
+        self.intersect_scene(scene, ray)
+    }
+
+    /// Closest hit in the scene BVH.
+    #[inline(always)]
+    fn intersect_scene(&self, scene: &TriangleBvh<Leaf>, ray: &Ray) -> Option<Hit> {
         let (o, d) = (ray.origin, ray.direction);
         let wt = WatertightRay::new(o, d, ray.t_min);
         let mut best_instance: Option<Hit> = None;
@@ -644,6 +676,25 @@ impl Geometry {
         let Some(scene) = &self.scene else {
             return self.single.is_some_and(|i| self.occludes(i, ray));
         };
+        #[cfg(target_arch = "x86_64")]
+        if self.simd.avx2() {
+            // SAFETY: `Simd::avx2` is true only where the CPU runs AVX2, FMA, BMI1/2, LZCNT
+            // and POPCNT.
+            return unsafe { self.occluded_scene_avx2(scene, ray) };
+        }
+        self.occluded_scene(scene, ray)
+    }
+
+    /// [`Self::occluded_scene`] compiled for x86-64-v3, as [`Self::intersect_scene_avx2`].
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt")]
+    unsafe fn occluded_scene_avx2(&self, scene: &TriangleBvh<Leaf>, ray: &Ray) -> bool {
+        self.occluded_scene(scene, ray)
+    }
+
+    /// Whether anything in the scene BVH blocks `ray`.
+    #[inline(always)]
+    fn occluded_scene(&self, scene: &TriangleBvh<Leaf>, ray: &Ray) -> bool {
         let (o, d) = (ray.origin, ray.direction);
         let wt = WatertightRay::new(o, d, ray.t_min);
         scene.any(o, d, ray.t_min, ray.t_max, |p, leaf, t_max| {

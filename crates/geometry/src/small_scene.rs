@@ -689,8 +689,7 @@ impl SmallScene {
 
     /// The same scene with the kernels of `simd` (for the tests that check every ISA's
     /// kernels agree).
-    #[cfg(test)]
-    fn with_simd(mut self, simd: prism_cpu::Simd) -> Self {
+    pub(crate) fn with_simd(mut self, simd: prism_cpu::Simd) -> Self {
         self.simd = simd;
         self
     }
