@@ -4,7 +4,8 @@
 //! index for a mesh's own BVH ([`crate::mesh_bvh::MeshBvh`]); for the scene BVH of
 //! [`crate::Geometry`], the original instance and triangle of a baked world-space triangle, or
 //! an instance whose slot holds its world box instead of vertices. Traversal runs obvhs'
-//! `traverse!` loop with our own uninitialised node stack ([`Traversal`]).
+//! `traverse!` loop with our own uninitialised node stack ([`Traversal`]); the closest-hit
+//! traversal prefetches the lines each node test selects.
 
 use std::mem::MaybeUninit;
 
@@ -136,10 +137,10 @@ impl<Id: Copy> TriangleBvh<Id> {
         );
     }
 
-    /// Start loading what the closest-hit traversal reads next: the primitives (vertices and ids) and the
-    /// child nodes that the ray enters. Incoherent rays miss the caches at every level;
-    /// without this each load waits for the one before it (docs/geometry.md, "Where an
-    /// incoherent ray's time goes").
+    /// Start loading what the closest-hit traversal reads next: the primitives (vertices and
+    /// ids) and the child nodes that the ray enters. Incoherent rays miss the caches at every
+    /// level; without this each load waits for the one before it (docs/geometry.md, "Where
+    /// an incoherent ray's time goes").
     #[inline(always)]
     fn prefetch_hits(&self, bvh: &CwBvh, node: &CwBvhNode, hits: u32, oct_inv4: u32) {
         #[cfg(target_arch = "x86_64")]
