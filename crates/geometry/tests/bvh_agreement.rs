@@ -224,6 +224,8 @@ fn every_isa_traverses_the_scene_bvh_to_the_same_bits() {
     )
     .unwrap();
     let mut geometry = b.build(BuildQuality::Fast);
+    // The premise: the scene BVH with an instance leaf, not the small-scene batches.
+    assert!(!geometry.is_small_scene() && geometry.instance_leaf_count() == 1);
     let rays: Vec<Ray> = (0..20_000)
         .map(|i| {
             let origin = Vec3A::new(
