@@ -505,17 +505,32 @@ impl Geometry {
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt")]
     unsafe fn intersect_scene_avx2(&self, scene: &TriangleBvh<Leaf>, ray: &Ray) -> Option<Hit> {
-        self.intersect_scene(scene, ray)
+        // SAFETY: this function runs only where the CPU has AVX2.
+        unsafe { self.intersect_scene_with::<true>(scene, ray) }
     }
 
     /// Closest hit in the scene BVH.
     #[inline(always)]
     fn intersect_scene(&self, scene: &TriangleBvh<Leaf>, ray: &Ray) -> Option<Hit> {
+        // SAFETY: the 4-wide node test needs nothing beyond the target's baseline.
+        unsafe { self.intersect_scene_with::<false>(scene, ray) }
+    }
+
+    /// [`Self::intersect_scene`] with the node test of `WIDE` (`TriangleBvh::traverse_with`).
+    ///
+    /// # Safety
+    /// With `WIDE`, the CPU must run AVX2.
+    #[inline(always)]
+    unsafe fn intersect_scene_with<const WIDE: bool>(
+        &self,
+        scene: &TriangleBvh<Leaf>,
+        ray: &Ray,
+    ) -> Option<Hit> {
         let (o, d) = (ray.origin, ray.direction);
         let wt = WatertightRay::new(o, d, ray.t_min);
         let mut best_instance: Option<Hit> = None;
         let mut best_triangle: Option<(TriangleHit, Leaf)> = None;
-        scene.traverse(o, d, ray.t_min, ray.t_max, |p, leaf, t_max| {
+        let test = |p: &[Vec3A; 3], leaf: Leaf, t_max: f32| {
             if leaf.is_instance() {
                 match self.intersect_instance(leaf.instance, ray, t_max) {
                     Some(h) => {
@@ -535,7 +550,9 @@ impl Geometry {
                     None => f32::INFINITY,
                 }
             }
-        });
+        };
+        // SAFETY: the caller's contract for `WIDE`.
+        unsafe { scene.traverse_with::<WIDE>(o, d, ray.t_min, ray.t_max, test) };
         best_instance
             .or_else(|| best_triangle.map(|(h, leaf)| self.baked_hit(ray, h.t, h.b1, h.b2, leaf)))
     }
@@ -689,21 +706,38 @@ impl Geometry {
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt")]
     unsafe fn occluded_scene_avx2(&self, scene: &TriangleBvh<Leaf>, ray: &Ray) -> bool {
-        self.occluded_scene(scene, ray)
+        // SAFETY: this function runs only where the CPU has AVX2.
+        unsafe { self.occluded_scene_with::<true>(scene, ray) }
     }
 
     /// Whether anything in the scene BVH blocks `ray`.
     #[inline(always)]
     fn occluded_scene(&self, scene: &TriangleBvh<Leaf>, ray: &Ray) -> bool {
+        // SAFETY: the 4-wide node test needs nothing beyond the target's baseline.
+        unsafe { self.occluded_scene_with::<false>(scene, ray) }
+    }
+
+    /// [`Self::occluded_scene`] with the node test of `WIDE` (`TriangleBvh::any_with`).
+    ///
+    /// # Safety
+    /// With `WIDE`, the CPU must run AVX2.
+    #[inline(always)]
+    unsafe fn occluded_scene_with<const WIDE: bool>(
+        &self,
+        scene: &TriangleBvh<Leaf>,
+        ray: &Ray,
+    ) -> bool {
         let (o, d) = (ray.origin, ray.direction);
         let wt = WatertightRay::new(o, d, ray.t_min);
-        scene.any(o, d, ray.t_min, ray.t_max, |p, leaf, t_max| {
+        let test = |p: &[Vec3A; 3], leaf: Leaf, t_max: f32| {
             if leaf.is_instance() {
                 self.occludes(leaf.instance, ray)
             } else {
                 wt.intersect(p[0], p[1], p[2], t_max).is_some()
             }
-        })
+        };
+        // SAFETY: the caller's contract for `WIDE`.
+        unsafe { scene.any_with::<WIDE>(o, d, ray.t_min, ray.t_max, test) }
     }
 
     #[inline]
