@@ -532,7 +532,7 @@ impl Geometry {
         let mut best_triangle: Option<(TriangleHit, Leaf)> = None;
         let test = |p: &[Vec3A; 3], leaf: Leaf, t_max: f32| {
             if leaf.is_instance() {
-                match self.intersect_instance(leaf.instance, ray, t_max) {
+                match self.intersect_instance_on::<WIDE>(leaf.instance, ray, t_max) {
                     Some(h) => {
                         best_instance = Some(h);
                         best_triangle = None;
@@ -636,30 +636,99 @@ impl Geometry {
     /// Closest hit on one instance with `t` in `(ray.t_min, t_max)`.
     #[inline]
     fn intersect_instance(&self, instance_id: u32, ray: &Ray, t_max: f32) -> Option<Hit> {
+        // SAFETY: the 4-wide node test needs nothing beyond the target's baseline.
+        unsafe { self.intersect_instance_with::<false>(instance_id, ray, t_max) }
+    }
+
+    /// [`Self::intersect_instance`] from the scene traversal of `WIDE`: out of line (the
+    /// scene loop stays small for the baked triangles it mostly tests), as x86-64-v3 code
+    /// with the 8-wide node test where `WIDE`.
+    #[inline(always)]
+    fn intersect_instance_on<const WIDE: bool>(
+        &self,
+        instance_id: u32,
+        ray: &Ray,
+        t_max: f32,
+    ) -> Option<Hit> {
+        #[cfg(target_arch = "x86_64")]
+        if WIDE {
+            // SAFETY: `WIDE` is instantiated only by the AVX2 traversal.
+            return unsafe { self.intersect_instance_avx2(instance_id, ray, t_max) };
+        }
+        self.intersect_instance(instance_id, ray, t_max)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt")]
+    #[inline(never)]
+    unsafe fn intersect_instance_avx2(
+        &self,
+        instance_id: u32,
+        ray: &Ray,
+        t_max: f32,
+    ) -> Option<Hit> {
+        // SAFETY: this function runs only where the CPU has AVX2.
+        unsafe { self.intersect_instance_with::<true>(instance_id, ray, t_max) }
+    }
+
+    /// [`Self::occludes`] from the scene traversal of `WIDE`, as [`Self::intersect_instance_on`].
+    #[inline(always)]
+    fn occludes_on<const WIDE: bool>(&self, instance_id: u32, ray: &Ray) -> bool {
+        #[cfg(target_arch = "x86_64")]
+        if WIDE {
+            // SAFETY: `WIDE` is instantiated only by the AVX2 traversal.
+            return unsafe { self.occludes_avx2(instance_id, ray) };
+        }
+        self.occludes(instance_id, ray)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt")]
+    #[inline(never)]
+    unsafe fn occludes_avx2(&self, instance_id: u32, ray: &Ray) -> bool {
+        // SAFETY: this function runs only where the CPU has AVX2.
+        unsafe { self.occludes_with::<true>(instance_id, ray) }
+    }
+
+    /// [`Self::intersect_instance`] with the mesh BVHs' node test of `WIDE`.
+    ///
+    /// # Safety
+    /// With `WIDE`, the CPU must run AVX2.
+    #[inline(always)]
+    unsafe fn intersect_instance_with<const WIDE: bool>(
+        &self,
+        instance_id: u32,
+        ray: &Ray,
+        t_max: f32,
+    ) -> Option<Hit> {
         let inst = &self.instances[instance_id as usize];
         let (o, d) = object_ray(inst, ray);
         match inst.shape {
-            Shape::Mesh(MeshId(m)) => self.meshes[m as usize]
-                .intersect(o, d, ray.t_min, t_max)
-                .map(|h| Hit {
-                    t: h.t,
-                    instance_id,
-                    primitive_id: h.triangle,
-                    b1: h.b1,
-                    b2: h.b2,
-                }),
+            // SAFETY (both arms): the caller's contract for `WIDE`.
+            Shape::Mesh(MeshId(m)) => {
+                unsafe { self.meshes[m as usize].intersect_with::<WIDE>(o, d, ray.t_min, t_max) }
+                    .map(|h| Hit {
+                        t: h.t,
+                        instance_id,
+                        primitive_id: h.triangle,
+                        b1: h.b1,
+                        b2: h.b2,
+                    })
+            }
             Shape::Tiled(tiling) => {
                 let tile = &self.meshes[tiling.mesh.0 as usize];
-                tiling.intersect(tile, o, d, ray.t_min, t_max).map(|h| Hit {
-                    t: h.hit.t,
-                    instance_id,
-                    primitive_id: Tiling::primitive_id(
-                        h.cell,
-                        h.hit.triangle,
-                        tile.mesh.triangle_count() as u32,
-                    ),
-                    b1: h.hit.b1,
-                    b2: h.hit.b2,
+                unsafe { tiling.intersect_with::<WIDE>(tile, o, d, ray.t_min, t_max) }.map(|h| {
+                    Hit {
+                        t: h.hit.t,
+                        instance_id,
+                        primitive_id: Tiling::primitive_id(
+                            h.cell,
+                            h.hit.triangle,
+                            tile.mesh.triangle_count() as u32,
+                        ),
+                        b1: h.hit.b1,
+                        b2: h.hit.b2,
+                    }
                 })
             }
             _ => analytic_intersect(&inst.shape, &Ray::new(o, d, ray.t_min, t_max)).map(|t| Hit {
@@ -731,7 +800,7 @@ impl Geometry {
         let wt = WatertightRay::new(o, d, ray.t_min);
         let test = |p: &[Vec3A; 3], leaf: Leaf, t_max: f32| {
             if leaf.is_instance() {
-                self.occludes(leaf.instance, ray)
+                self.occludes_on::<WIDE>(leaf.instance, ray)
             } else {
                 wt.intersect(p[0], p[1], p[2], t_max).is_some()
             }
@@ -742,17 +811,32 @@ impl Geometry {
 
     #[inline]
     fn occludes(&self, instance_id: u32, ray: &Ray) -> bool {
+        // SAFETY: the 4-wide node test needs nothing beyond the target's baseline.
+        unsafe { self.occludes_with::<false>(instance_id, ray) }
+    }
+
+    /// [`Self::occludes`] with the mesh BVHs' node test of `WIDE`.
+    ///
+    /// # Safety
+    /// With `WIDE`, the CPU must run AVX2.
+    #[inline(always)]
+    unsafe fn occludes_with<const WIDE: bool>(&self, instance_id: u32, ray: &Ray) -> bool {
         let inst = &self.instances[instance_id as usize];
         let (o, d) = object_ray(inst, ray);
         match inst.shape {
-            Shape::Mesh(MeshId(m)) => self.meshes[m as usize].occluded(o, d, ray.t_min, ray.t_max),
-            Shape::Tiled(tiling) => tiling.occluded(
-                &self.meshes[tiling.mesh.0 as usize],
-                o,
-                d,
-                ray.t_min,
-                ray.t_max,
-            ),
+            // SAFETY (both arms): the caller's contract for `WIDE`.
+            Shape::Mesh(MeshId(m)) => unsafe {
+                self.meshes[m as usize].occluded_with::<WIDE>(o, d, ray.t_min, ray.t_max)
+            },
+            Shape::Tiled(tiling) => unsafe {
+                tiling.occluded_with::<WIDE>(
+                    &self.meshes[tiling.mesh.0 as usize],
+                    o,
+                    d,
+                    ray.t_min,
+                    ray.t_max,
+                )
+            },
             _ => analytic_intersect(&inst.shape, &Ray::new(o, d, ray.t_min, ray.t_max)).is_some(),
         }
     }

@@ -61,20 +61,59 @@ impl MeshBvh {
         t_min: f32,
         t_max: f32,
     ) -> Option<MeshHit> {
-        self.bvh
-            .intersect(origin, direction, t_min, t_max)
-            .map(|(h, triangle)| MeshHit {
-                t: h.t,
-                triangle,
-                b0: h.b0,
-                b1: h.b1,
-                b2: h.b2,
-            })
+        // SAFETY: the 4-wide node test needs nothing beyond the target's baseline.
+        unsafe { self.intersect_with::<false>(origin, direction, t_min, t_max) }
+    }
+
+    /// [`Self::intersect`] with the BVH node test of `WIDE` (`TriangleBvh::intersect_with`).
+    ///
+    /// # Safety
+    /// With `WIDE`, the CPU must run AVX2.
+    #[inline(always)]
+    pub(crate) unsafe fn intersect_with<const WIDE: bool>(
+        &self,
+        origin: Vec3A,
+        direction: Vec3A,
+        t_min: f32,
+        t_max: f32,
+    ) -> Option<MeshHit> {
+        // SAFETY: the caller's contract for `WIDE`.
+        let hit = unsafe {
+            self.bvh
+                .intersect_with::<WIDE>(origin, direction, t_min, t_max)
+        };
+        hit.map(|(h, triangle)| MeshHit {
+            t: h.t,
+            triangle,
+            b0: h.b0,
+            b1: h.b1,
+            b2: h.b2,
+        })
     }
 
     /// Whether anything lies in `(t_min, t_max)` (stops at the first hit).
     #[inline]
     pub fn occluded(&self, origin: Vec3A, direction: Vec3A, t_min: f32, t_max: f32) -> bool {
-        self.bvh.occluded(origin, direction, t_min, t_max)
+        // SAFETY: the 4-wide node test needs nothing beyond the target's baseline.
+        unsafe { self.occluded_with::<false>(origin, direction, t_min, t_max) }
+    }
+
+    /// [`Self::occluded`] with the BVH node test of `WIDE` (`TriangleBvh::occluded_with`).
+    ///
+    /// # Safety
+    /// With `WIDE`, the CPU must run AVX2.
+    #[inline(always)]
+    pub(crate) unsafe fn occluded_with<const WIDE: bool>(
+        &self,
+        origin: Vec3A,
+        direction: Vec3A,
+        t_min: f32,
+        t_max: f32,
+    ) -> bool {
+        // SAFETY: the caller's contract for `WIDE`.
+        unsafe {
+            self.bvh
+                .occluded_with::<WIDE>(origin, direction, t_min, t_max)
+        }
     }
 }

@@ -63,8 +63,13 @@ impl Tiling {
         (primitive_id / triangles, primitive_id % triangles)
     }
 
-    /// Closest hit of the object-space ray `o + t·d`, `t` in `(t_min, t_max)`.
-    pub(crate) fn intersect(
+    /// Closest hit of the object-space ray `o + t·d`, `t` in `(t_min, t_max)`; the tile BVH's
+    /// node test is `WIDE`'s.
+    ///
+    /// # Safety
+    /// With `WIDE`, the CPU must run AVX2.
+    #[inline(always)]
+    pub(crate) unsafe fn intersect_with<const WIDE: bool>(
         &self,
         tile: &MeshBvh,
         o: Vec3A,
@@ -75,7 +80,9 @@ impl Tiling {
         let mut best: Option<TileHit> = None;
         let mut t_best = t_max;
         self.walk(tile, o, d, t_min, t_max, |cell, offset| {
-            if let Some(hit) = tile.intersect(o - offset, d, t_min, t_best) {
+            // SAFETY: the caller's contract for `WIDE`.
+            let copy_hit = unsafe { tile.intersect_with::<WIDE>(o - offset, d, t_min, t_best) };
+            if let Some(hit) = copy_hit {
                 t_best = hit.t;
                 best = Some(TileHit { cell, hit });
             }
@@ -84,8 +91,13 @@ impl Tiling {
         best
     }
 
-    /// Whether any copy lies on the object-space ray in `(t_min, t_max)`.
-    pub(crate) fn occluded(
+    /// Whether any copy lies on the object-space ray in `(t_min, t_max)`; the tile BVH's node
+    /// test is `WIDE`'s.
+    ///
+    /// # Safety
+    /// With `WIDE`, the CPU must run AVX2.
+    #[inline(always)]
+    pub(crate) unsafe fn occluded_with<const WIDE: bool>(
         &self,
         tile: &MeshBvh,
         o: Vec3A,
@@ -95,7 +107,8 @@ impl Tiling {
     ) -> bool {
         let mut hit = false;
         self.walk(tile, o, d, t_min, t_max, |_, offset| {
-            hit = tile.occluded(o - offset, d, t_min, t_max);
+            // SAFETY: the caller's contract for `WIDE`.
+            hit = unsafe { tile.occluded_with::<WIDE>(o - offset, d, t_min, t_max) };
             (hit, t_max)
         });
         hit

@@ -72,9 +72,12 @@ impl<Id: Copy> TriangleBvh<Id> {
     }
 
     /// Closest hit with `t` in `(t_min, t_max)`: the watertight test's record and the id of
-    /// the triangle.
-    #[inline]
-    pub fn intersect(
+    /// the triangle; the node test is `WIDE`'s ([`node_hits_on`]).
+    ///
+    /// # Safety
+    /// With `WIDE`, the CPU must run AVX2.
+    #[inline(always)]
+    pub unsafe fn intersect_with<const WIDE: bool>(
         &self,
         origin: Vec3A,
         direction: Vec3A,
@@ -83,19 +86,16 @@ impl<Id: Copy> TriangleBvh<Id> {
     ) -> Option<(TriangleHit, Id)> {
         let wt = WatertightRay::new(origin, direction, t_min);
         let mut best: Option<(TriangleHit, Id)> = None;
-        self.traverse(
-            origin,
-            direction,
-            t_min,
-            t_max,
-            |[a, b, c], id, t_max| match wt.intersect(*a, *b, *c, t_max) {
+        let test =
+            |[a, b, c]: &[Vec3A; 3], id: Id, t_max: f32| match wt.intersect(*a, *b, *c, t_max) {
                 Some(h) => {
                     best = Some((h, id));
                     h.t
                 }
                 None => f32::INFINITY,
-            },
-        );
+            };
+        // SAFETY: the caller's contract for `WIDE`.
+        unsafe { self.traverse_with::<WIDE>(origin, direction, t_min, t_max, test) };
         best
     }
 
@@ -103,20 +103,7 @@ impl<Id: Copy> TriangleBvh<Id> {
     /// intersects one stored primitive and returns its `t` (which then bounds the rest of the
     /// traversal) or `f32::INFINITY` for a miss; the caller keeps the record of the best hit.
     /// For soups that store other leaves than triangles (the flattened scene's instances).
-    #[inline(always)]
-    pub fn traverse(
-        &self,
-        origin: Vec3A,
-        direction: Vec3A,
-        t_min: f32,
-        t_max: f32,
-        test: impl FnMut(&[Vec3A; 3], Id, f32) -> f32,
-    ) {
-        // SAFETY: the 4-wide node test needs nothing beyond the target's baseline.
-        unsafe { self.traverse_with::<false>(origin, direction, t_min, t_max, test) }
-    }
-
-    /// [`Self::traverse`] with the node test of `WIDE` ([`node_hits_on`]).
+    /// The node test is `WIDE`'s ([`node_hits_on`]).
     ///
     /// # Safety
     /// With `WIDE`, the CPU must run AVX2.
@@ -199,21 +186,8 @@ impl<Id: Copy> TriangleBvh<Id> {
     }
 
     /// Any-hit traversal: whether `test(primitive, id, t_max)` accepts any primitive whose
-    /// box the ray reaches in `(t_min, t_max)` (stops at the first).
-    #[inline(always)]
-    pub fn any(
-        &self,
-        origin: Vec3A,
-        direction: Vec3A,
-        t_min: f32,
-        t_max: f32,
-        test: impl FnMut(&[Vec3A; 3], Id, f32) -> bool,
-    ) -> bool {
-        // SAFETY: the 4-wide node test needs nothing beyond the target's baseline.
-        unsafe { self.any_with::<false>(origin, direction, t_min, t_max, test) }
-    }
-
-    /// [`Self::any`] with the node test of `WIDE` ([`node_hits_on`]).
+    /// box the ray reaches in `(t_min, t_max)` (stops at the first); the
+    /// node test is `WIDE`'s ([`node_hits_on`]).
     ///
     /// # Safety
     /// With `WIDE`, the CPU must run AVX2.
@@ -252,13 +226,24 @@ impl<Id: Copy> TriangleBvh<Id> {
         hit
     }
 
-    /// Whether any triangle lies in `(t_min, t_max)` (stops at the first hit).
-    #[inline]
-    pub fn occluded(&self, origin: Vec3A, direction: Vec3A, t_min: f32, t_max: f32) -> bool {
+    /// Whether any triangle lies in `(t_min, t_max)` (stops at the first hit); the node
+    /// test is `WIDE`'s ([`node_hits_on`]).
+    ///
+    /// # Safety
+    /// With `WIDE`, the CPU must run AVX2.
+    #[inline(always)]
+    pub unsafe fn occluded_with<const WIDE: bool>(
+        &self,
+        origin: Vec3A,
+        direction: Vec3A,
+        t_min: f32,
+        t_max: f32,
+    ) -> bool {
         let wt = WatertightRay::new(origin, direction, t_min);
-        self.any(origin, direction, t_min, t_max, |[a, b, c], _, t_max| {
-            wt.intersect(*a, *b, *c, t_max).is_some()
-        })
+        let test =
+            |[a, b, c]: &[Vec3A; 3], _: Id, t_max: f32| wt.intersect(*a, *b, *c, t_max).is_some();
+        // SAFETY: the caller's contract for `WIDE`.
+        unsafe { self.any_with::<WIDE>(origin, direction, t_min, t_max, test) }
     }
 }
 
