@@ -4,7 +4,8 @@
 
 use glam::Vec3A;
 use prism_geometry::{
-    BuildQuality, Geometry, GeometryBuilder, Ray, Shape, Transform, TriangleMesh, WatertightRay,
+    BuildOptions, BuildQuality, Geometry, GeometryBuilder, Ray, Shape, Transform, TriangleMesh,
+    WatertightRay,
 };
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
@@ -202,9 +203,16 @@ fn scene_of_many_instances_agrees_with_brute_force_in_world_space() {
 /// returns the same hits, bit for bit, as the baseline build: the wider builds change the
 /// instructions, never the arithmetic. The scene mixes baked triangles (a soup and a
 /// sphere placed once) with instance leaves (an analytic sphere), and the rays include
-/// ones leaving a surface with a tiny `t_min`.
+/// ones leaving a surface with a tiny `t_min`. Built again without flattening, every
+/// instance is a leaf, so the meshes' own BVHs under the scene BVH are traversed too.
 #[test]
 fn every_isa_traverses_the_scene_bvh_to_the_same_bits() {
+    for flatten in [true, false] {
+        every_isa_traverses_to_the_same_bits(flatten);
+    }
+}
+
+fn every_isa_traverses_to_the_same_bits(flatten: bool) {
     let mut rng = Pcg64::seed_from_u64(11);
     let mut b = GeometryBuilder::new();
     let soup = b.add_mesh(triangle_soup(4_000, 2.0, 0.02..0.3, &mut rng));
@@ -223,9 +231,15 @@ fn every_isa_traverses_the_scene_bvh_to_the_same_bits() {
         None,
     )
     .unwrap();
-    let mut geometry = b.build(BuildQuality::Fast);
-    // The premise: the scene BVH with an instance leaf, not the small-scene batches.
-    assert!(!geometry.is_small_scene() && geometry.instance_leaf_count() == 1);
+    let mut geometry = b.build_with(BuildOptions {
+        quality: BuildQuality::Fast,
+        flatten,
+        small_scene_max_leaves: 0,
+    });
+    // The premise: the scene BVH with instance leaves, not the small-scene batches; the
+    // sphere alone when flattened, all three otherwise.
+    let instance_leaves = if flatten { 1 } else { 3 };
+    assert!(!geometry.is_small_scene() && geometry.instance_leaf_count() == instance_leaves);
     let rays: Vec<Ray> = (0..20_000)
         .map(|i| {
             let origin = Vec3A::new(
@@ -260,7 +274,13 @@ fn every_isa_traverses_the_scene_bvh_to_the_same_bits() {
         geometry = geometry.with_simd(simd);
         let got = trace(&geometry);
         for (i, (want, have)) in baseline.iter().zip(&got).enumerate() {
-            assert_eq!(want, have, "{} ray {i}: {:?}", simd.isa(), rays[i]);
+            assert_eq!(
+                want,
+                have,
+                "flatten {flatten}, {} ray {i}: {:?}",
+                simd.isa(),
+                rays[i]
+            );
         }
     }
 }
