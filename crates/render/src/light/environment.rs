@@ -118,9 +118,9 @@ pub struct EnvironmentLight {
     width: usize,
     height: usize,
     /// Per texel (row-major, top row first): the sigmoid polynomial and scale of its RGB
-    /// illuminant spectrum; the white illuminant is `white`.
-    polynomials: Vec<SigmoidPolynomial>,
-    scales: Vec<f32>,
+    /// illuminant spectrum, side by side so that a sampled texel costs one cache line; the
+    /// white illuminant is `white`.
+    texels: Vec<(SigmoidPolynomial, f32)>,
     white: Spectrum,
     /// The user's `scale`.
     pub scale: f32,
@@ -176,7 +176,6 @@ impl EnvironmentLight {
                     .unwrap_or((SigmoidPolynomial::constant(0.0), 0.0))
             })
             .collect();
-        let (polynomials, scales): (Vec<_>, Vec<_>) = upsampled.into_iter().unzip();
         let cos_rows: Vec<f32> = (0..=height)
             .map(|y| (std::f64::consts::PI * y as f64 / height as f64).cos() as f32)
             .collect();
@@ -208,8 +207,7 @@ impl EnvironmentLight {
         Ok(Self {
             width,
             height,
-            polynomials,
-            scales,
+            texels: upsampled,
             white,
             scale,
             cos_rows,
@@ -322,8 +320,9 @@ impl EnvironmentLight {
         wavelengths: &SampledWavelengths,
     ) -> SampledSpectrum {
         let i = y * self.width + x;
-        let s = self.polynomials[i].eval4(wavelengths.lambda());
-        self.white.eval(wavelengths) * SampledSpectrum::new(s) * (self.scales[i] * self.scale)
+        let (polynomial, scale) = &self.texels[i];
+        let s = polynomial.eval4(wavelengths.lambda());
+        self.white.eval(wavelengths) * SampledSpectrum::new(s) * (scale * self.scale)
     }
 
     /// Density of choosing texel (x, y) per steradian: P(texel)/ΔΩ.
