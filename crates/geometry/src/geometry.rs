@@ -488,7 +488,7 @@ impl Geometry {
         let Some(scene) = &self.scene else {
             return self
                 .single
-                .and_then(|i| self.intersect_instance(i, ray, ray.t_max));
+                .and_then(|i| self.intersect_instance_any_isa(i, ray, ray.t_max));
         };
         #[cfg(target_arch = "x86_64")]
         if self.simd.avx2() {
@@ -532,7 +532,8 @@ impl Geometry {
         let mut best_triangle: Option<(TriangleHit, Leaf)> = None;
         let test = |p: &[Vec3A; 3], leaf: Leaf, t_max: f32| {
             if leaf.is_instance() {
-                match self.intersect_instance_on::<WIDE>(leaf.instance, ray, t_max) {
+                // SAFETY: the caller's contract for `WIDE`.
+                match unsafe { self.intersect_instance_on::<WIDE>(leaf.instance, ray, t_max) } {
                     Some(h) => {
                         best_instance = Some(h);
                         best_triangle = None;
@@ -569,7 +570,7 @@ impl Geometry {
             let inv = bvh_ray(o, d, ray.t_min, ray.t_max).inv_direction;
             for leaf in &small.others {
                 if slab_hit(leaf.lo, leaf.hi, o, inv, ray.t_min, t_max) {
-                    if let Some(h) = self.intersect_instance(leaf.instance, ray, t_max) {
+                    if let Some(h) = self.intersect_instance_any_isa(leaf.instance, ray, t_max) {
                         t_max = h.t;
                         best_other = Some(h);
                     }
@@ -640,11 +641,28 @@ impl Geometry {
         unsafe { self.intersect_instance_with::<false>(instance_id, ray, t_max) }
     }
 
+    /// [`Self::intersect_instance`] as x86-64-v3 code with the 8-wide node test where the
+    /// CPU has it (`simd`): for the paths that test instances without the scene BVH (a
+    /// scene of one instance, the small scene's other leaves).
+    #[inline]
+    fn intersect_instance_any_isa(&self, instance_id: u32, ray: &Ray, t_max: f32) -> Option<Hit> {
+        #[cfg(target_arch = "x86_64")]
+        if self.simd.avx2() {
+            // SAFETY: `Simd::avx2` is true only where the CPU runs AVX2, FMA, BMI1/2, LZCNT
+            // and POPCNT.
+            return unsafe { self.intersect_instance_avx2(instance_id, ray, t_max) };
+        }
+        self.intersect_instance(instance_id, ray, t_max)
+    }
+
     /// [`Self::intersect_instance`] from the scene traversal of `WIDE`: out of line (the
     /// scene loop stays small for the baked triangles it mostly tests), as x86-64-v3 code
     /// with the 8-wide node test where `WIDE`.
+    ///
+    /// # Safety
+    /// With `WIDE`, the CPU must run AVX2, FMA, BMI1/2, LZCNT and POPCNT.
     #[inline(always)]
-    fn intersect_instance_on<const WIDE: bool>(
+    unsafe fn intersect_instance_on<const WIDE: bool>(
         &self,
         instance_id: u32,
         ray: &Ray,
@@ -652,7 +670,7 @@ impl Geometry {
     ) -> Option<Hit> {
         #[cfg(target_arch = "x86_64")]
         if WIDE {
-            // SAFETY: `WIDE` is instantiated only by the AVX2 traversal.
+            // SAFETY: the caller's contract for `WIDE`.
             return unsafe { self.intersect_instance_avx2(instance_id, ray, t_max) };
         }
         self.intersect_instance(instance_id, ray, t_max)
@@ -671,12 +689,27 @@ impl Geometry {
         unsafe { self.intersect_instance_with::<true>(instance_id, ray, t_max) }
     }
 
+    /// [`Self::occludes`] as [`Self::intersect_instance_any_isa`].
+    #[inline]
+    fn occludes_any_isa(&self, instance_id: u32, ray: &Ray) -> bool {
+        #[cfg(target_arch = "x86_64")]
+        if self.simd.avx2() {
+            // SAFETY: `Simd::avx2` is true only where the CPU runs AVX2, FMA, BMI1/2, LZCNT
+            // and POPCNT.
+            return unsafe { self.occludes_avx2(instance_id, ray) };
+        }
+        self.occludes(instance_id, ray)
+    }
+
     /// [`Self::occludes`] from the scene traversal of `WIDE`, as [`Self::intersect_instance_on`].
+    ///
+    /// # Safety
+    /// With `WIDE`, the CPU must run AVX2, FMA, BMI1/2, LZCNT and POPCNT.
     #[inline(always)]
-    fn occludes_on<const WIDE: bool>(&self, instance_id: u32, ray: &Ray) -> bool {
+    unsafe fn occludes_on<const WIDE: bool>(&self, instance_id: u32, ray: &Ray) -> bool {
         #[cfg(target_arch = "x86_64")]
         if WIDE {
-            // SAFETY: `WIDE` is instantiated only by the AVX2 traversal.
+            // SAFETY: the caller's contract for `WIDE`.
             return unsafe { self.occludes_avx2(instance_id, ray) };
         }
         self.occludes(instance_id, ray)
@@ -756,11 +789,11 @@ impl Geometry {
             let inv = bvh_ray(o, d, ray.t_min, ray.t_max).inv_direction;
             return small.others.iter().any(|leaf| {
                 slab_hit(leaf.lo, leaf.hi, o, inv, ray.t_min, ray.t_max)
-                    && self.occludes(leaf.instance, ray)
+                    && self.occludes_any_isa(leaf.instance, ray)
             });
         }
         let Some(scene) = &self.scene else {
-            return self.single.is_some_and(|i| self.occludes(i, ray));
+            return self.single.is_some_and(|i| self.occludes_any_isa(i, ray));
         };
         #[cfg(target_arch = "x86_64")]
         if self.simd.avx2() {
@@ -800,7 +833,8 @@ impl Geometry {
         let wt = WatertightRay::new(o, d, ray.t_min);
         let test = |p: &[Vec3A; 3], leaf: Leaf, t_max: f32| {
             if leaf.is_instance() {
-                self.occludes_on::<WIDE>(leaf.instance, ray)
+                // SAFETY: the caller's contract for `WIDE`.
+                unsafe { self.occludes_on::<WIDE>(leaf.instance, ray) }
             } else {
                 wt.intersect(p[0], p[1], p[2], t_max).is_some()
             }

@@ -5,7 +5,7 @@
 use glam::Vec3A;
 use prism_geometry::{
     BuildOptions, BuildQuality, Geometry, GeometryBuilder, Ray, Shape, Transform, TriangleMesh,
-    WatertightRay,
+    WatertightRay, SMALL_SCENE_MAX_LEAVES,
 };
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
@@ -204,15 +204,16 @@ fn scene_of_many_instances_agrees_with_brute_force_in_world_space() {
 /// instructions, never the arithmetic. The scene mixes baked triangles (a soup and a
 /// sphere placed once) with instance leaves (an analytic sphere), and the rays include
 /// ones leaving a surface with a tiny `t_min`. Built again without flattening, every
-/// instance is a leaf, so the meshes' own BVHs under the scene BVH are traversed too.
+/// instance is a leaf, so the meshes' own BVHs under the scene BVH are traversed too; and
+/// once more as a small scene, whose instance leaves are tested without the scene BVH.
 #[test]
 fn every_isa_traverses_the_scene_bvh_to_the_same_bits() {
-    for flatten in [true, false] {
-        every_isa_traverses_to_the_same_bits(flatten);
+    for (flatten, small) in [(true, false), (false, false), (false, true)] {
+        every_isa_traverses_to_the_same_bits(flatten, small);
     }
 }
 
-fn every_isa_traverses_to_the_same_bits(flatten: bool) {
+fn every_isa_traverses_to_the_same_bits(flatten: bool, small: bool) {
     let mut rng = Pcg64::seed_from_u64(11);
     let mut b = GeometryBuilder::new();
     let soup = b.add_mesh(triangle_soup(4_000, 2.0, 0.02..0.3, &mut rng));
@@ -234,12 +235,13 @@ fn every_isa_traverses_to_the_same_bits(flatten: bool) {
     let mut geometry = b.build_with(BuildOptions {
         quality: BuildQuality::Fast,
         flatten,
-        small_scene_max_leaves: 0,
+        small_scene_max_leaves: if small { SMALL_SCENE_MAX_LEAVES } else { 0 },
     });
-    // The premise: the scene BVH with instance leaves, not the small-scene batches; the
-    // sphere alone when flattened, all three otherwise.
+    // The premise: instance leaves under the scene BVH (the sphere alone when flattened,
+    // all three otherwise), or in the small-scene batches.
     let instance_leaves = if flatten { 1 } else { 3 };
-    assert!(!geometry.is_small_scene() && geometry.instance_leaf_count() == instance_leaves);
+    assert_eq!(geometry.is_small_scene(), small);
+    assert_eq!(geometry.instance_leaf_count(), instance_leaves);
     let rays: Vec<Ray> = (0..20_000)
         .map(|i| {
             let origin = Vec3A::new(
