@@ -532,8 +532,7 @@ impl Geometry {
         let mut best_triangle: Option<(TriangleHit, Leaf)> = None;
         let test = |p: &[Vec3A; 3], leaf: Leaf, t_max: f32| {
             if leaf.is_instance() {
-                // SAFETY: the caller's contract for `WIDE`.
-                match unsafe { self.intersect_instance_on::<WIDE>(leaf.instance, ray, t_max) } {
+                match self.intersect_instance_any_isa(leaf.instance, ray, t_max) {
                     Some(h) => {
                         best_instance = Some(h);
                         best_triangle = None;
@@ -642,35 +641,15 @@ impl Geometry {
     }
 
     /// [`Self::intersect_instance`] as x86-64-v3 code with the 8-wide node test where the
-    /// CPU has it (`simd`): for the paths that test instances without the scene BVH (a
-    /// scene of one instance, the small scene's other leaves).
+    /// CPU has it (`simd`), out of line: the scene traversal's loop stays small for the
+    /// baked triangles it mostly tests; also for the paths without a scene BVH (a scene of
+    /// one instance, the small scene's instance leaves).
     #[inline]
     fn intersect_instance_any_isa(&self, instance_id: u32, ray: &Ray, t_max: f32) -> Option<Hit> {
         #[cfg(target_arch = "x86_64")]
         if self.simd.avx2() {
             // SAFETY: `Simd::avx2` is true only where the CPU runs AVX2, FMA, BMI1/2, LZCNT
             // and POPCNT.
-            return unsafe { self.intersect_instance_avx2(instance_id, ray, t_max) };
-        }
-        self.intersect_instance(instance_id, ray, t_max)
-    }
-
-    /// [`Self::intersect_instance`] from the scene traversal of `WIDE`: out of line (the
-    /// scene loop stays small for the baked triangles it mostly tests), as x86-64-v3 code
-    /// with the 8-wide node test where `WIDE`.
-    ///
-    /// # Safety
-    /// With `WIDE`, the CPU must run AVX2, FMA, BMI1/2, LZCNT and POPCNT.
-    #[inline(always)]
-    unsafe fn intersect_instance_on<const WIDE: bool>(
-        &self,
-        instance_id: u32,
-        ray: &Ray,
-        t_max: f32,
-    ) -> Option<Hit> {
-        #[cfg(target_arch = "x86_64")]
-        if WIDE {
-            // SAFETY: the caller's contract for `WIDE`.
             return unsafe { self.intersect_instance_avx2(instance_id, ray, t_max) };
         }
         self.intersect_instance(instance_id, ray, t_max)
@@ -696,20 +675,6 @@ impl Geometry {
         if self.simd.avx2() {
             // SAFETY: `Simd::avx2` is true only where the CPU runs AVX2, FMA, BMI1/2, LZCNT
             // and POPCNT.
-            return unsafe { self.occludes_avx2(instance_id, ray) };
-        }
-        self.occludes(instance_id, ray)
-    }
-
-    /// [`Self::occludes`] from the scene traversal of `WIDE`, as [`Self::intersect_instance_on`].
-    ///
-    /// # Safety
-    /// With `WIDE`, the CPU must run AVX2, FMA, BMI1/2, LZCNT and POPCNT.
-    #[inline(always)]
-    unsafe fn occludes_on<const WIDE: bool>(&self, instance_id: u32, ray: &Ray) -> bool {
-        #[cfg(target_arch = "x86_64")]
-        if WIDE {
-            // SAFETY: the caller's contract for `WIDE`.
             return unsafe { self.occludes_avx2(instance_id, ray) };
         }
         self.occludes(instance_id, ray)
@@ -833,8 +798,7 @@ impl Geometry {
         let wt = WatertightRay::new(o, d, ray.t_min);
         let test = |p: &[Vec3A; 3], leaf: Leaf, t_max: f32| {
             if leaf.is_instance() {
-                // SAFETY: the caller's contract for `WIDE`.
-                unsafe { self.occludes_on::<WIDE>(leaf.instance, ray) }
+                self.occludes_any_isa(leaf.instance, ray)
             } else {
                 wt.intersect(p[0], p[1], p[2], t_max).is_some()
             }

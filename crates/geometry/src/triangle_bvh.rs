@@ -541,7 +541,7 @@ mod tests {
         let soup = TriangleBvh::build(&triangles, &ids, BuildQuality::default());
         let bvh = soup.bvh.as_ref().unwrap();
         let mut rng = rand_pcg::Pcg64::seed_from_u64(8);
-        let mut compared = 0usize;
+        let (mut compared, mut entered) = (0usize, 0usize);
         for k in 0..4000 {
             let origin = Vec3A::new(
                 rng.gen_range(-8.0..8.0),
@@ -569,8 +569,14 @@ mod tests {
                 let wide = unsafe { node_hits_avx2(node, &ray, oct_inv4) };
                 assert_eq!(wide, node_hits(node, &ray, oct_inv4), "ray {k}");
                 compared += 1;
+                entered += usize::from(wide != 0);
             }
         }
+        // The premise: enough node tests, and masks that enter children, not only misses.
         assert!(compared > 100_000, "{compared} node tests");
+        assert!(
+            entered > 1_000,
+            "{entered} of {compared} node tests entered a child"
+        );
     }
 }
