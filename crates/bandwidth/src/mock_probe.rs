@@ -36,24 +36,26 @@ impl ShadingProbe for MockProbe {
         hit: &GBufferHit,
         count: u32,
         out: &mut Vec<LightSample>,
-    ) {
+    ) -> u32 {
         out.clear();
         let to_light = self.light_position_m - hit.position_m();
         let distance_m = to_light.length();
         // The hit at the light itself (d = 0) or non-finite input: no direction.
         if distance_m.is_nan() || distance_m <= 0.0 || distance_m.is_infinite() {
-            return;
+            return count;
         }
         let direction = to_light / distance_m;
         let cos_theta_i = hit.normal().dot(direction);
         if cos_theta_i <= 0.0 {
-            return;
+            return count;
         }
+        let radiance_y = self.intensity_y / (distance_m * distance_m);
+        let bsdf_cos_per_sr = self.albedo * std::f32::consts::FRAC_1_PI * cos_theta_i;
         let sample = LightSample {
             direction,
-            radiance_y: self.intensity_y / (distance_m * distance_m),
+            radiance_y,
             pdf_per_sr: 0.0,
-            bsdf_cos_per_sr: self.albedo * std::f32::consts::FRAC_1_PI * cos_theta_i,
+            bsdf_cos_per_sr,
             cos_theta_i,
             distance_m,
             light_bandwidth: self.light_bandwidth,
@@ -62,7 +64,11 @@ impl ShadingProbe for MockProbe {
             material_bandwidth: self.material_bandwidth,
             lane_variance: 0.0,
             visibility: Visibility::Unknown,
+            // One light, one direction: every draw is the whole estimate.
+            estimator_y: radiance_y * bsdf_cos_per_sr,
+            draw: 0,
         };
-        out.extend(std::iter::repeat_n(sample, count as usize));
+        out.extend((0..count).map(|draw| LightSample { draw, ..sample }));
+        count
     }
 }

@@ -24,8 +24,8 @@ pub enum VarianceBandwidth {
     Incident,
     /// ν_a of eq. 4's one-bounce bandwidth at the eye, as the paper's eq. 9 writes it.
     OneBounce,
-    /// Not eq. 9: the sample variance of the probe's own weights (an unbiased estimate of
-    /// the per-sample variance of the direct-light estimator, in Y², on the same scale as
+    /// Not eq. 9: the probe's `measured_variance` (an unbiased estimate of the per-camera-
+    /// sample variance of the render's direct-light estimate, in Y², on the same scale as
     /// the colour noise of pixels that see the lights directly).
     Measured,
 }
@@ -40,7 +40,7 @@ pub struct PixelPrediction {
     /// V̂_p: eq. 9 plus the samples' mean lane variance (colour noise of hero-wavelength
     /// sampling), in Y² (the probe's units squared).
     pub variance: f32,
-    /// V̂_p's shading part alone: eq. 9 (cycles·Y²/sr) or, for `Measured`, the weights'
+    /// V̂_p's shading part alone: eq. 9 (cycles·Y²/sr) or, for `Measured`, the draws'
     /// sample variance (Y²).
     pub shading_variance: f32,
     /// V̂_p's colour part alone: the samples' mean lane variance (Y²).
@@ -51,9 +51,10 @@ pub struct PixelPrediction {
     /// The per-sample variance of the probe's one-bounce indirect estimates (Y²; 0 without
     /// them; `ShadingProbe::sample_indirect`).
     pub indirect_variance: f32,
-    /// The unbiased sample variance of the n_b samples' weights with their shadow rays'
-    /// outcomes (blocked = 0): the per-sample variance of the direct-light estimator at the
-    /// hit, in Y² (not eq. 9; what calibrates eq. 9's scale).
+    /// The unbiased sample variance of the estimator's draws, each the sum of its samples'
+    /// MIS-weighted values with their shadow rays' outcomes (blocked = 0): the per-camera-
+    /// sample variance of the render's direct-light estimate at the hit (one light and one
+    /// BSDF sample), in Y² (not eq. 9; what calibrates eq. 9's scale).
     pub measured_variance: f32,
     /// The shadow rays' outcomes (`visibility` module).
     pub visibility: VisibilitySummary,
@@ -67,6 +68,9 @@ pub struct PixelFootprint {
     pub rad_per_px: f32,
     /// n_b: the samples requested (samples the probe could not take count as zero).
     pub probe_samples: u32,
+    /// How many of the render estimator's draws (camera samples) the samples stand for
+    /// (`ShadingProbe::sample_lights`' answer; `LightSample::draw` is below it).
+    pub estimator_draws: u32,
 }
 
 /// ν^i of eq. 4 for one sample, or `None` for a sample that lights nothing (below the
@@ -151,6 +155,8 @@ pub fn predict_pixel(
         .min(MAX_IMAGE_BANDWIDTH_CYCLES_PER_PX);
     // Eq. 9 as a Monte Carlo mean over the probe's directions: (2π/n_b) Σ (ν_a + ν_ρa) χᵢ²/pᵢ.
     // A delta light is one direction, so it adds no variance to the shading integral.
+    let n = f64::from(n_b);
+    let measured_variance = draw_variance(samples, footprint.estimator_draws);
     let mut variance_sum = 0.0f64;
     match variance_bandwidth {
         VarianceBandwidth::Incident | VarianceBandwidth::OneBounce => {
@@ -176,7 +182,7 @@ pub fn predict_pixel(
             variance_sum *= std::f64::consts::TAU;
         }
         VarianceBandwidth::Measured => {
-            variance_sum = weight_variance_sum(samples, n_b, LightSample::weight_y);
+            variance_sum = f64::from(measured_variance) * n;
         }
     }
     // Colour noise (beyond the paper; the "spectral" term): the lanes' variance,
@@ -186,7 +192,6 @@ pub fn predict_pixel(
         .filter(|s| !s.is_blocked())
         .map(|s| f64::from(s.lane_variance))
         .sum();
-    let n = f64::from(n_b);
     let variance = ((variance_sum + lane_variance_sum) / n) as f32;
     // With shadow rays traced, blocked samples light nothing: L̂ is then the direct light
     // that arrives, not the unoccluded one (a shadow is dark, and its relative error large).
@@ -195,8 +200,6 @@ pub fn predict_pixel(
         .map(|s| f64::from(s.visible_weight_y()))
         .sum::<f64>()
         / n) as f32;
-    let measured_variance =
-        (weight_variance_sum(samples, n_b, LightSample::visible_weight_y) / n) as f32;
     let mut visibility = VisibilitySummary::default();
     // Eq. 5's weighting for the penumbra: each blocked sample's penumbra counts by its share
     // of the light the traced samples would bring unoccluded, so that the shadow of a dim
@@ -254,19 +257,20 @@ fn is_area_light_sample(sample: &LightSample) -> bool {
     !sample.is_delta() && sample.distance_m.is_finite()
 }
 
-/// Σ (wᵢ − mean)² over all n_b draws (missing ones are zeros) · n_b / (n_b − 1), so that a
-/// division by n_b leaves the unbiased sample variance of `weight`; 0 for n_b = 1.
-fn weight_variance_sum(samples: &[LightSample], n_b: u32, weight: fn(&LightSample) -> f32) -> f64 {
-    if n_b <= 1 {
+/// The unbiased sample variance of the estimator's draws (Y²): each draw's value is the sum
+/// of its samples' `visible_estimator_y`, a draw with no sample is 0; 0 for fewer than two
+/// draws or a sample whose draw is out of range (a probe that breaks its contract).
+fn draw_variance(samples: &[LightSample], draws: u32) -> f32 {
+    if draws <= 1 || samples.iter().any(|s| s.draw >= draws) {
         return 0.0;
     }
-    let mean = samples.iter().map(|s| f64::from(weight(s))).sum::<f64>() / f64::from(n_b);
-    let present: f64 = samples
-        .iter()
-        .map(|s| (f64::from(weight(s)) - mean).powi(2))
-        .sum();
-    let missing = f64::from(n_b - samples.len() as u32) * mean * mean;
-    (present + missing) * f64::from(n_b) / f64::from(n_b - 1)
+    let mut values = vec![0.0f64; draws as usize];
+    for s in samples {
+        values[s.draw as usize] += f64::from(s.visible_estimator_y());
+    }
+    let n = f64::from(draws);
+    let mean = values.iter().sum::<f64>() / n;
+    (values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0)) as f32
 }
 
 #[cfg(test)]
@@ -303,12 +307,15 @@ mod tests {
             material_bandwidth: MaterialBandwidth::new(rho, 0.0).unwrap(),
             lane_variance: 0.0,
             visibility: Visibility::Unknown,
+            estimator_y: 0.0,
+            draw: 0,
         }
     }
 
     const FOOTPRINT: PixelFootprint = PixelFootprint {
         rad_per_px: 0.01,
         probe_samples: 16,
+        estimator_draws: 16,
     };
 
     #[test]
@@ -506,10 +513,13 @@ mod tests {
             material_bandwidth: MaterialBandwidth::new(f32::INFINITY, 0.0).unwrap(),
             lane_variance: 0.0,
             visibility: Visibility::Unknown,
+            estimator_y: 0.0,
+            draw: 0,
         };
         let footprint = PixelFootprint {
             rad_per_px: 1e-3,
             probe_samples: 1,
+            estimator_draws: 1,
         };
         let p = predict_pixel(&hit, &[mirror], footprint, VarianceBandwidth::Incident).unwrap();
         let expected = nu_env * (1.0 + 2.0 * d_eye_m / radius_m) * 1e-3;
@@ -583,8 +593,47 @@ mod tests {
         let bad = PixelFootprint {
             rad_per_px: 0.0,
             probe_samples: 16,
+            estimator_draws: 16,
         };
         let e = predict_pixel(&plane_hit(1.0), &[s], bad, VarianceBandwidth::Incident).unwrap_err();
         assert!(e.to_string().contains("rad_per_px"), "{e}");
+    }
+
+    #[test]
+    fn the_measured_variance_is_over_the_estimators_draws() {
+        // Two draws of two samples each (a light and a BSDF sample per camera sample): the
+        // draws' values are 1 + 1 = 2 and 3 + 3 = 6, variance (2² + 2²)/1 = 8, whatever the
+        // samples' spread inside a draw. A third, empty draw counts 0: values 2, 6, 0.
+        let value = |estimator_y: f32, draw: u32| LightSample {
+            estimator_y,
+            draw,
+            ..sample(Bandwidth::ZERO, 0.0, 1.0, 0.5, 2.0)
+        };
+        let samples = [value(1.0, 0), value(1.0, 0), value(3.0, 1), value(3.0, 1)];
+        assert_eq!(draw_variance(&samples, 2), 8.0);
+        assert!((draw_variance(&samples, 3) - 28.0 / 3.0).abs() < 1e-5);
+        // A blocked sample brings nothing; a draw out of range breaks the contract.
+        let blocked = LightSample {
+            visibility: Visibility::Blocked {
+                blocker_distance_m: 1.0,
+            },
+            ..value(3.0, 1)
+        };
+        assert_eq!(draw_variance(&[value(1.0, 0), blocked], 2), 0.5);
+        assert_eq!(draw_variance(&samples, 1), 0.0);
+        assert_eq!(draw_variance(&[value(1.0, 4)], 2), 0.0);
+        let p = predict_pixel(
+            &plane_hit(2.0),
+            &samples,
+            FOOTPRINT,
+            VarianceBandwidth::Measured,
+        )
+        .unwrap();
+        // 16 draws: 2, 6 and fourteen 0s, mean ½: (1.5² + 5.5² + 14·0.5²)/15 = 2.4.
+        assert!((p.measured_variance - 2.4).abs() < 1e-5);
+        assert!(
+            (p.shading_variance - 2.4).abs() < 1e-5,
+            "`Measured` is the same variance"
+        );
     }
 }

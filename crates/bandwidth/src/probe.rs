@@ -68,6 +68,15 @@ pub struct LightSample {
     pub lane_variance: f32,
     /// What the sample's shadow ray met (`Unknown` where the probe does not trace it).
     pub visibility: Visibility,
+    /// The sample's part of the render estimator's direct-light value for the camera sample
+    /// it stands for (Y, occlusion ignored): L_i ρ cos θ_i over its own strategy's density,
+    /// times the estimator's MIS weight; for a delta light L_i ρ cos θ_i over the light's
+    /// selection probability. The estimator takes one light and one BSDF sample per hit,
+    /// so two probe samples (`draw`) make one camera sample's value.
+    pub estimator_y: f32,
+    /// Which of the estimator's draws (camera samples) the sample belongs to, below the
+    /// count `ShadingProbe::sample_lights` returns.
+    pub draw: u32,
 }
 
 impl LightSample {
@@ -83,6 +92,15 @@ impl LightSample {
             value
         } else {
             0.0
+        }
+    }
+
+    /// [`estimator_y`](Self::estimator_y) with the shadow ray's outcome (0 where blocked).
+    pub fn visible_estimator_y(&self) -> f32 {
+        if self.is_blocked() {
+            0.0
+        } else {
+            self.estimator_y
         }
     }
 
@@ -129,8 +147,16 @@ pub trait ShadingProbe: Sync {
     /// entry of `pixel` (fewer, possibly none, when no light can reach the hit's
     /// hemisphere). Deterministic: the samples depend only on (pixel, count) and the
     /// probe's own seed — seed them per pixel as the renderer's `PixelSampler` does, never
-    /// per thread — so a predicted plan is the same for any thread count.
-    fn sample_lights(&self, pixel: UVec2, hit: &GBufferHit, count: u32, out: &mut Vec<LightSample>);
+    /// per thread — so a predicted plan is the same for any thread count. Returns how many
+    /// of the render estimator's draws (camera samples) the samples stand for: their
+    /// `draw` indices are below it, and a draw with no sample is a zero value.
+    fn sample_lights(
+        &self,
+        pixel: UVec2,
+        hit: &GBufferHit,
+        count: u32,
+        out: &mut Vec<LightSample>,
+    ) -> u32;
 
     /// Beyond the paper: clears `out` and fills it with `count` one-bounce indirect
     /// estimates at `hit` (Y: a BSDF-sampled direction, the surface it meets, one light

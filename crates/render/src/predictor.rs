@@ -426,6 +426,13 @@ pub fn predict_with_probe<'a>(
     }
     let resolution = scene.resolution;
     probe.trace_visibility = settings.visibility;
+    // Light beyond the first bounce only where the estimator carries it (max_depth > 1):
+    // with direct light only, the indirect estimates would predict light the render lacks.
+    let indirect_samples = if probe.estimator.carries_indirect {
+        settings.indirect_samples
+    } else {
+        0
+    };
     type PixelRow = Vec<(
         PixelPrediction,
         f32,
@@ -451,13 +458,19 @@ pub fn predict_with_probe<'a>(
                             None,
                         ));
                     };
-                    let footprint = PixelFootprint {
-                        rad_per_px,
-                        probe_samples: settings.probe_samples,
-                    };
                     match centre_ray(scene, pixel) {
                         CentreRay::Hit(hit) => {
-                            probe.sample_lights(pixel, &hit, settings.probe_samples, &mut samples);
+                            let estimator_draws = probe.sample_lights(
+                                pixel,
+                                &hit,
+                                settings.probe_samples,
+                                &mut samples,
+                            );
+                            let footprint = PixelFootprint {
+                                rad_per_px,
+                                probe_samples: settings.probe_samples,
+                                estimator_draws,
+                            };
                             let mut p = predict_pixel(
                                 &hit,
                                 &samples,
@@ -468,12 +481,7 @@ pub fn predict_with_probe<'a>(
                             p.image_bandwidth_cycles_per_px = p
                                 .image_bandwidth_cycles_per_px
                                 .max(mirrored_sun_bandwidth(scene, &probe, &hit, rad_per_px));
-                            probe.sample_indirect(
-                                pixel,
-                                &hit,
-                                settings.indirect_samples,
-                                &mut indirect,
-                            );
+                            probe.sample_indirect(pixel, &hit, indirect_samples, &mut indirect);
                             let (mean, variance) = mean_and_variance(&indirect);
                             p.mean_y += mean;
                             p.indirect_variance = variance;

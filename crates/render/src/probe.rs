@@ -33,9 +33,12 @@ use prism_geometry::{Frame, Ray, SurfaceInteraction};
 use prism_spectrum::colorimetry::sampled_radiance_to_xyz;
 use prism_spectrum::{SampledSpectrum, SampledWavelengths};
 
+use prism_scene::MisHeuristic;
+
 use crate::bsdf::{Bsdf, Bxdf, TransportMode};
 use crate::bsdf_angular_table::MaterialAngularBandwidth;
 use crate::bsdf_table_cache::AngularTableCache;
+use crate::integrator::{mis_weight, Integrator};
 use crate::light::area_bandwidth::AreaLightBandwidth;
 use crate::light::environment_bandwidth::EnvironmentBandwidth;
 use crate::light::{Light, LightHit, LightSampleContext};
@@ -61,6 +64,38 @@ pub struct RenderProbe<'a> {
     /// Per material (`material_id` order): its shading textures' bandwidths (the texture
     /// term t); empty: t = 0.
     pub texture_bandwidths: Vec<Vec<TextureBandwidth>>,
+    /// The scene's estimator, whose per-camera-sample variance the probe measures.
+    pub estimator: ProbedEstimator,
+}
+
+/// What the probe imitates of the scene's estimator: its MIS heuristic between the light and
+/// the BSDF sample of a hit, and whether it carries light beyond the first bounce.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ProbedEstimator {
+    pub mis: MisHeuristic,
+    pub carries_indirect: bool,
+}
+
+impl ProbedEstimator {
+    /// The scene's integrator's; the ones without a heuristic of their own take the path
+    /// tracer's default (power).
+    pub fn of(integrator: &Integrator) -> Self {
+        let (mis, max_depth) = match integrator {
+            Integrator::Path(path) => (path.mis, path.max_depth),
+            Integrator::Bdpt(bdpt) => (bdpt.mis, bdpt.max_depth),
+            Integrator::Light(light) => (MisHeuristic::Power, light.max_depth),
+            Integrator::Photon(photon) => (MisHeuristic::Power, photon.max_depth),
+            Integrator::Radiosity(_) => (MisHeuristic::Power, u32::MAX),
+            Integrator::Depth
+            | Integrator::Normal
+            | Integrator::Albedo
+            | Integrator::AmbientOcclusion(_) => (MisHeuristic::Power, 0),
+        };
+        Self {
+            mis,
+            carries_indirect: max_depth > 1,
+        }
+    }
 }
 
 impl<'a> RenderProbe<'a> {
@@ -73,6 +108,7 @@ impl<'a> RenderProbe<'a> {
             material_tables: Vec::new(),
             trace_visibility: false,
             texture_bandwidths: Vec::new(),
+            estimator: ProbedEstimator::of(&scene.integrator),
         }
     }
 
@@ -467,12 +503,16 @@ impl ShadingProbe for RenderProbe<'_> {
         hit: &GBufferHit,
         count: u32,
         out: &mut Vec<LightSample>,
-    ) {
+    ) -> u32 {
         out.clear();
+        // The estimator takes a light and a BSDF sample per hit, the probe one of them per
+        // draw in turn: two draws make a camera sample, one where the BSDF is Dirac only.
+        let mut draws_per_camera_sample = 2;
         let lights = &self.scene.lights;
         if lights.is_empty() {
-            return;
+            return count.div_ceil(draws_per_camera_sample);
         }
+        let mis = self.estimator.mis;
         let si = hit_interaction(hit);
         let material = self.scene.material(hit.material_id());
         let texture_t = self.texture_bandwidth_at(hit.material_id(), &si);
@@ -487,6 +527,9 @@ impl ShadingProbe for RenderProbe<'_> {
             let mut stream = sampler.stream(pixel, k);
             let wavelengths = SampledWavelengths::sample_visible(stream.get_1d());
             let bsdf = material.bsdf(&si, &wavelengths);
+            if bsdf.is_specular() {
+                draws_per_camera_sample = 1;
+            }
             // A Dirac-only lobe: light sampling cannot reach it, BSDF sampling alone does.
             let strategy = if bsdf.is_specular() || k % 2 == 1 {
                 ProbeStrategy::Bsdf
@@ -530,6 +573,17 @@ impl ShadingProbe for RenderProbe<'_> {
                     // A sample the BSDF does not scatter towards the eye (the light behind
                     // a reflector) lights nothing, blocked or not: its shadow ray, which
                     // meets the surface's own back, would fake a shadow edge.
+                    // The estimator's light sample: its own density, its MIS weight against
+                    // the BSDF sample (a delta light's has none, `radiance_y` holds
+                    // E/(share·pmf), the estimator divides by the pmf only).
+                    let estimator_y = if ls.delta {
+                        bsdf_cos_per_sr * radiance_y * light_share
+                    } else {
+                        let light_pdf = pmf * ls.pdf;
+                        let bsdf_pdf = bsdf.pdf(wo_local, wi_local, TransportMode::Radiance);
+                        bsdf_cos_per_sr * radiance_y * mis_weight(mis, light_pdf, bsdf_pdf)
+                            / light_pdf
+                    };
                     let visibility = if self.trace_visibility && bsdf_cos_per_sr > 0.0 {
                         self.shadow_ray(&si, &ls)
                     } else {
@@ -559,6 +613,8 @@ impl ShadingProbe for RenderProbe<'_> {
                         ),
                         lane_variance: lanes,
                         visibility,
+                        estimator_y,
+                        draw: k / draws_per_camera_sample,
                     });
                 }
                 ProbeStrategy::Bsdf => {
@@ -581,6 +637,11 @@ impl ShadingProbe for RenderProbe<'_> {
                         if radiance_y.is_nan() || radiance_y <= 0.0 {
                             continue;
                         }
+                        let light_pdf = if bs.specular {
+                            0.0
+                        } else {
+                            self.light_pdf(&ctx, wi, light_hit.as_ref().map(|h| (l, h)))
+                        };
                         let (pdf_per_sr, bsdf_cos_per_sr) = if bs.specular {
                             // A Dirac lobe: one direction, weight f cos / (share · P(lobe)).
                             (
@@ -588,8 +649,6 @@ impl ShadingProbe for RenderProbe<'_> {
                                 reflectance_y(bs.f * (cos / (bsdf_share * bs.pdf)), &wavelengths),
                             )
                         } else {
-                            let light_pdf =
-                                self.light_pdf(&ctx, wi, light_hit.as_ref().map(|h| (l, h)));
                             (
                                 bsdf_share * bs.pdf + light_share * light_pdf,
                                 reflectance_y(bs.f * cos, &wavelengths),
@@ -601,6 +660,13 @@ impl ShadingProbe for RenderProbe<'_> {
                             pdf_per_sr
                         };
                         let lanes = lane_variance(le * bs.f * (cos / divisor), &wavelengths);
+                        // The estimator's BSDF sample: a Dirac lobe's has no MIS.
+                        let estimator_y = if bs.specular {
+                            radiance_y * reflectance_y(bs.f * (cos / bs.pdf), &wavelengths)
+                        } else {
+                            radiance_y * bsdf_cos_per_sr * mis_weight(mis, bs.pdf, light_pdf)
+                                / bs.pdf
+                        };
                         let (light_bandwidth, emitter_bandwidth) = self.light_bandwidths_towards(
                             l as usize,
                             wi,
@@ -625,11 +691,14 @@ impl ShadingProbe for RenderProbe<'_> {
                             ),
                             lane_variance: lanes,
                             visibility: Visibility::Unknown,
+                            estimator_y,
+                            draw: k / draws_per_camera_sample,
                         });
                     }
                 }
             }
         }
+        count.div_ceil(draws_per_camera_sample)
     }
 
     fn sample_indirect(&self, pixel: UVec2, hit: &GBufferHit, count: u32, out: &mut Vec<f32>) {
