@@ -36,7 +36,8 @@ pub enum VarianceArg {
     Eq9,
     /// Eq. 9 with eq. 4's one-bounce angular bandwidth at the eye, as the paper writes it.
     Eq9OneBounce,
-    /// The sample variance of the probe's own weights (not the paper).
+    /// The probe's sample variance of the render's estimate per camera sample (not the
+    /// paper; the default, which test d of docs/bandwidth.md found to rank pixels better).
     Measured,
 }
 
@@ -70,7 +71,7 @@ pub struct PlanArgs {
     #[arg(long = "plan-visibility", value_enum, default_value = "on")]
     pub plan_visibility: OnOff,
     /// `--plan predicted`: how V̂_p is predicted.
-    #[arg(long = "plan-variance", value_enum, default_value = "eq9")]
+    #[arg(long = "plan-variance", value_enum, default_value = "measured")]
     pub plan_variance: VarianceArg,
     /// `--plan predicted`: V̂_p is pooled over the (2R+1)² pixels of the same material around
     /// each pixel (0: per pixel, as the paper).
@@ -119,7 +120,7 @@ impl PlanArgs {
         let predictor_flags_given = self.plan_nb != DEFAULT_PROBE_SAMPLES
             || self.plan_floor != DEFAULT_FLOOR
             || self.plan_allocation != AllocationArg::Relative
-            || self.plan_variance != VarianceArg::Eq9
+            || self.plan_variance != VarianceArg::Measured
             || self.plan_visibility != OnOff::On
             || self.plan_pool_px != DEFAULT_POOL_RADIUS_PX
             || self.plan_indirect != DEFAULT_PROBE_SAMPLES
@@ -164,6 +165,7 @@ impl PlanArgs {
                 probe_samples: self.plan_nb,
                 floor_per_mille: (self.plan_floor * 1000.0).round() as u32,
                 allocation: self.allocation(),
+                variance: self.variance_bandwidth(),
                 hierarchical_max_level: (self.plan == PlanArg::PredictedHier)
                     .then_some(self.plan_max_level),
             },
@@ -182,6 +184,15 @@ impl PlanArgs {
         }
     }
 
+    /// How V̂_p is predicted (`--plan-variance`).
+    fn variance_bandwidth(&self) -> VarianceBandwidth {
+        match self.plan_variance {
+            VarianceArg::Eq9 => VarianceBandwidth::Incident,
+            VarianceArg::Eq9OneBounce => VarianceBandwidth::OneBounce,
+            VarianceArg::Measured => VarianceBandwidth::Measured,
+        }
+    }
+
     /// The predictor's settings for a render of `mean_spp` with `seed`.
     pub fn predictor(&self, mean_spp: u32, seed: u64) -> PredictorSettings {
         PredictorSettings {
@@ -192,11 +203,7 @@ impl PlanArgs {
                 allocation: self.allocation(),
                 seed,
             },
-            variance_bandwidth: match self.plan_variance {
-                VarianceArg::Eq9 => VarianceBandwidth::Incident,
-                VarianceArg::Eq9OneBounce => VarianceBandwidth::OneBounce,
-                VarianceArg::Measured => VarianceBandwidth::Measured,
-            },
+            variance_bandwidth: self.variance_bandwidth(),
             visibility: self.plan_visibility == OnOff::On,
             pool_radius_px: self.plan_pool_px,
             indirect_samples: self.plan_indirect,

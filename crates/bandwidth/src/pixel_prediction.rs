@@ -20,13 +20,14 @@ pub const MAX_IMAGE_BANDWIDTH_CYCLES_PER_PX: f32 = 2.0;
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum VarianceBandwidth {
     /// ν_a of the light field arriving at x (|T_d| ν_l): how fast the incident radiance
-    /// changes over the directions the shading integral sweeps. The default.
+    /// changes over the directions the shading integral sweeps. `--plan-variance eq9`.
     Incident,
     /// ν_a of eq. 4's one-bounce bandwidth at the eye, as the paper's eq. 9 writes it.
     OneBounce,
     /// Not eq. 9: the probe's `measured_variance` (an unbiased estimate of the per-camera-
     /// sample variance of the render's direct-light estimate, in Y², on the same scale as
-    /// the colour noise of pixels that see the lights directly).
+    /// the colour noise of pixels that see the lights directly). The default: it ranks
+    /// pixels by their measured variance better than eq. 9 (docs/bandwidth.md, test d).
     Measured,
 }
 
@@ -40,6 +41,9 @@ pub struct PixelPrediction {
     /// V̂_p: eq. 9 plus the samples' mean lane variance (colour noise of hero-wavelength
     /// sampling), in Y² (the probe's units squared).
     pub variance: f32,
+    /// V̂_p less the colour noise: the per-sample variance of luminance (Y²). Equal to
+    /// `variance` until the predictor's variance model sets both.
+    pub luminance_variance: f32,
     /// V̂_p's shading part alone: eq. 9 (cycles·Y²/sr) or, for `Measured`, the draws'
     /// sample variance (Y²).
     pub shading_variance: f32,
@@ -242,6 +246,7 @@ pub fn predict_pixel(
         bandwidth,
         image_bandwidth_cycles_per_px,
         variance,
+        luminance_variance: variance,
         shading_variance: (variance_sum / n) as f32,
         colour_variance: (lane_variance_sum / n) as f32,
         mean_y,

@@ -10,6 +10,9 @@
 //!
 //! V̂_p = pool(k·eq9_p + colour_p + indirect_p) + edge_p, L̂_p = pool(L_p)
 //!
+//! (with `Measured`, k·eq9_p is the probe's measured variance, k = 1); V̂_p less colour_p is
+//! the luminance part, what a render's `variance.Y` measures.
+//!
 //! with indirect_p the variance of the probe's one-bounce indirect estimates (Y²), `pool` the mean over the (2r+1)² same-surface window (`variance_pooling`) and
 //! edge_p = max over the 4-neighbours q of another surface of ¼ (L̂_p − L̂_q)²: a pixel whose
 //! footprint is split between two radiances L̂_p and L̂_q in shares s and 1 − s has the
@@ -26,6 +29,10 @@ use crate::variance_pooling::{pool_variance, PixelClass};
 pub struct ModelledVariance {
     /// V̂_p, Y² per camera sample.
     pub variance: Vec<f32>,
+    /// V̂_p without the colour term (the X and Z lanes' noise is not luminance's): the
+    /// per-sample variance of luminance a render's `variance.Y` measures. The background
+    /// keeps its own V̂ (its colour noise is the only variance it has).
+    pub luminance_variance: Vec<f32>,
     /// L̂_p pooled like V̂_p, Y.
     pub mean_y: Vec<f32>,
     /// Surface pixels where the probe found neither light nor variance (pooled): the
@@ -70,19 +77,23 @@ pub fn model_variance(
             0.0
         }
     };
-    let own: Vec<f32> = pixels
-        .iter()
-        .zip(class)
-        .map(|(p, c)| match c {
-            PixelClass::Material(_) => {
-                (shading_scale * f64::from(p.shading_variance)) as f32
-                    + p.colour_variance
-                    + p.indirect_variance
-            }
-            PixelClass::Background | PixelClass::Unpredicted => p.variance,
-        })
-        .collect();
-    let mut variance = pool_variance(resolution, &own, class, radius_px)?;
+    let own = |with_colour: bool| -> Vec<f32> {
+        pixels
+            .iter()
+            .zip(class)
+            .map(|(p, c)| match c {
+                PixelClass::Material(_) => {
+                    let colour = if with_colour { p.colour_variance } else { 0.0 };
+                    (shading_scale * f64::from(p.shading_variance)) as f32
+                        + colour
+                        + p.indirect_variance
+                }
+                PixelClass::Background | PixelClass::Unpredicted => p.variance,
+            })
+            .collect()
+    };
+    let mut variance = pool_variance(resolution, &own(true), class, radius_px)?;
+    let mut luminance_variance = pool_variance(resolution, &own(false), class, radius_px)?;
     let raw_mean: Vec<f32> = pixels.iter().map(|p| p.mean_y).collect();
     let mean_y = pool_variance(resolution, &raw_mean, class, radius_px)?;
     let (w, h) = (resolution.x as usize, resolution.y as usize);
@@ -101,6 +112,7 @@ pub fn model_variance(
             .map(|j| 0.25 * (mean_y[i] - mean_y[j]).powi(2))
             .fold(0.0f32, f32::max);
         variance[i] += edge;
+        luminance_variance[i] += edge;
     }
     let uninformed = (0..count)
         .map(|i| {
@@ -109,6 +121,7 @@ pub fn model_variance(
         .collect();
     Ok(ModelledVariance {
         variance,
+        luminance_variance,
         mean_y,
         uninformed,
         shading_scale,
@@ -138,6 +151,8 @@ mod tests {
         let m = model_variance(UVec2::new(2, 1), &pixels, &class, 0, false).unwrap();
         assert!((m.shading_scale - 0.1).abs() < 1e-12);
         assert_eq!(m.variance, vec![1.5, 3.0]);
+        // Less the first pixel's colour noise 0.5.
+        assert_eq!(m.luminance_variance, vec![1.0, 3.0]);
         let measured = model_variance(UVec2::new(2, 1), &pixels, &class, 0, true).unwrap();
         assert_eq!(measured.shading_scale, 1.0);
     }

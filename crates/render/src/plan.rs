@@ -69,6 +69,8 @@ pub enum SamplePlanKind {
         probe_samples: u32,
         floor_per_mille: u32,
         allocation: prism_bandwidth::Allocation,
+        /// How V̂_p is predicted (`--plan-variance`).
+        variance: prism_bandwidth::VarianceBandwidth,
         /// `predicted-hier`: hierarchical shading with lattices up to this level.
         hierarchical_max_level: Option<u32>,
     },
@@ -124,6 +126,7 @@ fn sample_plan_text(kind: SamplePlanKind) -> (&'static str, String) {
             probe_samples,
             floor_per_mille,
             allocation,
+            variance,
             hierarchical_max_level,
         } => (
             match hierarchical_max_level {
@@ -132,9 +135,20 @@ fn sample_plan_text(kind: SamplePlanKind) -> (&'static str, String) {
             },
             format!(
                 "--plan predicted: a G-buffer of pixel-centre hits, {probe_samples} probe light \
-                 samples per pixel, bandwidth by Bagher et al. 2013 eqs. 4-6, variance by eq. 9, \
+                 samples per pixel, bandwidth by Bagher et al. 2013 eqs. 4-6, variance {}, \
                  levels by eq. 11; {:.1} % of the budget uniform (indirect light is not \
                  predicted), the rest {}",
+                match variance {
+                    prism_bandwidth::VarianceBandwidth::Incident => {
+                        "by eq. 9 with the incident angular bandwidth"
+                    }
+                    prism_bandwidth::VarianceBandwidth::OneBounce => {
+                        "by eq. 9 with eq. 4's angular bandwidth at the eye"
+                    }
+                    prism_bandwidth::VarianceBandwidth::Measured => {
+                        "measured by the probe (the render's estimate per camera sample)"
+                    }
+                },
                 f64::from(floor_per_mille) / 10.0,
                 match allocation {
                     prism_bandwidth::Allocation::RelativeError => {

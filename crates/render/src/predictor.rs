@@ -47,8 +47,8 @@ pub struct PredictorSettings {
 
 impl PredictorSettings {
     /// `prism render --plan predicted`'s defaults for a mean of `mean_spp`: n_b = 16, a
-    /// quarter of the budget uniform, the relative-error allocation, eq. 9 with the
-    /// incident bandwidth, shadow edges on.
+    /// quarter of the budget uniform, the relative-error allocation, the probe's measured
+    /// variance, shadow edges on.
     pub fn defaults(mean_spp: f64, seed: u64) -> Self {
         Self {
             probe_samples: DEFAULT_PROBE_SAMPLES,
@@ -58,7 +58,7 @@ impl PredictorSettings {
                 allocation: prism_bandwidth::Allocation::RelativeError,
                 seed,
             },
-            variance_bandwidth: VarianceBandwidth::Incident,
+            variance_bandwidth: VarianceBandwidth::Measured,
             visibility: true,
             pool_radius_px: DEFAULT_POOL_RADIUS_PX,
             indirect_samples: DEFAULT_PROBE_SAMPLES,
@@ -319,6 +319,7 @@ fn escaping_pixel(
         image_bandwidth_cycles_per_px: (background_nu_a * rad_per_px)
             .min(MAX_IMAGE_BANDWIDTH_CYCLES_PER_PX),
         variance: variance as f32,
+        luminance_variance: variance as f32,
         shading_variance: 0.0,
         colour_variance: variance as f32,
         mean_y: mean.y as f32,
@@ -556,8 +557,13 @@ pub fn predict_with_probe<'a>(
         settings.variance_bandwidth == VarianceBandwidth::Measured,
     )
     .map_err(|e| e.to_string())?;
-    for (p, v) in pixels.iter_mut().zip(&modelled.variance) {
+    for ((p, v), luminance) in pixels
+        .iter_mut()
+        .zip(&modelled.variance)
+        .zip(&modelled.luminance_variance)
+    {
         p.variance = *v;
+        p.luminance_variance = *luminance;
     }
     let variance = &modelled.variance;
     let mean_y = &modelled.mean_y;

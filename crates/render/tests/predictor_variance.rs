@@ -1,7 +1,8 @@
 //! Test d of the predictor (docs/bandwidth.md): does V̂_p rank pixels as their measured
-//! per-sample variance does? The three benchmark scenes at 64×64; V̂_p from the predictor's
-//! defaults against `variance.Y` (per-pixel sample variance of luminance) of a 1024-spp
-//! render: Spearman's ρ ≥ 0.7 with direct light only (max_depth 1) and ≥ 0.5 with the
+//! per-sample variance does? The three benchmark scenes at 64×64; V̂_p's luminance part
+//! (less the colour term's X and Z noise, which `variance.Y` does not hold) from the
+//! predictor's defaults against `variance.Y` (per-pixel sample variance of luminance) of a
+//! 1024-spp render: Spearman's ρ ≥ 0.7 with direct light only (max_depth 1) and ≥ 0.5 with the
 //! scene's depth, and under-prediction (V̂/median V̂ < ½·V/median V) in ≤ 10 % of the
 //! direct-only pixels that see a surface. Minutes of rendering: `--ignored`
 //!
@@ -9,7 +10,7 @@
 
 use std::path::Path;
 
-use prism_bandwidth::model_variance;
+use prism_bandwidth::VarianceBandwidth;
 use prism_render::predictor::{predict, PredictorSettings};
 use prism_render::{render, RenderScene, RenderSettings};
 use prism_scene::{load_scene, Integrator};
@@ -65,37 +66,32 @@ fn agreement(scene_file: &str, direct_only: bool) -> Agreement {
     let measured = &image.aov("variance.Y").expect("variance.Y layer").values;
     let depth = &image.aov("depth.Z").expect("depth.Z layer").values;
     let (mut predicted_v, mut measured_v) = (Vec::new(), Vec::new());
+    // Eq. 9 (`--plan-variance eq9`) for comparison: its luminance part.
+    let eq9 = predict(
+        &scene,
+        &PredictorSettings {
+            variance_bandwidth: VarianceBandwidth::Incident,
+            ..PredictorSettings::defaults(64.0, 1)
+        },
+        1,
+    )
+    .unwrap();
     let mut candidates: Vec<(&str, Vec<f64>)> = vec![
-        ("eq9 alone", Vec::new()),
-        ("probe-measured", Vec::new()),
-        ("probe-measured + indirect", Vec::new()),
-        ("colour", Vec::new()),
-        ("luminance model on the measured variance", Vec::new()),
+        ("V̂_p with the colour term", Vec::new()),
+        ("eq. 9 (--plan-variance eq9), luminance part", Vec::new()),
+        ("probe-measured per pixel, unpooled", Vec::new()),
+        ("colour term alone", Vec::new()),
     ];
-    // The model of `variance_model` fed with the probe's measured variance and without the
-    // colour term (the X and Z lanes' noise, which `variance.Y` does not hold).
-    let luminance_inputs: Vec<_> = prediction
-        .pixels
-        .iter()
-        .map(|p| prism_bandwidth::PixelPrediction {
-            shading_variance: p.measured_variance,
-            colour_variance: 0.0,
-            ..*p
-        })
-        .collect();
-    let luminance_model =
-        model_variance(resolution, &luminance_inputs, &prediction.class, 2, true).unwrap();
     for (i, p) in prediction.pixels.iter().enumerate() {
         if depth[i].is_finite() && depth[i] > 0.0 {
-            predicted_v.push(f64::from(p.variance));
+            predicted_v.push(f64::from(p.luminance_variance));
             measured_v.push(f64::from(measured[i]));
-            candidates[0].1.push(f64::from(p.shading_variance));
-            candidates[1].1.push(f64::from(p.measured_variance));
-            candidates[2]
+            candidates[0].1.push(f64::from(p.variance));
+            candidates[1]
                 .1
-                .push(f64::from(p.measured_variance + p.indirect_variance));
+                .push(f64::from(eq9.pixels[i].luminance_variance));
+            candidates[2].1.push(f64::from(p.measured_variance));
             candidates[3].1.push(f64::from(p.colour_variance));
-            candidates[4].1.push(f64::from(luminance_model.variance[i]));
         }
     }
     for (name, v) in &candidates {
