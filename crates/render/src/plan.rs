@@ -135,7 +135,8 @@ fn sample_plan_text(kind: SamplePlanKind) -> (&'static str, String) {
             },
             format!(
                 "--plan predicted: a G-buffer of pixel-centre hits, {probe_samples} probe light \
-                 samples per pixel, bandwidth by Bagher et al. 2013 eqs. 4-6, variance {}, \
+                 samples per pixel, bandwidth by Bagher et al. 2013 eqs. 4-6 (silhouettes, creases \
+                 and material edges at the finest level), variance {}, \
                  levels by eq. 11; {:.1} % of the budget uniform (indirect light is not \
                  predicted), the rest {}",
                 match variance {

@@ -11,10 +11,10 @@
 use glam::{DVec3, UVec2, Vec2, Vec3A};
 use prism_bandwidth::pixel_prediction::MAX_IMAGE_BANDWIDTH_CYCLES_PER_PX;
 use prism_bandwidth::{
-    allocate, model_variance, predict_pixel, Allocated, AllocationInputs, AllocationSettings,
-    Bandwidth, BandwidthBuffer, GBufferHit, HierarchyInputs, LightSample, PixelClass,
-    PixelFootprint, PixelPrediction, ShadingProbe, SurfacePoint, Upsampling, VarianceBandwidth,
-    VisibilitySummary, DEFAULT_POOL_RADIUS_PX,
+    allocate, geometric_edges, model_variance, predict_pixel, Allocated, AllocationInputs,
+    AllocationSettings, Bandwidth, BandwidthBuffer, GBufferHit, HierarchyInputs, LightSample,
+    PixelClass, PixelFootprint, PixelPrediction, ShadingProbe, SurfacePoint, Upsampling,
+    VarianceBandwidth, VisibilitySummary, DEFAULT_POOL_RADIUS_PX,
 };
 use prism_spectrum::colorimetry::sampled_radiance_to_xyz;
 use prism_spectrum::{SampledSpectrum, SampledWavelengths};
@@ -119,7 +119,7 @@ const DISC_CUTOFF_CYCLES: f32 = 1.2197;
 
 /// A thin lens low-passes what lies out of focus (Soler et al. 2009, "Fourier depth of
 /// field", §4: the aperture's spectrum filters the image): each surface pixel's b_p (shadow
-/// edges included) is capped by the circle of confusion's cut-off at its centre hit, so
+/// and geometric edges included) is capped by the circle of confusion's cut-off at its centre hit, so
 /// out-of-focus pixels need fewer samples for their detail. In-focus pixels (CoC ≤ 1 px)
 /// and background pixels keep theirs; the lens adds no shading-variance term here.
 fn defocus_low_pass(
@@ -544,11 +544,6 @@ pub fn predict_with_probe<'a>(
     if settings.visibility {
         add_shadow_edges(resolution, &mut pixels, &eye);
     }
-    defocus_low_pass(scene, &mut pixels, &surface);
-    let b: Vec<f32> = pixels
-        .iter()
-        .map(|p| p.image_bandwidth_cycles_per_px)
-        .collect();
     let modelled = model_variance(
         resolution,
         &pixels,
@@ -565,6 +560,19 @@ pub fn predict_with_probe<'a>(
         p.variance = *v;
         p.luminance_variance = *luminance;
     }
+    // Silhouettes, creases and material edges inside a footprint: a step, not band-limited.
+    let edges = geometric_edges(resolution, &class, &surface, &modelled.mean_y)
+        .map_err(|e| e.to_string())?;
+    for (p, edge) in pixels.iter_mut().zip(edges) {
+        if edge {
+            p.image_bandwidth_cycles_per_px = MAX_IMAGE_BANDWIDTH_CYCLES_PER_PX;
+        }
+    }
+    defocus_low_pass(scene, &mut pixels, &surface);
+    let b: Vec<f32> = pixels
+        .iter()
+        .map(|p| p.image_bandwidth_cycles_per_px)
+        .collect();
     let variance = &modelled.variance;
     let mean_y = &modelled.mean_y;
     let buffer = BandwidthBuffer::new(resolution, &b, variance, &curvature)

@@ -829,6 +829,59 @@ mod tests {
         }
     }
 
+    /// A draw pairs a light and a BSDF sample as the path tracer does, each MIS-weighted:
+    /// the draws' mean is the reflected radiance, as the one-sample mixture's mean is (5
+    /// standard errors), and under a small lamp their variance is a fraction of the
+    /// mixture's, whose BSDF half finds the lamp rarely and whose light half counts double.
+    #[test]
+    fn draws_pair_a_light_and_a_bsdf_sample_with_the_estimators_weights() {
+        let json = r#"{"materials": {"white": {"type": "lambert", "reflectance": 0.8},
+                "black": {"type": "lambert", "reflectance": 0.0}},
+            "shapes": [{"type": "sphere", "material": "white"},
+                {"type": "rectangle", "name": "lamp", "size_m": [0.5, 0.5], "material": "black",
+                 "transform": [{"rotate": {"axis": [1, 0, 0], "angle_deg": 90}},
+                               {"translate": [0, 3, 0]}]}],
+            "lights": [{"type": "area", "shape": "lamp", "spectrum": 1.0}]}"#;
+        let scene = RenderScene::build(&parse_scene_str(json, "t.json").unwrap(), None).unwrap();
+        let probe = RenderProbe::new(&scene, 5);
+        assert_eq!(probe.estimator.mis, MisHeuristic::Power);
+        let hit = GBufferHit::new(
+            Vec3A::new(0.0, 1.0, 0.0),
+            2.0,
+            Vec3A::Y,
+            Curvature::default(),
+            Vec3A::Y,
+            0,
+        )
+        .unwrap();
+        let mut out = Vec::new();
+        let n = 8192u32;
+        let draws = probe.sample_lights(UVec2::ZERO, &hit, n, &mut out);
+        assert_eq!(draws, n / 2);
+        let mut draw_values = vec![0.0f64; draws as usize];
+        for s in &out {
+            draw_values[s.draw as usize] += f64::from(s.estimator_y);
+        }
+        let mut mixture = vec![0.0f64; n as usize];
+        for (slot, s) in mixture.iter_mut().zip(&out) {
+            *slot = f64::from(s.weight_y());
+        }
+        let mean_sd = |v: &[f64]| {
+            let m = v.iter().sum::<f64>() / v.len() as f64;
+            let var = v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (v.len() - 1) as f64;
+            (m, var)
+        };
+        let (draw_mean, draw_var) = mean_sd(&draw_values);
+        let (mix_mean, mix_var) = mean_sd(&mixture);
+        let se = (draw_var / f64::from(draws) + mix_var / f64::from(n)).sqrt();
+        assert!(draw_mean > 0.0);
+        assert!(
+            (draw_mean - mix_mean).abs() < 5.0 * se,
+            "{draw_mean} vs {mix_mean} (s.e. {se})"
+        );
+        assert!(draw_var < 0.25 * mix_var, "{draw_var} vs {mix_var}");
+    }
+
     /// One bounce of indirect light inside a Lambertian sphere (albedo a, radius R) around a
     /// point light of intensity I at its centre: every wall point leaves L_o = a I/(π R²),
     /// so the indirect radiance at the wall is a·L_o = a² I/(π R²) (0.159 for a = ½, I = 2,
