@@ -137,8 +137,8 @@ fn sample_plan_text(kind: SamplePlanKind) -> (&'static str, String) {
                 "--plan predicted: a G-buffer of pixel-centre hits, {probe_samples} probe light \
                  samples per pixel, bandwidth by Bagher et al. 2013 eqs. 4-6 (silhouettes, creases \
                  and material edges at the finest level), variance {}, \
-                 levels by eq. 11; {:.1} % of the budget uniform (indirect light is not \
-                 predicted), the rest {}",
+                 levels by eq. 11; {:.1} % of the budget uniform (light past the probe's one indirect \
+                 bounce is not predicted), the rest {}",
                 match variance {
                     prism_bandwidth::VarianceBandwidth::Incident => {
                         "by eq. 9 with the incident angular bandwidth"

@@ -361,7 +361,8 @@ enum ProbeStrategy {
 }
 
 impl RenderProbe<'_> {
-    /// Light sampling's solid-angle density towards `wi` (all lights, with their pmf).
+    /// Light sampling's solid-angle density towards `wi` (all lights, each with the pmf the
+    /// render's light selection gives it at `ctx`).
     fn light_pdf(&self, ctx: &LightSampleContext, wi: Vec3A, hit: Option<(u32, &LightHit)>) -> f32 {
         let lights = &self.scene.lights;
         let mut pdf = 0.0;
@@ -373,7 +374,7 @@ impl RenderProbe<'_> {
             };
             let on_this_light = light.is_infinite() || light_hit.is_some();
             if on_this_light && !light.is_delta() {
-                pdf += lights.pmf(index as u32) * light.pdf_li(ctx, wi, light_hit);
+                pdf += lights.pmf_at(ctx, index as u32) * light.pdf_li(ctx, wi, light_hit);
             }
         }
         pdf
@@ -417,11 +418,11 @@ impl RenderProbe<'_> {
             return None;
         }
         let second_frame = Frame::from_zx(second.n_shading, second.dpdu);
-        let (l, pmf) = lights.sample(stream.get_1d())?;
         let ctx = LightSampleContext {
             p: second.p,
             n: second.n_geometric,
         };
+        let (l, pmf) = lights.sample_at(&ctx, stream.get_1d())?;
         let ls = lights
             .light(l)
             .sample_li(&ctx, stream.get_2d(), wavelengths)?;
@@ -544,7 +545,7 @@ impl ShadingProbe for RenderProbe<'_> {
             };
             match strategy {
                 ProbeStrategy::Light => {
-                    let Some((l, pmf)) = lights.sample(stream.get_1d()) else {
+                    let Some((l, pmf)) = lights.sample_at(&ctx, stream.get_1d()) else {
                         continue;
                     };
                     let light = lights.light(l);
@@ -744,15 +745,7 @@ mod tests {
             "lights": [{"type": "point", "position_m": [0, 3, 0], "spectrum": 1.0, "scale": 2.0}]}"#;
         let scene = RenderScene::build(&parse_scene_str(json, "t.json").unwrap(), None).unwrap();
         let probe = RenderProbe::new(&scene, 1);
-        let hit = GBufferHit::new(
-            Vec3A::new(0.0, 1.0, 0.0),
-            2.0,
-            Vec3A::Y,
-            Curvature::default(),
-            Vec3A::Y,
-            0,
-        )
-        .unwrap();
+        let hit = top_of_the_unit_sphere();
         let mut out = Vec::new();
         probe.sample_lights(UVec2::new(3, 4), &hit, 64, &mut out);
         // Every other sample is a BSDF sample, which never finds a point light.
@@ -785,12 +778,21 @@ mod tests {
         assert_eq!(out, again);
     }
 
-    /// Shadow rays only where the BSDF scatters the light towards the eye: under a lamp, the
-    /// bottom of a sphere sees the lamp from behind, and its shadow rays, which would meet
-    /// the sphere itself, are not traced (they faked a shadow edge along the terminator).
-    /// The samples that are traced carry the lamp's size, 1/√A, for the penumbra.
-    #[test]
-    fn shadow_rays_are_traced_only_for_samples_that_light_the_hit() {
+    /// The G-buffer hit at the top of the unit sphere (material 0), seen from 2 m above.
+    fn top_of_the_unit_sphere() -> GBufferHit {
+        GBufferHit::new(
+            Vec3A::new(0.0, 1.0, 0.0),
+            2.0,
+            Vec3A::Y,
+            Curvature::default(),
+            Vec3A::Y,
+            0,
+        )
+        .unwrap()
+    }
+
+    /// A white Lambertian unit sphere under a 0.5 m square lamp 3 m above its centre.
+    fn sphere_under_a_lamp() -> RenderScene {
         let json = r#"{"materials": {"white": {"type": "lambert", "reflectance": 0.8},
                 "black": {"type": "lambert", "reflectance": 0.0}},
             "shapes": [{"type": "sphere", "material": "white"},
@@ -798,7 +800,16 @@ mod tests {
                  "transform": [{"rotate": {"axis": [1, 0, 0], "angle_deg": 90}},
                                {"translate": [0, 3, 0]}]}],
             "lights": [{"type": "area", "shape": "lamp", "spectrum": 1.0}]}"#;
-        let scene = RenderScene::build(&parse_scene_str(json, "t.json").unwrap(), None).unwrap();
+        RenderScene::build(&parse_scene_str(json, "t.json").unwrap(), None).unwrap()
+    }
+
+    /// Shadow rays only where the BSDF scatters the light towards the eye: under a lamp, the
+    /// bottom of a sphere sees the lamp from behind, and its shadow rays, which would meet
+    /// the sphere itself, are not traced (they faked a shadow edge along the terminator).
+    /// The samples that are traced carry the lamp's size, 1/√A, for the penumbra.
+    #[test]
+    fn shadow_rays_are_traced_only_for_samples_that_light_the_hit() {
+        let scene = sphere_under_a_lamp();
         let mut probe = RenderProbe::new(&scene, 1);
         probe.trace_visibility = true;
         let hit_facing = |y: f32| {
@@ -835,25 +846,10 @@ mod tests {
     /// mixture's, whose BSDF half finds the lamp rarely and whose light half counts double.
     #[test]
     fn draws_pair_a_light_and_a_bsdf_sample_with_the_estimators_weights() {
-        let json = r#"{"materials": {"white": {"type": "lambert", "reflectance": 0.8},
-                "black": {"type": "lambert", "reflectance": 0.0}},
-            "shapes": [{"type": "sphere", "material": "white"},
-                {"type": "rectangle", "name": "lamp", "size_m": [0.5, 0.5], "material": "black",
-                 "transform": [{"rotate": {"axis": [1, 0, 0], "angle_deg": 90}},
-                               {"translate": [0, 3, 0]}]}],
-            "lights": [{"type": "area", "shape": "lamp", "spectrum": 1.0}]}"#;
-        let scene = RenderScene::build(&parse_scene_str(json, "t.json").unwrap(), None).unwrap();
+        let scene = sphere_under_a_lamp();
         let probe = RenderProbe::new(&scene, 5);
         assert_eq!(probe.estimator.mis, MisHeuristic::Power);
-        let hit = GBufferHit::new(
-            Vec3A::new(0.0, 1.0, 0.0),
-            2.0,
-            Vec3A::Y,
-            Curvature::default(),
-            Vec3A::Y,
-            0,
-        )
-        .unwrap();
+        let hit = top_of_the_unit_sphere();
         let mut out = Vec::new();
         let n = 8192u32;
         let draws = probe.sample_lights(UVec2::ZERO, &hit, n, &mut out);
