@@ -15,7 +15,8 @@ variants compare by their allocation alone, without the noise of a converge run.
         [--variant "--plan-variance eq9"] [--no-file]
 
 Each `--variant` is extra `prism render --plan predicted` arguments ("" is the default plan,
-always included). Prints JSON and writes tools/bench-results/plan-allocation.json.
+always included). Prints JSON and writes tools/bench-results/plan-allocation.json
+(`bench_results.write`).
 """
 
 import argparse
@@ -30,7 +31,10 @@ import tempfile
 import numpy as np
 import OpenEXR
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import bench_results  # noqa: E402
+
+ROOT = bench_results.ROOT
 PRISM = os.path.join(ROOT, "target", "release", "prism")
 SCENES = {
     "fig9-spheres": ("scenes/bandwidth/fig9-spheres.json", "64x64"),
@@ -108,14 +112,10 @@ def main():
                     "load_average_1min_at_end": os.getloadavg()[0]},
         "scenes": results,
     }
-    print(json.dumps(result, indent=2))
-    if not opts.no_file:
-        path = os.path.join(ROOT, "tools", "bench-results", "plan-allocation.json")
-        with open(path + ".tmp", "w") as f:
-            json.dump(result, f, indent=2)
-            f.write("\n")
-        os.replace(path + ".tmp", path)
-
+    if opts.no_file:
+        print(json.dumps(result, indent=1))
+    else:
+        bench_results.write("plan-allocation", result)
 
 if __name__ == "__main__":
     main()

@@ -11,12 +11,9 @@
 use glam::UVec2;
 
 use crate::error::{check_lengths, pixel_count, BandwidthError};
-use crate::hierarchical_shading::SurfacePoint;
+use crate::hierarchical_shading::{SurfacePoint, CREASE_MIN_COS};
+use crate::pixel_neighbours::four_neighbours;
 use crate::variance_pooling::PixelClass;
-
-/// Two neighbours' normals further apart than 60° are a crease (the hierarchical shading's
-/// own threshold for not blending across normals).
-const CREASE_MIN_COS: f32 = 0.5;
 
 /// A neighbour's hit further off a pixel's tangent plane than sin 30° of the chord to it is
 /// on another surface (a depth step), whatever the depths: a floor seen at grazing angles
@@ -46,22 +43,12 @@ pub fn geometric_edges(
             ("L̂", mean_y.len()),
         ],
     )?;
-    let (w, h) = (resolution.x as usize, resolution.y as usize);
     Ok((0..count)
         .map(|i| {
             if class[i] == PixelClass::Unpredicted {
                 return false;
             }
-            let (x, y) = (i % w, i / w);
-            [
-                (x > 0).then(|| i - 1),
-                (x + 1 < w).then(|| i + 1),
-                (y > 0).then(|| i - w),
-                (y + 1 < h).then(|| i + w),
-            ]
-            .into_iter()
-            .flatten()
-            .any(|j| {
+            four_neighbours(i, resolution).any(|j| {
                 class[j] != PixelClass::Unpredicted
                     && is_discontinuous(class[i], class[j], surface[i], surface[j])
                     && is_visible_step(mean_y[i], mean_y[j])
@@ -83,22 +70,10 @@ fn is_discontinuous(
     match (p, q) {
         (Some(p), Some(q)) => {
             p.normal.dot(q.normal) < CREASE_MIN_COS
-                || off_plane_sine(&p, &q).max(off_plane_sine(&q, &p)) > STEP_MIN_SINE
+                || p.off_plane_sine(&q).max(q.off_plane_sine(&p)) > STEP_MIN_SINE
         }
         // Two background pixels, or a class without surface points: no geometry to differ.
         (None, None) | (Some(_), None) | (None, Some(_)) => false,
-    }
-}
-
-/// The sine of the angle between p's tangent plane and the chord from p to q (0 for
-/// coincident points).
-fn off_plane_sine(p: &SurfacePoint, q: &SurfacePoint) -> f32 {
-    let chord = q.position_m - p.position_m;
-    let length = chord.length();
-    if length > 0.0 {
-        p.normal.dot(chord).abs() / length
-    } else {
-        0.0
     }
 }
 

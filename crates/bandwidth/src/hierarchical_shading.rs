@@ -36,12 +36,30 @@ use crate::variance_pooling::PixelClass;
 /// The default coarsest lattice: one shaded pixel per 8×8 at most.
 pub const DEFAULT_MAX_LEVEL: u32 = 3;
 
+/// Two centre hits whose normals are further apart than 60° lie across a crease: the
+/// up-sampling does not blend across it, and `geometric_edges` marks it.
+pub(crate) const CREASE_MIN_COS: f32 = 0.5;
+
 /// The centre hit of a pixel, as the up-sampling compares it with its parents.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SurfacePoint {
     pub position_m: Vec3A,
     /// Unit shading normal.
     pub normal: Vec3A,
+}
+
+impl SurfacePoint {
+    /// The sine of the angle between this point's tangent plane and the chord to `other`
+    /// (0 for coincident points): how far `other` lies off the plane, whatever the depths.
+    pub fn off_plane_sine(&self, other: &SurfacePoint) -> f32 {
+        let chord = other.position_m - self.position_m;
+        let length = chord.length();
+        if length > 0.0 {
+            self.normal.dot(chord).abs() / length
+        } else {
+            0.0
+        }
+    }
 }
 
 /// What the hierarchy is built from, per pixel (row-major).
@@ -163,13 +181,7 @@ fn cell_axis(c: u32, spacing: u32, len: u32) -> (u32, u32, f32) {
 /// g_z: how far the parent's hit lies off p's tangent plane, as the sine of the angle
 /// between the plane and the chord to it (σ = 0.25).
 fn plane_weight(p: &SurfacePoint, parent: &SurfacePoint) -> f32 {
-    let chord = parent.position_m - p.position_m;
-    let length = chord.length();
-    if length <= 0.0 {
-        return 1.0;
-    }
-    let off_plane = p.normal.dot(chord).abs() / length;
-    (-(off_plane / 0.25).powi(2)).exp()
+    (-(p.off_plane_sine(parent) / 0.25).powi(2)).exp()
 }
 
 impl Upsampling {
@@ -231,7 +243,7 @@ impl Upsampling {
                     let g_z = match (inputs.class[i], inputs.class[j]) {
                         (PixelClass::Material(a), PixelClass::Material(b)) if a == b => {
                             match (&inputs.surface[i], &inputs.surface[j]) {
-                                (Some(p), Some(q)) if p.normal.dot(q.normal) >= 0.5 => {
+                                (Some(p), Some(q)) if p.normal.dot(q.normal) >= CREASE_MIN_COS => {
                                     plane_weight(p, q)
                                 }
                                 _ => 0.0,

@@ -161,9 +161,9 @@ pub fn predict_pixel(
     // A delta light is one direction, so it adds no variance to the shading integral.
     let n = f64::from(n_b);
     let measured_variance = draw_variance(samples, footprint.estimator_draws);
-    let mut variance_sum = 0.0f64;
-    match variance_bandwidth {
+    let shading_variance = match variance_bandwidth {
         VarianceBandwidth::Incident | VarianceBandwidth::OneBounce => {
+            let mut sum = 0.0f64;
             for (sample, nu) in &per_sample {
                 let Some(nu) = nu else { continue };
                 // A delta light is one direction; a blocked shadow ray (traced only with
@@ -180,15 +180,13 @@ pub fn predict_pixel(
                 let chi = sample.chi_y();
                 let term = (nu_a + sample.material_bandwidth.angular_cycles_per_rad) * chi * chi;
                 if term > 0.0 {
-                    variance_sum += f64::from(term) / f64::from(sample.pdf_per_sr);
+                    sum += f64::from(term) / f64::from(sample.pdf_per_sr);
                 }
             }
-            variance_sum *= std::f64::consts::TAU;
+            std::f64::consts::TAU * sum / n
         }
-        VarianceBandwidth::Measured => {
-            variance_sum = f64::from(measured_variance) * n;
-        }
-    }
+        VarianceBandwidth::Measured => f64::from(measured_variance),
+    };
     // Colour noise (beyond the paper; the "spectral" term): the lanes' variance,
     // averaged over the n_b samples like the weights.
     let lane_variance_sum: f64 = samples
@@ -196,7 +194,7 @@ pub fn predict_pixel(
         .filter(|s| !s.is_blocked())
         .map(|s| f64::from(s.lane_variance))
         .sum();
-    let variance = ((variance_sum + lane_variance_sum) / n) as f32;
+    let variance = (shading_variance + lane_variance_sum / n) as f32;
     // With shadow rays traced, blocked samples light nothing: L̂ is then the direct light
     // that arrives, not the unoccluded one (a shadow is dark, and its relative error large).
     let mean_y = (samples
@@ -247,7 +245,7 @@ pub fn predict_pixel(
         image_bandwidth_cycles_per_px,
         variance,
         luminance_variance: variance,
-        shading_variance: (variance_sum / n) as f32,
+        shading_variance: shading_variance as f32,
         colour_variance: (lane_variance_sum / n) as f32,
         mean_y,
         indirect_variance: 0.0,

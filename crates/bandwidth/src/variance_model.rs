@@ -21,6 +21,7 @@
 use glam::UVec2;
 
 use crate::error::{check_lengths, pixel_count, BandwidthError};
+use crate::pixel_neighbours::four_neighbours;
 use crate::pixel_prediction::PixelPrediction;
 use crate::variance_pooling::{pool_variance, PixelClass};
 
@@ -96,18 +97,8 @@ pub fn model_variance(
     let mut luminance_variance = pool_variance(resolution, &own(false), class, radius_px)?;
     let raw_mean: Vec<f32> = pixels.iter().map(|p| p.mean_y).collect();
     let mean_y = pool_variance(resolution, &raw_mean, class, radius_px)?;
-    let (w, h) = (resolution.x as usize, resolution.y as usize);
     for i in 0..count {
-        let (x, y) = (i % w, i / w);
-        let neighbours = [
-            (x > 0).then(|| i - 1),
-            (x + 1 < w).then(|| i + 1),
-            (y > 0).then(|| i - w),
-            (y + 1 < h).then(|| i + w),
-        ];
-        let edge = neighbours
-            .into_iter()
-            .flatten()
+        let edge = four_neighbours(i, resolution)
             .filter(|&j| class[j] != class[i])
             .map(|j| 0.25 * (mean_y[i] - mean_y[j]).powi(2))
             .fold(0.0f32, f32::max);

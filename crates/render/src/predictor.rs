@@ -11,10 +11,10 @@
 use glam::{DVec3, UVec2, Vec2, Vec3A};
 use prism_bandwidth::pixel_prediction::MAX_IMAGE_BANDWIDTH_CYCLES_PER_PX;
 use prism_bandwidth::{
-    allocate, geometric_edges, model_variance, predict_pixel, Allocated, AllocationInputs,
-    AllocationSettings, Bandwidth, BandwidthBuffer, GBufferHit, HierarchyInputs, LightSample,
-    PixelClass, PixelFootprint, PixelPrediction, ShadingProbe, SurfacePoint, Upsampling,
-    VarianceBandwidth, VisibilitySummary, DEFAULT_POOL_RADIUS_PX,
+    allocate, four_neighbours, geometric_edges, model_variance, predict_pixel, Allocated,
+    AllocationInputs, AllocationSettings, Bandwidth, BandwidthBuffer, GBufferHit, HierarchyInputs,
+    LightSample, PixelClass, PixelFootprint, PixelPrediction, ShadingProbe, SurfacePoint,
+    Upsampling, VarianceBandwidth, VisibilitySummary, DEFAULT_POOL_RADIUS_PX,
 };
 use prism_spectrum::colorimetry::sampled_radiance_to_xyz;
 use prism_spectrum::{SampledSpectrum, SampledWavelengths};
@@ -370,21 +370,13 @@ fn add_shadow_edges(
     pixels: &mut [PixelPrediction],
     eye: &[Option<EyeGeometry>],
 ) {
-    let (w, h) = (resolution.x as usize, resolution.y as usize);
     let before: Vec<VisibilitySummary> = pixels.iter().map(|p| p.visibility).collect();
-    for i in 0..w * h {
+    for i in 0..before.len() {
         let Some(eye) = eye[i] else { continue };
-        let (x, y) = (i % w, i / w);
         let own = before[i];
         let mut edge = own.in_area_penumbra;
         let mut penumbra = own.penumbra_cycles_per_m;
-        let neighbours = [
-            (x > 0).then(|| i - 1),
-            (x + 1 < w).then(|| i + 1),
-            (y > 0).then(|| i - w),
-            (y + 1 < h).then(|| i + w),
-        ];
-        for n in neighbours.into_iter().flatten() {
+        for n in four_neighbours(i, resolution) {
             if own.differs_from(&before[n]) {
                 edge = true;
                 penumbra = penumbra.max(before[n].penumbra_cycles_per_m);
