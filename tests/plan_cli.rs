@@ -121,6 +121,7 @@ fn plan_flags_are_checked() {
     let out = dir.path().join("x.exr");
     for (flags, expected) in [
         (vec!["--plan-nb", "4"], "add --plan predicted"),
+        (vec!["--plan-colour", "off"], "add --plan predicted"),
         (
             vec!["--plan", "predicted", "--plan-floor", "1.5"],
             "--plan-floor 1.5",
@@ -232,6 +233,22 @@ fn explain_names_the_plan() {
     assert!(text.contains("16 probe light samples"), "{text}");
     assert!(
         text.contains("predicted variance (the paper's rule)"),
+        "{text}"
+    );
+    assert!(text.contains("plus the colour noise"), "{text}");
+    let o = prism(&[
+        "render",
+        "scenes/glossy-env.json",
+        "--explain",
+        "--plan",
+        "predicted",
+        "--plan-colour",
+        "off",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        text.contains("of the luminance alone (--plan-colour off)"),
         "{text}"
     );
     let o = prism(&[

@@ -73,6 +73,10 @@ pub struct PlanArgs {
     /// `--plan predicted`: how V̂_p is predicted.
     #[arg(long = "plan-variance", value_enum, default_value = "measured")]
     pub plan_variance: VarianceArg,
+    /// `--plan predicted`: add the colour noise of hero-wavelength sampling (the X, Y and Z
+    /// lanes' variance, measured by the probe) to V̂_p (`off`: the luminance's variance alone).
+    #[arg(long = "plan-colour", value_enum, default_value = "on")]
+    pub plan_colour: OnOff,
     /// `--plan predicted`: V̂_p is pooled over the (2R+1)² pixels of the same material around
     /// each pixel (0: per pixel, as the paper).
     #[arg(long = "plan-pool-px", value_name = "R", default_value_t = DEFAULT_POOL_RADIUS_PX, value_parser = prism_args::numbers::parse_u32)]
@@ -122,13 +126,14 @@ impl PlanArgs {
             || self.plan_allocation != AllocationArg::Relative
             || self.plan_variance != VarianceArg::Measured
             || self.plan_visibility != OnOff::On
+            || self.plan_colour != OnOff::On
             || self.plan_pool_px != DEFAULT_POOL_RADIUS_PX
             || self.plan_indirect != DEFAULT_PROBE_SAMPLES
             || self.cache_dir.is_some();
         if !self.predicts() && predictor_flags_given {
             return Err(
                 "--plan-nb, --plan-floor, --plan-allocation, --plan-variance, \
-                 --plan-visibility, --plan-pool-px, --plan-indirect and --cache-dir set up \
+                 --plan-colour, --plan-visibility, --plan-pool-px, --plan-indirect and --cache-dir set up \
                  the predictor: add --plan predicted or predicted-hier"
                     .into(),
             );
@@ -166,6 +171,7 @@ impl PlanArgs {
                 floor_per_mille: (self.plan_floor * 1000.0).round() as u32,
                 allocation: self.allocation(),
                 variance: self.variance_bandwidth(),
+                colour_noise: self.plan_colour == OnOff::On,
                 hierarchical_max_level: (self.plan == PlanArg::PredictedHier)
                     .then_some(self.plan_max_level),
             },
@@ -205,6 +211,7 @@ impl PlanArgs {
             },
             variance_bandwidth: self.variance_bandwidth(),
             visibility: self.plan_visibility == OnOff::On,
+            colour_noise: self.plan_colour == OnOff::On,
             pool_radius_px: self.plan_pool_px,
             indirect_samples: self.plan_indirect,
         }

@@ -139,6 +139,17 @@ impl LightSample {
     }
 }
 
+/// One indirect estimate of the probe (`ShadingProbe::sample_indirect`): its luminance and
+/// the colour noise of its hero wavelengths.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct IndirectEstimate {
+    /// Y of the estimate (0 where it found no light).
+    pub radiance_y: f32,
+    /// The variance of its hero-wavelength XYZ estimate over the lanes (X, Y, Z summed), as
+    /// `LightSample::lane_variance`: dispersion through glass, spiky spectra.
+    pub lane_variance: f32,
+}
+
 /// What render implements so the predictor can probe the shading at G-buffer hits.
 ///
 /// `Sync` because the predictor probes pixels in parallel.
@@ -159,12 +170,18 @@ pub trait ShadingProbe: Sync {
     ) -> u32;
 
     /// Beyond the paper: clears `out` and fills it with `count` one-bounce indirect
-    /// estimates at `hit` (Y: a BSDF-sampled direction, the surface it meets, one light
-    /// sample there with its shadow ray; 0 where the direction meets nothing or an emitter,
-    /// whose light `sample_lights` counts), so that L̂_p and V̂_p see the light the paper's
-    /// direct-only probe misses. Deterministic like `sample_lights`. The default (a probe
-    /// without geometry) has none.
-    fn sample_indirect(&self, _pixel: UVec2, _hit: &GBufferHit, _count: u32, out: &mut Vec<f32>) {
+    /// estimates at `hit` (a BSDF-sampled direction, the first non-Dirac surface it meets,
+    /// one light sample there with its shadow ray; 0 where the direction meets nothing or
+    /// an emitter, whose light `sample_lights` counts), so that L̂_p and V̂_p see the light
+    /// the paper's direct-only probe misses. Deterministic like `sample_lights`. The
+    /// default (a probe without geometry) has none.
+    fn sample_indirect(
+        &self,
+        _pixel: UVec2,
+        _hit: &GBufferHit,
+        _count: u32,
+        out: &mut Vec<IndirectEstimate>,
+    ) {
         out.clear();
     }
 }

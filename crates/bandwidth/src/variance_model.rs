@@ -13,7 +13,10 @@
 //! (with `Measured`, k·eq9_p is the probe's measured variance, k = 1); V̂_p less colour_p is
 //! the luminance part, what a render's `variance.Y` measures.
 //!
-//! with indirect_p the variance of the probe's one-bounce indirect estimates (Y²), `pool` the mean over the (2r+1)² same-surface window (`variance_pooling`) and
+//! with indirect_p the variance of the probe's one-bounce indirect estimates (Y²), `pool` the
+//! mean over the (2r+1)² same-surface window (`variance_pooling`), scaled by the pixel's
+//! texture: a textured surface's V̂ goes as ρ_p² and its L̂ as ρ_p, so V̂/ρ² and L̂/ρ are
+//! pooled and multiplied back (`pool_scaled`; ρ_p = 1 on untextured surfaces), and
 //! edge_p = max over the 4-neighbours q of another surface of ¼ (L̂_p − L̂_q)²: a pixel whose
 //! footprint is split between two radiances L̂_p and L̂_q in shares s and 1 − s has the
 //! per-sample variance s(1 − s)(L̂_p − L̂_q)², ¼ (L̂_p − L̂_q)² at an even split.
@@ -23,7 +26,7 @@ use glam::UVec2;
 use crate::error::{check_lengths, pixel_count, BandwidthError};
 use crate::pixel_neighbours::four_neighbours;
 use crate::pixel_prediction::PixelPrediction;
-use crate::variance_pooling::{pool_variance, PixelClass};
+use crate::variance_pooling::{pool_scaled, PixelClass};
 
 /// What the allocation gets, per pixel (row-major), and the constant that put eq. 9 in Y².
 #[derive(Clone, Debug, PartialEq)]
@@ -45,11 +48,14 @@ pub struct ModelledVariance {
 }
 
 /// V̂_p and L̂_p for the allocation (module docs). `measured_shading` is true when the
-/// pixels' `shading_variance` is the measured variance already (k = 1).
+/// pixels' `shading_variance` is the measured variance already (k = 1). `texture_scale` is
+/// ρ_p, the reflectance of each pixel's texture relative to its surface (1 where the surface
+/// has no texture, and off surfaces).
 pub fn model_variance(
     resolution: UVec2,
     pixels: &[PixelPrediction],
     class: &[PixelClass],
+    texture_scale: &[f32],
     radius_px: u32,
     measured_shading: bool,
 ) -> Result<ModelledVariance, BandwidthError> {
@@ -60,6 +66,7 @@ pub fn model_variance(
         &[
             ("pixel predictions", pixels.len()),
             ("pixel classes", class.len()),
+            ("texture scales", texture_scale.len()),
         ],
     )?;
     let shading_scale = if measured_shading {
@@ -89,14 +96,22 @@ pub fn model_variance(
                         + colour
                         + p.indirect_variance
                 }
-                PixelClass::Background | PixelClass::Unpredicted => p.variance,
+                PixelClass::Background | PixelClass::Unpredicted => {
+                    if with_colour {
+                        p.variance
+                    } else {
+                        p.luminance_variance
+                    }
+                }
             })
             .collect()
     };
-    let mut variance = pool_variance(resolution, &own(true), class, radius_px)?;
-    let mut luminance_variance = pool_variance(resolution, &own(false), class, radius_px)?;
+    let squared_scale: Vec<f32> = texture_scale.iter().map(|s| s * s).collect();
+    let mut variance = pool_scaled(resolution, &own(true), &squared_scale, class, radius_px)?;
+    let mut luminance_variance =
+        pool_scaled(resolution, &own(false), &squared_scale, class, radius_px)?;
     let raw_mean: Vec<f32> = pixels.iter().map(|p| p.mean_y).collect();
-    let mean_y = pool_variance(resolution, &raw_mean, class, radius_px)?;
+    let mean_y = pool_scaled(resolution, &raw_mean, texture_scale, class, radius_px)?;
     for i in 0..count {
         let edge = four_neighbours(i, resolution)
             .filter(|&j| class[j] != class[i])
@@ -139,12 +154,13 @@ mod tests {
         // Eq. 9 says 10 and 30, the probe measured 1 and 3 in sum 4: k = 0.1.
         let pixels = [pixel(10.0, 2.0, 0.5, 1.0), pixel(30.0, 2.0, 0.0, 1.0)];
         let class = [PixelClass::Material(0); 2];
-        let m = model_variance(UVec2::new(2, 1), &pixels, &class, 0, false).unwrap();
+        let m = model_variance(UVec2::new(2, 1), &pixels, &class, &[1.0; 2], 0, false).unwrap();
         assert!((m.shading_scale - 0.1).abs() < 1e-12);
         assert_eq!(m.variance, vec![1.5, 3.0]);
         // Less the first pixel's colour noise 0.5.
         assert_eq!(m.luminance_variance, vec![1.0, 3.0]);
-        let measured = model_variance(UVec2::new(2, 1), &pixels, &class, 0, true).unwrap();
+        let measured =
+            model_variance(UVec2::new(2, 1), &pixels, &class, &[1.0; 2], 0, true).unwrap();
         assert_eq!(measured.shading_scale, 1.0);
     }
 
@@ -164,13 +180,13 @@ mod tests {
             PixelClass::Material(1),
             PixelClass::Material(1),
         ];
-        let m = model_variance(UVec2::new(4, 1), &pixels, &class, 0, false).unwrap();
+        let m = model_variance(UVec2::new(4, 1), &pixels, &class, &[1.0; 4], 0, false).unwrap();
         assert_eq!(m.variance, vec![0.0, 1.0, 1.0, 0.0]);
         assert_eq!(m.shading_scale, 0.0);
         // The two inner pixels know of their edge; the outer ones saw no light at all.
         assert_eq!(m.uninformed, vec![false, false, false, false]);
         let dark = [pixel(0.0, 0.0, 0.0, 0.0); 4];
-        let m = model_variance(UVec2::new(4, 1), &dark, &class, 0, false).unwrap();
+        let m = model_variance(UVec2::new(4, 1), &dark, &class, &[1.0; 4], 0, false).unwrap();
         assert_eq!(m.uninformed, vec![true; 4]);
     }
 
@@ -190,7 +206,7 @@ mod tests {
             PixelClass::Material(0),
             PixelClass::Background,
         ];
-        let m = model_variance(UVec2::new(3, 1), &pixels, &class, 1, false).unwrap();
+        let m = model_variance(UVec2::new(3, 1), &pixels, &class, &[1.0; 3], 1, false).unwrap();
         assert_eq!(m.mean_y, vec![3.0, 3.0, 3.0]);
         // k = 1/4; pooled own variance (1 + 0)/2 = 0.5; the middle pixel meets the
         // background with an equal L̂: no edge term.

@@ -39,17 +39,39 @@ pub fn pool_variance(
     class: &[PixelClass],
     radius_px: u32,
 ) -> Result<Vec<f32>, BandwidthError> {
+    pool_scaled(
+        resolution,
+        variance,
+        &vec![1.0; variance.len()],
+        class,
+        radius_px,
+    )
+}
+
+/// [`pool_variance`] of values that scale with a known per-pixel factor (V̂ and L̂ of a
+/// textured surface go as ρ² and ρ): pixel p gets scale_p · Σ_q value_q / Σ_q scale_q over
+/// its same-class window, the least-squares fit of value = c · scale there, so a texture's
+/// pattern survives the pooling that removes the probe's noise. Where the window's scales
+/// sum to 0 the plain mean is kept. All scales 1 is [`pool_variance`].
+pub fn pool_scaled(
+    resolution: UVec2,
+    values: &[f32],
+    scale: &[f32],
+    class: &[PixelClass],
+    radius_px: u32,
+) -> Result<Vec<f32>, BandwidthError> {
     let count = pixel_count("pooled V̂", resolution)?;
     check_lengths(
         resolution,
         count,
         &[
-            ("V̂ to pool", variance.len()),
+            ("V̂ to pool", values.len()),
+            ("pooling scales", scale.len()),
             ("pixel classes", class.len()),
         ],
     )?;
     if radius_px == 0 {
-        return Ok(variance.to_vec());
+        return Ok(values.to_vec());
     }
     let (w, h) = (resolution.x as usize, resolution.y as usize);
     let r = radius_px as usize;
@@ -59,21 +81,27 @@ pub fn pool_variance(
             let i = y * w + x;
             let own = class[i];
             if own == PixelClass::Unpredicted {
-                pooled.push(variance[i]);
+                pooled.push(values[i]);
                 continue;
             }
-            let (mut sum, mut n) = (0.0f64, 0u32);
+            let (mut sum, mut scale_sum, mut n) = (0.0f64, 0.0f64, 0u32);
             for yy in y.saturating_sub(r)..(y + r + 1).min(h) {
                 for xx in x.saturating_sub(r)..(x + r + 1).min(w) {
                     let j = yy * w + xx;
                     if class[j] == own {
-                        sum += f64::from(variance[j]);
+                        sum += f64::from(values[j]);
+                        scale_sum += f64::from(scale[j]);
                         n += 1;
                     }
                 }
             }
             // n ≥ 1: the pixel itself is in its window.
-            pooled.push((sum / f64::from(n)) as f32);
+            let value = if scale_sum > 0.0 {
+                f64::from(scale[i]) * (sum / scale_sum)
+            } else {
+                sum / f64::from(n)
+            };
+            pooled.push(value as f32);
         }
     }
     Ok(pooled)
@@ -129,6 +157,31 @@ mod tests {
         assert_eq!(p[0], 25.0 / 9.0);
         assert_eq!(p[12], 1.0);
         assert!(p.iter().all(|x| *x > 0.0));
+    }
+
+    /// A texture's pattern survives: values that are exactly c · scale come back unchanged,
+    /// and noise on them is averaged in proportion to the scale.
+    #[test]
+    fn scaled_pooling_keeps_a_pattern_proportional_to_the_scale() {
+        let scale = [0.2, 1.0, 0.5, 0.8, 0.1];
+        let values: Vec<f32> = scale.iter().map(|s| 3.0 * s).collect();
+        let c = [PixelClass::Material(0); 5];
+        let p = pool_scaled(UVec2::new(5, 1), &values, &scale, &c, 2).unwrap();
+        for (got, want) in p.iter().zip(&values) {
+            assert!((got - want).abs() < 1e-6, "{got} vs {want}");
+        }
+        // One pixel twice too high: its excess is shared by scale, not evenly.
+        let mut noisy = values.clone();
+        noisy[2] *= 2.0;
+        let p = pool_scaled(UVec2::new(5, 1), &noisy, &scale, &c, 4).unwrap();
+        let ratio: Vec<f32> = p.iter().zip(&scale).map(|(v, s)| v / s).collect();
+        assert!(
+            ratio.iter().all(|r| (r - ratio[0]).abs() < 1e-5),
+            "{ratio:?}"
+        );
+        // A window whose scales are all 0 keeps the plain mean.
+        let p = pool_scaled(UVec2::new(2, 1), &[1.0, 3.0], &[0.0, 0.0], &c[..2], 1).unwrap();
+        assert_eq!(p, vec![2.0, 2.0]);
     }
 
     #[test]

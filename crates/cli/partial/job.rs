@@ -85,14 +85,15 @@ pub fn identity(
     let plan = match args.plan.plan {
         PlanArg::Uniform => "uniform".to_string(),
         PlanArg::Predicted | PlanArg::PredictedHier | PlanArg::Adaptive => format!(
-            "{} nb={} floor={} allocation={:?} visibility={:?} variance={:?} pool={} indirect={} \
-             max_level={}",
+            "{} nb={} floor={} allocation={:?} visibility={:?} variance={:?} colour={:?} pool={} \
+             indirect={} max_level={}",
             args.plan.plan.name(),
             args.plan.plan_nb,
             args.plan.plan_floor,
             args.plan.plan_allocation,
             args.plan.plan_visibility,
             args.plan.plan_variance,
+            args.plan.plan_colour,
             args.plan.plan_pool_px,
             args.plan.plan_indirect,
             args.plan.plan_max_level

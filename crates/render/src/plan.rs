@@ -71,6 +71,9 @@ pub enum SamplePlanKind {
         allocation: prism_bandwidth::Allocation,
         /// How V̂_p is predicted (`--plan-variance`).
         variance: prism_bandwidth::VarianceBandwidth,
+        /// The colour noise of hero-wavelength sampling in V̂_p (`--plan-colour`; off: the
+        /// luminance's variance alone).
+        colour_noise: bool,
         /// `predicted-hier`: hierarchical shading with lattices up to this level.
         hierarchical_max_level: Option<u32>,
     },
@@ -127,6 +130,7 @@ fn sample_plan_text(kind: SamplePlanKind) -> (&'static str, String) {
             floor_per_mille,
             allocation,
             variance,
+            colour_noise,
             hierarchical_max_level,
         } => (
             match hierarchical_max_level {
@@ -136,7 +140,7 @@ fn sample_plan_text(kind: SamplePlanKind) -> (&'static str, String) {
             format!(
                 "--plan predicted: a G-buffer of pixel-centre hits, {probe_samples} probe light \
                  samples per pixel, bandwidth by Bagher et al. 2013 eqs. 4-6 (silhouettes, creases \
-                 and material edges at the finest level), variance {}, \
+                 and material edges at the finest level), variance {}{}, \
                  levels by eq. 11; {:.1} % of the budget uniform (light past the probe's one indirect \
                  bounce is not predicted), the rest {}",
                 match variance {
@@ -149,6 +153,11 @@ fn sample_plan_text(kind: SamplePlanKind) -> (&'static str, String) {
                     prism_bandwidth::VarianceBandwidth::Measured => {
                         "measured by the probe (the render's estimate per camera sample)"
                     }
+                },
+                if colour_noise {
+                    " plus the colour noise of the hero wavelengths' X, Y and Z"
+                } else {
+                    " of the luminance alone (--plan-colour off)"
                 },
                 f64::from(floor_per_mille) / 10.0,
                 match allocation {

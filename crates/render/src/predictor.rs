@@ -13,8 +13,8 @@ use prism_bandwidth::pixel_prediction::MAX_IMAGE_BANDWIDTH_CYCLES_PER_PX;
 use prism_bandwidth::{
     allocate, four_neighbours, geometric_edges, model_variance, predict_pixel, Allocated,
     AllocationInputs, AllocationSettings, Bandwidth, BandwidthBuffer, GBufferHit, HierarchyInputs,
-    LightSample, PixelClass, PixelFootprint, PixelPrediction, ShadingProbe, SurfacePoint,
-    Upsampling, VarianceBandwidth, VisibilitySummary, DEFAULT_POOL_RADIUS_PX,
+    IndirectEstimate, LightSample, PixelClass, PixelFootprint, PixelPrediction, ShadingProbe,
+    SurfacePoint, Upsampling, VarianceBandwidth, VisibilitySummary, DEFAULT_POOL_RADIUS_PX,
 };
 use prism_spectrum::colorimetry::sampled_radiance_to_xyz;
 use prism_spectrum::{SampledSpectrum, SampledWavelengths};
@@ -37,6 +37,9 @@ pub struct PredictorSettings {
     pub variance_bandwidth: VarianceBandwidth,
     /// Shadow edges from the probe's shadow rays (`--plan-visibility`; off = the paper).
     pub visibility: bool,
+    /// The colour noise of hero-wavelength sampling in V̂_p (`--plan-colour`; off: the
+    /// luminance's variance alone, which misses chroma noise under spiky spectra).
+    pub colour_noise: bool,
     /// One-bounce indirect estimates per pixel (`--plan-indirect`; 0 = the paper's
     /// direct-only probe; `ShadingProbe::sample_indirect`).
     pub indirect_samples: u32,
@@ -60,6 +63,7 @@ impl PredictorSettings {
             },
             variance_bandwidth: VarianceBandwidth::Measured,
             visibility: true,
+            colour_noise: true,
             pool_radius_px: DEFAULT_POOL_RADIUS_PX,
             indirect_samples: DEFAULT_PROBE_SAMPLES,
         }
@@ -302,14 +306,16 @@ fn escaping_pixel(
         .collect();
     let n = f64::from(count.max(1));
     let mean = estimates.iter().copied().sum::<DVec3>() / n;
-    let variance = if count > 1 {
-        estimates
-            .iter()
-            .map(|x| (*x - mean).length_squared())
-            .sum::<f64>()
-            / (n - 1.0)
+    // Unbiased sample variances: of the X, Y and Z lanes summed (the colour noise), and of
+    // Y alone (what `--plan-colour off` follows).
+    let (variance, luminance_variance) = if count > 1 {
+        let (xyz, y) = estimates.iter().fold((0.0, 0.0), |(xyz, y), x| {
+            let d = *x - mean;
+            (xyz + d.length_squared(), y + d.y * d.y)
+        });
+        (xyz / (n - 1.0), y / (n - 1.0))
     } else {
-        0.0
+        (0.0, 0.0)
     };
     PixelPrediction {
         bandwidth: Bandwidth {
@@ -319,7 +325,7 @@ fn escaping_pixel(
         image_bandwidth_cycles_per_px: (background_nu_a * rad_per_px)
             .min(MAX_IMAGE_BANDWIDTH_CYCLES_PER_PX),
         variance: variance as f32,
-        luminance_variance: variance as f32,
+        luminance_variance: luminance_variance as f32,
         shading_variance: 0.0,
         colour_variance: variance as f32,
         mean_y: mean.y as f32,
@@ -331,18 +337,15 @@ fn escaping_pixel(
 
 /// The mean and the unbiased sample variance of `values` (0, 0 when empty; variance 0
 /// for one value).
-fn mean_and_variance(values: &[f32]) -> (f32, f32) {
-    if values.is_empty() {
+fn mean_and_variance(values: impl Iterator<Item = f32> + Clone) -> (f32, f32) {
+    let n = values.clone().count();
+    if n == 0 {
         return (0.0, 0.0);
     }
-    let n = values.len() as f64;
-    let mean = values.iter().map(|v| f64::from(*v)).sum::<f64>() / n;
-    let variance = if values.len() > 1 {
-        values
-            .iter()
-            .map(|v| (f64::from(*v) - mean).powi(2))
-            .sum::<f64>()
-            / (n - 1.0)
+    let count = n as f64;
+    let mean = values.clone().map(f64::from).sum::<f64>() / count;
+    let variance = if n > 1 {
+        values.map(|v| (f64::from(v) - mean).powi(2)).sum::<f64>() / (count - 1.0)
     } else {
         0.0
     };
@@ -421,13 +424,14 @@ pub fn predict_with_probe<'a>(
     probe.trace_visibility = settings.visibility;
     // Light beyond the first bounce only where the estimator carries it (max_depth > 1):
     // with direct light only, the indirect estimates would predict light the render lacks.
-    let indirect_samples = if probe.estimator.carries_indirect {
+    let indirect_samples = if probe.estimator.carries_indirect() {
         settings.indirect_samples
     } else {
         0
     };
     type PixelRow = Vec<(
         PixelPrediction,
+        f32,
         f32,
         Option<EyeGeometry>,
         PixelClass,
@@ -437,7 +441,7 @@ pub fn predict_with_probe<'a>(
         .into_par_iter()
         .map(|y| {
             let mut samples: Vec<LightSample> = Vec::new();
-            let mut indirect: Vec<f32> = Vec::new();
+            let mut indirect: Vec<IndirectEstimate> = Vec::new();
             (0..resolution.x)
                 .map(|x| {
                     let pixel = UVec2::new(x, y);
@@ -446,6 +450,7 @@ pub fn predict_with_probe<'a>(
                         return Ok((
                             PixelPrediction::default(),
                             0.0,
+                            1.0,
                             None,
                             PixelClass::Unpredicted,
                             None,
@@ -475,9 +480,20 @@ pub fn predict_with_probe<'a>(
                                 .image_bandwidth_cycles_per_px
                                 .max(mirrored_sun_bandwidth(scene, &probe, &hit, rad_per_px));
                             probe.sample_indirect(pixel, &hit, indirect_samples, &mut indirect);
-                            let (mean, variance) = mean_and_variance(&indirect);
+                            let (mean, variance) =
+                                mean_and_variance(indirect.iter().map(|e| e.radiance_y));
                             p.mean_y += mean;
                             p.indirect_variance = variance;
+                            // The indirect light's own colour noise (dispersion through
+                            // glass, spiky spectra seen by a bounce), per camera sample.
+                            if !indirect.is_empty() {
+                                p.colour_variance += (indirect
+                                    .iter()
+                                    .map(|e| f64::from(e.lane_variance))
+                                    .sum::<f64>()
+                                    / indirect.len() as f64)
+                                    as f32;
+                            }
                             let c = hit.curvature();
                             let eye = EyeGeometry {
                                 depth_m: hit.depth_m(),
@@ -491,6 +507,7 @@ pub fn predict_with_probe<'a>(
                             Ok((
                                 p,
                                 c.k1.abs().max(c.k2.abs()),
+                                probe.texture_scale(&hit),
                                 Some(eye),
                                 PixelClass::Material(hit.material_id()),
                                 Some(surface),
@@ -505,6 +522,7 @@ pub fn predict_with_probe<'a>(
                                 rad_per_px,
                             ),
                             0.0,
+                            1.0,
                             None,
                             PixelClass::Background,
                             None,
@@ -512,6 +530,7 @@ pub fn predict_with_probe<'a>(
                         CentreRay::None => Ok((
                             PixelPrediction::default(),
                             0.0,
+                            1.0,
                             None,
                             PixelClass::Unpredicted,
                             None,
@@ -526,9 +545,11 @@ pub fn predict_with_probe<'a>(
     let mut eye = Vec::new();
     let mut class = Vec::new();
     let mut surface = Vec::new();
-    for (p, c, e, k, s) in rows.into_iter().flatten() {
+    let mut texture_scale = Vec::new();
+    for (p, c, t, e, k, s) in rows.into_iter().flatten() {
         pixels.push(p);
         curvature.push(c);
+        texture_scale.push(t);
         eye.push(e);
         class.push(k);
         surface.push(s);
@@ -540,6 +561,7 @@ pub fn predict_with_probe<'a>(
         resolution,
         &pixels,
         &class,
+        &texture_scale,
         settings.pool_radius_px,
         settings.variance_bandwidth == VarianceBandwidth::Measured,
     )
@@ -549,7 +571,11 @@ pub fn predict_with_probe<'a>(
         .zip(&modelled.variance)
         .zip(&modelled.luminance_variance)
     {
-        p.variance = *v;
+        p.variance = if settings.colour_noise {
+            *v
+        } else {
+            *luminance
+        };
         p.luminance_variance = *luminance;
     }
     // Silhouettes, creases and material edges inside a footprint: a step, not band-limited.
@@ -565,7 +591,8 @@ pub fn predict_with_probe<'a>(
         .iter()
         .map(|p| p.image_bandwidth_cycles_per_px)
         .collect();
-    let variance = &modelled.variance;
+    let variance: Vec<f32> = pixels.iter().map(|p| p.variance).collect();
+    let variance = &variance;
     let mean_y = &modelled.mean_y;
     let buffer = BandwidthBuffer::new(resolution, &b, variance, &curvature)
         .map_err(|e| unsupported(&e.to_string()))?;

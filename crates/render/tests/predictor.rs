@@ -432,3 +432,40 @@ fn defocus_caps_b_p_by_the_circle_of_confusion() {
         "b_p ratio / CoC ratio {ratio}"
     );
 }
+
+/// `--plan-colour off` leaves the colour noise out of V̂_p: under an F11 lamp (three narrow
+/// lines) a red Lambertian plane's hero-wavelength estimates scatter in X, Y and Z alike,
+/// so with the term every lit pixel's V̂_p is larger than its luminance part, and without
+/// it V̂_p is the luminance part exactly.
+#[test]
+fn the_colour_term_adds_the_lanes_noise_and_can_be_left_out() {
+    let scene = build(&format!(
+        r#"{{{CAMERA}, "materials": {{"red": {{"type": "lambert", "reflectance": {{"rgb": [0.8, 0.1, 0.1]}}}},
+            "black": {{"type": "lambert", "reflectance": 0.0}}}},
+        "shapes": [{{"type": "rectangle", "size_m": [3, 3], "material": "red",
+            "transform": {{"rotate": {{"axis": [1, 0, 0], "angle_deg": -90}}}}}},
+            {{"type": "rectangle", "name": "lamp", "size_m": [0.5, 0.5], "material": "black",
+            "transform": [{{"rotate": {{"axis": [1, 0, 0], "angle_deg": 90}}}}, {{"translate": [0, 2, 0]}}]}}],
+        "lights": [{{"type": "area", "shape": "lamp", "spectrum": "F11", "luminance_cd_m2": 1000}}]}}"#
+    ));
+    let with = predict(&scene, &PredictorSettings::defaults(16.0, 1), 1).unwrap();
+    let without = predict(
+        &scene,
+        &PredictorSettings {
+            colour_noise: false,
+            ..PredictorSettings::defaults(16.0, 1)
+        },
+        1,
+    )
+    .unwrap();
+    let lit: Vec<usize> = (0..with.pixels.len())
+        .filter(|&i| with.pixels[i].mean_y > 0.0)
+        .collect();
+    assert!(lit.len() > 1000, "{} lit pixels", lit.len());
+    for &i in &lit {
+        let (a, b) = (&with.pixels[i], &without.pixels[i]);
+        assert!(a.variance > 1.5 * a.luminance_variance, "pixel {i}: {a:?}");
+        assert_eq!(b.variance, b.luminance_variance, "pixel {i}");
+        assert_eq!(a.luminance_variance, b.luminance_variance, "pixel {i}");
+    }
+}
