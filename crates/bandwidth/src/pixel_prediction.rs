@@ -47,7 +47,8 @@ pub struct PixelPrediction {
     /// V̂_p's shading part alone: eq. 9 (cycles·Y²/sr) or, for `Measured`, the draws'
     /// sample variance (Y²).
     pub shading_variance: f32,
-    /// V̂_p's colour part alone: the samples' mean lane variance (Y²).
+    /// V̂_p's colour part alone: the samples' mean lane variance (Y²), to which the
+    /// predictor adds its indirect estimates' (`ShadingProbe::sample_indirect`).
     pub colour_variance: f32,
     /// L̂_p: the mean of the n_b samples' weights λᵢ/pᵢ (blocked shadow rays count 0), plus
     /// the mean one-bounce indirect estimate where the probe takes them, Y.

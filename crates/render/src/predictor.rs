@@ -286,6 +286,33 @@ fn mirrored_sun_bandwidth(
         .fold(0.0f32, f32::max)
 }
 
+/// What the probe pass finds at one pixel, before the image-wide steps.
+struct ProbedPixel {
+    prediction: PixelPrediction,
+    /// The larger principal curvature's magnitude at the centre hit (the MIP pyramid's).
+    curvature_per_m: f32,
+    /// ρ_p for the pooling (`RenderProbe::texture_scale`; 1 off textured surfaces).
+    texture_scale: f32,
+    eye: Option<EyeGeometry>,
+    class: PixelClass,
+    surface: Option<SurfacePoint>,
+}
+
+impl ProbedPixel {
+    /// A pixel the predictor says nothing about (no footprint, or no hit and no infinite
+    /// light).
+    fn unpredicted() -> Self {
+        Self {
+            prediction: PixelPrediction::default(),
+            curvature_per_m: 0.0,
+            texture_scale: 1.0,
+            eye: None,
+            class: PixelClass::Unpredicted,
+            surface: None,
+        }
+    }
+}
+
 fn escaping_pixel(
     scene: &RenderScene,
     direction: Vec3A,
@@ -429,15 +456,7 @@ pub fn predict_with_probe<'a>(
     } else {
         0
     };
-    type PixelRow = Vec<(
-        PixelPrediction,
-        f32,
-        f32,
-        Option<EyeGeometry>,
-        PixelClass,
-        Option<SurfacePoint>,
-    )>;
-    let rows: Vec<PixelRow> = (0..resolution.y)
+    let rows: Vec<Vec<ProbedPixel>> = (0..resolution.y)
         .into_par_iter()
         .map(|y| {
             let mut samples: Vec<LightSample> = Vec::new();
@@ -447,14 +466,7 @@ pub fn predict_with_probe<'a>(
                     let pixel = UVec2::new(x, y);
                     let Some(rad_per_px) = angular_footprint(scene, pixel).filter(|a| *a > 0.0)
                     else {
-                        return Ok((
-                            PixelPrediction::default(),
-                            0.0,
-                            1.0,
-                            None,
-                            PixelClass::Unpredicted,
-                            None,
-                        ));
+                        return Ok(ProbedPixel::unpredicted());
                     };
                     match centre_ray(scene, pixel) {
                         CentreRay::Hit(hit) => {
@@ -495,46 +507,34 @@ pub fn predict_with_probe<'a>(
                                     as f32;
                             }
                             let c = hit.curvature();
-                            let eye = EyeGeometry {
-                                depth_m: hit.depth_m(),
-                                cos_theta_x: hit.cos_theta_view(),
-                                rad_per_px,
-                            };
-                            let surface = SurfacePoint {
-                                position_m: hit.position_m(),
-                                normal: hit.normal(),
-                            };
-                            Ok((
-                                p,
-                                c.k1.abs().max(c.k2.abs()),
-                                probe.texture_scale(&hit),
-                                Some(eye),
-                                PixelClass::Material(hit.material_id()),
-                                Some(surface),
-                            ))
+                            Ok(ProbedPixel {
+                                prediction: p,
+                                curvature_per_m: c.k1.abs().max(c.k2.abs()),
+                                texture_scale: probe.texture_scale(&hit),
+                                eye: Some(EyeGeometry {
+                                    depth_m: hit.depth_m(),
+                                    cos_theta_x: hit.cos_theta_view(),
+                                    rad_per_px,
+                                }),
+                                class: PixelClass::Material(hit.material_id()),
+                                surface: Some(SurfacePoint {
+                                    position_m: hit.position_m(),
+                                    normal: hit.normal(),
+                                }),
+                            })
                         }
-                        CentreRay::Escapes(direction) => Ok((
-                            escaping_pixel(
+                        CentreRay::Escapes(direction) => Ok(ProbedPixel {
+                            prediction: escaping_pixel(
                                 scene,
                                 direction,
                                 settings.probe_samples,
                                 background_angular_bandwidth(scene, &probe, direction, rad_per_px),
                                 rad_per_px,
                             ),
-                            0.0,
-                            1.0,
-                            None,
-                            PixelClass::Background,
-                            None,
-                        )),
-                        CentreRay::None => Ok((
-                            PixelPrediction::default(),
-                            0.0,
-                            1.0,
-                            None,
-                            PixelClass::Unpredicted,
-                            None,
-                        )),
+                            class: PixelClass::Background,
+                            ..ProbedPixel::unpredicted()
+                        }),
+                        CentreRay::None => Ok(ProbedPixel::unpredicted()),
                     }
                 })
                 .collect::<Result<Vec<_>, String>>()
@@ -546,13 +546,13 @@ pub fn predict_with_probe<'a>(
     let mut class = Vec::new();
     let mut surface = Vec::new();
     let mut texture_scale = Vec::new();
-    for (p, c, t, e, k, s) in rows.into_iter().flatten() {
-        pixels.push(p);
-        curvature.push(c);
-        texture_scale.push(t);
-        eye.push(e);
-        class.push(k);
-        surface.push(s);
+    for probed in rows.into_iter().flatten() {
+        pixels.push(probed.prediction);
+        curvature.push(probed.curvature_per_m);
+        texture_scale.push(probed.texture_scale);
+        eye.push(probed.eye);
+        class.push(probed.class);
+        surface.push(probed.surface);
     }
     if settings.visibility {
         add_shadow_edges(resolution, &mut pixels, &eye);
