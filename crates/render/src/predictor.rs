@@ -286,6 +286,26 @@ fn mirrored_sun_bandwidth(
         .fold(0.0f32, f32::max)
 }
 
+/// A texel's scale (ρ_p) at least a tenth of its material's mean: a pixel whose centre
+/// hits a black texel still shares its footprint with lit ones (a checkerboard's black
+/// cell beside a white one), and a scale of 0 would pool its V̂ and L̂ to exactly 0.
+fn keep_texture_scales_off_zero(texture_scale: &mut [f32], class: &[PixelClass]) {
+    let mut sums: std::collections::HashMap<u32, (f64, u32)> = std::collections::HashMap::new();
+    for (scale, c) in texture_scale.iter().zip(class) {
+        if let PixelClass::Material(id) = c {
+            let entry = sums.entry(*id).or_default();
+            entry.0 += f64::from(*scale);
+            entry.1 += 1;
+        }
+    }
+    for (scale, c) in texture_scale.iter_mut().zip(class) {
+        if let PixelClass::Material(id) = c {
+            let (sum, n) = sums[id];
+            *scale = scale.max((0.1 * sum / f64::from(n)) as f32);
+        }
+    }
+}
+
 /// What the probe pass finds at one pixel, before the image-wide steps.
 struct ProbedPixel {
     prediction: PixelPrediction,
@@ -554,6 +574,7 @@ pub fn predict_with_probe<'a>(
         class.push(probed.class);
         surface.push(probed.surface);
     }
+    keep_texture_scales_off_zero(&mut texture_scale, &class);
     if settings.visibility {
         add_shadow_edges(resolution, &mut pixels, &eye);
     }

@@ -469,3 +469,70 @@ fn the_colour_term_adds_the_lanes_noise_and_can_be_left_out() {
         assert_eq!(a.luminance_variance, b.luminance_variance, "pixel {i}");
     }
 }
+
+/// Pooling scales V̂ and L̂ by each pixel's texel (ρ_p): a checkerboard of 0.1 and 0.7 in
+/// 3-px cells under a uniform sky (every 5 × 5 pooling window holds both) keeps V̂ ∝ ρ²,
+/// where the plain window mean gave both cells one value; and with black cells (ρ = 0) a
+/// dark pixel beside a bright one is not pooled to a noiseless 0: its scale is kept at a
+/// tenth of the surface's mean.
+#[test]
+fn pooling_keeps_a_texture_s_pattern_and_no_texel_goes_dark() {
+    let checks = |a: f32| {
+        let scene = build(&format!(
+            r#"{{{CAMERA},
+            "materials": {{"checks": {{"type": "lambert", "reflectance":
+                {{"texture": {{"type": "checkerboard", "a": {a}, "b": 0.7, "uv_scale": [8, 8]}}}}}}}},
+            "shapes": [{{"type": "rectangle", "size_m": [3, 3], "material": "checks",
+                "transform": {{"rotate": {{"axis": [1, 0, 0], "angle_deg": -90}}}}}}],
+            "lights": [{{"type": "sky", "spectrum": 1.0}}]}}"#
+        ));
+        run(&scene, true)
+    };
+    // The raw probe mean tells a pixel's cell; its pooled V̂ must follow the cell.
+    let median = |v: &mut Vec<f32>| {
+        v.sort_by(f32::total_cmp);
+        v[v.len() / 2]
+    };
+    let p = checks(0.1);
+    let (mut dark, mut bright): (Vec<f32>, Vec<f32>) = (Vec::new(), Vec::new());
+    for pixel in &p.pixels {
+        if pixel.mean_y < 0.35 {
+            dark.push(pixel.luminance_variance);
+        } else {
+            bright.push(pixel.luminance_variance);
+        }
+    }
+    assert!(dark.len() > 200 && bright.len() > 200);
+    let expected = (0.1f32 / 0.7).powi(2);
+    let got = median(&mut dark) / median(&mut bright);
+    assert!(
+        got > expected / 2.0 && got < expected * 2.0,
+        "V̂ dark/bright {got}, expected {expected}"
+    );
+    let p = checks(0.0);
+    let w = p.resolution.x as usize;
+    let bright_cell = |i: usize| p.pixels[i].mean_y > 0.35;
+    let mut beside_bright = 0;
+    for (i, pixel) in p.pixels.iter().enumerate() {
+        let (x, y) = ((i % w) as i64, (i / w) as i64);
+        let near_bright = (-2..=2).any(|dy| {
+            (-2..=2).any(|dx| {
+                let (xx, yy) = (x + dx, y + dy);
+                (0..w as i64).contains(&xx)
+                    && (0..p.resolution.y as i64).contains(&yy)
+                    && bright_cell((yy * w as i64 + xx) as usize)
+            })
+        });
+        if pixel.mean_y == 0.0 && near_bright {
+            beside_bright += 1;
+            assert!(
+                pixel.luminance_variance > 0.0,
+                "black texel {i} pooled to V̂ = 0"
+            );
+        }
+    }
+    assert!(
+        beside_bright > 100,
+        "{beside_bright} black pixels beside bright ones"
+    );
+}
