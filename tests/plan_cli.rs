@@ -216,19 +216,18 @@ fn the_hierarchical_plan_fills_the_pixels_it_does_not_shade() {
     }
 }
 
+/// `prism render scenes/glossy-env.json --explain` with `plan`'s flags: its stdout.
+fn explain(plan: &[&str]) -> String {
+    let mut args = vec!["render", "scenes/glossy-env.json", "--explain"];
+    args.extend_from_slice(plan);
+    let o = prism(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
 #[test]
 fn explain_names_the_plan() {
-    let o = prism(&[
-        "render",
-        "scenes/glossy-env.json",
-        "--explain",
-        "--plan",
-        "predicted",
-        "--plan-allocation",
-        "variance",
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let text = String::from_utf8_lossy(&o.stdout);
+    let text = explain(&["--plan", "predicted", "--plan-allocation", "variance"]);
     assert!(text.contains("predicted sample plan"), "{text}");
     assert!(text.contains("16 probe light samples"), "{text}");
     assert!(
@@ -236,30 +235,12 @@ fn explain_names_the_plan() {
         "{text}"
     );
     assert!(text.contains("plus the colour noise"), "{text}");
-    let o = prism(&[
-        "render",
-        "scenes/glossy-env.json",
-        "--explain",
-        "--plan",
-        "predicted",
-        "--plan-colour",
-        "off",
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let text = String::from_utf8_lossy(&o.stdout);
+    let text = explain(&["--plan", "predicted", "--plan-colour", "off"]);
     assert!(
         text.contains("of the luminance alone (--plan-colour off)"),
         "{text}"
     );
-    let o = prism(&[
-        "render",
-        "scenes/glossy-env.json",
-        "--explain",
-        "--plan",
-        "predicted-hier",
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let text = String::from_utf8_lossy(&o.stdout);
+    let text = explain(&["--plan", "predicted-hier"]);
     assert!(text.contains("predicted-hier sample plan"), "{text}");
     assert!(text.contains("at most 8 px apart"), "{text}");
 }

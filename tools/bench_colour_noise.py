@@ -20,7 +20,6 @@ Prints JSON and writes tools/bench-results/colour-noise.json (`bench_results.wri
 import argparse
 import json
 import os
-import platform
 import shlex
 import statistics
 import subprocess
@@ -108,18 +107,14 @@ def main():
         "spp": opts.spp,
         "seeds": opts.seeds,
         "reference_spp": opts.reference_spp,
-        "machine": {"platform": platform.platform(), "cpus": os.cpu_count(),
-                    "load_average_1min_at_end": os.getloadavg()[0]},
+        "machine": bench_results.machine(),
         "plans": summary,
         "colour_on_minus_off_delta_e2000": {
             "mean": statistics.mean(differences),
             "standard_error": statistics.stdev(differences) / len(differences) ** 0.5,
         },
     }
-    if opts.no_file:
-        print(json.dumps(result, indent=1))
-    else:
-        bench_results.write("colour-noise", result)
+    bench_results.publish("colour-noise", result, not opts.no_file)
 
 
 if __name__ == "__main__":

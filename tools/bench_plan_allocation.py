@@ -26,9 +26,7 @@ always included). Prints JSON and writes tools/bench-results/plan-allocation.jso
 """
 
 import argparse
-import json
 import os
-import platform
 import shlex
 import subprocess
 import sys
@@ -150,14 +148,10 @@ def main():
         "command": "tools/bench_plan_allocation.py " + " ".join(shlex.quote(a) for a in sys.argv[1:]),
         "renders": opts.renders,
         "spp": opts.spp,
-        "machine": {"platform": platform.platform(), "cpus": os.cpu_count(),
-                    "load_average_1min_at_end": os.getloadavg()[0]},
+        "machine": bench_results.machine(),
         "scenes": results,
     }
-    if opts.no_file:
-        print(json.dumps(result, indent=1))
-    else:
-        bench_results.write("plan-allocation", result)
+    bench_results.publish("plan-allocation", result, not opts.no_file)
 
 if __name__ == "__main__":
     main()

@@ -13,3 +13,18 @@ def write(name, result):
     with open(out + ".tmp", "w") as f:
         f.write(text + "\n")
     os.replace(out + ".tmp", out)
+
+
+def machine():
+    """What the result was measured on: platform, logical CPUs, the load at the end."""
+    import platform
+    return {"platform": platform.platform(), "cpus": os.cpu_count(),
+            "load_average_1min_at_end": os.getloadavg()[0]}
+
+
+def publish(name, result, to_file):
+    """`write` when `to_file`, else print the JSON only (a tool's `--no-file`)."""
+    if to_file:
+        write(name, result)
+    else:
+        print(json.dumps(result, indent=1))
