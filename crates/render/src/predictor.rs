@@ -518,14 +518,8 @@ pub fn predict_with_probe<'a>(
                             p.indirect_variance = variance;
                             // The indirect light's own colour noise (dispersion through
                             // glass, spiky spectra seen by a bounce), per camera sample.
-                            if !indirect.is_empty() {
-                                p.colour_variance += (indirect
-                                    .iter()
-                                    .map(|e| f64::from(e.lane_variance))
-                                    .sum::<f64>()
-                                    / indirect.len() as f64)
-                                    as f32;
-                            }
+                            p.colour_variance +=
+                                mean_and_variance(indirect.iter().map(|e| e.lane_variance)).0;
                             let c = hit.curvature();
                             Ok(ProbedPixel {
                                 prediction: p,
@@ -612,8 +606,11 @@ pub fn predict_with_probe<'a>(
         .iter()
         .map(|p| p.image_bandwidth_cycles_per_px)
         .collect();
-    let variance: Vec<f32> = pixels.iter().map(|p| p.variance).collect();
-    let variance = &variance;
+    let variance = if settings.colour_noise {
+        &modelled.variance
+    } else {
+        &modelled.luminance_variance
+    };
     let mean_y = &modelled.mean_y;
     let buffer = BandwidthBuffer::new(resolution, &b, variance, &curvature)
         .map_err(|e| unsupported(&e.to_string()))?;

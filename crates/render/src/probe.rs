@@ -186,11 +186,17 @@ impl<'a> RenderProbe<'a> {
         Ok(self)
     }
 
+    /// The shading textures of material `material_id` (`material_id` past the list: the
+    /// last, as `RenderScene::material` reads it); `None` before the tables are built.
+    fn textures_of(&self, material_id: u32) -> Option<&Vec<TextureBandwidth>> {
+        let index = (material_id as usize).min(self.texture_bandwidths.len().saturating_sub(1));
+        self.texture_bandwidths.get(index)
+    }
+
     /// t at the hit `si` of material `material_id`: the largest of its shading textures'
     /// bandwidths there (texture/bandwidth.rs), cycles/m; 0 without textures.
     pub(crate) fn texture_bandwidth_at(&self, material_id: u32, si: &SurfaceInteraction) -> f32 {
-        let index = (material_id as usize).min(self.texture_bandwidths.len().saturating_sub(1));
-        let Some(textures) = self.texture_bandwidths.get(index) else {
+        let Some(textures) = self.textures_of(material_id) else {
             return 0.0;
         };
         let ctx = TextureContext::from_interaction(si);
@@ -204,8 +210,10 @@ impl<'a> RenderProbe<'a> {
     /// albedo's Y at the hit, seen from the eye, where the material has a texture (which
     /// scales the pixel's light by its texel), else 1 (the whole surface shares one scale).
     pub fn texture_scale(&self, hit: &GBufferHit) -> f32 {
-        let index = hit.material_id() as usize;
-        if self.texture_bandwidths.get(index).is_none_or(Vec::is_empty) {
+        if self
+            .textures_of(hit.material_id())
+            .is_none_or(|t| t.is_empty())
+        {
             return 1.0;
         }
         let si = hit_interaction(hit);
