@@ -4,7 +4,10 @@
 use clap::{Args, ValueEnum};
 use prism_bandwidth::allocation::DEFAULT_FLOOR;
 use prism_bandwidth::hierarchical_shading::DEFAULT_MAX_LEVEL;
-use prism_bandwidth::{Allocation, AllocationSettings, VarianceBandwidth, DEFAULT_POOL_RADIUS_PX};
+use prism_bandwidth::{
+    Allocation, AllocationSettings, VarianceBandwidth, DEFAULT_POOL_RADIUS_PX,
+    DEFAULT_PROBE_STRIDE_PX,
+};
 use prism_render::bsdf_table_cache::AngularTableCache;
 use prism_render::predictor::{PredictorSettings, DEFAULT_PROBE_SAMPLES};
 use prism_render::SamplePlanKind;
@@ -85,6 +88,11 @@ pub struct PlanArgs {
     /// light's mean and variance to the prediction (0: direct light only, as the paper).
     #[arg(long = "plan-indirect", value_name = "N", default_value_t = DEFAULT_PROBE_SAMPLES, value_parser = prism_args::numbers::parse_u32)]
     pub plan_indirect: u32,
+    /// `--plan predicted`: the probe samples one pixel in S×S (and every pixel of a surface
+    /// with no probed pixel within --plan-pool-px); the others take their probed
+    /// neighbours' answers (1: every pixel, as the paper).
+    #[arg(long = "plan-probe-stride", value_name = "S", default_value_t = DEFAULT_PROBE_STRIDE_PX, value_parser = prism_args::numbers::parse_u32)]
+    pub plan_probe_stride: u32,
     /// `--plan predicted-hier`: the coarsest lattice, 2^L pixels between shaded pixels
     /// (1 to 8).
     #[arg(long = "plan-max-level", value_name = "L", default_value_t = DEFAULT_MAX_LEVEL, value_parser = prism_args::numbers::parse_u32)]
@@ -129,12 +137,14 @@ impl PlanArgs {
             || self.plan_colour != OnOff::On
             || self.plan_pool_px != DEFAULT_POOL_RADIUS_PX
             || self.plan_indirect != DEFAULT_PROBE_SAMPLES
+            || self.plan_probe_stride != DEFAULT_PROBE_STRIDE_PX
             || self.cache_dir.is_some();
         if !self.predicts() && predictor_flags_given {
             return Err(
                 "--plan-nb, --plan-floor, --plan-allocation, --plan-variance, \
-                 --plan-colour, --plan-visibility, --plan-pool-px, --plan-indirect and --cache-dir set up \
-                 the predictor: add --plan predicted or predicted-hier"
+                 --plan-colour, --plan-visibility, --plan-pool-px, --plan-indirect, \
+                 --plan-probe-stride and --cache-dir set up the predictor: add --plan predicted \
+                 or predicted-hier"
                     .into(),
             );
         }
@@ -152,6 +162,9 @@ impl PlanArgs {
         }
         if self.plan_nb == 0 {
             return Err("--plan-nb must be at least 1".into());
+        }
+        if self.plan_probe_stride == 0 {
+            return Err("--plan-probe-stride 0: expected at least 1 (1 probes every pixel)".into());
         }
         if !(0.0..=1.0).contains(&self.plan_floor) {
             return Err(format!(
@@ -172,6 +185,8 @@ impl PlanArgs {
                 allocation: self.allocation(),
                 variance: self.variance_bandwidth(),
                 colour_noise: self.plan_colour == OnOff::On,
+                probe_stride_px: self.plan_probe_stride,
+                pool_radius_px: self.plan_pool_px,
                 hierarchical_max_level: (self.plan == PlanArg::PredictedHier)
                     .then_some(self.plan_max_level),
             },
@@ -214,6 +229,7 @@ impl PlanArgs {
             colour_noise: self.plan_colour == OnOff::On,
             pool_radius_px: self.plan_pool_px,
             indirect_samples: self.plan_indirect,
+            probe_stride_px: self.plan_probe_stride,
         }
     }
 }

@@ -38,6 +38,7 @@ pub mod pixel_neighbours;
 pub mod pixel_prediction;
 pub mod probe;
 pub mod sample_plan;
+pub mod sparse_probing;
 mod stochastic_rounding;
 #[cfg(test)]
 mod test_rng;
@@ -60,6 +61,7 @@ pub use pixel_neighbours::four_neighbours;
 pub use pixel_prediction::{predict_pixel, PixelFootprint, PixelPrediction, VarianceBandwidth};
 pub use probe::{IndirectEstimate, LightSample, ShadingProbe};
 pub use sample_plan::{SamplePlan, DEFAULT_LIGHT_SAMPLES};
+pub use sparse_probing::{nearest_probed, probed_pixels, DEFAULT_PROBE_STRIDE_PX};
 pub use variance_model::{model_variance, ModelledVariance};
 pub use variance_pooling::{pool_scaled, pool_variance, PixelClass, DEFAULT_POOL_RADIUS_PX};
 pub use visibility::{Visibility, VisibilitySummary};

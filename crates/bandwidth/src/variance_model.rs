@@ -50,12 +50,14 @@ pub struct ModelledVariance {
 /// V̂_p and L̂_p for the allocation (module docs). `measured_shading` is true when the
 /// pixels' `shading_variance` is the measured variance already (k = 1). `texture_scale` is
 /// ρ_p, the reflectance of each pixel's texture relative to its surface (1 where the surface
-/// has no texture, and off surfaces).
+/// has no texture, and off surfaces). Only the `probed` pixels' own numbers count
+/// (`sparse_probing`): the others get their window's (all true: every pixel's).
 pub fn model_variance(
     resolution: UVec2,
     pixels: &[PixelPrediction],
     class: &[PixelClass],
     texture_scale: &[f32],
+    probed: &[bool],
     radius_px: u32,
     measured_shading: bool,
 ) -> Result<ModelledVariance, BandwidthError> {
@@ -67,14 +69,15 @@ pub fn model_variance(
             ("pixel predictions", pixels.len()),
             ("pixel classes", class.len()),
             ("texture scales", texture_scale.len()),
+            ("probed mask", probed.len()),
         ],
     )?;
     let shading_scale = if measured_shading {
         1.0
     } else {
         let (mut measured, mut predicted) = (0.0f64, 0.0f64);
-        for (p, c) in pixels.iter().zip(class) {
-            if let PixelClass::Material(_) = c {
+        for ((p, c), probed) in pixels.iter().zip(class).zip(probed) {
+            if let (PixelClass::Material(_), true) = (c, probed) {
                 measured += f64::from(p.measured_variance);
                 predicted += f64::from(p.shading_variance);
             }
@@ -107,11 +110,31 @@ pub fn model_variance(
             .collect()
     };
     let squared_scale: Vec<f32> = texture_scale.iter().map(|s| s * s).collect();
-    let mut variance = pool_scaled(resolution, &own(true), &squared_scale, class, radius_px)?;
-    let mut luminance_variance =
-        pool_scaled(resolution, &own(false), &squared_scale, class, radius_px)?;
+    let mut variance = pool_scaled(
+        resolution,
+        &own(true),
+        &squared_scale,
+        class,
+        probed,
+        radius_px,
+    )?;
+    let mut luminance_variance = pool_scaled(
+        resolution,
+        &own(false),
+        &squared_scale,
+        class,
+        probed,
+        radius_px,
+    )?;
     let raw_mean: Vec<f32> = pixels.iter().map(|p| p.mean_y).collect();
-    let mean_y = pool_scaled(resolution, &raw_mean, texture_scale, class, radius_px)?;
+    let mean_y = pool_scaled(
+        resolution,
+        &raw_mean,
+        texture_scale,
+        class,
+        probed,
+        radius_px,
+    )?;
     for i in 0..count {
         let edge = four_neighbours(i, resolution)
             .filter(|&j| class[j] != class[i])
@@ -154,13 +177,30 @@ mod tests {
         // Eq. 9 says 10 and 30, the probe measured 1 and 3 in sum 4: k = 0.1.
         let pixels = [pixel(10.0, 2.0, 0.5, 1.0), pixel(30.0, 2.0, 0.0, 1.0)];
         let class = [PixelClass::Material(0); 2];
-        let m = model_variance(UVec2::new(2, 1), &pixels, &class, &[1.0; 2], 0, false).unwrap();
+        let m = model_variance(
+            UVec2::new(2, 1),
+            &pixels,
+            &class,
+            &[1.0; 2],
+            &[true; 2],
+            0,
+            false,
+        )
+        .unwrap();
         assert!((m.shading_scale - 0.1).abs() < 1e-12);
         assert_eq!(m.variance, vec![1.5, 3.0]);
         // Less the first pixel's colour noise 0.5.
         assert_eq!(m.luminance_variance, vec![1.0, 3.0]);
-        let measured =
-            model_variance(UVec2::new(2, 1), &pixels, &class, &[1.0; 2], 0, true).unwrap();
+        let measured = model_variance(
+            UVec2::new(2, 1),
+            &pixels,
+            &class,
+            &[1.0; 2],
+            &[true; 2],
+            0,
+            true,
+        )
+        .unwrap();
         assert_eq!(measured.shading_scale, 1.0);
     }
 
@@ -180,13 +220,31 @@ mod tests {
             PixelClass::Material(1),
             PixelClass::Material(1),
         ];
-        let m = model_variance(UVec2::new(4, 1), &pixels, &class, &[1.0; 4], 0, false).unwrap();
+        let m = model_variance(
+            UVec2::new(4, 1),
+            &pixels,
+            &class,
+            &[1.0; 4],
+            &[true; 4],
+            0,
+            false,
+        )
+        .unwrap();
         assert_eq!(m.variance, vec![0.0, 1.0, 1.0, 0.0]);
         assert_eq!(m.shading_scale, 0.0);
         // The two inner pixels know of their edge; the outer ones saw no light at all.
         assert_eq!(m.uninformed, vec![false, false, false, false]);
         let dark = [pixel(0.0, 0.0, 0.0, 0.0); 4];
-        let m = model_variance(UVec2::new(4, 1), &dark, &class, &[1.0; 4], 0, false).unwrap();
+        let m = model_variance(
+            UVec2::new(4, 1),
+            &dark,
+            &class,
+            &[1.0; 4],
+            &[true; 4],
+            0,
+            false,
+        )
+        .unwrap();
         assert_eq!(m.uninformed, vec![true; 4]);
     }
 
@@ -206,7 +264,16 @@ mod tests {
             PixelClass::Material(0),
             PixelClass::Background,
         ];
-        let m = model_variance(UVec2::new(3, 1), &pixels, &class, &[1.0; 3], 1, false).unwrap();
+        let m = model_variance(
+            UVec2::new(3, 1),
+            &pixels,
+            &class,
+            &[1.0; 3],
+            &[true; 3],
+            1,
+            false,
+        )
+        .unwrap();
         assert_eq!(m.mean_y, vec![3.0, 3.0, 3.0]);
         // k = 1/4; pooled own variance (1 + 0)/2 = 0.5; the middle pixel meets the
         // background with an equal L̂: no edge term.

@@ -44,6 +44,7 @@ pub fn pool_variance(
         variance,
         &vec![1.0; variance.len()],
         class,
+        &vec![true; variance.len()],
         radius_px,
     )
 }
@@ -53,11 +54,16 @@ pub fn pool_variance(
 /// its same-class window, the least-squares fit of value = c · scale there, so a texture's
 /// pattern survives the pooling that removes the probe's noise. Where the window's scales
 /// sum to 0 the plain mean is kept. All scales 1 is [`pool_variance`].
+///
+/// Only pixels marked in `probed` lend their value (`sparse_probing`: the others were not
+/// sampled and carry none); a pixel with no probed pixel of its class in its window keeps
+/// its own value. All true pools every pixel.
 pub fn pool_scaled(
     resolution: UVec2,
     values: &[f32],
     scale: &[f32],
     class: &[PixelClass],
+    probed: &[bool],
     radius_px: u32,
 ) -> Result<Vec<f32>, BandwidthError> {
     let count = pixel_count("pooled V̂", resolution)?;
@@ -68,6 +74,7 @@ pub fn pool_scaled(
             ("V̂ to pool", values.len()),
             ("pooling scales", scale.len()),
             ("pixel classes", class.len()),
+            ("probed mask", probed.len()),
         ],
     )?;
     if radius_px == 0 {
@@ -88,15 +95,16 @@ pub fn pool_scaled(
             for yy in y.saturating_sub(r)..(y + r + 1).min(h) {
                 for xx in x.saturating_sub(r)..(x + r + 1).min(w) {
                     let j = yy * w + xx;
-                    if class[j] == own {
+                    if class[j] == own && probed[j] {
                         sum += f64::from(values[j]);
                         scale_sum += f64::from(scale[j]);
                         n += 1;
                     }
                 }
             }
-            // n ≥ 1: the pixel itself is in its window.
-            let value = if scale_sum > 0.0 {
+            let value = if n == 0 {
+                f64::from(values[i])
+            } else if scale_sum > 0.0 {
                 f64::from(scale[i]) * (sum / scale_sum)
             } else {
                 sum / f64::from(n)
@@ -166,22 +174,53 @@ mod tests {
         let scale = [0.2, 1.0, 0.5, 0.8, 0.1];
         let values: Vec<f32> = scale.iter().map(|s| 3.0 * s).collect();
         let c = [PixelClass::Material(0); 5];
-        let p = pool_scaled(UVec2::new(5, 1), &values, &scale, &c, 2).unwrap();
+        let p = pool_scaled(UVec2::new(5, 1), &values, &scale, &c, &[true; 5], 2).unwrap();
         for (got, want) in p.iter().zip(&values) {
             assert!((got - want).abs() < 1e-6, "{got} vs {want}");
         }
         // One pixel twice too high: its excess is shared by scale, not evenly.
         let mut noisy = values.clone();
         noisy[2] *= 2.0;
-        let p = pool_scaled(UVec2::new(5, 1), &noisy, &scale, &c, 4).unwrap();
+        let p = pool_scaled(UVec2::new(5, 1), &noisy, &scale, &c, &[true; 5], 4).unwrap();
         let ratio: Vec<f32> = p.iter().zip(&scale).map(|(v, s)| v / s).collect();
         assert!(
             ratio.iter().all(|r| (r - ratio[0]).abs() < 1e-5),
             "{ratio:?}"
         );
         // A window whose scales are all 0 keeps the plain mean.
-        let p = pool_scaled(UVec2::new(2, 1), &[1.0, 3.0], &[0.0, 0.0], &c[..2], 1).unwrap();
+        let p = pool_scaled(
+            UVec2::new(2, 1),
+            &[1.0, 3.0],
+            &[0.0, 0.0],
+            &c[..2],
+            &[true; 2],
+            1,
+        )
+        .unwrap();
         assert_eq!(p, vec![2.0, 2.0]);
+    }
+
+    /// Sparse probing: pixels that were not probed lend nothing and take their probed
+    /// neighbours' mean, scaled by their own texture.
+    #[test]
+    fn only_probed_pixels_lend_their_value() {
+        let values = [2.0, 0.0, 4.0, 0.0, 9.0];
+        let scale = [1.0, 0.5, 1.0, 1.0, 1.0];
+        let c = [
+            PixelClass::Material(0),
+            PixelClass::Material(0),
+            PixelClass::Material(0),
+            PixelClass::Material(0),
+            PixelClass::Material(1),
+        ];
+        let probed = [true, false, true, false, true];
+        let p = pool_scaled(UVec2::new(5, 1), &values, &scale, &c, &probed, 1).unwrap();
+        // Pixel 1: (2 + 4)/(1 + 1) × 0.5; pixel 3: its only probed neighbour of class 0 is
+        // pixel 2; pixel 4 is alone in its class.
+        assert_eq!(p, vec![2.0, 1.5, 4.0, 4.0, 9.0]);
+        // A pixel with no probed pixel of its class in the window keeps its own value.
+        let p = pool_scaled(UVec2::new(5, 1), &values, &scale, &c, &[false; 5], 1).unwrap();
+        assert_eq!(p, values.to_vec());
     }
 
     #[test]

@@ -86,7 +86,7 @@ pub fn identity(
         PlanArg::Uniform => "uniform".to_string(),
         PlanArg::Predicted | PlanArg::PredictedHier | PlanArg::Adaptive => format!(
             "{} nb={} floor={} allocation={:?} visibility={:?} variance={:?} colour={:?} pool={} \
-             indirect={} max_level={}",
+             indirect={} probe_stride={} max_level={}",
             args.plan.plan.name(),
             args.plan.plan_nb,
             args.plan.plan_floor,
@@ -96,6 +96,7 @@ pub fn identity(
             args.plan.plan_colour,
             args.plan.plan_pool_px,
             args.plan.plan_indirect,
+            args.plan.plan_probe_stride,
             args.plan.plan_max_level
         ),
     };

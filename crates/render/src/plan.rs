@@ -74,6 +74,11 @@ pub enum SamplePlanKind {
         /// The colour noise of hero-wavelength sampling in V̂_p (`--plan-colour`; off: the
         /// luminance's variance alone).
         colour_noise: bool,
+        /// The probe samples one pixel in S×S (`--plan-probe-stride`; 1 = every pixel).
+        probe_stride_px: u32,
+        /// The pooling radius (`--plan-pool-px`), within which a pixel the probe skips finds
+        /// a probed one.
+        pool_radius_px: u32,
         /// `predicted-hier`: hierarchical shading with lattices up to this level.
         hierarchical_max_level: Option<u32>,
     },
@@ -131,6 +136,8 @@ fn sample_plan_text(kind: SamplePlanKind) -> (&'static str, String) {
             allocation,
             variance,
             colour_noise,
+            probe_stride_px,
+            pool_radius_px,
             hierarchical_max_level,
         } => (
             match hierarchical_max_level {
@@ -139,10 +146,20 @@ fn sample_plan_text(kind: SamplePlanKind) -> (&'static str, String) {
             },
             format!(
                 "--plan predicted: a G-buffer of pixel-centre hits, {probe_samples} probe light \
-                 samples per pixel, bandwidth by Bagher et al. 2013 eqs. 4-6 (silhouettes, creases \
+                 samples per probed pixel ({}), bandwidth by Bagher et al. 2013 eqs. 4-6 (silhouettes, creases \
                  and material edges at the finest level), variance {}{}, \
                  levels by eq. 11; {:.1} % of the budget uniform (light past the probe's one indirect \
                  bounce is not predicted), the rest {}",
+                if probe_stride_px == 1 {
+                    "every pixel, as the paper".to_string()
+                } else {
+                    format!(
+                        "one pixel in {probe_stride_px}×{probe_stride_px}, and each pixel of a \
+                         surface with none within {pool_radius_px} px; the others take the \
+                         nearest probed pixel's bandwidth and the pooled V̂: \
+                         --plan-probe-stride"
+                    )
+                },
                 match variance {
                     prism_bandwidth::VarianceBandwidth::Incident => {
                         "by eq. 9 with the incident angular bandwidth"

@@ -15,6 +15,7 @@ use prism_bandwidth::{
     AllocationInputs, AllocationSettings, Bandwidth, BandwidthBuffer, GBufferHit, HierarchyInputs,
     IndirectEstimate, LightSample, PixelClass, PixelFootprint, PixelPrediction, ShadingProbe,
     SurfacePoint, Upsampling, VarianceBandwidth, VisibilitySummary, DEFAULT_POOL_RADIUS_PX,
+    DEFAULT_PROBE_STRIDE_PX,
 };
 use prism_spectrum::colorimetry::sampled_radiance_to_xyz;
 use prism_spectrum::{SampledSpectrum, SampledWavelengths};
@@ -46,6 +47,9 @@ pub struct PredictorSettings {
     /// V̂_p pooled over the (2r+1)² pixels of the same surface around each pixel
     /// (`--plan-pool-px`; 0 = the paper's per-pixel V̂_p; prism_bandwidth::variance_pooling).
     pub pool_radius_px: u32,
+    /// The probe samples one pixel in S×S (`--plan-probe-stride`; 1 = every pixel, as the
+    /// paper; prism_bandwidth::sparse_probing).
+    pub probe_stride_px: u32,
 }
 
 impl PredictorSettings {
@@ -66,6 +70,7 @@ impl PredictorSettings {
             colour_noise: true,
             pool_radius_px: DEFAULT_POOL_RADIUS_PX,
             indirect_samples: DEFAULT_PROBE_SAMPLES,
+            probe_stride_px: DEFAULT_PROBE_STRIDE_PX,
         }
     }
 }
@@ -444,6 +449,75 @@ fn add_shadow_edges(
     }
 }
 
+/// The class of what `pixel`'s centre ray meets, as the probe pass will find it.
+fn centre_class(scene: &RenderScene, pixel: UVec2) -> PixelClass {
+    if angular_footprint(scene, pixel)
+        .filter(|a| *a > 0.0)
+        .is_none()
+    {
+        return PixelClass::Unpredicted;
+    }
+    match centre_ray(scene, pixel) {
+        CentreRay::Hit(hit) => PixelClass::Material(hit.material_id()),
+        CentreRay::Escapes(_) => PixelClass::Background,
+        CentreRay::None => PixelClass::Unpredicted,
+    }
+}
+
+/// The pixels the probe samples (`prism_bandwidth::sparse_probing`): all at a stride of 1;
+/// otherwise a first pass of centre rays finds each pixel's surface, so that no surface is
+/// left without a probed pixel within the pooling radius.
+fn probed_pixels(scene: &RenderScene, settings: &PredictorSettings) -> Result<Vec<bool>, String> {
+    let resolution = scene.resolution;
+    let count = resolution.x as usize * resolution.y as usize;
+    if settings.probe_stride_px == 1 {
+        return Ok(vec![true; count]);
+    }
+    let class: Vec<PixelClass> = (0..count)
+        .into_par_iter()
+        .map(|i| {
+            let w = resolution.x as usize;
+            centre_class(scene, UVec2::new((i % w) as u32, (i / w) as u32))
+        })
+        .collect();
+    prism_bandwidth::probed_pixels(
+        resolution,
+        &class,
+        settings.probe_stride_px,
+        settings.pool_radius_px,
+    )
+    .map_err(|e| e.to_string())
+}
+
+/// A pixel the probe skipped takes the nearest probed pixel's bandwidth ν (of its own
+/// surface, within the pooling radius) and its shadow rays' summary, and turns ν into its
+/// own b_p with its own footprint (eq. 6); its V̂ and L̂ come from the pooling.
+fn borrow_from_probed(
+    resolution: UVec2,
+    pixels: &mut [PixelPrediction],
+    class: &[PixelClass],
+    probed: &[bool],
+    eye: &[Option<EyeGeometry>],
+    radius_px: u32,
+) -> Result<(), String> {
+    let donors = prism_bandwidth::nearest_probed(resolution, class, probed, radius_px)
+        .map_err(|e| e.to_string())?;
+    for (i, donor) in donors.iter().enumerate() {
+        let (Some(j), Some(eye)) = (donor, eye[i]) else {
+            continue;
+        };
+        let (bandwidth, visibility) = (pixels[*j].bandwidth, pixels[*j].visibility);
+        let p = &mut pixels[i];
+        p.bandwidth = bandwidth;
+        p.visibility = visibility;
+        p.image_bandwidth_cycles_per_px = p.image_bandwidth_cycles_per_px.max(
+            (bandwidth.angular_cycles_per_rad * eye.rad_per_px)
+                .min(MAX_IMAGE_BANDWIDTH_CYCLES_PER_PX),
+        );
+    }
+    Ok(())
+}
+
 /// Runs the predictor over every pixel of `scene` (in parallel on the current rayon pool).
 pub fn predict(
     scene: &RenderScene,
@@ -467,6 +541,9 @@ pub fn predict_with_probe<'a>(
     if settings.probe_samples == 0 {
         return Err("--plan-nb must be at least 1".into());
     }
+    if settings.probe_stride_px == 0 {
+        return Err("--plan-probe-stride must be at least 1".into());
+    }
     let resolution = scene.resolution;
     probe.trace_visibility = settings.visibility;
     // Light beyond the first bounce only where the estimator carries it (max_depth > 1):
@@ -476,6 +553,8 @@ pub fn predict_with_probe<'a>(
     } else {
         0
     };
+    let probed = probed_pixels(scene, settings)?;
+    let w = resolution.x as usize;
     let rows: Vec<Vec<ProbedPixel>> = (0..resolution.y)
         .into_par_iter()
         .map(|y| {
@@ -490,36 +569,42 @@ pub fn predict_with_probe<'a>(
                     };
                     match centre_ray(scene, pixel) {
                         CentreRay::Hit(hit) => {
-                            let estimator_draws = probe.sample_lights(
-                                pixel,
-                                &hit,
-                                settings.probe_samples,
-                                &mut samples,
-                            );
-                            let footprint = PixelFootprint {
-                                rad_per_px,
-                                probe_samples: settings.probe_samples,
-                                estimator_draws,
+                            let mut p = if probed[y as usize * w + x as usize] {
+                                let estimator_draws = probe.sample_lights(
+                                    pixel,
+                                    &hit,
+                                    settings.probe_samples,
+                                    &mut samples,
+                                );
+                                let footprint = PixelFootprint {
+                                    rad_per_px,
+                                    probe_samples: settings.probe_samples,
+                                    estimator_draws,
+                                };
+                                let mut p = predict_pixel(
+                                    &hit,
+                                    &samples,
+                                    footprint,
+                                    settings.variance_bandwidth,
+                                )
+                                .map_err(|e| e.to_string())?;
+                                probe.sample_indirect(pixel, &hit, indirect_samples, &mut indirect);
+                                let (mean, variance) =
+                                    mean_and_variance(indirect.iter().map(|e| e.radiance_y));
+                                p.mean_y += mean;
+                                p.indirect_variance = variance;
+                                // The indirect light's own colour noise (dispersion through
+                                // glass, spiky spectra seen by a bounce), per camera sample.
+                                p.colour_variance +=
+                                    mean_and_variance(indirect.iter().map(|e| e.lane_variance)).0;
+                                p
+                            } else {
+                                // Filled from the nearest probed pixel (`borrow_from_probed`).
+                                PixelPrediction::default()
                             };
-                            let mut p = predict_pixel(
-                                &hit,
-                                &samples,
-                                footprint,
-                                settings.variance_bandwidth,
-                            )
-                            .map_err(|e| e.to_string())?;
                             p.image_bandwidth_cycles_per_px = p
                                 .image_bandwidth_cycles_per_px
                                 .max(mirrored_sun_bandwidth(scene, &probe, &hit, rad_per_px));
-                            probe.sample_indirect(pixel, &hit, indirect_samples, &mut indirect);
-                            let (mean, variance) =
-                                mean_and_variance(indirect.iter().map(|e| e.radiance_y));
-                            p.mean_y += mean;
-                            p.indirect_variance = variance;
-                            // The indirect light's own colour noise (dispersion through
-                            // glass, spiky spectra seen by a bounce), per camera sample.
-                            p.colour_variance +=
-                                mean_and_variance(indirect.iter().map(|e| e.lane_variance)).0;
                             let c = hit.curvature();
                             Ok(ProbedPixel {
                                 prediction: p,
@@ -569,6 +654,14 @@ pub fn predict_with_probe<'a>(
         surface.push(probed.surface);
     }
     keep_texture_scales_off_zero(&mut texture_scale, &class);
+    borrow_from_probed(
+        resolution,
+        &mut pixels,
+        &class,
+        &probed,
+        &eye,
+        settings.pool_radius_px,
+    )?;
     if settings.visibility {
         add_shadow_edges(resolution, &mut pixels, &eye);
     }
@@ -577,21 +670,22 @@ pub fn predict_with_probe<'a>(
         &pixels,
         &class,
         &texture_scale,
+        &probed,
         settings.pool_radius_px,
         settings.variance_bandwidth == VarianceBandwidth::Measured,
     )
     .map_err(|e| e.to_string())?;
-    for ((p, v), luminance) in pixels
-        .iter_mut()
-        .zip(&modelled.variance)
-        .zip(&modelled.luminance_variance)
-    {
+    for (i, p) in pixels.iter_mut().enumerate() {
         p.variance = if settings.colour_noise {
-            *v
+            modelled.variance[i]
         } else {
-            *luminance
+            modelled.luminance_variance[i]
         };
-        p.luminance_variance = *luminance;
+        p.luminance_variance = modelled.luminance_variance[i];
+        // A pixel the probe skipped has no samples of its own: its L̂ is its window's.
+        if !probed[i] {
+            p.mean_y = modelled.mean_y[i];
+        }
     }
     // Silhouettes, creases and material edges inside a footprint: a step, not band-limited.
     let edges = geometric_edges(resolution, &class, &surface, &modelled.mean_y)

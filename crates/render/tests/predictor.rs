@@ -536,3 +536,72 @@ fn pooling_keeps_a_texture_s_pattern_and_no_texel_goes_dark() {
         "{beside_bright} black pixels beside bright ones"
     );
 }
+
+/// `--plan-probe-stride 2`: a quarter of the floor's pixels are probed, the others borrow;
+/// the shadow's edge stays sharp (within a pixel of where the full probe puts it) and the
+/// pooled L̂ stays the full probe's.
+#[test]
+fn a_sparse_probe_keeps_the_shadow_edge_and_the_pooled_mean() {
+    let scene = hard_shadow_scene();
+    let full = run(&scene, true);
+    let sparse = predict(
+        &scene,
+        &PredictorSettings {
+            probe_stride_px: 2,
+            ..PredictorSettings::defaults(16.0, 1)
+        },
+        1,
+    )
+    .unwrap();
+    let probed = sparse
+        .pixels
+        .iter()
+        .filter(|p| p.visibility.traced > 0 && p.measured_variance > 0.0)
+        .count();
+    let lit = full.pixels.iter().filter(|p| p.mean_y > 0.0).count();
+    assert!(lit > 48 * 40, "{lit} lit pixels");
+    // Every lit pixel has an answer, pooled from its probed neighbours.
+    let dark = (0..48 * 48)
+        .filter(|&i| full.pixels[i].mean_y > 0.0 && sparse.pixels[i].mean_y <= 0.0)
+        .count();
+    assert_eq!(dark, 0, "lit pixels the sparse probe left at L̂ = 0");
+    let (mut sum_full, mut sum_sparse) = (0.0f64, 0.0f64);
+    for (f, s) in full.pixels.iter().zip(&sparse.pixels) {
+        sum_full += f64::from(f.mean_y);
+        sum_sparse += f64::from(s.mean_y);
+    }
+    assert!(
+        (sum_sparse / sum_full - 1.0).abs() < 0.05,
+        "mean L̂: sparse {sum_sparse}, full {sum_full}"
+    );
+    // Sharp pixels of the sparse probe lie within a pixel of the full probe's.
+    let sharp = |p: &Prediction| -> Vec<bool> {
+        p.pixels
+            .iter()
+            .map(|x| x.image_bandwidth_cycles_per_px >= 0.25)
+            .collect()
+    };
+    let (sharp_full, sharp_sparse) = (sharp(&full), sharp(&sparse));
+    let near_full = |i: usize| {
+        let (x, y) = ((i % 48) as i32, (i / 48) as i32);
+        (-1..=1).any(|dy| {
+            (-1..=1).any(|dx| {
+                let (xx, yy) = (x + dx, y + dy);
+                (0..48).contains(&xx)
+                    && (0..48).contains(&yy)
+                    && sharp_full[(yy * 48 + xx) as usize]
+            })
+        })
+    };
+    let count_sparse = sharp_sparse.iter().filter(|b| **b).count();
+    let stray = (0..48 * 48)
+        .filter(|&i| sharp_sparse[i] && !near_full(i))
+        .count();
+    eprintln!(
+        "sparse probe: {probed} probed of {lit} lit pixels; sharp pixels {count_sparse} (full {}), {stray} away from the full probe's",
+        sharp_full.iter().filter(|b| **b).count()
+    );
+    assert!(probed * 3 < lit, "{probed} probed of {lit}");
+    assert!(count_sparse > 20, "{count_sparse} sharp pixels");
+    assert_eq!(stray, 0);
+}

@@ -1,0 +1,190 @@
+//! Which pixels the probe samples, and whose answer the others take (beyond the paper;
+//! docs/bandwidth.md, "Sparse probing").
+//!
+//! The variance model pools V̂_p and L̂_p over a (2r+1)² window of one surface
+//! (`variance_pooling`), so a pixel's own n_b samples are a small part of what it is given.
+//! Probing one pixel in S×S keeps n_b samples at each probed pixel and divides the probe's
+//! cost by about S²: the pooling then averages the probed pixels of the window only. A pixel
+//! of a surface with no probed pixel of that surface within r (a thin object, a small patch)
+//! is probed itself, so every surface keeps its own answer; S = 1 is the paper's probe at
+//! every pixel. A pixel that is not probed takes the bandwidth ν and the shadow rays'
+//! summary of the nearest probed pixel of its surface and keeps everything its own centre
+//! hit gives (depth, footprint, curvature, texture, edges).
+
+use glam::UVec2;
+
+use crate::error::{check_lengths, pixel_count, BandwidthError};
+use crate::variance_pooling::PixelClass;
+
+/// The default probe stride S, pixels between probed pixels along x and y: 1, the paper's
+/// probe at every pixel. Measured in docs/bandwidth.md: at 128² a stride of 2 halves the
+/// predictor's time and keeps all but 1–3 % of the allocation's expected gain.
+pub const DEFAULT_PROBE_STRIDE_PX: u32 = 1;
+
+/// True for a pixel on the stride's lattice (both coordinates multiples of S).
+fn on_lattice(x: usize, y: usize, stride: usize) -> bool {
+    x.is_multiple_of(stride) && y.is_multiple_of(stride)
+}
+
+/// The pixels the probe samples (row-major): for `stride_px` S and pooling radius r, every
+/// lattice pixel of a surface, every surface pixel with no lattice pixel of its own class
+/// within r (Chebyshev distance), and every pixel that sees the background (its prediction
+/// costs no shadow ray). Unpredicted pixels are never probed. S = 1 probes every predicted
+/// pixel.
+pub fn probed_pixels(
+    resolution: UVec2,
+    class: &[PixelClass],
+    stride_px: u32,
+    radius_px: u32,
+) -> Result<Vec<bool>, BandwidthError> {
+    let count = pixel_count("probed pixels", resolution)?;
+    check_lengths(resolution, count, &[("pixel classes", class.len())])?;
+    if stride_px == 0 {
+        return Err(BandwidthError::invalid(
+            "sparse probing",
+            "stride_px",
+            stride_px,
+            "at least 1",
+        ));
+    }
+    let (w, h) = (resolution.x as usize, resolution.y as usize);
+    let (s, r) = (stride_px as usize, radius_px as usize);
+    let mut probed = Vec::with_capacity(count);
+    for y in 0..h {
+        for x in 0..w {
+            let own = class[y * w + x];
+            probed.push(match own {
+                PixelClass::Unpredicted => false,
+                PixelClass::Background => true,
+                PixelClass::Material(_) => {
+                    on_lattice(x, y, s)
+                        || !(y.saturating_sub(r)..(y + r + 1).min(h)).any(|yy| {
+                            (x.saturating_sub(r)..(x + r + 1).min(w))
+                                .any(|xx| on_lattice(xx, yy, s) && class[yy * w + xx] == own)
+                        })
+                }
+            });
+        }
+    }
+    Ok(probed)
+}
+
+/// For each pixel that is not probed, the nearest probed pixel of its class within the
+/// Chebyshev radius r (Euclidean distance; ties go to the first in row-major order); `None`
+/// for probed pixels and for those with no such pixel. [`probed_pixels`] leaves no surface
+/// pixel without one.
+pub fn nearest_probed(
+    resolution: UVec2,
+    class: &[PixelClass],
+    probed: &[bool],
+    radius_px: u32,
+) -> Result<Vec<Option<usize>>, BandwidthError> {
+    let count = pixel_count("nearest probed pixels", resolution)?;
+    check_lengths(
+        resolution,
+        count,
+        &[
+            ("pixel classes", class.len()),
+            ("probed mask", probed.len()),
+        ],
+    )?;
+    let (w, h) = (resolution.x as usize, resolution.y as usize);
+    let r = radius_px as usize;
+    let mut donors = Vec::with_capacity(count);
+    for y in 0..h {
+        for x in 0..w {
+            let i = y * w + x;
+            if probed[i] || class[i] == PixelClass::Unpredicted {
+                donors.push(None);
+                continue;
+            }
+            let mut best: Option<(usize, usize)> = None;
+            for yy in y.saturating_sub(r)..(y + r + 1).min(h) {
+                for xx in x.saturating_sub(r)..(x + r + 1).min(w) {
+                    let j = yy * w + xx;
+                    if !probed[j] || class[j] != class[i] {
+                        continue;
+                    }
+                    let d2 = x.abs_diff(xx).pow(2) + y.abs_diff(yy).pow(2);
+                    if best.is_none_or(|(d, _)| d2 < d) {
+                        best = Some((d2, j));
+                    }
+                }
+            }
+            donors.push(best.map(|(_, j)| j));
+        }
+    }
+    Ok(donors)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn stride_one_probes_every_predicted_pixel() {
+        let class = [
+            PixelClass::Material(0),
+            PixelClass::Background,
+            PixelClass::Unpredicted,
+            PixelClass::Material(1),
+        ];
+        let p = probed_pixels(UVec2::new(2, 2), &class, 1, 2).unwrap();
+        assert_eq!(p, vec![true, true, false, true]);
+        let donors = nearest_probed(UVec2::new(2, 2), &class, &p, 2).unwrap();
+        assert_eq!(donors, vec![None; 4]);
+    }
+
+    #[test]
+    fn stride_two_probes_a_quarter_of_one_surface_and_each_pixel_has_a_donor() {
+        let resolution = UVec2::new(8, 8);
+        let class = vec![PixelClass::Material(3); 64];
+        let p = probed_pixels(resolution, &class, 2, 2).unwrap();
+        assert_eq!(p.iter().filter(|b| **b).count(), 16);
+        let donors = nearest_probed(resolution, &class, &p, 2).unwrap();
+        for (i, d) in donors.iter().enumerate() {
+            match d {
+                None => assert!(p[i]),
+                Some(j) => {
+                    assert!(p[*j]);
+                    let (x, y, xj, yj) = (i % 8, i / 8, j % 8, j / 8);
+                    // The nearest lattice pixel is at most one step away along each axis,
+                    // and ties go to the first in row-major order (up and left).
+                    assert!(x.abs_diff(xj) <= 1 && y.abs_diff(yj) <= 1);
+                    assert!(xj <= x && yj <= y);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_surface_without_a_lattice_pixel_nearby_is_probed_itself() {
+        // A one-pixel-wide column of material 1 at x = 3 (off the stride-2 lattice) in a
+        // field of material 0: all its pixels are probed, the field's only on the lattice.
+        let resolution = UVec2::new(6, 4);
+        let class: Vec<PixelClass> = (0..24)
+            .map(|i| PixelClass::Material(u32::from(i % 6 == 3)))
+            .collect();
+        let p = probed_pixels(resolution, &class, 2, 2).unwrap();
+        for (i, probed) in p.iter().enumerate() {
+            let (x, y) = (i % 6, i / 6);
+            let expected = x == 3 || (x % 2 == 0 && y % 2 == 0);
+            assert_eq!(*probed, expected, "pixel ({x}, {y})");
+        }
+        // Without pooling (r = 0) no pixel has a probed neighbour to borrow from: all are
+        // probed.
+        let p = probed_pixels(resolution, &class, 2, 0).unwrap();
+        assert!(p.iter().all(|b| *b));
+    }
+
+    #[test]
+    fn the_background_is_always_probed_and_a_zero_stride_is_refused() {
+        let class = vec![PixelClass::Background; 9];
+        let p = probed_pixels(UVec2::new(3, 3), &class, 3, 1).unwrap();
+        assert!(p.iter().all(|b| *b));
+        let e = probed_pixels(UVec2::new(3, 3), &class, 0, 1)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("stride_px"), "{e}");
+    }
+}
