@@ -19,6 +19,8 @@ the share of v in the top 1 % of pixels and each plan's ratio on either half.
     cargo build --release
     tools/mitsuba/.venv/bin/python tools/bench_plan_allocation.py [--renders 20] [--spp 64]
         [--variant "--plan-variance eq9"] [--resolution WxH] [--no-file]
+    (--scenes takes the names below or scene files, e.g. scenes/cornell-box-fog.json, at
+    64x64 unless --resolution says otherwise)
 
 Each `--variant` is extra `prism render --plan predicted` arguments ("" is the default plan,
 always included). Prints JSON and writes tools/bench-results/plan-allocation.json
@@ -108,9 +110,13 @@ def main():
     work = tempfile.mkdtemp(prefix="prism-plan-allocation-")
     results = {}
     for name in opts.scenes.split(","):
-        if name not in SCENES:
-            raise SystemExit(f"--scenes: unknown scene {name!r} (known: {', '.join(SCENES)})")
-        scene, resolution = SCENES[name]
+        if name in SCENES:
+            scene, resolution = SCENES[name]
+        elif name.endswith(".json") and os.path.exists(os.path.join(ROOT, name)):
+            scene, resolution = name, "64x64"
+        else:
+            raise SystemExit(f"--scenes: unknown scene {name!r} (known: {', '.join(SCENES)}, "
+                             "or a scene file's path from the repository root)")
         resolution = opts.resolution or resolution
         images = uniform_renders(scene, resolution, opts.renders, opts.spp, work)
         mean = images.mean(axis=0)

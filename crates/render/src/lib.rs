@@ -23,6 +23,7 @@ pub mod integrator;
 pub mod light;
 pub mod material;
 pub mod medium;
+mod medium_interfaces;
 pub mod plan;
 pub mod predictor;
 pub mod probe;

@@ -23,6 +23,7 @@ use rayon::prelude::*;
 
 use crate::film::AovPlane;
 use crate::light::Light;
+use crate::medium_interfaces::first_surface;
 use crate::probe::RenderProbe;
 use crate::scene_build::RenderScene;
 
@@ -152,7 +153,8 @@ fn defocus_low_pass(
     }
 }
 
-/// What `pixel`'s centre ray meets.
+/// What `pixel`'s centre ray meets (medium interfaces are crossed, as the render's rays
+/// cross them).
 enum CentreRay {
     /// A surface: its G-buffer hit (with curvature, which shading skips).
     Hit(GBufferHit),
@@ -168,7 +170,7 @@ fn centre_ray(scene: &RenderScene, pixel: UVec2) -> CentreRay {
         return CentreRay::None;
     };
     let ray = ray_differential.ray;
-    let Some(hit) = scene.geometry.intersect(&ray) else {
+    let Some(hit) = first_surface(scene, &ray) else {
         return CentreRay::Escapes(ray.direction);
     };
     let mut si = scene.geometry.interaction(&ray, &hit);

@@ -477,7 +477,7 @@ impl RenderProbe<'_> {
         let mut vertex = 1;
         let mut dirac_vertices = 0;
         loop {
-            let Some(hit) = self.scene.geometry.intersect(&ray) else {
+            let Some(hit) = crate::medium_interfaces::first_surface(self.scene, &ray) else {
                 // The direct samples' BSDF sample already sees what the first bounce escapes
                 // to; after a Dirac chain, the environment is the estimator's emission.
                 if dirac_vertices == 0 {
@@ -560,7 +560,7 @@ impl RenderProbe<'_> {
         } else {
             (Ray::spawn(si.p, ls.wi), 1.0)
         };
-        match self.scene.geometry.intersect(&ray) {
+        match crate::medium_interfaces::first_surface(self.scene, &ray) {
             None => Visibility::Visible,
             Some(hit) => Visibility::Blocked {
                 blocker_distance_m: hit.t * metres_per_t,
@@ -579,7 +579,7 @@ impl RenderProbe<'_> {
     ) -> Vec<(u32, SampledSpectrum, f32, Option<LightHit>)> {
         let lights = &self.scene.lights;
         let ray = Ray::spawn(si.p, wi);
-        match self.scene.geometry.intersect(&ray) {
+        match crate::medium_interfaces::first_surface(self.scene, &ray) {
             Some(hit) => {
                 let Some(l) = lights.area_light_of_instance(hit.instance_id) else {
                     return Vec::new();

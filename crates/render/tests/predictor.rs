@@ -4,6 +4,7 @@
 //! else on the floor but the box's own outline; `--plan-visibility off` (the paper, which ignores
 //! visibility) misses it. And the plan keeps its budget.
 
+use prism_bandwidth::PixelClass;
 use prism_render::predictor::{predict, Prediction, PredictorSettings};
 use prism_render::RenderScene;
 use prism_scene::parse_scene_str;
@@ -604,4 +605,49 @@ fn a_sparse_probe_keeps_the_shadow_edge_and_the_pooled_mean() {
     assert!(probed * 3 < lit, "{probed} probed of {lit}");
     assert!(count_sparse > 20, "{count_sparse} sharp pixels");
     assert_eq!(stray, 0);
+}
+
+/// A fog box around the camera's view (an `interface` boundary, as
+/// scenes/cornell-box-fog.json has): the predictor looks past it as the render's rays do.
+/// Before, every pixel's "surface" was the boundary and every shadow ray stopped on it, so
+/// nothing was predicted and the plan was uniform.
+#[test]
+fn the_predictor_looks_past_medium_interfaces() {
+    let scene = build(&format!(
+        r#"{{{CAMERA},
+        "materials": {{"white": {{"type": "lambert", "reflectance": 0.7}},
+                       "boundary": {{"type": "interface"}}}},
+        "media": {{"fog": {{"type": "homogeneous", "sigma_a_per_m": 0.01, "sigma_s_per_m": 0.2}}}},
+        "shapes": [
+          {{"type": "rectangle", "size_m": [20, 20], "material": "white",
+            "transform": {{"rotate": {{"axis": [1, 0, 0], "angle_deg": -90}}}}}},
+          {{"type": "cuboid", "size_m": [0.8, 0.1, 0.8], "material": "white",
+            "transform": {{"translate": [0.3, 0.5, 0]}}}},
+          {{"type": "cuboid", "size_m": [3, 3, 3], "material": "boundary",
+            "interior_medium": "fog", "transform": {{"translate": [0, 1.4, 0]}}}}],
+        "lights": [{{"type": "point", "position_m": [0.3, 2.5, 0], "spectrum": 1.0, "scale": 10, "medium": "fog"}}]}}"#
+    ));
+    let p = run(&scene, true);
+    let boundary_id = scene
+        .material_names
+        .iter()
+        .position(|n| n == "boundary")
+        .unwrap() as u32;
+    let on_boundary = p
+        .class
+        .iter()
+        .filter(|c| **c == PixelClass::Material(boundary_id))
+        .count();
+    let lit = p.pixels.iter().filter(|x| x.mean_y > 0.0).count();
+    let sharp = p
+        .pixels
+        .iter()
+        .filter(|x| x.image_bandwidth_cycles_per_px >= 0.25)
+        .count();
+    eprintln!("fog box: {on_boundary} pixels on the boundary, {lit} lit, {sharp} sharp");
+    assert_eq!(on_boundary, 0);
+    // The floor and the box top are lit (the box's shadow is not), and the shadow's edge
+    // is found through the boundary.
+    assert!(lit > 48 * 40, "{lit} lit pixels");
+    assert!(sharp > 20, "{sharp} sharp pixels");
 }
