@@ -130,6 +130,11 @@ fn plan_flags_are_checked() {
             vec!["--plan", "predicted", "--plan-nb", "0"],
             "--plan-nb must be at least 1",
         ),
+        (vec!["--plan-probe-stride", "2"], "add --plan predicted"),
+        (
+            vec!["--plan", "predicted", "--plan-probe-stride", "0"],
+            "--plan-probe-stride 0: expected at least 1",
+        ),
         (
             vec!["--plan", "predicted", "--plan-max-level", "2"],
             "add --plan predicted-hier",
@@ -238,6 +243,15 @@ fn explain_names_the_plan() {
     let text = explain(&["--plan", "predicted", "--plan-colour", "off"]);
     assert!(
         text.contains("of the luminance alone (--plan-colour off)"),
+        "{text}"
+    );
+    assert!(
+        text.contains("per probed pixel (every pixel, as the paper)"),
+        "{text}"
+    );
+    let text = explain(&["--plan", "predicted", "--plan-probe-stride", "3"]);
+    assert!(
+        text.contains("one pixel in 3×3, and each pixel of a surface with none within 2 px"),
         "{text}"
     );
     let text = explain(&["--plan", "predicted-hier"]);
