@@ -14,6 +14,7 @@
 use glam::UVec2;
 
 use crate::error::{check_lengths, pixel_count, BandwidthError};
+use crate::pixel_neighbours::window;
 use crate::variance_pooling::PixelClass;
 
 /// The default probe stride S, pixels between probed pixels along x and y: 1, the paper's
@@ -58,10 +59,8 @@ pub fn probed_pixels(
                 PixelClass::Background => true,
                 PixelClass::Material(_) => {
                     on_lattice(x, y, s)
-                        || !(y.saturating_sub(r)..(y + r + 1).min(h)).any(|yy| {
-                            (x.saturating_sub(r)..(x + r + 1).min(w))
-                                .any(|xx| on_lattice(xx, yy, s) && class[yy * w + xx] == own)
-                        })
+                        || !window((x, y), r, (w, h))
+                            .any(|(xx, yy)| on_lattice(xx, yy, s) && class[yy * w + xx] == own)
                 }
             });
         }
@@ -99,16 +98,14 @@ pub fn nearest_probed(
                 continue;
             }
             let mut best: Option<(usize, usize)> = None;
-            for yy in y.saturating_sub(r)..(y + r + 1).min(h) {
-                for xx in x.saturating_sub(r)..(x + r + 1).min(w) {
-                    let j = yy * w + xx;
-                    if !probed[j] || class[j] != class[i] {
-                        continue;
-                    }
-                    let d2 = x.abs_diff(xx).pow(2) + y.abs_diff(yy).pow(2);
-                    if best.is_none_or(|(d, _)| d2 < d) {
-                        best = Some((d2, j));
-                    }
+            for (xx, yy) in window((x, y), r, (w, h)) {
+                let j = yy * w + xx;
+                if !probed[j] || class[j] != class[i] {
+                    continue;
+                }
+                let d2 = x.abs_diff(xx).pow(2) + y.abs_diff(yy).pow(2);
+                if best.is_none_or(|(d, _)| d2 < d) {
+                    best = Some((d2, j));
                 }
             }
             donors.push(best.map(|(_, j)| j));

@@ -14,6 +14,7 @@
 use glam::UVec2;
 
 use crate::error::{check_lengths, pixel_count, BandwidthError};
+use crate::pixel_neighbours::window;
 
 /// The default pooling radius r in pixels (a 5×5 window).
 pub const DEFAULT_POOL_RADIUS_PX: u32 = 2;
@@ -92,14 +93,12 @@ pub fn pool_scaled(
                 continue;
             }
             let (mut sum, mut scale_sum, mut n) = (0.0f64, 0.0f64, 0u32);
-            for yy in y.saturating_sub(r)..(y + r + 1).min(h) {
-                for xx in x.saturating_sub(r)..(x + r + 1).min(w) {
-                    let j = yy * w + xx;
-                    if class[j] == own && probed[j] {
-                        sum += f64::from(values[j]);
-                        scale_sum += f64::from(scale[j]);
-                        n += 1;
-                    }
+            for (xx, yy) in window((x, y), r, (w, h)) {
+                let j = yy * w + xx;
+                if class[j] == own && probed[j] {
+                    sum += f64::from(values[j]);
+                    scale_sum += f64::from(scale[j]);
+                    n += 1;
                 }
             }
             let value = if n == 0 {
