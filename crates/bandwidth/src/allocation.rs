@@ -134,11 +134,9 @@ pub fn allocate(
     // none has no estimate at all (a hole in a box-filtered film), which no saving
     // elsewhere pays for; at 4 spp the anti-aliasing minimums alone left 72 % of the
     // Cornell box's pixels at 0 (64², before this floor).
-    // The sample each comes first: where the anti-aliasing minimums do not fit beside it,
-    // their excess over one is scaled down to what the budget leaves.
     let one_each = settings.mean_spp.min(1.0);
     let budget = settings.mean_spp * n as f64;
-    let excess: Vec<f64> = inputs
+    let anti_aliasing_excess: Vec<f64> = inputs
         .shading_level
         .iter()
         .map(|&level| {
@@ -149,14 +147,7 @@ pub fn allocate(
             }
         })
         .collect();
-    let total_excess: f64 = excess.iter().sum();
-    let room = budget - one_each * n as f64;
-    let excess_scale = if total_excess > room && total_excess > 0.0 {
-        (room / total_excess).max(0.0)
-    } else {
-        1.0
-    };
-    let minimum: Vec<f64> = excess.iter().map(|e| one_each + e * excess_scale).collect();
+    let minimum = minimums(one_each, &anti_aliasing_excess, budget);
     let expected = fill_with_minimums(&a, &minimum, budget);
     let camera_samples: Vec<u32> = expected
         .iter()
@@ -199,20 +190,26 @@ pub(crate) fn counts_for_density(density: &[f32], mean_spp: f64, seed: u64) -> V
         .collect()
 }
 
-/// x_p = k·a_p with the total `budget`, except that no pixel gets less than its minimum:
-/// pixels held at their minimum leave the rest a smaller budget, so k is solved again over
-/// the free pixels until no free pixel falls below its minimum (at most n rounds; a few in
-/// practice). Minimums that alone exceed the budget are scaled down to fit it: the budget
-/// is the user's (`--spp` is the mean), the minimums a preference.
-fn fill_with_minimums(a: &[f64], minimum: &[f64], budget: f64) -> Vec<f64> {
-    let total_minimum: f64 = minimum.iter().sum();
-    let scaled: Vec<f64>;
-    let minimum = if total_minimum > budget {
-        scaled = minimum.iter().map(|m| m * budget / total_minimum).collect();
-        &scaled[..]
+/// Per-pixel minimums: `each` for every pixel (at most the mean budget per pixel, so their
+/// total fits) plus `extra` above it, scaled down to what the budget leaves beside them
+/// where the extras do not fit: the budget is the user's (`--spp` is the mean), the extras
+/// a preference.
+fn minimums(each: f64, extra: &[f64], budget: f64) -> Vec<f64> {
+    let total_extra: f64 = extra.iter().sum();
+    let room = (budget - each * extra.len() as f64).max(0.0);
+    let scale = if total_extra > room {
+        room / total_extra
     } else {
-        minimum
+        1.0
     };
+    extra.iter().map(|e| each + e * scale).collect()
+}
+
+/// x_p = k·a_p with the total `budget`, except that no pixel gets less than its minimum
+/// (whose total is within the budget: [`minimums`]): pixels held at their minimum leave the
+/// rest a smaller budget, so k is solved again over the free pixels until no free pixel
+/// falls below its minimum (at most n rounds; a few in practice).
+fn fill_with_minimums(a: &[f64], minimum: &[f64], budget: f64) -> Vec<f64> {
     let mut held = vec![false; a.len()];
     loop {
         let held_total: f64 = (0..a.len()).filter(|&i| held[i]).map(|i| minimum[i]).sum();

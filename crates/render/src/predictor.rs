@@ -469,7 +469,7 @@ fn centre_class(scene: &RenderScene, pixel: UVec2) -> PixelClass {
 /// The pixels the probe samples (`prism_bandwidth::sparse_probing`): all at a stride of 1;
 /// otherwise a first pass of centre rays finds each pixel's surface, so that no surface is
 /// left without a probed pixel within the pooling radius.
-fn probed_pixels(scene: &RenderScene, settings: &PredictorSettings) -> Result<Vec<bool>, String> {
+fn pixels_to_probe(scene: &RenderScene, settings: &PredictorSettings) -> Result<Vec<bool>, String> {
     let resolution = scene.resolution;
     let count = resolution.x as usize * resolution.y as usize;
     if settings.probe_stride_px == 1 {
@@ -543,9 +543,6 @@ pub fn predict_with_probe<'a>(
     if settings.probe_samples == 0 {
         return Err("--plan-nb must be at least 1".into());
     }
-    if settings.probe_stride_px == 0 {
-        return Err("--plan-probe-stride must be at least 1".into());
-    }
     let resolution = scene.resolution;
     probe.trace_visibility = settings.visibility;
     // Light beyond the first bounce only where the estimator carries it (max_depth > 1):
@@ -555,7 +552,7 @@ pub fn predict_with_probe<'a>(
     } else {
         0
     };
-    let probed = probed_pixels(scene, settings)?;
+    let probed = pixels_to_probe(scene, settings)?;
     let w = resolution.x as usize;
     let rows: Vec<Vec<ProbedPixel>> = (0..resolution.y)
         .into_par_iter()

@@ -566,14 +566,37 @@ fn a_sparse_probe_keeps_the_shadow_edge_and_the_pooled_mean() {
         .filter(|&i| full.pixels[i].mean_y > 0.0 && sparse.pixels[i].mean_y <= 0.0)
         .count();
     assert_eq!(dark, 0, "lit pixels the sparse probe left at L̂ = 0");
-    let (mut sum_full, mut sum_sparse) = (0.0f64, 0.0f64);
-    for (f, s) in full.pixels.iter().zip(&sparse.pixels) {
-        sum_full += f64::from(f.mean_y);
-        sum_sparse += f64::from(s.mean_y);
-    }
+    // The probed pixels' L̂ are the full probe's (each pixel's samples are seeded by the
+    // pixel), the others' are means of probed neighbours: the sparse image's mean L̂ over the
+    // lit pixels estimates the full one's from a sample of `probed` of them, with standard
+    // error σ·√(1/probed − 1/lit) (σ the full probe's spread over the lit pixels, which
+    // holds the image's own variation too, so the bound is loose, not tight).
+    let lit_values: Vec<f64> = full
+        .pixels
+        .iter()
+        .filter(|p| p.mean_y > 0.0)
+        .map(|p| f64::from(p.mean_y))
+        .collect();
+    let mean_full = lit_values.iter().sum::<f64>() / lit as f64;
+    let sigma = (lit_values
+        .iter()
+        .map(|v| (v - mean_full).powi(2))
+        .sum::<f64>()
+        / (lit - 1) as f64)
+        .sqrt();
+    let mean_sparse = (0..48 * 48)
+        .filter(|&i| full.pixels[i].mean_y > 0.0)
+        .map(|i| f64::from(sparse.pixels[i].mean_y))
+        .sum::<f64>()
+        / lit as f64;
+    let standard_error = sigma * (1.0 / probed as f64 - 1.0 / lit as f64).sqrt();
+    eprintln!(
+        "mean L̂ over the lit pixels: sparse {mean_sparse}, full {mean_full}, s.e. {standard_error}"
+    );
     assert!(
-        (sum_sparse / sum_full - 1.0).abs() < 0.05,
-        "mean L̂: sparse {sum_sparse}, full {sum_full}"
+        (mean_sparse - mean_full).abs() < 4.0 * standard_error,
+        "mean L̂: sparse {mean_sparse}, full {mean_full}, 4 s.e. {}",
+        4.0 * standard_error
     );
     // Sharp pixels of the sparse probe lie within a pixel of the full probe's.
     let sharp = |p: &Prediction| -> Vec<bool> {
