@@ -62,7 +62,11 @@ def run(prism, scene, out_stem):
     if p.returncode != 0:
         sys.exit(p.stderr)
     text = p.stdout + p.stderr
-    stats = re.findall(r"iteration \d+: (\d+) patches, (\d+) elements, (\d+) links, ([0-9.]+) MiB", text)
+    stats = re.findall(
+        r"iteration \d+: (\d+) patches, (\d+) elements, (\d+) links "
+        r"\((\d+) from clusters, (\d+) through their Z-buffers\), ([0-9.]+) MiB",
+        text,
+    )
     solution = re.search(r"solution in ([0-9.]+) s", text)
     peak = re.search(r"peak_kib (\d+)", text)
     readings = json.load(open(out_stem + ".sensors.json"))
@@ -73,7 +77,9 @@ def run(prism, scene, out_stem):
         "patches": int(stats[-1][0]) if stats else None,
         "elements": int(stats[-1][1]) if stats else None,
         "links": int(stats[-1][2]) if stats else None,
-        "hierarchy_mib": float(stats[-1][3]) if stats else None,
+        "cluster_links": int(stats[-1][3]) if stats else None,
+        "z_buffer_links": int(stats[-1][4]) if stats else None,
+        "hierarchy_mib": float(stats[-1][5]) if stats else None,
         "sensors": readings,
     }
 

@@ -8,6 +8,7 @@
 //! with per-band reflectance and emission and a [`Visibility`] oracle (its ray tracer); the
 //! solution answers the radiosity at any point of a patch ([`Radiosity::radiosity_at`]).
 
+mod cluster_view;
 pub mod element;
 pub mod final_gather;
 pub mod form_factor;

@@ -15,6 +15,9 @@ use std::time::Instant;
 use glam::Vec3A;
 use rayon::prelude::*;
 
+use std::collections::HashMap;
+
+use crate::cluster_view::{cluster_fragments, Fragment};
 use crate::element::ElementShape;
 use crate::form_factor::{area_sample_factor, element_to_element, faces, point_to_polygon};
 use crate::hierarchy::{Hierarchy, NodeKind};
@@ -43,6 +46,18 @@ pub trait Visibility: Sync {
     /// covered part of an element is left out of its radiosity, so that the part that is
     /// seen is not darkened by it and no light is shot from under the box.
     fn covered(&self, _p: Vec3A, _n: Vec3A) -> bool {
+        false
+    }
+
+    /// The share of input patch `patch`'s area that a viewer looking back along `towards`
+    /// (unit, leaving the patch) sees through: a tiled carrier's transparency τ, 0 for an
+    /// opaque patch. A cluster's Z-buffer draws see-through patches over the opaque ones.
+    fn transparency(&self, _patch: u32, _towards: Vec3A) -> f32 {
+        0.0
+    }
+
+    /// Whether any patch may be seen through (`transparency` is 0 for all otherwise).
+    fn any_see_through(&self) -> bool {
         false
     }
 }
@@ -242,6 +257,16 @@ const MAX_FACING_SHARES: usize = 256;
 /// multiply (door-ajar 64 000 against 4 600) and the gather's time runs out.
 const PARTIAL_LINK_BOUND_SCALE: f32 = 0.1;
 
+/// A cluster source farther than this many of its radii (half its box's diagonal) from
+/// the receiver's centre is seen through its Z-buffer (`cluster_link_factor`); nearer,
+/// one direction cannot stand for the directions the receiver sees it in (a receiver
+/// inside the cluster's box sees it all around), and it is sampled
+/// (`sampled_cluster_factor`).
+const Z_BUFFER_DISTANCE_RADII: f32 = 3.0;
+
+/// At most this many shares per cluster link (`cluster_shares`).
+const MAX_CLUSTER_SHARES: usize = 32;
+
 impl Link {
     /// Adds what the link transfers, F · Σ share · B(node) per band (F · B(source)
     /// without shares), to the receiver's irradiance `out`.
@@ -271,6 +296,10 @@ pub struct IterationStats {
     /// Leaf elements (the finest pieces the solution holds).
     pub elements: usize,
     pub links: usize,
+    /// Links whose source is a cluster, and of them those seen through the cluster's
+    /// Z-buffer (the far ones; the near ones are sampled).
+    pub cluster_links: usize,
+    pub z_buffer_links: usize,
     pub memory_bytes: u64,
     pub refine_s: f64,
     pub solve_s: f64,
@@ -550,10 +579,22 @@ impl Radiosity {
                 )
             })
             .count();
+        let (mut cluster_links, mut z_buffer_links) = (0, 0);
+        for (r, links) in self.links.iter().enumerate() {
+            for link in links {
+                if let NodeKind::Cluster { .. } = self.hierarchy.nodes[link.source as usize].kind {
+                    cluster_links += 1;
+                    z_buffer_links +=
+                        usize::from(self.sees_through_z_buffer(r as u32, link.source));
+                }
+            }
+        }
         IterationStats {
             patches: self.hierarchy.patch_root.len(),
             elements,
             links: self.links.iter().map(Vec::len).sum(),
+            cluster_links,
+            z_buffer_links,
             memory_bytes: self.memory_bytes(),
             refine_s: 0.0,
             solve_s: 0.0,
@@ -1191,45 +1232,223 @@ impl Radiosity {
                 }
             }
             NodeKind::Cluster { patches, .. } => {
-                let piece = (self.hierarchy.cluster_area_m2(patches) / rays as f64) as f32;
-                let (mut sum, mut free, mut blocked) = (0.0, 0u32, 0u32);
-                // The node holding each free sample, and its factor: the cluster's light
-                // as the receiver sees it, not its area average (which mixes in the
-                // patches that face away).
-                let mut shares: Vec<(u32, f32)> = Vec::new();
-                for &k in &receivers {
-                    let Some((patch, source, y)) =
-                        self.hierarchy.cluster_point(patches, k, rays, (2, 3))
-                    else {
-                        continue;
-                    };
-                    let x = sample_point(&receiver, k, 0);
-                    let n_s = source.normal();
-                    let f = area_sample_factor(x, n_r, y, n_s, piece);
-                    if f > 0.0 && vis.visible(x, n_r, y, n_s) {
-                        sum += f;
-                        free += 1;
-                        let node = self.node_at(patch as usize, y, SOURCE_SHARE_DEPTH);
-                        match shares.iter_mut().find(|s| s.0 == node) {
-                            Some(share) => share.1 += f,
-                            None => shares.push((node, f)),
-                        }
-                    } else if f > 0.0 {
-                        blocked += 1;
-                    }
-                }
-                for share in &mut shares {
-                    share.1 /= sum;
-                }
-                // Each receiver point stands for 1/receivers of the receiver.
-                let scale = rays as f32 / receivers.len() as f32;
-                LinkFactor {
-                    form_factor: sum * scale,
-                    partial: free > 0 && blocked > 0,
-                    source_shares: shares.into_boxed_slice(),
+                if self.sees_through_z_buffer(r, s) {
+                    self.cluster_link_factor(&receiver, s, &receivers, vis)
+                } else {
+                    self.sampled_cluster_factor(&receiver, patches, &receivers, vis)
                 }
             }
         }
+    }
+
+    /// Whether element r sees cluster s through its Z-buffer: from at least
+    /// [`Z_BUFFER_DISTANCE_RADII`] of the cluster's radii away.
+    fn sees_through_z_buffer(&self, r: u32, s: u32) -> bool {
+        match self.hierarchy.nodes[r as usize].kind {
+            NodeKind::Element { shape, .. } => self.sees_through_z_buffer_from(shape.centre(), s),
+            NodeKind::Cluster { .. } => false,
+        }
+    }
+
+    /// Whether a receiver centred at `eye` sees cluster s through its Z-buffer.
+    fn sees_through_z_buffer_from(&self, eye: Vec3A, s: u32) -> bool {
+        let source = &self.hierarchy.nodes[s as usize];
+        let radius_m = 0.5 * (source.hi - source.lo).length();
+        let distance_m = eye.distance(0.5 * (source.lo + source.hi));
+        distance_m >= Z_BUFFER_DISTANCE_RADII * radius_m
+    }
+
+    /// A near cluster source's factor towards `receiver` (at its uncovered sample points
+    /// `receivers`): the disk approximation at one area-weighted point of the cluster's
+    /// patches per receiver point, with a ray between them (which tests the cluster's own
+    /// patches too), and shares by the nodes of the free points.
+    fn sampled_cluster_factor(
+        &self,
+        receiver: &ElementShape,
+        patches: (u32, u32),
+        receivers: &[usize],
+        vis: &dyn Visibility,
+    ) -> LinkFactor {
+        let rays = self.rays();
+        let n_r = receiver.normal();
+        let piece = (self.hierarchy.cluster_area_m2(patches) / rays as f64) as f32;
+        let (mut sum, mut free, mut blocked) = (0.0, 0u32, 0u32);
+        // The node holding each free sample, and its factor: the cluster's light as the
+        // receiver sees it, not its area average (which mixes in the patches that face
+        // away).
+        let mut shares: Vec<(u32, f32)> = Vec::new();
+        for &k in receivers {
+            let Some((patch, source, y)) = self.hierarchy.cluster_point(patches, k, rays, (2, 3))
+            else {
+                continue;
+            };
+            let x = sample_point(receiver, k, 0);
+            let n_s = source.normal();
+            let f = area_sample_factor(x, n_r, y, n_s, piece);
+            if f > 0.0 && vis.visible(x, n_r, y, n_s) {
+                sum += f;
+                free += 1;
+                let node = self.node_at(patch as usize, y, SOURCE_SHARE_DEPTH);
+                match shares.iter_mut().find(|s| s.0 == node) {
+                    Some(share) => share.1 += f,
+                    None => shares.push((node, f)),
+                }
+            } else if f > 0.0 {
+                blocked += 1;
+            }
+        }
+        for share in &mut shares {
+            share.1 /= sum;
+        }
+        // Each receiver point stands for 1/receivers of the receiver.
+        let scale = rays as f32 / receivers.len() as f32;
+        LinkFactor {
+            form_factor: sum * scale,
+            partial: free > 0 && blocked > 0,
+            source_shares: shares.into_boxed_slice(),
+        }
+    }
+
+    /// A cluster source's factor towards element r (at its uncovered sample points
+    /// `receivers`) and its shares: the cluster's Z-buffer towards r ([`cluster_fragments`])
+    /// gives what each patch shows past the cluster's own patches; each fragment adds
+    /// cos θ_r · A⊥/(π d²) at each receiver point (capped at cos θ_r where π d² < A⊥, as
+    /// `area_sample_factor`); and a ray from each receiver point to a fragment in front,
+    /// chosen in proportion to its factor there, tests the scene outside the cluster.
+    fn cluster_link_factor(
+        &self,
+        receiver: &ElementShape,
+        s: u32,
+        receivers: &[usize],
+        vis: &dyn Visibility,
+    ) -> LinkFactor {
+        let transparency = |patch, towards| vis.transparency(patch, towards);
+        let (corners, corner_count) = receiver.corners();
+        // The view from a free point: the centre of an element partly under a box lies
+        // inside it and sees the box's faces from within.
+        let points: Vec<Vec3A> = receivers
+            .iter()
+            .map(|&k| sample_point(receiver, k, 0))
+            .collect();
+        let mean = points.iter().copied().sum::<Vec3A>() / points.len() as f32;
+        let eye = points
+            .iter()
+            .copied()
+            .min_by(|a, b| {
+                a.distance_squared(mean)
+                    .total_cmp(&b.distance_squared(mean))
+            })
+            .unwrap_or(mean);
+        let Some(fragments) = cluster_fragments(
+            &self.hierarchy,
+            s,
+            eye,
+            &corners[..corner_count],
+            vis.any_see_through()
+                .then_some(&transparency as &dyn Fn(u32, Vec3A) -> f32),
+        ) else {
+            // The eye, off a large receiver's centre, sees part of the box beside or
+            // behind it: no one view frames the cluster.
+            let NodeKind::Cluster { patches, .. } = self.hierarchy.nodes[s as usize].kind else {
+                return LinkFactor::none();
+            };
+            return self.sampled_cluster_factor(receiver, patches, receivers, vis);
+        };
+        if fragments.is_empty() {
+            return LinkFactor::none();
+        }
+        let n_r = receiver.normal();
+        let mut weight = vec![0.0f32; fragments.len()];
+        let mut at_point = vec![0.0f32; fragments.len()];
+        let (mut free, mut tested) = (0u32, 0u32);
+        for (&k, &x) in receivers.iter().zip(&points) {
+            let mut in_front_sum = 0.0f32;
+            for (f, (w, here)) in fragments.iter().zip(weight.iter_mut().zip(&mut at_point)) {
+                let d = f.point_m - x;
+                let d2 = d.length_squared();
+                let cos_r = n_r.dot(d);
+                *here = 0.0;
+                if d2 <= 0.0 || cos_r <= 0.0 || f.normal.dot(d) >= 0.0 {
+                    continue;
+                }
+                let distance = d2.sqrt();
+                let cos_r = cos_r / distance;
+                let cos_s = -f.normal.dot(d) / distance;
+                let factor = cos_r * cos_s * (f.area_m2 / (std::f32::consts::PI * d2)).min(1.0);
+                *w += factor;
+                if f.in_front {
+                    *here = factor;
+                    in_front_sum += factor;
+                }
+            }
+            if in_front_sum <= 0.0 {
+                continue;
+            }
+            // The fragment this point's ray aims at, drawn by its factor here.
+            let target = r2(k as u32, 4).0 * in_front_sum;
+            let mut acc = 0.0;
+            let chosen = at_point
+                .iter()
+                .position(|&f| {
+                    acc += f;
+                    f > 0.0 && acc > target
+                })
+                .unwrap_or_else(|| at_point.iter().rposition(|&f| f > 0.0).unwrap_or(0));
+            let f = &fragments[chosen];
+            tested += 1;
+            free += u32::from(vis.visible(x, n_r, f.point_m, f.normal));
+        }
+        let total: f32 = weight.iter().sum();
+        if total <= 0.0 || tested == 0 {
+            return LinkFactor::none();
+        }
+        let free_fraction = free as f32 / tested as f32;
+        LinkFactor {
+            form_factor: total / receivers.len() as f32 * free_fraction,
+            partial: free > 0 && free < tested,
+            source_shares: if free > 0 {
+                self.cluster_shares(s, &fragments, &weight, total)
+            } else {
+                Box::default()
+            },
+        }
+    }
+
+    /// The shares of a cluster link: each fragment's factor credited to the node that
+    /// holds it `SOURCE_SHARE_DEPTH` levels below its patch; where that makes more than
+    /// [`MAX_CLUSTER_SHARES`] nodes, to the patches' roots; where still more, the heaviest
+    /// ones and the rest to the cluster's own (area-average) radiosity.
+    fn cluster_shares(
+        &self,
+        s: u32,
+        fragments: &[Fragment],
+        weight: &[f32],
+        total: f32,
+    ) -> Box<[(u32, f32)]> {
+        let mut by_node: Vec<(u32, f32)> = Vec::new();
+        for depth in [SOURCE_SHARE_DEPTH, 0] {
+            let mut map: HashMap<u32, f32> = HashMap::new();
+            for (f, &w) in fragments.iter().zip(weight) {
+                if w > 0.0 {
+                    *map.entry(self.node_at(f.patch as usize, f.point_m, depth))
+                        .or_insert(0.0) += w;
+                }
+            }
+            by_node = map.into_iter().collect();
+            if by_node.len() <= MAX_CLUSTER_SHARES {
+                break;
+            }
+        }
+        by_node.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
+        if by_node.len() > MAX_CLUSTER_SHARES {
+            let rest: f32 = by_node[MAX_CLUSTER_SHARES - 1..].iter().map(|n| n.1).sum();
+            by_node.truncate(MAX_CLUSTER_SHARES - 1);
+            by_node.push((s, rest));
+        }
+        for share in &mut by_node {
+            share.1 /= total;
+        }
+        by_node.into_boxed_slice()
     }
 
     // ---- solving ----------------------------------------------------------------------
@@ -1421,4 +1640,126 @@ pub fn r2(k: u32, stream: u32) -> (f32, f32) {
         ((base + A1 * i).fract()) as f32,
         ((base + A2 * i).fract()) as f32,
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The 12 outward-facing triangles of the box `lo`–`hi`.
+    fn cuboid(lo: Vec3A, hi: Vec3A) -> Vec<ElementShape> {
+        let d = hi - lo;
+        let (x, y, z) = (Vec3A::X * d.x, Vec3A::Y * d.y, Vec3A::Z * d.z);
+        // Each face as (corner, e1, e2) with e1 × e2 outward.
+        let faces = [
+            (lo, y, x),
+            (lo + z, x, y),
+            (lo, x, z),
+            (lo + y, z, x),
+            (lo, z, y),
+            (lo + x, y, z),
+        ];
+        faces
+            .iter()
+            .flat_map(|&(p0, e1, e2)| {
+                [
+                    ElementShape::Triangle { p0, e1, e2 },
+                    ElementShape::Triangle {
+                        p0: p0 + e1 + e2,
+                        e1: -e1,
+                        e2: -e2,
+                    },
+                ]
+            })
+            .collect()
+    }
+
+    /// A desk (a 1.6 × 0.04 × 0.8 m box of 12 triangles) as a cluster source, seen from
+    /// 2.9–3.5 m: through its Z-buffer, its factor at the receiver's sample points is the
+    /// exact factor of its faces that face each point (a convex cluster hides nothing of
+    /// what faces the point). Measured: ceiling +0.00 %, far ceiling −1.0 %, floor −1.9 %
+    /// (the desk's 4 cm sides, narrower than a pixel, are point-sampled). Sampling it at 16
+    /// area-weighted points, as near clusters are, read +11.2 %, +15.1 % and −1.9 %. A
+    /// receiver that straddles the planes of the cluster's faces (a wall element from 0.55
+    /// to 1.05 m beside a desk top at 0.75 m) sees the top from its upper points and the
+    /// underside from its lower ones, which one view cannot show: −31 % (sampled −59 %).
+    #[test]
+    fn a_convex_clusters_factor_is_the_sum_of_its_faces_towards_each_point() {
+        let desk = cuboid(Vec3A::new(-0.8, 0.71, -0.4), Vec3A::new(0.8, 0.75, 0.4));
+        let patches: Vec<InputPatch> = desk
+            .iter()
+            .map(|&shape| InputPatch {
+                shape,
+                reflectance: vec![0.5],
+                emission: vec![0.0],
+                surface: 0,
+            })
+            .collect();
+        let solution = Radiosity::new(&patches, 1, RadiositySettings::default()).unwrap();
+        let square = |centre: Vec3A, e1: Vec3A, e2: Vec3A| ElementShape::Parallelogram {
+            p0: centre - 0.5 * (e1 + e2),
+            e1,
+            e2,
+        };
+        let receivers = [
+            (
+                "ceiling",
+                square(Vec3A::new(0.5, 3.6, 0.3), Vec3A::X * 0.5, Vec3A::Z * 0.5),
+                0.02,
+            ),
+            (
+                "far ceiling",
+                square(Vec3A::new(2.5, 3.0, 1.5), Vec3A::X * 0.5, Vec3A::Z * 0.5),
+                0.02,
+            ),
+            (
+                "floor",
+                square(Vec3A::new(2.6, 0.0, 0.5), Vec3A::Z * 0.5, Vec3A::X * 0.5),
+                0.02,
+            ),
+            (
+                "straddling wall",
+                square(Vec3A::new(-3.0, 0.8, 0.0), Vec3A::Y * 0.5, Vec3A::Z * 0.5),
+                0.35,
+            ),
+        ];
+        let points: Vec<usize> = (0..solution.rays()).collect();
+        let root = solution.hierarchy.root;
+        let all = (0, desk.len() as u32);
+        for (name, receiver, tolerance) in receivers {
+            assert!(
+                solution.sees_through_z_buffer_from(receiver.centre(), root),
+                "{name}"
+            );
+            let exact = points
+                .iter()
+                .map(|&k| {
+                    let x = sample_point(&receiver, k, 0);
+                    desk.iter()
+                        .map(|face| {
+                            let (corners, count) = face.corners();
+                            point_to_polygon(x, receiver.normal(), &corners[..count], face.normal())
+                        })
+                        .sum::<f32>()
+                })
+                .sum::<f32>()
+                / points.len() as f32;
+            let z_buffer = solution
+                .cluster_link_factor(&receiver, root, &points, &Unoccluded)
+                .form_factor;
+            let sampled = solution
+                .sampled_cluster_factor(&receiver, all, &points, &Unoccluded)
+                .form_factor;
+            let error = z_buffer / exact - 1.0;
+            eprintln!(
+                "{name}: exact {exact:.6}, Z-buffer {z_buffer:.6} ({:+.2} %), sampled {sampled:.6} ({:+.2} %)",
+                100.0 * error,
+                100.0 * (sampled / exact - 1.0)
+            );
+            assert!(
+                error.abs() < tolerance,
+                "{name}: {z_buffer} against {exact}"
+            );
+        }
+    }
 }

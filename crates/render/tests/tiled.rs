@@ -442,3 +442,23 @@ fn a_paved_office_reads_the_same_lux_by_radiosity_and_by_path() {
     );
     assert_eq!(failures, 0);
 }
+
+/// A tiled carrier's two patches are seen through by its tile's τ in a cluster's
+/// Z-buffer (`Visibility::transparency`); every other patch is opaque.
+#[test]
+fn a_tiled_carriers_patches_are_the_see_through_ones() {
+    let dir = Dir::new("tiled", "see-through");
+    let scene = room_with_wicker(&dir, r#"{"type": "radiosity"}"#);
+    let (patches, map) =
+        prism_render::integrator::radiosity::patches::scene_patches(&scene).unwrap();
+    assert_eq!(map.carriers.0.len(), 1);
+    let carrier = &map.carriers.0[0];
+    let first = map.first_patch[carrier.instance as usize].unwrap();
+    for patch in 0..patches.len() as u32 {
+        let expected = (first..first + 2).contains(&patch).then_some(0);
+        assert_eq!(map.carrier_of_patch(patch), expected, "patch {patch}");
+    }
+    // Seen straight on, the wicker lets some light through and hides the rest.
+    let tau = map.carriers.transparency_towards(0, carrier.normal);
+    assert!(tau > 0.05 && tau < 0.5, "{tau}");
+}

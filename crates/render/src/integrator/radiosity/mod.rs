@@ -94,6 +94,17 @@ impl Visibility for SceneVisibility<'_> {
             si.n_geometric.dot(n) > 0.0
         })
     }
+
+    /// A tiled carrier's patches (one per side) are seen through by its tile's τ.
+    fn transparency(&self, patch: u32, towards: Vec3A) -> f32 {
+        self.1
+            .carrier_of_patch(patch)
+            .map_or(0.0, |c| self.1.carriers.transparency_towards(c, towards))
+    }
+
+    fn any_see_through(&self) -> bool {
+        !self.1.carriers.0.is_empty()
+    }
 }
 
 /// The solution for `scene`, with one line of statistics per iteration.
@@ -116,11 +127,13 @@ pub fn solve(
             .iterate(&visibility, &direct_lights)
             .map_err(|e| e.to_string())?;
         lines.push(format!(
-            "radiosity: iteration {i}: {} patches, {} elements, {} links, {:.1} MiB, refine {:.2} s, \
-             solve {:.2} s ({} sweeps)",
+            "radiosity: iteration {i}: {} patches, {} elements, {} links ({} from clusters, {} \
+             through their Z-buffers), {:.1} MiB, refine {:.2} s, solve {:.2} s ({} sweeps)",
             s.patches,
             s.elements,
             s.links,
+            s.cluster_links,
+            s.z_buffer_links,
             s.memory_bytes as f64 / 1048576.0,
             s.refine_s,
             s.solve_s,

@@ -91,6 +91,14 @@ impl PatchMap {
 }
 
 impl PatchMap {
+    /// The tiled carrier (an index into `carriers`) that input patch `patch` is a side of.
+    pub fn carrier_of_patch(&self, patch: u32) -> Option<usize> {
+        self.carriers.0.iter().position(|c| {
+            self.first_patch[c.instance as usize]
+                .is_some_and(|first| (first..first + 2).contains(&patch))
+        })
+    }
+
     /// Where rays of the patch point `p` (normal `n`) start when not just off its plane:
     /// above a tiled carrier's slab, or on the sphere a meshed sphere's triangle stands for.
     pub fn lift(&self, p: Vec3A, n: Vec3A) -> Option<Vec3A> {
