@@ -107,9 +107,11 @@ pub(crate) fn cluster_fragments(
     // Per member: its exact area over the area its pixels cover, which the rounding of
     // its edges to pixels leaves a little off 1.
     let mut area_scale = vec![0.0f32; members.len()];
+    let mut normals = vec![Vec3A::ZERO; members.len()];
     let mut see_through_members = Vec::new();
     for (local, (&patch, shape)) in members.iter().zip(shapes).enumerate() {
         let normal = shape.normal();
+        normals[local] = normal;
         let to_eye = eye - shape.centre();
         let on_plane = shape.point(0.0, 0.0);
         let facing = normal.dot(to_eye) > 0.0
@@ -141,7 +143,7 @@ pub(crate) fn cluster_fragments(
         see_through.resize_with(size * size, Vec::new);
         for &(local, tau) in &see_through_members {
             let shape = &shapes[local];
-            let covered = image.raster(shape, shape.normal(), |pixel, t| {
+            let covered = image.raster(shape, normals[local], |pixel, t| {
                 if t < distance[pixel] {
                     see_through[pixel].push(SeeThrough {
                         distance: t,
@@ -153,18 +155,19 @@ pub(crate) fn cluster_fragments(
             area_scale[local] = covered.exact_area_scale(shape);
         }
     }
-    // Per block of pixels: its fragments, one per patch and layer (merged as they come).
-    let blocks_across = size / FRAGMENT_BLOCK_PIXELS;
-    let mut blocks: Vec<Vec<(u32, Fragment)>> = vec![Vec::new(); blocks_across * blocks_across];
-    let mut emit = |local: u32, pixel: usize, through: f32| {
-        let shape = &shapes[local as usize];
-        let (point_m, pixel_m2) = image.on_plane(shape, pixel);
+    // The pixels block by block; a block's fragments, one per patch and layer, are merged
+    // as they come and lie from `block_start` on.
+    let mut fragments: Vec<(u32, Fragment)> = Vec::new();
+    let emit = |fragments: &mut Vec<(u32, Fragment)>,
+                block_start: usize,
+                local: u32,
+                pixel: usize,
+                through: f32| {
+        let (shape, normal) = (&shapes[local as usize], normals[local as usize]);
+        let (point_m, pixel_m2) = image.on_plane(shape, normal, pixel);
         let area_m2 = pixel_m2 * area_scale[local as usize] * through;
         let in_front = through == 1.0;
-        let (x, y) = (pixel % size, pixel / size);
-        let block =
-            &mut blocks[(y / FRAGMENT_BLOCK_PIXELS) * blocks_across + x / FRAGMENT_BLOCK_PIXELS];
-        match block
+        match fragments[block_start..]
             .iter_mut()
             .find(|(l, f)| *l == local && f.in_front == in_front)
         {
@@ -176,32 +179,42 @@ pub(crate) fn cluster_fragments(
                 }
                 f.area_m2 = total;
             }
-            None => block.push((
+            None => fragments.push((
                 local,
                 Fragment {
                     patch: members[local as usize],
                     point_m,
-                    normal: shape.normal(),
+                    normal,
                     area_m2,
                     in_front,
                 },
             )),
         }
     };
-    for (pixel, &shown) in front.iter().enumerate() {
-        let mut through = 1.0f32;
-        if let Some(layers) = see_through.get_mut(pixel) {
-            layers.sort_by(|a, b| a.distance.total_cmp(&b.distance));
-            for layer in layers.iter() {
-                emit(layer.local, pixel, through);
-                through *= layer.transparency;
+    let block = FRAGMENT_BLOCK_PIXELS;
+    for block_y in (0..size).step_by(block) {
+        for block_x in (0..size).step_by(block) {
+            let block_start = fragments.len();
+            for y in block_y..block_y + block {
+                for x in block_x..block_x + block {
+                    let pixel = y * size + x;
+                    let mut through = 1.0f32;
+                    if let Some(layers) = see_through.get_mut(pixel) {
+                        layers.sort_by(|a, b| a.distance.total_cmp(&b.distance));
+                        for layer in layers.iter() {
+                            emit(&mut fragments, block_start, layer.local, pixel, through);
+                            through *= layer.transparency;
+                        }
+                    }
+                    let shown = front[pixel];
+                    if shown != NOTHING_SHOWN && through > 0.0 {
+                        emit(&mut fragments, block_start, shown, pixel, through);
+                    }
+                }
             }
         }
-        if shown != NOTHING_SHOWN && through > 0.0 {
-            emit(shown, pixel, through);
-        }
     }
-    Some(blocks.into_iter().flatten().map(|(_, f)| f).collect())
+    Some(fragments.into_iter().map(|(_, f)| f).collect())
 }
 
 /// The pixels a patch covers and the area of its plane they cover, m².
@@ -221,6 +234,16 @@ impl Covered {
             1.0
         }
     }
+}
+
+/// Each pixel's sample offset within it (`Image::sample`).
+fn sample_offsets() -> &'static [(f32, f32)] {
+    static OFFSETS: OnceLock<Vec<(f32, f32)>> = OnceLock::new();
+    OFFSETS.get_or_init(|| {
+        (0..CLUSTER_IMAGE_PIXELS * CLUSTER_IMAGE_PIXELS)
+            .map(|k| r2(k as u32, 5))
+            .collect()
+    })
 }
 
 /// The perspective image from `eye` looking along `view`: the plane at unit distance,
@@ -288,11 +311,8 @@ impl Image {
             + self.across.1 * (self.origin.1 + y * self.pixel.1)
     }
 
-    /// How far along `line` (in its lengths) the shape's plane lies.
-    fn distance(&self, shape: &ElementShape, line: Vec3A) -> f32 {
-        self.distance_along(shape.normal(), shape, line)
-    }
-
+    /// How far along `line` (in its lengths) the plane of `shape` (unit normal `normal`)
+    /// lies.
     fn distance_along(&self, normal: Vec3A, shape: &ElementShape, line: Vec3A) -> f32 {
         normal.dot(shape.point(0.0, 0.0) - self.eye) / normal.dot(line)
     }
@@ -301,33 +321,23 @@ impl Image {
     /// edges aligned with the pixel grid (a symmetric view of a symmetric cluster) are not
     /// all sampled at the same offset.
     fn sample(pixel: usize) -> (f32, f32) {
-        static OFFSETS: OnceLock<Vec<(f32, f32)>> = OnceLock::new();
-        let offsets = OFFSETS.get_or_init(|| {
-            (0..CLUSTER_IMAGE_PIXELS * CLUSTER_IMAGE_PIXELS)
-                .map(|k| r2(k as u32, 5))
-                .collect()
-        });
         let size = CLUSTER_IMAGE_PIXELS;
-        let (a, b) = offsets[pixel];
+        let (a, b) = sample_offsets()[pixel];
         ((pixel % size) as f32 + a, (pixel / size) as f32 + b)
     }
 
-    /// Where the view line through `pixel`'s sample meets the shape's plane, and the area
-    /// of that plane the pixel covers, m².
-    fn on_plane(&self, shape: &ElementShape, pixel: usize) -> (Vec3A, f32) {
+    /// Where the view line through `pixel`'s sample meets the shape's plane (unit normal
+    /// `normal`), and the area of that plane the pixel covers, m².
+    fn on_plane(&self, shape: &ElementShape, normal: Vec3A, pixel: usize) -> (Vec3A, f32) {
         let (x, y) = Self::sample(pixel);
         let line = self.line(x, y);
-        let t = self.distance(shape, line);
-        (self.eye + line * t, self.pixel_area_m2(shape, line, t))
+        let t = self.distance_along(normal, shape, line);
+        (self.eye + line * t, self.pixel_area_along(normal, line, t))
     }
 
-    /// The area of the shape's plane that a pixel covers where its view line `line` meets
-    /// the plane at `t` line lengths: dA = dA_image · t² / |n · line| (the pixel's solid
-    /// angle dA_image / |line|³ times distance² over the cosine at the plane).
-    fn pixel_area_m2(&self, shape: &ElementShape, line: Vec3A, t: f32) -> f32 {
-        self.pixel_area_along(shape.normal(), line, t)
-    }
-
+    /// The area of a plane (unit normal `normal`) that a pixel covers where its view line
+    /// `line` meets the plane at `t` line lengths: dA = dA_image · t² / |n · line| (the
+    /// pixel's solid angle dA_image / |line|³ times distance² over the cosine at the plane).
     fn pixel_area_along(&self, normal: Vec3A, line: Vec3A, t: f32) -> f32 {
         self.pixel.0 * self.pixel.1 * t * t / normal.dot(line).abs()
     }
@@ -356,15 +366,25 @@ impl Image {
             *q = projected;
         }
         let polygon = &polygon[..count];
-        // The winding's sign, so that inside is where every edge function is ≥ 0.
-        let (a, b, c) = (polygon[0], polygon[1], polygon[2]);
-        let winding = ((b.0 - a.0) * (c.1 - a.1) - (b.1 - a.1) * (c.0 - a.0)).signum();
-        let inside = |x: f32, y: f32| {
-            (0..count).all(|i| {
-                let (p, q) = (polygon[i], polygon[(i + 1) % count]);
-                ((q.0 - p.0) * (y - p.1) - (q.1 - p.1) * (x - p.0)) * winding >= 0.0
-            })
-        };
+        // The winding's sign, so that inside is where every edge function is ≥ 0; each
+        // edge as e(x, y) = a x + b y + c.
+        let (p0, p1, p2) = (polygon[0], polygon[1], polygon[2]);
+        let winding = ((p1.0 - p0.0) * (p2.1 - p0.1) - (p1.1 - p0.1) * (p2.0 - p0.0)).signum();
+        let mut edges = [(0.0f32, 0.0f32, 0.0f32); 4];
+        for (i, edge) in edges.iter_mut().enumerate().take(count) {
+            let (p, q) = (polygon[i], polygon[(i + 1) % count]);
+            let (a, b) = (-(q.1 - p.1) * winding, (q.0 - p.0) * winding);
+            *edge = (a, b, -a * p.0 - b * p.1);
+        }
+        let edges = &edges[..count];
+        // n · line(x, y) is linear in the pixel coordinates; t = n · (p0 − eye) / n · line.
+        let along_0 = normal.dot(self.view)
+            + normal.dot(self.across.0) * self.origin.0
+            + normal.dot(self.across.1) * self.origin.1;
+        let along_x = normal.dot(self.across.0) * self.pixel.0;
+        let along_y = normal.dot(self.across.1) * self.pixel.1;
+        let numerator = normal.dot(shape.point(0.0, 0.0) - self.eye);
+        let pixel_image = self.pixel.0 * self.pixel.1;
         let (x_min, x_max) = polygon.iter().fold((f32::MAX, f32::MIN), |(lo, hi), p| {
             (lo.min(p.0), hi.max(p.0))
         });
@@ -374,16 +394,17 @@ impl Image {
         // Truncation is the floor at and above 0 (libm's floor is a call on x86-64 v1).
         let first = |v: f32| (v.max(0.0) as usize).min(size);
         let end = |v: f32| (v.max(-1.0) as usize + 1).min(size);
+        let offsets = sample_offsets();
         for y in first(y_min)..end(y_max) {
             for x in first(x_min)..end(x_max) {
                 let pixel = y * size + x;
-                let (cx, cy) = Self::sample(pixel);
-                if inside(cx, cy) {
-                    let line = self.line(cx, cy);
-                    let t = self.distance_along(normal, shape, line);
+                let (cx, cy) = (x as f32 + offsets[pixel].0, y as f32 + offsets[pixel].1);
+                if edges.iter().all(|&(a, b, c)| a * cx + b * cy + c >= 0.0) {
+                    let along = along_0 + along_x * cx + along_y * cy;
+                    let t = numerator / along;
                     draw(pixel, t);
                     covered.pixels += 1;
-                    covered.area_m2 += self.pixel_area_along(normal, line, t);
+                    covered.area_m2 += pixel_image * t * t / along.abs();
                 }
             }
         }
