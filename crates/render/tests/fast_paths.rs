@@ -41,6 +41,7 @@ const DECISIONS: &[(&str, bool, bool, &[SceneFeature])] = {
         ("minimal.json", false, false, &[DiagnosticIntegrator, Quadrics]),
         ("office/office.json", true, true, &[DeltaLights]),
         ("radiosity/cornell-box.json", false, true, &[RadiositySolution]),
+        ("radiosity/crate-hall.json", false, false, &[RadiositySolution]),
         ("stress/bulb-in-glass-fog.json", false, false, &[ParticipatingMedia, NonLambertianBsdfs, Quadrics, DeltaLights]),
         ("stress/caustic-glass-sphere.json", false, true, &[NonLambertianBsdfs, Quadrics, NonRectangleAreaLights]),
         ("stress/chromatic-smoke.json", false, false, &[ParticipatingMedia, OpacityMasks, InfiniteLights]),
