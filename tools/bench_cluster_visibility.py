@@ -14,43 +14,17 @@ Usage: python3 tools/bench_cluster_visibility.py [--prism target/release/prism]
 import argparse
 import json
 import os
-import re
-import subprocess
 import sys
 import tempfile
-import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "tools"))
 import bench_results  # noqa: E402
+from bench_tiled_radiosity import lux, run  # noqa: E402
 
 SCENE = os.path.join(ROOT, "scenes/radiosity/crate-hall.json")
-
-
-def lux(path):
-    data = json.load(open(path))
-    return [p["illuminance_lx"] for s in data["sensors"] for p in s["points"]]
-
-
-def run(prism, scene, stem):
-    start = time.perf_counter()
-    p = subprocess.run([prism, "render", scene, "--sensors-only", "-o", stem + ".exr"],
-                       capture_output=True, text=True)
-    wall = time.perf_counter() - start
-    if p.returncode != 0:
-        sys.exit(p.stderr)
-    text = p.stdout + p.stderr
-    solution = re.search(r"solution in ([0-9.]+) s", text)
-    links = re.findall(r"(\d+) links \((\d+) from clusters, (\d+) through their Z-buffers\)", text)
-    plain = re.findall(r"(\d+) elements, (\d+) links,", text)
-    result = {"wall_s": round(wall, 3),
-              "solution_s": float(solution.group(1)) if solution else None,
-              "lux": lux(stem + ".sensors.json")}
-    if links:
-        result["links"], result["cluster_links"], result["z_buffer_links"] = map(int, links[-1])
-    elif plain:
-        result["links"] = int(plain[-1][1])
-    return result
+KEPT = ("wall_s", "peak_mib", "solution_s", "elements", "links", "cluster_links",
+        "z_buffer_links", "hierarchy_mib")
 
 
 def main():
@@ -73,17 +47,18 @@ def main():
             s["samples"] = args.reference_samples
         json.dump(reference, open(os.path.join(d, "reference.json"), "w"))
         ref = run(args.prism, os.path.join(d, "reference.json"), os.path.join(d, "reference"))
+        ref_lux = lux(ref["sensors"])
         for bound in bounds:
             solved = json.loads(json.dumps(scene))
             solved["integrator"] = {"type": "radiosity", "error_bound_rel": bound}
             path = os.path.join(d, "bound-%g.json" % bound)
             json.dump(solved, open(path, "w"))
             for name, prism in builds.items():
-                r = run(prism, path, os.path.join(d, "%s-%g" % (name, bound)))
-                diff = [100 * (g / e - 1) for g, e in zip(r["lux"], ref["lux"])]
+                solved_run = run(prism, path, os.path.join(d, "%s-%g" % (name, bound)))
+                diff = [100 * (g / e - 1) for g, e in zip(lux(solved_run["sensors"]), ref_lux)]
+                r = {k: solved_run[k] for k in KEPT}
                 r["lux_vs_path_pct"] = [round(x, 2) for x in diff]
                 r["mean_vs_path_pct"] = round(sum(diff) / len(diff), 3)
-                del r["lux"]
                 results["%s, bound %g" % (name, bound)] = r
     bench_results.write("bench-cluster-visibility", {
         "benchmark": "bench-cluster-visibility",

@@ -13,10 +13,10 @@ use glam::Vec3A;
 
 use crate::element::ElementShape;
 use crate::hierarchy::{Hierarchy, NodeKind};
-use crate::solver::r2;
+use crate::solver::{r2, Visibility};
 
 /// Pixels along each side of a cluster's image.
-pub(crate) const CLUSTER_IMAGE_PIXELS: usize = 32;
+const CLUSTER_IMAGE_PIXELS: usize = 32;
 
 /// What a block of pixels shows of one patch.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -47,13 +47,13 @@ struct SeeThrough {
 /// point: an eighth of the cluster's width is fine enough for the 1/d² of a receiver three
 /// of the cluster's radii away, and the links' time goes into each receiver point's sum
 /// over the fragments.
-pub(crate) const FRAGMENT_BLOCK_PIXELS: usize = 4;
+const FRAGMENT_BLOCK_PIXELS: usize = 4;
 
 /// A patch covering at least this many pixels has them scaled to its exact area; below,
 /// the count is too coarse to scale by (a triangle on one pixel would count whole while
 /// it hides the others on that pixel, which then count for nothing: a woven panel of
 /// 36 864 triangles read its sensors 0.1 % darker that way), and point sampling stands.
-pub(crate) const EXACT_AREA_MIN_PIXELS: u32 = 8;
+const EXACT_AREA_MIN_PIXELS: u32 = 8;
 
 /// No patch, or a patch's side facing away from the receiver, in the opaque image.
 const NOTHING_SHOWN: u32 = u32::MAX;
@@ -65,8 +65,8 @@ const NOTHING_SHOWN: u32 = u32::MAX;
 /// front of it (the caller weighs each receiver point by its own cosine, which is 0 behind
 /// the patch), and hides what lies behind it either way: a desk top at the height of a
 /// wall element's middle faces the element's upper half, and leaving it out by the
-/// centre's view lost what the upper half receives. `transparency(patch, towards)`, where
-/// some patches are see-through, is the share of a patch's area seen through from
+/// centre's view lost what the upper half receives. Where `vis` has see-through patches,
+/// `vis.transparency(patch, towards)` is the share of a patch's area seen through from
 /// direction `towards` (unit, from the patch to the eye; a tiled carrier's τ, 0 for an
 /// opaque patch); a see-through surface has a patch per side, and the one facing the eye
 /// stands for it. A see-through patch counts with its whole area, since its radiosity is
@@ -86,17 +86,21 @@ pub(crate) fn cluster_fragments(
     cluster: u32,
     eye: Vec3A,
     receiver_corners: &[Vec3A],
-    transparency: Option<&dyn Fn(u32, Vec3A) -> f32>,
+    vis: &dyn Visibility,
 ) -> Option<Vec<Fragment>> {
     let node = &hierarchy.nodes[cluster as usize];
     let NodeKind::Cluster { patches, .. } = node.kind else {
         return None;
     };
-    let range = patches.0 as usize..patches.1 as usize;
-    let (members, shapes) = (
-        &hierarchy.order[range.clone()],
-        &hierarchy.order_shapes[range],
-    );
+    let members = &hierarchy.order[patches.0 as usize..patches.1 as usize];
+    let shape_of = |local: usize| {
+        let root = hierarchy.patch_root[members[local] as usize];
+        match hierarchy.nodes[root as usize].kind {
+            NodeKind::Element { shape, .. } => shape,
+            NodeKind::Cluster { .. } => unreachable!("patch roots are elements"),
+        }
+    };
+    let any_see_through = vis.any_see_through();
     let (lo, hi) = (node.lo, node.hi);
     let image = Image::framing(eye, lo, hi)?;
     let size = CLUSTER_IMAGE_PIXELS;
@@ -109,7 +113,8 @@ pub(crate) fn cluster_fragments(
     let mut area_scale = vec![0.0f32; members.len()];
     let mut normals = vec![Vec3A::ZERO; members.len()];
     let mut see_through_members = Vec::new();
-    for (local, (&patch, shape)) in members.iter().zip(shapes).enumerate() {
+    for (local, &patch) in members.iter().enumerate() {
+        let shape = &shape_of(local);
         let normal = shape.normal();
         normals[local] = normal;
         let to_eye = eye - shape.centre();
@@ -119,7 +124,11 @@ pub(crate) fn cluster_fragments(
             || receiver_corners
                 .iter()
                 .any(|&c| normal.dot(c - on_plane) > 0.0);
-        let tau = transparency.map_or(0.0, |t| t(patch, to_eye.normalize_or_zero()));
+        let tau = if any_see_through {
+            vis.transparency(patch, to_eye.normalize_or_zero())
+        } else {
+            0.0
+        };
         if tau > 0.0 {
             // Drawn after every opaque patch, by the side facing the eye only (both sides
             // would let τ² through).
@@ -144,7 +153,7 @@ pub(crate) fn cluster_fragments(
     if !see_through_members.is_empty() {
         see_through.resize_with(size * size, Vec::new);
         for &(local, tau) in &see_through_members {
-            let shape = &shapes[local];
+            let shape = &shape_of(local);
             let covered = image.raster(shape, normals[local], |pixel, t| {
                 if t < distance[pixel] {
                     see_through[pixel].push(SeeThrough {
@@ -165,7 +174,7 @@ pub(crate) fn cluster_fragments(
                 local: u32,
                 pixel: usize,
                 through: f32| {
-        let (shape, normal) = (&shapes[local as usize], normals[local as usize]);
+        let (shape, normal) = (&shape_of(local as usize), normals[local as usize]);
         let (point_m, pixel_m2) = image.on_plane(shape, normal, pixel);
         let area_m2 = pixel_m2 * area_scale[local as usize] * through;
         let in_front = through == 1.0;
@@ -417,6 +426,7 @@ impl Image {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::solver::Unoccluded;
 
     /// An eye far above the origin: the view is nearly orthographic.
     const FAR_ABOVE: Vec3A = Vec3A::new(0.0, 0.0, 1.0e3);
@@ -448,7 +458,7 @@ mod tests {
             })
             .collect();
         let h = Hierarchy::build(&plates);
-        let fragments = cluster_fragments(&h, h.root, FAR_ABOVE, &[], None).unwrap();
+        let fragments = cluster_fragments(&h, h.root, FAR_ABOVE, &[], &Unoccluded).unwrap();
         let mut seen = [0.0f32; 5];
         for f in &fragments {
             seen[f.patch as usize] += f.area_m2;
@@ -466,7 +476,7 @@ mod tests {
             );
         }
         // From below, the plates face away: nothing is shown.
-        assert!(cluster_fragments(&h, h.root, -FAR_ABOVE, &[], None)
+        assert!(cluster_fragments(&h, h.root, -FAR_ABOVE, &[], &Unoccluded)
             .unwrap()
             .is_empty());
     }
@@ -480,7 +490,7 @@ mod tests {
             square(Vec3A::new(0.0, 0.0, 0.2), 0.5, -1.0),
         ];
         let h = Hierarchy::build(&shapes);
-        assert!(cluster_fragments(&h, h.root, FAR_ABOVE, &[], None)
+        assert!(cluster_fragments(&h, h.root, FAR_ABOVE, &[], &Unoccluded)
             .unwrap()
             .is_empty());
         // Both sides of one surface: the side facing the viewer is shown, whole.
@@ -489,7 +499,7 @@ mod tests {
             square(Vec3A::ZERO, 0.5, 1.0),
         ];
         let h = Hierarchy::build(&shapes);
-        let fragments = cluster_fragments(&h, h.root, FAR_ABOVE, &[], None).unwrap();
+        let fragments = cluster_fragments(&h, h.root, FAR_ABOVE, &[], &Unoccluded).unwrap();
         let area: f32 = fragments.iter().map(|f| f.area_m2).sum();
         assert!(fragments.iter().all(|f| f.patch == 1));
         assert!((area - 1.0).abs() < 1e-4, "{area}");
@@ -504,8 +514,23 @@ mod tests {
             square(Vec3A::new(0.0, 0.0, 0.2), 0.5, -1.0),
         ];
         let h = Hierarchy::build(&shapes);
-        let tau = |p: u32, _: Vec3A| if p == 0 { 0.0 } else { 0.3 };
-        let fragments = cluster_fragments(&h, h.root, FAR_ABOVE, &[], Some(&tau)).unwrap();
+        struct Sheet;
+        impl Visibility for Sheet {
+            fn visible(&self, _: Vec3A, _: Vec3A, _: Vec3A, _: Vec3A) -> bool {
+                true
+            }
+            fn transparency(&self, patch: u32, _: Vec3A) -> f32 {
+                if patch == 0 {
+                    0.0
+                } else {
+                    0.3
+                }
+            }
+            fn any_see_through(&self) -> bool {
+                true
+            }
+        }
+        let fragments = cluster_fragments(&h, h.root, FAR_ABOVE, &[], &Sheet).unwrap();
         let mut seen = [0.0f32; 3];
         for f in &fragments {
             seen[f.patch as usize] += f.area_m2;
@@ -544,7 +569,7 @@ mod tests {
             }
         }
         let h = Hierarchy::build(&shapes);
-        let fragments = cluster_fragments(&h, h.root, FAR_ABOVE, &[], None).unwrap();
+        let fragments = cluster_fragments(&h, h.root, FAR_ABOVE, &[], &Unoccluded).unwrap();
         let top: f32 = fragments
             .iter()
             .filter(|f| f.patch < 10_000)
@@ -567,8 +592,10 @@ mod tests {
         ];
         let h = Hierarchy::build(&shapes);
         // The eye inside the box: part of it lies behind.
-        assert!(cluster_fragments(&h, h.root, Vec3A::new(0.0, 0.0, 0.1), &[], None).is_none());
+        assert!(
+            cluster_fragments(&h, h.root, Vec3A::new(0.0, 0.0, 0.1), &[], &Unoccluded).is_none()
+        );
         // A patch's root is not a cluster.
-        assert!(cluster_fragments(&h, h.patch_root[0], FAR_ABOVE, &[], None).is_none());
+        assert!(cluster_fragments(&h, h.patch_root[0], FAR_ABOVE, &[], &Unoccluded).is_none());
     }
 }

@@ -39,9 +39,6 @@ pub(crate) struct Hierarchy {
     pub patch_root: Vec<u32>,
     /// Input patches in cluster order (each cluster's patches are contiguous).
     pub order: Vec<u32>,
-    /// The shapes of `order`'s patches, in its order: a cluster's patches lie contiguous in
-    /// memory for its Z-buffer (`cluster_view`).
-    pub order_shapes: Vec<ElementShape>,
     /// Prefix sums of the areas of `order` (length + 1), for area-weighted sampling.
     pub order_area_prefix: Vec<f64>,
 }
@@ -77,13 +74,11 @@ impl Hierarchy {
             acc += f64::from(shapes[p as usize].area_m2());
             order_area_prefix.push(acc);
         }
-        let order_shapes = order.iter().map(|&p| shapes[p as usize]).collect();
         Self {
             nodes,
             root,
             patch_root,
             order,
-            order_shapes,
             order_area_prefix,
         }
     }

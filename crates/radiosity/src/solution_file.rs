@@ -313,17 +313,6 @@ impl Radiosity {
         if r.at != bytes.len() {
             return Err(format!("{} bytes after the solution", bytes.len() - r.at));
         }
-        let mut order_shapes = Vec::with_capacity(order.len());
-        for &p in &order {
-            let root_node = patch_root
-                .get(p as usize)
-                .and_then(|&n| nodes.get(n as usize))
-                .ok_or("a cluster's patch without its element")?;
-            match root_node.kind {
-                NodeKind::Element { shape, .. } => order_shapes.push(shape),
-                NodeKind::Cluster { .. } => return Err("a patch whose root is a cluster".into()),
-            }
-        }
         Ok(Self {
             settings,
             bands,
@@ -332,7 +321,6 @@ impl Radiosity {
                 root,
                 patch_root,
                 order,
-                order_shapes,
                 order_area_prefix,
             },
             reflectance,

@@ -10,12 +10,11 @@
 //! (`area_sample_factor`), which the oracle only accepts where the power it may carry is
 //! below the bound.
 
+use std::collections::HashMap;
 use std::time::Instant;
 
 use glam::Vec3A;
 use rayon::prelude::*;
-
-use std::collections::HashMap;
 
 use crate::cluster_view::{cluster_fragments, Fragment};
 use crate::element::ElementShape;
@@ -258,7 +257,7 @@ const MAX_FACING_SHARES: usize = 256;
 const PARTIAL_LINK_BOUND_SCALE: f32 = 0.1;
 
 /// A cluster source farther than this many of its radii (half its box's diagonal) from
-/// the receiver's centre is seen through its Z-buffer (`cluster_link_factor`); nearer,
+/// the receiver's centre is seen through its Z-buffer (`z_buffer_cluster_factor`); nearer,
 /// one direction cannot stand for the directions the receiver sees it in (a receiver
 /// inside the cluster's box sees it all around), and it is sampled
 /// (`sampled_cluster_factor`).
@@ -296,8 +295,9 @@ pub struct IterationStats {
     /// Leaf elements (the finest pieces the solution holds).
     pub elements: usize,
     pub links: usize,
-    /// Links whose source is a cluster, and of them those seen through the cluster's
-    /// Z-buffer (the far ones; the near ones are sampled).
+    /// Links whose source is a cluster, and of them the far ones, seen through the
+    /// cluster's Z-buffer (the near ones, and the rare far one whose view cannot be
+    /// framed, are sampled).
     pub cluster_links: usize,
     pub z_buffer_links: usize,
     pub memory_bytes: u64,
@@ -1232,11 +1232,15 @@ impl Radiosity {
                 }
             }
             NodeKind::Cluster { patches, .. } => {
-                if self.sees_through_z_buffer(r, s) {
-                    self.cluster_link_factor(&receiver, s, &receivers, vis)
-                } else {
-                    self.sampled_cluster_factor(&receiver, patches, &receivers, vis)
-                }
+                // A far cluster whose view cannot be framed (the eye, off a large
+                // receiver's centre, sees part of its box beside or behind it) is sampled
+                // as a near one is.
+                self.sees_through_z_buffer(r, s)
+                    .then(|| self.z_buffer_cluster_factor(&receiver, s, &receivers, vis))
+                    .flatten()
+                    .unwrap_or_else(|| {
+                        self.sampled_cluster_factor(&receiver, patches, &receivers, vis)
+                    })
             }
         }
     }
@@ -1309,20 +1313,20 @@ impl Radiosity {
         }
     }
 
-    /// A cluster source's factor towards element r (at its uncovered sample points
-    /// `receivers`) and its shares: the cluster's Z-buffer towards r ([`cluster_fragments`])
-    /// gives what each patch shows past the cluster's own patches; each fragment adds
-    /// cos θ_r · A⊥/(π d²) at each receiver point (capped at cos θ_r where π d² < A⊥, as
-    /// `area_sample_factor`); and a ray from each receiver point to a fragment in front,
-    /// chosen in proportion to its factor there, tests the scene outside the cluster.
-    fn cluster_link_factor(
+    /// A far cluster source's factor towards `receiver` (at its uncovered sample points
+    /// `receivers`) and its shares: the cluster's Z-buffer from a free receiver point
+    /// ([`cluster_fragments`]) gives what each patch shows past the cluster's own patches;
+    /// each fragment adds cos θ_r cos θ_s A/(π d²) at each receiver point (capped at
+    /// cos θ_r cos θ_s where π d² < A, as `area_sample_factor`); and a ray from each
+    /// receiver point to a fragment in front, chosen in proportion to its factor there,
+    /// tests the scene outside the cluster. `None` where the view cannot be framed.
+    fn z_buffer_cluster_factor(
         &self,
         receiver: &ElementShape,
         s: u32,
         receivers: &[usize],
         vis: &dyn Visibility,
-    ) -> LinkFactor {
-        let transparency = |patch, towards| vis.transparency(patch, towards);
+    ) -> Option<LinkFactor> {
         let (corners, corner_count) = receiver.corners();
         // The view from a free point: the centre of an element partly under a box lies
         // inside it and sees the box's faces from within.
@@ -1339,23 +1343,9 @@ impl Radiosity {
                     .total_cmp(&b.distance_squared(mean))
             })
             .unwrap_or(mean);
-        let Some(fragments) = cluster_fragments(
-            &self.hierarchy,
-            s,
-            eye,
-            &corners[..corner_count],
-            vis.any_see_through()
-                .then_some(&transparency as &dyn Fn(u32, Vec3A) -> f32),
-        ) else {
-            // The eye, off a large receiver's centre, sees part of the box beside or
-            // behind it: no one view frames the cluster.
-            let NodeKind::Cluster { patches, .. } = self.hierarchy.nodes[s as usize].kind else {
-                return LinkFactor::none();
-            };
-            return self.sampled_cluster_factor(receiver, patches, receivers, vis);
-        };
+        let fragments = cluster_fragments(&self.hierarchy, s, eye, &corners[..corner_count], vis)?;
         if fragments.is_empty() {
-            return LinkFactor::none();
+            return Some(LinkFactor::none());
         }
         let n_r = receiver.normal();
         let mut weight = vec![0.0f32; fragments.len()];
@@ -1400,10 +1390,10 @@ impl Radiosity {
         }
         let total: f32 = weight.iter().sum();
         if total <= 0.0 || tested == 0 {
-            return LinkFactor::none();
+            return Some(LinkFactor::none());
         }
         let free_fraction = free as f32 / tested as f32;
-        LinkFactor {
+        Some(LinkFactor {
             form_factor: total / receivers.len() as f32 * free_fraction,
             partial: free > 0 && free < tested,
             source_shares: if free > 0 {
@@ -1411,7 +1401,7 @@ impl Radiosity {
             } else {
                 Box::default()
             },
-        }
+        })
     }
 
     /// The shares of a cluster link: each fragment's factor credited to the node that
@@ -1745,7 +1735,8 @@ mod tests {
                 .sum::<f32>()
                 / points.len() as f32;
             let z_buffer = solution
-                .cluster_link_factor(&receiver, root, &points, &Unoccluded)
+                .z_buffer_cluster_factor(&receiver, root, &points, &Unoccluded)
+                .unwrap()
                 .form_factor;
             let sampled = solution
                 .sampled_cluster_factor(&receiver, all, &points, &Unoccluded)

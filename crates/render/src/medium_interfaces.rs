@@ -6,20 +6,19 @@
 
 use prism_geometry::{Hit, Ray};
 
+use crate::integrator::MAX_NULL_EVENTS;
 use crate::scene_build::RenderScene;
 
-/// Medium boundaries a ray may cross before the predictor gives up on it (nested boxes of
-/// media need a few; a ray caught between coincident boundaries would loop).
-const MAX_INTERFACES: usize = 64;
-
 /// The first hit along `ray` on a surface that is not a medium `interface` (interfaces
-/// scatter nothing: the render's rays cross them), with t in `ray`'s own parameter.
+/// scatter nothing: the render's rays cross them), with t in `ray`'s own parameter; `None`
+/// past [`MAX_NULL_EVENTS`] crossings, where the render's paths end too (a ray caught
+/// between coincident boundaries would loop).
 pub(crate) fn first_surface(scene: &RenderScene, ray: &Ray) -> Option<Hit> {
     let Some(media) = scene.media.as_ref() else {
         return scene.geometry.intersect(ray);
     };
     let mut rest = *ray;
-    for _ in 0..MAX_INTERFACES {
+    for _ in 0..MAX_NULL_EVENTS {
         let hit = scene.geometry.intersect(&rest)?;
         let si = scene.geometry.interaction(&rest, &hit);
         if !media.is_interface(si.material_id) {
