@@ -55,6 +55,16 @@ fn the_pyramid_is_computed_once_and_then_read_from_the_cache() {
     // narrowed by the strands' bulge).
     let tau = incident[0]["transparency"].as_f64().unwrap();
     assert!((0.1..0.2).contains(&tau), "τ {tau}");
+    // τ̄, over the whole bin (θ up to 41°), is close to it; near grazing it is where the
+    // bin's centre (83°) sees nothing through.
+    let tau_mean = incident[0]["transparency_bin_mean"].as_f64().unwrap();
+    assert!((tau_mean - tau).abs() < 0.03, "τ̄ {tau_mean}, τ {tau}");
+    let grazing = &incident[31];
+    let (tau, tau_mean) = (
+        grazing["transparency"].as_f64().unwrap(),
+        grazing["transparency_bin_mean"].as_f64().unwrap(),
+    );
+    assert!(tau <= tau_mean && tau_mean < 0.1, "τ̄ {tau_mean}, τ {tau}");
 
     let second = prism(dir.path(), &args);
     let stderr = String::from_utf8_lossy(&second.stderr);

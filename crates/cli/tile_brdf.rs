@@ -135,6 +135,7 @@ pub fn run(args: &TileBrdfArgs) -> Result<(), String> {
                 "scattered_transmittance": transmitted,
                 "scattered_transmittance_se": transmitted_se,
                 "transparency": pyramid.transparency(0, 0, 0, i),
+                "transparency_bin_mean": pyramid.view_transparency(0, 0, 0, i),
             })
         })
         .collect();

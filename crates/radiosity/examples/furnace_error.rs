@@ -13,6 +13,7 @@ fn square(p0: Vec3A, e1: Vec3A, e2: Vec3A, rho: f32) -> InputPatch {
         reflectance: vec![rho],
         emission: vec![1.0],
         surface: NEXT_SURFACE.fetch_add(1, Ordering::Relaxed),
+        directional: None,
     }
 }
 fn main() {

@@ -250,10 +250,13 @@ impl Radiosity {
         }
     }
 
-    /// Reflected radiosity (B − B_e) per band at point `y` of input patch `patch`.
-    fn reflected_at(&self, patch: u32, y: Vec3A, out: &mut [f32; MAX_BANDS]) {
-        let leaf = self.leaf_node(patch as usize, y);
-        let b = self.node_radiosity(leaf);
+    /// Reflected radiosity (B − B_e) per band at point `y` of input patch `patch`; on a
+    /// directional patch its reflected exitance towards `to`.
+    fn reflected_at(&self, patch: u32, y: Vec3A, to: Vec3A, out: &mut [f32; MAX_BANDS]) {
+        let b = match self.exitance_towards(patch as usize, y, (to - y).normalize_or_zero()) {
+            Some(exitance) => exitance,
+            None => self.node_radiosity(self.leaf_node(patch as usize, y)),
+        };
         let e = self.emission(patch as usize);
         for k in 0..self.bands {
             out[k] = (b[k] - e[k]).max(0.0);
@@ -281,7 +284,7 @@ impl Radiosity {
                     .collect();
                 let mut b = [0.0f32; MAX_BANDS];
                 for &y in &ys {
-                    self.reflected_at(patch, y, &mut b);
+                    self.reflected_at(patch, y, rx.centre, &mut b);
                     for (r, &x) in c.reflected[..bands].iter_mut().zip(&b[..bands]) {
                         *r += x / ys.len() as f32;
                     }
@@ -335,7 +338,7 @@ impl Radiosity {
                         continue;
                     };
                     let n_s = shape.normal();
-                    self.reflected_at(patch, y, &mut b);
+                    self.reflected_at(patch, y, rx.centre, &mut b);
                     if b[..bands].iter().all(|&x| x <= 0.0) {
                         continue;
                     }
@@ -545,6 +548,7 @@ mod tests {
                 reflectance: vec![rho; 2],
                 emission: vec![emission; 2],
                 surface: i as u32,
+                directional: None,
             })
             .collect();
         let settings = RadiositySettings {

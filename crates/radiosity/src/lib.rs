@@ -8,7 +8,9 @@
 //! with per-band reflectance and emission and a [`Visibility`] oracle (its ray tracer); the
 //! solution answers the radiosity at any point of a patch ([`Radiosity::radiosity_at`]).
 
+pub mod bins;
 mod cluster_view;
+pub mod directional;
 pub mod element;
 pub mod final_gather;
 pub mod form_factor;

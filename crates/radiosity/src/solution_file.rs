@@ -2,14 +2,18 @@
 //! --save-solution`/`--load-solution`): the hierarchy, the links and every per-node value,
 //! little-endian, after the magic `PRISMRAD` and a format version.
 
+use std::sync::Arc;
+
 use glam::Vec3A;
 
+use crate::bins::SPHERE_BINS;
+use crate::directional::{DirectionalSide, DirectionalState, DirectionalSurface, NO_SLOT};
 use crate::element::ElementShape;
 use crate::hierarchy::{Hierarchy, Node, NodeKind};
 use crate::solver::{Link, LinkTotals, Radiosity, RadiositySettings};
 
 const MAGIC: &[u8; 8] = b"PRISMRAD";
-const VERSION: u32 = 2;
+const VERSION: u32 = 3;
 const NONE: u32 = u32::MAX;
 
 struct Writer(Vec<u8>);
@@ -117,6 +121,15 @@ impl Radiosity {
         w.u32(h.patch_root.len() as u32);
         w.f32s(&self.reflectance);
         w.f32s(&self.emission);
+        for side in &self.directional.sides {
+            w.u8(u8::from(side.is_some()));
+            if let Some(side) = side {
+                w.u8(u8::from(side.front));
+                w.u32(side.partner);
+                side.surface.frame.iter().for_each(|&v| w.vec3(v));
+                w.f32s(&side.surface.gamma);
+            }
+        }
         h.patch_root.iter().for_each(|&v| w.u32(v));
         h.order.iter().for_each(|&v| w.u32(v));
         h.order_area_prefix.iter().for_each(|&v| w.f64(v));
@@ -167,6 +180,12 @@ impl Radiosity {
             w.u64(c.unwrap_or(0));
         }
         w.f32s(&self.free_area);
+        let d = &self.directional;
+        w.u32((d.gathered.len() / d.stride()) as u32);
+        d.slot.iter().for_each(|&v| w.u32(v));
+        for values in [&d.gathered, &d.direct, &d.irradiance, &d.exitance] {
+            w.f32s(values);
+        }
         for links in &self.links {
             w.u32(links.len() as u32);
             for l in links {
@@ -211,6 +230,27 @@ impl Radiosity {
         let patches = r.count(8 * bands.max(1))?;
         let reflectance = r.f32s(patches * bands)?;
         let emission = r.f32s(patches * bands)?;
+        let mut sides = Vec::with_capacity(patches);
+        for _ in 0..patches {
+            sides.push(if r.u8()? != 0 {
+                let front = r.u8()? != 0;
+                let partner = r.u32()?;
+                if partner as usize >= patches {
+                    return Err(format!(
+                        "a directional side's partner {partner} of {patches}"
+                    ));
+                }
+                let frame = [r.vec3()?, r.vec3()?, r.vec3()?];
+                let gamma = r.f32s(SPHERE_BINS * SPHERE_BINS * bands)?;
+                Some(DirectionalSide {
+                    surface: Arc::new(DirectionalSurface { frame, gamma }),
+                    front,
+                    partner,
+                })
+            } else {
+                None
+            });
+        }
         let patch_root: Vec<u32> = (0..patches).map(|_| r.u32()).collect::<Result<_, _>>()?;
         let order: Vec<u32> = (0..patches).map(|_| r.u32()).collect::<Result<_, _>>()?;
         let order_area_prefix: Vec<f64> =
@@ -287,6 +327,20 @@ impl Radiosity {
             })
             .collect::<Result<_, _>>()?;
         let free_area = r.f32s(node_count)?;
+        let mut directional = DirectionalState::new(sides, bands);
+        let slots = r.count(4 * directional.stride())?;
+        directional.slot = (0..node_count)
+            .map(|_| match r.u32()? {
+                NO_SLOT => Ok(NO_SLOT),
+                s if (s as usize) < slots => Ok(s),
+                s => Err(format!("directional slot {s} of {slots}")),
+            })
+            .collect::<Result<_, String>>()?;
+        let values = slots * directional.stride();
+        directional.gathered = r.f32s(values)?;
+        directional.direct = r.f32s(values)?;
+        directional.irradiance = r.f32s(values)?;
+        directional.exitance = r.f32s(values)?;
         let mut links = Vec::with_capacity(node_count);
         for _ in 0..node_count {
             let n = r.count(13)?;
@@ -328,6 +382,7 @@ impl Radiosity {
             radiosity,
             radiosity_max,
             gathered,
+            directional,
             link_totals: LinkTotals::of(links.iter().flatten()),
             links,
             direct,

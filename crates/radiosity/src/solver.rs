@@ -16,7 +16,9 @@ use std::time::Instant;
 use glam::Vec3A;
 use rayon::prelude::*;
 
+use crate::bins::SPHERE_BINS;
 use crate::cluster_view::{cluster_fragments, Fragment};
+use crate::directional::{self, DirectionalSide, DirectionalState};
 use crate::element::ElementShape;
 use crate::form_factor::{area_sample_factor, element_to_element, faces, point_to_polygon};
 use crate::hierarchy::{Hierarchy, NodeKind};
@@ -33,6 +35,9 @@ pub struct InputPatch {
     /// surface's power over all its patches, so that meshing a light (a sphere's 528
     /// triangles) does not tighten the bound 528-fold.
     pub surface: u32,
+    /// `Some`: one side of a directional surface (`directional.rs`), whose light leaves
+    /// by its Γ; `reflectance` is then its diffuse equivalent, which only the oracle reads.
+    pub directional: Option<DirectionalSide>,
 }
 
 /// Whether the segment between two surface points is free (the caller offsets the points
@@ -66,6 +71,21 @@ pub trait Visibility: Sync {
 /// a point `p` of a surface facing `n`; added to `out`.
 pub trait DirectIrradiance: Sync {
     fn irradiance(&self, p: Vec3A, n: Vec3A, out: &mut [f32]);
+
+    /// As `irradiance`, by where it comes from: `add(towards the light, irradiance per
+    /// band)` for each arrival (directional patches bin it). By default all of it arrives
+    /// along the normal.
+    fn irradiance_by_direction(
+        &self,
+        p: Vec3A,
+        n: Vec3A,
+        bands: usize,
+        add: &mut dyn FnMut(Vec3A, &[f32]),
+    ) {
+        let mut out = vec![0.0; bands];
+        self.irradiance(p, n, &mut out);
+        add(n, &out);
+    }
 }
 
 /// No lights besides the emitting patches.
@@ -133,6 +153,11 @@ pub enum RadiosityError {
         limit_bytes: u64,
         needed_bytes: u64,
     },
+    /// Input patch `patch`'s directional side does not fit (`reason`).
+    Directional {
+        patch: usize,
+        reason: String,
+    },
 }
 
 impl std::fmt::Display for RadiosityError {
@@ -141,6 +166,9 @@ impl std::fmt::Display for RadiosityError {
             RadiosityError::NoPatches => write!(f, "the scene has no surface for radiosity"),
             RadiosityError::BandCount { patch, expected } => {
                 write!(f, "patch {patch}: expected {expected} bands")
+            }
+            RadiosityError::Directional { patch, reason } => {
+                write!(f, "patch {patch}: directional side: {reason}")
             }
             RadiosityError::MemoryLimit {
                 limit_bytes,
@@ -266,18 +294,21 @@ const Z_BUFFER_DISTANCE_RADII: f32 = 3.0;
 /// At most this many shares per cluster link (`cluster_shares`).
 const MAX_CLUSTER_SHARES: usize = 32;
 
+/// No bin: that end of a link part is not directional (`Radiosity::link_bins`).
+const NO_BIN: u8 = u8::MAX;
+
 impl Link {
+    /// What the link draws from: its shares, or the source itself (share 1).
+    fn parts(&self) -> impl Iterator<Item = (u32, f32)> + '_ {
+        let own = self.source_shares.is_empty().then_some((self.source, 1.0));
+        own.into_iter().chain(self.source_shares.iter().copied())
+    }
+
     /// Adds what the link transfers, F · Σ share · B(node) per band (F · B(source)
     /// without shares), to the receiver's irradiance `out`.
     #[inline]
     fn add_transfer(&self, radiosity: &[f32], bands: usize, out: &mut [f32]) {
-        let own = [(self.source, 1.0)];
-        let parts: &[(u32, f32)] = if self.source_shares.is_empty() {
-            &own
-        } else {
-            &self.source_shares
-        };
-        for &(node, share) in parts {
+        for (node, share) in self.parts() {
             let weight = self.form_factor * share;
             let b = &radiosity[node as usize * bands..][..bands];
             for (o, v) in out.iter_mut().zip(b) {
@@ -320,6 +351,8 @@ pub struct Radiosity {
     pub(crate) radiosity_max: Vec<f32>,
     /// Per node × band: irradiance gathered over the node's own links.
     pub(crate) gathered: Vec<f32>,
+    /// The directional patches' values per direction bin.
+    pub(crate) directional: DirectionalState,
     pub(crate) links: Vec<Vec<Link>>,
     /// What `links` holds in all: links and their shares, kept as they change so that
     /// `memory_bytes` (checked on every split) does not walk every link, which made
@@ -363,6 +396,7 @@ impl Radiosity {
                 });
             }
         }
+        check_directional(patches, bands)?;
         let shapes: Vec<ElementShape> = patches.iter().map(|p| p.shape).collect();
         let hierarchy = Hierarchy::build(&shapes);
         // The brightest emitter (largest exitance in any band) and its power.
@@ -375,6 +409,10 @@ impl Radiosity {
             radiosity: Vec::new(),
             radiosity_max: Vec::new(),
             gathered: Vec::new(),
+            directional: DirectionalState::new(
+                patches.iter().map(|p| p.directional.clone()).collect(),
+                bands,
+            ),
             links: Vec::new(),
             link_totals: LinkTotals::default(),
             direct: Vec::new(),
@@ -432,7 +470,18 @@ impl Radiosity {
                 matches!(self.hierarchy.nodes[root].kind, NodeKind::Element { shape, .. } if shape == p.shape)
                     && p.reflectance == self.reflectance(i)
                     && p.emission == self.emission(i)
+                    && p.directional == self.directional.sides[i]
             })
+    }
+
+    /// The exitance per band (π × the radiance, emission included) that input patch
+    /// `patch` sends from point `p` towards `w` (unit, leaving it): its leaf's value in
+    /// `w`'s bin on a directional patch; `None` on a diffuse one, whose exitance is its
+    /// radiosity in every direction.
+    pub fn exitance_towards(&self, patch: usize, p: Vec3A, w: Vec3A) -> Option<&[f32]> {
+        let side = self.directional.sides.get(patch)?.as_ref()?;
+        let slot = self.directional.slot_of(self.leaf_node(patch, p))?;
+        Some(self.directional.exitance_towards(slot, side, w))
     }
 
     /// Every leaf element: its shape, input patch, radiosity and arriving irradiance per
@@ -613,6 +662,7 @@ impl Radiosity {
             + links * std::mem::size_of::<Link>() as u64
             + shares * std::mem::size_of::<(u32, f32)>() as u64
             + (self.reflectance.len() + self.emission.len()) as u64 * 4
+            + self.directional.memory_bytes()
     }
 
     /// The coverage mask of every element that has none yet, in parallel.
@@ -673,20 +723,34 @@ impl Radiosity {
             })
             .collect();
         let this = &*self;
-        let results: Vec<(Vec<f32>, f32)> = todo
+        let results: Vec<(Vec<f32>, f32, Vec<f32>)> = todo
             .par_iter()
             .map(|&n| {
                 let NodeKind::Element { shape, .. } = this.hierarchy.nodes[n as usize].kind else {
-                    return (vec![0.0; bands], 0.0);
+                    return (vec![0.0; bands], 0.0, Vec::new());
                 };
                 let normal = shape.normal();
                 let mut mean = vec![0.0f32; bands];
                 let (mut lo, mut hi) = (f32::INFINITY, 0.0f32);
                 let mut at = vec![0.0f32; bands];
                 let mut count = 0u32;
+                // A directional element's direct light per incident bin, summed over points.
+                let side = this.directional_side(n).map(|(_, side)| side);
+                let mut binned = vec![0.0f32; side.map_or(0, |_| this.directional.stride())];
                 for k in (0..rays).filter(|&k| !this.is_covered(n, k)) {
                     at.fill(0.0);
-                    light.irradiance(sample_point(&shape, k, 0), normal, &mut at);
+                    let p = sample_point(&shape, k, 0);
+                    match side {
+                        Some(side) => {
+                            light.irradiance_by_direction(p, normal, bands, &mut |w, e| {
+                                for (a, v) in at.iter_mut().zip(e) {
+                                    *a += v;
+                                }
+                                directional::add_arrival(side, w, e, &mut binned);
+                            })
+                        }
+                        None => light.irradiance(p, normal, &mut at),
+                    }
                     let top = at.iter().copied().fold(0.0f32, f32::max);
                     lo = lo.min(top);
                     hi = hi.max(top);
@@ -697,13 +761,18 @@ impl Radiosity {
                 }
                 if count > 0 {
                     mean.iter_mut().for_each(|m| *m /= count as f32);
+                    binned.iter_mut().for_each(|m| *m /= count as f32);
                 }
-                (mean, hi - lo.min(hi))
+                (mean, hi - lo.min(hi), binned)
             })
             .collect();
-        for (n, (mean, variation)) in todo.into_iter().zip(results) {
+        for (n, (mean, variation, binned)) in todo.into_iter().zip(results) {
             self.direct[n as usize * bands..][..bands].copy_from_slice(&mean);
             self.direct_variation[n as usize] = Some(variation);
+            if let Some(slot) = self.directional.slot_of(n) {
+                let range = self.directional.range(slot);
+                self.directional.direct[range].copy_from_slice(&binned);
+            }
         }
     }
 
@@ -758,6 +827,11 @@ impl Radiosity {
         self.free_area.resize(n, 0.0);
         self.irradiance.resize(n * self.bands, 0.0);
         self.radiosity.resize(n * self.bands, 0.0);
+        let nodes = &self.hierarchy.nodes;
+        self.directional.grow(n, |k| match nodes[k].kind {
+            NodeKind::Element { patch, .. } => Some(patch),
+            NodeKind::Cluster { .. } => None,
+        });
         self.radiosity_max.resize(n, 0.0);
         self.gathered.resize(n * self.bands, 0.0);
         self.links.resize_with(n, Vec::new);
@@ -1447,8 +1521,17 @@ impl Radiosity {
     /// of sweeps.
     fn solve(&mut self) -> u32 {
         let tolerance = self.settings.solve_tolerance_rel;
+        let link_bins = if self.directional.any() {
+            self.link_bins()
+        } else {
+            Vec::new()
+        };
         for sweep in 1..=self.settings.max_sweeps {
-            self.gather();
+            if self.directional.any() {
+                self.gather_directional(&link_bins);
+            } else {
+                self.gather();
+            }
             let before = self.radiosity.clone();
             self.push_pull();
             let largest = self.radiosity.iter().copied().fold(0.0f32, f32::max);
@@ -1481,14 +1564,118 @@ impl Radiosity {
             });
     }
 
+    /// The direction bins of every link part (`Link::add_transfer`'s (node, share)), per
+    /// receiver in link order: the source's outgoing bin towards the receiver and the
+    /// receiver's incident bin towards the source, from centre to centre (`NO_BIN` where
+    /// that end is not directional). Fixed while links are: built once per solve.
+    fn link_bins(&self) -> Vec<Box<[[u8; 2]]>> {
+        let centre = |n: u32| {
+            let node = &self.hierarchy.nodes[n as usize];
+            (node.lo + node.hi) * 0.5
+        };
+        (0..self.links.len() as u32)
+            .into_par_iter()
+            .map(|r| {
+                let receiver = self.directional_side(r);
+                let x_r = centre(r);
+                let mut bins = Vec::new();
+                for link in &self.links[r as usize] {
+                    for (node, _) in link.parts() {
+                        let x_s = centre(node);
+                        let sent = self.directional_side(node).map_or(NO_BIN, |(_, side)| {
+                            side.side_bin((x_r - x_s).normalize_or_zero()) as u8
+                        });
+                        let arrives = receiver.map_or(NO_BIN, |(_, side)| {
+                            side.side_bin((x_s - x_r).normalize_or_zero()) as u8
+                        });
+                        bins.push([sent, arrives]);
+                    }
+                }
+                bins.into_boxed_slice()
+            })
+            .collect()
+    }
+
+    /// `gather` where some patches are directional: a directional source sends its
+    /// exitance in the bin towards the receiver, and a directional receiver also keeps
+    /// what arrives per incident bin (`link_bins`).
+    fn gather_directional(&mut self, link_bins: &[Box<[[u8; 2]]>]) {
+        let bands = self.bands;
+        let stride = self.directional.stride();
+        let state = &self.directional;
+        let radiosity = &self.radiosity;
+        let links = &self.links;
+        let binned: Vec<Option<Vec<f32>>> = self
+            .gathered
+            .par_chunks_mut(bands)
+            .zip(links.par_iter())
+            .zip(link_bins.par_iter())
+            .enumerate()
+            .map(|(r, ((out, links), bins))| {
+                out.fill(0.0);
+                let receiver = state.slot_of(r as u32);
+                let mut binned = vec![0.0f32; receiver.map_or(0, |_| stride)];
+                let mut bins = bins.iter();
+                for link in links {
+                    for (node, share) in link.parts() {
+                        let [sent, arrives] = *bins.next().expect("a bin pair per link part");
+                        let weight = link.form_factor * share;
+                        let b = match state.slot_of(node).filter(|_| sent != NO_BIN) {
+                            Some(slot) => {
+                                &state.exitance[state.range(slot)][usize::from(sent) * bands..]
+                                    [..bands]
+                            }
+                            None => &radiosity[node as usize * bands..][..bands],
+                        };
+                        for (o, v) in out.iter_mut().zip(b) {
+                            *o += weight * v;
+                        }
+                        if arrives != NO_BIN {
+                            let bin = &mut binned[usize::from(arrives) * bands..][..bands];
+                            for (o, v) in bin.iter_mut().zip(b) {
+                                *o += weight * v;
+                            }
+                        }
+                    }
+                }
+                receiver.map(|_| binned)
+            })
+            .collect();
+        for (r, binned) in binned.into_iter().enumerate() {
+            if let (Some(slot), Some(binned)) = (self.directional.slot_of(r as u32), binned) {
+                let range = self.directional.range(slot);
+                self.directional.gathered[range].copy_from_slice(&binned);
+            }
+        }
+    }
+
+    /// The slot and side of node `n` when it is an element of a directional patch.
+    fn directional_side(&self, n: u32) -> Option<(usize, &DirectionalSide)> {
+        let slot = self.directional.slot_of(n)?;
+        let NodeKind::Element { patch, .. } = self.hierarchy.nodes[n as usize].kind else {
+            return None;
+        };
+        Some((slot, self.directional.sides[patch as usize].as_ref()?))
+    }
+
     /// Push irradiance down (inherited per area), pull radiosity up (area average).
+    /// Directional leaves take their exitance in a parallel pass once every leaf has its
+    /// irradiance (a side transmits what the other side receives), and a second pull
+    /// carries it up.
     fn push_pull(&mut self) {
         let root = self.hierarchy.root;
         let down = vec![0.0; self.bands];
-        self.push_pull_node(root, &down);
+        self.push_pull_node(root, &down, &[]);
+        if self.directional.any() {
+            self.directional_leaves();
+            self.pull_node(root);
+        }
     }
 
-    fn push_pull_node(&mut self, n: u32, down: &[f32]) {
+    /// `down_bins`: the irradiance per incident bin inherited by a directional element
+    /// (empty elsewhere). A directional leaf only stores its irradiance (its radiosity
+    /// here is the diffuse equivalent's, replaced by `directional_leaves`).
+    fn push_pull_node(&mut self, n: u32, down: &[f32], down_bins: &[f32]) {
         let bands = self.bands;
         let mut total: Vec<f32> = down.to_vec();
         for (t, g) in total
@@ -1496,6 +1683,14 @@ impl Radiosity {
             .zip(&self.gathered[n as usize * bands..][..bands])
         {
             *t += g;
+        }
+        let slot = self.directional.slot_of(n);
+        let mut total_bins: Vec<f32> = Vec::new();
+        if let Some(slot) = slot {
+            total_bins = self.directional.gathered[self.directional.range(slot)].to_vec();
+            for (t, d) in total_bins.iter_mut().zip(down_bins) {
+                *t += d;
+            }
         }
         let children = self.hierarchy.children(n);
         let mut b = vec![0.0f32; bands];
@@ -1510,6 +1705,17 @@ impl Radiosity {
                 self.irradiance[n as usize * bands + k] = e;
                 b[k] = self.emission[patch * bands + k] + self.reflectance[patch * bands + k] * e;
                 b_max = b_max.max(b[k]);
+            }
+            if let Some(slot) = slot {
+                let range = self.directional.range(slot);
+                let d = &mut self.directional;
+                for ((e, t), direct) in d.irradiance[range.clone()]
+                    .iter_mut()
+                    .zip(&total_bins)
+                    .zip(&d.direct[range])
+                {
+                    *e = t + direct;
+                }
             }
             self.free_area[n as usize] = self.hierarchy.nodes[n as usize].area_m2
                 * (1.0 - self.covered_fraction(n as usize));
@@ -1526,16 +1732,13 @@ impl Radiosity {
                 total
             };
             for c in children.clone() {
-                self.push_pull_node(c, &pass);
+                self.push_pull_node(c, &pass, &total_bins);
                 free += self.free_area[c as usize];
             }
-            let area = self.hierarchy.nodes[n as usize].area_m2;
+            self.free_area[n as usize] = free;
+            let mut arriving = vec![0.0f32; if slot.is_some() { total_bins.len() } else { 0 }];
             for c in children {
-                let w = if free > 0.0 {
-                    self.free_area[c as usize] / free
-                } else {
-                    self.hierarchy.nodes[c as usize].area_m2 / area
-                };
+                let w = self.pull_weight(n, c);
                 for (v, cb) in b
                     .iter_mut()
                     .zip(&self.radiosity[c as usize * bands..][..bands])
@@ -1543,12 +1746,157 @@ impl Radiosity {
                     *v += w * cb;
                 }
                 b_max = b_max.max(self.radiosity_max[c as usize]);
+                if let Some(child) = self.directional.slot_of(c).filter(|_| slot.is_some()) {
+                    let d = &self.directional;
+                    for (v, ce) in arriving.iter_mut().zip(&d.irradiance[d.range(child)]) {
+                        *v += w * ce;
+                    }
+                }
             }
-            self.free_area[n as usize] = free;
+            if let Some(slot) = slot {
+                let range = self.directional.range(slot);
+                self.directional.irradiance[range].copy_from_slice(&arriving);
+            }
         }
         self.radiosity[n as usize * bands..][..bands].copy_from_slice(&b);
         self.radiosity_max[n as usize] = b_max;
     }
+
+    /// Child `c`'s weight in node `n`'s averages: its share of the uncovered area (of the
+    /// plain area where all is covered).
+    fn pull_weight(&self, n: u32, c: u32) -> f32 {
+        let free = self.free_area[n as usize];
+        if free > 0.0 {
+            self.free_area[c as usize] / free
+        } else {
+            self.hierarchy.nodes[c as usize].area_m2 / self.hierarchy.nodes[n as usize].area_m2
+        }
+    }
+
+    /// Pulls radiosity, its largest band and directional exitance up from the leaves.
+    fn pull_node(&mut self, n: u32) {
+        let children = self.hierarchy.children(n);
+        if children.len() == 0 {
+            return;
+        }
+        let bands = self.bands;
+        let slot = self.directional.slot_of(n);
+        let mut b = vec![0.0f32; bands];
+        let mut b_max = 0.0f32;
+        let mut exitance = vec![
+            0.0f32;
+            if slot.is_some() {
+                self.directional.stride()
+            } else {
+                0
+            }
+        ];
+        for c in children {
+            self.pull_node(c);
+            let w = self.pull_weight(n, c);
+            for (v, cb) in b
+                .iter_mut()
+                .zip(&self.radiosity[c as usize * bands..][..bands])
+            {
+                *v += w * cb;
+            }
+            b_max = b_max.max(self.radiosity_max[c as usize]);
+            if let Some(child) = self.directional.slot_of(c).filter(|_| slot.is_some()) {
+                let d = &self.directional;
+                for (v, cm) in exitance.iter_mut().zip(&d.exitance[d.range(child)]) {
+                    *v += w * cm;
+                }
+            }
+        }
+        self.radiosity[n as usize * bands..][..bands].copy_from_slice(&b);
+        self.radiosity_max[n as usize] = b_max;
+        if let Some(slot) = slot {
+            let range = self.directional.range(slot);
+            self.directional.exitance[range].copy_from_slice(&exitance);
+        }
+    }
+
+    /// Every directional leaf's exitance per bin and radiosity, in parallel, from its
+    /// irradiance and what its partner received over the same area (the scattered
+    /// transmission: the partner's element at the leaf's level under the leaf's centre,
+    /// or its leaf there where it is coarser). The oracle's B is the largest exitance
+    /// over bins and bands: a link may carry that much towards its receiver.
+    fn directional_leaves(&mut self) {
+        let bands = self.bands;
+        let leaves: Vec<(u32, usize)> = (0..self.hierarchy.nodes.len() as u32)
+            .filter_map(|n| {
+                let slot = self.directional.slot_of(n)?;
+                (self.hierarchy.children(n).len() == 0).then_some((n, slot))
+            })
+            .collect();
+        let this = &*self;
+        let results: Vec<(Vec<f32>, Vec<f32>)> = leaves
+            .par_iter()
+            .map(|&(n, slot)| {
+                let state = &this.directional;
+                let node = &this.hierarchy.nodes[n as usize];
+                let NodeKind::Element { patch, level, .. } = node.kind else {
+                    unreachable!("a slot belongs to an element");
+                };
+                let side = state.sides[patch as usize]
+                    .as_ref()
+                    .expect("a slot's patch is directional");
+                let centre = (node.lo + node.hi) * 0.5;
+                let across = this.node_at(side.partner as usize, centre, u32::from(level));
+                let partner = state
+                    .slot_of(across)
+                    .map(|s| &state.irradiance[state.range(s)]);
+                let mut exitance = vec![0.0f32; state.stride()];
+                let mut b = vec![0.0f32; bands];
+                let emission = &this.emission[patch as usize * bands..][..bands];
+                let own = &state.irradiance[state.range(slot)];
+                directional::leaf_exitance(side, own, partner, emission, &mut exitance, &mut b);
+                (exitance, b)
+            })
+            .collect();
+        for ((n, slot), (exitance, b)) in leaves.into_iter().zip(results) {
+            self.radiosity_max[n as usize] = exitance.iter().copied().fold(0.0f32, f32::max);
+            self.radiosity[n as usize * bands..][..bands].copy_from_slice(&b);
+            let range = self.directional.range(slot);
+            self.directional.exitance[range].copy_from_slice(&exitance);
+        }
+    }
+}
+
+/// Each directional side's partner is the other side of the same surface, facing the other
+/// way, and its Γ has the solution's bins and bands.
+fn check_directional(patches: &[InputPatch], bands: usize) -> Result<(), RadiosityError> {
+    for (i, p) in patches.iter().enumerate() {
+        let Some(side) = &p.directional else {
+            continue;
+        };
+        let error = |reason: String| RadiosityError::Directional { patch: i, reason };
+        let expected = SPHERE_BINS * SPHERE_BINS * bands;
+        if side.surface.gamma.len() != expected {
+            return Err(error(format!(
+                "Γ has {} values, expected {expected} ({SPHERE_BINS}² bins × {bands} bands)",
+                side.surface.gamma.len()
+            )));
+        }
+        let partner = patches
+            .get(side.partner as usize)
+            .and_then(|q| q.directional.as_ref());
+        if !partner.is_some_and(|q| {
+            q.partner as usize == i && q.front != side.front && q.surface == side.surface
+        }) {
+            return Err(error(format!(
+                "its partner, patch {}, is not the other side of its surface",
+                side.partner
+            )));
+        }
+        let z = side.surface.frame[2] * if side.front { 1.0 } else { -1.0 };
+        if p.shape.normal().dot(z) < 0.999 {
+            return Err(error(
+                "its normal is not its surface frame's z (front) or −z (back)".into(),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// The emitted power (largest band's exitance × area, summed over its patches) of the
@@ -1683,6 +2031,7 @@ mod tests {
                 reflectance: vec![0.5],
                 emission: vec![0.0],
                 surface: 0,
+                directional: None,
             })
             .collect();
         let solution = Radiosity::new(&patches, 1, RadiositySettings::default()).unwrap();

@@ -16,6 +16,7 @@ fn square(p0: Vec3A, e1: Vec3A, e2: Vec3A, reflectance: &[f32], emission: &[f32]
         reflectance: reflectance.to_vec(),
         emission: emission.to_vec(),
         surface: NEXT_SURFACE.fetch_add(1, Ordering::Relaxed),
+        directional: None,
     }
 }
 
@@ -382,6 +383,7 @@ fn a_lamp_lit_corridor_absorbs_what_the_lamp_emits() {
         reflectance: grey.clone(),
         emission: vec![emission],
         surface,
+        directional: None,
     };
     let mut patches = Vec::new();
     for k in 0..8 {

@@ -52,6 +52,7 @@ fn patches() -> Vec<InputPatch> {
             reflectance: vec![0.0],
             emission: vec![0.0],
             surface: j as u32,
+            directional: None,
         })
         .collect();
     for k in 0..PLATES {
@@ -65,6 +66,7 @@ fn patches() -> Vec<InputPatch> {
             reflectance: vec![0.0],
             emission: vec![plate_exitance(k)],
             surface: (5 + k) as u32,
+            directional: None,
         });
     }
     patches

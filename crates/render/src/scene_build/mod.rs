@@ -95,7 +95,7 @@ pub struct RenderScene {
     /// pyramids from it (`tiled_surfaces`), whichever method the scene was built for
     /// (`prism converge` swaps methods on one scene).
     tile_description: Option<Box<SceneDescription>>,
-    /// Per material id, the diffuse-equivalent surface of a `tiled` material, computed by
+    /// Per material id, the radiosity surface of a `tiled` material, computed by
     /// the first `tiled_surfaces` call.
     tiled_surfaces:
         std::sync::OnceLock<Result<Vec<Option<crate::tile_pyramid::TiledSurface>>, String>>,
@@ -205,7 +205,7 @@ impl RenderScene {
         Ok(built)
     }
 
-    /// Per material id, the diffuse-equivalent surface `radiosity` holds a `tiled`
+    /// Per material id, the surface (Γ, τ̄, slab) `radiosity` holds a `tiled`
     /// material by (`None` for other materials; empty without tiled surfaces), computed
     /// from the tiles' pyramids by the first call.
     pub fn tiled_surfaces(&self) -> Result<&[Option<crate::tile_pyramid::TiledSurface>], String> {

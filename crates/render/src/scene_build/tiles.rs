@@ -261,9 +261,9 @@ impl CarrierQuad {
     }
 }
 
-/// Per material id, the diffuse-equivalent surface `radiosity` uses for a `tiled` material
-/// that a shape uses (`None` for every other material): the top level of the tile's
-/// pyramid (`tile_pyramid`, 64 samples per bin pair) and the slab of its tile.
+/// Per material id, the surface `radiosity` holds a `tiled` material by, where a shape uses
+/// it (`None` for every other material): the top level of the tile's pyramid
+/// (`tile_pyramid`, 64 samples per bin pair) and the slab of its tile.
 pub(crate) fn radiosity_surfaces(
     scene: &SceneDescription,
     geometry: &prism_geometry::Geometry,

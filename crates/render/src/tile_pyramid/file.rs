@@ -1,19 +1,24 @@
 //! A tile pyramid on disk (the cache of `prism tile-brdf`): the magic `PRISMBTF`, a version,
-//! the layout (levels, rings, sectors, bands) and the arrays as little-endian f32. A file of
-//! another layout or a damaged one is an error, never a wrong pyramid.
+//! the layout (levels, rings, sectors, bands) and the arrays (Γ, its variance, τ, τ̄) as
+//! little-endian f32. A file of another layout or a damaged one is an error, never a wrong
+//! pyramid.
 
 use super::bins::{RINGS, SECTORS};
 use super::TilePyramid;
 use crate::integrator::radiosity::patches::BANDS;
 
 const MAGIC: &[u8; 8] = b"PRISMBTF";
-const VERSION: u32 = 1;
+const VERSION: u32 = 2;
 
 impl TilePyramid {
     /// The pyramid as bytes (see the module).
     pub fn to_bytes(&self) -> Vec<u8> {
         let mut out = Vec::with_capacity(
-            32 + 4 * (self.gamma.len() + self.gamma_variance.len() + self.transparency.len()),
+            32 + 4
+                * (self.gamma.len()
+                    + self.gamma_variance.len()
+                    + self.transparency.len()
+                    + self.view_transparency.len()),
         );
         out.extend_from_slice(MAGIC);
         for v in [
@@ -30,6 +35,7 @@ impl TilePyramid {
             .iter()
             .chain(&self.gamma_variance)
             .chain(&self.transparency)
+            .chain(&self.view_transparency)
         {
             out.extend_from_slice(&x.to_le_bytes());
         }
@@ -64,7 +70,7 @@ impl TilePyramid {
         let cells = super::level_offset(levels);
         let n_gamma = cells * super::SPHERE_BINS * super::SPHERE_BINS * BANDS;
         let n_tau = cells * super::SPHERE_BINS;
-        let floats = 2 * n_gamma + n_tau;
+        let floats = 2 * n_gamma + 2 * n_tau;
         if bytes.len() != header + 4 * floats {
             return Err(format!(
                 "{} bytes, expected {} for {levels} levels (truncated or damaged)",
@@ -83,7 +89,8 @@ impl TilePyramid {
             levels,
             gamma: values[..n_gamma].to_vec(),
             gamma_variance: values[n_gamma..2 * n_gamma].to_vec(),
-            transparency: values[2 * n_gamma..].to_vec(),
+            transparency: values[2 * n_gamma..2 * n_gamma + n_tau].to_vec(),
+            view_transparency: values[2 * n_gamma + n_tau..].to_vec(),
         })
     }
 }

@@ -16,8 +16,10 @@
 //! of each level that holds its crossing point, so sub-cells describe the light leaving
 //! their part of the carrier.
 
-pub mod bins;
 mod file;
+
+/// The direction bins, shared with the radiosity solution's directional patches.
+pub use prism_radiosity::bins;
 
 use glam::{UVec2, Vec2, Vec3A};
 use prism_geometry::Ray;
@@ -89,6 +91,10 @@ pub struct TilePyramid {
     gamma_variance: Vec<f32>,
     /// τ per (cell, incident bin).
     transparency: Vec<f32>,
+    /// τ̄ per (cell, bin): τ averaged over the bin's directions (uniform in solid angle),
+    /// as Γ averages its outgoing bins: the share a viewer looking back along a direction
+    /// of the bin sees through, on average.
+    view_transparency: Vec<f32>,
 }
 
 /// The first cell of `level` among all levels' cells.
@@ -135,6 +141,11 @@ impl TilePyramid {
     /// `incident`: the fraction that passes through holes unscattered.
     pub fn transparency(&self, level: u32, u: u32, v: u32, incident: usize) -> f32 {
         self.transparency[self.cell(level, u, v) * SPHERE_BINS + incident]
+    }
+
+    /// τ̄ of cell (u, v) of `level` over the directions of `bin` (see the field).
+    pub fn view_transparency(&self, level: u32, u: u32, v: u32, bin: usize) -> f32 {
+        self.view_transparency[self.cell(level, u, v) * SPHERE_BINS + bin]
     }
 
     /// The directional-hemispherical reflectance of the whole period for light from
@@ -205,9 +216,11 @@ impl TilePyramid {
         let mut gamma = vec![0.0f32; cells * SPHERE_BINS * SPHERE_BINS * BANDS];
         let mut gamma_variance = vec![0.0f32; gamma.len()];
         let mut transparency = vec![0.0f32; cells * SPHERE_BINS];
+        let mut view_transparency = vec![0.0f32; cells * SPHERE_BINS];
         for (incident, r) in per_incident.iter().enumerate() {
             for cell in 0..cells {
                 transparency[cell * SPHERE_BINS + incident] = r.transparency[cell];
+                view_transparency[cell * SPHERE_BINS + incident] = r.view_transparency[cell];
                 for o in 0..SPHERE_BINS {
                     for b in 0..BANDS {
                         let k = (cell * SPHERE_BINS + o) * BANDS + b;
@@ -228,26 +241,32 @@ impl TilePyramid {
             gamma,
             gamma_variance,
             transparency,
+            view_transparency,
         })
     }
 }
 
-/// What `radiosity` keeps of a tile's pyramid: the whole period's diffuse-equivalent
-/// reflectance per side (Γ's albedo averaged over incident directions by their projected
-/// solid angle: the reflectance under uniform diffuse light) and its transparency per
-/// direction bin, with the slab the tile fills (metres along the carrier's normal).
+/// What `radiosity` keeps of a tile's pyramid: the whole period's Γ and τ̄ per direction
+/// bin, its diffuse-equivalent reflectance per side (Γ's albedo averaged over incident
+/// directions by their projected solid angle: the reflectance under uniform diffuse light,
+/// which the refinement oracle reads), with the slab the tile fills (metres along the
+/// carrier's normal).
 #[derive(Clone, Debug, PartialEq)]
 pub struct TiledSurface {
     /// Per band, for light arriving on the front (+z) and on the back.
     pub reflectance: [[f32; BANDS]; 2],
-    /// τ per direction bin (level 0), for light travelling against that bin's direction.
+    /// τ̄ per direction bin (level 0): the share of the carrier seen through along the
+    /// bin's directions, averaged over them as Γ averages an outgoing bin.
     pub transparency: Vec<f32>,
+    /// The top level's Γ(i → o) per (incident bin, outgoing bin, band), 1/sr: the
+    /// solution's directional transfer (`prism_radiosity::directional`).
+    pub gamma: Vec<f32>,
     /// The lowest and highest tile heights, metres.
     pub slab_m: (f32, f32),
 }
 
 impl TilePyramid {
-    /// The pyramid's top level as a diffuse-equivalent surface (see [`TiledSurface`]).
+    /// The pyramid's top level as the solution holds it (see [`TiledSurface`]).
     pub fn tiled_surface(&self, slab_m: (f32, f32)) -> TiledSurface {
         let side = |front: bool| -> [f32; BANDS] {
             let mut r = [0.0f32; BANDS];
@@ -263,8 +282,9 @@ impl TilePyramid {
         TiledSurface {
             reflectance: [side(true), side(false)],
             transparency: (0..SPHERE_BINS)
-                .map(|i| self.transparency(0, 0, 0, i))
+                .map(|i| self.view_transparency(0, 0, 0, i))
                 .collect(),
+            gamma: self.gamma[..self.at(1, 0, 0)].to_vec(),
             slab_m,
         }
     }
@@ -277,6 +297,7 @@ struct IncidentResult {
     sum_sq: Vec<f64>,
     count: Vec<f64>,
     transparency: Vec<f32>,
+    view_transparency: Vec<f32>,
 }
 
 /// The simulation scene: tile `tile` repeated over `SIMULATION_PERIODS`² periods centred
@@ -480,29 +501,39 @@ fn simulate_incident(
     } else {
         (bottom, top)
     };
+    // τ̄: the same over directions uniform in the bin.
+    let mut through_bin = vec![0u32; cells];
+    let blocked = |p: Vec3A, beam: Vec3A| {
+        let from = p + beam * (start / beam.z);
+        let to = p + beam * (end / beam.z);
+        scene
+            .geometry
+            .occluded(&Ray::new(from, to - from, 0.0, 1.0))
+    };
     for s in 0..options.transparency_samples {
         let mut stream = sampler.stream(UVec2::new(incident as u32, SPHERE_BINS as u32), s);
         let uv = stream.get_2d();
         let p = crossing(uv);
-        let from = p + beam * (start / beam.z);
-        let to = p + beam * (end / beam.z);
-        let blocked = scene
-            .geometry
-            .occluded(&Ray::new(from, to - from, 0.0, 1.0));
+        let at_centre = blocked(p, beam);
+        let in_bin = blocked(p, -bins::sample_in(incident, stream.get_2d()));
         for cell in cell_indices(uv) {
             lines[cell] += 1;
-            through[cell] += u32::from(!blocked);
+            through[cell] += u32::from(!at_centre);
+            through_bin[cell] += u32::from(!in_bin);
         }
     }
-    let transparency = through
-        .iter()
-        .zip(&lines)
-        .map(|(&t, &n)| if n > 0 { t as f32 / n as f32 } else { 0.0 })
-        .collect();
+    let fraction = |through: &[u32]| -> Vec<f32> {
+        through
+            .iter()
+            .zip(&lines)
+            .map(|(&t, &n)| if n > 0 { t as f32 / n as f32 } else { 0.0 })
+            .collect()
+    };
     Ok(IncidentResult {
         sum,
         sum_sq,
         count,
-        transparency,
+        transparency: fraction(&through),
+        view_transparency: fraction(&through_bin),
     })
 }

@@ -79,12 +79,41 @@ impl DirectIrradiance for PointLikeAndSkyLights<'_> {
             }
         }
     }
+
+    /// The same arrivals one by one, with the direction each comes from (a tiled
+    /// carrier's points bin them).
+    fn irradiance_by_direction(
+        &self,
+        p: Vec3A,
+        n: Vec3A,
+        bands: usize,
+        add: &mut dyn FnMut(Vec3A, &[f32]),
+    ) {
+        let p = self.map.lift(p, n).unwrap_or(p);
+        let ctx = LightSampleContext { p, n };
+        let mut one = vec![0.0f32; bands];
+        let mut arrive = |l: u32, u: Vec2, weight: f32| {
+            one.fill(0.0);
+            if let Some(wi) = self.add_direction(l, &ctx, u, weight, &mut one) {
+                add(wi, &one);
+            }
+        };
+        for &l in &self.lights {
+            arrive(l, Vec2::splat(0.5), 1.0);
+        }
+        for &l in &self.skies {
+            for k in 0..SKY_DIRECTIONS {
+                let (a, b) = prism_radiosity::r2(k, 0);
+                arrive(l, Vec2::new(a, b), 1.0 / SKY_DIRECTIONS as f32);
+            }
+        }
+    }
 }
 
 impl PointLikeAndSkyLights<'_> {
     /// Adds weight · L cos θ / pdf of light `l`'s sample `u` when it is above the surface
     /// and unshadowed (one shadow ray serves every wavelength: media, glazing and masks
-    /// are refused).
+    /// are refused); the direction towards the light when it added.
     fn add_direction(
         &self,
         l: u32,
@@ -92,14 +121,12 @@ impl PointLikeAndSkyLights<'_> {
         u: Vec2,
         weight: f32,
         out: &mut [f32],
-    ) {
+    ) -> Option<Vec3A> {
         let light = self.scene.lights.light(l);
-        let Some(first) = light.sample_li(ctx, u, &self.wavelength_sets[0]) else {
-            return;
-        };
+        let first = light.sample_li(ctx, u, &self.wavelength_sets[0])?;
         let cos = first.wi.dot(ctx.n);
         if cos <= 0.0 || first.pdf.is_nan() || first.pdf <= 0.0 {
-            return;
+            return None;
         }
         let mut counters = PathCounters::default();
         let t = PathTracer::default().transmittance(
@@ -109,9 +136,11 @@ impl PointLikeAndSkyLights<'_> {
             &self.wavelength_sets[0],
             &mut counters,
         );
-        if !t.is_black() {
-            self.add_sample(light, ctx, u, cos, weight, out);
+        if t.is_black() {
+            return None;
         }
+        self.add_sample(light, ctx, u, cos, weight, out);
+        Some(first.wi)
     }
 
     /// Adds weight · L cos θ / pdf of `light`'s sample `u` at every band wavelength.

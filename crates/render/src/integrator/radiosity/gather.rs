@@ -132,9 +132,14 @@ impl SolutionGather for SolvedScene {
         let faces_share = self.map.carrier[si.instance_id as usize].map_or(1.0, |c| {
             (1.0 - self.map.carriers.transparency_towards(c as usize, wo)).max(0.05)
         });
+        // A directional patch (a tiled carrier) sends its exitance towards wo's bin.
+        let exitance = self
+            .solution
+            .exitance_towards(patch, si.p, wo)
+            .unwrap_or(leaf.radiosity);
         Some(SampledSpectrum::from_fn(|lane| {
             let k = band_of(wavelengths.wavelength_nm(lane));
-            (leaf.radiosity[k] - e[k]).max(0.0) * std::f32::consts::FRAC_1_PI / faces_share
+            (exitance[k] - e[k]).max(0.0) * std::f32::consts::FRAC_1_PI / faces_share
         }))
     }
 

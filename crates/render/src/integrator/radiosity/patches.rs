@@ -5,6 +5,7 @@
 use glam::Vec3A;
 use prism_geometry::triangle_geometry::triangle_local_geometry;
 use prism_geometry::{Geometry, Shape, NO_MATERIAL};
+use prism_radiosity::directional::DirectionalSide;
 use prism_radiosity::{ElementShape, InputPatch};
 use prism_spectrum::Spectrum;
 
@@ -151,9 +152,11 @@ pub fn scene_patches(scene: &RenderScene) -> Result<(Vec<InputPatch>, PatchMap),
         map.carrier.push(carrier.map(|k| k as u32));
         map.meshing.push(None);
         if let Some(c) = carrier.map(|k| &map.carriers.0[k]) {
-            // Front and back, each with the pyramid's reflectance for its side.
+            // Front and back, each directional by the pyramid's top level (its diffuse
+            // equivalent for the oracle).
             let shape = c.shape();
-            map.first_patch.push(Some(patches.len() as u32));
+            let first = patches.len() as u32;
+            map.first_patch.push(Some(first));
             map.sides.push(2);
             for (side, n) in [c.normal, -c.normal].into_iter().enumerate() {
                 let oriented_shape = oriented(shape, n);
@@ -162,6 +165,11 @@ pub fn scene_patches(scene: &RenderScene) -> Result<(Vec<InputPatch>, PatchMap),
                     reflectance: c.reflectance[side].clone(),
                     emission: vec![0.0; BANDS],
                     surface: instance_id as u32,
+                    directional: Some(DirectionalSide {
+                        surface: c.surface.clone(),
+                        front: side == 0,
+                        partner: first + 1 - side as u32,
+                    }),
                 });
                 map.normals.push(oriented_shape.normal());
             }
@@ -251,6 +259,7 @@ pub fn scene_patches(scene: &RenderScene) -> Result<(Vec<InputPatch>, PatchMap),
                 reflectance: rho.clone(),
                 emission: emitted.clone(),
                 surface: instance_id as u32,
+                directional: None,
             });
             map.normals.push(front.normal());
             if both {
@@ -264,6 +273,7 @@ pub fn scene_patches(scene: &RenderScene) -> Result<(Vec<InputPatch>, PatchMap),
                         none.clone()
                     },
                     surface: instance_id as u32,
+                    directional: None,
                 });
                 map.normals.push(back.normal());
             }

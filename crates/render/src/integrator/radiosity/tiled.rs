@@ -1,14 +1,18 @@
-//! Tiled surfaces in the radiosity solution (Mostefaoui et al. §3, diffuse part): a tiled
-//! carrier is one patch per side whose reflectance is its tile pyramid's top level
-//! (`tile_pyramid::TiledSurface`), relative to the irradiance on the carrier's plane.
-//! Light through the tile's holes is not reflected: rays cross the carrier through its
-//! virtual geometry, so the transfers behind it see exactly the transparency τ (the
-//! paper's fourth kind of transfer). Points of a tiled patch therefore take their rays
+//! Tiled surfaces in the radiosity solution (Mostefaoui et al. §3): a tiled carrier is one
+//! patch per side, directional by its tile pyramid's top level Γ
+//! (`tile_pyramid::TiledSurface`, `prism_radiosity::directional`): light arriving on
+//! either side leaves both by Γ, per direction bin, relative to the irradiance on the
+//! carrier's plane. Light through the tile's holes is not in Γ: rays cross the carrier
+//! through its virtual geometry, so the transfers behind it see exactly the transparency
+//! (the paper's fourth kind of transfer). Points of a tiled patch therefore take their rays
 //! from above the tile's slab on their side, where the whole macro-surface's irradiance
 //! arrives: from the plane itself they would start inside the weave.
 
+use std::sync::Arc;
+
 use glam::Vec3A;
 use prism_geometry::{Geometry, Shape};
+use prism_radiosity::directional::DirectionalSurface;
 use prism_radiosity::ElementShape;
 
 use crate::tile_pyramid::bins;
@@ -38,10 +42,12 @@ pub struct TiledCarrier {
     pub tangent: Vec3A,
     /// The tile's heights along `normal`, metres.
     pub slab_m: (f32, f32),
-    /// τ per direction bin (`tile_pyramid::bins`).
+    /// τ̄ per direction bin (`tile_pyramid::bins`): averaged over the bin's directions.
     pub transparency: Vec<f32>,
-    /// Reflectance per band, front then back.
+    /// Reflectance per band, front then back (the diffuse equivalent the oracle reads).
     pub reflectance: [Vec<f32>; 2],
+    /// Its top level's Γ in the carrier's frame (tangent, normal × tangent, normal).
+    pub surface: Arc<DirectionalSurface>,
 }
 
 /// Every tiled carrier of a scene.
@@ -82,16 +88,21 @@ impl TiledCarriers {
             ));
             // The tile-to-world map keeps heights in metres along the unit normal.
             let normal = t.vector(Vec3A::Z).normalize();
+            let tangent = e1.normalize();
             out.push(TiledCarrier {
                 instance: instance as u32,
                 p0: t.point(Vec3A::ZERO),
                 e1,
                 e2,
                 normal,
-                tangent: e1.normalize(),
+                tangent,
                 slab_m: surface.slab_m,
                 transparency: surface.transparency.clone(),
                 reflectance: surface.reflectance.map(|r| r.to_vec()),
+                surface: Arc::new(DirectionalSurface {
+                    frame: [tangent, normal.cross(tangent), normal],
+                    gamma: surface.gamma.clone(),
+                }),
             });
         }
         Ok(Self(out))

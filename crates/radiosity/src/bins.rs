@@ -1,6 +1,7 @@
-//! Direction bins over the sphere of a tile's carrier (z = its normal): the paper's
+//! Direction bins over the sphere of a surface's frame (z = its normal): the paper's
 //! "discrete decomposition of the hemisphere into bins" (Mostefaoui et al. §3), one set above
-//! the carrier and one below it for transmission. Each hemisphere has `RINGS` rings of
+//! the surface and one below it for transmission. A tile's BRDF/BTDF pyramid and the
+//! solution's directional patches (`directional.rs`) share them. Each hemisphere has `RINGS` rings of
 //! equal solid angle (cos θ uniform) × `SECTORS` azimuth sectors, so every bin spans
 //! 2π/(RINGS·SECTORS) sr.
 
