@@ -57,6 +57,7 @@ const DECISIONS: &[(&str, bool, bool, &[SceneFeature])] = {
         ("stress/spiky-spectrum.json", false, true, &[Quadrics]),
         ("stress/spot-fog-glass.json", false, false, &[ParticipatingMedia, NonLambertianBsdfs, Quadrics, NonRectangleAreaLights]),
         ("textures.json", false, true, &[OpacityMasks, Textures, NonLambertianBsdfs, TwoSidedMaterials, ShadingNormalMaps, Quadrics, InfiniteLights]),
+        ("tiled/louvre-room.json", false, true, &[TwoSidedMaterials, DeltaLights, RadiositySolution, TiledSurfaces]),
         ("tiled/wicker-room.json", false, true, &[VertexNormals, RadiositySolution, TiledSurfaces]),
         ("tiled/wicker-wall.json", false, true, &[VertexNormals, DeltaLights, TiledSurfaces]),
     ]
