@@ -1736,23 +1736,8 @@ impl Radiosity {
                 free += self.free_area[c as usize];
             }
             self.free_area[n as usize] = free;
-            let mut arriving = vec![0.0f32; if slot.is_some() { total_bins.len() } else { 0 }];
-            for c in children {
-                let w = self.pull_weight(n, c);
-                for (v, cb) in b
-                    .iter_mut()
-                    .zip(&self.radiosity[c as usize * bands..][..bands])
-                {
-                    *v += w * cb;
-                }
-                b_max = b_max.max(self.radiosity_max[c as usize]);
-                if let Some(child) = self.directional.slot_of(c).filter(|_| slot.is_some()) {
-                    let d = &self.directional;
-                    for (v, ce) in arriving.iter_mut().zip(&d.irradiance[d.range(child)]) {
-                        *v += w * ce;
-                    }
-                }
-            }
+            let arriving;
+            (b, b_max, arriving) = self.children_average(n, |d| &d.irradiance);
             if let Some(slot) = slot {
                 let range = self.directional.range(slot);
                 self.directional.irradiance[range].copy_from_slice(&arriving);
@@ -1779,20 +1764,39 @@ impl Radiosity {
         if children.len() == 0 {
             return;
         }
+        for c in children {
+            self.pull_node(c);
+        }
+        let (b, b_max, exitance) = self.children_average(n, |d| &d.exitance);
+        self.radiosity[n as usize * self.bands..][..self.bands].copy_from_slice(&b);
+        self.radiosity_max[n as usize] = b_max;
+        if let Some(slot) = self.directional.slot_of(n) {
+            let range = self.directional.range(slot);
+            self.directional.exitance[range].copy_from_slice(&exitance);
+        }
+    }
+
+    /// Over node `n`'s children (`pull_weight`): the average radiosity, the largest band
+    /// radiosity, and for a directional node the average of the directional values
+    /// `values` picks (empty otherwise).
+    fn children_average(
+        &self,
+        n: u32,
+        values: impl Fn(&DirectionalState) -> &Vec<f32>,
+    ) -> (Vec<f32>, f32, Vec<f32>) {
         let bands = self.bands;
-        let slot = self.directional.slot_of(n);
+        let directional = self.directional.slot_of(n).is_some();
         let mut b = vec![0.0f32; bands];
         let mut b_max = 0.0f32;
-        let mut exitance = vec![
+        let mut average = vec![
             0.0f32;
-            if slot.is_some() {
+            if directional {
                 self.directional.stride()
             } else {
                 0
             }
         ];
-        for c in children {
-            self.pull_node(c);
+        for c in self.hierarchy.children(n) {
             let w = self.pull_weight(n, c);
             for (v, cb) in b
                 .iter_mut()
@@ -1801,19 +1805,14 @@ impl Radiosity {
                 *v += w * cb;
             }
             b_max = b_max.max(self.radiosity_max[c as usize]);
-            if let Some(child) = self.directional.slot_of(c).filter(|_| slot.is_some()) {
+            if let Some(child) = self.directional.slot_of(c).filter(|_| directional) {
                 let d = &self.directional;
-                for (v, cm) in exitance.iter_mut().zip(&d.exitance[d.range(child)]) {
-                    *v += w * cm;
+                for (v, cv) in average.iter_mut().zip(&values(d)[d.range(child)]) {
+                    *v += w * cv;
                 }
             }
         }
-        self.radiosity[n as usize * bands..][..bands].copy_from_slice(&b);
-        self.radiosity_max[n as usize] = b_max;
-        if let Some(slot) = slot {
-            let range = self.directional.range(slot);
-            self.directional.exitance[range].copy_from_slice(&exitance);
-        }
+        (b, b_max, average)
     }
 
     /// Every directional leaf's exitance per bin and radiosity, in parallel, from its
