@@ -7,9 +7,8 @@
 mod support;
 use support::{sensor_lux, Dir};
 
-/// scenes/tiled/louvre-room.json with the integrator `integrator` (JSON) and 32 768
-/// samples per sensor point, written into `dir` with its tile.
-fn louvre_room(dir: &Dir, integrator: &str) -> prism_render::RenderScene {
+/// scenes/tiled/louvre-room.json as `edit` leaves it, written into `dir` with its tile.
+fn louvre_scene(dir: &Dir, edit: impl FnOnce(&mut serde_json::Value)) -> prism_render::RenderScene {
     let scenes = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes/tiled");
     std::fs::create_dir_all(dir.0.join("tiles")).unwrap();
     for file in ["louvre.obj", "louvre.mtl"] {
@@ -21,11 +20,19 @@ fn louvre_room(dir: &Dir, integrator: &str) -> prism_render::RenderScene {
     }
     let text = std::fs::read_to_string(scenes.join("louvre-room.json")).unwrap();
     let mut json: serde_json::Value = serde_json::from_str(&text).unwrap();
-    json["integrator"] = serde_json::from_str(integrator).unwrap();
-    for sensor in json["sensors"].as_array_mut().unwrap() {
-        sensor["samples"] = serde_json::json!(32768);
-    }
+    edit(&mut json);
     dir.scene_at(&json.to_string(), Some(8))
+}
+
+/// The louvre room with the integrator `integrator` (JSON) and 32 768 samples per sensor
+/// point.
+fn louvre_room(dir: &Dir, integrator: &str) -> prism_render::RenderScene {
+    louvre_scene(dir, |json| {
+        json["integrator"] = serde_json::from_str(integrator).unwrap();
+        for sensor in json["sensors"].as_array_mut().unwrap() {
+            sensor["samples"] = serde_json::json!(32768);
+        }
+    })
 }
 
 /// Every point within 6 % + 4 s.e. of `path`. Measured (2026-12-06, path's s.e. 0.7 …
@@ -53,4 +60,30 @@ fn radiosity_carries_light_through_louvres_by_their_direction_bins() {
         failures += usize::from((g - e).abs() > 0.06 * e + 4.0 * se);
     }
     assert_eq!(failures, 0);
+}
+
+/// A carrier mirrored by its transform keeps the tile's own y as its frame's second axis
+/// (its frame is then left-handed): the louvres' Γ is not turned into its mirror image.
+#[test]
+fn a_mirrored_carrier_keeps_the_tiles_frame() {
+    let dir = Dir::new("tiled-louvres", "mirrored");
+    let scene = louvre_scene(&dir, |json| {
+        for shape in json["shapes"].as_array_mut().unwrap() {
+            if shape["name"] == "louvre" {
+                let transform = shape["transform"].as_array_mut().unwrap();
+                transform.insert(0, serde_json::json!({"scale": [1, -1, 1]}));
+            }
+        }
+    });
+    let (_, map) = prism_render::integrator::radiosity::patches::scene_patches(&scene).unwrap();
+    let carrier = &map.carriers.0[0];
+    let [x, y, z] = carrier.surface.frame;
+    // The mirror flips the tile's y, which the rotation then takes to world +z (−z
+    // unmirrored); the normal stays +y, and n × t would point along −z.
+    assert!((z - glam::Vec3A::Y).length() < 1e-5, "{z}");
+    assert!((y - glam::Vec3A::Z).length() < 1e-5, "{y}");
+    assert!(
+        x.cross(y).dot(z) < -0.999,
+        "a left-handed frame: {x} {y} {z}"
+    );
 }

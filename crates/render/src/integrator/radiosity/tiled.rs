@@ -40,13 +40,16 @@ pub struct TiledCarrier {
     pub normal: Vec3A,
     /// Unit tangent along `e1` (the tile's x).
     pub tangent: Vec3A,
+    /// Unit bitangent: the tile's y, made orthogonal to the tangent and the normal (−(n ×
+    /// t) under a mirroring transform, where the tile's frame is left-handed).
+    pub bitangent: Vec3A,
     /// The tile's heights along `normal`, metres.
     pub slab_m: (f32, f32),
     /// τ̄ per direction bin (`tile_pyramid::bins`): averaged over the bin's directions.
     pub transparency: Vec<f32>,
     /// Reflectance per band, front then back (the diffuse equivalent the oracle reads).
     pub reflectance: [Vec<f32>; 2],
-    /// Its top level's Γ in the carrier's frame (tangent, normal × tangent, normal).
+    /// Its top level's Γ in the carrier's frame (tangent, bitangent, normal).
     pub surface: Arc<DirectionalSurface>,
 }
 
@@ -89,6 +92,8 @@ impl TiledCarriers {
             // The tile-to-world map keeps heights in metres along the unit normal.
             let normal = t.vector(Vec3A::Z).normalize();
             let tangent = e1.normalize();
+            let y = t.vector(Vec3A::Y);
+            let bitangent = (y - normal * normal.dot(y) - tangent * tangent.dot(y)).normalize();
             out.push(TiledCarrier {
                 instance: instance as u32,
                 p0: t.point(Vec3A::ZERO),
@@ -96,11 +101,12 @@ impl TiledCarriers {
                 e2,
                 normal,
                 tangent,
+                bitangent,
                 slab_m: surface.slab_m,
                 transparency: surface.transparency.clone(),
                 reflectance: surface.reflectance.map(|r| r.to_vec()),
                 surface: Arc::new(DirectionalSurface {
-                    frame: [tangent, normal.cross(tangent), normal],
+                    frame: [tangent, bitangent, normal],
                     gamma: surface.gamma.clone(),
                 }),
             });
@@ -139,8 +145,7 @@ impl TiledCarriers {
     /// through.
     pub fn transparency_towards(&self, carrier: usize, wo: Vec3A) -> f32 {
         let c = &self.0[carrier];
-        let bitangent = c.normal.cross(c.tangent);
-        let local = Vec3A::new(wo.dot(c.tangent), wo.dot(bitangent), wo.dot(c.normal));
+        let local = Vec3A::new(wo.dot(c.tangent), wo.dot(c.bitangent), wo.dot(c.normal));
         c.transparency[bins::bin_of(local.normalize_or_zero())]
     }
 }
