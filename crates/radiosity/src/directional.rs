@@ -20,7 +20,8 @@ use crate::bins::{self, HEMISPHERE_BINS, SPHERE_BINS};
 /// The Γ of a two-sided directional surface.
 #[derive(Clone, Debug, PartialEq)]
 pub struct DirectionalSurface {
-    /// Its frame: x, y and z, the front side's normal (unit, orthogonal, right-handed).
+    /// Its frame: x, y and z, the front side's normal (unit, orthogonal; left-handed where
+    /// a mirroring transform placed the surface).
     pub frame: [Vec3A; 3],
     /// Γ(i → o) per (incident sphere bin, outgoing sphere bin, band), 1/sr: the radiance
     /// leaving towards o per unit irradiance on the surface's plane from i. Outgoing bins on
@@ -139,7 +140,8 @@ impl DirectionalState {
         slot * self.stride()..(slot + 1) * self.stride()
     }
 
-    /// The exitance of `node` (a slot of `patch`'s side) towards world direction `w`.
+    /// The exitance of the node in `slot` (an element of `side`) towards world direction
+    /// `w` (unit, leaving it).
     pub(crate) fn exitance_towards(&self, slot: usize, side: &DirectionalSide, w: Vec3A) -> &[f32] {
         let bin = side.side_bin(w);
         &self.exitance[self.range(slot)][bin * self.bands..][..self.bands]
@@ -185,15 +187,6 @@ pub(crate) fn leaf_exitance(
             // Γ(i → o) for the side's outgoing bins o, one after another.
             let row = &gamma[((first_in + i) * SPHERE_BINS + first_out) * bands..]
                 [..HEMISPHERE_BINS * bands];
-            if let Ok(e) = <&[f32; 16]>::try_from(e) {
-                // The renderer's 16 bands, unrolled (the per-sweep cost of a tiled scene).
-                for (m, g) in out.chunks_exact_mut(16).zip(row.chunks_exact(16)) {
-                    for k in 0..16 {
-                        m[k] += g[k] * e[k];
-                    }
-                }
-                continue;
-            }
             for (m, g) in out.chunks_exact_mut(bands).zip(row.chunks_exact(bands)) {
                 for ((m, g), e) in m.iter_mut().zip(g).zip(e) {
                     *m += g * e;

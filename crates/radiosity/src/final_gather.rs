@@ -253,10 +253,9 @@ impl Radiosity {
     /// Reflected radiosity (B − B_e) per band at point `y` of input patch `patch`; on a
     /// directional patch its reflected exitance towards `to`.
     fn reflected_at(&self, patch: u32, y: Vec3A, to: Vec3A, out: &mut [f32; MAX_BANDS]) {
-        let b = match self.exitance_towards(patch as usize, y, (to - y).normalize_or_zero()) {
-            Some(exitance) => exitance,
-            None => self.node_radiosity(self.leaf_node(patch as usize, y)),
-        };
+        let b = self
+            .leaf_towards(patch as usize, y, (to - y).normalize_or_zero())
+            .radiosity;
         let e = self.emission(patch as usize);
         for k in 0..self.bands {
             out[k] = (b[k] - e[k]).max(0.0);

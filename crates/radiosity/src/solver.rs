@@ -198,10 +198,11 @@ pub struct LeafElement<'a> {
     pub covered_fraction: f32,
 }
 
-/// The leaf element at a point (`Radiosity::leaf_at`).
+/// The leaf element at a point, seen from a direction (`Radiosity::leaf_towards`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LeafAt<'a> {
-    /// Radiosity per band (emission included).
+    /// Radiosity per band (emission included); on a directional patch the exitance
+    /// towards the direction asked for.
     pub radiosity: &'a [f32],
     pub area_m2: f32,
 }
@@ -302,19 +303,6 @@ impl Link {
     fn parts(&self) -> impl Iterator<Item = (u32, f32)> + '_ {
         let own = self.source_shares.is_empty().then_some((self.source, 1.0));
         own.into_iter().chain(self.source_shares.iter().copied())
-    }
-
-    /// Adds what the link transfers, F · Σ share · B(node) per band (F · B(source)
-    /// without shares), to the receiver's irradiance `out`.
-    #[inline]
-    fn add_transfer(&self, radiosity: &[f32], bands: usize, out: &mut [f32]) {
-        for (node, share) in self.parts() {
-            let weight = self.form_factor * share;
-            let b = &radiosity[node as usize * bands..][..bands];
-            for (o, v) in out.iter_mut().zip(b) {
-                *o += weight * v;
-            }
-        }
     }
 }
 
@@ -452,11 +440,18 @@ impl Radiosity {
         self.node_radiosity(self.leaf_node(patch, p))
     }
 
-    /// The leaf element `radiosity_at` reads: its radiosity per band and its area.
-    pub fn leaf_at(&self, patch: usize, p: Vec3A) -> LeafAt<'_> {
+    /// The leaf element `radiosity_at` reads, its area and what it sends towards `w`
+    /// (unit, leaving the patch): on a directional patch `radiosity` is the leaf's
+    /// exitance towards `w` ([`Self::exitance_towards`]); a diffuse patch sends its
+    /// radiosity in every direction.
+    pub fn leaf_towards(&self, patch: usize, p: Vec3A, w: Vec3A) -> LeafAt<'_> {
         let n = self.leaf_node(patch, p);
+        let radiosity = match self.directional_side(n) {
+            Some((slot, side)) => self.directional.exitance_towards(slot, side, w),
+            None => self.node_radiosity(n),
+        };
         LeafAt {
-            radiosity: self.node_radiosity(n),
+            radiosity,
             area_m2: self.hierarchy.nodes[n as usize].area_m2,
         }
     }
@@ -1527,11 +1522,7 @@ impl Radiosity {
             Vec::new()
         };
         for sweep in 1..=self.settings.max_sweeps {
-            if self.directional.any() {
-                self.gather_directional(&link_bins);
-            } else {
-                self.gather();
-            }
+            self.gather(&link_bins);
             let before = self.radiosity.clone();
             self.push_pull();
             let largest = self.radiosity.iter().copied().fold(0.0f32, f32::max);
@@ -1548,23 +1539,7 @@ impl Radiosity {
         self.settings.max_sweeps
     }
 
-    /// Irradiance over each node's links from the sources' current radiosities.
-    fn gather(&mut self) {
-        let bands = self.bands;
-        let radiosity = &self.radiosity;
-        let links = &self.links;
-        self.gathered
-            .par_chunks_mut(bands)
-            .zip(links.par_iter())
-            .for_each(|(out, links)| {
-                out.fill(0.0);
-                for link in links {
-                    link.add_transfer(radiosity, bands, out);
-                }
-            });
-    }
-
-    /// The direction bins of every link part (`Link::add_transfer`'s (node, share)), per
+    /// The direction bins of every link part (`Link::parts`), per
     /// receiver in link order: the source's outgoing bin towards the receiver and the
     /// receiver's incident bin towards the source, from centre to centre (`NO_BIN` where
     /// that end is not directional). Fixed while links are: built once per solve.
@@ -1596,10 +1571,11 @@ impl Radiosity {
             .collect()
     }
 
-    /// `gather` where some patches are directional: a directional source sends its
-    /// exitance in the bin towards the receiver, and a directional receiver also keeps
-    /// what arrives per incident bin (`link_bins`).
-    fn gather_directional(&mut self, link_bins: &[Box<[[u8; 2]]>]) {
+    /// Irradiance over each node's links from the sources' current radiosities, F · Σ
+    /// share · B(node) per band. Where some patches are directional (`link_bins`, empty
+    /// otherwise), a directional source sends its exitance in the bin towards the
+    /// receiver, and a directional receiver also keeps what arrives per incident bin.
+    fn gather(&mut self, link_bins: &[Box<[[u8; 2]]>]) {
         let bands = self.bands;
         let stride = self.directional.stride();
         let state = &self.directional;
@@ -1609,16 +1585,17 @@ impl Radiosity {
             .gathered
             .par_chunks_mut(bands)
             .zip(links.par_iter())
-            .zip(link_bins.par_iter())
             .enumerate()
-            .map(|(r, ((out, links), bins))| {
+            .map(|(r, (out, links))| {
                 out.fill(0.0);
                 let receiver = state.slot_of(r as u32);
                 let mut binned = vec![0.0f32; receiver.map_or(0, |_| stride)];
-                let mut bins = bins.iter();
+                let mut bins = link_bins.get(r).map(|b| b.iter());
                 for link in links {
                     for (node, share) in link.parts() {
-                        let [sent, arrives] = *bins.next().expect("a bin pair per link part");
+                        let [sent, arrives] = bins.as_mut().map_or([NO_BIN; 2], |b| {
+                            *b.next().expect("a bin pair per link part")
+                        });
                         let weight = link.form_factor * share;
                         let b = match state.slot_of(node).filter(|_| sent != NO_BIN) {
                             Some(slot) => {

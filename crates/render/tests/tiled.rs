@@ -383,17 +383,11 @@ fn radiosity_with_a_tiled_panel_agrees_with_path_at_the_sensors() {
 /// (30 × 20 stones of 0.2 m, 15 mm high) and the integrator `integrator` (JSON), written
 /// into `dir` as `scene.json`.
 fn paved_office(dir: &Dir, integrator: &str) -> prism_render::RenderScene {
-    let office = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes/office");
-    std::fs::create_dir_all(dir.0.join("tiles")).unwrap();
-    for file in ["paving.obj", "paving.mtl"] {
-        std::fs::copy(
-            office.join("tiles").join(file),
-            dir.0.join("tiles").join(file),
-        )
-        .unwrap();
-    }
-    let text = std::fs::read_to_string(office.join("office.json")).unwrap();
-    let mut json: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let office = support::scenes_dir().join("office");
+    let mut json = dir.repository_json(
+        "office/office.json",
+        &["tiles/paving.obj", "tiles/paving.mtl"],
+    );
     json["integrator"] = serde_json::from_str(integrator).unwrap();
     json["tiles"] = serde_json::json!({"paving": {"mesh": "tiles/paving.obj", "period_m": [0.2, 0.2],
         "materials": {"grout": "grout", "stone": "stone"}}});

@@ -5,21 +5,14 @@
 //! and transmitted, τ̄ through the gaps) and must read what `path` reads below them.
 
 mod support;
-use support::{sensor_lux, Dir};
+use support::{lux_disagreements_within, sensor_lux, Dir};
 
 /// scenes/tiled/louvre-room.json as `edit` leaves it, written into `dir` with its tile.
 fn louvre_scene(dir: &Dir, edit: impl FnOnce(&mut serde_json::Value)) -> prism_render::RenderScene {
-    let scenes = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes/tiled");
-    std::fs::create_dir_all(dir.0.join("tiles")).unwrap();
-    for file in ["louvre.obj", "louvre.mtl"] {
-        std::fs::copy(
-            scenes.join("tiles").join(file),
-            dir.0.join("tiles").join(file),
-        )
-        .unwrap();
-    }
-    let text = std::fs::read_to_string(scenes.join("louvre-room.json")).unwrap();
-    let mut json: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let mut json = dir.repository_json(
+        "tiled/louvre-room.json",
+        &["tiles/louvre.obj", "tiles/louvre.mtl"],
+    );
     edit(&mut json);
     dir.scene_at(&json.to_string(), Some(8))
 }
@@ -50,16 +43,7 @@ fn radiosity_carries_light_through_louvres_by_their_direction_bins() {
     let expected = sensor_lux(&path, &dir, 3);
     let radiosity = louvre_room(&dir, r#"{"type": "radiosity", "error_bound_rel": 0.001}"#);
     let got = sensor_lux(&radiosity, &dir, 3);
-    let mut failures = 0;
-    for (i, (&(e, e_se), &(g, g_se))) in expected.iter().zip(&got).enumerate() {
-        let se = (e_se * e_se + g_se * g_se).sqrt();
-        eprintln!(
-            "point {i}: radiosity {g:.2} lx, path {e:.2} lx ({:+.2} %), s.e. {se:.2}",
-            100.0 * (g / e - 1.0)
-        );
-        failures += usize::from((g - e).abs() > 0.06 * e + 4.0 * se);
-    }
-    assert_eq!(failures, 0);
+    assert_eq!(lux_disagreements_within(&expected, &got, 0.06), 0);
 }
 
 /// A carrier mirrored by its transform keeps the tile's own y as its frame's second axis

@@ -26,6 +26,18 @@ impl Dir {
         std::fs::write(&p, bytes).unwrap();
         p
     }
+    /// The repository's scene `name` (under scenes/) as JSON, with its data files `files`
+    /// (paths relative to the scene's folder) copied into this folder at the same paths.
+    pub fn repository_json(&self, name: &str, files: &[&str]) -> serde_json::Value {
+        let scene = scenes_dir().join(name);
+        let folder = scene.parent().unwrap();
+        for file in files {
+            let to = self.0.join(file);
+            std::fs::create_dir_all(to.parent().unwrap()).unwrap();
+            std::fs::copy(folder.join(file), to).unwrap();
+        }
+        serde_json::from_str(&std::fs::read_to_string(&scene).unwrap()).unwrap()
+    }
     pub fn scene(&self, json: &str) -> RenderScene {
         self.scene_at(json, None)
     }
@@ -150,11 +162,14 @@ pub fn repository_scene(name: &str, resolution: u32) -> RenderScene {
     repository_scene_at(name, UVec2::splat(resolution))
 }
 
+/// The repository's scenes/ folder.
+pub fn scenes_dir() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes")
+}
+
 /// The repository's scene `name` (under scenes/) at `resolution` (width, height).
 pub fn repository_scene_at(name: &str, resolution: UVec2) -> RenderScene {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../scenes")
-        .join(name);
+    let path = scenes_dir().join(name);
     let description = load_scene(&path).unwrap_or_else(|e| panic!("{e}"));
     RenderScene::build(&description, Some(resolution)).unwrap_or_else(|e| panic!("{e}"))
 }
@@ -182,6 +197,15 @@ pub fn sensor_lux(scene: &RenderScene, dir: &Dir, seed: u64) -> Vec<(f64, f64)> 
 /// The points where radiosity's reading `got` differs from path's `expected` by more than
 /// 2 % + 4 combined s.e. (each printed, with its relative difference).
 pub fn lux_disagreements(expected: &[(f64, f64)], got: &[(f64, f64)]) -> usize {
+    lux_disagreements_within(expected, got, 0.02)
+}
+
+/// As [`lux_disagreements`] with `relative` in place of 2 %.
+pub fn lux_disagreements_within(
+    expected: &[(f64, f64)],
+    got: &[(f64, f64)],
+    relative: f64,
+) -> usize {
     let mut failures = 0;
     for (i, (&(e, e_se), &(g, g_se))) in expected.iter().zip(got).enumerate() {
         let se = (e_se * e_se + g_se * g_se).sqrt();
@@ -189,7 +213,7 @@ pub fn lux_disagreements(expected: &[(f64, f64)], got: &[(f64, f64)]) -> usize {
             "point {i}: radiosity {g:.3} lx, path {e:.3} lx ({:+.2} %), s.e. {se:.3}",
             100.0 * (g / e - 1.0)
         );
-        failures += usize::from((g - e).abs() > 0.02 * e + 4.0 * se);
+        failures += usize::from((g - e).abs() > relative * e + 4.0 * se);
     }
     failures
 }

@@ -65,19 +65,10 @@ impl<'a> PointLikeAndSkyLights<'a> {
 
 impl DirectIrradiance for PointLikeAndSkyLights<'_> {
     fn irradiance(&self, p: Vec3A, n: Vec3A, out: &mut [f32]) {
-        let p = self.map.lift(p, n).unwrap_or(p);
-        let ctx = LightSampleContext { p, n };
-        for &l in &self.lights {
-            self.add_direction(l, &ctx, Vec2::splat(0.5), 1.0, out);
-        }
-        for &l in &self.skies {
-            for k in 0..SKY_DIRECTIONS {
-                // The same stratified directions at every point.
-                let (a, b) = prism_radiosity::r2(k, 0);
-                let u = Vec2::new(a, b);
-                self.add_direction(l, &ctx, u, 1.0 / SKY_DIRECTIONS as f32, out);
-            }
-        }
+        let ctx = self.context(p, n);
+        self.for_each_sample(|l, u, weight| {
+            self.add_direction(l, &ctx, u, weight, out);
+        });
     }
 
     /// The same arrivals one by one, with the direction each comes from (a tiled
@@ -89,22 +80,36 @@ impl DirectIrradiance for PointLikeAndSkyLights<'_> {
         bands: usize,
         add: &mut dyn FnMut(Vec3A, &[f32]),
     ) {
-        let p = self.map.lift(p, n).unwrap_or(p);
-        let ctx = LightSampleContext { p, n };
+        let ctx = self.context(p, n);
         let mut one = vec![0.0f32; bands];
-        let mut arrive = |l: u32, u: Vec2, weight: f32| {
+        self.for_each_sample(|l, u, weight| {
             one.fill(0.0);
             if let Some(wi) = self.add_direction(l, &ctx, u, weight, &mut one) {
                 add(wi, &one);
             }
-        };
+        });
+    }
+}
+
+impl PointLikeAndSkyLights<'_> {
+    /// The point `p` (normal `n`) where its rays start (`PatchMap::lift`).
+    fn context(&self, p: Vec3A, n: Vec3A) -> LightSampleContext {
+        LightSampleContext {
+            p: self.map.lift(p, n).unwrap_or(p),
+            n,
+        }
+    }
+
+    /// Every light sample a point takes, as (light, sample, weight): one per delta light,
+    /// `SKY_DIRECTIONS` per sky (the same stratified directions at every point).
+    fn for_each_sample(&self, mut sample: impl FnMut(u32, Vec2, f32)) {
         for &l in &self.lights {
-            arrive(l, Vec2::splat(0.5), 1.0);
+            sample(l, Vec2::splat(0.5), 1.0);
         }
         for &l in &self.skies {
             for k in 0..SKY_DIRECTIONS {
                 let (a, b) = prism_radiosity::r2(k, 0);
-                arrive(l, Vec2::new(a, b), 1.0 / SKY_DIRECTIONS as f32);
+                sample(l, Vec2::new(a, b), 1.0 / SKY_DIRECTIONS as f32);
             }
         }
     }

@@ -122,7 +122,8 @@ impl SolutionGather for SolvedScene {
         let Some(patch) = self.map.patch_of(si.instance_id, si.primitive_id, si.p, wo) else {
             return Some(SampledSpectrum::splat(0.0));
         };
-        let leaf = self.solution.leaf_at(patch, si.p);
+        // A directional patch (a tiled carrier) sends its exitance towards wo's bin.
+        let leaf = self.solution.leaf_towards(patch, si.p, wo);
         if seen_from_m.is_some_and(|d| d * d < leaf.area_m2) {
             return None;
         }
@@ -132,14 +133,9 @@ impl SolutionGather for SolvedScene {
         let faces_share = self.map.carrier[si.instance_id as usize].map_or(1.0, |c| {
             (1.0 - self.map.carriers.transparency_towards(c as usize, wo)).max(0.05)
         });
-        // A directional patch (a tiled carrier) sends its exitance towards wo's bin.
-        let exitance = self
-            .solution
-            .exitance_towards(patch, si.p, wo)
-            .unwrap_or(leaf.radiosity);
         Some(SampledSpectrum::from_fn(|lane| {
             let k = band_of(wavelengths.wavelength_nm(lane));
-            (exitance[k] - e[k]).max(0.0) * std::f32::consts::FRAC_1_PI / faces_share
+            (leaf.radiosity[k] - e[k]).max(0.0) * std::f32::consts::FRAC_1_PI / faces_share
         }))
     }
 

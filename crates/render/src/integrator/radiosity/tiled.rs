@@ -15,7 +15,6 @@ use prism_geometry::{Geometry, Shape};
 use prism_radiosity::directional::DirectionalSurface;
 use prism_radiosity::ElementShape;
 
-use crate::tile_pyramid::bins;
 use crate::tile_pyramid::TiledSurface;
 
 impl TiledCarrier {
@@ -38,18 +37,15 @@ pub struct TiledCarrier {
     pub e2: Vec3A,
     /// Unit normal (the tile's +z).
     pub normal: Vec3A,
-    /// Unit tangent along `e1` (the tile's x).
-    pub tangent: Vec3A,
-    /// Unit bitangent: the tile's y, made orthogonal to the tangent and the normal (−(n ×
-    /// t) under a mirroring transform, where the tile's frame is left-handed).
-    pub bitangent: Vec3A,
     /// The tile's heights along `normal`, metres.
     pub slab_m: (f32, f32),
     /// τ̄ per direction bin (`tile_pyramid::bins`): averaged over the bin's directions.
     pub transparency: Vec<f32>,
     /// Reflectance per band, front then back (the diffuse equivalent the oracle reads).
     pub reflectance: [Vec<f32>; 2],
-    /// Its top level's Γ in the carrier's frame (tangent, bitangent, normal).
+    /// Its top level's Γ in the tile's frame: the unit tangent along `e1` (the tile's x),
+    /// the tile's y made orthogonal to it and the normal (−(n × t) under a mirroring
+    /// transform, where the frame is left-handed), and `normal`.
     pub surface: Arc<DirectionalSurface>,
 }
 
@@ -100,8 +96,6 @@ impl TiledCarriers {
                 e1,
                 e2,
                 normal,
-                tangent,
-                bitangent,
                 slab_m: surface.slab_m,
                 transparency: surface.transparency.clone(),
                 reflectance: surface.reflectance.map(|r| r.to_vec()),
@@ -145,7 +139,6 @@ impl TiledCarriers {
     /// through.
     pub fn transparency_towards(&self, carrier: usize, wo: Vec3A) -> f32 {
         let c = &self.0[carrier];
-        let local = Vec3A::new(wo.dot(c.tangent), wo.dot(c.bitangent), wo.dot(c.normal));
-        c.transparency[bins::bin_of(local.normalize_or_zero())]
+        c.transparency[c.surface.bin_of(wo)]
     }
 }
