@@ -16,18 +16,28 @@ use std::sync::Arc;
 use glam::Vec3A;
 
 use crate::bins::{self, HEMISPHERE_BINS, SPHERE_BINS};
+use crate::element::ElementShape;
+use crate::tile_cells::{CellWeights, TileLattice};
 
-/// The Γ of a two-sided directional surface.
+/// The Γ pyramid of a two-sided directional surface (a tiled carrier).
 #[derive(Clone, Debug, PartialEq)]
 pub struct DirectionalSurface {
     /// Its frame: x, y and z, the front side's normal (unit, orthogonal; left-handed where
     /// a mirroring transform placed the surface).
     pub frame: [Vec3A; 3],
-    /// Γ(i → o) per (incident sphere bin, outgoing sphere bin, band), 1/sr: the radiance
-    /// leaving towards o per unit irradiance on the surface's plane from i. Outgoing bins on
-    /// i's side give the BRDF, the others the BTDF. Light that passes through holes
-    /// unscattered is not in it (the geometry lets it through).
+    /// Where its tile's periods lie: an element reads the pyramid's cells it covers
+    /// ([`TileLattice::cell_weights`]).
+    pub lattice: TileLattice,
+    /// Levels of the pyramid (1: the whole period only).
+    pub levels: u32,
+    /// Γ(i → o) per (pyramid cell, incident sphere bin, outgoing sphere bin, band), 1/sr:
+    /// the radiance leaving the cell towards o per unit irradiance on the surface's plane
+    /// from i. Outgoing bins on i's side give the BRDF, the others the BTDF. Light that
+    /// passes through holes unscattered is not in it (the geometry lets it through).
     pub gamma: Vec<f32>,
+    /// τ̄ per (pyramid cell, sphere bin): the share of the cell a viewer looking back along
+    /// the bin's directions sees through, averaged over them.
+    pub view_transparency: Vec<f32>,
 }
 
 impl DirectionalSurface {
@@ -35,6 +45,49 @@ impl DirectionalSurface {
     pub fn bin_of(&self, w: Vec3A) -> usize {
         let [x, y, z] = self.frame;
         bins::bin_of(Vec3A::new(w.dot(x), w.dot(y), w.dot(z)))
+    }
+
+    /// The pyramid cells that describe element `shape` of the surface.
+    pub fn cell_weights(&self, shape: &ElementShape) -> CellWeights {
+        self.lattice.cell_weights(self.levels, shape)
+    }
+
+    /// τ̄ towards world direction `w` (unit, leaving the surface) over the cells `cells`.
+    pub fn see_through(&self, cells: &CellWeights, w: Vec3A) -> f32 {
+        let bin = self.bin_of(w);
+        cells
+            .iter()
+            .map(|(c, weight)| weight * self.view_transparency[c * SPHERE_BINS + bin])
+            .sum()
+    }
+}
+
+/// Finer pyramids for directional surfaces, made when the solution's elements first get
+/// small enough to read a level their surface lacks (the renderer simulates the tile
+/// again).
+pub trait FinerPyramids {
+    /// `surface`, the surface of input patch `patch`'s side, with a pyramid of `levels`
+    /// levels or as many of them as it may have; `None` where it may have no more than it
+    /// has.
+    fn with_levels(
+        &self,
+        patch: usize,
+        surface: &DirectionalSurface,
+        levels: u32,
+    ) -> Result<Option<Arc<DirectionalSurface>>, String>;
+}
+
+/// Surfaces keep the pyramids they were given.
+pub struct NoFinerPyramids;
+
+impl FinerPyramids for NoFinerPyramids {
+    fn with_levels(
+        &self,
+        _: usize,
+        _: &DirectionalSurface,
+        _: u32,
+    ) -> Result<Option<Arc<DirectionalSurface>>, String> {
+        Ok(None)
     }
 }
 
@@ -160,9 +213,11 @@ impl DirectionalState {
 
 /// The exitance per side bin of a leaf of `side` (`out`, side bin × band) from the
 /// irradiance per side bin arriving on it (`own`) and on its partner over the same area
-/// (`partner`), with emission `emission`; its radiosity per band into `radiosity`.
+/// (`partner`), with emission `emission`, by the Γ of the pyramid cells `cells` it covers;
+/// its radiosity per band into `radiosity`.
 pub(crate) fn leaf_exitance(
     side: &DirectionalSide,
+    cells: &CellWeights,
     own: &[f32],
     partner: Option<&[f32]>,
     emission: &[f32],
@@ -170,26 +225,29 @@ pub(crate) fn leaf_exitance(
     radiosity: &mut [f32],
 ) {
     let bands = emission.len();
-    let gamma = &side.surface.gamma;
+    let cell_values = SPHERE_BINS * SPHERE_BINS * bands;
     // The side's outgoing bins are contiguous among the sphere bins.
     let first_out = side.sphere_bin(0);
     out.fill(0.0);
     let sources = [(side.front, Some(own)), (!side.front, partner)];
-    for (front, irradiance) in sources {
-        let Some(irradiance) = irradiance else {
-            continue;
-        };
-        let first_in = if front { 0 } else { HEMISPHERE_BINS };
-        for (i, e) in irradiance.chunks_exact(bands).enumerate() {
-            if e.iter().all(|&v| v == 0.0) {
+    for (cell, weight) in cells.iter() {
+        let gamma = &side.surface.gamma[cell * cell_values..][..cell_values];
+        for (front, irradiance) in sources {
+            let Some(irradiance) = irradiance else {
                 continue;
-            }
-            // Γ(i → o) for the side's outgoing bins o, one after another.
-            let row = &gamma[((first_in + i) * SPHERE_BINS + first_out) * bands..]
-                [..HEMISPHERE_BINS * bands];
-            for (m, g) in out.chunks_exact_mut(bands).zip(row.chunks_exact(bands)) {
-                for ((m, g), e) in m.iter_mut().zip(g).zip(e) {
-                    *m += g * e;
+            };
+            let first_in = if front { 0 } else { HEMISPHERE_BINS };
+            for (i, e) in irradiance.chunks_exact(bands).enumerate() {
+                if e.iter().all(|&v| v == 0.0) {
+                    continue;
+                }
+                // Γ(i → o) for the side's outgoing bins o, one after another.
+                let row = &gamma[((first_in + i) * SPHERE_BINS + first_out) * bands..]
+                    [..HEMISPHERE_BINS * bands];
+                for (m, g) in out.chunks_exact_mut(bands).zip(row.chunks_exact(bands)) {
+                    for ((m, g), e) in m.iter_mut().zip(g).zip(e) {
+                        *m += weight * g * e;
+                    }
                 }
             }
         }
@@ -224,6 +282,13 @@ pub(crate) fn add_arrival(
 mod tests {
     use super::*;
 
+    fn unit_lattice() -> TileLattice {
+        TileLattice {
+            origin: Vec3A::ZERO,
+            period: [Vec3A::X, Vec3A::Y],
+        }
+    }
+
     /// Γ = ρ/π into every bin on the light's side, τ_s/π on the other.
     fn lambertian(reflectance: f32, transmittance: f32) -> Arc<DirectionalSurface> {
         let mut gamma = vec![0.0; SPHERE_BINS * SPHERE_BINS];
@@ -236,7 +301,10 @@ mod tests {
         }
         Arc::new(DirectionalSurface {
             frame: [Vec3A::X, Vec3A::Y, Vec3A::Z],
+            lattice: unit_lattice(),
+            levels: 1,
             gamma,
+            view_transparency: vec![0.0; SPHERE_BINS],
         })
     }
 
@@ -270,7 +338,15 @@ mod tests {
         );
         assert_eq!(on_back.iter().sum::<f32>(), 1.0);
         let (mut m, mut b) = (vec![0.0; HEMISPHERE_BINS], [0.0]);
-        leaf_exitance(&front, &on_front, Some(&on_back), &[0.5], &mut m, &mut b);
+        leaf_exitance(
+            &front,
+            &CellWeights::TOP,
+            &on_front,
+            Some(&on_back),
+            &[0.5],
+            &mut m,
+            &mut b,
+        );
         // B = B_e + ρ E_front + τ_s E_back, the same towards every bin.
         let expected = 0.5 + 0.6 * 2.0 + 0.2 * 1.0;
         assert!((b[0] - expected).abs() < 1e-5, "{}", b[0]);
@@ -279,6 +355,7 @@ mod tests {
         }
         leaf_exitance(
             &back,
+            &CellWeights::TOP,
             &on_back,
             Some(&on_front),
             &[0.0],
@@ -292,7 +369,10 @@ mod tests {
     fn a_side_bins_directions_on_its_own_side_in_the_surfaces_frame() {
         let surface = Arc::new(DirectionalSurface {
             frame: [Vec3A::Y, Vec3A::Z, Vec3A::X],
+            lattice: unit_lattice(),
+            levels: 1,
             gamma: Vec::new(),
+            view_transparency: Vec::new(),
         });
         let back = DirectionalSide {
             surface,

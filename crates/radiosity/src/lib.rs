@@ -17,6 +17,7 @@ pub mod form_factor;
 mod hierarchy;
 mod solution_file;
 pub mod solver;
+pub mod tile_cells;
 
 pub use element::ElementShape;
 pub use final_gather::ReceiverGather;

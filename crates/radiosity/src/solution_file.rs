@@ -11,9 +11,10 @@ use crate::directional::{DirectionalSide, DirectionalState, DirectionalSurface, 
 use crate::element::ElementShape;
 use crate::hierarchy::{Hierarchy, Node, NodeKind};
 use crate::solver::{Link, LinkTotals, Radiosity, RadiositySettings};
+use crate::tile_cells::{pyramid_cells, TileLattice, MAX_PYRAMID_LEVELS};
 
 const MAGIC: &[u8; 8] = b"PRISMRAD";
-const VERSION: u32 = 3;
+const VERSION: u32 = 4;
 const NONE: u32 = u32::MAX;
 
 struct Writer(Vec<u8>);
@@ -126,8 +127,16 @@ impl Radiosity {
             if let Some(side) = side {
                 w.u8(u8::from(side.front));
                 w.u32(side.partner);
-                side.surface.frame.iter().for_each(|&v| w.vec3(v));
-                w.f32s(&side.surface.gamma);
+                // The two sides share their surface: the front side writes it.
+                if side.front {
+                    let surface = &side.surface;
+                    surface.frame.iter().for_each(|&v| w.vec3(v));
+                    w.vec3(surface.lattice.origin);
+                    surface.lattice.period.iter().for_each(|&v| w.vec3(v));
+                    w.u32(surface.levels);
+                    w.f32s(&surface.gamma);
+                    w.f32s(&surface.view_transparency);
+                }
             }
         }
         h.patch_root.iter().for_each(|&v| w.u32(v));
@@ -230,9 +239,10 @@ impl Radiosity {
         let patches = r.count(8 * bands.max(1))?;
         let reflectance = r.f32s(patches * bands)?;
         let emission = r.f32s(patches * bands)?;
-        let mut sides = Vec::with_capacity(patches);
+        // (front, partner, the surface where this is the front side)
+        let mut read_sides = Vec::with_capacity(patches);
         for _ in 0..patches {
-            sides.push(if r.u8()? != 0 {
+            read_sides.push(if r.u8()? != 0 {
                 let front = r.u8()? != 0;
                 let partner = r.u32()?;
                 if partner as usize >= patches {
@@ -240,15 +250,57 @@ impl Radiosity {
                         "a directional side's partner {partner} of {patches}"
                     ));
                 }
-                let frame = [r.vec3()?, r.vec3()?, r.vec3()?];
-                let gamma = r.f32s(SPHERE_BINS * SPHERE_BINS * bands)?;
-                Some(DirectionalSide {
-                    surface: Arc::new(DirectionalSurface { frame, gamma }),
-                    front,
-                    partner,
-                })
+                let surface = if front {
+                    let frame = [r.vec3()?, r.vec3()?, r.vec3()?];
+                    let lattice = TileLattice {
+                        origin: r.vec3()?,
+                        period: [r.vec3()?, r.vec3()?],
+                    };
+                    let levels = r.u32()?;
+                    if !(1..=MAX_PYRAMID_LEVELS).contains(&levels) {
+                        return Err(format!("a directional surface of {levels} levels"));
+                    }
+                    let cells = pyramid_cells(levels);
+                    let gamma = r.f32s(cells * SPHERE_BINS * SPHERE_BINS * bands)?;
+                    let view_transparency = r.f32s(cells * SPHERE_BINS)?;
+                    Some(Arc::new(DirectionalSurface {
+                        frame,
+                        lattice,
+                        levels,
+                        gamma,
+                        view_transparency,
+                    }))
+                } else {
+                    None
+                };
+                Some((front, partner, surface))
             } else {
                 None
+            });
+        }
+        let mut sides = Vec::with_capacity(patches);
+        for side in &read_sides {
+            sides.push(match side {
+                Some((front, partner, surface)) => {
+                    let surface = match surface {
+                        Some(surface) => surface.clone(),
+                        None => match &read_sides[*partner as usize] {
+                            Some((true, _, Some(surface))) => surface.clone(),
+                            _ => {
+                                return Err(format!(
+                                    "a directional back side's partner {partner} is not a \
+                                     front side"
+                                ))
+                            }
+                        },
+                    };
+                    Some(DirectionalSide {
+                        surface,
+                        front: *front,
+                        partner: *partner,
+                    })
+                }
+                None => None,
             });
         }
         let patch_root: Vec<u32> = (0..patches).map(|_| r.u32()).collect::<Result<_, _>>()?;

@@ -18,10 +18,13 @@ use rayon::prelude::*;
 
 use crate::bins::SPHERE_BINS;
 use crate::cluster_view::{cluster_fragments, Fragment};
-use crate::directional::{self, DirectionalSide, DirectionalState};
+use crate::directional::{
+    self, DirectionalSide, DirectionalState, DirectionalSurface, FinerPyramids, NoFinerPyramids,
+};
 use crate::element::ElementShape;
 use crate::form_factor::{area_sample_factor, element_to_element, faces, point_to_polygon};
 use crate::hierarchy::{Hierarchy, NodeKind};
+use crate::tile_cells::{pyramid_cells, MAX_PYRAMID_LEVELS};
 
 /// A surface the solution covers: one side of a planar patch, uniform over it.
 #[derive(Clone, Debug, PartialEq)]
@@ -205,6 +208,9 @@ pub struct LeafAt<'a> {
     /// towards the direction asked for.
     pub radiosity: &'a [f32],
     pub area_m2: f32,
+    /// On a directional patch, τ̄ of the pyramid cells the leaf covers towards the
+    /// direction asked for (the share seen through its holes); 0 elsewhere.
+    pub see_through: f32,
 }
 
 /// One link: the receiver gathers `form_factor × B(source)`.
@@ -446,13 +452,21 @@ impl Radiosity {
     /// radiosity in every direction.
     pub fn leaf_towards(&self, patch: usize, p: Vec3A, w: Vec3A) -> LeafAt<'_> {
         let n = self.leaf_node(patch, p);
-        let radiosity = match self.directional_side(n) {
-            Some((slot, side)) => self.directional.exitance_towards(slot, side, w),
-            None => self.node_radiosity(n),
+        let node = &self.hierarchy.nodes[n as usize];
+        let (radiosity, see_through) = match (self.directional_side(n), &node.kind) {
+            (Some((slot, side)), NodeKind::Element { shape, .. }) => {
+                let cells = side.surface.cell_weights(shape);
+                (
+                    self.directional.exitance_towards(slot, side, w),
+                    side.surface.see_through(&cells, w),
+                )
+            }
+            _ => (self.node_radiosity(n), 0.0),
         };
         LeafAt {
             radiosity,
-            area_m2: self.hierarchy.nodes[n as usize].area_m2,
+            area_m2: node.area_m2,
+            see_through,
         }
     }
 
@@ -465,7 +479,7 @@ impl Radiosity {
                 matches!(self.hierarchy.nodes[root].kind, NodeKind::Element { shape, .. } if shape == p.shape)
                     && p.reflectance == self.reflectance(i)
                     && p.emission == self.emission(i)
-                    && p.directional == self.directional.sides[i]
+                    && same_place(&p.directional, &self.directional.sides[i])
             })
     }
 
@@ -563,11 +577,23 @@ impl Radiosity {
     }
 
     /// One iteration: refine the links against the current radiosities, then solve to
-    /// convergence.
+    /// convergence. Directional surfaces keep the pyramids they have.
     pub fn iterate(
         &mut self,
         visibility: &dyn Visibility,
         direct: &dyn DirectIrradiance,
+    ) -> Result<IterationStats, RadiosityError> {
+        self.iterate_with(visibility, direct, &NoFinerPyramids)
+    }
+
+    /// [`Self::iterate`], and before the solve the directional surfaces whose elements
+    /// have got small enough to read finer levels of their pyramid than they hold ask
+    /// `pyramids` for them.
+    pub fn iterate_with(
+        &mut self,
+        visibility: &dyn Visibility,
+        direct: &dyn DirectIrradiance,
+        pyramids: &dyn FinerPyramids,
     ) -> Result<IterationStats, RadiosityError> {
         let start = Instant::now();
         if self.iterations == 0 {
@@ -596,6 +622,7 @@ impl Radiosity {
         self.compute_coverage(visibility);
         self.compute_direct(direct);
         self.refine_direct(direct, visibility)?;
+        self.deepen_pyramids(pyramids)?;
         let refine_s = start.elapsed().as_secs_f64();
         let start = Instant::now();
         let sweeps = self.solve();
@@ -1811,7 +1838,13 @@ impl Radiosity {
             .map(|&(n, slot)| {
                 let state = &this.directional;
                 let node = &this.hierarchy.nodes[n as usize];
-                let NodeKind::Element { patch, level, .. } = node.kind else {
+                let NodeKind::Element {
+                    patch,
+                    level,
+                    shape,
+                    ..
+                } = node.kind
+                else {
                     unreachable!("a slot belongs to an element");
                 };
                 let side = state.sides[patch as usize]
@@ -1826,7 +1859,16 @@ impl Radiosity {
                 let mut b = vec![0.0f32; bands];
                 let emission = &this.emission[patch as usize * bands..][..bands];
                 let own = &state.irradiance[state.range(slot)];
-                directional::leaf_exitance(side, own, partner, emission, &mut exitance, &mut b);
+                let cells = side.surface.cell_weights(&shape);
+                directional::leaf_exitance(
+                    side,
+                    &cells,
+                    own,
+                    partner,
+                    emission,
+                    &mut exitance,
+                    &mut b,
+                );
                 (exitance, b)
             })
             .collect();
@@ -1839,6 +1881,58 @@ impl Radiosity {
     }
 }
 
+impl Radiosity {
+    /// Gives each directional surface the pyramid levels its leaves (on either side) read
+    /// ([`crate::tile_cells::TileLattice::level_for`]) where it has fewer, from `pyramids`.
+    fn deepen_pyramids(&mut self, pyramids: &dyn FinerPyramids) -> Result<(), RadiosityError> {
+        if !self.directional.any() {
+            return Ok(());
+        }
+        // Per front side: the levels wanted.
+        let mut wanted = vec![0u32; self.directional.sides.len()];
+        for n in 0..self.hierarchy.nodes.len() as u32 {
+            if self.hierarchy.children(n).len() > 0 {
+                continue;
+            }
+            let (Some((_, side)), NodeKind::Element { shape, patch, .. }) = (
+                self.directional_side(n),
+                &self.hierarchy.nodes[n as usize].kind,
+            ) else {
+                continue;
+            };
+            let front = if side.front { *patch } else { side.partner } as usize;
+            let levels = side.surface.lattice.level_for(shape) + 1;
+            wanted[front] = wanted[front].max(levels);
+        }
+        for (front, &levels) in wanted.iter().enumerate() {
+            let Some(side) = &self.directional.sides[front] else {
+                continue;
+            };
+            if levels <= side.surface.levels {
+                continue;
+            }
+            let error = |reason: String| RadiosityError::Directional {
+                patch: front,
+                reason,
+            };
+            let Some(surface) = pyramids
+                .with_levels(front, &side.surface, levels)
+                .map_err(error)?
+            else {
+                continue;
+            };
+            check_surface(&surface, self.bands).map_err(error)?;
+            let partner = side.partner as usize;
+            for p in [front, partner] {
+                if let Some(s) = &mut self.directional.sides[p] {
+                    s.surface = surface.clone();
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
 /// Each directional side's partner is the other side of the same surface, facing the other
 /// way, and its Γ has the solution's bins and bands.
 fn check_directional(patches: &[InputPatch], bands: usize) -> Result<(), RadiosityError> {
@@ -1847,13 +1941,7 @@ fn check_directional(patches: &[InputPatch], bands: usize) -> Result<(), Radiosi
             continue;
         };
         let error = |reason: String| RadiosityError::Directional { patch: i, reason };
-        let expected = SPHERE_BINS * SPHERE_BINS * bands;
-        if side.surface.gamma.len() != expected {
-            return Err(error(format!(
-                "Γ has {} values, expected {expected} ({SPHERE_BINS}² bins × {bands} bands)",
-                side.surface.gamma.len()
-            )));
-        }
+        check_surface(&side.surface, bands).map_err(error)?;
         let partner = patches
             .get(side.partner as usize)
             .and_then(|q| q.directional.as_ref());
@@ -1871,6 +1959,55 @@ fn check_directional(patches: &[InputPatch], bands: usize) -> Result<(), Radiosi
                 "its normal is not its surface frame's z (front) or −z (back)".into(),
             ));
         }
+    }
+    Ok(())
+}
+
+/// Whether two patches' directional sides are the same side of a surface in the same
+/// place. Their pyramids may differ: a solution deepens the pyramids its elements need
+/// (the tile's materials are in the patches' diffuse-equivalent reflectances, compared
+/// apart).
+fn same_place(a: &Option<DirectionalSide>, b: &Option<DirectionalSide>) -> bool {
+    match (a, b) {
+        (None, None) => true,
+        (Some(a), Some(b)) => {
+            a.front == b.front
+                && a.partner == b.partner
+                && a.surface.frame == b.surface.frame
+                && a.surface.lattice == b.surface.lattice
+        }
+        (None, Some(_)) | (Some(_), None) => false,
+    }
+}
+
+/// A directional surface's pyramid fits the solution's bins and bands.
+fn check_surface(surface: &DirectionalSurface, bands: usize) -> Result<(), String> {
+    if !(1..=MAX_PYRAMID_LEVELS).contains(&surface.levels) {
+        return Err(format!(
+            "its pyramid has {} levels, expected 1 to {MAX_PYRAMID_LEVELS}",
+            surface.levels
+        ));
+    }
+    let cells = pyramid_cells(surface.levels);
+    let expected = cells * SPHERE_BINS * SPHERE_BINS * bands;
+    if surface.gamma.len() != expected {
+        return Err(format!(
+            "Γ has {} values, expected {expected} ({cells} cells × {SPHERE_BINS}² bins × \
+             {bands} bands)",
+            surface.gamma.len()
+        ));
+    }
+    if surface.view_transparency.len() != cells * SPHERE_BINS {
+        return Err(format!(
+            "τ̄ has {} values, expected {} ({cells} cells × {SPHERE_BINS} bins)",
+            surface.view_transparency.len(),
+            cells * SPHERE_BINS
+        ));
+    }
+    let [a, b] = surface.lattice.period;
+    let area = a.cross(b).length();
+    if area.is_nan() || area <= 0.0 || !surface.lattice.origin.is_finite() {
+        return Err("its tile lattice is degenerate".into());
     }
     Ok(())
 }

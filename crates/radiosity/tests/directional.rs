@@ -7,6 +7,7 @@ use std::sync::Arc;
 use glam::Vec3A;
 use prism_radiosity::bins::{self, HEMISPHERE_BINS, SECTORS, SPHERE_BINS};
 use prism_radiosity::directional::{DirectionalSide, DirectionalSurface};
+use prism_radiosity::tile_cells::{cell_index, pyramid_cells, TileLattice};
 use prism_radiosity::{
     ElementShape, InputPatch, NoDirectLight, Radiosity, RadiositySettings, Unoccluded, Visibility,
 };
@@ -38,15 +39,38 @@ fn panel(
     reflectance: [f32; 2],
     gamma: impl Fn(usize, usize) -> f32,
 ) {
-    let surface = Arc::new(DirectionalSurface {
-        frame: [Vec3A::X, Vec3A::Y, Vec3A::Z],
-        gamma: (0..SPHERE_BINS * SPHERE_BINS)
-            .map(|k| gamma(k / SPHERE_BINS, k % SPHERE_BINS))
-            .collect(),
+    pyramid_panel(patches, centre, size_m, reflectance, 1, |_, i, o| {
+        gamma(i, o)
     });
-    let first = patches.len() as u32;
+}
+
+/// `panel` with a pyramid of `levels` levels over one period (the panel): Γ
+/// `gamma(cell, i, o)`, cells numbered as `tile_cells::cell_index` does.
+fn pyramid_panel(
+    patches: &mut Vec<InputPatch>,
+    centre: Vec3A,
+    size_m: f32,
+    reflectance: [f32; 2],
+    levels: u32,
+    gamma: impl Fn(usize, usize, usize) -> f32,
+) {
     let p0 = centre - Vec3A::new(size_m, size_m, 0.0) * 0.5;
     let (x, y) = (Vec3A::X * size_m, Vec3A::Y * size_m);
+    let pairs = SPHERE_BINS * SPHERE_BINS;
+    let cells = pyramid_cells(levels);
+    let surface = Arc::new(DirectionalSurface {
+        frame: [Vec3A::X, Vec3A::Y, Vec3A::Z],
+        lattice: TileLattice {
+            origin: p0,
+            period: [x, y],
+        },
+        levels,
+        gamma: (0..cells * pairs)
+            .map(|k| gamma(k / pairs, (k % pairs) / SPHERE_BINS, k % SPHERE_BINS))
+            .collect(),
+        view_transparency: vec![0.0; cells * SPHERE_BINS],
+    });
+    let first = patches.len() as u32;
     for (front, e1, e2) in [(true, x, y), (false, y, x)] {
         let mut p = patch(
             p0,
@@ -290,7 +314,13 @@ fn a_directional_side_must_pair_with_its_other_side() {
     let mut short = patches;
     let surface = Arc::new(DirectionalSurface {
         frame: [Vec3A::X, Vec3A::Y, Vec3A::Z],
+        lattice: TileLattice {
+            origin: Vec3A::ZERO,
+            period: [Vec3A::X, Vec3A::Y],
+        },
+        levels: 1,
         gamma: vec![0.1; 7],
+        view_transparency: vec![0.0; SPHERE_BINS],
     });
     for p in &mut short {
         p.directional.as_mut().unwrap().surface = surface.clone();
@@ -335,4 +365,67 @@ fn a_saved_directional_solution_reads_back_the_same() {
     let mut other = patches.clone();
     other[2].directional.as_mut().unwrap().front = true;
     assert!(!loaded.matches_patches(&other));
+}
+
+/// Per-level Γ (Mostefaoui et al. §3): a panel that is one period of a tile whose left
+/// half reflects 0.8 and right half 0.2 (Lambertian on the light's side). Its elements no
+/// wider than half a period reflect their half's albedo; larger ones the period's mean.
+#[test]
+fn sub_patches_read_the_pyramid_level_of_their_size() {
+    let (left, right) = (0.8f32, 0.2f32);
+    let lambert = |cell: usize, i: usize, o: usize| -> f32 {
+        if !(bins::is_above(i) && bins::is_above(o)) {
+            return 0.0;
+        }
+        let rho = match cell {
+            0 => 0.5 * (left + right),
+            // Level 1: u = 0 is the left half.
+            c if c == cell_index(1, 0, 0) || c == cell_index(1, 0, 1) => left,
+            c if c < pyramid_cells(2) => right,
+            _ => unreachable!("two levels"),
+        };
+        rho / PI
+    };
+    let mut patches = vec![patch(
+        Vec3A::new(-1.0, -1.0, 0.6),
+        Vec3A::Y * 2.0,
+        Vec3A::X * 2.0,
+        0.0,
+        1.0,
+        0,
+    )];
+    pyramid_panel(
+        &mut patches,
+        Vec3A::ZERO,
+        1.0,
+        [0.5 * (left + right), 0.0],
+        2,
+        lambert,
+    );
+    let solution = solve(&patches, 0.0005);
+    let (mut halves, mut whole) = (0, 0);
+    for leaf in solution.leaves().filter(|l| l.patch == 1) {
+        let (lo, hi) = leaf.shape.bounds();
+        let ratio = leaf.radiosity[0] / leaf.irradiance[0];
+        let expected = if hi.x - lo.x > 0.5 + 1e-4 {
+            whole += 1;
+            0.5 * (left + right)
+        } else {
+            halves += 1;
+            if hi.x <= 1e-4 {
+                left
+            } else {
+                assert!(lo.x >= -1e-4, "{lo} {hi}");
+                right
+            }
+        };
+        assert!(
+            (ratio - expected).abs() < 1e-4,
+            "leaf {lo}..{hi}: B/E {ratio}, expected {expected}"
+        );
+    }
+    eprintln!("{halves} leaves in a half, {whole} over the whole period");
+    assert!(halves >= 8, "{halves}");
+    let loaded = Radiosity::from_bytes(&solution.to_bytes()).unwrap();
+    assert!(loaded.matches_patches(&patches));
 }

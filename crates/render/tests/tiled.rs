@@ -8,7 +8,8 @@ use prism_geometry::{load_obj, TriangleMesh};
 
 mod support;
 use support::{
-    assert_close, lux_disagreements, mean_se, pass_images, sensor_lux, window_mean, Dir,
+    assert_close, lux_disagreements, lux_disagreements_within, mean_se, pass_images, sensor_lux,
+    window_mean, Dir,
 };
 
 const PERIOD_M: f32 = 0.1;
@@ -456,4 +457,120 @@ fn a_tiled_carriers_patches_are_the_see_through_ones() {
     // Seen straight on, the wicker lets some light through and hides the rest.
     let tau = map.carriers.transparency_towards(0, carrier.normal);
     assert!(tau > 0.05 && tau < 0.5, "{tau}");
+}
+
+/// A tile of one 2 m period, its left half white (ρ 0.8) and its right half dark (ρ 0.1):
+/// two quads.
+const HALVES_OBJ: &[u8] =
+    b"mtllib halves.mtl\nv 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 2 0\nv 1 2 0\nv 2 2 0\n\
+    usemtl white\nf 1 2 5\nf 1 5 4\nusemtl dark\nf 2 3 6\nf 2 6 5\n";
+
+/// A closed 2 m room lit from its ceiling whose back wall is one period of the two-tone
+/// tile, `levels` levels; sensors at 0.5 m from the wall, facing it, in front of each half
+/// (the lamp is behind them: they read the wall's light alone, and the side walls').
+fn room_with_two_tone_wall(dir: &Dir, integrator: &str, levels: u32) -> prism_render::RenderScene {
+    std::fs::create_dir_all(dir.0.join("tiles")).unwrap();
+    dir.write("tiles/halves.obj", HALVES_OBJ);
+    dir.write(
+        "tiles/halves.mtl",
+        b"newmtl white\nKd 1 1 1\nnewmtl dark\nKd 0 0 0\n",
+    );
+    let face = |name: &str, material: &str, transform: &str| {
+        format!(
+            r#"{{"type": "rectangle", "name": "{name}", "size_m": [2, 2], "material": "{material}", "transform": {transform}}}"#
+        )
+    };
+    let faces = [
+        face(
+            "floor",
+            "plaster",
+            r#"[{"rotate": {"axis": [1, 0, 0], "angle_deg": -90}}, {"translate": [0, -1, 0]}]"#,
+        ),
+        face(
+            "ceiling",
+            "plaster",
+            r#"[{"rotate": {"axis": [1, 0, 0], "angle_deg": 90}}, {"translate": [0, 1, 0]}]"#,
+        ),
+        face("back", "two-tone", r#"[{"translate": [0, 0, -1]}]"#),
+        face(
+            "front",
+            "plaster",
+            r#"[{"rotate": {"axis": [0, 1, 0], "angle_deg": 180}}, {"translate": [0, 0, 1]}]"#,
+        ),
+        face(
+            "left",
+            "plaster",
+            r#"[{"rotate": {"axis": [0, 1, 0], "angle_deg": 90}}, {"translate": [-1, 0, 0]}]"#,
+        ),
+        face(
+            "right",
+            "plaster",
+            r#"[{"rotate": {"axis": [0, 1, 0], "angle_deg": -90}}, {"translate": [1, 0, 0]}]"#,
+        ),
+    ]
+    .join(",\n    ");
+    let json = format!(
+        r#"{{
+  "camera": {{"type": "pinhole", "fov_deg": 60, "transform": {{"look_at": {{"eye": [0, 0, 0.9], "target": [0, 0, 0], "up": [0, 1, 0]}}}}}},
+  "film": {{"resolution": [8, 8], "spp": 1}},
+  "integrator": {integrator},
+  "tiles": {{"halves": {{"mesh": "tiles/halves.obj", "period_m": [2, 2], "materials": {{"white": "white", "dark": "dark"}}}}}},
+  "materials": {{
+    "white": {{"type": "lambert", "reflectance": 0.8}},
+    "dark": {{"type": "lambert", "reflectance": 0.1}},
+    "two-tone": {{"type": "tiled", "tile": "halves", "levels": {levels}}},
+    "plaster": {{"type": "lambert", "reflectance": 0.3}}
+  }},
+  "shapes": [
+    {faces},
+    {{"type": "rectangle", "name": "lamp", "size_m": [0.5, 0.5], "transform": [{{"rotate": {{"axis": [1, 0, 0], "angle_deg": 90}}}}, {{"translate": [0, 0.99, 0.3]}}]}}
+  ],
+  "lights": [{{"type": "area", "shape": "lamp", "luminance_cd_m2": 10000}}],
+  "sensors": [
+    {{"type": "points", "name": "facing the wall", "samples": 8192,
+      "positions_m": [[-0.5, 0, -0.5], [0.5, 0, -0.5], [-0.5, -0.6, -0.5], [0.5, -0.6, -0.5]],
+      "normal": [0, 0, -1]}}
+  ]
+}}"#
+    );
+    dir.scene(&json)
+}
+
+/// Per-level Γ (Mostefaoui et al. §3): the wall's elements read the pyramid cells they
+/// cover, so the sensors in front of the white half read more than those in front of the
+/// dark half, as `path` does; with the pyramid's top level alone both read the mean.
+#[test]
+fn a_tiled_walls_elements_read_the_pyramid_cells_they_cover() {
+    let dir = Dir::new("tiled", "two-tone");
+    let path = room_with_two_tone_wall(
+        &dir,
+        r#"{"type": "path", "max_depth": 64, "rr_depth": 5, "sampler": "independent"}"#,
+        2,
+    );
+    let expected = sensor_lux(&path, &dir, 3);
+    let radiosity = room_with_two_tone_wall(&dir, r#"{"type": "radiosity"}"#, 2);
+    let got = sensor_lux(&radiosity, &dir, 3);
+    assert_eq!(lux_disagreements(&expected, &got), 0);
+    // The solution saved with its deepened pyramid loads for the scene it was solved for.
+    let bytes = radiosity
+        .radiosity_solution()
+        .unwrap()
+        .unwrap()
+        .solution
+        .to_bytes();
+    let loaded = prism_render::integrator::radiosity::solution_io::load_solution(
+        &radiosity,
+        std::path::Path::new("two-tone.prismrad"),
+        &bytes,
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    assert!(loaded.solution.to_bytes() == bytes);
+    let top_only = room_with_two_tone_wall(&dir, r#"{"type": "radiosity"}"#, 1);
+    let flat = sensor_lux(&top_only, &dir, 3);
+    eprintln!("top level only:");
+    // Each half's sensors are ≥ 10 % off with the whole period's mean.
+    assert_eq!(
+        lux_disagreements_within(&expected, &flat, 0.1),
+        expected.len()
+    );
 }

@@ -263,45 +263,67 @@ impl CarrierQuad {
 
 /// Per material id, the surface `radiosity` holds a `tiled` material by, where a shape uses
 /// it (`None` for every other material): the top level of the tile's pyramid
-/// (`tile_pyramid`, 64 samples per bin pair) and the slab of its tile.
+/// ([`radiosity_surface`] with 1 level). The solution asks for finer levels where its
+/// elements get smaller than a period.
 pub(crate) fn radiosity_surfaces(
     scene: &SceneDescription,
     geometry: &prism_geometry::Geometry,
 ) -> Result<Vec<Option<TiledSurface>>, String> {
-    let mut out = vec![None; scene.materials.len() + 1];
-    for (m, material) in scene.materials.iter().enumerate() {
-        let MaterialKind::Tiled {
-            tile,
-            self_shadowing,
-            interreflection,
-            ..
-        } = material.kind
-        else {
-            continue;
-        };
-        let slab = geometry
-            .instances()
-            .iter()
-            .find_map(|inst| match inst.shape {
-                prism_geometry::Shape::Tiled(t) if inst.material == Some(m as u32) => {
-                    let (lo, hi) = geometry.mesh(t.mesh).bounds();
-                    Some((lo.z, hi.z))
-                }
-                _ => None,
-            });
-        let Some(slab) = slab else {
-            continue;
-        };
-        let options = PyramidOptions {
-            levels: 1,
-            samples_per_bin_pair: 64,
-            self_shadowing,
-            interreflection,
-            ..PyramidOptions::default()
-        };
-        let pyramid = TilePyramid::simulate(scene, tile, &options)
-            .map_err(|e| format!("the pyramid of tile `{}`: {e}", scene.tiles[tile].name))?;
-        out[m] = Some(pyramid.tiled_surface(slab));
+    (0..=scene.materials.len())
+        .map(|m| Ok(radiosity_surface(scene, geometry, m, 1, 0)?.map(|(_, s)| s)))
+        .collect()
+}
+
+/// The surface `radiosity` holds `tiled` material `material` by, with a pyramid of `levels`
+/// levels, at most the material's own `levels`, and the slab of its tile; with the tile's
+/// name. `None` for another material, one no shape uses, or where that is no more than
+/// `more_than` levels. 16 samples per bin pair reach each cell of the pyramid's finest level
+/// (64 at least, 1 024 at most: beyond level 3 the finest cells get fewer).
+pub(crate) fn radiosity_surface(
+    scene: &SceneDescription,
+    geometry: &prism_geometry::Geometry,
+    material: usize,
+    levels: u32,
+    more_than: u32,
+) -> Result<Option<(String, TiledSurface)>, String> {
+    let Some(MaterialKind::Tiled {
+        tile,
+        levels: most,
+        self_shadowing,
+        interreflection,
+    }) = scene.materials.get(material).map(|m| &m.kind).cloned()
+    else {
+        return Ok(None);
+    };
+    let slab = geometry
+        .instances()
+        .iter()
+        .find_map(|inst| match inst.shape {
+            prism_geometry::Shape::Tiled(t) if inst.material == Some(material as u32) => {
+                let (lo, hi) = geometry.mesh(t.mesh).bounds();
+                Some((lo.z, hi.z))
+            }
+            _ => None,
+        });
+    let Some(slab) = slab else {
+        return Ok(None);
+    };
+    let levels = levels.clamp(1, most.max(1));
+    if levels <= more_than {
+        return Ok(None);
     }
-    Ok(out)
+    let finest_cells = 1u32 << (2 * (levels - 1));
+    let options = PyramidOptions {
+        levels,
+        samples_per_bin_pair: (16 * finest_cells).clamp(64, 1024),
+        self_shadowing,
+        interreflection,
+        ..PyramidOptions::default()
+    };
+    let pyramid = TilePyramid::simulate(scene, tile, &options)
+        .map_err(|e| format!("the pyramid of tile `{}`: {e}", scene.tiles[tile].name))?;
+    Ok(Some((
+        scene.tiles[tile].name.clone(),
+        pyramid.tiled_surface(slab),
+    )))
 }

@@ -246,8 +246,8 @@ impl TilePyramid {
     }
 }
 
-/// What `radiosity` keeps of a tile's pyramid: the whole period's Γ and τ̄ per direction
-/// bin, its diffuse-equivalent reflectance per side (Γ's albedo averaged over incident
+/// What `radiosity` keeps of a tile's pyramid: Γ and τ̄ per cell and direction bin, the
+/// whole period's diffuse-equivalent reflectance per side (Γ's albedo averaged over incident
 /// directions by their projected solid angle: the reflectance under uniform diffuse light,
 /// which the refinement oracle reads), with the slab the tile fills (metres along the
 /// carrier's normal).
@@ -255,18 +255,21 @@ impl TilePyramid {
 pub struct TiledSurface {
     /// Per band, for light arriving on the front (+z) and on the back.
     pub reflectance: [[f32; BANDS]; 2],
-    /// τ̄ per direction bin (level 0): the share of the carrier seen through along the
+    /// Levels of the pyramid below (1: the whole period only).
+    pub levels: u32,
+    /// τ̄ per (pyramid cell, direction bin): the share of the cell seen through along the
     /// bin's directions, averaged over them as Γ averages an outgoing bin.
-    pub transparency: Vec<f32>,
-    /// The top level's Γ(i → o) per (incident bin, outgoing bin, band), 1/sr: the
-    /// solution's directional transfer (`prism_radiosity::directional`).
+    pub view_transparency: Vec<f32>,
+    /// Γ(i → o) per (pyramid cell, incident bin, outgoing bin, band), 1/sr, cells of all
+    /// levels in the pyramid's order: the solution's directional transfer
+    /// (`prism_radiosity::directional`), each element by the cells it covers.
     pub gamma: Vec<f32>,
     /// The lowest and highest tile heights, metres.
     pub slab_m: (f32, f32),
 }
 
 impl TilePyramid {
-    /// The pyramid's top level as the solution holds it (see [`TiledSurface`]).
+    /// The pyramid as the solution holds it (see [`TiledSurface`]).
     pub fn tiled_surface(&self, slab_m: (f32, f32)) -> TiledSurface {
         let side = |front: bool| -> [f32; BANDS] {
             let mut r = [0.0f32; BANDS];
@@ -281,10 +284,9 @@ impl TilePyramid {
         };
         TiledSurface {
             reflectance: [side(true), side(false)],
-            transparency: (0..SPHERE_BINS)
-                .map(|i| self.view_transparency(0, 0, 0, i))
-                .collect(),
-            gamma: self.gamma[..self.at(1, 0, 0)].to_vec(),
+            levels: self.levels,
+            view_transparency: self.view_transparency.clone(),
+            gamma: self.gamma.clone(),
             slab_m,
         }
     }

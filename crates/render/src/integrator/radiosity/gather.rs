@@ -109,9 +109,9 @@ fn bsdf_towards(vertex: &ScatterVertex, wi: Vec3A) -> SampledSpectrum {
 impl SolutionGather for SolvedScene {
     /// (B − B_e)/π of the leaf element under the hit, at the band of each lane; resolved
     /// when the element is seen from at least its own size (√area). On a tiled carrier the
-    /// hit is on the tile's faces, which cover 1 − τ(ωo) of the carrier as seen from ωo
-    /// (rays through the holes see what is behind): their radiance is the carrier's
-    /// reflected radiance divided by that share.
+    /// hit is on the tile's faces, which cover 1 − τ̄(ωo) of the leaf as seen from ωo
+    /// (rays through the holes see what is behind; τ̄ of the pyramid cells the leaf
+    /// covers): their radiance is the leaf's reflected radiance divided by that share.
     fn reflected_radiance(
         &self,
         si: &SurfaceInteraction,
@@ -130,9 +130,8 @@ impl SolutionGather for SolvedScene {
         let e = self.solution.emission(patch);
         // At most a 20-fold gain: beyond that the faces are slivers the carrier's average
         // does not describe.
-        let faces_share = self.map.carrier[si.instance_id as usize].map_or(1.0, |c| {
-            (1.0 - self.map.carriers.transparency_towards(c as usize, wo)).max(0.05)
-        });
+        let faces_share = self.map.carrier[si.instance_id as usize]
+            .map_or(1.0, |_| (1.0 - leaf.see_through).max(0.05));
         Some(SampledSpectrum::from_fn(|lane| {
             let k = band_of(wavelengths.wavelength_nm(lane));
             (leaf.radiosity[k] - e[k]).max(0.0) * std::f32::consts::FRAC_1_PI / faces_share

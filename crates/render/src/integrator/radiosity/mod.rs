@@ -121,11 +121,13 @@ pub fn solve(
     let mut solution = Radiosity::new(&patches, BANDS, settings).map_err(|e| e.to_string())?;
     let visibility = SceneVisibility(scene, &map);
     let direct_lights = PointLikeAndSkyLights::new(scene, &map);
+    let pyramids = tiled::TilePyramids::new(scene, &map);
     let mut lines = Vec::new();
     for i in 1..=method.iterations {
         let s = solution
-            .iterate(&visibility, &direct_lights)
+            .iterate_with(&visibility, &direct_lights, &pyramids)
             .map_err(|e| e.to_string())?;
+        lines.extend(pyramids.take_lines());
         lines.push(format!(
             "radiosity: iteration {i}: {} patches, {} elements, {} links ({} from clusters, {} \
              through their Z-buffers), {:.1} MiB, refine {:.2} s, solve {:.2} s ({} sweeps)",

@@ -8,13 +8,19 @@
 //! from above the tile's slab on their side, where the whole macro-surface's irradiance
 //! arrives: from the plane itself they would start inside the weave.
 
+use std::cell::RefCell;
+use std::collections::HashMap;
 use std::sync::Arc;
+use std::time::Instant;
 
 use glam::Vec3A;
 use prism_geometry::{Geometry, Shape};
-use prism_radiosity::directional::DirectionalSurface;
+use prism_radiosity::directional::{DirectionalSurface, FinerPyramids};
+use prism_radiosity::tile_cells::TileLattice;
 use prism_radiosity::ElementShape;
 
+use super::patches::PatchMap;
+use crate::scene_build::RenderScene;
 use crate::tile_pyramid::TiledSurface;
 
 impl TiledCarrier {
@@ -39,13 +45,12 @@ pub struct TiledCarrier {
     pub normal: Vec3A,
     /// The tile's heights along `normal`, metres.
     pub slab_m: (f32, f32),
-    /// τ̄ per direction bin (`tile_pyramid::bins`): averaged over the bin's directions.
-    pub transparency: Vec<f32>,
     /// Reflectance per band, front then back (the diffuse equivalent the oracle reads).
     pub reflectance: [Vec<f32>; 2],
-    /// Its top level's Γ in the tile's frame: the unit tangent along `e1` (the tile's x),
-    /// the tile's y made orthogonal to it and the normal (−(n × t) under a mirroring
-    /// transform, where the frame is left-handed), and `normal`.
+    /// Its pyramid's Γ and τ̄ in the tile's frame: the unit tangent along `e1` (the tile's
+    /// x), the tile's y made orthogonal to it and the normal (−(n × t) under a mirroring
+    /// transform, where the frame is left-handed), and `normal`; its lattice has a period
+    /// corner at `p0`.
     pub surface: Arc<DirectionalSurface>,
 }
 
@@ -97,11 +102,16 @@ impl TiledCarriers {
                 e2,
                 normal,
                 slab_m: surface.slab_m,
-                transparency: surface.transparency.clone(),
                 reflectance: surface.reflectance.map(|r| r.to_vec()),
                 surface: Arc::new(DirectionalSurface {
                     frame: [tangent, bitangent, normal],
+                    lattice: TileLattice {
+                        origin: t.point(Vec3A::ZERO),
+                        period: [e1 / tiling.cells[0] as f32, e2 / tiling.cells[1] as f32],
+                    },
+                    levels: surface.levels,
                     gamma: surface.gamma.clone(),
+                    view_transparency: surface.view_transparency.clone(),
                 }),
             });
         }
@@ -134,11 +144,94 @@ impl TiledCarriers {
         })
     }
 
-    /// τ of carrier `carrier` (an index into the list) for light leaving along `wo`
+    /// τ̄ of carrier `carrier` (an index into the list) for light leaving along `wo`
     /// (world, unit): the share of its area that a viewer looking back along `wo` sees
-    /// through.
+    /// through (the whole period's).
     pub fn transparency_towards(&self, carrier: usize, wo: Vec3A) -> f32 {
         let c = &self.0[carrier];
-        c.transparency[c.surface.bin_of(wo)]
+        c.surface
+            .see_through(&prism_radiosity::tile_cells::CellWeights::TOP, wo)
+    }
+}
+
+/// A tile's name and the surface its pyramid makes.
+type NamedSurface = (String, TiledSurface);
+
+/// Finer pyramids for the solution's tiled carriers: the tile simulated again with the
+/// levels the carrier's elements read (at most its material's `levels`), once per
+/// material and depth. Each pyramid made adds a line of statistics.
+pub struct TilePyramids<'a> {
+    scene: &'a RenderScene,
+    map: &'a PatchMap,
+    /// Per (material, levels asked): the tile's name and its surface.
+    made: RefCell<HashMap<(u32, u32), Arc<NamedSurface>>>,
+    lines: RefCell<Vec<String>>,
+}
+
+impl<'a> TilePyramids<'a> {
+    pub fn new(scene: &'a RenderScene, map: &'a PatchMap) -> Self {
+        Self {
+            scene,
+            map,
+            made: RefCell::default(),
+            lines: RefCell::default(),
+        }
+    }
+
+    /// The statistics lines of the pyramids made since the last call.
+    pub fn take_lines(&self) -> Vec<String> {
+        std::mem::take(&mut self.lines.borrow_mut())
+    }
+}
+
+impl FinerPyramids for TilePyramids<'_> {
+    fn with_levels(
+        &self,
+        patch: usize,
+        surface: &DirectionalSurface,
+        levels: u32,
+    ) -> Result<Option<Arc<DirectionalSurface>>, String> {
+        let Some(carrier) = self.map.carrier_of_patch(patch as u32) else {
+            return Ok(None);
+        };
+        let instance = self.map.carriers.0[carrier].instance;
+        let Some(material) = self.scene.geometry.instances()[instance as usize].material else {
+            return Ok(None);
+        };
+        let key = (material, levels);
+        let made = self.made.borrow().get(&key).cloned();
+        let made = match made {
+            Some(made) => made,
+            None => {
+                let start = Instant::now();
+                let Some(made) =
+                    self.scene
+                        .tiled_surface_with_levels(material, levels, surface.levels)?
+                else {
+                    return Ok(None);
+                };
+                let (name, tiled) = &made;
+                self.lines.borrow_mut().push(format!(
+                    "radiosity: tile `{name}`: a {}-level pyramid for elements down to 1/{} of \
+                     a period ({:.2} s)",
+                    tiled.levels,
+                    1u32 << (tiled.levels - 1),
+                    start.elapsed().as_secs_f64()
+                ));
+                let made = Arc::new(made);
+                self.made.borrow_mut().insert(key, made.clone());
+                made
+            }
+        };
+        let tiled = &made.1;
+        Ok((tiled.levels > surface.levels).then(|| {
+            Arc::new(DirectionalSurface {
+                frame: surface.frame,
+                lattice: surface.lattice,
+                levels: tiled.levels,
+                gamma: tiled.gamma.clone(),
+                view_transparency: tiled.view_transparency.clone(),
+            })
+        }))
     }
 }
