@@ -63,8 +63,9 @@ pub struct ConvergeArgs {
     pub reference_spp: u32,
     /// A method, INTEGRATOR[+PLAN][:SAMPLER] (repeat for several; default `path`, the path
     /// tracer with the uniform plan and the independent sampler). Integrators: path, light,
-    /// bdpt, photon, photon_progressive, ambient_occlusion, depth, normal, albedo; plans:
-    /// uniform, predicted, adaptive (path only); samplers: independent, sobol.
+    /// bdpt, photon, photon_progressive, radiosity, ambient_occlusion, depth, normal,
+    /// albedo; plans: uniform, predicted, predicted-hier, adaptive, oracle (path only);
+    /// samplers: independent, sobol.
     #[arg(long = "method", value_name = "METHOD")]
     pub methods: Vec<String>,
     /// Time budget per method, seconds, on the --clock (wall or render CPU time; default 10
