@@ -1963,13 +1963,15 @@ fn check_directional(patches: &[InputPatch], bands: usize) -> Result<(), Radiosi
     Ok(())
 }
 
-/// Whether two patches' directional sides are the same side of a surface in the same
-/// place. Their pyramids may differ: a solution deepens the pyramids its elements need
-/// (the tile's materials are in the patches' diffuse-equivalent reflectances, compared
-/// apart).
-fn same_place(a: &Option<DirectionalSide>, b: &Option<DirectionalSide>) -> bool {
-    match (a, b) {
+/// Whether a scene's directional side `scene` is the same side of the same surface as a
+/// solution's `solved`. Where the solution deepened the pyramid its elements needed, the
+/// two pyramids differ (a finer simulation of the same tile): then the side's place is
+/// compared, and the tile's materials through the patches' diffuse-equivalent
+/// reflectances.
+fn same_place(scene: &Option<DirectionalSide>, solved: &Option<DirectionalSide>) -> bool {
+    match (scene, solved) {
         (None, None) => true,
+        (Some(a), Some(b)) if a.surface.levels == b.surface.levels => a == b,
         (Some(a), Some(b)) => {
             a.front == b.front
                 && a.partner == b.partner

@@ -293,21 +293,16 @@ fn the_scene_reader_checks_tiles_and_tiled_materials() {
 /// A closed 2 m room lit by a ceiling panel, with the wicker panel standing in it: the
 /// faces of the room with the scene's integrator (JSON), sensors on the floor in front of,
 /// under and behind the panel and on the walls.
-fn room_with_wicker(dir: &Dir, integrator: &str) -> prism_render::RenderScene {
-    std::fs::create_dir_all(dir.0.join("tiles")).unwrap();
-    for file in ["wicker.obj", "wicker.mtl"] {
-        std::fs::copy(
-            wicker_path().with_file_name(file),
-            dir.0.join("tiles").join(file),
-        )
-        .unwrap();
-    }
+/// The six 2 m faces of a closed room centred on the origin (JSON shape entries), each
+/// with `material(name)`.
+fn room_faces(material: impl Fn(&str) -> &'static str) -> String {
     let face = |name: &str, transform: &str| {
         format!(
-            r#"{{"type": "rectangle", "name": "{name}", "size_m": [2, 2], "material": "plaster", "transform": {transform}}}"#
+            r#"{{"type": "rectangle", "name": "{name}", "size_m": [2, 2], "material": "{}", "transform": {transform}}}"#,
+            material(name)
         )
     };
-    let faces = [
+    [
         face(
             "floor",
             r#"[{"rotate": {"axis": [1, 0, 0], "angle_deg": -90}}, {"translate": [0, -1, 0]}]"#,
@@ -330,7 +325,19 @@ fn room_with_wicker(dir: &Dir, integrator: &str) -> prism_render::RenderScene {
             r#"[{"rotate": {"axis": [0, 1, 0], "angle_deg": -90}}, {"translate": [1, 0, 0]}]"#,
         ),
     ]
-    .join(",\n    ");
+    .join(",\n    ")
+}
+
+fn room_with_wicker(dir: &Dir, integrator: &str) -> prism_render::RenderScene {
+    std::fs::create_dir_all(dir.0.join("tiles")).unwrap();
+    for file in ["wicker.obj", "wicker.mtl"] {
+        std::fs::copy(
+            wicker_path().with_file_name(file),
+            dir.0.join("tiles").join(file),
+        )
+        .unwrap();
+    }
+    let faces = room_faces(|_| "plaster");
     let json = format!(
         r#"{{
   "camera": {{"type": "pinhole", "fov_deg": 60, "transform": {{"look_at": {{"eye": [0, 0, 0.9], "target": [0, 0, 0], "up": [0, 1, 0]}}}}}},
@@ -475,40 +482,13 @@ fn room_with_two_tone_wall(dir: &Dir, integrator: &str, levels: u32) -> prism_re
         "tiles/halves.mtl",
         b"newmtl white\nKd 1 1 1\nnewmtl dark\nKd 0 0 0\n",
     );
-    let face = |name: &str, material: &str, transform: &str| {
-        format!(
-            r#"{{"type": "rectangle", "name": "{name}", "size_m": [2, 2], "material": "{material}", "transform": {transform}}}"#
-        )
-    };
-    let faces = [
-        face(
-            "floor",
-            "plaster",
-            r#"[{"rotate": {"axis": [1, 0, 0], "angle_deg": -90}}, {"translate": [0, -1, 0]}]"#,
-        ),
-        face(
-            "ceiling",
-            "plaster",
-            r#"[{"rotate": {"axis": [1, 0, 0], "angle_deg": 90}}, {"translate": [0, 1, 0]}]"#,
-        ),
-        face("back", "two-tone", r#"[{"translate": [0, 0, -1]}]"#),
-        face(
-            "front",
-            "plaster",
-            r#"[{"rotate": {"axis": [0, 1, 0], "angle_deg": 180}}, {"translate": [0, 0, 1]}]"#,
-        ),
-        face(
-            "left",
-            "plaster",
-            r#"[{"rotate": {"axis": [0, 1, 0], "angle_deg": 90}}, {"translate": [-1, 0, 0]}]"#,
-        ),
-        face(
-            "right",
-            "plaster",
-            r#"[{"rotate": {"axis": [0, 1, 0], "angle_deg": -90}}, {"translate": [1, 0, 0]}]"#,
-        ),
-    ]
-    .join(",\n    ");
+    let faces = room_faces(|name| {
+        if name == "back" {
+            "two-tone"
+        } else {
+            "plaster"
+        }
+    });
     let json = format!(
         r#"{{
   "camera": {{"type": "pinhole", "fov_deg": 60, "transform": {{"look_at": {{"eye": [0, 0, 0.9], "target": [0, 0, 0], "up": [0, 1, 0]}}}}}},

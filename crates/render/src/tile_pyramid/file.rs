@@ -67,7 +67,7 @@ impl TilePyramid {
         if levels == 0 || levels > prism_scene::material::MAX_TILE_LEVELS {
             return Err(format!("{levels} levels"));
         }
-        let cells = super::level_offset(levels);
+        let cells = prism_radiosity::tile_cells::pyramid_cells(levels);
         let n_gamma = cells * super::SPHERE_BINS * super::SPHERE_BINS * BANDS;
         let n_tau = cells * super::SPHERE_BINS;
         let floats = 2 * n_gamma + 2 * n_tau;

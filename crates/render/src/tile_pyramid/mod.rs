@@ -23,6 +23,7 @@ pub use prism_radiosity::bins;
 
 use glam::{UVec2, Vec2, Vec3A};
 use prism_geometry::Ray;
+use prism_radiosity::tile_cells::{cell_index, pyramid_cells, MAX_PYRAMID_LEVELS};
 use prism_scene::{
     FluorescenceLanes, Integrator as IntegratorDescription, Light, LightKind, MaterialKind,
     MisHeuristic, SamplerKind, SceneDescription, Shape, ShapeKind, SpectrumRef, Strength,
@@ -97,20 +98,19 @@ pub struct TilePyramid {
     view_transparency: Vec<f32>,
 }
 
-/// The first cell of `level` among all levels' cells.
-fn level_offset(level: u32) -> usize {
-    ((1usize << (2 * level)) - 1) / 3
-}
+// The solution reads the pyramid's cells in the same order (`prism_radiosity::tile_cells`)
+// and accepts as many levels as a `tiled` material may ask for.
+const _: () = assert!(prism_scene::material::MAX_TILE_LEVELS == MAX_PYRAMID_LEVELS);
 
 impl TilePyramid {
     /// Cells over all levels.
     pub fn cell_count(&self) -> usize {
-        level_offset(self.levels)
+        pyramid_cells(self.levels)
     }
 
     fn cell(&self, level: u32, u: u32, v: u32) -> usize {
         assert!(level < self.levels && u < 1 << level && v < 1 << level);
-        level_offset(level) + (v as usize) * (1usize << level) + u as usize
+        cell_index(level, u, v)
     }
 
     fn at(&self, cell: usize, incident: usize, outgoing: usize) -> usize {
@@ -199,7 +199,7 @@ impl TilePyramid {
         if tile >= description.tiles.len() {
             return Err(format!("the scene has no tile {tile}"));
         }
-        let cells = level_offset(options.levels);
+        let cells = pyramid_cells(options.levels);
         // One scene per worker (the tile's OBJ is read and its BVH built once each); each
         // incident bin only replaces the beam.
         let d = simulation_description(description, tile, options.max_depth);
@@ -420,7 +420,7 @@ fn simulate_incident(
     let period = simulation.tiles[tile].period_m.map(|p| p as f32);
     let margin = 0.01 * period[0].max(period[1]);
     let (top, bottom) = (hi.z.max(0.0) + margin, lo.z.min(0.0) - margin);
-    let cells = level_offset(options.levels);
+    let cells = pyramid_cells(options.levels);
     let levels = options.levels;
     // The crossing point's cell at every level: u, v in [0, 1) over the centre period.
     let cell_indices = |uv: Vec2| -> Vec<usize> {
@@ -429,7 +429,7 @@ fn simulate_incident(
                 let side = 1u32 << l;
                 let cu = ((uv.x * side as f32) as u32).min(side - 1);
                 let cv = ((uv.y * side as f32) as u32).min(side - 1);
-                level_offset(l) + (cv * side + cu) as usize
+                cell_index(l, cu, cv)
             })
             .collect()
     };
