@@ -1,6 +1,7 @@
 //! `prism tile-brdf`: the pyramid of the example wicker tile computed once, then read from
 //! the cache; a switched pyramid (`--no-self-shadowing`) under its own key; the summary's
-//! keys; the errors of a misnamed tile and of too few samples.
+//! keys; the errors of a misnamed tile, of too few samples and of a pyramid above the
+//! memory limit.
 
 mod support;
 use support::prism_in as prism;
@@ -133,6 +134,31 @@ fn misnamed_tiles_and_too_few_samples_are_errors() {
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert!(
         !o.status.success() && stderr.contains("at least 64"),
+        "{stderr}"
+    );
+    // 8 levels would take 53 GiB while simulated: refused before anything is allocated.
+    let o = prism(
+        dir.path(),
+        &[
+            "--max-memory",
+            "1G",
+            "tile-brdf",
+            &scene,
+            "--tile",
+            "wicker",
+            "--levels",
+            "8",
+            "--samples",
+            "65536",
+            "--cache-dir",
+            "c",
+        ],
+    );
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success()
+            && stderr.contains("a pyramid of 8 levels of tile `wicker` needs about")
+            && stderr.contains("more than the memory limit of 1.00 GiB set by --max-memory"),
         "{stderr}"
     );
 }

@@ -33,8 +33,8 @@ use prism_cpu::memory::MemoryBudget;
 )]
 struct Cli {
     /// Memory a command may use, e.g. 512M or 8G (default: 75 % of the physical memory):
-    /// `render`, `converge`, `compare` and `tonemap` estimate what they need before they
-    /// allocate and refuse above it (docs/reliability.md).
+    /// `render`, `converge`, `compare`, `tonemap` and `tile-brdf` estimate what they need
+    /// before they allocate and refuse above it (docs/reliability.md).
     #[arg(long = "max-memory", global = true, value_name = "SIZE", value_parser = prism_cpu::memory::parse_size)]
     max_memory: Option<u64>,
     #[command(subcommand)]
@@ -92,7 +92,7 @@ fn main() -> ExitCode {
         Command::MerlExport(args) => done(merl_export::run(&args)),
         // Non-zero without an error when a signal stopped it (the work is saved).
         Command::Render(args) => render::run(&args, &budget),
-        Command::TileBrdf(args) => done(tile_brdf::run(&args)),
+        Command::TileBrdf(args) => done(tile_brdf::run(&args, &budget)),
         Command::Tonemap(args) => done(tonemap::run(&args, &budget)),
     };
     match result {

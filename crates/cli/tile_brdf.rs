@@ -8,6 +8,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use clap::Args;
+use prism_cpu::memory::MemoryBudget;
 use prism_render::tile_pyramid::bins::{self, RINGS, SECTORS, SPHERE_BINS};
 use prism_render::tile_pyramid::{PyramidOptions, TilePyramid};
 use serde_json::json;
@@ -47,7 +48,7 @@ pub struct TileBrdfArgs {
     pub output: Option<PathBuf>,
 }
 
-pub fn run(args: &TileBrdfArgs) -> Result<(), String> {
+pub fn run(args: &TileBrdfArgs, budget: &MemoryBudget) -> Result<(), String> {
     let description = prism_scene::load_scene(&args.scene).map_err(|e| e.to_string())?;
     let scene = args.scene.display();
     let Some(tile) = description.tiles.iter().position(|t| t.name == args.tile) else {
@@ -89,6 +90,12 @@ pub fn run(args: &TileBrdfArgs) -> Result<(), String> {
         interreflection: interreflection && !args.no_interreflection,
         ..PyramidOptions::default()
     };
+    budget
+        .check(
+            &format!("a pyramid of {levels} levels of tile `{}`", args.tile),
+            TilePyramid::estimated_bytes(levels),
+        )
+        .map_err(|e| e.to_string())?;
     let cache_dir = prepare_cache_dir(args.cache_dir.as_deref(), "the tile pyramid cache", "")?;
     let key = cache_key(&description, tile, &options)?;
     let cache_file = cache_dir.join(format!(

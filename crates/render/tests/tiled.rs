@@ -554,3 +554,41 @@ fn a_tiled_walls_elements_read_the_pyramid_cells_they_cover() {
         expected.len()
     );
 }
+
+/// A finer pyramid is made only within half the memory limit: beyond it the elements read
+/// the deepest pyramid that fits, and the solution says so.
+#[test]
+fn a_finer_pyramid_stays_within_the_memory_limit() {
+    let dir = Dir::new("tiled", "two-tone-memory");
+    let scene = room_with_two_tone_wall(&dir, r#"{"type": "radiosity"}"#, 5);
+    let prism_render::integrator::Integrator::Radiosity(method) = scene.integrator else {
+        panic!("a radiosity scene");
+    };
+    let solved = |limit_mib: u64| {
+        let method = prism_render::integrator::radiosity::RadiosityMethod {
+            memory_limit_bytes: Some(limit_mib << 20),
+            ..method
+        };
+        prism_render::integrator::radiosity::solve(&scene, &method)
+            .unwrap_or_else(|e| panic!("{e}"))
+            .1
+    };
+    // Its elements get down to 1/8 of the 2 m period: 4 levels, 170 MiB to simulate.
+    let roomy = solved(1024);
+    assert!(
+        roomy.iter().any(|l| l.contains("a 4-level pyramid")),
+        "{roomy:#?}"
+    );
+    let tight = solved(200);
+    assert!(
+        tight
+            .iter()
+            .any(|l| l.contains("more than half the memory limit")
+                && l.ends_with("they read 3 levels")),
+        "{tight:#?}"
+    );
+    assert!(
+        tight.iter().any(|l| l.contains("a 3-level pyramid")),
+        "{tight:#?}"
+    );
+}

@@ -219,6 +219,18 @@ impl RenderScene {
             .map_err(|e| format!("{}: tiles: {e}", self.file.display()))
     }
 
+    /// The `levels` of `tiled` material `material` (the most its pyramid may have) and its
+    /// tile's name; `None` for another material.
+    pub fn tiled_material_levels(&self, material: u32) -> Option<(u32, &str)> {
+        let description = self.tile_description.as_ref()?;
+        match description.materials.get(material as usize)?.kind {
+            prism_scene::MaterialKind::Tiled { levels, tile, .. } => {
+                Some((levels, description.tiles.get(tile)?.name.as_str()))
+            }
+            _ => None,
+        }
+    }
+
     /// `tiled` material `material`'s surface with a pyramid of `levels` levels (at most the
     /// material's `levels`), computed anew, and its tile's name: what the solution asks for
     /// once its elements get smaller than a period. `None` for another material, or where

@@ -278,7 +278,8 @@ pub(crate) fn radiosity_surfaces(
 /// levels, at most the material's own `levels`, and the slab of its tile; with the tile's
 /// name. `None` for another material, one no shape uses, or where that is no more than
 /// `more_than` levels. 16 samples per bin pair reach each cell of the pyramid's finest level
-/// (64 at least, 1 024 at most: beyond level 3 the finest cells get fewer).
+/// (64 at least, 1 024 at most: beyond level 3 the finest cells get fewer, down to the one
+/// sample per cell and band group the simulation needs).
 pub(crate) fn radiosity_surface(
     scene: &SceneDescription,
     geometry: &prism_geometry::Geometry,
@@ -315,7 +316,7 @@ pub(crate) fn radiosity_surface(
     let finest_cells = 1u32 << (2 * (levels - 1));
     let options = PyramidOptions {
         levels,
-        samples_per_bin_pair: (16 * finest_cells).clamp(64, 1024),
+        samples_per_bin_pair: (16 * finest_cells).clamp(64, 1024).max(4 * finest_cells),
         self_shadowing,
         interreflection,
         ..PyramidOptions::default()

@@ -121,7 +121,7 @@ pub fn solve(
     let mut solution = Radiosity::new(&patches, BANDS, settings).map_err(|e| e.to_string())?;
     let visibility = SceneVisibility(scene, &map);
     let direct_lights = PointLikeAndSkyLights::new(scene, &map);
-    let pyramids = tiled::TilePyramids::new(scene, &map);
+    let pyramids = tiled::TilePyramids::new(scene, &map, method.memory_limit_bytes);
     let mut lines = Vec::new();
     for i in 1..=method.iterations {
         let s = solution

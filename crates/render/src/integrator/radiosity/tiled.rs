@@ -9,7 +9,7 @@
 //! arrives: from the plane itself they would start inside the weave.
 
 use std::cell::RefCell;
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -21,7 +21,7 @@ use prism_radiosity::ElementShape;
 
 use super::patches::PatchMap;
 use crate::scene_build::RenderScene;
-use crate::tile_pyramid::TiledSurface;
+use crate::tile_pyramid::{TilePyramid, TiledSurface};
 
 impl TiledCarrier {
     /// The carrier's parallelogram, front along `normal`.
@@ -157,23 +157,35 @@ impl TiledCarriers {
 /// A tile's name and the surface its pyramid makes.
 type NamedSurface = (String, TiledSurface);
 
+/// The memory a finer pyramid may take without a memory limit, bytes.
+const PYRAMID_BYTES_WITHOUT_LIMIT: u64 = 1 << 30;
+
 /// Finer pyramids for the solution's tiled carriers: the tile simulated again with the
-/// levels the carrier's elements read (at most its material's `levels`), once per
-/// material and depth. Each pyramid made adds a line of statistics.
+/// levels the carrier's elements read (at most its material's `levels`, and as many as
+/// half the memory limit holds while the tile is simulated), once per material and depth.
+/// Each pyramid made, or held back by the memory, adds a line of statistics.
 pub struct TilePyramids<'a> {
     scene: &'a RenderScene,
     map: &'a PatchMap,
+    /// What a pyramid may take while it is simulated, bytes.
+    budget_bytes: u64,
     /// Per (material, levels asked): the tile's name and its surface.
     made: RefCell<HashMap<(u32, u32), Arc<NamedSurface>>>,
+    /// (material, levels) pairs whose deeper pyramid the memory held back (said once).
+    held_back: RefCell<HashSet<(u32, u32)>>,
     lines: RefCell<Vec<String>>,
 }
 
 impl<'a> TilePyramids<'a> {
-    pub fn new(scene: &'a RenderScene, map: &'a PatchMap) -> Self {
+    /// Pyramids for `scene`'s carriers (`map`) within half of `memory_limit_bytes` (1 GiB
+    /// without a limit).
+    pub fn new(scene: &'a RenderScene, map: &'a PatchMap, memory_limit_bytes: Option<u64>) -> Self {
         Self {
             scene,
             map,
+            budget_bytes: memory_limit_bytes.map_or(PYRAMID_BYTES_WITHOUT_LIMIT, |m| m / 2),
             made: RefCell::default(),
+            held_back: RefCell::default(),
             lines: RefCell::default(),
         }
     }
@@ -198,7 +210,29 @@ impl FinerPyramids for TilePyramids<'_> {
         let Some(material) = self.scene.geometry.instances()[instance as usize].material else {
             return Ok(None);
         };
+        let Some((most, tile)) = self.scene.tiled_material_levels(material) else {
+            return Ok(None);
+        };
+        let wanted = levels.min(most);
+        // The deepest pyramid the memory allows.
+        let levels = (1..=wanted)
+            .rev()
+            .find(|&l| TilePyramid::estimated_bytes(l) <= self.budget_bytes)
+            .unwrap_or(1);
         let key = (material, levels);
+        if levels < wanted && self.held_back.borrow_mut().insert(key) {
+            self.lines.borrow_mut().push(format!(
+                "radiosity: tile `{tile}`: elements down to 1/{} of a period would \
+                 read a {wanted}-level pyramid, which needs {:.0} MiB while it is simulated, \
+                 more than half the memory limit ({:.0} MiB): they read {levels} levels",
+                1u32 << (wanted - 1),
+                TilePyramid::estimated_bytes(wanted) as f64 / 1048576.0,
+                self.budget_bytes as f64 / 1048576.0,
+            ));
+        }
+        if levels <= surface.levels {
+            return Ok(None);
+        }
         let made = self.made.borrow().get(&key).cloned();
         let made = match made {
             Some(made) => made,
