@@ -370,8 +370,9 @@ fn room_with_wicker(dir: &Dir, integrator: &str) -> prism_render::RenderScene {
     dir.scene(&json)
 }
 
-/// `radiosity` holds the tiled panel as a directional patch per side (its pyramid's top
-/// level Γ per direction bin) seen through by the tile's own geometry: its sensors agree
+/// `radiosity` holds the tiled panel as a directional patch per side (its pyramid's Γ per
+/// direction bin: the top level, as its elements stay above one period) seen through by
+/// the tile's own geometry: its sensors agree
 /// with `path` within 2 % + 4 s.e. (−0.6 … −2.5 %; −0.9 … −2.8 % as a diffuse
 /// equivalent).
 #[test]
