@@ -1,6 +1,6 @@
 //! `prism render` with the `radiosity` integrator on the Cornell box: the solution saved,
-//! exported as PLY and loaded again for another render, and the errors of misused solution
-//! files.
+//! exported as PLY and loaded again for another render, carried in the render's spectral
+//! bins, and the errors of misused solution files.
 
 mod support;
 use support::prism_in as prism;
@@ -159,4 +159,66 @@ fn misused_solution_files_are_errors() {
     ]);
     assert!(e.contains("not a Prism radiosity solution"), "{e}");
     assert!(!dir.path().join("b.exr").exists());
+}
+
+/// With `--spectral-bins N` the solution is carried in the N bins (here 47 of 10 nm over
+/// 360–830 nm) instead of 16 bands of 25 nm: the same lux within 1 %, and a solution saved
+/// in one set of bands is refused by a render in the other.
+#[test]
+fn a_solution_is_carried_in_the_renders_spectral_bins() {
+    let dir = tempfile::tempdir().unwrap();
+    cornell(dir.path(), "room.json", 1.0);
+    let text = std::fs::read_to_string(dir.path().join("room.json")).unwrap();
+    let mut json: serde_json::Value = serde_json::from_str(&text).unwrap();
+    json["sensors"] = serde_json::json!([{"type": "points", "name": "floor", "samples": 4096,
+        "positions_m": [[0.0, -0.999, 0.85], [-0.6, -0.999, 0.5], [0.7, -0.999, -0.6]],
+        "normal": [0, 1, 0]}]);
+    std::fs::write(dir.path().join("room.json"), json.to_string()).unwrap();
+    let render = |out: &str, extra: &[&str]| {
+        let mut args = vec!["render", "room.json", "-o", out];
+        args.extend_from_slice(extra);
+        let o = prism(dir.path(), &args);
+        let err = String::from_utf8_lossy(&o.stderr).into_owned();
+        assert!(o.status.success(), "{err}");
+        err
+    };
+    let err = render("a.exr", &[]);
+    assert!(err.contains("(16 bands of 25.000 nm from 380 nm)"), "{err}");
+    let err = render(
+        "b.exr",
+        &["--spectral-bins", "47", "--save-solution", "fine.rad"],
+    );
+    assert!(err.contains("(47 bands of 10.000 nm from 360 nm)"), "{err}");
+    let lux = |name: &str| -> Vec<f64> {
+        let text = std::fs::read_to_string(dir.path().join(name)).unwrap();
+        let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+        v["sensors"][0]["points"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|p| p["illuminance_lx"].as_f64().unwrap())
+            .collect()
+    };
+    let (coarse, fine) = (lux("a.sensors.json"), lux("b.sensors.json"));
+    assert_eq!(coarse.len(), 3);
+    for (c, f) in coarse.iter().zip(&fine) {
+        assert!((f / c - 1.0).abs() < 0.01, "{coarse:?} {fine:?}");
+    }
+    let o = prism(
+        dir.path(),
+        &[
+            "render",
+            "room.json",
+            "-o",
+            "c.exr",
+            "--load-solution",
+            "fine.rad",
+        ],
+    );
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success()
+            && err.contains("this solution is in 47 wavelength bands, the render asks for 16"),
+        "{err}"
+    );
 }

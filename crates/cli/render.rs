@@ -343,6 +343,8 @@ pub fn run(args: &RenderArgs, budget: &MemoryBudget) -> Result<ExitCode, String>
     scene
         .integrator
         .set_memory_limit_bytes(Some(budget.limit_bytes));
+    // A radiosity solution is carried in the spectral bins asked for.
+    scene.integrator.set_spectral_bins(spectral_bins);
     if !args.explain {
         radiosity_solution_files(args, &scene)?;
     }

@@ -454,7 +454,8 @@ fn a_tiled_carriers_patches_are_the_see_through_ones() {
     let dir = Dir::new("tiled", "see-through");
     let scene = room_with_wicker(&dir, r#"{"type": "radiosity"}"#);
     let (patches, map) =
-        prism_render::integrator::radiosity::patches::scene_patches(&scene).unwrap();
+        prism_render::integrator::radiosity::patches::scene_patches(&scene, Default::default())
+            .unwrap();
     assert_eq!(map.carriers.0.len(), 1);
     let carrier = &map.carriers.0[0];
     let first = map.first_patch[carrier.instance as usize].unwrap();

@@ -59,7 +59,9 @@ fn a_mirrored_carrier_keeps_the_tiles_frame() {
             }
         }
     });
-    let (_, map) = prism_render::integrator::radiosity::patches::scene_patches(&scene).unwrap();
+    let (_, map) =
+        prism_render::integrator::radiosity::patches::scene_patches(&scene, Default::default())
+            .unwrap();
     let carrier = &map.carriers.0[0];
     let [x, y, z] = carrier.surface.frame;
     // The mirror flips the tile's y, which the rotation then takes to world +z (−z

@@ -182,6 +182,7 @@ impl Integrator {
                 iterations,
                 gather_epsilon: gather_epsilon as f32,
                 memory_limit_bytes: None,
+                bands: radiosity::patches::SolutionBands::DEFAULT,
             }),
         })
     }
@@ -219,6 +220,27 @@ impl Integrator {
         }
     }
 
+    /// Carries `radiosity`'s solution in the render's spectral bins (`--spectral-bins`)
+    /// instead of its default bands; other methods have no bands.
+    pub fn set_spectral_bins(&mut self, bins: Option<crate::film::spectral_bins::SpectralBins>) {
+        match self {
+            Integrator::Radiosity(r) => {
+                r.bands = bins.map_or(
+                    radiosity::patches::SolutionBands::DEFAULT,
+                    radiosity::patches::SolutionBands::of_spectral_bins,
+                )
+            }
+            Integrator::Depth
+            | Integrator::Normal
+            | Integrator::Albedo
+            | Integrator::AmbientOcclusion(_)
+            | Integrator::Path(_)
+            | Integrator::Light(_)
+            | Integrator::Bdpt(_)
+            | Integrator::Photon(_) => {}
+        }
+    }
+
     /// Err with the reason when this method cannot render `scene` at all (checked when a
     /// scene is built and again by `prepare`): the photon integrators' refusals (no lights,
     /// re-radiation, emissive media) and their memory estimate.
@@ -231,7 +253,7 @@ impl Integrator {
                 Some(reason) => Err(reason),
                 None => m.plan(scene).map(|_| ()),
             },
-            Integrator::Radiosity(_) => radiosity::patches::scene_patches(scene)
+            Integrator::Radiosity(r) => radiosity::patches::scene_patches(scene, r.bands)
                 .map(|_| ())
                 .map_err(|m| {
                     crate::scene_build::SceneBuildError::new(&scene.file, "integrator", m)

@@ -10,13 +10,13 @@ use prism_radiosity::DirectIrradiance;
 use prism_spectrum::{SampledSpectrum, SampledWavelengths, N_SPECTRUM_SAMPLES};
 
 use super::patches::PatchMap;
-use super::patches::{band_point_nm, BANDS};
 use crate::integrator::{PathCounters, PathTracer};
 use crate::light::LightSampleContext;
 use crate::scene_build::RenderScene;
 
-/// Wavelengths per band averaged (a band's mean of a spiky lamp spectrum).
-const POINTS_PER_BAND: usize = 4;
+/// Wavelengths per 25 nm averaged (a band's mean of a spiky lamp spectrum): 4 per band
+/// of the default 25 nm, fewer (at least 1) in narrower bands.
+const POINTS_PER_25_NM: f64 = 4.0;
 
 /// Directions per point and sky (importance-sampled by the light, R2-stratified).
 const SKY_DIRECTIONS: u32 = 64;
@@ -30,8 +30,12 @@ pub struct PointLikeAndSkyLights<'a> {
     lights: Vec<u32>,
     /// Indices of the skies and environment maps.
     skies: Vec<u32>,
-    /// The band wavelengths in groups of the four lanes.
+    /// The band wavelengths in groups of the four lanes (the last group padded with its
+    /// last wavelength).
     wavelength_sets: Vec<SampledWavelengths>,
+    /// Wavelengths per band, and bands (`points_per_band × bands` lanes are not padding).
+    points_per_band: usize,
+    bands: usize,
 }
 
 impl<'a> PointLikeAndSkyLights<'a> {
@@ -40,16 +44,18 @@ impl<'a> PointLikeAndSkyLights<'a> {
             .filter(|&l| scene.lights.light(l).is_delta())
             .collect();
         let skies = scene.lights.infinite_lights().to_vec();
-        let all: Vec<f32> = (0..BANDS * POINTS_PER_BAND)
+        let bands = map.bands;
+        let points_per_band =
+            ((POINTS_PER_25_NM * bands.width_nm / 25.0).round() as usize).clamp(1, 4);
+        let all: Vec<f32> = (0..bands.count * points_per_band)
             .map(|i| {
-                band_point_nm(i / POINTS_PER_BAND, i % POINTS_PER_BAND, POINTS_PER_BAND) as f32
+                bands.point_nm(i / points_per_band, i % points_per_band, points_per_band) as f32
             })
             .collect();
         let wavelength_sets = all
             .chunks(N_SPECTRUM_SAMPLES)
             .map(|c| {
-                let mut lambda = [0.0; N_SPECTRUM_SAMPLES];
-                lambda.copy_from_slice(c);
+                let lambda = std::array::from_fn(|k| c[k.min(c.len() - 1)]);
                 SampledWavelengths::new(lambda, SampledSpectrum::splat(1.0))
             })
             .collect();
@@ -59,6 +65,8 @@ impl<'a> PointLikeAndSkyLights<'a> {
             lights,
             skies,
             wavelength_sets,
+            points_per_band,
+            bands: bands.count,
         }
     }
 }
@@ -165,9 +173,12 @@ impl PointLikeAndSkyLights<'_> {
             if ls.pdf.is_nan() || ls.pdf <= 0.0 {
                 continue;
             }
+            let points = self.points_per_band;
             for lane in 0..N_SPECTRUM_SAMPLES {
-                let band = (set * N_SPECTRUM_SAMPLES + lane) / POINTS_PER_BAND;
-                out[band] += weight * ls.radiance[lane] * cos / ls.pdf / POINTS_PER_BAND as f32;
+                let band = (set * N_SPECTRUM_SAMPLES + lane) / points;
+                if band < self.bands {
+                    out[band] += weight * ls.radiance[lane] * cos / ls.pdf / points as f32;
+                }
             }
         }
     }

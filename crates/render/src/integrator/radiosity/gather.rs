@@ -10,7 +10,7 @@ use prism_geometry::SurfaceInteraction;
 use prism_radiosity::{Radiosity, ReceiverGather};
 use prism_spectrum::{SampledSpectrum, SampledWavelengths, N_SPECTRUM_SAMPLES};
 
-use super::patches::{band_of, PatchMap};
+use super::patches::PatchMap;
 use super::SceneVisibility;
 use crate::bsdf::TransportMode;
 use crate::integrator::scatter_vertex::ScatterVertex;
@@ -133,7 +133,7 @@ impl SolutionGather for SolvedScene {
         let faces_share = self.map.carrier[si.instance_id as usize]
             .map_or(1.0, |_| (1.0 - leaf.see_through).max(0.05));
         Some(SampledSpectrum::from_fn(|lane| {
-            let k = band_of(wavelengths.wavelength_nm(lane));
+            let k = self.map.bands.band_of(wavelengths.wavelength_nm(lane));
             (leaf.radiosity[k] - e[k]).max(0.0) * std::f32::consts::FRAC_1_PI / faces_share
         }))
     }
@@ -158,7 +158,7 @@ impl SolutionGather for SolvedScene {
         let leaf = self.solution.leaf_id(patch, si.p);
         let receiver = self.receiver(scene, leaf)?;
         let bands: [usize; N_SPECTRUM_SAMPLES] =
-            std::array::from_fn(|lane| band_of(wavelengths.wavelength_nm(lane)));
+            std::array::from_fn(|lane| self.map.bands.band_of(wavelengths.wavelength_nm(lane)));
         if vertex.is_lambertian() {
             // f is the same towards every bin: one evaluation, along the patch's normal.
             let mut e = [0.0f32; N_SPECTRUM_SAMPLES];

@@ -21,7 +21,7 @@ use prism_geometry::Ray;
 use prism_radiosity::{Radiosity, RadiositySettings, Visibility};
 
 pub use self::direct::PointLikeAndSkyLights;
-use self::patches::{scene_patches, PatchMap, BANDS};
+use self::patches::{scene_patches, PatchMap, SolutionBands};
 use super::driver::RenderStats;
 use super::estimator::{Estimator, Pass, TileWork};
 use super::path_estimator::scalar_tile;
@@ -41,6 +41,9 @@ pub struct RadiosityMethod {
     pub gather_epsilon: f32,
     /// `--max-memory` for the hierarchy.
     pub memory_limit_bytes: Option<u64>,
+    /// The wavelength bands of the solution: the default 16, or the render's spectral
+    /// bins.
+    pub bands: SolutionBands,
 }
 
 /// The estimator: the solution, built by the first `prepare`.
@@ -112,13 +115,14 @@ pub fn solve(
     scene: &RenderScene,
     method: &RadiosityMethod,
 ) -> Result<(SolvedScene, Vec<String>), String> {
-    let (patches, map) = scene_patches(scene)?;
+    let (patches, map) = scene_patches(scene, method.bands)?;
     let settings = RadiositySettings {
         error_bound_rel: method.error_bound_rel,
         memory_limit_bytes: method.memory_limit_bytes,
         ..RadiositySettings::default()
     };
-    let mut solution = Radiosity::new(&patches, BANDS, settings).map_err(|e| e.to_string())?;
+    let mut solution =
+        Radiosity::new(&patches, method.bands.count, settings).map_err(|e| e.to_string())?;
     let visibility = SceneVisibility(scene, &map);
     let direct_lights = PointLikeAndSkyLights::new(scene, &map);
     let pyramids = tiled::TilePyramids::new(scene, &map, method.memory_limit_bytes);
@@ -158,9 +162,13 @@ pub fn solve_and_report(
     for line in lines {
         eprintln!("{line}");
     }
+    let bands = method.bands;
     eprintln!(
-        "radiosity: solution in {:.2} s",
-        start.elapsed().as_secs_f64()
+        "radiosity: solution in {:.2} s ({} bands of {:.3} nm from {} nm)",
+        start.elapsed().as_secs_f64(),
+        bands.count,
+        bands.width_nm,
+        bands.first_nm
     );
     Ok(solved)
 }

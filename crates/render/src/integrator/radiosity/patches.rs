@@ -11,40 +11,100 @@ use prism_spectrum::Spectrum;
 
 use super::meshed::{mesh_analytic, LiftSphere, Meshing};
 use super::tiled::TiledCarriers;
+use crate::film::spectral_bins::SpectralBins;
 use crate::light::Light;
 use crate::material::Material;
 use crate::scene_build::RenderScene;
 
-/// Bands of the solution: 16 of 25 nm over 380–780 nm.
+/// The default bands of the solution, and those of every tile pyramid: 16 of 25 nm over
+/// 380–780 nm.
 pub const BANDS: usize = 16;
 pub const FIRST_BAND_NM: f64 = 380.0;
 pub const BAND_WIDTH_NM: f64 = 25.0;
 
-/// The band holding `wavelength_nm` (the end bands extend beyond 380–780 nm).
-#[inline]
-pub fn band_of(wavelength_nm: f32) -> usize {
-    (((f64::from(wavelength_nm) - FIRST_BAND_NM) / BAND_WIDTH_NM)
-        .floor()
-        .max(0.0) as usize)
-        .min(BANDS - 1)
-}
-
-/// Wavelength `k` of `count` evenly spaced midpoints in band `band`, nm.
+/// Wavelength `k` of `count` evenly spaced midpoints in default band `band`, nm.
 pub fn band_point_nm(band: usize, k: usize, count: usize) -> f64 {
-    FIRST_BAND_NM + BAND_WIDTH_NM * (band as f64 + (k as f64 + 0.5) / count as f64)
+    SolutionBands::DEFAULT.point_nm(band, k, count)
 }
 
-/// A spectrum's mean over each band (5 points per band).
-fn band_means(spectrum: &Spectrum, scale: f64) -> Vec<f32> {
-    (0..BANDS)
-        .map(|b| {
-            let mean = (0..5)
-                .map(|k| spectrum.eval_nm(band_point_nm(b, k, 5)))
-                .sum::<f64>()
-                / 5.0;
-            (mean * scale) as f32
-        })
-        .collect()
+/// The wavelength bands a solution is carried in: equal bands from `first_nm`, the end
+/// bands extending beyond the range. The default, 16 of 25 nm over 380–780 nm, or the
+/// render's spectral bins (`--spectral-bins N`: N over 360–830 nm).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SolutionBands {
+    pub count: usize,
+    pub first_nm: f64,
+    pub width_nm: f64,
+}
+
+impl Default for SolutionBands {
+    fn default() -> Self {
+        Self::DEFAULT
+    }
+}
+
+impl SolutionBands {
+    pub const DEFAULT: Self = Self {
+        count: BANDS,
+        first_nm: FIRST_BAND_NM,
+        width_nm: BAND_WIDTH_NM,
+    };
+
+    /// The bands of the render's spectral bins (`--spectral-bins N`: N equal bins over
+    /// 360–830 nm).
+    pub fn of_spectral_bins(bins: SpectralBins) -> Self {
+        Self {
+            count: bins.count() as usize,
+            first_nm: bins.lower_edge_nm(0),
+            width_nm: bins.width_nm(),
+        }
+    }
+
+    /// The band holding `wavelength_nm` (the end bands extend beyond the range).
+    #[inline]
+    pub fn band_of(&self, wavelength_nm: f32) -> usize {
+        (((f64::from(wavelength_nm) - self.first_nm) / self.width_nm)
+            .floor()
+            .max(0.0) as usize)
+            .min(self.count - 1)
+    }
+
+    /// Wavelength `k` of `count` evenly spaced midpoints in band `band`, nm.
+    pub fn point_nm(&self, band: usize, k: usize, count: usize) -> f64 {
+        self.first_nm + self.width_nm * (band as f64 + (k as f64 + 0.5) / count as f64)
+    }
+
+    /// A spectrum's mean over each band (5 points per band), times `scale`.
+    pub fn means(&self, spectrum: &Spectrum, scale: f64) -> Vec<f32> {
+        (0..self.count)
+            .map(|b| {
+                let mean = (0..5)
+                    .map(|k| spectrum.eval_nm(self.point_nm(b, k, 5)))
+                    .sum::<f64>()
+                    / 5.0;
+                (mean * scale) as f32
+            })
+            .collect()
+    }
+
+    /// Values per default band (`BANDS` of them, a tile pyramid's) carried into these
+    /// bands: each band takes the mean of the default bands over its wavelengths, the end
+    /// default bands standing for what lies beyond 380–780 nm. Returns `values` itself
+    /// where these are the default bands.
+    pub fn from_default_bands(&self, values: &[f32]) -> Vec<f32> {
+        if *self == Self::DEFAULT {
+            return values.to_vec();
+        }
+        const SUB: usize = 8;
+        (0..self.count)
+            .map(|b| {
+                (0..SUB)
+                    .map(|k| values[Self::DEFAULT.band_of(self.point_nm(b, k, SUB) as f32)])
+                    .sum::<f32>()
+                    / SUB as f32
+            })
+            .collect()
+    }
 }
 
 /// Where each instance's patches start.
@@ -65,6 +125,8 @@ pub struct PatchMap {
     pub meshing: Vec<Option<Meshing>>,
     /// The meshed spheres, whose patches' points rays start from lifted onto them.
     pub spheres: Vec<LiftSphere>,
+    /// The bands the patches' values are in.
+    pub bands: SolutionBands,
 }
 
 impl PatchMap {
@@ -130,8 +192,12 @@ fn lambertian(material: &Material) -> Result<(&Spectrum, bool), String> {
         })
 }
 
-/// The patches of `scene` and their map; an error names what the solution cannot hold.
-pub fn scene_patches(scene: &RenderScene) -> Result<(Vec<InputPatch>, PatchMap), String> {
+/// The patches of `scene` in `bands` and their map; an error names what the solution cannot
+/// hold.
+pub fn scene_patches(
+    scene: &RenderScene,
+    bands: SolutionBands,
+) -> Result<(Vec<InputPatch>, PatchMap), String> {
     let geometry: &Geometry = &scene.geometry;
     let mut patches = Vec::new();
     let mut map = PatchMap {
@@ -139,7 +205,8 @@ pub fn scene_patches(scene: &RenderScene) -> Result<(Vec<InputPatch>, PatchMap),
         sides: Vec::with_capacity(geometry.instances().len()),
         normals: Vec::new(),
         carrier: Vec::with_capacity(geometry.instances().len()),
-        carriers: TiledCarriers::of_geometry(geometry, scene.tiled_surfaces()?)?,
+        carriers: TiledCarriers::of_geometry(geometry, scene.tiled_surfaces()?, bands)?,
+        bands,
         meshing: Vec::with_capacity(geometry.instances().len()),
         spheres: Vec::new(),
     };
@@ -163,7 +230,7 @@ pub fn scene_patches(scene: &RenderScene) -> Result<(Vec<InputPatch>, PatchMap),
                 patches.push(InputPatch {
                     shape: oriented_shape,
                     reflectance: c.reflectance[side].clone(),
-                    emission: vec![0.0; BANDS],
+                    emission: vec![0.0; bands.count],
                     surface: instance_id as u32,
                     directional: Some(DirectionalSide {
                         surface: c.surface.clone(),
@@ -186,7 +253,7 @@ pub fn scene_patches(scene: &RenderScene) -> Result<(Vec<InputPatch>, PatchMap),
                 }
             });
         let emission =
-            area_light.map(|a| (band_means(&a.radiance, std::f64::consts::PI), a.two_sided));
+            area_light.map(|a| (bands.means(&a.radiance, std::f64::consts::PI), a.two_sided));
         // (world triangle or parallelogram, object-space geometric normal, material id)
         let mut pieces: Vec<(ElementShape, Vec3A, u32)> = Vec::new();
         match inst.shape {
@@ -248,12 +315,12 @@ pub fn scene_patches(scene: &RenderScene) -> Result<(Vec<InputPatch>, PatchMap),
         let both = emits_back || kinds.iter().any(|&(_, two_sided)| two_sided);
         let sides: u8 = if both { 2 } else { 1 };
         let first = patches.len() as u32;
-        let none = vec![0.0; BANDS];
+        let none = vec![0.0; bands.count];
         let emitted = emission.as_ref().map_or(none.clone(), |(e, _)| e.clone());
         for ((shape, ng_object, _), (reflectance, two_sided)) in pieces.into_iter().zip(kinds) {
             let n = inst.to_world.normal(ng_object).normalize_or_zero();
             let front = oriented(shape, n);
-            let rho = band_means(reflectance, 1.0);
+            let rho = bands.means(reflectance, 1.0);
             patches.push(InputPatch {
                 shape: front,
                 reflectance: rho.clone(),

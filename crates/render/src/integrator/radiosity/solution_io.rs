@@ -10,7 +10,7 @@ use prism_spectrum::photometry::photopic_luminance_cd_per_m2;
 use prism_spectrum::DenseSpectrum;
 
 use super::gather::SolvedScene;
-use super::patches::{scene_patches, BANDS, BAND_WIDTH_NM, FIRST_BAND_NM};
+use super::patches::{scene_patches, SolutionBands};
 use crate::scene_build::RenderScene;
 
 /// `--load-solution FILE` (its `bytes`; `path` for messages): the solution, if it was
@@ -21,8 +21,28 @@ pub fn load_solution(
     bytes: &[u8],
 ) -> Result<SolvedScene, String> {
     let solution = Radiosity::from_bytes(bytes).map_err(|e| format!("{}: {e}", path.display()))?;
-    let (patches, map) = scene_patches(scene)?;
-    if solution.bands() != BANDS || !solution.matches_patches(&patches) {
+    // The bands of the scene's method (the render's spectral bins where it sets them).
+    let bands = if let crate::integrator::Integrator::Radiosity(m) = scene.integrator {
+        m.bands
+    } else {
+        SolutionBands::DEFAULT
+    };
+    let (patches, map) = scene_patches(scene, bands)?;
+    if solution.bands() != bands.count {
+        return Err(format!(
+            "{}: this solution is in {} wavelength bands, the render asks for {} ({}): solve \
+             it again with --save-solution, or render with the spectral bins it was solved in",
+            path.display(),
+            solution.bands(),
+            bands.count,
+            if bands == SolutionBands::DEFAULT {
+                "the default".to_string()
+            } else {
+                format!("--spectral-bins {}", bands.count)
+            }
+        ));
+    }
+    if !solution.matches_patches(&patches) {
         return Err(format!(
             "{}: this solution was solved for another scene (its patches, reflectances or \
              emission differ from {}'s): solve it again with --save-solution",
@@ -39,12 +59,12 @@ pub fn load_solution(
     Ok(SolvedScene::new(solution, map, gather_epsilon))
 }
 
-/// A band array as a spectrum over 360–830 nm (zero outside 380–780 nm) and its
-/// photometric value: lux of an irradiance, cd/m² of a radiance.
-fn photometric(values: &[f32]) -> f64 {
+/// A band array (in `bands`) as a spectrum over 360–830 nm (zero outside the bands) and
+/// its photometric value: lux of an irradiance, cd/m² of a radiance.
+fn photometric(values: &[f32], bands: SolutionBands) -> f64 {
     let spectrum = DenseSpectrum::from_fn(|nm| {
-        let band = (nm - FIRST_BAND_NM) / BAND_WIDTH_NM;
-        if (0.0..BANDS as f64).contains(&band) {
+        let band = (nm - bands.first_nm) / bands.width_nm;
+        if (0.0..bands.count as f64).contains(&band) {
             f64::from(values[band as usize])
         } else {
             0.0
@@ -65,13 +85,13 @@ pub fn to_ply(solved: &SolvedScene) -> String {
         if leaf.covered_fraction >= 1.0 {
             continue;
         }
-        let lux = photometric(leaf.irradiance);
+        let lux = photometric(leaf.irradiance, solved.map.bands);
         let radiance: Vec<f32> = leaf
             .radiosity
             .iter()
             .map(|b| b * std::f32::consts::FRAC_1_PI)
             .collect();
-        let luminance = photometric(&radiance);
+        let luminance = photometric(&radiance, solved.map.bands);
         let (corners, count) = leaf.shape.corners();
         for c in &corners[..count] {
             vertices.push_str(&format!(

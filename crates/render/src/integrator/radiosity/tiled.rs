@@ -19,7 +19,7 @@ use prism_radiosity::directional::{DirectionalSurface, FinerPyramids};
 use prism_radiosity::tile_cells::TileLattice;
 use prism_radiosity::ElementShape;
 
-use super::patches::PatchMap;
+use super::patches::{PatchMap, SolutionBands, BANDS};
 use crate::scene_build::RenderScene;
 use crate::tile_pyramid::{TilePyramid, TiledSurface};
 
@@ -60,10 +60,11 @@ pub struct TiledCarriers(pub Vec<TiledCarrier>);
 
 impl TiledCarriers {
     /// The carriers of the `Shape::Tiled` instances of `geometry`, with the surfaces of
-    /// their materials (`surfaces[material id]`).
+    /// their materials (`surfaces[material id]`), in the solution's `bands`.
     pub fn of_geometry(
         geometry: &Geometry,
         surfaces: &[Option<TiledSurface>],
+        bands: SolutionBands,
     ) -> Result<Self, String> {
         let mut out = Vec::new();
         for (instance, inst) in geometry.instances().iter().enumerate() {
@@ -102,17 +103,16 @@ impl TiledCarriers {
                 e2,
                 normal,
                 slab_m: surface.slab_m,
-                reflectance: surface.reflectance.map(|r| r.to_vec()),
-                surface: Arc::new(DirectionalSurface {
-                    frame: [tangent, bitangent, normal],
-                    lattice: TileLattice {
+                reflectance: surface.reflectance.map(|r| bands.from_default_bands(&r)),
+                surface: Arc::new(directional_surface(
+                    [tangent, bitangent, normal],
+                    TileLattice {
                         origin: t.point(Vec3A::ZERO),
                         period: [e1 / tiling.cells[0] as f32, e2 / tiling.cells[1] as f32],
                     },
-                    levels: surface.levels,
-                    gamma: surface.gamma.clone(),
-                    view_transparency: surface.view_transparency.clone(),
-                }),
+                    surface,
+                    bands,
+                )),
             });
         }
         Ok(Self(out))
@@ -259,13 +259,39 @@ impl FinerPyramids for TilePyramids<'_> {
         };
         let tiled = &made.1;
         Ok((tiled.levels > surface.levels).then(|| {
-            Arc::new(DirectionalSurface {
-                frame: surface.frame,
-                lattice: surface.lattice,
-                levels: tiled.levels,
-                gamma: tiled.gamma.clone(),
-                view_transparency: tiled.view_transparency.clone(),
-            })
+            Arc::new(directional_surface(
+                surface.frame,
+                surface.lattice,
+                tiled,
+                self.map.bands,
+            ))
         }))
+    }
+}
+
+/// The solution's surface of a tile's pyramid `tiled` placed by `frame` and `lattice`, its
+/// Γ carried from the pyramid's 16 bands into the solution's `bands` (each band the mean
+/// of the pyramid's bands over it: finer solution bands see Γ in 25 nm steps).
+fn directional_surface(
+    frame: [Vec3A; 3],
+    lattice: TileLattice,
+    tiled: &TiledSurface,
+    bands: SolutionBands,
+) -> DirectionalSurface {
+    let gamma = if bands == SolutionBands::DEFAULT {
+        tiled.gamma.clone()
+    } else {
+        tiled
+            .gamma
+            .chunks_exact(BANDS)
+            .flat_map(|g| bands.from_default_bands(g))
+            .collect()
+    };
+    DirectionalSurface {
+        frame,
+        lattice,
+        levels: tiled.levels,
+        gamma,
+        view_transparency: tiled.view_transparency.clone(),
     }
 }
