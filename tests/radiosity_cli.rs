@@ -162,7 +162,7 @@ fn misused_solution_files_are_errors() {
 }
 
 /// With `--spectral-bins N` the solution is carried in the N bins (here 47 of 10 nm over
-/// 360–830 nm) instead of 16 bands of 25 nm: the same lux within 1 %, and a solution saved
+/// 360–830 nm) instead of 16 bands of 25 nm: the same lux within 4 s.e., and a solution saved
 /// in one set of bands is refused by a render in the other.
 #[test]
 fn a_solution_is_carried_in_the_renders_spectral_bins() {
@@ -189,20 +189,26 @@ fn a_solution_is_carried_in_the_renders_spectral_bins() {
         &["--spectral-bins", "47", "--save-solution", "fine.rad"],
     );
     assert!(err.contains("(47 bands of 10.000 nm from 360 nm)"), "{err}");
-    let lux = |name: &str| -> Vec<f64> {
+    // (lux, its standard error) per point.
+    let lux = |name: &str| -> Vec<(f64, f64)> {
         let text = std::fs::read_to_string(dir.path().join(name)).unwrap();
         let v: serde_json::Value = serde_json::from_str(&text).unwrap();
         v["sensors"][0]["points"]
             .as_array()
             .unwrap()
             .iter()
-            .map(|p| p["illuminance_lx"].as_f64().unwrap())
+            .map(|p| {
+                let value = |key: &str| p[key].as_f64().unwrap();
+                (value("illuminance_lx"), value("std_error_lx"))
+            })
             .collect()
     };
     let (coarse, fine) = (lux("a.sensors.json"), lux("b.sensors.json"));
     assert_eq!(coarse.len(), 3);
-    for (c, f) in coarse.iter().zip(&fine) {
-        assert!((f / c - 1.0).abs() < 0.01, "{coarse:?} {fine:?}");
+    // Within 4 combined standard errors (measured: 0.15 % at most, s.e. 0.1–0.25 %).
+    for (&(c, c_se), &(f, f_se)) in coarse.iter().zip(&fine) {
+        let se = (c_se * c_se + f_se * f_se).sqrt();
+        assert!((f - c).abs() < 4.0 * se, "{coarse:?} {fine:?}");
     }
     let o = prism(
         dir.path(),

@@ -232,26 +232,18 @@ impl RenderScene {
     }
 
     /// `tiled` material `material`'s surface with a pyramid of `levels` levels (at most the
-    /// material's `levels`), computed anew, and its tile's name: what the solution asks for
-    /// once its elements get smaller than a period. `None` for another material, or where
-    /// the material allows no more than `more_than` levels.
+    /// material's `levels`), computed anew: what the solution asks for once its elements
+    /// get smaller than a period. `None` for another material.
     pub fn tiled_surface_with_levels(
         &self,
         material: u32,
         levels: u32,
-        more_than: u32,
-    ) -> Result<Option<(String, crate::tile_pyramid::TiledSurface)>, String> {
+    ) -> Result<Option<crate::tile_pyramid::TiledSurface>, String> {
         let Some(description) = &self.tile_description else {
             return Ok(None);
         };
-        tiles::radiosity_surface(
-            description,
-            &self.geometry,
-            material as usize,
-            levels,
-            more_than,
-        )
-        .map_err(|e| format!("{}: tiles: {e}", self.file.display()))
+        tiles::radiosity_surface(description, &self.geometry, material as usize, levels)
+            .map_err(|e| format!("{}: tiles: {e}", self.file.display()))
     }
 
     /// The solution of the scene's `radiosity` integrator (`None` for other methods),

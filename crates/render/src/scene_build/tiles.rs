@@ -270,14 +270,13 @@ pub(crate) fn radiosity_surfaces(
     geometry: &prism_geometry::Geometry,
 ) -> Result<Vec<Option<TiledSurface>>, String> {
     (0..=scene.materials.len())
-        .map(|m| Ok(radiosity_surface(scene, geometry, m, 1, 0)?.map(|(_, s)| s)))
+        .map(|m| radiosity_surface(scene, geometry, m, 1))
         .collect()
 }
 
 /// The surface `radiosity` holds `tiled` material `material` by, with a pyramid of `levels`
-/// levels, at most the material's own `levels`, and the slab of its tile; with the tile's
-/// name. `None` for another material, one no shape uses, or where that is no more than
-/// `more_than` levels. 16 samples per bin pair reach each cell of the pyramid's finest level
+/// levels, at most the material's own `levels`, and the slab of its tile. `None` for
+/// another material, or one no shape uses. 16 samples per bin pair reach each cell of the pyramid's finest level
 /// (64 at least, 1 024 at most: beyond level 3 the finest cells get fewer, down to the one
 /// sample per cell and band group the simulation needs).
 pub(crate) fn radiosity_surface(
@@ -285,8 +284,7 @@ pub(crate) fn radiosity_surface(
     geometry: &prism_geometry::Geometry,
     material: usize,
     levels: u32,
-    more_than: u32,
-) -> Result<Option<(String, TiledSurface)>, String> {
+) -> Result<Option<TiledSurface>, String> {
     let Some(MaterialKind::Tiled {
         tile,
         levels: most,
@@ -310,9 +308,6 @@ pub(crate) fn radiosity_surface(
         return Ok(None);
     };
     let levels = levels.clamp(1, most.max(1));
-    if levels <= more_than {
-        return Ok(None);
-    }
     let finest_cells = 1u32 << (2 * (levels - 1));
     let options = PyramidOptions {
         levels,
@@ -323,8 +318,5 @@ pub(crate) fn radiosity_surface(
     };
     let pyramid = TilePyramid::simulate(scene, tile, &options)
         .map_err(|e| format!("the pyramid of tile `{}`: {e}", scene.tiles[tile].name))?;
-    Ok(Some((
-        scene.tiles[tile].name.clone(),
-        pyramid.tiled_surface(slab),
-    )))
+    Ok(Some(pyramid.tiled_surface(slab)))
 }

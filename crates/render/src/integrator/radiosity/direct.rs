@@ -33,9 +33,8 @@ pub struct PointLikeAndSkyLights<'a> {
     /// The band wavelengths in groups of the four lanes (the last group padded with its
     /// last wavelength).
     wavelength_sets: Vec<SampledWavelengths>,
-    /// Wavelengths per band, and bands (`points_per_band × bands` lanes are not padding).
+    /// Wavelengths per band (the first `points_per_band × bands` lanes are not padding).
     points_per_band: usize,
-    bands: usize,
 }
 
 impl<'a> PointLikeAndSkyLights<'a> {
@@ -66,7 +65,6 @@ impl<'a> PointLikeAndSkyLights<'a> {
             skies,
             wavelength_sets,
             points_per_band,
-            bands: bands.count,
         }
     }
 }
@@ -176,7 +174,7 @@ impl PointLikeAndSkyLights<'_> {
             let points = self.points_per_band;
             for lane in 0..N_SPECTRUM_SAMPLES {
                 let band = (set * N_SPECTRUM_SAMPLES + lane) / points;
-                if band < self.bands {
+                if band < self.map.bands.count {
                     out[band] += weight * ls.radiance[lane] * cos / ls.pdf / points as f32;
                 }
             }

@@ -87,21 +87,25 @@ impl SolutionBands {
             .collect()
     }
 
-    /// Values per default band (`BANDS` of them, a tile pyramid's) carried into these
-    /// bands: each band takes the mean of the default bands over its wavelengths, the end
-    /// default bands standing for what lies beyond 380–780 nm. Returns `values` itself
-    /// where these are the default bands.
+    /// Values in runs of `BANDS` per default band (a tile pyramid's) carried into these
+    /// bands, run by run: each band takes the mean of the default bands over its
+    /// wavelengths, the end default bands standing for what lies beyond 380–780 nm. The
+    /// values themselves where these are the default bands.
     pub fn from_default_bands(&self, values: &[f32]) -> Vec<f32> {
         if *self == Self::DEFAULT {
             return values.to_vec();
         }
         const SUB: usize = 8;
-        (0..self.count)
-            .map(|b| {
-                (0..SUB)
-                    .map(|k| values[Self::DEFAULT.band_of(self.point_nm(b, k, SUB) as f32)])
-                    .sum::<f32>()
-                    / SUB as f32
+        // The default band of each of a band's SUB wavelengths, once for every run.
+        let source: Vec<usize> = (0..self.count * SUB)
+            .map(|i| Self::DEFAULT.band_of(self.point_nm(i / SUB, i % SUB, SUB) as f32))
+            .collect();
+        values
+            .chunks_exact(BANDS)
+            .flat_map(|run| {
+                source
+                    .chunks_exact(SUB)
+                    .map(move |bands| bands.iter().map(|&k| run[k]).sum::<f32>() / SUB as f32)
             })
             .collect()
     }

@@ -19,7 +19,7 @@ use prism_radiosity::directional::{DirectionalSurface, FinerPyramids};
 use prism_radiosity::tile_cells::TileLattice;
 use prism_radiosity::ElementShape;
 
-use super::patches::{PatchMap, SolutionBands, BANDS};
+use super::patches::{PatchMap, SolutionBands};
 use crate::scene_build::RenderScene;
 use crate::tile_pyramid::{TilePyramid, TiledSurface};
 
@@ -154,9 +154,6 @@ impl TiledCarriers {
     }
 }
 
-/// A tile's name and the surface its pyramid makes.
-type NamedSurface = (String, TiledSurface);
-
 /// The memory a finer pyramid may take without a memory limit, bytes.
 const PYRAMID_BYTES_WITHOUT_LIMIT: u64 = 1 << 30;
 
@@ -169,8 +166,8 @@ pub struct TilePyramids<'a> {
     map: &'a PatchMap,
     /// What a pyramid may take while it is simulated, bytes.
     budget_bytes: u64,
-    /// Per (material, levels asked): the tile's name and its surface.
-    made: RefCell<HashMap<(u32, u32), Arc<NamedSurface>>>,
+    /// Per (material, levels): the surface of its finer pyramid.
+    made: RefCell<HashMap<(u32, u32), Arc<TiledSurface>>>,
     /// (material, levels) pairs whose deeper pyramid the memory held back (said once).
     held_back: RefCell<HashSet<(u32, u32)>>,
     lines: RefCell<Vec<String>>,
@@ -234,38 +231,30 @@ impl FinerPyramids for TilePyramids<'_> {
             return Ok(None);
         }
         let made = self.made.borrow().get(&key).cloned();
-        let made = match made {
+        let tiled = match made {
             Some(made) => made,
             None => {
                 let start = Instant::now();
-                let Some(made) =
-                    self.scene
-                        .tiled_surface_with_levels(material, levels, surface.levels)?
-                else {
+                let Some(tiled) = self.scene.tiled_surface_with_levels(material, levels)? else {
                     return Ok(None);
                 };
-                let (name, tiled) = &made;
                 self.lines.borrow_mut().push(format!(
-                    "radiosity: tile `{name}`: a {}-level pyramid for elements down to 1/{} of \
-                     a period ({:.2} s)",
-                    tiled.levels,
-                    1u32 << (tiled.levels - 1),
+                    "radiosity: tile `{tile}`: a {levels}-level pyramid for elements down to \
+                     1/{} of a period ({:.2} s)",
+                    1u32 << (levels - 1),
                     start.elapsed().as_secs_f64()
                 ));
-                let made = Arc::new(made);
-                self.made.borrow_mut().insert(key, made.clone());
-                made
+                let tiled = Arc::new(tiled);
+                self.made.borrow_mut().insert(key, tiled.clone());
+                tiled
             }
         };
-        let tiled = &made.1;
-        Ok((tiled.levels > surface.levels).then(|| {
-            Arc::new(directional_surface(
-                surface.frame,
-                surface.lattice,
-                tiled,
-                self.map.bands,
-            ))
-        }))
+        Ok(Some(Arc::new(directional_surface(
+            surface.frame,
+            surface.lattice,
+            &tiled,
+            self.map.bands,
+        ))))
     }
 }
 
@@ -278,20 +267,11 @@ fn directional_surface(
     tiled: &TiledSurface,
     bands: SolutionBands,
 ) -> DirectionalSurface {
-    let gamma = if bands == SolutionBands::DEFAULT {
-        tiled.gamma.clone()
-    } else {
-        tiled
-            .gamma
-            .chunks_exact(BANDS)
-            .flat_map(|g| bands.from_default_bands(g))
-            .collect()
-    };
     DirectionalSurface {
         frame,
         lattice,
         levels: tiled.levels,
-        gamma,
+        gamma: bands.from_default_bands(&tiled.gamma),
         view_transparency: tiled.view_transparency.clone(),
     }
 }
