@@ -379,6 +379,7 @@ pub fn run(args: &ConvergeArgs, memory: &MemoryBudget) -> Result<(), String> {
                 spp: args.reference_spp,
                 seed: reference_seed,
                 integrator: integrator_description(&integrator),
+                asset_files: &description.asset_files,
             };
             let path = key.cache_path(cache_dir.as_deref().unwrap_or(Path::new(".")));
             let cached = path

@@ -4,11 +4,14 @@
 //! name that carries a hash of everything it depends on, so that editing the scene file
 //! invalidates it. A scene's folder may be read-only or shared, so nothing is written there.
 
+use std::io::Read;
 use std::path::{Path, PathBuf};
 
 use glam::UVec2;
 use prism_image::io::read_image;
 use prism_image::Image;
+
+use prism_render::stable_hash::Fnv1a64;
 
 use crate::cache_dir::fnv1a64;
 
@@ -61,18 +64,22 @@ pub struct ReferenceKey<'a> {
     pub seed: u64,
     /// The integrator's description (e.g. `path max_depth 7 …`).
     pub integrator: String,
+    /// The files the scene names (`SceneDescription::asset_files`): an edited texture or
+    /// environment map changes the image as much as an edited scene file.
+    pub asset_files: &'a [PathBuf],
 }
 
 impl ReferenceKey<'_> {
     /// `<dir>/<stem>.reference-<W>x<H>-<spp>spp-<hash>.exr`; the hash covers the scene
     /// file's absolute path (scenes of one name in different folders differ) and bytes, the
-    /// size, spp, seed, integrator and Prism's version.
+    /// bytes of every asset it names, the size, spp, seed, integrator and Prism's version.
     pub fn cache_path(&self, dir: &Path) -> PathBuf {
         let absolute = std::fs::canonicalize(self.scene_file)
             .unwrap_or_else(|_| self.scene_file.to_path_buf());
         let hash = fnv1a64(&[
             absolute.to_string_lossy().as_bytes(),
             self.scene_bytes,
+            &assets_hash(self.asset_files).to_le_bytes(),
             format!("{}x{}", self.resolution.x, self.resolution.y).as_bytes(),
             &self.spp.to_le_bytes(),
             &self.seed.to_le_bytes(),
@@ -92,6 +99,30 @@ impl ReferenceKey<'_> {
     }
 }
 
+/// The stable hash of the files' contents, in order. A file that cannot be read (it was
+/// read a moment ago by the scene's build) hashes as its error, so it never matches a cached
+/// reference.
+fn assets_hash(files: &[PathBuf]) -> u64 {
+    let mut hash = Fnv1a64::new();
+    let mut buffer = vec![0u8; 1 << 16];
+    for file in files {
+        hash.write(file.to_string_lossy().as_bytes());
+        hash.write(&[0xff]);
+        let read = std::fs::File::open(file).and_then(|mut f| loop {
+            let n = f.read(&mut buffer)?;
+            if n == 0 {
+                break Ok(());
+            }
+            hash.write(&buffer[..n]);
+        });
+        if let Err(e) = read {
+            hash.write(e.to_string().as_bytes());
+        }
+        hash.write(&[0xff]);
+    }
+    hash.finish()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -105,6 +136,7 @@ mod tests {
             spp,
             seed: 0,
             integrator: "path".into(),
+            asset_files: &[],
         };
         let a = key(b"{}", 1024).cache_path(Path::new("cache"));
         assert!(a.starts_with("cache"));
@@ -122,6 +154,27 @@ mod tests {
             elsewhere.cache_path(Path::new("cache")),
             "the folder counts"
         );
+    }
+
+    #[test]
+    fn the_cache_name_changes_when_an_asset_is_edited() {
+        let dir = tempfile::tempdir().unwrap();
+        let sky = dir.path().join("sky.hdr");
+        let assets = [sky.clone()];
+        let key = ReferenceKey {
+            scene_file: Path::new("scenes/box.json"),
+            scene_bytes: b"{}",
+            resolution: UVec2::new(64, 48),
+            spp: 1024,
+            seed: 0,
+            integrator: "path".into(),
+            asset_files: &assets,
+        };
+        std::fs::write(&sky, "first sky").unwrap();
+        let first = key.cache_path(Path::new("cache"));
+        assert_eq!(first, key.cache_path(Path::new("cache")), "stable");
+        std::fs::write(&sky, "second sky").unwrap();
+        assert_ne!(first, key.cache_path(Path::new("cache")));
     }
 
     #[test]

@@ -1,6 +1,7 @@
 //! Typed access to the positioned JSON tree. Every accessor knows its JSON path and the
 //! position of its value, so each error says where it is and what was expected.
 
+use std::cell::RefCell;
 use std::path::{Path, PathBuf};
 
 use prism_spectrum::names::did_you_mean;
@@ -11,10 +12,12 @@ use crate::schema::ObjectSchema;
 
 pub(crate) type Result<T> = std::result::Result<T, SceneError>;
 
-/// What every error needs: the scene file, and the folder assets resolve against.
+/// What every error needs: the scene file, and the folder assets resolve against; and
+/// the asset files resolved so far (`SceneDescription::asset_files`).
 pub(crate) struct Ctx {
     pub file: PathBuf,
     pub base_dir: PathBuf,
+    pub assets: RefCell<Vec<PathBuf>>,
 }
 
 impl Ctx {
@@ -309,6 +312,7 @@ impl<'a> V<'a> {
             )));
         }
         let resolved = self.cx.base_dir.join(given);
+        self.cx.assets.borrow_mut().push(resolved.clone());
         if resolved.is_dir() {
             return Err(self.err(format!(
                 "{what} file `{given}` is a directory ({}); expected a file",

@@ -1,6 +1,7 @@
 //! The whole scene: the top-level object and the order its sections are resolved in
 //! (spectra → media → reradiation → materials → meshes → shapes → lights; camera, film, integrator).
 
+use std::cell::RefCell;
 use std::path::{Path, PathBuf};
 
 use crate::camera::{parse_camera, Camera};
@@ -53,6 +54,10 @@ pub struct SceneDescription {
     pub reradiation: Vec<Reradiation>,
     /// The `tiles` section (`tiled` materials refer to it by index).
     pub tiles: Vec<Tile>,
+    /// Every file the scene names (meshes, textures, spectra, environment maps, MERL
+    /// tables, …), resolved against its folder, each once, in the order the scene names
+    /// them: what a cache keyed on the scene must hash besides the scene file itself.
+    pub asset_files: Vec<PathBuf>,
 }
 
 pub const TOP_LEVEL_FIELDS: [&str; 15] = [
@@ -94,6 +99,7 @@ pub fn parse_scene_str(
     let cx = Ctx {
         file: path.to_path_buf(),
         base_dir: path.parent().map(Path::to_path_buf).unwrap_or_default(),
+        assets: RefCell::new(Vec::new()),
     };
     // serde_json's syntax errors are the reference: exact, and with line:column.
     if let Err(e) = serde_json::from_str::<serde_json::Value>(text) {
@@ -236,5 +242,15 @@ fn parse_root(v: &V) -> Result<SceneDescription> {
         textures: textures.textures,
         reradiation,
         tiles,
+        asset_files: unique_in_order(v.cx.assets.take()),
     })
+}
+
+/// `paths` with repeats dropped, first occurrence kept.
+fn unique_in_order(paths: Vec<PathBuf>) -> Vec<PathBuf> {
+    let mut seen = std::collections::HashSet::new();
+    paths
+        .into_iter()
+        .filter(|p| seen.insert(p.clone()))
+        .collect()
 }

@@ -176,6 +176,21 @@ fn every_field_kind_comes_through() {
         }
     );
 
+    // Every named file once (the teapot is named twice), resolved against the folder.
+    let mut assets = s.asset_files.clone();
+    assets.sort();
+    let expected: Vec<_> = [
+        "meshes/bunny.ply",
+        "meshes/teapot.obj",
+        "sky.exr",
+        "spectra/paint.csv",
+        "spectra/two.csv",
+    ]
+    .iter()
+    .map(|f| dir.0.join(f))
+    .collect();
+    assert_eq!(assets, expected);
+
     // Spectra, in file order, references inlined.
     let names: Vec<&str> = s.spectra.iter().map(|(n, _)| n.as_str()).collect();
     assert_eq!(
