@@ -1,0 +1,72 @@
+#!/usr/bin/env python3
+"""Writes scenes/envmaps/windows-512x256.hdr: a procedural equirectangular interior lit
+through a few bright windows, for the bandwidth predictor's Fig. 9 scene
+(scenes/bandwidth/fig9-spheres.json). Bagher et al. 2013 light Fig. 9 with measured
+environment maps of interiors, where several small bright windows (not one sun) carry most
+of the energy: every window casts its own shadow edge on the floor and its own highlight on
+each sphere, so the image has the high-frequency detail and the shading noise the predictor
+is for, and a uniform path tracer needs hundreds of samples per pixel to settle. No
+photograph, so no licence question. Radiance RGBE (Ward 1991), flat scanlines, top row = +Y
+(docs/lights.md for Prism's orientation); linear Rec.709 values, arbitrary units.
+
+    python3 tools/make_windows_envmap.py   # needs only the standard library
+"""
+import math
+import os
+
+from make_sky_envmap import direction, rgbe
+
+W, H = 512, 256
+# (azimuth u, elevation in degrees, half-width in degrees, half-height in degrees, RGB):
+# windows of different sizes and colours around the room, a few of them high up.
+WINDOWS = [
+    (0.10, 35.0, 0.8, 1.8, (2100.0, 2025.0, 1820.0)),
+    (0.30, 20.0, 0.6, 1.2, (3150.0, 2800.0, 2170.0)),
+    (0.46, 50.0, 0.5, 0.5, (5250.0, 5250.0, 5600.0)),
+    (0.80, 15.0, 0.4, 0.8, (4200.0, 3500.0, 2800.0)),
+]
+
+
+def radiance(u, v):
+    d = direction(u, v)
+    elevation_deg = math.degrees(math.asin(max(-1.0, min(1.0, d[1]))))
+    azimuth_deg = 360.0 * u
+    for wu, we, half_w, half_h, rgb in WINDOWS:
+        du = (azimuth_deg - 360.0 * wu + 180.0) % 360.0 - 180.0
+        # Half-widths are measured along the horizon, so a window keeps its solid angle.
+        if abs(du) * math.cos(math.radians(we)) <= half_w and abs(elevation_deg - we) <= half_h:
+            return rgb
+    # Dim walls: a warm floor below the horizon, a greyish ceiling above.
+    if elevation_deg < 0:
+        return (0.04, 0.032, 0.024)
+    t = elevation_deg / 90.0
+    return tuple(0.07 * (1 - t) + 0.04 * t for _ in range(3))
+
+
+def main():
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    out = os.path.join(root, "scenes", "envmaps", "windows-512x256.hdr")
+    rows = []
+    n = 4  # 4×4 supersamples per texel: window edges fall between texels
+    for y in range(H):
+        row = bytearray()
+        for x in range(W):
+            acc = [0.0, 0.0, 0.0]
+            for a in range(n):
+                for b in range(n):
+                    c = radiance((x + (a + 0.5) / n) / W, (y + (b + 0.5) / n) / H)
+                    acc = [p + q for p, q in zip(acc, c)]
+            row += rgbe([c / (n * n) for c in acc])
+        rows.append(bytes(row))
+    header = f"#?RADIANCE\n# tools/make_windows_envmap.py\nFORMAT=32-bit_rle_rgbe\n\n-Y {H} +X {W}\n"
+    tmp = out + ".tmp"
+    with open(tmp, "wb") as f:
+        f.write(header.encode("ascii"))
+        for r in rows:
+            f.write(r)
+    os.replace(tmp, out)
+    print(out)
+
+
+if __name__ == "__main__":
+    main()
