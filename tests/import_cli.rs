@@ -374,6 +374,37 @@ fn write_square_exr(path: &Path, size: usize, pixels: Vec<[f32; 3]>) {
     .unwrap();
 }
 
+/// Mitsuba's `envmap` interpolates bilinearly, so its import asks for the bilinear filter.
+#[test]
+fn mitsuba_envmaps_import_with_the_bilinear_filter() {
+    let dir = tempfile::tempdir().unwrap();
+    write_square_exr(&dir.path().join("sky.exr"), 2, vec![[0.5; 3]; 4]);
+    let xml = dir.path().join("sky.xml");
+    std::fs::write(
+        &xml,
+        r#"<scene version="3.0.0">
+    <emitter type="envmap"><string name="filename" value="sky.exr"/></emitter>
+    <shape type="sphere"/>
+</scene>"#,
+    )
+    .unwrap();
+    let json = dir.path().join("sky.json");
+    run_ok(prism().arg("import").arg(&xml).arg("-o").arg(&json));
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let light = &v["lights"][0];
+    assert_eq!(light["type"], "environment", "{light}");
+    assert_eq!(light["filter"], "bilinear", "{light}");
+    let scene = prism_scene::load_scene(&json).unwrap();
+    assert!(matches!(
+        scene.lights[0].kind,
+        prism_scene::LightKind::Environment {
+            filter: prism_scene::EnvironmentFilter::Bilinear,
+            ..
+        }
+    ));
+}
+
 /// pbrt-v4's image infinite light (an equal-area octahedral square, +x to the right of the
 /// square's centre) becomes an `environment` light whose equirectangular side file holds
 /// the same sky: a square bright on its right half (pbrt's x > 0) gives a map bright

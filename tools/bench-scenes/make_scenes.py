@@ -249,8 +249,9 @@ def write_ply(path, v, n, uv, tris):
 def smooth_sky(w=256, h=128):
     """Linear Rec.709 radiance (arbitrary units, ~1): blue zenith to pale horizon, brown
     ground, blended over ±8° around the horizon; no sun disc. Smooth on purpose: Prism looks
-    texels up nearest, Mitsuba bilinearly (docs/lights.md), and a one-row horizon step would
-    show that difference as error along the horizon in every image."""
+    texels up nearest (the environment light's default `filter`), Mitsuba bilinearly
+    (docs/lights.md), and a one-row horizon step would show that difference as error along
+    the horizon in every image."""
     v = (np.arange(h) + 0.5) / h
     elev = (0.5 - v) * math.pi  # +π/2 at the top row
     up = np.clip(np.sin(elev), 0, 1)[:, None]

@@ -468,8 +468,14 @@ class Translator:
                                      "irradiance": self.light_spectrum(light, where, strength).mitsuba()}
             elif kind == "environment":
                 m = self.matrix(light.get("transform"), f"{where}.transform")
-                self.notes.append(f"{where}: Prism looks environment texels up nearest, Mitsuba "
-                                  "bilinearly with rows on the poles (half a texel apart)")
+                if light.get("filter", "nearest") == "bilinear":
+                    self.notes.append(f"{where}: both interpolate bilinearly; Prism puts the rows at "
+                                      "texel centres, Mitsuba the first and last on the poles "
+                                      "(half a texel apart)")
+                else:
+                    self.notes.append(f"{where}: Prism looks environment texels up nearest "
+                                      "(`filter` nearest), Mitsuba bilinearly with rows on the "
+                                      "poles (half a texel apart)")
                 out[f"light_{i}"] = {"type": "envmap", "filename": str(self.file(light["file"])),
                                      "scale": float(light.get("scale", 1)), "to_world": self.transform(m)}
             elif kind == "sky":

@@ -31,7 +31,7 @@ pub use film::{Aov, Film, PixelFilter, Reconstruction};
 pub use integrator::{
     FluorescenceLanes, Integrator, MisHeuristic, PhotonRadius, SamplerKind, DEFAULT_PHOTON_ALPHA,
 };
-pub use light::{Light, LightKind, Strength};
+pub use light::{EnvironmentFilter, Light, LightKind, Strength};
 pub use material::{
     ConductorOptics, Ior, LafortuneLobe, LibraryKind, Material, MaterialKind, Microfacet, Roughness,
 };

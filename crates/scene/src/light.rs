@@ -38,6 +38,16 @@ pub enum Strength {
     Scale(f64),
 }
 
+/// How an environment map is read between texel centres (`filter`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum EnvironmentFilter {
+    /// The texel a direction falls in (the default): a step at every texel edge.
+    #[default]
+    Nearest,
+    /// Bilinear between the four nearest texel centres, sampled to follow it.
+    Bilinear,
+}
+
 // Scenes hold few lights; boxing the environment's transform would only add noise.
 #[allow(clippy::large_enum_variant)]
 #[derive(Debug, Clone, PartialEq)]
@@ -69,6 +79,7 @@ pub enum LightKind {
     Environment {
         path: PathBuf,
         transform: Transform,
+        filter: EnvironmentFilter,
     },
     /// A sky of the same radiance in every direction.
     UniformSky,
@@ -227,7 +238,24 @@ pub(crate) fn parse_light(v: &V, spectra: &NamedSpectra, shapes: &[Shape]) -> Re
             let transform = o
                 .get("transform")
                 .map_or(Ok(Transform::IDENTITY), |t| parse_transform(&t))?;
-            (o, LightKind::Environment { path, transform }, s)
+            let filter = match o.one_of_or(
+                "filter",
+                "environment map filter",
+                &["nearest", "bilinear"],
+                "nearest",
+            )? {
+                "bilinear" => EnvironmentFilter::Bilinear,
+                _ => EnvironmentFilter::Nearest,
+            };
+            (
+                o,
+                LightKind::Environment {
+                    path,
+                    transform,
+                    filter,
+                },
+                s,
+            )
         }
         "cie_sky" | "perez_sky" | "preetham_sky" => {
             let sky = parse_daylight(v, kind)?;

@@ -306,7 +306,7 @@ pub const SCHEMA: &[ObjectSchema] = &[
     ),
     row(
         "lights[]<environment>",
-        &[&["type", "file", "transform", "scale", "medium"]],
+        &[&["type", "file", "transform", "scale", "medium", "filter"]],
     ),
     row("lights[]<sky>", &[LIGHT, &["luminance_cd_m2"]]),
     row(

@@ -416,3 +416,15 @@ fn light_tracing_refuses_mis_and_bdpt_takes_path_keys() {
     let e = dir.error(r#"{"integrator": {"type": "light", "max_depth": 0}}"#);
     assert!(e.contains("integrator.max_depth"), "{e}");
 }
+
+#[test]
+fn an_unknown_environment_filter_names_the_two_filters() {
+    let dir = Dir::new("environment-filter");
+    dir.write("sky.exr", "");
+    let e = dir
+        .error(r#"{"lights": [{"type": "environment", "file": "sky.exr", "filter": "linear"}]}"#);
+    assert!(
+        e.starts_with("DIR/scene.json:1:66: lights[0].filter: unknown environment map filter `linear`, expected one of `nearest`, `bilinear` (did you mean `bilinear`?)"),
+        "{e}"
+    );
+}

@@ -403,10 +403,11 @@ fn every_field_kind_comes_through() {
         s.lights[3].spectrum,
         SpectrumRef::Illuminant { name: "F11", .. }
     ));
-    let LightKind::Environment { path, .. } = &s.lights[4].kind else {
+    let LightKind::Environment { path, filter, .. } = &s.lights[4].kind else {
         panic!()
     };
     assert_eq!(path, &dir.0.join("sky.exr"));
+    assert_eq!(*filter, EnvironmentFilter::Nearest, "the default");
     assert_eq!(s.lights[4].strength, Strength::Scale(2.0));
     assert_eq!(s.lights[5].kind, LightKind::UniformSky);
 }

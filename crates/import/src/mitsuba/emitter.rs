@@ -112,6 +112,8 @@ pub fn emitter(ctx: &mut Ctx, el: &Element) -> Result<(), ImportError> {
                 json!(ctx.out.asset_path(&el.base_dir().join(file))),
             );
             light.insert("scale".into(), json!(props.float_or("scale", 1.0)?));
+            // Mitsuba interpolates its envmap bilinearly.
+            light.insert("filter".into(), json!("bilinear"));
             if to_world != DMat4::IDENTITY {
                 light.insert("transform".into(), matrix_json(&to_world));
             }

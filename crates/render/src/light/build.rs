@@ -314,7 +314,11 @@ pub(super) fn build_lights(
                     two_sided: *two_sided,
                 })
             }
-            LightKind::Environment { path, transform } => {
+            LightKind::Environment {
+                path,
+                transform,
+                filter,
+            } => {
                 let scale = match l.strength {
                     Strength::Scale(_) => value as f32,
                     Strength::LuminousFluxLm(_)
@@ -326,7 +330,7 @@ pub(super) fn build_lights(
                     return Err(b.err("scale", format!("{value} is beyond single precision")));
                 }
                 let rotation = rotation_of(&transform.matrix).map_err(|e| b.err("transform", e))?;
-                let env = EnvironmentLight::load(path, rotation, scale, scene_sphere)
+                let env = EnvironmentLight::load(path, rotation, scale, *filter, scene_sphere)
                     .map_err(|e| b.err("file", format!("cannot use the environment map: {e}")))?;
                 Light::Environment(Box::new(env))
             }

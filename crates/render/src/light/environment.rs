@@ -19,7 +19,11 @@
 //! light's `transform` (a rotation, possibly a mirror; translations and uniform scales do
 //! not change directions) maps local directions to the world.
 //!
-//! **Radiance.** Nearest texel, no interpolation: each texel's linear RGB (in the file's
+//! **Radiance.** `filter` `nearest` (the default): the texel a direction falls in. `bilinear`:
+//! the four nearest texel centres' spectra blended bilinearly (exact: spectra add), wrapping
+//! around in u and constant above the first row's and below the last row's centres, as
+//! Mitsuba 3's `envmap` and Cycles' default interpolate; nearest draws a step at every texel
+//! edge. Each texel's linear RGB (in the file's
 //! colour space when it is sRGB/Rec.709, Rec.2020 or ACEScg, else converted to linear
 //! sRGB; negative components clamped to 0) is upsampled once at load time to an RGB
 //! illuminant spectrum (Jakob & Hanika 2019 sigmoid polynomial × the space's white
@@ -29,11 +33,20 @@
 //! multiplies everything.
 //!
 //! **Sampling.** A texel is chosen by a 2-D piecewise-constant distribution (pbrt-v4 §A.5
-//! `PiecewiseConstant2D`) over luminance × the texel's solid angle ΔΩ = (2π/W)(cos θ_top −
-//! cos θ_bottom) (∝ sin θ averaged over the row), then a direction uniform in solid angle
-//! inside the texel (φ uniform, cos θ uniform between the row's bounds). The density is
-//! P(texel)/ΔΩ: constant over each texel and proportional to its luminance — exactly the
-//! shape of the nearest-texel radiance.
+//! `PiecewiseConstant2D`) over its luminance × its solid angle ΔΩ = (2π/W)(cos θ_top −
+//! cos θ_bottom) (∝ sin θ averaged over the row). Nearest: then a direction uniform in
+//! solid angle inside the texel (φ uniform, cos θ uniform between the row's bounds); the
+//! density is P(texel)/ΔΩ, constant over each texel and proportional to its luminance —
+//! exactly the shape of the nearest-texel radiance. Bilinear: the texel's luminance is the
+//! mean of the bilinear reconstruction over its cell, which weighs its 3 × 3 neighbourhood
+//! by (⅛, ¾, ⅛) per axis (the first and last rows by (⅞, ⅛)), so every cell the radiance
+//! reaches can be chosen (a black texel beside a bright one too: light sampling alone stays
+//! unbiased). Inside the cell, which the texel centre splits into four quadrants on each of
+//! which the reconstruction is one bilinear patch, a quadrant is chosen by its integral and
+//! a point in it by inverting the patch's marginal and conditional, both linear (pbrt-v4
+//! `SampleBilinear`). The density in image coordinates is then P(texel) · f(u, v) / ∫_cell f:
+//! proportional to the bilinear luminance f inside each cell; per steradian it is that over
+//! 2π² sin θ.
 //!
 //! **Emitted rays.** The same direction sampling, then an origin on the scene disk facing
 //! it (pbrt-v4 §12.5.2 `ImageInfiniteLight::SampleLe`); the radiance and pdf_dir are those
@@ -46,6 +59,7 @@ use std::path::Path;
 
 use glam::{DMat3, DMat4, Mat3A, Vec2, Vec3A};
 use prism_bandwidth::Bandwidth;
+pub use prism_scene::EnvironmentFilter;
 use prism_spectrum::rgb_upsample::{RgbIlluminantSpectrum, SigmoidPolynomial};
 use prism_spectrum::{DenseSpectrum, RgbGamut, SampledSpectrum, SampledWavelengths, Spectrum};
 use rayon::prelude::*;
@@ -124,6 +138,10 @@ pub struct EnvironmentLight {
     white: Spectrum,
     /// The user's `scale`.
     pub scale: f32,
+    pub filter: EnvironmentFilter,
+    /// Per texel, the luminance of its RGB (before `scale`; eq. 7's input and, bilinear, the
+    /// sampling's f).
+    luminance: Vec<f32>,
     /// cos θ at the row boundaries: cos(π y / H), y = 0..=H.
     cos_rows: Vec<f32>,
     distribution: PiecewiseConstant2D,
@@ -137,18 +155,21 @@ pub struct EnvironmentLight {
 }
 
 impl EnvironmentLight {
-    /// From linear RGB pixels in `gamut` (row-major, top row first). `rotation` maps local
-    /// directions to the world and must be orthogonal (see `rotation_of`). Errors name the
-    /// first non-finite pixel.
+    /// From linear RGB `texels`. `rotation` maps local directions to the world and must be
+    /// orthogonal (see `rotation_of`). Errors name the first non-finite pixel.
     pub fn from_rgb(
-        width: usize,
-        height: usize,
-        pixels: &[[f32; 3]],
-        gamut: RgbGamut,
+        texels: RgbTexels<'_>,
         rotation: Mat3A,
         scale: f32,
+        filter: EnvironmentFilter,
         scene: SceneSphere,
     ) -> Result<Self, String> {
+        let RgbTexels {
+            width,
+            height,
+            pixels,
+            gamut,
+        } = texels;
         if width == 0 || height == 0 || pixels.len() != width * height {
             return Err(format!(
                 "expected {width}×{height} pixels, found {}",
@@ -183,19 +204,32 @@ impl EnvironmentLight {
             let m = gamut.color_space().rgb_to_xyz;
             [m.x_axis.y, m.y_axis.y, m.z_axis.y]
         };
+        let luminance_f64: Vec<f64> = pixels
+            .iter()
+            .map(|p| {
+                (0..3)
+                    .map(|c| weights[c] * f64::from(p[c].max(0.0)))
+                    .sum::<f64>()
+                    .max(0.0)
+            })
+            .collect();
+        let luminance: Vec<f32> = luminance_f64.iter().map(|&l| l as f32).collect();
+        let per_texel: Vec<f64> = match filter {
+            EnvironmentFilter::Nearest => luminance_f64,
+            EnvironmentFilter::Bilinear => bilinear_texel_means(&luminance, width, height)
+                .into_iter()
+                .map(f64::from)
+                .collect(),
+        };
         let dphi = 2.0 * std::f64::consts::PI / width as f64;
         let mut values = vec![0.0f32; width * height];
         let mut luminance_solid_angle_sr = 0.0f64;
         for y in 0..height {
             let solid_angle = dphi * (f64::from(cos_rows[y]) - f64::from(cos_rows[y + 1]));
             for x in 0..width {
-                let p = pixels[y * width + x];
-                let lum: f64 = (0..3)
-                    .map(|c| weights[c] * f64::from(p[c].max(0.0)))
-                    .sum::<f64>()
-                    .max(0.0);
-                values[y * width + x] = (lum * solid_angle) as f32;
-                luminance_solid_angle_sr += lum * solid_angle;
+                let i = y * width + x;
+                values[i] = (per_texel[i] * solid_angle) as f32;
+                luminance_solid_angle_sr += per_texel[i] * solid_angle;
             }
         }
         let white_table = gamut.white_illuminant();
@@ -210,6 +244,8 @@ impl EnvironmentLight {
             texels: upsampled,
             white,
             scale,
+            filter,
+            luminance,
             cos_rows,
             distribution: PiecewiseConstant2D::new(&values, width, height),
             to_world: rotation,
@@ -226,6 +262,7 @@ impl EnvironmentLight {
         path: &Path,
         rotation: Mat3A,
         scale: f32,
+        filter: EnvironmentFilter,
         scene: SceneSphere,
     ) -> Result<Self, String> {
         let image = prism_image::io::read_image(path).map_err(|e| e.to_string())?;
@@ -271,7 +308,13 @@ impl EnvironmentLight {
                 (RgbGamut::Srgb, pixels)
             }
         };
-        Self::from_rgb(width, height, &pixels, gamut, rotation, scale, scene)
+        let texels = RgbTexels {
+            width,
+            height,
+            pixels: &pixels,
+            gamut,
+        };
+        Self::from_rgb(texels, rotation, scale, filter, scene)
             .map_err(|e| format!("{}: {e}", path.display()))
     }
 
@@ -280,17 +323,9 @@ impl EnvironmentLight {
     }
 
     /// Luminance of every texel (row-major, top row first) in the map's own units (Y of the
-    /// RGB pixels, before `scale`): what the sampling distribution was built from.
+    /// RGB pixels, before `scale`).
     pub fn luminance_texels(&self) -> Vec<f32> {
-        let mut out = Vec::with_capacity(self.width * self.height);
-        for y in 0..self.height {
-            let d_omega = self.texel_solid_angle(y);
-            for x in 0..self.width {
-                let v = self.distribution.value(x, y);
-                out.push(if d_omega > 0.0 { v / d_omega } else { 0.0 });
-            }
-        }
-        out
+        self.luminance.clone()
     }
 
     /// Local image coordinates in [0, 1)² of a world direction (towards the light).
@@ -312,6 +347,7 @@ impl EnvironmentLight {
         (2.0 * PI / self.width as f32) * (self.cos_rows[y] - self.cos_rows[y + 1])
     }
 
+    /// Radiance of texel (x, y) (nearest).
     #[inline]
     fn texel_radiance(
         &self,
@@ -325,14 +361,139 @@ impl EnvironmentLight {
         self.white.eval(wavelengths) * SampledSpectrum::new(s) * (scale * self.scale)
     }
 
-    /// Density of choosing texel (x, y) per steradian: P(texel)/ΔΩ.
+    /// Radiance at local image coordinates `uv`, by `filter` (module docs).
     #[inline]
-    fn texel_pdf(&self, x: usize, y: usize) -> f32 {
+    fn radiance_at(&self, uv: Vec2, wavelengths: &SampledWavelengths) -> SampledSpectrum {
+        match self.filter {
+            EnvironmentFilter::Nearest => {
+                let (x, y) = self.texel(uv);
+                self.texel_radiance(x, y, wavelengths)
+            }
+            EnvironmentFilter::Bilinear => {
+                let mut sum = [0.0f32; 4];
+                for (i, w) in self.bilinear_taps(uv) {
+                    if w > 0.0 {
+                        let (polynomial, scale) = &self.texels[i];
+                        let s = polynomial.eval4(wavelengths.lambda());
+                        for (total, value) in sum.iter_mut().zip(s) {
+                            *total += w * scale * value;
+                        }
+                    }
+                }
+                self.white.eval(wavelengths) * SampledSpectrum::new(sum) * self.scale
+            }
+        }
+    }
+
+    /// The four texels (row-major indices) whose centres bracket `uv`, with their bilinear
+    /// weights.
+    #[inline]
+    fn bilinear_taps(&self, uv: Vec2) -> [(usize, f32); 4] {
+        let ([x0, x1], fx) = wrapped_pair(uv.x, self.width);
+        let ([y0, y1], fy) = clamped_pair(uv.y, self.height);
+        let w = self.width;
+        [
+            (y0 * w + x0, (1.0 - fx) * (1.0 - fy)),
+            (y0 * w + x1, fx * (1.0 - fy)),
+            (y1 * w + x0, (1.0 - fx) * fy),
+            (y1 * w + x1, fx * fy),
+        ]
+    }
+
+    /// The bilinear luminance f at `uv` (the sampling's target, module docs).
+    #[inline]
+    fn bilinear_luminance(&self, uv: Vec2) -> f32 {
+        self.bilinear_taps(uv)
+            .iter()
+            .map(|&(i, w)| w * self.luminance[i])
+            .sum()
+    }
+
+    /// Bilinear filter: density per steradian at local image coordinates `uv`,
+    /// P(texel) · f(uv) / ∫_cell f / (2π² sin θ) (module docs).
+    #[inline]
+    fn bilinear_pdf(&self, uv: Vec2) -> f32 {
+        let (x, y) = self.texel(uv);
+        let cell_mean = self.distribution.value(x, y) / self.texel_solid_angle(y);
+        let sin_theta = (PI * uv.y).sin();
+        if !(cell_mean > 0.0 && sin_theta > 0.0) {
+            return 0.0;
+        }
+        let p_texel = self.texel_probability(x, y);
+        p_texel * self.bilinear_luminance(uv) * (self.width * self.height) as f32
+            / cell_mean
+            / (2.0 * PI * PI * sin_theta)
+    }
+
+    /// Probability of choosing texel (x, y).
+    #[inline]
+    fn texel_probability(&self, x: usize, y: usize) -> f32 {
         let uv = Vec2::new(
             (x as f32 + 0.5) / self.width as f32,
             (y as f32 + 0.5) / self.height as f32,
         );
-        let p_texel = self.distribution.pdf(uv) / (self.width * self.height) as f32;
+        self.distribution.pdf(uv) / (self.width * self.height) as f32
+    }
+
+    /// Bilinear filter: a point of cell (x, y) with density ∝ f, from `u` uniform in [0, 1)²
+    /// (module docs: a quadrant by its integral, then a point of its bilinear patch).
+    fn sample_in_cell(&self, x: usize, y: usize, u: Vec2) -> Vec2 {
+        // f at the cell's 3 × 3 nodes (corners, edge midpoints, centre), cell-local (a, b) ∈
+        // {0, ½, 1}²: the mean of the texels around each node, columns wrapping, rows clamped.
+        let (w, h) = (self.width, self.height);
+        let column = |dx: isize| (x as isize + dx).rem_euclid(w as isize) as usize;
+        let row = |dy: isize| (y as isize + dy).clamp(0, h as isize - 1) as usize;
+        let g = |dx: isize, dy: isize| self.luminance[row(dy) * w + column(dx)];
+        const AROUND: [&[isize]; 3] = [&[-1, 0], &[0], &[0, 1]];
+        let node = |i: usize, j: usize| {
+            let (xs, ys) = (AROUND[i], AROUND[j]);
+            let sum: f32 = ys
+                .iter()
+                .flat_map(|&dy| xs.iter().map(move |&dx| (dx, dy)))
+                .map(|(dx, dy)| g(dx, dy))
+                .sum();
+            sum / (xs.len() * ys.len()) as f32
+        };
+        let nodes: [[f32; 3]; 3] = std::array::from_fn(|j| std::array::from_fn(|i| node(i, j)));
+        let corners = |qx: usize, qy: usize| {
+            [
+                nodes[qy][qx],
+                nodes[qy][qx + 1],
+                nodes[qy + 1][qx],
+                nodes[qy + 1][qx + 1],
+            ]
+        };
+        let quadrants = [(0, 0), (1, 0), (0, 1), (1, 1)];
+        let weights = quadrants.map(|(qx, qy)| corners(qx, qy).iter().sum::<f32>());
+        let total: f32 = weights.iter().sum();
+        // The quadrant from u.x, which is then rescaled to [0, 1) within it.
+        let mut ux = u.x * total;
+        let mut chosen = 3;
+        for (k, &wk) in weights.iter().enumerate() {
+            if ux < wk || k == 3 {
+                chosen = k;
+                ux = if wk > 0.0 {
+                    (ux / wk).clamp(0.0, ONE_MINUS_EPSILON)
+                } else {
+                    0.5
+                };
+                break;
+            }
+            ux -= wk;
+        }
+        let (qx, qy) = quadrants[chosen];
+        let [w00, w10, w01, w11] = corners(qx, qy);
+        let t = sample_linear(u.y, w00 + w10, w01 + w11);
+        let s = sample_linear(ux, w00 + t * (w01 - w00), w10 + t * (w11 - w10));
+        let a = 0.5 * (qx as f32 + s);
+        let b = 0.5 * (qy as f32 + t);
+        Vec2::new((x as f32 + a) / w as f32, (y as f32 + b) / h as f32)
+    }
+
+    /// Nearest filter: density of choosing texel (x, y) per steradian, P(texel)/ΔΩ.
+    #[inline]
+    fn texel_pdf(&self, x: usize, y: usize) -> f32 {
+        let p_texel = self.texel_probability(x, y);
         let d_omega = self.texel_solid_angle(y);
         if d_omega > 0.0 {
             p_texel / d_omega
@@ -341,21 +502,55 @@ impl EnvironmentLight {
         }
     }
 
-    /// A direction from the texel distribution (world, towards the light) and its texel.
+    /// A direction (world, towards the light), its density per steradian and where its
+    /// radiance is read: the sampled texel (nearest; a direction on a texel edge may round
+    /// into its neighbour) or the sampled image point (bilinear).
     #[inline]
-    fn sample_direction(&self, u: Vec2) -> Option<(Vec3A, usize, usize)> {
+    fn sample_direction(&self, u: Vec2) -> Option<(Vec3A, f32, SampledAt)> {
         let (uv, pdf_uv, [x, y]) = self.distribution.sample(u);
         if pdf_uv.is_nan() || pdf_uv <= 0.0 || x >= self.width || y >= self.height {
             return None;
         }
-        // Uniform in solid angle within the texel: cos θ uniform between the row bounds.
-        let fv = (uv.y * self.height as f32 - y as f32).clamp(0.0, 1.0);
-        let (c0, c1) = (self.cos_rows[y], self.cos_rows[y + 1]);
-        let cos_theta = c0 + fv * (c1 - c0);
-        let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
-        let (sin_p, cos_p) = (2.0 * PI * uv.x).sin_cos();
-        let local = Vec3A::new(sin_p * sin_theta, cos_theta, -cos_p * sin_theta);
-        Some(((self.to_world * local).normalize(), x, y))
+        let (wi, pdf, at) = match self.filter {
+            EnvironmentFilter::Nearest => {
+                // Uniform in solid angle within the texel: cos θ uniform between the row
+                // bounds.
+                let fv = (uv.y * self.height as f32 - y as f32).clamp(0.0, 1.0);
+                let (c0, c1) = (self.cos_rows[y], self.cos_rows[y + 1]);
+                let cos_theta = c0 + fv * (c1 - c0);
+                let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
+                let (sin_p, cos_p) = (2.0 * PI * uv.x).sin_cos();
+                let local = Vec3A::new(sin_p * sin_theta, cos_theta, -cos_p * sin_theta);
+                (
+                    (self.to_world * local).normalize(),
+                    self.texel_pdf(x, y),
+                    SampledAt::Texel(x, y),
+                )
+            }
+            EnvironmentFilter::Bilinear => {
+                // The position inside the cell is uniform and independent of the cell.
+                let within = Vec2::new(
+                    (uv.x * self.width as f32 - x as f32).clamp(0.0, ONE_MINUS_EPSILON),
+                    (uv.y * self.height as f32 - y as f32).clamp(0.0, ONE_MINUS_EPSILON),
+                );
+                let at = self.sample_in_cell(x, y, within);
+                let local = equirect_direction(at);
+                (
+                    (self.to_world * local).normalize(),
+                    self.bilinear_pdf(at),
+                    SampledAt::Point(at),
+                )
+            }
+        };
+        (pdf > 0.0 && pdf.is_finite()).then_some((wi, pdf, at))
+    }
+
+    #[inline]
+    fn sampled_radiance(&self, at: SampledAt, wavelengths: &SampledWavelengths) -> SampledSpectrum {
+        match at {
+            SampledAt::Texel(x, y) => self.texel_radiance(x, y, wavelengths),
+            SampledAt::Point(uv) => self.radiance_at(uv, wavelengths),
+        }
     }
 
     /// The texel a world direction (towards the light) falls in.
@@ -367,8 +562,13 @@ impl EnvironmentLight {
     /// Solid-angle density of `sample_li`'s directions at `wi`.
     #[inline]
     pub fn direction_pdf(&self, wi: Vec3A) -> f32 {
-        let (x, y) = self.texel_of(wi);
-        self.texel_pdf(x, y)
+        match self.filter {
+            EnvironmentFilter::Nearest => {
+                let (x, y) = self.texel_of(wi);
+                self.texel_pdf(x, y)
+            }
+            EnvironmentFilter::Bilinear => self.bilinear_pdf(self.local_uv(wi)),
+        }
     }
 }
 
@@ -380,14 +580,10 @@ impl LightSource for EnvironmentLight {
         u: Vec2,
         wavelengths: &SampledWavelengths,
     ) -> Option<LightSample> {
-        let (wi, x, y) = self.sample_direction(u)?;
-        let pdf = self.texel_pdf(x, y);
-        if !(pdf > 0.0 && pdf.is_finite()) {
-            return None;
-        }
+        let (wi, pdf, at) = self.sample_direction(u)?;
         Some(LightSample {
             wi,
-            radiance: self.texel_radiance(x, y, wavelengths),
+            radiance: self.sampled_radiance(at, wavelengths),
             pdf,
             p_light: self.scene.point_beyond(ctx.p, wi),
             distance_m: f32::INFINITY,
@@ -412,8 +608,7 @@ impl LightSource for EnvironmentLight {
         direction: Vec3A,
         wavelengths: &SampledWavelengths,
     ) -> SampledSpectrum {
-        let (x, y) = self.texel_of(direction);
-        self.texel_radiance(x, y, wavelengths)
+        self.radiance_at(self.local_uv(direction), wavelengths)
     }
 
     fn sample_le(
@@ -424,14 +619,13 @@ impl LightSource for EnvironmentLight {
         wavelengths: &SampledWavelengths,
     ) -> Option<LightLeSample> {
         let (wi, _, _) = self.sample_direction(u_dir)?;
-        // The texel the direction maps back to (the sampled one but on a texel edge), so
-        // that the sample and `pdf_le` agree.
-        let (x, y) = self.texel_of(wi);
+        // The radiance and density the direction maps back to (the sampled texel's but on
+        // a texel edge), so that the sample and `pdf_le` agree.
         scene.emission(
             wi,
             u_pos,
-            self.texel_radiance(x, y, wavelengths),
-            self.texel_pdf(x, y),
+            self.radiance_at(self.local_uv(wi), wavelengths),
+            self.direction_pdf(wi),
         )
     }
 
@@ -474,6 +668,82 @@ impl LightSource for EnvironmentLight {
     }
 }
 
+/// An environment map's pixels: linear RGB in `gamut`, row-major, top row first.
+#[derive(Clone, Copy, Debug)]
+pub struct RgbTexels<'a> {
+    pub width: usize,
+    pub height: usize,
+    pub pixels: &'a [[f32; 3]],
+    pub gamut: RgbGamut,
+}
+
+/// Where a sampled direction's radiance is read (`EnvironmentLight::sample_direction`).
+#[derive(Clone, Copy, Debug)]
+enum SampledAt {
+    Texel(usize, usize),
+    Point(Vec2),
+}
+
+/// The largest f32 below 1.
+const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;
+
+/// x ∈ [0, 1) with density ∝ (1 − x)·a + x·b (a, b ≥ 0), by inverting its cdf, written so
+/// that it stays exact as a → b.
+#[inline]
+fn sample_linear(u: f32, a: f32, b: f32) -> f32 {
+    if a == b {
+        return u;
+    }
+    let x = u * (a + b) / (a + (a * a + u * (b * b - a * a)).max(0.0).sqrt());
+    x.clamp(0.0, ONE_MINUS_EPSILON)
+}
+
+/// The two texel columns whose centres bracket image coordinate `u` (wrapping around) and
+/// the weight of the second.
+#[inline]
+fn wrapped_pair(u: f32, width: usize) -> ([usize; 2], f32) {
+    let s = u * width as f32 - 0.5;
+    let floor = s.floor();
+    let x0 = (floor as i64).rem_euclid(width as i64) as usize;
+    ([x0, (x0 + 1) % width], (s - floor).clamp(0.0, 1.0))
+}
+
+/// The two texel rows whose centres bracket image coordinate `v`, and the weight of the
+/// second; above the first row's centre and below the last row's, that row alone.
+#[inline]
+fn clamped_pair(v: f32, height: usize) -> ([usize; 2], f32) {
+    let t = (v * height as f32 - 0.5).clamp(0.0, (height - 1) as f32);
+    let y0 = (t as usize).min(height - 1);
+    ([y0, (y0 + 1).min(height - 1)], t - y0 as f32)
+}
+
+/// Per texel, the mean over its cell of the bilinear reconstruction of `values` (module
+/// docs): (⅛, ¾, ⅛) over the row's neighbours (wrapping) times the same over the column's,
+/// where the first and last rows, constant over their outer halves, weigh (⅞, ⅛).
+fn bilinear_texel_means(values: &[f32], width: usize, height: usize) -> Vec<f32> {
+    let mut across = vec![0.0f32; values.len()];
+    for y in 0..height {
+        let row = &values[y * width..(y + 1) * width];
+        for x in 0..width {
+            let (left, right) = (row[(x + width - 1) % width], row[(x + 1) % width]);
+            across[y * width + x] = 0.75 * row[x] + 0.125 * (left + right);
+        }
+    }
+    let mut out = vec![0.0f32; values.len()];
+    for y in 0..height {
+        for x in 0..width {
+            let at = |y: usize| across[y * width + x];
+            out[y * width + x] = match (y, height) {
+                (_, 1) => at(0),
+                (0, _) => 0.875 * at(0) + 0.125 * at(1),
+                (y, h) if y == h - 1 => 0.875 * at(y) + 0.125 * at(y - 1),
+                (y, _) => 0.75 * at(y) + 0.125 * (at(y - 1) + at(y + 1)),
+            };
+        }
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -499,13 +769,20 @@ mod tests {
     }
 
     fn synthetic(rotation: Mat3A) -> EnvironmentLight {
+        synthetic_with(rotation, EnvironmentFilter::Nearest)
+    }
+
+    fn synthetic_with(rotation: Mat3A, filter: EnvironmentFilter) -> EnvironmentLight {
         EnvironmentLight::from_rgb(
-            16,
-            8,
-            &synthetic_pixels(),
-            RgbGamut::Srgb,
+            RgbTexels {
+                width: 16,
+                height: 8,
+                pixels: &synthetic_pixels(),
+                gamut: RgbGamut::Srgb,
+            },
             rotation,
             1.0,
+            filter,
             SceneSphere::default(),
         )
         .unwrap()
@@ -517,14 +794,15 @@ mod tests {
             Mat3A::IDENTITY,
             Mat3A::from_axis_angle(glam::Vec3::new(1.0, 2.0, 0.5).normalize(), 0.9),
         ];
-        let config = chi2_config(rotations.len(), 71);
+        let filters = [EnvironmentFilter::Nearest, EnvironmentFilter::Bilinear];
+        let config = chi2_config(rotations.len() * filters.len(), 71);
         let ctx = LightSampleContext {
             p: Vec3A::ZERO,
             n: Vec3A::Y,
         };
         let wl = SampledWavelengths::sample_uniform(0.4);
-        for rotation in rotations {
-            let env = synthetic(rotation);
+        for (rotation, filter) in rotations.into_iter().flat_map(|r| filters.map(|f| (r, f))) {
+            let env = synthetic_with(rotation, filter);
             let r = chi2_test_adaptive(
                 &config,
                 |_, u| env.sample_li(&ctx, u, &wl).map(|s| s.wi),
@@ -606,12 +884,15 @@ mod tests {
     fn a_grey_texel_emits_the_white_illuminant_at_its_value() {
         // RGB (v, v, v) → v × the sRGB white (D65 at Y = 1): luminance v · K_m ∫ȳ dλ.
         let env = EnvironmentLight::from_rgb(
-            2,
-            1,
-            &[[0.25; 3], [2.0; 3]],
-            RgbGamut::Srgb,
+            RgbTexels {
+                width: 2,
+                height: 1,
+                pixels: &[[0.25; 3], [2.0; 3]],
+                gamut: RgbGamut::Srgb,
+            },
             Mat3A::IDENTITY,
             3.0,
+            EnvironmentFilter::Nearest,
             SceneSphere::default(),
         )
         .unwrap();
@@ -709,6 +990,149 @@ mod tests {
         assert!(
             e.contains("lights[0].transform: an environment map can only be rotated"),
             "{e}"
+        );
+    }
+
+    /// Luminance of `synthetic_pixels` per texel.
+    fn synthetic_luminance() -> Vec<f64> {
+        let weights = RgbColorSpace::srgb().rgb_to_xyz;
+        synthetic_pixels()
+            .iter()
+            .map(|p| {
+                weights.x_axis.y * f64::from(p[0])
+                    + weights.y_axis.y * f64::from(p[1])
+                    + weights.z_axis.y * f64::from(p[2])
+            })
+            .collect()
+    }
+
+    #[test]
+    fn bilinear_radiance_interpolates_between_texel_centres() {
+        let env = synthetic_with(Mat3A::IDENTITY, EnvironmentFilter::Bilinear);
+        let lum = synthetic_luminance();
+        let per_unit = crate::film::xyz::cd_m2_per_unit();
+        let luminance = |u: f32, v: f32| {
+            photometric_sum(|wl| env.infinite_radiance(equirect_direction(Vec2::new(u, v)), wl))
+                / per_unit
+        };
+        let centre = |x: usize, y: usize| ((x as f32 + 0.5) / 16.0, (y as f32 + 0.5) / 8.0);
+        // The sigmoid upsampling keeps a texel's luminance within 1 %.
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-2 * b;
+        for (x, y) in [(4, 3), (0, 0), (15, 7)] {
+            let (u, v) = centre(x, y);
+            assert!(close(luminance(u, v), lum[y * 16 + x]), "centre of {x},{y}");
+        }
+        let (u, v) = centre(2, 5);
+        let between = 0.5 * (lum[5 * 16 + 2] + lum[5 * 16 + 3]);
+        assert!(close(luminance(u + 0.5 / 16.0, v), between));
+        let seam = 0.5 * (lum[2 * 16 + 15] + lum[2 * 16]);
+        assert!(
+            close(luminance(0.0, centre(0, 2).1), seam),
+            "across the seam"
+        );
+        let above_first = luminance(5.3 / 16.0, 0.2 / 8.0);
+        assert!(
+            close(above_first, luminance(5.3 / 16.0, 0.5 / 8.0)),
+            "constant to the pole"
+        );
+        assert_eq!(
+            luminance(9.5 / 16.0, 6.5 / 8.0),
+            0.0,
+            "the black texel's centre"
+        );
+        assert!(
+            luminance(9.9 / 16.0, 6.5 / 8.0) > 0.0,
+            "towards its neighbour"
+        );
+    }
+
+    #[test]
+    fn bilinear_density_follows_the_bilinear_luminance_inside_a_texel() {
+        // Inside one cell the density per unit image area is f(u, v) · const: the ratio
+        // pdf · sin θ / f is the same at every point of the cell.
+        let env = synthetic_with(Mat3A::IDENTITY, EnvironmentFilter::Bilinear);
+        let ratio = |a: f32, b: f32| {
+            let uv = Vec2::new((4.0 + a) / 16.0, (2.0 + b) / 8.0);
+            let d = equirect_direction(uv);
+            let sin_theta = (PI * uv.y).sin();
+            env.direction_pdf(d) * sin_theta / env.bilinear_luminance(uv)
+        };
+        let reference = ratio(0.5, 0.5);
+        for (a, b) in [(0.1, 0.1), (0.9, 0.2), (0.3, 0.8), (0.7, 0.6)] {
+            let r = ratio(a, b);
+            assert!(
+                (r - reference).abs() < 1e-4 * reference,
+                "{a},{b}: {r} vs {reference}"
+            );
+        }
+        // The black texel's cell is reachable where its neighbours light it.
+        assert!(env.direction_pdf(equirect_direction(Vec2::new(9.9 / 16.0, 6.5 / 8.0))) > 0.0);
+    }
+
+    #[test]
+    fn light_sampling_alone_integrates_the_radiance() {
+        // E[L/pdf] over sample_li = ∫ L dω only where the density covers every direction the
+        // radiance reaches: with the bilinear filter, a lone bright texel puts 7/16 of its
+        // light in the black cells around it.
+        let mut lone = vec![[0.0f32; 3]; 8 * 4];
+        lone[8 + 5] = [3.0, 2.0, 1.0];
+        for filter in [EnvironmentFilter::Nearest, EnvironmentFilter::Bilinear] {
+            let lone = EnvironmentLight::from_rgb(
+                RgbTexels {
+                    width: 8,
+                    height: 4,
+                    pixels: &lone,
+                    gamut: RgbGamut::Srgb,
+                },
+                Mat3A::IDENTITY,
+                1.0,
+                filter,
+                SceneSphere::default(),
+            )
+            .unwrap();
+            integrates_by_light_sampling(&lone);
+            integrates_by_light_sampling(&synthetic_with(Mat3A::IDENTITY, filter));
+        }
+    }
+
+    fn integrates_by_light_sampling(env: &EnvironmentLight) {
+        let ctx = LightSampleContext {
+            p: Vec3A::ZERO,
+            n: Vec3A::ZERO,
+        };
+        let wl = SampledWavelengths::sample_uniform(0.3);
+        let channel = |s: SampledSpectrum| f64::from(s.to_array()[0]);
+        let n = 1 << 16;
+        let (mut sum, mut sum_sq) = (0.0, 0.0);
+        for i in 0..n {
+            let u = Vec2::new(
+                (i as f32 + 0.5) / n as f32,
+                ((i as f64 * 0.618_033_988_749_895).fract()) as f32,
+            );
+            let f = env
+                .sample_li(&ctx, u, &wl)
+                .map_or(0.0, |s| channel(s.radiance) / f64::from(s.pdf));
+            sum += f;
+            sum_sq += f * f;
+        }
+        let mean = sum / f64::from(n);
+        let standard_error = ((sum_sq / f64::from(n) - mean * mean) / f64::from(n)).sqrt();
+        // The integral by a fine midpoint rule over equal-area cells in (cos θ, φ).
+        let (cells_u, cells_v) = (1024, 512);
+        let mut exact = 0.0;
+        for j in 0..cells_v {
+            let cos_theta = 1.0 - 2.0 * (j as f64 + 0.5) / cells_v as f64;
+            let v = (cos_theta.acos() / std::f64::consts::PI) as f32;
+            for k in 0..cells_u {
+                let u = ((k as f64 + 0.5) / cells_u as f64) as f32;
+                exact += channel(env.infinite_radiance(equirect_direction(Vec2::new(u, v)), &wl));
+            }
+        }
+        exact *= 4.0 * std::f64::consts::PI / f64::from(cells_u * cells_v);
+        assert!(
+            (mean - exact).abs() < 4.0 * standard_error + 2e-3 * exact,
+            "{:?}: {mean} vs {exact} (s.e. {standard_error})",
+            env.filter
         );
     }
 

@@ -64,12 +64,15 @@ mod tests {
 
     fn env(pixels: &[[f32; 3]], w: usize, h: usize) -> EnvironmentLight {
         EnvironmentLight::from_rgb(
-            w,
-            h,
-            pixels,
-            RgbGamut::Srgb,
+            crate::light::environment::RgbTexels {
+                width: w,
+                height: h,
+                pixels,
+                gamut: RgbGamut::Srgb,
+            },
             Mat3A::IDENTITY,
             1.0,
+            crate::light::environment::EnvironmentFilter::Nearest,
             SceneSphere::default(),
         )
         .unwrap()
