@@ -52,24 +52,24 @@ def rgbe(rgb):
     return bytes([min(255, int(c * scale)) for c in rgb] + [e + 128])
 
 
-def main():
-    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-    out = os.path.join(root, "scenes", "envmaps", "sky-512x256.hdr")
-    os.makedirs(os.path.dirname(out), exist_ok=True)
+def write_envmap(out, radiance, width, height, supersamples, source):
+    """Writes `radiance(u, v)` (linear RGB) as a flat RGBE file `out`, each texel the mean of
+    supersamples × supersamples points (edges that fall between texels stay smooth), through
+    a temporary file and a rename. `source` names the script in the header."""
+    n = supersamples
     rows = []
-    for y in range(H):
+    for y in range(height):
         row = bytearray()
-        for x in range(W):
-            # Sun disc is tiny: supersample texels near it 4×4 for a smooth edge.
+        for x in range(width):
             acc = [0.0, 0.0, 0.0]
-            n = 4
             for a in range(n):
                 for b in range(n):
-                    c = sky((x + (a + 0.5) / n) / W, (y + (b + 0.5) / n) / H)
+                    c = radiance((x + (a + 0.5) / n) / width, (y + (b + 0.5) / n) / height)
                     acc = [p + q for p, q in zip(acc, c)]
             row += rgbe([c / (n * n) for c in acc])
         rows.append(bytes(row))
-    header = f"#?RADIANCE\n# tools/make_sky_envmap.py\nFORMAT=32-bit_rle_rgbe\n\n-Y {H} +X {W}\n"
+    header = f"#?RADIANCE\n# {source}\nFORMAT=32-bit_rle_rgbe\n\n-Y {height} +X {width}\n"
+    os.makedirs(os.path.dirname(out), exist_ok=True)
     tmp = out + ".tmp"
     with open(tmp, "wb") as f:
         f.write(header.encode("ascii"))
@@ -77,6 +77,13 @@ def main():
             f.write(r)
     os.replace(tmp, out)
     print(out)
+
+
+def main():
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    out = os.path.join(root, "scenes", "envmaps", "sky-512x256.hdr")
+    # The sun disc is tiny: 4 × 4 supersamples per texel for a smooth edge.
+    write_envmap(out, sky, W, H, 4, "tools/make_sky_envmap.py")
 
 
 if __name__ == "__main__":

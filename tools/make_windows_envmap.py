@@ -14,7 +14,7 @@ photograph, so no licence question. Radiance RGBE (Ward 1991), flat scanlines, t
 import math
 import os
 
-from make_sky_envmap import direction, rgbe
+from make_sky_envmap import direction, write_envmap
 
 W, H = 512, 256
 # (azimuth u, elevation in degrees, half-width in degrees, half-height in degrees, RGB):
@@ -46,26 +46,8 @@ def radiance(u, v):
 def main():
     root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
     out = os.path.join(root, "scenes", "envmaps", "windows-512x256.hdr")
-    rows = []
-    n = 4  # 4×4 supersamples per texel: window edges fall between texels
-    for y in range(H):
-        row = bytearray()
-        for x in range(W):
-            acc = [0.0, 0.0, 0.0]
-            for a in range(n):
-                for b in range(n):
-                    c = radiance((x + (a + 0.5) / n) / W, (y + (b + 0.5) / n) / H)
-                    acc = [p + q for p, q in zip(acc, c)]
-            row += rgbe([c / (n * n) for c in acc])
-        rows.append(bytes(row))
-    header = f"#?RADIANCE\n# tools/make_windows_envmap.py\nFORMAT=32-bit_rle_rgbe\n\n-Y {H} +X {W}\n"
-    tmp = out + ".tmp"
-    with open(tmp, "wb") as f:
-        f.write(header.encode("ascii"))
-        for r in rows:
-            f.write(r)
-    os.replace(tmp, out)
-    print(out)
+    # 4 × 4 supersamples per texel: window edges fall between texels.
+    write_envmap(out, radiance, W, H, 4, "tools/make_windows_envmap.py")
 
 
 if __name__ == "__main__":
