@@ -428,7 +428,7 @@ pub const FIELD_USES: &[FieldRow] = &[
     ),
     read(
         &["lights[]<environment>"],
-        &["type", "file", "transform", "scale"],
+        &["type", "file", "transform", "scale", "filter"],
         "light::build::build_lights → EnvironmentLight::load",
     ),
     read(&["lights[]<sky>"], &["luminance_cd_m2"], BUILD_LIGHTS),
