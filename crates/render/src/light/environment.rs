@@ -142,6 +142,10 @@ pub struct EnvironmentLight {
     /// Per texel, the luminance of its RGB (before `scale`; eq. 7's input and, bilinear, the
     /// sampling's f).
     luminance: Vec<f32>,
+    /// Bilinear filter: per texel, P(texel) · W·H / (mean of f over its cell) / 2π², so that
+    /// the density per steradian is this × f(u, v) / sin θ (0 where the cell is dark; empty
+    /// for nearest).
+    bilinear_pdf_factor: Vec<f32>,
     /// cos θ at the row boundaries: cos(π y / H), y = 0..=H.
     cos_rows: Vec<f32>,
     distribution: PiecewiseConstant2D,
@@ -238,7 +242,7 @@ impl EnvironmentLight {
         });
         let white_integral_nm = white_dense.values().iter().sum();
         let white = Spectrum::from_dense(&white_dense).map_err(|e| e.to_string())?;
-        Ok(Self {
+        let mut light = Self {
             width,
             height,
             texels: upsampled,
@@ -246,6 +250,7 @@ impl EnvironmentLight {
             scale,
             filter,
             luminance,
+            bilinear_pdf_factor: Vec::new(),
             cos_rows,
             distribution: PiecewiseConstant2D::new(&values, width, height),
             to_world: rotation,
@@ -253,7 +258,22 @@ impl EnvironmentLight {
             scene,
             luminance_solid_angle_sr,
             white_integral_nm,
-        })
+        };
+        if filter == EnvironmentFilter::Bilinear {
+            let pixel_count = (width * height) as f32;
+            light.bilinear_pdf_factor = (0..width * height)
+                .map(|i| {
+                    let (x, y) = (i % width, i / width);
+                    let cell_mean = light.distribution.value(x, y) / light.texel_solid_angle(y);
+                    if cell_mean > 0.0 {
+                        light.texel_probability(x, y) * pixel_count / cell_mean / (2.0 * PI * PI)
+                    } else {
+                        0.0
+                    }
+                })
+                .collect();
+        }
+        Ok(light)
     }
 
     /// Reads an .exr/.hdr file with prism-image (`prism_image::io::read_image`); errors name
@@ -409,20 +429,17 @@ impl EnvironmentLight {
             .sum()
     }
 
-    /// Bilinear filter: density per steradian at local image coordinates `uv`,
-    /// P(texel) · f(uv) / ∫_cell f / (2π² sin θ) (module docs).
+    /// Bilinear filter: density per steradian at local image coordinates `uv` of local
+    /// direction `local`, P(texel) · f(uv) / ∫_cell f / (2π² sin θ) (module docs).
     #[inline]
-    fn bilinear_pdf(&self, uv: Vec2) -> f32 {
+    fn bilinear_pdf(&self, uv: Vec2, local: Vec3A) -> f32 {
         let (x, y) = self.texel(uv);
-        let cell_mean = self.distribution.value(x, y) / self.texel_solid_angle(y);
-        let sin_theta = (PI * uv.y).sin();
-        if !(cell_mean > 0.0 && sin_theta > 0.0) {
+        let factor = self.bilinear_pdf_factor[y * self.width + x];
+        let sin_theta = (1.0 - local.y * local.y).max(0.0).sqrt();
+        if !(factor > 0.0 && sin_theta > 0.0) {
             return 0.0;
         }
-        let p_texel = self.texel_probability(x, y);
-        p_texel * self.bilinear_luminance(uv) * (self.width * self.height) as f32
-            / cell_mean
-            / (2.0 * PI * PI * sin_theta)
+        factor * self.bilinear_luminance(uv) / sin_theta
     }
 
     /// Probability of choosing texel (x, y).
@@ -441,20 +458,18 @@ impl EnvironmentLight {
         // f at the cell's 3 × 3 nodes (corners, edge midpoints, centre), cell-local (a, b) ∈
         // {0, ½, 1}²: the mean of the texels around each node, columns wrapping, rows clamped.
         let (w, h) = (self.width, self.height);
-        let column = |dx: isize| (x as isize + dx).rem_euclid(w as isize) as usize;
-        let row = |dy: isize| (y as isize + dy).clamp(0, h as isize - 1) as usize;
-        let g = |dx: isize, dy: isize| self.luminance[row(dy) * w + column(dx)];
-        const AROUND: [&[isize]; 3] = [&[-1, 0], &[0], &[0, 1]];
-        let node = |i: usize, j: usize| {
-            let (xs, ys) = (AROUND[i], AROUND[j]);
-            let sum: f32 = ys
-                .iter()
-                .flat_map(|&dy| xs.iter().map(move |&dx| (dx, dy)))
-                .map(|(dx, dy)| g(dx, dy))
-                .sum();
-            sum / (xs.len() * ys.len()) as f32
-        };
-        let nodes: [[f32; 3]; 3] = std::array::from_fn(|j| std::array::from_fn(|i| node(i, j)));
+        let (left, right) = ((x + w - 1) % w, (x + 1) % w);
+        let rows = [y.saturating_sub(1), y, (y + 1).min(h - 1)];
+        // Per row, the texel and the means with its left and right neighbours.
+        let across = rows.map(|r| {
+            let g = &self.luminance[r * w..(r + 1) * w];
+            [0.5 * (g[left] + g[x]), g[x], 0.5 * (g[x] + g[right])]
+        });
+        let nodes: [[f32; 3]; 3] = [
+            std::array::from_fn(|i| 0.5 * (across[0][i] + across[1][i])),
+            across[1],
+            std::array::from_fn(|i| 0.5 * (across[1][i] + across[2][i])),
+        ];
         let corners = |qx: usize, qy: usize| {
             [
                 nodes[qy][qx],
@@ -537,7 +552,7 @@ impl EnvironmentLight {
                 let local = equirect_direction(at);
                 (
                     (self.to_world * local).normalize(),
-                    self.bilinear_pdf(at),
+                    self.bilinear_pdf(at, local),
                     SampledAt::Point(at),
                 )
             }
@@ -567,7 +582,10 @@ impl EnvironmentLight {
                 let (x, y) = self.texel_of(wi);
                 self.texel_pdf(x, y)
             }
-            EnvironmentFilter::Bilinear => self.bilinear_pdf(self.local_uv(wi)),
+            EnvironmentFilter::Bilinear => {
+                let local = (self.to_local * wi).normalize();
+                self.bilinear_pdf(equirect_uv(local), local)
+            }
         }
     }
 }
