@@ -1,8 +1,8 @@
 //! The reference image of `prism converge`: a file the user gives (checked before anything
 //! renders: it must exist, be an image and have the render's size), or one rendered at a
 //! stated spp and cached in a cache directory (`--cache-dir`, default the platform's) under a
-//! name that carries a hash of everything it depends on, so that editing the scene file
-//! invalidates it. A scene's folder may be read-only or shared, so nothing is written there.
+//! name that carries a hash of everything it depends on, so that editing the scene file or
+//! any file it names invalidates it. A scene's folder may be read-only or shared, so nothing is written there.
 
 use std::io::Read;
 use std::path::{Path, PathBuf};
@@ -10,7 +10,6 @@ use std::path::{Path, PathBuf};
 use glam::UVec2;
 use prism_image::io::read_image;
 use prism_image::Image;
-
 use prism_render::stable_hash::Fnv1a64;
 
 use crate::cache_dir::fnv1a64;
