@@ -19,6 +19,18 @@ fn wicker_path() -> std::path::PathBuf {
     std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes/tiled/tiles/wicker.obj")
 }
 
+/// Copies the wicker tile and its MTL into `dir`/tiles/, where the test scenes name it.
+fn copy_wicker_tile(dir: &Dir) {
+    std::fs::create_dir_all(dir.0.join("tiles")).unwrap();
+    for file in ["wicker.obj", "wicker.mtl"] {
+        std::fs::copy(
+            wicker_path().with_file_name(file),
+            dir.0.join("tiles").join(file),
+        )
+        .unwrap();
+    }
+}
+
 /// The scene around the panel: `panel` is its shape entries (JSON).
 fn scene_json(panel: &str, tiles: &str) -> String {
     format!(
@@ -108,14 +120,7 @@ fn block_means(images: &[Vec<f32>]) -> Vec<(String, Vec<f64>)> {
 fn virtual_ray_tracing_renders_what_the_explicit_mesh_renders() {
     let dir = Dir::new("tiled", "explicit");
     let tile = load_obj(wicker_path()).unwrap();
-    std::fs::create_dir_all(dir.0.join("tiles")).unwrap();
-    for file in ["wicker.obj", "wicker.mtl"] {
-        std::fs::copy(
-            wicker_path().with_file_name(file),
-            dir.0.join("tiles").join(file),
-        )
-        .unwrap();
-    }
+    copy_wicker_tile(&dir);
     dir.write("weft.obj", explicit_obj(&tile, "strand_weft").as_bytes());
     dir.write("warp.obj", explicit_obj(&tile, "strand_warp").as_bytes());
     let tiled = dir.scene(&scene_json(
@@ -166,14 +171,7 @@ fn error_of(dir: &Dir, panel: &str, tiles: &str) -> String {
 #[test]
 fn tiles_that_cannot_be_placed_are_errors_naming_the_cause() {
     let dir = Dir::new("tiled", "errors");
-    std::fs::create_dir_all(dir.0.join("tiles")).unwrap();
-    for file in ["wicker.obj", "wicker.mtl"] {
-        std::fs::copy(
-            wicker_path().with_file_name(file),
-            dir.0.join("tiles").join(file),
-        )
-        .unwrap();
-    }
+    copy_wicker_tile(&dir);
     let wicker = tiles_json("tiles/wicker.obj", "[0.1, 0.1]");
     let panel = |shape: &str| {
         format!(r#"{{"type": "{shape}", "name": "panel", "material": "wickerwork"}}"#)
@@ -329,14 +327,7 @@ fn room_faces(material: impl Fn(&str) -> &'static str) -> String {
 }
 
 fn room_with_wicker(dir: &Dir, integrator: &str) -> prism_render::RenderScene {
-    std::fs::create_dir_all(dir.0.join("tiles")).unwrap();
-    for file in ["wicker.obj", "wicker.mtl"] {
-        std::fs::copy(
-            wicker_path().with_file_name(file),
-            dir.0.join("tiles").join(file),
-        )
-        .unwrap();
-    }
+    copy_wicker_tile(dir);
     let faces = room_faces(|_| "plaster");
     let json = format!(
         r#"{{

@@ -23,7 +23,7 @@ impl EnvironmentBandwidth {
         let (width, height) = light.resolution();
         let resolution = UVec2::new(width as u32, height as u32);
         let local = LocalBandwidth::estimate(
-            &light.luminance_texels(),
+            light.luminance_texels(),
             resolution,
             1.0,
             Boundary::InsideOnly,

@@ -32,7 +32,7 @@ use prism_spectrum::{SampledSpectrum, SampledWavelengths};
 use rayon::prelude::*;
 
 use crate::bsdf::TransportMode;
-use crate::integrator::radiosity::patches::{band_point_nm, BANDS};
+use crate::integrator::radiosity::patches::{SolutionBands, BANDS};
 use crate::integrator::scatter_vertex::{ScatterVertex, SurfaceVertex};
 use crate::integrator::{LaneWavelengths, PathCounters, PathTracer};
 use crate::sampler::PixelSampler;
@@ -474,7 +474,9 @@ fn simulate_incident(
             let first = (s % 4) as usize;
             let jitter = stream.get_1d();
             let bands: [usize; 4] = std::array::from_fn(|k| first + 4 * k);
-            let lambda = bands.map(|b| band_point_nm(b, 0, 1) as f32 + (jitter - 0.5) * 25.0);
+            let band = SolutionBands::DEFAULT;
+            let lambda = bands
+                .map(|b| band.point_nm(b, 0, 1) as f32 + (jitter - 0.5) * band.width_nm as f32);
             let wavelengths = SampledWavelengths::new(lambda, SampledSpectrum::splat(1.0));
             let mut lanes = LaneWavelengths::new(wavelengths);
             let p = crossing(uv);

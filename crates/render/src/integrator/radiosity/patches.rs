@@ -22,11 +22,6 @@ pub const BANDS: usize = 16;
 pub const FIRST_BAND_NM: f64 = 380.0;
 pub const BAND_WIDTH_NM: f64 = 25.0;
 
-/// Wavelength `k` of `count` evenly spaced midpoints in default band `band`, nm.
-pub fn band_point_nm(band: usize, k: usize, count: usize) -> f64 {
-    SolutionBands::DEFAULT.point_nm(band, k, count)
-}
-
 /// The wavelength bands a solution is carried in: equal bands from `first_nm`, the end
 /// bands extending beyond the range. The default, 16 of 25 nm over 380–780 nm, or the
 /// render's spectral bins (`--spectral-bins N`: N over 360–830 nm).
