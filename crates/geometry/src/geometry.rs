@@ -34,6 +34,9 @@ use crate::triangle::{TriangleHit, WatertightRay};
 use crate::triangle_bvh::TriangleBvh;
 use crate::triangle_geometry::triangle_local_geometry;
 
+#[path = "geometry_stream.rs"]
+mod stream;
+
 /// Index of a mesh added to a [`GeometryBuilder`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct MeshId(pub u32);

@@ -7,7 +7,8 @@ use glam::Vec3A;
 
 use crate::bvh_build::BuildQuality;
 use crate::mesh::TriangleMesh;
-use crate::triangle_bvh::TriangleBvh;
+use crate::triangle::{TriangleHit, WatertightRay};
+use crate::triangle_bvh::{TriangleBvh, STREAM_LANES};
 
 /// Closest hit inside one mesh.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -114,6 +115,55 @@ impl MeshBvh {
         unsafe {
             self.bvh
                 .occluded_with::<WIDE>(origin, direction, t_min, t_max)
+        }
+    }
+
+    /// [`Self::intersect_with`] for `count` object-space rays, interleaved
+    /// (`TriangleBvh::traverse_stream_with`): `ray(i)` gives ray `i` (origin, direction,
+    /// `t_min`, `t_max`) and `hit(i, result)` receives its closest hit, the same bits as
+    /// `intersect_with`'s, in any order of `i`.
+    ///
+    /// # Safety
+    /// With `WIDE`, the CPU must run AVX2.
+    #[inline(always)]
+    pub(crate) unsafe fn intersect_stream_with<const WIDE: bool>(
+        &self,
+        count: usize,
+        mut ray: impl FnMut(usize) -> (Vec3A, Vec3A, f32, f32),
+        mut hit: impl FnMut(usize, Option<MeshHit>),
+    ) {
+        type Best = Option<(TriangleHit, u32)>;
+        let start = |i: usize| {
+            let (o, d, t_min, t_max) = ray(i);
+            let best: Best = None;
+            (o, d, t_min, t_max, (WatertightRay::new(o, d, t_min), best))
+        };
+        let test =
+            |(wt, best): &mut (WatertightRay, Best), [a, b, c]: &[Vec3A; 3], id, t_max| match wt
+                .intersect(*a, *b, *c, t_max)
+            {
+                Some(h) => {
+                    *best = Some((h, id));
+                    h.t
+                }
+                None => f32::INFINITY,
+            };
+        let finish = |i: usize, (_, best): (WatertightRay, Best)| {
+            hit(
+                i,
+                best.map(|(h, triangle)| MeshHit {
+                    t: h.t,
+                    triangle,
+                    b0: h.b0,
+                    b1: h.b1,
+                    b2: h.b2,
+                }),
+            )
+        };
+        // SAFETY: the caller's contract for `WIDE`.
+        unsafe {
+            self.bvh
+                .traverse_stream_with::<WIDE, STREAM_LANES, _>(count, start, test, finish)
         }
     }
 }

@@ -18,6 +18,10 @@ use obvhs::faststack::FastStack;
 use crate::bvh_build::{build_bvh, bvh_ray, padded_aabb, BuildQuality};
 use crate::triangle::{TriangleHit, WatertightRay};
 
+#[path = "triangle_bvh_stream.rs"]
+mod stream;
+pub(crate) use stream::STREAM_LANES;
+
 pub(crate) struct TriangleBvh<Id> {
     /// `None` for an empty soup.
     bvh: Option<CwBvh>,
@@ -434,6 +438,21 @@ impl Traversal {
             primitive_id: 0,
             hitmask: 0,
         }
+    }
+
+    /// The state of [`Traversal::new`] for another ray, the stack's storage kept.
+    #[inline(always)]
+    fn reset(&mut self, bvh: &CwBvh, direction: Vec3A) {
+        self.stack.clear();
+        self.current_group = if bvh.nodes.is_empty() {
+            UVec2::ZERO
+        } else {
+            UVec2::new(0, 0x8000_0000)
+        };
+        self.primitive_group = UVec2::ZERO;
+        self.oct_inv4 = octant_inv4(direction);
+        self.primitive_id = 0;
+        self.hitmask = 0;
     }
 }
 

@@ -284,5 +284,106 @@ fn every_isa_traverses_to_the_same_bits(flatten: bool, small: bool) {
                 rays[i]
             );
         }
+        // The same rays as one stream (interleaved traversals under the scene BVH; one by
+        // one in the small scene): the same bits.
+        let streamed = stream_hits(&geometry, &rays);
+        for (i, (want, have)) in baseline.iter().zip(&streamed).enumerate() {
+            assert_eq!(
+                want.0,
+                *have,
+                "stream, flatten {flatten}, small {small}, {} ray {i}: {:?}",
+                simd.isa(),
+                rays[i]
+            );
+        }
+    }
+}
+
+/// `Geometry::intersect_stream` of `rays`, each hit as its bits.
+fn stream_hits(geometry: &Geometry, rays: &[Ray]) -> Vec<Option<[u32; 5]>> {
+    let mut hits = vec![None; rays.len()];
+    geometry.intersect_stream(rays, &mut hits);
+    hits.iter()
+        .map(|h| {
+            h.map(|h| {
+                [
+                    h.t.to_bits(),
+                    h.instance_id,
+                    h.primitive_id,
+                    h.b1.to_bits(),
+                    h.b2.to_bits(),
+                ]
+            })
+        })
+        .collect()
+}
+
+/// A ray stream over one mesh instance (the mesh's own BVH, interleaved) finds each ray's
+/// one-ray hit, bit for bit, at every ISA: rays from inside and outside a soup of 20 000
+/// triangles, bounded and unbounded, and rays leaving a wall 10 µm in front of it with
+/// `t_min` 10⁻⁵ m, which must hit it (no entry distance is clamped above `t_min`).
+#[test]
+fn ray_streams_find_the_one_ray_hits_in_a_mesh() {
+    let mut rng = Pcg64::seed_from_u64(23);
+    let soup = triangle_soup(20_000, 2.0, 0.02..0.2, &mut rng);
+    // A wall at z = −2.5 facing +z, two triangles 6 m wide.
+    let mut positions = soup.positions.clone();
+    let mut indices = soup.indices.clone();
+    let base = positions.len() as u32;
+    positions.extend([
+        Vec3A::new(-3.0, -3.0, -2.5),
+        Vec3A::new(3.0, -3.0, -2.5),
+        Vec3A::new(3.0, 3.0, -2.5),
+        Vec3A::new(-3.0, 3.0, -2.5),
+    ]);
+    indices.extend([[base, base + 1, base + 2], [base, base + 2, base + 3]]);
+    let soup = TriangleMesh::new(positions, indices);
+    let wall = [soup.triangle_count() - 2, soup.triangle_count() - 1];
+    let mut geometry = single(&soup, BuildQuality::Fast);
+    let mut rays: Vec<Ray> = (0..30_000)
+        .map(|i| {
+            let origin = Vec3A::new(
+                rng.gen_range(-3.5..3.5),
+                rng.gen_range(-3.5..3.5),
+                rng.gen_range(-3.5..3.5),
+            );
+            let t_max = if i % 3 == 0 { 1.5 } else { f32::INFINITY };
+            Ray::new(origin, random_unit(&mut rng), 0.0, t_max)
+        })
+        .collect();
+    let near_wall = 2_000;
+    for _ in 0..near_wall {
+        let origin = Vec3A::new(
+            rng.gen_range(-2.9..2.9),
+            rng.gen_range(-2.9..2.9),
+            -2.5 + 1e-5,
+        );
+        let mut d = random_unit(&mut rng);
+        d.z = -d.z.abs().max(0.1);
+        rays.push(Ray::new(origin, d.normalize(), 1e-5, f32::INFINITY));
+    }
+    for simd in std::iter::once(prism_cpu::Simd::SCALAR).chain(prism_cpu::each_isa()) {
+        geometry = geometry.with_simd(simd);
+        let streamed = stream_hits(&geometry, &rays);
+        let mut hits = 0;
+        for (i, (ray, have)) in rays.iter().zip(&streamed).enumerate() {
+            let want = geometry.intersect(ray).map(|h| {
+                [
+                    h.t.to_bits(),
+                    h.instance_id,
+                    h.primitive_id,
+                    h.b1.to_bits(),
+                    h.b2.to_bits(),
+                ]
+            });
+            assert_eq!(want, *have, "{} ray {i}: {ray:?}", simd.isa());
+            hits += usize::from(have.is_some());
+        }
+        assert!(hits > 10_000, "{hits} hits");
+        // Every ray leaving the wall 10 µm in front of it hits the wall.
+        for (ray, have) in rays.iter().zip(&streamed).skip(rays.len() - near_wall) {
+            let hit = have.unwrap_or_else(|| panic!("{ray:?} missed the wall"));
+            assert!(wall.contains(&(hit[2] as usize)), "{ray:?}: {hit:?}");
+        }
     }
 }

@@ -287,6 +287,7 @@ fn peer_mode(dir: &std::path::Path) {
                        "preset": BuildQuality::default().name(), "build_s": build_s});
     println!("{ready}");
     std::io::stdout().flush().expect("stdout");
+    let mut stream_hits = vec![None; rays.len()];
     for line in std::io::stdin().lock().lines() {
         if line.is_err() {
             break;
@@ -294,7 +295,19 @@ fn peer_mode(dir: &std::path::Path) {
         let start = Instant::now();
         let hits = rays.iter().filter(|r| g.intersect(r).is_some()).count();
         let seconds = start.elapsed().as_secs_f64();
-        println!("{}", json!({"seconds": seconds, "hits": hits}));
+        let start = Instant::now();
+        g.intersect_stream(&rays, &mut stream_hits);
+        let stream_seconds = start.elapsed().as_secs_f64();
+        let stream_same = stream_hits
+            .iter()
+            .zip(&rays)
+            .all(|(h, r)| *h == g.intersect(r));
+        println!(
+            "{}",
+            json!({"seconds": seconds, "hits": hits, "stream_seconds": stream_seconds,
+                   "stream_hits": stream_hits.iter().filter(|h| h.is_some()).count(),
+                   "stream_same_hits": stream_same})
+        );
         std::io::stdout().flush().expect("stdout");
     }
 }
