@@ -132,6 +132,12 @@ pub struct RenderArgs {
     /// lights at infinity included; `bvh` through the light BVH whenever a light has bounds.
     #[arg(long = "light-selection", value_enum, default_value = "auto")]
     pub light_selection: LightSelectionArg,
+    /// Light samples per hit: `auto` one per light at infinity and one for the other lights
+    /// where lights at infinity are chosen apart beside lights with power (the choice
+    /// between a sky and a lamp then adds no noise), else one; `one` a single choice among
+    /// all lights (times the plan's light samples either way).
+    #[arg(long = "light-samples-per-hit", value_enum, default_value = "auto")]
+    pub light_samples_per_hit: LightSamplesPerHitArg,
     #[command(flatten)]
     pub plan: crate::plan_args::PlanArgs,
     #[command(flatten)]
@@ -145,6 +151,13 @@ pub enum LightSelectionArg {
     InfiniteApart,
     Power,
     Bvh,
+}
+
+/// `--light-samples-per-hit`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum LightSamplesPerHitArg {
+    Auto,
+    One,
 }
 
 /// How `prism render` reports progress.
@@ -339,6 +352,10 @@ pub fn run(args: &RenderArgs, budget: &MemoryBudget) -> Result<ExitCode, String>
                 ));
             }
         }
+    }
+    match args.light_samples_per_hit {
+        LightSamplesPerHitArg::Auto => {}
+        LightSamplesPerHitArg::One => scene.lights.set_sample_each_infinite(false),
     }
     scene
         .integrator

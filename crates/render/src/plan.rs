@@ -320,14 +320,42 @@ impl RenderPlan {
                             .into()
                     } else {
                         format!(
-                            "{} light(s), chosen in proportion to power; {} delta (point/spot/\
-                             parallel), {} with area or extent",
+                            "{} light(s), chosen as `light selection` says; {} delta (point/\
+                             spot/parallel), {} with area or extent",
                             lights.len(),
                             delta_lights,
                             hittable_lights
                         )
                     },
                 );
+                if nee {
+                    let per_hit = scene.light_samples_per_hit(1);
+                    choose(
+                        "light samples per hit",
+                        if per_hit > 1 {
+                            format!(
+                                "{per_hit} per light sample the plan asks for: each light at \
+                                 infinity and one of the others"
+                            )
+                        } else {
+                            "1 per light sample the plan asks for".into()
+                        },
+                        if per_hit > 1 {
+                            "lights at infinity are chosen apart beside lights with power: \
+                             samples stratified over their equal slices take every one of \
+                             them, so the choice between a sky and a lamp adds no noise"
+                                .into()
+                        } else if !scene.lights.sample_each_infinite() {
+                            "switched off (--light-samples-per-hit one): one choice among all \
+                             lights per light sample"
+                                .into()
+                        } else {
+                            "no light at infinity is chosen apart beside other lights: one \
+                             choice per light sample"
+                                .into()
+                        },
+                    );
+                }
                 let mis = nee && hittable_lights > 0;
                 choose(
                     "multiple importance sampling",

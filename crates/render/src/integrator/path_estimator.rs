@@ -1,7 +1,7 @@
 //! The `path` method as an `Estimator`: each camera sample of a tile through the scalar
 //! path tracer (`path`), or the whole tile through the packet tracer (`packet`) where the
-//! scene is one the packet tracer serves (`RenderScene::packet`, its allow-list) and the
-//! plan takes one light sample per hit.
+//! scene is one the packet tracer serves (`RenderScene::packet`, its allow-list) and each
+//! hit takes one light sample (`RenderScene::light_samples_per_hit`).
 
 use glam::UVec2;
 use prism_spectrum::SampledWavelengths;
@@ -46,10 +46,11 @@ impl Estimator for PathTracer {
         let mut stats = RenderStats::default();
         // Flat diffuse scenes: many paths at once (`integrator::packet`), for plans of one
         // light sample per hit.
-        let packet = scene
-            .packet
-            .as_ref()
-            .filter(|_| tile.bounds().pixels().all(|p| work.light_samples(p) <= 1));
+        let packet = scene.packet.as_ref().filter(|_| {
+            tile.bounds()
+                .pixels()
+                .all(|p| scene.light_samples_per_hit(work.light_samples(p)) <= 1)
+        });
         if let Some(packet) = packet {
             debug_assert!(tile.bounds().pixels().all(|p| {
                 let first = pass.first_sample + pass.plan.first_sample(p);
@@ -72,7 +73,7 @@ impl Estimator for PathTracer {
             stats.non_finite_samples += c.non_finite_samples;
         } else {
             scalar_tile(scene, work, tile, &mut stats, |cs, pixel, wavelengths| {
-                let light_samples = work.light_samples(pixel);
+                let light_samples = scene.light_samples_per_hit(work.light_samples(pixel));
                 if scene.texture_footprint.is_none() {
                     scene
                         .camera

@@ -140,6 +140,16 @@ impl LightBvh {
         index
     }
 
+    /// Lights at infinity chosen apart in front of the tree, each in its own slice of width
+    /// 1 / (this + 1) at the start of the unit interval (`sample`); 0 without a tree.
+    pub fn infinite_apart_count(&self) -> usize {
+        if self.nodes.is_empty() {
+            0
+        } else {
+            self.infinite.len()
+        }
+    }
+
     fn infinite_probability(&self) -> f32 {
         let tree = usize::from(!self.nodes.is_empty());
         let n = self.infinite.len() + tree;

@@ -42,6 +42,9 @@ pub struct LightSet {
     bvh: Option<LightBvh>,
     /// How `sample_at`/`pmf_at` choose.
     selection: ShadingSelection,
+    /// Each hit samples every light at infinity chosen apart (`samples_per_light_sample`);
+    /// `false`: one choice among all lights per light sample.
+    sample_each_infinite: bool,
 }
 
 /// How light samples at shading points choose a light (`prism render --light-selection`).
@@ -88,6 +91,7 @@ impl LightSet {
             },
             bvh: None,
             selection: ShadingSelection::InfiniteApart,
+            sample_each_infinite: true,
         }
     }
 
@@ -184,6 +188,41 @@ impl LightSet {
     /// scene has lights at infinity beside other lights with power.
     pub fn infinite_apart_differs_from_power(&self) -> bool {
         self.infinite_apart != self.power
+    }
+
+    /// Light samples a hit takes for each light sample it asks for: one per light at
+    /// infinity and one for the other lights where those at infinity are chosen apart
+    /// beside lights with power (`ShadingSelection::InfiniteApart` or `Bvh`), else 1. The
+    /// choice gives each light at infinity one slice of width 1 / (count + 1) at the start
+    /// of the unit interval, so light samples stratified over count + 1 slices
+    /// (`PathTracer::trace`) take every light at infinity and one of the others, and the
+    /// choice between them adds no noise (docs/lights.md, "Light samples per hit").
+    pub fn samples_per_light_sample(&self) -> u32 {
+        if !self.sample_each_infinite {
+            return 1;
+        }
+        let apart = match self.selection {
+            ShadingSelection::Power => 0,
+            ShadingSelection::InfiniteApart => self.infinite_apart.infinite_apart_count(),
+            ShadingSelection::Bvh => self.light_bvh().map_or(0, LightBvh::infinite_apart_count),
+        };
+        if apart == 0 {
+            1
+        } else {
+            apart as u32 + 1
+        }
+    }
+
+    /// Whether each hit samples every light at infinity chosen apart
+    /// (`samples_per_light_sample`; on by default) or makes one choice among all lights per
+    /// light sample (`prism render --light-samples-per-hit one`).
+    pub fn set_sample_each_infinite(&mut self, on: bool) {
+        self.sample_each_infinite = on;
+    }
+
+    /// See `set_sample_each_infinite`.
+    pub fn sample_each_infinite(&self) -> bool {
+        self.sample_each_infinite
     }
 
     /// Lights in the light BVH `build` made, on or off (0 without one).

@@ -1,11 +1,18 @@
 //! A discrete distribution over a scene's lights: probabilities and their running sums, for
 //! a light choice that does not depend on the shading point.
 
-/// Selection probabilities (sum 1, or all 0 for no light) and their running sums.
+/// Selection probabilities (sum 1, or all 0 for no light) and their running sums, taken in
+/// `order` (running-sum position → light index).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct SelectionTable {
+    /// By light index.
     pmf: Vec<f32>,
+    /// Running sums in `order`.
     cdf: Vec<f32>,
+    order: Vec<u32>,
+    /// Lights at infinity chosen apart: the first this many of `order`, each with share
+    /// 1 / (this + 1) (`infinite_apart`); 0 for a table in proportion to power.
+    infinite_apart: usize,
 }
 
 impl SelectionTable {
@@ -19,19 +26,25 @@ impl SelectionTable {
         } else {
             vec![1.0 / weights.len().max(1) as f32; weights.len()]
         };
-        Self::from_pmf(pmf)
+        let order = (0..pmf.len() as u32).collect();
+        Self::from_pmf(pmf, order, 0)
     }
 
-    fn from_pmf(pmf: Vec<f32>) -> Self {
+    fn from_pmf(pmf: Vec<f32>, order: Vec<u32>, infinite_apart: usize) -> Self {
         let mut run = 0.0f32;
-        let cdf = pmf
+        let cdf = order
             .iter()
-            .map(|p| {
-                run += p;
+            .map(|&i| {
+                run += pmf[i as usize];
                 run
             })
             .collect();
-        Self { pmf, cdf }
+        Self {
+            pmf,
+            cdf,
+            order,
+            infinite_apart,
+        }
     }
 
     /// Lights at infinity (`at_infinity[i]`) chosen apart, each with probability
@@ -40,7 +53,10 @@ impl SelectionTable {
     /// at infinity grows with the scene's bounding sphere (π r² times the radiance), so
     /// comparing it with a luminaire's says little about which light lights a point; this
     /// keeps the luminaires' share from vanishing in a large scene under a sky.
-    /// `proportional(power_w)` where either group is empty or the others have no power.
+    /// The lights at infinity come first in the running sums, so that the first
+    /// `count / (count + 1)` of the unit interval picks each of them in one equal slice
+    /// (`infinite_apart_count`). `proportional(power_w)` where either group is empty or the
+    /// others have no power.
     pub fn infinite_apart(power_w: &[f64], at_infinity: &[bool]) -> Self {
         debug_assert_eq!(power_w.len(), at_infinity.len());
         let infinite = at_infinity.iter().filter(|&&b| b).count();
@@ -71,7 +87,18 @@ impl SelectionTable {
                 }) as f32
             })
             .collect();
-        Self::from_pmf(pmf)
+        let n = at_infinity.len() as u32;
+        let order = (0..n)
+            .filter(|&i| at_infinity[i as usize])
+            .chain((0..n).filter(|&i| !at_infinity[i as usize]))
+            .collect();
+        Self::from_pmf(pmf, order, infinite)
+    }
+
+    /// Lights at infinity chosen apart, each in its own slice of width 1 / (this + 1) at
+    /// the start of the unit interval; 0 for a table in proportion to power.
+    pub fn infinite_apart_count(&self) -> usize {
+        self.infinite_apart
     }
 
     /// The first light whose running sum exceeds `u`: (index, probability); `None` without
@@ -81,12 +108,13 @@ impl SelectionTable {
         if self.pmf.is_empty() {
             return None;
         }
-        let i = self
+        let position = self
             .cdf
             .partition_point(|&c| c <= u)
             .min(self.pmf.len() - 1);
-        let p = self.pmf[i];
-        (p > 0.0).then_some((i as u32, p))
+        let i = self.order[position];
+        let p = self.pmf[i as usize];
+        (p > 0.0).then_some((i, p))
     }
 
     /// Probability of light `index` (0 past the end).
@@ -99,8 +127,14 @@ impl SelectionTable {
         &self.pmf
     }
 
+    /// Running sums in `order_slice` order.
     pub fn cdf_slice(&self) -> &[f32] {
         &self.cdf
+    }
+
+    /// Running-sum position → light index.
+    pub fn order_slice(&self) -> &[u32] {
+        &self.order
     }
 }
 
@@ -135,6 +169,25 @@ mod tests {
             );
         }
         assert!((t.cdf_slice()[3] - 1.0).abs() < 1e-6);
+        // The lights at infinity first, one slice of a third each: stratified samples over
+        // three slices take the sky, the sun and one lamp.
+        assert_eq!(t.infinite_apart_count(), 2);
+        assert_eq!(t.order_slice(), &[0, 2, 1, 3]);
+        for (u, light) in [
+            (0.0, 0),
+            (0.33, 0),
+            (0.34, 2),
+            (0.66, 2),
+            (0.67, 1),
+            (0.74, 1),
+            (0.76, 3),
+        ] {
+            assert_eq!(t.sample(u).map(|(i, _)| i), Some(light), "u = {u}");
+        }
+        assert_eq!(
+            SelectionTable::proportional(&[1.0, 3.0]).infinite_apart_count(),
+            0
+        );
         // Only lights at infinity, or none: by power.
         let only = SelectionTable::infinite_apart(&[1.0, 3.0], &[true, true]);
         assert_eq!(only, SelectionTable::proportional(&[1.0, 3.0]));

@@ -293,6 +293,17 @@ impl RenderScene {
         }
     }
 
+    /// Light samples each hit of a camera path takes where the plan asks for
+    /// `plan_light_samples` (at least 1): that many for each light at infinity and for the
+    /// other lights where the lights at infinity are chosen apart
+    /// (`LightSet::samples_per_light_sample`).
+    #[inline]
+    pub fn light_samples_per_hit(&self, plan_light_samples: u32) -> u32 {
+        plan_light_samples
+            .max(1)
+            .saturating_mul(self.lights.samples_per_light_sample())
+    }
+
     /// How light samples at shading points choose a light; `false` (nothing changed) for
     /// the light BVH where the scene has no light with bounds. The packet form is decided
     /// again (its allow-list excludes the light BVH).

@@ -882,6 +882,7 @@ fn choose_lights<const N: usize>(
     }
     let table = lights.shading_table();
     let cdf = table.cdf_slice();
+    let order = table.order_slice();
     let pmf = table.pmf_slice();
     // One rectangle emitter with its radiance slot (a Cornell box, a room with one
     // lamp): every lane picks it (`LightSet::sample_at` of one light) — its fields are
@@ -921,7 +922,7 @@ fn choose_lights<const N: usize>(
             for &c in cdf {
                 below += (c <= uc) as u32;
             }
-            chosen[l] = below.min(last);
+            chosen[l] = order[below.min(last) as usize];
         }
     } else {
         for l in 0..N {

@@ -230,7 +230,7 @@ impl Estimator for RadiosityEstimator {
                         &ray,
                         wavelengths,
                         &mut cs.stream,
-                        work.light_samples(pixel),
+                        scene.light_samples_per_hit(work.light_samples(pixel)),
                         settings.illumination_aov,
                         &mut counters,
                         solved,
