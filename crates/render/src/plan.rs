@@ -332,7 +332,12 @@ impl RenderPlan {
                     let per_hit = scene.light_samples_per_hit(1);
                     choose(
                         "light samples per hit",
-                        if per_hit > 1 {
+                        if per_hit > 1 && scene.lights.lights().iter().all(|l| l.is_infinite()) {
+                            format!(
+                                "{per_hit} per light sample the plan asks for: each light at \
+                                 infinity"
+                            )
+                        } else if per_hit > 1 {
                             format!(
                                 "{per_hit} per light sample the plan asks for: each light at \
                                  infinity and one of the others"
@@ -341,9 +346,10 @@ impl RenderPlan {
                             "1 per light sample the plan asks for".into()
                         },
                         if per_hit > 1 {
-                            "lights at infinity are chosen apart beside lights with power: \
-                             samples stratified over their equal slices take every one of \
-                             them, so the choice between a sky and a lamp adds no noise"
+                            "lights at infinity are chosen apart, each in an equal slice of \
+                             the choice: samples stratified over the slices take every one of \
+                             them, so the choice between a sky and a lamp (or a sun) adds no \
+                             noise"
                                 .into()
                         } else if !scene.lights.sample_each_infinite() {
                             "switched off (--light-samples-per-hit one): one choice among all \
@@ -800,7 +806,22 @@ fn light_selection_text(scene: &RenderScene) -> (String, String) {
             };
             match selection {
                 ShadingSelection::InfiniteApart
-                    if scene.lights.infinite_apart_differs_from_power() =>
+                    if scene.lights.infinite_apart_differs_from_power()
+                        && at_infinity == lights.len() =>
+                {
+                    let what = format!(
+                        "{at_infinity} lights at infinity, each 1/{at_infinity}, no other light"
+                    );
+                    let why = format!(
+                        "{reason}; only lights at infinity: each takes one light sample at \
+                         every hit (`light samples per hit`), so their powers need not be \
+                         compared"
+                    );
+                    (what, why)
+                }
+                ShadingSelection::InfiniteApart
+                    if scene.lights.infinite_apart_differs_from_power()
+                        && at_infinity < lights.len() =>
                 {
                     let what = format!(
                         "{at_infinity} light(s) at infinity apart (each 1/{}), the other {} in \

@@ -187,7 +187,7 @@ impl LightSet {
     /// Whether choosing lights at infinity apart differs from choosing by power here: the
     /// scene has lights at infinity beside other lights with power.
     pub fn infinite_apart_differs_from_power(&self) -> bool {
-        self.infinite_apart != self.power
+        self.shading_table() != &self.power
     }
 
     /// Light samples a hit takes for each light sample it asks for: one per light at
@@ -201,15 +201,21 @@ impl LightSet {
         if !self.sample_each_infinite {
             return 1;
         }
-        let apart = match self.selection {
-            ShadingSelection::Power => 0,
-            ShadingSelection::InfiniteApart => self.infinite_apart.infinite_apart_count(),
-            ShadingSelection::Bvh => self.light_bvh().map_or(0, LightBvh::infinite_apart_count),
+        let (apart, others) = match self.selection {
+            ShadingSelection::Power => (0, true),
+            ShadingSelection::InfiniteApart => (
+                self.infinite_apart.infinite_apart_count(),
+                self.infinite_apart.others_apart(),
+            ),
+            ShadingSelection::Bvh => (
+                self.light_bvh().map_or(0, LightBvh::infinite_apart_count),
+                true,
+            ),
         };
         if apart == 0 {
             1
         } else {
-            apart as u32 + 1
+            apart as u32 + u32::from(others)
         }
     }
 
@@ -243,6 +249,13 @@ impl LightSet {
     pub(crate) fn shading_table(&self) -> &SelectionTable {
         match self.selection {
             ShadingSelection::Power => &self.power,
+            // Only lights at infinity, one choice per hit: by power, as before they each
+            // took a sample.
+            ShadingSelection::InfiniteApart | ShadingSelection::Bvh
+                if !self.sample_each_infinite && !self.infinite_apart.others_apart() =>
+            {
+                &self.power
+            }
             ShadingSelection::InfiniteApart | ShadingSelection::Bvh => &self.infinite_apart,
         }
     }

@@ -10,9 +10,12 @@ pub struct SelectionTable {
     /// Running sums in `order`.
     cdf: Vec<f32>,
     order: Vec<u32>,
-    /// Lights at infinity chosen apart: the first this many of `order`, each with share
-    /// 1 / (this + 1) (`infinite_apart`); 0 for a table in proportion to power.
+    /// Lights at infinity chosen apart: the first this many of `order`, each with an equal
+    /// share (`infinite_apart`); 0 for a table in proportion to power.
     infinite_apart: usize,
+    /// Whether the other lights share one more slice after them (lights with power beside
+    /// the lights at infinity).
+    others_apart: bool,
 }
 
 impl SelectionTable {
@@ -27,10 +30,10 @@ impl SelectionTable {
             vec![1.0 / weights.len().max(1) as f32; weights.len()]
         };
         let order = (0..pmf.len() as u32).collect();
-        Self::from_pmf(pmf, order, 0)
+        Self::from_pmf(pmf, order, 0, false)
     }
 
-    fn from_pmf(pmf: Vec<f32>, order: Vec<u32>, infinite_apart: usize) -> Self {
+    fn from_pmf(pmf: Vec<f32>, order: Vec<u32>, infinite_apart: usize, others_apart: bool) -> Self {
         let mut run = 0.0f32;
         let cdf = order
             .iter()
@@ -44,6 +47,7 @@ impl SelectionTable {
             cdf,
             order,
             infinite_apart,
+            others_apart,
         }
     }
 
@@ -72,6 +76,20 @@ impl SelectionTable {
             })
             .collect();
         let bounded_total: f64 = bounded.iter().sum();
+        let n = at_infinity.len() as u32;
+        let order: Vec<u32> = (0..n)
+            .filter(|&i| at_infinity[i as usize])
+            .chain((0..n).filter(|&i| !at_infinity[i as usize]))
+            .collect();
+        if infinite >= 2 && bounded_total <= 0.0 {
+            // Only lights at infinity (a sky and a sun): an equal slice each.
+            let share = 1.0 / infinite as f32;
+            let pmf = at_infinity
+                .iter()
+                .map(|&inf| if inf { share } else { 0.0 })
+                .collect();
+            return Self::from_pmf(pmf, order, infinite, false);
+        }
         if infinite == 0 || bounded_total <= 0.0 {
             return Self::proportional(power_w);
         }
@@ -87,12 +105,12 @@ impl SelectionTable {
                 }) as f32
             })
             .collect();
-        let n = at_infinity.len() as u32;
-        let order = (0..n)
-            .filter(|&i| at_infinity[i as usize])
-            .chain((0..n).filter(|&i| !at_infinity[i as usize]))
-            .collect();
-        Self::from_pmf(pmf, order, infinite)
+        Self::from_pmf(pmf, order, infinite, true)
+    }
+
+    /// Whether the lights other than those at infinity share one slice after theirs.
+    pub fn others_apart(&self) -> bool {
+        self.others_apart
     }
 
     /// Lights at infinity chosen apart, each in its own slice of width 1 / (this + 1) at
@@ -188,9 +206,17 @@ mod tests {
             SelectionTable::proportional(&[1.0, 3.0]).infinite_apart_count(),
             0
         );
-        // Only lights at infinity, or none: by power.
-        let only = SelectionTable::infinite_apart(&[1.0, 3.0], &[true, true]);
-        assert_eq!(only, SelectionTable::proportional(&[1.0, 3.0]));
+        // Only lights at infinity (a sky and a sun, a lamp without power): an equal slice
+        // each, nothing after them; none at infinity: by power.
+        let only = SelectionTable::infinite_apart(&[1.0, 0.0, 3.0], &[true, false, true]);
+        assert_eq!(only.pmf_slice(), &[0.5, 0.0, 0.5]);
+        assert_eq!(only.order_slice(), &[0, 2, 1]);
+        assert_eq!(
+            (only.infinite_apart_count(), only.others_apart()),
+            (2, false)
+        );
+        assert_eq!(only.sample(0.49).map(|(i, _)| i), Some(0));
+        assert_eq!(only.sample(0.51).map(|(i, _)| i), Some(2));
         let none = SelectionTable::infinite_apart(&[1.0, 3.0], &[false, false]);
         assert_eq!(none, SelectionTable::proportional(&[1.0, 3.0]));
         // Lamps without power leave everything to the sky.
