@@ -216,18 +216,10 @@ const VARIANCE_BOUND_EACH: f64 = 0.3;
 fn explain_names_the_light_selection_each_flag_gives() {
     // A sky and one luminaire; the open office's 120 luminaires turn the light BVH on.
     let explain = |scene: &str, selection: &str| -> String {
-        let o = support::prism(&["render", scene, "--explain", "--light-selection", selection]);
-        let text = format!(
-            "{}{}",
-            String::from_utf8_lossy(&o.stdout),
-            support::stderr(&o)
-        );
-        assert!(o.status.success(), "{scene} {selection}: {text}");
-        text.lines()
-            .skip_while(|l| !l.starts_with("light selection"))
-            .take(2)
-            .collect::<Vec<_>>()
-            .join("\n")
+        explain_line(
+            &["render", scene, "--explain", "--light-selection", selection],
+            "light selection",
+        )
     };
     let sky_and_lamp = "scenes/stress/grazing-rough-conductor.json";
     let office = "scenes/many-lights/open-office.json";
@@ -268,28 +260,20 @@ fn explain_names_the_light_selection_each_flag_gives() {
 #[test]
 fn explain_says_how_many_light_samples_each_hit_takes() {
     let per_hit = |scene: &str, flag: &str| -> String {
-        let o = support::prism(&[
-            "render",
-            scene,
-            "--explain",
-            "--spp",
-            "1",
-            "--resolution",
-            "8x8",
-            "--light-samples-per-hit",
-            flag,
-        ]);
-        let text = format!(
-            "{}{}",
-            String::from_utf8_lossy(&o.stdout),
-            support::stderr(&o)
-        );
-        assert!(o.status.success(), "{scene} {flag}: {text}");
-        text.lines()
-            .skip_while(|l| !l.starts_with("light samples per hit"))
-            .take(2)
-            .collect::<Vec<_>>()
-            .join("\n")
+        explain_line(
+            &[
+                "render",
+                scene,
+                "--explain",
+                "--spp",
+                "1",
+                "--resolution",
+                "8x8",
+                "--light-samples-per-hit",
+                flag,
+            ],
+            "light samples per hit",
+        )
     };
     for (scene, flag, says) in [
         (
@@ -311,4 +295,20 @@ fn explain_says_how_many_light_samples_each_hit_takes() {
         let line = per_hit(scene, flag);
         assert!(line.contains(says), "{scene} {flag}: {line}");
     }
+}
+
+/// The `--explain` line starting with `start` and the reason below it, of `prism ARGS`.
+fn explain_line(args: &[&str], start: &str) -> String {
+    let o = support::prism(args);
+    let text = format!(
+        "{}{}",
+        String::from_utf8_lossy(&o.stdout),
+        support::stderr(&o)
+    );
+    assert!(o.status.success(), "{args:?}: {text}");
+    text.lines()
+        .skip_while(|l| !l.starts_with(start))
+        .take(2)
+        .collect::<Vec<_>>()
+        .join("\n")
 }

@@ -4,8 +4,8 @@
 
 use glam::Vec3A;
 use prism_geometry::{
-    BuildOptions, BuildQuality, Geometry, GeometryBuilder, Ray, Shape, Transform, TriangleMesh,
-    WatertightRay, SMALL_SCENE_MAX_LEAVES,
+    BuildOptions, BuildQuality, Geometry, GeometryBuilder, Hit, Ray, Shape, Transform,
+    TriangleMesh, WatertightRay, SMALL_SCENE_MAX_LEAVES,
 };
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
@@ -256,15 +256,7 @@ fn every_isa_traverses_to_the_same_bits(flatten: bool, small: bool) {
     let trace = |g: &Geometry| -> Vec<(Option<[u32; 5]>, bool)> {
         rays.iter()
             .map(|r| {
-                let hit = g.intersect(r).map(|h| {
-                    [
-                        h.t.to_bits(),
-                        h.instance_id,
-                        h.primitive_id,
-                        h.b1.to_bits(),
-                        h.b2.to_bits(),
-                    ]
-                });
+                let hit = g.intersect(r).map(hit_bits);
                 (hit, g.occluded(r))
             })
             .collect()
@@ -303,19 +295,18 @@ fn every_isa_traverses_to_the_same_bits(flatten: bool, small: bool) {
 fn stream_hits(geometry: &Geometry, rays: &[Ray]) -> Vec<Option<[u32; 5]>> {
     let mut hits = vec![None; rays.len()];
     geometry.intersect_stream(rays, &mut hits);
-    hits.iter()
-        .map(|h| {
-            h.map(|h| {
-                [
-                    h.t.to_bits(),
-                    h.instance_id,
-                    h.primitive_id,
-                    h.b1.to_bits(),
-                    h.b2.to_bits(),
-                ]
-            })
-        })
-        .collect()
+    hits.iter().map(|h| h.map(hit_bits)).collect()
+}
+
+/// A hit's fields as bits (t, instance, primitive, b1, b2).
+fn hit_bits(h: Hit) -> [u32; 5] {
+    [
+        h.t.to_bits(),
+        h.instance_id,
+        h.primitive_id,
+        h.b1.to_bits(),
+        h.b2.to_bits(),
+    ]
 }
 
 /// A ray stream over one mesh instance (the mesh's own BVH, interleaved) finds each ray's
@@ -367,15 +358,7 @@ fn ray_streams_find_the_one_ray_hits_in_a_mesh() {
         let streamed = stream_hits(&geometry, &rays);
         let mut hits = 0;
         for (i, (ray, have)) in rays.iter().zip(&streamed).enumerate() {
-            let want = geometry.intersect(ray).map(|h| {
-                [
-                    h.t.to_bits(),
-                    h.instance_id,
-                    h.primitive_id,
-                    h.b1.to_bits(),
-                    h.b2.to_bits(),
-                ]
-            });
+            let want = geometry.intersect(ray).map(hit_bits);
             assert_eq!(want, *have, "{} ray {i}: {ray:?}", simd.isa());
             hits += usize::from(have.is_some());
         }
