@@ -185,16 +185,18 @@ impl LightSet {
     }
 
     /// Whether choosing lights at infinity apart differs from choosing by power here: the
-    /// scene has lights at infinity beside other lights with power.
+    /// scene has lights at infinity beside other lights with power, or two or more lights at
+    /// infinity alone that each take a sample at every hit.
     pub fn infinite_apart_differs_from_power(&self) -> bool {
         self.shading_table() != &self.power
     }
 
     /// Light samples a hit takes for each light sample it asks for: one per light at
     /// infinity and one for the other lights where those at infinity are chosen apart
-    /// beside lights with power (`ShadingSelection::InfiniteApart` or `Bvh`), else 1. The
-    /// choice gives each light at infinity one slice of width 1 / (count + 1) at the start
-    /// of the unit interval, so light samples stratified over count + 1 slices
+    /// beside lights with power (`ShadingSelection::InfiniteApart` or `Bvh`), one per light
+    /// at infinity where two or more light the scene alone, else 1. The choice gives each
+    /// light at infinity one equal slice at the start of the unit interval (1 / (count + 1),
+    /// or 1 / count alone), so light samples stratified over that many slices
     /// (`PathTracer::trace`) take every light at infinity and one of the others, and the
     /// choice between them adds no noise (docs/lights.md, "Light samples per hit").
     pub fn samples_per_light_sample(&self) -> u32 {
