@@ -59,8 +59,11 @@ impl SelectionTable {
     /// keeps the luminaires' share from vanishing in a large scene under a sky.
     /// The lights at infinity come first in the running sums, so that the first
     /// `count / (count + 1)` of the unit interval picks each of them in one equal slice
-    /// (`infinite_apart_count`). `proportional(power_w)` where either group is empty or the
-    /// others have no power.
+    /// (`infinite_apart_count`). Two or more lights at infinity alone (the others without
+    /// power) get 1 / count each, with no slice after them (`others_apart` false): each
+    /// takes a light sample at every hit, so their powers are not compared.
+    /// `proportional(power_w)` where no light is at infinity, or one is and the others have
+    /// no power.
     pub fn infinite_apart(power_w: &[f64], at_infinity: &[bool]) -> Self {
         debug_assert_eq!(power_w.len(), at_infinity.len());
         let infinite = at_infinity.iter().filter(|&&b| b).count();
