@@ -408,6 +408,67 @@ impl Leaf {
     }
 }
 
+/// One ray's closest hit so far in the scene BVH: an instance leaf's, or a baked triangle's
+/// (completed by `baked_hit` only once the traversal has ended). The one-ray traversal
+/// (`intersect_scene_with`) and the ray stream (`intersect_stream`) share it.
+struct SceneBest {
+    watertight: WatertightRay,
+    instance: Option<Hit>,
+    triangle: Option<(TriangleHit, Leaf)>,
+}
+
+impl SceneBest {
+    #[inline(always)]
+    fn new(ray: &Ray) -> Self {
+        Self {
+            watertight: WatertightRay::new(ray.origin, ray.direction, ray.t_min),
+            instance: None,
+            triangle: None,
+        }
+    }
+
+    /// The scene traversal's leaf test for `ray`: the `t` of a hit on leaf `leaf` (stored
+    /// vertices `p`) below `t_max`, kept as the best, or ∞.
+    #[inline(always)]
+    fn test(
+        &mut self,
+        geometry: &Geometry,
+        ray: &Ray,
+        p: &[Vec3A; 3],
+        leaf: Leaf,
+        t_max: f32,
+    ) -> f32 {
+        if leaf.is_instance() {
+            match geometry.intersect_instance_any_isa(leaf.instance, ray, t_max) {
+                Some(h) => {
+                    self.instance = Some(h);
+                    self.triangle = None;
+                    h.t
+                }
+                None => f32::INFINITY,
+            }
+        } else {
+            match self.watertight.intersect(p[0], p[1], p[2], t_max) {
+                Some(h) => {
+                    self.triangle = Some((h, leaf));
+                    self.instance = None;
+                    h.t
+                }
+                None => f32::INFINITY,
+            }
+        }
+    }
+
+    /// The closest hit of `ray` once its traversal has ended.
+    #[inline(always)]
+    fn hit(self, geometry: &Geometry, ray: &Ray) -> Option<Hit> {
+        self.instance.or_else(|| {
+            self.triangle
+                .map(|(h, leaf)| geometry.baked_hit(ray, h.t, h.b1, h.b2, leaf))
+        })
+    }
+}
+
 /// Every shape of a scene with its acceleration structures; immutable and `Sync`, so many
 /// threads can trace against it.
 pub struct Geometry {
@@ -529,35 +590,13 @@ impl Geometry {
         scene: &TriangleBvh<Leaf>,
         ray: &Ray,
     ) -> Option<Hit> {
-        let (o, d) = (ray.origin, ray.direction);
-        let wt = WatertightRay::new(o, d, ray.t_min);
-        let mut best_instance: Option<Hit> = None;
-        let mut best_triangle: Option<(TriangleHit, Leaf)> = None;
-        let test = |p: &[Vec3A; 3], leaf: Leaf, t_max: f32| {
-            if leaf.is_instance() {
-                match self.intersect_instance_any_isa(leaf.instance, ray, t_max) {
-                    Some(h) => {
-                        best_instance = Some(h);
-                        best_triangle = None;
-                        h.t
-                    }
-                    None => f32::INFINITY,
-                }
-            } else {
-                match wt.intersect(p[0], p[1], p[2], t_max) {
-                    Some(h) => {
-                        best_triangle = Some((h, leaf));
-                        best_instance = None;
-                        h.t
-                    }
-                    None => f32::INFINITY,
-                }
-            }
-        };
+        let mut best = SceneBest::new(ray);
+        let test = |p: &[Vec3A; 3], leaf: Leaf, t_max: f32| best.test(self, ray, p, leaf, t_max);
         // SAFETY: the caller's contract for `WIDE`.
-        unsafe { scene.traverse_with::<WIDE>(o, d, ray.t_min, ray.t_max, test) };
-        best_instance
-            .or_else(|| best_triangle.map(|(h, leaf)| self.baked_hit(ray, h.t, h.b1, h.b2, leaf)))
+        unsafe {
+            scene.traverse_with::<WIDE>(ray.origin, ray.direction, ray.t_min, ray.t_max, test)
+        };
+        best.hit(self, ray)
     }
 
     /// [`Self::intersect`] of a small scene: all triangle and rectangle leaves at once, then
@@ -708,13 +747,7 @@ impl Geometry {
             // SAFETY (both arms): the caller's contract for `WIDE`.
             Shape::Mesh(MeshId(m)) => {
                 unsafe { self.meshes[m as usize].intersect_with::<WIDE>(o, d, ray.t_min, t_max) }
-                    .map(|h| Hit {
-                        t: h.t,
-                        instance_id,
-                        primitive_id: h.triangle,
-                        b1: h.b1,
-                        b2: h.b2,
-                    })
+                    .map(|h| h.in_instance(instance_id))
             }
             Shape::Tiled(tiling) => {
                 let tile = &self.meshes[tiling.mesh.0 as usize];

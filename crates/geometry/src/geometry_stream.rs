@@ -2,19 +2,11 @@
 //! one mesh instance's BVH traversed as a ray stream (`TriangleBvh::traverse_stream_with`),
 //! each ray's hit the same bits as [`Geometry::intersect`]'s.
 
-use super::{object_ray, Geometry, Hit, Leaf, MeshId, Shape};
-use crate::ray::Ray;
-use crate::triangle::{TriangleHit, WatertightRay};
-use crate::triangle_bvh::STREAM_LANES;
+use glam::Vec3A;
 
-/// A stream lane's closest hit so far in the scene BVH: an instance leaf's or a baked
-/// triangle's (as `Geometry::intersect_scene_with` keeps them).
-struct SceneBest {
-    watertight: WatertightRay,
-    index: usize,
-    instance: Option<Hit>,
-    triangle: Option<(TriangleHit, Leaf)>,
-}
+use super::{object_ray, Geometry, Hit, MeshId, SceneBest, Shape};
+use crate::mesh_bvh::MeshHit;
+use crate::ray::Ray;
 
 impl Geometry {
     /// `hits[i] = self.intersect(&rays[i])` for every ray, the same bits. Scenes with a BVH
@@ -58,45 +50,21 @@ impl Geometry {
         if let (None, Some(scene)) = (&self.small, &self.scene) {
             let start = |i: usize| {
                 let r = &rays[i];
-                let best = SceneBest {
-                    watertight: WatertightRay::new(r.origin, r.direction, r.t_min),
-                    index: i,
-                    instance: None,
-                    triangle: None,
-                };
-                (r.origin, r.direction, r.t_min, r.t_max, best)
+                (
+                    r.origin,
+                    r.direction,
+                    r.t_min,
+                    r.t_max,
+                    (r, SceneBest::new(r)),
+                )
             };
-            let test = |best: &mut SceneBest, p: &[glam::Vec3A; 3], leaf: Leaf, t_max: f32| {
-                if leaf.is_instance() {
-                    let ray = &rays[best.index];
-                    match self.intersect_instance_any_isa(leaf.instance, ray, t_max) {
-                        Some(h) => {
-                            best.instance = Some(h);
-                            best.triangle = None;
-                            h.t
-                        }
-                        None => f32::INFINITY,
-                    }
-                } else {
-                    match best.watertight.intersect(p[0], p[1], p[2], t_max) {
-                        Some(h) => {
-                            best.triangle = Some((h, leaf));
-                            best.instance = None;
-                            h.t
-                        }
-                        None => f32::INFINITY,
-                    }
-                }
+            let test = |(ray, best): &mut (&Ray, SceneBest), p: &[Vec3A; 3], leaf, t_max| {
+                best.test(self, ray, p, leaf, t_max)
             };
-            let finish = |i: usize, best: SceneBest| {
-                hits[i] = best.instance.or_else(|| {
-                    best.triangle
-                        .map(|(h, leaf)| self.baked_hit(&rays[i], h.t, h.b1, h.b2, leaf))
-                });
-            };
+            let finish = |i: usize, (ray, best): (&Ray, SceneBest)| hits[i] = best.hit(self, ray);
             // SAFETY: the caller's contract for `WIDE`.
             return unsafe {
-                scene.traverse_stream_with::<WIDE, STREAM_LANES, _>(rays.len(), start, test, finish)
+                scene.traverse_stream_with::<WIDE, _>(rays.len(), start, test, finish)
             };
         }
         if let (None, None, Some(instance_id)) = (&self.small, &self.scene, self.single) {
@@ -106,15 +74,8 @@ impl Geometry {
                     let (o, d) = object_ray(inst, &rays[i]);
                     (o, d, rays[i].t_min, rays[i].t_max)
                 };
-                let hit = |i: usize, h: Option<crate::mesh_bvh::MeshHit>| {
-                    hits[i] = h.map(|h| Hit {
-                        t: h.t,
-                        instance_id,
-                        primitive_id: h.triangle,
-                        b1: h.b1,
-                        b2: h.b2,
-                    });
-                };
+                let hit =
+                    |i: usize, h: Option<MeshHit>| hits[i] = h.map(|h| h.in_instance(instance_id));
                 // SAFETY: the caller's contract for `WIDE`.
                 return unsafe {
                     self.meshes[m as usize].intersect_stream_with::<WIDE>(rays.len(), ray, hit)

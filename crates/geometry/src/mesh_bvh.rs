@@ -7,8 +7,8 @@ use glam::Vec3A;
 
 use crate::bvh_build::BuildQuality;
 use crate::mesh::TriangleMesh;
-use crate::triangle::{TriangleHit, WatertightRay};
-use crate::triangle_bvh::{TriangleBvh, STREAM_LANES};
+use crate::triangle::TriangleHit;
+use crate::triangle_bvh::TriangleBvh;
 
 /// Closest hit inside one mesh.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -19,6 +19,32 @@ pub struct MeshHit {
     pub b0: f32,
     pub b1: f32,
     pub b2: f32,
+}
+
+impl MeshHit {
+    /// From a hit of the mesh's BVH on `triangle`.
+    #[inline(always)]
+    fn new(h: TriangleHit, triangle: u32) -> Self {
+        Self {
+            t: h.t,
+            triangle,
+            b0: h.b0,
+            b1: h.b1,
+            b2: h.b2,
+        }
+    }
+
+    /// The scene's record of this hit on instance `instance_id` of the mesh.
+    #[inline(always)]
+    pub(crate) fn in_instance(self, instance_id: u32) -> crate::geometry::Hit {
+        crate::geometry::Hit {
+            t: self.t,
+            instance_id,
+            primitive_id: self.triangle,
+            b1: self.b1,
+            b2: self.b2,
+        }
+    }
 }
 
 pub struct MeshBvh {
@@ -83,13 +109,7 @@ impl MeshBvh {
             self.bvh
                 .intersect_with::<WIDE>(origin, direction, t_min, t_max)
         };
-        hit.map(|(h, triangle)| MeshHit {
-            t: h.t,
-            triangle,
-            b0: h.b0,
-            b1: h.b1,
-            b2: h.b2,
-        })
+        hit.map(|(h, triangle)| MeshHit::new(h, triangle))
     }
 
     /// Whether anything lies in `(t_min, t_max)` (stops at the first hit).
@@ -129,41 +149,14 @@ impl MeshBvh {
     pub(crate) unsafe fn intersect_stream_with<const WIDE: bool>(
         &self,
         count: usize,
-        mut ray: impl FnMut(usize) -> (Vec3A, Vec3A, f32, f32),
+        ray: impl FnMut(usize) -> (Vec3A, Vec3A, f32, f32),
         mut hit: impl FnMut(usize, Option<MeshHit>),
     ) {
-        type Best = Option<(TriangleHit, u32)>;
-        let start = |i: usize| {
-            let (o, d, t_min, t_max) = ray(i);
-            let best: Best = None;
-            (o, d, t_min, t_max, (WatertightRay::new(o, d, t_min), best))
-        };
-        let test =
-            |(wt, best): &mut (WatertightRay, Best), [a, b, c]: &[Vec3A; 3], id, t_max| match wt
-                .intersect(*a, *b, *c, t_max)
-            {
-                Some(h) => {
-                    *best = Some((h, id));
-                    h.t
-                }
-                None => f32::INFINITY,
-            };
-        let finish = |i: usize, (_, best): (WatertightRay, Best)| {
-            hit(
-                i,
-                best.map(|(h, triangle)| MeshHit {
-                    t: h.t,
-                    triangle,
-                    b0: h.b0,
-                    b1: h.b1,
-                    b2: h.b2,
-                }),
-            )
-        };
         // SAFETY: the caller's contract for `WIDE`.
         unsafe {
-            self.bvh
-                .traverse_stream_with::<WIDE, STREAM_LANES, _>(count, start, test, finish)
+            self.bvh.intersect_stream_with::<WIDE>(count, ray, |i, h| {
+                hit(i, h.map(|(h, triangle)| MeshHit::new(h, triangle)))
+            })
         }
     }
 }

@@ -20,7 +20,6 @@ use crate::triangle::{TriangleHit, WatertightRay};
 
 #[path = "triangle_bvh_stream.rs"]
 mod stream;
-pub(crate) use stream::STREAM_LANES;
 
 pub(crate) struct TriangleBvh<Id> {
     /// `None` for an empty soup.
@@ -88,19 +87,11 @@ impl<Id: Copy> TriangleBvh<Id> {
         t_min: f32,
         t_max: f32,
     ) -> Option<(TriangleHit, Id)> {
-        let wt = WatertightRay::new(origin, direction, t_min);
-        let mut best: Option<(TriangleHit, Id)> = None;
-        let test =
-            |[a, b, c]: &[Vec3A; 3], id: Id, t_max: f32| match wt.intersect(*a, *b, *c, t_max) {
-                Some(h) => {
-                    best = Some((h, id));
-                    h.t
-                }
-                None => f32::INFINITY,
-            };
+        let mut best = TriangleBest::new(origin, direction, t_min);
+        let test = |p: &[Vec3A; 3], id: Id, t_max: f32| best.test(p, id, t_max);
         // SAFETY: the caller's contract for `WIDE`.
         unsafe { self.traverse_with::<WIDE>(origin, direction, t_min, t_max, test) };
-        best
+        best.hit
     }
 
     /// Closest-hit traversal of the ray over `(t_min, t_max)`: `test(primitive, id, t_max)`
@@ -248,6 +239,36 @@ impl<Id: Copy> TriangleBvh<Id> {
             |[a, b, c]: &[Vec3A; 3], _: Id, t_max: f32| wt.intersect(*a, *b, *c, t_max).is_some();
         // SAFETY: the caller's contract for `WIDE`.
         unsafe { self.any_with::<WIDE>(origin, direction, t_min, t_max, test) }
+    }
+}
+
+/// One ray's closest triangle so far: the leaf test of the closest-hit traversals, one ray
+/// at a time ([`TriangleBvh::intersect_with`]) or in a stream.
+struct TriangleBest<Id> {
+    watertight: WatertightRay,
+    hit: Option<(TriangleHit, Id)>,
+}
+
+impl<Id: Copy> TriangleBest<Id> {
+    #[inline(always)]
+    fn new(origin: Vec3A, direction: Vec3A, t_min: f32) -> Self {
+        Self {
+            watertight: WatertightRay::new(origin, direction, t_min),
+            hit: None,
+        }
+    }
+
+    /// The watertight test of the stored triangle `[a, b, c]`: its `t` below `t_max`, kept
+    /// with `id` as the best, or ∞.
+    #[inline(always)]
+    fn test(&mut self, [a, b, c]: &[Vec3A; 3], id: Id, t_max: f32) -> f32 {
+        match self.watertight.intersect(*a, *b, *c, t_max) {
+            Some(h) => {
+                self.hit = Some((h, id));
+                h.t
+            }
+            None => f32::INFINITY,
+        }
     }
 }
 
@@ -426,21 +447,20 @@ struct Traversal {
 impl Traversal {
     #[inline(always)]
     fn new(bvh: &CwBvh, direction: Vec3A) -> Self {
-        Self {
+        let mut state = Self {
             stack: NodeStack::new(),
-            current_group: if bvh.nodes.is_empty() {
-                UVec2::ZERO
-            } else {
-                UVec2::new(0, 0x8000_0000)
-            },
+            current_group: UVec2::ZERO,
             primitive_group: UVec2::ZERO,
-            oct_inv4: octant_inv4(direction),
+            oct_inv4: 0,
             primitive_id: 0,
             hitmask: 0,
-        }
+        };
+        state.reset(bvh, direction);
+        state
     }
 
-    /// The state of [`Traversal::new`] for another ray, the stack's storage kept.
+    /// The state before the first node of a ray along `direction` (the root's group
+    /// pending), the stack's storage kept: a stream's lane takes its next ray with it.
     #[inline(always)]
     fn reset(&mut self, bvh: &CwBvh, direction: Vec3A) {
         self.stack.clear();

@@ -1,7 +1,7 @@
-//! Closest-hit traversal of many rays interleaved (a ray stream): `LANES` rays are in flight
-//! at once and each takes one step of obvhs' `traverse!` loop in turn (the primitives the
-//! last node test selected, then the next child node), so the cache misses of one ray's node
-//! and leaf loads — requested ahead by the node test's prefetches — overlap with the other
+//! Closest-hit traversal of many rays interleaved (a ray stream): `STREAM_LANES` rays are in
+//! flight at once and each takes one step of obvhs' `traverse!` loop in turn (the primitives
+//! the last node test selected, then the next child node), so the cache misses of one ray's
+//! node and leaf loads — requested ahead by the node test's prefetches — overlap with the other
 //! rays' work instead of stalling the core (Kocberber et al. 2015, "Asynchronous memory
 //! access chaining"). Each ray visits the same nodes and primitives in the same order as the
 //! one-ray traversal, so its hit is the same bits; a lane whose ray ends takes the next ray.
@@ -10,12 +10,13 @@ use glam::{UVec2, Vec3A};
 use obvhs::cwbvh::{firstbithigh, CwBvh};
 use obvhs::faststack::FastStack;
 
-use super::{node_hits_on, Traversal, TriangleBvh};
+use super::{node_hits_on, Traversal, TriangleBest, TriangleBvh};
 use crate::bvh_build::bvh_ray;
+use crate::triangle::TriangleHit;
 
 /// Rays in flight per stream: chosen on bench-bvh's 10⁶-triangle workload (docs/geometry.md,
 /// "Ray streams").
-pub(crate) const STREAM_LANES: usize = 8;
+const STREAM_LANES: usize = 8;
 
 /// One ray of a stream in flight: its traversal state, its bounded ray, its index in the
 /// stream and the caller's state for it (the best hit so far).
@@ -27,16 +28,16 @@ struct Lane<L> {
 }
 
 impl<Id: Copy> TriangleBvh<Id> {
-    /// Closest-hit traversal of `count` rays, `LANES` interleaved: `start(i)` gives ray `i`
-    /// (origin, direction, `t_min`, `t_max`) and the caller's state for it, `test(state,
-    /// primitive, id, t_max)` is [`TriangleBvh::traverse_with`]'s leaf test for that ray,
+    /// Closest-hit traversal of `count` rays, `STREAM_LANES` interleaved: `start(i)` gives
+    /// ray `i` (origin, direction, `t_min`, `t_max`) and the caller's state for it,
+    /// `test(state, primitive, id, t_max)` is [`TriangleBvh::traverse_with`]'s leaf test for that ray,
     /// and `finish(i, state)` receives the state once ray `i` has ended (in any order of
     /// `i`). The node test is `WIDE`'s.
     ///
     /// # Safety
     /// With `WIDE`, the CPU must run AVX2.
     #[inline(always)]
-    pub unsafe fn traverse_stream_with<const WIDE: bool, const LANES: usize, L>(
+    pub unsafe fn traverse_stream_with<const WIDE: bool, L>(
         &self,
         count: usize,
         mut start: impl FnMut(usize) -> (Vec3A, Vec3A, f32, f32, L),
@@ -62,7 +63,7 @@ impl<Id: Copy> TriangleBvh<Id> {
             lane.user = Some(user);
             *next += 1;
         };
-        let mut lanes: [Lane<L>; LANES] = std::array::from_fn(|_| Lane {
+        let mut lanes: [Lane<L>; STREAM_LANES] = std::array::from_fn(|_| Lane {
             state: Traversal::new(bvh, Vec3A::X),
             ray: bvh_ray(Vec3A::ZERO, Vec3A::X, 0.0, 0.0),
             index: 0,
@@ -94,6 +95,29 @@ impl<Id: Copy> TriangleBvh<Id> {
                 break;
             }
         }
+    }
+
+    /// [`TriangleBvh::intersect_with`] for `count` rays, `STREAM_LANES` interleaved: `ray(i)`
+    /// gives ray `i` (origin, direction, `t_min`, `t_max`) and `hit(i, result)` receives its
+    /// closest hit, the same bits, in any order of `i`.
+    ///
+    /// # Safety
+    /// With `WIDE`, the CPU must run AVX2.
+    #[inline(always)]
+    pub unsafe fn intersect_stream_with<const WIDE: bool>(
+        &self,
+        count: usize,
+        mut ray: impl FnMut(usize) -> (Vec3A, Vec3A, f32, f32),
+        mut hit: impl FnMut(usize, Option<(TriangleHit, Id)>),
+    ) {
+        let start = |i: usize| {
+            let (o, d, t_min, t_max) = ray(i);
+            (o, d, t_min, t_max, TriangleBest::new(o, d, t_min))
+        };
+        let test = |best: &mut TriangleBest<Id>, p: &[Vec3A; 3], id, t_max| best.test(p, id, t_max);
+        let finish = |i: usize, best: TriangleBest<Id>| hit(i, best.hit);
+        // SAFETY: the caller's contract for `WIDE`.
+        unsafe { self.traverse_stream_with::<WIDE, _>(count, start, test, finish) }
     }
 
     /// One pass of `traverse!`'s loop for one lane (`TriangleBvh::traverse_with` is the
