@@ -141,6 +141,11 @@ fn pixels(path: &Path) -> Vec<[f32; 3]> {
     read_exr(path).unwrap().pixels().to_vec()
 }
 
+/// The JSON file at `path`, parsed.
+fn read_json(path: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
 fn run_ok(cmd: &mut Command) -> String {
     let out = cmd.output().unwrap();
     let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
@@ -197,8 +202,7 @@ fn mitsuba_defines_override_defaults() {
             .arg("-o")
             .arg(&json),
     );
-    let v: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let v = read_json(&json);
     assert_eq!(v["film"]["resolution"], serde_json::json!([32, 32]));
     assert_eq!(v["film"]["spp"], serde_json::json!(3));
     // Prism's max_depth = Mitsuba's − 1.
@@ -298,8 +302,7 @@ fn what_is_not_imported_is_listed_once_per_kind_and_refused_with_strict() {
         "{stderr}"
     );
     assert_eq!(warnings.iter().filter(|w| w.contains("hair")).count(), 1);
-    let v: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let v = read_json(&json);
     assert_eq!(
         v["shapes"].as_array().unwrap().len(),
         2,
@@ -390,8 +393,7 @@ fn mitsuba_envmaps_import_with_the_bilinear_filter() {
     .unwrap();
     let json = dir.path().join("sky.json");
     run_ok(prism().arg("import").arg(&xml).arg("-o").arg(&json));
-    let v: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let v = read_json(&json);
     let light = &v["lights"][0];
     assert_eq!(light["type"], "environment", "{light}");
     assert_eq!(light["filter"], "bilinear", "{light}");
@@ -436,8 +438,7 @@ fn pbrt_image_infinite_lights_become_equirectangular_environment_maps() {
     std::fs::create_dir(dir.path().join("out")).unwrap();
     let json = dir.path().join("out/sky.json");
     run_ok(prism().arg("import").arg(&scene).arg("-o").arg(&json));
-    let v: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let v = read_json(&json);
     let light = &v["lights"][0];
     assert_eq!(light["type"], "environment", "{light}");
     assert_eq!(light["scale"], 1.5);
@@ -488,8 +489,7 @@ fn pbrt_goniometric_lights_become_luminaires_with_pbrt_intensities() {
             name,
             &pbrt_floor_scene(32, 16, &world, "0 2 1  0 3 2"),
         );
-        let v: serde_json::Value =
-            serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+        let v = read_json(&json);
         let description = prism_scene::load_scene(&json).unwrap();
         let (rgb, _) = render_rgb(&description, 16, 7);
         (v, rgb)
@@ -571,8 +571,7 @@ fn pbrt_image_infinite_illuminance_scales_as_pbrt_does() {
     let json = dir.path().join("lit.json");
     let stderr = run_ok(prism().arg("import").arg(&scene).arg("-o").arg(&json));
     assert!(!stderr.contains("illuminance"), "{stderr}");
-    let v: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let v = read_json(&json);
     let scale = v["lights"][0]["scale"].as_f64().unwrap();
     let expected = 100.0 / (std::f64::consts::PI / 2.0);
     assert!(

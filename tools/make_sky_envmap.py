@@ -52,10 +52,13 @@ def rgbe(rgb):
     return bytes([min(255, int(c * scale)) for c in rgb] + [e + 128])
 
 
-def write_envmap(out, radiance, width, height, supersamples, source):
-    """Writes `radiance(u, v)` (linear RGB) as a flat RGBE file `out`, each texel the mean of
-    supersamples × supersamples points (edges that fall between texels stay smooth), through
-    a temporary file and a rename. `source` names the script in the header."""
+def write_envmap(name, radiance, width, height, supersamples, source):
+    """Writes `radiance(u, v)` (linear RGB) as a flat RGBE file scenes/envmaps/`name`, each
+    texel the mean of supersamples × supersamples points (edges that fall between texels
+    stay smooth), through a temporary file and a rename. `source` names the script in the
+    header."""
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    out = os.path.join(root, "scenes", "envmaps", name)
     n = supersamples
     rows = []
     for y in range(height):
@@ -80,10 +83,8 @@ def write_envmap(out, radiance, width, height, supersamples, source):
 
 
 def main():
-    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-    out = os.path.join(root, "scenes", "envmaps", "sky-512x256.hdr")
     # The sun disc is tiny: 4 × 4 supersamples per texel for a smooth edge.
-    write_envmap(out, sky, W, H, 4, "tools/make_sky_envmap.py")
+    write_envmap("sky-512x256.hdr", sky, W, H, 4, "tools/make_sky_envmap.py")
 
 
 if __name__ == "__main__":

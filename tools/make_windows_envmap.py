@@ -12,7 +12,6 @@ photograph, so no licence question. Radiance RGBE (Ward 1991), flat scanlines, t
     python3 tools/make_windows_envmap.py   # needs only the standard library
 """
 import math
-import os
 
 from make_sky_envmap import direction, write_envmap
 
@@ -44,10 +43,8 @@ def radiance(u, v):
 
 
 def main():
-    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-    out = os.path.join(root, "scenes", "envmaps", "windows-512x256.hdr")
     # 4 × 4 supersamples per texel: window edges fall between texels.
-    write_envmap(out, radiance, W, H, 4, "tools/make_windows_envmap.py")
+    write_envmap("windows-512x256.hdr", radiance, W, H, 4, "tools/make_windows_envmap.py")
 
 
 if __name__ == "__main__":

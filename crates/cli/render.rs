@@ -133,9 +133,10 @@ pub struct RenderArgs {
     #[arg(long = "light-selection", value_enum, default_value = "auto")]
     pub light_selection: LightSelectionArg,
     /// Light samples per hit: `auto` one per light at infinity and one for the other lights
-    /// where lights at infinity are chosen apart beside lights with power (the choice
-    /// between a sky and a lamp then adds no noise), else one; `one` a single choice among
-    /// all lights (times the plan's light samples either way).
+    /// where lights at infinity are chosen apart beside lights with power, one per light at
+    /// infinity where two or more light the scene alone (the choice between a sky and a lamp
+    /// or a sun then adds no noise), else one; `one` a single choice among all lights (times
+    /// the plan's light samples either way).
     #[arg(long = "light-samples-per-hit", value_enum, default_value = "auto")]
     pub light_samples_per_hit: LightSamplesPerHitArg,
     #[command(flatten)]

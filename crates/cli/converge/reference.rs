@@ -2,7 +2,8 @@
 //! renders: it must exist, be an image and have the render's size), or one rendered at a
 //! stated spp and cached in a cache directory (`--cache-dir`, default the platform's) under a
 //! name that carries a hash of everything it depends on, so that editing the scene file or
-//! any file it names invalidates it. A scene's folder may be read-only or shared, so nothing is written there.
+//! any file it names invalidates it. A scene's folder may be read-only or shared, so nothing
+//! is written there.
 
 use std::io::Read;
 use std::path::{Path, PathBuf};

@@ -116,8 +116,9 @@ impl SelectionTable {
         self.others_apart
     }
 
-    /// Lights at infinity chosen apart, each in its own slice of width 1 / (this + 1) at
-    /// the start of the unit interval; 0 for a table in proportion to power.
+    /// Lights at infinity chosen apart, each in its own equal slice at the start of the
+    /// unit interval (1 / (this + 1) beside other lights, 1 / this alone); 0 for a table in
+    /// proportion to power.
     pub fn infinite_apart_count(&self) -> usize {
         self.infinite_apart
     }
