@@ -1,14 +1,17 @@
 //! BVH construction with obvhs (PLOC build, Meister & Bittner 2018, "Parallel locally-ordered
 //! clustering for bounding volume hierarchy construction", + reinsertion optimisation,
 //! Meister & Bittner 2017; converted to an 8-wide compressed BVH, Ylitie et al. 2017,
-//! "Efficient incoherent ray traversal on GPUs through compressed wide BVHs").
+//! "Efficient incoherent ray traversal on GPUs through compressed wide BVHs", on every core:
+//! [`crate::cwbvh_convert`]).
 
 use glam::Vec3A;
 use obvhs::aabb::Aabb;
-use obvhs::cwbvh::builder::build_cwbvh;
+use obvhs::bvh2::reinsertion::ReinsertionOptimizer;
 use obvhs::cwbvh::CwBvh;
+use obvhs::ploc::PlocBuilder;
 use obvhs::BvhBuildParams;
-use std::time::Duration;
+
+use crate::cwbvh_convert::bvh2_to_cwbvh_parallel;
 
 /// Quality/speed trade-off of the build: the obvhs presets. obvhs' `pre_split` (spatial
 /// splits of large triangles) applies only to its triangle-specific builder, which we do not
@@ -66,16 +69,31 @@ pub fn padded_aabb(min: Vec3A, max: Vec3A) -> Aabb {
     Aabb::new(min - pad, max + pad)
 }
 
-/// Build a CWBVH over boxes; `None` for an empty list.
+/// Build a CWBVH over boxes; `None` for an empty list. The steps of obvhs' `build_cwbvh`
+/// (PLOC, reinsertion, conversion), with the conversion on every core.
 pub fn build_bvh(boxes: &[Aabb], quality: BuildQuality) -> Option<CwBvh> {
     if boxes.is_empty() {
         return None;
     }
-    Some(build_cwbvh(
-        boxes,
-        quality.params(),
-        &mut Duration::default(),
+    Some(bvh2_to_cwbvh_parallel(
+        &build_bvh2(boxes, quality),
+        quality.params().max_prims_per_leaf,
     ))
+}
+
+/// The binary BVH that [`build_bvh`] converts: PLOC with one primitive per leaf, then
+/// reinsertion.
+pub fn build_bvh2(boxes: &[Aabb], quality: BuildQuality) -> obvhs::bvh2::Bvh2 {
+    let params = quality.params();
+    let mut bvh2 = PlocBuilder::with_capacity(boxes.len()).build(
+        params.ploc_search_distance,
+        boxes,
+        (0..boxes.len() as u32).collect(),
+        params.sort_precision,
+        params.search_depth_threshold,
+    );
+    ReinsertionOptimizer::default().run(&mut bvh2, params.reinsertion_batch_ratio, None);
+    bvh2
 }
 
 /// Largest reciprocal used for a zero (or sub-1e-18) direction component in the slab test.

@@ -8,6 +8,7 @@
 
 pub mod bvh_build;
 pub mod curvature;
+pub mod cwbvh_convert;
 pub mod disk;
 pub mod error;
 pub mod fast_path;

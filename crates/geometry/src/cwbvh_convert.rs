@@ -1,0 +1,468 @@
+//! BVH2 → compressed 8-wide BVH on every core (Ylitie, Karras & Laine 2017, "Efficient
+//! incoherent ray traversal on GPUs through compressed wide BVHs", §3.1: the SAH dynamic
+//! programme over "distribute" decisions, then §3.2's quantised child boxes in ray-octant
+//! order). It takes the same decisions and writes the same nodes in the same order as obvhs'
+//! serial `bvh2_to_cwbvh` (`converts_exactly_as_obvhs` compares them node for node); on a
+//! 10⁶-triangle mesh that serial conversion took ≈ 0.3 s, twice the parallel PLOC build.
+//!
+//! Three passes over the binary tree, each splitting subtrees across threads: the decision
+//! table (bottom-up), the size of each wide subtree (so every subtree knows where its nodes
+//! and primitives go), then the nodes themselves into disjoint slices.
+
+use std::sync::atomic::{AtomicU32, AtomicU64, Ordering::Relaxed};
+
+use glam::{UVec3, Vec3A};
+use obvhs::bvh2::Bvh2;
+use obvhs::cwbvh::node::CwBvhNode;
+use obvhs::cwbvh::CwBvh;
+use rayon::prelude::*;
+
+/// SAH cost of a primitive relative to a node's (obvhs' and the paper's 0.3).
+const PRIM_COST: f32 = 0.3;
+/// 1 / (2⁸ − 1): child boxes are quantised to 8 bits per axis (Ylitie et al. §3.2).
+const QUANTISATION_DENOM: f32 = 1.0 / 255.0;
+/// Wide nodes have 8 children; a child takes at most this many decision slots below it.
+const SLOTS: usize = 7;
+/// Subtrees with fewer primitives are converted on the calling thread: below this, splitting
+/// costs more than it spreads.
+const PARALLEL_MIN_PRIMITIVES: u32 = 8192;
+/// The decision pass splits the top levels of the binary tree: at most 2¹² tasks.
+const PARALLEL_COST_DEPTH: u32 = 12;
+
+/// What becomes of a BVH2 node when it is to cover `i + 1` slots of its wide parent.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+enum DecisionKind {
+    /// A wide leaf holding every primitive below.
+    Leaf,
+    /// A wide internal node.
+    Internal,
+    /// Its two children share the slots.
+    Distribute,
+}
+
+#[derive(Clone, Copy, Debug)]
+struct Decision {
+    cost: f32,
+    kind: DecisionKind,
+    /// Slots given to the left and right child (as slot counts − 1) when distributing.
+    distribute_left: u8,
+    distribute_right: u8,
+}
+
+impl Decision {
+    const UNSET: u8 = u8::MAX;
+
+    fn pack(self) -> u64 {
+        let kind = match self.kind {
+            DecisionKind::Leaf => 0u64,
+            DecisionKind::Internal => 1,
+            DecisionKind::Distribute => 2,
+        };
+        u64::from(self.cost.to_bits())
+            | kind << 32
+            | u64::from(self.distribute_left) << 40
+            | u64::from(self.distribute_right) << 48
+    }
+
+    fn unpack(bits: u64) -> Self {
+        let kind = match (bits >> 32) & 0xff {
+            0 => DecisionKind::Leaf,
+            1 => DecisionKind::Internal,
+            2 => DecisionKind::Distribute,
+            other => unreachable!("decision kind {other} was never packed"),
+        };
+        Decision {
+            cost: f32::from_bits(bits as u32),
+            kind,
+            distribute_left: (bits >> 40) as u8,
+            distribute_right: (bits >> 48) as u8,
+        }
+    }
+}
+
+/// The converter's tables, indexed by BVH2 node. Each pass writes only the entries of the
+/// subtree it owns; atomics (relaxed: `rayon::join` orders a subtree's writes before its
+/// parent's reads) let disjoint subtrees write through a shared reference.
+struct Converter<'a> {
+    bvh2: &'a Bvh2,
+    max_prims_per_leaf: u32,
+    /// `SLOTS` packed decisions per node.
+    decisions: Vec<AtomicU64>,
+    /// Primitives below each node.
+    primitives: Vec<AtomicU32>,
+    /// Wide nodes below each node that becomes a wide internal node (itself not counted).
+    wide_nodes_below: Vec<AtomicU32>,
+    direction_lut: [Vec3A; 8],
+}
+
+/// Convert `bvh2` (one primitive per leaf, as PLOC builds it) with at most
+/// `max_prims_per_leaf` (1–3) primitives per wide leaf, children ordered by ray octant.
+pub fn bvh2_to_cwbvh_parallel(bvh2: &Bvh2, max_prims_per_leaf: u32) -> CwBvh {
+    if bvh2.nodes.is_empty() {
+        return CwBvh::default();
+    }
+    let n = bvh2.nodes.len();
+    let converter = Converter {
+        bvh2,
+        max_prims_per_leaf: max_prims_per_leaf.clamp(1, 3),
+        decisions: (0..n * SLOTS)
+            .into_par_iter()
+            .map(|_| AtomicU64::new(0))
+            .collect(),
+        primitives: (0..n).into_par_iter().map(|_| AtomicU32::new(0)).collect(),
+        wide_nodes_below: (0..n).into_par_iter().map(|_| AtomicU32::new(0)).collect(),
+        direction_lut: std::array::from_fn(|s| {
+            let sign = |bit: usize| if s & bit != 0 { -1.0 } else { 1.0 };
+            Vec3A::new(sign(0b100), sign(0b010), sign(0b001))
+        }),
+    };
+    let total_primitives = converter.costs(0, 0);
+    let below = converter.count_wide_nodes(0);
+    let mut nodes = vec![CwBvhNode::default(); 1 + below as usize];
+    let mut primitive_indices = vec![0u32; total_primitives as usize];
+    let (root, rest) = nodes.split_first_mut().expect("one root node");
+    converter.emit(0, root, 1, rest, 0, &mut primitive_indices);
+    CwBvh {
+        nodes,
+        primitive_indices,
+        total_aabb: *bvh2.nodes[0].aabb(),
+        exact_node_aabbs: None,
+        uses_spatial_splits: bvh2.uses_spatial_splits,
+    }
+}
+
+impl Converter<'_> {
+    fn decision(&self, node: usize, slot: usize) -> Decision {
+        Decision::unpack(self.decisions[node * SLOTS + slot].load(Relaxed))
+    }
+
+    fn set_decision(&self, node: usize, slot: usize, d: Decision) {
+        self.decisions[node * SLOTS + slot].store(d.pack(), Relaxed);
+    }
+
+    /// Fills the decision table below `node` (Ylitie et al. eqs. 1–3: cost of a wide leaf, a
+    /// wide internal node, or distributing i slots between the two children); returns the
+    /// primitives below it.
+    fn costs(&self, node: usize, depth: u32) -> u32 {
+        let bvh_node = &self.bvh2.nodes[node];
+        let half_area = bvh_node.aabb().half_area();
+        if bvh_node.prim_count != 0 {
+            assert_eq!(
+                bvh_node.prim_count, 1,
+                "the wide conversion expects one primitive per BVH2 leaf"
+            );
+            let leaf = Decision {
+                cost: half_area * PRIM_COST,
+                kind: DecisionKind::Leaf,
+                distribute_left: 0,
+                distribute_right: 0,
+            };
+            for slot in 0..SLOTS {
+                self.set_decision(node, slot, leaf);
+            }
+            self.primitives[node].store(1, Relaxed);
+            return 1;
+        }
+        let (left, right) = (
+            bvh_node.first_index as usize,
+            bvh_node.first_index as usize + 1,
+        );
+        // Subtree sizes are not known yet: split the top levels (2^depth tasks at most).
+        let primitives = if depth < PARALLEL_COST_DEPTH {
+            let (a, b) = rayon::join(
+                || self.costs(left, depth + 1),
+                || self.costs(right, depth + 1),
+            );
+            a + b
+        } else {
+            self.costs(left, depth + 1) + self.costs(right, depth + 1)
+        };
+        let left_cost = |k: usize| self.decision(left, k).cost;
+        let right_cost = |k: usize| self.decision(right, k).cost;
+
+        // One slot (the paper's i = 1): a wide leaf, or a wide internal node whose slots the
+        // two children share.
+        let cost_leaf = if primitives <= self.max_prims_per_leaf {
+            primitives as f32 * half_area * PRIM_COST
+        } else {
+            f32::INFINITY
+        };
+        let mut cost_distribute = f32::INFINITY;
+        let (mut distribute_left, mut distribute_right) = (Decision::UNSET, Decision::UNSET);
+        for k in 0..SLOTS {
+            let c = left_cost(k) + right_cost(SLOTS - 1 - k);
+            if c < cost_distribute {
+                cost_distribute = c;
+                distribute_left = k as u8;
+                distribute_right = (SLOTS - 1 - k) as u8;
+            }
+        }
+        let cost_internal = cost_distribute + half_area;
+        let (kind, cost) = if cost_leaf < cost_internal {
+            (DecisionKind::Leaf, cost_leaf)
+        } else {
+            (DecisionKind::Internal, cost_internal)
+        };
+        let mut previous = Decision {
+            cost,
+            kind,
+            distribute_left,
+            distribute_right,
+        };
+        self.set_decision(node, 0, previous);
+        // i + 1 slots (the paper's i = 2…8): the best of i slots, or a split between children.
+        for i in 1..SLOTS {
+            let mut cost_distribute = previous.cost;
+            let (mut distribute_left, mut distribute_right) = (Decision::UNSET, Decision::UNSET);
+            for k in 0..i {
+                let c = left_cost(k) + right_cost(i - k - 1);
+                if c < cost_distribute {
+                    cost_distribute = c;
+                    distribute_left = k as u8;
+                    distribute_right = (i - k - 1) as u8;
+                }
+            }
+            let decision = if distribute_left != Decision::UNSET {
+                Decision {
+                    cost: cost_distribute,
+                    kind: DecisionKind::Distribute,
+                    distribute_left,
+                    distribute_right,
+                }
+            } else {
+                previous
+            };
+            self.set_decision(node, i, decision);
+            previous = decision;
+        }
+        self.primitives[node].store(primitives, Relaxed);
+        primitives
+    }
+
+    /// The BVH2 nodes that become the wide children of `node` when it covers `slot + 1`
+    /// slots, appended to `children`.
+    fn children_of(&self, node: usize, slot: usize, children: &mut [u32; 8], count: &mut usize) {
+        let bvh_node = &self.bvh2.nodes[node];
+        if bvh_node.is_leaf() {
+            children[*count] = node as u32;
+            *count += 1;
+            return;
+        }
+        let d = self.decision(node, slot);
+        for (child, child_slot) in [
+            (bvh_node.first_index as usize, d.distribute_left),
+            (bvh_node.first_index as usize + 1, d.distribute_right),
+        ] {
+            if self.decision(child, child_slot as usize).kind == DecisionKind::Distribute {
+                self.children_of(child, child_slot as usize, children, count);
+            } else {
+                children[*count] = child as u32;
+                *count += 1;
+            }
+        }
+    }
+
+    /// The wide children of `node`, placed in the slots whose octant direction their centre
+    /// lies furthest along (greedy assignment, as obvhs and Ylitie et al. §3.2 suggest);
+    /// `u32::MAX` marks an empty slot.
+    fn ordered_children(&self, node: usize) -> [u32; 8] {
+        let mut children = [u32::MAX; 8];
+        let mut count = 0;
+        self.children_of(node, 0, &mut children, &mut count);
+        let centre = self.bvh2.nodes[node].aabb().center();
+        let mut cost = [[f32::MAX; 8]; 8];
+        for (s, direction) in self.direction_lut.iter().enumerate() {
+            for c in 0..count {
+                let offset = self.bvh2.nodes[children[c] as usize].aabb().center() - centre;
+                cost[c][s] = direction.dot(offset);
+            }
+        }
+        let mut assignment = [usize::MAX; 8];
+        let mut slot_filled = [false; 8];
+        loop {
+            let mut best = (f32::MAX, usize::MAX, usize::MAX);
+            for c in 0..count {
+                if assignment[c] != usize::MAX {
+                    continue;
+                }
+                for (s, &filled) in slot_filled.iter().enumerate() {
+                    if !filled && cost[c][s] < best.0 {
+                        best = (cost[c][s], s, c);
+                    }
+                }
+            }
+            let (_, slot, child) = best;
+            if slot == usize::MAX {
+                break;
+            }
+            slot_filled[slot] = true;
+            assignment[child] = slot;
+        }
+        let mut ordered = [u32::MAX; 8];
+        for c in 0..count {
+            ordered[assignment[c]] = children[c];
+        }
+        ordered
+    }
+
+    fn is_wide_internal(&self, node: u32) -> bool {
+        self.decision(node as usize, 0).kind == DecisionKind::Internal
+    }
+
+    /// Wide nodes below `node` (a wide internal node, or the root), recorded per node.
+    fn count_wide_nodes(&self, node: usize) -> u32 {
+        // The count does not depend on the children's order.
+        let mut children = [u32::MAX; 8];
+        let mut count = 0;
+        self.children_of(node, 0, &mut children, &mut count);
+        let internal: Vec<u32> = children[..count]
+            .iter()
+            .copied()
+            .filter(|&c| self.is_wide_internal(c))
+            .collect();
+        let below_children: u32 = if self.primitives[node].load(Relaxed) >= PARALLEL_MIN_PRIMITIVES
+        {
+            internal
+                .par_iter()
+                .map(|&c| self.count_wide_nodes(c as usize))
+                .sum()
+        } else {
+            internal
+                .iter()
+                .map(|&c| self.count_wide_nodes(c as usize))
+                .sum()
+        };
+        let below = internal.len() as u32 + below_children;
+        self.wide_nodes_below[node].store(below, Relaxed);
+        below
+    }
+
+    /// Appends the BVH2 primitives below `node` in depth-first order (left child first).
+    fn leaf_primitives(&self, node: usize, out: &mut [u32], at: &mut usize) {
+        let bvh_node = &self.bvh2.nodes[node];
+        if bvh_node.is_leaf() {
+            out[*at] = self.bvh2.primitive_indices[bvh_node.first_index as usize];
+            *at += 1;
+            return;
+        }
+        self.leaf_primitives(bvh_node.first_index as usize, out, at);
+        self.leaf_primitives(bvh_node.first_index as usize + 1, out, at);
+    }
+
+    /// Writes the wide node of BVH2 node `node` into `out`. Its children's nodes go to the
+    /// front of `below` (global index `below_base`), followed by each internal child's own
+    /// subtree; its leaves' primitives go to the front of `primitives` (global index
+    /// `primitive_base`), followed by each internal child's. This is the serial conversion's
+    /// depth-first layout.
+    fn emit(
+        &self,
+        node: usize,
+        out: &mut CwBvhNode,
+        below_base: u32,
+        below: &mut [CwBvhNode],
+        primitive_base: u32,
+        primitives: &mut [u32],
+    ) {
+        let aabb = self.bvh2.nodes[node].aabb();
+        let origin = aabb.min;
+        // Per-axis power-of-two scale so that 255 steps cover the box (Ylitie et al. §3.2).
+        let scale = ((aabb.max - aabb.min).max(Vec3A::splat(1e-20)) * QUANTISATION_DENOM)
+            .log2()
+            .ceil()
+            .exp2();
+        let inv_scale = 1.0 / scale;
+        let exponent = UVec3::new(
+            scale.x.to_bits() >> 23,
+            scale.y.to_bits() >> 23,
+            scale.z.to_bits() >> 23,
+        );
+        out.p = origin.into();
+        out.e = [exponent.x as u8, exponent.y as u8, exponent.z as u8];
+        out.imask = 0;
+        out.primitive_base_idx = primitive_base;
+        out.child_base_idx = below_base;
+
+        let children = self.ordered_children(node);
+        let mut internal = Vec::with_capacity(8);
+        let mut leaf_primitive_count = 0usize;
+        for (i, &child) in children.iter().enumerate() {
+            if child == u32::MAX {
+                continue;
+            }
+            let child_aabb = self.bvh2.nodes[child as usize].aabb();
+            let lo = ((child_aabb.min - origin) * inv_scale)
+                .floor()
+                .clamp(Vec3A::ZERO, Vec3A::splat(255.0));
+            let hi = ((child_aabb.max - origin) * inv_scale)
+                .ceil()
+                .clamp(Vec3A::ZERO, Vec3A::splat(255.0));
+            out.child_min_x[i] = lo.x as u8;
+            out.child_min_y[i] = lo.y as u8;
+            out.child_min_z[i] = lo.z as u8;
+            out.child_max_x[i] = hi.x as u8;
+            out.child_max_y[i] = hi.y as u8;
+            out.child_max_z[i] = hi.z as u8;
+            match self.decision(child as usize, 0).kind {
+                DecisionKind::Leaf => {
+                    let first = leaf_primitive_count;
+                    self.leaf_primitives(child as usize, primitives, &mut leaf_primitive_count);
+                    // The top three bits count the primitives in unary; the low five are the
+                    // offset from primitive_base_idx.
+                    let unary = match leaf_primitive_count - first {
+                        1 => 0b0010_0000,
+                        2 => 0b0110_0000,
+                        3 => 0b1110_0000,
+                        n => unreachable!("a wide leaf of {n} primitives (at most 3)"),
+                    };
+                    out.child_meta[i] = first as u8 | unary;
+                }
+                DecisionKind::Internal => {
+                    out.imask |= 1 << i;
+                    out.child_meta[i] = (24 + i as u8) | 0b0010_0000;
+                    internal.push(child as usize);
+                }
+                DecisionKind::Distribute => {
+                    unreachable!("children_of resolves every distributed slot")
+                }
+            }
+        }
+
+        // Each internal child: its node in the block, its subtree and primitives after.
+        let (block, mut rest) = below.split_at_mut(internal.len());
+        let (_, mut rest_primitives) = primitives.split_at_mut(leaf_primitive_count);
+        let mut next_below = below_base + internal.len() as u32;
+        let mut next_primitive = primitive_base + leaf_primitive_count as u32;
+        let mut jobs = Vec::with_capacity(internal.len());
+        for (&child, child_out) in internal.iter().zip(block.iter_mut()) {
+            let nodes = self.wide_nodes_below[child].load(Relaxed) as usize;
+            let prims = self.primitives[child].load(Relaxed) as usize;
+            let (child_below, tail) = std::mem::take(&mut rest).split_at_mut(nodes);
+            rest = tail;
+            let (child_primitives, tail) = std::mem::take(&mut rest_primitives).split_at_mut(prims);
+            rest_primitives = tail;
+            jobs.push((
+                child,
+                child_out,
+                next_below,
+                child_below,
+                next_primitive,
+                child_primitives,
+            ));
+            next_below += nodes as u32;
+            next_primitive += prims as u32;
+        }
+        let run = |(child, child_out, b, child_below, p, child_primitives): (
+            usize,
+            &mut CwBvhNode,
+            u32,
+            &mut [CwBvhNode],
+            u32,
+            &mut [u32],
+        )| self.emit(child, child_out, b, child_below, p, child_primitives);
+        if self.primitives[node].load(Relaxed) >= PARALLEL_MIN_PRIMITIVES {
+            jobs.into_par_iter().for_each(run);
+        } else {
+            jobs.into_iter().for_each(run);
+        }
+    }
+}
