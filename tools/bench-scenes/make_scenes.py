@@ -172,7 +172,11 @@ def mesh_scene():
              "transform": {"translate": [0, 1.0, 0]}},
         ],
         "lights": [
-            {"type": "environment", "file": "generated/" + SKY.name, "scale": 1.0},
+            # Bilinear, as Mitsuba's envmap always interpolates: with Prism's default (nearest)
+            # the two renderers' images differed by the texel steps of the directly seen sky,
+            # 46 % of Prism's MSE at 64 spp and no noise at all.
+            {"type": "environment", "file": "generated/" + SKY.name, "scale": 1.0,
+             "filter": "bilinear"},
             {"type": "directional", "direction": [-0.5, -0.75, -0.45], "illuminance_lx": 60000,
              "spectrum": "D65"},
         ],
@@ -248,10 +252,10 @@ def write_ply(path, v, n, uv, tris):
 
 def smooth_sky(w=256, h=128):
     """Linear Rec.709 radiance (arbitrary units, ~1): blue zenith to pale horizon, brown
-    ground, blended over ±8° around the horizon; no sun disc. Smooth on purpose: Prism looks
-    texels up nearest (the environment light's default `filter`), Mitsuba bilinearly
-    (docs/lights.md), and a one-row horizon step would show that difference as error along
-    the horizon in every image."""
+    ground, blended over ±8° around the horizon; no sun disc. Smooth on purpose: Prism puts
+    the rows at texel centres, Mitsuba the first and last on the poles (docs/lights.md), and
+    a one-row horizon step would show that half-texel difference as error along the horizon
+    in every image."""
     v = (np.arange(h) + 0.5) / h
     elev = (0.5 - v) * math.pi  # +π/2 at the top row
     up = np.clip(np.sin(elev), 0, 1)[:, None]
