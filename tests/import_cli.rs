@@ -29,16 +29,18 @@ fn prism() -> Command {
     Command::new(env!("CARGO_BIN_EXE_prism"))
 }
 
-/// Imports `scene` in process as `prism render` does and returns the description.
-fn import(scene: &Path) -> prism_scene::SceneDescription {
+/// Imports `scene` in process as `prism render` does and returns the description, with the
+/// folder of its side files (removed when the guard drops: keep it until the render ends).
+fn import(scene: &Path) -> (prism_scene::SceneDescription, tempfile::TempDir) {
     let dir = scene.parent().unwrap().to_path_buf();
+    let side_files = tempfile::Builder::new()
+        .prefix("prism-import-test-")
+        .tempdir()
+        .unwrap();
     let options = prism_import::ImportOptions {
         defines: Vec::new(),
         output_dir: dir.clone(),
-        side_dir: std::env::temp_dir()
-            .join(format!("prism-import-test-{}", std::process::id()))
-            .to_string_lossy()
-            .into_owned(),
+        side_dir: side_files.path().to_string_lossy().into_owned(),
     };
     let imported = prism_import::import_file(scene, &options).unwrap();
     for f in &imported.side_files {
@@ -47,7 +49,8 @@ fn import(scene: &Path) -> prism_scene::SceneDescription {
         std::fs::write(p, &f.contents).unwrap();
     }
     let as_json = dir.join("imported.json");
-    prism_scene::parse_scene_str(&imported.to_json_text(), as_json).unwrap()
+    let description = prism_scene::parse_scene_str(&imported.to_json_text(), as_json).unwrap();
+    (description, side_files)
 }
 
 fn render_rgb(
@@ -113,7 +116,7 @@ fn compare_means(a: &[[f64; 3]], b: &[[f64; 3]], width: usize, label: &str) {
 
 #[test]
 fn mitsuba_cornell_box_xml_renders_within_one_percent_of_mitsuba_and_of_the_json_scene() {
-    let imported = import(&root().join("scenes/import/cornell-box.xml"));
+    let (imported, _side_files) = import(&root().join("scenes/import/cornell-box.xml"));
     let json = prism_scene::load_scene(root().join("scenes/cornell-box.json")).unwrap();
     // 256 spp (the scene's 64 leave the blue channel's standard error at 0.34 %).
     let (ours, width) = render_rgb(&imported, 256, 1);
@@ -130,7 +133,7 @@ fn mitsuba_cornell_box_xml_renders_within_one_percent_of_mitsuba_and_of_the_json
 
 #[test]
 fn pbrt_room_renders_within_one_percent_of_its_prism_json() {
-    let imported = import(&root().join("scenes/import/room.pbrt"));
+    let (imported, _side_files) = import(&root().join("scenes/import/room.pbrt"));
     let json = prism_scene::load_scene(root().join("scenes/import/room.json")).unwrap();
     let (ours, width) = render_rgb(&imported, 256, 1);
     let (theirs, _) = render_rgb(&json, 256, 2);

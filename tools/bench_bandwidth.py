@@ -27,10 +27,12 @@ Writes tools/bench-results/bandwidth.json (per-scene converge JSON inside;
 """
 
 import argparse
+import atexit
 import json
 import math
 import os
 import platform
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -131,6 +133,7 @@ def main():
     opts = parser.parse_args()
     ensure_merl()
     work = tempfile.mkdtemp(prefix="prism-bandwidth-")
+    atexit.register(shutil.rmtree, work, ignore_errors=True)
     results = {}
     for name in opts.scenes.split(","):
         scene, resolution = SCENES[name]

@@ -28,8 +28,10 @@ always included). Prints JSON and writes tools/bench-results/plan-allocation.jso
 """
 
 import argparse
+import atexit
 import os
 import shlex
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -108,6 +110,7 @@ def main():
         raise SystemExit("--renders must be at least 4 (two halves of two)")
     variants = [""] + [v for v in opts.variant if v != ""]
     work = tempfile.mkdtemp(prefix="prism-plan-allocation-")
+    atexit.register(shutil.rmtree, work, ignore_errors=True)
     results = {}
     for name in opts.scenes.split(","):
         if name in SCENES:

@@ -147,22 +147,25 @@ pub fn import(path: &Path, options: &ImportOptions) -> Result<Imported, ImportEr
 mod tests {
     use super::*;
 
+    /// Imports `text` as a scene file in a fresh folder (removed afterwards).
     fn import_text(text: &str) -> Imported {
-        let dir =
-            std::env::temp_dir().join(format!("prism-import-xml-unit-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let path = dir.join(format!("t{}.xml", text.len()));
+        let dir = tempfile::tempdir().unwrap();
+        import_text_in(dir.path(), text)
+    }
+
+    /// Imports `text` as a scene file in `dir`, next to whatever files it names.
+    fn import_text_in(dir: &std::path::Path, text: &str) -> Imported {
+        let path = dir.join("scene.xml");
         std::fs::write(&path, text).unwrap();
-        let r = import(
+        import(
             &path,
             &ImportOptions {
-                output_dir: dir.clone(),
+                output_dir: dir.to_path_buf(),
                 side_dir: "a".into(),
                 ..Default::default()
             },
-        );
-        std::fs::remove_file(&path).unwrap();
-        r.unwrap()
+        )
+        .unwrap()
     }
 
     #[test]
@@ -208,15 +211,14 @@ mod tests {
 
     #[test]
     fn serialized_meshes_become_obj_side_files() {
-        let dir =
-            std::env::temp_dir().join(format!("prism-import-xml-unit-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = tempfile::tempdir().unwrap();
         std::fs::write(
-            dir.join("tri.serialized"),
+            dir.path().join("tri.serialized"),
             serialized::tests::one_triangle(),
         )
         .unwrap();
-        let i = import_text(
+        let i = import_text_in(
+            dir.path(),
             "<scene version=\"3.0.0\"><shape type=\"serialized\"><string name=\"filename\" value=\"tri.serialized\"/></shape></scene>",
         );
         assert_eq!(i.scene["shapes"][0]["file"], "a/serialized-0.obj");

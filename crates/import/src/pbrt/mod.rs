@@ -367,22 +367,25 @@ pub fn finish(im: &mut Importer, params: &Params, context: &str) {
 mod tests {
     use super::*;
 
+    /// Imports `text` as a scene file in a fresh folder (removed afterwards).
     fn import_text(text: &str) -> Imported {
-        let dir =
-            std::env::temp_dir().join(format!("prism-import-pbrt-unit-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let path = dir.join(format!("t{}.pbrt", text.len()));
+        let dir = tempfile::tempdir().unwrap();
+        import_text_in(dir.path(), text)
+    }
+
+    /// Imports `text` as a scene file in `dir`, next to whatever files it names.
+    fn import_text_in(dir: &std::path::Path, text: &str) -> Imported {
+        let path = dir.join("scene.pbrt");
         std::fs::write(&path, text).unwrap();
-        let r = import(
+        import(
             &path,
             &ImportOptions {
-                output_dir: dir.clone(),
+                output_dir: dir.to_path_buf(),
                 side_dir: "a".into(),
                 ..Default::default()
             },
-        );
-        std::fs::remove_file(&path).unwrap();
-        r.unwrap()
+        )
+        .unwrap()
     }
 
     /// pbrt's LookAt with up +Y looking down −Z puts image right at world −X (pbrt's
