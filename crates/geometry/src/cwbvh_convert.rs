@@ -5,9 +5,13 @@
 //! serial `bvh2_to_cwbvh` (`converts_exactly_as_obvhs` compares them node for node); on a
 //! 10⁶-triangle mesh that serial conversion took ≈ 0.3 s, twice the parallel PLOC build.
 //!
-//! Three passes over the binary tree, each splitting subtrees across threads: the decision
-//! table (bottom-up), the size of each wide subtree (so every subtree knows where its nodes
-//! and primitives go), then the nodes themselves into disjoint slices.
+//! Three passes over the binary tree, each splitting the top levels' subtrees across
+//! threads: the decision table (bottom-up), the size of each wide subtree (so every subtree
+//! knows where its nodes and primitives go), then the nodes themselves into disjoint
+//! slices. Below those levels each pass walks with a work list, not recursion: coincident
+//! boxes make PLOC's tree a chain as deep as it has primitives, which overflowed the stack
+//! of obvhs' recursive conversion (a mesh of 2·10⁵ duplicate triangles aborted `prism
+//! render`).
 
 use std::sync::atomic::{AtomicU32, AtomicU64, Ordering::Relaxed};
 
@@ -28,6 +32,8 @@ const SLOTS: usize = 7;
 const PARALLEL_MIN_PRIMITIVES: u32 = 8192;
 /// The decision pass splits the top levels of the binary tree: at most 2¹² tasks.
 const PARALLEL_COST_DEPTH: u32 = 12;
+/// The counting and writing passes split the top levels of the wide tree: at most 8⁵ tasks.
+const PARALLEL_WIDE_DEPTH: u32 = 5;
 
 /// What becomes of a BVH2 node when it is to cover `i + 1` slots of its wide parent.
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
@@ -117,11 +123,17 @@ pub fn bvh2_to_cwbvh_parallel(bvh2: &Bvh2, max_prims_per_leaf: u32) -> CwBvh {
         }),
     };
     let total_primitives = converter.costs(0, 0);
-    let below = converter.count_wide_nodes(0);
+    let below = converter.count_wide_nodes(0, 0);
     let mut nodes = vec![CwBvhNode::default(); 1 + below as usize];
     let mut primitive_indices = vec![0u32; total_primitives as usize];
     let (root, rest) = nodes.split_first_mut().expect("one root node");
-    converter.emit(0, root, 1, rest, 0, &mut primitive_indices);
+    let region = Region {
+        below_base: 1,
+        below: rest,
+        primitive_base: 0,
+        primitives: &mut primitive_indices,
+    };
+    converter.emit(0, root, region, 0);
     CwBvh {
         nodes,
         primitive_indices,
@@ -142,8 +154,39 @@ impl Converter<'_> {
 
     /// Fills the decision table below `node` (Ylitie et al. eqs. 1–3: cost of a wide leaf, a
     /// wide internal node, or distributing i slots between the two children); returns the
-    /// primitives below it.
+    /// primitives below it. Subtree sizes are not known yet: the top `PARALLEL_COST_DEPTH`
+    /// levels split across threads, the rest is an iterative post-order walk (a BVH2 of
+    /// coincident boxes is a chain as deep as it has primitives).
     fn costs(&self, node: usize, depth: u32) -> u32 {
+        let bvh_node = &self.bvh2.nodes[node];
+        if bvh_node.is_leaf() || depth >= PARALLEL_COST_DEPTH {
+            return self.costs_serial(node);
+        }
+        let first = bvh_node.first_index as usize;
+        rayon::join(
+            || self.costs(first, depth + 1),
+            || self.costs(first + 1, depth + 1),
+        );
+        self.node_decisions(node)
+    }
+
+    fn costs_serial(&self, root: usize) -> u32 {
+        // (node, its children are done)
+        let mut stack = vec![(root, false)];
+        while let Some((node, children_done)) = stack.pop() {
+            let bvh_node = &self.bvh2.nodes[node];
+            if bvh_node.is_leaf() || children_done {
+                self.node_decisions(node);
+            } else {
+                let first = bvh_node.first_index as usize;
+                stack.extend([(node, true), (first + 1, false), (first, false)]);
+            }
+        }
+        self.primitives[root].load(Relaxed)
+    }
+
+    /// The decisions of one node, its children's already made; returns its primitives.
+    fn node_decisions(&self, node: usize) -> u32 {
         let bvh_node = &self.bvh2.nodes[node];
         let half_area = bvh_node.aabb().half_area();
         if bvh_node.prim_count != 0 {
@@ -167,16 +210,7 @@ impl Converter<'_> {
             bvh_node.first_index as usize,
             bvh_node.first_index as usize + 1,
         );
-        // Subtree sizes are not known yet: split the top levels (2^depth tasks at most).
-        let primitives = if depth < PARALLEL_COST_DEPTH {
-            let (a, b) = rayon::join(
-                || self.costs(left, depth + 1),
-                || self.costs(right, depth + 1),
-            );
-            a + b
-        } else {
-            self.costs(left, depth + 1) + self.costs(right, depth + 1)
-        };
+        let primitives = self.primitives[left].load(Relaxed) + self.primitives[right].load(Relaxed);
         let left_cost = |k: usize| self.decision(left, k).cost;
         let right_cost = |k: usize| self.decision(right, k).cost;
 
@@ -309,35 +343,73 @@ impl Converter<'_> {
         self.decision(node as usize, 0).kind == DecisionKind::Internal
     }
 
-    /// Wide nodes below `node` (a wide internal node, or the root), recorded per node.
-    fn count_wide_nodes(&self, node: usize) -> u32 {
-        // The count does not depend on the children's order.
+    /// The wide internal nodes among `node`'s wide children (BVH2 indices), in any order.
+    fn internal_children(&self, node: usize) -> InternalChildren {
         let mut children = [u32::MAX; 8];
         let mut count = 0;
         self.children_of(node, 0, &mut children, &mut count);
-        let internal: Vec<u32> = children[..count]
-            .iter()
-            .copied()
-            .filter(|&c| self.is_wide_internal(c))
-            .collect();
-        let below_children: u32 = if self.primitives[node].load(Relaxed) >= PARALLEL_MIN_PRIMITIVES
-        {
-            internal
-                .par_iter()
-                .map(|&c| self.count_wide_nodes(c as usize))
-                .sum()
-        } else {
-            internal
-                .iter()
-                .map(|&c| self.count_wide_nodes(c as usize))
-                .sum()
+        let mut internal = InternalChildren {
+            nodes: [u32::MAX; 8],
+            count: 0,
         };
-        let below = internal.len() as u32 + below_children;
+        for &c in &children[..count] {
+            if self.is_wide_internal(c) {
+                internal.nodes[internal.count] = c;
+                internal.count += 1;
+            }
+        }
+        internal
+    }
+
+    /// Whether a wide subtree is split across threads: large, and near enough the root that
+    /// the splitting stays shallow whatever the tree's depth.
+    fn splits(&self, node: usize, wide_depth: u32) -> bool {
+        wide_depth < PARALLEL_WIDE_DEPTH
+            && self.primitives[node].load(Relaxed) >= PARALLEL_MIN_PRIMITIVES
+    }
+
+    /// Wide nodes below `node` (a wide internal node, or the root), recorded per node.
+    fn count_wide_nodes(&self, node: usize, wide_depth: u32) -> u32 {
+        if !self.splits(node, wide_depth) {
+            return self.count_wide_nodes_serial(node);
+        }
+        let internal = self.internal_children(node);
+        let below_children: u32 = internal
+            .as_slice()
+            .par_iter()
+            .map(|&c| self.count_wide_nodes(c as usize, wide_depth + 1))
+            .sum();
+        let below = internal.count as u32 + below_children;
         self.wide_nodes_below[node].store(below, Relaxed);
         below
     }
 
-    /// Appends the BVH2 primitives below `node` in depth-first order (left child first).
+    fn count_wide_nodes_serial(&self, root: usize) -> u32 {
+        // (node, its internal children once they are counted)
+        let mut stack: Vec<(usize, Option<InternalChildren>)> = vec![(root, None)];
+        while let Some((node, counted)) = stack.pop() {
+            match counted {
+                None => {
+                    let internal = self.internal_children(node);
+                    stack.push((node, Some(internal)));
+                    stack.extend(internal.as_slice().iter().map(|&c| (c as usize, None)));
+                }
+                Some(internal) => {
+                    let below = internal.count as u32
+                        + internal
+                            .as_slice()
+                            .iter()
+                            .map(|&c| self.wide_nodes_below[c as usize].load(Relaxed))
+                            .sum::<u32>();
+                    self.wide_nodes_below[node].store(below, Relaxed);
+                }
+            }
+        }
+        self.wide_nodes_below[root].load(Relaxed)
+    }
+
+    /// Appends the BVH2 primitives below `node` (a wide leaf: at most 3) in depth-first
+    /// order, left child first.
     fn leaf_primitives(&self, node: usize, out: &mut [u32], at: &mut usize) {
         let bvh_node = &self.bvh2.nodes[node];
         if bvh_node.is_leaf() {
@@ -349,20 +421,19 @@ impl Converter<'_> {
         self.leaf_primitives(bvh_node.first_index as usize + 1, out, at);
     }
 
-    /// Writes the wide node of BVH2 node `node` into `out`. Its children's nodes go to the
-    /// front of `below` (global index `below_base`), followed by each internal child's own
-    /// subtree; its leaves' primitives go to the front of `primitives` (global index
-    /// `primitive_base`), followed by each internal child's. This is the serial conversion's
-    /// depth-first layout.
-    fn emit(
+    /// The wide node of BVH2 node `node`, whose children's nodes start at global index
+    /// `below_base` and whose leaves' primitives start at `primitive_base`; writes those
+    /// primitives to the front of `primitives` and returns, per internal child in slot
+    /// order, its BVH2 index, its node's global index, where its own children and primitives
+    /// start, and how many it has below. This is the serial conversion's depth-first layout:
+    /// a node's children's block, then each internal child's subtree in turn.
+    fn wide_node(
         &self,
         node: usize,
-        out: &mut CwBvhNode,
         below_base: u32,
-        below: &mut [CwBvhNode],
         primitive_base: u32,
         primitives: &mut [u32],
-    ) {
+    ) -> (CwBvhNode, Vec<ChildPlacement>) {
         let aabb = self.bvh2.nodes[node].aabb();
         let origin = aabb.min;
         // Per-axis power-of-two scale so that 255 steps cover the box (Ylitie et al. §3.2).
@@ -376,11 +447,14 @@ impl Converter<'_> {
             scale.y.to_bits() >> 23,
             scale.z.to_bits() >> 23,
         );
-        out.p = origin.into();
-        out.e = [exponent.x as u8, exponent.y as u8, exponent.z as u8];
-        out.imask = 0;
-        out.primitive_base_idx = primitive_base;
-        out.child_base_idx = below_base;
+        let mut out = CwBvhNode {
+            p: origin.into(),
+            e: [exponent.x as u8, exponent.y as u8, exponent.z as u8],
+            imask: 0,
+            primitive_base_idx: primitive_base,
+            child_base_idx: below_base,
+            ..CwBvhNode::default()
+        };
 
         let children = self.ordered_children(node);
         let mut internal = Vec::with_capacity(8);
@@ -427,42 +501,129 @@ impl Converter<'_> {
             }
         }
 
-        // Each internal child: its node in the block, its subtree and primitives after.
-        let (block, mut rest) = below.split_at_mut(internal.len());
-        let (_, mut rest_primitives) = primitives.split_at_mut(leaf_primitive_count);
         let mut next_below = below_base + internal.len() as u32;
         let mut next_primitive = primitive_base + leaf_primitive_count as u32;
-        let mut jobs = Vec::with_capacity(internal.len());
-        for (&child, child_out) in internal.iter().zip(block.iter_mut()) {
-            let nodes = self.wide_nodes_below[child].load(Relaxed) as usize;
-            let prims = self.primitives[child].load(Relaxed) as usize;
-            let (child_below, tail) = std::mem::take(&mut rest).split_at_mut(nodes);
-            rest = tail;
-            let (child_primitives, tail) = std::mem::take(&mut rest_primitives).split_at_mut(prims);
-            rest_primitives = tail;
-            jobs.push((
-                child,
-                child_out,
-                next_below,
-                child_below,
-                next_primitive,
-                child_primitives,
-            ));
-            next_below += nodes as u32;
-            next_primitive += prims as u32;
+        let placements = internal
+            .iter()
+            .enumerate()
+            .map(|(j, &child)| {
+                let nodes_below = self.wide_nodes_below[child].load(Relaxed);
+                let primitives_below = self.primitives[child].load(Relaxed);
+                let placement = ChildPlacement {
+                    node: child,
+                    index: below_base + j as u32,
+                    below_base: next_below,
+                    nodes_below,
+                    primitive_base: next_primitive,
+                    primitives_below,
+                };
+                next_below += nodes_below;
+                next_primitive += primitives_below;
+                placement
+            })
+            .collect();
+        (out, placements)
+    }
+
+    /// Writes the wide node of `node` into `out` and its subtree into `region`: large
+    /// subtrees near the root split across threads into disjoint slices, the rest is written
+    /// by [`Converter::emit_serial`].
+    fn emit(&self, node: usize, out: &mut CwBvhNode, region: Region<'_>, wide_depth: u32) {
+        if !self.splits(node, wide_depth) {
+            return self.emit_serial(node, out, region);
         }
-        let run = |(child, child_out, b, child_below, p, child_primitives): (
-            usize,
-            &mut CwBvhNode,
-            u32,
-            &mut [CwBvhNode],
-            u32,
-            &mut [u32],
-        )| self.emit(child, child_out, b, child_below, p, child_primitives);
-        if self.primitives[node].load(Relaxed) >= PARALLEL_MIN_PRIMITIVES {
-            jobs.into_par_iter().for_each(run);
-        } else {
-            jobs.into_iter().for_each(run);
+        let Region {
+            below_base,
+            below,
+            primitive_base,
+            primitives,
+        } = region;
+        let (wide, placements) = self.wide_node(node, below_base, primitive_base, primitives);
+        *out = wide;
+        let leaf_primitives = placements.first().map_or(primitives.len(), |p| {
+            (p.primitive_base - primitive_base) as usize
+        });
+        let (block, mut rest) = below.split_at_mut(placements.len());
+        let (_, mut rest_primitives) = primitives.split_at_mut(leaf_primitives);
+        let mut jobs = Vec::with_capacity(placements.len());
+        for (placement, child_out) in placements.iter().zip(block.iter_mut()) {
+            let (child_below, tail) =
+                std::mem::take(&mut rest).split_at_mut(placement.nodes_below as usize);
+            rest = tail;
+            let (child_primitives, tail) = std::mem::take(&mut rest_primitives)
+                .split_at_mut(placement.primitives_below as usize);
+            rest_primitives = tail;
+            let child_region = Region {
+                below_base: placement.below_base,
+                below: child_below,
+                primitive_base: placement.primitive_base,
+                primitives: child_primitives,
+            };
+            jobs.push((placement.node, child_out, child_region));
+        }
+        jobs.into_par_iter()
+            .for_each(|(child, child_out, child_region)| {
+                self.emit(child, child_out, child_region, wide_depth + 1)
+            });
+    }
+
+    /// [`Converter::emit`] on one thread, with a work list instead of recursion.
+    fn emit_serial(&self, root: usize, root_out: &mut CwBvhNode, region: Region<'_>) {
+        let Region {
+            below_base,
+            below,
+            primitive_base,
+            primitives,
+        } = region;
+        let (wide, placements) = self.wide_node(root, below_base, primitive_base, primitives);
+        *root_out = wide;
+        let mut work = placements;
+        while let Some(p) = work.pop() {
+            let at = (p.primitive_base - primitive_base) as usize;
+            let (wide, placements) = self.wide_node(
+                p.node,
+                p.below_base,
+                p.primitive_base,
+                &mut primitives[at..],
+            );
+            below[(p.index - below_base) as usize] = wide;
+            work.extend(placements);
         }
     }
+}
+
+/// Where a wide subtree's nodes below its root go (global indices from `below_base`) and
+/// where its primitives go (from `primitive_base`).
+struct Region<'a> {
+    below_base: u32,
+    below: &'a mut [CwBvhNode],
+    primitive_base: u32,
+    primitives: &'a mut [u32],
+}
+
+/// A node's wide internal children (BVH2 indices, `count` of them).
+#[derive(Clone, Copy)]
+struct InternalChildren {
+    nodes: [u32; 8],
+    count: usize,
+}
+
+impl InternalChildren {
+    fn as_slice(&self) -> &[u32] {
+        &self.nodes[..self.count]
+    }
+}
+
+/// Where an internal wide child and its subtree go (global indices).
+struct ChildPlacement {
+    /// Its BVH2 node.
+    node: usize,
+    /// Its own wide node.
+    index: u32,
+    /// Its children's block, followed by their subtrees.
+    below_base: u32,
+    nodes_below: u32,
+    /// Its leaves' primitives, followed by its internal children's.
+    primitive_base: u32,
+    primitives_below: u32,
 }

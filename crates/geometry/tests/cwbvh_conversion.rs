@@ -49,3 +49,53 @@ fn converts_exactly_as_obvhs() {
         }
     }
 }
+
+/// Coincident or nested boxes (a mesh exported with many duplicate or collapsed triangles)
+/// make PLOC's BVH2 a chain as deep as it has primitives. The conversion walks it without
+/// recursion: here on threads of 64 KiB of stack, which a recursion that deep overflows
+/// (obvhs' recursive conversion runs on a thread with 512 MiB, for the comparison).
+#[test]
+fn chains_as_deep_as_their_primitives_convert_without_recursion() {
+    use glam::Vec3A;
+    // PLOC itself takes time quadratic in a chain's length (0.7 s for 10⁴, 56 s for 10⁵).
+    const N: usize = 10_000;
+    let coincident: Vec<_> = (0..N)
+        .map(|_| padded_aabb(Vec3A::ZERO, Vec3A::ONE))
+        .collect();
+    let nested: Vec<_> = (0..N)
+        .map(|i| {
+            let half = 1.001f32.powi(i as i32);
+            padded_aabb(Vec3A::splat(-half), Vec3A::splat(half))
+        })
+        .collect();
+    let small_stacks = rayon::ThreadPoolBuilder::new()
+        .num_threads(2)
+        .stack_size(64 << 10)
+        .build()
+        .unwrap();
+    for (name, boxes) in [("coincident", coincident), ("nested", nested)] {
+        let bvh2 = build_bvh2(&boxes, BuildQuality::Fast);
+        let mut depth = 0;
+        let mut stack = vec![(0usize, 1usize)];
+        while let Some((node, d)) = stack.pop() {
+            depth = depth.max(d);
+            let n = &bvh2.nodes[node];
+            if !n.is_leaf() {
+                let first = n.first_index as usize;
+                stack.extend([(first, d + 1), (first + 1, d + 1)]);
+            }
+        }
+        assert!(
+            depth > N / 2,
+            "{name}: the BVH2 is {depth} deep, not a chain"
+        );
+        let parallel = small_stacks.install(|| bvh2_to_cwbvh_parallel(&bvh2, 3));
+        let serial = std::thread::Builder::new()
+            .stack_size(512 << 20)
+            .spawn(move || bvh2_to_cwbvh(&bvh2, 3, true, false))
+            .unwrap()
+            .join()
+            .unwrap();
+        assert!(parallel == serial, "{name}: the conversions differ");
+    }
+}
