@@ -532,14 +532,13 @@ impl Converter<'_> {
         if !self.splits(node, wide_depth) {
             return self.emit_serial(node, out, region);
         }
+        let (placements, region) = self.emit_root(node, out, region);
         let Region {
-            below_base,
             below,
             primitive_base,
             primitives,
+            ..
         } = region;
-        let (wide, placements) = self.wide_node(node, below_base, primitive_base, primitives);
-        *out = wide;
         let leaf_primitives = placements.first().map_or(primitives.len(), |p| {
             (p.primitive_base - primitive_base) as usize
         });
@@ -567,17 +566,33 @@ impl Converter<'_> {
             });
     }
 
+    /// Writes the region's root node into `out` and its leaves' primitives to the front of
+    /// the region; returns its internal children's placements and the region.
+    fn emit_root<'a>(
+        &self,
+        node: usize,
+        out: &mut CwBvhNode,
+        region: Region<'a>,
+    ) -> (Vec<ChildPlacement>, Region<'a>) {
+        let (wide, placements) = self.wide_node(
+            node,
+            region.below_base,
+            region.primitive_base,
+            region.primitives,
+        );
+        *out = wide;
+        (placements, region)
+    }
+
     /// [`Converter::emit`] on one thread, with a work list instead of recursion.
     fn emit_serial(&self, root: usize, root_out: &mut CwBvhNode, region: Region<'_>) {
+        let (mut work, region) = self.emit_root(root, root_out, region);
         let Region {
             below_base,
             below,
             primitive_base,
             primitives,
         } = region;
-        let (wide, placements) = self.wide_node(root, below_base, primitive_base, primitives);
-        *root_out = wide;
-        let mut work = placements;
         while let Some(p) = work.pop() {
             let at = (p.primitive_base - primitive_base) as usize;
             let (wide, placements) = self.wide_node(
