@@ -25,7 +25,8 @@ use rayon::prelude::*;
 const PRIM_COST: f32 = 0.3;
 /// 1 / (2⁸ − 1): child boxes are quantised to 8 bits per axis (Ylitie et al. §3.2).
 const QUANTISATION_DENOM: f32 = 1.0 / 255.0;
-/// Wide nodes have 8 children; a child takes at most this many decision slots below it.
+/// Decisions per BVH2 node: for covering 1 to 7 of its wide parent's 8 child slots (its
+/// sibling takes at least one).
 const SLOTS: usize = 7;
 /// Subtrees with fewer primitives are converted on the calling thread: below this, splitting
 /// costs more than it spreads.
