@@ -59,30 +59,38 @@ struct Decision {
 impl Decision {
     const UNSET: u8 = u8::MAX;
 
-    fn pack(self) -> u64 {
+    /// Kind and slot split in one byte (2 + 3 + 3 bits; a split is at most 6 slots).
+    fn choice_byte(self) -> u8 {
         let kind = match self.kind {
-            DecisionKind::Leaf => 0u64,
+            DecisionKind::Leaf => 0,
             DecisionKind::Internal => 1,
             DecisionKind::Distribute => 2,
         };
-        u64::from(self.cost.to_bits())
-            | kind << 32
-            | u64::from(self.distribute_left) << 40
-            | u64::from(self.distribute_right) << 48
+        debug_assert!(self.distribute_left < 8 && self.distribute_right < 8);
+        kind | (self.distribute_left & 7) << 2 | (self.distribute_right & 7) << 5
     }
+}
 
-    fn unpack(bits: u64) -> Self {
-        let kind = match (bits >> 32) & 0xff {
+/// A decision's kind and slot split, without its cost.
+#[derive(Clone, Copy)]
+struct Choice {
+    kind: DecisionKind,
+    distribute_left: u8,
+    distribute_right: u8,
+}
+
+impl Choice {
+    fn from_byte(byte: u8) -> Self {
+        let kind = match byte & 3 {
             0 => DecisionKind::Leaf,
             1 => DecisionKind::Internal,
             2 => DecisionKind::Distribute,
             other => unreachable!("decision kind {other} was never packed"),
         };
-        Decision {
-            cost: f32::from_bits(bits as u32),
+        Choice {
             kind,
-            distribute_left: (bits >> 40) as u8,
-            distribute_right: (bits >> 48) as u8,
+            distribute_left: (byte >> 2) & 7,
+            distribute_right: byte >> 5,
         }
     }
 }
@@ -93,8 +101,12 @@ impl Decision {
 struct Converter<'a> {
     bvh2: &'a Bvh2,
     max_prims_per_leaf: u32,
-    /// `SLOTS` packed decisions per node.
-    decisions: Vec<AtomicU64>,
+    /// `SLOTS` decision costs per node (f32 bits).
+    costs: Vec<AtomicU32>,
+    /// The `SLOTS` decisions' kinds and splits per node, a byte each
+    /// ([`Decision::choice_byte`]): 36 bytes per node with the costs, where obvhs' table
+    /// takes 56.
+    choices: Vec<AtomicU64>,
     /// Primitives below each node.
     primitives: Vec<AtomicU32>,
     /// Wide nodes below each node that becomes a wide internal node (itself not counted).
@@ -112,10 +124,11 @@ pub fn bvh2_to_cwbvh_parallel(bvh2: &Bvh2, max_prims_per_leaf: u32) -> CwBvh {
     let converter = Converter {
         bvh2,
         max_prims_per_leaf: max_prims_per_leaf.clamp(1, 3),
-        decisions: (0..n * SLOTS)
+        costs: (0..n * SLOTS)
             .into_par_iter()
-            .map(|_| AtomicU64::new(0))
+            .map(|_| AtomicU32::new(0))
             .collect(),
+        choices: (0..n).into_par_iter().map(|_| AtomicU64::new(0)).collect(),
         primitives: (0..n).into_par_iter().map(|_| AtomicU32::new(0)).collect(),
         wide_nodes_below: (0..n).into_par_iter().map(|_| AtomicU32::new(0)).collect(),
         direction_lut: std::array::from_fn(|s| {
@@ -145,12 +158,21 @@ pub fn bvh2_to_cwbvh_parallel(bvh2: &Bvh2, max_prims_per_leaf: u32) -> CwBvh {
 }
 
 impl Converter<'_> {
-    fn decision(&self, node: usize, slot: usize) -> Decision {
-        Decision::unpack(self.decisions[node * SLOTS + slot].load(Relaxed))
+    fn cost(&self, node: usize, slot: usize) -> f32 {
+        f32::from_bits(self.costs[node * SLOTS + slot].load(Relaxed))
     }
 
-    fn set_decision(&self, node: usize, slot: usize, d: Decision) {
-        self.decisions[node * SLOTS + slot].store(d.pack(), Relaxed);
+    fn choice(&self, node: usize, slot: usize) -> Choice {
+        Choice::from_byte((self.choices[node].load(Relaxed) >> (8 * slot)) as u8)
+    }
+
+    fn store_decisions(&self, node: usize, decisions: &[Decision; SLOTS]) {
+        let mut choices = 0u64;
+        for (slot, d) in decisions.iter().enumerate() {
+            self.costs[node * SLOTS + slot].store(d.cost.to_bits(), Relaxed);
+            choices |= u64::from(d.choice_byte()) << (8 * slot);
+        }
+        self.choices[node].store(choices, Relaxed);
     }
 
     /// Fills the decision table below `node` (Ylitie et al. eqs. 1–3: cost of a wide leaf, a
@@ -201,9 +223,7 @@ impl Converter<'_> {
                 distribute_left: 0,
                 distribute_right: 0,
             };
-            for slot in 0..SLOTS {
-                self.set_decision(node, slot, leaf);
-            }
+            self.store_decisions(node, &[leaf; SLOTS]);
             self.primitives[node].store(1, Relaxed);
             return 1;
         }
@@ -212,8 +232,8 @@ impl Converter<'_> {
             bvh_node.first_index as usize + 1,
         );
         let primitives = self.primitives[left].load(Relaxed) + self.primitives[right].load(Relaxed);
-        let left_cost = |k: usize| self.decision(left, k).cost;
-        let right_cost = |k: usize| self.decision(right, k).cost;
+        let left_cost = |k: usize| self.cost(left, k);
+        let right_cost = |k: usize| self.cost(right, k);
 
         // One slot (the paper's i = 1): a wide leaf, or a wide internal node whose slots the
         // two children share.
@@ -238,15 +258,15 @@ impl Converter<'_> {
         } else {
             (DecisionKind::Internal, cost_internal)
         };
-        let mut previous = Decision {
+        let mut decisions = [Decision {
             cost,
             kind,
             distribute_left,
             distribute_right,
-        };
-        self.set_decision(node, 0, previous);
+        }; SLOTS];
         // i + 1 slots (the paper's i = 2…8): the best of i slots, or a split between children.
         for i in 1..SLOTS {
+            let previous = decisions[i - 1];
             let mut cost_distribute = previous.cost;
             let (mut distribute_left, mut distribute_right) = (Decision::UNSET, Decision::UNSET);
             for k in 0..i {
@@ -267,9 +287,9 @@ impl Converter<'_> {
             } else {
                 previous
             };
-            self.set_decision(node, i, decision);
-            previous = decision;
+            decisions[i] = decision;
         }
+        self.store_decisions(node, &decisions);
         self.primitives[node].store(primitives, Relaxed);
         primitives
     }
@@ -283,12 +303,12 @@ impl Converter<'_> {
             *count += 1;
             return;
         }
-        let d = self.decision(node, slot);
+        let d = self.choice(node, slot);
         for (child, child_slot) in [
             (bvh_node.first_index as usize, d.distribute_left),
             (bvh_node.first_index as usize + 1, d.distribute_right),
         ] {
-            if self.decision(child, child_slot as usize).kind == DecisionKind::Distribute {
+            if self.choice(child, child_slot as usize).kind == DecisionKind::Distribute {
                 self.children_of(child, child_slot as usize, children, count);
             } else {
                 children[*count] = child as u32;
@@ -341,7 +361,7 @@ impl Converter<'_> {
     }
 
     fn is_wide_internal(&self, node: u32) -> bool {
-        self.decision(node as usize, 0).kind == DecisionKind::Internal
+        self.choice(node as usize, 0).kind == DecisionKind::Internal
     }
 
     /// The wide internal nodes among `node`'s wide children (BVH2 indices), in any order.
@@ -477,7 +497,7 @@ impl Converter<'_> {
             out.child_max_x[i] = hi.x as u8;
             out.child_max_y[i] = hi.y as u8;
             out.child_max_z[i] = hi.z as u8;
-            match self.decision(child as usize, 0).kind {
+            match self.choice(child as usize, 0).kind {
                 DecisionKind::Leaf => {
                     let first = leaf_primitive_count;
                     self.leaf_primitives(child as usize, primitives, &mut leaf_primitive_count);
