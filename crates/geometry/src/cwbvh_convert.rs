@@ -36,6 +36,9 @@ const PARALLEL_COST_DEPTH: u32 = 12;
 /// The counting and writing passes split the top levels of the wide tree: at most 8⁵ tasks.
 const PARALLEL_WIDE_DEPTH: u32 = 5;
 
+/// No split found yet (a slot count − 1 is at most 6).
+const UNSET: u8 = u8::MAX;
+
 /// What becomes of a BVH2 node when it is to cover `i + 1` slots of its wide parent.
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
 enum DecisionKind {
@@ -47,20 +50,32 @@ enum DecisionKind {
     Distribute,
 }
 
+/// A decision: its SAH cost and what it does.
 #[derive(Clone, Copy, Debug)]
 struct Decision {
     cost: f32,
+    choice: Choice,
+}
+
+/// A decision's kind and slot split, stored apart from its cost in one byte.
+#[derive(Clone, Copy, Debug)]
+struct Choice {
     kind: DecisionKind,
     /// Slots given to the left and right child (as slot counts − 1) when distributing.
     distribute_left: u8,
     distribute_right: u8,
 }
 
-impl Decision {
-    const UNSET: u8 = u8::MAX;
+impl Choice {
+    /// A wide leaf's (a BVH2 leaf's, whatever the slots).
+    const LEAF: Choice = Choice {
+        kind: DecisionKind::Leaf,
+        distribute_left: 0,
+        distribute_right: 0,
+    };
 
-    /// Kind and slot split in one byte (2 + 3 + 3 bits; a split is at most 6 slots).
-    fn choice_byte(self) -> u8 {
+    /// Kind and split in one byte (2 + 3 + 3 bits; a split gives at most 6 slots).
+    fn to_byte(self) -> u8 {
         let kind = match self.kind {
             DecisionKind::Leaf => 0,
             DecisionKind::Internal => 1,
@@ -69,17 +84,7 @@ impl Decision {
         debug_assert!(self.distribute_left < 8 && self.distribute_right < 8);
         kind | (self.distribute_left & 7) << 2 | (self.distribute_right & 7) << 5
     }
-}
 
-/// A decision's kind and slot split, without its cost.
-#[derive(Clone, Copy)]
-struct Choice {
-    kind: DecisionKind,
-    distribute_left: u8,
-    distribute_right: u8,
-}
-
-impl Choice {
     fn from_byte(byte: u8) -> Self {
         let kind = match byte & 3 {
             0 => DecisionKind::Leaf,
@@ -104,7 +109,7 @@ struct Converter<'a> {
     /// `SLOTS` decision costs per node (f32 bits).
     costs: Vec<AtomicU32>,
     /// The `SLOTS` decisions' kinds and splits per node, a byte each
-    /// ([`Decision::choice_byte`]): 36 bytes per node with the costs, where obvhs' table
+    /// ([`Choice::to_byte`]): 36 bytes per node with the costs, where obvhs' table
     /// takes 56.
     choices: Vec<AtomicU64>,
     /// Primitives below each node.
@@ -124,13 +129,10 @@ pub fn bvh2_to_cwbvh_parallel(bvh2: &Bvh2, max_prims_per_leaf: u32) -> CwBvh {
     let converter = Converter {
         bvh2,
         max_prims_per_leaf: max_prims_per_leaf.clamp(1, 3),
-        costs: (0..n * SLOTS)
-            .into_par_iter()
-            .map(|_| AtomicU32::new(0))
-            .collect(),
-        choices: (0..n).into_par_iter().map(|_| AtomicU64::new(0)).collect(),
-        primitives: (0..n).into_par_iter().map(|_| AtomicU32::new(0)).collect(),
-        wide_nodes_below: (0..n).into_par_iter().map(|_| AtomicU32::new(0)).collect(),
+        costs: zeroed(n * SLOTS),
+        choices: zeroed(n),
+        primitives: zeroed(n),
+        wide_nodes_below: zeroed(n),
         direction_lut: std::array::from_fn(|s| {
             let sign = |bit: usize| if s & bit != 0 { -1.0 } else { 1.0 };
             Vec3A::new(sign(0b100), sign(0b010), sign(0b001))
@@ -157,6 +159,11 @@ pub fn bvh2_to_cwbvh_parallel(bvh2: &Bvh2, max_prims_per_leaf: u32) -> CwBvh {
     }
 }
 
+/// `len` zeroed atomics, written on every core.
+fn zeroed<T: Default + Send>(len: usize) -> Vec<T> {
+    (0..len).into_par_iter().map(|_| T::default()).collect()
+}
+
 impl Converter<'_> {
     fn cost(&self, node: usize, slot: usize) -> f32 {
         f32::from_bits(self.costs[node * SLOTS + slot].load(Relaxed))
@@ -170,7 +177,7 @@ impl Converter<'_> {
         let mut choices = 0u64;
         for (slot, d) in decisions.iter().enumerate() {
             self.costs[node * SLOTS + slot].store(d.cost.to_bits(), Relaxed);
-            choices |= u64::from(d.choice_byte()) << (8 * slot);
+            choices |= u64::from(d.choice.to_byte()) << (8 * slot);
         }
         self.choices[node].store(choices, Relaxed);
     }
@@ -219,9 +226,7 @@ impl Converter<'_> {
             );
             let leaf = Decision {
                 cost: half_area * PRIM_COST,
-                kind: DecisionKind::Leaf,
-                distribute_left: 0,
-                distribute_right: 0,
+                choice: Choice::LEAF,
             };
             self.store_decisions(node, &[leaf; SLOTS]);
             self.primitives[node].store(1, Relaxed);
@@ -243,7 +248,7 @@ impl Converter<'_> {
             f32::INFINITY
         };
         let mut cost_distribute = f32::INFINITY;
-        let (mut distribute_left, mut distribute_right) = (Decision::UNSET, Decision::UNSET);
+        let (mut distribute_left, mut distribute_right) = (UNSET, UNSET);
         for k in 0..SLOTS {
             let c = left_cost(k) + right_cost(SLOTS - 1 - k);
             if c < cost_distribute {
@@ -260,15 +265,17 @@ impl Converter<'_> {
         };
         let mut decisions = [Decision {
             cost,
-            kind,
-            distribute_left,
-            distribute_right,
+            choice: Choice {
+                kind,
+                distribute_left,
+                distribute_right,
+            },
         }; SLOTS];
         // i + 1 slots (the paper's i = 2…8): the best of i slots, or a split between children.
         for i in 1..SLOTS {
             let previous = decisions[i - 1];
             let mut cost_distribute = previous.cost;
-            let (mut distribute_left, mut distribute_right) = (Decision::UNSET, Decision::UNSET);
+            let (mut distribute_left, mut distribute_right) = (UNSET, UNSET);
             for k in 0..i {
                 let c = left_cost(k) + right_cost(i - k - 1);
                 if c < cost_distribute {
@@ -277,12 +284,14 @@ impl Converter<'_> {
                     distribute_right = (i - k - 1) as u8;
                 }
             }
-            let decision = if distribute_left != Decision::UNSET {
+            let decision = if distribute_left != UNSET {
                 Decision {
                     cost: cost_distribute,
-                    kind: DecisionKind::Distribute,
-                    distribute_left,
-                    distribute_right,
+                    choice: Choice {
+                        kind: DecisionKind::Distribute,
+                        distribute_left,
+                        distribute_right,
+                    },
                 }
             } else {
                 previous
@@ -369,14 +378,10 @@ impl Converter<'_> {
         let mut children = [u32::MAX; 8];
         let mut count = 0;
         self.children_of(node, 0, &mut children, &mut count);
-        let mut internal = InternalChildren {
-            nodes: [u32::MAX; 8],
-            count: 0,
-        };
+        let mut internal = InternalChildren::EMPTY;
         for &c in &children[..count] {
             if self.is_wide_internal(c) {
-                internal.nodes[internal.count] = c;
-                internal.count += 1;
+                internal.push(c);
             }
         }
         internal
@@ -478,7 +483,7 @@ impl Converter<'_> {
         };
 
         let children = self.ordered_children(node);
-        let mut internal = Vec::with_capacity(8);
+        let mut internal = InternalChildren::EMPTY;
         let mut leaf_primitive_count = 0usize;
         for (i, &child) in children.iter().enumerate() {
             if child == u32::MAX {
@@ -514,7 +519,7 @@ impl Converter<'_> {
                 DecisionKind::Internal => {
                     out.imask |= 1 << i;
                     out.child_meta[i] = (24 + i as u8) | 0b0010_0000;
-                    internal.push(child as usize);
+                    internal.push(child);
                 }
                 DecisionKind::Distribute => {
                     unreachable!("children_of resolves every distributed slot")
@@ -522,12 +527,14 @@ impl Converter<'_> {
             }
         }
 
-        let mut next_below = below_base + internal.len() as u32;
+        let mut next_below = below_base + internal.count as u32;
         let mut next_primitive = primitive_base + leaf_primitive_count as u32;
         let placements = internal
+            .as_slice()
             .iter()
             .enumerate()
             .map(|(j, &child)| {
+                let child = child as usize;
                 let nodes_below = self.wide_nodes_below[child].load(Relaxed);
                 let primitives_below = self.primitives[child].load(Relaxed);
                 let placement = ChildPlacement {
@@ -645,6 +652,16 @@ struct InternalChildren {
 }
 
 impl InternalChildren {
+    const EMPTY: InternalChildren = InternalChildren {
+        nodes: [u32::MAX; 8],
+        count: 0,
+    };
+
+    fn push(&mut self, node: u32) {
+        self.nodes[self.count] = node;
+        self.count += 1;
+    }
+
     fn as_slice(&self) -> &[u32] {
         &self.nodes[..self.count]
     }

@@ -30,9 +30,9 @@ struct Lane<L> {
 impl<Id: Copy> TriangleBvh<Id> {
     /// Closest-hit traversal of `count` rays, `STREAM_LANES` interleaved: `start(i)` gives
     /// ray `i` (origin, direction, `t_min`, `t_max`) and the caller's state for it,
-    /// `test(state, primitive, id, t_max)` is [`TriangleBvh::traverse_with`]'s leaf test for that ray,
-    /// and `finish(i, state)` receives the state once ray `i` has ended (in any order of
-    /// `i`). The node test is `WIDE`'s.
+    /// `test(state, primitive, id, t_max)` is [`TriangleBvh::traverse_with`]'s leaf test for
+    /// that ray, and `finish(i, state)` receives the state once ray `i` has ended (in any
+    /// order of `i`). The node test is `WIDE`'s.
     ///
     /// # Safety
     /// With `WIDE`, the CPU must run AVX2.
