@@ -66,3 +66,30 @@ pub fn import_file(path: &Path, options: &ImportOptions) -> Result<Imported, Imp
         )),
     }
 }
+
+/// Scene text imported from a file, for the importers' unit tests.
+#[cfg(test)]
+pub(crate) mod test_support {
+    use std::path::Path;
+
+    use crate::{import_file, ImportOptions, Imported};
+
+    /// Imports `text` as the scene file `file_name` (its extension picks the importer) in a
+    /// fresh folder, removed afterwards.
+    pub fn import_text(file_name: &str, text: &str) -> Imported {
+        let dir = tempfile::tempdir().unwrap();
+        import_text_in(dir.path(), file_name, text)
+    }
+
+    /// Imports `text` as the scene file `dir/file_name`, next to whatever files it names.
+    pub fn import_text_in(dir: &Path, file_name: &str, text: &str) -> Imported {
+        let path = dir.join(file_name);
+        std::fs::write(&path, text).unwrap();
+        let options = ImportOptions {
+            output_dir: dir.to_path_buf(),
+            side_dir: "a".into(),
+            ..Default::default()
+        };
+        import_file(&path, &options).unwrap()
+    }
+}

@@ -149,23 +149,7 @@ mod tests {
 
     /// Imports `text` as a scene file in a fresh folder (removed afterwards).
     fn import_text(text: &str) -> Imported {
-        let dir = tempfile::tempdir().unwrap();
-        import_text_in(dir.path(), text)
-    }
-
-    /// Imports `text` as a scene file in `dir`, next to whatever files it names.
-    fn import_text_in(dir: &std::path::Path, text: &str) -> Imported {
-        let path = dir.join("scene.xml");
-        std::fs::write(&path, text).unwrap();
-        import(
-            &path,
-            &ImportOptions {
-                output_dir: dir.to_path_buf(),
-                side_dir: "a".into(),
-                ..Default::default()
-            },
-        )
-        .unwrap()
+        crate::test_support::import_text("scene.xml", text)
     }
 
     #[test]
@@ -217,8 +201,9 @@ mod tests {
             serialized::tests::one_triangle(),
         )
         .unwrap();
-        let i = import_text_in(
+        let i = crate::test_support::import_text_in(
             dir.path(),
+            "scene.xml",
             "<scene version=\"3.0.0\"><shape type=\"serialized\"><string name=\"filename\" value=\"tri.serialized\"/></shape></scene>",
         );
         assert_eq!(i.scene["shapes"][0]["file"], "a/serialized-0.obj");

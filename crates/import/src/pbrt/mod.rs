@@ -369,23 +369,7 @@ mod tests {
 
     /// Imports `text` as a scene file in a fresh folder (removed afterwards).
     fn import_text(text: &str) -> Imported {
-        let dir = tempfile::tempdir().unwrap();
-        import_text_in(dir.path(), text)
-    }
-
-    /// Imports `text` as a scene file in `dir`, next to whatever files it names.
-    fn import_text_in(dir: &std::path::Path, text: &str) -> Imported {
-        let path = dir.join("scene.pbrt");
-        std::fs::write(&path, text).unwrap();
-        import(
-            &path,
-            &ImportOptions {
-                output_dir: dir.to_path_buf(),
-                side_dir: "a".into(),
-                ..Default::default()
-            },
-        )
-        .unwrap()
+        crate::test_support::import_text("scene.pbrt", text)
     }
 
     /// pbrt's LookAt with up +Y looking down −Z puts image right at world −X (pbrt's
