@@ -117,10 +117,10 @@ fn unbiased_and_less_noisy(
     better: ShadingSelection,
     variance_bound: f64,
 ) {
-    let bvh = renders(description, better);
+    let chosen = renders(description, better);
     let power = renders(description, ShadingSelection::Power);
     agree_and_first_less_noisy(
-        &bvh,
+        &chosen,
         &power,
         &format!("{better:?}"),
         "power",
@@ -132,8 +132,8 @@ fn unbiased_and_less_noisy(
 /// errors of their difference, and `better`'s floor variance below `variance_bound` times
 /// `worse`'s in every channel.
 fn agree_and_first_less_noisy(
-    bvh: &[Vec<[f64; 3]>],
-    power: &[Vec<[f64; 3]>],
+    better_renders: &[Vec<[f64; 3]>],
+    worse_renders: &[Vec<[f64; 3]>],
     better: &str,
     worse: &str,
     variance_bound: f64,
@@ -145,8 +145,8 @@ fn agree_and_first_less_noisy(
                 .map(|im| im.iter().map(|p| p[c]).sum::<f64>() / im.len() as f64)
                 .collect()
         };
-        let (mb, sb) = mean_and_standard_error(&image_means(bvh));
-        let (mp, sp) = mean_and_standard_error(&image_means(power));
+        let (mb, sb) = mean_and_standard_error(&image_means(better_renders));
+        let (mp, sp) = mean_and_standard_error(&image_means(worse_renders));
         let se = (sb * sb + sp * sp).sqrt();
         eprintln!(
             "channel {c}: {better} {mb:.5} ± {sb:.5}, {worse} {mp:.5} ± {sp:.5}, difference \
@@ -162,7 +162,10 @@ fn agree_and_first_less_noisy(
             (mb - mp).abs() <= 4.0 * se,
             "channel {c}: {better} {mb} vs {worse} {mp}, beyond 4 standard errors ({se})"
         );
-        let (vb, vp) = (mean_pixel_variance(bvh, c), mean_pixel_variance(power, c));
+        let (vb, vp) = (
+            mean_pixel_variance(better_renders, c),
+            mean_pixel_variance(worse_renders, c),
+        );
         eprintln!(
             "channel {c}: mean pixel variance {better} {vb:.3e}, {worse} {vp:.3e} ({:.3})",
             vb / vp
