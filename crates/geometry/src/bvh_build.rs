@@ -4,13 +4,17 @@
 //! "Efficient incoherent ray traversal on GPUs through compressed wide BVHs", on every core:
 //! [`crate::cwbvh_convert`]).
 
+use std::collections::HashMap;
+
 use glam::Vec3A;
 use obvhs::aabb::Aabb;
+use obvhs::bvh2::node::Bvh2Node;
 use obvhs::bvh2::reinsertion::ReinsertionOptimizer;
 use obvhs::cwbvh::CwBvh;
 use obvhs::ploc::PlocBuilder;
 use obvhs::BvhBuildParams;
 
+use crate::coincident_boxes::coincident_groups;
 use crate::cwbvh_convert::bvh2_to_cwbvh_parallel;
 
 /// Quality/speed trade-off of the build: the obvhs presets. obvhs' `pre_split` (spatial
@@ -82,18 +86,96 @@ pub fn build_bvh(boxes: &[Aabb], quality: BuildQuality) -> Option<CwBvh> {
 }
 
 /// The binary BVH that [`build_bvh`] converts: PLOC with one primitive per leaf, then
-/// reinsertion.
+/// reinsertion. Large groups of identical boxes go to PLOC as one box each and get a
+/// balanced subtree under its leaf ([`crate::coincident_boxes`]): PLOC alone makes them a
+/// chain, in time quadratic in its length.
 pub fn build_bvh2(boxes: &[Aabb], quality: BuildQuality) -> obvhs::bvh2::Bvh2 {
+    let groups = coincident_groups(boxes);
+    if groups.is_empty() {
+        return ploc_with_reinsertion(boxes, (0..boxes.len() as u32).collect(), quality);
+    }
+    // PLOC sees every box outside the groups and each group's first member.
+    let mut stand_in = vec![false; boxes.len()];
+    let mut group_of_first: HashMap<u32, usize> = HashMap::with_capacity(groups.len());
+    for (g, members) in groups.iter().enumerate() {
+        group_of_first.insert(members[0], g);
+        for &m in &members[1..] {
+            stand_in[m as usize] = true;
+        }
+    }
+    let (kept_boxes, kept): (Vec<Aabb>, Vec<u32>) = boxes
+        .iter()
+        .zip(0u32..)
+        .filter(|&(_, i)| !stand_in[i as usize])
+        .map(|(b, i)| (*b, i))
+        .unzip();
+    // PLOC writes a leaf's label into its `first_index`, which the conversion reads as a
+    // slot of `primitive_indices`: positions as labels, then the slots map them back.
+    let mut bvh2 = ploc_with_reinsertion(&kept_boxes, (0..kept.len() as u32).collect(), quality);
+    debug_assert_eq!(bvh2.primitive_indices.len(), kept.len());
+    bvh2.primitive_indices = kept;
+    for node in 0..bvh2.nodes.len() {
+        let leaf = bvh2.nodes[node];
+        if !leaf.is_leaf() {
+            continue;
+        }
+        debug_assert_eq!(leaf.prim_count, 1, "PLOC builds one primitive per leaf");
+        let first = bvh2.primitive_indices[leaf.first_index as usize];
+        if let Some(&g) = group_of_first.get(&first) {
+            hang_balanced_subtree(&mut bvh2, node, &groups[g]);
+        }
+    }
+    // The optional maps reinsertion may have filled no longer cover the new nodes.
+    bvh2.parents.clear();
+    bvh2.primitives_to_nodes.clear();
+    bvh2
+}
+
+fn ploc_with_reinsertion(
+    boxes: &[Aabb],
+    indices: Vec<u32>,
+    quality: BuildQuality,
+) -> obvhs::bvh2::Bvh2 {
     let params = quality.params();
     let mut bvh2 = PlocBuilder::with_capacity(boxes.len()).build(
         params.ploc_search_distance,
         boxes,
-        (0..boxes.len() as u32).collect(),
+        indices,
         params.sort_precision,
         params.search_depth_threshold,
     );
     ReinsertionOptimizer::default().run(&mut bvh2, params.reinsertion_batch_ratio, None);
     bvh2
+}
+
+/// Turns leaf `node` (one primitive, `members[0]`) into a balanced binary subtree with a
+/// leaf per member; all share the leaf's box. New nodes go at the end in sibling pairs
+/// (children after their parent, as obvhs lays a tree out), new primitives likewise.
+fn hang_balanced_subtree(bvh2: &mut obvhs::bvh2::Bvh2, node: usize, members: &[u32]) {
+    let aabb = *bvh2.nodes[node].aabb();
+    let first_slot = bvh2.nodes[node].first_index;
+    // (node to fill, members it holds); a leaf's primitive slot is appended, except the
+    // first member's, which keeps the slot PLOC gave it.
+    let mut work = vec![(node, 0..members.len())];
+    while let Some((at, range)) = work.pop() {
+        if range.len() == 1 {
+            let slot = if range.start == 0 {
+                first_slot
+            } else {
+                bvh2.primitive_indices.push(members[range.start]);
+                (bvh2.primitive_indices.len() - 1) as u32
+            };
+            bvh2.nodes[at] = Bvh2Node::new(aabb, 1, slot);
+            continue;
+        }
+        let children = bvh2.nodes.len();
+        bvh2.nodes
+            .extend([Bvh2Node::new(aabb, 0, 0), Bvh2Node::new(aabb, 0, 0)]);
+        bvh2.nodes[at] = Bvh2Node::new(aabb, 0, children as u32);
+        let mid = range.start + range.len() / 2;
+        work.push((children + 1, mid..range.end));
+        work.push((children, range.start..mid));
+    }
 }
 
 /// Largest reciprocal used for a zero (or sub-1e-18) direction component in the slab test.

@@ -7,6 +7,7 @@
 //! Units: positions and distances in metres, angles in radians, curvature in 1/m.
 
 pub mod bvh_build;
+pub mod coincident_boxes;
 pub mod curvature;
 pub mod cwbvh_convert;
 pub mod disk;

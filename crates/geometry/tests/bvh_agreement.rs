@@ -42,7 +42,29 @@ fn test_meshes() -> Vec<(&'static str, TriangleMesh)> {
         ("uv_sphere", TriangleMesh::uv_sphere(1.2, 16, 32)),
         ("cube", TriangleMesh::cuboid(Vec3A::new(1.0, 0.6, 0.8))),
         ("soup", triangle_soup(600, 1.5, 0.02..0.4, &mut rng)),
+        (
+            "soup with duplicates",
+            with_duplicates(triangle_soup(600, 1.5, 0.02..0.4, &mut rng)),
+        ),
     ]
+}
+
+/// `mesh` with 100 copies of each of its first five triangles spread through it and 100
+/// triangles collapsed onto one vertex: groups the build takes apart from PLOC
+/// (`prism_geometry::coincident_boxes`).
+fn with_duplicates(mut mesh: TriangleMesh) -> TriangleMesh {
+    let originals = mesh.indices.clone();
+    let mut indices = Vec::new();
+    for (i, tri) in originals.iter().enumerate() {
+        indices.push(*tri);
+        if i % 6 == 0 {
+            indices.extend((0..5).map(|k| originals[k]));
+        }
+    }
+    let collapsed = originals[7][0];
+    indices.extend(std::iter::repeat_n([collapsed; 3], 100));
+    mesh.indices = indices;
+    TriangleMesh::new(mesh.positions, mesh.indices)
 }
 
 #[test]

@@ -51,7 +51,8 @@ fn converts_exactly_as_obvhs() {
 }
 
 /// Coincident or nested boxes (a mesh exported with many duplicate or collapsed triangles)
-/// make PLOC's BVH2 a chain as deep as it has primitives. The conversion walks it without
+/// make PLOC's BVH2 a chain as deep as it has primitives (`build_bvh2` takes large groups
+/// of coincident boxes apart, so the chains here are PLOC's own). The conversion walks it without
 /// recursion: here on threads of 64 KiB of stack, which a recursion that deep overflows
 /// (obvhs' recursive conversion runs on a thread with 512 MiB, for the comparison).
 #[test]
@@ -74,7 +75,14 @@ fn chains_as_deep_as_their_primitives_convert_without_recursion() {
         .build()
         .unwrap();
     for (name, boxes) in [("coincident", coincident), ("nested", nested)] {
-        let bvh2 = build_bvh2(&boxes, BuildQuality::Fast);
+        let params = BuildQuality::Fast.params();
+        let bvh2 = obvhs::ploc::PlocBuilder::with_capacity(N).build(
+            params.ploc_search_distance,
+            &boxes,
+            (0..N as u32).collect(),
+            params.sort_precision,
+            params.search_depth_threshold,
+        );
         let mut depth = 0;
         let mut stack = vec![(0usize, 1usize)];
         while let Some((node, d)) = stack.pop() {
