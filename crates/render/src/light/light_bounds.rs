@@ -121,6 +121,10 @@ pub struct LightBounds4 {
     centre: [Vec4; 3],
     /// Squared radius of each box's bounding sphere (half its diagonal), m².
     radius2: Vec4,
+    /// That radius, m, and 1 / its square (1/m², finite for points): `importance` then
+    /// takes one square root and one division before its cones.
+    radius: Vec4,
+    inv_radius2: Vec4,
     w: [Vec4; 3],
     cos_o: Vec4,
     sin_o: Vec4,
@@ -142,6 +146,12 @@ impl LightBounds4 {
                 lane(&|b| b.centroid().z),
             ],
             radius2: lane(&|b| (b.hi - b.centroid()).length_squared()),
+            radius: lane(&|b| (b.hi - b.centroid()).length()),
+            inv_radius2: lane(&|b| {
+                1.0 / (b.hi - b.centroid())
+                    .length_squared()
+                    .max(f32::MIN_POSITIVE)
+            }),
             w: [
                 lane(&|b| b.normals.w.x),
                 lane(&|b| b.normals.w.y),
@@ -184,14 +194,14 @@ impl LightBounds4 {
         let sin_w = safe_sqrt(one - cos_w * cos_w);
         // θ_b: the half-angle of the bounding sphere seen from p (all directions inside).
         let inside = dist2.cmple(self.radius2);
-        let sin2 = self.radius2 / dist2;
-        let sin_b = Vec4::select(inside, zero, sin2.sqrt());
-        let cos_b = Vec4::select(inside, -one, safe_sqrt(one - sin2));
+        let sin_b = Vec4::select(inside, zero, self.radius * inv);
+        let cos_b = Vec4::select(inside, -one, safe_sqrt(one - sin_b * sin_b));
         let cos_x = cos_sub(sin_w, cos_w, self.sin_o, self.cos_o);
         let sin_x = sin_sub(sin_w, cos_w, self.sin_o, self.cos_o);
         let cos_p = cos_sub(sin_x, cos_x, sin_b, cos_b);
-        let d2 = dist2.max(self.radius2).max(Vec4::splat(f32::MIN_POSITIVE));
-        let mut importance = self.phi * cos_p / d2;
+        // 1 / max(d², r²): the bounding sphere's radius inside it.
+        let inv_d2 = Vec4::select(away, (inv * inv).min(self.inv_radius2), self.inv_radius2);
+        let mut importance = self.phi * cos_p * inv_d2;
         if n != Vec3A::ZERO {
             let cos_i = (wi[0] * n.x + wi[1] * n.y + wi[2] * n.z).abs();
             let sin_i = safe_sqrt(one - cos_i * cos_i);
