@@ -7,6 +7,10 @@
 //! change of material has a step in its image, and a step is not band-limited: such a pixel
 //! gets eq. 11's finest anti-aliasing level. A step the eye cannot see (the two sides' L̂
 //! within `EDGE_MIN_CONTRAST` of each other) is no edge.
+//!
+//! A mirror or smooth glass shows another surface: its pixels are compared also by what
+//! their Dirac chain reaches ([`SeenSurface`]), so that the outline of an object, or the
+//! horizon, seen in a mirror sphere is an edge as it would be seen directly.
 
 use glam::UVec2;
 
@@ -23,14 +27,27 @@ const STEP_MIN_SINE: f32 = 0.5;
 /// The smallest step in L̂, relative to the brighter side, that counts as an edge.
 pub const EDGE_MIN_CONTRAST: f32 = 0.1;
 
-/// Per pixel (row-major): true where a 4-neighbour lies across a visible geometric edge.
-/// `class` and `surface` come from the G-buffer (`surface` is `None` off surfaces),
-/// `mean_y` is L̂ (pooled per surface). Unpredicted pixels are never edges, nor do they make
-/// their neighbours one.
+/// What a pixel whose centre hit is a Dirac surface (mirror, smooth glass) shows: where its
+/// centre ray's chain of Dirac vertices ends (a surface's class and point, or the
+/// background's class and no point), and the pixel's own L̂, not pooled: pooling over the
+/// mirror would blur the very steps it shows.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SeenSurface {
+    pub class: PixelClass,
+    pub surface: Option<SurfacePoint>,
+    pub mean_y: f32,
+}
+
+/// Per pixel (row-major): true where a 4-neighbour lies across a visible geometric edge,
+/// directly or through a Dirac chain. `class` and `surface` come from the G-buffer
+/// (`surface` is `None` off surfaces), `seen` from the Dirac chains (`None` where the
+/// centre hit is not Dirac), `mean_y` is L̂ (pooled per surface). Unpredicted pixels are
+/// never edges, nor do they make their neighbours one.
 pub fn geometric_edges(
     resolution: UVec2,
     class: &[PixelClass],
     surface: &[Option<SurfacePoint>],
+    seen: &[Option<SeenSurface>],
     mean_y: &[f32],
 ) -> Result<Vec<bool>, BandwidthError> {
     let count = pixel_count("geometric edges", resolution)?;
@@ -40,6 +57,7 @@ pub fn geometric_edges(
         &[
             ("pixel classes", class.len()),
             ("surface points", surface.len()),
+            ("surfaces seen through Dirac chains", seen.len()),
             ("L̂", mean_y.len()),
         ],
     )?;
@@ -50,8 +68,9 @@ pub fn geometric_edges(
             }
             four_neighbours(i, resolution).any(|j| {
                 class[j] != PixelClass::Unpredicted
-                    && is_discontinuous(class[i], class[j], surface[i], surface[j])
-                    && is_visible_step(mean_y[i], mean_y[j])
+                    && ((is_discontinuous(class[i], class[j], surface[i], surface[j])
+                        && is_visible_step(mean_y[i], mean_y[j]))
+                        || seen_across_edge(seen[i], seen[j]))
             })
         })
         .collect())
@@ -73,6 +92,18 @@ fn is_discontinuous(
                 || p.off_plane_sine(&q).max(q.off_plane_sine(&p)) > STEP_MIN_SINE
         }
         // Two background pixels, or a class without surface points: no geometry to differ.
+        (None, None) | (Some(_), None) | (None, Some(_)) => false,
+    }
+}
+
+/// Two Dirac pixels that show discontinuous surfaces with a visible step between their own
+/// L̂ (a pixel whose chain was lost compares as continuous).
+fn seen_across_edge(p: Option<SeenSurface>, q: Option<SeenSurface>) -> bool {
+    match (p, q) {
+        (Some(p), Some(q)) => {
+            is_discontinuous(p.class, q.class, p.surface, q.surface)
+                && is_visible_step(p.mean_y, q.mean_y)
+        }
         (None, None) | (Some(_), None) | (None, Some(_)) => false,
     }
 }
@@ -103,7 +134,7 @@ mod tests {
             .map(|&z| point(0.0, z, Vec3A::Y))
             .collect();
         let l = [1.0; 5];
-        let none = geometric_edges(UVec2::new(5, 1), &[m; 5], &plane, &l).unwrap();
+        let none = geometric_edges(UVec2::new(5, 1), &[m; 5], &plane, &[None; 5], &l).unwrap();
         assert_eq!(none, vec![false; 5]);
         // A depth step between pixels 2 and 3: pixel 3 lies 1 m above pixel 2's plane.
         let mut step = plane.clone();
@@ -113,10 +144,11 @@ mod tests {
         });
         step[4] = step[3];
         let l = [1.0, 1.0, 1.0, 2.0, 2.0];
-        let edges = geometric_edges(UVec2::new(5, 1), &[m; 5], &step, &l).unwrap();
+        let edges = geometric_edges(UVec2::new(5, 1), &[m; 5], &step, &[None; 5], &l).unwrap();
         assert_eq!(edges, vec![false, false, true, true, false]);
         // The same step with equal radiance on both sides is invisible.
-        let flat = geometric_edges(UVec2::new(5, 1), &[m; 5], &step, &[1.0; 5]).unwrap();
+        let flat =
+            geometric_edges(UVec2::new(5, 1), &[m; 5], &step, &[None; 5], &[1.0; 5]).unwrap();
         assert_eq!(flat, vec![false; 5]);
         // A crease: normals 90° apart at pixels 1 | 2.
         let crease = [
@@ -124,18 +156,73 @@ mod tests {
             point(0.1, 1.0, Vec3A::Y),
             point(0.2, 1.0, Vec3A::X),
         ];
-        let edges = geometric_edges(UVec2::new(3, 1), &[m; 3], &crease, &[1.0, 1.0, 0.5]).unwrap();
+        let edges = geometric_edges(
+            UVec2::new(3, 1),
+            &[m; 3],
+            &crease,
+            &[None; 3],
+            &[1.0, 1.0, 0.5],
+        )
+        .unwrap();
         assert_eq!(edges, vec![false, true, true]);
         // A silhouette against the background marks both sides; unpredicted pixels neither.
         let class = [m, PixelClass::Background, PixelClass::Unpredicted];
         let surface = [point(0.0, 1.0, Vec3A::Y), None, None];
-        let edges = geometric_edges(UVec2::new(3, 1), &class, &surface, &[1.0, 3.0, 0.0]).unwrap();
+        let edges = geometric_edges(
+            UVec2::new(3, 1),
+            &class,
+            &surface,
+            &[None; 3],
+            &[1.0, 3.0, 0.0],
+        )
+        .unwrap();
         assert_eq!(edges, vec![true, true, false]);
+    }
+
+    /// Four pixels on one mirror sphere (one material, normals a few degrees apart): the
+    /// first two show the floor, the third the background above the horizon, the fourth a
+    /// lost chain. The horizon is an edge; the mirror's own surface is smooth.
+    #[test]
+    fn a_horizon_seen_in_a_mirror_is_an_edge() {
+        let mirror = PixelClass::Material(1);
+        let floor = |x: f32| SeenSurface {
+            class: PixelClass::Material(0),
+            surface: point(x, 5.0, Vec3A::Y),
+            mean_y: 0.2,
+        };
+        let sky = SeenSurface {
+            class: PixelClass::Background,
+            surface: None,
+            mean_y: 1.0,
+        };
+        let tilt = |a: f32| Vec3A::new(a.sin(), 0.0, a.cos());
+        let surface: Vec<_> = (0..4)
+            .map(|k| {
+                Some(SurfacePoint {
+                    position_m: Vec3A::new(0.01 * k as f32, 0.0, 1.0),
+                    normal: tilt(0.05 * k as f32),
+                })
+            })
+            .collect();
+        let seen = [Some(floor(0.0)), Some(floor(0.3)), Some(sky), None];
+        // L̂ pooled over the mirror: the step is blurred away there, not in `seen`.
+        let l = [0.5; 4];
+        let edges = geometric_edges(UVec2::new(4, 1), &[mirror; 4], &surface, &seen, &l).unwrap();
+        assert_eq!(edges, vec![false, true, true, false]);
+        // A horizon the eye cannot see is none.
+        let faint = seen.map(|s| s.map(|s| SeenSurface { mean_y: 0.5, ..s }));
+        let edges = geometric_edges(UVec2::new(4, 1), &[mirror; 4], &surface, &faint, &l);
+        assert_eq!(edges.unwrap(), vec![false; 4]);
+        // Without the chains the same pixels have no edge.
+        let direct = geometric_edges(UVec2::new(4, 1), &[mirror; 4], &surface, &[None; 4], &l);
+        assert_eq!(direct.unwrap(), vec![false; 4]);
     }
 
     #[test]
     fn mismatched_lengths_are_refused() {
         let m = PixelClass::Material(0);
-        assert!(geometric_edges(UVec2::new(2, 1), &[m; 2], &[None], &[1.0; 2]).is_err());
+        assert!(
+            geometric_edges(UVec2::new(2, 1), &[m; 2], &[None], &[None; 2], &[1.0; 2]).is_err()
+        );
     }
 }

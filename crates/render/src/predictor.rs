@@ -13,9 +13,9 @@ use prism_bandwidth::pixel_prediction::MAX_IMAGE_BANDWIDTH_CYCLES_PER_PX;
 use prism_bandwidth::{
     allocate, four_neighbours, geometric_edges, model_variance, predict_pixel, Allocated,
     AllocationInputs, AllocationSettings, Bandwidth, BandwidthBuffer, GBufferHit, HierarchyInputs,
-    IndirectEstimate, LightSample, PixelClass, PixelFootprint, PixelPrediction, ShadingProbe,
-    SurfacePoint, Upsampling, VarianceBandwidth, VisibilitySummary, DEFAULT_POOL_RADIUS_PX,
-    DEFAULT_PROBE_STRIDE_PX,
+    IndirectEstimate, LightSample, PixelClass, PixelFootprint, PixelPrediction, SeenSurface,
+    ShadingProbe, SurfacePoint, Upsampling, VarianceBandwidth, VisibilitySummary,
+    DEFAULT_POOL_RADIUS_PX, DEFAULT_PROBE_STRIDE_PX,
 };
 use prism_spectrum::colorimetry::sampled_radiance_to_xyz;
 use prism_spectrum::{SampledSpectrum, SampledWavelengths};
@@ -251,16 +251,8 @@ fn background_angular_bandwidth(
 /// spread plus twice the normal's turn across the footprint, 2·k·d·rad_per_px / cos θ_x
 /// (k the larger principal curvature, d the depth). Within it of the sun's disk, the pixel
 /// sees the disk's edge: b_p = the sun's ν_a times that spread (cycles/px, clamped as
-/// eq. 6 clamps). Beyond the paper, like the shadow edges.
-fn mirrored_sun_bandwidth(
-    scene: &RenderScene,
-    probe: &RenderProbe<'_>,
-    hit: &GBufferHit,
-    rad_per_px: f32,
-) -> f32 {
-    if !probe.is_dirac_at(hit) {
-        return 0.0;
-    }
+/// eq. 6 clamps). Beyond the paper, like the shadow edges. For Dirac hits only.
+fn mirrored_sun_bandwidth(scene: &RenderScene, hit: &GBufferHit, rad_per_px: f32) -> f32 {
     let (n, v) = (hit.normal(), hit.view_direction());
     let mirrored = 2.0 * n.dot(v) * n - v;
     let c = hit.curvature();
@@ -323,6 +315,8 @@ struct ProbedPixel {
     eye: Option<EyeGeometry>,
     class: PixelClass,
     surface: Option<SurfacePoint>,
+    /// What a Dirac centre hit shows (`RenderProbe::seen_through_dirac`).
+    seen: Option<(PixelClass, Option<SurfacePoint>)>,
 }
 
 impl ProbedPixel {
@@ -336,6 +330,7 @@ impl ProbedPixel {
             eye: None,
             class: PixelClass::Unpredicted,
             surface: None,
+            seen: None,
         }
     }
 }
@@ -601,9 +596,12 @@ pub fn predict_with_probe<'a>(
                                 // Filled from the nearest probed pixel (`borrow_from_probed`).
                                 PixelPrediction::default()
                             };
-                            p.image_bandwidth_cycles_per_px = p
-                                .image_bandwidth_cycles_per_px
-                                .max(mirrored_sun_bandwidth(scene, &probe, &hit, rad_per_px));
+                            let dirac = probe.is_dirac_at(&hit);
+                            if dirac {
+                                p.image_bandwidth_cycles_per_px = p
+                                    .image_bandwidth_cycles_per_px
+                                    .max(mirrored_sun_bandwidth(scene, &hit, rad_per_px));
+                            }
                             let c = hit.curvature();
                             Ok(ProbedPixel {
                                 prediction: p,
@@ -619,6 +617,7 @@ pub fn predict_with_probe<'a>(
                                     position_m: hit.position_m(),
                                     normal: hit.normal(),
                                 }),
+                                seen: dirac.then(|| probe.seen_through_dirac(&hit)).flatten(),
                             })
                         }
                         CentreRay::Escapes(direction) => Ok(ProbedPixel {
@@ -643,6 +642,7 @@ pub fn predict_with_probe<'a>(
     let mut eye = Vec::new();
     let mut class = Vec::new();
     let mut surface = Vec::new();
+    let mut seen = Vec::new();
     let mut texture_scale = Vec::new();
     for probed in rows.into_iter().flatten() {
         pixels.push(probed.prediction);
@@ -651,6 +651,7 @@ pub fn predict_with_probe<'a>(
         eye.push(probed.eye);
         class.push(probed.class);
         surface.push(probed.surface);
+        seen.push(probed.seen);
     }
     keep_texture_scales_off_zero(&mut texture_scale, &class);
     borrow_from_probed(
@@ -664,6 +665,18 @@ pub fn predict_with_probe<'a>(
     if settings.visibility {
         add_shadow_edges(resolution, &mut pixels, &eye);
     }
+    // Each Dirac pixel's own L̂ (a skipped pixel's borrowed from its probed neighbour).
+    let seen: Vec<Option<SeenSurface>> = seen
+        .into_iter()
+        .zip(&pixels)
+        .map(|(chain, p)| {
+            chain.map(|(class, surface)| SeenSurface {
+                class,
+                surface,
+                mean_y: p.mean_y,
+            })
+        })
+        .collect();
     let modelled = model_variance(
         resolution,
         &pixels,
@@ -686,8 +699,9 @@ pub fn predict_with_probe<'a>(
             p.mean_y = modelled.mean_y[i];
         }
     }
-    // Silhouettes, creases and material edges inside a footprint: a step, not band-limited.
-    let edges = geometric_edges(resolution, &class, &surface, &modelled.mean_y)
+    // Silhouettes, creases and material edges inside a footprint, seen directly or in a
+    // mirror: a step, not band-limited.
+    let edges = geometric_edges(resolution, &class, &surface, &seen, &modelled.mean_y)
         .map_err(|e| e.to_string())?;
     for (p, edge) in pixels.iter_mut().zip(edges) {
         if edge {

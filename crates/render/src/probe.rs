@@ -27,8 +27,8 @@
 
 use glam::{UVec2, Vec3A};
 use prism_bandwidth::{
-    Bandwidth, GBufferHit, IndirectEstimate, LightSample, MaterialBandwidth, ShadingProbe,
-    Visibility,
+    Bandwidth, GBufferHit, IndirectEstimate, LightSample, MaterialBandwidth, PixelClass,
+    ShadingProbe, SurfacePoint, Visibility,
 };
 use prism_geometry::{Frame, Ray, SurfaceInteraction};
 use prism_spectrum::colorimetry::sampled_radiance_to_xyz;
@@ -273,6 +273,64 @@ impl<'a> RenderProbe<'a> {
             .material(hit.material_id())
             .bsdf(&si, &wavelengths)
             .is_specular()
+    }
+
+    /// What a pixel whose centre hit is a Dirac surface shows: its centre ray followed
+    /// through the chain of Dirac vertices (each time the lobe the BSDF picks at u = ½ for
+    /// the middle of the visible range: the reflection where it outweighs the refraction)
+    /// to the first other surface, or out to the background. `None` where the hit is not
+    /// Dirac (`is_dirac_at`) or the chain is longer than [`MAX_SPECULAR_CHAIN`].
+    pub(crate) fn seen_through_dirac(
+        &self,
+        hit: &GBufferHit,
+    ) -> Option<(PixelClass, Option<SurfacePoint>)> {
+        let wavelengths = SampledWavelengths::sample_visible(0.5);
+        let mut si = hit_interaction(hit);
+        let mut wo = hit.view_direction();
+        for _ in 0..MAX_SPECULAR_CHAIN {
+            let bsdf = self.scene.material(si.material_id).bsdf(&si, &wavelengths);
+            if !bsdf.is_specular() {
+                return None;
+            }
+            let frame = Frame::from_zx(si.n_shading, si.dpdu);
+            let bs = bsdf.sample(
+                frame.to_local(wo),
+                0.5,
+                glam::Vec2::splat(0.5),
+                TransportMode::Radiance,
+            )?;
+            let ray = Ray::spawn(si.p, frame.from_local(bs.wi));
+            let Some(next) = crate::medium_interfaces::first_surface(self.scene, &ray) else {
+                return Some((PixelClass::Background, None));
+            };
+            si = self.scene.geometry.shading_interaction(&ray, &next);
+            let emitter = self
+                .scene
+                .lights
+                .area_light_of_instance(next.instance_id)
+                .is_some();
+            wo = -ray.direction.normalize();
+            let dirac_next = self
+                .scene
+                .material(si.material_id)
+                .bsdf(&si, &wavelengths)
+                .is_specular();
+            if !dirac_next || emitter {
+                let normal = if si.n_shading.dot(wo) < 0.0 {
+                    -si.n_shading
+                } else {
+                    si.n_shading
+                };
+                return Some((
+                    PixelClass::Material(si.material_id),
+                    Some(SurfacePoint {
+                        position_m: si.p,
+                        normal: normal.normalize(),
+                    }),
+                ));
+            }
+        }
+        None
     }
 
     /// ν_l of light `index` towards `wi`, met at `at_m` on the light when it has a
