@@ -8,12 +8,9 @@
 # Steps (each timed): a virtual environment under the target directory (kept between runs),
 # maturin, NumPy and pytest from the package index (crates/python/requirements-test.txt),
 # colour-science when it installs (the ColorChecker cross-check is skipped, with the reason
-# printed, when it cannot be imported), the `prism` binary and the wheel (maturin), then
-# pytest. Both build with the `test` profile and the binary with the whole workspace's
-# features, as `cargo test --workspace` builds them, so that after it (.ci/run) nothing but
-# prism-python is compiled again: with the dev profile, or the root package's features
-# alone, the binary's crates were compiled a second time (82 s on the CI machine, 2026-12-06)
-# and prism-image, prism-render and prism-post a third.
+# printed, when it cannot be imported), the `prism` binary (dev profile, as `cargo test`
+# builds it), the wheel (maturin, dev profile, sharing the target directory so that the
+# workspace crates are not compiled again), then pytest.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 TARGET="${CARGO_TARGET_DIR:-$PWD/target}"
@@ -36,13 +33,13 @@ if ! "$VENV/bin/python" -m pip install -q --disable-pip-version-check colour-sci
 fi
 step "virtual environment $VENV ready"
 
-cargo build --profile test --workspace --bin prism
+cargo build --bin prism
 step "prism binary built"
 
 rm -rf "$TARGET/python-wheels"
 # No --strip: it changes the flags of every crate, which would then be compiled again
 # instead of reused from the workspace build.
-"$VENV/bin/maturin" build --profile test --manifest-path crates/python/Cargo.toml \
+"$VENV/bin/maturin" build --profile dev --manifest-path crates/python/Cargo.toml \
     --interpreter "$VENV/bin/python" --out "$TARGET/python-wheels"
 "$VENV/bin/python" -m pip install -q --disable-pip-version-check --force-reinstall --no-deps \
     "$TARGET"/python-wheels/prism-*.whl

@@ -287,11 +287,11 @@ impl<'a> RenderProbe<'a> {
         let wavelengths = SampledWavelengths::sample_visible(0.5);
         let mut si = hit_interaction(hit);
         let mut wo = hit.view_direction();
+        let mut bsdf = self.scene.material(si.material_id).bsdf(&si, &wavelengths);
+        if !bsdf.is_specular() {
+            return None;
+        }
         for _ in 0..MAX_SPECULAR_CHAIN {
-            let bsdf = self.scene.material(si.material_id).bsdf(&si, &wavelengths);
-            if !bsdf.is_specular() {
-                return None;
-            }
             let frame = Frame::from_zx(si.n_shading, si.dpdu);
             let bs = bsdf.sample(
                 frame.to_local(wo),
@@ -304,18 +304,14 @@ impl<'a> RenderProbe<'a> {
                 return Some((PixelClass::Background, None));
             };
             si = self.scene.geometry.shading_interaction(&ray, &next);
+            wo = -ray.direction.normalize();
+            bsdf = self.scene.material(si.material_id).bsdf(&si, &wavelengths);
             let emitter = self
                 .scene
                 .lights
                 .area_light_of_instance(next.instance_id)
                 .is_some();
-            wo = -ray.direction.normalize();
-            let dirac_next = self
-                .scene
-                .material(si.material_id)
-                .bsdf(&si, &wavelengths)
-                .is_specular();
-            if !dirac_next || emitter {
+            if !bsdf.is_specular() || emitter {
                 let normal = if si.n_shading.dot(wo) < 0.0 {
                     -si.n_shading
                 } else {

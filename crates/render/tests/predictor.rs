@@ -350,6 +350,52 @@ fn the_sun_disk_is_sharp_and_the_sky_beside_it_smooth() {
     eprintln!("{sharp} pixels around the sun with b_p ≥ 0.25");
 }
 
+/// A sphere on a grey floor under a uniform sky, seen from a little above: a mirror or
+/// smooth glass shows the floor's horizon inside its outline, a step the G-buffer alone
+/// does not see (one material, a smooth surface). The pixels along it are edges (eq. 11's
+/// finest level, b_p = 2); a rough metal shows no step, and no interior pixel is one.
+#[test]
+fn a_horizon_seen_in_a_mirror_or_through_glass_is_an_edge() {
+    let interior_edges = |material: &str| {
+        let scene = build(&format!(
+            r#"{{"camera": {{"type": "pinhole", "fov_deg": 20,
+                "transform": {{"look_at": {{"eye": [0, 0.9, 6], "target": [0, 0.5, 0]}}}}}},
+            "film": {{"resolution": [48, 48]}},
+            "materials": {{"ball": {material},
+                           "grey": {{"type": "lambert", "reflectance": 0.2}}}},
+            "shapes": [{{"type": "sphere", "radius_m": 0.5, "material": "ball",
+                         "transform": {{"translate": [0, 0.5, 0]}}}},
+                       {{"type": "rectangle", "size_m": [400, 400], "material": "grey",
+                         "transform": {{"rotate": {{"axis": [1, 0, 0], "angle_deg": -90}}}}}}],
+            "lights": [{{"type": "sky", "spectrum": 1.0}}]}}"#
+        ));
+        let p = run(&scene, true);
+        let sphere = p.class[24 * 48 + 24];
+        assert!(matches!(sphere, PixelClass::Material(_)), "{sphere:?}");
+        // Sphere pixels whose four neighbours are on the sphere too (not its outline).
+        (1..47)
+            .flat_map(|y| (1..47).map(move |x| (x, y)))
+            .filter(|&(x, y)| {
+                [(0, 0), (-1, 0), (1, 0), (0, -1), (0, 1)]
+                    .iter()
+                    .all(|&(dx, dy)| p.class[((y + dy) * 48 + x + dx) as usize] == sphere)
+            })
+            .filter(|&(x, y)| {
+                p.pixels[(y * 48 + x) as usize].image_bandwidth_cycles_per_px
+                    >= prism_bandwidth::pixel_prediction::MAX_IMAGE_BANDWIDTH_CYCLES_PER_PX
+            })
+            .count()
+    };
+    let mirror = interior_edges(r#"{"type": "conductor", "metal": "Ag"}"#);
+    let glass = interior_edges(r#"{"type": "dielectric", "ior": 1.5}"#);
+    let rough = interior_edges(r#"{"type": "conductor", "metal": "Ag", "roughness": 0.3}"#);
+    eprintln!("interior edge pixels: mirror {mirror}, glass {glass}, rough metal {rough}");
+    // The horizon crosses the sphere's image, about 14 px wide here.
+    assert!(mirror >= 8, "mirror: {mirror}");
+    assert!(glass >= 8, "glass: {glass}");
+    assert_eq!(rough, 0);
+}
+
 /// Hierarchical shading (§3.2) on the hard-shadow scene: the floor is interpolated from a
 /// lattice, but no interpolated pixel takes a parent on the other side of the shadow edge
 /// (the min-filtered cells), and the plan's budget is unchanged.
