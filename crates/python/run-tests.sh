@@ -4,13 +4,18 @@
 #
 #   crates/python/run-tests.sh            # from anywhere; CARGO_TARGET_DIR is honoured
 #   PYTHON=python3.9 crates/python/run-tests.sh
+#   PRISM_BIN=target/debug/prism crates/python/run-tests.sh   # test this binary, built already
 #
 # Steps (each timed): a virtual environment under the target directory (kept between runs),
 # maturin, NumPy and pytest from the package index (crates/python/requirements-test.txt),
 # colour-science when it installs (the ColorChecker cross-check is skipped, with the reason
-# printed, when it cannot be imported), the `prism` binary (dev profile, as `cargo test`
-# builds it), the wheel (maturin, dev profile, sharing the target directory so that the
-# workspace crates are not compiled again), then pytest.
+# printed, when it cannot be imported), the `prism` binary (dev profile) unless PRISM_BIN
+# names one, the wheel (maturin, dev profile, sharing the target directory), then pytest.
+# .ci/run passes the binary its `cargo test --workspace` built for the CLI tests: `cargo
+# build --bin prism` after it compiled prism-image, prism-post, prism-import, prism-render
+# and the binary again (63 s on the 2-core development machine, 82 s on the CI machine),
+# since a test build unifies the dev-dependencies' features into theirs; neither the test
+# profile nor --workspace avoided that (measured 2026-12-06).
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 TARGET="${CARGO_TARGET_DIR:-$PWD/target}"
@@ -33,8 +38,15 @@ if ! "$VENV/bin/python" -m pip install -q --disable-pip-version-check colour-sci
 fi
 step "virtual environment $VENV ready"
 
-cargo build --bin prism
-step "prism binary built"
+if [ -z "${PRISM_BIN:-}" ]; then
+    cargo build --bin prism
+    PRISM_BIN="$TARGET/debug/prism"
+    step "prism binary built"
+fi
+if [ ! -x "$PRISM_BIN" ]; then
+    echo "python-tests: PRISM_BIN=$PRISM_BIN is not an executable" >&2
+    exit 2
+fi
 
 rm -rf "$TARGET/python-wheels"
 # No --strip: it changes the flags of every crate, which would then be compiled again
@@ -45,5 +57,5 @@ rm -rf "$TARGET/python-wheels"
     "$TARGET"/python-wheels/prism-*.whl
 step "wheel built and installed"
 
-PRISM_BIN="$TARGET/debug/prism" "$VENV/bin/python" -m pytest -q -rs crates/python/tests
+PRISM_BIN="$PRISM_BIN" "$VENV/bin/python" -m pytest -q -rs crates/python/tests
 step "pytest passed"
