@@ -13,7 +13,7 @@
 # names one, the wheel (maturin, dev profile, sharing the target directory), then pytest.
 # .ci/run passes the binary its `cargo test --workspace` built for the CLI tests: `cargo
 # build --bin prism` after it compiled prism-image, prism-post, prism-import, prism-render
-# and the binary again (63 s on the 2-core development machine, 82 s on the CI machine),
+# and the binary again (63–82 s in clean-clone runs on the 2-core development machine),
 # since a test build unifies the dev-dependencies' features into theirs; neither the test
 # profile nor --workspace avoided that (measured 2026-12-06).
 set -euo pipefail
