@@ -4,8 +4,6 @@
 //! "Efficient incoherent ray traversal on GPUs through compressed wide BVHs", on every core:
 //! [`crate::cwbvh_convert`]).
 
-use std::collections::HashMap;
-
 use glam::Vec3A;
 use obvhs::aabb::Aabb;
 use obvhs::bvh2::node::Bvh2Node;
@@ -94,19 +92,21 @@ pub fn build_bvh2(boxes: &[Aabb], quality: BuildQuality) -> obvhs::bvh2::Bvh2 {
     if groups.is_empty() {
         return ploc_with_reinsertion(boxes, (0..boxes.len() as u32).collect(), quality);
     }
-    // PLOC sees every box outside the groups and each group's first member.
-    let mut stand_in = vec![false; boxes.len()];
-    let mut group_of_first: HashMap<u32, usize> = HashMap::with_capacity(groups.len());
+    // PLOC sees every box outside the groups and each group's first member; `group_led`
+    // names the group a first member leads.
+    const OUTSIDE: u32 = u32::MAX;
+    const STAND_IN: u32 = u32::MAX - 1;
+    let mut group_led = vec![OUTSIDE; boxes.len()];
     for (g, members) in groups.iter().enumerate() {
-        group_of_first.insert(members[0], g);
+        group_led[members[0] as usize] = g as u32;
         for &m in &members[1..] {
-            stand_in[m as usize] = true;
+            group_led[m as usize] = STAND_IN;
         }
     }
     let (kept_boxes, kept): (Vec<Aabb>, Vec<u32>) = boxes
         .iter()
         .zip(0u32..)
-        .filter(|&(_, i)| !stand_in[i as usize])
+        .filter(|&(_, i)| group_led[i as usize] != STAND_IN)
         .map(|(b, i)| (*b, i))
         .unzip();
     // PLOC writes a leaf's label into its `first_index`, which the conversion reads as a
@@ -121,8 +121,9 @@ pub fn build_bvh2(boxes: &[Aabb], quality: BuildQuality) -> obvhs::bvh2::Bvh2 {
         }
         debug_assert_eq!(leaf.prim_count, 1, "PLOC builds one primitive per leaf");
         let first = bvh2.primitive_indices[leaf.first_index as usize];
-        if let Some(&g) = group_of_first.get(&first) {
-            hang_balanced_subtree(&mut bvh2, node, &groups[g]);
+        let g = group_led[first as usize];
+        if g != OUTSIDE {
+            hang_balanced_subtree(&mut bvh2, node, &groups[g as usize]);
         }
     }
     // The optional maps reinsertion may have filled no longer cover the new nodes.

@@ -13,10 +13,8 @@
 //! boxes of a pseudo-random sixty-fourth of the input are counted; only the keys seen twice
 //! or more there are looked for in the whole input.
 
-use std::collections::HashMap;
-use std::hash::{BuildHasherDefault, Hasher};
-
 use obvhs::aabb::Aabb;
+use rustc_hash::FxHashMap;
 
 /// Groups smaller than this stay with PLOC: their k² merges take well under a millisecond,
 /// and a pair of triangles sharing a rectangle's box keeps the tree obvhs would build.
@@ -32,40 +30,15 @@ fn key(b: &Aabb) -> BoxKey {
     [b.min.x, b.min.y, b.min.z, b.max.x, b.max.y, b.max.z].map(f32::to_bits)
 }
 
-/// A multiply–rotate hash of the key's words: the keys are not chosen by an adversary, and
-/// SipHash (std's default) doubles the cost of the count.
-#[derive(Default)]
-struct WordHasher(u64);
-
-impl Hasher for WordHasher {
-    fn finish(&self) -> u64 {
-        self.0
-    }
-    fn write(&mut self, bytes: &[u8]) {
-        for chunk in bytes.chunks(4) {
-            let mut word = [0u8; 4];
-            word[..chunk.len()].copy_from_slice(chunk);
-            self.write_u32(u32::from_le_bytes(word));
-        }
-    }
-    fn write_u32(&mut self, word: u32) {
-        self.0 = (self.0.rotate_left(26) ^ u64::from(word)).wrapping_mul(0x9e37_79b9_7f4a_7c15);
-    }
-    fn write_usize(&mut self, length: usize) {
-        self.write_u32(length as u32);
-    }
-}
-
-type KeyMap<V> = HashMap<BoxKey, V, BuildHasherDefault<WordHasher>>;
-
-/// The sample: one box in each run of `SAMPLE_STRIDE`, at an offset hashed from the run's
-/// index, so that no period in the input's layout can hide a group from it.
-fn sample(len: usize) -> impl Iterator<Item = usize> {
-    (0..len.div_ceil(SAMPLE_STRIDE)).filter_map(move |run| {
+/// The boxes counted: one in each run of `stride`, at an offset hashed from the run's
+/// index, so that no period in the input's layout can hide a group (every box for
+/// `stride` 1).
+fn sample(len: usize, stride: usize) -> impl Iterator<Item = usize> {
+    (0..len.div_ceil(stride)).filter_map(move |run| {
         let mut h = (run as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15);
         h ^= h >> 29;
-        let offset = (h.wrapping_mul(0xbf58_476d_1ce4_e5b9) >> 32) as usize % SAMPLE_STRIDE;
-        Some(run * SAMPLE_STRIDE + offset).filter(|&i| i < len)
+        let offset = (h.wrapping_mul(0xbf58_476d_1ce4_e5b9) >> 32) as usize % stride;
+        Some(run * stride + offset).filter(|&i| i < len)
     })
 }
 
@@ -75,20 +48,14 @@ fn sample(len: usize) -> impl Iterator<Item = usize> {
 /// which it costs little.
 pub fn coincident_groups(boxes: &[Aabb]) -> Vec<Vec<u32>> {
     let count_all = boxes.len() <= COUNT_ALL_UP_TO;
-    let (counted, count): (Box<dyn Iterator<Item = usize>>, usize) = if count_all {
-        (Box::new(0..boxes.len()), boxes.len())
-    } else {
-        (
-            Box::new(sample(boxes.len())),
-            boxes.len().div_ceil(SAMPLE_STRIDE),
-        )
-    };
-    let mut seen: KeyMap<u32> = KeyMap::with_capacity_and_hasher(count, Default::default());
-    for i in counted {
+    let stride = if count_all { 1 } else { SAMPLE_STRIDE };
+    let mut seen: FxHashMap<BoxKey, u32> = FxHashMap::default();
+    seen.reserve(boxes.len().div_ceil(stride));
+    for i in sample(boxes.len(), stride) {
         *seen.entry(key(&boxes[i])).or_default() += 1;
     }
     let enough = if count_all { GROUP_MIN as u32 } else { 2 };
-    let mut candidates: KeyMap<Vec<u32>> = seen
+    let mut candidates: FxHashMap<BoxKey, Vec<u32>> = seen
         .into_iter()
         .filter(|&(_, n)| n >= enough)
         .map(|(k, _)| (k, Vec::new()))

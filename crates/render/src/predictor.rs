@@ -24,7 +24,7 @@ use rayon::prelude::*;
 use crate::film::AovPlane;
 use crate::light::Light;
 use crate::medium_interfaces::first_surface;
-use crate::probe::RenderProbe;
+use crate::probe::{facing_normal, RenderProbe};
 use crate::scene_build::RenderScene;
 
 /// n_b: probe samples per pixel (Bagher: 16 suffice, Fig. 13).
@@ -178,11 +178,7 @@ fn centre_ray(scene: &RenderScene, pixel: UVec2) -> CentreRay {
     si.compute_differentials(&ray_differential);
     let view = -ray.direction;
     // The side the camera sees: eq. 3's cosines are of that side.
-    let normal = if si.n_shading.dot(view) < 0.0 {
-        -si.n_shading
-    } else {
-        si.n_shading
-    };
+    let normal = facing_normal(si.n_shading, view);
     match GBufferHit::new(
         si.p,
         hit.t,

@@ -312,16 +312,11 @@ impl<'a> RenderProbe<'a> {
                 .area_light_of_instance(next.instance_id)
                 .is_some();
             if !bsdf.is_specular() || emitter {
-                let normal = if si.n_shading.dot(wo) < 0.0 {
-                    -si.n_shading
-                } else {
-                    si.n_shading
-                };
                 return Some((
                     PixelClass::Material(si.material_id),
                     Some(SurfacePoint {
                         position_m: si.p,
-                        normal: normal.normalize(),
+                        normal: facing_normal(si.n_shading, wo).normalize(),
                     }),
                 ));
             }
@@ -443,6 +438,15 @@ fn scatter(
         return None;
     }
     Some((bs.f * (bs.wi.z.abs() / bs.pdf), bs.wi))
+}
+
+/// The shading normal `n` turned to the side `towards` lies on (the side a viewer sees).
+pub(crate) fn facing_normal(n: Vec3A, towards: Vec3A) -> Vec3A {
+    if n.dot(towards) < 0.0 {
+        -n
+    } else {
+        n
+    }
 }
 
 fn hit_interaction(hit: &GBufferHit) -> SurfaceInteraction {
