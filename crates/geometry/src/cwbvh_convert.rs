@@ -374,11 +374,11 @@ impl Converter<'_> {
     }
 
     /// The wide internal nodes among `node`'s wide children (BVH2 indices), in any order.
-    fn internal_children(&self, node: usize) -> InternalChildren {
+    fn internal_children(&self, node: usize) -> UpToEight<u32> {
         let mut children = [u32::MAX; 8];
         let mut count = 0;
         self.children_of(node, 0, &mut children, &mut count);
-        let mut internal = InternalChildren::EMPTY;
+        let mut internal = UpToEight::default();
         for &c in &children[..count] {
             if self.is_wide_internal(c) {
                 internal.push(c);
@@ -405,14 +405,14 @@ impl Converter<'_> {
             .par_iter()
             .map(|&c| self.count_wide_nodes(c as usize, wide_depth + 1))
             .sum();
-        let below = internal.count as u32 + below_children;
+        let below = internal.as_slice().len() as u32 + below_children;
         self.wide_nodes_below[node].store(below, Relaxed);
         below
     }
 
     fn count_wide_nodes_serial(&self, root: usize) -> u32 {
         // (node, its internal children once they are counted)
-        let mut stack: Vec<(usize, Option<InternalChildren>)> = vec![(root, None)];
+        let mut stack: Vec<(usize, Option<UpToEight<u32>>)> = vec![(root, None)];
         while let Some((node, counted)) = stack.pop() {
             match counted {
                 None => {
@@ -421,7 +421,7 @@ impl Converter<'_> {
                     stack.extend(internal.as_slice().iter().map(|&c| (c as usize, None)));
                 }
                 Some(internal) => {
-                    let below = internal.count as u32
+                    let below = internal.as_slice().len() as u32
                         + internal
                             .as_slice()
                             .iter()
@@ -459,7 +459,7 @@ impl Converter<'_> {
         below_base: u32,
         primitive_base: u32,
         primitives: &mut [u32],
-    ) -> (CwBvhNode, Vec<ChildPlacement>) {
+    ) -> (CwBvhNode, UpToEight<ChildPlacement>) {
         let aabb = self.bvh2.nodes[node].aabb();
         let origin = aabb.min;
         // Per-axis power-of-two scale so that 255 steps cover the box (Ylitie et al. §3.2).
@@ -483,7 +483,7 @@ impl Converter<'_> {
         };
 
         let children = self.ordered_children(node);
-        let mut internal = InternalChildren::EMPTY;
+        let mut internal = UpToEight::default();
         let mut leaf_primitive_count = 0usize;
         for (i, &child) in children.iter().enumerate() {
             if child == u32::MAX {
@@ -527,29 +527,24 @@ impl Converter<'_> {
             }
         }
 
-        let mut next_below = below_base + internal.count as u32;
+        let mut next_below = below_base + internal.as_slice().len() as u32;
         let mut next_primitive = primitive_base + leaf_primitive_count as u32;
-        let placements = internal
-            .as_slice()
-            .iter()
-            .enumerate()
-            .map(|(j, &child)| {
-                let child = child as usize;
-                let nodes_below = self.wide_nodes_below[child].load(Relaxed);
-                let primitives_below = self.primitives[child].load(Relaxed);
-                let placement = ChildPlacement {
-                    node: child,
-                    index: below_base + j as u32,
-                    below_base: next_below,
-                    nodes_below,
-                    primitive_base: next_primitive,
-                    primitives_below,
-                };
-                next_below += nodes_below;
-                next_primitive += primitives_below;
-                placement
-            })
-            .collect();
+        let mut placements = UpToEight::default();
+        for (j, &child) in internal.as_slice().iter().enumerate() {
+            let child = child as usize;
+            let nodes_below = self.wide_nodes_below[child].load(Relaxed);
+            let primitives_below = self.primitives[child].load(Relaxed);
+            placements.push(ChildPlacement {
+                node: child,
+                index: below_base + j as u32,
+                below_base: next_below,
+                nodes_below,
+                primitive_base: next_primitive,
+                primitives_below,
+            });
+            next_below += nodes_below;
+            next_primitive += primitives_below;
+        }
         (out, placements)
     }
 
@@ -560,13 +555,15 @@ impl Converter<'_> {
         if !self.splits(node, wide_depth) {
             return self.emit_serial(node, out, region);
         }
-        let (placements, region) = self.emit_root(node, out, region);
         let Region {
+            below_base,
             below,
             primitive_base,
             primitives,
-            ..
         } = region;
+        let placements;
+        (*out, placements) = self.wide_node(node, below_base, primitive_base, primitives);
+        let placements = placements.as_slice();
         let leaf_primitives = placements.first().map_or(primitives.len(), |p| {
             (p.primitive_base - primitive_base) as usize
         });
@@ -594,33 +591,17 @@ impl Converter<'_> {
             });
     }
 
-    /// Writes the region's root node into `out` and its leaves' primitives to the front of
-    /// the region; returns its internal children's placements and the region.
-    fn emit_root<'a>(
-        &self,
-        node: usize,
-        out: &mut CwBvhNode,
-        region: Region<'a>,
-    ) -> (Vec<ChildPlacement>, Region<'a>) {
-        let (wide, placements) = self.wide_node(
-            node,
-            region.below_base,
-            region.primitive_base,
-            region.primitives,
-        );
-        *out = wide;
-        (placements, region)
-    }
-
     /// [`Converter::emit`] on one thread, with a work list instead of recursion.
     fn emit_serial(&self, root: usize, root_out: &mut CwBvhNode, region: Region<'_>) {
-        let (mut work, region) = self.emit_root(root, root_out, region);
         let Region {
             below_base,
             below,
             primitive_base,
             primitives,
         } = region;
+        let (wide, first) = self.wide_node(root, below_base, primitive_base, primitives);
+        *root_out = wide;
+        let mut work = first.as_slice().to_vec();
         while let Some(p) = work.pop() {
             let at = (p.primitive_base - primitive_base) as usize;
             let (wide, placements) = self.wide_node(
@@ -630,7 +611,7 @@ impl Converter<'_> {
                 &mut primitives[at..],
             );
             below[(p.index - below_base) as usize] = wide;
-            work.extend(placements);
+            work.extend_from_slice(placements.as_slice());
         }
     }
 }
@@ -644,30 +625,27 @@ struct Region<'a> {
     primitives: &'a mut [u32],
 }
 
-/// A node's wide internal children (BVH2 indices, `count` of them).
-#[derive(Clone, Copy)]
-struct InternalChildren {
-    nodes: [u32; 8],
+/// Up to eight items (a wide node's children, or some of them) without a heap allocation:
+/// one per wide node would be on the conversion's hot path.
+#[derive(Clone, Copy, Default)]
+struct UpToEight<T> {
+    items: [T; 8],
     count: usize,
 }
 
-impl InternalChildren {
-    const EMPTY: InternalChildren = InternalChildren {
-        nodes: [u32::MAX; 8],
-        count: 0,
-    };
-
-    fn push(&mut self, node: u32) {
-        self.nodes[self.count] = node;
+impl<T: Copy> UpToEight<T> {
+    fn push(&mut self, item: T) {
+        self.items[self.count] = item;
         self.count += 1;
     }
 
-    fn as_slice(&self) -> &[u32] {
-        &self.nodes[..self.count]
+    fn as_slice(&self) -> &[T] {
+        &self.items[..self.count]
     }
 }
 
 /// Where an internal wide child and its subtree go (global indices).
+#[derive(Clone, Copy, Default)]
 struct ChildPlacement {
     /// Its BVH2 node.
     node: usize,
