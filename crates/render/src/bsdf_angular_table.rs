@@ -20,6 +20,7 @@ use crate::bsdf::{Bsdf, Bxdf, TransportMode};
 use crate::material::Material;
 use crate::plan::probe_hit;
 use crate::probe::reflectance_y;
+use prism_spectrum::colorimetry::LaneXyz;
 
 /// Incident and outgoing cells per axis (θ, φ) of a table.
 pub const TABLE_CELLS: usize = 16;
@@ -157,10 +158,11 @@ fn rotated_in_phi(slice: &[f32], k: usize) -> Vec<f32> {
 /// One incident direction's 16×16 outgoing bandwidths (row = θ_o, column = φ_o).
 fn slice_bandwidth(bsdf: &Bsdf, wi: Vec3A, wavelengths: &SampledWavelengths) -> Vec<f32> {
     let n = SLICE_TEXELS;
+    let xyz = LaneXyz::new(wavelengths);
     let values: Vec<f32> = (0..n * n)
         .map(|k| {
             let wo = cell_direction(k / n, k % n, n);
-            reflectance_y(bsdf.eval(wo, wi, TransportMode::Radiance), wavelengths)
+            reflectance_y(bsdf.eval(wo, wi, TransportMode::Radiance), &xyz)
         })
         .collect();
     // φₒ is periodic: the map is continued by a full period on either side (3n columns),
@@ -295,7 +297,7 @@ mod tests {
                 let wo = Vec3A::new(ax.sin(), ay.sin(), 1.0).normalize();
                 f64::from(reflectance_y(
                     bsdf.eval(wo, Vec3A::Z, TransportMode::Radiance),
-                    &wavelengths,
+                    &LaneXyz::new(&wavelengths),
                 ))
             })
             .collect();

@@ -23,6 +23,7 @@ use crate::bsdf_angular_table::{
 use crate::material::Material;
 use crate::probe::reflectance_y;
 use crate::stable_hash::Fnv1a64;
+use prism_spectrum::colorimetry::LaneXyz;
 
 /// Bumped whenever a table's construction or this file layout changes.
 const FORMAT_VERSION: u32 = 1;
@@ -100,11 +101,12 @@ pub fn fingerprint(material: &Material) -> Option<u64> {
         }
         let n = TABLE_CELLS;
         let m = FINGERPRINT_OUTGOING;
+        let xyz = LaneXyz::new(wavelengths);
         for incident in 0..n * n {
             let wi = cell_direction(incident / n, incident % n, n);
             for outgoing in 0..m * m {
                 let wo = cell_direction(outgoing / m, outgoing % m, m);
-                let y = reflectance_y(bsdf.eval(wo, wi, TransportMode::Radiance), wavelengths);
+                let y = reflectance_y(bsdf.eval(wo, wi, TransportMode::Radiance), &xyz);
                 hash.write(&y.to_bits().to_le_bytes());
             }
         }

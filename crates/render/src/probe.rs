@@ -31,7 +31,7 @@ use prism_bandwidth::{
     ShadingProbe, SurfacePoint, Visibility,
 };
 use prism_geometry::{Frame, Ray, SurfaceInteraction};
-use prism_spectrum::colorimetry::sampled_radiance_to_xyz;
+use prism_spectrum::colorimetry::LaneXyz;
 use prism_spectrum::{SampledSpectrum, SampledWavelengths};
 
 use prism_scene::MisHeuristic;
@@ -227,7 +227,7 @@ impl<'a> RenderProbe<'a> {
             frame.to_local(hit.view_direction()),
             TransportMode::Radiance,
         );
-        let y = reflectance_y(albedo, &wavelengths);
+        let y = reflectance_y(albedo, &LaneXyz::new(&wavelengths));
         if y.is_finite() {
             y.max(0.0)
         } else {
@@ -385,16 +385,16 @@ pub fn material_bandwidth(bsdf: &Bsdf) -> MaterialBandwidth {
     }
 }
 
-/// Y of a spectral quantity at `wavelengths` (hero-wavelength estimate).
-fn luminance_y(s: SampledSpectrum, wavelengths: &SampledWavelengths) -> f32 {
-    sampled_radiance_to_xyz(s, wavelengths).y as f32
+/// Y of a spectral quantity at the wavelengths of `lanes` (hero-wavelength estimate).
+fn luminance_y(s: SampledSpectrum, lanes: &LaneXyz) -> f32 {
+    lanes.y(s) as f32
 }
 
 /// The ȳ-weighted mean of a BSDF value over the lanes (a white Lambertian gives 1/π).
-pub(crate) fn reflectance_y(f: SampledSpectrum, wavelengths: &SampledWavelengths) -> f32 {
-    let ones = luminance_y(SampledSpectrum::splat(1.0), wavelengths);
+pub(crate) fn reflectance_y(f: SampledSpectrum, lanes: &LaneXyz) -> f32 {
+    let ones = luminance_y(SampledSpectrum::splat(1.0), lanes);
     if ones > 0.0 {
-        luminance_y(f, wavelengths) / ones
+        luminance_y(f, lanes) / ones
     } else {
         0.0
     }
@@ -404,16 +404,13 @@ pub(crate) fn reflectance_y(f: SampledSpectrum, wavelengths: &SampledWavelengths
 /// summed): each lane alone is an unbiased single-wavelength estimate, the hero estimate is
 /// their mean, so its variance is the lanes' sample variance / 4. Spiky spectra (F11,
 /// narrow LEDs) give much, flat ones none.
-pub(crate) fn lane_variance(weight: SampledSpectrum, wavelengths: &SampledWavelengths) -> f32 {
-    let lanes = prism_spectrum::N_SPECTRUM_SAMPLES;
-    let per_lane: [glam::DVec3; prism_spectrum::N_SPECTRUM_SAMPLES] = std::array::from_fn(|j| {
-        let mut only = [0.0f32; prism_spectrum::N_SPECTRUM_SAMPLES];
-        only[j] = weight[j];
-        sampled_radiance_to_xyz(SampledSpectrum::new(only), wavelengths) * lanes as f64
-    });
-    let mean = per_lane.iter().copied().sum::<glam::DVec3>() / lanes as f64;
+pub(crate) fn lane_variance(weight: SampledSpectrum, lanes: &LaneXyz) -> f32 {
+    let n = prism_spectrum::N_SPECTRUM_SAMPLES;
+    let per_lane: [glam::DVec3; prism_spectrum::N_SPECTRUM_SAMPLES] =
+        std::array::from_fn(|j| lanes.lane(weight, j) * n as f64);
+    let mean = per_lane.iter().copied().sum::<glam::DVec3>() / n as f64;
     let sum_sq: f64 = per_lane.iter().map(|x| (*x - mean).length_squared()).sum();
-    let variance = sum_sq / ((lanes - 1) * lanes) as f64;
+    let variance = sum_sq / ((n - 1) * n) as f64;
     if variance.is_finite() {
         variance as f32
     } else {
@@ -693,10 +690,28 @@ impl ShadingProbe for RenderProbe<'_> {
             n: si.n_geometric,
         };
         let sampler = PixelSampler::with_kind(SamplerKind::Independent, self.seed);
+        // The wavelengths, their CMF weights and the BSDF of the current camera sample.
+        let mut camera_sample = None;
         for k in 0..count {
             let mut stream = sampler.stream(pixel, k);
-            let wavelengths = SampledWavelengths::sample_visible(stream.get_1d());
-            let bsdf = material.bsdf(&si, &wavelengths);
+            let u_wavelengths = stream.get_1d();
+            // The estimator's light and BSDF samples of one camera sample share its
+            // wavelengths, so draws 2j and 2j + 1 share them (and the BSDF built for them,
+            // which reads the hit's textures) where a camera sample takes two draws.
+            let (wavelengths, xyz, bsdf) = match camera_sample.take() {
+                Some(shared) if k % 2 == 1 && draws_per_camera_sample == 2 => {
+                    camera_sample.insert(shared)
+                }
+                Some(_) | None => {
+                    let wavelengths = SampledWavelengths::sample_visible(u_wavelengths);
+                    camera_sample.insert((
+                        wavelengths,
+                        LaneXyz::new(&wavelengths),
+                        material.bsdf(&si, &wavelengths),
+                    ))
+                }
+            };
+            let (wavelengths, xyz, bsdf) = (&*wavelengths, &*xyz, &*bsdf);
             if bsdf.is_specular() {
                 draws_per_camera_sample = 1;
             }
@@ -718,13 +733,13 @@ impl ShadingProbe for RenderProbe<'_> {
                         continue;
                     };
                     let light = lights.light(l);
-                    let Some(ls) = light.sample_li(&ctx, stream.get_2d(), &wavelengths) else {
+                    let Some(ls) = light.sample_li(&ctx, stream.get_2d(), wavelengths) else {
                         continue;
                     };
                     let wi_local = frame.to_local(ls.wi);
                     let cos = wi_local.z.abs();
                     let f = bsdf.eval(wo_local, wi_local, TransportMode::Radiance) * cos;
-                    let mut radiance_y = luminance_y(ls.radiance, &wavelengths);
+                    let mut radiance_y = luminance_y(ls.radiance, xyz);
                     let pdf_per_sr = if ls.delta {
                         // One direction: the estimator's weight divides by the selection.
                         radiance_y /= light_share * pmf;
@@ -738,8 +753,8 @@ impl ShadingProbe for RenderProbe<'_> {
                     } else {
                         pdf_per_sr
                     };
-                    let lanes = lane_variance(ls.radiance * f * (1.0 / divisor), &wavelengths);
-                    let bsdf_cos_per_sr = reflectance_y(f, &wavelengths);
+                    let lanes = lane_variance(ls.radiance * f * (1.0 / divisor), xyz);
+                    let bsdf_cos_per_sr = reflectance_y(f, xyz);
                     // A sample the BSDF does not scatter towards the eye (the light behind
                     // a reflector) lights nothing, blocked or not: its shadow ray, which
                     // meets the surface's own back, would fake a shadow edge.
@@ -776,7 +791,7 @@ impl ShadingProbe for RenderProbe<'_> {
                         light_index: l,
                         material_bandwidth: self.material_bandwidth_at(
                             hit.material_id(),
-                            &bsdf,
+                            bsdf,
                             wi_local,
                             wo_local,
                             texture_t,
@@ -801,9 +816,9 @@ impl ShadingProbe for RenderProbe<'_> {
                     }
                     let cos = bs.wi.z.abs();
                     let wi = frame.from_local(bs.wi);
-                    for (l, le, distance_m, light_hit) in self.emitters_along(&si, wi, &wavelengths)
+                    for (l, le, distance_m, light_hit) in self.emitters_along(&si, wi, wavelengths)
                     {
-                        let radiance_y = luminance_y(le, &wavelengths);
+                        let radiance_y = luminance_y(le, xyz);
                         if radiance_y.is_nan() || radiance_y <= 0.0 {
                             continue;
                         }
@@ -816,12 +831,12 @@ impl ShadingProbe for RenderProbe<'_> {
                             // A Dirac lobe: one direction, weight f cos / (share · P(lobe)).
                             (
                                 0.0,
-                                reflectance_y(bs.f * (cos / (bsdf_share * bs.pdf)), &wavelengths),
+                                reflectance_y(bs.f * (cos / (bsdf_share * bs.pdf)), xyz),
                             )
                         } else {
                             (
                                 bsdf_share * bs.pdf + light_share * light_pdf,
-                                reflectance_y(bs.f * cos, &wavelengths),
+                                reflectance_y(bs.f * cos, xyz),
                             )
                         };
                         let divisor = if bs.specular {
@@ -829,10 +844,10 @@ impl ShadingProbe for RenderProbe<'_> {
                         } else {
                             pdf_per_sr
                         };
-                        let lanes = lane_variance(le * bs.f * (cos / divisor), &wavelengths);
+                        let lanes = lane_variance(le * bs.f * (cos / divisor), xyz);
                         // The estimator's BSDF sample: a Dirac lobe's has no MIS.
                         let estimator_y = if bs.specular {
-                            radiance_y * reflectance_y(bs.f * (cos / bs.pdf), &wavelengths)
+                            radiance_y * reflectance_y(bs.f * (cos / bs.pdf), xyz)
                         } else {
                             radiance_y * bsdf_cos_per_sr * mis_weight(mis, bs.pdf, light_pdf)
                                 / bs.pdf
@@ -854,7 +869,7 @@ impl ShadingProbe for RenderProbe<'_> {
                             light_index: l,
                             material_bandwidth: self.material_bandwidth_at(
                                 hit.material_id(),
-                                &bsdf,
+                                bsdf,
                                 bs.wi,
                                 wo_local,
                                 texture_t,
@@ -901,9 +916,12 @@ impl ShadingProbe for RenderProbe<'_> {
                     &wavelengths,
                     &mut stream,
                 )
-                .map_or(IndirectEstimate::default(), |l| IndirectEstimate {
-                    radiance_y: luminance_y(l, &wavelengths),
-                    lane_variance: lane_variance(l, &wavelengths),
+                .map_or(IndirectEstimate::default(), |l| {
+                    let xyz = LaneXyz::new(&wavelengths);
+                    IndirectEstimate {
+                        radiance_y: luminance_y(l, &xyz),
+                        lane_variance: lane_variance(l, &xyz),
+                    }
                 }),
             );
         }
