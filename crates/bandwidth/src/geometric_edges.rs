@@ -6,7 +6,7 @@
 //! normals and illumination". A pixel whose footprint holds a silhouette, a crease or a
 //! change of material has a step in its image, and a step is not band-limited: such a pixel
 //! gets eq. 11's finest anti-aliasing level. A step the eye cannot see (the two sides' L̂
-//! within `EDGE_MIN_CONTRAST` of each other) is no edge.
+//! within `EDGE_MIN_CONTRAST` of each other, Weber's fraction) is no edge.
 //!
 //! A mirror or smooth glass shows another surface: its pixels are compared also by what
 //! their Dirac chain reaches ([`SeenSurface`]), so that the outline of an object, or the
@@ -24,8 +24,11 @@ use crate::variance_pooling::PixelClass;
 /// changes depth fast but stays in its plane.
 const STEP_MIN_SINE: f32 = 0.5;
 
-/// The smallest step in L̂, relative to the brighter side, that counts as an edge.
-pub const EDGE_MIN_CONTRAST: f32 = 0.1;
+/// The smallest step in L̂, relative to the brighter side, that counts as an edge: the
+/// Weber fraction of luminance discrimination, about 2 % over the photopic range. Noise
+/// in L̂ can pass an invisible step, which costs samples at a real discontinuity; also
+/// asking for 3 standard errors lost real edges (docs/bandwidth.md, "Geometric edges").
+pub const EDGE_MIN_CONTRAST: f32 = 0.02;
 
 /// What a pixel whose centre hit is a Dirac surface (mirror, smooth glass) shows: where its
 /// centre ray's chain of Dirac vertices ends (a surface's class and point, or the
@@ -41,14 +44,19 @@ pub struct SeenSurface {
 /// Per pixel (row-major): true where a 4-neighbour lies across a visible geometric edge,
 /// directly or through a Dirac chain. `class` and `surface` come from the G-buffer
 /// (`surface` is `None` off surfaces), `seen` from the Dirac chains (`None` where the
-/// centre hit is not Dirac), `mean_y` is L̂ (pooled per surface). Unpredicted pixels are
-/// never edges, nor do they make their neighbours one.
+/// centre hit is not Dirac), L̂ `pooled_mean_y` over each pixel's class and each pixel's
+/// `own_mean_y`. Two pixels of different classes compare their pooled L̂ (pooling never
+/// mixes classes, so it removes noise and keeps the step); two of one class (a crease, a
+/// box standing on a floor of the same paint) their own, since pooling over the class
+/// blurs the step between its surfaces. Unpredicted pixels are never edges, nor do they
+/// make their neighbours one.
 pub fn geometric_edges(
     resolution: UVec2,
     class: &[PixelClass],
     surface: &[Option<SurfacePoint>],
     seen: &[Option<SeenSurface>],
-    mean_y: &[f32],
+    pooled_mean_y: &[f32],
+    own_mean_y: &[f32],
 ) -> Result<Vec<bool>, BandwidthError> {
     let count = pixel_count("geometric edges", resolution)?;
     check_lengths(
@@ -58,7 +66,8 @@ pub fn geometric_edges(
             ("pixel classes", class.len()),
             ("surface points", surface.len()),
             ("surfaces seen through Dirac chains", seen.len()),
-            ("L̂", mean_y.len()),
+            ("pooled L̂", pooled_mean_y.len()),
+            ("own L̂", own_mean_y.len()),
         ],
     )?;
     Ok((0..count)
@@ -69,7 +78,11 @@ pub fn geometric_edges(
             four_neighbours(i, resolution).any(|j| {
                 class[j] != PixelClass::Unpredicted
                     && ((is_discontinuous(class[i], class[j], surface[i], surface[j])
-                        && is_visible_step(mean_y[i], mean_y[j]))
+                        && if class[i] == class[j] {
+                            is_visible_step(own_mean_y[i], own_mean_y[j])
+                        } else {
+                            is_visible_step(pooled_mean_y[i], pooled_mean_y[j])
+                        })
                         || seen_across_edge(seen[i], seen[j]))
             })
         })
@@ -134,7 +147,7 @@ mod tests {
             .map(|&z| point(0.0, z, Vec3A::Y))
             .collect();
         let l = [1.0; 5];
-        let none = geometric_edges(UVec2::new(5, 1), &[m; 5], &plane, &[None; 5], &l).unwrap();
+        let none = geometric_edges(UVec2::new(5, 1), &[m; 5], &plane, &[None; 5], &l, &l).unwrap();
         assert_eq!(none, vec![false; 5]);
         // A depth step between pixels 2 and 3: pixel 3 lies 1 m above pixel 2's plane.
         let mut step = plane.clone();
@@ -144,11 +157,18 @@ mod tests {
         });
         step[4] = step[3];
         let l = [1.0, 1.0, 1.0, 2.0, 2.0];
-        let edges = geometric_edges(UVec2::new(5, 1), &[m; 5], &step, &[None; 5], &l).unwrap();
+        let edges = geometric_edges(UVec2::new(5, 1), &[m; 5], &step, &[None; 5], &l, &l).unwrap();
         assert_eq!(edges, vec![false, false, true, true, false]);
         // The same step with equal radiance on both sides is invisible.
-        let flat =
-            geometric_edges(UVec2::new(5, 1), &[m; 5], &step, &[None; 5], &[1.0; 5]).unwrap();
+        let flat = geometric_edges(
+            UVec2::new(5, 1),
+            &[m; 5],
+            &step,
+            &[None; 5],
+            &[1.0; 5],
+            &[1.0; 5],
+        )
+        .unwrap();
         assert_eq!(flat, vec![false; 5]);
         // A crease: normals 90° apart at pixels 1 | 2.
         let crease = [
@@ -162,6 +182,7 @@ mod tests {
             &crease,
             &[None; 3],
             &[1.0, 1.0, 0.5],
+            &[1.0, 1.0, 0.5],
         )
         .unwrap();
         assert_eq!(edges, vec![false, true, true]);
@@ -173,6 +194,7 @@ mod tests {
             &class,
             &surface,
             &[None; 3],
+            &[1.0, 3.0, 0.0],
             &[1.0, 3.0, 0.0],
         )
         .unwrap();
@@ -205,24 +227,70 @@ mod tests {
             })
             .collect();
         let seen = [Some(floor(0.0)), Some(floor(0.3)), Some(sky), None];
-        // L̂ pooled over the mirror: the step is blurred away there, not in `seen`.
+        // The mirror pixels' L̂, equal here: the step is in what they show (`seen`).
         let l = [0.5; 4];
-        let edges = geometric_edges(UVec2::new(4, 1), &[mirror; 4], &surface, &seen, &l).unwrap();
+        let edges =
+            geometric_edges(UVec2::new(4, 1), &[mirror; 4], &surface, &seen, &l, &l).unwrap();
         assert_eq!(edges, vec![false, true, true, false]);
         // A horizon the eye cannot see is none.
         let faint = seen.map(|s| s.map(|s| SeenSurface { mean_y: 0.5, ..s }));
-        let edges = geometric_edges(UVec2::new(4, 1), &[mirror; 4], &surface, &faint, &l);
+        let edges = geometric_edges(UVec2::new(4, 1), &[mirror; 4], &surface, &faint, &l, &l);
         assert_eq!(edges.unwrap(), vec![false; 4]);
         // Without the chains the same pixels have no edge.
-        let direct = geometric_edges(UVec2::new(4, 1), &[mirror; 4], &surface, &[None; 4], &l);
+        let direct = geometric_edges(UVec2::new(4, 1), &[mirror; 4], &surface, &[None; 4], &l, &l);
         assert_eq!(direct.unwrap(), vec![false; 4]);
     }
 
     #[test]
     fn mismatched_lengths_are_refused() {
         let m = PixelClass::Material(0);
-        assert!(
-            geometric_edges(UVec2::new(2, 1), &[m; 2], &[None], &[None; 2], &[1.0; 2]).is_err()
-        );
+        assert!(geometric_edges(
+            UVec2::new(2, 1),
+            &[m; 2],
+            &[None],
+            &[None; 2],
+            &[1.0; 2],
+            &[1.0; 2]
+        )
+        .is_err());
+    }
+
+    /// A silhouette against the background with steps of 5 % and 1 %: the first is seen
+    /// (above Weber's 2 %), the second is not. Across classes the pooled L̂ decides, within
+    /// one (a crease) each pixel's own.
+    #[test]
+    fn a_step_is_an_edge_where_the_eye_sees_it() {
+        let m = PixelClass::Material(0);
+        let class = [m, PixelClass::Background];
+        let surface = [point(0.0, 1.0, Vec3A::Y), None];
+        // The pixels' own L̂ has no step: only the pooled one can make this edge.
+        let silhouette = |pooled: [f32; 2]| {
+            geometric_edges(
+                UVec2::new(2, 1),
+                &class,
+                &surface,
+                &[None; 2],
+                &pooled,
+                &[1.0; 2],
+            )
+            .unwrap()
+        };
+        assert_eq!(silhouette([1.0, 1.05]), vec![true, true]);
+        assert_eq!(silhouette([1.0, 1.01]), vec![false, false]);
+        // A crease on one material: its pooled L̂ is blurred (no step), its own shows one.
+        let crease = [point(0.0, 1.0, Vec3A::Y), point(0.1, 1.0, Vec3A::X)];
+        let crease_edges = |own: [f32; 2]| {
+            geometric_edges(
+                UVec2::new(2, 1),
+                &[m; 2],
+                &crease,
+                &[None; 2],
+                &[1.0; 2],
+                &own,
+            )
+            .unwrap()
+        };
+        assert_eq!(crease_edges([1.0, 0.5]), vec![true, true]);
+        assert_eq!(crease_edges([1.0, 1.0]), vec![false, false]);
     }
 }

@@ -148,7 +148,8 @@ fn sample_plan_text(kind: SamplePlanKind) -> (&'static str, String) {
                 "--plan predicted: a G-buffer of pixel-centre hits, {probe_samples} probe light \
                  samples per probed pixel ({}), bandwidth by Bagher et al. 2013 eqs. 4-6 (silhouettes, creases \
                  and material edges at the finest level, seen directly or through mirrors and \
-                 smooth glass), variance {}{}, \
+                 smooth glass, where the two sides' L̂ differ by over 2 %), \
+                 variance {}{}, \
                  levels by eq. 11; {:.1} % of the budget uniform (light past the probe's one indirect \
                  bounce is not predicted), the rest {}",
                 if probe_stride_px == 1 {

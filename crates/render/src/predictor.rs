@@ -696,9 +696,17 @@ pub fn predict_with_probe<'a>(
         }
     }
     // Silhouettes, creases and material edges inside a footprint, seen directly or in a
-    // mirror: a step, not band-limited.
-    let edges = geometric_edges(resolution, &class, &surface, &seen, &modelled.mean_y)
-        .map_err(|e| e.to_string())?;
+    // mirror: a step, not band-limited. Each pixel's own L̂ is a skipped pixel's borrowed one.
+    let own_mean_y: Vec<f32> = pixels.iter().map(|p| p.mean_y).collect();
+    let edges = geometric_edges(
+        resolution,
+        &class,
+        &surface,
+        &seen,
+        &modelled.mean_y,
+        &own_mean_y,
+    )
+    .map_err(|e| e.to_string())?;
     for (p, edge) in pixels.iter_mut().zip(edges) {
         if edge {
             p.image_bandwidth_cycles_per_px = MAX_IMAGE_BANDWIDTH_CYCLES_PER_PX;
