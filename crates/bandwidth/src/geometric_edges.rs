@@ -32,13 +32,11 @@ pub const EDGE_MIN_CONTRAST: f32 = 0.02;
 
 /// What a pixel whose centre hit is a Dirac surface (mirror, smooth glass) shows: where its
 /// centre ray's chain of Dirac vertices ends (a surface's class and point, or the
-/// background's class and no point), and the pixel's own L̂, not pooled: pooling over the
-/// mirror would blur the very steps it shows.
+/// background's class and no point).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SeenSurface {
     pub class: PixelClass,
     pub surface: Option<SurfacePoint>,
-    pub mean_y: f32,
 }
 
 /// Per pixel (row-major): true where a 4-neighbour lies across a visible geometric edge,
@@ -83,7 +81,8 @@ pub fn geometric_edges(
                         } else {
                             is_visible_step(pooled_mean_y[i], pooled_mean_y[j])
                         })
-                        || seen_across_edge(seen[i], seen[j]))
+                        || (seen_across_edge(seen[i], seen[j])
+                            && is_visible_step(own_mean_y[i], own_mean_y[j])))
             })
         })
         .collect())
@@ -109,14 +108,12 @@ fn is_discontinuous(
     }
 }
 
-/// Two Dirac pixels that show discontinuous surfaces with a visible step between their own
-/// L̂ (a pixel whose chain was lost compares as continuous).
+/// Two Dirac pixels that show discontinuous surfaces (a pixel whose chain was lost compares
+/// as continuous). Their own L̂ decides whether the step is seen: pooling over the mirror
+/// would blur the very steps it shows.
 fn seen_across_edge(p: Option<SeenSurface>, q: Option<SeenSurface>) -> bool {
     match (p, q) {
-        (Some(p), Some(q)) => {
-            is_discontinuous(p.class, q.class, p.surface, q.surface)
-                && is_visible_step(p.mean_y, q.mean_y)
-        }
+        (Some(p), Some(q)) => is_discontinuous(p.class, q.class, p.surface, q.surface),
         (None, None) | (Some(_), None) | (None, Some(_)) => false,
     }
 }
@@ -210,12 +207,10 @@ mod tests {
         let floor = |x: f32| SeenSurface {
             class: PixelClass::Material(0),
             surface: point(x, 5.0, Vec3A::Y),
-            mean_y: 0.2,
         };
         let sky = SeenSurface {
             class: PixelClass::Background,
             surface: None,
-            mean_y: 1.0,
         };
         let tilt = |a: f32| Vec3A::new(a.sin(), 0.0, a.cos());
         let surface: Vec<_> = (0..4)
@@ -227,18 +222,17 @@ mod tests {
             })
             .collect();
         let seen = [Some(floor(0.0)), Some(floor(0.3)), Some(sky), None];
-        // The mirror pixels' L̂, equal here: the step is in what they show (`seen`).
-        let l = [0.5; 4];
-        let edges =
-            geometric_edges(UVec2::new(4, 1), &[mirror; 4], &surface, &seen, &l, &l).unwrap();
-        assert_eq!(edges, vec![false, true, true, false]);
+        // L̂ pooled over the mirror is blurred flat; each pixel's own shows what it sees.
+        let pooled = [0.5; 4];
+        let own = [0.2, 0.2, 1.0, 0.5];
+        let edges = |seen: &[Option<SeenSurface>], own: &[f32]| {
+            geometric_edges(UVec2::new(4, 1), &[mirror; 4], &surface, seen, &pooled, own).unwrap()
+        };
+        assert_eq!(edges(&seen, &own), vec![false, true, true, false]);
         // A horizon the eye cannot see is none.
-        let faint = seen.map(|s| s.map(|s| SeenSurface { mean_y: 0.5, ..s }));
-        let edges = geometric_edges(UVec2::new(4, 1), &[mirror; 4], &surface, &faint, &l, &l);
-        assert_eq!(edges.unwrap(), vec![false; 4]);
+        assert_eq!(edges(&seen, &[0.5; 4]), vec![false; 4]);
         // Without the chains the same pixels have no edge.
-        let direct = geometric_edges(UVec2::new(4, 1), &[mirror; 4], &surface, &[None; 4], &l, &l);
-        assert_eq!(direct.unwrap(), vec![false; 4]);
+        assert_eq!(edges(&[None; 4], &own), vec![false; 4]);
     }
 
     #[test]

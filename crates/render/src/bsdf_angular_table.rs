@@ -17,10 +17,10 @@ use prism_spectrum::SampledWavelengths;
 use rayon::prelude::*;
 
 use crate::bsdf::{Bsdf, Bxdf, TransportMode};
+use crate::film::xyz::XyzWeights;
 use crate::material::Material;
 use crate::plan::probe_hit;
 use crate::probe::reflectance_y;
-use prism_spectrum::colorimetry::LaneXyz;
 
 /// Incident and outgoing cells per axis (θ, φ) of a table.
 pub const TABLE_CELLS: usize = 16;
@@ -158,7 +158,7 @@ fn rotated_in_phi(slice: &[f32], k: usize) -> Vec<f32> {
 /// One incident direction's 16×16 outgoing bandwidths (row = θ_o, column = φ_o).
 fn slice_bandwidth(bsdf: &Bsdf, wi: Vec3A, wavelengths: &SampledWavelengths) -> Vec<f32> {
     let n = SLICE_TEXELS;
-    let xyz = LaneXyz::new(wavelengths);
+    let xyz = XyzWeights::new(wavelengths);
     let values: Vec<f32> = (0..n * n)
         .map(|k| {
             let wo = cell_direction(k / n, k % n, n);
@@ -297,7 +297,7 @@ mod tests {
                 let wo = Vec3A::new(ax.sin(), ay.sin(), 1.0).normalize();
                 f64::from(reflectance_y(
                     bsdf.eval(wo, Vec3A::Z, TransportMode::Radiance),
-                    &LaneXyz::new(&wavelengths),
+                    &XyzWeights::new(&wavelengths),
                 ))
             })
             .collect();

@@ -20,10 +20,10 @@ use crate::bsdf::{Bxdf, TransportMode};
 use crate::bsdf_angular_table::{
     cell_direction, with_tabulated_bsdf, MaterialAngularBandwidth, SLICE_TEXELS, TABLE_CELLS,
 };
+use crate::film::xyz::XyzWeights;
 use crate::material::Material;
 use crate::probe::reflectance_y;
 use crate::stable_hash::Fnv1a64;
-use prism_spectrum::colorimetry::LaneXyz;
 
 /// Bumped whenever a table's construction or this file layout changes.
 const FORMAT_VERSION: u32 = 1;
@@ -101,7 +101,7 @@ pub fn fingerprint(material: &Material) -> Option<u64> {
         }
         let n = TABLE_CELLS;
         let m = FINGERPRINT_OUTGOING;
-        let xyz = LaneXyz::new(wavelengths);
+        let xyz = XyzWeights::new(wavelengths);
         for incident in 0..n * n {
             let wi = cell_direction(incident / n, incident % n, n);
             for outgoing in 0..m * m {

@@ -312,7 +312,7 @@ struct ProbedPixel {
     class: PixelClass,
     surface: Option<SurfacePoint>,
     /// What a Dirac centre hit shows (`RenderProbe::seen_through_dirac`).
-    seen: Option<(PixelClass, Option<SurfacePoint>)>,
+    seen: Option<SeenSurface>,
 }
 
 impl ProbedPixel {
@@ -661,18 +661,9 @@ pub fn predict_with_probe<'a>(
     if settings.visibility {
         add_shadow_edges(resolution, &mut pixels, &eye);
     }
-    // Each Dirac pixel's own L̂ (a skipped pixel's borrowed from its probed neighbour).
-    let seen: Vec<Option<SeenSurface>> = seen
-        .into_iter()
-        .zip(&pixels)
-        .map(|(chain, p)| {
-            chain.map(|(class, surface)| SeenSurface {
-                class,
-                surface,
-                mean_y: p.mean_y,
-            })
-        })
-        .collect();
+    // Each pixel's own L̂ (a skipped pixel's borrowed from its probed neighbour), before
+    // the skipped pixels take their window's below.
+    let own_mean_y: Vec<f32> = pixels.iter().map(|p| p.mean_y).collect();
     let modelled = model_variance(
         resolution,
         &pixels,
@@ -696,8 +687,7 @@ pub fn predict_with_probe<'a>(
         }
     }
     // Silhouettes, creases and material edges inside a footprint, seen directly or in a
-    // mirror: a step, not band-limited. Each pixel's own L̂ is a skipped pixel's borrowed one.
-    let own_mean_y: Vec<f32> = pixels.iter().map(|p| p.mean_y).collect();
+    // mirror: a step, not band-limited.
     let edges = geometric_edges(
         resolution,
         &class,

@@ -28,10 +28,9 @@
 use glam::{UVec2, Vec3A};
 use prism_bandwidth::{
     Bandwidth, GBufferHit, IndirectEstimate, LightSample, MaterialBandwidth, PixelClass,
-    ShadingProbe, SurfacePoint, Visibility,
+    SeenSurface, ShadingProbe, SurfacePoint, Visibility,
 };
 use prism_geometry::{Frame, Ray, SurfaceInteraction};
-use prism_spectrum::colorimetry::LaneXyz;
 use prism_spectrum::{SampledSpectrum, SampledWavelengths};
 
 use prism_scene::MisHeuristic;
@@ -39,6 +38,7 @@ use prism_scene::MisHeuristic;
 use crate::bsdf::{Bsdf, Bxdf, TransportMode};
 use crate::bsdf_angular_table::MaterialAngularBandwidth;
 use crate::bsdf_table_cache::AngularTableCache;
+use crate::film::xyz::XyzWeights;
 use crate::integrator::{mis_weight, Integrator};
 use crate::light::area_bandwidth::AreaLightBandwidth;
 use crate::light::environment_bandwidth::EnvironmentBandwidth;
@@ -227,7 +227,7 @@ impl<'a> RenderProbe<'a> {
             frame.to_local(hit.view_direction()),
             TransportMode::Radiance,
         );
-        let y = reflectance_y(albedo, &LaneXyz::new(&wavelengths));
+        let y = reflectance_y(albedo, &XyzWeights::new(&wavelengths));
         if y.is_finite() {
             y.max(0.0)
         } else {
@@ -280,10 +280,7 @@ impl<'a> RenderProbe<'a> {
     /// the middle of the visible range: the reflection where it outweighs the refraction)
     /// to the first other surface, or out to the background. `None` where the hit is not
     /// Dirac (`is_dirac_at`) or the chain is longer than [`MAX_SPECULAR_CHAIN`].
-    pub(crate) fn seen_through_dirac(
-        &self,
-        hit: &GBufferHit,
-    ) -> Option<(PixelClass, Option<SurfacePoint>)> {
+    pub(crate) fn seen_through_dirac(&self, hit: &GBufferHit) -> Option<SeenSurface> {
         let wavelengths = SampledWavelengths::sample_visible(0.5);
         let mut si = hit_interaction(hit);
         let mut wo = hit.view_direction();
@@ -301,7 +298,10 @@ impl<'a> RenderProbe<'a> {
             )?;
             let ray = Ray::spawn(si.p, frame.from_local(bs.wi));
             let Some(next) = crate::medium_interfaces::first_surface(self.scene, &ray) else {
-                return Some((PixelClass::Background, None));
+                return Some(SeenSurface {
+                    class: PixelClass::Background,
+                    surface: None,
+                });
             };
             si = self.scene.geometry.shading_interaction(&ray, &next);
             wo = -ray.direction.normalize();
@@ -312,13 +312,13 @@ impl<'a> RenderProbe<'a> {
                 .area_light_of_instance(next.instance_id)
                 .is_some();
             if !bsdf.is_specular() || emitter {
-                return Some((
-                    PixelClass::Material(si.material_id),
-                    Some(SurfacePoint {
+                return Some(SeenSurface {
+                    class: PixelClass::Material(si.material_id),
+                    surface: Some(SurfacePoint {
                         position_m: si.p,
                         normal: facing_normal(si.n_shading, wo).normalize(),
                     }),
-                ));
+                });
             }
         }
         None
@@ -385,16 +385,17 @@ pub fn material_bandwidth(bsdf: &Bsdf) -> MaterialBandwidth {
     }
 }
 
-/// Y of a spectral quantity at the wavelengths of `lanes` (hero-wavelength estimate).
-fn luminance_y(s: SampledSpectrum, lanes: &LaneXyz) -> f32 {
-    lanes.y(s) as f32
+/// Y of a spectral quantity at the wavelengths `weights` were built for (hero-wavelength
+/// estimate).
+fn luminance_y(s: SampledSpectrum, weights: &XyzWeights) -> f32 {
+    weights.y(s) as f32
 }
 
 /// The ȳ-weighted mean of a BSDF value over the lanes (a white Lambertian gives 1/π).
-pub(crate) fn reflectance_y(f: SampledSpectrum, lanes: &LaneXyz) -> f32 {
-    let ones = luminance_y(SampledSpectrum::splat(1.0), lanes);
+pub(crate) fn reflectance_y(f: SampledSpectrum, weights: &XyzWeights) -> f32 {
+    let ones = luminance_y(SampledSpectrum::splat(1.0), weights);
     if ones > 0.0 {
-        luminance_y(f, lanes) / ones
+        luminance_y(f, weights) / ones
     } else {
         0.0
     }
@@ -404,10 +405,10 @@ pub(crate) fn reflectance_y(f: SampledSpectrum, lanes: &LaneXyz) -> f32 {
 /// summed): each lane alone is an unbiased single-wavelength estimate, the hero estimate is
 /// their mean, so its variance is the lanes' sample variance / 4. Spiky spectra (F11,
 /// narrow LEDs) give much, flat ones none.
-pub(crate) fn lane_variance(weight: SampledSpectrum, lanes: &LaneXyz) -> f32 {
+pub(crate) fn lane_variance(weight: SampledSpectrum, weights: &XyzWeights) -> f32 {
     let n = prism_spectrum::N_SPECTRUM_SAMPLES;
     let per_lane: [glam::DVec3; prism_spectrum::N_SPECTRUM_SAMPLES] =
-        std::array::from_fn(|j| lanes.lane(weight, j) * n as f64);
+        std::array::from_fn(|j| weights.lane(weight, j) * n as f64);
     let mean = per_lane.iter().copied().sum::<glam::DVec3>() / n as f64;
     let sum_sq: f64 = per_lane.iter().map(|x| (*x - mean).length_squared()).sum();
     let variance = sum_sq / ((n - 1) * n) as f64;
@@ -698,20 +699,17 @@ impl ShadingProbe for RenderProbe<'_> {
             // The estimator's light and BSDF samples of one camera sample share its
             // wavelengths, so draws 2j and 2j + 1 share them (and the BSDF built for them,
             // which reads the hit's textures) where a camera sample takes two draws.
-            let (wavelengths, xyz, bsdf) = match camera_sample.take() {
-                Some(shared) if k % 2 == 1 && draws_per_camera_sample == 2 => {
-                    camera_sample.insert(shared)
-                }
-                Some(_) | None => {
-                    let wavelengths = SampledWavelengths::sample_visible(u_wavelengths);
-                    camera_sample.insert((
-                        wavelengths,
-                        LaneXyz::new(&wavelengths),
-                        material.bsdf(&si, &wavelengths),
-                    ))
-                }
-            };
-            let (wavelengths, xyz, bsdf) = (&*wavelengths, &*xyz, &*bsdf);
+            if k % draws_per_camera_sample == 0 {
+                camera_sample = None;
+            }
+            let (wavelengths, xyz, bsdf) = &*camera_sample.get_or_insert_with(|| {
+                let wavelengths = SampledWavelengths::sample_visible(u_wavelengths);
+                (
+                    wavelengths,
+                    XyzWeights::new(&wavelengths),
+                    material.bsdf(&si, &wavelengths),
+                )
+            });
             if bsdf.is_specular() {
                 draws_per_camera_sample = 1;
             }
@@ -917,7 +915,7 @@ impl ShadingProbe for RenderProbe<'_> {
                     &mut stream,
                 )
                 .map_or(IndirectEstimate::default(), |l| {
-                    let xyz = LaneXyz::new(&wavelengths);
+                    let xyz = XyzWeights::new(&wavelengths);
                     IndirectEstimate {
                         radiance_y: luminance_y(l, &xyz),
                         lane_variance: lane_variance(l, &xyz),

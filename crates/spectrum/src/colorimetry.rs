@@ -84,61 +84,6 @@ pub fn sampled_radiance_to_xyz(
     xyz / (N_SPECTRUM_SAMPLES as f64 * y_bar_integral_1931_nm())
 }
 
-/// Each lane's share of [`sampled_radiance_to_xyz`] for one set of wavelengths, so that
-/// callers converting many spectra at the same wavelengths (the predictor's probe: a
-/// sample's radiance, its BSDF value and each lane alone) look the CMFs up once:
-/// XYZ = Σᵢ L(λᵢ) wᵢ with wᵢ = (x̄, ȳ, z̄)(λᵢ) / (4 p(λᵢ) ∫ ȳ dλ), 0 where p(λᵢ) = 0.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct LaneXyz {
-    pub per_lane: [DVec3; N_SPECTRUM_SAMPLES],
-}
-
-impl LaneXyz {
-    pub fn new(wavelengths: &SampledWavelengths) -> Self {
-        let table = cie1931_interleaved();
-        let pdf = wavelengths.pdf();
-        let norm = N_SPECTRUM_SAMPLES as f64 * y_bar_integral_1931_nm();
-        Self {
-            per_lane: std::array::from_fn(|lane| {
-                let p = f64::from(pdf[lane]);
-                if p > 0.0 {
-                    cmf_lerp(table, f64::from(wavelengths.wavelength_nm(lane))) / (p * norm)
-                } else {
-                    DVec3::ZERO
-                }
-            }),
-        }
-    }
-
-    /// [`sampled_radiance_to_xyz`] of `radiance` (equal up to rounding).
-    #[inline]
-    pub fn xyz(&self, radiance: SampledSpectrum) -> DVec3 {
-        (0..N_SPECTRUM_SAMPLES)
-            .map(|lane| self.lane(radiance, lane))
-            .sum()
-    }
-
-    /// Its Y alone.
-    #[inline]
-    pub fn y(&self, radiance: SampledSpectrum) -> f64 {
-        (0..N_SPECTRUM_SAMPLES)
-            .map(|lane| self.lane(radiance, lane).y)
-            .sum()
-    }
-
-    /// Lane `lane`'s term of the sum (zero where the lane's value is zero, so that a zero
-    /// value on a lane of zero weight stays zero).
-    #[inline]
-    pub fn lane(&self, radiance: SampledSpectrum, lane: usize) -> DVec3 {
-        let l = f64::from(radiance[lane]);
-        if l == 0.0 {
-            DVec3::ZERO
-        } else {
-            self.per_lane[lane] * l
-        }
-    }
-}
-
 /// The CIE 1931 x̄, ȳ, z̄ interleaved per 1 nm sample (one row per wavelength), for
 /// `sampled_radiance_to_xyz`: the film converts every camera sample, and one index
 /// computation for the three functions instead of three `DenseSpectrum::eval` calls halves
@@ -409,25 +354,6 @@ mod tests {
         for wl in [360.0, 830.0, 555.0] {
             let expected = DVec3::new(c.x_bar.eval(wl), c.y_bar.eval(wl), c.z_bar.eval(wl));
             assert_eq!(cmf_lerp(table, wl), expected);
-        }
-    }
-
-    #[test]
-    fn lane_weights_give_the_hero_wavelength_xyz() {
-        for u in [0.0, 0.137, 0.5, 0.93] {
-            let mut wavelengths = SampledWavelengths::sample_visible(u);
-            let weights = LaneXyz::new(&wavelengths);
-            let radiance = SampledSpectrum::new([0.3, 2.0, 0.0, 7.5]);
-            let expected = sampled_radiance_to_xyz(radiance, &wavelengths);
-            let got = weights.xyz(radiance);
-            assert!((got - expected).abs().max_element() <= 1e-12 * expected.max_element());
-            assert!((weights.y(radiance) - expected.y).abs() <= 1e-12 * expected.y);
-            // A terminated secondary lane (pdf 0) contributes nothing, as in the sum.
-            wavelengths.terminate_secondary();
-            let weights = LaneXyz::new(&wavelengths);
-            let expected = sampled_radiance_to_xyz(radiance, &wavelengths);
-            assert!((weights.xyz(radiance) - expected).abs().max_element() <= 1e-12 * expected.y);
-            assert_eq!(weights.lane(radiance, 1), DVec3::ZERO);
         }
     }
 

@@ -111,6 +111,20 @@ impl XyzWeights {
         let l = radiance.values.map(f64::from);
         (c[0] * l[0] + c[1] * l[1]) + (c[2] * l[2] + c[3] * l[3])
     }
+
+    /// The Y of [`Self::xyz`] alone.
+    #[inline]
+    pub fn y(&self, radiance: SampledSpectrum) -> f64 {
+        let c = &self.columns;
+        let l = radiance.values.map(f64::from);
+        (c[0].y * l[0] + c[1].y * l[1]) + (c[2].y * l[2] + c[3].y * l[3])
+    }
+
+    /// Lane `lane`'s term of [`Self::xyz`]: its column times L(λ_lane).
+    #[inline]
+    pub fn lane(&self, radiance: SampledSpectrum, lane: usize) -> DVec3 {
+        self.columns[lane] * f64::from(radiance[lane])
+    }
 }
 
 #[cfg(test)]
@@ -173,6 +187,9 @@ mod tests {
                         (want - got).abs().max_element() <= 1e-12 * scale,
                         "{u} {terminate}: {want} vs {got}"
                     );
+                    assert!((weights.y(l) - want.y).abs() <= 1e-12 * scale);
+                    let lanes: DVec3 = (0..N_SPECTRUM_SAMPLES).map(|i| weights.lane(l, i)).sum();
+                    assert!((lanes - want).abs().max_element() <= 1e-12 * scale);
                 }
             }
         }
