@@ -131,6 +131,11 @@ fn plan_flags_are_checked() {
             "--plan-nb must be at least 1",
         ),
         (vec!["--plan-probe-stride", "2"], "add --plan predicted"),
+        (vec!["--plan-pool-px", "3"], "add --plan predicted"),
+        (
+            vec!["--plan", "predicted", "--plan-pool-px", "2.5"],
+            "'2.5': expected `auto` or a radius in whole pixels",
+        ),
         (
             vec!["--plan", "predicted", "--plan-probe-stride", "0"],
             "--plan-probe-stride 0: expected at least 1",
@@ -249,9 +254,21 @@ fn explain_names_the_plan() {
         text.contains("per probed pixel (every pixel, as the paper)"),
         "{text}"
     );
+    // glossy-env is 480×270: the automatic pooling radius is 270/32 ≈ 8 px.
     let text = explain(&["--plan", "predicted", "--plan-probe-stride", "3"]);
     assert!(
-        text.contains("one pixel in 3×3, and each pixel of a surface with none within 2 px"),
+        text.contains("one pixel in 3×3, and each pixel of a surface with none within 8 px"),
+        "{text}"
+    );
+    assert!(
+        text.contains(
+            "pooled over the pixels of the same material within 8 px (--plan-pool-px auto"
+        ),
+        "{text}"
+    );
+    let text = explain(&["--plan", "predicted", "--plan-pool-px", "3"]);
+    assert!(
+        text.contains("same material within 3 px (--plan-pool-px)"),
         "{text}"
     );
     let text = explain(&["--plan", "predicted-hier"]);

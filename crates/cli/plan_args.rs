@@ -5,7 +5,7 @@ use clap::{Args, ValueEnum};
 use prism_bandwidth::allocation::DEFAULT_FLOOR;
 use prism_bandwidth::hierarchical_shading::DEFAULT_MAX_LEVEL;
 use prism_bandwidth::{
-    Allocation, AllocationSettings, VarianceBandwidth, DEFAULT_POOL_RADIUS_PX,
+    Allocation, AllocationSettings, PoolRadius, VarianceBandwidth, DEFAULT_POOL_RADIUS,
     DEFAULT_PROBE_STRIDE_PX,
 };
 use prism_render::bsdf_table_cache::AngularTableCache;
@@ -81,9 +81,9 @@ pub struct PlanArgs {
     #[arg(long = "plan-colour", value_enum, default_value = "on")]
     pub plan_colour: OnOff,
     /// `--plan predicted`: V̂_p is pooled over the (2R+1)² pixels of the same material around
-    /// each pixel (0: per pixel, as the paper).
-    #[arg(long = "plan-pool-px", value_name = "R", default_value_t = DEFAULT_POOL_RADIUS_PX, value_parser = prism_args::numbers::parse_u32)]
-    pub plan_pool_px: u32,
+    /// each pixel (`auto`: R = min(W, H)/32, at least 1; 0: per pixel, as the paper).
+    #[arg(long = "plan-pool-px", value_name = "R|auto", default_value_t = DEFAULT_POOL_RADIUS, value_parser = PoolRadius::parse)]
+    pub plan_pool_px: PoolRadius,
     /// `--plan predicted`: one-bounce indirect estimates per pixel, which add the indirect
     /// light's mean and variance to the prediction (0: direct light only, as the paper).
     #[arg(long = "plan-indirect", value_name = "N", default_value_t = DEFAULT_PROBE_SAMPLES, value_parser = prism_args::numbers::parse_u32)]
@@ -135,7 +135,7 @@ impl PlanArgs {
             || self.plan_variance != VarianceArg::Measured
             || self.plan_visibility != OnOff::On
             || self.plan_colour != OnOff::On
-            || self.plan_pool_px != DEFAULT_POOL_RADIUS_PX
+            || self.plan_pool_px != DEFAULT_POOL_RADIUS
             || self.plan_indirect != DEFAULT_PROBE_SAMPLES
             || self.plan_probe_stride != DEFAULT_PROBE_STRIDE_PX
             || self.cache_dir.is_some();
@@ -186,7 +186,7 @@ impl PlanArgs {
                 variance: self.variance_bandwidth(),
                 colour_noise: self.plan_colour == OnOff::On,
                 probe_stride_px: self.plan_probe_stride,
-                pool_radius_px: self.plan_pool_px,
+                pool_radius: self.plan_pool_px,
                 hierarchical_max_level: (self.plan == PlanArg::PredictedHier)
                     .then_some(self.plan_max_level),
             },
@@ -227,7 +227,7 @@ impl PlanArgs {
             variance_bandwidth: self.variance_bandwidth(),
             visibility: self.plan_visibility == OnOff::On,
             colour_noise: self.plan_colour == OnOff::On,
-            pool_radius_px: self.plan_pool_px,
+            pool_radius: self.plan_pool_px,
             indirect_samples: self.plan_indirect,
             probe_stride_px: self.plan_probe_stride,
         }

@@ -63,5 +63,7 @@ pub use probe::{IndirectEstimate, LightSample, ShadingProbe};
 pub use sample_plan::{SamplePlan, DEFAULT_LIGHT_SAMPLES};
 pub use sparse_probing::{nearest_probed, probed_pixels, DEFAULT_PROBE_STRIDE_PX};
 pub use variance_model::{model_variance, ModelledVariance};
-pub use variance_pooling::{pool_scaled, pool_variance, PixelClass, DEFAULT_POOL_RADIUS_PX};
+pub use variance_pooling::{
+    pool_scaled, pool_variance, PixelClass, PoolRadius, DEFAULT_POOL_RADIUS,
+};
 pub use visibility::{Visibility, VisibilitySummary};

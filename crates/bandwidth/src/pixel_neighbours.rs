@@ -1,6 +1,7 @@
 //! A pixel's neighbours in a row-major image: its 4-neighbours, which the edge tests of the
 //! variance model, the geometric edges and the shadow edges compare it with, and the square
-//! window around it that pooling and sparse probing search.
+//! window around it that pooling sums, and that window's rings, which sparse probing searches
+//! from the inside out.
 
 use glam::UVec2;
 
@@ -31,9 +32,60 @@ pub fn window(
     })
 }
 
+/// The (x, y) of the pixels at Chebyshev distance exactly `distance` from (x, y), clipped
+/// at the border of a `width` × `height` image: rings 0..=r cover [`window`] once each, so a
+/// search for the nearest pixel can stop at the first ring past its best distance.
+pub fn ring(
+    (x, y): (usize, usize),
+    distance: usize,
+    (width, height): (usize, usize),
+) -> impl Iterator<Item = (usize, usize)> {
+    let d = distance;
+    let columns = x.saturating_sub(d)..(x + d + 1).min(width);
+    let top = (y >= d).then(|| y - d);
+    let bottom = (d > 0 && y + d < height).then_some(y + d);
+    let rows = [top, bottom]
+        .into_iter()
+        .flatten()
+        .flat_map(move |yy| columns.clone().map(move |xx| (xx, yy)));
+    // The sides, without the corners the rows hold (none at d = 0).
+    let inner = (y + 1).saturating_sub(d)..(y + d).min(height);
+    let left = (d > 0 && x >= d).then(|| x - d);
+    let right = (d > 0 && x + d < width).then_some(x + d);
+    let sides = [left, right]
+        .into_iter()
+        .flatten()
+        .flat_map(move |xx| inner.clone().map(move |yy| (xx, yy)));
+    rows.chain(sides)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Rings 0..=r hold exactly the window's pixels, each once, at their own distance.
+    #[test]
+    fn rings_partition_the_window() {
+        for (size, centre) in [
+            ((7, 5), (3, 2)),
+            ((7, 5), (0, 0)),
+            ((4, 9), (3, 8)),
+            ((1, 1), (0, 0)),
+        ] {
+            for r in 0..6 {
+                let mut from_rings: Vec<(usize, usize)> = (0..=r)
+                    .flat_map(|d| {
+                        ring(centre, d, size).inspect(move |&(xx, yy)| {
+                            assert_eq!(xx.abs_diff(centre.0).max(yy.abs_diff(centre.1)), d);
+                        })
+                    })
+                    .collect();
+                from_rings.sort_by_key(|&(xx, yy)| (yy, xx));
+                let whole: Vec<_> = window(centre, r, size).collect();
+                assert_eq!(from_rings, whole, "{size:?} {centre:?} r {r}");
+            }
+        }
+    }
 
     #[test]
     fn a_window_is_clipped_at_the_border_in_row_major_order() {

@@ -14,7 +14,7 @@
 use glam::UVec2;
 
 use crate::error::{check_lengths, pixel_count, BandwidthError};
-use crate::pixel_neighbours::window;
+use crate::pixel_neighbours::ring;
 use crate::variance_pooling::PixelClass;
 
 /// The default probe stride S, pixels between probed pixels along x and y: 1, the paper's
@@ -59,8 +59,12 @@ pub fn probed_pixels(
                 PixelClass::Background => true,
                 PixelClass::Material(_) => {
                     on_lattice(x, y, s)
-                        || !window((x, y), r, (w, h))
-                            .any(|(xx, yy)| on_lattice(xx, yy, s) && class[yy * w + xx] == own)
+                        // Ring by ring: the nearest lattice pixel is usually within S − 1.
+                        || !(0..=r).any(|d| {
+                            ring((x, y), d, (w, h)).any(|(xx, yy)| {
+                                on_lattice(xx, yy, s) && class[yy * w + xx] == own
+                            })
+                        })
                 }
             });
         }
@@ -97,15 +101,23 @@ pub fn nearest_probed(
                 donors.push(None);
                 continue;
             }
+            // (squared distance, index): the least wins, so ties go to the first in
+            // row-major order. Ring d lies at a Euclidean distance of at least d, so the
+            // search stops past the best one found.
             let mut best: Option<(usize, usize)> = None;
-            for (xx, yy) in window((x, y), r, (w, h)) {
-                let j = yy * w + xx;
-                if !probed[j] || class[j] != class[i] {
-                    continue;
+            for d in 0..=r {
+                if best.is_some_and(|(b, _)| d * d > b) {
+                    break;
                 }
-                let d2 = x.abs_diff(xx).pow(2) + y.abs_diff(yy).pow(2);
-                if best.is_none_or(|(d, _)| d2 < d) {
-                    best = Some((d2, j));
+                for (xx, yy) in ring((x, y), d, (w, h)) {
+                    let j = yy * w + xx;
+                    if !probed[j] || class[j] != class[i] {
+                        continue;
+                    }
+                    let d2 = x.abs_diff(xx).pow(2) + y.abs_diff(yy).pow(2);
+                    if best.is_none_or(|b| (d2, j) < b) {
+                        best = Some((d2, j));
+                    }
                 }
             }
             donors.push(best.map(|(_, j)| j));
@@ -183,5 +195,37 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("stride_px"), "{e}");
+    }
+
+    /// The ring search finds the definition's donor: the nearest probed pixel of the class
+    /// in the whole window, ties to the first in row-major order.
+    #[test]
+    fn the_ring_search_finds_the_window_s_nearest_donor() {
+        let resolution = UVec2::new(19, 13);
+        let (w, h) = (19usize, 13usize);
+        let class: Vec<PixelClass> = (0..w * h)
+            .map(|i| PixelClass::Material(((i * 7 + i / 5) % 3) as u32))
+            .collect();
+        let probed: Vec<bool> = (0..w * h).map(|i| (i * 13) % 11 == 0).collect();
+        for r in [0usize, 1, 3, 8, 30] {
+            let got = nearest_probed(resolution, &class, &probed, r as u32).unwrap();
+            for i in 0..w * h {
+                let want = if probed[i] {
+                    None
+                } else {
+                    crate::pixel_neighbours::window((i % w, i / w), r, (w, h))
+                        .map(|(xx, yy)| yy * w + xx)
+                        .filter(|&j| probed[j] && class[j] == class[i])
+                        .map(|j| {
+                            let d2 =
+                                (i % w).abs_diff(j % w).pow(2) + (i / w).abs_diff(j / w).pow(2);
+                            (d2, j)
+                        })
+                        .min()
+                        .map(|(_, j)| j)
+                };
+                assert_eq!(got[i], want, "pixel {i}, r {r}");
+            }
+        }
     }
 }

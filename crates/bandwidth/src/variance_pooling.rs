@@ -9,18 +9,67 @@
 //! (2r+1)²·n_b samples; the shading variance of one surface changes slowly apart from its
 //! edges, which the material classes keep apart. Measured (docs/bandwidth.md): with r = 2
 //! the allocation's expected relMSE beats uniform sampling's on the three benchmark scenes,
-//! where per-pixel V̂ lost to it.
+//! where per-pixel V̂ lost to it. The best radius grows with the image ([`PoolRadius::Auto`]),
+//! so each class's window sums are separable (a row pass, then a column pass within the
+//! class's bounding box, O(1) per pixel) wherever that costs less than summing each window,
+//! (2r+1)² reads per pixel.
+
+use std::collections::HashMap;
 
 use glam::UVec2;
 
 use crate::error::{check_lengths, pixel_count, BandwidthError};
-use crate::pixel_neighbours::window;
 
-/// The default pooling radius r in pixels (a 5×5 window).
-pub const DEFAULT_POOL_RADIUS_PX: u32 = 2;
+/// The default pooling radius: [`PoolRadius::Auto`].
+pub const DEFAULT_POOL_RADIUS: PoolRadius = PoolRadius::Auto;
+
+/// Image pixels per pixel of automatic pooling radius: r = min(W, H)/32, at least 1.
+const AUTO_POOL_PX_PER_RADIUS_PX: u32 = 32;
+
+/// The pooling radius r (`--plan-pool-px`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PoolRadius {
+    /// In proportion to the image, r = min(W, H)/32 rounded, at least 1: a window that
+    /// covers the same share of the scene at every resolution. Measured best among fixed
+    /// radii at 64², 128² and 256² (r = 2, 4, 8; docs/bandwidth.md).
+    Auto,
+    /// A fixed radius in pixels; 0 = the paper's per-pixel V̂_p.
+    Px(u32),
+}
+
+impl PoolRadius {
+    /// The radius in pixels for an image of `resolution`.
+    pub fn px(self, resolution: UVec2) -> u32 {
+        match self {
+            PoolRadius::Auto => ((resolution.x.min(resolution.y) + AUTO_POOL_PX_PER_RADIUS_PX / 2)
+                / AUTO_POOL_PX_PER_RADIUS_PX)
+                .max(1),
+            PoolRadius::Px(r) => r,
+        }
+    }
+
+    /// Parses `auto` or a radius in whole pixels.
+    pub fn parse(text: &str) -> Result<Self, String> {
+        match text {
+            "auto" => Ok(PoolRadius::Auto),
+            _ => text.parse().map(PoolRadius::Px).map_err(|_| {
+                format!("'{text}': expected `auto` or a radius in whole pixels (0, 1, 2, ...)")
+            }),
+        }
+    }
+}
+
+impl std::fmt::Display for PoolRadius {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            PoolRadius::Auto => f.write_str("auto"),
+            PoolRadius::Px(r) => write!(f, "{r}"),
+        }
+    }
+}
 
 /// The surface class of a pixel: pooling only mixes pixels of one class.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum PixelClass {
     /// The centre ray hits a surface of this material.
     Material(u32),
@@ -81,37 +130,247 @@ pub fn pool_scaled(
     if radius_px == 0 {
         return Ok(values.to_vec());
     }
-    let (w, h) = (resolution.x as usize, resolution.y as usize);
-    let r = radius_px as usize;
-    let mut pooled = Vec::with_capacity(count);
-    for y in 0..h {
-        for x in 0..w {
-            let i = y * w + x;
-            let own = class[i];
-            if own == PixelClass::Unpredicted {
-                pooled.push(values[i]);
-                continue;
-            }
-            let (mut sum, mut scale_sum, mut n) = (0.0f64, 0.0f64, 0u32);
-            for (xx, yy) in window((x, y), r, (w, h)) {
-                let j = yy * w + xx;
-                if class[j] == own && probed[j] {
-                    sum += f64::from(values[j]);
-                    scale_sum += f64::from(scale[j]);
-                    n += 1;
-                }
-            }
-            let value = if n == 0 {
-                f64::from(values[i])
-            } else if scale_sum > 0.0 {
-                f64::from(scale[i]) * (sum / scale_sum)
-            } else {
-                sum / f64::from(n)
-            };
-            pooled.push(value as f32);
-        }
+    let mut pooled = values.to_vec();
+    for extent in class_extents(resolution, class) {
+        let summation = WindowSummation::cheaper(&extent, radius_px as usize);
+        pool_class(
+            resolution,
+            values,
+            scale,
+            class,
+            probed,
+            radius_px,
+            &extent,
+            summation,
+            &mut pooled,
+        );
     }
     Ok(pooled)
+}
+
+/// Where one class's pixels lie: their bounding box (inclusive) and their count. No
+/// pixel of the class lies outside the box, so neither do the windows' members.
+#[derive(Clone, Copy, Debug)]
+struct ClassExtent {
+    class: PixelClass,
+    min: (usize, usize),
+    max: (usize, usize),
+    pixels: usize,
+}
+
+impl ClassExtent {
+    fn size(&self) -> (usize, usize) {
+        (self.max.0 - self.min.0 + 1, self.max.1 - self.min.1 + 1)
+    }
+}
+
+/// The extents of the pooled classes (all but `Unpredicted`), in no particular order:
+/// each class writes only its own pixels.
+fn class_extents(resolution: UVec2, class: &[PixelClass]) -> Vec<ClassExtent> {
+    let w = resolution.x as usize;
+    let mut extents: HashMap<PixelClass, ClassExtent> = HashMap::new();
+    for (i, &c) in class.iter().enumerate() {
+        match c {
+            PixelClass::Unpredicted => continue,
+            PixelClass::Material(_) | PixelClass::Background => {}
+        }
+        let (x, y) = (i % w, i / w);
+        extents
+            .entry(c)
+            .and_modify(|e| {
+                e.min = (e.min.0.min(x), e.min.1.min(y));
+                e.max = (e.max.0.max(x), e.max.1.max(y));
+                e.pixels += 1;
+            })
+            .or_insert(ClassExtent {
+                class: c,
+                min: (x, y),
+                max: (x, y),
+                pixels: 1,
+            });
+    }
+    extents.into_values().collect()
+}
+
+/// How one class's window sums are taken; both give the same sums up to rounding.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum WindowSummation {
+    /// (2r+1)² reads per pixel of the class: cheaper for a class whose pixels are few in
+    /// its bounding box (scattered, or thin and diagonal).
+    PerWindow,
+    /// A row pass, then a column pass, over the bounding box, each O(1) per pixel
+    /// ([`BlockSums`]): a few reads per box pixel whatever the radius.
+    Separable,
+}
+
+impl WindowSummation {
+    fn cheaper(extent: &ClassExtent, radius_px: usize) -> Self {
+        let side = 2 * radius_px + 1;
+        let (bw, bh) = extent.size();
+        let per_window = extent.pixels.saturating_mul(side * side);
+        // Measured: the two passes cost about as much as 8 reads per box pixel.
+        let separable = (bw * bh).saturating_mul(8);
+        if separable < per_window {
+            WindowSummation::Separable
+        } else {
+            WindowSummation::PerWindow
+        }
+    }
+}
+
+/// Σ value, Σ scale and the count of a window's lending pixels.
+#[derive(Clone, Copy, Debug, Default)]
+struct WindowSum {
+    value: f64,
+    scale: f64,
+    count: u32,
+}
+
+impl WindowSum {
+    fn add(&mut self, other: WindowSum) {
+        self.value += other.value;
+        self.scale += other.scale;
+        self.count += other.count;
+    }
+
+    /// `pool_scaled`'s value for a pixel of `own_value` and `own_scale` whose window sums
+    /// to `self`.
+    fn pooled(self, own_value: f32, own_scale: f32) -> f32 {
+        let value = if self.count == 0 {
+            f64::from(own_value)
+        } else if self.scale > 0.0 {
+            f64::from(own_scale) * (self.value / self.scale)
+        } else {
+            self.value / f64::from(self.count)
+        };
+        value as f32
+    }
+}
+
+/// Writes the pooled values of `extent`'s class into `pooled`.
+#[allow(clippy::too_many_arguments)]
+fn pool_class(
+    resolution: UVec2,
+    values: &[f32],
+    scale: &[f32],
+    class: &[PixelClass],
+    probed: &[bool],
+    radius_px: u32,
+    extent: &ClassExtent,
+    summation: WindowSummation,
+    pooled: &mut [f32],
+) {
+    let w = resolution.x as usize;
+    let r = radius_px as usize;
+    let own = extent.class;
+    // A pixel's contribution to its class's windows: nothing unless it is of the class and
+    // was probed (a non-finite value elsewhere never reaches this class's sums).
+    let lend = |j: usize| {
+        if class[j] == own && probed[j] {
+            WindowSum {
+                value: f64::from(values[j]),
+                scale: f64::from(scale[j]),
+                count: 1,
+            }
+        } else {
+            WindowSum::default()
+        }
+    };
+    let (x0, y0) = extent.min;
+    let (x1, y1) = extent.max;
+    match summation {
+        WindowSummation::PerWindow => {
+            for y in y0..=y1 {
+                for x in x0..=x1 {
+                    let i = y * w + x;
+                    if class[i] != own {
+                        continue;
+                    }
+                    let mut sum = WindowSum::default();
+                    for yy in y.saturating_sub(r).max(y0)..=(y + r).min(y1) {
+                        for xx in x.saturating_sub(r).max(x0)..=(x + r).min(x1) {
+                            sum.add(lend(yy * w + xx));
+                        }
+                    }
+                    pooled[i] = sum.pooled(values[i], scale[i]);
+                }
+            }
+        }
+        WindowSummation::Separable => {
+            let (bw, bh) = extent.size();
+            let mut sums: Vec<WindowSum> = (0..bw * bh)
+                .map(|k| lend((y0 + k / bw) * w + x0 + k % bw))
+                .collect();
+            let mut line = Vec::with_capacity(bw.max(bh));
+            let mut scratch = BlockSums::default();
+            for row in sums.chunks_exact_mut(bw) {
+                line.clear();
+                line.extend_from_slice(row);
+                scratch.window_sums(&line, r, row);
+            }
+            let mut column = vec![WindowSum::default(); bh];
+            for bx in 0..bw {
+                line.clear();
+                line.extend((0..bh).map(|by| sums[by * bw + bx]));
+                scratch.window_sums(&line, r, &mut column);
+                for (by, sum) in column.iter().enumerate() {
+                    let i = (y0 + by) * w + x0 + bx;
+                    if class[i] == own {
+                        pooled[i] = sum.pooled(values[i], scale[i]);
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Window sums along a line in O(1) per element without subtracting (so without the
+/// cancellation of running sums on values that span many decades): the van Herk / Gil–Werman
+/// scheme. The line is cut into blocks of the window's length k = 2r+1; a window then covers
+/// a suffix of one block and a prefix of the next, or (clipped at an end of the line) one
+/// block's prefix or suffix.
+#[derive(Default)]
+struct BlockSums {
+    prefix: Vec<WindowSum>,
+    suffix: Vec<WindowSum>,
+}
+
+impl BlockSums {
+    /// `out[i]` = Σ `line[j]` over |j − i| ≤ r within the line.
+    fn window_sums(&mut self, line: &[WindowSum], r: usize, out: &mut [WindowSum]) {
+        let n = line.len();
+        let k = 2 * r + 1;
+        self.prefix.clear();
+        self.prefix.extend_from_slice(line);
+        self.suffix.clear();
+        self.suffix.extend_from_slice(line);
+        for i in 1..n {
+            if i % k != 0 {
+                let before = self.prefix[i - 1];
+                self.prefix[i].add(before);
+            }
+        }
+        for i in (0..n.saturating_sub(1)).rev() {
+            if (i + 1) % k != 0 {
+                let after = self.suffix[i + 1];
+                self.suffix[i].add(after);
+            }
+        }
+        for (i, out) in out.iter_mut().enumerate().take(n) {
+            let (a, b) = (i.saturating_sub(r), (i + r).min(n - 1));
+            *out = if a / k != b / k {
+                let mut sum = self.suffix[a];
+                sum.add(self.prefix[b]);
+                sum
+            } else if a % k == 0 {
+                // From its block's start (the line's start when clipped there).
+                self.prefix[b]
+            } else {
+                // To its block's end: b is the line's end, where the last block ends.
+                self.suffix[a]
+            };
+        }
+    }
 }
 
 #[cfg(test)]
@@ -220,6 +479,168 @@ mod tests {
         // A pixel with no probed pixel of its class in the window keeps its own value.
         let p = pool_scaled(UVec2::new(5, 1), &values, &scale, &c, &[false; 5], 1).unwrap();
         assert_eq!(p, values.to_vec());
+    }
+
+    /// Pools with every class summed one way, whatever costs less.
+    fn pool_forced(
+        resolution: UVec2,
+        values: &[f32],
+        scale: &[f32],
+        class: &[PixelClass],
+        probed: &[bool],
+        radius_px: u32,
+        summation: WindowSummation,
+    ) -> Vec<f32> {
+        let mut pooled = values.to_vec();
+        for extent in class_extents(resolution, class) {
+            pool_class(
+                resolution,
+                values,
+                scale,
+                class,
+                probed,
+                radius_px,
+                &extent,
+                summation,
+                &mut pooled,
+            );
+        }
+        pooled
+    }
+
+    /// The definition, pixel by pixel over the whole image's clipped window.
+    fn pool_by_definition(
+        resolution: UVec2,
+        values: &[f32],
+        scale: &[f32],
+        class: &[PixelClass],
+        probed: &[bool],
+        r: usize,
+    ) -> Vec<f32> {
+        let (w, h) = (resolution.x as usize, resolution.y as usize);
+        (0..w * h)
+            .map(|i| {
+                if class[i] == PixelClass::Unpredicted {
+                    return values[i];
+                }
+                let mut sum = WindowSum::default();
+                for (xx, yy) in crate::pixel_neighbours::window((i % w, i / w), r, (w, h)) {
+                    let j = yy * w + xx;
+                    if class[j] == class[i] && probed[j] {
+                        sum.add(WindowSum {
+                            value: f64::from(values[j]),
+                            scale: f64::from(scale[j]),
+                            count: 1,
+                        });
+                    }
+                }
+                sum.pooled(values[i], scale[i])
+            })
+            .collect()
+    }
+
+    /// Both summations give the definition's pooled values (to f32 rounding) on random
+    /// images of four materials, the background and unpredicted pixels, with values over
+    /// eight decades (the probe's heavy tail), sparse probing and radii up to past the
+    /// image; a non-finite value spoils only its own class's windows that hold it.
+    #[test]
+    fn separable_and_per_window_sums_agree_with_the_definition() {
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let resolution = UVec2::new(37, 23);
+        let n = (resolution.x * resolution.y) as usize;
+        for round in 0..6 {
+            let class: Vec<PixelClass> = (0..n)
+                .map(|i| {
+                    // Blocks of materials with noise, so classes have both compact and
+                    // scattered members.
+                    let u = next();
+                    let (x, y) = (i % 37, i / 37);
+                    if u < 0.05 {
+                        PixelClass::Unpredicted
+                    } else if u < 0.15 {
+                        PixelClass::Material(3)
+                    } else if y < 8 {
+                        PixelClass::Background
+                    } else {
+                        PixelClass::Material((x / 12) as u32)
+                    }
+                })
+                .collect();
+            let mut values: Vec<f32> = (0..n)
+                .map(|_| 10f64.powf(8.0 * next() - 4.0) as f32)
+                .collect();
+            let scale: Vec<f32> = (0..n).map(|_| next() as f32).collect();
+            let probed: Vec<bool> = (0..n).map(|_| round % 2 == 0 || next() < 0.3).collect();
+            if round == 5 {
+                values[0] = f32::INFINITY;
+            }
+            for r in [1u32, 2, 5, 40] {
+                let want =
+                    pool_by_definition(resolution, &values, &scale, &class, &probed, r as usize);
+                for summation in [WindowSummation::PerWindow, WindowSummation::Separable] {
+                    let got =
+                        pool_forced(resolution, &values, &scale, &class, &probed, r, summation);
+                    for i in 0..n {
+                        let (g, w) = (got[i], want[i]);
+                        let same =
+                            g == w || (g.is_nan() && w.is_nan()) || (g - w).abs() <= 1e-6 * w.abs();
+                        assert!(
+                            same,
+                            "round {round} r {r} {summation:?} pixel {i}: {g} vs {w}"
+                        );
+                    }
+                }
+                let chosen = pool_scaled(resolution, &values, &scale, &class, &probed, r).unwrap();
+                assert_eq!(chosen.len(), n);
+            }
+        }
+    }
+
+    #[test]
+    fn summation_is_separable_where_that_costs_less() {
+        let compact = ClassExtent {
+            class: PixelClass::Background,
+            min: (0, 0),
+            max: (99, 99),
+            pixels: 10_000,
+        };
+        assert_eq!(
+            WindowSummation::cheaper(&compact, 1),
+            WindowSummation::Separable
+        );
+        assert_eq!(
+            WindowSummation::cheaper(&compact, 8),
+            WindowSummation::Separable
+        );
+        // 50 pixels scattered over the same box: summing their windows costs less.
+        let scattered = ClassExtent {
+            pixels: 50,
+            ..compact
+        };
+        assert_eq!(
+            WindowSummation::cheaper(&scattered, 8),
+            WindowSummation::PerWindow
+        );
+    }
+
+    #[test]
+    fn the_automatic_radius_follows_the_image() {
+        let r = |w, h| PoolRadius::Auto.px(UVec2::new(w, h));
+        assert_eq!((r(64, 64), r(128, 128), r(256, 256)), (2, 4, 8));
+        assert_eq!((r(64, 36), r(16, 16), r(1920, 1080)), (1, 1, 34));
+        assert_eq!(PoolRadius::Px(0).px(UVec2::new(512, 512)), 0);
+        assert_eq!(PoolRadius::parse("auto"), Ok(PoolRadius::Auto));
+        assert_eq!(PoolRadius::parse("3"), Ok(PoolRadius::Px(3)));
+        let e = PoolRadius::parse("-1").unwrap_err();
+        assert!(e.contains("auto") && e.contains("-1"), "{e}");
+        assert_eq!(PoolRadius::Auto.to_string(), "auto");
+        assert_eq!(PoolRadius::Px(5).to_string(), "5");
     }
 
     #[test]

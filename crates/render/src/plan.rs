@@ -76,9 +76,9 @@ pub enum SamplePlanKind {
         colour_noise: bool,
         /// The probe samples one pixel in S×S (`--plan-probe-stride`; 1 = every pixel).
         probe_stride_px: u32,
-        /// The pooling radius (`--plan-pool-px`), within which a pixel the probe skips finds
-        /// a probed one.
-        pool_radius_px: u32,
+        /// The pooling radius (`--plan-pool-px`) of V̂ and L̂, within which a pixel the
+        /// probe skips finds a probed one.
+        pool_radius: prism_bandwidth::PoolRadius,
         /// `predicted-hier`: hierarchical shading with lattices up to this level.
         hierarchical_max_level: Option<u32>,
     },
@@ -124,7 +124,7 @@ fn within(features: SceneFeatures, list: &str) -> String {
 }
 
 /// The sample plan's name and what it switches on, for the `sampler` line.
-fn sample_plan_text(kind: SamplePlanKind) -> (&'static str, String) {
+fn sample_plan_text(kind: SamplePlanKind, resolution: glam::UVec2) -> (&'static str, String) {
     match kind {
         SamplePlanKind::Uniform => (
             "uniform",
@@ -137,9 +137,11 @@ fn sample_plan_text(kind: SamplePlanKind) -> (&'static str, String) {
             variance,
             colour_noise,
             probe_stride_px,
-            pool_radius_px,
+            pool_radius,
             hierarchical_max_level,
-        } => (
+        } => {
+            let pool_radius_px = pool_radius.px(resolution);
+            (
             match hierarchical_max_level {
                 Some(_) => "predicted-hier",
                 None => "predicted",
@@ -149,8 +151,8 @@ fn sample_plan_text(kind: SamplePlanKind) -> (&'static str, String) {
                  samples per probed pixel ({}), bandwidth by Bagher et al. 2013 eqs. 4-6 (silhouettes, creases \
                  and material edges at the finest level, seen directly or through mirrors and \
                  smooth glass, where the two sides' L̂ differ by over 2 %), \
-                 variance {}{}, \
-                 levels by eq. 11; {:.1} % of the budget uniform (light past the probe's one indirect \
+                 variance {}{}, pooled over the pixels of the same material within \
+                 {pool_radius_px} px ({}), levels by eq. 11; {:.1} % of the budget uniform (light past the probe's one indirect \
                  bounce is not predicted), the rest {}",
                 if probe_stride_px == 1 {
                     "every pixel, as the paper".to_string()
@@ -178,6 +180,12 @@ fn sample_plan_text(kind: SamplePlanKind) -> (&'static str, String) {
                 } else {
                     " of the luminance alone (--plan-colour off)"
                 },
+                match pool_radius {
+                    prism_bandwidth::PoolRadius::Auto => {
+                        "--plan-pool-px auto: min(W, H)/32, at least 1".to_string()
+                    }
+                    prism_bandwidth::PoolRadius::Px(_) => "--plan-pool-px".to_string(),
+                },
                 f64::from(floor_per_mille) / 10.0,
                 match allocation {
                     prism_bandwidth::Allocation::RelativeError => {
@@ -197,7 +205,8 @@ fn sample_plan_text(kind: SamplePlanKind) -> (&'static str, String) {
                 ),
                 None => String::new(),
             },
-        ),
+        )
+        }
         SamplePlanKind::Adaptive => (
             "adaptive",
             "--plan adaptive: 4 spp everywhere, then passes spread by the error of a \
@@ -253,7 +262,8 @@ impl RenderPlan {
                     ),
                     "the scene's `integrator` section (default `path`)".into(),
                 );
-                let (plan_name, plan_reason) = sample_plan_text(request.sample_plan);
+                let (plan_name, plan_reason) =
+                    sample_plan_text(request.sample_plan, scene.resolution);
                 choose(
                     "sampler",
                     format!(

@@ -13,9 +13,9 @@ use prism_bandwidth::pixel_prediction::MAX_IMAGE_BANDWIDTH_CYCLES_PER_PX;
 use prism_bandwidth::{
     allocate, four_neighbours, geometric_edges, model_variance, predict_pixel, Allocated,
     AllocationInputs, AllocationSettings, Bandwidth, BandwidthBuffer, GBufferHit, HierarchyInputs,
-    IndirectEstimate, LightSample, PixelClass, PixelFootprint, PixelPrediction, SeenSurface,
-    ShadingProbe, SurfacePoint, Upsampling, VarianceBandwidth, VisibilitySummary,
-    DEFAULT_POOL_RADIUS_PX, DEFAULT_PROBE_STRIDE_PX,
+    IndirectEstimate, LightSample, PixelClass, PixelFootprint, PixelPrediction, PoolRadius,
+    SeenSurface, ShadingProbe, SurfacePoint, Upsampling, VarianceBandwidth, VisibilitySummary,
+    DEFAULT_POOL_RADIUS, DEFAULT_PROBE_STRIDE_PX,
 };
 use prism_spectrum::colorimetry::sampled_radiance_to_xyz;
 use prism_spectrum::{SampledSpectrum, SampledWavelengths};
@@ -46,8 +46,9 @@ pub struct PredictorSettings {
     /// direct-only probe; `ShadingProbe::sample_indirect`).
     pub indirect_samples: u32,
     /// V̂_p pooled over the (2r+1)² pixels of the same surface around each pixel
-    /// (`--plan-pool-px`; 0 = the paper's per-pixel V̂_p; prism_bandwidth::variance_pooling).
-    pub pool_radius_px: u32,
+    /// (`--plan-pool-px`; `auto` = min(W, H)/32 px, 0 = the paper's per-pixel V̂_p;
+    /// prism_bandwidth::variance_pooling).
+    pub pool_radius: PoolRadius,
     /// The probe samples one pixel in S×S (`--plan-probe-stride`; 1 = every pixel, as the
     /// paper; prism_bandwidth::sparse_probing).
     pub probe_stride_px: u32,
@@ -69,7 +70,7 @@ impl PredictorSettings {
             variance_bandwidth: VarianceBandwidth::Measured,
             visibility: true,
             colour_noise: true,
-            pool_radius_px: DEFAULT_POOL_RADIUS_PX,
+            pool_radius: DEFAULT_POOL_RADIUS,
             indirect_samples: DEFAULT_PROBE_SAMPLES,
             probe_stride_px: DEFAULT_PROBE_STRIDE_PX,
         }
@@ -477,7 +478,7 @@ fn pixels_to_probe(scene: &RenderScene, settings: &PredictorSettings) -> Result<
         resolution,
         &class,
         settings.probe_stride_px,
-        settings.pool_radius_px,
+        settings.pool_radius.px(resolution),
     )
     .map_err(|e| e.to_string())
 }
@@ -656,7 +657,7 @@ pub fn predict_with_probe<'a>(
         &class,
         &probed,
         &eye,
-        settings.pool_radius_px,
+        settings.pool_radius.px(resolution),
     )?;
     if settings.visibility {
         add_shadow_edges(resolution, &mut pixels, &eye);
@@ -670,7 +671,7 @@ pub fn predict_with_probe<'a>(
         &class,
         &texture_scale,
         &probed,
-        settings.pool_radius_px,
+        settings.pool_radius.px(resolution),
         settings.variance_bandwidth == VarianceBandwidth::Measured,
     )
     .map_err(|e| e.to_string())?;
