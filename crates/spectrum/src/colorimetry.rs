@@ -88,7 +88,7 @@ pub fn sampled_radiance_to_xyz(
 /// `sampled_radiance_to_xyz`: the film converts every camera sample, and one index
 /// computation for the three functions instead of three `DenseSpectrum::eval` calls halves
 /// its cost. Same values and arithmetic, so the same bits (tested).
-fn cie1931_interleaved() -> &'static [DVec3; DENSE_SAMPLE_COUNT] {
+pub(crate) fn cie1931_interleaved() -> &'static [DVec3; DENSE_SAMPLE_COUNT] {
     static TABLE: std::sync::OnceLock<Box<[DVec3; DENSE_SAMPLE_COUNT]>> =
         std::sync::OnceLock::new();
     TABLE.get_or_init(|| {
@@ -121,7 +121,7 @@ fn cmf_lerp(table: &[DVec3; DENSE_SAMPLE_COUNT], wavelength_nm: f64) -> DVec3 {
 }
 
 /// ∫ ȳ dλ of CIE 1931, cached (the hot-path normaliser of [`sampled_radiance_to_xyz`]).
-fn y_bar_integral_1931_nm() -> f64 {
+pub(crate) fn y_bar_integral_1931_nm() -> f64 {
     static Y: std::sync::OnceLock<f64> = std::sync::OnceLock::new();
     *Y.get_or_init(|| crate::photometry::y_bar_integral_nm(Observer::Cie1931))
 }

@@ -26,6 +26,7 @@ pub mod sampled_wavelengths;
 pub mod spectrum;
 pub mod spectrum_file;
 pub mod table;
+pub mod xyz_weights;
 
 pub use adaptation::{adaptation_matrix, AdaptationMethod};
 pub use bfc::{load_bfc, parse_bfc, BfcData, NegativesPolicy};
