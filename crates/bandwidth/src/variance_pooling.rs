@@ -130,22 +130,16 @@ pub fn pool_scaled(
     if radius_px == 0 {
         return Ok(values.to_vec());
     }
-    let mut pooled = values.to_vec();
-    for extent in class_extents(resolution, class) {
-        let summation = WindowSummation::cheaper(&extent, radius_px as usize);
-        pool_class(
-            resolution,
-            values,
-            scale,
-            class,
-            probed,
-            radius_px,
-            &extent,
-            summation,
-            &mut pooled,
-        );
-    }
-    Ok(pooled)
+    let image = PoolImage {
+        resolution,
+        values,
+        scale,
+        class,
+        probed,
+    };
+    Ok(image.pool(radius_px, |extent| {
+        WindowSummation::cheaper(extent, radius_px as usize)
+    }))
 }
 
 /// Where one class's pixels lie: their bounding box (inclusive) and their count. No
@@ -247,76 +241,96 @@ impl WindowSum {
     }
 }
 
-/// Writes the pooled values of `extent`'s class into `pooled`.
-#[allow(clippy::too_many_arguments)]
-fn pool_class(
+/// What `pool_scaled` pools, checked to one length.
+struct PoolImage<'a> {
     resolution: UVec2,
-    values: &[f32],
-    scale: &[f32],
-    class: &[PixelClass],
-    probed: &[bool],
-    radius_px: u32,
-    extent: &ClassExtent,
-    summation: WindowSummation,
-    pooled: &mut [f32],
-) {
-    let w = resolution.x as usize;
-    let r = radius_px as usize;
-    let own = extent.class;
-    // A pixel's contribution to its class's windows: nothing unless it is of the class and
-    // was probed (a non-finite value elsewhere never reaches this class's sums).
-    let lend = |j: usize| {
-        if class[j] == own && probed[j] {
-            WindowSum {
-                value: f64::from(values[j]),
-                scale: f64::from(scale[j]),
-                count: 1,
-            }
-        } else {
-            WindowSum::default()
+    values: &'a [f32],
+    scale: &'a [f32],
+    class: &'a [PixelClass],
+    probed: &'a [bool],
+}
+
+impl PoolImage<'_> {
+    /// Every class pooled, each summed as `summation` picks for its extent.
+    fn pool(
+        &self,
+        radius_px: u32,
+        summation: impl Fn(&ClassExtent) -> WindowSummation,
+    ) -> Vec<f32> {
+        let mut pooled = self.values.to_vec();
+        for extent in class_extents(self.resolution, self.class) {
+            self.pool_class(radius_px, &extent, summation(&extent), &mut pooled);
         }
-    };
-    let (x0, y0) = extent.min;
-    let (x1, y1) = extent.max;
-    match summation {
-        WindowSummation::PerWindow => {
-            for y in y0..=y1 {
-                for x in x0..=x1 {
-                    let i = y * w + x;
-                    if class[i] != own {
-                        continue;
-                    }
-                    let mut sum = WindowSum::default();
-                    for yy in y.saturating_sub(r).max(y0)..=(y + r).min(y1) {
-                        for xx in x.saturating_sub(r).max(x0)..=(x + r).min(x1) {
-                            sum.add(lend(yy * w + xx));
+        pooled
+    }
+
+    /// Writes the pooled values of `extent`'s class into `pooled`.
+    fn pool_class(
+        &self,
+        radius_px: u32,
+        extent: &ClassExtent,
+        summation: WindowSummation,
+        pooled: &mut [f32],
+    ) {
+        let (values, scale, class, probed) = (self.values, self.scale, self.class, self.probed);
+        let w = self.resolution.x as usize;
+        let r = radius_px as usize;
+        let own = extent.class;
+        // A pixel's contribution to its class's windows: nothing unless it is of the class and
+        // was probed (a non-finite value elsewhere never reaches this class's sums).
+        let lend = |j: usize| {
+            if class[j] == own && probed[j] {
+                WindowSum {
+                    value: f64::from(values[j]),
+                    scale: f64::from(scale[j]),
+                    count: 1,
+                }
+            } else {
+                WindowSum::default()
+            }
+        };
+        let (x0, y0) = extent.min;
+        let (x1, y1) = extent.max;
+        match summation {
+            WindowSummation::PerWindow => {
+                for y in y0..=y1 {
+                    for x in x0..=x1 {
+                        let i = y * w + x;
+                        if class[i] != own {
+                            continue;
                         }
+                        let mut sum = WindowSum::default();
+                        for yy in y.saturating_sub(r).max(y0)..=(y + r).min(y1) {
+                            for xx in x.saturating_sub(r).max(x0)..=(x + r).min(x1) {
+                                sum.add(lend(yy * w + xx));
+                            }
+                        }
+                        pooled[i] = sum.pooled(values[i], scale[i]);
                     }
-                    pooled[i] = sum.pooled(values[i], scale[i]);
                 }
             }
-        }
-        WindowSummation::Separable => {
-            let (bw, bh) = extent.size();
-            let mut sums: Vec<WindowSum> = (0..bw * bh)
-                .map(|k| lend((y0 + k / bw) * w + x0 + k % bw))
-                .collect();
-            let mut line = Vec::with_capacity(bw.max(bh));
-            let mut scratch = BlockSums::default();
-            for row in sums.chunks_exact_mut(bw) {
-                line.clear();
-                line.extend_from_slice(row);
-                scratch.window_sums(&line, r, row);
-            }
-            let mut column = vec![WindowSum::default(); bh];
-            for bx in 0..bw {
-                line.clear();
-                line.extend((0..bh).map(|by| sums[by * bw + bx]));
-                scratch.window_sums(&line, r, &mut column);
-                for (by, sum) in column.iter().enumerate() {
-                    let i = (y0 + by) * w + x0 + bx;
-                    if class[i] == own {
-                        pooled[i] = sum.pooled(values[i], scale[i]);
+            WindowSummation::Separable => {
+                let (bw, bh) = extent.size();
+                let mut sums: Vec<WindowSum> = (0..bw * bh)
+                    .map(|k| lend((y0 + k / bw) * w + x0 + k % bw))
+                    .collect();
+                let mut line = Vec::with_capacity(bw.max(bh));
+                let mut scratch = BlockSums::default();
+                for row in sums.chunks_exact_mut(bw) {
+                    line.clear();
+                    line.extend_from_slice(row);
+                    scratch.window_sums(&line, r, row);
+                }
+                let mut column = vec![WindowSum::default(); bh];
+                for bx in 0..bw {
+                    line.clear();
+                    line.extend((0..bh).map(|by| sums[by * bw + bx]));
+                    scratch.window_sums(&line, r, &mut column);
+                    for (by, sum) in column.iter().enumerate() {
+                        let i = (y0 + by) * w + x0 + bx;
+                        if class[i] == own {
+                            pooled[i] = sum.pooled(values[i], scale[i]);
+                        }
                     }
                 }
             }
@@ -491,21 +505,14 @@ mod tests {
         radius_px: u32,
         summation: WindowSummation,
     ) -> Vec<f32> {
-        let mut pooled = values.to_vec();
-        for extent in class_extents(resolution, class) {
-            pool_class(
-                resolution,
-                values,
-                scale,
-                class,
-                probed,
-                radius_px,
-                &extent,
-                summation,
-                &mut pooled,
-            );
-        }
-        pooled
+        let image = PoolImage {
+            resolution,
+            values,
+            scale,
+            class,
+            probed,
+        };
+        image.pool(radius_px, |_| summation)
     }
 
     /// The definition, pixel by pixel over the whole image's clipped window.
