@@ -266,6 +266,11 @@ fn explain_names_the_plan() {
         ),
         "{text}"
     );
+    let text = explain(&["--plan", "predicted", "--plan-pool-px", "0"]);
+    assert!(
+        text.contains("per pixel, not pooled, as the paper (--plan-pool-px 0)"),
+        "{text}"
+    );
     let text = explain(&["--plan", "predicted", "--plan-pool-px", "3"]);
     assert!(
         text.contains("same material within 3 px (--plan-pool-px)"),

@@ -151,8 +151,7 @@ fn sample_plan_text(kind: SamplePlanKind, resolution: glam::UVec2) -> (&'static 
                  samples per probed pixel ({}), bandwidth by Bagher et al. 2013 eqs. 4-6 (silhouettes, creases \
                  and material edges at the finest level, seen directly or through mirrors and \
                  smooth glass, where the two sides' L̂ differ by over 2 %), \
-                 variance {}{}, pooled over the pixels of the same material within \
-                 {pool_radius_px} px ({}), levels by eq. 11; {:.1} % of the budget uniform (light past the probe's one indirect \
+                 variance {}{}, {}, levels by eq. 11; {:.1} % of the budget uniform (light past the probe's one indirect \
                  bounce is not predicted), the rest {}",
                 if probe_stride_px == 1 {
                     "every pixel, as the paper".to_string()
@@ -180,11 +179,18 @@ fn sample_plan_text(kind: SamplePlanKind, resolution: glam::UVec2) -> (&'static 
                 } else {
                     " of the luminance alone (--plan-colour off)"
                 },
-                match pool_radius {
-                    prism_bandwidth::PoolRadius::Auto => {
-                        "--plan-pool-px auto: min(W, H)/32, at least 1".to_string()
+                match (pool_radius, pool_radius_px) {
+                    (prism_bandwidth::PoolRadius::Auto, r) => format!(
+                        "pooled over the pixels of the same material within {r} px \
+                         (--plan-pool-px auto: min(W, H)/32, at least 1)"
+                    ),
+                    (prism_bandwidth::PoolRadius::Px(_), 0) => {
+                        "per pixel, not pooled, as the paper (--plan-pool-px 0)".to_string()
                     }
-                    prism_bandwidth::PoolRadius::Px(_) => "--plan-pool-px".to_string(),
+                    (prism_bandwidth::PoolRadius::Px(_), r) => format!(
+                        "pooled over the pixels of the same material within {r} px \
+                         (--plan-pool-px)"
+                    ),
                 },
                 f64::from(floor_per_mille) / 10.0,
                 match allocation {
