@@ -132,6 +132,14 @@ fn plan_flags_are_checked() {
         ),
         (vec!["--plan-probe-stride", "2"], "add --plan predicted"),
         (vec!["--plan-pool-px", "3"], "add --plan predicted"),
+        // An option given at its default value is still an option given without its plan.
+        (vec!["--plan-nb", "16"], "add --plan predicted"),
+        (vec!["--plan-pool-px", "auto"], "add --plan predicted"),
+        (vec!["--plan-visibility", "on"], "add --plan predicted"),
+        (
+            vec!["--plan", "predicted", "--plan-max-level", "3"],
+            "add --plan predicted-hier",
+        ),
         (
             vec!["--plan", "predicted", "--plan-pool-px", "2.5"],
             "'2.5': expected `auto` or a radius in whole pixels",

@@ -55,48 +55,50 @@ pub struct PlanArgs {
     /// How camera samples are spread over the pixels; `--spp` is the mean.
     #[arg(long, value_enum, default_value = "uniform")]
     pub plan: PlanArg,
-    /// `--plan predicted`: probe light samples per pixel (n_b).
-    #[arg(long = "plan-nb", value_name = "N", default_value_t = DEFAULT_PROBE_SAMPLES, value_parser = prism_args::numbers::parse_u32)]
-    pub plan_nb: u32,
+    /// `--plan predicted`: probe light samples per pixel (n_b; default 16).
+    #[arg(long = "plan-nb", value_name = "N", value_parser = prism_args::numbers::parse_u32)]
+    pub plan_nb: Option<u32>,
     /// `--plan predicted`: where the BSDF angular tables are kept across runs (created if
     /// missing; default $XDG_CACHE_HOME/prism, else ~/.cache/prism, and built each run when
     /// that is not writable).
     #[arg(long = "cache-dir", value_name = "DIR")]
     pub cache_dir: Option<std::path::PathBuf>,
-    /// `--plan predicted`: share of the budget spread uniformly, in [0, 1].
-    #[arg(long = "plan-floor", value_name = "F", default_value_t = DEFAULT_FLOOR)]
-    pub plan_floor: f64,
-    /// `--plan predicted`: what the samples follow.
-    #[arg(long = "plan-allocation", value_enum, default_value = "relative")]
-    pub plan_allocation: AllocationArg,
-    /// `--plan predicted`: shadow edges from the probe's shadow rays (`off`: the paper,
-    /// which ignores visibility).
-    #[arg(long = "plan-visibility", value_enum, default_value = "on")]
-    pub plan_visibility: OnOff,
-    /// `--plan predicted`: how V̂_p is predicted.
-    #[arg(long = "plan-variance", value_enum, default_value = "measured")]
-    pub plan_variance: VarianceArg,
+    /// `--plan predicted`: share of the budget spread uniformly, in [0, 1] (default 0.25).
+    #[arg(long = "plan-floor", value_name = "F")]
+    pub plan_floor: Option<f64>,
+    /// `--plan predicted`: what the samples follow (default relative).
+    #[arg(long = "plan-allocation", value_enum)]
+    pub plan_allocation: Option<AllocationArg>,
+    /// `--plan predicted`: shadow edges from the probe's shadow rays (default on; `off`: the
+    /// paper, which ignores visibility).
+    #[arg(long = "plan-visibility", value_enum)]
+    pub plan_visibility: Option<OnOff>,
+    /// `--plan predicted`: how V̂_p is predicted (default measured).
+    #[arg(long = "plan-variance", value_enum)]
+    pub plan_variance: Option<VarianceArg>,
     /// `--plan predicted`: add the colour noise of hero-wavelength sampling (the X, Y and Z
-    /// lanes' variance, measured by the probe) to V̂_p (`off`: the luminance's variance alone).
-    #[arg(long = "plan-colour", value_enum, default_value = "on")]
-    pub plan_colour: OnOff,
+    /// lanes' variance, measured by the probe) to V̂_p (default on; `off`: the luminance's
+    /// variance alone).
+    #[arg(long = "plan-colour", value_enum)]
+    pub plan_colour: Option<OnOff>,
     /// `--plan predicted`: V̂_p is pooled over the (2R+1)² pixels of the same material around
-    /// each pixel (`auto`: R = min(W, H)/32, at least 1; 0: per pixel, as the paper).
-    #[arg(long = "plan-pool-px", value_name = "R|auto", default_value_t = DEFAULT_POOL_RADIUS, value_parser = PoolRadius::parse)]
-    pub plan_pool_px: PoolRadius,
+    /// each pixel (default `auto`: R = min(W, H)/32, at least 1; 0: per pixel, as the paper).
+    #[arg(long = "plan-pool-px", value_name = "R|auto", value_parser = PoolRadius::parse)]
+    pub plan_pool_px: Option<PoolRadius>,
     /// `--plan predicted`: one-bounce indirect estimates per pixel, which add the indirect
-    /// light's mean and variance to the prediction (0: direct light only, as the paper).
-    #[arg(long = "plan-indirect", value_name = "N", default_value_t = DEFAULT_PROBE_SAMPLES, value_parser = prism_args::numbers::parse_u32)]
-    pub plan_indirect: u32,
+    /// light's mean and variance to the prediction (default 16; 0: direct light only, as the
+    /// paper).
+    #[arg(long = "plan-indirect", value_name = "N", value_parser = prism_args::numbers::parse_u32)]
+    pub plan_indirect: Option<u32>,
     /// `--plan predicted`: the probe samples one pixel in S×S (and every pixel of a surface
     /// with no probed pixel within --plan-pool-px); the others take their probed
-    /// neighbours' answers (1: every pixel, as the paper).
-    #[arg(long = "plan-probe-stride", value_name = "S", default_value_t = DEFAULT_PROBE_STRIDE_PX, value_parser = prism_args::numbers::parse_u32)]
-    pub plan_probe_stride: u32,
+    /// neighbours' answers (default 1: every pixel, as the paper).
+    #[arg(long = "plan-probe-stride", value_name = "S", value_parser = prism_args::numbers::parse_u32)]
+    pub plan_probe_stride: Option<u32>,
     /// `--plan predicted-hier`: the coarsest lattice, 2^L pixels between shaded pixels
-    /// (1 to 8).
-    #[arg(long = "plan-max-level", value_name = "L", default_value_t = DEFAULT_MAX_LEVEL, value_parser = prism_args::numbers::parse_u32)]
-    pub plan_max_level: u32,
+    /// (1 to 8; default 3).
+    #[arg(long = "plan-max-level", value_name = "L", value_parser = prism_args::numbers::parse_u32)]
+    pub plan_max_level: Option<u32>,
 }
 
 impl PlanArg {
@@ -112,6 +114,39 @@ impl PlanArg {
 }
 
 impl PlanArgs {
+    // Each option's value, its default where it was not given: an option given without the
+    // plan it sets up is refused (`check`), whatever its value.
+    pub fn nb(&self) -> u32 {
+        self.plan_nb.unwrap_or(DEFAULT_PROBE_SAMPLES)
+    }
+    pub fn floor(&self) -> f64 {
+        self.plan_floor.unwrap_or(DEFAULT_FLOOR)
+    }
+    pub fn allocation_arg(&self) -> AllocationArg {
+        self.plan_allocation.unwrap_or(AllocationArg::Relative)
+    }
+    pub fn visibility(&self) -> OnOff {
+        self.plan_visibility.unwrap_or(OnOff::On)
+    }
+    pub fn variance(&self) -> VarianceArg {
+        self.plan_variance.unwrap_or(VarianceArg::Measured)
+    }
+    pub fn colour(&self) -> OnOff {
+        self.plan_colour.unwrap_or(OnOff::On)
+    }
+    pub fn pool_radius(&self) -> PoolRadius {
+        self.plan_pool_px.unwrap_or(DEFAULT_POOL_RADIUS)
+    }
+    pub fn indirect(&self) -> u32 {
+        self.plan_indirect.unwrap_or(DEFAULT_PROBE_SAMPLES)
+    }
+    pub fn probe_stride(&self) -> u32 {
+        self.plan_probe_stride.unwrap_or(DEFAULT_PROBE_STRIDE_PX)
+    }
+    pub fn max_level(&self) -> u32 {
+        self.plan_max_level.unwrap_or(DEFAULT_MAX_LEVEL)
+    }
+
     /// True for the plans the predictor makes.
     pub fn predicts(&self) -> bool {
         match self.plan {
@@ -121,7 +156,7 @@ impl PlanArgs {
     }
 
     fn allocation(&self) -> Allocation {
-        match self.plan_allocation {
+        match self.allocation_arg() {
             AllocationArg::Relative => Allocation::RelativeError,
             AllocationArg::Variance => Allocation::Variance,
         }
@@ -129,15 +164,15 @@ impl PlanArgs {
 
     /// The checked options; errors name the flag.
     pub fn check(&self) -> Result<(), String> {
-        let predictor_flags_given = self.plan_nb != DEFAULT_PROBE_SAMPLES
-            || self.plan_floor != DEFAULT_FLOOR
-            || self.plan_allocation != AllocationArg::Relative
-            || self.plan_variance != VarianceArg::Measured
-            || self.plan_visibility != OnOff::On
-            || self.plan_colour != OnOff::On
-            || self.plan_pool_px != DEFAULT_POOL_RADIUS
-            || self.plan_indirect != DEFAULT_PROBE_SAMPLES
-            || self.plan_probe_stride != DEFAULT_PROBE_STRIDE_PX
+        let predictor_flags_given = self.plan_nb.is_some()
+            || self.plan_floor.is_some()
+            || self.plan_allocation.is_some()
+            || self.plan_variance.is_some()
+            || self.plan_visibility.is_some()
+            || self.plan_colour.is_some()
+            || self.plan_pool_px.is_some()
+            || self.plan_indirect.is_some()
+            || self.plan_probe_stride.is_some()
             || self.cache_dir.is_some();
         if !self.predicts() && predictor_flags_given {
             return Err(
@@ -148,28 +183,28 @@ impl PlanArgs {
                     .into(),
             );
         }
-        if self.plan_max_level != DEFAULT_MAX_LEVEL && self.plan != PlanArg::PredictedHier {
+        if self.plan_max_level.is_some() && self.plan != PlanArg::PredictedHier {
             return Err("--plan-max-level sets up hierarchical shading: add --plan \
                         predicted-hier"
                 .into());
         }
-        if !(1..=8).contains(&self.plan_max_level) {
+        if !(1..=8).contains(&self.max_level()) {
             return Err(format!(
                 "--plan-max-level {}: expected a level from 1 (2 pixels between shaded \
                  pixels) to 8 (256)",
-                self.plan_max_level
+                self.max_level()
             ));
         }
-        if self.plan_nb == 0 {
+        if self.nb() == 0 {
             return Err("--plan-nb must be at least 1".into());
         }
-        if self.plan_probe_stride == 0 {
+        if self.probe_stride() == 0 {
             return Err("--plan-probe-stride 0: expected at least 1 (1 probes every pixel)".into());
         }
-        if !(0.0..=1.0).contains(&self.plan_floor) {
+        if !(0.0..=1.0).contains(&self.floor()) {
             return Err(format!(
                 "--plan-floor {}: expected a share of the budget in [0, 1]",
-                self.plan_floor
+                self.floor()
             ));
         }
         Ok(())
@@ -180,15 +215,15 @@ impl PlanArgs {
         match self.plan {
             PlanArg::Uniform => SamplePlanKind::Uniform,
             PlanArg::Predicted | PlanArg::PredictedHier => SamplePlanKind::Predicted {
-                probe_samples: self.plan_nb,
-                floor_per_mille: (self.plan_floor * 1000.0).round() as u32,
+                probe_samples: self.nb(),
+                floor_per_mille: (self.floor() * 1000.0).round() as u32,
                 allocation: self.allocation(),
                 variance: self.variance_bandwidth(),
-                colour_noise: self.plan_colour == OnOff::On,
-                probe_stride_px: self.plan_probe_stride,
-                pool_radius: self.plan_pool_px,
+                colour_noise: self.colour() == OnOff::On,
+                probe_stride_px: self.probe_stride(),
+                pool_radius: self.pool_radius(),
                 hierarchical_max_level: (self.plan == PlanArg::PredictedHier)
-                    .then_some(self.plan_max_level),
+                    .then_some(self.max_level()),
             },
             PlanArg::Adaptive => SamplePlanKind::Adaptive,
         }
@@ -207,7 +242,7 @@ impl PlanArgs {
 
     /// How V̂_p is predicted (`--plan-variance`).
     fn variance_bandwidth(&self) -> VarianceBandwidth {
-        match self.plan_variance {
+        match self.variance() {
             VarianceArg::Eq9 => VarianceBandwidth::Incident,
             VarianceArg::Eq9OneBounce => VarianceBandwidth::OneBounce,
             VarianceArg::Measured => VarianceBandwidth::Measured,
@@ -217,19 +252,19 @@ impl PlanArgs {
     /// The predictor's settings for a render of `mean_spp` with `seed`.
     pub fn predictor(&self, mean_spp: u32, seed: u64) -> PredictorSettings {
         PredictorSettings {
-            probe_samples: self.plan_nb,
+            probe_samples: self.nb(),
             allocation: AllocationSettings {
                 mean_spp: f64::from(mean_spp),
-                floor: self.plan_floor,
+                floor: self.floor(),
                 allocation: self.allocation(),
                 seed,
             },
             variance_bandwidth: self.variance_bandwidth(),
-            visibility: self.plan_visibility == OnOff::On,
-            colour_noise: self.plan_colour == OnOff::On,
-            pool_radius: self.plan_pool_px,
-            indirect_samples: self.plan_indirect,
-            probe_stride_px: self.plan_probe_stride,
+            visibility: self.visibility() == OnOff::On,
+            colour_noise: self.colour() == OnOff::On,
+            pool_radius: self.pool_radius(),
+            indirect_samples: self.indirect(),
+            probe_stride_px: self.probe_stride(),
         }
     }
 }

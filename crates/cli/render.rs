@@ -574,7 +574,7 @@ pub fn run(args: &RenderArgs, budget: &MemoryBudget) -> Result<ExitCode, String>
                 PlanArg::PredictedHier => Some(
                     prediction
                         .make_hierarchical(
-                            args.plan.plan_max_level,
+                            args.plan.max_level(),
                             f64::from(settings.spp),
                             settings.seed,
                         )

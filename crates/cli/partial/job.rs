@@ -88,16 +88,16 @@ pub fn identity(
             "{} nb={} floor={} allocation={:?} visibility={:?} variance={:?} colour={:?} pool={} \
              indirect={} probe_stride={} max_level={}",
             args.plan.plan.name(),
-            args.plan.plan_nb,
-            args.plan.plan_floor,
-            args.plan.plan_allocation,
-            args.plan.plan_visibility,
-            args.plan.plan_variance,
-            args.plan.plan_colour,
-            args.plan.plan_pool_px,
-            args.plan.plan_indirect,
-            args.plan.plan_probe_stride,
-            args.plan.plan_max_level
+            args.plan.nb(),
+            args.plan.floor(),
+            args.plan.allocation_arg(),
+            args.plan.visibility(),
+            args.plan.variance(),
+            args.plan.colour(),
+            args.plan.pool_radius(),
+            args.plan.indirect(),
+            args.plan.probe_stride(),
+            args.plan.max_level()
         ),
     };
     RenderIdentity {
