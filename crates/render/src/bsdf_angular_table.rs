@@ -17,10 +17,10 @@ use prism_spectrum::SampledWavelengths;
 use rayon::prelude::*;
 
 use crate::bsdf::{Bsdf, Bxdf, TransportMode};
-use crate::film::xyz::XyzWeights;
 use crate::material::Material;
 use crate::plan::probe_hit;
 use crate::probe::reflectance_y;
+use prism_spectrum::XyzWeights;
 
 /// Incident and outgoing cells per axis (θ, φ) of a table.
 pub const TABLE_CELLS: usize = 16;

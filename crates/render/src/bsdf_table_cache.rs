@@ -20,10 +20,10 @@ use crate::bsdf::{Bxdf, TransportMode};
 use crate::bsdf_angular_table::{
     cell_direction, with_tabulated_bsdf, MaterialAngularBandwidth, SLICE_TEXELS, TABLE_CELLS,
 };
-use crate::film::xyz::XyzWeights;
 use crate::material::Material;
 use crate::probe::reflectance_y;
 use crate::stable_hash::Fnv1a64;
+use prism_spectrum::XyzWeights;
 
 /// Bumped whenever a table's construction or this file layout changes.
 const FORMAT_VERSION: u32 = 1;

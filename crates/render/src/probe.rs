@@ -38,7 +38,6 @@ use prism_scene::MisHeuristic;
 use crate::bsdf::{Bsdf, Bxdf, TransportMode};
 use crate::bsdf_angular_table::MaterialAngularBandwidth;
 use crate::bsdf_table_cache::AngularTableCache;
-use crate::film::xyz::XyzWeights;
 use crate::integrator::{mis_weight, Integrator};
 use crate::light::area_bandwidth::AreaLightBandwidth;
 use crate::light::environment_bandwidth::EnvironmentBandwidth;
@@ -46,6 +45,7 @@ use crate::light::{Light, LightHit, LightSampleContext};
 use crate::sampler::{PixelSampler, SamplerKind};
 use crate::scene_build::RenderScene;
 use crate::texture::{TextureBandwidth, TextureContext};
+use prism_spectrum::XyzWeights;
 
 /// Sample indices of the indirect estimates (`sample_indirect`), apart from the light
 /// samples' 0..n_b.

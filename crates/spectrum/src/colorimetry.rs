@@ -105,7 +105,7 @@ pub(crate) fn cie1931_interleaved() -> &'static [DVec3; DENSE_SAMPLE_COUNT] {
 /// `DenseSpectrum::eval` of the three rows at once (linear between the 1 nm samples, zero
 /// outside 360–830 nm), with the same arithmetic per component.
 #[inline(always)]
-fn cmf_lerp(table: &[DVec3; DENSE_SAMPLE_COUNT], wavelength_nm: f64) -> DVec3 {
+pub(crate) fn cmf_lerp(table: &[DVec3; DENSE_SAMPLE_COUNT], wavelength_nm: f64) -> DVec3 {
     let x = wavelength_nm - LAMBDA_MIN_NM as f64;
     if !(x >= 0.0 && x <= (DENSE_SAMPLE_COUNT - 1) as f64) {
         return DVec3::ZERO;

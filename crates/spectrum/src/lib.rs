@@ -44,3 +44,4 @@ pub use sampled_spectrum::{SampledSpectrum, N_SPECTRUM_SAMPLES};
 pub use sampled_wavelengths::SampledWavelengths;
 pub use spectrum::{DenseTable, InvalidSpectrum, PiecewiseLinear, Spectrum};
 pub use table::{DenseSpectrum, Tabulated};
+pub use xyz_weights::XyzWeights;

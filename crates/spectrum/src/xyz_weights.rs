@@ -4,15 +4,13 @@
 
 use glam::DVec3;
 
-use crate::colorimetry::{cie1931_interleaved, y_bar_integral_1931_nm};
-use crate::{
-    SampledSpectrum, SampledWavelengths, DENSE_SAMPLE_COUNT, LAMBDA_MIN_NM, N_SPECTRUM_SAMPLES,
-};
+use crate::colorimetry::{cie1931_interleaved, cmf_lerp, y_bar_integral_1931_nm};
+use crate::{SampledSpectrum, SampledWavelengths, N_SPECTRUM_SAMPLES};
 
 /// The linear map from one camera sample's radiance lanes to its XYZ estimate:
 /// column i is (x̄, ȳ, z̄)(λᵢ) / (4 p(λᵢ) ∫ȳ dλ) (zero where p(λᵢ) = 0, a terminated
-/// secondary), so `xyz(L)` = Σᵢ column i · L(λᵢ) is `sampled_radiance_to_xyz(L, wavelengths)` up to the
-/// rounding of the reordered products (≤ a few ulp). The film converts both the beauty and
+/// secondary), so `xyz(L)` = Σᵢ column i · L(λᵢ) is `sampled_radiance_to_xyz(L, wavelengths)`
+/// up to the rounding of the reordered products (≤ a few ulp). The film converts both the beauty and
 /// the illumination AOV of a sample at the same wavelengths: building this once per sample
 /// halves the colour-matching lookups (callgrind: ≈ 170 instructions per conversion).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -27,17 +25,12 @@ impl XyzWeights {
         let norm = 1.0 / (N_SPECTRUM_SAMPLES as f64 * y_bar_integral_1931_nm());
         let columns = std::array::from_fn(|lane| {
             let p = f64::from(pdf[lane]);
-            let x = f64::from(wavelengths.wavelength_nm(lane) - LAMBDA_MIN_NM);
-            // The CMFs are 0 outside the table (`DenseSpectrum::eval`), like a lane of pdf 0.
-            if !(p > 0.0 && x >= 0.0 && x <= (DENSE_SAMPLE_COUNT - 1) as f64) {
-                return DVec3::ZERO;
+            // A lane of pdf 0 (a terminated secondary) weighs nothing, as in the conversion.
+            if p > 0.0 {
+                cmf_lerp(table, f64::from(wavelengths.wavelength_nm(lane))) * (norm / p)
+            } else {
+                DVec3::ZERO
             }
-            // SAFETY: x ∈ [0, 470] (checked above, so not NaN), inside u32: the truncation
-            // is defined, and is the floor; `min` keeps i + 1 in the table.
-            let i = (unsafe { x.to_int_unchecked::<u32>() } as usize).min(DENSE_SAMPLE_COUNT - 2);
-            let t = x - i as f64;
-            let (a, b) = (table[i], table[i + 1]);
-            (a + t * (b - a)) * (norm / p)
         });
         Self { columns }
     }

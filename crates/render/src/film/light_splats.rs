@@ -32,7 +32,7 @@ use prism_spectrum::{SampledSpectrum, SampledWavelengths};
 use super::filter_sampler::FilterSampler;
 use super::fixed_sum::{FixedSum, FixedSum3};
 use super::spectral_bins::SpectralBins;
-use super::xyz::XyzWeights;
+use prism_spectrum::XyzWeights;
 
 /// A splat: its XYZ and the rectangle of pixels its filter reaches.
 #[derive(Clone, Copy, Debug, PartialEq)]

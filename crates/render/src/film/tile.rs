@@ -12,8 +12,9 @@ use super::filter_sampler::FilterSampler;
 use super::filter_table::FilterTable;
 use super::fixed_sum::{split_limbs, FixedSum, FixedSum3, HIGH_LIMB_SCALE, MAGIC};
 use super::spectral_bins::SpectralBins;
-use super::xyz::{xyz_of_sample, XyzWeights};
+use super::xyz::xyz_of_sample;
 use super::AovSelection;
+use prism_spectrum::XyzWeights;
 
 /// A half-open pixel rectangle [min, max).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]

@@ -54,8 +54,6 @@ pub fn rec709_to_xyz(rgb: [f32; 3]) -> DVec3 {
 /// `colorimetry::sampled_radiance_to_xyz`).
 pub use prism_spectrum::colorimetry::sampled_radiance_to_xyz as xyz_of_sample;
 
-pub use prism_spectrum::xyz_weights::XyzWeights;
-
 #[cfg(test)]
 mod tests {
     use super::*;

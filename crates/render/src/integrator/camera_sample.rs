@@ -8,10 +8,10 @@ use super::dimensions::LENS_DIMENSIONS;
 use super::estimator::TileWork;
 use super::path::FirstHit;
 use super::RenderStats;
-use crate::film::xyz::XyzWeights;
 use crate::film::{FilmTile, SurfaceAov};
 use crate::sampler::SampleStream;
 use crate::scene_build::RenderScene;
+use prism_spectrum::XyzWeights;
 
 /// A camera sample before its first ray.
 #[derive(Clone, Copy, Debug)]

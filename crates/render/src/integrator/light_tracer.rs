@@ -78,7 +78,7 @@ impl LightTracer {
         let sensor = *state.wavelengths.sensor();
         let transport = *state.wavelengths.transport();
         let importance_area = scene.camera.importance_area_px2();
-        let xyz_weights = crate::film::xyz::XyzWeights::new(&sensor);
+        let xyz_weights = prism_spectrum::XyzWeights::new(&sensor);
         let tracer = self.path_tracer();
         // The light's own point, seen by the camera.
         if let Some(c) = self.connect_light_point(

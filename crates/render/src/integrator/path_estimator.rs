@@ -12,9 +12,9 @@ use super::estimator::{Estimator, Pass, TileWork};
 use super::lane_wavelengths::LaneWavelengths;
 use super::packet::{render_tile as render_packet_tile, TileJob};
 use super::{PathCounters, PathResult, PathTracer};
-use crate::film::xyz::XyzWeights;
 use crate::film::{FilmTile, LightSplats};
 use crate::scene_build::RenderScene;
+use prism_spectrum::XyzWeights;
 
 impl Estimator for PathTracer {
     fn name(&self) -> &'static str {

@@ -199,7 +199,7 @@ impl Bdpt {
         });
         let tracer = self.path_tracer();
         let importance_area = scene.camera.importance_area_px2();
-        let xyz_weights = crate::film::xyz::XyzWeights::new(&sensor);
+        let xyz_weights = prism_spectrum::XyzWeights::new(&sensor);
         let mut radiance = zero;
         let (n_camera, n_light) = (camera_path.len(), light_path.len());
         let light_first = start_of_light_vertex_blocks(start);

@@ -17,7 +17,6 @@ use prism_spectrum::{SampledSpectrum, SampledWavelengths};
 use super::intersect::{closest, occluded, RayLanes};
 use super::shade::{select, shade, VertexIn, VertexOut, LIGHT_GIVEN, LIGHT_NONE, LIGHT_RECTANGLE};
 use super::{PacketScene, RectangleLight, LIGHT_SLOTS, REFLECTANCE_SLOTS};
-use crate::film::xyz::XyzWeights;
 use crate::film::FilmTile;
 use crate::film::SurfaceAov;
 use crate::integrator::dimensions::{VertexDimensions, LENS_DIMENSIONS};
@@ -29,6 +28,7 @@ use crate::sampler::independent;
 use crate::sampler::{PixelSampler, SampleStream};
 use crate::scene_build::RenderScene;
 use crate::spectrum_cache::SpectrumCache;
+use prism_spectrum::XyzWeights;
 
 /// What the driver passes in and sums up: one tile's work.
 pub(crate) struct TileJob<'a> {

@@ -20,7 +20,6 @@ use super::replay::replay_pass;
 use super::settings::{PhotonMapper, PhotonPlan};
 use super::shoot::shoot;
 use super::sppm::SppmStatistics;
-use crate::film::xyz::XyzWeights;
 use crate::film::{FilmTile, LightSplats};
 use crate::integrator::camera_sample::CameraSample;
 use crate::integrator::driver::RenderStats;
@@ -28,6 +27,7 @@ use crate::integrator::estimator::{Estimator, Pass, TileWork};
 use crate::integrator::lane_wavelengths::LaneWavelengths;
 use crate::integrator::{PathCounters, PathTracer};
 use crate::scene_build::{RenderScene, SceneBuildError};
+use prism_spectrum::XyzWeights;
 
 /// A photon integrator with the state its passes keep: the resolved settings and the
 /// current pass's photons.
