@@ -83,7 +83,7 @@ pub struct PlanArgs {
     pub plan_colour: Option<OnOff>,
     /// `--plan predicted`: V̂_p is pooled over the (2R+1)² pixels of the same material around
     /// each pixel (default `auto`: R = min(W, H)/32, at least 1; 0: per pixel, as the paper).
-    #[arg(long = "plan-pool-px", value_name = "R|auto", value_parser = PoolRadius::parse)]
+    #[arg(long = "plan-pool-px", value_name = "R|auto", value_parser = parse_pool_radius)]
     pub plan_pool_px: Option<PoolRadius>,
     /// `--plan predicted`: one-bounce indirect estimates per pixel, which add the indirect
     /// light's mean and variance to the prediction (default 16; 0: direct light only, as the
@@ -266,5 +266,30 @@ impl PlanArgs {
             indirect_samples: self.indirect(),
             probe_stride_px: self.probe_stride(),
         }
+    }
+}
+
+/// `--plan-pool-px`: `auto` or a radius in whole pixels (the project's whole-number rules).
+fn parse_pool_radius(text: &str) -> Result<PoolRadius, String> {
+    match text.trim() {
+        "auto" => Ok(PoolRadius::Auto),
+        _ => prism_args::numbers::parse_u32(text)
+            .map(PoolRadius::Px)
+            .map_err(|_| {
+                format!("'{text}': expected `auto` or a radius in whole pixels (0, 1, 2, ...)")
+            }),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_pool_radius_is_auto_or_whole_pixels() {
+        assert_eq!(parse_pool_radius("auto"), Ok(PoolRadius::Auto));
+        assert_eq!(parse_pool_radius("3"), Ok(PoolRadius::Px(3)));
+        let e = parse_pool_radius("-1").unwrap_err();
+        assert!(e.contains("auto") && e.contains("-1"), "{e}");
     }
 }

@@ -460,8 +460,12 @@ fn centre_class(scene: &RenderScene, pixel: UVec2) -> PixelClass {
 
 /// The pixels the probe samples (`prism_bandwidth::sparse_probing`): all at a stride of 1;
 /// otherwise a first pass of centre rays finds each pixel's surface, so that no surface is
-/// left without a probed pixel within the pooling radius.
-fn pixels_to_probe(scene: &RenderScene, settings: &PredictorSettings) -> Result<Vec<bool>, String> {
+/// left without a probed pixel within the pooling radius `pool_radius_px`.
+fn pixels_to_probe(
+    scene: &RenderScene,
+    settings: &PredictorSettings,
+    pool_radius_px: u32,
+) -> Result<Vec<bool>, String> {
     let resolution = scene.resolution;
     let count = resolution.x as usize * resolution.y as usize;
     if settings.probe_stride_px == 1 {
@@ -474,13 +478,8 @@ fn pixels_to_probe(scene: &RenderScene, settings: &PredictorSettings) -> Result<
             centre_class(scene, UVec2::new((i % w) as u32, (i / w) as u32))
         })
         .collect();
-    prism_bandwidth::probed_pixels(
-        resolution,
-        &class,
-        settings.probe_stride_px,
-        settings.pool_radius.px(resolution),
-    )
-    .map_err(|e| e.to_string())
+    prism_bandwidth::probed_pixels(resolution, &class, settings.probe_stride_px, pool_radius_px)
+        .map_err(|e| e.to_string())
 }
 
 /// A pixel the probe skipped takes the nearest probed pixel's bandwidth ν (of its own
@@ -544,7 +543,8 @@ pub fn predict_with_probe<'a>(
     } else {
         0
     };
-    let probed = pixels_to_probe(scene, settings)?;
+    let pool_radius_px = settings.pool_radius.px(resolution);
+    let probed = pixels_to_probe(scene, settings, pool_radius_px)?;
     let w = resolution.x as usize;
     let rows: Vec<Vec<ProbedPixel>> = (0..resolution.y)
         .into_par_iter()
@@ -657,7 +657,7 @@ pub fn predict_with_probe<'a>(
         &class,
         &probed,
         &eye,
-        settings.pool_radius.px(resolution),
+        pool_radius_px,
     )?;
     if settings.visibility {
         add_shadow_edges(resolution, &mut pixels, &eye);
@@ -671,7 +671,7 @@ pub fn predict_with_probe<'a>(
         &class,
         &texture_scale,
         &probed,
-        settings.pool_radius.px(resolution),
+        pool_radius_px,
         settings.variance_bandwidth == VarianceBandwidth::Measured,
     )
     .map_err(|e| e.to_string())?;
