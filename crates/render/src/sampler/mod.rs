@@ -23,7 +23,10 @@
 
 pub(crate) mod hash;
 pub(crate) mod independent;
+mod lanes;
 mod sobol;
+
+pub(crate) use lanes::StreamLanes;
 
 use glam::{UVec2, Vec2};
 pub use prism_scene::SamplerKind;
@@ -207,6 +210,18 @@ impl SampleStream {
     #[inline]
     pub fn seed_at(&self, dimension: u32) -> u64 {
         mix64(self.tail_key ^ u64::from(dimension).wrapping_mul(DIMENSION_SPREAD))
+    }
+
+    /// The stream's words as `StreamLanes` reads them: (key, index reversed, tail key,
+    /// Sobol dimensions), with no Sobol dimension for an independent stream.
+    #[inline(always)]
+    pub(crate) fn words(&self) -> (u64, u32, u64, u32) {
+        (
+            self.key,
+            self.index_reversed,
+            self.tail_key,
+            self.sobol_dimensions,
+        )
     }
 
     /// Dimensions used so far.

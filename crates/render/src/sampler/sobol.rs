@@ -57,7 +57,7 @@ fn reverse_bits(x: u32) -> u32 {
 /// Burley 2020's hash-based Laine–Karras permutation (his listing 2): each output bit k is
 /// the input bit k flipped by a hash of the bits below k and `seed`.
 #[inline(always)]
-fn laine_karras_permutation(mut x: u32, seed: u32) -> u32 {
+pub(crate) fn laine_karras_permutation(mut x: u32, seed: u32) -> u32 {
     x = x.wrapping_add(seed);
     x ^= x.wrapping_mul(0x6c50_b47c);
     x ^= x.wrapping_mul(0xb82f_1e52);
@@ -91,7 +91,7 @@ pub(crate) fn shuffle_reversed_index(index_reversed: u32, seed: u32) -> u32 {
 /// Digits of Sobol dimension 1 in index-bit order (bit k = digit k + 1 after the point):
 /// digit k = ⊕ over the index bits j whose bit set contains k (Pascal matrix mod 2).
 #[inline(always)]
-fn pascal_digits(index: u32) -> u32 {
+pub(crate) fn pascal_digits(index: u32) -> u32 {
     let mut w = index;
     w ^= (w >> 1) & 0x5555_5555;
     w ^= (w >> 2) & 0x3333_3333;

@@ -4,8 +4,9 @@
 //! each step — the two ray queries, the vertex's bookkeeping, the light choice, the
 //! shading, the light sample's resolution — is one pass over the lanes that LLVM turns
 //! into vector code; what only some paths meet (an emitter hit, an escape to infinite
-//! lights, a light the scalar `Light` code samples, a Sobol stream's draws, a material past
-//! the reflectance slots) runs lane by lane inside those passes.
+//! lights, a light the scalar `Light` code samples, a material past the reflectance slots)
+//! runs lane by lane inside those passes. The samplers' draws are passes too: independent
+//! values and Sobol points for all lanes at once (`sampler::StreamLanes`).
 
 // Lanes index several arrays at once: `for l in 0..N` is the clearest form.
 #![allow(clippy::needless_range_loop)]
@@ -19,13 +20,21 @@ use super::shade::{select, shade, VertexIn, VertexOut, LIGHT_GIVEN, LIGHT_NONE, 
 use super::{PacketScene, RectangleLight, LIGHT_SLOTS, REFLECTANCE_SLOTS};
 use crate::film::FilmTile;
 use crate::film::SurfaceAov;
-use crate::integrator::dimensions::{VertexDimensions, LENS_DIMENSIONS};
+use crate::integrator::dimensions::{
+    VertexDimensions, CAMERA_SAMPLE_DIMENSIONS, FILM_DIMENSIONS, LENS_DIMENSIONS,
+};
+
+/// The dimensions of a camera sample's draws: film point (2), lens (2), wavelength
+/// (`camera_sample::CameraSample`'s order).
+const FILM_DIMENSION: u32 = 0;
+const LENS_DIMENSION: u32 = FILM_DIMENSIONS;
+const WAVELENGTH_DIMENSION: u32 = FILM_DIMENSIONS + LENS_DIMENSIONS;
 use crate::integrator::path::{add_contribution, FirstHit, PathCounters, PathTracer};
 use crate::light::{LightHit, LightSampleContext};
 use crate::material::{Material, SurfaceMaterial};
 use crate::sampler::hash::u32_to_unit_f32;
 use crate::sampler::independent;
-use crate::sampler::{PixelSampler, SampleStream};
+use crate::sampler::{PixelSampler, SampleStream, StreamLanes};
 use crate::scene_build::RenderScene;
 use crate::spectrum_cache::SpectrumCache;
 use prism_spectrum::XyzWeights;
@@ -131,7 +140,6 @@ struct LaneSample {
     pixel: UVec2,
     film_point: Vec2,
     filter_weight: f32,
-    stream: SampleStream,
     wavelengths: SampledWavelengths,
     first_hit: Option<FirstHit>,
     le_cache: SpectrumCache,
@@ -428,21 +436,34 @@ impl<const N: usize> Starts<N> {
             let mut film_points = [Vec2::ZERO; N];
             let mut lens_samples = [Vec2::ZERO; N];
             let zero = SampledSpectrum::splat(0.0);
-            while self.ready.len() < N {
+            // The streams first, then their film, lens and wavelength draws for all lanes
+            // at once (`StreamLanes`, the values of `get_2d`, `get_2d_at` and `get_1d`).
+            let mut lanes = StreamLanes::<N>::new();
+            let mut taken = [(UVec2::ZERO, None); N];
+            let mut count = 0;
+            while count < N {
                 let Some((pixel, s)) = queue.next(job.camera_samples, job.first_sample) else {
                     break;
                 };
                 let mut stream = job.sampler.stream(pixel, s);
-                let (film_point, filter_weight) = tile.sample_film_point(pixel, stream.get_2d());
-                let lens_dimension = stream.reserve(LENS_DIMENSIONS);
-                let lens = if job.uses_lens {
-                    stream.get_2d_at(lens_dimension)
-                } else {
-                    Vec2::ZERO
-                };
-                let k = self.ready.len();
-                u[k] = stream.get_1d();
-                (film_points[k], lens_samples[k]) = (film_point, lens);
+                lanes.set(count, &stream);
+                stream.reserve(CAMERA_SAMPLE_DIMENSIONS);
+                taken[count] = (pixel, Some(stream));
+                count += 1;
+            }
+            let (film_x, film_y) = lanes.get_2d_at(&[FILM_DIMENSION; N]);
+            let (lens_x, lens_y) = if job.uses_lens {
+                lanes.get_2d_at(&[LENS_DIMENSION; N])
+            } else {
+                ([0.0; N], [0.0; N])
+            };
+            let wavelength_u = lanes.get_1d_at(&[WAVELENGTH_DIMENSION; N]);
+            for (k, &(pixel, stream)) in taken[..count].iter().enumerate() {
+                let Some(stream) = stream else { continue };
+                let (film_point, filter_weight) =
+                    tile.sample_film_point(pixel, Vec2::new(film_x[k], film_y[k]));
+                u[k] = wavelength_u[k];
+                (film_points[k], lens_samples[k]) = (film_point, Vec2::new(lens_x[k], lens_y[k]));
                 self.ready.push(Start {
                     pixel,
                     stream,
@@ -496,7 +517,6 @@ fn start_lane(
         pixel: start.pixel,
         film_point: start.film_point,
         filter_weight: start.filter_weight,
-        stream: start.stream,
         wavelengths: start.wavelengths,
         first_hit: None,
         le_cache: SpectrumCache::new(),
@@ -538,6 +558,7 @@ fn start_path<const N: usize>(
     let key = start.stream.independent_key();
     variates.hashed[l] = key.is_some();
     variates.key[l] = key.unwrap_or(0);
+    variates.lanes.set(l, &start.stream);
     for (slot, r) in start.reflectance.iter().enumerate() {
         set_spectrum(&mut paths.reflectance[slot], l, *r);
     }
@@ -573,8 +594,10 @@ struct Variates<const N: usize> {
     /// The path's independent stream key (`SampleStream::independent_key`), if `hashed`.
     key: [u64; N],
     first_dimension: [u32; N],
-    /// Independent stream: `u` is hashed from `key`; else drawn from the stream.
+    /// Independent stream: `u` is hashed from `key`; else drawn from `lanes`.
     hashed: [bool; N],
+    /// Every lane's stream, for the lanes that are not `hashed`.
+    lanes: StreamLanes<N>,
     u: [[f32; N]; 6],
 }
 
@@ -584,6 +607,7 @@ impl<const N: usize> Variates<N> {
             key: [0; N],
             first_dimension: [0; N],
             hashed: [false; N],
+            lanes: StreamLanes::new(),
             u: [[0.0; N]; 6],
         }
     }
@@ -591,7 +615,8 @@ impl<const N: usize> Variates<N> {
 
 /// The vertex's variates (after `begin_vertices`): the independent sampler's values
 /// (`independent::value`, SplitMix64) for all lanes at once — a loop over lanes of 64-bit
-/// multiplies, vector code with AVX-512 — then those of other streams lane by lane. The
+/// multiplies, vector code with AVX-512 — then those of other streams (Sobol), again for all
+/// lanes at once (`StreamLanes`); each part only where some lane needs it. The
 /// light choice's is skipped where a scene has one light (never read), the roulette's
 /// where no lane has reached `rr_depth` (read only there).
 #[inline(always)]
@@ -606,8 +631,9 @@ fn draw_variates<const N: usize>(
         roulette |= vertex.active[l] & vertex.roulette[l];
     }
     let needed = [job.scene.lights.len() > 1, true, true, true, true, roulette];
+    let any_hashed = v.hashed.contains(&true);
     for (k, &offset) in VARIATE_OFFSETS.iter().enumerate() {
-        if !needed[k] {
+        if !(needed[k] && any_hashed) {
             continue;
         }
         for l in 0..N {
@@ -615,19 +641,42 @@ fn draw_variates<const N: usize>(
             v.u[k][l] = u32_to_unit_f32(bits);
         }
     }
+    // Other streams (Sobol): all lanes at once (`StreamLanes`), the same values as each
+    // stream's `get_1d_at`/`get_2d_at`; lanes that hashed above keep theirs.
+    let mut drawn = [false; N];
     for l in 0..N {
-        let (true, false, Some(sample)) = (vertex.active[l], v.hashed[l], &samples[l]) else {
-            continue;
-        };
-        let dims = VertexDimensions::starting_at(v.first_dimension[l]);
-        let stream = &sample.stream;
-        let u = &mut v.u;
-        u[0][l] = stream.get_1d_at(dims.light_choice());
-        let ul = stream.get_2d_at(dims.light());
-        (u[1][l], u[2][l]) = (ul.x, ul.y);
-        let ub = stream.get_2d_at(dims.bsdf());
-        (u[3][l], u[4][l]) = (ub.x, ub.y);
-        u[5][l] = stream.get_1d_at(dims.roulette());
+        drawn[l] = vertex.active[l] & !v.hashed[l] & samples[l].is_some();
+    }
+    if !drawn.contains(&true) {
+        return;
+    }
+    let at = |offset: u32| -> [u32; N] { std::array::from_fn(|l| v.first_dimension[l] + offset) };
+    let put = |k: usize, values: [f32; N], u: &mut [[f32; N]; 6]| {
+        for l in 0..N {
+            if drawn[l] {
+                u[k][l] = values[l];
+            }
+        }
+    };
+    if needed[0] {
+        put(
+            0,
+            v.lanes.get_1d_at(&at(VertexDimensions::LIGHT_CHOICE)),
+            &mut v.u,
+        );
+    }
+    let (x, y) = v.lanes.get_2d_at(&at(VertexDimensions::LIGHT));
+    put(1, x, &mut v.u);
+    put(2, y, &mut v.u);
+    let (x, y) = v.lanes.get_2d_at(&at(VertexDimensions::BSDF));
+    put(3, x, &mut v.u);
+    put(4, y, &mut v.u);
+    if needed[5] {
+        put(
+            5,
+            v.lanes.get_1d_at(&at(VertexDimensions::ROULETTE)),
+            &mut v.u,
+        );
     }
 }
 
