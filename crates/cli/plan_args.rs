@@ -2,14 +2,10 @@
 //! (docs/bandwidth.md).
 
 use clap::{Args, ValueEnum};
-use prism_bandwidth::allocation::DEFAULT_FLOOR;
 use prism_bandwidth::hierarchical_shading::DEFAULT_MAX_LEVEL;
-use prism_bandwidth::{
-    Allocation, AllocationSettings, PoolRadius, VarianceBandwidth, DEFAULT_POOL_RADIUS,
-    DEFAULT_PROBE_STRIDE_PX,
-};
+use prism_bandwidth::{Allocation, AllocationSettings, PoolRadius, VarianceBandwidth};
 use prism_render::bsdf_table_cache::AngularTableCache;
-use prism_render::predictor::{PredictorSettings, DEFAULT_PROBE_SAMPLES};
+use prism_render::predictor::PredictorSettings;
 use prism_render::SamplePlanKind;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -113,35 +109,60 @@ impl PlanArg {
     }
 }
 
+/// The predictor's defaults, in one place (`PredictorSettings::defaults`; the mean and
+/// seed are the render's, not options).
+const DEFAULTS: PredictorSettings = PredictorSettings::defaults(1.0, 0);
+
+impl From<bool> for OnOff {
+    fn from(on: bool) -> Self {
+        if on {
+            OnOff::On
+        } else {
+            OnOff::Off
+        }
+    }
+}
+
 impl PlanArgs {
     // Each option's value, its default where it was not given: an option given without the
     // plan it sets up is refused (`check`), whatever its value.
     pub fn nb(&self) -> u32 {
-        self.plan_nb.unwrap_or(DEFAULT_PROBE_SAMPLES)
+        self.plan_nb.unwrap_or(DEFAULTS.probe_samples)
     }
     pub fn floor(&self) -> f64 {
-        self.plan_floor.unwrap_or(DEFAULT_FLOOR)
+        self.plan_floor.unwrap_or(DEFAULTS.allocation.floor)
     }
     pub fn allocation_arg(&self) -> AllocationArg {
-        self.plan_allocation.unwrap_or(AllocationArg::Relative)
+        self.plan_allocation
+            .unwrap_or(match DEFAULTS.allocation.allocation {
+                Allocation::RelativeError => AllocationArg::Relative,
+                Allocation::Variance => AllocationArg::Variance,
+            })
     }
     pub fn visibility(&self) -> OnOff {
-        self.plan_visibility.unwrap_or(OnOff::On)
+        self.plan_visibility
+            .unwrap_or(OnOff::from(DEFAULTS.visibility))
     }
     pub fn variance(&self) -> VarianceArg {
-        self.plan_variance.unwrap_or(VarianceArg::Measured)
+        self.plan_variance
+            .unwrap_or(match DEFAULTS.variance_bandwidth {
+                VarianceBandwidth::Incident => VarianceArg::Eq9,
+                VarianceBandwidth::OneBounce => VarianceArg::Eq9OneBounce,
+                VarianceBandwidth::Measured => VarianceArg::Measured,
+            })
     }
     pub fn colour(&self) -> OnOff {
-        self.plan_colour.unwrap_or(OnOff::On)
+        self.plan_colour
+            .unwrap_or(OnOff::from(DEFAULTS.colour_noise))
     }
     pub fn pool_radius(&self) -> PoolRadius {
-        self.plan_pool_px.unwrap_or(DEFAULT_POOL_RADIUS)
+        self.plan_pool_px.unwrap_or(DEFAULTS.pool_radius)
     }
     pub fn indirect(&self) -> u32 {
-        self.plan_indirect.unwrap_or(DEFAULT_PROBE_SAMPLES)
+        self.plan_indirect.unwrap_or(DEFAULTS.indirect_samples)
     }
     pub fn probe_stride(&self) -> u32 {
-        self.plan_probe_stride.unwrap_or(DEFAULT_PROBE_STRIDE_PX)
+        self.plan_probe_stride.unwrap_or(DEFAULTS.probe_stride_px)
     }
     pub fn max_level(&self) -> u32 {
         self.plan_max_level.unwrap_or(DEFAULT_MAX_LEVEL)

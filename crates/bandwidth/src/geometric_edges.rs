@@ -39,11 +39,19 @@ pub struct SeenSurface {
     pub surface: Option<SurfacePoint>,
 }
 
+/// Each pixel's L̂ (row-major), pooled over its class and its own: named fields, where two
+/// slices side by side in an argument list could be swapped unnoticed.
+#[derive(Clone, Copy, Debug)]
+pub struct MeanLuminance<'a> {
+    pub pooled_y: &'a [f32],
+    pub own_y: &'a [f32],
+}
+
 /// Per pixel (row-major): true where a 4-neighbour lies across a visible geometric edge,
 /// directly or through a Dirac chain. `class` and `surface` come from the G-buffer
 /// (`surface` is `None` off surfaces), `seen` from the Dirac chains (`None` where the
-/// centre hit is not Dirac), L̂ `pooled_mean_y` over each pixel's class and each pixel's
-/// `own_mean_y`. Two pixels of different classes compare their pooled L̂ (pooling never
+/// centre hit is not Dirac), L̂ pooled over each pixel's class and each pixel's own
+/// (`mean_y`). Two pixels of different classes compare their pooled L̂ (pooling never
 /// mixes classes, so it removes noise and keeps the step); two of one class (a crease, a
 /// box standing on a floor of the same paint) their own, since pooling over the class
 /// blurs the step between its surfaces. Unpredicted pixels are never edges, nor do they
@@ -53,9 +61,12 @@ pub fn geometric_edges(
     class: &[PixelClass],
     surface: &[Option<SurfacePoint>],
     seen: &[Option<SeenSurface>],
-    pooled_mean_y: &[f32],
-    own_mean_y: &[f32],
+    mean_y: MeanLuminance,
 ) -> Result<Vec<bool>, BandwidthError> {
+    let MeanLuminance {
+        pooled_y: pooled_mean_y,
+        own_y: own_mean_y,
+    } = mean_y;
     let count = pixel_count("geometric edges", resolution)?;
     check_lengths(
         resolution,
@@ -127,6 +138,10 @@ mod tests {
     use super::*;
     use glam::Vec3A;
 
+    fn mean<'a>(pooled_y: &'a [f32], own_y: &'a [f32]) -> MeanLuminance<'a> {
+        MeanLuminance { pooled_y, own_y }
+    }
+
     fn point(x: f32, z: f32, normal: Vec3A) -> Option<SurfacePoint> {
         Some(SurfacePoint {
             position_m: Vec3A::new(x, 0.0, z),
@@ -144,7 +159,8 @@ mod tests {
             .map(|&z| point(0.0, z, Vec3A::Y))
             .collect();
         let l = [1.0; 5];
-        let none = geometric_edges(UVec2::new(5, 1), &[m; 5], &plane, &[None; 5], &l, &l).unwrap();
+        let none =
+            geometric_edges(UVec2::new(5, 1), &[m; 5], &plane, &[None; 5], mean(&l, &l)).unwrap();
         assert_eq!(none, vec![false; 5]);
         // A depth step between pixels 2 and 3: pixel 3 lies 1 m above pixel 2's plane.
         let mut step = plane.clone();
@@ -154,7 +170,8 @@ mod tests {
         });
         step[4] = step[3];
         let l = [1.0, 1.0, 1.0, 2.0, 2.0];
-        let edges = geometric_edges(UVec2::new(5, 1), &[m; 5], &step, &[None; 5], &l, &l).unwrap();
+        let edges =
+            geometric_edges(UVec2::new(5, 1), &[m; 5], &step, &[None; 5], mean(&l, &l)).unwrap();
         assert_eq!(edges, vec![false, false, true, true, false]);
         // The same step with equal radiance on both sides is invisible.
         let flat = geometric_edges(
@@ -162,8 +179,7 @@ mod tests {
             &[m; 5],
             &step,
             &[None; 5],
-            &[1.0; 5],
-            &[1.0; 5],
+            mean(&[1.0; 5], &[1.0; 5]),
         )
         .unwrap();
         assert_eq!(flat, vec![false; 5]);
@@ -178,8 +194,7 @@ mod tests {
             &[m; 3],
             &crease,
             &[None; 3],
-            &[1.0, 1.0, 0.5],
-            &[1.0, 1.0, 0.5],
+            mean(&[1.0, 1.0, 0.5], &[1.0, 1.0, 0.5]),
         )
         .unwrap();
         assert_eq!(edges, vec![false, true, true]);
@@ -191,8 +206,7 @@ mod tests {
             &class,
             &surface,
             &[None; 3],
-            &[1.0, 3.0, 0.0],
-            &[1.0, 3.0, 0.0],
+            mean(&[1.0, 3.0, 0.0], &[1.0, 3.0, 0.0]),
         )
         .unwrap();
         assert_eq!(edges, vec![true, true, false]);
@@ -226,7 +240,14 @@ mod tests {
         let pooled = [0.5; 4];
         let own = [0.2, 0.2, 1.0, 0.5];
         let edges = |seen: &[Option<SeenSurface>], own: &[f32]| {
-            geometric_edges(UVec2::new(4, 1), &[mirror; 4], &surface, seen, &pooled, own).unwrap()
+            geometric_edges(
+                UVec2::new(4, 1),
+                &[mirror; 4],
+                &surface,
+                seen,
+                mean(&pooled, own),
+            )
+            .unwrap()
         };
         assert_eq!(edges(&seen, &own), vec![false, true, true, false]);
         // A horizon the eye cannot see is none.
@@ -243,8 +264,7 @@ mod tests {
             &[m; 2],
             &[None],
             &[None; 2],
-            &[1.0; 2],
-            &[1.0; 2]
+            mean(&[1.0; 2], &[1.0; 2])
         )
         .is_err());
     }
@@ -264,8 +284,7 @@ mod tests {
                 &class,
                 &surface,
                 &[None; 2],
-                &pooled,
-                &[1.0; 2],
+                mean(&pooled, &[1.0; 2]),
             )
             .unwrap()
         };
@@ -279,8 +298,7 @@ mod tests {
                 &[m; 2],
                 &crease,
                 &[None; 2],
-                &[1.0; 2],
-                &own,
+                mean(&[1.0; 2], &own),
             )
             .unwrap()
         };

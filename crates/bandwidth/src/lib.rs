@@ -52,7 +52,7 @@ pub use bandwidth::{Bandwidth, MaterialBandwidth};
 pub use bandwidth_buffer::{shading_level, BandwidthBuffer, BandwidthLevel};
 pub use error::BandwidthError;
 pub use gbuffer::{GBuffer, GBufferHit};
-pub use geometric_edges::{geometric_edges, SeenSurface};
+pub use geometric_edges::{geometric_edges, MeanLuminance, SeenSurface};
 pub use hierarchical_shading::{HierarchyInputs, SurfacePoint, Upsampling};
 pub use local_bandwidth::{Boundary, LocalBandwidth};
 pub use mock_probe::MockProbe;

@@ -13,9 +13,9 @@ use prism_bandwidth::pixel_prediction::MAX_IMAGE_BANDWIDTH_CYCLES_PER_PX;
 use prism_bandwidth::{
     allocate, four_neighbours, geometric_edges, model_variance, predict_pixel, Allocated,
     AllocationInputs, AllocationSettings, Bandwidth, BandwidthBuffer, GBufferHit, HierarchyInputs,
-    IndirectEstimate, LightSample, PixelClass, PixelFootprint, PixelPrediction, PoolRadius,
-    SeenSurface, ShadingProbe, SurfacePoint, Upsampling, VarianceBandwidth, VisibilitySummary,
-    DEFAULT_POOL_RADIUS, DEFAULT_PROBE_STRIDE_PX,
+    IndirectEstimate, LightSample, MeanLuminance, PixelClass, PixelFootprint, PixelPrediction,
+    PoolRadius, SeenSurface, ShadingProbe, SurfacePoint, Upsampling, VarianceBandwidth,
+    VisibilitySummary, DEFAULT_POOL_RADIUS, DEFAULT_PROBE_STRIDE_PX,
 };
 use prism_spectrum::colorimetry::sampled_radiance_to_xyz;
 use prism_spectrum::{SampledSpectrum, SampledWavelengths};
@@ -58,7 +58,7 @@ impl PredictorSettings {
     /// `prism render --plan predicted`'s defaults for a mean of `mean_spp`: n_b = 16, a
     /// quarter of the budget uniform, the relative-error allocation, the probe's measured
     /// variance, shadow edges on.
-    pub fn defaults(mean_spp: f64, seed: u64) -> Self {
+    pub const fn defaults(mean_spp: f64, seed: u64) -> Self {
         Self {
             probe_samples: DEFAULT_PROBE_SAMPLES,
             allocation: AllocationSettings {
@@ -694,8 +694,10 @@ pub fn predict_with_probe<'a>(
         &class,
         &surface,
         &seen,
-        &modelled.mean_y,
-        &own_mean_y,
+        MeanLuminance {
+            pooled_y: &modelled.mean_y,
+            own_y: &own_mean_y,
+        },
     )
     .map_err(|e| e.to_string())?;
     for (p, edge) in pixels.iter_mut().zip(edges) {

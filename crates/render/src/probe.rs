@@ -385,17 +385,11 @@ pub fn material_bandwidth(bsdf: &Bsdf) -> MaterialBandwidth {
     }
 }
 
-/// Y of a spectral quantity at the wavelengths `weights` were built for (hero-wavelength
-/// estimate).
-fn luminance_y(s: SampledSpectrum, weights: &XyzWeights) -> f32 {
-    weights.y(s) as f32
-}
-
 /// The ȳ-weighted mean of a BSDF value over the lanes (a white Lambertian gives 1/π).
 pub(crate) fn reflectance_y(f: SampledSpectrum, weights: &XyzWeights) -> f32 {
-    let ones = luminance_y(SampledSpectrum::splat(1.0), weights);
+    let ones = weights.y(SampledSpectrum::splat(1.0)) as f32;
     if ones > 0.0 {
-        luminance_y(f, weights) / ones
+        weights.y(f) as f32 / ones
     } else {
         0.0
     }
@@ -737,7 +731,7 @@ impl ShadingProbe for RenderProbe<'_> {
                     let wi_local = frame.to_local(ls.wi);
                     let cos = wi_local.z.abs();
                     let f = bsdf.eval(wo_local, wi_local, TransportMode::Radiance) * cos;
-                    let mut radiance_y = luminance_y(ls.radiance, xyz);
+                    let mut radiance_y = xyz.y(ls.radiance) as f32;
                     let pdf_per_sr = if ls.delta {
                         // One direction: the estimator's weight divides by the selection.
                         radiance_y /= light_share * pmf;
@@ -816,7 +810,7 @@ impl ShadingProbe for RenderProbe<'_> {
                     let wi = frame.from_local(bs.wi);
                     for (l, le, distance_m, light_hit) in self.emitters_along(&si, wi, wavelengths)
                     {
-                        let radiance_y = luminance_y(le, xyz);
+                        let radiance_y = xyz.y(le) as f32;
                         if radiance_y.is_nan() || radiance_y <= 0.0 {
                             continue;
                         }
@@ -917,7 +911,7 @@ impl ShadingProbe for RenderProbe<'_> {
                 .map_or(IndirectEstimate::default(), |l| {
                     let xyz = XyzWeights::new(&wavelengths);
                     IndirectEstimate {
-                        radiance_y: luminance_y(l, &xyz),
+                        radiance_y: xyz.y(l) as f32,
                         lane_variance: lane_variance(l, &xyz),
                     }
                 }),
