@@ -52,6 +52,21 @@ SCENES = {
 RELMSE_EPSILON = 1e-2
 
 
+def scaled_resolution(own, requested):
+    """`requested` (WxH) for a square scene; for another aspect ratio the scene's own at width
+    W, so that --resolution does not stretch glossy-env's 16:9 frame into a square."""
+    if requested is None:
+        return own
+    try:
+        w, h = (int(x) for x in requested.lower().split("x"))
+        ow, oh = (int(x) for x in own.lower().split("x"))
+    except ValueError:
+        raise SystemExit(f"--resolution {requested!r}: expected WIDTHxHEIGHT, e.g. 128x128")
+    if ow == oh:
+        return f"{w}x{h}"
+    return f"{w}x{max(1, round(w * oh / ow))}"
+
+
 def channel(path, name):
     """One channel, or for "RGB" the colour as height × width × 3 (OpenEXR 3 groups R, G, B
     into one "RGB" channel)."""
@@ -103,7 +118,8 @@ def main():
     parser.add_argument("--scenes", default=",".join(SCENES))
     parser.add_argument("--variant", action="append", default=[])
     parser.add_argument("--resolution", default=None,
-                        help="WxH for every scene (default: each scene's own in SCENES)")
+                        help="WxH for the square scenes; a scene of another aspect ratio in "
+                             "SCENES keeps it at width W (default: each scene's own)")
     parser.add_argument("--no-file", action="store_true")
     opts = parser.parse_args()
     if opts.renders < 4:
@@ -120,7 +136,7 @@ def main():
         else:
             raise SystemExit(f"--scenes: unknown scene {name!r} (known: {', '.join(SCENES)}, "
                              "or a scene file's path from the repository root)")
-        resolution = opts.resolution or resolution
+        resolution = scaled_resolution(resolution, opts.resolution)
         images = uniform_renders(scene, resolution, opts.renders, opts.spp, work)
         mean = images.mean(axis=0)
         v = relative_variance(images, opts.spp, mean)
