@@ -309,7 +309,7 @@ pub(super) fn build_lights(
                     *slot = light_index;
                 }
                 Light::Area(AreaLight {
-                    shape: emitter,
+                    shape: emitter.emitting_sides(*two_sided),
                     radiance: b.absolute(spectrum()?, target)?,
                     two_sided: *two_sided,
                 })

@@ -38,7 +38,7 @@ use intersect::{BoxSet, PatchSet};
 
 use prism_spectrum::Spectrum;
 
-use crate::light::area::{AreaLight, AreaShape};
+use crate::light::area::{AreaLight, AreaShape, SolidAngleSampling};
 use crate::light::Light;
 use crate::scene_build::{small_scene_not_used, RenderScene, SceneFeature, SceneFeatures};
 
@@ -79,6 +79,9 @@ struct RectangleLight {
     radiance: Spectrum,
     /// Its slot in `PacketScene::light_radiances`, or `None` past the first `LIGHT_SLOTS`.
     radiance_slot: Option<usize>,
+    /// Where the emitter samples in solid angle (`RectangleEmitter::solid_angle_sampling`):
+    /// lanes whose vertex lies there take the scalar `Light` code's sample.
+    solid_angle: Option<SolidAngleSampling>,
 }
 
 /// A scene the packet tracer can render: its patches and their shading.
@@ -211,6 +214,7 @@ impl PacketScene {
                         two_sided: *two_sided,
                         radiance: radiance.clone(),
                         radiance_slot,
+                        solid_angle: r.solid_angle_sampling().copied(),
                     })
                 }
                 // Other emitters (and empty rectangles) go through the scalar `Light` code.

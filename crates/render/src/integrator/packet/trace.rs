@@ -957,6 +957,23 @@ fn choose_lights<const N: usize>(
                     LIGHT_NONE
                 };
             }
+            // Lanes near the emitter sample it in solid angle, by the scalar code.
+            if let Some(sampling) = &rect.solid_angle {
+                let near = sampling.in_range_lanes(&hit_points(vertex));
+                if near.contains(&true) {
+                    for l in 0..N {
+                        if !(near[l] && vertex.active[l])
+                            || sampling.solid_angle_from(hit_point(vertex, l)).is_none()
+                        {
+                            continue;
+                        }
+                        vertex.light_kind[l] = LIGHT_NONE;
+                        if let Some(sample) = &mut samples[l] {
+                            sample_light_scalar(job, paths, vertex, sample, l, 0, u);
+                        }
+                    }
+                }
+            }
             return;
         }
     }
@@ -991,7 +1008,11 @@ fn choose_lights<const N: usize>(
         }
         vertex.pmf[l] = p;
         match &job.packet.lights[li as usize] {
-            Some(rect) => {
+            Some(rect)
+                if rect
+                    .solid_angle
+                    .is_none_or(|s| s.solid_angle_from(hit_point(vertex, l)).is_none()) =>
+            {
                 if rectangle_in_lane[l] != li {
                     rectangle_in_lane[l] = li;
                     put_rectangle(vertex, l, rect);
@@ -1003,38 +1024,62 @@ fn choose_lights<const N: usize>(
                 set_spectrum(&mut vertex.le, l, le);
                 vertex.light_kind[l] = LIGHT_RECTANGLE;
             }
-            None => {
-                let (o, d, t) = (vertex.o, vertex.d, vertex.t[l]);
-                // The same bits as `shade`'s hit point.
-                let p = Vec3A::new(
-                    o[0][l] + t * d[0][l],
-                    o[1][l] + t * d[1][l],
-                    o[2][l] + t * d[2][l],
-                );
-                let ctx = LightSampleContext {
-                    p,
-                    n: vec_at(&paths.n_geometric, l),
-                };
-                let ul = Vec2::new(u[1][l], u[2][l]);
-                if let Some(ls) = lights.light(li).sample_li_cached(
-                    li,
-                    &ctx,
-                    ul,
-                    &sample.wavelengths,
-                    &mut sample.le_cache,
-                ) {
-                    set_spectrum(&mut vertex.le, l, ls.radiance);
-                    for a in 0..3 {
-                        vertex.given_p[a][l] = ls.p_light[a];
-                        vertex.given_wi[a][l] = ls.wi[a];
-                    }
-                    vertex.given_pdf[l] = ls.pdf;
-                    vertex.given_distance[l] = ls.distance_m;
-                    vertex.given_delta[l] = ls.delta;
-                    vertex.light_kind[l] = LIGHT_GIVEN;
-                }
-            }
+            // Other lights, and a rectangle sampled in solid angle from here.
+            Some(_) | None => sample_light_scalar(job, paths, vertex, sample, l, li, u),
         }
+    }
+}
+
+/// Every lane's hit point, `hit_point`'s bits.
+#[inline(always)]
+fn hit_points<const N: usize>(vertex: &VertexIn<N>) -> [[f32; N]; 3] {
+    std::array::from_fn(|a| std::array::from_fn(|l| vertex.o[a][l] + vertex.t[l] * vertex.d[a][l]))
+}
+
+/// The vertex's hit point in lane `l`: the same bits as `shade`'s.
+#[inline(always)]
+fn hit_point<const N: usize>(vertex: &VertexIn<N>, l: usize) -> Vec3A {
+    let (o, d, t) = (vertex.o, vertex.d, vertex.t[l]);
+    Vec3A::new(
+        o[0][l] + t * d[0][l],
+        o[1][l] + t * d[1][l],
+        o[2][l] + t * d[2][l],
+    )
+}
+
+/// Light `li`'s sample for lane `l` by the scalar `Light` code, as the lane's given sample
+/// (`LIGHT_GIVEN`; the lane's kind is left as it is where the light gives none).
+#[inline(always)]
+fn sample_light_scalar<const N: usize>(
+    job: &TileJob,
+    paths: &Paths<N>,
+    vertex: &mut VertexIn<N>,
+    sample: &mut LaneSample,
+    l: usize,
+    li: u32,
+    u: &[[f32; N]; 6],
+) {
+    let ctx = LightSampleContext {
+        p: hit_point(vertex, l),
+        n: vec_at(&paths.n_geometric, l),
+    };
+    let ul = Vec2::new(u[1][l], u[2][l]);
+    if let Some(ls) = job.scene.lights.light(li).sample_li_cached(
+        li,
+        &ctx,
+        ul,
+        &sample.wavelengths,
+        &mut sample.le_cache,
+    ) {
+        set_spectrum(&mut vertex.le, l, ls.radiance);
+        for a in 0..3 {
+            vertex.given_p[a][l] = ls.p_light[a];
+            vertex.given_wi[a][l] = ls.wi[a];
+        }
+        vertex.given_pdf[l] = ls.pdf;
+        vertex.given_distance[l] = ls.distance_m;
+        vertex.given_delta[l] = ls.delta;
+        vertex.light_kind[l] = LIGHT_GIVEN;
     }
 }
 

@@ -7,7 +7,9 @@
 //! - sphere: uniform in the cone that the sphere subtends (only its visible cap) from
 //!   outside (pbrt-v4 §6.2.4); uniform in area from inside, and under a non-uniform scale
 //!   (an ellipsoid);
-//! - disk, rectangle: uniform in area;
+//! - disk: uniform in area;
+//! - rectangle: uniform in solid angle from reference points near it (Ureña et al. 2013,
+//!   `spherical_rectangle`), uniform in area from further away;
 //! - triangle meshes (every instance of the shape): a triangle in proportion to its world
 //!   area, then a uniform point in it (Heitz 2019).
 //!
@@ -31,10 +33,11 @@ mod disk;
 mod mesh;
 mod rectangle;
 mod sphere;
+mod spherical_rectangle;
 
 pub use disk::DiskEmitter;
 pub use mesh::{EmitterMesh, MeshEmitter};
-pub use rectangle::RectangleEmitter;
+pub use rectangle::{RectangleEmitter, SolidAngleSampling};
 pub use sphere::SphereEmitter;
 
 use std::f32::consts::PI;
@@ -135,6 +138,15 @@ impl AreaShape {
             AreaShape::Disk(s) => s.pdf_area(),
             AreaShape::Rectangle(s) => s.pdf_area(),
             AreaShape::Mesh(s) => s.pdf_area(),
+        }
+    }
+
+    /// This shape for a light that emits from both sides or (false) only from the side of
+    /// its normal: a rectangle then samples in solid angle only from points that side.
+    pub fn emitting_sides(self, two_sided: bool) -> Self {
+        match self {
+            AreaShape::Rectangle(r) => AreaShape::Rectangle(r.emitting_sides(two_sided)),
+            AreaShape::Sphere(_) | AreaShape::Disk(_) | AreaShape::Mesh(_) => self,
         }
     }
 

@@ -1,12 +1,25 @@
 //! A rectangle emitter (local XY plane, centred, normal +Z, any affine placement — a
-//! parallelogram under shear): points uniform in area, density 1/A, converted to solid
-//! angle.
+//! parallelogram under shear). Seen from a reference point within
+//! `SOLID_ANGLE_SAMPLING_RANGE` half-diagonals of its centre (on its emitting side, when
+//! one-sided), a rectangle (not a sheared parallelogram) is sampled uniformly in solid
+//! angle (`SphericalRectangle`, density 1/Ω); from further away, or where that solid angle
+//! is not positive and finite, points are uniform in area, density 1/A converted to solid
+//! angle. Both `sample` and `pdf` make the choice from the reference point alone, so they
+//! agree.
 
 use glam::{Vec2, Vec3A};
 use prism_geometry::{Rectangle, Transform};
 
+use super::spherical_rectangle::SphericalRectangle;
 use super::{area_to_solid_angle, plane_normal_and_area_scale, ShapeSample};
 use crate::light::LightHit;
+
+/// Distance from the centre, in half-diagonals, within which a rectangle emitter is
+/// sampled in solid angle. Nearer, uniform area sampling's density d²/(A cos θ_light)
+/// varies over the light by far more than the receiver's cosine; further, the two
+/// densities differ little and the solid angle's arithmetic (four arc cosines and a
+/// sine–cosine pair in f64) is not worth its cost (docs/lights.md, "Sampling").
+pub const SOLID_ANGLE_SAMPLING_RANGE: f32 = 1.5;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct RectangleEmitter {
@@ -14,13 +27,110 @@ pub struct RectangleEmitter {
     pub to_world: Transform,
     normal: Vec3A,
     area_m2: f32,
+    /// The rectangle for solid-angle sampling and where it is used; `None` under shear or
+    /// without area.
+    solid_angle: Option<SolidAngleSampling>,
+}
+
+/// Where and how a rectangle emitter samples in solid angle.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SolidAngleSampling {
+    rectangle: SphericalRectangle,
+    centre: Vec3A,
+    range2_m2: f32,
+    /// For a one-sided emitter, its normal: points behind it see nothing emitted and take
+    /// the cheap area sampling (whose samples the light then refuses); zero when two-sided.
+    emitting_normal: Vec3A,
+}
+
+/// |p − centre|² < range² and, where `normal` is not zero, (p − centre)·normal > 0: plain
+/// f32 arithmetic in a fixed order, so that the packet tracer's lanes decide with the same
+/// bits (`SolidAngleSampling::in_range_lanes`).
+#[inline(always)]
+fn in_range(centre: [f32; 3], range2_m2: f32, normal: [f32; 3], p: [f32; 3]) -> bool {
+    let d = [p[0] - centre[0], p[1] - centre[1], p[2] - centre[2]];
+    let distance2 = (d[0] * d[0] + d[1] * d[1]) + d[2] * d[2];
+    let side = (d[0] * normal[0] + d[1] * normal[1]) + d[2] * normal[2];
+    let two_sided = normal[0] == 0.0 && normal[1] == 0.0 && normal[2] == 0.0;
+    distance2 < range2_m2 && (two_sided || side > 0.0)
+}
+
+impl SolidAngleSampling {
+    /// Whether `reference` lies within the range and on the emitting side (the cheap half
+    /// of the choice).
+    #[inline(always)]
+    fn in_range(&self, reference: Vec3A) -> bool {
+        in_range(
+            self.centre.to_array(),
+            self.range2_m2,
+            self.emitting_normal.to_array(),
+            reference.to_array(),
+        )
+    }
+
+    /// `in_range` for every lane's point `p[axis][lane]`.
+    #[inline(always)]
+    pub fn in_range_lanes<const N: usize>(&self, p: &[[f32; N]; 3]) -> [bool; N] {
+        let (c, n) = (self.centre.to_array(), self.emitting_normal.to_array());
+        std::array::from_fn(|l| in_range(c, self.range2_m2, n, [p[0][l], p[1][l], p[2][l]]))
+    }
+
+    /// The solid angle (sr) sampled from `reference`, or `None` where the emitter samples
+    /// in area: beyond the range or behind a one-sided emitter, or where the solid angle
+    /// is not positive and finite (a point in the rectangle's plane).
+    #[inline]
+    pub fn solid_angle_from(&self, reference: Vec3A) -> Option<f64> {
+        if !self.in_range(reference) {
+            return None;
+        }
+        self.solid_angle_in_range(reference)
+    }
+
+    // Out of line: its f64 arithmetic would bloat every light sample it were inlined into.
+    #[inline(never)]
+    fn solid_angle_in_range(&self, reference: Vec3A) -> Option<f64> {
+        let omega = self.rectangle.solid_angle_sr(reference);
+        (omega > 0.0 && omega < f64::INFINITY).then_some(omega)
+    }
+
+    /// A point uniform in solid angle and that solid angle, where `solid_angle_from` gives
+    /// one.
+    #[inline]
+    fn sample(&self, reference: Vec3A, u: Vec2) -> Option<(Vec3A, f64)> {
+        if !self.in_range(reference) {
+            return None;
+        }
+        self.sample_in_range(reference, u)
+    }
+
+    #[inline(never)]
+    fn sample_in_range(&self, reference: Vec3A, u: Vec2) -> Option<(Vec3A, f64)> {
+        self.rectangle.sample(reference, u)
+    }
 }
 
 impl RectangleEmitter {
     pub fn new(rectangle: Rectangle, to_world: Transform) -> Self {
         let (normal, scale) = plane_normal_and_area_scale(&to_world);
         let area = 4.0 * rectangle.half_width_m * rectangle.half_height_m * scale;
+        let (w, h) = (rectangle.half_width_m, rectangle.half_height_m);
+        let corner = to_world.point(Vec3A::new(-w, -h, 0.0));
+        let centre = to_world.point(Vec3A::ZERO);
+        let half_diagonal_m = (centre - corner).length();
+        let solid_angle = SphericalRectangle::new(
+            corner,
+            to_world.vector(Vec3A::new(2.0 * w, 0.0, 0.0)),
+            to_world.vector(Vec3A::new(0.0, 2.0 * h, 0.0)),
+        )
+        .map(|rectangle| SolidAngleSampling {
+            rectangle,
+            centre,
+            range2_m2: (SOLID_ANGLE_SAMPLING_RANGE * half_diagonal_m).powi(2),
+            emitting_normal: Vec3A::ZERO,
+        })
+        .filter(|s| s.range2_m2 > 0.0 && s.range2_m2.is_finite());
         Self {
+            solid_angle,
             rectangle,
             to_world,
             normal,
@@ -33,6 +143,22 @@ impl RectangleEmitter {
         f64::from(self.area_m2)
     }
 
+    /// This emitter for a light emitting from both sides, or (false) only from the side of
+    /// its normal (`AreaShape::emitting_sides`).
+    pub fn emitting_sides(mut self, two_sided: bool) -> Self {
+        let normal = self.normal;
+        if let Some(s) = &mut self.solid_angle {
+            s.emitting_normal = if two_sided { Vec3A::ZERO } else { normal };
+        }
+        self
+    }
+
+    /// Its solid-angle sampling (`None` under shear): the packet tracer asks it which
+    /// reference points it serves.
+    pub fn solid_angle_sampling(&self) -> Option<&SolidAngleSampling> {
+        self.solid_angle.as_ref()
+    }
+
     /// The world unit normal (the side a one-sided emitter lights).
     pub fn normal(&self) -> Vec3A {
         self.normal
@@ -42,6 +168,17 @@ impl RectangleEmitter {
     pub fn sample(&self, reference: Vec3A, u: Vec2) -> Option<ShapeSample> {
         if self.area_m2 <= 0.0 {
             return None;
+        }
+        if let Some((p, omega)) = self
+            .solid_angle
+            .as_ref()
+            .and_then(|s| s.sample(reference, u))
+        {
+            return Some(ShapeSample {
+                p,
+                n: self.normal,
+                pdf: (1.0 / omega) as f32,
+            });
         }
         let (w, h) = (self.rectangle.half_width_m, self.rectangle.half_height_m);
         let local = Vec3A::new((2.0 * u.x - 1.0) * w, (2.0 * u.y - 1.0) * h, 0.0);
@@ -79,6 +216,13 @@ impl RectangleEmitter {
     pub fn pdf(&self, reference: Vec3A, hit: &LightHit) -> f32 {
         if self.area_m2 <= 0.0 {
             return 0.0;
+        }
+        if let Some(omega) = self
+            .solid_angle
+            .as_ref()
+            .and_then(|s| s.solid_angle_from(reference))
+        {
+            return (1.0 / omega) as f32;
         }
         area_to_solid_angle(1.0 / self.area_m2, reference, hit.p, self.normal)
     }

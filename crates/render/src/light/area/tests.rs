@@ -115,9 +115,16 @@ fn chi2_area_disk() {
 #[test]
 fn chi2_area_rectangle() {
     let rect = r#"{"type": "rectangle", "name": "lamp", "size_m": [2, 1]}"#;
+    // Near (uniform in solid angle: within `SOLID_ANGLE_SAMPLING_RANGE` half-diagonals,
+    // 2.24 m here) and far (uniform in area).
     check_chi2(
         &scene(rect, ""),
-        &[([0.0, 0.0, 0.5], Some(1.0)), ([1.5, 0.2, 0.3], Some(1.0))],
+        &[
+            ([0.0, 0.0, 0.5], Some(1.0)),
+            ([1.5, 0.2, 0.3], Some(1.0)),
+            ([0.9, 0.4, 0.02], Some(1.0)),
+            ([0.5, -0.3, 3.0], Some(1.0)),
+        ],
         31,
     );
     // A sheared parallelogram.
@@ -202,6 +209,43 @@ fn disk_light_irradiance_on_axis_is_pi_l_sin2_alpha() {
         assert!(
             (e - exact).abs() < 4.0 * se + 1e-5 * exact,
             "h {h}: {e} ± {se} vs {exact}"
+        );
+    }
+}
+
+#[test]
+fn rectangle_light_irradiance_is_the_parallel_form_factors() {
+    // A surface parallel to a rectangle of radiance L at height h: E = π L F, F by the
+    // corner form factor (1/2π)[X/√(1+X²) atan(Y/√(1+X²)) + Y/√(1+Y²) atan(X/√(1+Y²))],
+    // X = x/h, Y = y/h, summed over the four corners with signs. From close by (solid-angle
+    // sampling, where a point 2 cm under the light is near its plane) and from afar (area
+    // sampling).
+    let dir = tempfile::tempdir().unwrap();
+    let json = scene(
+        r#"{"type": "rectangle", "name": "lamp", "size_m": [2, 1]}"#,
+        r#", "scale": 3"#,
+    );
+    let (_, lights) = build_scene(dir.path(), &json).unwrap();
+    let corner = |x: f64, y: f64| {
+        let (sx, sy) = ((1.0 + x * x).sqrt(), (1.0 + y * y).sqrt());
+        (x / sx * (y / sx).atan() + y / sy * (x / sy).atan()) / std::f64::consts::TAU
+    };
+    for p in [
+        [0.3f32, 0.1, 0.02],
+        [1.2, 0.4, 0.5],
+        [0.9, -0.6, 1.5],
+        [0.5, 0.2, 4.0],
+    ] {
+        let c = facing(p, [0.0, 0.0, -1.0]);
+        let (e, se) = irradiance_estimate(lights.light(0), c, 200_000, 9);
+        let h = f64::from(p[2]);
+        let (x0, x1) = ((-1.0 - f64::from(p[0])) / h, (1.0 - f64::from(p[0])) / h);
+        let (y0, y1) = ((-0.5 - f64::from(p[1])) / h, (0.5 - f64::from(p[1])) / h);
+        let f = corner(x1, y1) - corner(x0, y1) - corner(x1, y0) + corner(x0, y0);
+        let exact = std::f64::consts::PI * 3.0 * f;
+        assert!(
+            (e - exact).abs() < 4.0 * se + 1e-5 * exact,
+            "at {p:?}: {e} ± {se} vs {exact}"
         );
     }
 }
