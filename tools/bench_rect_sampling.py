@@ -23,10 +23,13 @@ import platform
 import statistics
 import subprocess
 import tempfile
+import sys
 import time
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
-OUT = ROOT / "tools" / "bench-results" / "rect-solid-angle.json"
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import bench_results  # noqa: E402
+
+ROOT = pathlib.Path(bench_results.ROOT)
 
 
 def rect(size, material, transform, name=None):
@@ -138,9 +141,7 @@ def main():
         "time_ratio_this_over_baseline": med["this"]["wall_s"] / med["baseline"]["wall_s"],
         "mse_ratio_this_over_baseline": med["this"]["mse"] / med["baseline"]["mse"],
     }
-    tmp_out = OUT.with_suffix(".json.tmp")
-    tmp_out.write_text(json.dumps(result, indent=2) + "\n")
-    os.replace(tmp_out, OUT)
+    bench_results.write("rect-solid-angle", result)
     print(json.dumps({k: result[k] for k in ["equal_error_ratio_this_over_baseline",
                                              "time_ratio_this_over_baseline",
                                              "mse_ratio_this_over_baseline"]}))
