@@ -97,23 +97,24 @@ impl AreaShape {
     // Always inlined: as a call (LLVM's choice, the mesh arm is large) the Cornell box's
     // rectangle sample returned through memory, ≈ 30 instructions per light sample.
     #[inline(always)]
-    pub fn sample(&self, reference: Vec3A, u: Vec2) -> Option<ShapeSample> {
+    pub fn sample(&self, reference: Vec3A, normal: Vec3A, u: Vec2) -> Option<ShapeSample> {
         match self {
             AreaShape::Sphere(s) => s.sample(reference, u),
             AreaShape::Disk(s) => s.sample(reference, u),
-            AreaShape::Rectangle(s) => s.sample(reference, u),
+            AreaShape::Rectangle(s) => s.sample(reference, normal, u),
             AreaShape::Mesh(s) => s.sample(reference, u),
         }
     }
 
-    /// Solid-angle density with which `sample` from `reference` picks the direction to
-    /// `hit`, a point of this shape.
+    /// Solid-angle density with which `sample` from `reference` (a receiver of unit
+    /// geometric `normal`, zero in a medium) picks the direction to `hit`, a point of this
+    /// shape.
     #[inline]
-    pub fn pdf(&self, reference: Vec3A, hit: &LightHit) -> f32 {
+    pub fn pdf(&self, reference: Vec3A, normal: Vec3A, hit: &LightHit) -> f32 {
         match self {
             AreaShape::Sphere(s) => s.pdf(reference, hit),
             AreaShape::Disk(s) => s.pdf(reference, hit),
-            AreaShape::Rectangle(s) => s.pdf(reference, hit),
+            AreaShape::Rectangle(s) => s.pdf(reference, normal, hit),
             AreaShape::Mesh(s) => s.pdf(reference, hit),
         }
     }
@@ -202,7 +203,7 @@ impl AreaLight {
         u: Vec2,
         radiance: impl FnOnce() -> SampledSpectrum,
     ) -> Option<LightSample> {
-        let s = self.shape.sample(ctx.p, u)?;
+        let s = self.shape.sample(ctx.p, ctx.n, u)?;
         let to = s.p - ctx.p;
         let d = to.length();
         // 0 < x < ∞ is "positive and finite" (false for NaN) in one comparison pair each,
@@ -264,7 +265,7 @@ impl LightSource for AreaLight {
     #[inline]
     fn pdf_li(&self, ctx: &LightSampleContext, wi: Vec3A, hit: Option<&LightHit>) -> f32 {
         match hit {
-            Some(hit) if self.emits_towards(hit.n, -wi) => self.shape.pdf(ctx.p, hit),
+            Some(hit) if self.emits_towards(hit.n, -wi) => self.shape.pdf(ctx.p, ctx.n, hit),
             Some(_) | None => 0.0,
         }
     }

@@ -93,19 +93,35 @@ impl SolidAngleSampling {
         (omega > 0.0 && omega < f64::INFINITY).then_some(omega)
     }
 
-    /// A point uniform in solid angle and that solid angle, where `solid_angle_from` gives
-    /// one.
+    /// A point in solid angle, warped by the receiver's corner cosines
+    /// (`SphericalRectangle::sample_cosine_warped`), and its density (sr⁻¹), where
+    /// `solid_angle_from` gives a solid angle.
     #[inline]
-    fn sample(&self, reference: Vec3A, u: Vec2) -> Option<(Vec3A, f64)> {
+    fn sample(&self, reference: Vec3A, normal: Vec3A, u: Vec2) -> Option<(Vec3A, f64)> {
         if !self.in_range(reference) {
             return None;
         }
-        self.sample_in_range(reference, u)
+        self.sample_in_range(reference, normal, u)
     }
 
     #[inline(never)]
-    fn sample_in_range(&self, reference: Vec3A, u: Vec2) -> Option<(Vec3A, f64)> {
-        self.rectangle.sample(reference, u)
+    fn sample_in_range(&self, reference: Vec3A, normal: Vec3A, u: Vec2) -> Option<(Vec3A, f64)> {
+        self.rectangle.sample_cosine_warped(reference, normal, u)
+    }
+
+    /// The density (sr⁻¹) of `sample` towards `point`, where `solid_angle_from` gives a
+    /// solid angle.
+    #[inline]
+    fn pdf(&self, reference: Vec3A, normal: Vec3A, point: Vec3A) -> Option<f64> {
+        if !self.in_range(reference) {
+            return None;
+        }
+        self.pdf_in_range(reference, normal, point)
+    }
+
+    #[inline(never)]
+    fn pdf_in_range(&self, reference: Vec3A, normal: Vec3A, point: Vec3A) -> Option<f64> {
+        self.rectangle.pdf_cosine_warped(reference, normal, point)
     }
 }
 
@@ -165,19 +181,19 @@ impl RectangleEmitter {
     }
 
     #[inline]
-    pub fn sample(&self, reference: Vec3A, u: Vec2) -> Option<ShapeSample> {
+    pub fn sample(&self, reference: Vec3A, normal: Vec3A, u: Vec2) -> Option<ShapeSample> {
         if self.area_m2 <= 0.0 {
             return None;
         }
-        if let Some((p, omega)) = self
+        if let Some((p, pdf)) = self
             .solid_angle
             .as_ref()
-            .and_then(|s| s.sample(reference, u))
+            .and_then(|s| s.sample(reference, normal, u))
         {
             return Some(ShapeSample {
                 p,
                 n: self.normal,
-                pdf: (1.0 / omega) as f32,
+                pdf: pdf as f32,
             });
         }
         let (w, h) = (self.rectangle.half_width_m, self.rectangle.half_height_m);
@@ -213,16 +229,16 @@ impl RectangleEmitter {
     }
 
     #[inline]
-    pub fn pdf(&self, reference: Vec3A, hit: &LightHit) -> f32 {
+    pub fn pdf(&self, reference: Vec3A, normal: Vec3A, hit: &LightHit) -> f32 {
         if self.area_m2 <= 0.0 {
             return 0.0;
         }
-        if let Some(omega) = self
+        if let Some(pdf) = self
             .solid_angle
             .as_ref()
-            .and_then(|s| s.solid_angle_from(reference))
+            .and_then(|s| s.pdf(reference, normal, hit.p))
         {
-            return (1.0 / omega) as f32;
+            return pdf as f32;
         }
         area_to_solid_angle(1.0 / self.area_m2, reference, hit.p, self.normal)
     }

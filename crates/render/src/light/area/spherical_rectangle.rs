@@ -68,6 +68,14 @@ impl SphericalRectangle {
             z_axis = -z_axis;
         }
         let (x1, y1) = (x0 + self.width_m, y0 + self.height_m);
+        local_view(x0, x1, y0, y1, z0, z_axis)
+    }
+}
+
+/// `View` of the rectangle [x0, x1] × [y0, y1] in the plane z = z0 ≤ 0 of a reference
+/// point's frame.
+fn local_view(x0: f64, x1: f64, y0: f64, y1: f64, z0: f64, z_axis: DVec3) -> View {
+    {
         // Unit normals of the planes through the reference point and each edge: the cross
         // products of consecutive corner vectors, in closed form.
         let n0 = DVec3::new(0.0, z0, -y0).normalize();
@@ -91,11 +99,80 @@ impl SphericalRectangle {
             solid_angle_sr: g0 + g1 + g2 + g3 - tau,
         }
     }
+}
 
+impl SphericalRectangle {
     /// The solid angle (sr) the rectangle subtends from `reference`; NaN where the
     /// reference point lies in its plane (nothing to sample there).
     pub fn solid_angle_sr(&self, reference: Vec3A) -> f64 {
         self.view(reference).solid_angle_sr
+    }
+
+    /// The receiver's cosine towards each corner, (x0, y0), (x1, y0), (x0, y1), (x1, y1),
+    /// at least 0.01 (pbrt-v4 `BilinearPatch::Sample`): the weights of the bilinear warp
+    /// that makes the solid-angle sample roughly follow cos θ at the receiver.
+    fn corner_cosines(&self, reference: Vec3A, normal: Vec3A) -> [f64; 4] {
+        let (r, n) = (reference.as_dvec3(), normal.as_dvec3());
+        let (ex, ey) = (self.x_axis * self.width_m, self.y_axis * self.height_m);
+        [
+            self.corner,
+            self.corner + ex,
+            self.corner + ey,
+            self.corner + ex + ey,
+        ]
+        .map(|c| n.dot((c - r).normalize()).abs().max(0.01))
+    }
+
+    /// `sample` with `u` first warped by the bilinear density of the receiver's corner
+    /// cosines (pbrt-v4 `BilinearPatch::Sample` for rectangles), for a receiver with unit
+    /// normal `normal` (zero: no warp, a point in a medium): (point, density sr⁻¹).
+    pub fn sample_cosine_warped(
+        &self,
+        reference: Vec3A,
+        normal: Vec3A,
+        u: Vec2,
+    ) -> Option<(Vec3A, f64)> {
+        if normal == Vec3A::ZERO {
+            return self.sample(reference, u).map(|(p, omega)| (p, 1.0 / omega));
+        }
+        let w = self.corner_cosines(reference, normal);
+        let warped = sample_bilinear([f64::from(u.x), f64::from(u.y)], w);
+        let (p, omega) = self.sample(reference, Vec2::new(warped[0] as f32, warped[1] as f32))?;
+        Some((p, bilinear_pdf(warped, w) / omega))
+    }
+
+    /// The density (sr⁻¹) of `sample_cosine_warped` for the direction to `point`, a point
+    /// of the rectangle: the bilinear density at the point's preimage — x from the share of
+    /// the solid angle left of it, y from its h (Ureña et al.'s parametrization, inverted) —
+    /// over Ω.
+    pub fn pdf_cosine_warped(&self, reference: Vec3A, normal: Vec3A, point: Vec3A) -> Option<f64> {
+        let v = self.view(reference);
+        let omega = v.solid_angle_sr;
+        if !(omega > 0.0 && omega < f64::INFINITY) {
+            return None;
+        }
+        if normal == Vec3A::ZERO {
+            return Some(1.0 / omega);
+        }
+        let d = point.as_dvec3() - reference.as_dvec3();
+        let xu = d.dot(self.x_axis).clamp(v.x0, v.x1);
+        let yv = d.dot(self.y_axis).clamp(v.y0, v.y1);
+        let left = local_view(v.x0, xu, v.y0, v.y1, v.z0, v.z_axis).solid_angle_sr;
+        let ux = if left > 0.0 {
+            (left / omega).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        let dist = (xu * xu + v.z0 * v.z0).sqrt();
+        let h = |y: f64| y / (dist * dist + y * y).sqrt();
+        let (h0, h1) = (h(v.y0), h(v.y1));
+        let uy = if h1 > h0 {
+            ((h(yv) - h0) / (h1 - h0)).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        let w = self.corner_cosines(reference, normal);
+        Some(bilinear_pdf([ux, uy], w) / omega)
     }
 
     /// A point of the rectangle whose direction from `reference` is uniform in the solid
@@ -131,6 +208,38 @@ impl SphericalRectangle {
         let p = reference.as_dvec3() + xu * self.x_axis + yv * self.y_axis + v.z0 * v.z_axis;
         Some((p.as_vec3a(), v.solid_angle_sr))
     }
+}
+
+/// Density on [0, 1]² of the bilinear interpolation of corner weights `w` (order (0, 0),
+/// (1, 0), (0, 1), (1, 1)), normalised (pbrt-v4 `BilinearPDF`).
+fn bilinear_pdf(p: [f64; 2], w: [f64; 4]) -> f64 {
+    let sum = w[0] + w[1] + w[2] + w[3];
+    if sum <= 0.0 {
+        return 1.0;
+    }
+    let [x, y] = p;
+    4.0 * ((1.0 - x) * (1.0 - y) * w[0]
+        + x * (1.0 - y) * w[1]
+        + (1.0 - x) * y * w[2]
+        + x * y * w[3])
+        / sum
+}
+
+/// A point of [0, 1]² with density `bilinear_pdf` from `u` uniform (pbrt-v4
+/// `SampleBilinear`): y from the marginal, then x from the conditional, each linear.
+fn sample_bilinear(u: [f64; 2], w: [f64; 4]) -> [f64; 2] {
+    let y = sample_linear(u[1], w[0] + w[1], w[2] + w[3]);
+    let x = sample_linear(u[0], w[0] + y * (w[2] - w[0]), w[1] + y * (w[3] - w[1]));
+    [x, y]
+}
+
+/// x ∈ [0, 1) with density ∝ (1 − x) a + x b for u uniform (pbrt-v4 `SampleLinear`).
+fn sample_linear(u: f64, a: f64, b: f64) -> f64 {
+    if u == 0.0 && a == 0.0 {
+        return 0.0;
+    }
+    let x = u * (a + b) / (a + (a * a + u * (b * b - a * a)).sqrt());
+    x.min(1.0 - f64::EPSILON)
 }
 
 #[cfg(test)]

@@ -127,6 +127,30 @@ fn chi2_area_rectangle() {
         ],
         31,
     );
+    // Near, from receivers with a normal: the solid-angle sample warped by their corner
+    // cosines (one receiver faces the light, one is a wall beside it).
+    let dir = tempfile::tempdir().unwrap();
+    let (geometry, lights) = build_scene(dir.path(), &scene(rect, "")).unwrap();
+    let config = chi2_config(2, 33);
+    for c in [
+        facing([0.3, 0.2, 0.4], [0.2, 0.1, -1.0]),
+        facing([1.4, 0.0, 0.3], [-1.0, 0.0, 0.0]),
+    ] {
+        let r = chi2_light(&config, &geometry, &lights, 0, c);
+        assert!(r.passed, "at {:?}: {}", c.p, r.message);
+        assert!(
+            (r.success_fraction - 1.0).abs() < 1e-4,
+            "at {:?}: {}",
+            c.p,
+            r.message
+        );
+        assert!(
+            (r.pdf_integral - 1.0).abs() < 0.01,
+            "at {:?}: {}",
+            c.p,
+            r.message
+        );
+    }
     // A sheared parallelogram.
     let sheared = r#"{"type": "rectangle", "name": "lamp", "size_m": [1, 1],
         "transform": {"matrix": [[1, 0.6, 0, 0], [0, 1, 0.2, 0], [0, 0, 1, 0], [0, 0, 0, 1]]}}"#;
