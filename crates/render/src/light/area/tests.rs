@@ -238,6 +238,35 @@ fn disk_light_irradiance_on_axis_is_pi_l_sin2_alpha() {
 }
 
 #[test]
+fn a_two_sided_rectangle_seen_from_its_own_plane_gives_finite_samples_or_none() {
+    // Points on the light itself (a path vertex on a two-sided emitter) and just off its
+    // plane, where the solid angle degenerates: every sample and density is finite.
+    let dir = tempfile::tempdir().unwrap();
+    let json = scene(
+        r#"{"type": "rectangle", "name": "lamp", "size_m": [2, 1]}"#,
+        r#", "two_sided": true"#,
+    );
+    let (_, lights) = build_scene(dir.path(), &json).unwrap();
+    let light = lights.light(0);
+    let wl = SampledWavelengths::sample_uniform(0.5);
+    for z in [0.0f32, 1e-7, -1e-7, 1e-4] {
+        for c in [
+            facing([0.3, 0.1, z], [0.0, 0.0, 1.0]),
+            ctx([0.3, 0.1, z]),
+            ctx([1.0, 0.5, z]),
+        ] {
+            for i in 0..64 {
+                let u = Vec2::new((i % 8) as f32 / 8.0 + 0.01, (i / 8) as f32 / 8.0 + 0.01);
+                if let Some(s) = light.sample_li(&c, u, &wl) {
+                    assert!(s.pdf.is_finite() && s.pdf > 0.0, "z {z}: pdf {}", s.pdf);
+                    assert!(s.wi.is_finite() && s.p_light.is_finite(), "z {z}: {s:?}");
+                }
+            }
+        }
+    }
+}
+
+#[test]
 fn rectangle_light_irradiance_is_the_parallel_form_factors() {
     // A surface parallel to a rectangle of radiance L at height h: E = π L F, F by the
     // corner form factor (1/2π)[X/√(1+X²) atan(Y/√(1+X²)) + Y/√(1+Y²) atan(X/√(1+Y²))],
