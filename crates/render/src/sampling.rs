@@ -1,4 +1,5 @@
-//! Sample warps used by the cameras.
+//! Sample warps: the cameras', the lights' (a linear and a bilinear density on the unit
+//! square, for environment-map cells and the cosine warp of solid-angle rectangle samples).
 
 use glam::Vec2;
 use std::f32::consts::FRAC_PI_4;
@@ -50,6 +51,46 @@ pub fn power_cosine_pdf(cos_theta: f32, exponent: f32) -> f32 {
         return 0.0;
     }
     (exponent + 1.0) * 0.5 * std::f32::consts::FRAC_1_PI * cos_theta.powf(exponent)
+}
+
+/// The largest f32 below 1.
+pub const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;
+
+/// x ∈ [0, 1) with density ∝ (1 − x)·a + x·b (a, b ≥ 0), by inverting its cdf, written so
+/// that it stays exact as a → b.
+#[inline]
+pub fn sample_linear(u: f32, a: f32, b: f32) -> f32 {
+    if a == b {
+        return u;
+    }
+    let x = u * (a + b) / (a + (a * a + u * (b * b - a * a)).max(0.0).sqrt());
+    x.clamp(0.0, ONE_MINUS_EPSILON)
+}
+
+/// A point of [0, 1)² with density `bilinear_pdf(·, w)` for `u` uniform, w the corner weights
+/// at (0, 0), (1, 0), (0, 1), (1, 1): y from its marginal, then x from its conditional, each
+/// linear (pbrt-v4 `SampleBilinear`).
+#[inline]
+pub fn sample_bilinear(u: Vec2, w: [f32; 4]) -> Vec2 {
+    let y = sample_linear(u.y, w[0] + w[1], w[2] + w[3]);
+    let x = sample_linear(u.x, w[0] + y * (w[2] - w[0]), w[1] + y * (w[3] - w[1]));
+    Vec2::new(x, y)
+}
+
+/// Density on [0, 1]² of the bilinear interpolation of the corner weights `w` (order as
+/// `sample_bilinear`), normalised; 1 where every weight is 0 (pbrt-v4 `BilinearPDF`).
+#[inline]
+pub fn bilinear_pdf(p: Vec2, w: [f32; 4]) -> f32 {
+    let sum = w[0] + w[1] + w[2] + w[3];
+    if sum <= 0.0 {
+        return 1.0;
+    }
+    let (x, y) = (p.x, p.y);
+    4.0 * ((1.0 - x) * (1.0 - y) * w[0]
+        + x * (1.0 - y) * w[1]
+        + (1.0 - x) * y * w[2]
+        + x * y * w[3])
+        / sum
 }
 
 #[cfg(test)]

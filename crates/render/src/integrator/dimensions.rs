@@ -22,6 +22,10 @@ pub const LENS_DIMENSIONS: u32 = 2;
 pub const WAVELENGTH_DIMENSIONS: u32 = 1;
 /// The dimensions a camera sample uses before its first vertex.
 pub const CAMERA_SAMPLE_DIMENSIONS: u32 = FILM_DIMENSIONS + LENS_DIMENSIONS + WAVELENGTH_DIMENSIONS;
+/// The first dimension of each of those draws: film point, lens point, wavelength.
+pub const FILM_DIMENSION: u32 = 0;
+pub const LENS_DIMENSION: u32 = FILM_DIMENSION + FILM_DIMENSIONS;
+pub const WAVELENGTH_DIMENSION: u32 = LENS_DIMENSION + LENS_DIMENSIONS;
 
 /// The block of dimensions one path vertex reserves. Offsets within the block:
 /// opacity mask 0, light choice 1, light position 2–3, BSDF lobe 4, BSDF direction 5–6,

@@ -67,6 +67,7 @@ use rayon::prelude::*;
 use super::piecewise_constant::PiecewiseConstant2D;
 use super::scene_sphere::SceneSphere;
 use super::{LightHit, LightLeSample, LightSample, LightSampleContext, LightSource};
+use crate::sampling::{sample_bilinear, ONE_MINUS_EPSILON};
 
 /// The local direction of image coordinates (u, v) (see the module docs).
 #[inline]
@@ -497,11 +498,9 @@ impl EnvironmentLight {
             ux -= wk;
         }
         let (qx, qy) = quadrants[chosen];
-        let [w00, w10, w01, w11] = corners(qx, qy);
-        let t = sample_linear(u.y, w00 + w10, w01 + w11);
-        let s = sample_linear(ux, w00 + t * (w01 - w00), w10 + t * (w11 - w10));
-        let a = 0.5 * (qx as f32 + s);
-        let b = 0.5 * (qy as f32 + t);
+        let st = sample_bilinear(Vec2::new(ux, u.y), corners(qx, qy));
+        let a = 0.5 * (qx as f32 + st.x);
+        let b = 0.5 * (qy as f32 + st.y);
         Vec2::new((x as f32 + a) / w as f32, (y as f32 + b) / h as f32)
     }
 
@@ -700,20 +699,6 @@ pub struct RgbTexels<'a> {
 enum SampledAt {
     Texel(usize, usize),
     Point(Vec2),
-}
-
-/// The largest f32 below 1.
-const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;
-
-/// x ∈ [0, 1) with density ∝ (1 − x)·a + x·b (a, b ≥ 0), by inverting its cdf, written so
-/// that it stays exact as a → b.
-#[inline]
-fn sample_linear(u: f32, a: f32, b: f32) -> f32 {
-    if a == b {
-        return u;
-    }
-    let x = u * (a + b) / (a + (a * a + u * (b * b - a * a)).max(0.0).sqrt());
-    x.clamp(0.0, ONE_MINUS_EPSILON)
 }
 
 /// The two texel columns whose centres bracket image coordinate `u` (wrapping around) and

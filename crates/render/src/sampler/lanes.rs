@@ -5,9 +5,10 @@
 //! permutations, `u32::reverse_bits` as a byte shuffle instead of table lookups). The
 //! values are the same bits as the scalar calls (tested below).
 
-use super::hash::{mix64, u32_to_unit_f32, DIMENSION_SPREAD};
+use super::hash::{mix64, u32_to_unit_f32};
+use super::independent;
 use super::sobol::{laine_karras_permutation, pascal_digits};
-use super::SampleStream;
+use super::{dimension_hash, SampleStream};
 
 /// The words of `N` streams (`SampleStream::words`), one per lane.
 #[derive(Clone, Copy, Debug)]
@@ -31,12 +32,10 @@ impl<const N: usize> StreamLanes<N> {
     /// Lane `lane` draws from `stream`.
     #[inline(always)]
     pub(crate) fn set(&mut self, lane: usize, stream: &SampleStream) {
-        (
-            self.key[lane],
-            self.index_reversed[lane],
-            self.tail_key[lane],
-            self.sobol_dimensions[lane],
-        ) = stream.words();
+        self.key[lane] = stream.key;
+        self.index_reversed[lane] = stream.index_reversed;
+        self.tail_key[lane] = stream.tail_key;
+        self.sobol_dimensions[lane] = stream.sobol_dimensions;
     }
 
     /// What `get_1d_at(dimension[l])` of lane l's stream returns, for every lane.
@@ -44,6 +43,13 @@ impl<const N: usize> StreamLanes<N> {
     pub(crate) fn get_1d_at(&self, dimension: &[u32; N]) -> [f32; N] {
         let (x, _) = self.bits_2d_at(dimension, false);
         x.map(u32_to_unit_f32)
+    }
+
+    /// What `get_1d_at(dimension[l])` returns for the lanes whose streams are independent
+    /// (`SamplerKind::Independent`): their hashes alone, without the Sobol arithmetic.
+    #[inline(always)]
+    pub(crate) fn independent_1d_at(&self, dimension: &[u32; N]) -> [f32; N] {
+        std::array::from_fn(|l| u32_to_unit_f32(independent::value(self.tail_key[l], dimension[l])))
     }
 
     /// What `get_2d_at(dimension[l])` of lane l's stream returns, for every lane: (x, y).
@@ -63,10 +69,10 @@ impl<const N: usize> StreamLanes<N> {
         for l in 0..N {
             let d = dimension[l];
             // `dimension_hash`, `shuffle_reversed_index`, `scrambled_dimension_0`.
-            let h = mix64(self.key[l] ^ u64::from(d).wrapping_mul(DIMENSION_SPREAD));
+            let h = dimension_hash(self.key[l], d);
             let index = laine_karras_permutation(self.index_reversed[l], h as u32).reverse_bits();
             let sobol_x = laine_karras_permutation(index, (h >> 32) as u32).reverse_bits();
-            let tail_x = independent_bits(self.tail_key[l], d);
+            let tail_x = independent::value(self.tail_key[l], d);
             x[l] = if d >= self.sobol_dimensions[l] {
                 tail_x
             } else {
@@ -75,7 +81,7 @@ impl<const N: usize> StreamLanes<N> {
             if with_y {
                 let seed_y = (mix64(h) >> 32) as u32;
                 let sobol_y = laine_karras_permutation(pascal_digits(index), seed_y).reverse_bits();
-                let tail_y = independent_bits(self.tail_key[l], d.wrapping_add(1));
+                let tail_y = independent::value(self.tail_key[l], d.wrapping_add(1));
                 y[l] = if d.wrapping_add(1) < self.sobol_dimensions[l] {
                     sobol_y
                 } else {
@@ -85,12 +91,6 @@ impl<const N: usize> StreamLanes<N> {
         }
         (x, y)
     }
-}
-
-/// `independent::value`.
-#[inline(always)]
-fn independent_bits(key: u64, dimension: u32) -> u32 {
-    (mix64(key ^ u64::from(dimension).wrapping_mul(DIMENSION_SPREAD)) >> 32) as u32
 }
 
 #[cfg(test)]

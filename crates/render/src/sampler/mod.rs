@@ -197,31 +197,12 @@ impl SampleStream {
         p
     }
 
-    /// The key of an independent stream's values (`independent::value(key, dimension)` is
-    /// `bits` of `get_1d_at(dimension)`), for callers that hash many streams at once; `None`
-    /// for a Sobol stream.
-    pub(crate) fn independent_key(&self) -> Option<u64> {
-        (self.kind == SamplerKind::Independent).then_some(self.tail_key)
-    }
-
     /// A 64-bit hash of (seed, pixel, sample index, `dimension`): the seed of a
     /// generator for an unbounded number of variates that one reserved dimension stands
     /// for (a medium segment's collisions, `integrator::medium_transport`).
     #[inline]
     pub fn seed_at(&self, dimension: u32) -> u64 {
         mix64(self.tail_key ^ u64::from(dimension).wrapping_mul(DIMENSION_SPREAD))
-    }
-
-    /// The stream's words as `StreamLanes` reads them: (key, index reversed, tail key,
-    /// Sobol dimensions), with no Sobol dimension for an independent stream.
-    #[inline(always)]
-    pub(crate) fn words(&self) -> (u64, u32, u64, u32) {
-        (
-            self.key,
-            self.index_reversed,
-            self.tail_key,
-            self.sobol_dimensions,
-        )
     }
 
     /// Dimensions used so far.

@@ -21,20 +21,13 @@ use super::{PacketScene, RectangleLight, LIGHT_SLOTS, REFLECTANCE_SLOTS};
 use crate::film::FilmTile;
 use crate::film::SurfaceAov;
 use crate::integrator::dimensions::{
-    VertexDimensions, CAMERA_SAMPLE_DIMENSIONS, FILM_DIMENSIONS, LENS_DIMENSIONS,
+    VertexDimensions, CAMERA_SAMPLE_DIMENSIONS, FILM_DIMENSION, LENS_DIMENSION,
+    WAVELENGTH_DIMENSION,
 };
-
-/// The dimensions of a camera sample's draws: film point (2), lens (2), wavelength
-/// (`camera_sample::CameraSample`'s order).
-const FILM_DIMENSION: u32 = 0;
-const LENS_DIMENSION: u32 = FILM_DIMENSIONS;
-const WAVELENGTH_DIMENSION: u32 = FILM_DIMENSIONS + LENS_DIMENSIONS;
 use crate::integrator::path::{add_contribution, FirstHit, PathCounters, PathTracer};
 use crate::light::{LightHit, LightSampleContext};
 use crate::material::{Material, SurfaceMaterial};
-use crate::sampler::hash::u32_to_unit_f32;
-use crate::sampler::independent;
-use crate::sampler::{PixelSampler, SampleStream, StreamLanes};
+use crate::sampler::{PixelSampler, SampleStream, SamplerKind, StreamLanes};
 use crate::scene_build::RenderScene;
 use crate::spectrum_cache::SpectrumCache;
 use prism_spectrum::XyzWeights;
@@ -555,9 +548,7 @@ fn start_path<const N: usize>(
     flags.pending[l] = false;
     paths.depth[l] = 0;
     paths.dimension[l] = start.stream.dimension();
-    let key = start.stream.independent_key();
-    variates.hashed[l] = key.is_some();
-    variates.key[l] = key.unwrap_or(0);
+    variates.hashed[l] = start.stream.kind() == SamplerKind::Independent;
     variates.lanes.set(l, &start.stream);
     for (slot, r) in start.reflectance.iter().enumerate() {
         set_spectrum(&mut paths.reflectance[slot], l, *r);
@@ -591,12 +582,11 @@ const VARIATE_OFFSETS: [u32; 6] = [
 /// The variates of one vertex per lane: light choice, light position (2), BSDF direction
 /// (2), roulette — the values `SampleStream::get_1d_at` gives at those dimensions.
 struct Variates<const N: usize> {
-    /// The path's independent stream key (`SampleStream::independent_key`), if `hashed`.
-    key: [u64; N],
     first_dimension: [u32; N],
-    /// Independent stream: `u` is hashed from `key`; else drawn from `lanes`.
+    /// Independent stream: `u` is its hashes alone (`StreamLanes::independent_1d_at`);
+    /// else the stream's Sobol or independent values (`StreamLanes::get_1d_at`).
     hashed: [bool; N],
-    /// Every lane's stream, for the lanes that are not `hashed`.
+    /// Every lane's stream.
     lanes: StreamLanes<N>,
     u: [[f32; N]; 6],
 }
@@ -604,7 +594,6 @@ struct Variates<const N: usize> {
 impl<const N: usize> Variates<N> {
     fn new() -> Self {
         Self {
-            key: [0; N],
             first_dimension: [0; N],
             hashed: [false; N],
             lanes: StreamLanes::new(),
@@ -636,10 +625,9 @@ fn draw_variates<const N: usize>(
         if !(needed[k] && any_hashed) {
             continue;
         }
-        for l in 0..N {
-            let bits = independent::value(v.key[l], v.first_dimension[l] + offset);
-            v.u[k][l] = u32_to_unit_f32(bits);
-        }
+        v.u[k] = v
+            .lanes
+            .independent_1d_at(&std::array::from_fn(|l| v.first_dimension[l] + offset));
     }
     // Other streams (Sobol): all lanes at once (`StreamLanes`), the same values as each
     // stream's `get_1d_at`/`get_2d_at`; lanes that hashed above keep theirs.
@@ -962,9 +950,7 @@ fn choose_lights<const N: usize>(
                 let near = sampling.in_range_lanes(&hit_points(vertex));
                 if near.contains(&true) {
                     for l in 0..N {
-                        if !(near[l] && vertex.active[l])
-                            || sampling.solid_angle_from(hit_point(vertex, l)).is_none()
-                        {
+                        if !(near[l] && vertex.active[l]) {
                             continue;
                         }
                         vertex.light_kind[l] = LIGHT_NONE;
@@ -1011,7 +997,7 @@ fn choose_lights<const N: usize>(
             Some(rect)
                 if rect
                     .solid_angle
-                    .is_none_or(|s| s.solid_angle_from(hit_point(vertex, l)).is_none()) =>
+                    .is_none_or(|s| !s.in_range(hit_point(vertex, l))) =>
             {
                 if rectangle_in_lane[l] != li {
                     rectangle_in_lane[l] = li;
@@ -1024,7 +1010,8 @@ fn choose_lights<const N: usize>(
                 set_spectrum(&mut vertex.le, l, le);
                 vertex.light_kind[l] = LIGHT_RECTANGLE;
             }
-            // Other lights, and a rectangle sampled in solid angle from here.
+            // Other lights, and a rectangle near enough to sample in solid angle from here
+            // (the scalar code also falls back to area sampling where it must).
             Some(_) | None => sample_light_scalar(job, paths, vertex, sample, l, li, u),
         }
     }

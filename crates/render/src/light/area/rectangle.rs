@@ -38,64 +38,42 @@ pub struct SolidAngleSampling {
     rectangle: SphericalRectangle,
     centre: Vec3A,
     range2_m2: f32,
-    /// For a one-sided emitter, its normal: points behind it see nothing emitted and take
-    /// the cheap area sampling (whose samples the light then refuses); zero when two-sided.
-    emitting_normal: Vec3A,
-}
-
-/// |p − centre|² < range² and, where `normal` is not zero, (p − centre)·normal > 0: plain
-/// f32 arithmetic in a fixed order, so that the packet tracer's lanes decide with the same
-/// bits (`SolidAngleSampling::in_range_lanes`).
-#[inline(always)]
-fn in_range(centre: [f32; 3], range2_m2: f32, normal: [f32; 3], p: [f32; 3]) -> bool {
-    let d = [p[0] - centre[0], p[1] - centre[1], p[2] - centre[2]];
-    let distance2 = (d[0] * d[0] + d[1] * d[1]) + d[2] * d[2];
-    let side = (d[0] * normal[0] + d[1] * normal[1]) + d[2] * normal[2];
-    let two_sided = normal[0] == 0.0 && normal[1] == 0.0 && normal[2] == 0.0;
-    distance2 < range2_m2 && (two_sided || side > 0.0)
+    /// The emitter's normal, and whether it emits from both sides: points behind a
+    /// one-sided emitter see nothing emitted and take the cheap area sampling (whose
+    /// samples the light then refuses).
+    normal: Vec3A,
+    two_sided: bool,
 }
 
 impl SolidAngleSampling {
-    /// Whether `reference` lies within the range and on the emitting side (the cheap half
-    /// of the choice).
+    /// Whether `reference` is sampled in solid angle: within the range and, for a one-sided
+    /// emitter, on its emitting side. Plain f32 arithmetic in a fixed order, so that the
+    /// packet tracer's lanes (`in_range_lanes`) decide with the same bits; where the solid
+    /// angle then turns out not positive and finite (a point in the plane of a two-sided
+    /// emitter), `sample` and `pdf` fall back to area sampling alike.
     #[inline(always)]
-    fn in_range(&self, reference: Vec3A) -> bool {
-        in_range(
-            self.centre.to_array(),
-            self.range2_m2,
-            self.emitting_normal.to_array(),
-            reference.to_array(),
-        )
+    pub fn in_range(&self, reference: Vec3A) -> bool {
+        self.in_range_at(reference.to_array())
     }
 
     /// `in_range` for every lane's point `p[axis][lane]`.
     #[inline(always)]
     pub fn in_range_lanes<const N: usize>(&self, p: &[[f32; N]; 3]) -> [bool; N] {
-        let (c, n) = (self.centre.to_array(), self.emitting_normal.to_array());
-        std::array::from_fn(|l| in_range(c, self.range2_m2, n, [p[0][l], p[1][l], p[2][l]]))
+        std::array::from_fn(|l| self.in_range_at([p[0][l], p[1][l], p[2][l]]))
     }
 
-    /// The solid angle (sr) sampled from `reference`, or `None` where the emitter samples
-    /// in area: beyond the range or behind a one-sided emitter, or where the solid angle
-    /// is not positive and finite (a point in the rectangle's plane).
-    #[inline]
-    pub fn solid_angle_from(&self, reference: Vec3A) -> Option<f64> {
-        if !self.in_range(reference) {
-            return None;
-        }
-        self.solid_angle_in_range(reference)
-    }
-
-    // Out of line: its f64 arithmetic would bloat every light sample it were inlined into.
-    #[inline(never)]
-    fn solid_angle_in_range(&self, reference: Vec3A) -> Option<f64> {
-        let omega = self.rectangle.solid_angle_sr(reference);
-        (omega > 0.0 && omega < f64::INFINITY).then_some(omega)
+    #[inline(always)]
+    fn in_range_at(&self, p: [f32; 3]) -> bool {
+        let (c, n) = (self.centre.to_array(), self.normal.to_array());
+        let d = [p[0] - c[0], p[1] - c[1], p[2] - c[2]];
+        let distance2 = (d[0] * d[0] + d[1] * d[1]) + d[2] * d[2];
+        let side = (d[0] * n[0] + d[1] * n[1]) + d[2] * n[2];
+        distance2 < self.range2_m2 && (self.two_sided || side > 0.0)
     }
 
     /// A point in solid angle, warped by the receiver's corner cosines
     /// (`SphericalRectangle::sample_cosine_warped`), and its density (sr⁻¹), where
-    /// `solid_angle_from` gives a solid angle.
+    /// `in_range` and the solid angle is positive and finite.
     #[inline]
     fn sample(&self, reference: Vec3A, normal: Vec3A, u: Vec2) -> Option<(Vec3A, f64)> {
         if !self.in_range(reference) {
@@ -109,8 +87,8 @@ impl SolidAngleSampling {
         self.rectangle.sample_cosine_warped(reference, normal, u)
     }
 
-    /// The density (sr⁻¹) of `sample` towards `point`, where `solid_angle_from` gives a
-    /// solid angle.
+    /// The density (sr⁻¹) of `sample` towards `point`, where `sample` samples in solid
+    /// angle.
     #[inline]
     fn pdf(&self, reference: Vec3A, normal: Vec3A, point: Vec3A) -> Option<f64> {
         if !self.in_range(reference) {
@@ -142,7 +120,8 @@ impl RectangleEmitter {
             rectangle,
             centre,
             range2_m2: (SOLID_ANGLE_SAMPLING_RANGE * half_diagonal_m).powi(2),
-            emitting_normal: Vec3A::ZERO,
+            normal,
+            two_sided: true,
         })
         .filter(|s| s.range2_m2 > 0.0 && s.range2_m2.is_finite());
         Self {
@@ -162,9 +141,8 @@ impl RectangleEmitter {
     /// This emitter for a light emitting from both sides, or (false) only from the side of
     /// its normal (`AreaShape::emitting_sides`).
     pub fn emitting_sides(mut self, two_sided: bool) -> Self {
-        let normal = self.normal;
         if let Some(s) = &mut self.solid_angle {
-            s.emitting_normal = if two_sided { Vec3A::ZERO } else { normal };
+            s.two_sided = two_sided;
         }
         self
     }

@@ -8,6 +8,8 @@
 
 use glam::{DVec3, Vec2, Vec3A};
 
+use crate::sampling::{bilinear_pdf, sample_bilinear};
+
 /// A rectangle given by a corner and two orthogonal edges, world space.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SphericalRectangle {
@@ -70,40 +72,10 @@ impl SphericalRectangle {
         let (x1, y1) = (x0 + self.width_m, y0 + self.height_m);
         local_view(x0, x1, y0, y1, z0, z_axis)
     }
-}
 
-/// `View` of the rectangle [x0, x1] × [y0, y1] in the plane z = z0 ≤ 0 of a reference
-/// point's frame.
-fn local_view(x0: f64, x1: f64, y0: f64, y1: f64, z0: f64, z_axis: DVec3) -> View {
-    {
-        // Unit normals of the planes through the reference point and each edge: the cross
-        // products of consecutive corner vectors, in closed form.
-        let n0 = DVec3::new(0.0, z0, -y0).normalize();
-        let n1 = DVec3::new(-z0, 0.0, x1).normalize();
-        let n2 = DVec3::new(0.0, -z0, y1).normalize();
-        let n3 = DVec3::new(z0, 0.0, -x0).normalize();
-        // The spherical rectangle's inner angles.
-        let angle = |a: DVec3, b: DVec3| (-a.dot(b)).clamp(-1.0, 1.0).acos();
-        let (g0, g1, g2, g3) = (angle(n0, n1), angle(n1, n2), angle(n2, n3), angle(n3, n0));
-        let tau = std::f64::consts::TAU;
-        View {
-            x0,
-            x1,
-            y0,
-            y1,
-            z0,
-            z_axis,
-            b0: n0.z,
-            b1: n2.z,
-            k: tau - g2 - g3,
-            solid_angle_sr: g0 + g1 + g2 + g3 - tau,
-        }
-    }
-}
-
-impl SphericalRectangle {
     /// The solid angle (sr) the rectangle subtends from `reference`; NaN where the
     /// reference point lies in its plane (nothing to sample there).
+    #[cfg(test)]
     pub fn solid_angle_sr(&self, reference: Vec3A) -> f64 {
         self.view(reference).solid_angle_sr
     }
@@ -111,7 +83,7 @@ impl SphericalRectangle {
     /// The receiver's cosine towards each corner, (x0, y0), (x1, y0), (x0, y1), (x1, y1),
     /// at least 0.01 (pbrt-v4 `BilinearPatch::Sample`): the weights of the bilinear warp
     /// that makes the solid-angle sample roughly follow cos θ at the receiver.
-    fn corner_cosines(&self, reference: Vec3A, normal: Vec3A) -> [f64; 4] {
+    fn corner_cosines(&self, reference: Vec3A, normal: Vec3A) -> [f32; 4] {
         let (r, n) = (reference.as_dvec3(), normal.as_dvec3());
         let (ex, ey) = (self.x_axis * self.width_m, self.y_axis * self.height_m);
         [
@@ -120,7 +92,7 @@ impl SphericalRectangle {
             self.corner + ey,
             self.corner + ex + ey,
         ]
-        .map(|c| n.dot((c - r).normalize()).abs().max(0.01))
+        .map(|c| n.dot((c - r).normalize()).abs().max(0.01) as f32)
     }
 
     /// `sample` with `u` first warped by the bilinear density of the receiver's corner
@@ -136,9 +108,9 @@ impl SphericalRectangle {
             return self.sample(reference, u).map(|(p, omega)| (p, 1.0 / omega));
         }
         let w = self.corner_cosines(reference, normal);
-        let warped = sample_bilinear([f64::from(u.x), f64::from(u.y)], w);
-        let (p, omega) = self.sample(reference, Vec2::new(warped[0] as f32, warped[1] as f32))?;
-        Some((p, bilinear_pdf(warped, w) / omega))
+        let warped = sample_bilinear(u, w);
+        let (p, omega) = self.sample(reference, warped)?;
+        Some((p, f64::from(bilinear_pdf(warped, w)) / omega))
     }
 
     /// The density (sr⁻¹) of `sample_cosine_warped` for the direction to `point`, a point
@@ -147,10 +119,7 @@ impl SphericalRectangle {
     /// over Ω.
     pub fn pdf_cosine_warped(&self, reference: Vec3A, normal: Vec3A, point: Vec3A) -> Option<f64> {
         let v = self.view(reference);
-        let omega = v.solid_angle_sr;
-        if !(omega > 0.0 && omega < f64::INFINITY) {
-            return None;
-        }
+        let omega = v.sampleable_solid_angle()?;
         if normal == Vec3A::ZERO {
             return Some(1.0 / omega);
         }
@@ -172,7 +141,7 @@ impl SphericalRectangle {
             0.0
         };
         let w = self.corner_cosines(reference, normal);
-        Some(bilinear_pdf([ux, uy], w) / omega)
+        Some(f64::from(bilinear_pdf(Vec2::new(ux as f32, uy as f32), w)) / omega)
     }
 
     /// A point of the rectangle whose direction from `reference` is uniform in the solid
@@ -182,9 +151,7 @@ impl SphericalRectangle {
     /// rounding.
     pub fn sample(&self, reference: Vec3A, u: Vec2) -> Option<(Vec3A, f64)> {
         let v = self.view(reference);
-        if !(v.solid_angle_sr > 0.0 && v.solid_angle_sr < f64::INFINITY) {
-            return None;
-        }
+        v.sampleable_solid_angle()?;
         let (su, sv) = (f64::from(u.x), f64::from(u.y));
         // The area of the part of the spherical rectangle left of x = xu is su·Ω: solve
         // for the cosine cu of the angle that edge makes (their eqs. 8–10).
@@ -210,36 +177,40 @@ impl SphericalRectangle {
     }
 }
 
-/// Density on [0, 1]² of the bilinear interpolation of corner weights `w` (order (0, 0),
-/// (1, 0), (0, 1), (1, 1)), normalised (pbrt-v4 `BilinearPDF`).
-fn bilinear_pdf(p: [f64; 2], w: [f64; 4]) -> f64 {
-    let sum = w[0] + w[1] + w[2] + w[3];
-    if sum <= 0.0 {
-        return 1.0;
+impl View {
+    /// The solid angle (sr) where it is positive and finite: not so for a reference point
+    /// in the rectangle's plane, where nothing is sampled.
+    fn sampleable_solid_angle(&self) -> Option<f64> {
+        (self.solid_angle_sr > 0.0 && self.solid_angle_sr < f64::INFINITY)
+            .then_some(self.solid_angle_sr)
     }
-    let [x, y] = p;
-    4.0 * ((1.0 - x) * (1.0 - y) * w[0]
-        + x * (1.0 - y) * w[1]
-        + (1.0 - x) * y * w[2]
-        + x * y * w[3])
-        / sum
 }
 
-/// A point of [0, 1]² with density `bilinear_pdf` from `u` uniform (pbrt-v4
-/// `SampleBilinear`): y from the marginal, then x from the conditional, each linear.
-fn sample_bilinear(u: [f64; 2], w: [f64; 4]) -> [f64; 2] {
-    let y = sample_linear(u[1], w[0] + w[1], w[2] + w[3]);
-    let x = sample_linear(u[0], w[0] + y * (w[2] - w[0]), w[1] + y * (w[3] - w[1]));
-    [x, y]
-}
-
-/// x ∈ [0, 1) with density ∝ (1 − x) a + x b for u uniform (pbrt-v4 `SampleLinear`).
-fn sample_linear(u: f64, a: f64, b: f64) -> f64 {
-    if u == 0.0 && a == 0.0 {
-        return 0.0;
+/// `View` of the rectangle [x0, x1] × [y0, y1] in the plane z = z0 ≤ 0 of a reference
+/// point's frame.
+fn local_view(x0: f64, x1: f64, y0: f64, y1: f64, z0: f64, z_axis: DVec3) -> View {
+    // Unit normals of the planes through the reference point and each edge: the cross
+    // products of consecutive corner vectors, in closed form.
+    let n0 = DVec3::new(0.0, z0, -y0).normalize();
+    let n1 = DVec3::new(-z0, 0.0, x1).normalize();
+    let n2 = DVec3::new(0.0, -z0, y1).normalize();
+    let n3 = DVec3::new(z0, 0.0, -x0).normalize();
+    // The spherical rectangle's inner angles.
+    let angle = |a: DVec3, b: DVec3| (-a.dot(b)).clamp(-1.0, 1.0).acos();
+    let (g0, g1, g2, g3) = (angle(n0, n1), angle(n1, n2), angle(n2, n3), angle(n3, n0));
+    let tau = std::f64::consts::TAU;
+    View {
+        x0,
+        x1,
+        y0,
+        y1,
+        z0,
+        z_axis,
+        b0: n0.z,
+        b1: n2.z,
+        k: tau - g2 - g3,
+        solid_angle_sr: g0 + g1 + g2 + g3 - tau,
     }
-    let x = u * (a + b) / (a + (a * a + u * (b * b - a * a)).sqrt());
-    x.min(1.0 - f64::EPSILON)
 }
 
 #[cfg(test)]

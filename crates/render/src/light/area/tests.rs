@@ -25,6 +25,17 @@ fn facing(p: [f32; 3], n: [f32; 3]) -> LightSampleContext {
     }
 }
 
+/// The light's irradiance estimate at `c` (200 000 samples) within 4 standard errors of
+/// `exact` (plus 10⁻⁵ of it for f32 rounding).
+fn assert_irradiance(light: &Light, c: LightSampleContext, exact: f64, seed: u64) {
+    let (e, se) = irradiance_estimate(light, c, 200_000, seed);
+    assert!(
+        (e - exact).abs() < 4.0 * se + 1e-5 * exact,
+        "at {:?}: {e} ± {se} vs {exact}",
+        c.p
+    );
+}
+
 fn scene(shape: &str, light_extra: &str) -> String {
     format!(
         r#"{{"shapes": [{shape}],
@@ -36,11 +47,18 @@ fn scene(shape: &str, light_extra: &str) -> String {
 /// samples is the expected one (when given: 1 where the whole light faces the point) and
 /// that ∫ pdf dω over the sphere equals it.
 fn check_chi2(json: &str, points: &[([f32; 3], Option<f64>)], seed: u64) {
+    let contexts: Vec<_> = points.iter().map(|&(p, f)| (ctx(p), f)).collect();
+    check_chi2_at(json, &contexts, seed);
+}
+
+/// `check_chi2` from reference points with their normals.
+fn check_chi2_at(json: &str, points: &[(LightSampleContext, Option<f64>)], seed: u64) {
     let dir = tempfile::tempdir().unwrap();
     let (geometry, lights) = build_scene(dir.path(), json).unwrap();
     let config = chi2_config(points.len(), seed);
-    for (p, expected_fraction) in points {
-        let r = chi2_light(&config, &geometry, &lights, 0, ctx(*p));
+    for &(c, expected_fraction) in points {
+        let p = c.p;
+        let r = chi2_light(&config, &geometry, &lights, 0, c);
         assert!(r.passed, "at {p:?}: {}", r.message);
         if let Some(f) = expected_fraction {
             // Up to a few grazing samples at the outline.
@@ -129,28 +147,14 @@ fn chi2_area_rectangle() {
     );
     // Near, from receivers with a normal: the solid-angle sample warped by their corner
     // cosines (one receiver faces the light, one is a wall beside it).
-    let dir = tempfile::tempdir().unwrap();
-    let (geometry, lights) = build_scene(dir.path(), &scene(rect, "")).unwrap();
-    let config = chi2_config(2, 33);
-    for c in [
-        facing([0.3, 0.2, 0.4], [0.2, 0.1, -1.0]),
-        facing([1.4, 0.0, 0.3], [-1.0, 0.0, 0.0]),
-    ] {
-        let r = chi2_light(&config, &geometry, &lights, 0, c);
-        assert!(r.passed, "at {:?}: {}", c.p, r.message);
-        assert!(
-            (r.success_fraction - 1.0).abs() < 1e-4,
-            "at {:?}: {}",
-            c.p,
-            r.message
-        );
-        assert!(
-            (r.pdf_integral - 1.0).abs() < 0.01,
-            "at {:?}: {}",
-            c.p,
-            r.message
-        );
-    }
+    check_chi2_at(
+        &scene(rect, ""),
+        &[
+            (facing([0.3, 0.2, 0.4], [0.2, 0.1, -1.0]), Some(1.0)),
+            (facing([1.4, 0.0, 0.3], [-1.0, 0.0, 0.0]), Some(1.0)),
+        ],
+        33,
+    );
     // A sheared parallelogram.
     let sheared = r#"{"type": "rectangle", "name": "lamp", "size_m": [1, 1],
         "transform": {"matrix": [[1, 0.6, 0, 0], [0, 1, 0.2, 0], [0, 0, 1, 0], [0, 0, 0, 1]]}}"#;
@@ -227,13 +231,9 @@ fn disk_light_irradiance_on_axis_is_pi_l_sin2_alpha() {
     let (_, lights) = build_scene(dir.path(), &json).unwrap();
     for h in [0.3f32, 1.0, 4.0] {
         let c = facing([0.0, 2.0 - h, 0.0], [0.0, 1.0, 0.0]);
-        let (e, se) = irradiance_estimate(lights.light(0), c, 200_000, 7);
         let (r, h) = (0.5f64, f64::from(h));
         let exact = std::f64::consts::PI * 3.0 * r * r / (r * r + h * h);
-        assert!(
-            (e - exact).abs() < 4.0 * se + 1e-5 * exact,
-            "h {h}: {e} ± {se} vs {exact}"
-        );
+        assert_irradiance(lights.light(0), c, exact, 7);
     }
 }
 
@@ -255,12 +255,18 @@ fn a_two_sided_rectangle_seen_from_its_own_plane_gives_finite_samples_or_none() 
             ctx([0.3, 0.1, z]),
             ctx([1.0, 0.5, z]),
         ] {
+            let mut sampled = 0;
             for i in 0..64 {
                 let u = Vec2::new((i % 8) as f32 / 8.0 + 0.01, (i / 8) as f32 / 8.0 + 0.01);
                 if let Some(s) = light.sample_li(&c, u, &wl) {
                     assert!(s.pdf.is_finite() && s.pdf > 0.0, "z {z}: pdf {}", s.pdf);
                     assert!(s.wi.is_finite() && s.p_light.is_finite(), "z {z}: {s:?}");
+                    sampled += 1;
                 }
+            }
+            // Off the plane the whole light is seen: every sample lands.
+            if z == 1e-4 {
+                assert_eq!(sampled, 64, "z {z} at {:?}", c.p);
             }
         }
     }
@@ -290,16 +296,11 @@ fn rectangle_light_irradiance_is_the_parallel_form_factors() {
         [0.5, 0.2, 4.0],
     ] {
         let c = facing(p, [0.0, 0.0, -1.0]);
-        let (e, se) = irradiance_estimate(lights.light(0), c, 200_000, 9);
         let h = f64::from(p[2]);
         let (x0, x1) = ((-1.0 - f64::from(p[0])) / h, (1.0 - f64::from(p[0])) / h);
         let (y0, y1) = ((-0.5 - f64::from(p[1])) / h, (0.5 - f64::from(p[1])) / h);
         let f = corner(x1, y1) - corner(x0, y1) - corner(x1, y0) + corner(x0, y0);
-        let exact = std::f64::consts::PI * 3.0 * f;
-        assert!(
-            (e - exact).abs() < 4.0 * se + 1e-5 * exact,
-            "at {p:?}: {e} ± {se} vs {exact}"
-        );
+        assert_irradiance(lights.light(0), c, std::f64::consts::PI * 3.0 * f, 9);
     }
 }
 
@@ -317,12 +318,8 @@ fn sphere_light_irradiance_is_pi_l_r2_over_d2() {
         let dir_to = Vec3A::new(1.0, 2.0, -2.0).normalize();
         let p = Vec3A::ONE - dir_to * d;
         let c = LightSampleContext { p, n: dir_to };
-        let (e, se) = irradiance_estimate(lights.light(0), c, 200_000, 8);
         let exact = std::f64::consts::PI * 2.0 * (0.25 / f64::from(d)).powi(2);
-        assert!(
-            (e - exact).abs() < 4.0 * se + 1e-5 * exact,
-            "d {d}: {e} ± {se} vs {exact}"
-        );
+        assert_irradiance(lights.light(0), c, exact, 8);
     }
 }
 
