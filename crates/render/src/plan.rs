@@ -280,8 +280,8 @@ impl RenderPlan {
                 );
                 choose(
                     "wavelengths",
-                    "hero + 3 rotated wavelengths per path, visible-importance density".into(),
-                    "spectral transport (Wilkie et al. 2014); 4 wavelengths share every ray".into(),
+                    "hero + 3 rotated wavelengths per path, RGB-output density (½ visible, ½ Rec. 709 CMF norm)".into(),
+                    "spectral transport (Wilkie et al. 2014); 4 wavelengths share every ray; the density follows the film's red, green and blue, not luminance alone, so the spectrum's ends are sampled enough for the colour channels (prism_spectrum::rgb_wavelength_density)".into(),
                 );
                 let (selection, why) = light_selection_text(scene);
                 choose("light selection", selection, why);

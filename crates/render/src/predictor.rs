@@ -342,7 +342,8 @@ fn escaping_pixel(
     let lights = &scene.lights;
     let estimates: Vec<DVec3> = (0..count)
         .map(|k| {
-            let wavelengths = SampledWavelengths::sample_visible((k as f32 + 0.5) / count as f32);
+            let wavelengths =
+                SampledWavelengths::sample_rgb_output((k as f32 + 0.5) / count as f32);
             let mut radiance = SampledSpectrum::splat(0.0);
             for &l in lights.infinite_lights() {
                 radiance += lights.light(l).infinite_radiance(direction, &wavelengths);

@@ -697,7 +697,7 @@ impl ShadingProbe for RenderProbe<'_> {
                 camera_sample = None;
             }
             let (wavelengths, xyz, bsdf) = &*camera_sample.get_or_insert_with(|| {
-                let wavelengths = SampledWavelengths::sample_visible(u_wavelengths);
+                let wavelengths = SampledWavelengths::sample_rgb_output(u_wavelengths);
                 (
                     wavelengths,
                     XyzWeights::new(&wavelengths),
@@ -898,7 +898,7 @@ impl ShadingProbe for RenderProbe<'_> {
         for k in 0..count {
             // Streams apart from `sample_lights`' (indices 0..count).
             let mut stream = sampler.stream(pixel, INDIRECT_STREAM_OFFSET + k);
-            let wavelengths = SampledWavelengths::sample_visible(stream.get_1d());
+            let wavelengths = SampledWavelengths::sample_rgb_output(stream.get_1d());
             out.push(
                 self.one_bounce_indirect(
                     &si,

@@ -21,6 +21,7 @@ pub mod photometry;
 pub mod reradiation;
 pub mod rgb_space;
 pub mod rgb_upsample;
+pub mod rgb_wavelength_density;
 pub mod sampled_spectrum;
 pub mod sampled_wavelengths;
 pub mod spectrum;

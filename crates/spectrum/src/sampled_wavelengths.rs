@@ -28,6 +28,7 @@
 //! λ = c + atanh(t₀ + u (t₁ − t₀)) / k, with t₀ = tanh(k(360 − c)), t₁ = tanh(k(830 − c)).
 
 use crate::constants::{LAMBDA_MAX_NM, LAMBDA_MIN_NM};
+use crate::rgb_wavelength_density::RgbWavelengthDensity;
 use crate::sampled_spectrum::{SampledSpectrum, N_SPECTRUM_SAMPLES};
 
 /// Falloff k of the visible-wavelength density, in nm⁻¹ (pbrt-v4).
@@ -193,6 +194,51 @@ impl SampledWavelengths {
         for i in 0..N_SPECTRUM_SAMPLES {
             for k in 0..N {
                 (lambda_nm[i][k], pdf[i][k]) = visible_wavelength_and_pdf(variates[i][k]);
+            }
+        }
+        std::array::from_fn(|k| Self {
+            lambda_nm: std::array::from_fn(|i| lambda_nm[i][k]),
+            pdf: SampledSpectrum::new(std::array::from_fn(|i| pdf[i][k])),
+        })
+    }
+
+    /// Hero wavelength from `u` ∈ [0, 1) by the RGB-output density
+    /// ([`crate::rgb_wavelength_density`]: half the visible density, half the norm of the
+    /// Rec. 709 colour-matching functions), plus three rotated copies, each with its pdf.
+    /// For estimates that end as RGB: the film's camera samples.
+    #[inline]
+    pub fn sample_rgb_output(u: f32) -> Self {
+        let density = RgbWavelengthDensity::get();
+        let variates = rotated_variates(u);
+        let mut lambda_nm = [0.0f32; N_SPECTRUM_SAMPLES];
+        let mut pdf = [0.0f32; N_SPECTRUM_SAMPLES];
+        for lane in 0..N_SPECTRUM_SAMPLES {
+            (lambda_nm[lane], pdf[lane]) = density.sample(variates[lane]);
+        }
+        Self {
+            lambda_nm,
+            pdf: SampledSpectrum::new(pdf),
+        }
+    }
+
+    /// `sample_rgb_output` for `N` variates at once, the same bits per sample (the packet
+    /// path tracer starts 16 camera samples at a time).
+    #[inline(always)]
+    pub fn sample_rgb_output_many<const N: usize>(u: &[f32; N]) -> [Self; N] {
+        let density = RgbWavelengthDensity::get();
+        let mut variates = [[0.0f32; N]; N_SPECTRUM_SAMPLES];
+        for (i, row) in variates.iter_mut().enumerate() {
+            for (v, &u) in row.iter_mut().zip(u) {
+                // `rotated_variates`, lane i of every sample.
+                let x = u + i as f32 / N_SPECTRUM_SAMPLES as f32;
+                *v = if x >= 1.0 { x - 1.0 } else { x };
+            }
+        }
+        let mut lambda_nm = [[0.0f32; N]; N_SPECTRUM_SAMPLES];
+        let mut pdf = [[0.0f32; N]; N_SPECTRUM_SAMPLES];
+        for i in 0..N_SPECTRUM_SAMPLES {
+            for k in 0..N {
+                (lambda_nm[i][k], pdf[i][k]) = density.sample(variates[i][k]);
             }
         }
         std::array::from_fn(|k| Self {

@@ -70,6 +70,7 @@ mod tests {
     fn flat_radiance_integrates_to_y_one_with_stratified_wavelengths() {
         for sample in [
             SampledWavelengths::sample_visible as fn(f32) -> SampledWavelengths,
+            SampledWavelengths::sample_rgb_output,
             SampledWavelengths::sample_uniform,
         ] {
             let n = 20_000;

@@ -130,7 +130,7 @@ pub(super) fn scalar_tile(
         for s in work.samples_of(pixel) {
             let mut cs = CameraSample::start(tile, work, pixel, s);
             let mut wavelengths =
-                LaneWavelengths::new(SampledWavelengths::sample_visible(cs.stream.get_1d()));
+                LaneWavelengths::new(SampledWavelengths::sample_rgb_output(cs.stream.get_1d()));
             let result = radiance(&mut cs, pixel, &mut wavelengths);
             let sensor = wavelengths.sensor();
             let xyz_weights = XyzWeights::new(sensor);

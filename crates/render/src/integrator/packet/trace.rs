@@ -406,7 +406,7 @@ struct Start {
 /// The tile's next camera samples, their first draws made `N` at a time (the scalar
 /// driver's order of dimensions: filter 2, lens 2, wavelength 1), so that the wavelengths
 /// are sampled and the camera rays made in vector loops
-/// (`SampledWavelengths::sample_visible_many`, `Camera::generate_rays_only_many`).
+/// (`SampledWavelengths::sample_rgb_output_many`, `Camera::generate_rays_only_many`).
 struct Starts<const N: usize> {
     ready: Vec<Start>,
     next: usize,
@@ -473,7 +473,7 @@ impl<const N: usize> Starts<N> {
             for (start, ray) in self.ready.iter_mut().zip(rays) {
                 start.ray = ray;
             }
-            let wavelengths = SampledWavelengths::sample_visible_many(&u);
+            let wavelengths = SampledWavelengths::sample_rgb_output_many(&u);
             for (start, wl) in self.ready.iter_mut().zip(wavelengths) {
                 start.wavelengths = wl;
             }

@@ -565,5 +565,5 @@ impl CameraPaths<'_> {
 pub fn pass_wavelengths(seed: u64, iteration: u32) -> SampledWavelengths {
     let h = super::shoot::mix_seed(seed ^ 0x5741_5645_4C45_4E47, iteration, u64::MAX);
     let u = (h >> 40) as f32 * (1.0 / (1u32 << 24) as f32);
-    SampledWavelengths::sample_visible(u)
+    SampledWavelengths::sample_rgb_output(u)
 }
