@@ -280,7 +280,7 @@ impl RenderPlan {
                 );
                 choose(
                     "wavelengths",
-                    "hero + 3 rotated wavelengths per path, RGB-output density (½ visible, ½ Rec. 709 CMF norm)".into(),
+                    "hero + 3 rotated wavelengths per path, RGB-output density (0.4 visible + 0.6 Rec. 709 CMF norm)".into(),
                     "spectral transport (Wilkie et al. 2014); 4 wavelengths share every ray; the density follows the film's red, green and blue, not luminance alone, so the spectrum's ends are sampled enough for the colour channels (prism_spectrum::rgb_wavelength_density)".into(),
                 );
                 let (selection, why) = light_selection_text(scene);
