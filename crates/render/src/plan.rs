@@ -278,10 +278,22 @@ impl RenderPlan {
                     ),
                     plan_reason,
                 );
+                let (density, density_why) = match request.spectral_bins {
+                    Some(_) => (
+                        "visible density (pbrt-v4)",
+                        "the film records spectral bins, whose far-red and violet bins need the samples the colour-matching functions give little weight to",
+                    ),
+                    None => (
+                        "RGB-output density (0.4 visible + 0.6 Rec. 709 CMF norm)",
+                        "the output is colour: the density follows the film's red, green and blue, not luminance alone, so the spectrum's ends are sampled enough for the colour channels (prism_spectrum::rgb_wavelength_density)",
+                    ),
+                };
                 choose(
                     "wavelengths",
-                    "hero + 3 rotated wavelengths per path, RGB-output density (0.4 visible + 0.6 Rec. 709 CMF norm)".into(),
-                    "spectral transport (Wilkie et al. 2014); 4 wavelengths share every ray; the density follows the film's red, green and blue, not luminance alone, so the spectrum's ends are sampled enough for the colour channels (prism_spectrum::rgb_wavelength_density)".into(),
+                    format!("hero + 3 rotated wavelengths per path, {density}"),
+                    format!(
+                        "spectral transport (Wilkie et al. 2014); 4 wavelengths share every ray; {density_why}"
+                    ),
                 );
                 let (selection, why) = light_selection_text(scene);
                 choose("light selection", selection, why);

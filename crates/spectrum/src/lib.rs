@@ -42,7 +42,7 @@ pub use rgb_upsample::{
     RgbUpsampleError, SigmoidPolynomial,
 };
 pub use sampled_spectrum::{SampledSpectrum, N_SPECTRUM_SAMPLES};
-pub use sampled_wavelengths::SampledWavelengths;
+pub use sampled_wavelengths::{SampledWavelengths, WavelengthDensity};
 pub use spectrum::{DenseTable, InvalidSpectrum, PiecewiseLinear, Spectrum};
 pub use table::{DenseSpectrum, Tabulated};
 pub use xyz_weights::XyzWeights;

@@ -132,6 +132,47 @@ fn visible_wavelength_and_pdf(variate: f32) -> (f32, f32) {
     )
 }
 
+/// Which density a camera sample's hero wavelength is drawn from (the three others are its
+/// rotations): one contract, `sample`, for every estimator that writes a film.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum WavelengthDensity {
+    /// pbrt-v4's visible density, which follows luminance and keeps mass out to 830 nm: for
+    /// films that record spectral bins, whose far-red and violet bins need their samples.
+    Visible,
+    /// The RGB-output density ([`crate::rgb_wavelength_density`]): for films whose output is
+    /// colour (XYZ / RGB) alone.
+    RgbOutput,
+}
+
+impl WavelengthDensity {
+    /// The density for a film that records spectral bins or not.
+    pub fn for_film(records_spectral_bins: bool) -> Self {
+        if records_spectral_bins {
+            WavelengthDensity::Visible
+        } else {
+            WavelengthDensity::RgbOutput
+        }
+    }
+
+    /// Hero wavelength from `u` ∈ [0, 1) and its three rotations, with their pdfs.
+    #[inline]
+    pub fn sample(self, u: f32) -> SampledWavelengths {
+        match self {
+            WavelengthDensity::Visible => SampledWavelengths::sample_visible(u),
+            WavelengthDensity::RgbOutput => SampledWavelengths::sample_rgb_output(u),
+        }
+    }
+
+    /// `sample` for `N` variates at once, the same bits per sample.
+    #[inline(always)]
+    pub fn sample_many<const N: usize>(self, u: &[f32; N]) -> [SampledWavelengths; N] {
+        match self {
+            WavelengthDensity::Visible => SampledWavelengths::sample_visible_many(u),
+            WavelengthDensity::RgbOutput => SampledWavelengths::sample_rgb_output_many(u),
+        }
+    }
+}
+
 /// Four wavelengths (nm) with the density (nm⁻¹) each was sampled with.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SampledWavelengths {

@@ -6,7 +6,7 @@
 use std::sync::Arc;
 
 use glam::{DVec3, UVec2, Vec2, Vec3A};
-use prism_spectrum::{SampledSpectrum, SampledWavelengths};
+use prism_spectrum::{SampledSpectrum, SampledWavelengths, WavelengthDensity};
 
 use super::filter_sampler::FilterSampler;
 use super::filter_table::FilterTable;
@@ -535,6 +535,14 @@ impl FilmTile {
             filter_sampler,
             splat: None,
         }
+    }
+
+    /// The density the camera samples of this tile draw their wavelengths from: the visible
+    /// density where the film records spectral bins (their far-red and violet bins need
+    /// samples the colour-matching functions give little weight to), the RGB-output
+    /// density where its output is colour alone.
+    pub fn wavelength_density(&self) -> WavelengthDensity {
+        WavelengthDensity::for_film(self.spectral_bins.is_some())
     }
 
     /// The spectral bins this tile accumulates, if any.

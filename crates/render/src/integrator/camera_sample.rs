@@ -2,7 +2,7 @@
 //! point (`dimensions`: film 2, lens 2; the wavelength dimension is the estimator's).
 
 use glam::{UVec2, Vec2};
-use prism_spectrum::{SampledSpectrum, SampledWavelengths};
+use prism_spectrum::{SampledSpectrum, SampledWavelengths, WavelengthDensity};
 
 use super::dimensions::LENS_DIMENSIONS;
 use super::estimator::TileWork;
@@ -24,6 +24,8 @@ pub struct CameraSample {
     pub lens: Vec2,
     /// The stream, after the film and lens dimensions.
     pub stream: SampleStream,
+    /// The density its wavelengths are drawn from (`FilmTile::wavelength_density`).
+    pub wavelength_density: WavelengthDensity,
 }
 
 impl CameraSample {
@@ -45,6 +47,7 @@ impl CameraSample {
             filter_weight,
             lens,
             stream,
+            wavelength_density: tile.wavelength_density(),
         }
     }
 }

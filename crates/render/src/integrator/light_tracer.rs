@@ -231,7 +231,7 @@ impl Estimator for LightTracer {
             for s in work.samples_of(pixel) {
                 let mut cs = CameraSample::start(tile, work, pixel, s);
                 let wavelengths =
-                    LaneWavelengths::new(SampledWavelengths::sample_rgb_output(cs.stream.get_1d()));
+                    LaneWavelengths::new(cs.wavelength_density.sample(cs.stream.get_1d()));
                 // Camera side: the infinite lights seen directly, and the AOVs.
                 let mut radiance = SampledSpectrum::splat(0.0);
                 let mut aov = None;

@@ -4,7 +4,6 @@
 //! hit takes one light sample (`RenderScene::light_samples_per_hit`).
 
 use glam::UVec2;
-use prism_spectrum::SampledWavelengths;
 
 use super::camera_sample::CameraSample;
 use super::driver::RenderStats;
@@ -66,6 +65,7 @@ impl Estimator for PathTracer {
                 first_sample: &|p| pass.first_sample + pass.plan.first_sample(p),
                 uses_lens: work.uses_lens,
                 want_illumination: settings.illumination_aov,
+                wavelength_density: tile.wavelength_density(),
             };
             let c = render_packet_tile(&job, tile, &mut counters);
             stats.rays_traced += c.camera_rays;
@@ -130,7 +130,7 @@ pub(super) fn scalar_tile(
         for s in work.samples_of(pixel) {
             let mut cs = CameraSample::start(tile, work, pixel, s);
             let mut wavelengths =
-                LaneWavelengths::new(SampledWavelengths::sample_rgb_output(cs.stream.get_1d()));
+                LaneWavelengths::new(cs.wavelength_density.sample(cs.stream.get_1d()));
             let result = radiance(&mut cs, pixel, &mut wavelengths);
             let sensor = wavelengths.sensor();
             let xyz_weights = XyzWeights::new(sensor);

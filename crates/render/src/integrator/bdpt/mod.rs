@@ -131,8 +131,7 @@ impl Bdpt {
         bool,
     ) {
         let zero = SampledSpectrum::splat(0.0);
-        let wavelengths =
-            LaneWavelengths::new(SampledWavelengths::sample_rgb_output(cs.stream.get_1d()));
+        let wavelengths = LaneWavelengths::new(cs.wavelength_density.sample(cs.stream.get_1d()));
         debug_assert_eq!(cs.stream.dimension(), CAMERA_SAMPLE_DIMENSIONS);
         let camera_ray = scene.camera.generate_ray_only(cs.film_point, cs.lens);
         let mut camera_state = PathState::new(Vec3A::ZERO, None, cs.stream, wavelengths);

@@ -13,6 +13,7 @@
 
 use glam::{UVec2, Vec2, Vec3A};
 use prism_geometry::Ray;
+use prism_spectrum::WavelengthDensity;
 use prism_spectrum::{SampledSpectrum, SampledWavelengths};
 
 use super::intersect::{closest, occluded, RayLanes};
@@ -44,6 +45,8 @@ pub(crate) struct TileJob<'a> {
     pub first_sample: &'a dyn Fn(UVec2) -> u32,
     pub uses_lens: bool,
     pub want_illumination: bool,
+    /// The tile's (`FilmTile::wavelength_density`).
+    pub wavelength_density: WavelengthDensity,
 }
 
 /// Per-tile totals, as the driver's scalar loop counts them.
@@ -406,7 +409,7 @@ struct Start {
 /// The tile's next camera samples, their first draws made `N` at a time (the scalar
 /// driver's order of dimensions: filter 2, lens 2, wavelength 1), so that the wavelengths
 /// are sampled and the camera rays made in vector loops
-/// (`SampledWavelengths::sample_rgb_output_many`, `Camera::generate_rays_only_many`).
+/// (`WavelengthDensity::sample_many`, `Camera::generate_rays_only_many`).
 struct Starts<const N: usize> {
     ready: Vec<Start>,
     next: usize,
@@ -473,7 +476,7 @@ impl<const N: usize> Starts<N> {
             for (start, ray) in self.ready.iter_mut().zip(rays) {
                 start.ray = ray;
             }
-            let wavelengths = SampledWavelengths::sample_rgb_output_many(&u);
+            let wavelengths = job.wavelength_density.sample_many(&u);
             for (start, wl) in self.ready.iter_mut().zip(wavelengths) {
                 start.wavelengths = wl;
             }

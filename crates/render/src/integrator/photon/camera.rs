@@ -18,6 +18,7 @@
 
 use glam::Vec3A;
 use prism_geometry::{Ray, RayDifferential};
+use prism_spectrum::WavelengthDensity;
 use prism_spectrum::{SampledSpectrum, SampledWavelengths};
 
 use super::medium_flight::{segment_transmittance, shadow_transmittance, Transmittance};
@@ -561,9 +562,13 @@ impl CameraPaths<'_> {
 
 /// The pass's wavelengths: one set for every photon and camera path of pass
 /// `iteration` (pbrt-v4 SPPM samples one `SampledWavelengths` per iteration), its hero
-/// from a hash of (seed, pass).
-pub fn pass_wavelengths(seed: u64, iteration: u32) -> SampledWavelengths {
+/// from a hash of (seed, pass), drawn from `density` (the film's).
+pub fn pass_wavelengths(
+    seed: u64,
+    iteration: u32,
+    density: WavelengthDensity,
+) -> SampledWavelengths {
     let h = super::shoot::mix_seed(seed ^ 0x5741_5645_4C45_4E47, iteration, u64::MAX);
     let u = (h >> 40) as f32 * (1.0 / (1u32 << 24) as f32);
-    SampledWavelengths::sample_rgb_output(u)
+    density.sample(u)
 }

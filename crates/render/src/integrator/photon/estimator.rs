@@ -27,6 +27,7 @@ use crate::integrator::estimator::{Estimator, Pass, TileWork};
 use crate::integrator::lane_wavelengths::LaneWavelengths;
 use crate::integrator::{PathCounters, PathTracer};
 use crate::scene_build::{RenderScene, SceneBuildError};
+use prism_spectrum::WavelengthDensity;
 use prism_spectrum::XyzWeights;
 
 /// A photon integrator with the state its passes keep: the resolved settings and the
@@ -199,7 +200,11 @@ impl Estimator for PhotonEstimator {
         self.advance_statistics(scene, pass, &plan, &sources, iteration);
         // Drop the last pass's photons before the next are shot.
         self.maps = PhotonMaps::default();
-        self.wavelengths = pass_wavelengths(pass.settings.seed, iteration);
+        self.wavelengths = pass_wavelengths(
+            pass.settings.seed,
+            iteration,
+            WavelengthDensity::for_film(pass.settings.spectral_bins.is_some()),
+        );
         let radius = plan.radius_from(iteration, self.radius);
         self.radius = Some(radius);
         let radius_m = radius.1.sqrt() as f32;
