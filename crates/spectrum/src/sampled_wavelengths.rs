@@ -205,16 +205,7 @@ impl SampledWavelengths {
     /// the lanes vectorises (the logarithm is `ln_positive` below).
     #[inline]
     pub fn sample_visible(u: f32) -> Self {
-        let variates = rotated_variates(u);
-        let mut lambda_nm = [0.0f32; N_SPECTRUM_SAMPLES];
-        let mut pdf = [0.0f32; N_SPECTRUM_SAMPLES];
-        for lane in 0..N_SPECTRUM_SAMPLES {
-            (lambda_nm[lane], pdf[lane]) = visible_wavelength_and_pdf(variates[lane]);
-        }
-        Self {
-            lambda_nm,
-            pdf: SampledSpectrum::new(pdf),
-        }
+        Self::drawn_by(u, visible_wavelength_and_pdf)
     }
 
     /// `sample_visible` for `N` variates at once, the same bits per sample: one loop over
@@ -222,39 +213,35 @@ impl SampledWavelengths {
     /// for it (the packet path tracer starts 16 camera samples at a time).
     #[inline(always)]
     pub fn sample_visible_many<const N: usize>(u: &[f32; N]) -> [Self; N] {
-        let mut variates = [[0.0f32; N]; N_SPECTRUM_SAMPLES];
-        for (i, row) in variates.iter_mut().enumerate() {
-            for (v, &u) in row.iter_mut().zip(u) {
-                // `rotated_variates`, lane i of every sample.
-                let x = u + i as f32 / N_SPECTRUM_SAMPLES as f32;
-                *v = if x >= 1.0 { x - 1.0 } else { x };
-            }
-        }
-        let mut lambda_nm = [[0.0f32; N]; N_SPECTRUM_SAMPLES];
-        let mut pdf = [[0.0f32; N]; N_SPECTRUM_SAMPLES];
-        for i in 0..N_SPECTRUM_SAMPLES {
-            for k in 0..N {
-                (lambda_nm[i][k], pdf[i][k]) = visible_wavelength_and_pdf(variates[i][k]);
-            }
-        }
-        std::array::from_fn(|k| Self {
-            lambda_nm: std::array::from_fn(|i| lambda_nm[i][k]),
-            pdf: SampledSpectrum::new(std::array::from_fn(|i| pdf[i][k])),
-        })
+        Self::many_drawn_by(u, visible_wavelength_and_pdf)
     }
 
     /// Hero wavelength from `u` ∈ [0, 1) by the RGB-output density
-    /// ([`crate::rgb_wavelength_density`]: half the visible density, half the norm of the
+    /// ([`crate::rgb_wavelength_density`]: 0.4 × the visible density + 0.6 × the norm of the
     /// Rec. 709 colour-matching functions), plus three rotated copies, each with its pdf.
-    /// For estimates that end as RGB: the film's camera samples.
+    /// For estimates that end as colour: the film's camera samples.
     #[inline]
     pub fn sample_rgb_output(u: f32) -> Self {
         let density = RgbWavelengthDensity::get();
+        Self::drawn_by(u, |v| density.sample(v))
+    }
+
+    /// `sample_rgb_output` for `N` variates at once, the same bits per sample.
+    #[inline(always)]
+    pub fn sample_rgb_output_many<const N: usize>(u: &[f32; N]) -> [Self; N] {
+        let density = RgbWavelengthDensity::get();
+        Self::many_drawn_by(u, |v| density.sample(v))
+    }
+
+    /// The hero from `u` and its three rotations, each drawn by `draw` (variate →
+    /// (λ in nm, pdf in nm⁻¹)).
+    #[inline(always)]
+    fn drawn_by(u: f32, draw: impl Fn(f32) -> (f32, f32)) -> Self {
         let variates = rotated_variates(u);
         let mut lambda_nm = [0.0f32; N_SPECTRUM_SAMPLES];
         let mut pdf = [0.0f32; N_SPECTRUM_SAMPLES];
         for lane in 0..N_SPECTRUM_SAMPLES {
-            (lambda_nm[lane], pdf[lane]) = density.sample(variates[lane]);
+            (lambda_nm[lane], pdf[lane]) = draw(variates[lane]);
         }
         Self {
             lambda_nm,
@@ -262,11 +249,9 @@ impl SampledWavelengths {
         }
     }
 
-    /// `sample_rgb_output` for `N` variates at once, the same bits per sample (the packet
-    /// path tracer starts 16 camera samples at a time).
+    /// `drawn_by` for `N` variates, lane-major so that the `4N` draws form one loop.
     #[inline(always)]
-    pub fn sample_rgb_output_many<const N: usize>(u: &[f32; N]) -> [Self; N] {
-        let density = RgbWavelengthDensity::get();
+    fn many_drawn_by<const N: usize>(u: &[f32; N], draw: impl Fn(f32) -> (f32, f32)) -> [Self; N] {
         let mut variates = [[0.0f32; N]; N_SPECTRUM_SAMPLES];
         for (i, row) in variates.iter_mut().enumerate() {
             for (v, &u) in row.iter_mut().zip(u) {
@@ -279,7 +264,7 @@ impl SampledWavelengths {
         let mut pdf = [[0.0f32; N]; N_SPECTRUM_SAMPLES];
         for i in 0..N_SPECTRUM_SAMPLES {
             for k in 0..N {
-                (lambda_nm[i][k], pdf[i][k]) = density.sample(variates[i][k]);
+                (lambda_nm[i][k], pdf[i][k]) = draw(variates[i][k]);
             }
         }
         std::array::from_fn(|k| Self {
@@ -374,23 +359,26 @@ mod tests {
     /// Standard normal quantile at 1 − 10⁻³.
     const Z_0_999: f64 = 3.090_232_306;
 
-    /// The batch form gives `sample_visible`'s bits for every sample.
+    /// The batch forms give the one-sample forms' bits for every sample, with both
+    /// densities.
     #[test]
-    fn sample_visible_many_is_sample_visible_per_sample() {
+    fn the_batch_forms_are_the_one_sample_forms_per_sample() {
         let mut u = [0.0f32; 16];
         for (k, v) in u.iter_mut().enumerate() {
             *v = (k as f32 * 0.618_034).fract();
         }
         u[3] = 0.0;
         u[7] = 1.0 - f32::EPSILON;
-        let many = SampledWavelengths::sample_visible_many(&u);
-        for (k, w) in many.iter().enumerate() {
-            let one = SampledWavelengths::sample_visible(u[k]);
-            assert_eq!(w.lambda().map(f32::to_bits), one.lambda().map(f32::to_bits));
-            assert_eq!(
-                w.pdf().to_array().map(f32::to_bits),
-                one.pdf().to_array().map(f32::to_bits)
-            );
+        for density in [WavelengthDensity::Visible, WavelengthDensity::RgbOutput] {
+            let many = density.sample_many(&u);
+            for (k, w) in many.iter().enumerate() {
+                let one = density.sample(u[k]);
+                assert_eq!(w.lambda().map(f32::to_bits), one.lambda().map(f32::to_bits));
+                assert_eq!(
+                    w.pdf().to_array().map(f32::to_bits),
+                    one.pdf().to_array().map(f32::to_bits)
+                );
+            }
         }
     }
 
