@@ -278,12 +278,14 @@ impl RenderPlan {
                     ),
                     plan_reason,
                 );
-                let (density, density_why) = match request.spectral_bins {
-                    Some(_) => (
+                let (density, density_why) = match crate::film::film_wavelength_density(
+                    request.spectral_bins.is_some(),
+                ) {
+                    prism_spectrum::WavelengthDensity::Visible => (
                         "visible density (pbrt-v4)",
                         "the film records spectral bins, whose far-red and violet bins need the samples the colour-matching functions give little weight to",
                     ),
-                    None => (
+                    prism_spectrum::WavelengthDensity::RgbOutput => (
                         "RGB-output density (0.4 visible + 0.6 Rec. 709 CMF norm)",
                         "the output is colour: the density follows the film's red, green and blue, not luminance alone, so the spectrum's ends are sampled enough for the colour channels (prism_spectrum::rgb_wavelength_density)",
                     ),

@@ -114,21 +114,6 @@ impl RgbWavelengthDensity {
         let (lo, hi) = (self.edges_nm[cell], self.edges_nm[cell + 1]);
         (lo + t * (hi - lo), self.pdf_per_nm[cell])
     }
-
-    /// Density at `wavelength_nm` in nm⁻¹ (zero outside 360–830 nm).
-    pub(crate) fn pdf(&self, wavelength_nm: f32) -> f32 {
-        if !(LAMBDA_MIN_NM..=LAMBDA_MAX_NM).contains(&wavelength_nm) {
-            return 0.0;
-        }
-        let cell = self.edges_nm[1..CELLS].partition_point(|&e| e <= wavelength_nm);
-        self.pdf_per_nm[cell]
-    }
-}
-
-/// Density of [`crate::SampledWavelengths::sample_rgb_output`] at `wavelength_nm`, in nm⁻¹;
-/// zero outside 360–830 nm.
-pub fn rgb_output_wavelength_pdf(wavelength_nm: f32) -> f32 {
-    RgbWavelengthDensity::get().pdf(wavelength_nm)
 }
 
 /// The linear Rec. 709 colour-matching functions at `wavelength_nm` (for the tests).
@@ -175,7 +160,8 @@ mod tests {
                 "bin {bin}: {c} draws, the mixture {want}"
             );
             let wl = LAMBDA_MIN_NM + bin as f32 + 0.5;
-            let pdf = f64::from(rgb_output_wavelength_pdf(wl));
+            let cell = d.edges_nm[1..CELLS].partition_point(|&e| e <= wl);
+            let pdf = f64::from(d.pdf_per_nm[cell]);
             assert!(
                 (pdf / (mass[bin] / total) - 1.0).abs() < 0.03,
                 "{wl}: {pdf}"

@@ -145,15 +145,6 @@ pub enum WavelengthDensity {
 }
 
 impl WavelengthDensity {
-    /// The density for a film that records spectral bins or not.
-    pub fn for_film(records_spectral_bins: bool) -> Self {
-        if records_spectral_bins {
-            WavelengthDensity::Visible
-        } else {
-            WavelengthDensity::RgbOutput
-        }
-    }
-
     /// Hero wavelength from `u` ∈ [0, 1) and its three rotations, with their pdfs.
     #[inline]
     pub fn sample(self, u: f32) -> SampledWavelengths {

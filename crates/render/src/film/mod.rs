@@ -27,7 +27,7 @@ pub use fixed_sum::{FixedSum, FixedSum3};
 pub use image::{AovPlane, FilmImage, SpectralPlanes};
 pub use light_splats::LightSplats;
 pub use memory_estimate::FilmMemory;
-pub use spectral_bins::SpectralBins;
+pub use spectral_bins::{film_wavelength_density, SpectralBins};
 pub use sums::{CountPlane, FilmSums, SumPlane, SumsMismatch};
 pub use tile::{FilmTile, SurfaceAov, TileBounds};
 

@@ -18,7 +18,21 @@
 //! its filter weight w and divides by Σw, as it does for XYZ.
 
 use crate::error::InvalidParameter;
-use prism_spectrum::{SampledSpectrum, SampledWavelengths, LAMBDA_MAX_NM, LAMBDA_MIN_NM};
+use prism_spectrum::{
+    SampledSpectrum, SampledWavelengths, WavelengthDensity, LAMBDA_MAX_NM, LAMBDA_MIN_NM,
+};
+
+/// The density a film's camera samples draw their wavelengths from: the visible density
+/// where it records spectral bins (their far-red and violet bins need samples the
+/// colour-matching functions give little weight to), the RGB-output density where its
+/// output is colour alone. The one rule for tiles, photon passes and `--explain`.
+pub fn film_wavelength_density(records_spectral_bins: bool) -> WavelengthDensity {
+    if records_spectral_bins {
+        WavelengthDensity::Visible
+    } else {
+        WavelengthDensity::RgbOutput
+    }
+}
 
 /// Fewest bins.
 pub const MIN_SPECTRAL_BINS: u32 = 1;

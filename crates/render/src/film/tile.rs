@@ -537,12 +537,10 @@ impl FilmTile {
         }
     }
 
-    /// The density the camera samples of this tile draw their wavelengths from: the visible
-    /// density where the film records spectral bins (their far-red and violet bins need
-    /// samples the colour-matching functions give little weight to), the RGB-output
-    /// density where its output is colour alone.
+    /// The density the camera samples of this tile draw their wavelengths from
+    /// (`film_wavelength_density`).
     pub fn wavelength_density(&self) -> WavelengthDensity {
-        WavelengthDensity::for_film(self.spectral_bins.is_some())
+        super::film_wavelength_density(self.spectral_bins.is_some())
     }
 
     /// The spectral bins this tile accumulates, if any.

@@ -42,6 +42,14 @@ pub struct RenderSettings {
     pub variance_aov: bool,
 }
 
+impl RenderSettings {
+    /// The density the film these settings ask for draws wavelengths from
+    /// (`film_wavelength_density`).
+    pub fn wavelength_density(&self) -> prism_spectrum::WavelengthDensity {
+        crate::film::film_wavelength_density(self.spectral_bins.is_some())
+    }
+}
+
 impl Default for RenderSettings {
     /// 16 spp, seed 0, 16-pixel tiles, Sobol, no spectral bins, no illumination or variance AOV.
     fn default() -> Self {

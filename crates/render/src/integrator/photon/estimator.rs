@@ -27,7 +27,6 @@ use crate::integrator::estimator::{Estimator, Pass, TileWork};
 use crate::integrator::lane_wavelengths::LaneWavelengths;
 use crate::integrator::{PathCounters, PathTracer};
 use crate::scene_build::{RenderScene, SceneBuildError};
-use prism_spectrum::WavelengthDensity;
 use prism_spectrum::XyzWeights;
 
 /// A photon integrator with the state its passes keep: the resolved settings and the
@@ -203,7 +202,7 @@ impl Estimator for PhotonEstimator {
         self.wavelengths = pass_wavelengths(
             pass.settings.seed,
             iteration,
-            WavelengthDensity::for_film(pass.settings.spectral_bins.is_some()),
+            pass.settings.wavelength_density(),
         );
         let radius = plan.radius_from(iteration, self.radius);
         self.radius = Some(radius);

@@ -10,7 +10,6 @@
 //! vertex: splitting a render into ranges saves none of the earlier passes' photon work.
 
 use glam::UVec2;
-use prism_spectrum::WavelengthDensity;
 use rayon::prelude::*;
 
 use super::camera::{camera_ray, pass_wavelengths, CameraPaths, CausticGather, PhotonMaps};
@@ -44,11 +43,7 @@ pub fn replay_pass(
 ) {
     debug_assert_eq!(stats.pass(), iteration);
     let seed = pass.settings.seed;
-    let wavelengths = pass_wavelengths(
-        seed,
-        iteration,
-        WavelengthDensity::for_film(pass.settings.spectral_bins.is_some()),
-    );
+    let wavelengths = pass_wavelengths(seed, iteration, pass.settings.wavelength_density());
     let (_, r2) = plan.radius_from(iteration, None);
     let radius_m = r2.sqrt() as f32;
     let shot = shoot(

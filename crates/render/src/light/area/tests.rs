@@ -25,6 +25,13 @@ fn facing(p: [f32; 3], n: [f32; 3]) -> LightSampleContext {
     }
 }
 
+/// The lights of scene `json` (built in a scratch directory), for tests that need no
+/// geometry.
+fn lights_of(json: &str) -> crate::light::LightSet {
+    let dir = tempfile::tempdir().unwrap();
+    build_scene(dir.path(), json).unwrap().1
+}
+
 /// The light's irradiance estimate at `c` (200 000 samples) within 4 standard errors of
 /// `exact` (plus 10⁻⁵ of it for f32 rounding).
 fn assert_irradiance(light: &Light, c: LightSampleContext, exact: f64, seed: u64) {
@@ -222,13 +229,12 @@ fn chi2_area_mesh_success_fraction_of_a_cuboid_is_its_visible_area_share() {
 #[test]
 fn disk_light_irradiance_on_axis_is_pi_l_sin2_alpha() {
     // E = π L sin²α, sin²α = R²/(R² + h²), on a surface facing the disk on its axis.
-    let dir = tempfile::tempdir().unwrap();
     let json = scene(
         r#"{"type": "disk", "name": "lamp", "radius_m": 0.5,
             "transform": [{"rotate": {"axis": [1, 0, 0], "angle_deg": 90}}, {"translate": [0, 2, 0]}]}"#,
         r#", "two_sided": true, "scale": 3"#,
     );
-    let (_, lights) = build_scene(dir.path(), &json).unwrap();
+    let lights = lights_of(&json);
     for h in [0.3f32, 1.0, 4.0] {
         let c = facing([0.0, 2.0 - h, 0.0], [0.0, 1.0, 0.0]);
         let (r, h) = (0.5f64, f64::from(h));
@@ -241,12 +247,11 @@ fn disk_light_irradiance_on_axis_is_pi_l_sin2_alpha() {
 fn a_two_sided_rectangle_seen_from_its_own_plane_gives_finite_samples_or_none() {
     // Points on the light itself (a path vertex on a two-sided emitter) and just off its
     // plane, where the solid angle degenerates: every sample and density is finite.
-    let dir = tempfile::tempdir().unwrap();
     let json = scene(
         r#"{"type": "rectangle", "name": "lamp", "size_m": [2, 1]}"#,
         r#", "two_sided": true"#,
     );
-    let (_, lights) = build_scene(dir.path(), &json).unwrap();
+    let lights = lights_of(&json);
     let light = lights.light(0);
     let wl = SampledWavelengths::sample_uniform(0.5);
     for z in [0.0f32, 1e-7, -1e-7, 1e-4] {
@@ -279,12 +284,11 @@ fn rectangle_light_irradiance_is_the_parallel_form_factors() {
     // X = x/h, Y = y/h, summed over the four corners with signs. From close by (solid-angle
     // sampling, where a point 2 cm under the light is near its plane) and from afar (area
     // sampling).
-    let dir = tempfile::tempdir().unwrap();
     let json = scene(
         r#"{"type": "rectangle", "name": "lamp", "size_m": [2, 1]}"#,
         r#", "scale": 3"#,
     );
-    let (_, lights) = build_scene(dir.path(), &json).unwrap();
+    let lights = lights_of(&json);
     let corner = |x: f64, y: f64| {
         let (sx, sy) = ((1.0 + x * x).sqrt(), (1.0 + y * y).sqrt());
         (x / sx * (y / sx).atan() + y / sy * (x / sy).atan()) / std::f64::consts::TAU
@@ -308,12 +312,11 @@ fn rectangle_light_irradiance_is_the_parallel_form_factors() {
 fn sphere_light_irradiance_is_pi_l_r2_over_d2() {
     // A sphere of radius r at distance d from a surface facing its centre gives
     // E = π L (r/d)² (it looks like a point of intensity π r² L).
-    let dir = tempfile::tempdir().unwrap();
     let json = scene(
         r#"{"type": "sphere", "name": "lamp", "radius_m": 0.25, "transform": {"translate": [1, 1, 1]}}"#,
         r#", "scale": 2"#,
     );
-    let (_, lights) = build_scene(dir.path(), &json).unwrap();
+    let lights = lights_of(&json);
     for d in [0.3f32, 1.0, 10.0] {
         let dir_to = Vec3A::new(1.0, 2.0, -2.0).normalize();
         let p = Vec3A::ONE - dir_to * d;
@@ -328,12 +331,11 @@ fn inside_a_closed_emitting_sphere_the_irradiance_is_pi_l_even_on_its_wall() {
     // An enclosure of uniform radiance L gives E = π L at every point and orientation.
     // Reference points on the wall itself (as hits give them, rounded to either side of
     // the surface) must sample the interior, not the degenerate cone of an outside point.
-    let dir = tempfile::tempdir().unwrap();
     let json = scene(
         r#"{"type": "sphere", "name": "lamp", "radius_m": 2, "transform": {"translate": [0.5, 0, 0]}}"#,
         r#", "two_sided": true, "scale": 0.25"#,
     );
-    let (_, lights) = build_scene(dir.path(), &json).unwrap();
+    let lights = lights_of(&json);
     let c = Vec3A::new(0.5, 0.0, 0.0);
     // On the wall facing inwards, and inside (any orientation).
     for (k, (radial, n)) in [
@@ -422,11 +424,10 @@ fn one_sided_lights_are_dark_from_behind_and_two_sided_ones_are_not() {
 
 #[test]
 fn every_instance_of_the_shape_maps_to_its_light() {
-    let dir = tempfile::tempdir().unwrap();
     let json = r#"{"shapes": [{"type": "sphere"}, {"type": "cuboid", "name": "lamp"},
         {"type": "disk", "name": "d"}],
         "lights": [{"type": "point"}, {"type": "area", "shape": "d"}, {"type": "area", "shape": "lamp"}]}"#;
-    let (_, lights) = build_scene(dir.path(), json).unwrap();
+    let lights = lights_of(json);
     assert_eq!(lights.area_light_of_instance(0), None);
     assert_eq!(lights.area_light_of_instance(1), Some(2));
     assert_eq!(lights.area_light_of_instance(2), Some(1));
