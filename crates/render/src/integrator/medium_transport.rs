@@ -528,7 +528,7 @@ impl PathTracer {
                 };
                 let light = lights.light(l);
                 let le = light.emitted_radiance_cached(
-                    l,
+                    lights.emission_key(l),
                     &light_hit,
                     -ray.direction,
                     &path.wavelengths,

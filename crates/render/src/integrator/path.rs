@@ -704,7 +704,8 @@ impl PathTracer {
         le_cache: &mut SpectrumCache,
     ) -> Option<SampledSpectrum> {
         let light = scene.lights.light(l);
-        let le = light.emitted_radiance_cached(l, light_hit, -direction, wavelengths, le_cache);
+        let key = scene.lights.emission_key(l);
+        let le = light.emitted_radiance_cached(key, light_hit, -direction, wavelengths, le_cache);
         if le.is_black() {
             return None;
         }
@@ -766,7 +767,8 @@ impl PathTracer {
             return (zero, zero);
         };
         let light = lights.light(l);
-        let Some(ls) = light.sample_li_cached(l, ctx, u, wavelengths, le_cache) else {
+        let key = lights.emission_key(l);
+        let Some(ls) = light.sample_li_cached(key, ctx, u, wavelengths, le_cache) else {
             return (zero, zero);
         };
         if ls.pdf <= 0.0 || ls.radiance.is_black() {

@@ -142,9 +142,13 @@ impl ScatterVertex<'_> {
         let lights = &scene.lights;
         let ctx = self.light_context();
         let (l, pmf) = lights.sample_at(&ctx, u_choice)?;
-        let sample = lights
-            .light(l)
-            .sample_li_cached(l, &ctx, u, wavelengths, le_cache)?;
+        let sample = lights.light(l).sample_li_cached(
+            lights.emission_key(l),
+            &ctx,
+            u,
+            wavelengths,
+            le_cache,
+        )?;
         if sample.pdf <= 0.0 || sample.radiance.is_black() {
             return None;
         }

@@ -14,6 +14,7 @@ use std::ops::Range;
 
 use prism_geometry::Geometry;
 use prism_scene::SceneDescription;
+use prism_spectrum::Spectrum;
 
 use super::build::build_lights;
 use super::light_bounds::light_bounds;
@@ -45,7 +46,13 @@ pub struct LightSet {
     /// Each hit samples every light at infinity chosen apart (`samples_per_light_sample`);
     /// `false`: one choice among all lights per light sample.
     sample_each_infinite: bool,
+    /// Per light, its key in a path's light `SpectrumCache` ([`Self::emission_key`]).
+    emission_keys: Vec<u32>,
 }
+
+/// Distinct emission spectra [`LightSet`] looks for equal ones among; past this many, a
+/// light keeps its own key (scenes of many lights have few kinds of luminaire).
+const EMISSION_KINDS_MAX: usize = 64;
 
 /// How light samples at shading points choose a light (`prism render --light-selection`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -63,7 +70,7 @@ pub enum ShadingSelection {
 
 /// From this many lights with bounds on, light samples at shading points choose through
 /// the light BVH; below it from `SelectionTable::infinite_apart` (a handful of lights gains
-/// little from the tree, and the packet tracer keeps serving them).
+/// little from the tree).
 pub const LIGHT_BVH_MIN_BOUNDED: usize = 8;
 
 impl LightSet {
@@ -82,7 +89,6 @@ impl LightSet {
         Self {
             power: SelectionTable::proportional(&powers),
             infinite_apart: SelectionTable::infinite_apart(&powers, &at_infinity),
-            lights,
             instance_light,
             infinite,
             scene: SceneSphere {
@@ -92,7 +98,18 @@ impl LightSet {
             bvh: None,
             selection: ShadingSelection::InfiniteApart,
             sample_each_infinite: true,
+            emission_keys: emission_keys(&lights),
+            lights,
         }
+    }
+
+    /// Light `l`'s key in a path's light `SpectrumCache` (`Light::sample_li_cached`,
+    /// `Light::emitted_radiance_cached`): the first light whose uniform emission spectrum
+    /// equals `l`'s, so a room of identical luminaires evaluates it once per path (and
+    /// wavelength shift), not once per luminaire it samples or meets.
+    #[inline]
+    pub fn emission_key(&self, l: u32) -> u32 {
+        self.emission_keys[l as usize]
     }
 
     /// Builds the scene's lights; `geometry` must have been built from `scene`
@@ -331,6 +348,26 @@ impl LightSet {
     }
 }
 
+/// [`LightSet::emission_key`] of every light: lights with the same uniform emission
+/// spectrum (`Light::uniform_emission`) share the first one's index; others keep their own.
+fn emission_keys(lights: &[Light]) -> Vec<u32> {
+    let mut kinds: Vec<(&Spectrum, u32)> = Vec::new();
+    (0..lights.len() as u32)
+        .map(|i| {
+            let Some(spectrum) = lights[i as usize].uniform_emission() else {
+                return i;
+            };
+            if let Some(&(_, key)) = kinds.iter().find(|(s, _)| *s == spectrum) {
+                return key;
+            }
+            if kinds.len() < EMISSION_KINDS_MAX {
+                kinds.push((spectrum, i));
+            }
+            i
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -345,6 +382,51 @@ mod tests {
         assert_eq!(lights.sample(0.2).map(|s| s.0), Some(0));
         assert_eq!(lights.sample(0.3).map(|s| s.0), Some(1));
         assert!(lights.infinite_lights().is_empty());
+    }
+
+    /// Lights with equal uniform spectra share one cache key, the first one's; a different
+    /// strength or spectrum, or a light without a uniform spectrum, keeps its own. A light
+    /// sample through the cache is the uncached sample, bit for bit.
+    #[test]
+    fn equal_emission_spectra_share_a_cache_key() {
+        let dir = tempfile::tempdir().unwrap();
+        let lamp = |x: f32, lm: f32, k: f32| {
+            format!(
+                r#"{{"type": "point", "position_m": [{x}, 2, 0], "power_lm": {lm},
+                    "spectrum": {{"blackbody_k": {k}}}}}"#
+            )
+        };
+        let json = format!(
+            r#"{{"lights": [{}, {}, {}, {}, {{"type": "sky", "luminance_cd_m2": 100}}, {}]}}"#,
+            lamp(0.0, 400.0, 3000.0),
+            lamp(1.0, 400.0, 3000.0),
+            lamp(2.0, 800.0, 3000.0),
+            lamp(3.0, 400.0, 5000.0),
+            lamp(4.0, 400.0, 3000.0),
+        );
+        let (_, lights) = build_scene(dir.path(), &json).unwrap();
+        let keys: Vec<u32> = (0..6).map(|l| lights.emission_key(l)).collect();
+        assert_eq!(keys, [0, 0, 2, 3, 4, 0]);
+
+        let ctx = LightSampleContext {
+            p: glam::Vec3A::ZERO,
+            n: glam::Vec3A::Y,
+        };
+        let wavelengths = prism_spectrum::SampledWavelengths::sample_visible(0.37);
+        let mut cache = crate::spectrum_cache::SpectrumCache::new();
+        for l in [0, 1, 2, 5, 1] {
+            let light = lights.light(l);
+            let u = glam::Vec2::new(0.3, 0.6);
+            let cached = light
+                .sample_li_cached(lights.emission_key(l), &ctx, u, &wavelengths, &mut cache)
+                .unwrap();
+            let plain = light.sample_li(&ctx, u, &wavelengths).unwrap();
+            assert_eq!(
+                cached.radiance.to_array().map(f32::to_bits),
+                plain.radiance.to_array().map(f32::to_bits),
+                "light {l}"
+            );
+        }
     }
 
     #[test]

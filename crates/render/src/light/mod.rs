@@ -75,7 +75,7 @@ pub use spot::SpotLight;
 use glam::{Vec2, Vec3A};
 use prism_bandwidth::Bandwidth;
 use prism_geometry::Ray;
-use prism_spectrum::{SampledSpectrum, SampledWavelengths};
+use prism_spectrum::{SampledSpectrum, SampledWavelengths, Spectrum};
 
 pub use crate::spectrum_cache::{SpectrumCache, TransportWavelengths};
 
@@ -222,13 +222,30 @@ pub enum Light {
 }
 
 impl Light {
-    /// `sample_li` for light number `index` of the scene's `LightSet`, with its spectrum
-    /// from the path's `cache` (keyed by light index) where the radiance is uniform (area
-    /// lights).
+    /// The spectrum the light emits alike at every point and in every direction, which a
+    /// path's `SpectrumCache` can hold: an area light's radiance, a point light's
+    /// intensity; `None` for the others (maps and skies vary over directions; spots,
+    /// luminaires and distant lights evaluate their own spectra and are not cached).
+    pub fn uniform_emission(&self) -> Option<&Spectrum> {
+        match self {
+            Light::Area(l) => Some(&l.radiance),
+            Light::Point(l) => Some(&l.intensity),
+            Light::Spot(_)
+            | Light::Directional(_)
+            | Light::Environment(_)
+            | Light::Sky(_)
+            | Light::Daylight(_)
+            | Light::Goniometric(_) => None,
+        }
+    }
+
+    /// `sample_li` with the light's uniform emission (`uniform_emission`) from the path's
+    /// `cache` under `cache_key` (`LightSet::emission_key`: lights with equal spectra share
+    /// one).
     #[inline]
     pub fn sample_li_cached(
         &self,
-        index: u32,
+        cache_key: u32,
         ctx: &LightSampleContext,
         u: Vec2,
         wavelengths: &impl TransportWavelengths,
@@ -236,10 +253,12 @@ impl Light {
     ) -> Option<LightSample> {
         match self {
             Light::Area(l) => {
-                l.sample_li_with(ctx, u, || cache.get(index, &l.radiance, wavelengths))
+                l.sample_li_with(ctx, u, || cache.get(cache_key, &l.radiance, wavelengths))
             }
-            Light::Point(_)
-            | Light::Spot(_)
+            Light::Point(l) => point::point_emitter_sample(ctx, l.position_m, |_| {
+                Some(cache.get(cache_key, &l.intensity, wavelengths))
+            }),
+            Light::Spot(_)
             | Light::Directional(_)
             | Light::Environment(_)
             | Light::Sky(_)
@@ -248,12 +267,12 @@ impl Light {
         }
     }
 
-    /// `emitted_radiance` for light number `index`, with its spectrum from `cache` (see
-    /// `sample_li_cached`).
+    /// `emitted_radiance` with the light's uniform emission from `cache` under `cache_key`
+    /// (see `sample_li_cached`).
     #[inline]
     pub fn emitted_radiance_cached(
         &self,
-        index: u32,
+        cache_key: u32,
         hit: &LightHit,
         wo: Vec3A,
         wavelengths: &impl TransportWavelengths,
@@ -261,7 +280,7 @@ impl Light {
     ) -> SampledSpectrum {
         match self {
             Light::Area(l) => {
-                l.emitted_radiance_with(hit, wo, || cache.get(index, &l.radiance, wavelengths))
+                l.emitted_radiance_with(hit, wo, || cache.get(cache_key, &l.radiance, wavelengths))
             }
             Light::Point(_)
             | Light::Spot(_)

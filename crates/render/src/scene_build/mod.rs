@@ -306,7 +306,7 @@ impl RenderScene {
 
     /// How light samples at shading points choose a light; `false` (nothing changed) for
     /// the light BVH where the scene has no light with bounds. The packet form is decided
-    /// again (its allow-list excludes the light BVH).
+    /// again (whether its tiles take one light sample per hit depends on the choice).
     pub fn set_light_selection(&mut self, selection: crate::light::ShadingSelection) -> bool {
         let done = self.lights.set_shading_selection(selection);
         self.set_packet_tracing(self.packet_tracing);

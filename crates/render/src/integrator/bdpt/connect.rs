@@ -157,7 +157,7 @@ pub fn connect(
         let (index, pmf) = lights.sample(variates.u_light_choice)?;
         let light_source = lights.light(index);
         let ls: LightSample = light_source.sample_li_cached(
-            index,
+            lights.emission_key(index),
             &pt.light_context(),
             variates.u_light,
             wavelengths,

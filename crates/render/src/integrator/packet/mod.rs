@@ -62,8 +62,8 @@ struct LeafShading {
 /// once (`Spectrum::eval_many`); later ones through the per-path cache.
 pub(crate) const REFLECTANCE_SLOTS: usize = 4;
 
-/// Rectangle emitters whose L(λ) every camera sample evaluates up front, as the
-/// reflectances; later ones through the per-path cache.
+/// Distinct rectangle-emitter radiances whose L(λ) every camera sample evaluates up front,
+/// as the reflectances; emitters with another, later radiance through the per-path cache.
 pub(crate) const LIGHT_SLOTS: usize = 4;
 
 /// A rectangle emitter as the lanes sample it (`light::area::RectangleEmitter`).
@@ -77,7 +77,8 @@ struct RectangleLight {
     inv_area_m2: f32,
     two_sided: bool,
     radiance: Spectrum,
-    /// Its slot in `PacketScene::light_radiances`, or `None` past the first `LIGHT_SLOTS`.
+    /// Its radiance's slot in `PacketScene::light_radiances` (emitters with equal radiances
+    /// share one), or `None` past the first `LIGHT_SLOTS` distinct radiances.
     radiance_slot: Option<usize>,
     /// Where the emitter samples in solid angle (`RectangleEmitter::solid_angle_sampling`):
     /// lanes whose vertex lies there take the scalar `Light` code's sample.
@@ -96,7 +97,7 @@ pub struct PacketScene {
     /// Per light of the scene's `LightSet`: its rectangle form, or `None` for lights the
     /// scalar `Light` code samples.
     lights: Vec<Option<RectangleLight>>,
-    /// The radiances of the first `LIGHT_SLOTS` rectangle emitters.
+    /// The first `LIGHT_SLOTS` distinct radiances of the rectangle emitters.
     light_radiances: Vec<Spectrum>,
     /// The kernels that run (`trace::render_tile`): 16 lanes with AVX-512, 8 with AVX2 and
     /// FMA, 8 baseline (SSE2) for scalar; `prism_cpu::active()` when the scene was built
@@ -137,13 +138,6 @@ impl PacketScene {
         let outside = scene.features.outside(Self::SUPPORTS);
         if !outside.is_empty() {
             return Err(outside.names());
-        }
-        if let Some(bvh) = scene.lights.light_bvh() {
-            return Err(format!(
-                "light samples choose among {} lights through the light BVH; the packet \
-                 tracer chooses by power",
-                bvh.bounded_count()
-            ));
         }
         // Lanes test every patch of the scene: only a small scene has few enough.
         if let Some(why) = small_scene_not_used(&scene.geometry, scene.features) {
@@ -201,10 +195,17 @@ impl PacketScene {
                     two_sided,
                 }) if r.area_m2() > 0.0 => {
                     let m = r.to_world.matrix();
-                    let radiance_slot = (light_radiances.len() < LIGHT_SLOTS).then(|| {
-                        light_radiances.push(radiance.clone());
-                        light_radiances.len() - 1
-                    });
+                    // Lamps of one kind share a slot (an office of identical luminaires).
+                    let radiance_slot =
+                        light_radiances
+                            .iter()
+                            .position(|s| s == radiance)
+                            .or_else(|| {
+                                (light_radiances.len() < LIGHT_SLOTS).then(|| {
+                                    light_radiances.push(radiance.clone());
+                                    light_radiances.len() - 1
+                                })
+                            });
                     Some(RectangleLight {
                         axes: [m.x_axis, m.y_axis, m.z_axis, m.w_axis].map(Vec3A::from_vec4),
                         half_width_m: r.rectangle.half_width_m,

@@ -146,6 +146,45 @@ fn packet_tracer_agrees_past_its_slots_and_with_a_sky() {
     agrees_with_the_scalar_tracer(scene, &settings(8));
 }
 
+/// Eight or more lights with bounds: each lane descends the light BVH at its own hit
+/// point (`LightSet::sample_at`), and BSDF-sampled hits on the lamps weigh by the BVH's
+/// pmf at the previous vertex, as in the scalar tracer.
+#[test]
+fn packet_tracer_agrees_when_lights_are_chosen_through_the_light_bvh() {
+    let mut materials = String::new();
+    let mut lamps = String::new();
+    let mut lights = String::new();
+    for k in 0..12 {
+        let (x, z) = (-0.75 + 0.3 * (k % 6) as f32, 0.3 + 0.4 * (k / 6) as f32);
+        materials.push_str(&format!(
+            r#""lamp-{k}": {{"type": "lambert", "reflectance": 0.2}},"#
+        ));
+        lamps.push_str(&format!(
+            r#"{{"type": "rectangle", "name": "lamp-{k}", "size_m": [0.1, 0.1],
+                 "transform": [{{"rotate": {{"axis": [1, 0, 0], "angle_deg": 90}}}},
+                               {{"translate": [{x}, 0.97, {z}]}}],
+                 "material": "lamp-{k}"}},"#
+        ));
+        lights.push_str(&format!(
+            r#"{{"type": "area", "shape": "lamp-{k}", "luminance_cd_m2": {}, "two_sided": false,
+                 "spectrum": {{"blackbody_k": {}}}}},"#,
+            500_000 + 200_000 * k,
+            2700 + 200 * k
+        ));
+    }
+    let scene = cornell_edited(
+        40,
+        &[
+            ("\"materials\": {", &format!("\"materials\": {{{materials}")),
+            ("\"shapes\": [", &format!("\"shapes\": [{lamps}")),
+            ("\"lights\": [", &format!("\"lights\": [{lights}")),
+        ],
+    );
+    assert_eq!(scene.lights.len(), 13);
+    assert!(scene.lights.light_bvh().is_some(), "the light BVH chooses");
+    agrees_with_the_scalar_tracer(scene, &settings(8));
+}
+
 fn agrees_with_the_scalar_tracer(scene: RenderScene, settings: &RenderSettings) {
     let ((packet, ps), (scalar, ss)) = render_both(scene, settings);
     assert_eq!(ps.samples, ss.samples);

@@ -893,7 +893,7 @@ fn put_rectangle<const N: usize>(vertex: &mut VertexIn<N>, l: usize, rect: &Rect
 /// Lights with at most this many entries are picked for all lanes in one vector pass.
 const VECTOR_LIGHT_CHOICE_MAX: usize = 16;
 
-/// Each vertex's light choice (`LightSet::sample_at` without the BVH), the chosen
+/// Each vertex's light choice (`LightSet::sample_at`), the chosen
 /// rectangle's fields and L(λ), or a light sample by the scalar `Light` code for other
 /// lights (after `draw_variates`). `rectangle_in_lane[l]` names the light whose fields lane `l` of
 /// `vertex` already holds.
@@ -918,6 +918,25 @@ fn choose_lights<const N: usize>(
     }
     let lights = &job.scene.lights;
     if lights.is_empty() {
+        return;
+    }
+    // Many lights: each lane descends the light BVH at its own hit point
+    // (`LightSet::sample_at`), as the scalar tracer does.
+    if lights.light_bvh().is_some() {
+        for l in 0..N {
+            let (true, Some(sample)) = (vertex.active[l], &mut samples[l]) else {
+                continue;
+            };
+            let ctx = LightSampleContext {
+                p: hit_point(vertex, l),
+                n: vec_at(&paths.n_geometric, l),
+            };
+            let Some((li, p)) = lights.sample_at(&ctx, u[0][l]) else {
+                continue;
+            };
+            vertex.pmf[l] = p;
+            take_light(job, paths, vertex, sample, l, li, u, rectangle_in_lane);
+        }
         return;
     }
     let table = lights.shading_table();
@@ -996,27 +1015,48 @@ fn choose_lights<const N: usize>(
             continue;
         }
         vertex.pmf[l] = p;
-        match &job.packet.lights[li as usize] {
-            Some(rect)
-                if rect
-                    .solid_angle
-                    .is_none_or(|s| !s.in_range(hit_point(vertex, l))) =>
-            {
-                if rectangle_in_lane[l] != li {
-                    rectangle_in_lane[l] = li;
-                    put_rectangle(vertex, l, rect);
-                }
-                let le = match rect.radiance_slot {
-                    Some(s) => spectrum_at(&paths.light_le[s], l),
-                    None => sample.le_cache.get(li, &rect.radiance, &sample.wavelengths),
-                };
-                set_spectrum(&mut vertex.le, l, le);
-                vertex.light_kind[l] = LIGHT_RECTANGLE;
+        take_light(job, paths, vertex, sample, l, li, u, rectangle_in_lane);
+    }
+}
+
+/// Lane `l`'s light sample of the chosen light `li`: a rectangle emitter's fields and L(λ)
+/// for the lanes' area sampling, or the scalar `Light` code's sample for other lights.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn take_light<const N: usize>(
+    job: &TileJob,
+    paths: &Paths<N>,
+    vertex: &mut VertexIn<N>,
+    sample: &mut LaneSample,
+    l: usize,
+    li: u32,
+    u: &[[f32; N]; 6],
+    rectangle_in_lane: &mut [u32; N],
+) {
+    match &job.packet.lights[li as usize] {
+        Some(rect)
+            if rect
+                .solid_angle
+                .is_none_or(|s| !s.in_range(hit_point(vertex, l))) =>
+        {
+            if rectangle_in_lane[l] != li {
+                rectangle_in_lane[l] = li;
+                put_rectangle(vertex, l, rect);
             }
-            // Other lights, and a rectangle near enough to sample in solid angle from here
-            // (the scalar code also falls back to area sampling where it must).
-            Some(_) | None => sample_light_scalar(job, paths, vertex, sample, l, li, u),
+            let le = match rect.radiance_slot {
+                Some(s) => spectrum_at(&paths.light_le[s], l),
+                None => sample.le_cache.get(
+                    job.scene.lights.emission_key(li),
+                    &rect.radiance,
+                    &sample.wavelengths,
+                ),
+            };
+            set_spectrum(&mut vertex.le, l, le);
+            vertex.light_kind[l] = LIGHT_RECTANGLE;
         }
+        // Other lights, and a rectangle near enough to sample in solid angle from here
+        // (the scalar code also falls back to area sampling where it must).
+        Some(_) | None => sample_light_scalar(job, paths, vertex, sample, l, li, u),
     }
 }
 
@@ -1054,8 +1094,9 @@ fn sample_light_scalar<const N: usize>(
         n: vec_at(&paths.n_geometric, l),
     };
     let ul = Vec2::new(u[1][l], u[2][l]);
-    if let Some(ls) = job.scene.lights.light(li).sample_li_cached(
-        li,
+    let lights = &job.scene.lights;
+    if let Some(ls) = lights.light(li).sample_li_cached(
+        lights.emission_key(li),
         &ctx,
         ul,
         &sample.wavelengths,
