@@ -920,18 +920,19 @@ fn choose_lights<const N: usize>(
     if lights.is_empty() {
         return;
     }
-    // Many lights: each lane descends the light BVH at its own hit point
-    // (`LightSet::sample_at`), as the scalar tracer does.
+    // Many lights: each lane descends the light BVH at its own hit point, as the scalar
+    // tracer does (`LightSet::sample_at`), the lanes' descents side by side.
     if lights.light_bvh().is_some() {
-        for l in 0..N {
-            let (true, Some(sample)) = (vertex.active[l], &mut samples[l]) else {
-                continue;
-            };
-            let ctx = LightSampleContext {
-                p: hit_point(vertex, l),
-                n: vec_at(&paths.n_geometric, l),
-            };
-            let Some((li, p)) = lights.sample_at(&ctx, u[0][l]) else {
+        let contexts: [LightSampleContext; N] = std::array::from_fn(|l| LightSampleContext {
+            p: hit_point(vertex, l),
+            n: vec_at(&paths.n_geometric, l),
+        });
+        let active: [bool; N] = std::array::from_fn(|l| vertex.active[l] && samples[l].is_some());
+        let picks = lights
+            .sample_at_lanes(&contexts, &u[0], &active)
+            .expect("the light BVH chooses");
+        for (l, pick) in picks.into_iter().enumerate() {
+            let (Some((li, p)), Some(sample)) = (pick, &mut samples[l]) else {
                 continue;
             };
             vertex.pmf[l] = p;
