@@ -493,13 +493,8 @@ mod tests {
     #[test]
     fn lanes_pick_what_each_point_picks_alone() {
         let bvh = grid(10);
-        let mut rng = 0x9e37_79b9_7f4a_7c15u64;
-        let mut next = || {
-            rng = rng
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (rng >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut rng = prism_testkit::chi2::SplitMix64(3);
+        let mut next = || rng.next_f32();
         for _ in 0..500 {
             let p: [Vec3A; 4] = std::array::from_fn(|_| {
                 Vec3A::new(12.0 * next() - 1.0, 4.0 * next(), 12.0 * next() - 1.0)

@@ -97,41 +97,74 @@ fn packet_tracer_agrees_with_a_point_light_beside_the_rectangle() {
     agrees_with_the_scalar_tracer(scene, &settings(8));
 }
 
+/// A ceiling lamp added to the Cornell box ([`cornell_with_lamps`]): its material's
+/// reflectance (JSON), square side, position under the ceiling and emission.
+struct Lamp {
+    reflectance: String,
+    side_m: f32,
+    x_m: f32,
+    z_m: f32,
+    luminance_cd_m2: u32,
+    blackbody_k: u32,
+}
+
+/// The Cornell box with one-sided rectangle `lamps` under its ceiling (a material each) and
+/// `extra_lights` (JSON objects, each followed by a comma) before its own light.
+fn cornell_with_lamps(lamps: &[Lamp], extra_lights: &str) -> RenderScene {
+    let mut materials = String::new();
+    let mut shapes = String::new();
+    let mut lights = String::new();
+    for (k, lamp) in lamps.iter().enumerate() {
+        let Lamp {
+            reflectance,
+            side_m,
+            x_m,
+            z_m,
+            luminance_cd_m2,
+            blackbody_k,
+        } = lamp;
+        materials.push_str(&format!(
+            r#""lamp-{k}": {{"type": "lambert", "reflectance": {reflectance}}},"#
+        ));
+        shapes.push_str(&format!(
+            r#"{{"type": "rectangle", "name": "lamp-{k}", "size_m": [{side_m}, {side_m}],
+                 "transform": [{{"rotate": {{"axis": [1, 0, 0], "angle_deg": 90}}}},
+                               {{"translate": [{x_m}, 0.97, {z_m}]}}],
+                 "material": "lamp-{k}"}},"#
+        ));
+        lights.push_str(&format!(
+            r#"{{"type": "area", "shape": "lamp-{k}", "luminance_cd_m2": {luminance_cd_m2},
+                 "two_sided": false, "spectrum": {{"blackbody_k": {blackbody_k}}}}},"#
+        ));
+    }
+    lights.push_str(extra_lights);
+    cornell_edited(
+        40,
+        &[
+            ("\"materials\": {", &format!("\"materials\": {{{materials}")),
+            ("\"shapes\": [", &format!("\"shapes\": [{shapes}")),
+            ("\"lights\": [", &format!("\"lights\": [{lights}")),
+        ],
+    )
+}
+
 /// More materials than reflectance slots and more rectangle emitters than light slots
 /// (those through the per-path caches), and a uniform sky that escaping rays see and the
 /// light sampler picks (the scalar `Light` code) — the passes that run lane by lane.
 #[test]
 fn packet_tracer_agrees_past_its_slots_and_with_a_sky() {
-    let mut materials = String::new();
-    let mut lamps = String::new();
-    let mut lights = String::new();
-    for k in 0..6 {
-        let x = -0.75 + 0.3 * k as f32;
-        materials.push_str(&format!(
-            r#""lamp-{k}": {{"type": "lambert", "reflectance": {{"rgb": [0.{k}5, 0.5, 0.3]}}}},"#
-        ));
-        lamps.push_str(&format!(
-            r#"{{"type": "rectangle", "name": "lamp-{k}", "size_m": [0.12, 0.12],
-                 "transform": [{{"rotate": {{"axis": [1, 0, 0], "angle_deg": 90}}}},
-                               {{"translate": [{x}, 0.97, 0.5]}}],
-                 "material": "lamp-{k}"}},"#
-        ));
-        lights.push_str(&format!(
-            r#"{{"type": "area", "shape": "lamp-{k}", "luminance_cd_m2": {}, "two_sided": false,
-                 "spectrum": {{"blackbody_k": {}}}}},"#,
-            1_000_000 + 400_000 * k,
-            2700 + 300 * k
-        ));
-    }
-    lights.push_str(r#"{"type": "sky", "luminance_cd_m2": 300, "spectrum": "D65"},"#);
-    let scene = cornell_edited(
-        40,
-        &[
-            ("\"materials\": {", &format!("\"materials\": {{{materials}")),
-            ("\"shapes\": [", &format!("\"shapes\": [{lamps}")),
-            ("\"lights\": [", &format!("\"lights\": [{lights}")),
-        ],
-    );
+    let lamps: Vec<Lamp> = (0..6)
+        .map(|k| Lamp {
+            reflectance: format!(r#"{{"rgb": [0.{k}5, 0.5, 0.3]}}"#),
+            side_m: 0.12,
+            x_m: -0.75 + 0.3 * k as f32,
+            z_m: 0.5,
+            luminance_cd_m2: 1_000_000 + 400_000 * k,
+            blackbody_k: 2700 + 300 * k,
+        })
+        .collect();
+    let sky = r#"{"type": "sky", "luminance_cd_m2": 300, "spectrum": "D65"},"#;
+    let scene = cornell_with_lamps(&lamps, sky);
     assert_eq!(scene.lights.len(), 8);
     let packet = scene.packet.as_ref().expect("the scene qualifies");
     assert_eq!(packet.reflectances.len(), REFLECTANCE_SLOTS);
@@ -147,41 +180,41 @@ fn packet_tracer_agrees_past_its_slots_and_with_a_sky() {
 }
 
 /// Eight or more lights with bounds: each lane descends the light BVH at its own hit
-/// point (`LightSet::sample_at`), and BSDF-sampled hits on the lamps weigh by the BVH's
-/// pmf at the previous vertex, as in the scalar tracer.
+/// point, and BSDF-sampled hits on the lamps weigh by the BVH's pmf at the previous
+/// vertex, as in the scalar tracer. Lamps of one kind share a radiance slot.
 #[test]
 fn packet_tracer_agrees_when_lights_are_chosen_through_the_light_bvh() {
-    let mut materials = String::new();
-    let mut lamps = String::new();
-    let mut lights = String::new();
-    for k in 0..12 {
-        let (x, z) = (-0.75 + 0.3 * (k % 6) as f32, 0.3 + 0.4 * (k / 6) as f32);
-        materials.push_str(&format!(
-            r#""lamp-{k}": {{"type": "lambert", "reflectance": 0.2}},"#
-        ));
-        lamps.push_str(&format!(
-            r#"{{"type": "rectangle", "name": "lamp-{k}", "size_m": [0.1, 0.1],
-                 "transform": [{{"rotate": {{"axis": [1, 0, 0], "angle_deg": 90}}}},
-                               {{"translate": [{x}, 0.97, {z}]}}],
-                 "material": "lamp-{k}"}},"#
-        ));
-        lights.push_str(&format!(
-            r#"{{"type": "area", "shape": "lamp-{k}", "luminance_cd_m2": {}, "two_sided": false,
-                 "spectrum": {{"blackbody_k": {}}}}},"#,
-            500_000 + 200_000 * k,
-            2700 + 200 * k
-        ));
-    }
-    let scene = cornell_edited(
-        40,
-        &[
-            ("\"materials\": {", &format!("\"materials\": {{{materials}")),
-            ("\"shapes\": [", &format!("\"shapes\": [{lamps}")),
-            ("\"lights\": [", &format!("\"lights\": [{lights}")),
-        ],
-    );
+    let lamps: Vec<Lamp> = (0..12)
+        .map(|k| Lamp {
+            reflectance: "0.2".into(),
+            side_m: 0.1,
+            x_m: -0.75 + 0.3 * (k % 6) as f32,
+            z_m: 0.3 + 0.4 * (k / 6) as f32,
+            // Two kinds of lamp, and four of their own.
+            luminance_cd_m2: if k < 8 {
+                500_000 + 200_000 * (k % 2)
+            } else {
+                300_000 * k
+            },
+            blackbody_k: if k < 8 {
+                2700 + 1000 * (k % 2)
+            } else {
+                2000 + 200 * k
+            },
+        })
+        .collect();
+    let scene = cornell_with_lamps(&lamps, "");
     assert_eq!(scene.lights.len(), 13);
     assert!(scene.lights.light_bvh().is_some(), "the light BVH chooses");
+    let packet = scene.packet.as_ref().expect("the scene qualifies");
+    // The two kinds and the first two lamps of their own; the box's light has its own.
+    assert_eq!(packet.light_radiances.len(), LIGHT_SLOTS);
+    let slots: Vec<Option<usize>> = packet.lights[..12]
+        .iter()
+        .map(|r| r.as_ref().unwrap().radiance_slot)
+        .collect();
+    assert_eq!(&slots[..8], &[Some(0), Some(1)].repeat(4)[..]);
+    assert_eq!(&slots[8..], &[Some(2), Some(3), None, None]);
     agrees_with_the_scalar_tracer(scene, &settings(8));
 }
 
