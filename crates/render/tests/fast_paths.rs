@@ -34,8 +34,8 @@ const DECISIONS: &[(&str, bool, bool, &[SceneFeature])] = {
         ("glossy-env.json", false, true, &[Dispersion, NonLambertianBsdfs, Quadrics, InfiniteLights]),
         ("import/room.json", false, true, &[NonLambertianBsdfs, Quadrics, InfiniteLights]),
         // 120 luminaires: light samples choose through the light BVH, which the packet
-        // tracer (choosing by power) does not serve.
-        ("many-lights/open-office.json", false, true, &[DeltaLights]),
+        // tracer serves (each lane descends it at its own hit point).
+        ("many-lights/open-office.json", true, true, &[DeltaLights]),
         ("material-gallery.json", false, true, &[ThinGlazing, NonLambertianBsdfs, Quadrics, InfiniteLights]),
         ("merl/sources.json", false, true, &[NonLambertianBsdfs, Quadrics]),
         ("minimal.json", false, false, &[DiagnosticIntegrator, Quadrics]),
