@@ -6,7 +6,7 @@
 //! scene's depth, and under-prediction (V̂/median V̂ < ½·V/median V) in ≤ 10 % of the
 //! direct-only pixels that see a surface. Minutes of rendering: `--ignored`
 //!
-//!     cargo test --release -p prism-render --test predictor_variance -- --ignored --nocapture
+//!     cargo test -p prism-render --test predictor_variance -- --ignored --nocapture
 
 use std::path::Path;
 
