@@ -174,12 +174,18 @@ pub struct SampledWavelengths {
 /// The hero's variate rotated by i/4 (mod 1) for lane i: stratified over [0, 1).
 #[inline]
 fn rotated_variates(u: f32) -> [f32; N_SPECTRUM_SAMPLES] {
-    let mut out = [0.0; N_SPECTRUM_SAMPLES];
-    for (i, up) in out.iter_mut().enumerate() {
-        let v = u + i as f32 / N_SPECTRUM_SAMPLES as f32;
-        *up = if v >= 1.0 { v - 1.0 } else { v };
+    std::array::from_fn(|lane| rotated_variate(u, lane))
+}
+
+/// Lane `lane` of [`rotated_variates`].
+#[inline(always)]
+fn rotated_variate(u: f32, lane: usize) -> f32 {
+    let v = u + lane as f32 / N_SPECTRUM_SAMPLES as f32;
+    if v >= 1.0 {
+        v - 1.0
+    } else {
+        v
     }
-    out
 }
 
 impl SampledWavelengths {
@@ -246,9 +252,7 @@ impl SampledWavelengths {
         let mut variates = [[0.0f32; N]; N_SPECTRUM_SAMPLES];
         for (i, row) in variates.iter_mut().enumerate() {
             for (v, &u) in row.iter_mut().zip(u) {
-                // `rotated_variates`, lane i of every sample.
-                let x = u + i as f32 / N_SPECTRUM_SAMPLES as f32;
-                *v = if x >= 1.0 { x - 1.0 } else { x };
+                *v = rotated_variate(u, i);
             }
         }
         let mut lambda_nm = [[0.0f32; N]; N_SPECTRUM_SAMPLES];

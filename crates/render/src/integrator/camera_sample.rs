@@ -7,6 +7,7 @@ use prism_spectrum::{SampledSpectrum, SampledWavelengths, WavelengthDensity};
 use super::dimensions::LENS_DIMENSIONS;
 use super::estimator::TileWork;
 use super::path::FirstHit;
+use super::LaneWavelengths;
 use super::RenderStats;
 use crate::film::{FilmTile, SurfaceAov};
 use crate::sampler::SampleStream;
@@ -24,8 +25,9 @@ pub struct CameraSample {
     pub lens: Vec2,
     /// The stream, after the film and lens dimensions.
     pub stream: SampleStream,
-    /// The density its wavelengths are drawn from (`FilmTile::wavelength_density`).
-    pub wavelength_density: WavelengthDensity,
+    /// The density its wavelengths are drawn from (`FilmTile::wavelength_density`); read
+    /// through [`Self::draw_wavelengths`].
+    wavelength_density: WavelengthDensity,
 }
 
 impl CameraSample {
@@ -53,6 +55,14 @@ impl CameraSample {
 }
 
 impl CameraSample {
+    /// The sample's wavelengths: the hero from the stream's next dimension (the wavelength
+    /// dimension, right after the lens), drawn from the film's density, and its three
+    /// rotations.
+    #[inline(always)]
+    pub fn draw_wavelengths(&mut self) -> LaneWavelengths {
+        LaneWavelengths::new(self.wavelength_density.sample(self.stream.get_1d()))
+    }
+
     /// Adds this sample of `pixel` to `tile`: its `estimate` (radiance at `sensor`, and
     /// the first hit for the AOVs; `None` when the film point had no camera ray, a zero),
     /// counted in `stats` (a traced ray, a non-finite estimate, a sample).

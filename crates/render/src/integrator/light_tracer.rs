@@ -230,8 +230,7 @@ impl Estimator for LightTracer {
         for pixel in tile.bounds().pixels() {
             for s in work.samples_of(pixel) {
                 let mut cs = CameraSample::start(tile, work, pixel, s);
-                let wavelengths =
-                    LaneWavelengths::new(cs.wavelength_density.sample(cs.stream.get_1d()));
+                let wavelengths = cs.draw_wavelengths();
                 // Camera side: the infinite lights seen directly, and the AOVs.
                 let mut radiance = SampledSpectrum::splat(0.0);
                 let mut aov = None;

@@ -129,8 +129,7 @@ pub(super) fn scalar_tile(
     for pixel in tile.bounds().pixels() {
         for s in work.samples_of(pixel) {
             let mut cs = CameraSample::start(tile, work, pixel, s);
-            let mut wavelengths =
-                LaneWavelengths::new(cs.wavelength_density.sample(cs.stream.get_1d()));
+            let mut wavelengths = cs.draw_wavelengths();
             let result = radiance(&mut cs, pixel, &mut wavelengths);
             let sensor = wavelengths.sensor();
             let xyz_weights = XyzWeights::new(sensor);

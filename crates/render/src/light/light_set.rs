@@ -289,19 +289,6 @@ impl LightSet {
         }
     }
 
-    /// `sample_at` for `K` points of the light BVH's choice at once (`LightBvh::sample_lanes`,
-    /// the same picks); `None` where the lights are not chosen through the BVH.
-    #[inline]
-    pub fn sample_at_lanes<const K: usize>(
-        &self,
-        ctx: &[LightSampleContext; K],
-        u: &[f32; K],
-        active: &[bool; K],
-    ) -> Option<[Option<(u32, f32)>; K]> {
-        let bvh = self.light_bvh()?;
-        Some(bvh.sample_lanes(&ctx.map(|c| c.p), &ctx.map(|c| c.n), u, active))
-    }
-
     /// Probability that `sample_at(ctx, ·)` picks light `index`.
     #[inline]
     pub fn pmf_at(&self, ctx: &LightSampleContext, index: u32) -> f32 {

@@ -33,7 +33,6 @@ use super::dimensions::{
 };
 use super::driver::RenderStats;
 use super::estimator::{Estimator, Pass, TileWork};
-use super::lane_wavelengths::LaneWavelengths;
 use super::path_state::PathState;
 use super::{PathCounters, PathTracer};
 use crate::film::{FilmTile, LightSplats, SurfaceAov};
@@ -131,7 +130,7 @@ impl Bdpt {
         bool,
     ) {
         let zero = SampledSpectrum::splat(0.0);
-        let wavelengths = LaneWavelengths::new(cs.wavelength_density.sample(cs.stream.get_1d()));
+        let wavelengths = cs.draw_wavelengths();
         debug_assert_eq!(cs.stream.dimension(), CAMERA_SAMPLE_DIMENSIONS);
         let camera_ray = scene.camera.generate_ray_only(cs.film_point, cs.lens);
         let mut camera_state = PathState::new(Vec3A::ZERO, None, cs.stream, wavelengths);

@@ -920,17 +920,14 @@ fn choose_lights<const N: usize>(
     if lights.is_empty() {
         return;
     }
-    // Many lights: each lane descends the light BVH at its own hit point, as the scalar
-    // tracer does (`LightSet::sample_at`), the lanes' descents side by side.
-    if lights.light_bvh().is_some() {
-        let contexts: [LightSampleContext; N] = std::array::from_fn(|l| LightSampleContext {
-            p: hit_point(vertex, l),
-            n: vec_at(&paths.n_geometric, l),
-        });
+    // Many lights: each lane descends the light BVH at its own hit point and geometric
+    // normal, as the scalar tracer's `LightSet::sample_at` does, the lanes' descents side
+    // by side (`LightBvh::sample_lanes`: the same picks).
+    if let Some(bvh) = lights.light_bvh() {
+        let points: [Vec3A; N] = std::array::from_fn(|l| hit_point(vertex, l));
+        let normals: [Vec3A; N] = std::array::from_fn(|l| vec_at(&paths.n_geometric, l));
         let active: [bool; N] = std::array::from_fn(|l| vertex.active[l] && samples[l].is_some());
-        let picks = lights
-            .sample_at_lanes(&contexts, &u[0], &active)
-            .expect("the light BVH chooses");
+        let picks = bvh.sample_lanes(&points, &normals, &u[0], &active);
         for (l, pick) in picks.into_iter().enumerate() {
             let (Some((li, p)), Some(sample)) = (pick, &mut samples[l]) else {
                 continue;
