@@ -54,11 +54,15 @@ fn predicted_and_adaptive_plans_write_their_layers_and_keep_the_budget() {
             assert_eq!(channels, ["level", "spp", "variance"]);
         }
     }
-    // A uniform render writes none of them.
+    // A uniform render writes none of them, and its statistics time no predictor.
     let out = dir.path().join("uniform.exr");
-    assert!(render(&[], &out).status.success());
+    let stats = dir.path().join("uniform.json");
+    assert!(render(&["--stats-json", s(&stats)], &out).status.success());
     let image = read_exr(&out).unwrap();
     assert!(image.layer("plan").is_none() && image.layer("bandwidth").is_none());
+    let stats: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&stats).unwrap()).unwrap();
+    assert!(stats.get("predictor").is_none(), "{stats}");
 }
 
 /// The BSDF angular tables (glossy-env's brushed copper) are written to --cache-dir once
@@ -80,7 +84,18 @@ fn predicted_plans_keep_their_bsdf_tables_in_the_cache_dir() {
         files
     };
     let first = dir.path().join("first.exr");
-    let o = render(&["--plan", "predicted", "--cache-dir", s(&cache)], &first);
+    let first_stats = dir.path().join("first.json");
+    let o = render(
+        &[
+            "--plan",
+            "predicted",
+            "--cache-dir",
+            s(&cache),
+            "--stats-json",
+            s(&first_stats),
+        ],
+        &first,
+    );
     assert!(o.status.success(), "{}", stderr(&o));
     let written = tables(&cache);
     assert!(
@@ -93,8 +108,46 @@ fn predicted_plans_keep_their_bsdf_tables_in_the_cache_dir() {
         .map(|f| std::fs::metadata(f).unwrap().modified().unwrap())
         .collect();
     let second = dir.path().join("second.exr");
-    let o = render(&["--plan", "predicted", "--cache-dir", s(&cache)], &second);
+    let second_stats = dir.path().join("second.json");
+    let o = render(
+        &[
+            "--plan",
+            "predicted",
+            "--cache-dir",
+            s(&cache),
+            "--stats-json",
+            s(&second_stats),
+        ],
+        &second,
+    );
     assert!(o.status.success(), "{}", stderr(&o));
+    // The statistics time the predictor, tables apart: building the brushed copper's 256
+    // slices costs far more than reading them back.
+    let predictor = |path: &std::path::Path| -> serde_json::Value {
+        let stats: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+        stats["predictor"].clone()
+    };
+    let (built, read) = (predictor(&first_stats), predictor(&second_stats));
+    for p in [&built, &read] {
+        for key in [
+            "tables_cpu_s",
+            "predict_cpu_s",
+            "tables_wall_s",
+            "predict_wall_s",
+        ] {
+            let v = p[key].as_f64().unwrap_or_else(|| panic!("{key} in {p}"));
+            assert!(v.is_finite() && v >= 0.0, "{key} = {v}");
+        }
+    }
+    let (built_s, read_s) = (
+        built["tables_cpu_s"].as_f64().unwrap(),
+        read["tables_cpu_s"].as_f64().unwrap(),
+    );
+    assert!(
+        built_s > 2.0 * read_s,
+        "tables built in {built_s} s, read back in {read_s} s"
+    );
     assert_eq!(
         tables(&cache),
         written,

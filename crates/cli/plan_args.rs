@@ -82,7 +82,7 @@ pub struct PlanArgs {
     #[arg(long = "plan-pool-px", value_name = "R|auto", value_parser = parse_pool_radius)]
     pub plan_pool_px: Option<PoolRadius>,
     /// `--plan predicted`: one-bounce indirect estimates per pixel, which add the indirect
-    /// light's mean and variance to the prediction (default 16; 0: direct light only, as the
+    /// light's mean and variance to the prediction (default 4; 0: direct light only, as the
     /// paper).
     #[arg(long = "plan-indirect", value_name = "N", value_parser = prism_args::numbers::parse_u32)]
     pub plan_indirect: Option<u32>,

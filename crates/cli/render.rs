@@ -552,6 +552,7 @@ pub fn run(args: &RenderArgs, budget: &MemoryBudget) -> Result<ExitCode, String>
         ));
     }
     crate::partial::signals::install(&temp_files)?;
+    let mut predictor_time = None;
     let (plan, extra_aovs, upsampling) = match args.plan.plan {
         PlanArg::Uniform | PlanArg::Adaptive => (
             prism_bandwidth::SamplePlan::uniform(scene.resolution, settings.spp)
@@ -563,13 +564,17 @@ pub fn run(args: &RenderArgs, budget: &MemoryBudget) -> Result<ExitCode, String>
             // Deterministic in the seed: every process of a split render computes it alike.
             let predictor = args.plan.predictor(settings.spp, settings.seed);
             let table_cache = args.plan.table_cache()?;
+            let started = PredictorClock::now();
+            let mut tables_done = None;
             let mut prediction = pool
                 .install(|| {
                     let probe = prism_render::probe::RenderProbe::new(&scene, settings.seed)
                         .with_bandwidth_tables_cached(table_cache.as_ref())?;
+                    tables_done = Some(PredictorClock::now());
                     prism_render::predictor::predict_with_probe(&scene, &predictor, probe)
                 })
                 .map_err(|e| format!("{}: {e}", args.scene.display()))?;
+            predictor_time = tables_done.map(|t| PredictorTime::between(started, t));
             let upsampling = match args.plan.plan {
                 PlanArg::PredictedHier => Some(
                     prediction
@@ -655,7 +660,7 @@ pub fn run(args: &RenderArgs, budget: &MemoryBudget) -> Result<ExitCode, String>
             rendered.checkpoint.display()
         );
         if let Some(path) = &args.stats_json {
-            write_stats(path, &scene, &settings, threads, &rendered)?;
+            write_stats(path, &scene, &settings, threads, &rendered, predictor_time)?;
         }
         // The shell's convention for a signal (130 for SIGINT, 143 for SIGTERM).
         return Ok(ExitCode::from(
@@ -712,7 +717,7 @@ pub fn run(args: &RenderArgs, budget: &MemoryBudget) -> Result<ExitCode, String>
         }
     }
     if let Some(path) = &args.stats_json {
-        write_stats(path, &scene, &settings, threads, &rendered)?;
+        write_stats(path, &scene, &settings, threads, &rendered, predictor_time)?;
     }
     report_medium_mismatches(args, &rendered.stats);
     if let Some(Ok(solved)) = scene.radiosity_solution() {
@@ -831,14 +836,68 @@ fn render_adaptive(
     Ok(())
 }
 
-/// The statistics of a (possibly partial or resumed) render: the common ones, and the
-/// sample range with the time spent on it in this run and in earlier runs.
+/// A moment on the wall clock and on the process's CPU clock (all threads).
+#[derive(Clone, Copy)]
+struct PredictorClock {
+    wall: std::time::Instant,
+    cpu_s: Option<f64>,
+}
+
+impl PredictorClock {
+    fn now() -> Self {
+        Self {
+            wall: std::time::Instant::now(),
+            cpu_s: crate::converge::progressive::process_cpu_s(),
+        }
+    }
+}
+
+/// What `--plan predicted` spent before the first sample: the BSDF angular tables (built
+/// or read from the cache) and the rest of the predictor (G-buffer, probe, eqs. 5–11, the
+/// allocation), in process CPU seconds (null where the platform has no such clock) and
+/// wall seconds. Measured to the end of the prediction, so `predict_*` is its whole cost
+/// less the tables', as `prism converge` reports `tables_cpu_s` and `predict_cpu_s`.
+#[derive(Clone, Copy)]
+struct PredictorTime {
+    tables: PredictorClock,
+    started: PredictorClock,
+    finished: PredictorClock,
+}
+
+impl PredictorTime {
+    fn between(started: PredictorClock, tables: PredictorClock) -> Self {
+        Self {
+            tables,
+            started,
+            finished: PredictorClock::now(),
+        }
+    }
+
+    fn json(&self) -> serde_json::Value {
+        let cpu = |a: PredictorClock, b: PredictorClock| match (a.cpu_s, b.cpu_s) {
+            (Some(a), Some(b)) => json!(b - a),
+            _ => serde_json::Value::Null,
+        };
+        let wall = |a: PredictorClock, b: PredictorClock| (b.wall - a.wall).as_secs_f64();
+        json!({
+            "tables_cpu_s": cpu(self.started, self.tables),
+            "predict_cpu_s": cpu(self.tables, self.finished),
+            "tables_wall_s": wall(self.started, self.tables),
+            "predict_wall_s": wall(self.tables, self.finished),
+        })
+    }
+}
+
+/// The statistics of a (possibly partial or resumed) render: the common ones, the sample
+/// range with the time spent on it in this run and in earlier runs, and the predictor's
+/// time where the plan was predicted.
 fn write_stats(
     path: &Path,
     scene: &RenderScene,
     settings: &RenderSettings,
     threads: usize,
     rendered: &crate::partial::job::Rendered,
+    predictor_time: Option<PredictorTime>,
 ) -> Result<(), String> {
     let mut value = prism_render::stats_json::stats_json(
         scene,
@@ -853,6 +912,9 @@ fn write_stats(
         "wall_time_s": rendered.wall_time_s,
         "earlier_wall_time_s": rendered.earlier_wall_time_s,
     }]);
+    if let Some(time) = predictor_time {
+        value["predictor"] = time.json();
+    }
     write_json(path, &value)
 }
 

@@ -30,6 +30,12 @@ use crate::scene_build::RenderScene;
 /// n_b: probe samples per pixel (Bagher: 16 suffice, Fig. 13).
 pub const DEFAULT_PROBE_SAMPLES: u32 = 16;
 
+/// One-bounce indirect estimates per pixel (`--plan-indirect`). Beyond the paper; the pooling
+/// gives each pixel its window's estimates, so 4 per pixel allocate as well as 16 within
+/// the noise of `tools/bench_plan_allocation.py` on nine scenes, for a sixth to a fifth less
+/// of the predictor's time (docs/bandwidth.md, "indirect").
+pub const DEFAULT_INDIRECT_SAMPLES: u32 = 4;
+
 /// What the predictor is asked.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PredictorSettings {
@@ -71,7 +77,7 @@ impl PredictorSettings {
             visibility: true,
             colour_noise: true,
             pool_radius: DEFAULT_POOL_RADIUS,
-            indirect_samples: DEFAULT_PROBE_SAMPLES,
+            indirect_samples: DEFAULT_INDIRECT_SAMPLES,
             probe_stride_px: DEFAULT_PROBE_STRIDE_PX,
         }
     }
