@@ -16,6 +16,7 @@ use prism_render::{PlanRequest, RenderPlan, RenderScene};
 const DECISIONS: &[(&str, bool, bool, &[SceneFeature])] = {
     use SceneFeature::*;
     &[
+        ("bandwidth/curved-diffuse-windows.json", false, true, &[Quadrics, InfiniteLights]),
         ("bandwidth/fig17-curved-area.json", false, true, &[NonLambertianBsdfs, Quadrics]),
         ("bandwidth/fig9-spheres.json", false, true, &[Textures, NonLambertianBsdfs, Quadrics, InfiniteLights]),
         ("bandwidth/merl-sources.json", false, true, &[NonLambertianBsdfs, Quadrics]),
