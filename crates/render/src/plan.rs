@@ -305,10 +305,12 @@ impl RenderPlan {
                     choose(
                         "predictor: defocus",
                         "on: b_p capped at 1.22 / (circle of confusion in px) at each pixel's \
-                         hit"
-                        .into(),
+                         hit; V̂ and L̂ mixed over each circle of confusion"
+                            .into(),
                         "the camera is a thin lens: the aperture low-passes what lies out of \
-                         focus (Soler et al. 2009), so detail there needs fewer samples"
+                         focus (Soler et al. 2009), so detail there needs fewer samples, and \
+                         a lens sample sees what a pinhole pixel up to half a circle away \
+                         sees, so the variance is the mixture's (law of total variance)"
                             .into(),
                     );
                 }

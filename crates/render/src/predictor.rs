@@ -160,6 +160,36 @@ fn defocus_low_pass(
     }
 }
 
+/// A thin lens mixes what neighbouring pinhole pixels see (`prism_bandwidth::
+/// defocus_mixing`): each pixel's V̂ and L̂ become its circle of confusion's mixture, the
+/// circle taken at its centre hit (at infinity where the centre ray leaves the scene).
+fn defocus_mixing(
+    scene: &RenderScene,
+    surface: &[Option<SurfacePoint>],
+    own_mean_y: &[f32],
+    modelled: &mut prism_bandwidth::variance_model::ModelledVariance,
+) -> Result<(), String> {
+    let crate::camera::Camera::ThinLens(lens) = &scene.camera else {
+        return Ok(());
+    };
+    let at_infinity = lens.circle_of_confusion_at_infinity_px();
+    let circle_of_confusion_px: Vec<f32> = surface
+        .iter()
+        .map(|s| s.map_or(at_infinity, |s| lens.circle_of_confusion_px(s.position_m)))
+        .collect();
+    prism_bandwidth::mix_over_circles_of_confusion(
+        scene.resolution,
+        prism_bandwidth::DefocusPlanes {
+            circle_of_confusion_px: &circle_of_confusion_px,
+            variance: &mut modelled.variance,
+            luminance_variance: &mut modelled.luminance_variance,
+            mean_y: &mut modelled.mean_y,
+            own_mean_y,
+        },
+    )
+    .map_err(|e| e.to_string())
+}
+
 /// What `pixel`'s centre ray meets (medium interfaces are crossed, as the render's rays
 /// cross them).
 enum CentreRay {
@@ -672,7 +702,7 @@ pub fn predict_with_probe<'a>(
     // Each pixel's own L̂ (a skipped pixel's borrowed from its probed neighbour), before
     // the skipped pixels take their window's below.
     let own_mean_y: Vec<f32> = pixels.iter().map(|p| p.mean_y).collect();
-    let modelled = model_variance(
+    let mut modelled = model_variance(
         resolution,
         &pixels,
         &class,
@@ -682,6 +712,7 @@ pub fn predict_with_probe<'a>(
         settings.variance_bandwidth == VarianceBandwidth::Measured,
     )
     .map_err(|e| e.to_string())?;
+    defocus_mixing(scene, &surface, &own_mean_y, &mut modelled)?;
     for (i, p) in pixels.iter_mut().enumerate() {
         p.variance = if settings.colour_noise {
             modelled.variance[i]

@@ -491,6 +491,57 @@ fn defocus_caps_b_p_by_the_circle_of_confusion() {
     );
 }
 
+/// A thin lens mixes what neighbouring pinhole pixels see (prism_bandwidth::defocus_mixing):
+/// out of focus, floor pixels near the hard shadow's edge take lit and shadowed points (and
+/// the brighter plate) through the lens, so their per-sample variance is that of the
+/// radiances' mixture: at least a sixth of L_floor² where the window straddles the edge and
+/// at most ¼ of the brightest pixel's L² (the largest variance of values in [0, L_max]) plus
+/// what the pixels had. In focus the point light leaves the floor without shading variance.
+#[test]
+fn defocus_mixes_the_radiances_within_the_circle_of_confusion() {
+    let scene = |focus_m: f32| {
+        hard_shadow_scene_seen_by(&format!(
+            r#""camera": {{"type": "thin_lens", "focal_length_mm": 50, "f_number": 1.0,
+                "focus_distance_m": {focus_m},
+                "transform": {{"look_at": {{"eye": [0, 4, 0], "target": [0, 0, 0],
+                    "up": [0, 0, -1]}}}}}},
+            "film": {{"resolution": [48, 48]}}"#
+        ))
+    };
+    // (floor pixels with V̂ ≥ 0.05 L_floor², their largest V̂, lit floor L, brightest L).
+    let floor = |focus_m: f32| -> (usize, f32, f32, f32) {
+        let p = run(&scene(focus_m), true);
+        let on_floor: Vec<usize> = (0..p.pixels.len())
+            .filter(|&i| p.surface[i].is_some_and(|s| s.position_m.y.abs() < 1e-3))
+            .collect();
+        let largest = |v: &mut dyn Iterator<Item = f32>| v.fold(0.0f32, f32::max);
+        let lit = largest(&mut on_floor.iter().map(|&i| p.pixels[i].mean_y));
+        let brightest = largest(&mut p.pixels.iter().map(|x| x.mean_y));
+        let max_v = largest(&mut on_floor.iter().map(|&i| p.pixels[i].luminance_variance));
+        let wide = on_floor
+            .iter()
+            .filter(|&&i| p.pixels[i].luminance_variance >= 0.05 * lit * lit)
+            .count();
+        (wide, max_v, lit, brightest)
+    };
+    let (focused_wide, focused_max, lit, brightest) = floor(4.0);
+    let (defocused_wide, defocused_max, ..) = floor(1.0);
+    eprintln!(
+        "floor pixels with V̂ ≥ 0.05 L²: in focus {focused_wide} (max V̂ {focused_max:.3e}), \
+         focus 1 m {defocused_wide} (max {defocused_max:.3e}); lit floor L̂ {lit:.3e}, \
+         brightest {brightest:.3e}"
+    );
+    assert!(lit > 0.0 && focused_wide == 0);
+    assert!(
+        defocused_max >= lit * lit / 6.0
+            && defocused_max <= 0.25 * brightest * brightest + focused_max,
+        "{defocused_max}: L_floor² {}, L_max² {}",
+        lit * lit,
+        brightest * brightest
+    );
+    assert!(defocused_wide >= 24, "{defocused_wide} pixels mixed");
+}
+
 /// `--plan-colour off` leaves the colour noise out of V̂_p: under an F11 lamp (three narrow
 /// lines) a red Lambertian plane's hero-wavelength estimates scatter in X, Y and Z alike,
 /// so with the term every lit pixel's V̂_p is larger than its luminance part, and without
