@@ -83,20 +83,18 @@ fn predicted_plans_keep_their_bsdf_tables_in_the_cache_dir() {
         files.sort();
         files
     };
-    let first = dir.path().join("first.exr");
-    let first_stats = dir.path().join("first.json");
-    let o = render(
-        &[
-            "--plan",
-            "predicted",
-            "--cache-dir",
-            s(&cache),
-            "--stats-json",
-            s(&first_stats),
-        ],
-        &first,
-    );
-    assert!(o.status.success(), "{}", stderr(&o));
+    // A predicted render with the cache, writing NAME.exr and its statistics NAME.json.
+    let render_cached = |name: &str| -> (std::path::PathBuf, std::path::PathBuf) {
+        let (image, stats) = (
+            dir.path().join(format!("{name}.exr")),
+            dir.path().join(format!("{name}.json")),
+        );
+        let flags = ["--plan", "predicted", "--cache-dir", s(&cache)];
+        let o = render(&[&flags[..], &["--stats-json", s(&stats)]].concat(), &image);
+        assert!(o.status.success(), "{name}: {}", stderr(&o));
+        (image, stats)
+    };
+    let (first, first_stats) = render_cached("first");
     let written = tables(&cache);
     assert!(
         !written.is_empty(),
@@ -107,20 +105,7 @@ fn predicted_plans_keep_their_bsdf_tables_in_the_cache_dir() {
         .iter()
         .map(|f| std::fs::metadata(f).unwrap().modified().unwrap())
         .collect();
-    let second = dir.path().join("second.exr");
-    let second_stats = dir.path().join("second.json");
-    let o = render(
-        &[
-            "--plan",
-            "predicted",
-            "--cache-dir",
-            s(&cache),
-            "--stats-json",
-            s(&second_stats),
-        ],
-        &second,
-    );
-    assert!(o.status.success(), "{}", stderr(&o));
+    let (second, second_stats) = render_cached("second");
     // The statistics time the predictor, tables apart: building the brushed copper's 256
     // slices costs far more than reading them back.
     let predictor = |path: &std::path::Path| -> serde_json::Value {

@@ -439,6 +439,18 @@ fn hierarchical_shading_never_interpolates_across_a_shadow_edge() {
     }
 }
 
+/// The hard-shadow scene seen from 4 m above through a 50 mm f/1.0 lens focused at
+/// `focus_m` (the floor is 4 m away), 48 × 48 px.
+fn hard_shadow_through_a_lens_focused_at(focus_m: f32) -> RenderScene {
+    hard_shadow_scene_seen_by(&format!(
+        r#""camera": {{"type": "thin_lens", "focal_length_mm": 50, "f_number": 1.0,
+            "focus_distance_m": {focus_m},
+            "transform": {{"look_at": {{"eye": [0, 4, 0], "target": [0, 0, 0],
+                "up": [0, 0, -1]}}}}}},
+        "film": {{"resolution": [48, 48]}}"#
+    ))
+}
+
 /// A thin lens low-passes what lies out of focus (Soler et al. 2009): b_p on the edge of a
 /// hard shadow (sharp, b_p ≥ 0.25, in focus) is capped by the circle of confusion's cut-off
 /// (1.22 / CoC cycles/px) when the floor is out of focus, so two defocus settings give b_p
@@ -446,15 +458,7 @@ fn hierarchical_shading_never_interpolates_across_a_shadow_edge() {
 /// focus keeps its own b_p.
 #[test]
 fn defocus_caps_b_p_by_the_circle_of_confusion() {
-    let scene = |focus_m: f32| {
-        hard_shadow_scene_seen_by(&format!(
-            r#""camera": {{"type": "thin_lens", "focal_length_mm": 50, "f_number": 1.0,
-                "focus_distance_m": {focus_m},
-                "transform": {{"look_at": {{"eye": [0, 4, 0], "target": [0, 0, 0],
-                    "up": [0, 0, -1]}}}}}},
-            "film": {{"resolution": [48, 48]}}"#
-        ))
-    };
+    let scene = hard_shadow_through_a_lens_focused_at;
     // The largest b_p on the floor (depth 4 m; the box top is nearer).
     let max_b = |focus_m: f32| -> (f32, f32) {
         let s = scene(focus_m);
@@ -499,15 +503,7 @@ fn defocus_caps_b_p_by_the_circle_of_confusion() {
 /// what the pixels had. In focus the point light leaves the floor without shading variance.
 #[test]
 fn defocus_mixes_the_radiances_within_the_circle_of_confusion() {
-    let scene = |focus_m: f32| {
-        hard_shadow_scene_seen_by(&format!(
-            r#""camera": {{"type": "thin_lens", "focal_length_mm": 50, "f_number": 1.0,
-                "focus_distance_m": {focus_m},
-                "transform": {{"look_at": {{"eye": [0, 4, 0], "target": [0, 0, 0],
-                    "up": [0, 0, -1]}}}}}},
-            "film": {{"resolution": [48, 48]}}"#
-        ))
-    };
+    let scene = hard_shadow_through_a_lens_focused_at;
     // (floor pixels with V̂ ≥ 0.05 L_floor², their largest V̂, lit floor L, brightest L).
     let floor = |focus_m: f32| -> (usize, f32, f32, f32) {
         let p = run(&scene(focus_m), true);
