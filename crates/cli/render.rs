@@ -564,29 +564,27 @@ pub fn run(args: &RenderArgs, budget: &MemoryBudget) -> Result<ExitCode, String>
             // Deterministic in the seed: every process of a split render computes it alike.
             let predictor = args.plan.predictor(settings.spp, settings.seed);
             let table_cache = args.plan.table_cache()?;
-            let started = PredictorClock::now();
-            let mut tables_done = None;
-            let mut prediction = pool
+            let (prediction, upsampling, time) = pool
                 .install(|| {
-                    let probe = prism_render::probe::RenderProbe::new(&scene, settings.seed)
-                        .with_bandwidth_tables_cached(table_cache.as_ref())?;
-                    tables_done = Some(PredictorClock::now());
-                    prism_render::predictor::predict_with_probe(&scene, &predictor, probe)
+                    crate::predictor_time::predict_timed(
+                        &scene,
+                        &predictor,
+                        settings.seed,
+                        table_cache.as_ref(),
+                        |prediction| match args.plan.plan {
+                            PlanArg::PredictedHier => prediction
+                                .make_hierarchical(
+                                    args.plan.max_level(),
+                                    f64::from(settings.spp),
+                                    settings.seed,
+                                )
+                                .map(Some),
+                            PlanArg::Predicted | PlanArg::Uniform | PlanArg::Adaptive => Ok(None),
+                        },
+                    )
                 })
                 .map_err(|e| format!("{}: {e}", args.scene.display()))?;
-            predictor_time = tables_done.map(|t| PredictorTime::between(started, t));
-            let upsampling = match args.plan.plan {
-                PlanArg::PredictedHier => Some(
-                    prediction
-                        .make_hierarchical(
-                            args.plan.max_level(),
-                            f64::from(settings.spp),
-                            settings.seed,
-                        )
-                        .map_err(|e| format!("{}: {e}", args.scene.display()))?,
-                ),
-                PlanArg::Predicted | PlanArg::Uniform | PlanArg::Adaptive => None,
-            };
+            predictor_time = Some(time);
             let aovs = prediction.aov_planes();
             (prediction.allocated.plan, aovs, upsampling)
         }
@@ -836,58 +834,6 @@ fn render_adaptive(
     Ok(())
 }
 
-/// A moment on the wall clock and on the process's CPU clock (all threads).
-#[derive(Clone, Copy)]
-struct PredictorClock {
-    wall: std::time::Instant,
-    cpu_s: Option<f64>,
-}
-
-impl PredictorClock {
-    fn now() -> Self {
-        Self {
-            wall: std::time::Instant::now(),
-            cpu_s: crate::converge::progressive::process_cpu_s(),
-        }
-    }
-}
-
-/// What `--plan predicted` spent before the first sample: the BSDF angular tables (built
-/// or read from the cache) and the rest of the predictor (G-buffer, probe, eqs. 5–11, the
-/// allocation), in process CPU seconds (null where the platform has no such clock) and
-/// wall seconds. Measured to the end of the prediction, so `predict_*` is its whole cost
-/// less the tables', as `prism converge` reports `tables_cpu_s` and `predict_cpu_s`.
-#[derive(Clone, Copy)]
-struct PredictorTime {
-    tables: PredictorClock,
-    started: PredictorClock,
-    finished: PredictorClock,
-}
-
-impl PredictorTime {
-    fn between(started: PredictorClock, tables: PredictorClock) -> Self {
-        Self {
-            tables,
-            started,
-            finished: PredictorClock::now(),
-        }
-    }
-
-    fn json(&self) -> serde_json::Value {
-        let cpu = |a: PredictorClock, b: PredictorClock| match (a.cpu_s, b.cpu_s) {
-            (Some(a), Some(b)) => json!(b - a),
-            _ => serde_json::Value::Null,
-        };
-        let wall = |a: PredictorClock, b: PredictorClock| (b.wall - a.wall).as_secs_f64();
-        json!({
-            "tables_cpu_s": cpu(self.started, self.tables),
-            "predict_cpu_s": cpu(self.tables, self.finished),
-            "tables_wall_s": wall(self.started, self.tables),
-            "predict_wall_s": wall(self.tables, self.finished),
-        })
-    }
-}
-
 /// The statistics of a (possibly partial or resumed) render: the common ones, the sample
 /// range with the time spent on it in this run and in earlier runs, and the predictor's
 /// time where the plan was predicted.
@@ -897,7 +843,7 @@ fn write_stats(
     settings: &RenderSettings,
     threads: usize,
     rendered: &crate::partial::job::Rendered,
-    predictor_time: Option<PredictorTime>,
+    predictor_time: Option<crate::predictor_time::PredictorTime>,
 ) -> Result<(), String> {
     let mut value = prism_render::stats_json::stats_json(
         scene,

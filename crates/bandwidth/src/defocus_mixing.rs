@@ -8,9 +8,10 @@
 //!
 //! with W_p the square of half-width ⌊c_p/2⌋ px around p (the circle of confusion c_p at
 //! the pixel's centre hit, as a box), clipped to the image, and L_q each pixel's own mean
-//! (not the pooled L̂, which the pooling window has already spread across edges). The pinhole probe sees one
-//! point per pixel, so without this a defocused pixel over an edge in the scene is
-//! predicted as smooth as either side, and its variance is the lens's mixing of the two.
+//! (not the pooled L̂, which the pooling window has already spread across edges). The
+//! pinhole probe sees one point per pixel, so without this a defocused pixel over an edge
+//! in the scene is predicted as smooth as either side, and its variance is the lens's
+//! mixing of the two.
 //! The image's blur itself is `defocus_low_pass` in the renderer (Soler et al. 2009).
 //!
 //! The window sums come from summed-area tables (f64), so any circle of confusion costs
@@ -142,6 +143,11 @@ mod tests {
         /// Mixes with each pixel's own mean equal to its pooled one.
         fn mix(&mut self, resolution: UVec2) -> Result<(), BandwidthError> {
             self.own = self.l.clone();
+            self.mix_with_own_means(resolution)
+        }
+
+        /// Mixes with the own means in `self.own` as they are.
+        fn mix_with_own_means(&mut self, resolution: UVec2) -> Result<(), BandwidthError> {
             mix_over_circles_of_confusion(
                 resolution,
                 DefocusPlanes {
@@ -201,20 +207,10 @@ mod tests {
         let (r, n) = (UVec2::new(20, 10), 200);
         let mut p = Planes::new(n, 6.0);
         p.l.fill(0.5);
-        let own: Vec<f32> = (0..n)
+        p.own = (0..n)
             .map(|i| if i % 20 >= 10 { 1.0 } else { 0.0 })
             .collect();
-        mix_over_circles_of_confusion(
-            r,
-            DefocusPlanes {
-                circle_of_confusion_px: &p.coc,
-                variance: &mut p.v,
-                luminance_variance: &mut p.vy,
-                mean_y: &mut p.l,
-                own_mean_y: &own,
-            },
-        )
-        .unwrap();
+        p.mix_with_own_means(r).unwrap();
         let i = 5 * 20 + 10; // 4 of 7 columns bright
         let m = 4.0 / 7.0;
         assert!((p.v[i] - m * (1.0 - m)).abs() < 1e-6, "{}", p.v[i]);

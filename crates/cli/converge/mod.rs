@@ -10,7 +10,7 @@ mod chart;
 mod fit;
 mod method;
 mod pass_planner;
-pub(crate) mod progressive;
+mod progressive;
 mod ratios;
 mod reference;
 mod report;

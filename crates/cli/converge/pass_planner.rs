@@ -14,20 +14,12 @@ use prism_bandwidth::hierarchical_shading::DEFAULT_MAX_LEVEL;
 use prism_bandwidth::{adaptive_pass_counts, Allocated, Upsampling};
 use prism_render::adaptive::{PerPixelPasses, ADAPTIVE_FIRST_PASS_SPP};
 use prism_render::bsdf_table_cache::AngularTableCache;
-use prism_render::predictor::{predict_with_probe, PredictorSettings};
-use prism_render::probe::RenderProbe;
+use prism_render::predictor::PredictorSettings;
 use prism_render::{Film, RenderScene, RenderSettings, RenderStats};
 
-use super::method::PlanKind;
-use super::progressive::process_cpu_s;
+use crate::predictor_time::{predict_timed, PredictorCpu};
 
-/// Process CPU time the predictor took (`predicted` plans), s: its BSDF and environment
-/// tables apart from the per-pixel prediction (the "tables apart, cached").
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct PredictorCpu {
-    pub tables_cpu_s: f64,
-    pub predict_cpu_s: f64,
-}
+use super::method::PlanKind;
 
 /// The mean spp the predicted plan's densities are computed for (its anti-aliasing
 /// minimums depend on the budget; the densities are then scaled to each checkpoint).
@@ -68,25 +60,23 @@ impl PassPlanner {
         let allocated = match kind {
             PlanKind::Predicted | PlanKind::PredictedHier => {
                 let predictor = PredictorSettings::defaults(PREDICTED_PLAN_SPP, settings.seed);
-                let start = process_cpu_s();
-                let probe = RenderProbe::new(scene, settings.seed)
-                    .with_bandwidth_tables_cached(inputs.table_cache)?;
-                let tables_done = process_cpu_s();
-                let mut prediction = predict_with_probe(scene, &predictor, probe)?;
-                if kind == PlanKind::PredictedHier {
-                    upsampling = Some(Arc::new(prediction.make_hierarchical(
-                        DEFAULT_MAX_LEVEL,
-                        PREDICTED_PLAN_SPP,
-                        settings.seed,
-                    )?));
-                }
-                predictor_cpu = match (start, tables_done, process_cpu_s()) {
-                    (Some(a), Some(b), Some(c)) => Some(PredictorCpu {
-                        tables_cpu_s: b - a,
-                        predict_cpu_s: c - b,
-                    }),
-                    _ => None,
-                };
+                let (prediction, hierarchy, time) = predict_timed(
+                    scene,
+                    &predictor,
+                    settings.seed,
+                    inputs.table_cache,
+                    |prediction| match kind {
+                        PlanKind::PredictedHier => prediction
+                            .make_hierarchical(DEFAULT_MAX_LEVEL, PREDICTED_PLAN_SPP, settings.seed)
+                            .map(Some),
+                        PlanKind::Predicted
+                        | PlanKind::Uniform
+                        | PlanKind::Adaptive
+                        | PlanKind::Oracle => Ok(None),
+                    },
+                )?;
+                upsampling = hierarchy.map(Arc::new);
+                predictor_cpu = time.cpu();
                 Some(prediction.allocated)
             }
             PlanKind::Oracle => Some(

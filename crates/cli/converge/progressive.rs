@@ -28,6 +28,8 @@ use prism_render::adaptive::ADAPTIVE_FIRST_PASS_SPP;
 use prism_render::{Film, RenderScene, RenderSettings, RenderStats};
 use prism_spectrum::rgb_space::RgbColorSpace;
 
+use crate::cpu_clock::{process_cpu_s, thread_cpu_s};
+
 use super::method::PlanKind;
 use super::pass_planner::{PassPlanner, PlanInputs};
 
@@ -105,42 +107,7 @@ pub struct MethodRun {
     /// `predicted-hier`: how the film's pixels without samples are filled.
     pub upsampling: Option<Arc<Upsampling>>,
     /// The predictor's CPU time (`predicted` plans; inside the method's clock).
-    pub predictor_cpu: Option<super::pass_planner::PredictorCpu>,
-}
-
-#[cfg(unix)]
-fn cpu_clock_s(clock: libc::clockid_t) -> Option<f64> {
-    let mut ts = libc::timespec {
-        tv_sec: 0,
-        tv_nsec: 0,
-    };
-    // SAFETY: `ts` is a valid, writable timespec; the clock id is a constant.
-    let rc = unsafe { libc::clock_gettime(clock, &mut ts) };
-    (rc == 0).then_some(ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9)
-}
-
-/// CPU time of the whole process (all threads), s.
-pub fn process_cpu_s() -> Option<f64> {
-    #[cfg(unix)]
-    {
-        cpu_clock_s(libc::CLOCK_PROCESS_CPUTIME_ID)
-    }
-    #[cfg(not(unix))]
-    {
-        None
-    }
-}
-
-/// CPU time of the calling thread, s.
-fn thread_cpu_s() -> Option<f64> {
-    #[cfg(unix)]
-    {
-        cpu_clock_s(libc::CLOCK_THREAD_CPUTIME_ID)
-    }
-    #[cfg(not(unix))]
-    {
-        None
-    }
+    pub predictor_cpu: Option<crate::predictor_time::PredictorCpu>,
 }
 
 /// The film's image as prism-post sees it (linear Rec.709, like `prism render`'s EXR),

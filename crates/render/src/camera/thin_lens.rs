@@ -164,14 +164,19 @@ impl ThinLensCamera {
         if depth_m <= 0.0 {
             return 0.0;
         }
-        self.circle_of_confusion_m(depth_m) * self.frame.size_px().x / self.sensor_width_m
+        self.circle_of_confusion_m(depth_m) * self.px_per_sensor_m()
     }
 
     /// Diameter in pixels of the circle of confusion of a point at infinity (what a ray
     /// that leaves the scene shows): the limit of c for d → ∞, 2A·f/(d_f − f).
     pub fn circle_of_confusion_at_infinity_px(&self) -> f32 {
         let (f, df) = (self.focal_length_m, self.focus_distance_m);
-        2.0 * self.aperture_radius_m * f / (df - f) * self.frame.size_px().x / self.sensor_width_m
+        2.0 * self.aperture_radius_m * f / (df - f) * self.px_per_sensor_m()
+    }
+
+    /// Pixels per metre on the sensor.
+    fn px_per_sensor_m(&self) -> f32 {
+        self.frame.size_px().x / self.sensor_width_m
     }
 
     /// The aperture point (camera space, z = 0) of `lens_sample` ∈ [0, 1)².
