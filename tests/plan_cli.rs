@@ -184,7 +184,7 @@ fn plan_flags_are_checked() {
         ),
         (
             vec!["--plan", "predicted", "--plan-probe-stride", "0"],
-            "--plan-probe-stride 0: expected at least 1",
+            "'0': expected `auto` or a stride in whole pixels, at least 1",
         ),
         (
             vec!["--plan", "predicted", "--plan-max-level", "2"],
@@ -285,7 +285,7 @@ fn explain(plan: &[&str]) -> String {
 fn explain_names_the_plan() {
     let text = explain(&["--plan", "predicted", "--plan-allocation", "variance"]);
     assert!(text.contains("predicted sample plan"), "{text}");
-    assert!(text.contains("16 probe light samples"), "{text}");
+    assert!(text.contains("64 probe light samples"), "{text}");
     assert!(
         text.contains("predicted variance (the paper's rule)"),
         "{text}"
@@ -296,14 +296,49 @@ fn explain_names_the_plan() {
         text.contains("of the luminance alone (--plan-colour off)"),
         "{text}"
     );
+    // glossy-env is 480×270: the automatic pooling radius is 270/32 ≈ 8 px, the automatic
+    // probe stride half of it.
     assert!(
-        text.contains("per probed pixel (every pixel, as the paper)"),
+        text.contains(
+            "64 probe light samples per probed pixel (n_b = 16 times S²/4, at least n_b, and \
+             the indirect estimates likewise, at one pixel in 4×4 and each pixel of a \
+             surface with none within 8 px; the others take the nearest probed pixel's \
+             bandwidth and the pooled V̂: --plan-probe-stride auto, half the pooling radius \
+             within 1 to 4; 1 probes every pixel, as the paper)"
+        ),
         "{text}"
     );
-    // glossy-env is 480×270: the automatic pooling radius is 270/32 ≈ 8 px.
+    let text = explain(&["--plan", "predicted", "--plan-probe-stride", "1"]);
+    assert!(
+        text.contains(
+            "16 probe light samples per probed pixel (every pixel, as the paper: \
+             --plan-probe-stride 1)"
+        ),
+        "{text}"
+    );
+    let text = explain(&["--plan", "predicted-hier"]);
+    assert!(
+        text.contains(
+            "16 probe light samples per probed pixel (every pixel, as the paper: \
+             --plan-probe-stride auto is 1 for predicted-hier"
+        ),
+        "{text}"
+    );
+    let text = explain(&["--plan", "predicted", "--resolution", "64x36"]);
+    assert!(
+        text.contains(
+            "per probed pixel (every pixel, as the paper: --plan-probe-stride auto is half the \
+             pooling radius of 1 px, at least 1)"
+        ),
+        "{text}"
+    );
     let text = explain(&["--plan", "predicted", "--plan-probe-stride", "3"]);
     assert!(
-        text.contains("one pixel in 3×3, and each pixel of a surface with none within 8 px"),
+        text.contains("36 probe light samples per probed pixel (n_b = 16 times S²/4"),
+        "{text}"
+    );
+    assert!(
+        text.contains("at one pixel in 3×3 and each pixel of a surface with none within 8 px"),
         "{text}"
     );
     assert!(

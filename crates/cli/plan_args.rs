@@ -3,7 +3,7 @@
 
 use clap::{Args, ValueEnum};
 use prism_bandwidth::hierarchical_shading::DEFAULT_MAX_LEVEL;
-use prism_bandwidth::{Allocation, AllocationSettings, PoolRadius, VarianceBandwidth};
+use prism_bandwidth::{Allocation, AllocationSettings, PoolRadius, ProbeStride, VarianceBandwidth};
 use prism_render::bsdf_table_cache::AngularTableCache;
 use prism_render::predictor::PredictorSettings;
 use prism_render::SamplePlanKind;
@@ -88,9 +88,10 @@ pub struct PlanArgs {
     pub plan_indirect: Option<u32>,
     /// `--plan predicted`: the probe samples one pixel in S×S (and every pixel of a surface
     /// with no probed pixel within --plan-pool-px); the others take their probed
-    /// neighbours' answers (default 1: every pixel, as the paper).
-    #[arg(long = "plan-probe-stride", value_name = "S", value_parser = prism_args::numbers::parse_u32)]
-    pub plan_probe_stride: Option<u32>,
+    /// neighbours' answers (default `auto`: half the pooling radius, 1 to 4, and 1 for
+    /// predicted-hier; 1: every pixel, as the paper).
+    #[arg(long = "plan-probe-stride", value_name = "S|auto", value_parser = parse_probe_stride)]
+    pub plan_probe_stride: Option<ProbeStride>,
     /// `--plan predicted-hier`: the coarsest lattice, 2^L pixels between shaded pixels
     /// (1 to 8; default 3).
     #[arg(long = "plan-max-level", value_name = "L", value_parser = prism_args::numbers::parse_u32)]
@@ -161,8 +162,8 @@ impl PlanArgs {
     pub fn indirect(&self) -> u32 {
         self.plan_indirect.unwrap_or(DEFAULTS.indirect_samples)
     }
-    pub fn probe_stride(&self) -> u32 {
-        self.plan_probe_stride.unwrap_or(DEFAULTS.probe_stride_px)
+    pub fn probe_stride(&self) -> ProbeStride {
+        self.plan_probe_stride.unwrap_or(DEFAULTS.probe_stride)
     }
     pub fn max_level(&self) -> u32 {
         self.plan_max_level.unwrap_or(DEFAULT_MAX_LEVEL)
@@ -219,9 +220,6 @@ impl PlanArgs {
         if self.nb() == 0 {
             return Err("--plan-nb must be at least 1".into());
         }
-        if self.probe_stride() == 0 {
-            return Err("--plan-probe-stride 0: expected at least 1 (1 probes every pixel)".into());
-        }
         if !(0.0..=1.0).contains(&self.floor()) {
             return Err(format!(
                 "--plan-floor {}: expected a share of the budget in [0, 1]",
@@ -241,7 +239,7 @@ impl PlanArgs {
                 allocation: self.allocation(),
                 variance: self.variance_bandwidth(),
                 colour_noise: self.colour() == OnOff::On,
-                probe_stride_px: self.probe_stride(),
+                probe_stride: self.probe_stride(),
                 pool_radius: self.pool_radius(),
                 hierarchical_max_level: (self.plan == PlanArg::PredictedHier)
                     .then_some(self.max_level()),
@@ -285,7 +283,8 @@ impl PlanArgs {
             colour_noise: self.colour() == OnOff::On,
             pool_radius: self.pool_radius(),
             indirect_samples: self.indirect(),
-            probe_stride_px: self.probe_stride(),
+            probe_stride: self.probe_stride(),
+            hierarchical: self.plan == PlanArg::PredictedHier,
         }
     }
 }
@@ -302,9 +301,31 @@ fn parse_pool_radius(text: &str) -> Result<PoolRadius, String> {
     }
 }
 
+/// `--plan-probe-stride`: `auto` or a stride of at least one whole pixel.
+fn parse_probe_stride(text: &str) -> Result<ProbeStride, String> {
+    let expected = "expected `auto` or a stride in whole pixels, at least 1 (1 probes every pixel)";
+    match text.trim() {
+        "auto" => Ok(ProbeStride::Auto),
+        _ => match prism_args::numbers::parse_u32(text) {
+            Ok(0) | Err(_) => Err(format!("'{text}': {expected}")),
+            Ok(s) => Ok(ProbeStride::Px(s)),
+        },
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_probe_stride_is_auto_or_at_least_one_pixel() {
+        assert_eq!(parse_probe_stride("auto"), Ok(ProbeStride::Auto));
+        assert_eq!(parse_probe_stride("2"), Ok(ProbeStride::Px(2)));
+        for bad in ["0", "-1", "two"] {
+            let e = parse_probe_stride(bad).unwrap_err();
+            assert!(e.contains("auto") && e.contains(bad), "{e}");
+        }
+    }
 
     #[test]
     fn the_pool_radius_is_auto_or_whole_pixels() {

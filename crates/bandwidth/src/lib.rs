@@ -63,7 +63,10 @@ pub use pixel_neighbours::four_neighbours;
 pub use pixel_prediction::{predict_pixel, PixelFootprint, PixelPrediction, VarianceBandwidth};
 pub use probe::{IndirectEstimate, LightSample, ShadingProbe};
 pub use sample_plan::{SamplePlan, DEFAULT_LIGHT_SAMPLES};
-pub use sparse_probing::{nearest_probed, probed_pixels, DEFAULT_PROBE_STRIDE_PX};
+pub use sparse_probing::{
+    nearest_probed, probed_pixels, samples_per_probed_pixel, ProbeStride, AUTO_MAX_STRIDE_PX,
+    DEFAULT_PROBE_STRIDE,
+};
 pub use variance_model::{model_variance, ModelledVariance};
 pub use variance_pooling::{
     pool_scaled, pool_variance, PixelClass, PoolRadius, DEFAULT_POOL_RADIUS,

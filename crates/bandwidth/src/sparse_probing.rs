@@ -17,10 +17,62 @@ use crate::error::{check_lengths, pixel_count, BandwidthError};
 use crate::pixel_neighbours::ring;
 use crate::variance_pooling::PixelClass;
 
-/// The default probe stride S, pixels between probed pixels along x and y: 1, the paper's
-/// probe at every pixel. Measured in docs/bandwidth.md: at 128² a stride of 2 halves the
-/// predictor's time and keeps all but 1–3 % of the allocation's expected gain.
-pub const DEFAULT_PROBE_STRIDE_PX: u32 = 1;
+/// The default probe stride: [`ProbeStride::Auto`].
+pub const DEFAULT_PROBE_STRIDE: ProbeStride = ProbeStride::Auto;
+
+/// The largest stride [`ProbeStride::Auto`] picks: measured up to 256² (r = 8, S = 4) in
+/// docs/bandwidth.md; wider strides leave shadow edges and bandwidth to fewer probes than
+/// were measured.
+pub const AUTO_MAX_STRIDE_PX: u32 = 4;
+
+/// The probe stride S, pixels between probed pixels along x and y (`--plan-probe-stride`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ProbeStride {
+    /// Half the pooling radius r, S = ⌊r/2⌋ within [1, [`AUTO_MAX_STRIDE_PX`]]: a
+    /// (2r+1)² window then holds about 20 probed pixels of one surface at every resolution,
+    /// so that the probe's cost grows with the windows rather than the pixels (1 at 64²,
+    /// 2 at 128², 4 from 256² with the automatic radius; 1 where r ≤ 3, 0 = the paper's
+    /// unpooled probe included). 1 for hierarchical shading, whose lattice pixels are
+    /// shaded for their neighbours and take each its own probe (fig17 at 128² and 256 spp:
+    /// relMSE 10–46 % above the probe at every pixel with S = 2, docs/bandwidth.md).
+    Auto,
+    /// A fixed stride in pixels; 1 = every pixel, as the paper.
+    Px(u32),
+}
+
+impl ProbeStride {
+    /// The stride in pixels for a pooling radius of `pool_radius_px`, for a plan shaded
+    /// hierarchically (Bagher et al. 2013 §3.2) or not.
+    pub fn px(self, pool_radius_px: u32, hierarchical: bool) -> u32 {
+        match self {
+            ProbeStride::Auto if hierarchical => 1,
+            ProbeStride::Auto => (pool_radius_px / 2).clamp(1, AUTO_MAX_STRIDE_PX),
+            ProbeStride::Px(s) => s,
+        }
+    }
+}
+
+impl std::fmt::Display for ProbeStride {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            ProbeStride::Auto => f.write_str("auto"),
+            ProbeStride::Px(s) => write!(f, "{s}"),
+        }
+    }
+}
+
+/// The samples a probed pixel takes at stride S for `per_pixel` at every pixel (n_b, or the
+/// indirect estimates): `per_pixel`·S²/4, at least `per_pixel`. A probed pixel stands for the
+/// S² pixels of its lattice cell, and a quarter of their samples keeps the expected gain of
+/// the probe at every pixel where n_b alone loses 2–5 % at S = 4 (the pooled V̂ averages S²
+/// fewer samples; docs/bandwidth.md, "Sparse probing"): the probe then costs about a
+/// quarter of the paper's at every stride from 2.
+pub fn samples_per_probed_pixel(per_pixel: u32, stride_px: u32) -> u32 {
+    let quarter_cell = u64::from(per_pixel) * u64::from(stride_px).pow(2) / 4;
+    u32::try_from(quarter_cell)
+        .unwrap_or(u32::MAX)
+        .max(per_pixel)
+}
 
 /// True for a pixel on the stride's lattice (both coordinates multiples of S).
 fn on_lattice(x: usize, y: usize, stride: usize) -> bool {
@@ -129,6 +181,28 @@ pub fn nearest_probed(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_automatic_stride_is_half_the_pooling_radius_within_one_to_four_and_one_for_hier() {
+        let s = |r| ProbeStride::Auto.px(r, false);
+        assert_eq!(
+            [s(0), s(1), s(2), s(3), s(4), s(5), s(8), s(16)],
+            [1, 1, 1, 1, 2, 2, 4, 4]
+        );
+        assert_eq!(ProbeStride::Auto.px(8, true), 1);
+        assert_eq!(ProbeStride::Px(3).px(16, false), 3);
+        assert_eq!(ProbeStride::Px(3).px(16, true), 3);
+        assert_eq!(ProbeStride::Auto.to_string(), "auto");
+        assert_eq!(ProbeStride::Px(2).to_string(), "2");
+    }
+
+    #[test]
+    fn a_probed_pixel_takes_a_quarter_of_its_cells_samples_at_least_its_own() {
+        let n = |s| samples_per_probed_pixel(16, s);
+        assert_eq!([n(1), n(2), n(3), n(4), n(8)], [16, 16, 36, 64, 256]);
+        assert_eq!(samples_per_probed_pixel(0, 4), 0);
+        assert_eq!(samples_per_probed_pixel(u32::MAX, 4), u32::MAX);
+    }
 
     #[test]
     fn stride_one_probes_every_predicted_pixel() {

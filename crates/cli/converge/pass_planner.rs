@@ -59,7 +59,10 @@ impl PassPlanner {
         let mut upsampling = None;
         let allocated = match kind {
             PlanKind::Predicted | PlanKind::PredictedHier => {
-                let predictor = PredictorSettings::defaults(PREDICTED_PLAN_SPP, settings.seed);
+                let predictor = PredictorSettings {
+                    hierarchical: kind == PlanKind::PredictedHier,
+                    ..PredictorSettings::defaults(PREDICTED_PLAN_SPP, settings.seed)
+                };
                 let (prediction, hierarchy, time) = predict_timed(
                     scene,
                     &predictor,

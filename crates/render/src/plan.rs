@@ -74,8 +74,9 @@ pub enum SamplePlanKind {
         /// The colour noise of hero-wavelength sampling in V̂_p (`--plan-colour`; off: the
         /// luminance's variance alone).
         colour_noise: bool,
-        /// The probe samples one pixel in S×S (`--plan-probe-stride`; 1 = every pixel).
-        probe_stride_px: u32,
+        /// The probe samples one pixel in S×S (`--plan-probe-stride`; `auto` = half the
+        /// pooling radius, 1 = every pixel).
+        probe_stride: prism_bandwidth::ProbeStride,
         /// The pooling radius (`--plan-pool-px`) of V̂ and L̂, within which a pixel the
         /// probe skips finds a probed one.
         pool_radius: prism_bandwidth::PoolRadius,
@@ -136,32 +137,56 @@ fn sample_plan_text(kind: SamplePlanKind, resolution: glam::UVec2) -> (&'static 
             allocation,
             variance,
             colour_noise,
-            probe_stride_px,
+            probe_stride,
             pool_radius,
             hierarchical_max_level,
         } => {
             let pool_radius_px = pool_radius.px(resolution);
+            let probe_stride_px = probe_stride.px(pool_radius_px, hierarchical_max_level.is_some());
             (
             match hierarchical_max_level {
                 Some(_) => "predicted-hier",
                 None => "predicted",
             },
             format!(
-                "--plan predicted: a G-buffer of pixel-centre hits, {probe_samples} probe light \
+                "--plan predicted: a G-buffer of pixel-centre hits, {} probe light \
                  samples per probed pixel ({}), bandwidth by Bagher et al. 2013 eqs. 4-6 (silhouettes, creases \
                  and material edges at the finest level, seen directly or through mirrors and \
                  smooth glass, where the two sides' L̂ differ by over 2 %), \
                  variance {}{}, {}, levels by eq. 11; {:.1} % of the budget uniform (light past the probe's one indirect \
                  bounce is not predicted), the rest {}",
-                if probe_stride_px == 1 {
-                    "every pixel, as the paper".to_string()
-                } else {
-                    format!(
-                        "one pixel in {probe_stride_px}×{probe_stride_px}, and each pixel of a \
+                prism_bandwidth::samples_per_probed_pixel(probe_samples, probe_stride_px),
+                match (probe_stride, probe_stride_px) {
+                    (prism_bandwidth::ProbeStride::Auto, 1) => {
+                        if hierarchical_max_level.is_some() {
+                            "every pixel, as the paper: --plan-probe-stride auto is 1 for \
+                             predicted-hier, whose lattice pixels shade for their neighbours"
+                                .to_string()
+                        } else {
+                            format!(
+                                "every pixel, as the paper: --plan-probe-stride auto is half \
+                                 the pooling radius of {pool_radius_px} px, at least 1"
+                            )
+                        }
+                    }
+                    (prism_bandwidth::ProbeStride::Px(_), 1) => {
+                        "every pixel, as the paper: --plan-probe-stride 1".to_string()
+                    }
+                    (stride, s) => format!(
+                        "n_b = {probe_samples} times S²/4, at least n_b, and the indirect \
+                         estimates likewise, at one pixel in {s}×{s} and each pixel of a \
                          surface with none within {pool_radius_px} px; the others take the \
                          nearest probed pixel's bandwidth and the pooled V̂: \
-                         --plan-probe-stride"
-                    )
+                         --plan-probe-stride {}",
+                        match stride {
+                            prism_bandwidth::ProbeStride::Auto => format!(
+                                "auto, half the pooling radius within 1 to {}; 1 probes every \
+                                 pixel, as the paper",
+                                prism_bandwidth::AUTO_MAX_STRIDE_PX
+                            ),
+                            prism_bandwidth::ProbeStride::Px(_) => s.to_string(),
+                        }
+                    ),
                 },
                 match variance {
                     prism_bandwidth::VarianceBandwidth::Incident => {

@@ -14,8 +14,8 @@ use prism_bandwidth::{
     allocate, four_neighbours, geometric_edges, model_variance, predict_pixel, Allocated,
     AllocationInputs, AllocationSettings, Bandwidth, BandwidthBuffer, GBufferHit, HierarchyInputs,
     IndirectEstimate, LightSample, MeanLuminance, PixelClass, PixelFootprint, PixelPrediction,
-    PoolRadius, SeenSurface, ShadingProbe, SurfacePoint, Upsampling, VarianceBandwidth,
-    VisibilitySummary, DEFAULT_POOL_RADIUS, DEFAULT_PROBE_STRIDE_PX,
+    PoolRadius, ProbeStride, SeenSurface, ShadingProbe, SurfacePoint, Upsampling,
+    VarianceBandwidth, VisibilitySummary, DEFAULT_POOL_RADIUS, DEFAULT_PROBE_STRIDE,
 };
 use prism_spectrum::colorimetry::sampled_radiance_to_xyz;
 use prism_spectrum::{SampledSpectrum, SampledWavelengths};
@@ -55,15 +55,18 @@ pub struct PredictorSettings {
     /// (`--plan-pool-px`; `auto` = min(W, H)/32 px, 0 = the paper's per-pixel V̂_p;
     /// prism_bandwidth::variance_pooling).
     pub pool_radius: PoolRadius,
-    /// The probe samples one pixel in S×S (`--plan-probe-stride`; 1 = every pixel, as the
-    /// paper; prism_bandwidth::sparse_probing).
-    pub probe_stride_px: u32,
+    /// The probe samples one pixel in S×S (`--plan-probe-stride`; `auto` = half the pooling
+    /// radius, 1 = every pixel, as the paper; prism_bandwidth::sparse_probing).
+    pub probe_stride: ProbeStride,
+    /// The plan will be shaded hierarchically (`Prediction::make_hierarchical`): the
+    /// automatic probe stride is then 1.
+    pub hierarchical: bool,
 }
 
 impl PredictorSettings {
     /// `prism render --plan predicted`'s defaults for a mean of `mean_spp`: n_b = 16, a
     /// quarter of the budget uniform, the relative-error allocation, the probe's measured
-    /// variance, shadow edges on.
+    /// variance, shadow edges on, the automatic pooling radius and probe stride.
     pub const fn defaults(mean_spp: f64, seed: u64) -> Self {
         Self {
             probe_samples: DEFAULT_PROBE_SAMPLES,
@@ -78,7 +81,8 @@ impl PredictorSettings {
             colour_noise: true,
             pool_radius: DEFAULT_POOL_RADIUS,
             indirect_samples: DEFAULT_INDIRECT_SAMPLES,
-            probe_stride_px: DEFAULT_PROBE_STRIDE_PX,
+            probe_stride: DEFAULT_PROBE_STRIDE,
+            hierarchical: false,
         }
     }
 }
@@ -500,12 +504,12 @@ fn centre_class(scene: &RenderScene, pixel: UVec2) -> PixelClass {
 /// left without a probed pixel within the pooling radius `pool_radius_px`.
 fn pixels_to_probe(
     scene: &RenderScene,
-    settings: &PredictorSettings,
+    stride_px: u32,
     pool_radius_px: u32,
 ) -> Result<Vec<bool>, String> {
     let resolution = scene.resolution;
     let count = resolution.x as usize * resolution.y as usize;
-    if settings.probe_stride_px == 1 {
+    if stride_px == 1 {
         return Ok(vec![true; count]);
     }
     let class: Vec<PixelClass> = (0..count)
@@ -515,7 +519,7 @@ fn pixels_to_probe(
             centre_class(scene, UVec2::new((i % w) as u32, (i / w) as u32))
         })
         .collect();
-    prism_bandwidth::probed_pixels(resolution, &class, settings.probe_stride_px, pool_radius_px)
+    prism_bandwidth::probed_pixels(resolution, &class, stride_px, pool_radius_px)
         .map_err(|e| e.to_string())
 }
 
@@ -575,13 +579,18 @@ pub fn predict_with_probe<'a>(
     probe.trace_visibility = settings.visibility;
     // Light beyond the first bounce only where the estimator carries it (max_depth > 1):
     // with direct light only, the indirect estimates would predict light the render lacks.
+    let pool_radius_px = settings.pool_radius.px(resolution);
+    let stride_px = settings
+        .probe_stride
+        .px(pool_radius_px, settings.hierarchical);
+    let light_samples =
+        prism_bandwidth::samples_per_probed_pixel(settings.probe_samples, stride_px);
     let indirect_samples = if probe.estimator.carries_indirect() {
-        settings.indirect_samples
+        prism_bandwidth::samples_per_probed_pixel(settings.indirect_samples, stride_px)
     } else {
         0
     };
-    let pool_radius_px = settings.pool_radius.px(resolution);
-    let probed = pixels_to_probe(scene, settings, pool_radius_px)?;
+    let probed = pixels_to_probe(scene, stride_px, pool_radius_px)?;
     let w = resolution.x as usize;
     let rows: Vec<Vec<ProbedPixel>> = (0..resolution.y)
         .into_par_iter()
@@ -598,15 +607,11 @@ pub fn predict_with_probe<'a>(
                     match centre_ray(scene, pixel) {
                         CentreRay::Hit(hit) => {
                             let mut p = if probed[y as usize * w + x as usize] {
-                                let estimator_draws = probe.sample_lights(
-                                    pixel,
-                                    &hit,
-                                    settings.probe_samples,
-                                    &mut samples,
-                                );
+                                let estimator_draws =
+                                    probe.sample_lights(pixel, &hit, light_samples, &mut samples);
                                 let footprint = PixelFootprint {
                                     rad_per_px,
-                                    probe_samples: settings.probe_samples,
+                                    probe_samples: light_samples,
                                     estimator_draws,
                                 };
                                 let mut p = predict_pixel(

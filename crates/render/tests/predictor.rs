@@ -652,7 +652,7 @@ fn a_sparse_probe_keeps_the_shadow_edge_and_the_pooled_mean() {
     let sparse = predict(
         &scene,
         &PredictorSettings {
-            probe_stride_px: 2,
+            probe_stride: prism_bandwidth::ProbeStride::Px(2),
             ..PredictorSettings::defaults(16.0, 1)
         },
         1,
