@@ -64,8 +64,8 @@ pub use pixel_prediction::{predict_pixel, PixelFootprint, PixelPrediction, Varia
 pub use probe::{IndirectEstimate, LightSample, ShadingProbe};
 pub use sample_plan::{SamplePlan, DEFAULT_LIGHT_SAMPLES};
 pub use sparse_probing::{
-    nearest_probed, probed_pixels, samples_per_probed_pixel, ProbeStride, AUTO_MAX_STRIDE_PX,
-    DEFAULT_PROBE_STRIDE,
+    nearest_probed, on_probe_lattice, probed_pixels, samples_per_probed_pixel, ProbeStride,
+    AUTO_MAX_STRIDE_PX, DEFAULT_PROBE_STRIDE,
 };
 pub use variance_model::{model_variance, ModelledVariance};
 pub use variance_pooling::{

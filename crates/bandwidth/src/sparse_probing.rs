@@ -79,6 +79,13 @@ fn on_lattice(x: usize, y: usize, stride: usize) -> bool {
     x.is_multiple_of(stride) && y.is_multiple_of(stride)
 }
 
+/// True for pixel (x, y) on the lattice of stride `stride_px` (every pixel at 1, and at 0,
+/// which [`probed_pixels`] refuses): the pixels [`probed_pixels`] probes wherever their
+/// surface is, so that a renderer can probe them before it knows the surfaces.
+pub fn on_probe_lattice(x: u32, y: u32, stride_px: u32) -> bool {
+    stride_px <= 1 || on_lattice(x as usize, y as usize, stride_px as usize)
+}
+
 /// The pixels the probe samples (row-major): for `stride_px` S and pooling radius r, every
 /// lattice pixel of a surface, every surface pixel with no lattice pixel of its own class
 /// within r (Chebyshev distance), and every pixel that sees the background (its prediction
@@ -202,6 +209,26 @@ mod tests {
         assert_eq!([n(1), n(2), n(3), n(4), n(8)], [16, 16, 36, 64, 256]);
         assert_eq!(samples_per_probed_pixel(0, 4), 0);
         assert_eq!(samples_per_probed_pixel(u32::MAX, 4), u32::MAX);
+    }
+
+    #[test]
+    fn every_surface_pixel_on_the_lattice_is_probed_and_the_lattice_is_all_at_stride_one() {
+        let class: Vec<PixelClass> = (0..36)
+            .map(|i| match i % 3 {
+                0 => PixelClass::Material(0),
+                1 => PixelClass::Material(1),
+                _ => PixelClass::Background,
+            })
+            .collect();
+        let probed = probed_pixels(UVec2::new(6, 6), &class, 2, 1).unwrap();
+        for (i, c) in class.iter().enumerate() {
+            let (x, y) = ((i % 6) as u32, (i / 6) as u32);
+            if on_probe_lattice(x, y, 2) && *c != PixelClass::Unpredicted {
+                assert!(probed[i], "pixel ({x}, {y})");
+            }
+            assert!(on_probe_lattice(x, y, 1));
+        }
+        assert!(on_probe_lattice(4, 2, 2) && !on_probe_lattice(3, 2, 2));
     }
 
     #[test]

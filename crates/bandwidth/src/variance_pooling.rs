@@ -148,32 +148,48 @@ impl ClassExtent {
     }
 }
 
-/// The extents of the pooled classes (all but `Unpredicted`), in no particular order:
-/// each class writes only its own pixels.
+/// The extents of the pooled classes (all but `Unpredicted`), in the order they are first
+/// met: each class writes only its own pixels.
 fn class_extents(resolution: UVec2, class: &[PixelClass]) -> Vec<ClassExtent> {
     let w = resolution.x as usize;
-    let mut extents: HashMap<PixelClass, ClassExtent> = HashMap::new();
+    // Classes come in long runs along a row: the class met last is checked first, and the
+    // map is asked only where a run changes (hashing every pixel was several per cent of
+    // the predictor at 128², fig17).
+    let mut extents: Vec<ClassExtent> = Vec::new();
+    let mut index: HashMap<PixelClass, usize> = HashMap::new();
+    let mut last = 0;
     for (i, &c) in class.iter().enumerate() {
         match c {
             PixelClass::Unpredicted => continue,
             PixelClass::Material(_) | PixelClass::Background => {}
         }
         let (x, y) = (i % w, i / w);
-        extents
-            .entry(c)
-            .and_modify(|e| {
+        let found = if extents.get(last).is_some_and(|e| e.class == c) {
+            Some(last)
+        } else {
+            index.get(&c).copied()
+        };
+        match found {
+            Some(k) => {
+                let e = &mut extents[k];
                 e.min = (e.min.0.min(x), e.min.1.min(y));
                 e.max = (e.max.0.max(x), e.max.1.max(y));
                 e.pixels += 1;
-            })
-            .or_insert(ClassExtent {
-                class: c,
-                min: (x, y),
-                max: (x, y),
-                pixels: 1,
-            });
+                last = k;
+            }
+            None => {
+                last = extents.len();
+                index.insert(c, last);
+                extents.push(ClassExtent {
+                    class: c,
+                    min: (x, y),
+                    max: (x, y),
+                    pixels: 1,
+                });
+            }
+        }
     }
-    extents.into_values().collect()
+    extents
 }
 
 /// How one class's window sums are taken; both give the same sums up to rounding.

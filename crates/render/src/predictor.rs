@@ -484,45 +484,6 @@ fn add_shadow_edges(
     }
 }
 
-/// The class of what `pixel`'s centre ray meets, as the probe pass will find it.
-fn centre_class(scene: &RenderScene, pixel: UVec2) -> PixelClass {
-    if angular_footprint(scene, pixel)
-        .filter(|a| *a > 0.0)
-        .is_none()
-    {
-        return PixelClass::Unpredicted;
-    }
-    match centre_ray(scene, pixel) {
-        CentreRay::Hit(hit) => PixelClass::Material(hit.material_id()),
-        CentreRay::Escapes(_) => PixelClass::Background,
-        CentreRay::None => PixelClass::Unpredicted,
-    }
-}
-
-/// The pixels the probe samples (`prism_bandwidth::sparse_probing`): all at a stride of 1;
-/// otherwise a first pass of centre rays finds each pixel's surface, so that no surface is
-/// left without a probed pixel within the pooling radius `pool_radius_px`.
-fn pixels_to_probe(
-    scene: &RenderScene,
-    stride_px: u32,
-    pool_radius_px: u32,
-) -> Result<Vec<bool>, String> {
-    let resolution = scene.resolution;
-    let count = resolution.x as usize * resolution.y as usize;
-    if stride_px == 1 {
-        return Ok(vec![true; count]);
-    }
-    let class: Vec<PixelClass> = (0..count)
-        .into_par_iter()
-        .map(|i| {
-            let w = resolution.x as usize;
-            centre_class(scene, UVec2::new((i % w) as u32, (i / w) as u32))
-        })
-        .collect();
-    prism_bandwidth::probed_pixels(resolution, &class, stride_px, pool_radius_px)
-        .map_err(|e| e.to_string())
-}
-
 /// A pixel the probe skipped takes the nearest probed pixel's bandwidth ν (of its own
 /// surface, within the pooling radius) and its shadow rays' summary, and turns ν into its
 /// own b_p with its own footprint (eq. 6); its V̂ and L̂ come from the pooling.
@@ -550,6 +511,70 @@ fn borrow_from_probed(
         );
     }
     Ok(())
+}
+
+/// What the probe needs at each surface pixel, shared by the G-buffer's pass and the pass
+/// over the pixels off the probe's lattice.
+struct ProbeWork<'a, 'p> {
+    scene: &'a RenderScene,
+    probe: &'p RenderProbe<'a>,
+    /// n_b at a probed pixel (`samples_per_probed_pixel`).
+    light_samples: u32,
+    /// One-bounce indirect estimates at a probed pixel.
+    indirect_samples: u32,
+    variance_bandwidth: VarianceBandwidth,
+}
+
+/// A thread's reusable buffers for the probe's samples.
+#[derive(Default)]
+struct ProbeScratch {
+    samples: Vec<LightSample>,
+    indirect: Vec<IndirectEstimate>,
+}
+
+impl ProbeWork<'_, '_> {
+    /// A surface pixel's prediction: the probe's where `probed` (eqs. 5, 6, 9 and the
+    /// indirect estimates), otherwise the default that `borrow_from_probed` fills; both
+    /// with the sun's bandwidth seen in a mirror at the centre hit.
+    fn surface_prediction(
+        &self,
+        pixel: UVec2,
+        hit: &GBufferHit,
+        rad_per_px: f32,
+        probed: bool,
+        scratch: &mut ProbeScratch,
+    ) -> Result<PixelPrediction, String> {
+        let mut p = if probed {
+            let estimator_draws =
+                self.probe
+                    .sample_lights(pixel, hit, self.light_samples, &mut scratch.samples);
+            let footprint = PixelFootprint {
+                rad_per_px,
+                probe_samples: self.light_samples,
+                estimator_draws,
+            };
+            let mut p = predict_pixel(hit, &scratch.samples, footprint, self.variance_bandwidth)
+                .map_err(|e| e.to_string())?;
+            self.probe
+                .sample_indirect(pixel, hit, self.indirect_samples, &mut scratch.indirect);
+            let (mean, variance) = mean_and_variance(scratch.indirect.iter().map(|e| e.radiance_y));
+            p.mean_y += mean;
+            p.indirect_variance = variance;
+            // The indirect light's own colour noise (dispersion through glass, spiky spectra
+            // seen by a bounce), per camera sample.
+            p.colour_variance +=
+                mean_and_variance(scratch.indirect.iter().map(|e| e.lane_variance)).0;
+            p
+        } else {
+            PixelPrediction::default()
+        };
+        if self.probe.is_dirac_at(hit) {
+            p.image_bandwidth_cycles_per_px = p
+                .image_bandwidth_cycles_per_px
+                .max(mirrored_sun_bandwidth(self.scene, hit, rad_per_px));
+        }
+        Ok(p)
+    }
 }
 
 /// Runs the predictor over every pixel of `scene` (in parallel on the current rayon pool).
@@ -590,13 +615,21 @@ pub fn predict_with_probe<'a>(
     } else {
         0
     };
-    let probed = pixels_to_probe(scene, stride_px, pool_radius_px)?;
-    let w = resolution.x as usize;
+    let probe_work = ProbeWork {
+        scene,
+        probe: &probe,
+        light_samples,
+        indirect_samples,
+        variance_bandwidth: settings.variance_bandwidth,
+    };
+    // The lattice's pixels are probed in the G-buffer's pass; the pixels of surfaces with no
+    // lattice pixel within the pooling radius, which only the G-buffer's classes find, in a
+    // second pass (the centre rays are traced once, but for those few).
+    let on_lattice = |x: u32, y: u32| prism_bandwidth::on_probe_lattice(x, y, stride_px);
     let rows: Vec<Vec<ProbedPixel>> = (0..resolution.y)
         .into_par_iter()
         .map(|y| {
-            let mut samples: Vec<LightSample> = Vec::new();
-            let mut indirect: Vec<IndirectEstimate> = Vec::new();
+            let mut scratch = ProbeScratch::default();
             (0..resolution.x)
                 .map(|x| {
                     let pixel = UVec2::new(x, y);
@@ -606,41 +639,14 @@ pub fn predict_with_probe<'a>(
                     };
                     match centre_ray(scene, pixel) {
                         CentreRay::Hit(hit) => {
-                            let mut p = if probed[y as usize * w + x as usize] {
-                                let estimator_draws =
-                                    probe.sample_lights(pixel, &hit, light_samples, &mut samples);
-                                let footprint = PixelFootprint {
-                                    rad_per_px,
-                                    probe_samples: light_samples,
-                                    estimator_draws,
-                                };
-                                let mut p = predict_pixel(
-                                    &hit,
-                                    &samples,
-                                    footprint,
-                                    settings.variance_bandwidth,
-                                )
-                                .map_err(|e| e.to_string())?;
-                                probe.sample_indirect(pixel, &hit, indirect_samples, &mut indirect);
-                                let (mean, variance) =
-                                    mean_and_variance(indirect.iter().map(|e| e.radiance_y));
-                                p.mean_y += mean;
-                                p.indirect_variance = variance;
-                                // The indirect light's own colour noise (dispersion through
-                                // glass, spiky spectra seen by a bounce), per camera sample.
-                                p.colour_variance +=
-                                    mean_and_variance(indirect.iter().map(|e| e.lane_variance)).0;
-                                p
-                            } else {
-                                // Filled from the nearest probed pixel (`borrow_from_probed`).
-                                PixelPrediction::default()
-                            };
+                            let p = probe_work.surface_prediction(
+                                pixel,
+                                &hit,
+                                rad_per_px,
+                                on_lattice(x, y),
+                                &mut scratch,
+                            )?;
                             let dirac = probe.is_dirac_at(&hit);
-                            if dirac {
-                                p.image_bandwidth_cycles_per_px = p
-                                    .image_bandwidth_cycles_per_px
-                                    .max(mirrored_sun_bandwidth(scene, &hit, rad_per_px));
-                            }
                             let c = hit.curvature();
                             Ok(ProbedPixel {
                                 prediction: p,
@@ -676,13 +682,14 @@ pub fn predict_with_probe<'a>(
                 .collect::<Result<Vec<_>, String>>()
         })
         .collect::<Result<Vec<_>, String>>()?;
-    let mut pixels = Vec::new();
-    let mut curvature = Vec::new();
-    let mut eye = Vec::new();
-    let mut class = Vec::new();
-    let mut surface = Vec::new();
-    let mut seen = Vec::new();
-    let mut texture_scale = Vec::new();
+    let count = resolution.x as usize * resolution.y as usize;
+    let mut pixels = Vec::with_capacity(count);
+    let mut curvature = Vec::with_capacity(count);
+    let mut eye = Vec::with_capacity(count);
+    let mut class = Vec::with_capacity(count);
+    let mut surface = Vec::with_capacity(count);
+    let mut seen = Vec::with_capacity(count);
+    let mut texture_scale = Vec::with_capacity(count);
     for probed in rows.into_iter().flatten() {
         pixels.push(probed.prediction);
         curvature.push(probed.curvature_per_m);
@@ -691,6 +698,31 @@ pub fn predict_with_probe<'a>(
         class.push(probed.class);
         surface.push(probed.surface);
         seen.push(probed.seen);
+    }
+    let probed = prism_bandwidth::probed_pixels(resolution, &class, stride_px, pool_radius_px)
+        .map_err(|e| e.to_string())?;
+    let w = resolution.x as usize;
+    let off_lattice: Vec<(usize, PixelPrediction)> = (0..count)
+        .into_par_iter()
+        .filter(|&i| {
+            probed[i]
+                && matches!(class[i], PixelClass::Material(_))
+                && !on_lattice((i % w) as u32, (i / w) as u32)
+        })
+        .map_init(ProbeScratch::default, |scratch, i| {
+            let pixel = UVec2::new((i % w) as u32, (i / w) as u32);
+            let (Some(eye), CentreRay::Hit(hit)) = (eye[i], centre_ray(scene, pixel)) else {
+                return Err(format!(
+                    "pixel {pixel}: its centre ray no longer meets the surface it met (the \
+                     G-buffer's rays are deterministic; this is a bug)"
+                ));
+            };
+            let p = probe_work.surface_prediction(pixel, &hit, eye.rad_per_px, true, scratch)?;
+            Ok((i, p))
+        })
+        .collect::<Result<Vec<_>, String>>()?;
+    for (i, p) in off_lattice {
+        pixels[i] = p;
     }
     keep_texture_scales_off_zero(&mut texture_scale, &class);
     borrow_from_probed(
