@@ -535,13 +535,14 @@ struct ProbeScratch {
 impl ProbeWork<'_, '_> {
     /// A surface pixel's prediction: the probe's where `probed` (eqs. 5, 6, 9 and the
     /// indirect estimates), otherwise the default that `borrow_from_probed` fills; both
-    /// with the sun's bandwidth seen in a mirror at the centre hit.
+    /// with the sun's bandwidth seen in a mirror where the centre hit is `dirac`
+    /// (`RenderProbe::is_dirac_at`).
     fn surface_prediction(
         &self,
         pixel: UVec2,
         hit: &GBufferHit,
         rad_per_px: f32,
-        probed: bool,
+        (probed, dirac): (bool, bool),
         scratch: &mut ProbeScratch,
     ) -> Result<PixelPrediction, String> {
         let mut p = if probed {
@@ -568,7 +569,7 @@ impl ProbeWork<'_, '_> {
         } else {
             PixelPrediction::default()
         };
-        if self.probe.is_dirac_at(hit) {
+        if dirac {
             p.image_bandwidth_cycles_per_px = p
                 .image_bandwidth_cycles_per_px
                 .max(mirrored_sun_bandwidth(self.scene, hit, rad_per_px));
@@ -639,14 +640,14 @@ pub fn predict_with_probe<'a>(
                     };
                     match centre_ray(scene, pixel) {
                         CentreRay::Hit(hit) => {
+                            let dirac = probe.is_dirac_at(&hit);
                             let p = probe_work.surface_prediction(
                                 pixel,
                                 &hit,
                                 rad_per_px,
-                                on_lattice(x, y),
+                                (on_lattice(x, y), dirac),
                                 &mut scratch,
                             )?;
-                            let dirac = probe.is_dirac_at(&hit);
                             let c = hit.curvature();
                             Ok(ProbedPixel {
                                 prediction: p,
@@ -717,7 +718,14 @@ pub fn predict_with_probe<'a>(
                      G-buffer's rays are deterministic; this is a bug)"
                 ));
             };
-            let p = probe_work.surface_prediction(pixel, &hit, eye.rad_per_px, true, scratch)?;
+            let dirac = probe.is_dirac_at(&hit);
+            let p = probe_work.surface_prediction(
+                pixel,
+                &hit,
+                eye.rad_per_px,
+                (true, dirac),
+                scratch,
+            )?;
             Ok((i, p))
         })
         .collect::<Result<Vec<_>, String>>()?;
