@@ -168,6 +168,10 @@ impl PlanArgs {
     pub fn max_level(&self) -> u32 {
         self.plan_max_level.unwrap_or(DEFAULT_MAX_LEVEL)
     }
+    /// `predicted-hier`'s coarsest lattice level; `None` for the other plans.
+    fn hierarchical_max_level(&self) -> Option<u32> {
+        (self.plan == PlanArg::PredictedHier).then_some(self.max_level())
+    }
 
     /// True for the plans the predictor makes.
     pub fn predicts(&self) -> bool {
@@ -241,8 +245,7 @@ impl PlanArgs {
                 colour_noise: self.colour() == OnOff::On,
                 probe_stride: self.probe_stride(),
                 pool_radius: self.pool_radius(),
-                hierarchical_max_level: (self.plan == PlanArg::PredictedHier)
-                    .then_some(self.max_level()),
+                hierarchical_max_level: self.hierarchical_max_level(),
             },
             PlanArg::Adaptive => SamplePlanKind::Adaptive,
         }
@@ -284,7 +287,7 @@ impl PlanArgs {
             pool_radius: self.pool_radius(),
             indirect_samples: self.indirect(),
             probe_stride: self.probe_stride(),
-            hierarchical: self.plan == PlanArg::PredictedHier,
+            hierarchical_max_level: self.hierarchical_max_level(),
         }
     }
 }

@@ -1,10 +1,11 @@
 //! The bandwidth predictor run and timed as `prism render --plan predicted` and `prism
 //! converge`'s predicted methods both run it: the BSDF angular tables (built, or read from
-//! `--cache-dir`), then the prediction and whatever the caller derives from it (the
-//! hierarchical plan), each phase in process CPU seconds and wall seconds.
+//! `--cache-dir`), then the prediction and, for `predicted-hier`, its hierarchical plan,
+//! each phase in process CPU seconds and wall seconds.
 
 use std::time::Instant;
 
+use prism_bandwidth::Upsampling;
 use prism_render::bsdf_table_cache::AngularTableCache;
 use prism_render::predictor::{predict_with_probe, Prediction, PredictorSettings};
 use prism_render::probe::RenderProbe;
@@ -75,24 +76,33 @@ impl PredictorTime {
 }
 
 /// Builds the probe's tables for `scene` (through `table_cache`), predicts with
-/// `predictor`, then runs `finish` on the prediction inside the same clock: the
-/// prediction, `finish`'s result and the time of both phases.
-pub fn predict_timed<T>(
+/// `predictor` and, where it asks for hierarchical shading, makes the hierarchical plan
+/// (at the allocation's mean spp and seed) inside the same clock: the prediction, the
+/// up-sampling of `predicted-hier` and the time of both phases.
+pub fn predict_timed(
     scene: &RenderScene,
     predictor: &PredictorSettings,
     seed: u64,
     table_cache: Option<&AngularTableCache>,
-    finish: impl FnOnce(&mut Prediction) -> Result<T, String>,
-) -> Result<(Prediction, T, PredictorTime), String> {
+) -> Result<(Prediction, Option<Upsampling>, PredictorTime), String> {
     let started = Moment::now();
     let probe = RenderProbe::new(scene, seed).with_bandwidth_tables_cached(table_cache)?;
     let tables_done = Moment::now();
     let mut prediction = predict_with_probe(scene, predictor, probe)?;
-    let finished_with = finish(&mut prediction)?;
+    let upsampling = predictor
+        .hierarchical_max_level
+        .map(|max_level| {
+            prediction.make_hierarchical(
+                max_level,
+                predictor.allocation.mean_spp,
+                predictor.allocation.seed,
+            )
+        })
+        .transpose()?;
     let time = PredictorTime {
         started,
         tables_done,
         finished: Moment::now(),
     };
-    Ok((prediction, finished_with, time))
+    Ok((prediction, upsampling, time))
 }

@@ -571,16 +571,6 @@ pub fn run(args: &RenderArgs, budget: &MemoryBudget) -> Result<ExitCode, String>
                         &predictor,
                         settings.seed,
                         table_cache.as_ref(),
-                        |prediction| match args.plan.plan {
-                            PlanArg::PredictedHier => prediction
-                                .make_hierarchical(
-                                    args.plan.max_level(),
-                                    f64::from(settings.spp),
-                                    settings.seed,
-                                )
-                                .map(Some),
-                            PlanArg::Predicted | PlanArg::Uniform | PlanArg::Adaptive => Ok(None),
-                        },
                     )
                 })
                 .map_err(|e| format!("{}: {e}", args.scene.display()))?;

@@ -60,24 +60,12 @@ impl PassPlanner {
         let allocated = match kind {
             PlanKind::Predicted | PlanKind::PredictedHier => {
                 let predictor = PredictorSettings {
-                    hierarchical: kind == PlanKind::PredictedHier,
+                    hierarchical_max_level: (kind == PlanKind::PredictedHier)
+                        .then_some(DEFAULT_MAX_LEVEL),
                     ..PredictorSettings::defaults(PREDICTED_PLAN_SPP, settings.seed)
                 };
-                let (prediction, hierarchy, time) = predict_timed(
-                    scene,
-                    &predictor,
-                    settings.seed,
-                    inputs.table_cache,
-                    |prediction| match kind {
-                        PlanKind::PredictedHier => prediction
-                            .make_hierarchical(DEFAULT_MAX_LEVEL, PREDICTED_PLAN_SPP, settings.seed)
-                            .map(Some),
-                        PlanKind::Predicted
-                        | PlanKind::Uniform
-                        | PlanKind::Adaptive
-                        | PlanKind::Oracle => Ok(None),
-                    },
-                )?;
+                let (prediction, hierarchy, time) =
+                    predict_timed(scene, &predictor, settings.seed, inputs.table_cache)?;
                 upsampling = hierarchy.map(Arc::new);
                 predictor_cpu = time.cpu();
                 Some(prediction.allocated)

@@ -58,9 +58,10 @@ pub struct PredictorSettings {
     /// The probe samples one pixel in S×S (`--plan-probe-stride`; `auto` = half the pooling
     /// radius, 1 = every pixel, as the paper; prism_bandwidth::sparse_probing).
     pub probe_stride: ProbeStride,
-    /// The plan will be shaded hierarchically (`Prediction::make_hierarchical`): the
+    /// `predicted-hier`: the plan is shaded hierarchically with lattices up to this level
+    /// (`Prediction::make_hierarchical`, with the allocation's mean spp and seed); the
     /// automatic probe stride is then 1.
-    pub hierarchical: bool,
+    pub hierarchical_max_level: Option<u32>,
 }
 
 impl PredictorSettings {
@@ -82,7 +83,7 @@ impl PredictorSettings {
             pool_radius: DEFAULT_POOL_RADIUS,
             indirect_samples: DEFAULT_INDIRECT_SAMPLES,
             probe_stride: DEFAULT_PROBE_STRIDE,
-            hierarchical: false,
+            hierarchical_max_level: None,
         }
     }
 }
@@ -542,7 +543,8 @@ impl ProbeWork<'_, '_> {
         pixel: UVec2,
         hit: &GBufferHit,
         rad_per_px: f32,
-        (probed, dirac): (bool, bool),
+        probed: bool,
+        dirac: bool,
         scratch: &mut ProbeScratch,
     ) -> Result<PixelPrediction, String> {
         let mut p = if probed {
@@ -603,14 +605,14 @@ pub fn predict_with_probe<'a>(
     }
     let resolution = scene.resolution;
     probe.trace_visibility = settings.visibility;
-    // Light beyond the first bounce only where the estimator carries it (max_depth > 1):
-    // with direct light only, the indirect estimates would predict light the render lacks.
     let pool_radius_px = settings.pool_radius.px(resolution);
     let stride_px = settings
         .probe_stride
-        .px(pool_radius_px, settings.hierarchical);
+        .px(pool_radius_px, settings.hierarchical_max_level.is_some());
     let light_samples =
         prism_bandwidth::samples_per_probed_pixel(settings.probe_samples, stride_px);
+    // Light beyond the first bounce only where the estimator carries it (max_depth > 1):
+    // with direct light only, the indirect estimates would predict light the render lacks.
     let indirect_samples = if probe.estimator.carries_indirect() {
         prism_bandwidth::samples_per_probed_pixel(settings.indirect_samples, stride_px)
     } else {
@@ -645,7 +647,8 @@ pub fn predict_with_probe<'a>(
                                 pixel,
                                 &hit,
                                 rad_per_px,
-                                (on_lattice(x, y), dirac),
+                                on_lattice(x, y),
+                                dirac,
                                 &mut scratch,
                             )?;
                             let c = hit.curvature();
@@ -719,13 +722,8 @@ pub fn predict_with_probe<'a>(
                 ));
             };
             let dirac = probe.is_dirac_at(&hit);
-            let p = probe_work.surface_prediction(
-                pixel,
-                &hit,
-                eye.rad_per_px,
-                (true, dirac),
-                scratch,
-            )?;
+            let p =
+                probe_work.surface_prediction(pixel, &hit, eye.rad_per_px, true, dirac, scratch)?;
             Ok((i, p))
         })
         .collect::<Result<Vec<_>, String>>()?;
