@@ -16,7 +16,6 @@ use glam::UVec2;
 
 use crate::error::{check_lengths, pixel_count, BandwidthError};
 use crate::hierarchical_shading::{SurfacePoint, CREASE_MIN_COS};
-use crate::pixel_neighbours::four_neighbours;
 use crate::variance_pooling::PixelClass;
 
 /// A neighbour's hit further off a pixel's tangent plane than sin 30° of the chord to it is
@@ -79,24 +78,35 @@ pub fn geometric_edges(
             ("own L̂", own_mean_y.len()),
         ],
     )?;
-    Ok((0..count)
-        .map(|i| {
-            if class[i] == PixelClass::Unpredicted {
-                return false;
+    // Whether the pair (i, j) straddles a visible edge. Symmetric in i and j, so each pair
+    // is judged once (a pixel and its right and lower neighbours) and marks both; the
+    // luminance steps, cheaper than the geometry, are asked first.
+    let straddles = |i: usize, j: usize| {
+        let own_step = is_visible_step(own_mean_y[i], own_mean_y[j]);
+        let step = if class[i] == class[j] {
+            own_step
+        } else {
+            is_visible_step(pooled_mean_y[i], pooled_mean_y[j])
+        };
+        (step && is_discontinuous(class[i], class[j], surface[i], surface[j]))
+            || (own_step && seen_across_edge(seen[i], seen[j]))
+    };
+    let width = resolution.x as usize;
+    let mut edges = vec![false; count];
+    for i in 0..count {
+        if class[i] == PixelClass::Unpredicted {
+            continue;
+        }
+        let right = (i % width + 1 < width).then_some(i + 1);
+        let below = (i + width < count).then_some(i + width);
+        for j in [right, below].into_iter().flatten() {
+            if class[j] != PixelClass::Unpredicted && straddles(i, j) {
+                edges[i] = true;
+                edges[j] = true;
             }
-            four_neighbours(i, resolution).any(|j| {
-                class[j] != PixelClass::Unpredicted
-                    && ((is_discontinuous(class[i], class[j], surface[i], surface[j])
-                        && if class[i] == class[j] {
-                            is_visible_step(own_mean_y[i], own_mean_y[j])
-                        } else {
-                            is_visible_step(pooled_mean_y[i], pooled_mean_y[j])
-                        })
-                        || (seen_across_edge(seen[i], seen[j])
-                            && is_visible_step(own_mean_y[i], own_mean_y[j])))
-            })
-        })
-        .collect())
+        }
+    }
+    Ok(edges)
 }
 
 /// Another material or the background, a crease or a depth step.

@@ -17,8 +17,7 @@ use prism_bandwidth::{
     PoolRadius, ProbeStride, SeenSurface, ShadingProbe, SurfacePoint, Upsampling,
     VarianceBandwidth, VisibilitySummary, DEFAULT_POOL_RADIUS, DEFAULT_PROBE_STRIDE,
 };
-use prism_spectrum::colorimetry::sampled_radiance_to_xyz;
-use prism_spectrum::{SampledSpectrum, SampledWavelengths};
+use prism_spectrum::{SampledSpectrum, SampledWavelengths, XyzWeights};
 use rayon::prelude::*;
 
 use crate::film::AovPlane;
@@ -237,9 +236,6 @@ fn centre_ray(scene: &RenderScene, pixel: UVec2) -> CentreRay {
     }
 }
 
-/// A pixel that sees the infinite lights directly: its noise is colour noise alone (the
-/// hero wavelengths' estimate of the radiance along the ray, sampled `count` times with
-/// stratified hero wavelengths) plus the anti-aliasing of the lights' own detail (b_p).
 /// ν_a of the infinite lights a pixel whose centre ray escapes along `direction` sees: an
 /// environment map's eq. 7 value in that direction, a sun disk's only within its radius
 /// plus two pixel footprints of the direction (elsewhere it adds nothing to what the pixel
@@ -348,7 +344,7 @@ struct ProbedPixel {
     prediction: PixelPrediction,
     /// The larger principal curvature's magnitude at the centre hit (the MIP pyramid's).
     curvature_per_m: f32,
-    /// ρ_p for the pooling (`RenderProbe::texture_scale`; 1 off textured surfaces).
+    /// ρ_p for the pooling (`RenderProbe::hit_material`; 1 off textured surfaces).
     texture_scale: f32,
     eye: Option<EyeGeometry>,
     class: PixelClass,
@@ -373,26 +369,53 @@ impl ProbedPixel {
     }
 }
 
+/// The wavelengths of an escaping pixel's quadrature (`escaping_pixel`): `count` stratified
+/// sets over the RGB-output density with their CMF weights, built once per prediction since
+/// every background pixel takes the same.
+struct BackgroundQuadrature {
+    wavelengths: Vec<SampledWavelengths>,
+    weights: Vec<XyzWeights>,
+}
+
+impl BackgroundQuadrature {
+    fn new(count: u32) -> Self {
+        let wavelengths: Vec<SampledWavelengths> = (0..count)
+            .map(|k| SampledWavelengths::sample_rgb_output((k as f32 + 0.5) / count as f32))
+            .collect();
+        let weights = wavelengths.iter().map(XyzWeights::new).collect();
+        Self {
+            wavelengths,
+            weights,
+        }
+    }
+}
+
+/// A pixel that sees the infinite lights directly: its noise is colour noise alone (the
+/// hero wavelengths' estimate of the radiance along the ray, over the stratified hero
+/// wavelengths of `quadrature`) plus the anti-aliasing of the lights' own detail (b_p).
 fn escaping_pixel(
     scene: &RenderScene,
     direction: Vec3A,
-    count: u32,
+    quadrature: &BackgroundQuadrature,
     background_nu_a: f32,
     rad_per_px: f32,
 ) -> PixelPrediction {
     let lights = &scene.lights;
-    let estimates: Vec<DVec3> = (0..count)
-        .map(|k| {
-            let wavelengths =
-                SampledWavelengths::sample_rgb_output((k as f32 + 0.5) / count as f32);
-            let mut radiance = SampledSpectrum::splat(0.0);
-            for &l in lights.infinite_lights() {
-                radiance += lights.light(l).infinite_radiance(direction, &wavelengths);
-            }
-            sampled_radiance_to_xyz(radiance, &wavelengths)
-        })
+    let mut radiance = vec![SampledSpectrum::splat(0.0); quadrature.wavelengths.len()];
+    for &l in lights.infinite_lights() {
+        lights.light(l).add_infinite_radiance_each(
+            direction,
+            &quadrature.wavelengths,
+            &mut radiance,
+        );
+    }
+    let estimates: Vec<DVec3> = radiance
+        .iter()
+        .zip(&quadrature.weights)
+        .map(|(&r, weights)| weights.xyz(r))
         .collect();
-    let n = f64::from(count.max(1));
+    let count = estimates.len();
+    let n = count.max(1) as f64;
     let mean = estimates.iter().copied().sum::<DVec3>() / n;
     // Unbiased sample variances: of the X, Y and Z lanes summed (the colour noise), and of
     // Y alone (what `--plan-colour off` follows).
@@ -537,7 +560,7 @@ impl ProbeWork<'_, '_> {
     /// A surface pixel's prediction: the probe's where `probed` (eqs. 5, 6, 9 and the
     /// indirect estimates), otherwise the default that `borrow_from_probed` fills; both
     /// with the sun's bandwidth seen in a mirror where the centre hit is `dirac`
-    /// (`RenderProbe::is_dirac_at`).
+    /// (`RenderProbe::hit_material`).
     fn surface_prediction(
         &self,
         pixel: UVec2,
@@ -629,6 +652,7 @@ pub fn predict_with_probe<'a>(
     // lattice pixel within the pooling radius, which only the G-buffer's classes find, in a
     // second pass (the centre rays are traced once, but for those few).
     let on_lattice = |x: u32, y: u32| prism_bandwidth::on_probe_lattice(x, y, stride_px);
+    let background_quadrature = BackgroundQuadrature::new(settings.probe_samples);
     let rows: Vec<Vec<ProbedPixel>> = (0..resolution.y)
         .into_par_iter()
         .map(|y| {
@@ -642,7 +666,8 @@ pub fn predict_with_probe<'a>(
                     };
                     match centre_ray(scene, pixel) {
                         CentreRay::Hit(hit) => {
-                            let dirac = probe.is_dirac_at(&hit);
+                            let material = probe.hit_material(&hit);
+                            let dirac = material.dirac;
                             let p = probe_work.surface_prediction(
                                 pixel,
                                 &hit,
@@ -655,7 +680,7 @@ pub fn predict_with_probe<'a>(
                             Ok(ProbedPixel {
                                 prediction: p,
                                 curvature_per_m: c.k1.abs().max(c.k2.abs()),
-                                texture_scale: probe.texture_scale(&hit),
+                                texture_scale: material.texture_scale,
                                 eye: Some(EyeGeometry {
                                     depth_m: hit.depth_m(),
                                     cos_theta_x: hit.cos_theta_view(),
@@ -673,7 +698,7 @@ pub fn predict_with_probe<'a>(
                             prediction: escaping_pixel(
                                 scene,
                                 direction,
-                                settings.probe_samples,
+                                &background_quadrature,
                                 background_angular_bandwidth(scene, &probe, direction, rad_per_px),
                                 rad_per_px,
                             ),
@@ -721,7 +746,7 @@ pub fn predict_with_probe<'a>(
                      G-buffer's rays are deterministic; this is a bug)"
                 ));
             };
-            let dirac = probe.is_dirac_at(&hit);
+            let dirac = probe.hit_material(&hit).dirac;
             let p =
                 probe_work.surface_prediction(pixel, &hit, eye.rad_per_px, true, dirac, scratch)?;
             Ok((i, p))

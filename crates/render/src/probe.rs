@@ -206,32 +206,40 @@ impl<'a> RenderProbe<'a> {
             .fold(0.0, f32::max)
     }
 
-    /// ρ_p for pooling V̂ and L̂ (`prism_bandwidth::model_variance`): the directional
-    /// albedo's Y at the hit, seen from the eye, where the material has a texture (which
-    /// scales the pixel's light by its texel), else 1 (the whole surface shares one scale).
-    pub fn texture_scale(&self, hit: &GBufferHit) -> f32 {
-        if self
-            .textures_of(hit.material_id())
-            .is_none_or(|t| t.is_empty())
-        {
-            return 1.0;
-        }
+    /// What the G-buffer pass asks of the material at `hit`, from one BSDF (which reads the
+    /// hit's textures), judged at the middle of the visible range: whether it scatters only
+    /// in Dirac directions there (a mirror, smooth glass), and ρ_p for pooling V̂ and L̂
+    /// (`prism_bandwidth::model_variance`): the directional albedo's Y seen from the eye
+    /// where the material has a texture (which scales the pixel's light by its texel), else
+    /// 1 (the whole surface shares one scale).
+    pub(crate) fn hit_material(&self, hit: &GBufferHit) -> HitMaterial {
         let si = hit_interaction(hit);
-        let frame = Frame::from_zx(si.n_shading, si.dpdu);
         let wavelengths = SampledWavelengths::sample_visible(0.5);
         let bsdf = self
             .scene
             .material(hit.material_id())
             .bsdf(&si, &wavelengths);
-        let albedo = bsdf.albedo(
-            frame.to_local(hit.view_direction()),
-            TransportMode::Radiance,
-        );
-        let y = reflectance_y(albedo, &XyzWeights::new(&wavelengths));
-        if y.is_finite() {
-            y.max(0.0)
+        let textured = self
+            .textures_of(hit.material_id())
+            .is_some_and(|t| !t.is_empty());
+        let texture_scale = if textured {
+            let frame = Frame::from_zx(si.n_shading, si.dpdu);
+            let albedo = bsdf.albedo(
+                frame.to_local(hit.view_direction()),
+                TransportMode::Radiance,
+            );
+            let y = reflectance_y(albedo, &XyzWeights::new(&wavelengths));
+            if y.is_finite() {
+                y.max(0.0)
+            } else {
+                0.0
+            }
         } else {
-            0.0
+            1.0
+        };
+        HitMaterial {
+            dirac: bsdf.is_specular(),
+            texture_scale,
         }
     }
 
@@ -264,22 +272,11 @@ impl<'a> RenderProbe<'a> {
         }
     }
 
-    /// Whether the material at `hit` scatters only in Dirac directions there (a mirror,
-    /// smooth glass), judged at the middle of the visible range.
-    pub(crate) fn is_dirac_at(&self, hit: &GBufferHit) -> bool {
-        let si = hit_interaction(hit);
-        let wavelengths = SampledWavelengths::sample_visible(0.5);
-        self.scene
-            .material(hit.material_id())
-            .bsdf(&si, &wavelengths)
-            .is_specular()
-    }
-
     /// What a pixel whose centre hit is a Dirac surface shows: its centre ray followed
     /// through the chain of Dirac vertices (each time the lobe the BSDF picks at u = ½ for
     /// the middle of the visible range: the reflection where it outweighs the refraction)
     /// to the first other surface, or out to the background. `None` where the hit is not
-    /// Dirac (`is_dirac_at`) or the chain is longer than [`MAX_SPECULAR_CHAIN`].
+    /// Dirac (`hit_material`) or the chain is longer than [`MAX_SPECULAR_CHAIN`].
     pub(crate) fn seen_through_dirac(&self, hit: &GBufferHit) -> Option<SeenSurface> {
         let wavelengths = SampledWavelengths::sample_visible(0.5);
         let mut si = hit_interaction(hit);
@@ -439,6 +436,15 @@ pub(crate) fn facing_normal(n: Vec3A, towards: Vec3A) -> Vec3A {
     } else {
         n
     }
+}
+
+/// The material at a G-buffer hit (`RenderProbe::hit_material`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct HitMaterial {
+    /// Dirac scattering only (a mirror, smooth glass).
+    pub dirac: bool,
+    /// ρ_p for pooling V̂ and L̂.
+    pub texture_scale: f32,
 }
 
 fn hit_interaction(hit: &GBufferHit) -> SurfaceInteraction {

@@ -391,17 +391,53 @@ impl EnvironmentLight {
                 self.texel_radiance(x, y, wavelengths)
             }
             EnvironmentFilter::Bilinear => {
-                let mut sum = [0.0f32; 4];
-                for (i, w) in self.bilinear_taps(uv) {
-                    if w > 0.0 {
-                        let (polynomial, scale) = &self.texels[i];
-                        let s = polynomial.eval4(wavelengths.lambda());
-                        for (total, value) in sum.iter_mut().zip(s) {
-                            *total += w * scale * value;
-                        }
-                    }
+                self.bilinear_radiance(&self.bilinear_taps(uv), wavelengths)
+            }
+        }
+    }
+
+    /// The bilinear radiance of the four `taps` (`bilinear_taps`).
+    #[inline]
+    fn bilinear_radiance(
+        &self,
+        taps: &[(usize, f32); 4],
+        wavelengths: &SampledWavelengths,
+    ) -> SampledSpectrum {
+        let mut sum = [0.0f32; 4];
+        for &(i, w) in taps {
+            if w > 0.0 {
+                let (polynomial, scale) = &self.texels[i];
+                let s = polynomial.eval4(wavelengths.lambda());
+                for (total, value) in sum.iter_mut().zip(s) {
+                    *total += w * scale * value;
                 }
-                self.white.eval(wavelengths) * SampledSpectrum::new(sum) * self.scale
+            }
+        }
+        self.white.eval(wavelengths) * SampledSpectrum::new(sum) * self.scale
+    }
+
+    /// `infinite_radiance` along `direction` at each of `wavelength_sets`, added to `out`:
+    /// the texel lookup once, the spectra per set.
+    pub fn add_radiance_each(
+        &self,
+        direction: Vec3A,
+        wavelength_sets: &[SampledWavelengths],
+        out: &mut [SampledSpectrum],
+    ) {
+        let uv = self.local_uv(direction);
+        let sets = out.iter_mut().zip(wavelength_sets);
+        match self.filter {
+            EnvironmentFilter::Nearest => {
+                let (x, y) = self.texel(uv);
+                for (o, wavelengths) in sets {
+                    *o += self.texel_radiance(x, y, wavelengths);
+                }
+            }
+            EnvironmentFilter::Bilinear => {
+                let taps = self.bilinear_taps(uv);
+                for (o, wavelengths) in sets {
+                    *o += self.bilinear_radiance(&taps, wavelengths);
+                }
             }
         }
     }

@@ -373,6 +373,32 @@ impl Light {
         }
     }
 
+    /// [`Self::infinite_radiance`] along `direction` at each of `wavelength_sets`, added to
+    /// the matching entry of `out`: an environment map finds its texels once for all sets
+    /// (the predictor's background quadrature).
+    pub fn add_infinite_radiance_each(
+        &self,
+        direction: Vec3A,
+        wavelength_sets: &[SampledWavelengths],
+        out: &mut [SampledSpectrum],
+    ) {
+        let mut each = |radiance: &dyn Fn(&SampledWavelengths) -> SampledSpectrum| {
+            for (o, w) in out.iter_mut().zip(wavelength_sets) {
+                *o += radiance(w);
+            }
+        };
+        match self {
+            Light::Environment(l) => l.add_radiance_each(direction, wavelength_sets, out),
+            Light::Point(l) => each(&|w| l.infinite_radiance(direction, w)),
+            Light::Spot(l) => each(&|w| l.infinite_radiance(direction, w)),
+            Light::Directional(l) => each(&|w| l.infinite_radiance(direction, w)),
+            Light::Area(l) => each(&|w| l.infinite_radiance(direction, w)),
+            Light::Sky(l) => each(&|w| l.infinite_radiance(direction, w)),
+            Light::Daylight(l) => each(&|w| l.infinite_radiance(direction, w)),
+            Light::Goniometric(l) => each(&|w| l.infinite_radiance(direction, w)),
+        }
+    }
+
     /// Samples an emitted ray (light tracing, BDPT): the origin from `u_pos`, the
     /// direction from `u_dir`; `scene` is the bounding sphere infinite lights start from
     /// (`LightSet::scene_sphere`). See `LightLeSample` for what `radiance` means per kind.
