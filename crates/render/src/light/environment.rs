@@ -828,6 +828,27 @@ mod tests {
     }
 
     #[test]
+    fn radiance_for_many_wavelength_sets_is_each_sets_radiance() {
+        let sets: Vec<SampledWavelengths> = (0..16)
+            .map(|k| SampledWavelengths::sample_rgb_output((k as f32 + 0.5) / 16.0))
+            .collect();
+        let rotation = Mat3A::from_axis_angle(glam::Vec3::new(0.3, 1.0, -0.2).normalize(), 0.7);
+        for filter in [EnvironmentFilter::Nearest, EnvironmentFilter::Bilinear] {
+            let env = synthetic_with(rotation, filter);
+            for k in 0..200 {
+                let u = Vec2::new((k as f32 * 0.618_034).fract(), (k as f32 + 0.5) / 200.0);
+                let direction = crate::light::warp::sample_uniform_sphere(u);
+                let mut each = vec![SampledSpectrum::splat(0.5); sets.len()];
+                env.add_radiance_each(direction, &sets, &mut each);
+                for (sum, wavelengths) in each.iter().zip(&sets) {
+                    let one = env.infinite_radiance(direction, wavelengths);
+                    assert_eq!(*sum, SampledSpectrum::splat(0.5) + one, "{filter:?} {k}");
+                }
+            }
+        }
+    }
+
+    #[test]
     fn chi2_environment() {
         let rotations = [
             Mat3A::IDENTITY,
