@@ -349,6 +349,8 @@ struct ProbedPixel {
     eye: Option<EyeGeometry>,
     class: PixelClass,
     surface: Option<SurfacePoint>,
+    /// The centre hit scatters only in Dirac directions (`RenderProbe::hit_material`).
+    dirac: bool,
     /// What a Dirac centre hit shows (`RenderProbe::seen_through_dirac`).
     seen: Option<SeenSurface>,
 }
@@ -364,6 +366,7 @@ impl ProbedPixel {
             eye: None,
             class: PixelClass::Unpredicted,
             surface: None,
+            dirac: false,
             seen: None,
         }
     }
@@ -399,29 +402,30 @@ fn escaping_pixel(
     quadrature: &BackgroundQuadrature,
     background_nu_a: f32,
     rad_per_px: f32,
+    radiance: &mut Vec<SampledSpectrum>,
 ) -> PixelPrediction {
     let lights = &scene.lights;
-    let mut radiance = vec![SampledSpectrum::splat(0.0); quadrature.wavelengths.len()];
+    radiance.clear();
+    radiance.resize(quadrature.wavelengths.len(), SampledSpectrum::splat(0.0));
     for &l in lights.infinite_lights() {
-        lights.light(l).add_infinite_radiance_each(
-            direction,
-            &quadrature.wavelengths,
-            &mut radiance,
-        );
+        lights
+            .light(l)
+            .add_infinite_radiance_each(direction, &quadrature.wavelengths, radiance);
     }
-    let estimates: Vec<DVec3> = radiance
-        .iter()
-        .zip(&quadrature.weights)
-        .map(|(&r, weights)| weights.xyz(r))
-        .collect();
-    let count = estimates.len();
+    let estimates = || {
+        radiance
+            .iter()
+            .zip(&quadrature.weights)
+            .map(|(&r, weights)| weights.xyz(r))
+    };
+    let count = radiance.len();
     let n = count.max(1) as f64;
-    let mean = estimates.iter().copied().sum::<DVec3>() / n;
+    let mean = estimates().sum::<DVec3>() / n;
     // Unbiased sample variances: of the X, Y and Z lanes summed (the colour noise), and of
     // Y alone (what `--plan-colour off` follows).
     let (variance, luminance_variance) = if count > 1 {
-        let (xyz, y) = estimates.iter().fold((0.0, 0.0), |(xyz, y), x| {
-            let d = *x - mean;
+        let (xyz, y) = estimates().fold((0.0, 0.0), |(xyz, y), x| {
+            let d = x - mean;
             (xyz + d.length_squared(), y + d.y * d.y)
         });
         (xyz / (n - 1.0), y / (n - 1.0))
@@ -554,6 +558,8 @@ struct ProbeWork<'a, 'p> {
 struct ProbeScratch {
     samples: Vec<LightSample>,
     indirect: Vec<IndirectEstimate>,
+    /// An escaping pixel's radiance per wavelength set of the background quadrature.
+    background: Vec<SampledSpectrum>,
 }
 
 impl ProbeWork<'_, '_> {
@@ -691,6 +697,7 @@ pub fn predict_with_probe<'a>(
                                     position_m: hit.position_m(),
                                     normal: hit.normal(),
                                 }),
+                                dirac,
                                 seen: dirac.then(|| probe.seen_through_dirac(&hit)).flatten(),
                             })
                         }
@@ -701,6 +708,7 @@ pub fn predict_with_probe<'a>(
                                 &background_quadrature,
                                 background_angular_bandwidth(scene, &probe, direction, rad_per_px),
                                 rad_per_px,
+                                &mut scratch.background,
                             ),
                             class: PixelClass::Background,
                             ..ProbedPixel::unpredicted()
@@ -719,6 +727,7 @@ pub fn predict_with_probe<'a>(
     let mut surface = Vec::with_capacity(count);
     let mut seen = Vec::with_capacity(count);
     let mut texture_scale = Vec::with_capacity(count);
+    let mut dirac = Vec::with_capacity(count);
     for probed in rows.into_iter().flatten() {
         pixels.push(probed.prediction);
         curvature.push(probed.curvature_per_m);
@@ -726,6 +735,7 @@ pub fn predict_with_probe<'a>(
         eye.push(probed.eye);
         class.push(probed.class);
         surface.push(probed.surface);
+        dirac.push(probed.dirac);
         seen.push(probed.seen);
     }
     let probed = prism_bandwidth::probed_pixels(resolution, &class, stride_px, pool_radius_px)
@@ -746,9 +756,14 @@ pub fn predict_with_probe<'a>(
                      G-buffer's rays are deterministic; this is a bug)"
                 ));
             };
-            let dirac = probe.hit_material(&hit).dirac;
-            let p =
-                probe_work.surface_prediction(pixel, &hit, eye.rad_per_px, true, dirac, scratch)?;
+            let p = probe_work.surface_prediction(
+                pixel,
+                &hit,
+                eye.rad_per_px,
+                true,
+                dirac[i],
+                scratch,
+            )?;
             Ok((i, p))
         })
         .collect::<Result<Vec<_>, String>>()?;

@@ -385,35 +385,44 @@ impl EnvironmentLight {
     /// Radiance at local image coordinates `uv`, by `filter` (module docs).
     #[inline]
     fn radiance_at(&self, uv: Vec2, wavelengths: &SampledWavelengths) -> SampledSpectrum {
+        self.lookup_radiance(self.lookup(uv), wavelengths)
+    }
+
+    /// The texels `filter` reads at local image coordinates `uv`.
+    #[inline]
+    fn lookup(&self, uv: Vec2) -> TexelLookup {
         match self.filter {
             EnvironmentFilter::Nearest => {
                 let (x, y) = self.texel(uv);
-                self.texel_radiance(x, y, wavelengths)
+                TexelLookup::Nearest(x, y)
             }
-            EnvironmentFilter::Bilinear => {
-                self.bilinear_radiance(&self.bilinear_taps(uv), wavelengths)
-            }
+            EnvironmentFilter::Bilinear => TexelLookup::Bilinear(self.bilinear_taps(uv)),
         }
     }
 
-    /// The bilinear radiance of the four `taps` (`bilinear_taps`).
+    /// The radiance of the texels `lookup` found.
     #[inline]
-    fn bilinear_radiance(
+    fn lookup_radiance(
         &self,
-        taps: &[(usize, f32); 4],
+        lookup: TexelLookup,
         wavelengths: &SampledWavelengths,
     ) -> SampledSpectrum {
-        let mut sum = [0.0f32; 4];
-        for &(i, w) in taps {
-            if w > 0.0 {
-                let (polynomial, scale) = &self.texels[i];
-                let s = polynomial.eval4(wavelengths.lambda());
-                for (total, value) in sum.iter_mut().zip(s) {
-                    *total += w * scale * value;
+        match lookup {
+            TexelLookup::Nearest(x, y) => self.texel_radiance(x, y, wavelengths),
+            TexelLookup::Bilinear(taps) => {
+                let mut sum = [0.0f32; 4];
+                for (i, w) in taps {
+                    if w > 0.0 {
+                        let (polynomial, scale) = &self.texels[i];
+                        let s = polynomial.eval4(wavelengths.lambda());
+                        for (total, value) in sum.iter_mut().zip(s) {
+                            *total += w * scale * value;
+                        }
+                    }
                 }
+                self.white.eval(wavelengths) * SampledSpectrum::new(sum) * self.scale
             }
         }
-        self.white.eval(wavelengths) * SampledSpectrum::new(sum) * self.scale
     }
 
     /// `infinite_radiance` along `direction` at each of `wavelength_sets`, added to `out`:
@@ -424,21 +433,9 @@ impl EnvironmentLight {
         wavelength_sets: &[SampledWavelengths],
         out: &mut [SampledSpectrum],
     ) {
-        let uv = self.local_uv(direction);
-        let sets = out.iter_mut().zip(wavelength_sets);
-        match self.filter {
-            EnvironmentFilter::Nearest => {
-                let (x, y) = self.texel(uv);
-                for (o, wavelengths) in sets {
-                    *o += self.texel_radiance(x, y, wavelengths);
-                }
-            }
-            EnvironmentFilter::Bilinear => {
-                let taps = self.bilinear_taps(uv);
-                for (o, wavelengths) in sets {
-                    *o += self.bilinear_radiance(&taps, wavelengths);
-                }
-            }
+        let lookup = self.lookup(self.local_uv(direction));
+        for (o, wavelengths) in out.iter_mut().zip(wavelength_sets) {
+            *o += self.lookup_radiance(lookup, wavelengths);
         }
     }
 
@@ -728,6 +725,14 @@ pub struct RgbTexels<'a> {
     pub height: usize,
     pub pixels: &'a [[f32; 3]],
     pub gamut: RgbGamut,
+}
+
+/// The texels the map's filter reads at one point of the image (`EnvironmentLight::lookup`):
+/// texel (x, y), or the four bilinear taps (row-major index, weight).
+#[derive(Clone, Copy, Debug)]
+enum TexelLookup {
+    Nearest(usize, usize),
+    Bilinear([(usize, f32); 4]),
 }
 
 /// Where a sampled direction's radiance is read (`EnvironmentLight::sample_direction`).

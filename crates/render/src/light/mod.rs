@@ -382,20 +382,19 @@ impl Light {
         wavelength_sets: &[SampledWavelengths],
         out: &mut [SampledSpectrum],
     ) {
-        let mut each = |radiance: &dyn Fn(&SampledWavelengths) -> SampledSpectrum| {
-            for (o, w) in out.iter_mut().zip(wavelength_sets) {
-                *o += radiance(w);
-            }
-        };
         match self {
             Light::Environment(l) => l.add_radiance_each(direction, wavelength_sets, out),
-            Light::Point(l) => each(&|w| l.infinite_radiance(direction, w)),
-            Light::Spot(l) => each(&|w| l.infinite_radiance(direction, w)),
-            Light::Directional(l) => each(&|w| l.infinite_radiance(direction, w)),
-            Light::Area(l) => each(&|w| l.infinite_radiance(direction, w)),
-            Light::Sky(l) => each(&|w| l.infinite_radiance(direction, w)),
-            Light::Daylight(l) => each(&|w| l.infinite_radiance(direction, w)),
-            Light::Goniometric(l) => each(&|w| l.infinite_radiance(direction, w)),
+            Light::Point(_)
+            | Light::Spot(_)
+            | Light::Directional(_)
+            | Light::Area(_)
+            | Light::Sky(_)
+            | Light::Daylight(_)
+            | Light::Goniometric(_) => {
+                for (o, wavelengths) in out.iter_mut().zip(wavelength_sets) {
+                    *o += self.infinite_radiance(direction, wavelengths);
+                }
+            }
         }
     }
 
