@@ -140,28 +140,39 @@ fn clip_strip(line: Vec2, b: Vec2, rho: f32) -> Bandwidth {
 /// two clipping lines), then bounded. The polygon is symmetric about the origin, so the
 /// half-sizes are the largest |x| and |y| of its vertices.
 fn clip_parallelogram(a: Vec2, b: Vec2, rho: f32) -> Bandwidth {
-    let corners = [a + b, a - b, -a - b, -a + b];
-    let mut polygon: Vec<Vec2> = corners.to_vec();
+    // Each edge keeps at most its start and one cut, so 4 vertices become at most 8, then
+    // 16 (a convex polygon gains one per cut; the bound holds for any input). On the
+    // stack: this runs for every probe sample.
+    const MAX_VERTICES: usize = 16;
+    let mut polygon = [Vec2::ZERO; MAX_VERTICES];
+    polygon[..4].copy_from_slice(&[a + b, a - b, -a - b, -a + b]);
+    let mut len = 4;
     for sign in [1.0f32, -1.0] {
         // Keep sign·y ≤ ρ.
         let inside = |p: Vec2| sign * p.y <= rho;
-        let mut clipped = Vec::with_capacity(polygon.len() + 2);
-        for (i, &p) in polygon.iter().enumerate() {
-            let q = polygon[(i + 1) % polygon.len()];
+        let mut clipped = [Vec2::ZERO; MAX_VERTICES];
+        let mut clipped_len = 0;
+        for i in 0..len {
+            let (p, q) = (polygon[i], polygon[(i + 1) % len]);
             if inside(p) {
-                clipped.push(p);
+                clipped[clipped_len] = p;
+                clipped_len += 1;
             }
             if inside(p) != inside(q) {
                 let s = (sign * rho - p.y) / (q.y - p.y);
-                clipped.push(Vec2::new(p.x + s * (q.x - p.x), sign * rho));
+                clipped[clipped_len] = Vec2::new(p.x + s * (q.x - p.x), sign * rho);
+                clipped_len += 1;
             }
         }
         polygon = clipped;
+        len = clipped_len;
     }
-    polygon.iter().fold(Bandwidth::ZERO, |acc, p| Bandwidth {
-        spatial_cycles_per_m: acc.spatial_cycles_per_m.max(p.x.abs()),
-        angular_cycles_per_rad: acc.angular_cycles_per_rad.max(p.y.abs()),
-    })
+    polygon[..len]
+        .iter()
+        .fold(Bandwidth::ZERO, |acc, p| Bandwidth {
+            spatial_cycles_per_m: acc.spatial_cycles_per_m.max(p.x.abs()),
+            angular_cycles_per_rad: acc.angular_cycles_per_rad.max(p.y.abs()),
+        })
 }
 
 /// c of C_c: the normal curvature along the tangent direction of the flatland plane

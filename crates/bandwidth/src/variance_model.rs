@@ -26,7 +26,7 @@ use glam::UVec2;
 use crate::error::{check_lengths, pixel_count, BandwidthError};
 use crate::pixel_neighbours::four_neighbours;
 use crate::pixel_prediction::PixelPrediction;
-use crate::variance_pooling::{pool_scaled, PixelClass};
+use crate::variance_pooling::{pool_scaled, pool_scaled_each, PixelClass};
 
 /// What the allocation gets, per pixel (row-major), and the constant that put eq. 9 in Y².
 #[derive(Clone, Debug, PartialEq)]
@@ -110,17 +110,10 @@ pub fn model_variance(
             .collect()
     };
     let squared_scale: Vec<f32> = texture_scale.iter().map(|s| s * s).collect();
-    let mut variance = pool_scaled(
+    // V̂ with and without the colour noise share their scale ρ²: pooled in one pass.
+    let [mut variance, mut luminance_variance] = pool_scaled_each(
         resolution,
-        &own(true),
-        &squared_scale,
-        class,
-        probed,
-        radius_px,
-    )?;
-    let mut luminance_variance = pool_scaled(
-        resolution,
-        &own(false),
+        [&own(true), &own(false)],
         &squared_scale,
         class,
         probed,

@@ -106,19 +106,35 @@ pub fn pool_scaled(
     probed: &[bool],
     radius_px: u32,
 ) -> Result<Vec<f32>, BandwidthError> {
+    let [pooled] = pool_scaled_each(resolution, [values], scale, class, probed, radius_px)?;
+    Ok(pooled)
+}
+
+/// [`pool_scaled`] of `N` images that share one scale, in one pass over the windows: each
+/// the same values as its own [`pool_scaled`] call.
+pub fn pool_scaled_each<const N: usize>(
+    resolution: UVec2,
+    values: [&[f32]; N],
+    scale: &[f32],
+    class: &[PixelClass],
+    probed: &[bool],
+    radius_px: u32,
+) -> Result<[Vec<f32>; N], BandwidthError> {
     let count = pixel_count("pooled V̂", resolution)?;
+    for v in values {
+        check_lengths(resolution, count, &[("V̂ to pool", v.len())])?;
+    }
     check_lengths(
         resolution,
         count,
         &[
-            ("V̂ to pool", values.len()),
             ("pooling scales", scale.len()),
             ("pixel classes", class.len()),
             ("probed mask", probed.len()),
         ],
     )?;
     if radius_px == 0 {
-        return Ok(values.to_vec());
+        return Ok(values.map(<[f32]>::to_vec));
     }
     let image = PoolImage {
         resolution,
@@ -218,52 +234,71 @@ impl WindowSummation {
     }
 }
 
-/// Σ value, Σ scale and the count of a window's lending pixels.
-#[derive(Clone, Copy, Debug, Default)]
-struct WindowSum {
-    value: f64,
+/// Σ value (per image), Σ scale and the count of a window's lending pixels.
+#[derive(Clone, Copy, Debug)]
+struct WindowSum<const N: usize> {
+    value: [f64; N],
     scale: f64,
     count: u32,
 }
 
-impl WindowSum {
-    fn add(&mut self, other: WindowSum) {
-        self.value += other.value;
+impl<const N: usize> Default for WindowSum<N> {
+    fn default() -> Self {
+        Self {
+            value: [0.0; N],
+            scale: 0.0,
+            count: 0,
+        }
+    }
+}
+
+impl<const N: usize> WindowSum<N> {
+    fn add(&mut self, other: WindowSum<N>) {
+        for (v, o) in self.value.iter_mut().zip(other.value) {
+            *v += o;
+        }
         self.scale += other.scale;
         self.count += other.count;
     }
 
-    /// `pool_scaled`'s value for a pixel of `own_value` and `own_scale` whose window sums
-    /// to `self`.
-    fn pooled(self, own_value: f32, own_scale: f32) -> f32 {
+    /// `pool_scaled`'s value of image `k` for a pixel of `own_value` and `own_scale` whose
+    /// window sums to `self`.
+    fn pooled(&self, k: usize, own_value: f32, own_scale: f32) -> f32 {
         let value = if self.count == 0 {
             f64::from(own_value)
         } else if self.scale > 0.0 {
-            f64::from(own_scale) * (self.value / self.scale)
+            f64::from(own_scale) * (self.value[k] / self.scale)
         } else {
-            self.value / f64::from(self.count)
+            self.value[k] / f64::from(self.count)
         };
         value as f32
+    }
+
+    /// Pixel `i`'s pooled value of every image into `pooled`.
+    fn write(&self, i: usize, values: [&[f32]; N], scale: &[f32], pooled: &mut [Vec<f32>; N]) {
+        for (k, out) in pooled.iter_mut().enumerate() {
+            out[i] = self.pooled(k, values[k][i], scale[i]);
+        }
     }
 }
 
 /// What `pool_scaled` pools, checked to one length.
-struct PoolImage<'a> {
+struct PoolImage<'a, const N: usize> {
     resolution: UVec2,
-    values: &'a [f32],
+    values: [&'a [f32]; N],
     scale: &'a [f32],
     class: &'a [PixelClass],
     probed: &'a [bool],
 }
 
-impl PoolImage<'_> {
+impl<const N: usize> PoolImage<'_, N> {
     /// Every class pooled, each summed as `summation` picks for its extent.
     fn pool(
         &self,
         radius_px: u32,
         summation: impl Fn(&ClassExtent) -> WindowSummation,
-    ) -> Vec<f32> {
-        let mut pooled = self.values.to_vec();
+    ) -> [Vec<f32>; N] {
+        let mut pooled = self.values.map(<[f32]>::to_vec);
         for extent in class_extents(self.resolution, self.class) {
             self.pool_class(radius_px, &extent, summation(&extent), &mut pooled);
         }
@@ -276,7 +311,7 @@ impl PoolImage<'_> {
         radius_px: u32,
         extent: &ClassExtent,
         summation: WindowSummation,
-        pooled: &mut [f32],
+        pooled: &mut [Vec<f32>; N],
     ) {
         let (values, scale, class, probed) = (self.values, self.scale, self.class, self.probed);
         let w = self.resolution.x as usize;
@@ -287,7 +322,7 @@ impl PoolImage<'_> {
         let lend = |j: usize| {
             if class[j] == own && probed[j] {
                 WindowSum {
-                    value: f64::from(values[j]),
+                    value: values.map(|v| f64::from(v[j])),
                     scale: f64::from(scale[j]),
                     count: 1,
                 }
@@ -311,13 +346,13 @@ impl PoolImage<'_> {
                                 sum.add(lend(yy * w + xx));
                             }
                         }
-                        pooled[i] = sum.pooled(values[i], scale[i]);
+                        sum.write(i, values, scale, pooled);
                     }
                 }
             }
             WindowSummation::Separable => {
                 let (bw, bh) = extent.size();
-                let mut sums: Vec<WindowSum> = (0..bw * bh)
+                let mut sums: Vec<WindowSum<N>> = (0..bw * bh)
                     .map(|k| lend((y0 + k / bw) * w + x0 + k % bw))
                     .collect();
                 let mut line = Vec::with_capacity(bw.max(bh));
@@ -335,7 +370,7 @@ impl PoolImage<'_> {
                     for (by, sum) in column.iter().enumerate() {
                         let i = (y0 + by) * w + x0 + bx;
                         if class[i] == own {
-                            pooled[i] = sum.pooled(values[i], scale[i]);
+                            sum.write(i, values, scale, pooled);
                         }
                     }
                 }
@@ -349,15 +384,23 @@ impl PoolImage<'_> {
 /// scheme. The line is cut into blocks of the window's length k = 2r+1; a window then covers
 /// a suffix of one block and a prefix of the next, or (clipped at an end of the line) one
 /// block's prefix or suffix.
-#[derive(Default)]
-struct BlockSums {
-    prefix: Vec<WindowSum>,
-    suffix: Vec<WindowSum>,
+struct BlockSums<const N: usize> {
+    prefix: Vec<WindowSum<N>>,
+    suffix: Vec<WindowSum<N>>,
 }
 
-impl BlockSums {
+impl<const N: usize> Default for BlockSums<N> {
+    fn default() -> Self {
+        Self {
+            prefix: Vec::new(),
+            suffix: Vec::new(),
+        }
+    }
+}
+
+impl<const N: usize> BlockSums<N> {
     /// `out[i]` = Σ `line[j]` over |j − i| ≤ r within the line.
-    fn window_sums(&mut self, line: &[WindowSum], r: usize, out: &mut [WindowSum]) {
+    fn window_sums(&mut self, line: &[WindowSum<N>], r: usize, out: &mut [WindowSum<N>]) {
         let n = line.len();
         let k = 2 * r + 1;
         self.prefix.clear();
@@ -513,12 +556,13 @@ mod tests {
     ) -> Vec<f32> {
         let image = PoolImage {
             resolution,
-            values,
+            values: [values],
             scale,
             class,
             probed,
         };
-        image.pool(radius_px, |_| summation)
+        let [pooled] = image.pool(radius_px, |_| summation);
+        pooled
     }
 
     /// The definition, pixel by pixel over the whole image's clipped window.
@@ -541,15 +585,41 @@ mod tests {
                     let j = yy * w + xx;
                     if class[j] == class[i] && probed[j] {
                         sum.add(WindowSum {
-                            value: f64::from(values[j]),
+                            value: [f64::from(values[j])],
                             scale: f64::from(scale[j]),
                             count: 1,
                         });
                     }
                 }
-                sum.pooled(values[i], scale[i])
+                sum.pooled(0, values[i], scale[i])
             })
             .collect()
+    }
+
+    /// Images pooled together are each pooled as alone, to the bit, whichever summation
+    /// their classes take (a large radius picks the separable one, a small one windows).
+    #[test]
+    fn images_pooled_together_are_each_pooled_alone() {
+        let resolution = UVec2::new(29, 17);
+        let n = (resolution.x * resolution.y) as usize;
+        let class: Vec<PixelClass> = (0..n)
+            .map(|i| match (i * 7919) % 11 {
+                0 => PixelClass::Unpredicted,
+                1 | 2 => PixelClass::Background,
+                k => PixelClass::Material((k % 3) as u32),
+            })
+            .collect();
+        let a: Vec<f32> = (0..n).map(|i| ((i * 37) % 101) as f32 * 1e-3).collect();
+        let b: Vec<f32> = (0..n).map(|i| 10f32.powi((i % 9) as i32 - 4)).collect();
+        let scale: Vec<f32> = (0..n).map(|i| ((i * 13) % 7) as f32 / 6.0).collect();
+        let probed: Vec<bool> = (0..n).map(|i| i % 3 != 1).collect();
+        for r in [0u32, 1, 3, 20] {
+            let [pa, pb] =
+                pool_scaled_each(resolution, [&a, &b], &scale, &class, &probed, r).unwrap();
+            let alone = |v: &[f32]| pool_scaled(resolution, v, &scale, &class, &probed, r).unwrap();
+            assert_eq!(pa, alone(&a), "r = {r}");
+            assert_eq!(pb, alone(&b), "r = {r}");
+        }
     }
 
     /// Both summations give the definition's pooled values (to f32 rounding) on random

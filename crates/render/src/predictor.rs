@@ -106,31 +106,59 @@ fn unsupported(why: &str) -> String {
     format!("the bandwidth predictor cannot plan this scene: {why}")
 }
 
+/// The unit direction of every pixel's centre ray (row-major; `None` where there is none,
+/// outside a fisheye's image circle), from which [`angular_footprint`] reads each pixel's
+/// and its neighbours' without generating them again.
+fn centre_directions(scene: &RenderScene) -> Vec<Option<Vec3A>> {
+    let resolution = scene.resolution;
+    let count = resolution.x as usize * resolution.y as usize;
+    let mut directions = vec![None; count];
+    directions
+        .par_chunks_mut(resolution.x as usize)
+        .enumerate()
+        .for_each(|(y, row)| {
+            for (x, d) in row.iter_mut().enumerate() {
+                let p = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
+                *d = scene
+                    .camera
+                    .generate_ray_only(p, Vec2::splat(0.5))
+                    .map(|r| r.direction);
+            }
+        });
+    directions
+}
+
 /// Radians between the centre ray of `pixel` and those of its right and lower neighbours
-/// (the larger), or `None` where a ray is missing (outside a fisheye's image circle).
-fn angular_footprint(scene: &RenderScene, pixel: UVec2) -> Option<f32> {
-    let centre = |dx: f32, dy: f32| {
-        let p = Vec2::new(pixel.x as f32 + 0.5 + dx, pixel.y as f32 + 0.5 + dy);
-        scene
-            .camera
-            .generate_ray_only(p, Vec2::splat(0.5))
-            .map(|r| r.direction)
+/// (the larger; towards the image's inside at its last column and row), or `None` where
+/// the pixel has no ray. `directions` are [`centre_directions`]; a neighbour off an image
+/// one pixel wide or high is generated here.
+fn angular_footprint(
+    scene: &RenderScene,
+    directions: &[Option<Vec3A>],
+    pixel: UVec2,
+) -> Option<f32> {
+    let resolution = scene.resolution;
+    let d = directions[pixel.y as usize * resolution.x as usize + pixel.x as usize]?;
+    let neighbour = |dx: i64, dy: i64| {
+        let (x, y) = (i64::from(pixel.x) + dx, i64::from(pixel.y) + dy);
+        if (0..i64::from(resolution.x)).contains(&x) && (0..i64::from(resolution.y)).contains(&y) {
+            directions[y as usize * resolution.x as usize + x as usize]
+        } else {
+            let p = Vec2::new(
+                pixel.x as f32 + 0.5 + dx as f32,
+                pixel.y as f32 + 0.5 + dy as f32,
+            );
+            scene
+                .camera
+                .generate_ray_only(p, Vec2::splat(0.5))
+                .map(|r| r.direction)
+        }
     };
-    let d = centre(0.0, 0.0)?;
-    // Towards the image's inside at its last column and row.
-    let sx = if pixel.x + 1 < scene.resolution.x {
-        1.0
-    } else {
-        -1.0
-    };
-    let sy = if pixel.y + 1 < scene.resolution.y {
-        1.0
-    } else {
-        -1.0
-    };
-    let angle = |e: glam::Vec3A| d.dot(e).clamp(-1.0, 1.0).acos();
-    let ax = centre(sx, 0.0).map(angle).unwrap_or(0.0);
-    let ay = centre(0.0, sy).map(angle).unwrap_or(0.0);
+    let sx = if pixel.x + 1 < resolution.x { 1 } else { -1 };
+    let sy = if pixel.y + 1 < resolution.y { 1 } else { -1 };
+    let angle = |e: Vec3A| d.dot(e).clamp(-1.0, 1.0).acos();
+    let ax = neighbour(sx, 0).map(angle).unwrap_or(0.0);
+    let ay = neighbour(0, sy).map(angle).unwrap_or(0.0);
     Some(ax.max(ay))
 }
 
@@ -551,6 +579,9 @@ struct ProbeWork<'a, 'p> {
     /// One-bounce indirect estimates at a probed pixel.
     indirect_samples: u32,
     variance_bandwidth: VarianceBandwidth,
+    /// S of the probe's lattice (`ProbeStride::px`).
+    stride_px: u32,
+    background_quadrature: BackgroundQuadrature,
 }
 
 /// A thread's reusable buffers for the probe's samples.
@@ -607,6 +638,67 @@ impl ProbeWork<'_, '_> {
         }
         Ok(p)
     }
+
+    /// The G-buffer's pass at `pixel`: its footprint from the centre `directions`
+    /// ([`centre_directions`]), its centre hit or escape, and the probe's prediction where
+    /// the pixel is on the probe's lattice.
+    fn gbuffer_pixel(
+        &self,
+        pixel: UVec2,
+        directions: &[Option<Vec3A>],
+        scratch: &mut ProbeScratch,
+    ) -> Result<ProbedPixel, String> {
+        let Some(rad_per_px) =
+            angular_footprint(self.scene, directions, pixel).filter(|a| *a > 0.0)
+        else {
+            return Ok(ProbedPixel::unpredicted());
+        };
+        match centre_ray(self.scene, pixel) {
+            CentreRay::Hit(hit) => {
+                let material = self.probe.hit_material(&hit);
+                let dirac = material.dirac;
+                let p = self.surface_prediction(
+                    pixel,
+                    &hit,
+                    rad_per_px,
+                    prism_bandwidth::on_probe_lattice(pixel.x, pixel.y, self.stride_px),
+                    dirac,
+                    scratch,
+                )?;
+                let c = hit.curvature();
+                Ok(ProbedPixel {
+                    prediction: p,
+                    curvature_per_m: c.k1.abs().max(c.k2.abs()),
+                    texture_scale: material.texture_scale,
+                    eye: Some(EyeGeometry {
+                        depth_m: hit.depth_m(),
+                        cos_theta_x: hit.cos_theta_view(),
+                        rad_per_px,
+                    }),
+                    class: PixelClass::Material(hit.material_id()),
+                    surface: Some(SurfacePoint {
+                        position_m: hit.position_m(),
+                        normal: hit.normal(),
+                    }),
+                    dirac,
+                    seen: dirac.then(|| self.probe.seen_through_dirac(&hit)).flatten(),
+                })
+            }
+            CentreRay::Escapes(direction) => Ok(ProbedPixel {
+                prediction: escaping_pixel(
+                    self.scene,
+                    direction,
+                    &self.background_quadrature,
+                    background_angular_bandwidth(self.scene, self.probe, direction, rad_per_px),
+                    rad_per_px,
+                    &mut scratch.background,
+                ),
+                class: PixelClass::Background,
+                ..ProbedPixel::unpredicted()
+            }),
+            CentreRay::None => Ok(ProbedPixel::unpredicted()),
+        }
+    }
 }
 
 /// Runs the predictor over every pixel of `scene` (in parallel on the current rayon pool).
@@ -653,94 +745,58 @@ pub fn predict_with_probe<'a>(
         light_samples,
         indirect_samples,
         variance_bandwidth: settings.variance_bandwidth,
+        stride_px,
+        background_quadrature: BackgroundQuadrature::new(settings.probe_samples),
     };
     // The lattice's pixels are probed in the G-buffer's pass; the pixels of surfaces with no
     // lattice pixel within the pooling radius, which only the G-buffer's classes find, in a
     // second pass (the centre rays are traced once, but for those few).
     let on_lattice = |x: u32, y: u32| prism_bandwidth::on_probe_lattice(x, y, stride_px);
-    let background_quadrature = BackgroundQuadrature::new(settings.probe_samples);
-    let rows: Vec<Vec<ProbedPixel>> = (0..resolution.y)
-        .into_par_iter()
-        .map(|y| {
-            let mut scratch = ProbeScratch::default();
-            (0..resolution.x)
-                .map(|x| {
-                    let pixel = UVec2::new(x, y);
-                    let Some(rad_per_px) = angular_footprint(scene, pixel).filter(|a| *a > 0.0)
-                    else {
-                        return Ok(ProbedPixel::unpredicted());
-                    };
-                    match centre_ray(scene, pixel) {
-                        CentreRay::Hit(hit) => {
-                            let material = probe.hit_material(&hit);
-                            let dirac = material.dirac;
-                            let p = probe_work.surface_prediction(
-                                pixel,
-                                &hit,
-                                rad_per_px,
-                                on_lattice(x, y),
-                                dirac,
-                                &mut scratch,
-                            )?;
-                            let c = hit.curvature();
-                            Ok(ProbedPixel {
-                                prediction: p,
-                                curvature_per_m: c.k1.abs().max(c.k2.abs()),
-                                texture_scale: material.texture_scale,
-                                eye: Some(EyeGeometry {
-                                    depth_m: hit.depth_m(),
-                                    cos_theta_x: hit.cos_theta_view(),
-                                    rad_per_px,
-                                }),
-                                class: PixelClass::Material(hit.material_id()),
-                                surface: Some(SurfacePoint {
-                                    position_m: hit.position_m(),
-                                    normal: hit.normal(),
-                                }),
-                                dirac,
-                                seen: dirac.then(|| probe.seen_through_dirac(&hit)).flatten(),
-                            })
-                        }
-                        CentreRay::Escapes(direction) => Ok(ProbedPixel {
-                            prediction: escaping_pixel(
-                                scene,
-                                direction,
-                                &background_quadrature,
-                                background_angular_bandwidth(scene, &probe, direction, rad_per_px),
-                                rad_per_px,
-                                &mut scratch.background,
-                            ),
-                            class: PixelClass::Background,
-                            ..ProbedPixel::unpredicted()
-                        }),
-                        CentreRay::None => Ok(ProbedPixel::unpredicted()),
-                    }
-                })
-                .collect::<Result<Vec<_>, String>>()
-        })
-        .collect::<Result<Vec<_>, String>>()?;
+    let directions = centre_directions(scene);
     let count = resolution.x as usize * resolution.y as usize;
-    let mut pixels = Vec::with_capacity(count);
-    let mut curvature = Vec::with_capacity(count);
-    let mut eye = Vec::with_capacity(count);
-    let mut class = Vec::with_capacity(count);
-    let mut surface = Vec::with_capacity(count);
-    let mut seen = Vec::with_capacity(count);
-    let mut texture_scale = Vec::with_capacity(count);
-    let mut dirac = Vec::with_capacity(count);
-    for probed in rows.into_iter().flatten() {
-        pixels.push(probed.prediction);
-        curvature.push(probed.curvature_per_m);
-        texture_scale.push(probed.texture_scale);
-        eye.push(probed.eye);
-        class.push(probed.class);
-        surface.push(probed.surface);
-        dirac.push(probed.dirac);
-        seen.push(probed.seen);
-    }
+    let w = resolution.x as usize;
+    let unpredicted = ProbedPixel::unpredicted();
+    let mut pixels = vec![unpredicted.prediction; count];
+    let mut curvature = vec![unpredicted.curvature_per_m; count];
+    let mut texture_scale = vec![unpredicted.texture_scale; count];
+    let mut eye = vec![unpredicted.eye; count];
+    let mut class = vec![unpredicted.class; count];
+    let mut surface = vec![unpredicted.surface; count];
+    let mut dirac = vec![unpredicted.dirac; count];
+    let mut seen = vec![unpredicted.seen; count];
+    // Each row written straight into the image-wide buffers (no per-pixel record kept).
+    (
+        pixels.par_chunks_mut(w),
+        curvature.par_chunks_mut(w),
+        texture_scale.par_chunks_mut(w),
+        eye.par_chunks_mut(w),
+        class.par_chunks_mut(w),
+        surface.par_chunks_mut(w),
+        dirac.par_chunks_mut(w),
+        seen.par_chunks_mut(w),
+    )
+        .into_par_iter()
+        .enumerate()
+        .try_for_each(|(y, row)| -> Result<(), String> {
+            let y = y as u32;
+            let mut scratch = ProbeScratch::default();
+            let (pixels, curvature, texture_scale, eye, class, surface, dirac, seen) = row;
+            for x in 0..w {
+                let probed =
+                    probe_work.gbuffer_pixel(UVec2::new(x as u32, y), &directions, &mut scratch)?;
+                pixels[x] = probed.prediction;
+                curvature[x] = probed.curvature_per_m;
+                texture_scale[x] = probed.texture_scale;
+                eye[x] = probed.eye;
+                class[x] = probed.class;
+                surface[x] = probed.surface;
+                dirac[x] = probed.dirac;
+                seen[x] = probed.seen;
+            }
+            Ok(())
+        })?;
     let probed = prism_bandwidth::probed_pixels(resolution, &class, stride_px, pool_radius_px)
         .map_err(|e| e.to_string())?;
-    let w = resolution.x as usize;
     let off_lattice: Vec<(usize, PixelPrediction)> = (0..count)
         .into_par_iter()
         .filter(|&i| {

@@ -626,19 +626,21 @@ impl RenderProbe<'_> {
 
     /// What a BSDF-sampled direction from `si` meets: the area light it hits (occlusion
     /// by other surfaces counts here, as the render's BSDF samples see it), else every
-    /// infinite light along it. Per emitter: (light index, radiance, distance, its hit).
-    fn emitters_along(
+    /// infinite light along it. `visit(light index, radiance, distance, its hit)` per
+    /// emitter (a callback: this runs for every BSDF draw of the probe, without allocating).
+    fn for_each_emitter_along(
         &self,
         si: &SurfaceInteraction,
         wi: Vec3A,
         wavelengths: &SampledWavelengths,
-    ) -> Vec<(u32, SampledSpectrum, f32, Option<LightHit>)> {
+        mut visit: impl FnMut(u32, SampledSpectrum, f32, Option<LightHit>),
+    ) {
         let lights = &self.scene.lights;
         let ray = Ray::spawn(si.p, wi);
         match crate::medium_interfaces::first_surface(self.scene, &ray) {
             Some(hit) => {
                 let Some(l) = lights.area_light_of_instance(hit.instance_id) else {
-                    return Vec::new();
+                    return;
                 };
                 let hit_si = self.scene.geometry.shading_interaction(&ray, &hit);
                 let light_hit = LightHit {
@@ -650,16 +652,14 @@ impl RenderProbe<'_> {
                 let le = lights
                     .light(l)
                     .emitted_radiance(&light_hit, -wi, wavelengths);
-                vec![(l, le, hit.t, Some(light_hit))]
+                visit(l, le, hit.t, Some(light_hit));
             }
-            None => lights
-                .infinite_lights()
-                .iter()
-                .map(|&l| {
+            None => {
+                for &l in lights.infinite_lights() {
                     let le = lights.light(l).infinite_radiance(wi, wavelengths);
-                    (l, le, f32::INFINITY, None)
-                })
-                .collect(),
+                    visit(l, le, f32::INFINITY, None);
+                }
+            }
         }
     }
 }
@@ -814,70 +814,75 @@ impl ShadingProbe for RenderProbe<'_> {
                     }
                     let cos = bs.wi.z.abs();
                     let wi = frame.from_local(bs.wi);
-                    for (l, le, distance_m, light_hit) in self.emitters_along(&si, wi, wavelengths)
-                    {
-                        let radiance_y = xyz.y(le) as f32;
-                        if radiance_y.is_nan() || radiance_y <= 0.0 {
-                            continue;
-                        }
-                        let light_pdf = if bs.specular {
-                            0.0
-                        } else {
-                            self.light_pdf(&ctx, wi, light_hit.as_ref().map(|h| (l, h)))
-                        };
-                        let (pdf_per_sr, bsdf_cos_per_sr) = if bs.specular {
-                            // A Dirac lobe: one direction, weight f cos / (share · P(lobe)).
-                            (
-                                0.0,
-                                reflectance_y(bs.f * (cos / (bsdf_share * bs.pdf)), xyz),
-                            )
-                        } else {
-                            (
-                                bsdf_share * bs.pdf + light_share * light_pdf,
-                                reflectance_y(bs.f * cos, xyz),
-                            )
-                        };
-                        let divisor = if bs.specular {
-                            bsdf_share * bs.pdf
-                        } else {
-                            pdf_per_sr
-                        };
-                        let lanes = lane_variance(le * bs.f * (cos / divisor), xyz);
-                        // The estimator's BSDF sample: a Dirac lobe's has no MIS.
-                        let estimator_y = if bs.specular {
-                            radiance_y * reflectance_y(bs.f * (cos / bs.pdf), xyz)
-                        } else {
-                            radiance_y * bsdf_cos_per_sr * mis_weight(mis, bs.pdf, light_pdf)
-                                / bs.pdf
-                        };
-                        let (light_bandwidth, emitter_bandwidth) = self.light_bandwidths_towards(
-                            l as usize,
-                            wi,
-                            light_hit.as_ref().map(|h| h.p),
-                        );
-                        out.push(LightSample {
-                            direction: wi,
-                            radiance_y,
-                            pdf_per_sr,
-                            bsdf_cos_per_sr,
-                            cos_theta_i: cos,
-                            distance_m,
-                            light_bandwidth,
-                            emitter_bandwidth,
-                            light_index: l,
-                            material_bandwidth: self.material_bandwidth_at(
-                                hit.material_id(),
-                                bsdf,
-                                bs.wi,
-                                wo_local,
-                                texture_t,
-                            ),
-                            lane_variance: lanes,
-                            visibility: Visibility::Unknown,
-                            estimator_y,
-                            draw: k / draws_per_camera_sample,
-                        });
-                    }
+                    self.for_each_emitter_along(
+                        &si,
+                        wi,
+                        wavelengths,
+                        |l, le, distance_m, light_hit| {
+                            let radiance_y = xyz.y(le) as f32;
+                            if radiance_y.is_nan() || radiance_y <= 0.0 {
+                                return;
+                            }
+                            let light_pdf = if bs.specular {
+                                0.0
+                            } else {
+                                self.light_pdf(&ctx, wi, light_hit.as_ref().map(|h| (l, h)))
+                            };
+                            let (pdf_per_sr, bsdf_cos_per_sr) = if bs.specular {
+                                // A Dirac lobe: one direction, weight f cos / (share · P(lobe)).
+                                (
+                                    0.0,
+                                    reflectance_y(bs.f * (cos / (bsdf_share * bs.pdf)), xyz),
+                                )
+                            } else {
+                                (
+                                    bsdf_share * bs.pdf + light_share * light_pdf,
+                                    reflectance_y(bs.f * cos, xyz),
+                                )
+                            };
+                            let divisor = if bs.specular {
+                                bsdf_share * bs.pdf
+                            } else {
+                                pdf_per_sr
+                            };
+                            let lanes = lane_variance(le * bs.f * (cos / divisor), xyz);
+                            // The estimator's BSDF sample: a Dirac lobe's has no MIS.
+                            let estimator_y = if bs.specular {
+                                radiance_y * reflectance_y(bs.f * (cos / bs.pdf), xyz)
+                            } else {
+                                radiance_y * bsdf_cos_per_sr * mis_weight(mis, bs.pdf, light_pdf)
+                                    / bs.pdf
+                            };
+                            let (light_bandwidth, emitter_bandwidth) = self
+                                .light_bandwidths_towards(
+                                    l as usize,
+                                    wi,
+                                    light_hit.as_ref().map(|h| h.p),
+                                );
+                            out.push(LightSample {
+                                direction: wi,
+                                radiance_y,
+                                pdf_per_sr,
+                                bsdf_cos_per_sr,
+                                cos_theta_i: cos,
+                                distance_m,
+                                light_bandwidth,
+                                emitter_bandwidth,
+                                light_index: l,
+                                material_bandwidth: self.material_bandwidth_at(
+                                    hit.material_id(),
+                                    bsdf,
+                                    bs.wi,
+                                    wo_local,
+                                    texture_t,
+                                ),
+                                lane_variance: lanes,
+                                visibility: Visibility::Unknown,
+                                estimator_y,
+                                draw: k / draws_per_camera_sample,
+                            });
+                        },
+                    );
                 }
             }
         }
