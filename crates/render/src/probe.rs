@@ -702,29 +702,24 @@ impl ShadingProbe for RenderProbe<'_> {
             if k % draws_per_camera_sample == 0 {
                 camera_sample = None;
             }
-            let (wavelengths, xyz, bsdf) = &*camera_sample.get_or_insert_with(|| {
+            let (wavelengths, xyz, bsdf, specular) = &*camera_sample.get_or_insert_with(|| {
                 let wavelengths = SampledWavelengths::sample_rgb_output(u_wavelengths);
-                (
-                    wavelengths,
-                    XyzWeights::new(&wavelengths),
-                    material.bsdf(&si, &wavelengths),
-                )
+                let bsdf = material.bsdf(&si, &wavelengths);
+                let specular = bsdf.is_specular();
+                (wavelengths, XyzWeights::new(&wavelengths), bsdf, specular)
             });
-            if bsdf.is_specular() {
+            let specular = *specular;
+            if specular {
                 draws_per_camera_sample = 1;
             }
             // A Dirac-only lobe: light sampling cannot reach it, BSDF sampling alone does.
-            let strategy = if bsdf.is_specular() || k % 2 == 1 {
+            let strategy = if specular || k % 2 == 1 {
                 ProbeStrategy::Bsdf
             } else {
                 ProbeStrategy::Light
             };
             // The share of samples each strategy takes (the mixture's weights).
-            let (light_share, bsdf_share) = if bsdf.is_specular() {
-                (0.0, 1.0)
-            } else {
-                (0.5, 0.5)
-            };
+            let (light_share, bsdf_share) = if specular { (0.0, 1.0) } else { (0.5, 0.5) };
             match strategy {
                 ProbeStrategy::Light => {
                     let Some((l, pmf)) = lights.sample_at(&ctx, stream.get_1d()) else {
@@ -738,13 +733,18 @@ impl ShadingProbe for RenderProbe<'_> {
                     let cos = wi_local.z.abs();
                     let f = bsdf.eval(wo_local, wi_local, TransportMode::Radiance) * cos;
                     let mut radiance_y = xyz.y(ls.radiance) as f32;
+                    // A delta light's direction has no BSDF density to weigh against.
+                    let bsdf_pdf = if ls.delta {
+                        0.0
+                    } else {
+                        bsdf.pdf(wo_local, wi_local, TransportMode::Radiance)
+                    };
                     let pdf_per_sr = if ls.delta {
                         // One direction: the estimator's weight divides by the selection.
                         radiance_y /= light_share * pmf;
                         0.0
                     } else {
-                        light_share * pmf * ls.pdf
-                            + bsdf_share * bsdf.pdf(wo_local, wi_local, TransportMode::Radiance)
+                        light_share * pmf * ls.pdf + bsdf_share * bsdf_pdf
                     };
                     let divisor = if ls.delta {
                         light_share * pmf
@@ -763,7 +763,6 @@ impl ShadingProbe for RenderProbe<'_> {
                         bsdf_cos_per_sr * radiance_y * light_share
                     } else {
                         let light_pdf = pmf * ls.pdf;
-                        let bsdf_pdf = bsdf.pdf(wo_local, wi_local, TransportMode::Radiance);
                         bsdf_cos_per_sr * radiance_y * mis_weight(mis, light_pdf, bsdf_pdf)
                             / light_pdf
                     };
