@@ -6,12 +6,13 @@
 //! (page faults), as a `prism render` run does; the later rounds reuse freed memory.
 //!
 //!     CARGO_PROFILE_RELEASE_LTO=false cargo run --release -p bench-predictor -- \
-//!         [--rounds 15] [--threads 1] [--resolution 128] [--scene SCENE]…
+//!         [--rounds 15] [--threads 1] [--resolution 128] [--scene SCENE]… [--no-file]
 //!
 //! (Without LTO: linked with the workspace's thin LTO, this binary is left with undefined
 //! prism-radiosity symbols, as prism-render's integration tests are under `--release`.)
 //! The default scenes are scenes/bandwidth/fig17-curved-area.json and fig9-spheres.json.
-//! To time a change, build the tool at both commits and alternate the two binaries.
+//! To time a change, build the tool at both commits and alternate the two binaries with
+//! `--no-file`, so that the comparison's runs do not overwrite the benchmark's JSON.
 //!
 //! Prints JSON (per scene: the first round, the median and the minimum of the others, in
 //! CPU seconds of the whole process) and writes it to tools/bench-results/bench-predictor.json.
@@ -110,5 +111,7 @@ fn main() {
     });
     let text = serde_json::to_string_pretty(&out).expect("JSON");
     println!("{text}");
-    let _ = std::fs::write("tools/bench-results/bench-predictor.json", text + "\n");
+    if !args.iter().any(|a| a == "--no-file") {
+        let _ = std::fs::write("tools/bench-results/bench-predictor.json", text + "\n");
+    }
 }
