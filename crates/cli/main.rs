@@ -6,7 +6,6 @@ mod cache_dir;
 mod color;
 mod compare;
 mod converge;
-mod cpu_clock;
 mod daylight_factor;
 mod falsecolour;
 mod import;

@@ -12,7 +12,7 @@ use prism_render::probe::RenderProbe;
 use prism_render::RenderScene;
 use serde_json::json;
 
-use crate::cpu_clock::process_cpu_s;
+use prism_cpu::clock::process_cpu_s;
 
 /// A moment on the wall clock and on the process's CPU clock (all threads).
 #[derive(Clone, Copy, Debug)]

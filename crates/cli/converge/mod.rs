@@ -255,12 +255,9 @@ fn check_memory(
 /// The 1-minute load average and the logical CPU count (for the JSON: timings on a busy
 /// machine read differently).
 fn machine_load() -> Value {
-    let load = std::fs::read_to_string("/proc/loadavg")
-        .ok()
-        .and_then(|s| s.split_whitespace().next()?.parse::<f64>().ok());
     json!({
         "logical_cpus": std::thread::available_parallelism().map(|n| n.get()).ok(),
-        "load_average_1m": load,
+        "load_average_1m": prism_cpu::clock::load_average_1m(),
     })
 }
 

@@ -28,7 +28,7 @@ use prism_render::adaptive::ADAPTIVE_FIRST_PASS_SPP;
 use prism_render::{Film, RenderScene, RenderSettings, RenderStats};
 use prism_spectrum::rgb_space::RgbColorSpace;
 
-use crate::cpu_clock::{process_cpu_s, thread_cpu_s};
+use prism_cpu::clock::{process_cpu_s, thread_cpu_s};
 
 use super::method::PlanKind;
 use super::pass_planner::{PassPlanner, PlanInputs};

@@ -23,7 +23,9 @@
 //! The machine's other limits live here too: [`memory`] (the `--max-memory` budget and the
 //! physical memory) and [`threads`] (the bound on `--threads`); and [`text_file`], how
 //! every crate reads a user's text file, because this crate is the one below all others.
+//! [`clock`] holds the CPU clocks that commands and benchmarks report time on.
 
+pub mod clock;
 pub mod memory;
 pub mod text_file;
 pub mod threads;

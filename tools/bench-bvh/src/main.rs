@@ -228,16 +228,6 @@ fn build(mesh: &TriangleMesh, quality: BuildQuality) -> (Geometry, f64, Option<f
     (g, wall, cpu)
 }
 
-/// 1-minute load average, to judge whether other processes shared the cores during the run.
-fn load_average() -> Option<f64> {
-    std::fs::read_to_string("/proc/loadavg")
-        .ok()?
-        .split_whitespace()
-        .next()?
-        .parse()
-        .ok()
-}
-
 const UNITS: &str = "mrays_s: million rays per wall-clock second; mrays_per_cpu_s: million rays per CPU-second of this process (all threads)";
 
 fn mrays(x: f64) -> Value {
@@ -327,13 +317,13 @@ fn main() {
         .position(|a| a == "--scene")
         .and_then(|i| args.get(i + 1))
         .map_or("", |s| s.as_str());
-    let load_at_start = load_average();
+    let load_at_start = prism_cpu::clock::load_average_1m();
     let instanced = instanced_scenes(filter);
     if instanced_only {
         let out = json!({
             "command": format!("cargo run --release -p bench-bvh -- {}", args[1..].join(" ")),
             "load_average_1min_at_start": load_at_start,
-            "load_average_1min_at_end": load_average(),
+            "load_average_1min_at_end": prism_cpu::clock::load_average_1m(),
             "units": UNITS,
             "instanced_scenes": instanced,
         });
@@ -440,7 +430,7 @@ fn main() {
     let out = json!({
         "command": "cargo run --release -p bench-bvh",
         "load_average_1min_at_start": load_at_start,
-        "load_average_1min_at_end": load_average(),
+        "load_average_1min_at_end": prism_cpu::clock::load_average_1m(),
         "mesh": { "triangles": mesh.triangle_count(), "kind": "displaced uv sphere, 501 x 1000" },
         "ray_count": RAY_COUNT,
         "threads_available": std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1),

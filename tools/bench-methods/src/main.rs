@@ -33,15 +33,6 @@ fn cpu_seconds() -> f64 {
     (ticks(11) + ticks(12)) / 100.0
 }
 
-fn load_average() -> Option<f64> {
-    std::fs::read_to_string("/proc/loadavg")
-        .ok()?
-        .split_whitespace()
-        .next()?
-        .parse()
-        .ok()
-}
-
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let value = |flag: &str| -> Vec<String> {
@@ -76,7 +67,7 @@ fn main() {
         .num_threads(1)
         .build()
         .expect("a thread pool");
-    let load_start = load_average();
+    let load_start = prism_cpu::clock::load_average_1m();
     let mut results = Vec::new();
     for scene_path in &scenes {
         let description = prism_scene::load_scene(scene_path).expect("the scene loads");
@@ -158,7 +149,7 @@ fn main() {
         "benchmark": "bench-methods",
         "rounds": rounds,
         "threads": 1,
-        "load_average_1m": {"start": load_start, "end": load_average()},
+        "load_average_1m": {"start": load_start, "end": prism_cpu::clock::load_average_1m()},
         "command": format!("cargo run --release -p bench-methods -- {}", args.join(" ")),
         "results": results,
     });

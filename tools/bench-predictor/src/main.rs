@@ -18,30 +18,11 @@
 //! CPU seconds of the whole process) and writes it to tools/bench-results/bench-predictor.json.
 
 use glam::UVec2;
+use prism_cpu::clock::{load_average_1m, process_cpu_s};
 use prism_render::predictor::{predict_with_probe, PredictorSettings};
 use prism_render::probe::RenderProbe;
 use prism_render::RenderScene;
 use serde_json::json;
-
-/// CPU seconds of every thread of the process (CLOCK_PROCESS_CPUTIME_ID).
-fn process_cpu_s() -> f64 {
-    let mut ts = libc::timespec {
-        tv_sec: 0,
-        tv_nsec: 0,
-    };
-    // SAFETY: `ts` is a valid timespec for the call to write.
-    unsafe { libc::clock_gettime(libc::CLOCK_PROCESS_CPUTIME_ID, &mut ts) };
-    ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9
-}
-
-fn load_average() -> Option<f64> {
-    std::fs::read_to_string("/proc/loadavg")
-        .ok()?
-        .split_whitespace()
-        .next()?
-        .parse()
-        .ok()
-}
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -71,7 +52,7 @@ fn main() {
         .num_threads(threads)
         .build()
         .expect("a thread pool");
-    let load_start = load_average();
+    let load_start = load_average_1m();
     let mut results = Vec::new();
     for path in &scenes {
         let description = prism_scene::load_scene(path).expect("the scene loads");
@@ -84,9 +65,12 @@ fn main() {
                 .with_bandwidth_tables()
                 .expect("the tables build");
             let (elapsed, prediction) = pool.install(|| {
-                let start = process_cpu_s();
+                let start = process_cpu_s().expect("a process CPU clock");
                 let prediction = predict_with_probe(&scene, &settings, probe);
-                (process_cpu_s() - start, prediction)
+                (
+                    process_cpu_s().expect("a process CPU clock") - start,
+                    prediction,
+                )
             });
             prediction.expect("the prediction");
             times.push(elapsed);
@@ -106,7 +90,7 @@ fn main() {
         "resolution": [side, side],
         "threads": threads,
         "rounds": rounds,
-        "load_average_1m": {"start": load_start, "end": load_average()},
+        "load_average_1m": {"start": load_start, "end": load_average_1m()},
         "scenes": results,
     });
     let text = serde_json::to_string_pretty(&out).expect("JSON");
