@@ -106,9 +106,17 @@ fn unsupported(why: &str) -> String {
     format!("the bandwidth predictor cannot plan this scene: {why}")
 }
 
-/// The unit direction of every pixel's centre ray (row-major; `None` where there is none,
-/// outside a fisheye's image circle), from which [`angular_footprint`] reads each pixel's
-/// and its neighbours' without generating them again.
+/// The unit direction of the camera ray through `film_point_px` at the lens centre, or
+/// `None` where there is none (outside a fisheye's image circle).
+fn centre_direction(scene: &RenderScene, film_point_px: Vec2) -> Option<Vec3A> {
+    scene
+        .camera
+        .generate_ray_only(film_point_px, Vec2::splat(0.5))
+        .map(|r| r.direction)
+}
+
+/// Every pixel's [`centre_direction`] (row-major), from which [`angular_footprint`] reads
+/// each pixel's and its neighbours' without generating them again.
 fn centre_directions(scene: &RenderScene) -> Vec<Option<Vec3A>> {
     let resolution = scene.resolution;
     let count = resolution.x as usize * resolution.y as usize;
@@ -118,11 +126,7 @@ fn centre_directions(scene: &RenderScene) -> Vec<Option<Vec3A>> {
         .enumerate()
         .for_each(|(y, row)| {
             for (x, d) in row.iter_mut().enumerate() {
-                let p = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
-                *d = scene
-                    .camera
-                    .generate_ray_only(p, Vec2::splat(0.5))
-                    .map(|r| r.direction);
+                *d = centre_direction(scene, Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
             }
         });
     directions
@@ -148,10 +152,7 @@ fn angular_footprint(
                 pixel.x as f32 + 0.5 + dx as f32,
                 pixel.y as f32 + 0.5 + dy as f32,
             );
-            scene
-                .camera
-                .generate_ray_only(p, Vec2::splat(0.5))
-                .map(|r| r.direction)
+            centre_direction(scene, p)
         }
     };
     let sx = if pixel.x + 1 < resolution.x { 1 } else { -1 };
@@ -639,6 +640,11 @@ impl ProbeWork<'_, '_> {
         Ok(p)
     }
 
+    /// Whether the probe samples `pixel` in the G-buffer's pass (the lattice of stride S).
+    fn on_lattice(&self, pixel: UVec2) -> bool {
+        prism_bandwidth::on_probe_lattice(pixel.x, pixel.y, self.stride_px)
+    }
+
     /// The G-buffer's pass at `pixel`: its footprint from the centre `directions`
     /// ([`centre_directions`]), its centre hit or escape, and the probe's prediction where
     /// the pixel is on the probe's lattice.
@@ -661,7 +667,7 @@ impl ProbeWork<'_, '_> {
                     pixel,
                     &hit,
                     rad_per_px,
-                    prism_bandwidth::on_probe_lattice(pixel.x, pixel.y, self.stride_px),
+                    self.on_lattice(pixel),
                     dirac,
                     scratch,
                 )?;
@@ -751,7 +757,6 @@ pub fn predict_with_probe<'a>(
     // The lattice's pixels are probed in the G-buffer's pass; the pixels of surfaces with no
     // lattice pixel within the pooling radius, which only the G-buffer's classes find, in a
     // second pass (the centre rays are traced once, but for those few).
-    let on_lattice = |x: u32, y: u32| prism_bandwidth::on_probe_lattice(x, y, stride_px);
     let directions = centre_directions(scene);
     let count = resolution.x as usize * resolution.y as usize;
     let w = resolution.x as usize;
@@ -802,7 +807,7 @@ pub fn predict_with_probe<'a>(
         .filter(|&i| {
             probed[i]
                 && matches!(class[i], PixelClass::Material(_))
-                && !on_lattice((i % w) as u32, (i / w) as u32)
+                && !probe_work.on_lattice(UVec2::new((i % w) as u32, (i / w) as u32))
         })
         .map_init(ProbeScratch::default, |scratch, i| {
             let pixel = UVec2::new((i % w) as u32, (i / w) as u32);
