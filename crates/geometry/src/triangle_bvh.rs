@@ -18,6 +18,8 @@ use obvhs::faststack::FastStack;
 use crate::bvh_build::{build_bvh, bvh_ray, padded_aabb, BuildQuality};
 use crate::triangle::{TriangleHit, WatertightRay};
 
+#[path = "triangle_bvh_nearest.rs"]
+mod nearest;
 #[path = "triangle_bvh_stream.rs"]
 mod stream;
 
@@ -98,7 +100,8 @@ impl<Id: Copy> TriangleBvh<Id> {
     /// intersects one stored primitive and returns its `t` (which then bounds the rest of the
     /// traversal) or `f32::INFINITY` for a miss; the caller keeps the record of the best hit.
     /// For soups that store other leaves than triangles (the flattened scene's instances).
-    /// The node test is `WIDE`'s ([`node_hits_on`]).
+    /// Children are visited nearest first and culled once a hit lies nearer
+    /// ([`Self::traverse_nearest_first`]); the node test is `WIDE`'s ([`node_entries_on`]).
     ///
     /// # Safety
     /// With `WIDE`, the CPU must run AVX2.
@@ -109,32 +112,13 @@ impl<Id: Copy> TriangleBvh<Id> {
         direction: Vec3A,
         t_min: f32,
         t_max: f32,
-        mut test: impl FnMut(&[Vec3A; 3], Id, f32) -> f32,
+        test: impl FnMut(&[Vec3A; 3], Id, f32) -> f32,
     ) {
         let Some(bvh) = self.bvh.as_ref() else {
             return;
         };
-        let mut ray = bvh_ray(origin, direction, t_min, t_max);
-        let mut state = Traversal::new(bvh, direction);
-        let mut node;
-        obvhs::traverse!(
-            bvh,
-            node,
-            state,
-            {
-                // SAFETY: the caller's contract for `WIDE`.
-                let hits = unsafe { node_hits_on::<WIDE>(node, &ray, state.oct_inv4) };
-                self.prefetch_hits(bvh, node, hits, state.oct_inv4);
-                hits
-            },
-            {
-                let slot = state.primitive_id as usize;
-                let t = test(&self.leaf_triangles[slot], self.leaf_ids[slot], ray.tmax);
-                if t < ray.tmax {
-                    ray.tmax = t;
-                }
-            }
-        );
+        // SAFETY: the caller's contract for `WIDE`.
+        unsafe { self.traverse_nearest_first::<WIDE>(bvh, origin, direction, t_min, t_max, test) };
     }
 
     /// Start loading what the closest-hit traversal reads next: the primitives (vertices and
@@ -143,26 +127,13 @@ impl<Id: Copy> TriangleBvh<Id> {
     /// an incoherent ray's time goes").
     #[inline(always)]
     fn prefetch_hits(&self, bvh: &CwBvh, node: &CwBvhNode, hits: u32, oct_inv4: u32) {
-        #[cfg(target_arch = "x86_64")]
         {
-            use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
-            // The lines of an object's first and last byte: all of it for objects of up to
-            // 64 bytes (a triangle is 48, an id 8), and of a node (80 bytes) unless it
-            // starts in a line's last 16 bytes.
-            fn object<T>(p: *const T) {
-                let first = p as *const i8;
-                // SAFETY: prefetching never faults, whatever the address.
-                unsafe {
-                    _mm_prefetch::<_MM_HINT_T0>(first);
-                    _mm_prefetch::<_MM_HINT_T0>(first.wrapping_add(size_of::<T>() - 1));
-                }
-            }
             let mut primitives = hits & 0x00ff_ffff;
             while primitives != 0 {
                 let slot = (node.primitive_base_idx + primitives.trailing_zeros()) as usize;
                 primitives &= primitives - 1;
-                object(self.leaf_triangles.as_ptr().wrapping_add(slot));
-                object(self.leaf_ids.as_ptr().wrapping_add(slot));
+                prefetch_object(self.leaf_triangles.as_ptr().wrapping_add(slot));
+                prefetch_object(self.leaf_ids.as_ptr().wrapping_add(slot));
             }
             // The bit of a child node is its slot in the ray's octant order (obvhs'
             // `traverse!`: slot = bit ^ octant, node = child_base_idx + internal children
@@ -173,11 +144,9 @@ impl<Id: Copy> TriangleBvh<Id> {
                 children &= children - 1;
                 let before = u32::from(node.imask) & ((1u32 << child_slot) - 1);
                 let index = (node.child_base_idx + before.count_ones()) as usize;
-                object(bvh.nodes.as_ptr().wrapping_add(index));
+                prefetch_object(bvh.nodes.as_ptr().wrapping_add(index));
             }
         }
-        #[cfg(not(target_arch = "x86_64"))]
-        let _ = (bvh, node, hits, oct_inv4);
     }
 
     /// Any-hit traversal: whether `test(primitive, id, t_max)` accepts any primitive whose
@@ -272,6 +241,57 @@ impl<Id: Copy> TriangleBest<Id> {
     }
 }
 
+/// Start loading the cache lines of an object's first and last byte: all of it for objects
+/// of up to 64 bytes (a triangle is 48, an id 8), and of a node (80 bytes) unless it starts
+/// in a line's last 16 bytes. Nothing on other architectures.
+#[inline(always)]
+fn prefetch_object<T>(p: *const T) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+        let first = p as *const i8;
+        // SAFETY: prefetching never faults, whatever the address.
+        unsafe {
+            _mm_prefetch::<_MM_HINT_T0>(first);
+            _mm_prefetch::<_MM_HINT_T0>(first.wrapping_add(size_of::<T>() - 1));
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = p;
+}
+
+/// The children of `node` that are not empty, one bit per slot (a slot's meta byte is 0
+/// when empty).
+#[inline(always)]
+fn occupied_slots(node: &CwBvhNode) -> u32 {
+    const LOW7: u64 = 0x7f7f_7f7f_7f7f_7f7f;
+    let meta8 = u64::from_le_bytes(node.child_meta);
+    // The high bit of each byte set where the byte is not zero, then the eight high bits
+    // gathered into one byte by a multiplication.
+    let nonzero = (meta8 | ((meta8 & LOW7) + LOW7)) & !LOW7;
+    ((nonzero >> 7).wrapping_mul(0x0102_0408_1020_4080) >> 56) as u32
+}
+
+/// [`node_entries_avx2`] where `WIDE`, else [`node_entries`]: the same slots and distances,
+/// bit for bit.
+///
+/// # Safety
+/// With `WIDE`, the CPU must run AVX2.
+#[inline(always)]
+unsafe fn node_entries_on<const WIDE: bool>(
+    node: &CwBvhNode,
+    ray: &obvhs::ray::Ray,
+) -> (u32, [f32; 8]) {
+    #[cfg(target_arch = "x86_64")]
+    if WIDE {
+        // SAFETY: the caller's contract.
+        let (entered, t_entry) = unsafe { node_entries_avx2(node, ray) };
+        return (entered & occupied_slots(node), t_entry);
+    }
+    let (entered, t_entry) = node_entries(node, ray);
+    (entered & occupied_slots(node), t_entry)
+}
+
 /// [`node_hits_avx2`] where `WIDE`, else [`node_hits`]: the same mask, bit for bit.
 ///
 /// # Safety
@@ -300,10 +320,27 @@ unsafe fn node_hits_on<const WIDE: bool>(
 #[inline]
 fn node_hits_avx2(node: &CwBvhNode, ray: &obvhs::ray::Ray, oct_inv4: u32) -> u32 {
     use obvhs::cwbvh::node::extract_byte64;
+    let (mut entered, _) = node_entries_avx2(node, ray);
+    let (child_bits8, bit_index8) = node.get_child_and_index_bits(oct_inv4);
+    let mut hit_mask = 0u32;
+    while entered != 0 {
+        let child = entered.trailing_zeros() as usize;
+        entered &= entered - 1;
+        hit_mask |= extract_byte64(child_bits8, child) << extract_byte64(bit_index8, child);
+    }
+    hit_mask
+}
+
+/// The slab test of [`node_entries`] for all eight slots at once in AVX2: which slots' boxes
+/// the ray enters within `[ray.tmin, ray.tmax]` (empty slots included) and each slot's
+/// entry distance.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[inline]
+fn node_entries_avx2(node: &CwBvhNode, ray: &obvhs::ray::Ray) -> (u32, [f32; 8]) {
     use std::arch::x86_64::*;
     let dir_inv = node.compute_extent() * ray.inv_direction;
     let origin = (Vec3A::from(node.p) - ray.origin) * ray.inv_direction;
-    let (child_bits8, bit_index8) = node.get_child_and_index_bits(oct_inv4);
     // Eight u8 bounds → eight f32 (exact).
     macro_rules! widen {
         ($bytes:expr) => {
@@ -353,14 +390,11 @@ fn node_hits_avx2(node: &CwBvhNode, ray: &obvhs::ray::Ray, oct_inv4: u32) -> u32
         _mm256_min_ps(tmax_x, _mm256_min_ps(tmax_y, tmax_z)),
         _mm256_set1_ps(ray.tmax),
     );
-    let mut entered = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OS>(tmin, tmax)) as u32;
-    let mut hit_mask = 0u32;
-    while entered != 0 {
-        let child = entered.trailing_zeros() as usize;
-        entered &= entered - 1;
-        hit_mask |= extract_byte64(child_bits8, child) << extract_byte64(bit_index8, child);
-    }
-    hit_mask
+    let entered = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OS>(tmin, tmax)) as u32;
+    let mut t_entry = [0.0f32; 8];
+    // SAFETY: `t_entry` holds eight f32 (an unaligned store).
+    unsafe { _mm256_storeu_ps(t_entry.as_mut_ptr(), tmin) };
+    (entered, t_entry)
 }
 
 /// Which children of `node` the ray enters within `[ray.tmin, ray.tmax]`: obvhs'
@@ -371,8 +405,24 @@ fn node_hits_avx2(node: &CwBvhNode, ray: &obvhs::ray::Ray, oct_inv4: u32) -> u32
 /// ray leaving a point 10 µm in front of a wall) was never reached.
 #[inline(always)]
 fn node_hits(node: &CwBvhNode, ray: &obvhs::ray::Ray, oct_inv4: u32) -> u32 {
-    use glam::Vec4;
     use obvhs::cwbvh::node::extract_byte64;
+    let (mut entered, _) = node_entries(node, ray);
+    let (child_bits8, bit_index8) = node.get_child_and_index_bits(oct_inv4);
+    let mut hit_mask = 0u32;
+    while entered != 0 {
+        let child = entered.trailing_zeros() as usize;
+        entered &= entered - 1;
+        hit_mask |= extract_byte64(child_bits8, child) << extract_byte64(bit_index8, child);
+    }
+    hit_mask
+}
+
+/// The slab test of [`node_hits`] per slot, four at a time: which slots' boxes the ray
+/// enters within `[ray.tmin, ray.tmax]` (empty slots included; bit i for slot i) and each
+/// slot's entry distance.
+#[inline(always)]
+fn node_entries(node: &CwBvhNode, ray: &obvhs::ray::Ray) -> (u32, [f32; 8]) {
+    use glam::Vec4;
     let dir_inv = node.compute_extent() * ray.inv_direction;
     let origin = (Vec3A::from(node.p) - ray.origin) * ray.inv_direction;
     let (rdx, rdy, rdz) = (
@@ -380,9 +430,9 @@ fn node_hits(node: &CwBvhNode, ray: &obvhs::ray::Ray, oct_inv4: u32) -> u32 {
         ray.direction.y < 0.0,
         ray.direction.z < 0.0,
     );
-    let (child_bits8, bit_index8) = node.get_child_and_index_bits(oct_inv4);
     let (t_lo, t_hi) = (Vec4::splat(ray.tmin), Vec4::splat(ray.tmax));
-    let mut hit_mask = 0u32;
+    let mut entered = 0u32;
+    let mut t_entry = [0.0f32; 8];
     for i in 0..2 {
         let q = |v: &[u8; 8]| {
             Vec4::new(
@@ -420,15 +470,10 @@ fn node_hits(node: &CwBvhNode, ray: &obvhs::ray::Ray, oct_inv4: u32) -> u32 {
         );
         let tmin = tmin_x.max(tmin_y.max(tmin_z)).max(t_lo);
         let tmax = tmax_x.min(tmax_y.min(tmax_z)).min(t_hi);
-        let mask = tmin.cmple(tmax).bitmask();
-        for j in 0..4 {
-            if mask & (1 << j) != 0 {
-                let child = i * 4 + j;
-                hit_mask |= extract_byte64(child_bits8, child) << extract_byte64(bit_index8, child);
-            }
-        }
+        entered |= tmin.cmple(tmax).bitmask() << (i * 4);
+        t_entry[i * 4..i * 4 + 4].copy_from_slice(&tmin.to_array());
     }
-    hit_mask
+    (entered, t_entry)
 }
 
 /// Traversal state for obvhs' `traverse!` macro (the fields it reads and writes). obvhs'

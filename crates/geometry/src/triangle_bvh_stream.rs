@@ -3,8 +3,11 @@
 //! the last node test selected, then the next child node), so the cache misses of one ray's
 //! node and leaf loads — requested ahead by the node test's prefetches — overlap with the other
 //! rays' work instead of stalling the core (Kocberber et al. 2015, "Asynchronous memory
-//! access chaining"). Each ray visits the same nodes and primitives in the same order as the
-//! one-ray traversal, so its hit is the same bits; a lane whose ray ends takes the next ray.
+//! access chaining"). Each ray finds the closest hit, as the one-ray traversal does, though in
+//! the octant order of obvhs' `traverse!` where the one-ray traversal goes nearest first
+//! (triangle_bvh_nearest.rs): the hit is the same bits unless two primitives give the ray the
+//! very same `t`, where each keeps the first it tested. A lane whose ray ends takes the next
+//! ray.
 
 use glam::{UVec2, Vec3A};
 use obvhs::cwbvh::{firstbithigh, CwBvh};
@@ -99,7 +102,8 @@ impl<Id: Copy> TriangleBvh<Id> {
 
     /// [`TriangleBvh::intersect_with`] for `count` rays, `STREAM_LANES` interleaved: `ray(i)`
     /// gives ray `i` (origin, direction, `t_min`, `t_max`) and `hit(i, result)` receives its
-    /// closest hit, the same bits, in any order of `i`.
+    /// closest hit, the same bits but for exact ties in `t` (module comment), in any order
+    /// of `i`.
     ///
     /// # Safety
     /// With `WIDE`, the CPU must run AVX2.

@@ -1,0 +1,225 @@
+//! Closest-hit traversal of one ray in the order of the children's entry distances, with
+//! children culled on the stack once a hit lies nearer than their entry (Embree's
+//! single-ray BVH8 traversal, Wald et al. 2014, over the same CWBVH nodes). obvhs'
+//! `traverse!` visits children in the ray octant's order and keeps the entered children of
+//! a node as one group bit mask: after a hit it still loads and tests every child it had
+//! entered before, and a near child can wait behind a far one of the same octant order.
+
+use std::mem::MaybeUninit;
+
+use glam::Vec3A;
+use obvhs::cwbvh::node::CwBvhNode;
+use obvhs::cwbvh::CwBvh;
+
+use super::{node_entries_on, prefetch_object, TriangleBvh};
+use crate::bvh_build::bvh_ray;
+
+/// A child node still to visit and the ray's entry distance into its box.
+#[derive(Clone, Copy)]
+struct Pending {
+    node: u32,
+    t_entry: f32,
+}
+
+/// Entries kept without allocation; a deeper stack (a tree far from balanced: up to seven
+/// entries per level) spills to the heap rather than losing a child.
+const INLINE_ENTRIES: usize = 128;
+
+/// A last-in first-out stack of [`Pending`] children without initialisation cost.
+struct PendingStack {
+    inline: [MaybeUninit<Pending>; INLINE_ENTRIES],
+    len: usize,
+    spilled: Vec<Pending>,
+}
+
+impl PendingStack {
+    #[inline(always)]
+    fn new() -> Self {
+        Self {
+            inline: [MaybeUninit::uninit(); INLINE_ENTRIES],
+            len: 0,
+            spilled: Vec::new(),
+        }
+    }
+
+    #[inline(always)]
+    fn push(&mut self, entry: Pending) {
+        if self.len < INLINE_ENTRIES {
+            self.inline[self.len] = MaybeUninit::new(entry);
+            self.len += 1;
+        } else {
+            self.spilled.push(entry);
+        }
+    }
+
+    #[inline(always)]
+    fn pop(&mut self) -> Option<Pending> {
+        if let Some(entry) = self.spilled.pop() {
+            return Some(entry);
+        }
+        if self.len == 0 {
+            return None;
+        }
+        self.len -= 1;
+        // SAFETY: slots below `len` were written by `push`.
+        Some(unsafe { self.inline[self.len].assume_init() })
+    }
+}
+
+impl<Id: Copy> TriangleBvh<Id> {
+    /// [`TriangleBvh::traverse_with`]'s traversal: at each node its entered leaf children's
+    /// primitives are tested first (lowering `t_max`), then the entered internal children
+    /// whose entry lies within `t_max` are visited nearest first; a child waiting on the
+    /// stack is skipped once the best hit lies nearer than its entry.
+    ///
+    /// # Safety
+    /// With `WIDE`, the CPU must run AVX2.
+    #[inline(always)]
+    pub(super) unsafe fn traverse_nearest_first<const WIDE: bool>(
+        &self,
+        bvh: &CwBvh,
+        origin: Vec3A,
+        direction: Vec3A,
+        t_min: f32,
+        t_max: f32,
+        mut test: impl FnMut(&[Vec3A; 3], Id, f32) -> f32,
+    ) {
+        if bvh.nodes.is_empty() {
+            return;
+        }
+        let mut ray = bvh_ray(origin, direction, t_min, t_max);
+        let mut stack = PendingStack::new();
+        let mut node_index = 0u32;
+        'nodes: loop {
+            let node = &bvh.nodes[node_index as usize];
+            // SAFETY: the caller's contract for `WIDE`.
+            let (entered, t_entry) = unsafe { node_entries_on::<WIDE>(node, &ray) };
+            let internal_mask = u32::from(node.imask);
+            let mut leaves = entered & !internal_mask;
+            let mut internal = entered & internal_mask;
+            self.prefetch_entered(bvh, node, leaves, internal);
+            // Leaf children nearest first, each skipped once a hit lies nearer than its box.
+            let mut leaf_order = [(0usize, 0.0f32); 8];
+            let mut leaf_count = 0;
+            while leaves != 0 {
+                let slot = leaves.trailing_zeros() as usize;
+                leaves &= leaves - 1;
+                let t = t_entry[slot];
+                let mut at = leaf_count;
+                while at > 0 && leaf_order[at - 1].1 > t {
+                    leaf_order[at] = leaf_order[at - 1];
+                    at -= 1;
+                }
+                leaf_order[at] = (slot, t);
+                leaf_count += 1;
+            }
+            for &(slot, t) in &leaf_order[..leaf_count] {
+                if t > ray.tmax {
+                    break;
+                }
+                let meta = u32::from(node.child_meta[slot]);
+                let first = node.primitive_base_idx + (meta & 0b1_1111);
+                for slot in first..first + (meta >> 5).count_ones() {
+                    let slot = slot as usize;
+                    let t = test(&self.leaf_triangles[slot], self.leaf_ids[slot], ray.tmax);
+                    if t < ray.tmax {
+                        ray.tmax = t;
+                    }
+                }
+            }
+            // The internal children within reach, sorted nearest first (stable: equal
+            // distances keep the slot order, so every ISA visits them alike).
+            let mut order = [Pending {
+                node: 0,
+                t_entry: 0.0,
+            }; 8];
+            let mut count = 0;
+            while internal != 0 {
+                let slot = internal.trailing_zeros();
+                internal &= internal - 1;
+                let t = t_entry[slot as usize];
+                if t > ray.tmax {
+                    continue;
+                }
+                let before = internal_mask & ((1u32 << slot) - 1);
+                let child = Pending {
+                    node: node.child_base_idx + before.count_ones(),
+                    t_entry: t,
+                };
+                let mut at = count;
+                while at > 0 && order[at - 1].t_entry > t {
+                    order[at] = order[at - 1];
+                    at -= 1;
+                }
+                order[at] = child;
+                count += 1;
+            }
+            if count > 0 {
+                for &far in order[1..count].iter().rev() {
+                    stack.push(far);
+                }
+                node_index = order[0].node;
+                continue 'nodes;
+            }
+            while let Some(pending) = stack.pop() {
+                if pending.t_entry <= ray.tmax {
+                    node_index = pending.node;
+                    continue 'nodes;
+                }
+            }
+            return;
+        }
+    }
+
+    /// Start loading the primitives (vertices and ids) of the entered leaf children and the
+    /// entered child nodes, so that their cache misses overlap (as `prefetch_hits` does for
+    /// obvhs' traversal).
+    #[inline(always)]
+    fn prefetch_entered(&self, bvh: &CwBvh, node: &CwBvhNode, leaves: u32, internal: u32) {
+        let mut leaves = leaves;
+        while leaves != 0 {
+            let slot = leaves.trailing_zeros() as usize;
+            leaves &= leaves - 1;
+            let meta = u32::from(node.child_meta[slot]);
+            let first = node.primitive_base_idx + (meta & 0b1_1111);
+            for slot in first..first + (meta >> 5).count_ones() {
+                prefetch_object(self.leaf_triangles.as_ptr().wrapping_add(slot as usize));
+                prefetch_object(self.leaf_ids.as_ptr().wrapping_add(slot as usize));
+            }
+        }
+        let mut internal = internal;
+        let internal_mask = u32::from(node.imask);
+        while internal != 0 {
+            let slot = internal.trailing_zeros();
+            internal &= internal - 1;
+            let before = internal_mask & ((1u32 << slot) - 1);
+            let index = (node.child_base_idx + before.count_ones()) as usize;
+            prefetch_object(bvh.nodes.as_ptr().wrapping_add(index));
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Beyond its inline entries the stack spills to the heap and still pops last in,
+    /// first out, every entry once.
+    #[test]
+    fn the_pending_stack_spills_and_keeps_its_order() {
+        let mut stack = PendingStack::new();
+        let count = 3 * INLINE_ENTRIES as u32 + 5;
+        for node in 0..count {
+            stack.push(Pending {
+                node,
+                t_entry: node as f32,
+            });
+        }
+        assert!(!stack.spilled.is_empty());
+        for node in (0..count).rev() {
+            let entry = stack.pop().expect("an entry per push");
+            assert_eq!((entry.node, entry.t_entry), (node, node as f32));
+        }
+        assert!(stack.pop().is_none());
+    }
+}
