@@ -6,6 +6,7 @@
 //! entered before, and a near child can wait behind a far one of the same octant order.
 
 use std::mem::MaybeUninit;
+use std::ops::ControlFlow;
 
 use glam::Vec3A;
 use obvhs::cwbvh::node::CwBvhNode;
@@ -67,10 +68,13 @@ impl PendingStack {
 }
 
 impl<Id: Copy> TriangleBvh<Id> {
-    /// [`TriangleBvh::traverse_with`]'s traversal: at each node its entered leaf children's
-    /// primitives are tested first (lowering `t_max`), then the entered internal children
-    /// whose entry lies within `t_max` are visited nearest first; a child waiting on the
-    /// stack is skipped once the best hit lies nearer than its entry.
+    /// The traversal of [`TriangleBvh::traverse_with`] and [`TriangleBvh::any_with`]: at
+    /// each node its entered leaf children's primitives are tested first, nearest first
+    /// (`test(primitive, id, t_max)` continues with the primitive's `t`, which lowers
+    /// `t_max` where it is nearer, or breaks off the traversal), then the entered internal
+    /// children whose entry lies within `t_max` are visited nearest first; a child waiting
+    /// on the stack is skipped once the best hit lies nearer than its entry. Whether `test`
+    /// broke off.
     ///
     /// # Safety
     /// With `WIDE`, the CPU must run AVX2.
@@ -82,10 +86,10 @@ impl<Id: Copy> TriangleBvh<Id> {
         direction: Vec3A,
         t_min: f32,
         t_max: f32,
-        mut test: impl FnMut(&[Vec3A; 3], Id, f32) -> f32,
-    ) {
+        mut test: impl FnMut(&[Vec3A; 3], Id, f32) -> ControlFlow<(), f32>,
+    ) -> bool {
         if bvh.nodes.is_empty() {
-            return;
+            return false;
         }
         let mut ray = bvh_ray(origin, direction, t_min, t_max);
         let mut stack = PendingStack::new();
@@ -121,7 +125,11 @@ impl<Id: Copy> TriangleBvh<Id> {
                 let first = node.primitive_base_idx + (meta & 0b1_1111);
                 for slot in first..first + (meta >> 5).count_ones() {
                     let slot = slot as usize;
-                    let t = test(&self.leaf_triangles[slot], self.leaf_ids[slot], ray.tmax);
+                    let ControlFlow::Continue(t) =
+                        test(&self.leaf_triangles[slot], self.leaf_ids[slot], ray.tmax)
+                    else {
+                        return true;
+                    };
                     if t < ray.tmax {
                         ray.tmax = t;
                     }
@@ -167,7 +175,7 @@ impl<Id: Copy> TriangleBvh<Id> {
                     continue 'nodes;
                 }
             }
-            return;
+            return false;
         }
     }
 
