@@ -3,9 +3,10 @@
 //! `cornell_box_cwbvh` example). Each leaf slot also carries a caller-chosen id: the triangle
 //! index for a mesh's own BVH ([`crate::mesh_bvh::MeshBvh`]); for the scene BVH of
 //! [`crate::Geometry`], the original instance and triangle of a baked world-space triangle, or
-//! an instance whose slot holds its world box instead of vertices. Traversal runs obvhs'
-//! `traverse!` loop with our own uninitialised node stack ([`Traversal`]); the closest-hit
-//! traversal prefetches the lines each node test selects.
+//! an instance whose slot holds its world box instead of vertices. One ray's closest-hit and
+//! any-hit traversals visit children nearest first (triangle_bvh_nearest.rs); a ray stream
+//! runs obvhs' `traverse!` loop with our own uninitialised node stack ([`Traversal`]). Both
+//! prefetch the lines each node test selects.
 
 use std::mem::MaybeUninit;
 use std::ops::ControlFlow;
