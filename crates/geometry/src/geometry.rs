@@ -398,6 +398,21 @@ struct Leaf {
     primitive: u32,
 }
 
+impl crate::leaf_record::SlotId for Leaf {
+    #[inline(always)]
+    fn to_lanes(self) -> [u32; 3] {
+        [self.instance, self.primitive, 0]
+    }
+
+    #[inline(always)]
+    fn from_lanes(lanes: [u32; 3]) -> Self {
+        Self {
+            instance: lanes[0],
+            primitive: lanes[1],
+        }
+    }
+}
+
 impl Leaf {
     /// The leaf is a whole instance, intersected in its object space.
     const INSTANCE: u32 = u32::MAX;

@@ -16,6 +16,7 @@ pub mod fast_path;
 pub mod frame;
 pub mod geometry;
 pub mod interaction;
+mod leaf_record;
 pub mod mesh;
 pub mod mesh_bvh;
 pub mod obj;

@@ -8,6 +8,7 @@
 //! runs obvhs' `traverse!` loop with our own uninitialised node stack ([`Traversal`]). Both
 //! prefetch the lines each node test selects.
 
+use std::marker::PhantomData;
 use std::mem::MaybeUninit;
 use std::ops::ControlFlow;
 
@@ -18,6 +19,7 @@ use obvhs::cwbvh::CwBvh;
 use obvhs::faststack::FastStack;
 
 use crate::bvh_build::{build_bvh, padded_aabb, BuildQuality};
+use crate::leaf_record::{LeafRecord, SlotId};
 use crate::triangle::{TriangleHit, WatertightRay};
 
 #[path = "triangle_bvh_nearest.rs"]
@@ -28,13 +30,12 @@ mod stream;
 pub(crate) struct TriangleBvh<Id> {
     /// `None` for an empty soup.
     bvh: Option<CwBvh>,
-    /// Vertices in BVH leaf order.
-    leaf_triangles: Vec<[Vec3A; 3]>,
-    /// BVH leaf slot → id of the triangle.
-    leaf_ids: Vec<Id>,
+    /// Vertices and id of each slot, in BVH leaf order.
+    leaves: Vec<LeafRecord>,
+    id: PhantomData<Id>,
 }
 
-impl<Id: Copy> TriangleBvh<Id> {
+impl<Id: SlotId> TriangleBvh<Id> {
     /// Build over `triangles`, where `ids[i]` names `triangles[i]`.
     pub fn build(triangles: &[[Vec3A; 3]], ids: &[Id], quality: BuildQuality) -> Self {
         Self::build_with_bounds(
@@ -63,18 +64,18 @@ impl<Id: Copy> TriangleBvh<Id> {
             })
             .collect();
         let bvh = build_bvh(&boxes, quality);
-        let (leaf_triangles, leaf_ids) = match &bvh {
+        let leaves = match &bvh {
             Some(b) => b
                 .primitive_indices
                 .iter()
-                .map(|&i| (triangles[i as usize], ids[i as usize]))
-                .unzip(),
-            None => (Vec::new(), Vec::new()),
+                .map(|&i| LeafRecord::new(&triangles[i as usize], ids[i as usize]))
+                .collect(),
+            None => Vec::new(),
         };
         Self {
             bvh,
-            leaf_triangles,
-            leaf_ids,
+            leaves,
+            id: PhantomData,
         }
     }
 
@@ -135,8 +136,7 @@ impl<Id: Copy> TriangleBvh<Id> {
             while primitives != 0 {
                 let slot = (node.primitive_base_idx + primitives.trailing_zeros()) as usize;
                 primitives &= primitives - 1;
-                prefetch_object(self.leaf_triangles.as_ptr().wrapping_add(slot));
-                prefetch_object(self.leaf_ids.as_ptr().wrapping_add(slot));
+                prefetch_object(self.leaves.as_ptr().wrapping_add(slot));
             }
             // The bit of a child node is its slot in the ray's octant order (obvhs'
             // `traverse!`: slot = bit ^ octant, node = child_base_idx + internal children

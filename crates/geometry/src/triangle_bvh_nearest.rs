@@ -14,6 +14,7 @@ use obvhs::cwbvh::CwBvh;
 
 use super::{node_entries_on, prefetch_object, TriangleBvh};
 use crate::bvh_build::bvh_ray;
+use crate::leaf_record::SlotId;
 
 /// A child node still to visit and the ray's entry distance into its box.
 #[derive(Clone, Copy)]
@@ -67,7 +68,7 @@ impl PendingStack {
     }
 }
 
-impl<Id: Copy> TriangleBvh<Id> {
+impl<Id: SlotId> TriangleBvh<Id> {
     /// The traversal of [`TriangleBvh::traverse_with`] and [`TriangleBvh::any_with`]: at
     /// each node its entered leaf children's primitives are tested first, nearest first
     /// (`test(primitive, id, t_max)` continues with the primitive's `t`, which lowers
@@ -125,8 +126,8 @@ impl<Id: Copy> TriangleBvh<Id> {
                 let first = node.primitive_base_idx + (meta & 0b1_1111);
                 for slot in first..first + (meta >> 5).count_ones() {
                     let slot = slot as usize;
-                    let ControlFlow::Continue(t) =
-                        test(&self.leaf_triangles[slot], self.leaf_ids[slot], ray.tmax)
+                    let leaf = &self.leaves[slot];
+                    let ControlFlow::Continue(t) = test(&leaf.vectors(), leaf.id(), ray.tmax)
                     else {
                         return true;
                     };
@@ -191,8 +192,7 @@ impl<Id: Copy> TriangleBvh<Id> {
             let meta = u32::from(node.child_meta[slot]);
             let first = node.primitive_base_idx + (meta & 0b1_1111);
             for slot in first..first + (meta >> 5).count_ones() {
-                prefetch_object(self.leaf_triangles.as_ptr().wrapping_add(slot as usize));
-                prefetch_object(self.leaf_ids.as_ptr().wrapping_add(slot as usize));
+                prefetch_object(self.leaves.as_ptr().wrapping_add(slot as usize));
             }
         }
         let mut internal = internal;

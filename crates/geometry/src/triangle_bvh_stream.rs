@@ -15,6 +15,7 @@ use obvhs::faststack::FastStack;
 
 use super::{node_hits_on, Traversal, TriangleBest, TriangleBvh};
 use crate::bvh_build::bvh_ray;
+use crate::leaf_record::SlotId;
 use crate::triangle::TriangleHit;
 
 /// Rays in flight per stream: chosen on bench-bvh's 10⁶-triangle workload (docs/geometry.md,
@@ -30,7 +31,7 @@ struct Lane<L> {
     user: Option<L>,
 }
 
-impl<Id: Copy> TriangleBvh<Id> {
+impl<Id: SlotId> TriangleBvh<Id> {
     /// Closest-hit traversal of `count` rays, `STREAM_LANES` interleaved: `start(i)` gives
     /// ray `i` (origin, direction, `t_min`, `t_max`) and the caller's state for it,
     /// `test(state, primitive, id, t_max)` is [`TriangleBvh::traverse_with`]'s leaf test for
@@ -144,12 +145,8 @@ impl<Id: Copy> TriangleBvh<Id> {
             let local = firstbithigh(state.primitive_group.y);
             state.primitive_group.y &= !(1u32 << local);
             let slot = (state.primitive_group.x + local) as usize;
-            let t = test(
-                user,
-                &self.leaf_triangles[slot],
-                self.leaf_ids[slot],
-                ray.tmax,
-            );
+            let leaf = &self.leaves[slot];
+            let t = test(user, &leaf.vectors(), leaf.id(), ray.tmax);
             if t < ray.tmax {
                 ray.tmax = t;
             }
