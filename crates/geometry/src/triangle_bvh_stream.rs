@@ -5,8 +5,8 @@
 //! rays' work instead of stalling the core (Kocberber et al. 2015, "Asynchronous memory
 //! access chaining"). Each ray finds the closest hit, as the one-ray traversal does, though in
 //! the octant order of obvhs' `traverse!` where the one-ray traversal goes nearest first
-//! (triangle_bvh_nearest.rs): the hit is the same bits unless two primitives give the ray the
-//! very same `t`, where each keeps the first it tested. A lane whose ray ends takes the next
+//! (triangle_bvh_nearest.rs): the hit is the same bits except where the ray meets the edge two
+//! triangles share (both hit, at the same `t` or one ulp apart), where either may be kept. A lane whose ray ends takes the next
 //! ray.
 
 use glam::{UVec2, Vec3A};
@@ -103,7 +103,7 @@ impl<Id: SlotId> TriangleBvh<Id> {
 
     /// [`TriangleBvh::intersect_with`] for `count` rays, `STREAM_LANES` interleaved: `ray(i)`
     /// gives ray `i` (origin, direction, `t_min`, `t_max`) and `hit(i, result)` receives its
-    /// closest hit, the same bits but for exact ties in `t` (module comment), in any order
+    /// closest hit, the same bits but at edges two triangles share (module comment), in any order
     /// of `i`.
     ///
     /// # Safety
