@@ -312,16 +312,7 @@ unsafe fn node_hits_on<const WIDE: bool>(
 #[target_feature(enable = "avx2")]
 #[inline]
 fn node_hits_avx2(node: &CwBvhNode, ray: &obvhs::ray::Ray, oct_inv4: u32) -> u32 {
-    use obvhs::cwbvh::node::extract_byte64;
-    let (mut entered, _) = node_entries_avx2(node, ray);
-    let (child_bits8, bit_index8) = node.get_child_and_index_bits(oct_inv4);
-    let mut hit_mask = 0u32;
-    while entered != 0 {
-        let child = entered.trailing_zeros() as usize;
-        entered &= entered - 1;
-        hit_mask |= extract_byte64(child_bits8, child) << extract_byte64(bit_index8, child);
-    }
-    hit_mask
+    octant_hit_mask(node, node_entries_avx2(node, ray).0, oct_inv4)
 }
 
 /// The slab test of [`node_entries`] for all eight slots at once in AVX2: which slots' boxes
@@ -398,8 +389,15 @@ fn node_entries_avx2(node: &CwBvhNode, ray: &obvhs::ray::Ray) -> (u32, [f32; 8])
 /// ray leaving a point 10 µm in front of a wall) was never reached.
 #[inline(always)]
 fn node_hits(node: &CwBvhNode, ray: &obvhs::ray::Ray, oct_inv4: u32) -> u32 {
+    octant_hit_mask(node, node_entries(node, ray).0, oct_inv4)
+}
+
+/// obvhs' `traverse!` hit mask of the entered slots (bit i for slot i): a leaf child's
+/// primitives in the low 24 bits, an internal child's bit in the high byte at its place in
+/// the ray octant's order.
+#[inline(always)]
+fn octant_hit_mask(node: &CwBvhNode, mut entered: u32, oct_inv4: u32) -> u32 {
     use obvhs::cwbvh::node::extract_byte64;
-    let (mut entered, _) = node_entries(node, ray);
     let (child_bits8, bit_index8) = node.get_child_and_index_bits(oct_inv4);
     let mut hit_mask = 0u32;
     while entered != 0 {
