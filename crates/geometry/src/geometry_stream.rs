@@ -1,8 +1,6 @@
 //! Closest hits of many rays at once ([`Geometry::intersect_stream`]): the scene BVH or the
 //! one mesh instance's BVH traversed as a ray stream (`TriangleBvh::traverse_stream_with`),
-//! each ray's hit the same bits as [`Geometry::intersect`]'s, except where the ray meets the
-//! edge two triangles share: the two traversals visit them in another order and may keep the
-//! other one (docs/geometry.md, "Ray streams").
+//! each ray's hit the same bits as [`Geometry::intersect`]'s.
 
 use glam::Vec3A;
 
@@ -11,8 +9,7 @@ use crate::mesh_bvh::MeshHit;
 use crate::ray::Ray;
 
 impl Geometry {
-    /// `hits[i] = self.intersect(&rays[i])` for every ray, the same bits (but where a ray
-    /// meets the edge two triangles share, where the stream may keep the other one). Scenes with a BVH
+    /// `hits[i] = self.intersect(&rays[i])` for every ray, the same bits. Scenes with a BVH
     /// (a scene BVH, or one mesh instance) trace the rays interleaved, a few in flight at
     /// once, so that one ray's cache misses overlap with the others' work
     /// (docs/geometry.md, "Ray streams"); small scenes and single analytic shapes, which

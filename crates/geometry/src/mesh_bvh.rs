@@ -141,7 +141,7 @@ impl MeshBvh {
     /// [`Self::intersect_with`] for `count` object-space rays, interleaved
     /// (`TriangleBvh::traverse_stream_with`): `ray(i)` gives ray `i` (origin, direction,
     /// `t_min`, `t_max`) and `hit(i, result)` receives its closest hit, the same bits as
-    /// `intersect_with`'s but at edges two triangles share, in any order of `i`.
+    /// `intersect_with`'s, in any order of `i`.
     ///
     /// # Safety
     /// With `WIDE`, the CPU must run AVX2.

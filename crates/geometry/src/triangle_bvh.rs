@@ -3,20 +3,19 @@
 //! `cornell_box_cwbvh` example). Each leaf slot also carries a caller-chosen id: the triangle
 //! index for a mesh's own BVH ([`crate::mesh_bvh::MeshBvh`]); for the scene BVH of
 //! [`crate::Geometry`], the original instance and triangle of a baked world-space triangle, or
-//! an instance whose slot holds its world box instead of vertices. One ray's closest-hit and
-//! any-hit traversals visit children nearest first (triangle_bvh_nearest.rs); a ray stream
-//! runs obvhs' `traverse!` loop with our own uninitialised node stack ([`Traversal`]). Both
-//! prefetch the lines each node test selects.
+//! an instance whose slot holds its world box instead of vertices (one 48-byte record,
+//! leaf_record.rs). The closest-hit and any-hit traversals visit children nearest first and
+//! prefetch the lines each node test selects (triangle_bvh_nearest.rs); a ray stream runs
+//! the same steps for several rays interleaved (triangle_bvh_stream.rs). The nodes are
+//! obvhs' compressed 8-wide nodes; obvhs' own `traverse!` loop is not used.
 
 use std::marker::PhantomData;
-use std::mem::MaybeUninit;
 use std::ops::ControlFlow;
 
-use glam::{UVec2, Vec3A};
+use glam::Vec3A;
 use obvhs::aabb::Aabb;
 use obvhs::cwbvh::node::CwBvhNode;
 use obvhs::cwbvh::CwBvh;
-use obvhs::faststack::FastStack;
 
 use crate::bvh_build::{build_bvh, padded_aabb, BuildQuality};
 use crate::leaf_record::{LeafRecord, SlotId};
@@ -123,33 +122,6 @@ impl<Id: SlotId> TriangleBvh<Id> {
         let test = |p: &[Vec3A; 3], id: Id, t_max: f32| ControlFlow::Continue(test(p, id, t_max));
         // SAFETY: the caller's contract for `WIDE`.
         unsafe { self.traverse_nearest_first::<WIDE>(bvh, origin, direction, t_min, t_max, test) };
-    }
-
-    /// Start loading what the closest-hit traversal reads next: the primitives (vertices and
-    /// ids) and the child nodes that the ray enters. Incoherent rays miss the caches at every
-    /// level; without this each load waits for the one before it (docs/geometry.md, "Where
-    /// an incoherent ray's time goes").
-    #[inline(always)]
-    fn prefetch_hits(&self, bvh: &CwBvh, node: &CwBvhNode, hits: u32, oct_inv4: u32) {
-        {
-            let mut primitives = hits & 0x00ff_ffff;
-            while primitives != 0 {
-                let slot = (node.primitive_base_idx + primitives.trailing_zeros()) as usize;
-                primitives &= primitives - 1;
-                prefetch_object(self.leaves.as_ptr().wrapping_add(slot));
-            }
-            // The bit of a child node is its slot in the ray's octant order (obvhs'
-            // `traverse!`: slot = bit ^ octant, node = child_base_idx + internal children
-            // before that slot).
-            let mut children = hits >> 24;
-            while children != 0 {
-                let child_slot = children.trailing_zeros() ^ (oct_inv4 & 0xff);
-                children &= children - 1;
-                let before = u32::from(node.imask) & ((1u32 << child_slot) - 1);
-                let index = (node.child_base_idx + before.count_ones()) as usize;
-                prefetch_object(bvh.nodes.as_ptr().wrapping_add(index));
-            }
-        }
     }
 
     /// Any-hit traversal: whether `test(primitive, id, t_max)` accepts any primitive whose
@@ -285,39 +257,11 @@ unsafe fn node_entries_on<const WIDE: bool>(
     (entered & occupied_slots(node), t_entry)
 }
 
-/// [`node_hits_avx2`] where `WIDE`, else [`node_hits`]: the same mask, bit for bit.
-///
-/// # Safety
-/// With `WIDE`, the CPU must run AVX2.
-#[inline(always)]
-unsafe fn node_hits_on<const WIDE: bool>(
-    node: &CwBvhNode,
-    ray: &obvhs::ray::Ray,
-    oct_inv4: u32,
-) -> u32 {
-    #[cfg(target_arch = "x86_64")]
-    if WIDE {
-        // SAFETY: the caller's contract.
-        return unsafe { node_hits_avx2(node, ray, oct_inv4) };
-    }
-    node_hits(node, ray, oct_inv4)
-}
-
-/// [`node_hits`] for all eight children at once in AVX2. The quantised bounds are widened
+/// [`node_entries`] for all eight slots at once in AVX2. The quantised bounds are widened
 /// from bytes by two instructions per axis and side instead of 24 scalar conversions (the
 /// costliest part of the 4-wide test, as obvhs' `intersect_ray_simd` notes); the slab
 /// arithmetic, its operand order (min/max pass the second operand on NaN) and the bound by
-/// `tmin` are [`node_hits`]', so the masks are equal.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-#[inline]
-fn node_hits_avx2(node: &CwBvhNode, ray: &obvhs::ray::Ray, oct_inv4: u32) -> u32 {
-    octant_hit_mask(node, node_entries_avx2(node, ray).0, oct_inv4)
-}
-
-/// The slab test of [`node_entries`] for all eight slots at once in AVX2: which slots' boxes
-/// the ray enters within `[ray.tmin, ray.tmax]` (empty slots included) and each slot's
-/// entry distance.
+/// `tmin` are [`node_entries`]', so the slots and distances are the same bits.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 #[inline]
@@ -381,36 +325,13 @@ fn node_entries_avx2(node: &CwBvhNode, ray: &obvhs::ray::Ray) -> (u32, [f32; 8])
     (entered, t_entry)
 }
 
-/// Which children of `node` the ray enters within `[ray.tmin, ray.tmax]`: obvhs'
+/// Which slots' boxes of `node` the ray enters within `[ray.tmin, ray.tmax]` (empty slots
+/// included; bit i for slot i) and each slot's entry distance: obvhs'
 /// `CwBvhNode::intersect_ray_simd` (the same slab arithmetic, lane order and NaN handling,
 /// four children at a time in SSE through glam's `Vec4`), except that a child's entry
 /// distance is bounded below by the ray's own `tmin` where obvhs clamps it to ≥ 10⁻⁴
 /// whatever `tmin` is (`cwbvh::node::EPSILON`): a hit closer than 10⁻⁴ m to the origin (a
 /// ray leaving a point 10 µm in front of a wall) was never reached.
-#[inline(always)]
-fn node_hits(node: &CwBvhNode, ray: &obvhs::ray::Ray, oct_inv4: u32) -> u32 {
-    octant_hit_mask(node, node_entries(node, ray).0, oct_inv4)
-}
-
-/// obvhs' `traverse!` hit mask of the entered slots (bit i for slot i): a leaf child's
-/// primitives in the low 24 bits, an internal child's bit in the high byte at its place in
-/// the ray octant's order.
-#[inline(always)]
-fn octant_hit_mask(node: &CwBvhNode, mut entered: u32, oct_inv4: u32) -> u32 {
-    use obvhs::cwbvh::node::extract_byte64;
-    let (child_bits8, bit_index8) = node.get_child_and_index_bits(oct_inv4);
-    let mut hit_mask = 0u32;
-    while entered != 0 {
-        let child = entered.trailing_zeros() as usize;
-        entered &= entered - 1;
-        hit_mask |= extract_byte64(child_bits8, child) << extract_byte64(bit_index8, child);
-    }
-    hit_mask
-}
-
-/// The slab test of [`node_hits`] per slot, four at a time: which slots' boxes the ray
-/// enters within `[ray.tmin, ray.tmax]` (empty slots included; bit i for slot i) and each
-/// slot's entry distance.
 #[inline(always)]
 fn node_entries(node: &CwBvhNode, ray: &obvhs::ray::Ray) -> (u32, [f32; 8]) {
     use glam::Vec4;
@@ -467,134 +388,18 @@ fn node_entries(node: &CwBvhNode, ray: &obvhs::ray::Ray) -> (u32, [f32; 8]) {
     (entered, t_entry)
 }
 
-/// Traversal state for obvhs' `traverse!` macro (the fields it reads and writes). obvhs'
-/// own `Traversal` zero-fills its 32-entry stack (256 bytes, a `memset` per query — 9 % of
-/// the closest-hit time of the Cornell box in a profile); this stack is left uninitialised
-/// and never reads a slot it has not written.
-struct Traversal {
-    stack: NodeStack,
-    current_group: UVec2,
-    primitive_group: UVec2,
-    oct_inv4: u32,
-    primitive_id: u32,
-    hitmask: u32,
-}
-
-impl Traversal {
-    #[inline(always)]
-    fn new(bvh: &CwBvh, direction: Vec3A) -> Self {
-        let mut state = Self {
-            stack: NodeStack::new(),
-            current_group: UVec2::ZERO,
-            primitive_group: UVec2::ZERO,
-            oct_inv4: 0,
-            primitive_id: 0,
-            hitmask: 0,
-        };
-        state.reset(bvh, direction);
-        state
-    }
-
-    /// The state before the first node of a ray along `direction` (the root's group
-    /// pending), the stack's storage kept: a stream's lane takes its next ray with it.
-    #[inline(always)]
-    fn reset(&mut self, bvh: &CwBvh, direction: Vec3A) {
-        self.stack.clear();
-        self.current_group = if bvh.nodes.is_empty() {
-            UVec2::ZERO
-        } else {
-            UVec2::new(0, 0x8000_0000)
-        };
-        self.primitive_group = UVec2::ZERO;
-        self.oct_inv4 = octant_inv4(direction);
-        self.primitive_id = 0;
-        self.hitmask = 0;
-    }
-}
-
-/// The ray octant code obvhs' node test expects (its private `ray_get_octant_inv4`): which
-/// child order to visit, from the signs of the direction (`d < 0`, so `-0.0` counts as
-/// positive, as in [`crate::bvh_build::bvh_ray`]).
-#[inline(always)]
-fn octant_inv4(d: Vec3A) -> u32 {
-    (if d.x < 0.0 { 0 } else { 0x0404_0404 })
-        | (if d.y < 0.0 { 0 } else { 0x0202_0202 })
-        | (if d.z < 0.0 { 0 } else { 0x0101_0101 })
-}
-
-/// Entries of [`NodeStack`]: one per level of an 8-wide BVH at most, so 64 covers any tree
-/// obvhs builds (its own traversal stack has 32 and silently overwrites its top entry beyond).
-const NODE_STACK_SIZE: usize = 64;
-
-/// A fixed-capacity stack of node groups without initialisation cost.
-struct NodeStack {
-    data: [MaybeUninit<UVec2>; NODE_STACK_SIZE],
-    len: usize,
-}
-
-impl NodeStack {
-    #[inline(always)]
-    fn new() -> Self {
-        Self {
-            data: [MaybeUninit::uninit(); NODE_STACK_SIZE],
-            len: 0,
-        }
-    }
-}
-
-impl FastStack<UVec2> for NodeStack {
-    #[inline(always)]
-    fn push(&mut self, v: UVec2) {
-        // As obvhs' stack: a full stack overwrites its top entry (never reached, see above).
-        let i = self.len.min(NODE_STACK_SIZE - 1);
-        self.data[i] = MaybeUninit::new(v);
-        self.len = i + 1;
-    }
-
-    #[inline(always)]
-    fn pop_fast(&mut self) -> UVec2 {
-        // `traverse!` pops only after checking `is_empty`; an empty stack yields no group.
-        if self.len == 0 {
-            return UVec2::ZERO;
-        }
-        self.len -= 1;
-        // SAFETY: slots below `len` were written by `push`.
-        unsafe { self.data[self.len].assume_init() }
-    }
-
-    #[inline(always)]
-    fn pop(&mut self) -> Option<UVec2> {
-        (self.len > 0).then(|| self.pop_fast())
-    }
-
-    #[inline(always)]
-    fn len(&self) -> usize {
-        self.len
-    }
-
-    #[inline(always)]
-    fn is_empty(&self) -> bool {
-        self.len == 0
-    }
-
-    #[inline(always)]
-    fn clear(&mut self) {
-        self.len = 0;
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::bvh_build::bvh_ray;
     use rand::{Rng, SeedableRng};
 
-    /// The AVX2 node test returns the 4-wide test's mask on every node of a real BVH, for
-    /// rays from inside and outside, axis-parallel directions (infinite inverse clamped) and
-    /// `tmin` above the quantisation's 10⁻⁴.
+    /// The AVX2 node test enters the 4-wide test's slots at the same entry distances, bit
+    /// for bit, on every node of a real BVH, for rays from inside and outside, axis-parallel
+    /// directions (infinite inverse clamped) and `tmin` above the quantisation's 10⁻⁴.
     #[test]
     #[cfg(target_arch = "x86_64")]
-    fn the_avx2_node_test_gives_the_four_wide_mask() {
+    fn the_avx2_node_test_gives_the_four_wide_entries() {
         if !prism_cpu::Simd::detected().avx2() {
             eprintln!("skipped: this CPU has no AVX2");
             return;
@@ -639,13 +444,20 @@ mod tests {
             let t_min = [0.0, 1e-5, 0.5][k % 3];
             let t_max = [f32::INFINITY, 3.0][k % 2];
             let ray = bvh_ray(origin, direction, t_min, t_max);
-            let oct_inv4 = octant_inv4(direction);
             for node in &bvh.nodes {
+                let occupied = occupied_slots(node);
                 // SAFETY: checked above that the CPU has AVX2.
-                let wide = unsafe { node_hits_avx2(node, &ray, oct_inv4) };
-                assert_eq!(wide, node_hits(node, &ray, oct_inv4), "ray {k}");
+                let (wide_slots, wide_t) = unsafe { node_entries_avx2(node, &ray) };
+                let (slots, t) = node_entries(node, &ray);
+                assert_eq!(wide_slots & occupied, slots & occupied, "ray {k}");
+                let mut each = slots & occupied;
+                while each != 0 {
+                    let slot = each.trailing_zeros() as usize;
+                    each &= each - 1;
+                    assert_eq!(wide_t[slot].to_bits(), t[slot].to_bits(), "ray {k}");
+                }
                 compared += 1;
-                entered += usize::from(wide != 0);
+                entered += usize::from(slots & occupied != 0);
             }
         }
         // The premise: enough node tests, and masks that enter children, not only misses.

@@ -28,7 +28,7 @@ struct Pending {
 const INLINE_ENTRIES: usize = 128;
 
 /// A last-in first-out stack of [`Pending`] children without initialisation cost.
-struct PendingStack {
+pub(super) struct PendingStack {
     inline: [MaybeUninit<Pending>; INLINE_ENTRIES],
     len: usize,
     spilled: Vec<Pending>,
@@ -36,12 +36,19 @@ struct PendingStack {
 
 impl PendingStack {
     #[inline(always)]
-    fn new() -> Self {
+    pub(super) fn new() -> Self {
         Self {
             inline: [MaybeUninit::uninit(); INLINE_ENTRIES],
             len: 0,
             spilled: Vec::new(),
         }
+    }
+
+    /// Empty, its storage kept (a stream's lane takes its next ray with it).
+    #[inline(always)]
+    pub(super) fn clear(&mut self) {
+        self.len = 0;
+        self.spilled.clear();
     }
 
     #[inline(always)]
@@ -68,14 +75,30 @@ impl PendingStack {
     }
 }
 
+/// A node's test, kept for its expansion: the node, its entered leaf and internal children
+/// (bit i for slot i) and each slot's entry distance.
+#[derive(Clone, Copy)]
+pub(super) struct Entered {
+    node: u32,
+    leaves: u32,
+    internal: u32,
+    t_entry: [f32; 8],
+}
+
+/// Where a traversal goes after a node's expansion.
+pub(super) enum Next {
+    /// Test this node.
+    Node(u32),
+    /// Nothing is left within reach.
+    Done,
+    /// The leaf test broke off the traversal.
+    Stopped,
+}
+
 impl<Id: SlotId> TriangleBvh<Id> {
-    /// The traversal of [`TriangleBvh::traverse_with`] and [`TriangleBvh::any_with`]: at
-    /// each node its entered leaf children's primitives are tested first, nearest first
-    /// (`test(primitive, id, t_max)` continues with the primitive's `t`, which lowers
-    /// `t_max` where it is nearer, or breaks off the traversal), then the entered internal
-    /// children whose entry lies within `t_max` are visited nearest first; a child waiting
-    /// on the stack is skipped once the best hit lies nearer than its entry. Whether `test`
-    /// broke off.
+    /// The traversal of [`TriangleBvh::traverse_with`] and [`TriangleBvh::any_with`]: each
+    /// node is tested ([`Self::enter`]) and expanded ([`Self::expand`]) in turn, from the
+    /// root. Whether `test` broke off.
     ///
     /// # Safety
     /// With `WIDE`, the CPU must run AVX2.
@@ -94,90 +117,133 @@ impl<Id: SlotId> TriangleBvh<Id> {
         }
         let mut ray = bvh_ray(origin, direction, t_min, t_max);
         let mut stack = PendingStack::new();
-        let mut node_index = 0u32;
-        'nodes: loop {
-            let node = &bvh.nodes[node_index as usize];
+        let mut node = 0u32;
+        loop {
             // SAFETY: the caller's contract for `WIDE`.
-            let (entered, t_entry) = unsafe { node_entries_on::<WIDE>(node, &ray) };
-            let internal_mask = u32::from(node.imask);
-            let mut leaves = entered & !internal_mask;
-            let mut internal = entered & internal_mask;
-            self.prefetch_entered(bvh, node, leaves, internal);
-            // Leaf children nearest first, each skipped once a hit lies nearer than its box.
-            let mut leaf_order = [(0usize, 0.0f32); 8];
-            let mut leaf_count = 0;
-            while leaves != 0 {
-                let slot = leaves.trailing_zeros() as usize;
-                leaves &= leaves - 1;
-                let t = t_entry[slot];
-                let mut at = leaf_count;
-                while at > 0 && leaf_order[at - 1].1 > t {
-                    leaf_order[at] = leaf_order[at - 1];
-                    at -= 1;
-                }
-                leaf_order[at] = (slot, t);
-                leaf_count += 1;
+            let entered = unsafe { self.enter::<WIDE>(bvh, node, &ray) };
+            match self.expand(bvh, &entered, &mut ray, &mut stack, &mut test) {
+                Next::Node(child) => node = child,
+                Next::Done => return false,
+                Next::Stopped => return true,
             }
-            for &(slot, t) in &leaf_order[..leaf_count] {
-                if t > ray.tmax {
-                    break;
-                }
-                let meta = u32::from(node.child_meta[slot]);
-                let first = node.primitive_base_idx + (meta & 0b1_1111);
-                for slot in first..first + (meta >> 5).count_ones() {
-                    let slot = slot as usize;
-                    let leaf = &self.leaves[slot];
-                    let ControlFlow::Continue(t) = test(&leaf.vectors(), leaf.id(), ray.tmax)
-                    else {
-                        return true;
-                    };
-                    if t < ray.tmax {
-                        ray.tmax = t;
-                    }
-                }
-            }
-            // The internal children within reach, sorted nearest first (stable: equal
-            // distances keep the slot order, so every ISA visits them alike).
-            let mut order = [Pending {
-                node: 0,
-                t_entry: 0.0,
-            }; 8];
-            let mut count = 0;
-            while internal != 0 {
-                let slot = internal.trailing_zeros();
-                internal &= internal - 1;
-                let t = t_entry[slot as usize];
-                if t > ray.tmax {
-                    continue;
-                }
-                let before = internal_mask & ((1u32 << slot) - 1);
-                let child = Pending {
-                    node: node.child_base_idx + before.count_ones(),
-                    t_entry: t,
-                };
-                let mut at = count;
-                while at > 0 && order[at - 1].t_entry > t {
-                    order[at] = order[at - 1];
-                    at -= 1;
-                }
-                order[at] = child;
-                count += 1;
-            }
-            if count > 0 {
-                for &far in order[1..count].iter().rev() {
-                    stack.push(far);
-                }
-                node_index = order[0].node;
-                continue 'nodes;
-            }
-            while let Some(pending) = stack.pop() {
-                if pending.t_entry <= ray.tmax {
-                    node_index = pending.node;
-                    continue 'nodes;
-                }
-            }
-            return false;
         }
+    }
+
+    /// Node `node`'s test against `ray`, with the prefetches of what it selects: the
+    /// entered children's primitives and nodes.
+    ///
+    /// # Safety
+    /// With `WIDE`, the CPU must run AVX2.
+    #[inline(always)]
+    pub(super) unsafe fn enter<const WIDE: bool>(
+        &self,
+        bvh: &CwBvh,
+        node: u32,
+        ray: &obvhs::ray::Ray,
+    ) -> Entered {
+        let tested = &bvh.nodes[node as usize];
+        // SAFETY: the caller's contract for `WIDE`.
+        let (entered, t_entry) = unsafe { node_entries_on::<WIDE>(tested, ray) };
+        let internal_mask = u32::from(tested.imask);
+        let entered = Entered {
+            node,
+            leaves: entered & !internal_mask,
+            internal: entered & internal_mask,
+            t_entry,
+        };
+        self.prefetch_entered(bvh, tested, entered.leaves, entered.internal);
+        entered
+    }
+
+    /// A tested node's expansion: its entered leaf children's primitives are tested first,
+    /// nearest first (`test(primitive, id, t_max)` continues with the primitive's `t`, which
+    /// lowers `ray.tmax` where it is nearer, or breaks off the traversal), each leaf skipped
+    /// once a hit lies nearer than its box; then its entered internal children whose entry
+    /// lies within `ray.tmax` go on the stack nearest on top, and the nearest is next. With
+    /// none, the stack is popped, skipping the children whose entry a hit now lies before.
+    #[inline(always)]
+    pub(super) fn expand(
+        &self,
+        bvh: &CwBvh,
+        entered: &Entered,
+        ray: &mut obvhs::ray::Ray,
+        stack: &mut PendingStack,
+        test: &mut impl FnMut(&[Vec3A; 3], Id, f32) -> ControlFlow<(), f32>,
+    ) -> Next {
+        let node = &bvh.nodes[entered.node as usize];
+        let t_entry = &entered.t_entry;
+        let mut leaves = entered.leaves;
+        let mut leaf_order = [(0usize, 0.0f32); 8];
+        let mut leaf_count = 0;
+        while leaves != 0 {
+            let slot = leaves.trailing_zeros() as usize;
+            leaves &= leaves - 1;
+            let t = t_entry[slot];
+            let mut at = leaf_count;
+            while at > 0 && leaf_order[at - 1].1 > t {
+                leaf_order[at] = leaf_order[at - 1];
+                at -= 1;
+            }
+            leaf_order[at] = (slot, t);
+            leaf_count += 1;
+        }
+        for &(slot, t) in &leaf_order[..leaf_count] {
+            if t > ray.tmax {
+                break;
+            }
+            let meta = u32::from(node.child_meta[slot]);
+            let first = node.primitive_base_idx + (meta & 0b1_1111);
+            for slot in first..first + (meta >> 5).count_ones() {
+                let leaf = &self.leaves[slot as usize];
+                let ControlFlow::Continue(t) = test(&leaf.vectors(), leaf.id(), ray.tmax) else {
+                    return Next::Stopped;
+                };
+                if t < ray.tmax {
+                    ray.tmax = t;
+                }
+            }
+        }
+        // The internal children within reach, sorted nearest first (stable: equal
+        // distances keep the slot order, so every ISA visits them alike).
+        let internal_mask = u32::from(node.imask);
+        let mut internal = entered.internal;
+        let mut order = [Pending {
+            node: 0,
+            t_entry: 0.0,
+        }; 8];
+        let mut count = 0;
+        while internal != 0 {
+            let slot = internal.trailing_zeros();
+            internal &= internal - 1;
+            let t = t_entry[slot as usize];
+            if t > ray.tmax {
+                continue;
+            }
+            let before = internal_mask & ((1u32 << slot) - 1);
+            let child = Pending {
+                node: node.child_base_idx + before.count_ones(),
+                t_entry: t,
+            };
+            let mut at = count;
+            while at > 0 && order[at - 1].t_entry > t {
+                order[at] = order[at - 1];
+                at -= 1;
+            }
+            order[at] = child;
+            count += 1;
+        }
+        if count > 0 {
+            for &far in order[1..count].iter().rev() {
+                stack.push(far);
+            }
+            return Next::Node(order[0].node);
+        }
+        while let Some(pending) = stack.pop() {
+            if pending.t_entry <= ray.tmax {
+                return Next::Node(pending.node);
+            }
+        }
+        Next::Done
     }
 
     /// Start loading the primitives (vertices and ids) of the entered leaf children and the

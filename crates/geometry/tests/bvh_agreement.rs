@@ -392,3 +392,41 @@ fn ray_streams_find_the_one_ray_hits_in_a_mesh() {
         }
     }
 }
+
+/// Camera rays of a pinhole grid over a uv sphere meet the edges its triangles share (both
+/// triangles hit, at the same `t` or one ulp apart, and the visiting order decides which is
+/// kept): a stream keeps the triangle one ray keeps, at every ISA.
+#[test]
+fn ray_streams_keep_one_rays_triangle_where_rays_meet_shared_edges() {
+    let sphere = TriangleMesh::uv_sphere(1.0, 101, 200);
+    let mut geometry = single(&sphere, BuildQuality::Fast);
+    let side = 384;
+    let eye = Vec3A::new(0.0, 0.0, 3.0);
+    let rays: Vec<Ray> = (0..side * side)
+        .map(|i| {
+            let (x, y) = ((i % side) as f32, (i / side) as f32);
+            let sx = (2.0 * x / (side - 1) as f32 - 1.0) * 0.4;
+            let sy = (1.0 - 2.0 * y / (side - 1) as f32) * 0.4;
+            Ray::new(
+                eye,
+                Vec3A::new(sx, sy, -1.0).normalize(),
+                0.0,
+                f32::INFINITY,
+            )
+        })
+        .collect();
+    for simd in std::iter::once(prism_cpu::Simd::SCALAR).chain(prism_cpu::each_isa()) {
+        geometry = geometry.with_simd(simd);
+        let streamed = stream_hits(&geometry, &rays);
+        let mut on_edges = 0;
+        for (i, (ray, have)) in rays.iter().zip(&streamed).enumerate() {
+            let want = geometry.intersect(ray);
+            if let Some(h) = want {
+                on_edges += usize::from(h.b1 == 0.0 || h.b2 == 0.0 || h.b1 + h.b2 == 1.0);
+            }
+            assert_eq!(want.map(hit_bits), *have, "{} ray {i}: {ray:?}", simd.isa());
+        }
+        // The premise: rays that meet shared edges exactly.
+        assert!(on_edges > 100, "{on_edges} rays met an edge");
+    }
+}
