@@ -79,7 +79,7 @@ impl<Id: SlotId> TriangleBvh<Id> {
     }
 
     /// Closest hit with `t` in `(t_min, t_max)`: the watertight test's record and the id of
-    /// the triangle; the node test is `WIDE`'s ([`node_hits_on`]).
+    /// the triangle; the node test is `WIDE`'s ([`node_entries_on`]).
     ///
     /// # Safety
     /// With `WIDE`, the CPU must run AVX2.
@@ -156,7 +156,7 @@ impl<Id: SlotId> TriangleBvh<Id> {
     }
 
     /// Whether any triangle lies in `(t_min, t_max)` (stops at the first hit); the node
-    /// test is `WIDE`'s ([`node_hits_on`]).
+    /// test is `WIDE`'s ([`node_entries_on`]).
     ///
     /// # Safety
     /// With `WIDE`, the CPU must run AVX2.

@@ -1,9 +1,10 @@
-//! Closest-hit traversal of one ray in the order of the children's entry distances, with
-//! children culled on the stack once a hit lies nearer than their entry (Embree's
-//! single-ray BVH8 traversal, Wald et al. 2014, over the same CWBVH nodes). obvhs'
-//! `traverse!` visits children in the ray octant's order and keeps the entered children of
-//! a node as one group bit mask: after a hit it still loads and tests every child it had
-//! entered before, and a near child can wait behind a far one of the same octant order.
+//! Traversal of one ray in the order of the children's entry distances, with children culled
+//! on the stack once a hit lies nearer than their entry (Embree's single-ray BVH8 traversal,
+//! Wald et al. 2014, over obvhs' CWBVH nodes): the closest-hit and any-hit queries of one
+//! ray, and the steps a ray stream interleaves (triangle_bvh_stream.rs). obvhs' own
+//! `traverse!` visits children in the ray octant's order and keeps a node's entered children
+//! as one bit mask: after a hit it still loads and tests every child it had entered, and a
+//! near child can wait behind a far one.
 
 use std::mem::MaybeUninit;
 use std::ops::ControlFlow;
@@ -21,6 +22,36 @@ use crate::leaf_record::SlotId;
 struct Pending {
     node: u32,
     t_entry: f32,
+}
+
+/// The primitive slots of leaf child `slot` of `node` (its meta byte: the offset from the
+/// node's first primitive in the low five bits, the count in unary in the high three).
+#[inline(always)]
+fn leaf_slots(node: &CwBvhNode, slot: usize) -> std::ops::Range<usize> {
+    let meta = u32::from(node.child_meta[slot]);
+    let first = node.primitive_base_idx + (meta & 0b1_1111);
+    first as usize..(first + (meta >> 5).count_ones()) as usize
+}
+
+/// The node index of internal child `slot` of `node`: the internal children are stored in
+/// slot order from `child_base_idx`.
+#[inline(always)]
+fn child_node(node: &CwBvhNode, slot: u32) -> u32 {
+    let before = u32::from(node.imask) & ((1u32 << slot) - 1);
+    node.child_base_idx + before.count_ones()
+}
+
+/// Insert `item` at its entry distance `t` into the first `len` entries of `order`, sorted
+/// nearest first; equal distances keep their insertion order (slot order), so every ISA
+/// visits them alike.
+#[inline(always)]
+fn insert_nearest_first<T: Copy>(order: &mut [(T, f32); 8], len: usize, item: T, t: f32) {
+    let mut at = len;
+    while at > 0 && order[at - 1].1 > t {
+        order[at] = order[at - 1];
+        at -= 1;
+    }
+    order[at] = (item, t);
 }
 
 /// Entries kept without allocation; a deeper stack (a tree far from balanced: up to seven
@@ -178,23 +209,15 @@ impl<Id: SlotId> TriangleBvh<Id> {
         while leaves != 0 {
             let slot = leaves.trailing_zeros() as usize;
             leaves &= leaves - 1;
-            let t = t_entry[slot];
-            let mut at = leaf_count;
-            while at > 0 && leaf_order[at - 1].1 > t {
-                leaf_order[at] = leaf_order[at - 1];
-                at -= 1;
-            }
-            leaf_order[at] = (slot, t);
+            insert_nearest_first(&mut leaf_order, leaf_count, slot, t_entry[slot]);
             leaf_count += 1;
         }
         for &(slot, t) in &leaf_order[..leaf_count] {
             if t > ray.tmax {
                 break;
             }
-            let meta = u32::from(node.child_meta[slot]);
-            let first = node.primitive_base_idx + (meta & 0b1_1111);
-            for slot in first..first + (meta >> 5).count_ones() {
-                let leaf = &self.leaves[slot as usize];
+            for primitive in leaf_slots(node, slot) {
+                let leaf = &self.leaves[primitive];
                 let ControlFlow::Continue(t) = test(&leaf.vectors(), leaf.id(), ray.tmax) else {
                     return Next::Stopped;
                 };
@@ -203,40 +226,24 @@ impl<Id: SlotId> TriangleBvh<Id> {
                 }
             }
         }
-        // The internal children within reach, sorted nearest first (stable: equal
-        // distances keep the slot order, so every ISA visits them alike).
-        let internal_mask = u32::from(node.imask);
+        // The internal children within reach, nearest first.
         let mut internal = entered.internal;
-        let mut order = [Pending {
-            node: 0,
-            t_entry: 0.0,
-        }; 8];
+        let mut order = [(0u32, 0.0f32); 8];
         let mut count = 0;
         while internal != 0 {
             let slot = internal.trailing_zeros();
             internal &= internal - 1;
             let t = t_entry[slot as usize];
-            if t > ray.tmax {
-                continue;
+            if t <= ray.tmax {
+                insert_nearest_first(&mut order, count, child_node(node, slot), t);
+                count += 1;
             }
-            let before = internal_mask & ((1u32 << slot) - 1);
-            let child = Pending {
-                node: node.child_base_idx + before.count_ones(),
-                t_entry: t,
-            };
-            let mut at = count;
-            while at > 0 && order[at - 1].t_entry > t {
-                order[at] = order[at - 1];
-                at -= 1;
-            }
-            order[at] = child;
-            count += 1;
         }
         if count > 0 {
-            for &far in order[1..count].iter().rev() {
-                stack.push(far);
+            for &(node, t_entry) in order[1..count].iter().rev() {
+                stack.push(Pending { node, t_entry });
             }
-            return Next::Node(order[0].node);
+            return Next::Node(order[0].0);
         }
         while let Some(pending) = stack.pop() {
             if pending.t_entry <= ray.tmax {
@@ -246,29 +253,27 @@ impl<Id: SlotId> TriangleBvh<Id> {
         Next::Done
     }
 
-    /// Start loading the primitives (vertices and ids) of the entered leaf children and the
-    /// entered child nodes, so that their cache misses overlap (as `prefetch_hits` does for
-    /// obvhs' traversal).
+    /// Start loading the primitives (vertex and id records) of the entered leaf children and
+    /// the entered child nodes, so that their cache misses overlap.
     #[inline(always)]
     fn prefetch_entered(&self, bvh: &CwBvh, node: &CwBvhNode, leaves: u32, internal: u32) {
         let mut leaves = leaves;
         while leaves != 0 {
             let slot = leaves.trailing_zeros() as usize;
             leaves &= leaves - 1;
-            let meta = u32::from(node.child_meta[slot]);
-            let first = node.primitive_base_idx + (meta & 0b1_1111);
-            for slot in first..first + (meta >> 5).count_ones() {
-                prefetch_object(self.leaves.as_ptr().wrapping_add(slot as usize));
+            for primitive in leaf_slots(node, slot) {
+                prefetch_object(self.leaves.as_ptr().wrapping_add(primitive));
             }
         }
         let mut internal = internal;
-        let internal_mask = u32::from(node.imask);
         while internal != 0 {
             let slot = internal.trailing_zeros();
             internal &= internal - 1;
-            let before = internal_mask & ((1u32 << slot) - 1);
-            let index = (node.child_base_idx + before.count_ones()) as usize;
-            prefetch_object(bvh.nodes.as_ptr().wrapping_add(index));
+            prefetch_object(
+                bvh.nodes
+                    .as_ptr()
+                    .wrapping_add(child_node(node, slot) as usize),
+            );
         }
     }
 }
