@@ -10,58 +10,76 @@
 
 use std::time::Instant;
 
+use clap::{Parser, ValueEnum};
 use glam::UVec2;
+use prism_cpu::clock::process_cpu_s;
 use prism_render::integrator::{Bdpt, LightTracer, PathTracer};
 use prism_render::{render_plan, Integrator, RenderScene, RenderSettings};
 use serde_json::json;
 
-fn cpu_seconds() -> f64 {
-    // The process's user + system time (`/proc/self/stat`, clock ticks of 1/100 s).
-    let stat = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
-    let fields: Vec<&str> = stat
-        .rsplit(')')
-        .next()
-        .unwrap_or("")
-        .split_whitespace()
-        .collect();
-    let ticks = |i: usize| {
-        fields
-            .get(i)
-            .and_then(|v| v.parse::<f64>().ok())
-            .unwrap_or(0.0)
-    };
-    (ticks(11) + ticks(12)) / 100.0
+/// A rendering method the benchmark times.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+enum Method {
+    /// The path tracer as `prism render` runs it (packets where the scene is on their list).
+    Path,
+    /// The scalar path tracer alone (the reference path).
+    PathScalar,
+    Light,
+    Bdpt,
+}
+
+impl Method {
+    /// The name on the command line and in the JSON.
+    fn name(self) -> &'static str {
+        match self {
+            Method::Path => "path",
+            Method::PathScalar => "path-scalar",
+            Method::Light => "light",
+            Method::Bdpt => "bdpt",
+        }
+    }
+}
+
+/// The flags (module comment).
+#[derive(Parser)]
+#[command(about = "Time per camera sample of each rendering method, in alternating rounds")]
+struct Args {
+    /// Renders per method and scene.
+    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..))]
+    rounds: u32,
+    /// Samples per pixel of each render.
+    #[arg(long, default_value_t = 8)]
+    spp: u32,
+    /// Image width, px (the height keeps the scene's aspect ratio).
+    #[arg(long, default_value_t = 128)]
+    resolution: u32,
+    /// Scene files (default: scenes/cornell-box.json and scenes/glossy-env.json).
+    #[arg(long = "scene")]
+    scenes: Vec<String>,
+    /// Methods (default: all four).
+    #[arg(long = "method", value_enum)]
+    methods: Vec<Method>,
 }
 
 fn main() {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    let value = |flag: &str| -> Vec<String> {
-        args.windows(2)
-            .filter(|w| w[0] == flag)
-            .map(|w| w[1].clone())
-            .collect()
-    };
-    let rounds: usize = value("--rounds")
-        .first()
-        .map_or(5, |v| v.parse().expect("--rounds N"));
-    let spp: u32 = value("--spp")
-        .first()
-        .map_or(8, |v| v.parse().expect("--spp N"));
-    let side: u32 = value("--resolution")
-        .first()
-        .map_or(128, |v| v.parse().expect("--resolution N"));
-    let mut scenes = value("--scene");
+    let command_line: Vec<String> = std::env::args().skip(1).collect();
+    let args = Args::parse();
+    let (rounds, spp, side) = (args.rounds as usize, args.spp, args.resolution);
+    let mut scenes = args.scenes;
     if scenes.is_empty() {
         scenes = vec![
             "scenes/cornell-box.json".into(),
             "scenes/glossy-env.json".into(),
         ];
     }
-    let mut methods = value("--method");
+    let mut methods = args.methods;
     if methods.is_empty() {
-        methods = ["path", "path-scalar", "light", "bdpt"]
-            .map(String::from)
-            .to_vec();
+        methods = vec![
+            Method::Path,
+            Method::PathScalar,
+            Method::Light,
+            Method::Bdpt,
+        ];
     }
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(1)
@@ -95,17 +113,17 @@ fn main() {
         let mut times: Vec<Vec<(f64, f64)>> = vec![Vec::new(); methods.len()];
         for _ in 0..rounds {
             for (k, method) in methods.iter().enumerate() {
-                let (integrator, packet) = match method.as_str() {
-                    "path" => (Integrator::Path(path), true),
-                    "path-scalar" => (Integrator::Path(path), false),
-                    "light" => (
+                let (integrator, packet) = match method {
+                    Method::Path => (Integrator::Path(path), true),
+                    Method::PathScalar => (Integrator::Path(path), false),
+                    Method::Light => (
                         Integrator::Light(LightTracer {
                             max_depth: path.max_depth,
                             rr_depth: path.rr_depth,
                         }),
                         false,
                     ),
-                    "bdpt" => (
+                    Method::Bdpt => (
                         Integrator::Bdpt(Bdpt {
                             max_depth: path.max_depth,
                             rr_depth: path.rr_depth,
@@ -114,14 +132,17 @@ fn main() {
                         }),
                         false,
                     ),
-                    other => panic!("unknown method {other}: path, path-scalar, light, bdpt"),
                 };
                 scene.integrator = integrator;
                 scene.set_packet_tracing(packet);
-                let (cpu0, wall0) = (cpu_seconds(), Instant::now());
+                let (cpu0, wall0) = (
+                    process_cpu_s().expect("a process CPU clock"),
+                    Instant::now(),
+                );
                 pool.install(|| render_plan(&scene, &settings, &plan, &|_| {}))
                     .expect("renders");
-                times[k].push((wall0.elapsed().as_secs_f64(), cpu_seconds() - cpu0));
+                let cpu1 = process_cpu_s().expect("a process CPU clock");
+                times[k].push((wall0.elapsed().as_secs_f64(), cpu1 - cpu0));
             }
         }
         let samples = f64::from(resolution.x * resolution.y * spp);
@@ -135,7 +156,7 @@ fn main() {
             .map(|(m, t)| {
                 let wall = median(t.iter().map(|x| x.0).collect());
                 let cpu = median(t.iter().map(|x| x.1).collect());
-                json!({"method": m, "median_wall_s": wall, "median_cpu_s": cpu,
+                json!({"method": m.name(), "median_wall_s": wall, "median_cpu_s": cpu,
                        "cpu_us_per_sample": cpu / samples * 1e6,
                        "wall_s_rounds": t.iter().map(|x| x.0).collect::<Vec<_>>()})
             })
@@ -150,7 +171,7 @@ fn main() {
         "rounds": rounds,
         "threads": 1,
         "load_average_1m": {"start": load_start, "end": prism_cpu::clock::load_average_1m()},
-        "command": format!("cargo run --release -p bench-methods -- {}", args.join(" ")),
+        "command": format!("cargo run --release -p bench-methods -- {}", command_line.join(" ")),
         "results": results,
     });
     let text = serde_json::to_string_pretty(&out).expect("JSON") + "\n";

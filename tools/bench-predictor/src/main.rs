@@ -17,6 +17,7 @@
 //! Prints JSON (per scene: the first round, the median and the minimum of the others, in
 //! CPU seconds of the whole process) and writes it to tools/bench-results/bench-predictor.json.
 
+use clap::Parser;
 use glam::UVec2;
 use prism_cpu::clock::{load_average_1m, process_cpu_s};
 use prism_render::predictor::{predict_with_probe, PredictorSettings};
@@ -24,24 +25,31 @@ use prism_render::probe::RenderProbe;
 use prism_render::RenderScene;
 use serde_json::json;
 
+/// The flags (module comment).
+#[derive(Parser)]
+#[command(about = "CPU seconds of the bandwidth predictor's prediction, repeated in one process")]
+struct Args {
+    /// Predictions per scene (at least 2: the first is reported apart).
+    #[arg(long, default_value_t = 15, value_parser = clap::value_parser!(u32).range(2..))]
+    rounds: u32,
+    /// Worker threads of the prediction.
+    #[arg(long, default_value_t = 1)]
+    threads: usize,
+    /// Square image side, px.
+    #[arg(long, default_value_t = 128)]
+    resolution: u32,
+    /// Scene files (default: fig17-curved-area and fig9-spheres of scenes/bandwidth/).
+    #[arg(long = "scene")]
+    scenes: Vec<String>,
+    /// Print the JSON only, leaving tools/bench-results/bench-predictor.json alone.
+    #[arg(long)]
+    no_file: bool,
+}
+
 fn main() {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    let value = |flag: &str| -> Vec<String> {
-        args.windows(2)
-            .filter(|w| w[0] == flag)
-            .map(|w| w[1].clone())
-            .collect()
-    };
-    let number = |flag: &str, default: usize| -> usize {
-        value(flag).first().map_or(default, |v| {
-            v.parse()
-                .unwrap_or_else(|_| panic!("{flag} takes a whole number, not {v:?}"))
-        })
-    };
-    let rounds = number("--rounds", 15).max(2);
-    let threads = number("--threads", 1);
-    let side = number("--resolution", 128) as u32;
-    let mut scenes = value("--scene");
+    let args = Args::parse();
+    let (rounds, threads, side) = (args.rounds as usize, args.threads, args.resolution);
+    let mut scenes = args.scenes;
     if scenes.is_empty() {
         scenes = vec![
             "scenes/bandwidth/fig17-curved-area.json".into(),
@@ -95,7 +103,7 @@ fn main() {
     });
     let text = serde_json::to_string_pretty(&out).expect("JSON");
     println!("{text}");
-    if !args.iter().any(|a| a == "--no-file") {
+    if !args.no_file {
         let _ = std::fs::write("tools/bench-results/bench-predictor.json", text + "\n");
     }
 }
