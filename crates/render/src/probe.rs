@@ -702,13 +702,15 @@ impl ShadingProbe for RenderProbe<'_> {
             if k % draws_per_camera_sample == 0 {
                 camera_sample = None;
             }
-            let (wavelengths, xyz, bsdf, specular) = &*camera_sample.get_or_insert_with(|| {
+            let (wavelengths, xyz, bsdf) = &*camera_sample.get_or_insert_with(|| {
                 let wavelengths = SampledWavelengths::sample_rgb_output(u_wavelengths);
-                let bsdf = material.bsdf(&si, &wavelengths);
-                let specular = bsdf.is_specular();
-                (wavelengths, XyzWeights::new(&wavelengths), bsdf, specular)
+                (
+                    wavelengths,
+                    XyzWeights::new(&wavelengths),
+                    material.bsdf(&si, &wavelengths),
+                )
             });
-            let specular = *specular;
+            let specular = bsdf.is_specular();
             if specular {
                 draws_per_camera_sample = 1;
             }
